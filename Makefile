@@ -1,0 +1,36 @@
+# robokit courseware. The two commands an instructor needs:
+#   make course   build the course: run every lesson and solution notebook, write build/course/
+#   make test     run the test-suite (the README's test command; .ci/run calls exactly this)
+# Each target creates .venv on first use and installs robokit with its extras from pyproject.toml.
+
+PYTHON ?= python3
+VENV   ?= .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.robokit-installed
+PYTEST_ARGS ?=
+COURSE_ARGS ?=
+
+.PHONY: course test lab venv assignments bench clean
+
+$(STAMP): pyproject.toml
+	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[lab,dev]'
+	@touch $(STAMP)
+
+venv: $(STAMP)
+
+course: $(STAMP)
+	$(BIN)/robokit course build $(COURSE_ARGS)
+
+test: $(STAMP)
+	$(BIN)/python -m pytest $(PYTEST_ARGS)
+
+lab: $(STAMP)
+	$(BIN)/jupyter lab lessons/
+
+bench: $(STAMP)
+	@for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f || exit 1; done
+
+clean:
+	rm -rf build .pytest_cache

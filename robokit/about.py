@@ -1,0 +1,40 @@
+"""What robokit runs on: versions of Python and the libraries the course uses."""
+from __future__ import annotations
+
+import platform
+from importlib import metadata
+
+__all__ = ["versions", "REQUIRED"]
+
+#: Distribution names the lessons need at run time (pyproject.toml's runtime dependencies).
+REQUIRED = ("numpy", "scipy", "matplotlib", "opencv-python-headless", "meshcat", "control", "nbformat")
+
+
+def versions(extra: tuple[str, ...] = ()) -> dict[str, str]:
+    """Return installed versions of Python, robokit and its runtime dependencies.
+
+    Parameters
+    ----------
+    extra : tuple of str
+        Further distribution names to report.
+
+    Returns
+    -------
+    dict
+        Name to version string; ``"missing"`` for a package that is not installed.
+
+    Notes
+    -----
+    Environment check for lesson 00; not from a paper.
+    """
+    out = {"python": platform.python_version(), "robokit": _version("robokit")}
+    for name in REQUIRED + tuple(extra):
+        out[name] = _version(name)
+    return out
+
+
+def _version(dist: str) -> str:
+    try:
+        return metadata.version(dist)
+    except metadata.PackageNotFoundError:
+        return "missing"

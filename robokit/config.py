@@ -1,0 +1,127 @@
+"""Run-time configuration shared by every lesson: fast mode and the cache directory.
+
+``ROBOKIT_FAST=1`` (set by the test-suite and the course build) asks every experiment to shrink
+(fewer trials, smaller images) so that a notebook runs in seconds; the full size stays the default
+for students. Generated datasets are deterministic and are cached under :func:`cache_dir`.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+__all__ = ["fast_mode", "FAST", "cache_dir", "cache_key"]
+
+_TRUE = {"1", "true", "yes", "on"}
+_FALSE = {"", "0", "false", "no", "off"}
+
+
+def fast_mode(environ: "os._Environ[str] | dict[str, str] | None" = None) -> bool:
+    """Return whether fast mode is requested by the ``ROBOKIT_FAST`` environment variable.
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        Environment to read; defaults to :data:`os.environ`.
+
+    Returns
+    -------
+    bool
+        ``True`` for ``1``/``true``/``yes``/``on`` (any case), ``False`` when unset or
+        ``0``/``false``/``no``/``off``.
+
+    Raises
+    ------
+    ValueError
+        If the variable holds anything else, so a typo never silently runs the full experiment.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Fast mode"); not from a paper.
+    """
+    env = os.environ if environ is None else environ
+    raw = str(env.get("ROBOKIT_FAST", "")).strip().lower()
+    if raw in _TRUE:
+        return True
+    if raw in _FALSE:
+        return False
+    raise ValueError(
+        f"ROBOKIT_FAST: expected one of 1/0/true/false/yes/no/on/off, got {env.get('ROBOKIT_FAST')!r}"
+    )
+
+
+#: Fast mode as read once at import time (``robokit.FAST``).
+FAST: bool = fast_mode()
+
+
+def cache_dir(*parts: str, create: bool = True) -> Path:
+    """Return robokit's cache directory (or a sub-directory of it).
+
+    The location is ``$ROBOKIT_CACHE`` if set, else ``$XDG_CACHE_HOME/robokit``, else
+    ``~/.cache/robokit``.
+
+    Parameters
+    ----------
+    *parts : str
+        Sub-directory names, e.g. ``cache_dir("runs")``. Each must be a plain name (no path
+        separators, not ``..``).
+    create : bool, default True
+        Create the directory if it does not exist.
+
+    Returns
+    -------
+    pathlib.Path
+        Absolute path of the directory.
+
+    Raises
+    ------
+    ValueError
+        If a part is empty, contains a path separator or is ``.``/``..``.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Caching"); not from a paper.
+    """
+    for p in parts:
+        if not isinstance(p, str) or not p or p in {".", ".."} or "/" in p or os.sep in p:
+            raise ValueError(f"parts: expected plain directory names, got {p!r}")
+    if os.environ.get("ROBOKIT_CACHE"):
+        base = Path(os.environ["ROBOKIT_CACHE"])
+    elif os.environ.get("XDG_CACHE_HOME"):
+        base = Path(os.environ["XDG_CACHE_HOME"]) / "robokit"
+    else:
+        base = Path.home() / ".cache" / "robokit"
+    path = base.expanduser().resolve().joinpath(*parts)
+    if create:
+        path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def cache_key(**params: object) -> str:
+    """Return a short, stable hash of keyword parameters, for naming cached files.
+
+    Parameters
+    ----------
+    **params
+        JSON-serialisable values (numbers, strings, lists, dicts, ``None``, booleans).
+
+    Returns
+    -------
+    str
+        16 hexadecimal characters; equal parameters give equal keys across runs and machines.
+
+    Raises
+    ------
+    TypeError
+        If a value cannot be serialised to JSON.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Caching"); not from a paper.
+    """
+    try:
+        text = json.dumps(params, sort_keys=True, separators=(",", ":"))
+    except TypeError as exc:
+        raise TypeError(f"params: expected JSON-serialisable values ({exc})") from None
+    return hashlib.sha256(text.encode()).hexdigest()[:16]

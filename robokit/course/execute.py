@@ -1,0 +1,230 @@
+"""Execute a notebook headless in a fresh kernel, with a time limit and no network.
+
+:func:`run_notebook` is used by both the test-suite and ``robokit course build``. Each notebook
+runs in its own worker process (``python -m robokit.course.execute``) that starts a fresh Jupyter
+kernel with nbclient; the parent enforces a wall-clock limit on the whole notebook and kills the
+worker's process group (kernel included) when it is exceeded, so a hanging notebook is reported as
+``timeout`` and never blocks the others. Every kernel runs with:
+
+* ``ROBOKIT_FAST`` set as requested (``1`` under tests),
+* its working directory a fresh temporary directory,
+* a private ``IPYTHONDIR`` whose startup file installs :mod:`robokit.course.netguard`,
+* ``PYTHONHASHSEED=0`` for reproducible ordering.
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+__all__ = ["NotebookRun", "run_notebook", "execute_in_process"]
+
+#: Exception names an assignment notebook may raise: the stubs students have not filled in yet.
+STUB_ERRORS = ("NotImplementedError",)
+
+_STARTUP = "from robokit.course import netguard as _rk_netguard\n_rk_netguard.install()\ndel _rk_netguard\n"
+
+
+@dataclasses.dataclass
+class NotebookRun:
+    """Outcome of executing one notebook.
+
+    Attributes
+    ----------
+    path : Path
+        The source notebook.
+    status : str
+        ``"ok"``, ``"failed"`` or ``"timeout"``.
+    seconds : float
+        Wall-clock run time.
+    error : str
+        The last lines of the error (empty when ``ok``).
+    executed : Path or None
+        The executed notebook with outputs, if it was written.
+    """
+
+    path: Path
+    status: str
+    seconds: float
+    error: str = ""
+    executed: Path | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+
+def _tail(text: str, lines: int = 12) -> str:
+    import re
+
+    text = re.sub(r"\x1b\[[0-9;]*m", "", text)  # strip ANSI colours from tracebacks
+    return "\n".join(text.strip().splitlines()[-lines:])
+
+
+def _kernel_env(workdir: Path, fast: bool) -> dict[str, str]:
+    ipydir = workdir / ".ipython"
+    startup = ipydir / "profile_default" / "startup"
+    startup.mkdir(parents=True, exist_ok=True)
+    (startup / "00-robokit-netguard.py").write_text(_STARTUP)
+    env = dict(os.environ)
+    env.update(
+        ROBOKIT_FAST="1" if fast else "0",
+        IPYTHONDIR=str(ipydir),
+        PYTHONHASHSEED="0",
+        JUPYTER_PLATFORM_DIRS="1",
+        PYDEVD_DISABLE_FILE_VALIDATION="1",
+    )
+    env.pop("MPLBACKEND", None)  # the inline backend must stay in charge inside the kernel
+    return env
+
+
+def execute_in_process(src: Path, dst: Path, *, cwd: Path, cell_timeout: int,
+                       allowed_errors: tuple[str, ...] = ()) -> tuple[str, str]:
+    """Execute ``src`` with nbclient in this process and write the executed notebook to ``dst``.
+
+    Returns ``(status, error_tail)``. With ``allowed_errors`` every cell runs and the notebook
+    fails only on an error whose exception name is not in the list (used for assignments, whose
+    stubs raise ``NotImplementedError``).
+    """
+    import nbformat
+    from nbclient import NotebookClient
+    from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
+
+    nb = nbformat.read(src, as_version=4)
+    client = NotebookClient(
+        nb,
+        timeout=cell_timeout,
+        kernel_name="python3",
+        allow_errors=bool(allowed_errors),
+        resources={"metadata": {"path": str(cwd)}},
+        record_timing=False,
+    )
+    status, error = "ok", ""
+    try:
+        client.execute(cwd=str(cwd))
+    except CellTimeoutError as exc:
+        status, error = "timeout", _tail(str(exc))
+    except (CellExecutionError, DeadKernelError) as exc:
+        status, error = "failed", _tail(str(exc))
+    except Exception as exc:  # kernel failed to start, bad notebook, ...
+        status, error = "failed", _tail(f"{type(exc).__name__}: {exc}")
+    if status == "ok" and allowed_errors:
+        for i, cell in enumerate(nb.cells):
+            for out in cell.get("outputs", []):
+                if out.get("output_type") == "error" and out.get("ename") not in allowed_errors:
+                    status = "failed"
+                    error = _tail(f"cell {i}: {out.get('ename')}: {out.get('evalue')}\n"
+                                  + "\n".join(out.get("traceback", [])))
+                    break
+            if status != "ok":
+                break
+    nbformat.write(nb, dst)
+    return status, error
+
+
+def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
+                 output: str | Path | None = None, assignment: bool | None = None) -> NotebookRun:
+    """Execute a notebook in a fresh kernel in a worker process and report the outcome.
+
+    Parameters
+    ----------
+    path : str or Path
+        Notebook to run.
+    timeout : float, default 600
+        Wall-clock limit for the whole notebook in seconds; the worker and its kernel are killed
+        when it is exceeded and the run is reported as ``"timeout"``.
+    fast : bool, default True
+        Value of ``ROBOKIT_FAST`` inside the kernel.
+    output : str or Path, optional
+        Where to write the executed notebook; defaults to a file in the temporary directory.
+    assignment : bool, optional
+        Treat the notebook as a student assignment (``NotImplementedError`` from stubs is allowed).
+        Defaults to whether the notebook lives in an ``assignments`` directory.
+
+    Returns
+    -------
+    NotebookRun
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    ValueError
+        If ``timeout`` is not positive.
+
+    Notes
+    -----
+    Course tooling (DESIGN.md, "Fast mode"); not from a paper.
+    """
+    path = Path(path).resolve()
+    if not path.is_file():
+        raise FileNotFoundError(f"path: notebook {path} does not exist")
+    if not timeout > 0:
+        raise ValueError(f"timeout: expected a positive number of seconds, got {timeout!r}")
+    if assignment is None:
+        assignment = path.parent.name == "assignments"
+    workdir = Path(tempfile.mkdtemp(prefix="robokit-nb-"))
+    cwd = workdir / "cwd"
+    cwd.mkdir()
+    dst = Path(output).resolve() if output else workdir / path.name
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    result_file = workdir / "result.json"
+    cmd = [sys.executable, "-m", "robokit.course.execute", str(path), str(dst), str(result_file),
+           "--cwd", str(cwd), "--cell-timeout", str(int(max(1, timeout)))]
+    if assignment:
+        cmd += ["--allow-errors", *STUB_ERRORS]
+    start = time.perf_counter()
+    proc = subprocess.Popen(cmd, env=_kernel_env(workdir, fast), cwd=cwd, start_new_session=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        log, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        _kill_group(proc)
+        log = ""
+        status, error = "timeout", f"stopped after the notebook time limit of {timeout:g} s"
+    else:
+        _kill_group(proc)  # the kernel may outlive a crashed worker
+        try:
+            result = json.loads(result_file.read_text())
+            status, error = result["status"], result["error"]
+        except (OSError, ValueError, KeyError):
+            status, error = "failed", _tail(log or f"worker exited with code {proc.returncode}")
+    seconds = time.perf_counter() - start
+    return NotebookRun(path, status, seconds, error, dst if dst.exists() else None)
+
+
+def _kill_group(proc: subprocess.Popen) -> None:
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    try:
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        pass
+
+
+def _main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description="robokit notebook worker (internal)")
+    parser.add_argument("src", type=Path)
+    parser.add_argument("dst", type=Path)
+    parser.add_argument("result", type=Path)
+    parser.add_argument("--cwd", type=Path, required=True)
+    parser.add_argument("--cell-timeout", type=int, default=600)
+    parser.add_argument("--allow-errors", nargs="*", default=[])
+    args = parser.parse_args(argv)
+    status, error = execute_in_process(args.src, args.dst, cwd=args.cwd, cell_timeout=args.cell_timeout,
+                                       allowed_errors=tuple(args.allow_errors))
+    args.result.write_text(json.dumps({"status": status, "error": error}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(_main())

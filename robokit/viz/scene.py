@@ -1,0 +1,228 @@
+"""A meshcat scene that needs no server.
+
+:class:`Scene` records meshcat drawing commands. It renders them as one self-contained HTML page
+(meshcat's viewer JavaScript, shipped inside the ``meshcat`` package, plus the commands encoded
+with MessagePack as meshcat's own server would send them), so a scene shows in JupyterLab, in an
+executed notebook, in the course site and in a saved file without starting any process or opening
+any port. Notebooks executed in parallel therefore never clash. With ``live=True`` the same
+commands are also sent to a running meshcat server for interactive work.
+"""
+from __future__ import annotations
+
+import base64
+import functools
+import html as _html
+from importlib import resources
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..validation import as_array, as_points, check_positive
+
+__all__ = ["Scene", "viewer_javascript"]
+
+
+@functools.lru_cache(maxsize=1)
+def viewer_javascript() -> str:
+    """Return meshcat's bundled viewer JavaScript (read once from the installed package)."""
+    return resources.files("meshcat").joinpath("viewer/dist/main.min.js").read_text(encoding="utf-8")
+
+
+def _color(value: Any, name: str = "color") -> int:
+    """Accept 0xRRGGBB or an (r, g, b) triple of floats in [0, 1]."""
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool) and 0 <= int(value) <= 0xFFFFFF:
+        return int(value)
+    rgb = as_array(value, name, shape=(3,))
+    if np.any((rgb < 0) | (rgb > 1)):
+        raise ValueError(f"{name}: expected 0xRRGGBB or RGB floats in [0, 1], got {value!r}")
+    r, g, b = (np.round(rgb * 255)).astype(int)
+    return int(r) << 16 | int(g) << 8 | int(b)
+
+
+def _transform(value: Any, name: str = "transform") -> np.ndarray:
+    if value is None:
+        return np.eye(4)
+    T = as_array(value, name, shape=(4, 4))
+    if not np.allclose(T[3], [0, 0, 0, 1]):
+        raise ValueError(f"{name}: expected a homogeneous 4x4 transform with last row [0, 0, 0, 1], got {T[3]}")
+    return T
+
+
+class Scene:
+    """A 3D scene built from meshcat commands, shown without a server.
+
+    Parameters
+    ----------
+    title : str, default "robokit scene"
+        Page title of the saved HTML.
+    height : int, default 420
+        Height in pixels of the scene when shown in a notebook.
+    live : bool, default False
+        Also send every command to a meshcat server started on first use (interactive work only;
+        headless runs keep the default so no process is left behind).
+
+    Examples
+    --------
+    >>> scene = Scene()
+    >>> scene.add_box("robot/body", size=(0.5, 0.25, 0.15), color=0x3366cc)
+    >>> scene.add_triad("world")
+    >>> page = scene.html()  # a complete, offline HTML page
+    """
+
+    def __init__(self, title: str = "robokit scene", height: int = 420, live: bool = False) -> None:
+        self.title = str(title)
+        self.height = int(check_positive(height, "height"))
+        self._commands: list[Any] = []
+        self._live = None
+        if live:
+            import meshcat
+
+            self._live = meshcat.Visualizer()
+
+    # --- recording -------------------------------------------------------------------------------
+    @staticmethod
+    def _path(path: str):
+        from meshcat.path import Path as MeshcatPath
+
+        if not isinstance(path, str) or not path.strip("/"):
+            raise ValueError(f"path: expected a non-empty scene path like 'robot/body', got {path!r}")
+        return MeshcatPath(("meshcat",)).append(path.strip("/"))
+
+    def _send(self, command: Any) -> None:
+        self._commands.append(command)
+        if self._live is not None:
+            self._live.window.send(command)
+
+    @property
+    def commands(self) -> list[dict]:
+        """The recorded commands in meshcat's wire form (plain dicts), oldest first."""
+        return [c.lower() for c in self._commands]
+
+    def set_object(self, path: str, geometry: Any, material: Any = None) -> "Scene":
+        """Place a meshcat geometry (or object) at ``path``; the building block of the helpers."""
+        from meshcat.commands import SetObject
+
+        self._send(SetObject(geometry, material, self._path(path)))
+        return self
+
+    def set_transform(self, path: str, transform: Any) -> "Scene":
+        """Set the 4x4 homogeneous pose of ``path`` relative to its parent."""
+        from meshcat.commands import SetTransform
+
+        self._send(SetTransform(_transform(transform), self._path(path)))
+        return self
+
+    def delete(self, path: str) -> "Scene":
+        """Remove ``path`` and everything below it."""
+        from meshcat.commands import Delete
+
+        self._send(Delete(self._path(path)))
+        return self
+
+    # --- helpers ---------------------------------------------------------------------------------
+    def _material(self, color: Any, opacity: float):
+        from meshcat.geometry import MeshLambertMaterial
+
+        opacity = check_positive(opacity, "opacity")
+        if opacity > 1:
+            raise ValueError(f"opacity: expected a value in (0, 1], got {opacity}")
+        return MeshLambertMaterial(color=_color(color), opacity=opacity, transparent=opacity < 1)
+
+    def add_box(self, path: str, size: Sequence[float], transform: Any = None, color: Any = 0x8899AA,
+                opacity: float = 1.0) -> "Scene":
+        """Add a box of ``size`` (x, y, z extents in metres) centred at ``transform``."""
+        from meshcat.geometry import Box
+
+        dims = as_array(size, "size", shape=(3,))
+        if np.any(dims <= 0):
+            raise ValueError(f"size: expected three positive extents, got {dims.tolist()}")
+        self.set_object(path, Box(dims.tolist()), self._material(color, opacity))
+        return self.set_transform(path, transform)
+
+    def add_sphere(self, path: str, radius: float, transform: Any = None, color: Any = 0xCC5533,
+                   opacity: float = 1.0) -> "Scene":
+        """Add a sphere of ``radius`` metres centred at ``transform``."""
+        from meshcat.geometry import Sphere
+
+        self.set_object(path, Sphere(check_positive(radius, "radius")), self._material(color, opacity))
+        return self.set_transform(path, transform)
+
+    def add_triad(self, path: str, transform: Any = None, scale: float = 0.3) -> "Scene":
+        """Add a coordinate frame: x red, y green, z blue, each ``scale`` metres long."""
+        from meshcat.geometry import LineBasicMaterial, LineSegments, PointsGeometry
+
+        s = check_positive(scale, "scale")
+        position = np.array([[0, 0, 0], [s, 0, 0], [0, 0, 0], [0, s, 0], [0, 0, 0], [0, 0, s]], np.float32).T
+        color = np.array([[1, 0, 0], [1, 0.6, 0], [0, 1, 0], [0.6, 1, 0], [0, 0, 1], [0, 0.6, 1]], np.float32).T
+        self.set_object(path, LineSegments(PointsGeometry(position, color),
+                                           LineBasicMaterial(vertexColors=True, linewidth=2)))
+        return self.set_transform(path, transform)
+
+    def add_points(self, path: str, points: Any, colors: Any = None, size: float = 0.03,
+                   color: Any = 0x222222) -> "Scene":
+        """Add a point cloud; ``points`` is (N, 3), ``colors`` optional (N, 3) RGB in [0, 1]."""
+        from meshcat.geometry import PointsGeometry, PointsMaterial
+
+        pts = as_points(points, "points", 3).astype(np.float32)
+        if colors is None:  # meshcat's PointsMaterial always reads per-vertex colours
+            c = _color(color)
+            cols = np.tile(np.array([c >> 16, (c >> 8) & 255, c & 255], np.float32) / 255, (len(pts), 1))
+        else:
+            cols = as_points(colors, "colors", 3).astype(np.float32)
+            if cols.shape != pts.shape:
+                raise ValueError(f"colors: expected shape {pts.shape} to match points, got {cols.shape}")
+            if np.any((cols < 0) | (cols > 1)):
+                raise ValueError("colors: expected RGB values in [0, 1]")
+        material = PointsMaterial(size=check_positive(size, "size"))
+        return self.set_object(path, PointsGeometry(pts.T, cols.T), material)
+
+    def add_line(self, path: str, points: Any, color: Any = 0x222222) -> "Scene":
+        """Add a polyline through ``points`` (N, 3), e.g. a trajectory."""
+        from meshcat.geometry import Line, LineBasicMaterial, PointsGeometry
+
+        pts = as_points(points, "points", 3, min_count=2).astype(np.float32)
+        return self.set_object(path, Line(PointsGeometry(pts.T), LineBasicMaterial(color=_color(color))))
+
+    # --- output ----------------------------------------------------------------------------------
+    def html(self) -> str:
+        """Return the scene as one self-contained HTML page (works offline, no server)."""
+        import umsgpack
+
+        payload = ",\n".join(
+            '"' + base64.b64encode(umsgpack.packb(c)).decode("ascii") + '"' for c in self.commands
+        )
+        return (
+            "<!DOCTYPE html><html><head><meta charset='utf-8'>"
+            f"<title>{_html.escape(self.title)}</title><style>body{{margin:0}}"
+            "#meshcat-pane{width:100vw;height:100vh;overflow:hidden}</style></head><body>"
+            "<div id='meshcat-pane'></div>"
+            f"<script>{viewer_javascript()}</script>"
+            "<script>var viewer = new MeshCat.Viewer(document.getElementById('meshcat-pane'));\n"
+            f"var robokitCommands = [{payload}];\n"
+            "for (const c of robokitCommands) {"
+            " viewer.handle_command_bytearray(Uint8Array.from(atob(c), ch => ch.charCodeAt(0))); }\n"
+            "</script></body></html>"
+        )
+
+    def save_html(self, path: str | Path) -> Path:
+        """Write :meth:`html` to ``path`` and return it."""
+        path = Path(path)
+        path.write_text(self.html(), encoding="utf-8")
+        return path
+
+    def _repr_html_(self) -> str:
+        return (f"<iframe srcdoc=\"{_html.escape(self.html(), quote=True)}\" "
+                f"style=\"width:100%;height:{self.height}px;border:1px solid #ccc\" "
+                "title=\"robokit meshcat scene\"></iframe>")
+
+    def show(self):
+        """Display the scene in a notebook (an embedded, offline viewer) and return the display object."""
+        from IPython.display import HTML, display
+
+        obj = HTML(self._repr_html_())
+        display(obj)
+        return obj
+
+    def __repr__(self) -> str:
+        return f"Scene(title={self.title!r}, commands={len(self._commands)})"

@@ -1,0 +1,17 @@
+"""Every notebook in the repository runs top to bottom in a fresh kernel (ROBOKIT_FAST=1, no
+network, cwd a temp dir, time limit). Lessons and solutions must not raise; assignments may only
+raise NotImplementedError from their stubs."""
+import pytest
+
+from robokit.course.build import ALL_DIRS, discover
+from robokit.course.execute import run_notebook
+from tests.conftest import ROOT
+
+TIME_LIMIT = 300  # seconds per notebook under ROBOKIT_FAST=1
+
+
+@pytest.mark.notebook
+@pytest.mark.parametrize("path", discover(ROOT, ALL_DIRS), ids=lambda p: f"{p.parent.name}/{p.name}")
+def test_notebook_runs(path):
+    run = run_notebook(path, timeout=TIME_LIMIT, fast=True)
+    assert run.status == "ok", f"{path.name}: {run.status} after {run.seconds:.0f}s\n{run.error}"
