@@ -1,0 +1,75 @@
+"""``check(exercise_id, fn)``: immediate feedback on public cases inside the student's notebook."""
+from __future__ import annotations
+
+from typing import Any, Callable
+
+from .exercise import call_student, expected_output, judge
+from .registry import get_exercise
+
+__all__ = ["check", "PUBLIC_SEED"]
+
+#: Seed of the public cases used by :func:`check`; official grading uses the instructor's seed.
+PUBLIC_SEED = 2024
+
+
+def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> int:
+    """Run the public cases of an exercise on ``fn`` and print a short report.
+
+    This is feedback only: it runs in your own notebook on public cases, and your grade comes
+    from the instructor's grader on fresh hidden cases.
+
+    Parameters
+    ----------
+    exercise_id : str
+        E.g. ``"00.wrap_angle"``.
+    fn : callable
+        Your implementation.
+    verbose : bool, default True
+        Print one line per case (otherwise only the summary and failures).
+
+    Returns
+    -------
+    int
+        Number of cases passed (all of them, since failures raise).
+
+    Raises
+    ------
+    NotImplementedError
+        If ``fn`` is still the stub: the report says "not implemented yet". (It raises, rather than
+        returning quietly, so that nbgrader's in-kernel autograde scores an untouched stub zero;
+        robokit's harness lets the rest of an assignment notebook run on.)
+    AssertionError
+        If any case fails, so the cell shows red.
+    TypeError
+        If ``fn`` is not callable.
+
+    Notes
+    -----
+    Grading design (DESIGN.md, "Grading"); not from a paper.
+    """
+    exercise = get_exercise(exercise_id)
+    if not callable(fn):
+        raise TypeError(f"fn: expected your function {exercise.function}, got {type(fn).__name__}")
+    cases = exercise.make_cases(PUBLIC_SEED)
+    lines, failed = [], 0
+    for i, case in enumerate(cases, 1):
+        result = call_student(fn, case)
+        if result.get("error", {}).get("type") == "NotImplementedError":
+            print(f"{exercise.id}: not implemented yet — replace `raise NotImplementedError` in "
+                  f"{exercise.function} with your code, then run this cell again.")
+            raise NotImplementedError(f"{exercise.id} is not implemented yet")
+        outcome = judge(exercise, case, expected_output(exercise, case), result)
+        mark = "pass" if outcome.passed else "FAIL"
+        where = f" [{result['error'].get('line')}]" if not outcome.passed and result.get("error", {}).get("line") else ""
+        text = f"  {mark}  case {i}" + (f" ({case.label})" if case.label else "")
+        if not outcome.passed:
+            failed += 1
+            text += f": {outcome.message}{where}"
+        if verbose or not outcome.passed:
+            lines.append(text)
+    print(f"check {exercise.id}: {len(cases) - failed}/{len(cases)} public cases passed "
+          "(feedback only; your grade comes from hidden cases)")
+    print("\n".join(lines))
+    if failed:
+        raise AssertionError(f"{exercise.id}: {failed} of {len(cases)} public cases failed (see above)")
+    return len(cases)
