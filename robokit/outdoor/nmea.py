@@ -1,0 +1,531 @@
+"""NMEA 0183 sentences: checksum, typed records and a stream reader that never stops on bad input.
+
+A sentence looks like ``$GPRMC,123519,A,4807.038,N,...*6A\\r\\n``: a ``$``, an address (a two-letter
+talker such as ``GP``, ``GN``, ``GL`` or ``HC``, then a three-letter sentence type), comma separated
+fields, ``*`` and a two-hex-digit checksum (NMEA 0183 v4.11, Sec. 5.2-5.3). Hamid et al. (seed 000
+Q3, Sec. 3) drive their truck from ``$GPRMC``, ``$GPRMB``, ``$GPGGA`` and ``$HCHDG``; those four get
+typed records (:class:`RMC`, :class:`RMB`, :class:`GGA`, :class:`HDG`) for any talker, and every other
+type is returned as a :class:`Sentence` (never an error).
+
+Conventions: empty fields become ``None``; latitude and longitude are signed decimal degrees (north
+and east positive) as the fields carry them; the records keep NMEA's own units (knots, degrees) in
+their field names and offer SI properties (``speed_mps``, ``course_rad``, ...).
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import io
+import os
+from functools import reduce
+from operator import xor
+from typing import Any, BinaryIO, Callable, Iterator, NamedTuple
+
+from ..validation import check_int, describe
+from .nmea_records import GGA, HDG, RMB, RMC, Sentence
+
+__all__ = [
+    "NMEAError", "NMEAChecksumError", "NMEAFormatError",
+    "RMC", "RMB", "GGA", "HDG", "Sentence",
+    "nmea_checksum", "parse_sentence", "parse_latitude", "parse_longitude", "parse_time", "parse_date",
+    "BadSentence", "NMEAReader", "read_nmea",
+]
+
+
+class NMEAError(ValueError):
+    """Base class of every NMEA problem (a ``ValueError``, so callers may catch either)."""
+
+
+class NMEAChecksumError(NMEAError):
+    """The checksum is missing (when required), not two hex digits, or does not match."""
+
+
+class NMEAFormatError(NMEAError):
+    """The sentence is malformed: framing, address, too few fields, or a field out of range."""
+
+
+# every spelling of a two-hex-digit checksum -> its value (one dict lookup per sentence)
+_HEX2 = {**{f"{i:02X}": i for i in range(256)}, **{f"{i:02x}": i for i in range(256)},
+         **{f"{i:02x}"[0] + f"{i:02X}"[1]: i for i in range(256)}, **{f"{i:02X}"[0] + f"{i:02x}"[1]: i for i in range(256)}}
+
+
+def _xor(data: bytes) -> int:
+    return reduce(xor, data, 0)
+
+
+def nmea_checksum(sentence: str) -> str:
+    """Return the NMEA checksum of a sentence as two upper-case hex digits.
+
+    Parameters
+    ----------
+    sentence : str
+        Either the body between ``$`` and ``*`` (``"GPGGA,..."``) or a full sentence; a leading
+        ``$`` and anything from ``*`` on are ignored.
+
+    Returns
+    -------
+    str
+        ``"%02X"`` of the XOR of the ASCII codes of the body's characters.
+
+    Raises
+    ------
+    TypeError
+        If ``sentence`` is not a string.
+    NMEAFormatError
+        If the body is empty or contains non-ASCII characters.
+
+    Notes
+    -----
+    NMEA 0183 v4.11, Sec. 5.2.1 (checksum field); the example in Hamid et al. (seed 000 Q3, Sec. 3)
+    reads the receiver's ASCII output in exactly this form.
+    """
+    if not isinstance(sentence, str):
+        raise TypeError(f"sentence: expected a str, got {describe(sentence)}")
+    body = sentence[1:] if sentence[:1] in ("$", "!") else sentence
+    star = body.find("*")
+    if star >= 0:
+        body = body[:star]
+    if not body:
+        raise NMEAFormatError(f"sentence: expected characters between '$' and '*', got {sentence!r}")
+    try:
+        data = body.encode("ascii")
+    except UnicodeEncodeError:
+        raise NMEAFormatError(f"sentence: expected ASCII characters only, got {sentence!r}") from None
+    return "%02X" % _xor(data)
+
+
+# --- fields ------------------------------------------------------------------------------------
+
+def _float(text: str, name: str) -> float | None:
+    if not text:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        raise NMEAFormatError(f"{name}: expected a number, got {text!r}") from None
+
+
+def _int(text: str, name: str) -> int | None:
+    if not text:
+        return None
+    if not text.isdigit():
+        raise NMEAFormatError(f"{name}: expected a non-negative integer, got {text!r}")
+    return int(text)
+
+
+def _angle(value: str, hemi: str, name: str, max_deg: int, pos: str, neg: str) -> float | None:
+    if not value and not hemi:
+        return None
+    if not value or hemi not in (pos, neg):
+        raise NMEAFormatError(f"{name}: expected a value with hemisphere {pos}/{neg}, got {value!r},{hemi!r}")
+    dot = value.find(".")
+    whole = value if dot < 0 else value[:dot]
+    if len(whole) < 3 or not whole.isdigit():
+        raise NMEAFormatError(f"{name}: expected {'dd' if max_deg == 90 else 'ddd'}mm.mmmm, got {value!r}")
+    try:
+        minutes = float(value[len(whole) - 2:])
+    except ValueError:
+        raise NMEAFormatError(f"{name}: expected {'dd' if max_deg == 90 else 'ddd'}mm.mmmm, got {value!r}") from None
+    degrees = float(whole[:-2]) + minutes / 60.0
+    if minutes >= 60.0 or degrees > max_deg:
+        raise NMEAFormatError(f"{name}: expected at most {max_deg} degrees with minutes < 60, got {value!r}")
+    return -degrees if hemi == neg else degrees
+
+
+def parse_latitude(value: str, hemisphere: str) -> float | None:
+    """Convert an NMEA latitude ``ddmm.mmmm`` and ``N``/``S`` to signed decimal degrees.
+
+    Parameters
+    ----------
+    value : str
+        Degrees (two digits) and decimal minutes, e.g. ``"4807.038"``.
+    hemisphere : str
+        ``"N"`` or ``"S"``.
+
+    Returns
+    -------
+    float or None
+        Degrees in [-90, 90], north positive; ``None`` when both fields are empty.
+
+    Raises
+    ------
+    NMEAFormatError
+        Malformed value, missing or wrong hemisphere, minutes >= 60 or more than 90 degrees.
+
+    Notes
+    -----
+    NMEA 0183 v4.11, Sec. 6.2 (field type "latitude").
+    """
+    return _angle(str(value), str(hemisphere), "latitude", 90, "N", "S")
+
+
+def parse_longitude(value: str, hemisphere: str) -> float | None:
+    """Convert an NMEA longitude ``dddmm.mmmm`` and ``E``/``W`` to signed decimal degrees.
+
+    Parameters
+    ----------
+    value : str
+        Degrees (three digits) and decimal minutes, e.g. ``"01131.000"``.
+    hemisphere : str
+        ``"E"`` or ``"W"``.
+
+    Returns
+    -------
+    float or None
+        Degrees in [-180, 180], east positive; ``None`` when both fields are empty.
+
+    Raises
+    ------
+    NMEAFormatError
+        Malformed value, missing or wrong hemisphere, minutes >= 60 or more than 180 degrees.
+
+    Notes
+    -----
+    NMEA 0183 v4.11, Sec. 6.2 (field type "longitude").
+    """
+    return _angle(str(value), str(hemisphere), "longitude", 180, "E", "W")
+
+
+def parse_time(value: str) -> _dt.time | None:
+    """Convert an NMEA UTC time ``hhmmss.ss`` to a ``datetime.time`` (``None`` when empty).
+
+    Raises
+    ------
+    NMEAFormatError
+        If the field is not ``hhmmss[.s...]`` or hours/minutes/seconds are out of range.
+
+    Notes
+    -----
+    NMEA 0183 v4.11, Sec. 6.2 (field type "time").
+    """
+    if not value:
+        return None
+    head = value[:6]
+    frac = value[6:]
+    if len(head) < 6 or not head.isdigit() or (frac and (frac[0] != "." or not (frac[1:].isdigit() or frac == "."))):
+        raise NMEAFormatError(f"time: expected hhmmss.ss, got {value!r}")
+    h, m, s = int(head[:2]), int(head[2:4]), int(head[4:6])
+    if h > 23 or m > 59 or s > 59:
+        raise NMEAFormatError(f"time: expected hours < 24, minutes < 60, seconds < 60, got {value!r}")
+    us = int(round(float("0" + frac) * 1e6)) if len(frac) > 1 else 0
+    return _dt.time(h, m, s, min(us, 999999))
+
+
+def parse_date(value: str) -> _dt.date | None:
+    """Convert an NMEA date ``ddmmyy`` to a ``datetime.date`` (``None`` when empty).
+
+    Two-digit years 69-99 are 1969-1999 and 00-68 are 2000-2068 (the POSIX ``%y`` rule, as
+    ``time.strptime`` and pynmea2 use).
+
+    Raises
+    ------
+    NMEAFormatError
+        If the field is not six digits or is not a calendar date (e.g. 310299).
+
+    Notes
+    -----
+    NMEA 0183 v4.11, Sec. 6.3 (RMC field 9, "date: ddmmyy").
+    """
+    if not value:
+        return None
+    if len(value) != 6 or not value.isdigit():
+        raise NMEAFormatError(f"date: expected ddmmyy, got {value!r}")
+    yy = int(value[4:])
+    try:
+        return _dt.date(1900 + yy if yy >= 69 else 2000 + yy, int(value[2:4]), int(value[:2]))
+    except ValueError:
+        raise NMEAFormatError(f"date: expected a calendar date ddmmyy, got {value!r}") from None
+
+
+def _signed(value: str, direction: str, name: str, pos: str, neg: str) -> float | None:
+    x = _float(value, name)
+    if x is None:
+        return None
+    if direction == neg:
+        return -x
+    if direction == pos or not direction:
+        return x
+    raise NMEAFormatError(f"{name}: expected direction {pos}/{neg}, got {direction!r}")
+
+
+def _flag(value: str, name: str, allowed: str) -> str | None:
+    if not value:
+        return None
+    if len(value) != 1 or value not in allowed:
+        raise NMEAFormatError(f"{name}: expected one of {list(allowed)}, got {value!r}")
+    return value
+
+
+# --- typed sentences ------------------------------------------------------------------------------
+
+def _need(f: list, n: int, kind: str) -> None:
+    if len(f) < n:
+        raise NMEAFormatError(f"{kind}: expected at least {n} fields, got {len(f)}")
+
+
+def _rmc(talker: str, f: list) -> RMC:
+    _need(f, 9, "RMC")
+    f = f + [""] * (13 - len(f)) if len(f) < 13 else f
+    return RMC(talker, parse_time(f[0]), _flag(f[1], "RMC status", "AV"),
+               _angle(f[2], f[3], "RMC latitude", 90, "N", "S"),
+               _angle(f[4], f[5], "RMC longitude", 180, "E", "W"),
+               _float(f[6], "RMC speed"), _float(f[7], "RMC course"), parse_date(f[8]),
+               _signed(f[9], f[10], "RMC magnetic variation", "E", "W"), f[11] or None)
+
+
+def _rmb(talker: str, f: list) -> RMB:
+    _need(f, 13, "RMB")
+    xte = _float(f[1], "RMB cross-track error")
+    steer = _flag(f[2], "RMB steer direction", "LR")
+    return RMB(talker, _flag(f[0], "RMB status", "AV"), xte, steer, f[3] or None, f[4] or None,
+               _angle(f[5], f[6], "RMB destination latitude", 90, "N", "S"),
+               _angle(f[7], f[8], "RMB destination longitude", 180, "E", "W"),
+               _float(f[9], "RMB range"), _float(f[10], "RMB bearing"),
+               _float(f[11], "RMB closing velocity"), _flag(f[12], "RMB arrival", "AV"),
+               f[13] or None if len(f) > 13 else None)
+
+
+def _gga(talker: str, f: list) -> GGA:
+    _need(f, 9, "GGA")
+    f = f + [""] * (14 - len(f)) if len(f) < 14 else f
+    return GGA(talker, parse_time(f[0]),
+               _angle(f[1], f[2], "GGA latitude", 90, "N", "S"),
+               _angle(f[3], f[4], "GGA longitude", 180, "E", "W"),
+               _int(f[5], "GGA quality"), _int(f[6], "GGA satellites"), _float(f[7], "GGA HDOP"),
+               _float(f[8], "GGA altitude"), _float(f[10], "GGA geoid separation"),
+               _float(f[12], "GGA DGPS age"), f[13] or None)
+
+
+def _hdg(talker: str, f: list) -> HDG:
+    _need(f, 5, "HDG")
+    heading = _float(f[0], "HDG heading")
+    if heading is not None and not 0.0 <= heading <= 360.0:
+        raise NMEAFormatError(f"HDG heading: expected degrees in [0, 360], got {f[0]!r}")
+    return HDG(talker, heading, _signed(f[1], f[2], "HDG deviation", "E", "W"),
+               _signed(f[3], f[4], "HDG variation", "E", "W"))
+
+
+_TYPED: dict[str, Callable[[str, list], Any]] = {"RMC": _rmc, "RMB": _rmb, "GGA": _gga, "HDG": _hdg}
+
+
+def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> RMC | RMB | GGA | HDG | Sentence:
+    """Parse one NMEA sentence into a typed record.
+
+    Parameters
+    ----------
+    sentence : str or bytes
+        ``$<address>,<fields>*hh`` with optional trailing ``\\r\\n``; bytes must be ASCII.
+    require_checksum : bool, default True
+        Reject sentences without ``*hh`` (a truncated line loses its checksum first). A checksum
+        that is present is always verified.
+
+    Returns
+    -------
+    RMC, RMB, GGA, HDG or Sentence
+        A typed record for those four types (any talker), otherwise a generic :class:`Sentence`.
+
+    Raises
+    ------
+    TypeError
+        If ``sentence`` is neither str nor bytes.
+    NMEAChecksumError
+        Missing (when required), malformed or wrong checksum.
+    NMEAFormatError
+        No leading ``$``, non-ASCII characters, a bad address, too few fields or a field out of
+        range (latitude > 90 degrees, invalid date, ...).
+
+    Notes
+    -----
+    Framing and checksum: NMEA 0183 v4.11, Sec. 5.2-5.3; field layouts: Sec. 6.3 (RMC, RMB, GGA,
+    HDG), the four sentences Hamid et al. read (seed 000 Q3, Sec. 3).
+    """
+    if type(sentence) is not str:
+        if isinstance(sentence, (bytes, bytearray)):
+            try:
+                sentence = bytes(sentence).decode("ascii")
+            except UnicodeDecodeError as exc:
+                raise NMEAFormatError(f"sentence: expected ASCII bytes, got byte 0x{sentence[exc.start]:02X} "
+                                      f"at position {exc.start}") from None
+        elif isinstance(sentence, str):
+            sentence = str(sentence)
+        else:
+            raise TypeError(f"sentence: expected a str or bytes, got {describe(sentence)}")
+    text = sentence.rstrip("\r\n") if sentence[-1:] in ("\n", "\r") else sentence
+    if text[:1] != "$":
+        raise NMEAFormatError(f"sentence: expected it to start with '$', got {text[:20]!r}")
+    star = text.find("*", 1)
+    if star >= 0:
+        body = text[1:star]
+        want = _HEX2.get(text[star + 1:])
+        if want is None:
+            raise NMEAChecksumError(f"checksum: expected two hex digits after '*', got {text[star + 1:]!r}")
+        try:
+            got = _xor(body.encode("ascii"))
+        except UnicodeEncodeError:
+            raise NMEAFormatError(f"sentence: expected ASCII characters only, got {text[:40]!r}") from None
+        if got != want:
+            raise NMEAChecksumError(f"checksum: expected {got:02X} for the body, got {text[star + 1:]} "
+                                    f"in {text[:40]!r}")
+    else:
+        if require_checksum:
+            raise NMEAChecksumError(f"checksum: expected '*hh' at the end (truncated sentence?), got {text[:40]!r}")
+        body = text[1:]
+        if not body.isascii():
+            raise NMEAFormatError(f"sentence: expected ASCII characters only, got {text[:40]!r}")
+    fields = body.split(",")
+    address = fields[0]
+    if not (address.isalnum() and address.isupper()) or len(address) < 2:
+        raise NMEAFormatError(f"address: expected a talker and type like 'GPRMC', got {address!r}")
+    if address[0] == "P":
+        talker, kind = "P", address[1:]
+    else:
+        talker, kind = address[:2], address[2:]
+    parser = _TYPED.get(kind)
+    if parser is None or len(address) != 5:
+        return Sentence(talker, kind, tuple(fields[1:]))
+    return parser(talker, fields[1:])
+
+
+# --- streams ------------------------------------------------------------------------------------
+
+class BadSentence(NamedTuple):
+    """A sentence the reader rejected: ``line`` (1-based), the raw ``text`` and the ``error``."""
+
+    line: int
+    text: bytes
+    error: NMEAError
+
+
+class NMEAReader:
+    """Read NMEA sentences from a byte stream, skipping junk and reporting bad sentences.
+
+    Iterating yields parsed records in order. Bytes before a ``$`` (binary junk, the tail of a
+    partial line) are skipped and counted in :attr:`junk_bytes`; every candidate sentence that fails
+    to parse is appended to :attr:`errors` as a :class:`BadSentence` with its line number (and passed
+    to ``on_error`` if given), and reading continues with the next ``$``.
+
+    Parameters
+    ----------
+    source : bytes, str path, os.PathLike or binary file-like
+        A path is opened (and closed at the end); a file-like must have ``read(n)`` returning bytes
+        (a serial port works the same way).
+    require_checksum : bool, default True
+        See :func:`parse_sentence`.
+    on_error : callable, optional
+        ``on_error(bad: BadSentence)`` called for every rejected sentence.
+    chunk_size : int, default 65536
+        Bytes read per call to ``read``.
+    max_line : int, default 4096
+        A run of bytes longer than this without a newline is cut at its last ``$`` so that a
+        newline-free binary stream cannot grow the buffer without bound (NMEA sentences are at most
+        82 characters, NMEA 0183 v4.11 Sec. 5.3).
+
+    Raises
+    ------
+    TypeError
+        If ``source`` is not bytes, a path or a binary file-like.
+
+    Notes
+    -----
+    Resynchronising on ``$`` is how a receiver's listener recovers after noise or a lost
+    character (NMEA 0183 v4.11, Sec. 5.3: ``$`` only ever starts a sentence).
+    """
+
+    def __init__(self, source: Any, *, require_checksum: bool = True,
+                 on_error: Callable[[BadSentence], Any] | None = None,
+                 chunk_size: int = 65536, max_line: int = 4096) -> None:
+        self._close = False
+        if isinstance(source, (bytes, bytearray, memoryview)):
+            self._stream: BinaryIO = io.BytesIO(bytes(source))
+        elif isinstance(source, (str, os.PathLike)):
+            self._stream = open(source, "rb")
+            self._close = True
+        elif hasattr(source, "read"):
+            self._stream = source
+        else:
+            raise TypeError(f"source: expected bytes, a path or a binary file-like, got {describe(source)}")
+        self.require_checksum = bool(require_checksum)
+        self.on_error = on_error
+        self.chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
+        self.max_line = check_int(max_line, "max_line", minimum=82)
+        self.errors: list[BadSentence] = []
+        self.junk_bytes = 0
+        self.lines = 0
+
+    def _bad(self, line: int, text: bytes, error: NMEAError) -> None:
+        bad = BadSentence(line, text, error)
+        self.errors.append(bad)
+        if self.on_error is not None:
+            self.on_error(bad)
+
+    def _line(self, raw: bytes, number: int) -> Iterator[Any]:
+        start = raw.find(b"$")
+        if start < 0:
+            self.junk_bytes += len(raw.strip())
+            return
+        self.junk_bytes += len(raw[:start].strip())
+        pieces = raw[start:].split(b"$")
+        for piece in pieces[1:]:
+            text = b"$" + piece.rstrip(b"\r\n \t\x00")
+            try:
+                yield parse_sentence(text.decode("ascii"), require_checksum=self.require_checksum)
+            except UnicodeDecodeError as exc:
+                self._bad(number, text, NMEAFormatError(
+                    f"sentence: expected ASCII bytes, got byte 0x{text[exc.start]:02X} at position {exc.start}"))
+            except NMEAError as exc:
+                self._bad(number, text, exc)
+
+    def __iter__(self) -> Iterator[RMC | RMB | GGA | HDG | Sentence]:
+        rest = b""
+        number = 0
+        try:
+            while True:
+                chunk = self._stream.read(self.chunk_size)
+                if chunk is None:  # non-blocking stream with nothing yet
+                    continue
+                if not isinstance(chunk, (bytes, bytearray)):
+                    raise TypeError(f"source: expected read() to return bytes, got {describe(chunk)}")
+                if not chunk:
+                    break
+                lines = (rest + chunk).split(b"\n")
+                rest = lines.pop()
+                for raw in lines:
+                    number += 1
+                    yield from self._line(raw, number)
+                if len(rest) > self.max_line:
+                    cut = rest.rfind(b"$")
+                    cut = cut if 0 < cut and len(rest) - cut <= self.max_line else len(rest)
+                    yield from self._line(rest[:cut], number + 1)
+                    rest = rest[cut:]
+            if rest:
+                number += 1
+                yield from self._line(rest, number)
+        finally:
+            self.lines = number
+            if self._close:
+                self._stream.close()
+
+
+def read_nmea(source: Any, *, require_checksum: bool = True) -> tuple[list, list[BadSentence]]:
+    """Read a whole NMEA log and return ``(records, bad_sentences)``.
+
+    Parameters
+    ----------
+    source : bytes, path or binary file-like
+        See :class:`NMEAReader`.
+    require_checksum : bool, default True
+        See :func:`parse_sentence`.
+
+    Returns
+    -------
+    records : list
+        Every sentence that parsed, in order.
+    bad_sentences : list of BadSentence
+        Every rejected sentence with its 1-based line number and the reason.
+
+    Notes
+    -----
+    A convenience over :class:`NMEAReader` (NMEA 0183 v4.11, Sec. 5.3 framing).
+    """
+    reader = NMEAReader(source, require_checksum=require_checksum)
+    return list(reader), reader.errors
+
