@@ -1,0 +1,23 @@
+"""Robot-arm kinematics: DH chains, Jacobians, analytic and numerical inverse kinematics.
+
+Lesson 06 (redundant 7-DOF arms, seed 000 Q4: Huang & Jiang's separation of position and posture).
+
+* :class:`Chain`, :func:`dh_transform`, :func:`mdh_transform` - DH / modified-DH forward kinematics.
+* :func:`iiwa14`, :func:`panda` - two real arms with their published parameters.
+* :func:`geometric_jacobian`, :func:`manipulability`.
+* :func:`ik_srs`, :func:`ik_srs_batch`, :func:`ik_srs_branches`, :func:`arm_angle` - the analytic
+  arm-angle IK of S-R-S arms (KUKA LBR iiwa).
+* :func:`ik_numeric`, :func:`ik_numeric_batch` - damped least squares with null-space gradient
+  projection (Dubey) or weighted least norm (Chan), random restarts; any chain.
+"""
+from .chain import Chain
+from .dh import dh_transform, mdh_transform
+from .ik_analytic import SRSArm, arm_angle, ik_srs, ik_srs_batch, ik_srs_branches
+from .jacobian import geometric_jacobian, manipulability
+from .result import IKBatchResult, IKResult
+from .robots import iiwa14, panda
+from .se3 import pose_error
+
+__all__ = ["Chain", "dh_transform", "mdh_transform", "iiwa14", "panda", "geometric_jacobian",
+           "manipulability", "SRSArm", "arm_angle", "ik_srs", "ik_srs_batch", "ik_srs_branches",
+           "IKResult", "IKBatchResult", "pose_error"]

@@ -1,0 +1,217 @@
+"""Serial chains of revolute joints described by DH or modified-DH parameters.
+
+A :class:`Chain` knows its link parameters, joint offsets and limits, a fixed tool (flange)
+transform and a base transform. It computes the pose of every link frame in one vectorised pass,
+for one configuration or a batch of them.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..validation import as_array, as_rng, check_choice, check_int
+from .dh import link_matrices
+from .se3 import as_se3
+
+__all__ = ["Chain"]
+
+
+class Chain:
+    """A serial chain of revolute joints.
+
+    Parameters
+    ----------
+    name : str
+        Human-readable name, e.g. ``"KUKA LBR iiwa 14 R820"``.
+    d, a, alpha : array_like, shape (n,)
+        DH parameters of each link [m, m, rad]. For ``convention="modified"`` they are Craig's
+        ``d_i, a_{i-1}, alpha_{i-1}``.
+    qmin, qmax : array_like, shape (n,)
+        Joint limits [rad]; ``qmin <= qmax`` elementwise.
+    convention : {"standard", "modified"}, default "standard"
+        Standard DH (joint ``i`` turns about ``z_{i-1}``) or modified DH (about ``z_i``).
+    offset : array_like, shape (n,), optional
+        Constant added to each joint variable (``theta_i = q_i + offset_i``); zeros by default.
+    tool : array_like, shape (4, 4), optional
+        Pose of the flange (end-effector) in the last link frame; identity by default.
+    base : array_like, shape (4, 4), optional
+        Pose of frame 0 in the world; identity by default.
+
+    Raises
+    ------
+    ValueError
+        If the parameter vectors differ in length, contain NaN, if ``qmin > qmax`` for a joint, or if
+        ``tool``/``base`` are not SE(3) matrices.
+
+    Notes
+    -----
+    Link transforms follow Denavit & Hartenberg (1955) as in Spong et al. (2006), Eq. (3.10), or
+    Craig (2005), Eq. (3.6); forward kinematics is their ordered product (Spong et al., Eq. (3.5)).
+    """
+
+    def __init__(self, name: str, d: Any, a: Any, alpha: Any, qmin: Any, qmax: Any, *,
+                 convention: str = "standard", offset: Any = None, tool: Any = None, base: Any = None):
+        if not isinstance(name, str):
+            raise TypeError(f"name: expected a string, got {type(name).__name__}")
+        self.name = name
+        self.d = as_array(d, "d", ndim=1, min_size=1)
+        n = self.d.shape[0]
+        self.a = as_array(a, "a", shape=(n,))
+        self.alpha = as_array(alpha, "alpha", shape=(n,))
+        self.offset = np.zeros(n) if offset is None else as_array(offset, "offset", shape=(n,))
+        self.qmin = as_array(qmin, "qmin", shape=(n,))
+        self.qmax = as_array(qmax, "qmax", shape=(n,))
+        bad = np.flatnonzero(self.qmin > self.qmax)
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(f"qmin, qmax: expected qmin <= qmax for every joint, got joint {i + 1} with "
+                             f"qmin = {self.qmin[i]:.4g} > qmax = {self.qmax[i]:.4g} rad")
+        self.convention = check_choice(convention, "convention", ("standard", "modified"))
+        self.tool = np.eye(4) if tool is None else as_se3(tool, "tool")
+        self.base = np.eye(4) if base is None else as_se3(base, "base")
+        for arr in (self.d, self.a, self.alpha, self.offset, self.qmin, self.qmax, self.tool, self.base):
+            arr.setflags(write=False)
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return self.d.shape[0]
+
+    @property
+    def modified(self) -> bool:
+        """True for the modified (Craig) DH convention."""
+        return self.convention == "modified"
+
+    def __repr__(self) -> str:
+        return f"Chain({self.name!r}, n={self.n}, convention={self.convention!r})"
+
+    # --- validation ------------------------------------------------------------------------------
+    def check_q(self, q: Any, name: str = "q", *, batch: bool = False) -> np.ndarray:
+        """Return ``q`` as a finite float array of shape ``(n,)`` (or ``(N, n)`` with ``batch``).
+
+        Raises
+        ------
+        ValueError
+            If the joint vector has the wrong length or contains NaN/infinity.
+        """
+        q = as_array(q, name)
+        if batch and q.ndim == 1:
+            q = q[None]
+        if q.ndim != (2 if batch else 1) or q.shape[-1] != self.n:
+            want = f"(N, {self.n})" if batch else f"({self.n},)"
+            raise ValueError(f"{name}: expected {self.n} joint angles for {self.name}, shape {want}, got shape {q.shape}")
+        return q
+
+    def within_limits(self, q: Any, tol: float = 0.0) -> np.ndarray | bool:
+        """Return whether each configuration lies inside ``[qmin - tol, qmax + tol]``.
+
+        Parameters
+        ----------
+        q : array_like, shape (n,) or (N, n)
+            Joint angles [rad].
+        tol : float, default 0
+            Slack [rad] (for rounding).
+
+        Returns
+        -------
+        bool or numpy.ndarray of bool, shape (N,)
+        """
+        q = self.check_q(q, batch=np.ndim(q) == 2)
+        ok = np.all((q >= self.qmin - tol) & (q <= self.qmax + tol), axis=-1)
+        return bool(ok) if ok.ndim == 0 else ok
+
+    def random_q(self, size: int | None = None, rng: Any = None) -> np.ndarray:
+        """Draw configurations uniformly inside the joint limits.
+
+        Parameters
+        ----------
+        size : int, optional
+            Number of configurations; ``None`` returns a single ``(n,)`` vector.
+        rng : numpy.random.Generator or int, optional
+            Source of randomness (seed 0 by default).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,) or (size, n)
+        """
+        gen = as_rng(rng)
+        if size is None:
+            return gen.uniform(self.qmin, self.qmax)
+        size = check_int(size, "size", minimum=1)
+        return gen.uniform(self.qmin, self.qmax, size=(size, self.n))
+
+    def reach(self) -> float:
+        """Upper bound [m] on the distance from the base origin to the flange.
+
+        The sum of every link's offset ``sqrt(a^2 + d^2)`` plus the tool offset (triangle
+        inequality); targets farther away are certainly unreachable.
+        """
+        return float(np.sum(np.hypot(self.a, self.d)) + np.linalg.norm(self.tool[:3, 3]))
+
+    # --- kinematics ------------------------------------------------------------------------------
+    def _frames(self, q: np.ndarray) -> np.ndarray:
+        """Unchecked: poses of frames 0..n for ``q`` of shape (..., n) -> (..., n + 1, 4, 4)."""
+        links = link_matrices(q + self.offset, self.d, self.a, self.alpha, modified=self.modified)
+        out = np.empty(q.shape[:-1] + (self.n + 1, 4, 4))
+        out[..., 0, :, :] = self.base
+        for i in range(self.n):
+            out[..., i + 1, :, :] = out[..., i, :, :] @ links[..., i, :, :]
+        return out
+
+    def _flange(self, frames: np.ndarray) -> np.ndarray:
+        """Unchecked: flange pose from the frames of :meth:`_frames`."""
+        return frames[..., -1, :, :] @ self.tool
+
+    def joint_frames(self, frames: np.ndarray) -> np.ndarray:
+        """Select, from frames 0..n, the frame whose z axis is each joint's axis -> (..., n, 4, 4).
+
+        Standard DH: joint ``i`` turns about ``z_{i-1}``; modified DH: about ``z_i`` (Craig 2005,
+        Sec. 3.4).
+        """
+        return frames[..., 1:, :, :] if self.modified else frames[..., :-1, :, :]
+
+    def link_frames(self, q: Any) -> np.ndarray:
+        """Poses of every link frame 0..n and of the flange in the world frame.
+
+        Parameters
+        ----------
+        q : array_like, shape (n,) or (N, n)
+            Joint angles [rad].
+
+        Returns
+        -------
+        numpy.ndarray, shape (n + 2, 4, 4) or (N, n + 2, 4, 4)
+            Frame 0 (the base), the n link frames, then the flange.
+
+        Raises
+        ------
+        ValueError
+            On a wrong-length or non-finite joint vector.
+
+        Notes
+        -----
+        Product of link transforms, Spong et al. (2006), Eq. (3.5).
+        """
+        q = self.check_q(q, batch=np.ndim(q) == 2)
+        frames = self._frames(q)
+        return np.concatenate([frames, self._flange(frames)[..., None, :, :]], axis=-3)
+
+    def fk(self, q: Any) -> np.ndarray:
+        """Pose of the flange for joint angles ``q`` (one ``(n,)`` vector or a batch ``(N, n)``).
+
+        Returns
+        -------
+        numpy.ndarray, shape (4, 4) or (N, 4, 4)
+
+        Raises
+        ------
+        ValueError
+            On a wrong-length or non-finite joint vector.
+
+        Notes
+        -----
+        Spong et al. (2006), Eq. (3.5), followed by the fixed tool transform.
+        """
+        q = self.check_q(q, batch=np.ndim(q) == 2)
+        return self._flange(self._frames(q))

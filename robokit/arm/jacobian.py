@@ -1,0 +1,84 @@
+"""The geometric Jacobian of a serial chain and Yoshikawa's manipulability."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..validation import as_array
+from .chain import Chain
+
+__all__ = ["geometric_jacobian", "manipulability"]
+
+
+def jacobian_from_frames(chain: Chain, frames: np.ndarray) -> np.ndarray:
+    """Unchecked kernel: the 6xn Jacobian from the frames 0..n of ``Chain._frames``."""
+    jf = chain.joint_frames(frames)
+    z = jf[..., :3, 2]                       # (..., n, 3) joint axes
+    p = jf[..., :3, 3]                       # (..., n, 3) points on the axes
+    p_e = chain._flange(frames)[..., None, :3, 3]
+    Jv = np.cross(z, p_e - p)
+    return np.swapaxes(np.concatenate([Jv, z], axis=-1), -1, -2)
+
+
+def geometric_jacobian(chain: Chain, q: Any) -> np.ndarray:
+    """The geometric Jacobian mapping joint rates to the flange twist ``[v; omega]``.
+
+    Parameters
+    ----------
+    chain : Chain
+    q : array_like, shape (n,) or (N, n)
+        Joint angles [rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (6, n) or (N, 6, n)
+        Rows 0-2: linear velocity of the flange origin [m/s per rad/s]; rows 3-5: angular velocity
+        [rad/s per rad/s]; both in the base (world) frame. Column ``i`` is ``[z_i x (p_e - p_i); z_i]``.
+
+    Raises
+    ------
+    TypeError
+        If ``chain`` is not a :class:`Chain`.
+    ValueError
+        On a wrong-length or non-finite joint vector.
+
+    Notes
+    -----
+    Siciliano et al., *Robotics: Modelling, Planning and Control* (2009), Eq. (3.30) for revolute
+    joints.
+    """
+    if not isinstance(chain, Chain):
+        raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
+    q = chain.check_q(q, batch=np.ndim(q) == 2)
+    return jacobian_from_frames(chain, chain._frames(q))
+
+
+def manipulability(J: Any) -> float | np.ndarray:
+    """Yoshikawa's manipulability ``w = sqrt(det(J J^T))``.
+
+    Parameters
+    ----------
+    J : array_like, shape (m, n) or (N, m, n)
+        Jacobian(s) with ``m <= n``.
+
+    Returns
+    -------
+    float or numpy.ndarray, shape (N,)
+        Zero exactly at singular configurations; the volume of the velocity ellipsoid otherwise.
+
+    Raises
+    ------
+    ValueError
+        If ``J`` is not 2-D/3-D, has more rows than columns or is not finite.
+
+    Notes
+    -----
+    Yoshikawa, "Manipulability of robotic mechanisms", IJRR 4(2), 1985, Eq. (7).
+    """
+    J = as_array(J, "J")
+    if J.ndim not in (2, 3) or J.shape[-2] > J.shape[-1]:
+        raise ValueError(f"J: expected a Jacobian of shape (m, n) or (N, m, n) with m <= n, got shape {J.shape}")
+    det = np.linalg.det(J @ np.swapaxes(J, -1, -2))
+    w = np.sqrt(np.clip(det, 0.0, None))
+    return float(w) if w.ndim == 0 else w
