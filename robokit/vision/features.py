@@ -1,0 +1,140 @@
+"""Containers shared by every detector and descriptor: grey images, keypoints, features.
+
+Image convention: ``image[row, col]``; keypoint positions are ``(x, y) = (col, row)`` in pixels,
+orientations are ``atan2(dy, dx)`` in image axes (x right, y down), in ``[0, 2 pi)``, and the scale
+of a keypoint is the standard deviation (pixels) of the Gaussian it was found at. PLOT (Lin et al.)
+and OpenCV's SIFT (Lowe 2004; Se, Lowe & Little 2002) both produce :class:`Features`, so every
+pipeline accepts either.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..validation import as_array, describe
+
+__all__ = ["as_gray_image", "Keypoints", "Features"]
+
+
+def as_gray_image(image, name: str = "image") -> np.ndarray:
+    """Return ``image`` as a float32 grey image with values in [0, 1] (for integer input).
+
+    Parameters
+    ----------
+    image : array_like, shape (H, W) or (H, W, 3|4)
+        Grey or RGB(A) image. Integer images are divided by their dtype's maximum; float images
+        are kept as they are (expected in [0, 1]).
+    name : str
+        Argument name for error messages.
+
+    Returns
+    -------
+    numpy.ndarray, shape (H, W), float32
+
+    Raises
+    ------
+    TypeError
+        If the input is not a numeric array.
+    ValueError
+        If it is empty, smaller than 3 x 3, has the wrong number of dimensions or channels, or
+        holds NaN/infinity.
+
+    Notes
+    -----
+    Course convention (DESIGN.md "Errors"); the luminance weights are ITU-R BT.601, as in OpenCV.
+    """
+    raw = np.asarray(image)
+    if raw.dtype == object or not (np.issubdtype(raw.dtype, np.number) or raw.dtype == bool):
+        raise TypeError(f"{name}: expected a numeric image array, got {describe(image)}")
+    if raw.size == 0:
+        raise ValueError(f"{name}: expected a non-empty image, got shape {raw.shape}")
+    if raw.ndim == 3 and raw.shape[2] in (3, 4):
+        scale = np.iinfo(raw.dtype).max if np.issubdtype(raw.dtype, np.integer) else 1.0
+        rgb = raw[..., :3].astype(np.float32) / np.float32(scale)
+        gray = rgb @ np.array([0.299, 0.587, 0.114], dtype=np.float32)
+    elif raw.ndim == 2:
+        scale = np.iinfo(raw.dtype).max if np.issubdtype(raw.dtype, np.integer) else 1.0
+        gray = raw.astype(np.float32) / np.float32(scale)
+    else:
+        raise ValueError(f"{name}: expected shape (H, W) or (H, W, 3), got shape {raw.shape}")
+    if min(gray.shape) < 3:
+        raise ValueError(f"{name}: expected an image of at least 3 x 3 pixels, got shape {gray.shape}")
+    if not np.all(np.isfinite(gray)):
+        raise ValueError(f"{name}: expected finite pixel values, got NaN or infinity")
+    return np.ascontiguousarray(gray)
+
+
+@dataclass(frozen=True)
+class Keypoints:
+    """Image keypoints (Lin et al. Sec. 2.i: position, scale, response; Sec. 2.ii: orientation).
+
+    Attributes
+    ----------
+    xy : numpy.ndarray, shape (N, 2)
+        Sub-pixel positions ``(col, row)`` in pixels.
+    scale : numpy.ndarray, shape (N,)
+        Gaussian scale sigma in pixels.
+    response : numpy.ndarray, shape (N,)
+        Detector strength (PLOT: junction strength lambda_2; SIFT: |DoG|).
+    orientation : numpy.ndarray, shape (N,)
+        Dominant gradient orientation in radians, ``[0, 2 pi)``; zeros before assignment.
+    """
+
+    xy: np.ndarray
+    scale: np.ndarray
+    response: np.ndarray
+    orientation: np.ndarray
+
+    def __post_init__(self):
+        xy = as_array(self.xy, "xy")
+        xy = as_array(xy.reshape(0, 2) if xy.size == 0 else xy, "xy", shape=(None, 2))
+        n = xy.shape[0]
+        object.__setattr__(self, "xy", xy)
+        for field in ("scale", "response", "orientation"):
+            arr = as_array(getattr(self, field), field, shape=(n,)) if n else np.zeros(0)
+            object.__setattr__(self, field, arr)
+        if n and np.any(self.scale <= 0):
+            raise ValueError("scale: expected positive keypoint scales, got a value <= 0")
+
+    def __len__(self) -> int:
+        return self.xy.shape[0]
+
+    @classmethod
+    def empty(cls) -> "Keypoints":
+        """Return zero keypoints (the documented result for a textureless image)."""
+        return cls(np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0))
+
+    def subset(self, index) -> "Keypoints":
+        """Return the keypoints selected by a boolean mask or an index array."""
+        return Keypoints(self.xy[index], self.scale[index], self.response[index], self.orientation[index])
+
+
+@dataclass(frozen=True)
+class Features:
+    """Keypoints with one descriptor row each (what every matcher in ``robokit.vision`` consumes).
+
+    Attributes
+    ----------
+    keypoints : Keypoints
+    descriptors : numpy.ndarray, shape (N, D), float32
+        D = 128 for the SIFT-style descriptor, 16 for Se et al.'s reduced vector (Sec. 4).
+    """
+
+    keypoints: Keypoints
+    descriptors: np.ndarray
+
+    def __post_init__(self):
+        if not isinstance(self.keypoints, Keypoints):
+            raise TypeError(f"keypoints: expected Keypoints, got {describe(self.keypoints)}")
+        d = np.asarray(self.descriptors, dtype=np.float32)
+        if d.ndim != 2 or d.shape[0] != len(self.keypoints):
+            raise ValueError(f"descriptors: expected shape ({len(self.keypoints)}, D), got shape {d.shape}")
+        object.__setattr__(self, "descriptors", d)
+
+    def __len__(self) -> int:
+        return len(self.keypoints)
+
+    def subset(self, index) -> "Features":
+        """Return the features selected by a boolean mask or an index array."""
+        return Features(self.keypoints.subset(index), self.descriptors[index])

@@ -1,0 +1,140 @@
+"""Nearest-neighbour distance-ratio matching of descriptors (Lin et al. Sec. 3).
+
+A descriptor ``D_A`` is matched to its nearest neighbour ``D_B`` when
+``||D_A - D_B|| / ||D_A - D_C|| < t`` with ``D_C`` the second nearest (Lin et al. use t = 0.65).
+The neighbour search is scipy's KD-tree or OpenCV's brute-force matcher (the library reference);
+both give the same matches.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..validation import as_array, check_choice, check_positive
+
+__all__ = ["Matches", "two_nearest", "ratio_match"]
+
+
+@dataclass(frozen=True)
+class Matches:
+    """Index pairs of matched descriptors.
+
+    Attributes
+    ----------
+    query, train : numpy.ndarray of int, shape (M,)
+        Row in the first and the second descriptor set.
+    distance : numpy.ndarray, shape (M,)
+        Euclidean descriptor distance to the nearest neighbour.
+    ratio : numpy.ndarray, shape (M,)
+        Nearest / second-nearest distance.
+    """
+
+    query: np.ndarray
+    train: np.ndarray
+    distance: np.ndarray
+    ratio: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.query.size)
+
+    @classmethod
+    def empty(cls) -> "Matches":
+        """Return zero matches."""
+        z = np.zeros(0, int)
+        return cls(z, z.copy(), np.zeros(0), np.zeros(0))
+
+
+def _descriptors(value, name):
+    arr = as_array(value, name, dtype=np.float32)
+    if arr.ndim == 2 and arr.shape[0] == 0:
+        return arr
+    if arr.ndim != 2:
+        raise ValueError(f"{name}: expected shape (N, D), got shape {arr.shape}")
+    return arr
+
+
+def two_nearest(query, train, *, method: str = "kdtree") -> tuple[np.ndarray, np.ndarray]:
+    """Distances and indices of the two nearest ``train`` descriptors of every ``query`` row.
+
+    Parameters
+    ----------
+    query : array_like, shape (N, D)
+    train : array_like, shape (M, D), M >= 2
+    method : {"kdtree", "opencv"}
+        scipy ``cKDTree`` or OpenCV ``BFMatcher.knnMatch``.
+
+    Returns
+    -------
+    dist : numpy.ndarray, shape (N, 2)
+    index : numpy.ndarray of int, shape (N, 2)
+
+    Raises
+    ------
+    ValueError
+        If the descriptor lengths differ or ``train`` has fewer than 2 rows.
+
+    Notes
+    -----
+    The search behind Lin et al.'s nearest-neighbour ratio (Sec. 3).
+    """
+    method = check_choice(method, "method", ("kdtree", "opencv"))
+    q, t = _descriptors(query, "query"), _descriptors(train, "train")
+    if t.shape[0] < 2:
+        raise ValueError(f"train: expected at least 2 descriptors for a distance ratio, got {t.shape[0]}")
+    if q.shape[0] and q.shape[1] != t.shape[1]:
+        raise ValueError(f"query: expected descriptors of length {t.shape[1]}, got {q.shape[1]}")
+    if q.shape[0] == 0:
+        return np.zeros((0, 2)), np.zeros((0, 2), int)
+    if method == "kdtree":
+        dist, index = cKDTree(t).query(q, k=2)
+        return np.asarray(dist, float), np.asarray(index, int)
+    pairs = cv2.BFMatcher(cv2.NORM_L2).knnMatch(np.ascontiguousarray(q), np.ascontiguousarray(t), k=2)
+    dist = np.array([[m.distance for m in p] for p in pairs], float)
+    index = np.array([[m.trainIdx for m in p] for p in pairs], int)
+    return dist, index
+
+
+def ratio_match(query, train, *, ratio: float = 0.65, method: str = "kdtree",
+                max_distance: float | None = None) -> Matches:
+    """Nearest-neighbour distance-ratio matching.
+
+    Parameters
+    ----------
+    query : array_like, shape (N, D)
+    train : array_like, shape (M, D)
+    ratio : float, default 0.65
+        Threshold ``t`` on ``||D_A - D_B|| / ||D_A - D_C||`` (Lin et al. use 0.65).
+    method : {"kdtree", "opencv"}
+    max_distance : float, optional
+        Also reject matches whose nearest distance exceeds this.
+
+    Returns
+    -------
+    Matches
+        Empty when either set is empty or ``train`` has fewer than two rows (no ratio exists).
+
+    Raises
+    ------
+    ValueError
+        For a ratio outside (0, 1] or descriptors of different lengths.
+
+    Notes
+    -----
+    Lin et al. Sec. 3, "the nearest neighbor ratio"; Lowe 2004, Sec. 7.1.
+    """
+    ratio = check_positive(ratio, "ratio")
+    if ratio > 1:
+        raise ValueError(f"ratio: expected a value in (0, 1], got {ratio}")
+    q, t = _descriptors(query, "query"), _descriptors(train, "train")
+    if q.shape[0] == 0 or t.shape[0] < 2:
+        return Matches.empty()
+    dist, index = two_nearest(q, t, method=method)
+    r = np.divide(dist[:, 0], dist[:, 1], out=np.ones(len(dist)), where=dist[:, 1] > 0)
+    keep = r < ratio
+    if max_distance is not None:
+        keep &= dist[:, 0] <= check_positive(max_distance, "max_distance")
+    rows = np.nonzero(keep)[0]
+    return Matches(rows, index[rows, 0], dist[rows, 0], r[rows])

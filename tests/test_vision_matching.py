@@ -1,0 +1,87 @@
+"""NN-ratio matching (Lin et al. Sec. 3) and recall vs 1-precision (Lin et al. Sec. 2.iii)."""
+import cv2
+import numpy as np
+import pytest
+from matplotlib import cbook
+from PIL import Image
+
+from robokit.vision.descriptors import plot_features, sift_features
+from robokit.vision.evaluation import apply_homography, recall_precision, similarity_homography
+from robokit.vision.matching import ratio_match, two_nearest
+
+
+@pytest.fixture(scope="module")
+def photo():
+    with cbook.get_sample_data("grace_hopper.jpg") as f:
+        img = np.array(Image.open(f).convert("L"))
+    return cv2.resize(img, (640, 480), interpolation=cv2.INTER_AREA)
+
+
+def test_ratio_test_accepts_distinct_and_rejects_ambiguous():
+    train = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 10.0], [0.2, 10.0]])
+    query = np.array([[0.05, 0.0], [0.1, 10.0], [5.0, 5.0]])
+    m = ratio_match(query, train, ratio=0.65)
+    assert m.query.tolist() == [0] and m.train.tolist() == [0]
+    assert m.ratio[0] == pytest.approx(0.05 / 0.95)
+
+
+def test_kdtree_and_opencv_agree():
+    rng = np.random.default_rng(3)
+    train = rng.normal(size=(300, 16)).astype(np.float32)
+    query = train[:100] + rng.normal(scale=0.05, size=(100, 16)).astype(np.float32)
+    a = ratio_match(query, train, method="kdtree")
+    b = ratio_match(query, train, method="opencv")
+    assert np.array_equal(a.query, b.query) and np.array_equal(a.train, b.train)
+    assert np.allclose(a.distance, b.distance, atol=1e-4)
+    assert len(a) > 90 and np.array_equal(a.train, a.query)
+    d, i = two_nearest(query, train)
+    assert d.shape == (100, 2) and np.all(d[:, 0] <= d[:, 1])
+
+
+def test_matching_degenerate_inputs():
+    assert len(ratio_match(np.zeros((0, 8)), np.ones((5, 8)))) == 0
+    assert len(ratio_match(np.ones((3, 8)), np.ones((1, 8)))) == 0
+    with pytest.raises(ValueError, match="ratio: expected a value in"):
+        ratio_match(np.ones((3, 8)), np.ones((4, 8)), ratio=1.5)
+    with pytest.raises(ValueError, match="query: expected descriptors of length 8"):
+        two_nearest(np.ones((3, 4)), np.ones((4, 8)))
+    with pytest.raises(ValueError, match="train: expected at least 2"):
+        two_nearest(np.ones((3, 8)), np.ones((1, 8)))
+
+
+def test_similarity_homography_and_bad_homographies():
+    h = similarity_homography((101, 201), 2.0, np.pi / 2)
+    assert np.allclose(apply_homography(h, [[100, 50]]), [[100, 50]])
+    # counter-clockwise on screen (y down): +x maps to -y
+    assert np.allclose(apply_homography(h, [[110, 50]]), [[100, 30]])
+    with pytest.raises(ValueError, match="homography: expected an invertible"):
+        apply_homography(np.zeros((3, 3)), [[1, 2]])
+    with pytest.raises(ValueError, match="homography: expected shape"):
+        apply_homography(np.eye(2), [[1, 2]])
+
+
+@pytest.mark.parametrize("extract", [plot_features, sift_features], ids=["plot", "sift"])
+def test_recall_precision_on_boat_and_leuven_like_pairs(photo, extract):
+    h = similarity_homography(photo.shape, 1.25, np.deg2rad(30))
+    zoomed = cv2.warpPerspective(photo, h, (640, 480))
+    darker = np.clip(0.45 * photo.astype(float) + 15, 0, 255).astype(np.uint8)
+    fa = extract(photo)
+    for other, hh, min_recall in ((zoomed, h, 0.3), (darker, np.eye(3), 0.8)):
+        r = recall_precision(fa, extract(other), hh, other.shape)
+        assert np.allclose(r["thresholds"], np.linspace(0.15, 0.7, 12))
+        assert np.all(np.diff(r["recall"]) >= 0) and np.all(np.diff(r["n_false"]) >= 0)
+        assert r["recall"][-1] >= min_recall
+        assert r["one_minus_precision"][-1] < 0.1
+        assert np.all((r["recall"] <= 1) & (r["one_minus_precision"] >= 0))
+
+
+def test_recall_precision_detects_wrong_ground_truth(photo):
+    fa = sift_features(photo, n_features=300)
+    h = similarity_homography(photo.shape, 1.0, np.deg2rad(20))
+    fb = sift_features(cv2.warpPerspective(photo, h, (640, 480)), n_features=300)
+    good = recall_precision(fa, fb, h, photo.shape)
+    wrong = recall_precision(fa, fb, similarity_homography(photo.shape, 1.0, np.deg2rad(-20)), photo.shape)
+    assert good["recall"][-1] > 0.5 and good["one_minus_precision"][-1] < 0.1
+    assert wrong["one_minus_precision"][-1] > 0.8
+    empty = recall_precision(fa.subset(slice(0, 0)), fb, h, photo.shape)
+    assert empty["n_correspondences"] == 0 and not np.any(np.isnan(empty["recall"]))

@@ -1,0 +1,118 @@
+"""PLOT detector (Lin et al. Sec. 2.i): tensor eigenvalues, keypoints on known structures."""
+import cv2
+import numpy as np
+import pytest
+from matplotlib import cbook
+from PIL import Image
+from scipy.spatial import cKDTree
+
+from robokit.vision.evaluation import apply_homography, similarity_homography
+from robokit.vision.plot import (PlotParams, detect_plot, edge_strength, junction_strength,
+                                 orientation_tensor, plot_scales, polynomial_expansion,
+                                 tensor_eigenvalues)
+
+
+@pytest.fixture(scope="module")
+def photo():
+    with cbook.get_sample_data("grace_hopper.jpg") as f:
+        img = np.array(Image.open(f).convert("L"))
+    return cv2.resize(img, (640, 480), interpolation=cv2.INTER_AREA)
+
+
+def test_eigenvalues_match_numpy_and_split_edge_and_junction():
+    rng = np.random.default_rng(1)
+    m = rng.normal(size=(50, 2, 2))
+    t = m @ np.swapaxes(m, 1, 2)
+    lam1, lam2 = tensor_eigenvalues(t)
+    ref = np.linalg.eigvalsh(t)
+    assert np.allclose(lam2, ref[:, 0]) and np.allclose(lam1, ref[:, 1])
+    assert np.allclose(edge_strength(t), lam1 - lam2)
+    assert np.allclose(junction_strength(t), lam2)
+
+
+def test_junction_strength_is_zero_for_an_edge_and_rotation_invariant():
+    e = np.array([np.cos(0.3), np.sin(0.3)])
+    edge = 4.0 * np.outer(e, e)
+    assert junction_strength(edge) == pytest.approx(0.0, abs=1e-12)
+    assert edge_strength(edge) == pytest.approx(4.0)
+    t = np.array([[3.0, 1.0], [1.0, 2.0]])
+    c, s = np.cos(1.1), np.sin(1.1)
+    r = np.array([[c, -s], [s, c]])
+    assert junction_strength(r @ t @ r.T) == pytest.approx(junction_strength(t))
+
+
+def test_tensor_input_is_validated():
+    with pytest.raises(ValueError, match="tensor: expected shape"):
+        junction_strength(np.zeros((4, 3)))
+    with pytest.raises(ValueError, match="symmetric"):
+        junction_strength(np.array([[1.0, 2.0], [0.0, 1.0]]))
+    with pytest.raises(ValueError, match="finite"):
+        junction_strength(np.full((2, 2), np.nan))
+
+
+def test_polynomial_expansion_recovers_a_quadratic():
+    y, x = np.mgrid[0:64, 0:64].astype(float)
+    x0, y0 = x - 32, y - 32
+    img = 0.5 + 1e-4 * (3 * x0 ** 2 + 2 * x0 * y0 - y0 ** 2) + 2e-3 * x0 - 1e-3 * y0
+    a, b, c = polynomial_expansion(img, 2.0)
+    # Gaussian smoothing only adds a constant to a quadratic; A and b are exact at the centre
+    assert np.allclose(a[32, 32], 1e-4 * np.array([[3, 1], [1, -1]]), atol=2e-6)
+    assert np.allclose(b[32, 32], [2e-3, -1e-3], atol=2e-6)
+    assert c[32, 32] == pytest.approx(img[32, 32] + 1e-4 * (3 - 1) * 4.0, abs=1e-4)
+
+
+def test_scales_follow_the_paper():
+    assert np.allclose(plot_scales(1.6, 2 ** 0.5, 4), 1.6 * 2 ** (np.arange(4) / 2))
+    with pytest.raises(ValueError, match="k: expected a scale factor > 1"):
+        plot_scales(1.6, 1.0, 4)
+
+
+def test_corners_of_a_square_are_the_strongest_keypoints():
+    img = np.zeros((120, 160), np.float32)
+    img[30:90, 50:110] = 1.0
+    kp = detect_plot(img, sigma0=1.5, threshold=0.05)
+    corners = np.array([[49.5, 29.5], [109.5, 29.5], [49.5, 89.5], [109.5, 89.5]])
+    d, i = cKDTree(kp.xy[:8]).query(corners)
+    # a junction detector localises a step corner to within about its scale (the peak of lambda_2
+    # of the smoothed signal sits just inside the corner)
+    assert np.all(d < 1.6 * kp.scale[i]), d
+    # nothing fires on the middle of the straight edges (lambda_2 ~ 0 there)
+    mid = np.array([[80, 29.5], [80, 89.5], [49.5, 60], [109.5, 60]])
+    d, _ = cKDTree(kp.xy).query(mid)
+    assert np.all(d > 10)
+    assert tensor_eigenvalues(orientation_tensor(img, 2.0)[60, 49])[1] < 1e-3 * tensor_eigenvalues(
+        orientation_tensor(img, 2.0)[30, 50])[0]
+
+
+def test_textureless_image_gives_zero_keypoints_and_bad_images_raise():
+    assert len(detect_plot(np.full((50, 60), 0.4))) == 0
+    with pytest.raises(ValueError, match="image: expected a non-empty image"):
+        detect_plot(np.zeros((0, 10)))
+    with pytest.raises(ValueError, match="image: expected shape"):
+        detect_plot(np.zeros(10))
+    with pytest.raises(ValueError, match="finite"):
+        detect_plot(np.full((20, 20), np.nan))
+    with pytest.raises(TypeError, match="image"):
+        detect_plot([["a"]])
+    with pytest.raises(TypeError, match="params"):
+        detect_plot(np.zeros((20, 20)), params={"sigma0": 1})
+
+
+def test_keypoints_sorted_capped_and_scaled(photo):
+    kp = detect_plot(photo, PlotParams(max_keypoints=300))
+    assert len(kp) == 300
+    assert np.all(np.diff(kp.response) <= 0)
+    sig = plot_scales()
+    assert np.all((kp.scale >= sig[0] / 2 ** 0.25 - 1e-9) & (kp.scale <= sig[-1] + 1e-9))
+    assert np.all((kp.xy >= 4.5) & (kp.xy <= [640 - 5.5, 480 - 5.5]))
+
+
+def test_repeatable_under_rotation_and_zoom(photo):
+    h = similarity_homography(photo.shape, 1.2, np.deg2rad(25))
+    warped = cv2.warpPerspective(photo, h, (640, 480))
+    a, b = detect_plot(photo), detect_plot(warped)
+    pa = apply_homography(h, a.xy)
+    inside = np.all((pa > 15) & (pa < [625, 465]), axis=1)
+    d, _ = cKDTree(b.xy).query(pa[inside])
+    assert inside.sum() > 200
+    assert np.mean(d < 2.5) > 0.6
