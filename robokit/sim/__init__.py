@@ -1,0 +1,1 @@
+"""Simulation: textured worlds, cameras, LiDAR, motion and recorded runs (filled in below)."""

@@ -1,0 +1,319 @@
+"""Pinhole cameras and a rectified stereo rig (optionally trinocular, like the Triclops).
+
+Frames: a camera's pose is ``T_world_cam`` (4x4), its frame the OpenCV optical frame (x right,
+y down, z forward). A camera carries a ``mount`` ``T_body_cam`` so that :meth:`PinholeCamera.observe`
+can render from a planar robot pose ``[x, y, theta]``.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ..geometry import R_BODY_OPTICAL, euler_matrix, se2_to_se3, se3_from_rt, se3_inverse, transform_points
+from ..validation import as_array, as_points, as_rng, check_int, check_positive
+from .render import render_pinhole
+from .textures import illuminate
+from .world import World
+
+__all__ = ["Frame", "mount_pose", "PinholeCamera", "StereoRig", "finish_image", "check_pose"]
+
+
+class Frame(NamedTuple):
+    """A rendered view: ``image`` (H, W, 3) uint8 RGB and ``depth`` (H, W) float32 metres (inf: nothing)."""
+
+    image: np.ndarray
+    depth: np.ndarray
+
+
+def mount_pose(height: float, forward: float = 0.0, pitch: float = 0.0) -> np.ndarray:
+    """Return ``T_body_cam`` of a forward-looking camera on a robot (body: x forward, y left, z up).
+
+    Parameters
+    ----------
+    height : float
+        Height of the optical centre above the floor (metres, > 0).
+    forward : float, default 0
+        Offset of the optical centre ahead of the robot's origin (metres).
+    pitch : float, default 0
+        Tilt in radians; positive looks down.
+
+    Returns
+    -------
+    numpy.ndarray, shape (4, 4)
+
+    Raises
+    ------
+    ValueError
+        For a non-positive height or non-finite values.
+
+    Notes
+    -----
+    Optical-frame convention of OpenCV / Hartley & Zisserman (2004), Sec. 6.1; body frame of
+    ROS REP 103.
+    """
+    h = check_positive(height, "height")
+    R = euler_matrix([0.0, pitch, 0.0]) @ R_BODY_OPTICAL  # pitch about the body's y axis (left)
+    return se3_from_rt(R, [as_array(forward, "forward", shape=()).item(), 0.0, h])
+
+
+def check_pose(pose: Any, name: str = "pose") -> np.ndarray:
+    """Validate a 4x4 rigid pose (finite, last row [0, 0, 0, 1], rotation block orthonormal)."""
+    T = as_array(pose, name, shape=(4, 4))
+    try:
+        se3_inverse(T)
+    except ValueError as exc:
+        raise ValueError(f"{name}: expected a rigid 4x4 transform; {exc}") from None
+    return T
+
+
+def finish_image(image: np.ndarray, noise: float, rng: Any, lighting: dict | None) -> np.ndarray:
+    """Apply lighting (see :func:`robokit.sim.textures.illuminate`) and Gaussian pixel noise."""
+    if lighting:
+        image = illuminate(image, **lighting)
+    sigma = check_positive(noise, "noise", allow_zero=True)
+    if sigma > 0:
+        gen = as_rng(rng)
+        image = np.clip(image + gen.normal(0.0, sigma, image.shape), 0, 255).astype(np.uint8)
+    return image
+
+
+@dataclasses.dataclass
+class PinholeCamera:
+    """A distortion-free pinhole camera ``u = fx X/Z + cx``, ``v = fy Y/Z + cy``.
+
+    Parameters
+    ----------
+    fx, fy : float
+        Focal lengths in pixels (> 0).
+    cx, cy : float
+        Principal point in pixels.
+    width, height : int
+        Image size.
+    mount : array_like (4, 4), optional
+        ``T_body_cam``; default :func:`mount_pose` at 0.8 m height, level.
+
+    Notes
+    -----
+    Hartley & Zisserman, *Multiple View Geometry* (2004), Eq. (6.4)-(6.5).
+    """
+
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int = 640
+    height: int = 480
+    mount: Any = None
+
+    def __post_init__(self) -> None:
+        self.fx = check_positive(self.fx, "fx")
+        self.fy = check_positive(self.fy, "fy")
+        self.width = check_int(self.width, "width", minimum=8)
+        self.height = check_int(self.height, "height", minimum=8)
+        self.cx = float(as_array(self.cx, "cx", shape=()))
+        self.cy = float(as_array(self.cy, "cy", shape=()))
+        self.mount = mount_pose(0.8) if self.mount is None else check_pose(self.mount, "mount")
+
+    @classmethod
+    def from_fov(cls, hfov: float = np.deg2rad(65.0), width: int = 640, height: int = 480,
+                 mount: Any = None) -> "PinholeCamera":
+        """Square-pixel camera with horizontal field of view ``hfov`` (radians) and centred principal point.
+
+        Notes
+        -----
+        ``fx = (width / 2) / tan(hfov / 2)`` (Hartley & Zisserman 2004, Sec. 6.1).
+        """
+        fov = check_positive(hfov, "hfov")
+        if fov >= np.pi:
+            raise ValueError(f"hfov: expected a field of view below pi rad, got {fov}")
+        w = check_int(width, "width", minimum=8)
+        f = (w / 2) / np.tan(fov / 2)
+        h = check_int(height, "height", minimum=8)
+        return cls(f, f, (w - 1) / 2, (h - 1) / 2, w, h, mount)
+
+    @property
+    def K(self) -> np.ndarray:
+        """Intrinsic matrix (3, 3)."""
+        return np.array([[self.fx, 0, self.cx], [0, self.fy, self.cy], [0, 0, 1.0]])
+
+    def project(self, points: Any, pose: Any = None) -> tuple[np.ndarray, np.ndarray]:
+        """Project 3D points to pixels.
+
+        Parameters
+        ----------
+        points : array_like, shape (N, 3)
+            World points if ``pose`` is given, else camera-frame points.
+        pose : array_like (4, 4), optional
+            ``T_world_cam``.
+
+        Returns
+        -------
+        pixels : numpy.ndarray, shape (N, 2)
+            ``(u, v)``; NaN for points with ``Z <= 0`` (behind the camera).
+        depth : numpy.ndarray, shape (N,)
+            ``Z`` in the camera frame.
+
+        Notes
+        -----
+        Hartley & Zisserman (2004), Eq. (6.5). Consistent with :meth:`render`: a surface point is
+        painted at its projected pixel with this depth.
+        """
+        P = as_points(points, "points", 3)
+        if pose is not None:
+            P = transform_points(se3_inverse(check_pose(pose)), P)
+        z = P[:, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            uv = np.column_stack([self.fx * P[:, 0] / z + self.cx, self.fy * P[:, 1] / z + self.cy])
+        uv[z <= 0] = np.nan
+        return uv, z
+
+    def backproject(self, pixels: Any, depth: Any, pose: Any = None) -> np.ndarray:
+        """Lift pixels with known depth ``Z`` to 3D points (inverse of :meth:`project`).
+
+        Parameters
+        ----------
+        pixels : array_like, shape (N, 2)
+        depth : array_like, shape (N,)
+            Positive ``Z`` values (e.g. read from the rendered depth image).
+        pose : array_like (4, 4), optional
+            ``T_world_cam``; when given the points are returned in the world frame.
+
+        Returns
+        -------
+        numpy.ndarray, shape (N, 3)
+
+        Raises
+        ------
+        ValueError
+            For mismatched lengths or non-positive / non-finite depths.
+
+        Notes
+        -----
+        ``X = Z K^-1 [u, v, 1]^T`` (Hartley & Zisserman 2004, Sec. 6.2.2).
+        """
+        uv = as_points(pixels, "pixels", 2)
+        z = as_array(depth, "depth", ndim=1) if np.ndim(depth) else as_array([depth], "depth", ndim=1)
+        if len(z) != len(uv):
+            raise ValueError(f"depth: expected {len(uv)} values to match pixels, got {len(z)}")
+        if np.any(z <= 0):
+            raise ValueError("depth: expected positive depths, got a value <= 0")
+        P = np.column_stack([(uv[:, 0] - self.cx) / self.fx * z, (uv[:, 1] - self.cy) / self.fy * z, z])
+        return P if pose is None else transform_points(check_pose(pose), P)
+
+    def pose_at(self, robot_pose: Any) -> np.ndarray:
+        """``T_world_cam`` for a planar robot pose ``[x, y, theta]`` (uses :attr:`mount`)."""
+        return se2_to_se3(as_array(robot_pose, "robot_pose", shape=(3,))) @ self.mount
+
+    def render(self, world: World, pose: Any, *, noise: float = 0.0, rng: Any = None,
+               lighting: dict | None = None) -> Frame:
+        """Render colour and depth of ``world`` from camera pose ``T_world_cam``.
+
+        Parameters
+        ----------
+        world : World
+        pose : array_like (4, 4)
+            ``T_world_cam``; must be inside the world's free space, below the ceiling.
+        noise : float, default 0
+            Standard deviation of additive Gaussian pixel noise (grey levels).
+        rng : Generator or int, optional
+            Noise source.
+        lighting : dict, optional
+            Keyword arguments of :func:`robokit.sim.textures.illuminate` (gain, offset, gradient).
+
+        Returns
+        -------
+        Frame
+            ``image`` uint8 (H, W, 3) and ``depth`` float32 (H, W), Z in metres.
+
+        Raises
+        ------
+        TypeError
+            If ``world`` is not a World.
+        ValueError
+            For a NaN or non-rigid pose, or a camera inside a wall or outside the world.
+
+        Notes
+        -----
+        Renderer: :func:`robokit.sim.render.render_pinhole` (plane homographies + z-buffer).
+        """
+        if not isinstance(world, World):
+            raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
+        T = check_pose(pose)
+        world.check_viewpoint(T[:3, 3], "pose")
+        image, depth = render_pinhole(world, self.K, self.width, self.height, T)
+        return Frame(finish_image(image, noise, rng, lighting), depth)
+
+    def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> Frame:
+        """Render from the camera mounted on a robot at planar pose ``[x, y, theta]`` (see :meth:`render`)."""
+        return self.render(world, self.pose_at(robot_pose), **kwargs)
+
+
+@dataclasses.dataclass
+class StereoRig:
+    """Rectified stereo: identical cameras, the right one ``baseline`` metres along the left's +x.
+
+    Parameters
+    ----------
+    camera : PinholeCamera
+        Intrinsics (and mount) of the left, reference camera.
+    baseline : float, default 0.12
+        Distance between optical centres (metres, > 0); Se, Lowe & Little's interocular distance I.
+    trinocular : bool, default False
+        Add a third camera ``baseline`` metres above the left one, like the Triclops
+        (Se, Lowe & Little 2002, Sec. 1), giving vertical disparities.
+
+    Notes
+    -----
+    In a rectified pair a point at depth Z has disparity ``d = u_left - u_right = f B / Z`` and
+    lies on the same row (Hartley & Zisserman 2004, Sec. 9.3; Se, Lowe & Little 2002, Sec. 3.1:
+    ``Z = f I / d``).
+    """
+
+    camera: PinholeCamera
+    baseline: float = 0.12
+    trinocular: bool = False
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.camera, PinholeCamera):
+            raise TypeError(f"camera: expected a PinholeCamera, got {type(self.camera).__name__}")
+        self.baseline = check_positive(self.baseline, "baseline")
+
+    @property
+    def offsets(self) -> dict[str, np.ndarray]:
+        """``T_left_cam`` of every camera of the rig, keyed ``left``, ``right`` (and ``top``)."""
+        out = {"left": np.eye(4), "right": se3_from_rt(np.eye(3), [self.baseline, 0, 0])}
+        if self.trinocular:
+            out["top"] = se3_from_rt(np.eye(3), [0, -self.baseline, 0])  # optical y points down
+        return out
+
+    def disparity(self, depth: Any) -> np.ndarray:
+        """Horizontal disparity ``f_x B / Z`` (pixels) of points at depth ``Z`` (metres)."""
+        z = as_array(depth, "depth")
+        if np.any(z <= 0):
+            raise ValueError("depth: expected positive depths, got a value <= 0")
+        return self.camera.fx * self.baseline / z
+
+    def depth(self, disparity: Any) -> np.ndarray:
+        """Depth ``Z = f_x B / d`` (metres) from disparities (pixels, > 0)."""
+        d = as_array(disparity, "disparity")
+        if np.any(d <= 0):
+            raise ValueError("disparity: expected positive disparities, got a value <= 0")
+        return self.camera.fx * self.baseline / d
+
+    def render(self, world: World, pose: Any, **kwargs: Any) -> dict[str, Frame]:
+        """Render every camera of the rig; ``pose`` is the left camera's ``T_world_cam``.
+
+        Returns
+        -------
+        dict of str to Frame
+            ``"left"``, ``"right"`` (and ``"top"``); noise uses independent draws per camera.
+        """
+        T = check_pose(pose)
+        rng = as_rng(kwargs.pop("rng", None))
+        return {name: self.camera.render(world, T @ off, rng=rng, **kwargs) for name, off in self.offsets.items()}
+
+    def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> dict[str, Frame]:
+        """Render the rig mounted on a robot at planar pose ``[x, y, theta]``."""
+        return self.render(world, self.camera.pose_at(robot_pose), **kwargs)

@@ -1,0 +1,245 @@
+"""World builders following the seeds' environments (all seeded, deterministic).
+
+* :func:`box_room` - a plain rectangular room (tests, first experiments);
+* :func:`lab_room` - the 10 m x 10 m lab of Se, Lowe & Little (2002, Sec. 3.6) with furniture
+  and posters;
+* :func:`long_corridor` - the 36.10 m x 2.17 m corridor of Ge et al. (2023, Sec. 4.1) with 0.07 m
+  door recesses, 1.00 m and 2.25 m doors, facing and staggered layouts;
+* :func:`office_floor` - four rooms and a horizontal corridor (seed 001, Fig. 6a).
+
+Worlds are cached per parameter set (they are immutable), so calling a builder twice is cheap.
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from ..validation import check_choice, check_int, check_positive
+from . import textures as tx
+from .build import Builder, random_decoration, wall_with_doors
+from .world import World
+
+__all__ = ["box_room", "lab_room", "long_corridor", "office_floor"]
+
+
+def _rect_walls(b: Builder, name: str, x0: float, y0: float, x1: float, y1: float, height: float) -> None:
+    """Four walls of a room, walked clockwise so that they face inwards."""
+    corners = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]
+    for k in range(4):
+        b.wall(f"{name}/{k}", corners[k], corners[(k + 1) % 4], 0.0, height)
+
+
+def _hang(b: Builder, name: str, a, t, s: float, width: float, z_top: float, height: float, fn) -> None:
+    b.decal(name, np.asarray(a) + s * np.asarray(t), np.asarray(a) + (s + width) * np.asarray(t), z_top, height, fn)
+
+
+@functools.lru_cache(maxsize=8)
+def box_room(width: float = 6.0, depth: float = 4.0, height: float = 2.5, seed: int = 0) -> World:
+    """A rectangular room ``[0, width] x [0, depth]`` with plain walls, tiled floor and ceiling.
+
+    Parameters
+    ----------
+    width, depth, height : float
+        Room size in metres.
+    seed : int, default 0
+        Texture seed.
+
+    Returns
+    -------
+    World
+        Footprint: the four walls; ``info`` holds the size.
+
+    Raises
+    ------
+    ValueError
+        For non-positive sizes.
+
+    Notes
+    -----
+    The simplest test world: LiDAR ranges have closed-form values (ray-line intersection).
+    """
+    w, d, h = (check_positive(v, n) for v, n in ((width, "width"), (depth, "depth"), (height, "height")))
+    b = Builder(check_int(seed, "seed", minimum=0), density=100)
+    _rect_walls(b, "wall", 0, 0, w, d, h)
+    b.horizontal("floor", 0, 0, w, d, 0.0, True, tx.floor_tiles)
+    b.horizontal("ceiling", 0, 0, w, d, h, False, tx.ceiling_panels)
+    return b.world("box_room", (w / 2, d / 2), h, info={"width": w, "depth": d, "seed": seed})
+
+
+@functools.lru_cache(maxsize=4)
+def lab_room(seed: int = 3) -> World:
+    """The 10 m x 10 m robotics lab of seed 003: desks, cabinets, shelves, posters and boards.
+
+    Parameters
+    ----------
+    seed : int, default 3
+        Seeds the textures and the placement of decorations.
+
+    Returns
+    -------
+    World
+        ``[0, 10] x [0, 10]`` m, ceiling 2.8 m; ``info["furniture"]`` lists the boxes
+        ``(name, centre, size, yaw)``.
+
+    Notes
+    -----
+    Se, Lowe & Little, "Global localization using distinctive visual features" (IROS 2002),
+    Sec. 3.6: the robot maps "our 10m by 10m lab"; the furniture and posters give SIFT texture.
+    """
+    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
+    H = 2.8
+    b = Builder(rng, density=110)
+    _rect_walls(b, "wall", 0, 0, 10, 10, H)
+    b.horizontal("floor", 0, 0, 10, 10, 0.0, True, tx.floor_tiles)
+    b.horizontal("ceiling", 0, 0, 10, 10, H, False, tx.ceiling_panels)
+    walls = [((0, 0), (0, 1)), ((0, 10), (1, 0)), ((10, 10), (0, -1)), ((10, 0), (-1, 0))]
+    k = 0
+    for a, t in walls:  # three or four decorations per wall at irregular spacing
+        s = rng.uniform(0.4, 1.2)
+        while s < 8.6:
+            width = rng.uniform(0.6, 1.3)
+            if s + width > 9.6:
+                break
+            height = width * rng.uniform(0.7, 1.4)
+            _hang(b, f"poster/{k}", a, t, s, width, rng.uniform(1.6, 2.1), height, random_decoration(rng))
+            k += 1
+            s += width + rng.uniform(0.8, 2.2)
+    furniture = [
+        ("desk/0", (1.2, 3.0), (1.6, 0.8, 0.75), np.pi / 2), ("desk/1", (1.2, 6.5), (1.6, 0.8, 0.75), np.pi / 2),
+        ("cabinet/0", (4.0, 9.55), (1.0, 0.5, 1.8), 0.0), ("cabinet/1", (9.55, 3.0), (1.0, 0.5, 1.9), np.pi / 2),
+        ("shelf/0", (6.5, 9.6), (1.8, 0.4, 1.6), 0.0), ("table/0", (5.5, 5.0), (1.8, 0.9, 0.75), 0.3),
+        ("crate/0", (8.2, 1.0), (0.6, 0.6, 0.6), 0.5), ("crate/1", (3.2, 0.8), (0.8, 0.5, 1.0), 0.0),
+    ]
+    for name, centre, size, yaw in furniture:
+        b.box(name, centre, size, yaw, texture_fn=tx.wood if rng.random() < 0.6 else tx.notice_board)
+    return b.world("lab_room", (5.0, 2.5), H, info={"size": (10.0, 10.0), "seed": seed,
+                                                     "furniture": furniture})
+
+
+def _door_plan(layout: str) -> tuple[list, list]:
+    """Door centres and widths (north side, south side) along the 36.10 m corridor."""
+    north = [(3.0, 1.00), (7.5, 1.00), (12.0, 2.25), (16.5, 1.00), (21.0, 1.00), (25.5, 2.25), (30.0, 1.00),
+             (33.6, 1.00)]
+    facing = [(c, w) for c, w in north]
+    staggered = [(c + 2.25, w) for c, w in north if c + 2.25 + w / 2 < 35.5]
+    if layout == "facing":
+        south = facing
+    elif layout == "staggered":
+        south = staggered
+    else:  # first half facing (Ge et al. Fig. 3a), second half staggered (their inequality (3))
+        south = [d for d in facing if d[0] < 18] + [d for d in staggered if d[0] > 18]
+    south = [(c, 2.25 if i % 3 == 1 else 1.00) for i, (c, _) in enumerate(south)]
+    return north, south
+
+
+@functools.lru_cache(maxsize=6)
+def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
+    """The long corridor of seed 002: 36.10 m x 2.17 m, 0.07 m door recesses, 1.00/2.25 m doors.
+
+    Parameters
+    ----------
+    layout : {"mixed", "facing", "staggered"}, default "mixed"
+        Door layout: doors face each other, are staggered, or (default) facing in the first half
+        and staggered in the second.
+    seed : int, default 2
+        Seeds textures, posters, boards and room-number plates.
+
+    Returns
+    -------
+    World
+        The corridor runs along +x from 0 to 36.10 m with its middle line on y = 0; walls at
+        y = +-1.085 m; ``info`` has ``length``, ``width``, ``recess``, ``doors`` (side, x0, x1).
+
+    Notes
+    -----
+    Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor environment"
+    (FITEE 2023), Sec. 4.1 (dimensions) and Sec. 3.1, Fig. 3 and Eqs. (1)-(3) (door recesses in
+    facing and staggered layouts). The door geometry repeats every 4.5 m, so LiDAR scans alias;
+    plates, posters and boards make each stretch look different to a camera (their Sec. 3.2).
+    """
+    layout = check_choice(layout, "layout", ["mixed", "facing", "staggered"])
+    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
+    L, W, D, H = 36.10, 2.17, 0.07, 2.6
+    b = Builder(rng, density=100)
+    north, south = _door_plan(layout)
+    doors = []
+    # north wall y = +W/2 walked east (room on the right), south wall y = -W/2 walked west
+    nd = [(c - w / 2, c + w / 2) for c, w in north]
+    wall_with_doors(b, "wall/north", (0, W / 2), (L, W / 2), nd, height=H, depth=D)
+    sd = [(L - c - w / 2, L - c + w / 2) for c, w in south]
+    wall_with_doors(b, "wall/south", (L, -W / 2), (0, -W / 2), sd, height=H, depth=D)
+    b.wall("wall/west", (0, -W / 2), (0, W / 2), 0.0, H)
+    b.wall("wall/east", (L, W / 2), (L, -W / 2), 0.0, H)
+    b.horizontal("floor", 0, -W / 2 - D, L, W / 2 + D, 0.0, True, tx.floor_tiles)
+    b.horizontal("ceiling", 0, -W / 2, L, W / 2, H, False, tx.ceiling_panels)
+    for side, plan, y, t in (("north", north, W / 2, (1, 0)), ("south", south, -W / 2, (-1, 0))):
+        a = (0.0, y) if side == "north" else (L, y)
+        for k, (c, w) in enumerate(plan):
+            x0, x1 = c - w / 2, c + w / 2
+            doors.append((side, x0, x1))
+            number = f"B{(2 * k + 1) if side == 'north' else (2 * k + 2):02d}"
+            s_plate = (x1 + 0.15) if side == "north" else (L - x0 + 0.15)
+            _hang(b, f"plate/{number}", a, t, s_plate, 0.22, 1.65, 0.09,
+                  lambda w_, h_, r, n=number: tx.room_plate(n, w_, h_, r))
+        # decorations between doors: a poster or a board in most gaps, none in some (repetition)
+        edges = sorted([(c - w / 2, c + w / 2) for c, w in plan])
+        gaps = [(e0[1] + 0.5, e1[0] - 0.2) for e0, e1 in zip(edges[:-1], edges[1:])]
+        for k, (g0, g1) in enumerate(gaps):
+            width = min(1.2, g1 - g0 - 0.2)
+            if width < 0.5 or rng.random() < 0.25:
+                continue
+            s = (g0 + 0.1) if side == "north" else (L - g0 - 0.1 - width)
+            _hang(b, f"decor/{side}/{k}", a, t, s, width, 1.9, width * rng.uniform(0.6, 0.9),
+                  random_decoration(rng))
+    return b.world("long_corridor", (1.0, 0.0), H,
+                   info={"length": L, "width": W, "recess": D, "layout": layout, "doors": doors, "seed": seed})
+
+
+@functools.lru_cache(maxsize=4)
+def office_floor(seed: int = 1) -> World:
+    """Four rooms R1-R4 and a horizontal corridor (seed 001's test environment).
+
+    Parameters
+    ----------
+    seed : int, default 1
+
+    Returns
+    -------
+    World
+        ``[0, 16] x [0, 12]`` m: corridor ``y in [5, 7]``; R1 lower right, R2 lower left, R3 upper
+        left, R4 upper right (``info["rooms"]``), each opening onto the corridor by a 1 m doorway.
+
+    Notes
+    -----
+    "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
+    navigation", Sec. "Experimental results", Fig. 6a: "four rooms R1, R2, R3, R4 and a horizontal
+    corridor". Dimensions are our choice (the paper gives none).
+    """
+    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
+    H = 2.7
+    b = Builder(rng, density=100)
+    _rect_walls(b, "wall/outer", 0, 0, 16, 12, H)
+    # corridor walls: south one (y = 5) walked west so the corridor is on its right; doorways at x = 4, 12
+    wall_with_doors(b, "wall/corridor_s", (16, 5), (0, 5), [(3.5, 4.5), (11.5, 12.5)], height=H, leaf=False)
+    wall_with_doors(b, "wall/corridor_n", (0, 7), (16, 7), [(3.5, 4.5), (11.5, 12.5)], height=H, leaf=False)
+    b.wall("wall/r1r2", (8, 0), (8, 5), 0.0, H)
+    b.wall("wall/r3r4", (8, 12), (8, 7), 0.0, H)
+    b.horizontal("floor", 0, 0, 16, 12, 0.0, True, tx.floor_tiles)
+    b.horizontal("ceiling", 0, 0, 16, 12, H, False, tx.ceiling_panels)
+    rooms = {"R1": (8, 0, 16, 5), "R2": (0, 0, 8, 5), "R3": (0, 7, 8, 12), "R4": (8, 7, 16, 12)}
+    k = 0
+    for rname, (x0, y0, x1, y1) in rooms.items():
+        far_y = y0 if y0 == 0 else y1
+        a, t = ((x1, far_y), (-1, 0)) if far_y == 0 else ((x0, far_y), (1, 0))
+        for s in (1.0, 3.2, 5.4):
+            width = rng.uniform(0.8, 1.4)
+            _hang(b, f"poster/{k}", a, t, s, width, 2.0, width * 0.8, random_decoration(rng))
+            k += 1
+        cx, cy = (x0 + x1) / 2 + rng.uniform(-1, 1), (y0 + y1) / 2 + rng.uniform(-0.5, 0.5)
+        b.box(f"{rname}/table", (cx, cy), (1.6, 0.8, 0.75), rng.uniform(0, np.pi))
+        b.box(f"{rname}/cabinet", (x0 + 0.4, (y0 + y1) / 2), (1.0, 0.5, 1.8), np.pi / 2, tx.notice_board)
+    for s in (2.0, 7.0, 9.5, 14.5):  # boards along the corridor's north wall
+        _hang(b, f"corridor_board/{s}", (0, 7), (1, 0), s - 0.5, 1.0, 1.9, 0.7, random_decoration(rng))
+    return b.world("office_floor", (2.0, 6.0), H, info={"size": (16.0, 12.0), "corridor": (5.0, 7.0),
+                                                         "rooms": rooms, "seed": seed})
