@@ -16,6 +16,7 @@ Every function here is vectorised over many targets at once.
 """
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -30,6 +31,10 @@ __all__ = ["SRSArm", "arm_angle", "ik_srs_branches", "ik_srs", "ik_srs_batch"]
 _ALPHA = np.array([-1, 1, 1, -1, -1, 1, 0]) * np.pi / 2
 #: Branch order of the 8 solutions for one arm angle: (elbow, shoulder, wrist) sign flags.
 BRANCHES = [(e, s, w) for e in (0, 1) for s in (0, 1) for w in (0, 1)]
+#: Matrix entries read by the ZYZ decomposition: (0,2) (1,2) (2,2) (2,1) (2,0) (1,0) (1,1).
+_GROUPS = np.array([[0, 1, 2], [4, 5, 6]])
+_ROWS = np.array([0, 1, 2, 2, 2, 1, 1])
+_COLS = np.array([2, 2, 2, 1, 0, 0, 1])
 
 
 def _wrap(x):
@@ -38,14 +43,16 @@ def _wrap(x):
 
 def _rz(a):
     c, s = np.cos(a), np.sin(a)
-    z, o = np.zeros_like(a), np.ones_like(a)
-    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
+    R = np.zeros(np.shape(a) + (3, 3))
+    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
+    return R
 
 
 def _ry(a):
     c, s = np.cos(a), np.sin(a)
-    z, o = np.zeros_like(a), np.ones_like(a)
-    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
+    R = np.zeros(np.shape(a) + (3, 3))
+    R[..., 0, 0], R[..., 0, 2], R[..., 2, 0], R[..., 2, 2], R[..., 1, 1] = c, s, -s, c, 1.0
+    return R
 
 
 def _zyz(m02, m12, m22, m21, m20, m10, m11):
@@ -55,10 +62,18 @@ def _zyz(m02, m12, m22, m21, m20, m10, m11):
     """
     sb = np.hypot(m02, m12)
     b = np.arctan2(sb, m22)
+    a = np.arctan2(m12, m02)
+    c = np.arctan2(m21, -m20)
     sing = sb < 1e-12
-    a = np.where(sing, 0.0, np.arctan2(m12, m02))
-    c = np.where(sing, np.arctan2(m10, m11), np.arctan2(m21, -m20))
+    if np.any(sing):
+        a = np.where(sing, 0.0, a)
+        c = np.where(sing, np.arctan2(m10, m11), c)
     return a, b, c
+
+
+def _flip(x):
+    """``x + pi`` wrapped to (-pi, pi] for ``x`` in (-pi, pi]."""
+    return np.where(x > 0, x - np.pi, x + np.pi)
 
 
 class SRSArm:
@@ -119,12 +134,13 @@ class SRSArm:
         return _rz(q1) @ _ry(q2)
 
     def coefficients(self, T7: np.ndarray):
-        """Unchecked: Shimizu's ``A, B, C`` matrices for shoulder and wrist, per elbow sign.
+        """Unchecked: Shimizu's ``A, B, C`` coefficients for shoulder and wrist, per elbow sign.
 
-        Returns ``(As, Bs, Cs, Aw, Bw, Cw, q4, reach_cos)`` where ``M(psi) = As sin psi +
-        Bs cos psi + Cs`` is ``Rz(q1) Ry(q2) Rz(q3)`` and ``Aw sin psi + Bw cos psi + Cw`` is
-        ``Rz(q5) Ry(q6) Rz(q7)``; arrays have shape (N, 2, 3, 3) for the elbow signs (+, -).
-        Shimizu et al. (2008), Eqs. (13)-(17) and (20)-(22), in this chain's frames.
+        Returns ``(A, B, C, q4, cos_q4)``. ``A, B, C`` have shape (N, 2, 2, 7): elbow sign (+, -),
+        group (shoulder ``M = Rz(q1) Ry(q2) Rz(q3)``, wrist ``Rz(q5) Ry(q6) Rz(q7)``) and the seven
+        matrix entries that the ZYZ decomposition reads; each entry is
+        ``A sin psi + B cos psi + C``. Shimizu et al. (2008), Eqs. (13)-(17) and (20)-(22), in this
+        chain's frames: ``M(psi) = R_psi M_ref`` and ``R_4^7 = Ry(q4) M^T R_0^7``.
         """
         sw = self.wrist_centre(T7) - np.array([0.0, 0.0, self.d_bs])
         L = np.linalg.norm(sw, axis=-1)
@@ -134,31 +150,41 @@ class SRSArm:
         R_ref = self.reference_shoulder(sw[:, None, :], q4)       # (N, 2, 3, 3)
         u = sw / np.where(L > 0, L, 1.0)[:, None]
         K = skew(u)[:, None]
-        As = K @ R_ref
+        As = K @ R_ref                                            # R_psi = I + sin K + (1 - cos) K^2
         Bs = -(K @ As)
         Cs = R_ref - Bs
+        Rt_Ry4 = _ry(q4)
         Rt = T7[:, None, :3, :3]
-        Ry4 = _ry(q4)
-        Aw, Bw, Cw = (Ry4 @ np.swapaxes(X, -1, -2) @ Rt for X in (As, Bs, Cs))
-        return As, Bs, Cs, Aw, Bw, Cw, q4, c4
+        mats = [np.stack([X, Rt_Ry4 @ np.swapaxes(X, -1, -2) @ Rt], 2) for X in (As, Bs, Cs)]
+        A, B, C = (X[..., _ROWS, _COLS] for X in mats)
+        return A, B, C, q4, c4
+
+    def angles(self, coeffs, psi: np.ndarray):
+        """Unchecked: shoulder and wrist angles of every branch for arm angles ``psi`` (N, K).
+
+        Returns three arrays (first, second and third ZYZ angle), each of shape (N, 2, 2, 2, K):
+        elbow sign, group (shoulder q1-q3 / wrist q5-q7), branch (``b >= 0`` or its mirror
+        ``(a + pi, -b, c + pi)``), arm angle.
+        """
+        A, B, C = coeffs[:3]
+        s, c = np.sin(psi)[:, None, None, None, :], np.cos(psi)[:, None, None, None, :]
+        E = A[..., None] * s + B[..., None] * c + C[..., None]   # (N, 2, 2, 7, K)
+        a, b, cc = _zyz(*(E[..., r, :] for r in range(7)))        # (N, 2, 2, K)
+        return (np.stack([a, _flip(a)], 3), np.stack([b, -b], 3), np.stack([cc, _flip(cc)], 3))
 
     def joints(self, coeffs, psi: np.ndarray) -> np.ndarray:
-        """Unchecked: all 8 branches for arm angles ``psi`` (N, K) -> q of shape (N, K, 8, 7)."""
-        As, Bs, Cs, Aw, Bw, Cw, q4, _ = coeffs
-        s, c = np.sin(psi)[:, None, :], np.cos(psi)[:, None, :]   # (N, 1, K)
+        """Unchecked: all 8 branches for arm angles ``psi`` (N, K) -> q of shape (N, K, 8, 7).
 
-        def entry(A, B, C, r, k):
-            return A[..., r, k, None] * s + B[..., r, k, None] * c + C[..., r, k, None]
-
-        idx = ((0, 2), (1, 2), (2, 2), (2, 1), (2, 0), (1, 0), (1, 1))
-        q1, q2, q3 = _zyz(*(entry(As, Bs, Cs, r, k) for r, k in idx))   # (N, 2, K)
-        q5, q6, q7 = _zyz(*(entry(Aw, Bw, Cw, r, k) for r, k in idx))
-        shoulder = [np.stack([q1, q2, q3], -1), np.stack([_wrap(q1 + np.pi), -q2, _wrap(q3 + np.pi)], -1)]
-        wrist = [np.stack([q5, q6, q7], -1), np.stack([_wrap(q5 + np.pi), -q6, _wrap(q7 + np.pi)], -1)]
-        q4k = np.broadcast_to(q4[:, :, None, None], q1.shape + (1,))
+        Branch ``b`` of the 8 is ``BRANCHES[b] = (elbow, shoulder, wrist)`` mirror flags.
+        """
+        ang = self.angles(coeffs, psi)
+        q4 = coeffs[3]
         out = np.empty(psi.shape + (8, 7))
-        for b, (e, sh, wr) in enumerate(BRANCHES):
-            out[:, :, b, :] = np.concatenate([shoulder[sh][:, e], q4k[:, e], wrist[wr][:, e]], -1)
+        for k, (e, sh, wr) in enumerate(BRANCHES):
+            for j in range(3):
+                out[:, :, k, j] = ang[j][:, e, 0, sh]
+                out[:, :, k, 4 + j] = ang[j][:, e, 1, wr]
+            out[:, :, k, 3] = q4[:, e, None]
         return out
 
     def arm_angle(self, q: np.ndarray) -> np.ndarray:
@@ -174,6 +200,59 @@ class SRSArm:
         u = sw / np.linalg.norm(sw, axis=-1, keepdims=True)
         vee = 0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], -1)
         return np.arctan2(np.sum(vee * u, -1), 0.5 * (np.trace(R, axis1=1, axis2=2) - 1.0))
+
+
+_CHUNK = 256
+_LOCAL = np.linspace(-1.0, 1.0, 9)
+
+
+def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, seeds: np.ndarray):
+    """Unchecked: over arm angles ``psi`` (m, K) and all 8 branches, the feasible solution nearest
+    ``seeds`` (m, 7). Returns ``(cost, q, psi)``; cost is ``inf`` where nothing is feasible.
+
+    The squared distance to the seed separates into shoulder, elbow and wrist terms, so the best
+    shoulder and wrist branch are chosen independently for each elbow sign and arm angle.
+    """
+    chain = arm.chain
+    m = len(psi)
+    ang = arm.angles(coeffs, psi)                                   # 3 x (m, 2e, 2g, 2b, K)
+    mid = 0.5 * (chain.qmin + chain.qmax)
+    half = 0.5 * (chain.qmax - chain.qmin)
+    ok = None
+    cost = 0.0
+    for j in range(3):
+        g = _GROUPS[:, j]
+        x = ang[j]
+        ok_j = np.abs(x - mid[g][:, None, None]) <= half[g][:, None, None]
+        ok = ok_j if ok is None else ok & ok_j
+        cost = cost + (x - seeds[:, g][:, None, :, None, None]) ** 2
+    cost = np.where(ok, cost, np.inf)                                # (m, 2e, 2g, 2b, K)
+    br = (cost[:, :, :, 1] < cost[:, :, :, 0]).astype(np.intp)       # (m, 2e, 2g, K)
+    cmin = np.minimum(cost[:, :, :, 0], cost[:, :, :, 1])
+    q4 = coeffs[3]
+    c4 = np.where(np.abs(q4 - mid[3]) <= half[3], (q4 - seeds[:, 3:4]) ** 2, np.inf)
+    total = cmin[:, :, 0] + cmin[:, :, 1] + c4[:, :, None]           # (m, 2e, K)
+    flat = total.reshape(m, -1).argmin(1)
+    e, k = np.divmod(flat, psi.shape[1])
+    i = np.arange(m)
+    q = np.empty((m, 7))
+    for j in range(3):
+        q[:, j] = ang[j][i, e, 0, br[i, e, 0, k], k]
+        q[:, 4 + j] = ang[j][i, e, 1, br[i, e, 1, k], k]
+    q[:, 3] = q4[i, e]
+    return total[i, e, k], q, psi[i, k]
+
+
+def _srs(chain: Chain) -> SRSArm:
+    """The (validated) S-R-S geometry of a chain, built once per chain object."""
+    if not isinstance(chain, Chain):
+        raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
+    return _srs_cached(chain)
+
+
+@functools.lru_cache(maxsize=16)
+def _srs_cached(chain: Chain) -> SRSArm:
+    return SRSArm(chain)
 
 
 def _check_psi(psi: Any) -> float:
@@ -205,7 +284,7 @@ def arm_angle(chain: Chain, q: Any) -> float | np.ndarray:
     Shimizu et al., "Analytical inverse kinematic computation for 7-DOF redundant manipulators
     with joint limits ...", IEEE T-RO 24(5), 2008, Sec. III-A, Eq. (9).
     """
-    arm = SRSArm(chain)
+    arm = _srs(chain)
     qq = chain.check_q(q, batch=True)
     out = arm.arm_angle(qq)
     return float(out[0]) if np.ndim(q) == 1 else out
@@ -241,11 +320,11 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
     Shimizu et al. (2008), Sec. III-B, Eqs. (13)-(22); Huang & Jiang (2013) separation of position
     and posture.
     """
-    arm = SRSArm(chain)
+    arm = _srs(chain)
     T7 = arm.to_link7(as_se3(T, "T")[None])
     p = _check_psi(psi)
     coeffs = arm.coefficients(T7)
-    if abs(coeffs[7][0]) > 1.0 + 1e-12:
+    if abs(coeffs[4][0]) > 1.0 + 1e-12:
         return np.zeros((0, 7))
     q = arm.joints(coeffs, np.array([[p]]))[0, 0]
     if within_limits:
@@ -253,16 +332,19 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
     return q
 
 
-def ik_srs(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 36, tol: float = 1e-6) -> IKResult:
+def ik_srs(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, tol: float = 1e-6) -> IKResult:
     """Analytic IK of an S-R-S arm: the valid solution closest to ``q_seed``.
 
     See :func:`ik_srs_batch` (this is its one-target form).
     """
-    seeds = None if q_seed is None else chain.check_q(q_seed, "q_seed")[None]
-    return ik_srs_batch(chain, as_se3(T, "T")[None], seeds, n_psi=n_psi, tol=tol)[0]
+    if np.ndim(T) != 2:
+        raise ValueError(f"T: expected one pose of shape (4, 4), got shape {np.shape(T)}")
+    if q_seed is not None and np.ndim(q_seed) != 1:
+        raise ValueError(f"q_seed: expected one joint vector of shape (7,), got shape {np.shape(q_seed)}")
+    return ik_srs_batch(chain, T, q_seed, n_psi=n_psi, tol=tol)[0]
 
 
-def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 36, tol: float = 1e-6,
+def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, tol: float = 1e-6,
                  n_fine: int = 720) -> IKBatchResult:
     """Analytic IK of an S-R-S arm for many targets, with joint limits and a preferred solution.
 
@@ -274,7 +356,7 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 36, t
         Target flange poses.
     q_seed : array_like, shape (N, 7) or (7,), optional
         Preferred configurations; the middle of the joint ranges by default.
-    n_psi : int, default 36
+    n_psi : int, default 12
         Arm angles tried in the first pass (evenly spaced, starting at each seed's own arm angle).
     tol : float, default 1e-6
         Tolerance on the FK-verified position error [m] and orientation error [rad].
@@ -297,12 +379,12 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 36, t
     The iteration over the redundancy parameter (Huang & Jiang 2013, "algebraic iteration") runs
     over the arm angle of Shimizu et al. (2008): (1) evaluate the 8 closed-form branches at
     ``n_psi`` arm angles; keep those inside the limits and take the one nearest the seed; (2)
-    refine ``psi`` by two parabolic steps on the distance to the seed, accepting only feasible
-    improvements; (3) targets with no feasible branch are retried on a finer grid. Shimizu et al.
+    refine ``psi`` on a local grid of 9 arm angles spanning one grid step either side, accepting
+    only feasible improvements; (3) targets with no feasible branch are retried on a finer grid. Shimizu et al.
     compute the feasible arm-angle intervals exactly (Sec. IV); the sampled search here is simpler
     and is what the lesson's experiment measures.
     """
-    arm = SRSArm(chain)
+    arm = _srs(chain)
     Tt = as_se3(T, "T", batch=True)
     N = Tt.shape[0]
     n_psi = check_int(n_psi, "n_psi", minimum=4)
@@ -318,67 +400,35 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 36, t
             raise ValueError(f"q_seed: expected one seed or {N} seeds (one per target), got {seeds.shape[0]}")
 
     T7 = arm.to_link7(Tt)
-    coeffs = arm.coefficients(T7)
-    reach = np.abs(coeffs[7]) <= 1.0 + 1e-12
     psi0 = arm.arm_angle(seeds)
     q_best = seeds.copy()
     found = np.zeros(N, bool)
+    reach = np.zeros(N, bool)
     evals = np.zeros(N, int)
-
-    def search(rows, n):
-        sub = tuple(c[rows] for c in coeffs)
-        psi = psi0[rows, None] + np.arange(n) * (2 * np.pi / n)
-        q = arm.joints(sub, psi)                                               # (m, n, 8, 7)
-        ok = np.all((q >= chain.qmin) & (q <= chain.qmax), axis=-1)
-        cost = np.where(ok, np.sum((q - seeds[rows, None, None]) ** 2, -1), np.inf)
-        flat = cost.reshape(len(rows), -1).argmin(1)
-        k, b = np.divmod(flat, 8)
-        has = np.isfinite(cost.reshape(len(rows), -1)[np.arange(len(rows)), flat])
-        best_q = q[np.arange(len(rows)), k, b]
-        best_c = cost[np.arange(len(rows)), k, b]
-        h = 2 * np.pi / n
-        psi_k = psi[np.arange(len(rows)), k]
-        # two parabolic refinements of the distance to the seed along psi (same branch)
-        for step in (h, h / 4):
-            trial = psi_k[:, None] + np.array([-step, step])
-            qt = arm.joints(sub, trial)[np.arange(len(rows)), :, b]             # (m, 2, 7)
-            okt = np.all((qt >= chain.qmin) & (qt <= chain.qmax), -1)
-            ct = np.where(okt, np.sum((qt - seeds[rows, None]) ** 2, -1), np.inf)
-            f0, f1, f2 = ct[:, 0], best_c, ct[:, 1]
-            den = f0 - 2 * f1 + f2
-            with np.errstate(invalid="ignore", divide="ignore"):
-                x = np.where(np.isfinite(den) & (den > 0), 0.5 * (f0 - f2) / den, 0.0)
-            x = np.clip(x, -1.0, 1.0)
-            # also allow the better of the two probes when the parabola is not usable
-            cand_psi = np.stack([psi_k + x * step, trial[:, 0], trial[:, 1]], -1)
-            qc = arm.joints(sub, cand_psi[:, :1])[np.arange(len(rows)), 0, b]
-            okc = np.all((qc >= chain.qmin) & (qc <= chain.qmax), -1)
-            cc = np.where(okc, np.sum((qc - seeds[rows]) ** 2, -1), np.inf)
-            all_c = np.stack([cc, ct[:, 0], ct[:, 1]], -1)
-            all_q = np.stack([qc, qt[:, 0], qt[:, 1]], 1)
-            j = all_c.argmin(1)
-            better = all_c[np.arange(len(rows)), j] < best_c
-            best_c = np.where(better, all_c[np.arange(len(rows)), j], best_c)
-            best_q = np.where(better[:, None], all_q[np.arange(len(rows)), j], best_q)
-            psi_k = np.where(better, cand_psi[np.arange(len(rows)), j], psi_k)
-        return has, best_q, n * 8 + 6
-
-    rows = np.flatnonzero(reach)
-    if rows.size:
-        has, qb, ne = search(rows, n_psi)
-        q_best[rows[has]] = qb[has]
-        found[rows[has]] = True
-        evals[rows] += ne
-        retry = rows[~has]
-        if retry.size:
-            has, qb, ne = search(retry, n_fine)
-            q_best[retry[has]] = qb[has]
-            found[retry[has]] = True
-            evals[retry] += ne
+    for start in range(0, N, _CHUNK):
+        rows = np.arange(start, min(N, start + _CHUNK))
+        coeffs = arm.coefficients(T7[rows])
+        r_ok = np.abs(coeffs[4]) <= 1.0 + 1e-12
+        reach[rows] = r_ok
+        rows, coeffs = rows[r_ok], tuple(c[r_ok] for c in coeffs)
+        for n in (n_psi, n_fine):
+            if not rows.size:
+                break
+            psi_grid = psi0[rows, None] + np.arange(n) * (2 * np.pi / n)
+            cost, q, psi = _best_on_grid(arm, coeffs, psi_grid, seeds[rows])
+            # the iteration on the redundancy parameter: a finer local grid around the best psi
+            c2, q2, _ = _best_on_grid(arm, coeffs, psi[:, None] + (2 * np.pi / n) * _LOCAL, seeds[rows])
+            better = c2 < cost
+            cost, q = np.where(better, c2, cost), np.where(better[:, None], q2, q)
+            evals[rows] += 8 * (n + len(_LOCAL))
+            has = np.isfinite(cost)
+            q_best[rows[has]] = q[has]
+            found[rows[has]] = True
+            rows, coeffs = rows[~has], tuple(c[~has] for c in coeffs)
 
     success, reasons, residual, pos, rot = verify(chain, Tt, q_best, tol, tol)
     for i in np.flatnonzero(~reach):
-        L = np.linalg.norm(arm.wrist_centre(T7[i]) - [0, 0, arm.d_bs])
+        L = float(np.linalg.norm(arm.wrist_centre(T7[i]) - [0, 0, arm.d_bs]))
         reasons[i] = (f"out of reach: shoulder-wrist distance {L:.4f} m outside "
                       f"[{abs(arm.d_se - arm.d_ew):.4f}, {arm.d_se + arm.d_ew:.4f}] m")
     for i in np.flatnonzero(reach & ~found):

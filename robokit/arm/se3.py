@@ -51,11 +51,14 @@ def as_se3(value: Any, name: str, *, batch: bool = False, tol: float = SE3_TOL) 
     want = (None, 4, 4) if batch else (4, 4)
     T = as_array(T, name, shape=want)
     R = T[..., :3, :3]
-    last = T[..., 3, :]
-    if not np.allclose(last, [0.0, 0.0, 0.0, 1.0], atol=tol, rtol=0):
-        raise ValueError(f"{name}: expected an SE(3) matrix with last row [0, 0, 0, 1], got {np.asarray(last).reshape(-1, 4)[0].tolist()}")
+    last_dev = np.abs(T[..., 3, :] - (0.0, 0.0, 0.0, 1.0)).max(axis=-1)
+    if np.any(last_dev > tol):
+        i = int(np.argmax(np.atleast_1d(last_dev)))
+        raise ValueError(f"{name}: expected an SE(3) matrix with last row [0, 0, 0, 1], got "
+                         f"{np.asarray(T[..., 3, :]).reshape(-1, 4)[i].tolist()}" + (f" at index {i}" if batch else ""))
     ortho = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1))
-    det = np.linalg.det(R)
+    # det R = +1 for an orthonormal R <=> (r0 x r1) . r2 = 1
+    det = np.einsum("...i,...i->...", np.cross(R[..., 0, :], R[..., 1, :]), R[..., 2, :])
     bad = (ortho > tol) | (np.abs(det - 1.0) > tol)
     if np.any(bad):
         i = int(np.argmax(np.atleast_1d(bad)))
