@@ -1,0 +1,239 @@
+"""Landmark database with per-landmark Kalman filters (Se, Lowe & Little, Sec. 3).
+
+Every landmark keeps its 3-D position in the initial (world) frame, a 3 x 3 covariance, a
+descriptor (with the keypoint's scale and orientation for the matching constraints) and a count of
+consecutive frames in which it was not matched. A new observation is transformed backwards into
+the world frame with the pose covariance propagated (:func:`robokit.mapping.frames.transform_covariance`)
+and fused with the landmark by the information-form Kalman update of Sec. 3.5.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..validation import as_array, check_int
+from .frames import transform_covariance
+
+__all__ = ["kalman_fuse", "LandmarkMap"]
+
+
+def _covariances(value, name, n):
+    cov = as_array(value, name, shape=(n, 3, 3))
+    if not np.allclose(cov, np.swapaxes(cov, 1, 2), atol=1e-12 + 1e-9 * np.abs(cov).max(initial=0)):
+        raise ValueError(f"{name}: expected symmetric 3 x 3 covariances, got a non-symmetric one")
+    if n and np.any(np.linalg.eigvalsh(cov)[:, 0] <= 0):
+        raise ValueError(f"{name}: expected positive-definite covariances, got a singular or indefinite one")
+    return cov
+
+
+def kalman_fuse(s, sigma, r_new, sigma_new) -> tuple[np.ndarray, np.ndarray]:
+    """Fuse landmark estimates with new observations (information-form Kalman update).
+
+    Parameters
+    ----------
+    s : array_like, shape (3,) or (N, 3)
+        Landmark positions ``s_KF`` in the database.
+    sigma : array_like, shape (3, 3) or (N, 3, 3)
+        Their covariances ``Sigma_KF`` (positive definite).
+    r_new : array_like, shape like ``s``
+        New observations transformed into the same frame.
+    sigma_new : array_like, shape like ``sigma``
+        Their covariances.
+
+    Returns
+    -------
+    s_fused : numpy.ndarray
+        ``Sigma' (Sigma_KF^-1 s_KF + Sigma_new^-1 r_new)``.
+    sigma_fused : numpy.ndarray
+        ``Sigma' = (Sigma_KF^-1 + Sigma_new^-1)^-1``.
+
+    Raises
+    ------
+    ValueError
+        For mismatched shapes or covariances that are not symmetric positive definite.
+
+    Notes
+    -----
+    Se, Lowe & Little, Sec. 3.5 ("Filter update"). The fused covariance is never larger than
+    either input, so a landmark's uncertainty ellipse shrinks as it is re-observed (Sec. 3.6).
+    """
+    single = np.ndim(s) == 1
+    pts = as_array(s, "s", shape=(3,) if single else (None, 3))
+    n = 1 if single else pts.shape[0]
+    cshape = (3, 3) if single else (n, 3, 3)
+    new = as_array(r_new, "r_new", shape=pts.shape).reshape(n, 3)
+    cov = _covariances(as_array(sigma, "sigma", shape=cshape).reshape(n, 3, 3), "sigma", n)
+    cov_new = _covariances(as_array(sigma_new, "sigma_new", shape=cshape).reshape(n, 3, 3), "sigma_new", n)
+    pts = pts.reshape(n, 3)
+    info, info_new = np.linalg.inv(cov), np.linalg.inv(cov_new)
+    fused = np.linalg.inv(info + info_new)
+    fused = 0.5 * (fused + np.swapaxes(fused, 1, 2))
+    mean = np.einsum("nij,nj->ni", fused, np.einsum("nij,nj->ni", info, pts) + np.einsum("nij,nj->ni", info_new, new))
+    return (mean[0], fused[0]) if single else (mean, fused)
+
+
+class LandmarkMap:
+    """The database map of 3-D landmarks with uncertainty (Se et al. Sec. 3; Lin et al. Sec. V).
+
+    Parameters
+    ----------
+    descriptor_size : int
+        Length of the stored descriptors (128 or 16).
+    max_missed : int, default 20
+        A landmark is dropped once it has gone unmatched for more than this many consecutive
+        frames (Se et al. Sec. 3.2: kept through temporary occlusion, dropped otherwise).
+
+    Attributes
+    ----------
+    positions : numpy.ndarray, shape (N, 3)
+        World-frame positions (metres).
+    covariances : numpy.ndarray, shape (N, 3, 3)
+    descriptors : numpy.ndarray, shape (N, D), float32
+    scales, orientations : numpy.ndarray, shape (N,)
+        Keypoint scale (pixels) and orientation (radians) at the first observation.
+    missed : numpy.ndarray of int, shape (N,)
+        Consecutive unmatched frames.
+    observations : numpy.ndarray of int, shape (N,)
+        Number of times each landmark was observed.
+    ids : numpy.ndarray of int, shape (N,)
+        Stable identifiers (never reused).
+    """
+
+    def __init__(self, descriptor_size: int, *, max_missed: int = 20):
+        self.descriptor_size = check_int(descriptor_size, "descriptor_size", minimum=1)
+        self.max_missed = check_int(max_missed, "max_missed", minimum=0)
+        self.positions = np.zeros((0, 3))
+        self.covariances = np.zeros((0, 3, 3))
+        self.descriptors = np.zeros((0, self.descriptor_size), np.float32)
+        self.scales = np.zeros(0)
+        self.orientations = np.zeros(0)
+        self.missed = np.zeros(0, int)
+        self.observations = np.zeros(0, int)
+        self.ids = np.zeros(0, int)
+        self._next_id = 0
+
+    def __len__(self) -> int:
+        return self.positions.shape[0]
+
+    def add(self, positions, covariances, descriptors, scales=None, orientations=None) -> np.ndarray:
+        """Append new landmarks (world frame); return their ids.
+
+        Raises
+        ------
+        ValueError
+            For shapes that do not agree or invalid covariances.
+        """
+        pts = as_array(positions, "positions", shape=(None, 3))
+        n = pts.shape[0]
+        cov = _covariances(covariances, "covariances", n)
+        desc = as_array(descriptors, "descriptors", shape=(n, self.descriptor_size), dtype=np.float32)
+        sc = np.ones(n) if scales is None else as_array(scales, "scales", shape=(n,))
+        ori = np.zeros(n) if orientations is None else as_array(orientations, "orientations", shape=(n,))
+        ids = np.arange(self._next_id, self._next_id + n)
+        self._next_id += n
+        self.positions = np.vstack([self.positions, pts])
+        self.covariances = np.concatenate([self.covariances, cov])
+        self.descriptors = np.vstack([self.descriptors, desc])
+        self.scales = np.concatenate([self.scales, sc])
+        self.orientations = np.concatenate([self.orientations, ori])
+        self.missed = np.concatenate([self.missed, np.zeros(n, int)])
+        self.observations = np.concatenate([self.observations, np.ones(n, int)])
+        self.ids = np.concatenate([self.ids, ids])
+        return ids
+
+    def _index(self, index) -> np.ndarray:
+        idx = as_array(index, "index", ndim=1, dtype=int)
+        if idx.size and (idx.min() < 0 or idx.max() >= len(self)):
+            raise ValueError(f"index: expected rows in [0, {len(self)}), got {idx.min()}..{idx.max()}")
+        if np.unique(idx).size != idx.size:
+            raise ValueError("index: expected each landmark at most once per update, got duplicates")
+        return idx
+
+    def fuse(self, index, positions, covariances) -> None:
+        """Kalman-update the landmarks in rows ``index`` with world-frame observations.
+
+        Notes
+        -----
+        Se et al. Sec. 3.5 via :func:`kalman_fuse`; resets the landmarks' missed counters.
+        """
+        idx = self._index(index)
+        if idx.size == 0:
+            return
+        s, cov = kalman_fuse(self.positions[idx], self.covariances[idx], positions, covariances)
+        self.positions[idx], self.covariances[idx] = s, cov
+        self.missed[idx] = 0
+        self.observations[idx] += 1
+
+    def end_frame(self, matched) -> np.ndarray:
+        """Count a frame: unmatched landmarks age, those unmatched too long are dropped.
+
+        Parameters
+        ----------
+        matched : array_like of int
+            Rows matched in this frame.
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Ids of the dropped landmarks.
+
+        Notes
+        -----
+        Se et al. Sec. 3.2: "A landmark will be discarded from the database if it has not been
+        matched for more than a predefined number of consecutive frames".
+        """
+        idx = self._index(matched)
+        seen = np.zeros(len(self), bool)
+        seen[idx] = True
+        self.missed[~seen] += 1
+        self.missed[seen] = 0
+        drop = self.missed > self.max_missed
+        dropped = self.ids[drop]
+        if drop.any():
+            keep = ~drop
+            for name in ("positions", "covariances", "descriptors", "scales", "orientations", "missed",
+                         "observations", "ids"):
+                setattr(self, name, getattr(self, name)[keep])
+        return dropped
+
+    def integrate(self, points, covariances, descriptors, pose, pose_covariance, landmark,
+                  scales=None, orientations=None) -> np.ndarray:
+        """One frame of map building: backward transformation, fusion, insertion and ageing.
+
+        Parameters
+        ----------
+        points, covariances : array_like, shapes (N, 3), (N, 3, 3)
+            Stereo observations in the robot frame and their covariances.
+        descriptors : array_like, shape (N, D)
+        pose, pose_covariance : array_like, shapes (3,), (3, 3)
+            Robot pose ``[p, q, theta]`` and its covariance.
+        landmark : array_like of int, shape (N,)
+            Row of the matched landmark per observation, or -1 for a new landmark.
+        scales, orientations : array_like, shape (N,), optional
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (N,)
+            The landmark id of every observation (new ids for new landmarks).
+
+        Notes
+        -----
+        Se et al. Sec. 3.3-3.5 and Lin et al. Sec. V (the database is updated incrementally).
+        """
+        pts = as_array(points, "points", shape=(None, 3))
+        n = pts.shape[0]
+        lm = as_array(landmark, "landmark", shape=(n,), dtype=int)
+        if np.any(lm >= len(self)) or np.any(lm < -1):
+            raise ValueError(f"landmark: expected -1 or rows in [0, {len(self)}), got {lm.min()}..{lm.max()}")
+        world, cov = transform_covariance(pts, covariances, pose, pose_covariance)
+        old = lm >= 0
+        self.fuse(lm[old], world[old], cov[old])
+        out = np.empty(n, int)
+        out[old] = self.ids[lm[old]]
+        desc = as_array(descriptors, "descriptors", shape=(n, self.descriptor_size), dtype=np.float32)
+        new = ~old
+        sc = None if scales is None else as_array(scales, "scales", shape=(n,))[new]
+        ori = None if orientations is None else as_array(orientations, "orientations", shape=(n,))[new]
+        out[new] = self.add(world[new], cov[new], desc[new], sc, ori)
+        matched_rows = np.nonzero(np.isin(self.ids, out))[0]
+        self.end_frame(matched_rows)
+        return out

@@ -1,0 +1,104 @@
+"""Landmark database (Se et al. Sec. 3): Kalman fusion, backward transformation, ageing."""
+import numpy as np
+import pytest
+
+from robokit.geometry import se2_compose
+from robokit.mapping.frames import robot_to_world, rotation_y, transform_covariance, world_to_robot
+from robokit.mapping.landmarks import LandmarkMap, kalman_fuse
+
+
+def _spd(rng, n, scale=0.01):
+    m = rng.normal(size=(n, 3, 3)) * np.sqrt(scale)
+    return m @ np.swapaxes(m, 1, 2) + 1e-4 * np.eye(3)
+
+
+def test_pose_convention_matches_se2_on_the_ground_plane():
+    rng = np.random.default_rng(0)
+    pose = np.array([0.4, -1.2, 0.7])
+    pts = rng.normal(size=(10, 3))
+    world = robot_to_world(pts, pose)
+    for r, w in zip(pts, world):
+        assert np.allclose(se2_compose(pose, [r[0], r[2], 0.0])[:2], w[[0, 2]])
+    assert np.allclose(world[:, 1], pts[:, 1])
+    assert np.allclose(world_to_robot(world, pose), pts)
+    # theta = +90 degrees: the robot looks along -X (it has turned left)
+    assert np.allclose(robot_to_world([[0, 0, 1.0]], [0, 0, np.pi / 2]), [[-1, 0, 0]])
+    assert np.allclose(rotation_y(0.3) @ rotation_y(-0.3), np.eye(3))
+
+
+def test_kalman_fusion_formula_and_shrinking_uncertainty():
+    rng = np.random.default_rng(1)
+    s, r = rng.normal(size=(20, 3)), rng.normal(size=(20, 3))
+    a, b = _spd(rng, 20), _spd(rng, 20)
+    mean, cov = kalman_fuse(s, a, r, b)
+    for i in range(20):
+        ia, ib = np.linalg.inv(a[i]), np.linalg.inv(b[i])
+        ref = np.linalg.inv(ia + ib)
+        assert np.allclose(cov[i], ref)
+        assert np.allclose(mean[i], ref @ (ia @ s[i] + ib @ r[i]))
+        # fused covariance is below both inputs in the positive semi-definite order
+        assert np.linalg.eigvalsh(a[i] - cov[i]).min() > -1e-12
+        assert np.linalg.eigvalsh(b[i] - cov[i]).min() > -1e-12
+    m1, c1 = kalman_fuse(s[0], a[0], r[0], b[0])
+    assert np.allclose(m1, mean[0]) and np.allclose(c1, cov[0])
+    # equal covariances: the average
+    m2, c2 = kalman_fuse([0, 0, 0], np.eye(3), [2, 4, 6], np.eye(3))
+    assert np.allclose(m2, [1, 2, 3]) and np.allclose(c2, 0.5 * np.eye(3))
+
+
+def test_kalman_fusion_rejects_bad_covariances():
+    with pytest.raises(ValueError, match="sigma: expected positive-definite"):
+        kalman_fuse([0, 0, 0], np.zeros((3, 3)), [1, 1, 1], np.eye(3))
+    with pytest.raises(ValueError, match="sigma_new: expected symmetric"):
+        kalman_fuse([0, 0, 0], np.eye(3), [1, 1, 1], np.triu(np.ones((3, 3))))
+    with pytest.raises(ValueError, match="r_new: expected shape"):
+        kalman_fuse(np.zeros((2, 3)), np.stack([np.eye(3)] * 2), np.zeros((3, 3)), np.stack([np.eye(3)] * 2))
+
+
+def test_backward_transformation_covariance_matches_monte_carlo():
+    rng = np.random.default_rng(2)
+    pt = np.array([[0.5, 0.3, 3.0]])
+    cov = np.diag([0.001, 0.001, 0.02])[None]
+    pose = np.array([1.0, 2.0, 0.4])
+    pose_cov = np.diag([0.01 ** 2, 0.02 ** 2, np.deg2rad(1.0) ** 2])
+    world, wcov = transform_covariance(pt, cov, pose, pose_cov)
+    assert np.allclose(world, robot_to_world(pt, pose))
+    n = 40000
+    samples_p = rng.multivariate_normal(pose, pose_cov, n)
+    samples_r = rng.multivariate_normal(pt[0], cov[0], n)
+    c, s = np.cos(samples_p[:, 2]), np.sin(samples_p[:, 2])
+    out = np.column_stack([c * samples_r[:, 0] - s * samples_r[:, 2] + samples_p[:, 0], samples_r[:, 1],
+                           s * samples_r[:, 0] + c * samples_r[:, 2] + samples_p[:, 1]])
+    emp = np.cov(out.T)
+    assert np.allclose(emp, wcov[0], rtol=0.05, atol=5e-5)
+    # without the pose term the covariance would be too small
+    _, only_obs = transform_covariance(pt, cov, pose, np.zeros((3, 3)))
+    assert np.trace(wcov[0]) > np.trace(only_obs[0])
+
+
+def test_map_integrates_frames_and_forgets_unseen_landmarks():
+    rng = np.random.default_rng(3)
+    truth = rng.uniform([-3, 0, 1], [3, 2, 6], (30, 3))
+    m = LandmarkMap(16, max_missed=2)
+    desc = rng.random((30, 16)).astype(np.float32)
+    obs_cov = np.stack([np.diag([1e-3, 1e-3, 1e-2])] * 30)
+    poses = [np.array([0.0, 0.0, 0.0]), np.array([0.1, 0.3, 0.05]), np.array([0.2, 0.6, 0.1])]
+    ids = None
+    for k, pose in enumerate(poses):
+        robot = world_to_robot(truth, pose) + rng.normal(size=(30, 3)) * [0.03, 0.03, 0.1]
+        lm = -np.ones(30, int) if k == 0 else np.searchsorted(m.ids, ids)
+        ids = m.integrate(robot, obs_cov, desc, pose, np.diag([1e-6, 1e-6, 1e-8]), lm)
+    assert len(m) == 30 and np.all(m.observations == 3)
+    first_cov = np.trace(obs_cov[0])
+    assert np.all(np.trace(m.covariances, axis1=1, axis2=2) < 0.5 * first_cov)
+    assert np.array_equal(m.descriptors, desc)
+    # landmarks 0..9 are no longer seen: dropped after more than max_missed frames
+    for _ in range(3):
+        keep = np.nonzero(~np.isin(m.ids, ids[:10]))[0]
+        m.fuse(keep, m.positions[keep], m.covariances[keep])
+        dropped = m.end_frame(keep)
+    assert np.array_equal(np.sort(dropped), np.sort(ids[:10])) and len(m) == 20
+    with pytest.raises(ValueError, match="landmark: expected -1 or rows"):
+        m.integrate(truth[:1], obs_cov[:1], desc[:1], poses[0], np.eye(3) * 1e-6, [99])
+    with pytest.raises(ValueError, match="index: expected each landmark at most once"):
+        m.fuse([0, 0], truth[:2], obs_cov[:2])
