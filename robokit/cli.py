@@ -43,6 +43,78 @@ def _cmd_course_check(args: argparse.Namespace) -> int:
     return 1 if problems else 0
 
 
+def _cmd_assign(args: argparse.Namespace) -> int:
+    from .grading.assign import AssignmentError, write_assignment
+    from .grading.registry import assignments
+
+    root = Path(args.root)
+    slugs = args.slugs or sorted(p.stem for p in (root / "solutions").glob("*.ipynb"))
+    known = assignments()
+    status = 0
+    for slug in slugs:
+        if slug not in known:
+            print(f"robokit assign: solutions/{slug}.ipynb has no exercise module declaring "
+                  f"ASSIGNMENT = {slug!r} in robokit/exercises/", file=sys.stderr)
+            status = 1
+            continue
+        try:
+            changed = write_assignment(root, slug, check_only=args.check)
+        except AssignmentError as exc:
+            print(f"robokit assign: {exc}", file=sys.stderr)
+            status = 1
+            continue
+        if args.check and changed:
+            print(f"assignments/{slug}.ipynb is out of date: run `robokit assign {slug}`")
+            status = 1
+        elif changed:
+            print(f"wrote assignments/{slug}.ipynb")
+        else:
+            print(f"assignments/{slug}.ipynb is up to date")
+    return status
+
+
+def _cmd_grade(args: argparse.Namespace) -> int:
+    import os
+
+    from .grading.grader import GradingError, grade_batch, isolation_note
+    from .grading.reports import write_feedback, write_gradebook, write_gradescope
+    from .grading.sandbox import Limits
+
+    seed = args.seed or os.environ.get("ROBOKIT_GRADING_SEED", "")
+    if not seed:
+        print("robokit grade: error: a secret seed is required: --seed SECRET (or set "
+              "ROBOKIT_GRADING_SEED); keep it private so students cannot predict the cases", file=sys.stderr)
+        return 2
+    if args.gradescope and len(args.submissions) != 1:
+        print("robokit grade: error: --gradescope writes one results.json, so give exactly one submission",
+              file=sys.stderr)
+        return 2
+    limits = Limits(wall_seconds=args.timeout, cpu_seconds=int(args.timeout),
+                    memory_bytes=int(args.memory_mb) * 1024 * 1024)
+    root = Path(args.root).resolve()
+    hide = [p for p in (root / "solutions", Path(args.out).resolve().parent,
+                        Path(args.feedback).resolve() if args.feedback else None, Path.home()) if p]
+    print(f"grading {len(args.submissions)} submission(s) of {args.assignment} with {args.jobs} job(s); "
+          f"{isolation_note()}")
+    try:
+        results = grade_batch(args.submissions, args.assignment, seed, jobs=args.jobs, limits=limits, hide=hide)
+    except GradingError as exc:
+        print(f"robokit grade: error: {exc}", file=sys.stderr)
+        return 2
+    write_gradebook(results, args.out)
+    print(f"gradebook: {args.out}")
+    if args.feedback:
+        write_feedback(results, args.feedback, args.assignment)
+        print(f"feedback: {args.feedback}/")
+    if args.gradescope:
+        write_gradescope(results[0], args.assignment, args.gradescope)
+        print(f"gradescope results: {args.gradescope}")
+    problems = [r for r in results if r.read_error]
+    for r in problems:
+        print(f"robokit grade: {r.path}: {r.reason}", file=sys.stderr)
+    return 1 if problems else 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``robokit`` command."""
     parser = argparse.ArgumentParser(
@@ -69,6 +141,25 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("paths", nargs="*")
     check.add_argument("--root", default=".")
     check.set_defaults(func=_cmd_course_check)
+
+    assign = sub.add_parser("assign", help="generate assignments/ from solutions/ (deterministic)")
+    assign.add_argument("slugs", nargs="*", help="e.g. 05_gps_sonar_truck (default: every solution)")
+    assign.add_argument("--root", default=".", help="course repository root (default: .)")
+    assign.add_argument("--check", action="store_true", help="only report assignments that are out of date")
+    assign.set_defaults(func=_cmd_assign)
+
+    grade = sub.add_parser("grade", help="grade submitted notebooks in sandboxed workers")
+    grade.add_argument("submissions", nargs="+", help="submitted .ipynb files")
+    grade.add_argument("--assignment", required=True, help="e.g. 01_visual_slam")
+    grade.add_argument("--seed", help="instructor's secret seed (or env ROBOKIT_GRADING_SEED)")
+    grade.add_argument("--out", default="grades.csv", help="gradebook CSV (default: grades.csv)")
+    grade.add_argument("--feedback", help="folder for per-student feedback (markdown)")
+    grade.add_argument("--jobs", type=int, default=1, help="submissions graded at once (default: 1)")
+    grade.add_argument("--gradescope", help="also write Gradescope's results.json (one submission)")
+    grade.add_argument("--timeout", type=float, default=300, help="seconds per submission (default: 300)")
+    grade.add_argument("--memory-mb", type=int, default=4096, help="address-space limit (default: 4096)")
+    grade.add_argument("--root", default=".", help="course root; its solutions/ is hidden from workers")
+    grade.set_defaults(func=_cmd_grade)
     return parser
 
 

@@ -1,0 +1,177 @@
+"""``robokit assign``: generate the student notebook of an assignment from its solution notebook.
+
+Conventions in ``solutions/NN_slug.ipynb`` (the single source of the assignment):
+
+* a code cell holding a solution has lines ``# BEGIN SOLUTION`` and ``# END SOLUTION``; what lies
+  between them (markers included) becomes ``raise NotImplementedError`` at the same indentation,
+  so the ``def`` line and the docstring stay;
+* a check cell calls ``check("NN.name", function)``; it becomes an nbgrader *grade* cell worth
+  the exercise's points (from ``robokit.exercises``);
+* a written answer is a markdown cell with ``<!-- BEGIN SOLUTION NN.name -->`` ...
+  ``<!-- END SOLUTION -->``; the answer becomes "YOUR ANSWER HERE" and the cell a manually graded
+  nbgrader cell worth ``WRITTEN[NN.name]`` points;
+* every other cell is locked.
+
+The output is deterministic (same input, same bytes) and carries nbgrader metadata
+(``schema_version`` 3) so the same notebooks work with nbgrader's in-kernel autograde.
+"""
+from __future__ import annotations
+
+import copy
+import importlib
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+from ..course.hygiene import strip_notebook
+from .registry import assignments, exercises_for
+
+__all__ = ["make_assignment", "write_assignment", "written_points", "AssignmentError"]
+
+_BEGIN = re.compile(r"^(\s*)#+\s*BEGIN SOLUTION\s*$")
+_END = re.compile(r"^\s*#+\s*END SOLUTION\s*$")
+_CHECK = re.compile(r"""\bcheck\(\s*["'](\d\d\.[a-z][a-z0-9_]*)["']""")
+_MD_BEGIN = re.compile(r"<!--\s*BEGIN SOLUTION\s+(\d\d\.[a-z][a-z0-9_]*)\s*-->")
+_MD_REGION = re.compile(r"<!--\s*BEGIN SOLUTION\s+(\d\d\.[a-z][a-z0-9_]*)\s*-->.*?<!--\s*END SOLUTION\s*-->", re.S)
+_DEF = re.compile(r"^def\s+([A-Za-z_]\w*)\s*\(", re.M)
+
+
+class AssignmentError(ValueError):
+    """The solution notebook breaks the conventions (unbalanced markers, unknown exercise, ...)."""
+
+
+def written_points(slug: str) -> dict[str, float]:
+    """Return ``{"NN.name": points}`` for the written questions of an assignment."""
+    exercises_for(slug)  # raises UnknownAssignmentError with the known list
+    for info_module in _exercise_modules():
+        if getattr(info_module, "ASSIGNMENT", None) == slug:
+            return dict(getattr(info_module, "WRITTEN", {}))
+    return {}
+
+
+def _exercise_modules():
+    import pkgutil
+
+    import robokit.exercises as pkg
+
+    for info in pkgutil.iter_modules(pkg.__path__):
+        yield importlib.import_module(f"{pkg.__name__}.{info.name}")
+
+
+def _source(cell: dict) -> str:
+    src = cell.get("source", "")
+    return "".join(src) if isinstance(src, list) else src
+
+
+def _clear_code(src: str, where: str) -> str:
+    out, inside, indent = [], False, ""
+    for line in src.splitlines():
+        begin = _BEGIN.match(line)
+        if begin:
+            if inside:
+                raise AssignmentError(f"{where}: nested '# BEGIN SOLUTION'")
+            inside, indent = True, begin.group(1)
+            out.append(f"{indent}raise NotImplementedError")
+            continue
+        if _END.match(line):
+            if not inside:
+                raise AssignmentError(f"{where}: '# END SOLUTION' without BEGIN")
+            inside = False
+            continue
+        if not inside:
+            out.append(line)
+    if inside:
+        raise AssignmentError(f"{where}: '# BEGIN SOLUTION' without END")
+    return "\n".join(out)
+
+
+def _nbgrader(grade_id: str, *, grade: bool, solution: bool, locked: bool, points: float | None = None) -> dict:
+    md = {"grade": grade, "grade_id": grade_id, "locked": locked, "schema_version": 3, "solution": solution}
+    if points is not None:
+        md["points"] = points
+    return md
+
+
+def make_assignment(solution: dict[str, Any], slug: str) -> dict[str, Any]:
+    """Return the student notebook generated from a solution notebook (pure, deterministic).
+
+    Raises
+    ------
+    AssignmentError
+        If markers are unbalanced, a check cell names an unknown exercise, or an exercise of the
+        assignment has no solution or no check cell.
+    """
+    exercises = {ex.id: ex for ex in exercises_for(slug)}
+    by_function = {ex.function: ex for ex in exercises.values()}
+    written = written_points(slug)
+    nb = strip_notebook(copy.deepcopy(solution))
+    seen_checks, seen_solutions, seen_written = set(), set(), set()
+    for i, cell in enumerate(nb.get("cells", [])):
+        src = _source(cell)
+        meta = cell.setdefault("metadata", {})
+        where = f"solutions/{slug}.ipynb cell {i}"
+        if cell.get("cell_type") == "code" and any(_BEGIN.match(l) for l in src.splitlines()):
+            names = _DEF.findall(src)
+            ex = next((by_function[n] for n in names if n in by_function), None)
+            grade_id = f"{ex.id}.solution" if ex else f"solution-{i:02d}"
+            if ex:
+                seen_solutions.add(ex.id)
+            cell["source"] = _clear_code(src, where)
+            meta["nbgrader"] = _nbgrader(grade_id, grade=False, solution=True, locked=False)
+        elif cell.get("cell_type") == "code" and _CHECK.search(src):
+            ex_id = _CHECK.search(src).group(1)
+            if ex_id not in exercises:
+                raise AssignmentError(f"{where}: check() names {ex_id!r}, not an exercise of {slug}")
+            seen_checks.add(ex_id)
+            meta["nbgrader"] = _nbgrader(ex_id, grade=True, solution=False, locked=True,
+                                         points=float(exercises[ex_id].points))
+        elif cell.get("cell_type") == "markdown" and _MD_BEGIN.search(src):
+            qid = _MD_BEGIN.search(src).group(1)
+            if qid not in written:
+                raise AssignmentError(f"{where}: written question {qid!r} is not in WRITTEN of {slug}")
+            if not _MD_REGION.search(src):
+                raise AssignmentError(f"{where}: '<!-- BEGIN SOLUTION {qid} -->' without END")
+            seen_written.add(qid)
+            cell["source"] = _MD_REGION.sub("YOUR ANSWER HERE", src)
+            meta["nbgrader"] = _nbgrader(qid, grade=True, solution=True, locked=False, points=float(written[qid]))
+        else:
+            meta["nbgrader"] = _nbgrader(f"locked-{i:02d}", grade=False, solution=False, locked=True)
+        meta["editable"] = not meta["nbgrader"]["locked"]
+        meta["deletable"] = False
+    missing = [(k, "solution cell") for k in exercises if k not in seen_solutions] + \
+              [(k, "check cell") for k in exercises if k not in seen_checks] + \
+              [(k, "written answer cell") for k in written if k not in seen_written]
+    if missing:
+        raise AssignmentError(f"solutions/{slug}.ipynb: missing " +
+                              ", ".join(f"{what} for {k}" for k, what in missing))
+    nb.setdefault("metadata", {})["robokit"] = {"assignment": slug, "generated_from": f"solutions/{slug}.ipynb"}
+    return nb
+
+
+def _dumps(nb: dict) -> str:
+    return json.dumps(nb, indent=1, sort_keys=True, ensure_ascii=False) + "\n"
+
+
+def write_assignment(root: str | Path, slug: str, *, check_only: bool = False) -> bool:
+    """Generate ``assignments/<slug>.ipynb``; return whether it differed from what was there.
+
+    With ``check_only`` nothing is written (used by the tests and CI to detect stale assignments).
+    """
+    root = Path(root)
+    src = root / "solutions" / f"{slug}.ipynb"
+    if not src.is_file():
+        raise FileNotFoundError(f"slug: no solution notebook {src}")
+    text = _dumps(make_assignment(json.loads(src.read_text(encoding="utf-8")), slug))
+    dst = root / "assignments" / f"{slug}.ipynb"
+    old = dst.read_text(encoding="utf-8") if dst.exists() else None
+    if old != text and not check_only:
+        dst.parent.mkdir(exist_ok=True)
+        dst.write_text(text, encoding="utf-8")
+    return old != text
+
+
+def known_slugs(root: str | Path) -> list[str]:
+    """Slugs that have both a solution notebook and an exercise module."""
+    have = {p.stem for p in (Path(root) / "solutions").glob("*.ipynb")}
+    return [s for s in assignments() if s in have]
