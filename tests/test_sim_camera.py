@@ -1,0 +1,159 @@
+"""Pinhole, stereo and omni cameras agree with the renderer (issue 4 acceptance)."""
+import dataclasses
+
+import cv2
+import numpy as np
+import pytest
+
+from robokit.geometry import se2_to_se3, se3_from_rt
+from robokit.sim import camera as cm
+from robokit.sim.omni import OmniCamera
+from robokit.sim.world import World
+from robokit.sim.worlds import box_room, lab_room, long_corridor, office_floor
+
+CAM = cm.PinholeCamera.from_fov(np.deg2rad(65), 640, 480)
+
+
+def dot_world(a=0.37, b=0.41):
+    """box_room with one wall tile replaced by a dark texture carrying a single bright dot."""
+    base = box_room()
+    target = next(s for s in base.surfaces if s.name == "wall/1/1")  # the wall at y = 4, facing -y
+    tex = np.full((200, 200, 3), 30, np.uint8)
+    cv2.circle(tex, (int(a * 200), int(b * 200)), 3, (255, 0, 255), -1)  # magenta: no other texture has it
+    swapped = [dataclasses.replace(s, texture=tex) if s is target else s for s in base.surfaces]
+    world = World(swapped, "dot", base.interior, base.height)
+    # centre of the drawn disc in texture coordinates (texel centres at i + 0.5)
+    point = target.point((int(a * 200) + 0.5) / 200, (int(b * 200) + 0.5) / 200)
+    return world, point
+
+
+def bright_centroid(image):
+    g = image[..., 0].astype(float)
+    m = (g > 100) & (image[..., 2] > 100) & (image[..., 1] < 60)
+    v, u = np.nonzero(m)
+    w = g[m]
+    return np.array([(u * w).sum() / w.sum(), (v * w).sum() / w.sum()])
+
+
+@pytest.mark.parametrize("pose", [[3.0, 1.0, np.pi / 2], [2.0, 2.0, 1.2], [4.2, 1.5, 2.0]])
+def test_point_on_wall_is_painted_where_it_projects(pose):
+    world, X = dot_world()
+    T = CAM.pose_at(pose)
+    frame = CAM.render(world, T)
+    uv, z = CAM.project(X, T)
+    assert np.linalg.norm(bright_centroid(frame.image) - uv[0]) < 1.0
+
+
+def test_rendered_depth_backprojects_to_the_wall_within_1mm():
+    world = box_room()
+    T = CAM.pose_at([2.0, 1.5, 0.7])
+    frame = CAM.render(world, T)
+    rng = np.random.default_rng(0)
+    pix = np.column_stack([rng.integers(0, 640, 300), rng.integers(0, 480, 300)]).astype(float)
+    depth = frame.depth[pix[:, 1].astype(int), pix[:, 0].astype(int)]
+    P = CAM.backproject(pix, depth, T)
+    # every back-projected point lies on a wall, the floor or the ceiling of the 6 x 4 x 2.5 room
+    gaps = np.min(np.abs(np.column_stack([P[:, 0], P[:, 0] - 6, P[:, 1], P[:, 1] - 4, P[:, 2], P[:, 2] - 2.5])), axis=1)
+    assert gaps.max() < 1e-3
+    uv, z = CAM.project(P, T)
+    np.testing.assert_allclose(uv, pix, atol=1e-6)
+    np.testing.assert_allclose(z, depth, rtol=1e-6)
+
+
+def test_stereo_disparity_is_f_b_over_z():
+    world, X = dot_world()
+    rig = cm.StereoRig(CAM, baseline=0.2, trinocular=True)
+    T = CAM.pose_at([3.0, 1.2, np.pi / 2])
+    views = rig.render(world, T)
+    uv_l, Z = CAM.project(X, T)
+    cl, cr, ct = (bright_centroid(views[k].image) for k in ("left", "right", "top"))
+    expected = CAM.fx * 0.2 / Z[0]
+    assert abs((cl[0] - cr[0]) - expected) < 1.0 and abs(cl[1] - cr[1]) < 1.0
+    # the top camera sits above the left one, so the point appears lower (larger v) in its image
+    assert abs((ct[1] - cl[1]) - CAM.fy * 0.2 / Z[0]) < 1.0 and abs(cl[0] - ct[0]) < 1.0
+    np.testing.assert_allclose(rig.depth(rig.disparity(Z)), Z)
+
+
+def test_omni_projection_round_trip_and_renderer():
+    cam = OmniCamera()
+    rng = np.random.default_rng(1)
+    az = rng.uniform(-np.pi, np.pi, 200)
+    el = rng.uniform(*cam.elevation_range, 200)
+    r = rng.uniform(0.5, 10, 200)
+    P = np.column_stack([r * np.cos(el) * np.cos(az), r * np.cos(el) * np.sin(az), -r * np.sin(el)])
+    uv, ranges = cam.project(P)
+    assert np.isfinite(uv).all()
+    np.testing.assert_allclose(cam.backproject(uv, ranges), P, atol=1e-9)
+    # renderer: the dot appears where the model projects it, at the right range
+    world, X = dot_world()
+    T = cam.pose_at([3.0, 2.0, 0.3])
+    frame = cam.render(world, T)
+    uvx, rx = cam.project(X, T)
+    c = bright_centroid(frame.image)
+    assert np.linalg.norm(c - uvx[0]) < 1.0
+    assert abs(frame.depth[int(round(c[1])), int(round(c[0]))] - rx[0]) < 0.02
+
+
+def _sift_ratio(world, pose, step):
+    """Keypoints in view 1 and the fraction of ratio-test matches to a view ``step`` metres ahead
+    that agree with the ground-truth geometry (depth back-projection, 3 px)."""
+    T1 = CAM.pose_at(pose)
+    T2 = CAM.pose_at([pose[0] + step * np.cos(pose[2]), pose[1] + step * np.sin(pose[2]), pose[2]])
+    f1, f2 = CAM.render(world, T1), CAM.render(world, T2)
+    sift = cv2.SIFT_create()
+    k1, d1 = sift.detectAndCompute(cv2.cvtColor(f1.image, cv2.COLOR_RGB2GRAY), None)
+    k2, d2 = sift.detectAndCompute(cv2.cvtColor(f2.image, cv2.COLOR_RGB2GRAY), None)
+    pairs = cv2.BFMatcher(cv2.NORM_L2).knnMatch(d1, d2, k=2)
+    good = [m for m, n in pairs if m.distance < 0.8 * n.distance]
+    p1 = np.array([k1[m.queryIdx].pt for m in good])
+    p2 = np.array([k2[m.trainIdx].pt for m in good])
+    depth = f1.depth[np.round(p1[:, 1]).astype(int), np.round(p1[:, 0]).astype(int)]
+    X = CAM.backproject(p1, depth, T1)
+    pred, _ = CAM.project(X, T2)
+    ok = np.linalg.norm(pred - p2, axis=1) < 3.0
+    return len(k1), len(good), ok.mean()
+
+
+@pytest.mark.parametrize("builder, pose", [
+    (lab_room, [5.0, 2.0, np.pi / 2]), (long_corridor, [3.0, 0.0, 0.0]), (office_floor, [10.0, 4.3, -np.pi / 2]),
+    (box_room, [1.0, 1.0, 0.4]),
+])
+def test_sift_finds_hundreds_of_keypoints_and_correct_matches(builder, pose):
+    n_kp, n_match, inliers = _sift_ratio(builder(), pose, 0.3)
+    print(f"{builder.__name__}: {n_kp} keypoints, {n_match} matches, inlier ratio {inliers:.3f}")
+    assert n_kp >= 200
+    assert n_match >= 50
+    assert inliers > 0.8
+
+
+def test_lighting_and_noise_change_the_image_reproducibly():
+    world = box_room()
+    T = CAM.pose_at([3.0, 2.0, 0.0])
+    a = CAM.render(world, T).image
+    dark = CAM.render(world, T, lighting={"gain": 0.5}).image
+    assert dark.mean() < 0.6 * a.mean()
+    n1 = CAM.render(world, T, noise=5, rng=3).image
+    n2 = CAM.render(world, T, noise=5, rng=3).image
+    assert np.array_equal(n1, n2) and not np.array_equal(n1, a)
+    assert abs((n1.astype(float) - a).std() - 5) < 0.5
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda: cm.PinholeCamera(0.0, 500, 320, 240), "fx"),
+    (lambda: cm.PinholeCamera(500, -1.0, 320, 240), "fy"),
+    (lambda: cm.StereoRig(CAM, baseline=0.0), "baseline"),
+    (lambda: cm.StereoRig(CAM, baseline=-0.1), "baseline"),
+    (lambda: CAM.render(box_room(), np.full((4, 4), np.nan)), "pose"),
+    (lambda: CAM.observe(box_room(), [np.nan, 1.0, 0.0]), "robot_pose"),
+    (lambda: CAM.observe(box_room(), [-1.0, 1.0, 0.0]), "pose"),       # outside the world
+    (lambda: CAM.observe(box_room(), [0.01, 1.0, 0.0]), "pose"),       # inside a wall
+    (lambda: CAM.observe(lab_room(), [5.5, 5.0, 0.0]), "pose"),        # inside the table
+    (lambda: CAM.render(box_room(), se3_from_rt(np.eye(3), [3, 2, 3.0])), "pose"),  # above the ceiling
+    (lambda: CAM.render("world", se2_to_se3([1, 1, 0], 1)), "world"),
+    (lambda: World([], "empty", (0, 0), 2.5), "surfaces"),
+    (lambda: OmniCamera(xi=0.0), "xi"),
+    (lambda: OmniCamera().observe(box_room(), [7.0, 1.0, 0.0]), "pose"),
+])
+def test_bad_input_is_named(call, match):
+    with pytest.raises((ValueError, TypeError), match=match):
+        call()
