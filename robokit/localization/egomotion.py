@@ -1,0 +1,401 @@
+"""3-DoF ego-motion ``[p, q, theta]`` from 3-D correspondences: RANSAC and least squares.
+
+Lin et al. Sec. 4-7: two tentative matches between features (robot frame) and landmarks (world
+frame) fix a pose hypothesis; a match supports it when the transformed feature lies within
+``d_threshold`` of its landmark; the hypothesis with most support is refined by least squares. The
+number of samples follows ``P = 1 - (1 - (1 - eps)^p)^m``. With fewer than 15 supporting matches the
+odometry is used. Matches come from the continuation constraint (landmarks predicted by odometry,
+searched within a window; Lin et al. Sec. 3, Se et al. Sec. 3.2) or, when that finds too few (the
+robot seems kidnapped), from the whole database.
+
+Frames and pose convention: :mod:`robokit.mapping.frames`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..geometry import wrap_angle
+from ..mapping.frames import as_pose, robot_to_world, world_to_robot
+from ..mapping.landmarks import LandmarkMap
+from ..validation import as_array, as_points, as_rng, check_int, check_positive
+from ..vision.matching import ratio_match
+
+__all__ = ["DegenerateCorrespondenceError", "InsufficientMatchesError", "EgomotionResult",
+           "ransac_sample_count", "pose_from_two", "fit_pose", "ransac_pose", "continuation_matches",
+           "track"]
+
+_MIN_SEPARATION = 1e-3  # metres: two points closer than this on the ground plane fix no heading
+
+
+class DegenerateCorrespondenceError(ValueError):
+    """Raised when correspondences cannot fix a pose (coincident points on the ground plane)."""
+
+
+class InsufficientMatchesError(ValueError):
+    """Raised when there are too few matches and no odometry to fall back on."""
+
+
+@dataclass(frozen=True)
+class EgomotionResult:
+    """Outcome of pose estimation.
+
+    Attributes
+    ----------
+    pose : numpy.ndarray, shape (3,)
+        ``[p, q, theta]`` (metres, metres, radians); always finite.
+    covariance : numpy.ndarray, shape (3, 3)
+        Least-squares covariance, or the odometry covariance on fall-back.
+    inliers : numpy.ndarray of bool, shape (N,)
+        Matches supporting the pose (all False on fall-back).
+    source : str
+        ``"ransac"`` or ``"odometry"``.
+    iterations : int
+        Hypotheses drawn.
+    rms : float
+        Root-mean-square 3-D residual of the inliers (metres; 0 on fall-back).
+    """
+
+    pose: np.ndarray
+    covariance: np.ndarray
+    inliers: np.ndarray
+    source: str
+    iterations: int
+    rms: float
+
+    @property
+    def n_inliers(self) -> int:
+        """Number of supporting matches."""
+        return int(np.count_nonzero(self.inliers))
+
+
+def ransac_sample_count(contamination: float, sample_size: int = 2, confidence: float = 0.99) -> int:
+    """Number of RANSAC samples ``m`` so that a clean sample is drawn with probability ``P``.
+
+    Parameters
+    ----------
+    contamination : float
+        Ratio ``eps`` of false matches, in [0, 1).
+    sample_size : int, default 2
+        Matches per hypothesis ``p`` (two for the 3-DoF pose).
+    confidence : float, default 0.99
+        Required probability ``P`` in (0, 1).
+
+    Returns
+    -------
+    int
+        ``ceil(log(1 - P) / log(1 - (1 - eps)^p))``, at least 1.
+
+    Raises
+    ------
+    ValueError
+        For ``eps`` outside [0, 1) (``eps = 1`` would need infinitely many samples) or ``P``
+        outside (0, 1).
+
+    Notes
+    -----
+    Lin et al. Sec. 7, ``P = 1 - (1 - (1 - eps)^p)^m`` solved for ``m`` (Fischler & Bolles 1981).
+    """
+    eps = check_positive(contamination, "contamination", allow_zero=True)
+    if eps >= 1:
+        raise ValueError(f"contamination: expected a ratio in [0, 1), got {eps}")
+    p = check_int(sample_size, "sample_size", minimum=1)
+    conf = check_positive(confidence, "confidence")
+    if conf >= 1:
+        raise ValueError(f"confidence: expected a probability in (0, 1), got {conf}")
+    good = (1 - eps) ** p
+    if good >= 1:
+        return 1
+    return max(1, int(np.ceil(np.log(1 - conf) / np.log(1 - good))))
+
+
+def _poses_from_pairs(r1, r2, w1, w2):
+    """Vectorised two-point poses; inputs (K, 2) ground-plane (X, Z) coordinates."""
+    dr, dw = r2 - r1, w2 - w1
+    theta = np.arctan2(dr[:, 0] * dw[:, 1] - dr[:, 1] * dw[:, 0], (dr * dw).sum(1))
+    c, s = np.cos(theta), np.sin(theta)
+    mid_r, mid_w = 0.5 * (r1 + r2), 0.5 * (w1 + w2)
+    p = mid_w[:, 0] - (c * mid_r[:, 0] - s * mid_r[:, 1])
+    q = mid_w[:, 1] - (s * mid_r[:, 0] + c * mid_r[:, 1])
+    return np.column_stack([p, q, theta])
+
+
+def pose_from_two(robot_points, world_points) -> np.ndarray:
+    """Pose ``[p, q, theta]`` from two feature-landmark correspondences.
+
+    Parameters
+    ----------
+    robot_points : array_like, shape (2, 3)
+        Feature positions in the robot frame (X sideways, Y up, Z forward).
+    world_points : array_like, shape (2, 3)
+        The matched landmarks in the world frame.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        Heading from the direction between the two points, translation from their midpoints.
+
+    Raises
+    ------
+    DegenerateCorrespondenceError
+        If either pair is (nearly) coincident on the ground plane.
+
+    Notes
+    -----
+    Lin et al. Sec. 5: equating ``(X_i, Z_i) = R(theta) (X'_i, Z'_i) + (p, q)`` for two matches.
+    """
+    r = as_array(robot_points, "robot_points", shape=(2, 3))[:, [0, 2]]
+    w = as_array(world_points, "world_points", shape=(2, 3))[:, [0, 2]]
+    if min(np.linalg.norm(r[1] - r[0]), np.linalg.norm(w[1] - w[0])) < _MIN_SEPARATION:
+        raise DegenerateCorrespondenceError("robot_points, world_points: expected two distinct points on the "
+                                            "ground plane, got coincident ones")
+    return _poses_from_pairs(r[:1], r[1:], w[:1], w[1:])[0]
+
+
+def fit_pose(robot_points, world_points) -> tuple[np.ndarray, np.ndarray, float]:
+    """Least-squares pose from N >= 2 correspondences (closed-form planar Procrustes).
+
+    Parameters
+    ----------
+    robot_points, world_points : array_like, shape (N, 3)
+
+    Returns
+    -------
+    pose : numpy.ndarray, shape (3,)
+    covariance : numpy.ndarray, shape (3, 3)
+        ``s^2 (J^T J)^-1`` with ``s^2`` the residual variance per coordinate (floored at 1 mm^2).
+    rms : float
+        Root-mean-square ground-plane residual (metres).
+
+    Raises
+    ------
+    DegenerateCorrespondenceError
+        If all points coincide on the ground plane (the heading is then undetermined).
+    ValueError
+        For shapes that do not agree or fewer than two points.
+
+    Notes
+    -----
+    Lin et al. Sec. 6 and Se et al. Sec. 2.3 (least-squares refinement); the minimiser of
+    ``sum ||R r_i + t - w_i||^2`` over the plane is the Procrustes solution (Umeyama 1991).
+    """
+    r = as_points(robot_points, "robot_points", 3, min_count=2)[:, [0, 2]]
+    w = as_points(world_points, "world_points", 3, min_count=2)
+    if w.shape[0] != r.shape[0]:
+        raise ValueError(f"world_points: expected {r.shape[0]} points, got {w.shape[0]}")
+    w = w[:, [0, 2]]
+    rc, wc = r - r.mean(0), w - w.mean(0)
+    if np.sqrt((rc ** 2).sum(1).max()) < _MIN_SEPARATION or np.sqrt((wc ** 2).sum(1).max()) < _MIN_SEPARATION:
+        raise DegenerateCorrespondenceError("robot_points, world_points: expected points spread on the ground "
+                                            "plane, got (nearly) coincident ones")
+    theta = np.arctan2((rc[:, 0] * wc[:, 1] - rc[:, 1] * wc[:, 0]).sum(), (rc * wc).sum())
+    c, s = np.cos(theta), np.sin(theta)
+    rot = np.array([[c, -s], [s, c]])
+    t = w.mean(0) - rot @ r.mean(0)
+    res = w - (r @ rot.T + t)
+    n = r.shape[0]
+    s2 = max((res ** 2).sum() / max(2 * n - 3, 1), 1e-6)
+    jac = np.zeros((2 * n, 3))
+    jac[0::2, 0] = 1.0
+    jac[1::2, 1] = 1.0
+    jac[0::2, 2] = -s * r[:, 0] - c * r[:, 1]
+    jac[1::2, 2] = c * r[:, 0] - s * r[:, 1]
+    cov = s2 * np.linalg.pinv(jac.T @ jac)
+    return np.array([t[0], t[1], wrap_angle(theta)]), cov, float(np.sqrt((res ** 2).sum(1).mean()))
+
+
+def _fallback(n, odometry, odometry_covariance, iterations, why):
+    if odometry is None:
+        raise InsufficientMatchesError(f"{why}, and no odometry was given to fall back on")
+    cov = np.eye(3) * 1e-2 if odometry_covariance is None else as_array(odometry_covariance, "odometry_covariance",
+                                                                          shape=(3, 3))
+    return EgomotionResult(as_pose(odometry, "odometry"), cov, np.zeros(n, bool), "odometry", iterations, 0.0)
+
+
+def ransac_pose(robot_points, world_points, *, threshold: float = 0.1, confidence: float = 0.99,
+                min_matches: int = 15, max_iterations: int = 5000, odometry=None, odometry_covariance=None,
+                rng=None) -> EgomotionResult:
+    """RANSAC over two-point pose hypotheses, then least-squares refinement of the winner.
+
+    Parameters
+    ----------
+    robot_points, world_points : array_like, shape (N, 3)
+        Tentative matches: feature in the robot frame, landmark in the world frame.
+    threshold : float, default 0.1
+        ``d_threshold`` (metres): a match supports a pose when its transformed feature lies this
+        close to its landmark.
+    confidence : float, default 0.99
+        ``P`` in the sample-count formula; the contamination is re-estimated from the best support
+        found so far (adaptive RANSAC).
+    min_matches : int, default 15
+        Fewer supporting matches means the estimate is unreliable: odometry is used instead.
+    max_iterations : int, default 5000
+        Cap on hypotheses.
+    odometry, odometry_covariance : array_like, optional
+        Fall-back pose ``[p, q, theta]`` and its covariance.
+    rng : numpy.random.Generator or int, optional
+
+    Returns
+    -------
+    EgomotionResult
+
+    Raises
+    ------
+    InsufficientMatchesError
+        If fewer than ``min_matches`` matches support any pose and no odometry is given.
+
+    Notes
+    -----
+    Lin et al. Sec. 5-7 (hypotheses from two tentative matches, support counting, least squares,
+    15 matches minimum, odometry fall-back). Hypotheses are evaluated in vectorised batches.
+    """
+    r = as_array(robot_points, "robot_points", shape=(None, 3))
+    w = as_array(world_points, "world_points", shape=(r.shape[0], 3))
+    thr = check_positive(threshold, "threshold")
+    min_matches = check_int(min_matches, "min_matches", minimum=2)
+    max_iterations = check_int(max_iterations, "max_iterations", minimum=1)
+    gen = as_rng(rng)
+    n = r.shape[0]
+    if n < max(2, min_matches):
+        return _fallback(n, odometry, odometry_covariance, 0, f"only {n} matches (need {min_matches})")
+    rg, wg = r[:, [0, 2]], w[:, [0, 2]]
+    best, best_count, best_cost = None, -1, np.inf
+    needed, drawn = ransac_sample_count(0.99, 2, confidence), 0
+    while drawn < min(needed, max_iterations):
+        k = min(64, max_iterations - drawn)
+        i = gen.integers(0, n, k)
+        j = (i + gen.integers(1, n, k)) % n           # a distinct second index
+        drawn += k
+        ok = (np.linalg.norm(rg[j] - rg[i], axis=1) >= _MIN_SEPARATION) & \
+             (np.linalg.norm(wg[j] - wg[i], axis=1) >= _MIN_SEPARATION)
+        if not ok.any():
+            continue
+        poses = _poses_from_pairs(rg[i[ok]], rg[j[ok]], wg[i[ok]], wg[j[ok]])
+        c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
+        px = c * rg[None, :, 0] - s * rg[None, :, 1] + poses[:, :1] - wg[None, :, 0]
+        pz = s * rg[None, :, 0] + c * rg[None, :, 1] + poses[:, 1:2] - wg[None, :, 1]
+        dist = np.sqrt(px * px + pz * pz + (r[None, :, 1] - w[None, :, 1]) ** 2)
+        support = dist < thr
+        count = support.sum(1)
+        cost = np.where(support, dist, thr).sum(1)
+        h = int(np.lexsort((cost, -count))[0])
+        if count[h] > best_count or (count[h] == best_count and cost[h] < best_cost):
+            best, best_count, best_cost = poses[h], int(count[h]), float(cost[h])
+            needed = ransac_sample_count(min(1 - best_count / n, 0.999), 2, confidence)
+    if best is None or best_count < min_matches:
+        return _fallback(n, odometry, odometry_covariance, drawn,
+                         f"only {max(best_count, 0)} matches support a pose (need {min_matches})")
+    pose, inliers = best, None
+    for _ in range(3):  # refit on the support, recompute the support
+        inliers = np.linalg.norm(robot_to_world(r, pose) - w, axis=1) < thr
+        if inliers.sum() < 2:
+            break
+        pose, cov, rms = fit_pose(r[inliers], w[inliers])
+    inliers = np.linalg.norm(robot_to_world(r, pose) - w, axis=1) < thr
+    if inliers.sum() < min_matches:
+        return _fallback(n, odometry, odometry_covariance, drawn,
+                         f"only {int(inliers.sum())} matches support the refined pose (need {min_matches})")
+    pose, cov, rms = fit_pose(r[inliers], w[inliers])
+    return EgomotionResult(pose, cov, inliers, "ransac", drawn, rms)
+
+
+def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_pose, *, window: float = 0.3,
+                         ratio: float = 0.8, max_distance: float = 0.8) -> tuple[np.ndarray, np.ndarray]:
+    """Match features to landmarks predicted (by odometry) to lie within a window around them.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 3)
+        Feature positions in the robot frame.
+    descriptors : array_like, shape (N, D)
+    landmarks : LandmarkMap
+    predicted_pose : array_like, shape (3,)
+        Odometry prediction of the pose.
+    window : float, default 0.3
+        Search radius (metres) around each feature.
+    ratio : float, default 0.8
+        Best / second-best descriptor distance among the landmarks in the window.
+    max_distance : float, default 0.8
+        Maximum descriptor distance.
+
+    Returns
+    -------
+    feature_index, landmark_row : numpy.ndarray of int, shape (M,)
+
+    Notes
+    -----
+    Lin et al. Sec. 3 (continuation constraint) and Se et al. Sec. 3.2 (predict the database
+    landmarks in the new frame from odometry and look for matches in the vicinity).
+    """
+    pts = as_array(points, "points", shape=(None, 3))
+    desc = as_array(descriptors, "descriptors", shape=(pts.shape[0], landmarks.descriptor_size), dtype=np.float32)
+    rad = check_positive(window, "window")
+    ratio = check_positive(ratio, "ratio")
+    none = (np.zeros(0, int), np.zeros(0, int))
+    if len(landmarks) == 0 or pts.shape[0] == 0:
+        return none
+    predicted = world_to_robot(landmarks.positions, predicted_pose)
+    lists = cKDTree(predicted).query_ball_point(pts, rad)
+    counts = np.array([len(x) for x in lists])
+    if counts.sum() == 0:
+        return none
+    fi = np.repeat(np.arange(pts.shape[0]), counts)
+    li = np.concatenate([np.asarray(x, int) for x in lists if x])
+    dist = np.linalg.norm(desc[fi] - landmarks.descriptors[li], axis=1)
+    order = np.lexsort((dist, fi))
+    fi, li, dist = fi[order], li[order], dist[order]
+    first = np.r_[True, fi[1:] != fi[:-1]]
+    start = np.nonzero(first)[0]
+    has_second = np.r_[start[1:], fi.size] - start > 1
+    second = np.full(start.size, np.inf)
+    second[has_second] = dist[start[has_second] + 1]
+    keep = (dist[start] <= max_distance) & (dist[start] < ratio * second)
+    return fi[start[keep]], li[start[keep]]
+
+
+def track(points, descriptors, landmarks: LandmarkMap, odometry, odometry_covariance=None, *,
+          window: float = 0.3, min_matches: int = 15, threshold: float = 0.1, ratio: float = 0.8,
+          rng=None) -> tuple[EgomotionResult, np.ndarray, np.ndarray, bool]:
+    """Estimate the pose of one frame against the landmark map.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 3)
+        Stereo features in the robot frame.
+    descriptors : array_like, shape (N, D)
+    landmarks : LandmarkMap
+    odometry : array_like, shape (3,)
+        Odometry-predicted pose.
+    odometry_covariance : array_like, shape (3, 3), optional
+    window, min_matches, threshold, ratio
+        See :func:`continuation_matches` and :func:`ransac_pose`.
+    rng : numpy.random.Generator or int, optional
+
+    Returns
+    -------
+    result : EgomotionResult
+    feature_index, landmark_row : numpy.ndarray of int
+        The supporting matches (empty on odometry fall-back).
+    kidnapped : bool
+        True when the continuation constraint found fewer than ``min_matches`` matches and the
+        whole database was searched instead.
+
+    Notes
+    -----
+    Lin et al. Sec. 3 and 7: continuation constraint first; too few matches suggests the robot was
+    kidnapped or the scene changed, so the features are matched against the whole database (a
+    higher contamination, hence more RANSAC samples); too few supporting matches -> odometry.
+    """
+    odo = as_pose(odometry, "odometry")
+    pts = as_array(points, "points", shape=(None, 3))
+    fi, li = continuation_matches(pts, descriptors, landmarks, odo, window=window, ratio=ratio)
+    kidnapped = fi.size < min_matches
+    if kidnapped and len(landmarks) >= 2 and pts.shape[0]:
+        m = ratio_match(descriptors, landmarks.descriptors, ratio=ratio)
+        fi, li = m.query, m.train
+    result = ransac_pose(pts[fi], landmarks.positions[li], threshold=threshold, min_matches=min_matches,
+                         odometry=odo, odometry_covariance=odometry_covariance, rng=rng)
+    keep = result.inliers
+    return result, fi[keep], li[keep], kidnapped
