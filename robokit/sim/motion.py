@@ -1,0 +1,290 @@
+"""Robot motion: unicycle / differential-drive and skid-steer kinematics, odometry noise, paths.
+
+Planar poses are ``[x, y, theta]`` (see :mod:`robokit.geometry`). The odometry noise model is the
+four-parameter model of Thrun, Burgard & Fox, *Probabilistic Robotics* (2005), Sec. 5.4: a motion
+between two poses is decomposed into a rotation ``delta_rot1``, a translation ``delta_trans`` and a
+rotation ``delta_rot2`` (Table 5.5), each corrupted by zero-mean Gaussian noise whose variance
+grows with the motion (Table 5.6, ``sample_motion_model_odometry``):
+
+    var(rot1) = a1 rot1^2 + a2 trans^2,  var(trans) = a3 trans^2 + a4 (rot1^2 + rot2^2),
+    var(rot2) = a1 rot2^2 + a2 trans^2.
+"""
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ..geometry import se2_compose, wrap_angle
+from ..validation import as_array, as_points, as_rng, check_positive
+
+__all__ = ["unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "odometry_increment",
+           "sample_motion_model_odometry", "noisy_odometry", "Path", "waypoint_path", "corridor_path",
+           "lab_lap"]
+
+
+def unicycle_step(pose: Any, v: Any, omega: Any, dt: float) -> np.ndarray:
+    """Advance poses by driving at speed ``v`` and turn rate ``omega`` for ``dt`` seconds (exact arc).
+
+    Parameters
+    ----------
+    pose : array_like, shape (3,) or (N, 3)
+    v, omega : float or array_like (N,)
+        Forward speed (m/s) and turn rate (rad/s).
+    dt : float
+        Duration (s, >= 0).
+
+    Returns
+    -------
+    numpy.ndarray, same shape as ``pose``
+
+    Notes
+    -----
+    Thrun, Burgard & Fox (2005), Eq. (5.9) (circular arc of radius ``v / omega``); the straight
+    line when ``omega = 0``.
+    """
+    P = as_array(pose, "pose")
+    single = P.ndim == 1
+    P = as_points(P, "pose", 3)
+    v = np.broadcast_to(as_array(v, "v"), (len(P),))
+    w = np.broadcast_to(as_array(omega, "omega"), (len(P),))
+    dt = check_positive(dt, "dt", allow_zero=True)
+    th = P[:, 2]
+    small = np.abs(w * dt) < 1e-9
+    ws = np.where(small, 1.0, w)
+    dx = np.where(small, v * dt * np.cos(th + w * dt / 2), v / ws * (np.sin(th + w * dt) - np.sin(th)))
+    dy = np.where(small, v * dt * np.sin(th + w * dt / 2), v / ws * (np.cos(th) - np.cos(th + w * dt)))
+    out = np.column_stack([P[:, 0] + dx, P[:, 1] + dy, wrap_angle(th + w * dt)])
+    return out[0] if single else out
+
+
+def diff_drive_velocities(omega_left: Any, omega_right: Any, wheel_radius: float, track: float) -> tuple:
+    """Body speed and turn rate of a differential drive from wheel angular speeds.
+
+    Returns
+    -------
+    (v, omega) : ``v = r (w_r + w_l) / 2``, ``omega = r (w_r - w_l) / track``.
+
+    Notes
+    -----
+    Siegwart, Nourbakhsh & Scaramuzza, *Introduction to Autonomous Mobile Robots* (2011), Sec. 3.2.
+    """
+    r = check_positive(wheel_radius, "wheel_radius")
+    b = check_positive(track, "track")
+    wl, wr = as_array(omega_left, "omega_left"), as_array(omega_right, "omega_right")
+    return r * (wr + wl) / 2, r * (wr - wl) / b
+
+
+def skid_steer_velocities(v_left: Any, v_right: Any, track: float, chi: float = 1.5) -> tuple:
+    """Body speed and turn rate of a skid-steer vehicle from its left/right track (wheel) speeds.
+
+    Parameters
+    ----------
+    v_left, v_right : float or array_like
+        Linear speeds of the left and right wheel sets (m/s).
+    track : float
+        Distance between left and right wheels (m).
+    chi : float, default 1.5
+        Expansion factor (>= 1): skidding makes the vehicle turn as if its track were ``chi * track``.
+
+    Returns
+    -------
+    (v, omega)
+
+    Notes
+    -----
+    Mandow et al., "Experimental kinematics for wheeled skid-steer mobile robots" (IROS 2007),
+    Eq. (12): ``omega = (v_r - v_l) / (chi B)``; ``chi = 1`` is the ideal differential drive.
+    """
+    b = check_positive(track, "track")
+    c = check_positive(chi, "chi")
+    if c < 1:
+        raise ValueError(f"chi: expected an expansion factor >= 1, got {c}")
+    vl, vr = as_array(v_left, "v_left"), as_array(v_right, "v_right")
+    return (vr + vl) / 2, (vr - vl) / (c * b)
+
+
+def odometry_increment(previous: Any, current: Any) -> np.ndarray:
+    """Decompose the motion between two poses into ``[delta_rot1, delta_trans, delta_rot2]``.
+
+    Parameters
+    ----------
+    previous, current : array_like, shape (3,) or (N, 3)
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,) or (N, 3)
+
+    Notes
+    -----
+    Thrun, Burgard & Fox (2005), Table 5.5 lines 2-4 (``rot1 = 0`` for a pure rotation).
+    """
+    a = as_array(previous, "previous")
+    b = as_array(current, "current")
+    if a.shape != b.shape or a.shape[-1:] != (3,):
+        raise ValueError(f"current: expected the shape of previous {a.shape} with 3 columns, got {b.shape}")
+    dx, dy = b[..., 0] - a[..., 0], b[..., 1] - a[..., 1]
+    trans = np.hypot(dx, dy)
+    rot1 = np.where(trans > 1e-12, wrap_angle(np.arctan2(dy, dx) - a[..., 2]), 0.0)
+    rot2 = wrap_angle(b[..., 2] - a[..., 2] - rot1)
+    return np.stack([rot1, trans, rot2], axis=-1)
+
+
+def _alphas(alphas: Any) -> np.ndarray:
+    a = as_array(alphas, "alphas", shape=(4,))
+    if np.any(a < 0):
+        raise ValueError(f"alphas: expected four non-negative noise parameters, got {a.tolist()}")
+    return a
+
+
+def _perturb(delta: np.ndarray, a: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    r1, t, r2 = delta[..., 0], delta[..., 1], delta[..., 2]
+    sd1 = np.sqrt(a[0] * r1 ** 2 + a[1] * t ** 2)
+    sdt = np.sqrt(a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2))
+    sd2 = np.sqrt(a[0] * r2 ** 2 + a[1] * t ** 2)
+    noise = rng.standard_normal(delta.shape)
+    return np.stack([r1 - sd1 * noise[..., 0], t - sdt * noise[..., 1], r2 - sd2 * noise[..., 2]], axis=-1)
+
+
+def _apply(pose: np.ndarray, d: np.ndarray) -> np.ndarray:
+    th = pose[..., 2] + d[..., 0]
+    return np.stack([pose[..., 0] + d[..., 1] * np.cos(th), pose[..., 1] + d[..., 1] * np.sin(th),
+                     wrap_angle(th + d[..., 2])], axis=-1)
+
+
+def sample_motion_model_odometry(odom_prev: Any, odom_now: Any, poses: Any, alphas: Any, rng: Any = None) -> np.ndarray:
+    """Sample successor poses given an odometry reading (for particle filters).
+
+    Parameters
+    ----------
+    odom_prev, odom_now : array_like, shape (3,)
+        Consecutive odometry poses (the reading ``u = (x_bar_{t-1}, x_bar_t)``).
+    poses : array_like, shape (N, 3) or (3,)
+        Poses ``x_{t-1}`` (e.g. particles).
+    alphas : array_like, shape (4,)
+        Noise parameters ``a1..a4`` (non-negative).
+    rng : Generator or int, optional
+
+    Returns
+    -------
+    numpy.ndarray, same shape as ``poses``
+
+    Notes
+    -----
+    Thrun, Burgard & Fox (2005), Table 5.6 (``sample(b^2)`` draws a zero-mean Gaussian of
+    variance ``b^2``).
+    """
+    delta = odometry_increment(odom_prev, odom_now)
+    P = as_array(poses, "poses")
+    if P.shape[-1:] != (3,) or P.ndim > 2:
+        raise ValueError(f"poses: expected shape (3,) or (N, 3), got shape {P.shape}")
+    d = _perturb(np.broadcast_to(delta, P.shape), _alphas(alphas), as_rng(rng))
+    return _apply(P, d)
+
+
+def noisy_odometry(poses: Any, alphas: Any, rng: Any = None) -> np.ndarray:
+    """Simulate wheel odometry along a true trajectory: accumulate noisy motion increments.
+
+    Parameters
+    ----------
+    poses : array_like, shape (N, 3)
+        Ground-truth poses.
+    alphas : array_like, shape (4,)
+        Noise parameters of Table 5.6 (``(0, 0, 0, 0)`` gives perfect odometry).
+    rng : Generator or int, optional
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3)
+        Odometry poses, starting at the first true pose; each increment is the true increment
+        (Table 5.5) corrupted as in Table 5.6, so drift grows like a random walk.
+
+    Notes
+    -----
+    Thrun, Burgard & Fox (2005), Sec. 5.4.
+    """
+    P = as_points(poses, "poses", 3, min_count=1)
+    a = _alphas(alphas)
+    d = _perturb(odometry_increment(P[:-1], P[1:]), a, as_rng(rng))
+    out = np.empty_like(P)
+    out[0] = P[0]
+    for k in range(len(d)):  # sequential by nature: each increment starts where the last ended
+        out[k + 1] = _apply(out[k], d[k])
+    return out
+
+
+class Path(NamedTuple):
+    """A timed trajectory: ``t`` (N,) seconds and ``poses`` (N, 3)."""
+
+    t: np.ndarray
+    poses: np.ndarray
+
+
+def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, rate: float = 10.0) -> Path:
+    """A remote-controlled drive through waypoints: turn on the spot, then drive straight.
+
+    Parameters
+    ----------
+    waypoints : array_like, shape (K, 2)
+        At least two (x, y) points; the robot starts at the first, facing the second.
+    speed : float, default 0.3
+        Forward speed (m/s).
+    turn_rate : float, default 0.6
+        Turn rate for the on-the-spot turns (rad/s).
+    rate : float, default 10
+        Sampling rate of the returned poses (Hz).
+
+    Returns
+    -------
+    Path
+
+    Notes
+    -----
+    Piecewise unicycle motion (Thrun et al. 2005, Sec. 5.3) with ``omega = 0`` or ``v = 0``;
+    Ge et al. (2023, Sec. 3.4) drive their robot by remote control along the corridor's middle line.
+    """
+    W = as_points(waypoints, "waypoints", 2, min_count=2)
+    v = check_positive(speed, "speed")
+    w = check_positive(turn_rate, "turn_rate")
+    dt = 1.0 / check_positive(rate, "rate")
+    heading = np.arctan2(*(W[1] - W[0])[::-1])
+    knots_t, knots = [0.0], [np.array([W[0, 0], W[0, 1], heading])]
+    for a, b in zip(W[:-1], W[1:]):
+        target = np.arctan2(b[1] - a[1], b[0] - a[0])
+        turn = wrap_angle(target - knots[-1][2])
+        if abs(turn) > 1e-12:
+            knots_t.append(knots_t[-1] + abs(turn) / w)
+            knots.append(np.array([a[0], a[1], knots[-1][2] + turn]))
+        length = float(np.linalg.norm(b - a))
+        if length > 0:
+            knots_t.append(knots_t[-1] + length / v)
+            knots.append(np.array([b[0], b[1], knots[-1][2]]))
+    kt, kp = np.array(knots_t), np.array(knots)
+    t = np.arange(0.0, kt[-1] + 1e-9, dt)
+    poses = np.column_stack([np.interp(t, kt, kp[:, i]) for i in range(3)])
+    poses[:, 2] = wrap_angle(poses[:, 2])
+    return Path(t, poses)
+
+
+def corridor_path(world: Any, speed: float = 0.3, rate: float = 10.0, margin: float = 0.8) -> Path:
+    """Drive along the middle line of :func:`robokit.sim.long_corridor`, stopping ``margin`` m from the ends.
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 3.4 and 4.1: remote-controlled along the middle line, stopping about
+    0.8 m from the end wall.
+    """
+    length = float(world.info["length"])
+    m = check_positive(margin, "margin")
+    return waypoint_path([[m, 0.0], [length - m, 0.0]], speed, rate=rate)
+
+
+def lab_lap(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
+    """One lap around the middle of :func:`robokit.sim.lab_room`, clear of the furniture.
+
+    Notes
+    -----
+    Se, Lowe & Little (2002), Sec. 3.6: the robot "traverses around our 10m by 10m lab".
+    """
+    lap = [[3.0, 2.0], [7.5, 2.0], [7.8, 5.0], [7.5, 8.0], [3.0, 8.0], [2.6, 5.0], [3.0, 2.0]]
+    return waypoint_path(lap, speed, rate=rate)
