@@ -1,1 +1,60 @@
-"""Simulation: textured worlds, cameras, LiDAR, motion and recorded runs (filled in below)."""
+"""Simulation: textured worlds, cameras (pinhole, stereo, omnidirectional), 2D LiDAR, motion, runs.
+
+Everything a lesson needs to produce images, depth, scans and ground truth without any dataset:
+
+Worlds (textured planar rectangles + 2D footprint; world frame right-handed, z up, floor z = 0)
+    ``lab_room()``       10 m x 10 m lab with furniture and posters (Se, Lowe & Little 2002)
+    ``long_corridor()``  36.10 m x 2.17 m corridor, 0.07 m door recesses (Ge et al. 2023)
+    ``office_floor()``   four rooms R1-R4 and a corridor (seed 001)
+    ``box_room()``       a plain rectangular room
+    A :class:`World` has ``surfaces``, ``segments`` (the footprint at ``footprint_height``),
+    ``slice(z)``, ``free_space()``, ``is_free(xy)`` and ``info`` (builder facts).
+
+Cameras (poses are 4x4 ``T_world_cam``; optical frame x right, y down, z forward)
+    ``PinholeCamera.from_fov(hfov, width, height)``; ``.K``, ``.project(points, pose)``,
+    ``.backproject(pixels, depth, pose)``, ``.render(world, pose) -> Frame(image, depth)``,
+    ``.observe(world, robot_pose)`` (uses ``.mount``, default 0.8 m high, level).
+    ``StereoRig(camera, baseline, trinocular=False)``: ``.render``/``.observe`` return
+    ``{"left", "right"[, "top"]}`` frames; ``.disparity(Z) = f B / Z``.
+    ``OmniCamera()``: 640x480 unified-model catadioptric camera; ``.project``, ``.rays``,
+    ``.backproject``, ``.render`` (depth = range). See :mod:`robokit.sim.omni` for the model.
+    ``illuminate(image, gain, offset, gradient)`` or ``render(..., lighting={...})`` for
+    lighting changes; ``render(..., noise=sigma, rng=seed)`` for pixel noise.
+
+LiDAR and motion
+    ``Lidar(beams=360, r_min=0.15, r_max=8.0, noise=0.0).scan(world, robot_pose)``;
+    ``unicycle_step``, ``diff_drive_velocities``, ``skid_steer_velocities``,
+    ``odometry_increment``, ``sample_motion_model_odometry``, ``noisy_odometry``
+    (Thrun et al. 2005, Table 5.6); paths ``waypoint_path``, ``corridor_path``, ``lab_lap``.
+
+Recorded runs
+    ``record(world, path, sensors={"cam": cam, "laser": lidar}, rate=5)`` -> :class:`Run`
+    (``t``, ``poses``, ``odometry``, ``images``, ``depths``, ``scans``), cached as ``.npz``.
+
+Example
+-------
+>>> from robokit.sim import lab_room, PinholeCamera, StereoRig
+>>> world = lab_room()
+>>> rig = StereoRig(PinholeCamera.from_fov(), baseline=0.12)
+>>> views = rig.observe(world, [5.0, 2.0, 1.57])   # robot pose [x, y, theta]
+>>> views["left"].image.shape, views["left"].depth.dtype
+((480, 640, 3), dtype('float32'))
+"""
+from .camera import Frame, PinholeCamera, StereoRig, mount_pose
+from .lidar import Lidar, ray_segment_ranges, scan_points
+from .motion import (Path, corridor_path, diff_drive_velocities, lab_lap, noisy_odometry, odometry_increment,
+                     sample_motion_model_odometry, skid_steer_velocities, unicycle_step, waypoint_path)
+from .omni import OmniCamera, omni_mount
+from .runs import Run, record
+from .textures import illuminate, photo
+from .world import FreeSpace, Surface, World
+from .worlds import box_room, lab_room, long_corridor, office_floor
+
+__all__ = [
+    "World", "Surface", "FreeSpace", "box_room", "lab_room", "long_corridor", "office_floor",
+    "Frame", "PinholeCamera", "StereoRig", "mount_pose", "OmniCamera", "omni_mount", "illuminate", "photo",
+    "Lidar", "ray_segment_ranges", "scan_points",
+    "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "odometry_increment",
+    "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap",
+    "Run", "record",
+]

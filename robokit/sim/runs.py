@@ -1,0 +1,207 @@
+"""Recorded runs: drive a path through a world, log ground truth, odometry, images and scans.
+
+A :class:`Run` is plain arrays (no pickled objects), saved as one compressed ``.npz`` file and
+cached under ``robokit.cache_dir("runs")`` keyed by every parameter of the recording, so a lesson
+that records the same run twice renders it once.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+from pathlib import Path as FsPath
+from typing import Any
+
+import numpy as np
+
+from ..config import cache_dir, cache_key
+from ..validation import as_array, as_points, as_rng, check_positive
+from .camera import PinholeCamera, StereoRig
+from .lidar import Lidar
+from .motion import Path, noisy_odometry
+from .omni import OmniCamera
+from .world import World
+
+__all__ = ["Run", "record"]
+
+_FORMAT = 1
+
+
+@dataclasses.dataclass
+class Run:
+    """A recorded drive.
+
+    Attributes
+    ----------
+    t : numpy.ndarray (N,)
+        Timestamps (s).
+    poses : numpy.ndarray (N, 3)
+        Ground-truth planar poses ``[x, y, theta]``.
+    odometry : numpy.ndarray (N, 3)
+        Odometry poses (Thrun et al. 2005, Table 5.6 noise; see :func:`robokit.sim.noisy_odometry`).
+    images : dict of str to numpy.ndarray (N, H, W, 3) uint8
+        Per camera (stereo rigs give ``name/left``, ``name/right``, ...).
+    depths : dict of str to numpy.ndarray (N, H, W) float32
+        Matching depth images (Z for pinhole cameras, range for omni cameras).
+    scans : dict of str to numpy.ndarray (N, B)
+        LiDAR ranges (``inf`` = no return).
+    meta : dict
+        Recording parameters (world, rate, sensors, seed), JSON-serialisable.
+    """
+
+    t: np.ndarray
+    poses: np.ndarray
+    odometry: np.ndarray
+    images: dict
+    depths: dict
+    scans: dict
+    meta: dict
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def save(self, path: str | FsPath) -> FsPath:
+        """Write the run as a compressed ``.npz`` (arrays only; ``meta`` as JSON text)."""
+        arrays = {"t": self.t, "poses": self.poses, "odometry": self.odometry,
+                  "meta": np.array(json.dumps({**self.meta, "format": _FORMAT}))}
+        for group in ("images", "depths", "scans"):
+            for name, arr in getattr(self, group).items():
+                arrays[f"{group}:{name}"] = arr
+        path = FsPath(path)
+        with open(path, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+        return path
+
+    @classmethod
+    def load(cls, path: str | FsPath) -> "Run":
+        """Read a run written by :meth:`save` (``allow_pickle=False``: no code is ever loaded).
+
+        Raises
+        ------
+        ValueError
+            If the file is not a robokit run.
+        """
+        with np.load(FsPath(path), allow_pickle=False) as data:
+            if "meta" not in data.files or "poses" not in data.files:
+                raise ValueError(f"path: expected a robokit run (.npz with meta and poses), got {path}")
+            groups: dict[str, dict] = {"images": {}, "depths": {}, "scans": {}}
+            for key in data.files:
+                if ":" in key:
+                    group, name = key.split(":", 1)
+                    groups[group][name] = data[key]
+            return cls(data["t"], data["poses"], data["odometry"], groups["images"], groups["depths"],
+                       groups["scans"], json.loads(str(data["meta"])))
+
+
+def _describe(sensor: Any) -> dict:
+    """JSON description of a sensor's parameters (for the cache key)."""
+    out = {"type": type(sensor).__name__}
+    for field in dataclasses.fields(sensor):
+        value = getattr(sensor, field.name)
+        if isinstance(value, (PinholeCamera,)):
+            value = _describe(value)
+        elif isinstance(value, np.ndarray):
+            value = np.round(value, 12).tolist()
+        elif isinstance(value, tuple):
+            value = [float(v) for v in value]
+        out[field.name] = value
+    return out
+
+
+def record(world: World, path: Path, sensors: dict, rate: float | None = None, *,
+           odometry_alphas: Any = (0.01, 0.001, 0.01, 0.001), seed: int = 0, cache: bool = True) -> Run:
+    """Drive ``path`` through ``world`` and record every sensor at ``rate``.
+
+    Parameters
+    ----------
+    world : World
+    path : Path, (t, poses) tuple or array_like (N, 3)
+        Timed ground-truth trajectory (a bare pose array is taken as sampled at ``rate``).
+    sensors : dict of str to sensor
+        ``PinholeCamera``, ``StereoRig``, ``OmniCamera`` or ``Lidar`` objects (their mounts define
+        where they sit on the robot).
+    rate : float, optional
+        Recording rate in Hz; the path is resampled (linear interpolation). Default: the path's
+        own samples.
+    odometry_alphas : array_like (4,)
+        Odometry noise parameters (Thrun et al. 2005, Table 5.6).
+    seed : int, default 0
+        Seeds odometry, image and LiDAR noise.
+    cache : bool, default True
+        Load from / save to ``robokit.cache_dir("runs")``, keyed by all parameters.
+
+    Returns
+    -------
+    Run
+
+    Raises
+    ------
+    TypeError, ValueError
+        For an unknown sensor, a bad path or rate, or a path leaving the world's free space.
+
+    Notes
+    -----
+    Ge et al. (2023, Sec. 3.4) record scans and keyframes with timestamps while the robot is
+    remote-controlled; Se, Lowe & Little (2002, Sec. 3.6) record stereo frames and odometry
+    around the lab. Deterministic, hence cacheable (DESIGN.md, "Caching").
+    """
+    if not isinstance(world, World):
+        raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
+    if not isinstance(sensors, dict) or not sensors:
+        raise ValueError(f"sensors: expected a non-empty dict name -> sensor, got {sensors!r}")
+    for name, s in sensors.items():
+        if not isinstance(s, (PinholeCamera, StereoRig, OmniCamera, Lidar)) or "/" in str(name) or ":" in str(name):
+            raise TypeError(f"sensors: expected camera/LiDAR objects under plain names, got {name!r}: {type(s).__name__}")
+    if isinstance(path, tuple) and len(path) == 2 and not isinstance(path, Path):
+        path = Path(*path)
+    if isinstance(path, Path):
+        t0, p0 = as_array(path.t, "path.t", ndim=1), as_points(path.poses, "path.poses", 3, min_count=1)
+    else:
+        p0 = as_points(path, "path", 3, min_count=1)
+        t0 = np.arange(len(p0)) / check_positive(rate if rate is not None else 10.0, "rate")
+    if len(t0) != len(p0) or np.any(np.diff(t0) <= 0):
+        raise ValueError("path: expected strictly increasing timestamps, one per pose")
+    if rate is not None:
+        t = np.arange(t0[0], t0[-1] + 1e-9, 1.0 / check_positive(rate, "rate"))
+        unwrapped = np.unwrap(p0[:, 2])
+        poses = np.column_stack([np.interp(t, t0, p0[:, 0]), np.interp(t, t0, p0[:, 1]),
+                                 np.angle(np.exp(1j * np.interp(t, t0, unwrapped)))])
+    else:
+        t, poses = t0, p0
+    bad = ~world.is_free(poses[:, :2], clearance=0.05)
+    if bad.any():
+        raise ValueError(f"path: expected poses inside the free space of {world.name!r}, got {bad.sum()} outside "
+                         f"(first at {poses[np.argmax(bad), :2].round(3).tolist()})")
+    alphas = as_array(odometry_alphas, "odometry_alphas", shape=(4,))
+    digest = hashlib.sha256(np.ascontiguousarray(poses).tobytes() + t.tobytes()).hexdigest()[:16]
+    geometry = hashlib.sha256(np.round(world.corner_array, 9).tobytes()).hexdigest()[:16]
+    meta = {"world": world.name, "world_info": json.loads(json.dumps(world.info, default=str)), "geometry": geometry,
+            "rate": rate, "path": digest, "sensors": {k: _describe(s) for k, s in sensors.items()},
+            "odometry_alphas": alphas.tolist(), "seed": int(seed)}
+    target = cache_dir("runs") / f"{world.name}-{cache_key(**meta)}.npz" if cache else None
+    if target is not None and target.exists():
+        return Run.load(target)
+    rng = as_rng(int(seed))
+    odometry = noisy_odometry(poses, alphas, rng)
+    images: dict[str, list] = {}
+    depths: dict[str, list] = {}
+    scans: dict[str, list] = {}
+    for pose in poses:
+        for name, sensor in sensors.items():
+            if isinstance(sensor, Lidar):
+                scans.setdefault(name, []).append(sensor.scan(world, pose, rng=rng))
+                continue
+            out = sensor.observe(world, pose, rng=rng)
+            views = out.items() if isinstance(out, dict) else [("", out)]
+            for sub, frame in views:
+                key = f"{name}/{sub}" if sub else name
+                images.setdefault(key, []).append(frame.image)
+                depths.setdefault(key, []).append(frame.depth)
+    run = Run(t, poses, odometry, {k: np.stack(v) for k, v in images.items()},
+              {k: np.stack(v) for k, v in depths.items()}, {k: np.stack(v) for k, v in scans.items()}, meta)
+    if target is not None:
+        tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp")
+        run.save(tmp)
+        tmp.replace(target)  # atomic: notebooks running in parallel never read a half-written file
+    return run

@@ -1,0 +1,74 @@
+"""Recorded runs: contents, .npz round trip without pickle, caching by parameters."""
+import numpy as np
+import pytest
+
+from robokit.sim import (Lidar, OmniCamera, PinholeCamera, Run, StereoRig, box_room, lab_lap, lab_room, record,
+                         waypoint_path)
+
+
+@pytest.fixture()
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("ROBOKIT_CACHE", str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def small_sensors():
+    cam = PinholeCamera.from_fov(width=80, height=60)
+    return {"cam": cam, "stereo": StereoRig(cam, 0.1), "laser": Lidar(beams=90, noise=0.01)}
+
+
+def test_record_contents_and_round_trip(cache, tmp_path):
+    world = box_room()
+    path = waypoint_path([[1.0, 1.0], [4.0, 1.0], [4.0, 3.0]], speed=0.5, rate=2)
+    run = record(world, path, small_sensors(), rate=1.0, seed=3)
+    n = len(run)
+    assert n == len(run.poses) == len(run.odometry) and n >= 8
+    assert run.images["cam"].shape == (n, 60, 80, 3) and run.images["cam"].dtype == np.uint8
+    assert set(run.images) == {"cam", "stereo/left", "stereo/right"}
+    assert run.scans["laser"].shape == (n, 90)
+    np.testing.assert_allclose(run.poses[0], [1, 1, 0])
+    assert not np.allclose(run.odometry[-1], run.poses[-1])  # noisy odometry drifts
+    back = Run.load(run.save(tmp_path / "r.npz"))
+    for a, b in [(run.t, back.t), (run.poses, back.poses), (run.images["stereo/right"], back.images["stereo/right"]),
+                 (run.scans["laser"], back.scans["laser"]), (run.depths["cam"], back.depths["cam"])]:
+        assert np.array_equal(a, b)
+    assert back.meta["seed"] == 3 and back.meta["world"] == "box_room"
+
+
+def test_cache_is_keyed_by_parameters(cache):
+    world = box_room()
+    path = waypoint_path([[1.0, 1.0], [2.0, 1.0]], rate=2)
+    a = record(world, path, small_sensors(), seed=1)
+    files = list((cache / "runs").glob("*.npz"))
+    assert len(files) == 1
+    b = record(world, path, small_sensors(), seed=1)
+    assert np.array_equal(a.images["cam"], b.images["cam"])
+    assert len(list((cache / "runs").glob("*.npz"))) == 1  # loaded, not re-recorded
+    record(world, path, small_sensors(), seed=2)
+    assert len(list((cache / "runs").glob("*.npz"))) == 2
+    c = record(world, path, small_sensors(), seed=1, cache=False)
+    assert np.array_equal(a.odometry, c.odometry)  # deterministic
+
+
+def test_record_omni_and_lab_lap(cache):
+    world = lab_room()
+    lap = lab_lap(world, rate=1.0)
+    omni = OmniCamera(width=64, height=48, face_size=48)
+    run = record(world, (lap.t[:3], lap.poses[:3]), {"omni": omni}, rate=None)
+    assert run.images["omni"].shape == (3, 48, 64, 3)
+    assert np.isinf(run.depths["omni"][0, 0, 0])  # corner pixel is outside the mirror's annulus
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"sensors": {}}, "sensors"),
+    ({"sensors": {"x": object()}}, "sensors"),
+    ({"path": np.array([[1.0, 1.0, 0.0], [9.0, 1.0, 0.0]])}, "path"),
+    ({"path": np.array([[1.0, np.nan, 0.0]])}, "path"),
+    ({"rate": 0.0}, "rate"),
+])
+def test_bad_input_is_named(cache, kwargs, match):
+    args = {"world": box_room(), "path": np.array([[1.0, 1.0, 0.0], [1.5, 1.0, 0.0]]),
+            "sensors": {"laser": Lidar()}, "rate": 1.0}
+    args.update(kwargs)
+    with pytest.raises((ValueError, TypeError), match=match):
+        record(**args)
