@@ -18,8 +18,11 @@ def _cmd_course_build(args: argparse.Namespace) -> int:
         print(f"robokit course build: no lessons/ directory under {root.resolve()} "
               "(run it from the course repository or pass --root)", file=sys.stderr)
         return 2
+    from .grading.selfcheck import course_grading_step
+
+    steps = [] if args.no_grading else [course_grading_step]
     return build_course(root, args.out, jobs=args.jobs, timeout=args.timeout, fast=args.fast,
-                        notebooks=[Path(p) for p in args.notebooks] or None)
+                        notebooks=[Path(p) for p in args.notebooks] or None, extra_steps=steps)
 
 
 def _cmd_course_strip(args: argparse.Namespace) -> int:
@@ -93,7 +96,8 @@ def _cmd_grade(args: argparse.Namespace) -> int:
                     memory_bytes=int(args.memory_mb) * 1024 * 1024)
     root = Path(args.root).resolve()
     hide = [p for p in (root / "solutions", Path(args.out).resolve().parent,
-                        Path(args.feedback).resolve() if args.feedback else None, Path.home()) if p]
+                        Path(args.feedback).resolve() if args.feedback else None, Path.home(),
+                        *[Path(h).resolve() for h in args.hide]) if p]
     print(f"grading {len(args.submissions)} submission(s) of {args.assignment} with {args.jobs} job(s); "
           f"{isolation_note()}")
     try:
@@ -115,6 +119,22 @@ def _cmd_grade(args: argparse.Namespace) -> int:
     return 1 if problems else 0
 
 
+def _cmd_gradescope(args: argparse.Namespace) -> int:
+    import os
+
+    from .grading.gradescope import build_autograder
+    from .grading.registry import UnknownAssignmentError
+
+    seed = args.seed or os.environ.get("ROBOKIT_GRADING_SEED", "")
+    try:
+        path = build_autograder(args.assignment, seed, args.output, root=args.root, timeout=args.timeout)
+    except (UnknownAssignmentError, RuntimeError) as exc:
+        print(f"robokit gradescope: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"wrote {path} (upload it as the autograder of {args.assignment}; it contains the seed: keep it private)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``robokit`` command."""
     parser = argparse.ArgumentParser(
@@ -133,6 +153,8 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument("--jobs", type=int, default=None, help="notebooks run at once (default: cores)")
     build.add_argument("--timeout", type=float, default=900, help="per-notebook limit in s (default: 900)")
     build.add_argument("--fast", action="store_true", help="run with ROBOKIT_FAST=1 (shrunk experiments)")
+    build.add_argument("--no-grading", action="store_true",
+                       help="skip grading solutions (full marks) and blank assignments (zero)")
     build.set_defaults(func=_cmd_course_build)
     strip = csub.add_parser("strip", help="remove outputs and execution counts from notebooks")
     strip.add_argument("paths", nargs="+")
@@ -159,7 +181,17 @@ def build_parser() -> argparse.ArgumentParser:
     grade.add_argument("--timeout", type=float, default=300, help="seconds per submission (default: 300)")
     grade.add_argument("--memory-mb", type=int, default=4096, help="address-space limit (default: 4096)")
     grade.add_argument("--root", default=".", help="course root; its solutions/ is hidden from workers")
+    grade.add_argument("--hide", action="append", default=[], metavar="PATH",
+                       help="another path student code must not see (repeatable)")
     grade.set_defaults(func=_cmd_grade)
+
+    gs = sub.add_parser("gradescope", help="build a Gradescope autograder zip for an assignment")
+    gs.add_argument("--assignment", required=True)
+    gs.add_argument("--seed", help="instructor's secret seed (or env ROBOKIT_GRADING_SEED)")
+    gs.add_argument("-o", "--output", default="autograder.zip")
+    gs.add_argument("--root", default=".")
+    gs.add_argument("--timeout", type=float, default=600)
+    gs.set_defaults(func=_cmd_gradescope)
     return parser
 
 

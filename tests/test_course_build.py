@@ -23,7 +23,7 @@ def course(tmp_path_factory):
               "import matplotlib.pyplot as plt\nplt.plot([0, 1], [1, 0]); plt.xlabel('x [m]'); plt.show()")
     _notebook(root / "lessons" / "01_raises.ipynb", "x = 1", "raise ValueError('boom in lesson one')")
     _notebook(root / "solutions" / "02_hangs.ipynb", "import time\ntime.sleep(600)")
-    code = main(["course", "build", "--root", str(root), "--timeout", "25", "--fast"])
+    code = main(["course", "build", "--root", str(root), "--timeout", "25", "--fast", "--no-grading"])
     return root, code
 
 

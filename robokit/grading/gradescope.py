@@ -1,0 +1,96 @@
+"""``robokit gradescope``: package an assignment as a Gradescope autograder zip.
+
+The zip holds a robokit wheel, ``setup.sh`` (installs it into a virtual environment on
+Gradescope's Ubuntu image), ``run_autograder`` (grades ``/autograder/submission/*.ipynb`` with
+``robokit grade`` and writes ``/autograder/results/results.json``) and the secret seed, read into
+an environment variable so it never appears on a command line. Gradescope runs the autograder as
+root, so student code gets the full sandbox: its own unprivileged uid, the autograder's source
+folder hidden, no network.
+"""
+from __future__ import annotations
+
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+from .registry import exercises_for
+
+__all__ = ["build_autograder"]
+
+_SETUP = """#!/usr/bin/env bash
+# Gradescope autograder setup: install robokit from the wheel shipped in this zip.
+set -euo pipefail
+apt-get update -qq
+DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3 python3-venv python3-pip >/dev/null
+python3 -m venv /opt/robokit
+/opt/robokit/bin/pip install --quiet /autograder/source/{wheel}
+"""
+
+_RUN = """#!/usr/bin/env bash
+# Gradescope autograder entry point: grade the submitted notebook in robokit's sandbox.
+set -uo pipefail
+mkdir -p /autograder/results
+shopt -s nullglob
+notebooks=(/autograder/submission/*.ipynb)
+if [ ${{#notebooks[@]}} -eq 0 ]; then
+  printf '{{"score": 0, "output": "No .ipynb file was submitted: upload your {slug}.ipynb notebook."}}' \\
+    > /autograder/results/results.json
+  exit 0
+fi
+ROBOKIT_GRADING_SEED="$(cat /autograder/source/seed.txt)" /opt/robokit/bin/robokit grade "${{notebooks[0]}}" \\
+  --assignment {slug} --out /autograder/results/grades.csv --gradescope /autograder/results/results.json \\
+  --feedback /autograder/results/feedback --root /autograder/source --timeout {timeout} \\
+  --hide /autograder/source
+"""
+
+
+def build_autograder(slug: str, seed: str, output: str | Path, *, root: str | Path = ".",
+                     timeout: float = 600) -> Path:
+    """Write the Gradescope autograder zip for assignment ``slug``.
+
+    Parameters
+    ----------
+    slug : str
+        Assignment, e.g. ``"05_gps_sonar_truck"``.
+    seed : str
+        The instructor's secret seed (stored inside the zip, which only instructors see).
+    output : path
+        Zip file to write.
+    root : path, default "."
+        The course repository (the wheel is built from it).
+    timeout : float, default 600
+        Seconds allowed per submission.
+
+    Raises
+    ------
+    ValueError
+        Unknown assignment or empty seed.
+    RuntimeError
+        If the wheel cannot be built.
+
+    Notes
+    -----
+    Gradescope's autograder specification (setup.sh, run_autograder, results/results.json).
+    """
+    exercises_for(slug)
+    if not seed:
+        raise ValueError("seed: a non-empty secret seed is required")
+    output = Path(output)
+    with tempfile.TemporaryDirectory() as tmp:
+        proc = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", tmp,
+                               str(Path(root).resolve())], capture_output=True, text=True)
+        wheels = list(Path(tmp).glob("robokit-*.whl"))
+        if proc.returncode != 0 or not wheels:
+            raise RuntimeError(f"building the robokit wheel failed: {proc.stderr[-800:]}")
+        wheel = wheels[0]
+        with zipfile.ZipFile(output, "w", zipfile.ZIP_DEFLATED) as z:
+            z.write(wheel, wheel.name)
+            for name, text in (("setup.sh", _SETUP.format(wheel=wheel.name)),
+                               ("run_autograder", _RUN.format(slug=slug, timeout=int(timeout)))):
+                info = zipfile.ZipInfo(name)
+                info.external_attr = 0o755 << 16
+                z.writestr(info, text)
+            z.writestr("seed.txt", seed)
+    return output

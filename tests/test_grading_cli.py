@@ -1,0 +1,70 @@
+"""`robokit grade` end to end: gradebook, feedback, Gradescope JSON, and clear errors on bad input."""
+import csv
+import json
+import shutil
+
+import pytest
+
+from robokit.cli import main
+from robokit.grading.selfcheck import grade_course
+from tests.conftest import ROOT
+
+SOL = ROOT / "solutions" / "00_getting_started.ipynb"
+BLANK = ROOT / "assignments" / "00_getting_started.ipynb"
+
+
+def test_every_solution_full_marks_and_every_blank_assignment_zero():
+    rows = grade_course(ROOT)
+    assert rows, "no assignments found"
+    bad = [r for r in rows if not r["ok"]]
+    assert not bad, bad
+
+
+def test_grade_writes_gradebook_feedback_and_gradescope(tmp_path, capsys):
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    shutil.copy(SOL, subs / "alice.ipynb")
+    code = main(["grade", str(subs / "alice.ipynb"), "--assignment", "00_getting_started", "--seed", "s",
+                 "--out", str(tmp_path / "g.csv"), "--feedback", str(tmp_path / "fb"),
+                 "--gradescope", str(tmp_path / "results.json")])
+    assert code == 0
+    rows = list(csv.DictReader(open(tmp_path / "g.csv")))
+    assert rows[0]["student"] == "alice" and rows[0]["total"] == "3" and rows[0]["max"] == "3"
+    assert "Score: 3 / 3" in (tmp_path / "fb" / "alice.md").read_text()
+    gs = json.loads((tmp_path / "results.json").read_text())
+    assert gs["score"] == 3 and {t["name"] for t in gs["tests"]} == {"00.wrap_angle", "00.se2_compose"}
+
+
+def test_missing_function_is_zero_with_feedback(tmp_path):
+    nb = json.loads(SOL.read_text())
+    nb["cells"] = [c for c in nb["cells"] if not "".join(c["source"]).startswith("def se2_compose")]
+    (tmp_path / "bob.ipynb").write_text(json.dumps(nb))
+    assert main(["grade", str(tmp_path / "bob.ipynb"), "--assignment", "00_getting_started", "--seed", "s",
+                 "--out", str(tmp_path / "g.csv"), "--feedback", str(tmp_path / "fb")]) == 0
+    fb = (tmp_path / "fb" / "bob.md").read_text()
+    assert "function not defined" in fb and "| 00.se2_compose | 0 / 2 |" in fb and "| 00.wrap_angle | 1 / 1 |" in fb
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--assignment", "99_nothing", "--seed", "s"], "unknown assignment"),
+    (["--assignment", "00_getting_started"], "secret seed is required"),
+])
+def test_request_errors_are_clear(tmp_path, capsys, monkeypatch, args, message):
+    monkeypatch.delenv("ROBOKIT_GRADING_SEED", raising=False)
+    code = main(["grade", str(SOL), "--out", str(tmp_path / "g.csv"), *args])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and "Traceback" not in err
+
+
+def test_unreadable_and_wrong_assignment_exit_nonzero_but_batch_completes(tmp_path, capsys):
+    wrong = json.loads(BLANK.read_text())
+    wrong["metadata"]["robokit"]["assignment"] = "05_gps_sonar_truck"
+    (tmp_path / "wrong.ipynb").write_text(json.dumps(wrong))
+    shutil.copy(SOL, tmp_path / "good.ipynb")
+    code = main(["grade", str(tmp_path / "wrong.ipynb"), str(tmp_path / "missing.ipynb"), str(tmp_path / "good.ipynb"),
+                 "--assignment", "00_getting_started", "--seed", "s", "--out", str(tmp_path / "g.csv")])
+    captured = capsys.readouterr()
+    assert code == 1 and "Traceback" not in captured.err
+    assert "could not be read" in captured.err and "not '00_getting_started'" in captured.err
+    rows = {r["student"]: r for r in csv.DictReader(open(tmp_path / "g.csv"))}
+    assert rows["good"]["total"] == "3" and rows["wrong"]["total"] == "0" and rows["missing"]["total"] == "0"

@@ -1,0 +1,146 @@
+"""check(), plain-data conversion, comparisons, the exercise registry and assignment generation."""
+import json
+
+import numpy as np
+import pytest
+
+from robokit.cli import main
+from robokit.grading import Case, check, close, exact, unordered_rows
+from robokit.grading.assign import AssignmentError, make_assignment, write_assignment
+from robokit.grading.plain import NotPlainData, to_plain
+from robokit.grading.registry import UnknownExerciseError, assignments, get_exercise
+from robokit.grading.transport import TransportError, read_plain, write_plain
+from tests.conftest import ROOT
+
+
+def test_to_plain_rejects_subclasses_and_objects():
+    class Liar(float):
+        def __eq__(self, other):
+            return True
+
+    with pytest.raises(NotPlainData):
+        to_plain(Liar(1.0))
+    with pytest.raises(NotPlainData):
+        to_plain(object())
+    with pytest.raises(NotPlainData):
+        to_plain({1: 2})
+    assert to_plain((np.float32(1.5), [np.int64(2)], {"a": np.eye(2)}))[1] == [2]
+
+
+def test_comparisons():
+    assert close()(1.0, 1.0 + 1e-12) is None
+    assert "values differ" in close(rtol=0, atol=1e-9)([1.0, 2.0], [1.0, 2.1])
+    assert "shape" in close()(np.zeros(3), np.zeros(4))
+    assert close()({"a": 1.0}, {"a": 1.0}) is None and "missing keys" in close()({"a": 1.0}, {})
+    assert exact()("2A", "2a") is not None and exact()("2A", "2A") is None
+    rows = np.array([[0.0, 1.0], [2.0, 3.0]])
+    assert unordered_rows()(rows, rows[::-1]) is None
+    assert unordered_rows()(rows, rows + 1) is not None
+
+
+def test_transport_round_trip_and_limits(tmp_path):
+    value = {"a": np.arange(3.0), "b": [1, "x", None, float("nan")], "c": np.array([True, False])}
+    write_plain(value, tmp_path / "v")
+    back = read_plain(tmp_path / "v")
+    assert np.array_equal(back["a"], value["a"]) and back["b"][:3] == [1, "x", None] and np.isnan(back["b"][3])
+    np.save(tmp_path / "obj.npy", np.array([object()], dtype=object), allow_pickle=True)
+    (tmp_path / "w.json").write_text(json.dumps({"__robokit_array__": "a0"}))
+    np.savez(tmp_path / "w.npz", a0=np.array([{"x": 1}], dtype=object))
+    with pytest.raises(TransportError):
+        read_plain(tmp_path / "w")  # pickled object arrays are refused
+    with pytest.raises(TransportError, match="missing"):
+        read_plain(tmp_path / "nothing")
+
+
+def test_check_reports_and_raises(capsys):
+    def good(angle):
+        a = np.asarray(angle, float)
+        if np.isnan(a).any():
+            raise ValueError("nan")
+        r = np.mod(a + np.pi, 2 * np.pi) - np.pi
+        return float(r) if r.ndim == 0 else r
+
+    assert check("00.wrap_angle", good) == 6
+    assert "feedback only" in capsys.readouterr().out
+    with pytest.raises(AssertionError, match="public cases failed"):
+        check("00.wrap_angle", lambda a: a)
+    assert "FAIL" in capsys.readouterr().out
+
+    def stub(angle):
+        raise NotImplementedError
+
+    with pytest.raises(NotImplementedError):
+        check("00.wrap_angle", stub)
+    assert "not implemented yet" in capsys.readouterr().out
+    with pytest.raises(UnknownExerciseError):
+        check("99.nothing", good)
+    with pytest.raises(TypeError, match="fn"):
+        check("00.wrap_angle", 3)
+
+
+def test_case_inputs_are_plain():
+    with pytest.raises(NotPlainData):
+        Case((object(),))
+
+
+@pytest.mark.parametrize("slug", list(assignments()))
+def test_reference_passes_its_own_cases(slug):
+    from robokit.grading.exercise import call_student, expected_output, judge
+
+    for ex in assignments()[slug]:
+        for seed in ("public", 12345):
+            for case in ex.make_cases(seed):
+                outcome = judge(ex, case, expected_output(ex, case), call_student(ex.reference, case))
+                assert outcome.passed, (ex.id, case.label, outcome.message)
+
+
+@pytest.mark.parametrize("slug", list(assignments()))
+def test_cases_are_deterministic_per_seed(slug):
+    for ex in assignments()[slug]:
+        a, b = repr(ex.make_cases("seed-a")), repr(ex.make_cases("seed-a"))
+        assert a == b
+    # a different secret seed gives different cases for at least one exercise
+    assert any(repr(ex.make_cases("seed-a")) != repr(ex.make_cases("seed-b")) for ex in assignments()[slug])
+
+
+def test_committed_assignments_are_generated():
+    for slug in assignments():
+        if (ROOT / "solutions" / f"{slug}.ipynb").exists():
+            assert not write_assignment(ROOT, slug, check_only=True), (
+                f"assignments/{slug}.ipynb differs from what `robokit assign {slug}` generates")
+
+
+def test_assignment_hides_solutions_and_carries_nbgrader_metadata():
+    nb = json.loads((ROOT / "assignments" / "00_getting_started.ipynb").read_text())
+    text = json.dumps(nb)
+    assert "BEGIN SOLUTION" not in text and "np.mod" not in text
+    grade_cells = [c["metadata"]["nbgrader"] for c in nb["cells"] if c["metadata"]["nbgrader"]["grade"]]
+    assert {c["grade_id"]: c["points"] for c in grade_cells} == {"00.wrap_angle": 1.0, "00.se2_compose": 2.0,
+                                                               "00.why_seeds": 1.0}
+    assert all(c["metadata"]["nbgrader"]["schema_version"] == 3 for c in nb["cells"])
+    assert nb["metadata"]["robokit"]["assignment"] == "00_getting_started"
+
+
+def test_assign_rejects_broken_markers():
+    nb = json.loads((ROOT / "solutions" / "00_getting_started.ipynb").read_text())
+    for cell in nb["cells"]:
+        if "# END SOLUTION" in "".join(cell["source"]):
+            cell["source"] = "".join(cell["source"]).replace("# END SOLUTION", "")
+            break
+    with pytest.raises(AssignmentError, match="without END"):
+        make_assignment(nb, "00_getting_started")
+    nb = json.loads((ROOT / "solutions" / "00_getting_started.ipynb").read_text())
+    nb["cells"] = [c for c in nb["cells"] if "check(\"00.se2_compose\"" not in "".join(c["source"])]
+    with pytest.raises(AssignmentError, match="check cell for 00.se2_compose"):
+        make_assignment(nb, "00_getting_started")
+
+
+def test_registry_lookup():
+    assert get_exercise("00.se2_compose").points == 2
+    with pytest.raises(UnknownExerciseError):
+        get_exercise("00.nope")
+
+
+def test_assign_cli_check_mode(capsys):
+    assert main(["assign", "--check", "--root", str(ROOT)]) == 0
+    assert "up to date" in capsys.readouterr().out
