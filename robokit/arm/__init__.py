@@ -13,11 +13,14 @@ Lesson 06 (redundant 7-DOF arms, seed 000 Q4: Huang & Jiang's separation of posi
 from .chain import Chain
 from .dh import dh_transform, mdh_transform
 from .ik_analytic import SRSArm, arm_angle, ik_srs, ik_srs_batch, ik_srs_branches
+from .ik_numeric import METHODS, dls_step, ik_numeric, ik_numeric_batch, null_space_step
 from .jacobian import geometric_jacobian, manipulability
+from .limits import limit_distance_gradient, wln_weights
 from .result import IKBatchResult, IKResult
 from .robots import iiwa14, panda
 from .se3 import pose_error
 
 __all__ = ["Chain", "dh_transform", "mdh_transform", "iiwa14", "panda", "geometric_jacobian",
            "manipulability", "SRSArm", "arm_angle", "ik_srs", "ik_srs_batch", "ik_srs_branches",
-           "IKResult", "IKBatchResult", "pose_error"]
+           "IKResult", "IKBatchResult", "pose_error", "METHODS", "dls_step", "null_space_step",
+           "ik_numeric", "ik_numeric_batch", "limit_distance_gradient", "wln_weights"]

@@ -156,7 +156,7 @@ class Chain:
         out = np.empty(q.shape[:-1] + (self.n + 1, 4, 4))
         out[..., 0, :, :] = self.base
         for i in range(self.n):
-            out[..., i + 1, :, :] = out[..., i, :, :] @ links[..., i, :, :]
+            np.matmul(out[..., i, :, :], links[..., i, :, :], out=out[..., i + 1, :, :])
         return out
 
     def _flange(self, frames: np.ndarray) -> np.ndarray:

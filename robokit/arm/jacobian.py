@@ -17,8 +17,13 @@ def jacobian_from_frames(chain: Chain, frames: np.ndarray) -> np.ndarray:
     z = jf[..., :3, 2]                       # (..., n, 3) joint axes
     p = jf[..., :3, 3]                       # (..., n, 3) points on the axes
     p_e = chain._flange(frames)[..., None, :3, 3]
-    Jv = np.cross(z, p_e - p)
-    return np.swapaxes(np.concatenate([Jv, z], axis=-1), -1, -2)
+    r = p_e - p
+    J = np.empty(z.shape[:-2] + (6, z.shape[-2]))
+    J[..., 0, :] = z[..., 1] * r[..., 2] - z[..., 2] * r[..., 1]   # z x (p_e - p)
+    J[..., 1, :] = z[..., 2] * r[..., 0] - z[..., 0] * r[..., 2]
+    J[..., 2, :] = z[..., 0] * r[..., 1] - z[..., 1] * r[..., 0]
+    J[..., 3:, :] = np.swapaxes(z, -1, -2)
+    return J
 
 
 def geometric_jacobian(chain: Chain, q: Any) -> np.ndarray:

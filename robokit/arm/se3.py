@@ -109,14 +109,16 @@ def rotation_log(R: np.ndarray) -> np.ndarray:
     Internal helper: no validation.
     """
     R = np.asarray(R, dtype=float)
-    vee = 0.5 * np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
-                          R[..., 1, 0] - R[..., 0, 1]], -1)
-    cos = np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0)
-    sin = np.linalg.norm(vee, axis=-1)
+    r = R.reshape(R.shape[:-2] + (9,))
+    vee = 0.5 * (r[..., [7, 2, 3]] - r[..., [5, 6, 1]])
+    cos = np.clip(0.5 * (r[..., 0] + r[..., 4] + r[..., 8] - 1.0), -1.0, 1.0)
+    sin = np.sqrt((vee * vee).sum(-1))
     theta = np.arctan2(sin, cos)
-    # theta / sin(theta) -> 1 as theta -> 0; fine away from pi
-    with np.errstate(invalid="ignore", divide="ignore"):
-        scale = np.where(sin > 1e-12, theta / np.where(sin > 1e-12, sin, 1.0), 1.0 + theta**2 / 6.0)
+    # theta / sin(theta) -> 1 as theta -> 0; the near-pi case is handled below
+    small = sin < 1e-12
+    scale = theta / np.where(small, 1.0, sin)
+    if small.any():
+        scale = np.where(small, 1.0 + theta**2 / 6.0, scale)
     out = vee * scale[..., None]
     near_pi = cos < -0.99
     if np.any(near_pi):
