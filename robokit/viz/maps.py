@@ -1,0 +1,159 @@
+"""Matplotlib helpers for bird's-eye maps: footprints, scans, trajectories, occupancy grids.
+
+Every helper draws on a given ``matplotlib.axes.Axes`` (or a new one), labels the axes in metres
+and keeps the aspect ratio equal, so maps from different lessons look alike.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..sim.lidar import scan_points
+from ..sim.world import World
+from ..validation import as_array, as_points, check_positive
+
+__all__ = ["map_axes", "plot_footprint", "plot_scan", "plot_trajectory", "plot_occupancy", "plot_covariance"]
+
+
+def map_axes(ax: Any = None, title: str | None = None, figsize: tuple = (7, 5)):
+    """Return ``ax`` (or a new one) set up for a map: equal aspect, x/y labels in metres."""
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(figsize=figsize)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    if title:
+        ax.set_title(title)
+    return ax
+
+
+def plot_footprint(world: World, ax: Any = None, color: str = "k", **kwargs: Any):
+    """Draw a world's wall segments (its 2D footprint) from above.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Notes
+    -----
+    The footprint is the world sliced at the LiDAR height (:meth:`robokit.sim.World.slice`).
+    """
+    from matplotlib.collections import LineCollection
+
+    if not isinstance(world, World):
+        raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
+    ax = map_axes(ax, kwargs.pop("title", f"{world.name}: footprint"))
+    ax.add_collection(LineCollection(world.segments, colors=color, linewidths=kwargs.pop("linewidth", 1.5), **kwargs))
+    x0, y0, x1, y1 = world.bounds
+    pad = 0.03 * max(x1 - x0, y1 - y0)
+    ax.set_xlim(x0 - pad, x1 + pad)
+    ax.set_ylim(y0 - pad, y1 + pad)
+    return ax
+
+
+def plot_scan(ranges: Any, sensor_pose: Any, angles: Any, ax: Any = None, color: str = "tab:red",
+              rays: bool = False):
+    """Draw a LiDAR scan's end points (and optionally its rays) in the world frame.
+
+    Parameters
+    ----------
+    ranges : array_like (B,)
+        Ranges; ``inf`` returns are skipped.
+    sensor_pose : array_like (3,)
+        Sensor pose ``[x, y, theta]``.
+    angles : array_like (B,)
+        Beam angles in the sensor frame (``Lidar.angles``).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    pts = scan_points(ranges, sensor_pose, angles)
+    p = as_array(sensor_pose, "sensor_pose", shape=(3,))
+    ax = map_axes(ax)
+    if rays and len(pts):
+        from matplotlib.collections import LineCollection
+
+        ax.add_collection(LineCollection([[p[:2], q] for q in pts], colors=color, alpha=0.15, linewidths=0.5))
+    ax.plot(pts[:, 0], pts[:, 1], ".", ms=3, color=color, label="scan")
+    ax.plot(p[0], p[1], "o", color=color)
+    ax.arrow(p[0], p[1], 0.4 * np.cos(p[2]), 0.4 * np.sin(p[2]), width=0.03, color=color)
+    return ax
+
+
+def plot_trajectory(poses: Any, ax: Any = None, label: str | None = None, every: int = 0, **kwargs: Any):
+    """Draw a planar trajectory ``(N, 3)``; with ``every > 0`` also heading arrows every ``every`` poses."""
+    P = as_points(poses, "poses", 3, min_count=1)
+    ax = map_axes(ax)
+    line, = ax.plot(P[:, 0], P[:, 1], label=label, **kwargs)
+    if every:
+        sel = P[::int(every)]
+        ax.quiver(sel[:, 0], sel[:, 1], np.cos(sel[:, 2]), np.sin(sel[:, 2]), color=line.get_color(),
+                  angles="xy", scale_units="xy", scale=4, width=0.004)
+    return ax
+
+
+def plot_occupancy(grid: Any, origin: Any, resolution: float, ax: Any = None, cmap: str = "gray_r",
+                   colorbar: bool = True):
+    """Show an occupancy grid: ``grid[i, j]`` is P(occupied) of the cell at ``origin + (j, i) * resolution``.
+
+    Parameters
+    ----------
+    grid : array_like (rows, cols)
+        Probabilities in [0, 1] (NaN = unknown, drawn light blue) or booleans.
+    origin : array_like (2,)
+        World (x, y) of the lower-left corner of cell (0, 0).
+    resolution : float
+        Cell size in metres.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Notes
+    -----
+    Occupancy grid maps: Thrun, Burgard & Fox (2005), Ch. 9; row 0 is drawn at the bottom
+    (``origin="lower"``) so the map is not upside down.
+    """
+    import matplotlib as mpl
+
+    G = np.asarray(grid, float)
+    if G.ndim != 2:
+        raise ValueError(f"grid: expected a 2-D array, got shape {G.shape}")
+    if np.any((G[np.isfinite(G)] < 0) | (G[np.isfinite(G)] > 1)):
+        raise ValueError("grid: expected probabilities in [0, 1]")
+    o = as_array(origin, "origin", shape=(2,))
+    r = check_positive(resolution, "resolution")
+    ax = map_axes(ax)
+    cm = mpl.colormaps[cmap].with_extremes(bad="#cfe3f5")
+    extent = (o[0], o[0] + G.shape[1] * r, o[1], o[1] + G.shape[0] * r)
+    im = ax.imshow(np.ma.masked_invalid(G), origin="lower", extent=extent, cmap=cm, vmin=0, vmax=1,
+                   interpolation="nearest")
+    if colorbar:
+        ax.figure.colorbar(im, ax=ax, label="P(occupied)")
+    return ax
+
+
+def plot_covariance(mean: Any, cov: Any, ax: Any = None, nsigma: float = 1.0, **kwargs: Any):
+    """Draw the ``nsigma`` ellipse of a 2x2 covariance around ``mean`` (e.g. a landmark's X-Z uncertainty).
+
+    Notes
+    -----
+    Se, Lowe & Little (2002), Sec. 3.6, Fig. 2: one-standard-deviation ellipses in the bird's-eye view.
+    """
+    from matplotlib.patches import Ellipse
+
+    m = as_array(mean, "mean", shape=(2,))
+    C = as_array(cov, "cov", shape=(2, 2))
+    lam, V = np.linalg.eigh((C + C.T) / 2)
+    if lam.min() < -1e-12:
+        raise ValueError("cov: expected a positive semi-definite matrix")
+    s = check_positive(nsigma, "nsigma")
+    w, h = 2 * s * np.sqrt(np.clip(lam[::-1], 0, None))
+    angle = np.degrees(np.arctan2(V[1, 1], V[0, 1]))
+    ax = map_axes(ax)
+    ax.add_patch(Ellipse(m, w, h, angle=angle, fill=False, **kwargs))
+    return ax

@@ -1,0 +1,265 @@
+"""3D helpers on top of :class:`robokit.viz.Scene`: textured worlds, camera frustums, trajectories,
+particle clouds, landmarks with covariance ellipsoids, and pose animations.
+
+Each helper takes the scene as its first argument, records meshcat commands and returns the scene,
+so calls chain and the result is the same offline HTML page (no server, no ports).
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import cv2
+import numpy as np
+
+from ..geometry import se2_to_se3
+from ..sim.camera import PinholeCamera
+from ..sim.world import World
+from ..validation import as_array, as_points, check_int, check_positive
+from .scene import Scene, _color
+
+__all__ = ["add_world", "add_camera", "add_trajectory", "add_particles", "add_landmarks", "animate_poses"]
+
+
+def _textured_mesh(vertices: np.ndarray, faces: np.ndarray, uvs: np.ndarray):
+    """A meshcat BufferGeometry with texture coordinates (three.js ``uv`` attribute)."""
+    from meshcat.geometry import TriangularMeshGeometry, pack_numpy_array
+
+    class TexturedMesh(TriangularMeshGeometry):
+        def lower(self, object_data):
+            data = super().lower(object_data)
+            data["data"]["attributes"]["uv"] = pack_numpy_array(np.asarray(uvs, np.float32).T)
+            return data
+
+    return TexturedMesh(vertices, faces)
+
+
+def _atlas(world: World, cell: int) -> tuple[np.ndarray, int]:
+    """Pack every surface texture, shrunk to ``cell`` x ``cell`` pixels, into one square image."""
+    n = len(world.surfaces)
+    cols = int(np.ceil(np.sqrt(n)))
+    atlas = np.zeros((cols * cell, cols * cell, 3), np.uint8)
+    for k, s in enumerate(world.surfaces):
+        r, c = divmod(k, cols)
+        atlas[r * cell:(r + 1) * cell, c * cell:(c + 1) * cell] = cv2.resize(s.texture, (cell, cell),
+                                                                             interpolation=cv2.INTER_AREA)
+    return atlas, cols
+
+
+def add_world(scene: Scene, world: World, path: str = "world", cell: int = 48, ceiling: bool = False) -> Scene:
+    """Add a world's textured surfaces as one mesh (one texture atlas), plus its footprint in red.
+
+    Parameters
+    ----------
+    scene : Scene
+    world : World
+    path : str, default "world"
+    cell : int, default 48
+        Pixels per surface in the texture atlas (small keeps the HTML page light).
+    ceiling : bool, default False
+        Draw the ceiling (hidden by default so the scene can be seen from above).
+
+    Returns
+    -------
+    Scene
+
+    Notes
+    -----
+    One ``BufferGeometry`` with ``uv`` coordinates into an atlas image (three.js texture
+    mapping); the world's own surfaces, so the 3D view matches what the cameras render.
+    """
+    from meshcat.geometry import ImageTexture, Mesh, MeshBasicMaterial, PngImage
+
+    if not isinstance(world, World):
+        raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
+    cell = check_int(cell, "cell", minimum=4)
+    atlas, cols = _atlas(world, cell)
+    verts, faces, uvs = [], [], []
+    size = cols * cell
+    for k, s in enumerate(world.surfaces):
+        if not ceiling and s.normal[2] < -0.5 and s.corner[2] >= world.height - 1e-6:
+            continue
+        r, c = divmod(k, cols)
+        u0, u1 = (c * cell + 0.5) / size, ((c + 1) * cell - 0.5) / size
+        v0, v1 = 1 - (r * cell + 0.5) / size, 1 - ((r + 1) * cell - 0.5) / size  # three.js flips images
+        base = len(verts)
+        verts.extend(s.corners)  # corner, +u, +u+v, +v
+        uvs.extend([[u0, v0], [u1, v0], [u1, v1], [u0, v1]])
+        faces.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]])
+    ok, png = cv2.imencode(".png", cv2.cvtColor(atlas, cv2.COLOR_RGB2BGR))
+    texture = ImageTexture(PngImage(png.tobytes()))
+    scene.set_object(f"{path}/surfaces", Mesh(_textured_mesh(np.array(verts), np.array(faces), np.array(uvs)),
+                                              MeshBasicMaterial(map=texture, side=2)))
+    seg = world.segments
+    pts = np.concatenate([np.column_stack([seg[:, 0], np.full(len(seg), 0.01)]),
+                          np.column_stack([seg[:, 1], np.full(len(seg), 0.01)])], axis=1).reshape(-1, 3)
+    return _segments(scene, f"{path}/footprint", pts, 0xCC2222)
+
+
+def _segments(scene: Scene, path: str, pts: np.ndarray, color: Any) -> Scene:
+    from meshcat.geometry import LineBasicMaterial, LineSegments, PointsGeometry
+
+    return scene.set_object(path, LineSegments(PointsGeometry(np.asarray(pts, np.float32).T),
+                                               LineBasicMaterial(color=_color(color))))
+
+
+def add_camera(scene: Scene, path: str, camera: PinholeCamera, pose: Any, depth: float = 0.4,
+               color: Any = 0x2255CC) -> Scene:
+    """Draw a pinhole camera as a frustum (apex at the optical centre) plus its axes.
+
+    Parameters
+    ----------
+    scene : Scene
+    path : str
+    camera : PinholeCamera
+    pose : array_like (4, 4)
+        ``T_world_cam``.
+    depth : float, default 0.4
+        Distance of the drawn image rectangle from the apex (metres).
+
+    Returns
+    -------
+    Scene
+
+    Notes
+    -----
+    The image corners back-projected to depth ``depth`` (Hartley & Zisserman 2004, Sec. 6.2.2).
+    """
+    if not isinstance(camera, PinholeCamera):
+        raise TypeError(f"camera: expected a PinholeCamera, got {type(camera).__name__}")
+    d = check_positive(depth, "depth")
+    corners = np.array([[0, 0], [camera.width - 1, 0], [camera.width - 1, camera.height - 1], [0, camera.height - 1]], float)
+    P = camera.backproject(corners, np.full(4, d), pose)
+    apex = np.asarray(pose, float)[:3, 3]
+    lines = []
+    for k in range(4):
+        lines += [apex, P[k], P[k], P[(k + 1) % 4]]
+    _segments(scene, f"{path}/frustum", np.array(lines), color)
+    return scene.add_triad(f"{path}/axes", pose, scale=d / 2)
+
+
+def add_trajectory(scene: Scene, path: str, poses: Any, z: float = 0.02, color: Any = 0x22AA22,
+                   every: int = 0) -> Scene:
+    """Draw a planar trajectory ``(N, 3)`` as a polyline at height ``z``; optionally a triad every ``every`` poses."""
+    P = as_points(poses, "poses", 3, min_count=2)
+    scene.add_line(f"{path}/line", np.column_stack([P[:, :2], np.full(len(P), z)]), color=color)
+    step = check_int(every, "every", minimum=0)
+    if step:
+        for k in range(0, len(P), step):
+            scene.add_triad(f"{path}/pose{k}", se2_to_se3(P[k], z), scale=0.2)
+    return scene
+
+
+def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, z: float = 0.03,
+                  arrow: float = 0.15, color: Any = 0xAA2288) -> Scene:
+    """Draw a particle cloud ``(N, 3)`` of planar poses: points plus short heading strokes.
+
+    Weights (optional, ``(N,)`` non-negative) scale the stroke length, so likely particles stand out.
+
+    Notes
+    -----
+    The usual display of Monte Carlo localization (Thrun et al. 2005, Sec. 8.3, Fig. 8.11).
+    """
+    P = as_points(particles, "particles", 3, min_count=1)
+    if weights is None:
+        w = np.ones(len(P))
+    else:
+        w = as_array(weights, "weights", shape=(len(P),))
+        if np.any(w < 0) or w.sum() <= 0:
+            raise ValueError("weights: expected non-negative weights with a positive sum")
+        w = w / w.max()
+    L = check_positive(arrow, "arrow") * (0.3 + 0.7 * w)
+    base = np.column_stack([P[:, :2], np.full(len(P), z)])
+    tip = base + np.column_stack([L * np.cos(P[:, 2]), L * np.sin(P[:, 2]), np.zeros(len(P))])
+    scene.add_points(f"{path}/points", base, size=0.04, color=color)
+    return _segments(scene, f"{path}/headings", np.stack([base, tip], axis=1).reshape(-1, 3), color)
+
+
+def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None, sigma: float = 1.0,
+                  colors: Any = None, max_ellipsoids: int = 500) -> Scene:
+    """Draw 3D landmarks with optional covariance ellipsoids (``sigma``-standard-deviation surfaces).
+
+    Parameters
+    ----------
+    points : array_like (N, 3)
+    covariances : array_like (N, 3, 3), optional
+        Symmetric positive semi-definite covariances (m^2).
+    sigma : float, default 1
+        Ellipsoid scale in standard deviations (Se et al. 2002 draw 1 sigma).
+    colors : array_like (N, 3), optional
+        RGB in [0, 1].
+    max_ellipsoids : int, default 500
+        Draw at most this many ellipsoids (the first ones) to keep the page light.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    ValueError
+        For shape mismatches or covariances that are not symmetric PSD.
+
+    Notes
+    -----
+    Principal axes from the eigen-decomposition ``C = V diag(l) V^T``, radii ``sigma sqrt(l)``
+    (Se, Lowe & Little 2002, Sec. 3.6: landmark uncertainty drawn as ellipsoids).
+    """
+    from meshcat.geometry import Ellipsoid, MeshLambertMaterial
+
+    P = as_points(points, "points", 3, min_count=1)
+    scene.add_points(f"{path}/points", P, colors=colors, size=0.05)
+    if covariances is None:
+        return scene
+    C = as_array(covariances, "covariances", shape=(len(P), 3, 3))
+    if not np.allclose(C, np.swapaxes(C, 1, 2), atol=1e-12):
+        raise ValueError("covariances: expected symmetric matrices")
+    lam, V = np.linalg.eigh(C)
+    if np.any(lam < -1e-12):
+        raise ValueError("covariances: expected positive semi-definite matrices, got a negative eigenvalue")
+    s = check_positive(sigma, "sigma")
+    for k in range(min(len(P), check_int(max_ellipsoids, "max_ellipsoids", minimum=0))):
+        R = V[k] * np.sign(np.linalg.det(V[k]))
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = R, P[k]
+        radii = np.maximum(s * np.sqrt(np.clip(lam[k], 0, None)), 1e-4)
+        scene.set_object(f"{path}/ellipsoid{k}", Ellipsoid(radii.tolist()),
+                         MeshLambertMaterial(color=0xFFAA00, opacity=0.35, transparent=True))
+        scene.set_transform(f"{path}/ellipsoid{k}", T)
+    return scene
+
+
+def animate_poses(scene: Scene, path: str, transforms: Any, fps: float = 10.0, repetitions: int = 1) -> Scene:
+    """Animate the object at ``path`` through a sequence of 4x4 poses (meshcat animation).
+
+    Parameters
+    ----------
+    transforms : array_like (N, 4, 4) or (N, 3)
+        Poses per frame; planar ``[x, y, theta]`` rows are lifted with :func:`robokit.geometry.se2_to_se3`.
+    fps : float, default 10
+        Frames per second of playback.
+    repetitions : int, default 1
+
+    Notes
+    -----
+    meshcat's ``set_animation`` command (three.js AnimationClip keyframe tracks).
+    """
+    from meshcat.animation import AnimationClip, js_position, js_quaternion
+    from meshcat.commands import SetAnimation
+
+    T = np.asarray(transforms, float)
+    if T.ndim == 2 and T.shape[1] == 3:
+        T = np.stack([se2_to_se3(p) for p in as_points(T, "transforms", 3)])
+    T = as_array(T, "transforms", shape=(None, 4, 4))
+    if len(T) < 2:
+        raise ValueError(f"transforms: expected at least 2 poses, got {len(T)}")
+    clip = AnimationClip(fps=check_positive(fps, "fps"))
+    for k, M in enumerate(T):
+        clip.set_property(k, "position", "vector3", js_position(M))
+        clip.set_property(k, "quaternion", "quaternion", js_quaternion(M))
+
+    class _Animation:  # meshcat's Animation keyed by our own path object
+        def lower(self):
+            return [{"path": Scene._path(path).lower(), "clip": clip.lower()}]
+
+    scene._send(SetAnimation(_Animation(), play=True, repetitions=check_int(repetitions, "repetitions", minimum=1)))
+    return scene
