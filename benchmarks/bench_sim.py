@@ -1,0 +1,102 @@
+"""Speed of the simulator against peer operations run in the same process, plus SIFT statistics.
+
+Run: ``.venv/bin/python benchmarks/bench_sim.py`` (add ``--quick`` for fewer repeats).
+
+Prints median times of: a 640x480 pinhole frame of ``long_corridor()`` (issue 4 target < 100 ms), a
+640x480 omni frame (< 400 ms), a 360-beam LiDAR scan (< 2 ms), each with its ratio to a peer
+operation timed in the same run (``cv2.warpPerspective`` of a full 640x480 RGB frame; a numpy
+``hypot`` over the same number of beam-segment pairs). Then, per world, SIFT keypoints on a rendered
+640x480 view and the fraction of ratio-test matches between two views 0.3 m apart that agree with
+the ground-truth geometry (back-projection with the rendered depth, 3 px).
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import cv2
+import numpy as np
+
+from robokit.sim import Lidar, OmniCamera, PinholeCamera, box_room, lab_room, long_corridor, office_floor
+
+
+def median_time(fn, repeats: int) -> float:
+    fn()  # warm-up (caches, mip-maps)
+    times = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return statistics.median(times)
+
+
+def sift_stats(world, pose, cam, step=0.3):
+    T1 = cam.pose_at(pose)
+    T2 = cam.pose_at([pose[0] + step * np.cos(pose[2]), pose[1] + step * np.sin(pose[2]), pose[2]])
+    f1, f2 = cam.render(world, T1), cam.render(world, T2)
+    sift = cv2.SIFT_create()
+    k1, d1 = sift.detectAndCompute(cv2.cvtColor(f1.image, cv2.COLOR_RGB2GRAY), None)
+    k2, d2 = sift.detectAndCompute(cv2.cvtColor(f2.image, cv2.COLOR_RGB2GRAY), None)
+    good = [m for m, n in cv2.BFMatcher(cv2.NORM_L2).knnMatch(d1, d2, k=2) if m.distance < 0.8 * n.distance]
+    p1 = np.array([k1[m.queryIdx].pt for m in good])
+    p2 = np.array([k2[m.trainIdx].pt for m in good])
+    depth = f1.depth[np.round(p1[:, 1]).astype(int), np.round(p1[:, 0]).astype(int)]
+    pred, _ = cam.project(cam.backproject(p1, depth, T1), T2)
+    return len(k1), len(good), float((np.linalg.norm(pred - p2, axis=1) < 3.0).mean())
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="fewer repeats")
+    args = ap.parse_args()
+    reps = 5 if args.quick else 21
+    corridor = long_corridor()
+    cam = PinholeCamera.from_fov(width=640, height=480)
+    omni = OmniCamera()
+    lidar = Lidar(beams=360)
+    poses = [[1.0, 0.0, 0.0], [10.0, 0.3, 0.2], [20.0, -0.4, np.pi], [30.0, 0.0, 2.5]]
+    state = {"k": 0}
+
+    def pinhole():
+        state["k"] += 1
+        cam.observe(corridor, poses[state["k"] % len(poses)])
+
+    def omni_frame():
+        state["k"] += 1
+        omni.observe(corridor, poses[state["k"] % len(poses)])
+
+    def scan():
+        state["k"] += 1
+        lidar.scan(corridor, poses[state["k"] % len(poses)])
+
+    frame = cam.observe(corridor, poses[0]).image
+    H = np.array([[1.01, 0.02, 3.0], [-0.01, 0.99, 2.0], [1e-5, 2e-5, 1.0]])
+    warp = lambda: cv2.warpPerspective(frame, H, (640, 480))
+    pairs = np.random.default_rng(0).random((360, len(corridor.segments)))
+    hyp = lambda: np.hypot(pairs, pairs)
+
+    t_pin, t_omni, t_scan = median_time(pinhole, reps), median_time(omni_frame, reps), median_time(scan, 5 * reps)
+    t_warp, t_hyp = median_time(warp, 5 * reps), median_time(hyp, 5 * reps)
+    print(f"cores available: {len(__import__('os').sched_getaffinity(0))}; cv2 threads: {cv2.getNumThreads()}")
+    print(f"{'operation':<44}{'median':>12}{'target':>10}{'ratio to peer':>16}")
+    print(f"{'pinhole 640x480 frame, long_corridor':<44}{t_pin * 1e3:>9.1f} ms{'100 ms':>10}"
+          f"{t_pin / t_warp:>12.1f} x warp")
+    print(f"{'omni 640x480 frame, long_corridor':<44}{t_omni * 1e3:>9.1f} ms{'400 ms':>10}"
+          f"{t_omni / t_warp:>12.1f} x warp")
+    print(f"{'LiDAR scan, 360 beams x %d segments' % len(corridor.segments):<44}{t_scan * 1e3:>9.3f} ms{'2 ms':>10}"
+          f"{t_scan / t_hyp:>11.1f} x hypot")
+    print(f"{'peer: cv2.warpPerspective 640x480 RGB':<44}{t_warp * 1e3:>9.2f} ms")
+    print(f"{'peer: np.hypot over the same beam x segment':<44}{t_hyp * 1e3:>9.3f} ms")
+    print()
+    print(f"{'world':<16}{'keypoints':>10}{'matches':>9}{'inlier ratio':>14}   (SIFT, views 0.3 m apart)")
+    for name, world, pose in [("lab_room", lab_room(), [5.0, 2.0, np.pi / 2]),
+                              ("long_corridor", corridor, [3.0, 0.0, 0.0]),
+                              ("office_floor", office_floor(), [10.0, 4.3, -np.pi / 2]),
+                              ("box_room", box_room(), [1.0, 1.0, 0.4])]:
+        n_kp, n_m, ratio = sift_stats(world, pose, cam)
+        print(f"{name:<16}{n_kp:>10}{n_m:>9}{ratio:>14.3f}")
+
+
+if __name__ == "__main__":
+    main()
