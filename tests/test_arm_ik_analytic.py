@@ -112,3 +112,26 @@ def test_bad_input():
         ik_srs_branches(IIWA, T, float("nan"))
     with pytest.raises(TypeError, match="chain"):
         ik_srs([1, 2], T)
+
+
+def test_step_functions_reproduce_the_solver():
+    from robokit.arm import elbow_angle, shoulder_angles, wrist_centre
+
+    q = IIWA.random_q(20, rng=30)
+    for qi in q:
+        T = IIWA.fk(qi)
+        frames = IIWA.link_frames(qi)
+        W = wrist_centre(T, 0.126)
+        assert np.allclose(W, frames[5, :3, 3], atol=1e-12)
+        S = np.array([0, 0, 0.36])
+        q4 = elbow_angle(S, W, 0.42, 0.40)
+        assert abs(q4 - abs(qi[3])) < 1e-9
+        psi = arm_angle(IIWA, qi)
+        sh = shoulder_angles(S, W, qi[3], psi, 0.42, 0.40)
+        mirror = np.array([sh[0] + np.pi, -sh[1], sh[2] + np.pi])
+        mirror[[0, 2]] = (mirror[[0, 2]] + np.pi) % (2 * np.pi) - np.pi
+        assert min(np.abs(sh - qi[:3]).max(), np.abs(mirror - qi[:3]).max()) < 1e-9
+    with pytest.raises(ValueError, match="out of reach"):
+        elbow_angle([0, 0, 0.36], [0, 0, 2.0], 0.42, 0.40)
+    with pytest.raises(ValueError, match="T"):
+        wrist_centre(np.eye(3), 0.126)

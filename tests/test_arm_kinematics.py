@@ -170,3 +170,20 @@ def test_bad_input_is_rejected_with_clear_messages():
         Chain("bad", d=[0.1], a=[0], alpha=[0], qmin=[0], qmax=[1], convention="craig")
     with pytest.raises(TypeError, match="chain"):
         geometric_jacobian("iiwa", np.zeros(7))
+
+
+def test_plain_table_functions_match_the_chain():
+    from robokit.arm import dh_fk, dh_jacobian
+
+    chain = iiwa14()
+    table = np.stack([chain.d, chain.a, chain.alpha], 1)
+    q = chain.random_q(rng=11)
+    assert np.allclose(dh_fk(table, q), chain.fk(q), atol=1e-14)
+    assert np.allclose(dh_jacobian(table, q), geometric_jacobian(chain, q), atol=1e-14)
+    p = panda()
+    ptable = np.stack([p.d, p.a, p.alpha], 1)
+    assert np.allclose(dh_fk(ptable, q, modified=True) @ p.tool, p.fk(q), atol=1e-14)
+    with pytest.raises(ValueError, match="dh"):
+        dh_fk(table[:, :2], q)
+    with pytest.raises(ValueError, match="q"):
+        dh_fk(table, q[:5])

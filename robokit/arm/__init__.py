@@ -5,22 +5,26 @@ Lesson 06 (redundant 7-DOF arms, seed 000 Q4: Huang & Jiang's separation of posi
 * :class:`Chain`, :func:`dh_transform`, :func:`mdh_transform` - DH / modified-DH forward kinematics.
 * :func:`iiwa14`, :func:`panda` - two real arms with their published parameters.
 * :func:`geometric_jacobian`, :func:`manipulability`.
+* :func:`wrist_centre`, :func:`elbow_angle`, :func:`shoulder_angles` - the S-R-S decomposition
+  step by step; :func:`dh_fk`, :func:`dh_jacobian` - the same for a plain DH table.
 * :func:`ik_srs`, :func:`ik_srs_batch`, :func:`ik_srs_branches`, :func:`arm_angle` - the analytic
   arm-angle IK of S-R-S arms (KUKA LBR iiwa).
 * :func:`ik_numeric`, :func:`ik_numeric_batch` - damped least squares with null-space gradient
   projection (Dubey) or weighted least norm (Chan), random restarts; any chain.
 """
-from .chain import Chain
+from .chain import Chain, chain_from_table, dh_fk
 from .dh import dh_transform, mdh_transform
 from .ik_analytic import SRSArm, arm_angle, ik_srs, ik_srs_batch, ik_srs_branches
 from .ik_numeric import METHODS, dls_step, ik_numeric, ik_numeric_batch, null_space_step
-from .jacobian import geometric_jacobian, manipulability
+from .jacobian import dh_jacobian, geometric_jacobian, manipulability
 from .limits import limit_distance_gradient, wln_weights
 from .result import IKBatchResult, IKResult
 from .robots import iiwa14, panda
 from .se3 import pose_error
+from .srs import elbow_angle, shoulder_angles, wrist_centre
 
 __all__ = ["Chain", "dh_transform", "mdh_transform", "iiwa14", "panda", "geometric_jacobian",
            "manipulability", "SRSArm", "arm_angle", "ik_srs", "ik_srs_batch", "ik_srs_branches",
            "IKResult", "IKBatchResult", "pose_error", "METHODS", "dls_step", "null_space_step",
-           "ik_numeric", "ik_numeric_batch", "limit_distance_gradient", "wln_weights"]
+           "ik_numeric", "ik_numeric_batch", "limit_distance_gradient", "wln_weights", "chain_from_table",
+           "dh_fk", "dh_jacobian", "elbow_angle", "shoulder_angles", "wrist_centre"]

@@ -14,7 +14,7 @@ from ..validation import as_array, as_rng, check_choice, check_int
 from .dh import link_matrices
 from .se3 import as_se3
 
-__all__ = ["Chain"]
+__all__ = ["Chain", "dh_fk", "chain_from_table"]
 
 
 class Chain:
@@ -27,8 +27,8 @@ class Chain:
     d, a, alpha : array_like, shape (n,)
         DH parameters of each link [m, m, rad]. For ``convention="modified"`` they are Craig's
         ``d_i, a_{i-1}, alpha_{i-1}``.
-    qmin, qmax : array_like, shape (n,)
-        Joint limits [rad]; ``qmin <= qmax`` elementwise.
+    qmin, qmax : array_like, shape (n,), optional
+        Joint limits [rad]; ``qmin <= qmax`` elementwise; ``-pi`` and ``pi`` by default.
     convention : {"standard", "modified"}, default "standard"
         Standard DH (joint ``i`` turns about ``z_{i-1}``) or modified DH (about ``z_i``).
     offset : array_like, shape (n,), optional
@@ -50,7 +50,7 @@ class Chain:
     Craig (2005), Eq. (3.6); forward kinematics is their ordered product (Spong et al., Eq. (3.5)).
     """
 
-    def __init__(self, name: str, d: Any, a: Any, alpha: Any, qmin: Any, qmax: Any, *,
+    def __init__(self, name: str, d: Any, a: Any, alpha: Any, qmin: Any = None, qmax: Any = None, *,
                  convention: str = "standard", offset: Any = None, tool: Any = None, base: Any = None):
         if not isinstance(name, str):
             raise TypeError(f"name: expected a string, got {type(name).__name__}")
@@ -60,8 +60,8 @@ class Chain:
         self.a = as_array(a, "a", shape=(n,))
         self.alpha = as_array(alpha, "alpha", shape=(n,))
         self.offset = np.zeros(n) if offset is None else as_array(offset, "offset", shape=(n,))
-        self.qmin = as_array(qmin, "qmin", shape=(n,))
-        self.qmax = as_array(qmax, "qmax", shape=(n,))
+        self.qmin = np.full(n, -np.pi) if qmin is None else as_array(qmin, "qmin", shape=(n,))
+        self.qmax = np.full(n, np.pi) if qmax is None else as_array(qmax, "qmax", shape=(n,))
         bad = np.flatnonzero(self.qmin > self.qmax)
         if bad.size:
             i = int(bad[0])
@@ -215,3 +215,46 @@ class Chain:
         """
         q = self.check_q(q, batch=np.ndim(q) == 2)
         return self._flange(self._frames(q))
+
+
+def chain_from_table(dh: Any, *, modified: bool = False) -> Chain:
+    """A :class:`Chain` from a plain DH table with rows ``[d, a, alpha]`` (no limits, no tool).
+
+    Raises
+    ------
+    ValueError
+        If ``dh`` is not an (n, 3) table of finite numbers with n >= 1.
+    """
+    table = as_array(dh, "dh")
+    if table.ndim != 2 or table.shape[1] != 3 or table.shape[0] < 1:
+        raise ValueError(f"dh: expected a table with rows [d, a, alpha], shape (n, 3), got shape {table.shape}")
+    return Chain("DH table", d=table[:, 0], a=table[:, 1], alpha=table[:, 2],
+                 convention="modified" if modified else "standard")
+
+
+def dh_fk(dh: Any, q: Any, *, modified: bool = False) -> np.ndarray:
+    """Flange pose of a chain given as a plain DH table.
+
+    Parameters
+    ----------
+    dh : array_like, shape (n, 3)
+        Rows ``[d, a, alpha]`` [m, m, rad], standard DH (or modified with ``modified=True``).
+    q : array_like, shape (n,)
+        Joint angles [rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (4, 4)
+        ``A_1(q_1) A_2(q_2) ... A_n(q_n)``.
+
+    Raises
+    ------
+    ValueError
+        On a malformed table or a joint vector of the wrong length.
+
+    Notes
+    -----
+    Spong et al. (2006), Eq. (3.5).
+    """
+    chain = chain_from_table(dh, modified=modified)
+    return chain.fk(chain.check_q(q))

@@ -24,7 +24,8 @@ import numpy as np
 from ..validation import as_array, check_int, check_positive
 from .chain import Chain
 from .result import IKBatchResult, IKResult, verify
-from .se3 import as_se3, axis_angle_rotation, skew
+from .se3 import as_se3, skew
+from .srs import flip, reference_rotation, rot_y, rot_z, zyz
 
 __all__ = ["SRSArm", "arm_angle", "ik_srs_branches", "ik_srs", "ik_srs_batch"]
 
@@ -35,45 +36,6 @@ BRANCHES = [(e, s, w) for e in (0, 1) for s in (0, 1) for w in (0, 1)]
 _GROUPS = np.array([[0, 1, 2], [4, 5, 6]])
 _ROWS = np.array([0, 1, 2, 2, 2, 1, 1])
 _COLS = np.array([2, 2, 2, 1, 0, 0, 1])
-
-
-def _wrap(x):
-    return np.mod(x + np.pi, 2 * np.pi) - np.pi
-
-
-def _rz(a):
-    c, s = np.cos(a), np.sin(a)
-    R = np.zeros(np.shape(a) + (3, 3))
-    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
-    return R
-
-
-def _ry(a):
-    c, s = np.cos(a), np.sin(a)
-    R = np.zeros(np.shape(a) + (3, 3))
-    R[..., 0, 0], R[..., 0, 2], R[..., 2, 0], R[..., 2, 2], R[..., 1, 1] = c, s, -s, c, 1.0
-    return R
-
-
-def _zyz(m02, m12, m22, m21, m20, m10, m11):
-    """ZYZ Euler angles (a, b >= 0, c) of ``Rz(a) Ry(b) Rz(c)`` from its entries.
-
-    At ``sin b = 0`` only ``a + c`` (or ``a - c``) is defined; then ``a = 0``.
-    """
-    sb = np.hypot(m02, m12)
-    b = np.arctan2(sb, m22)
-    a = np.arctan2(m12, m02)
-    c = np.arctan2(m21, -m20)
-    sing = sb < 1e-12
-    if np.any(sing):
-        a = np.where(sing, 0.0, a)
-        c = np.where(sing, np.arctan2(m10, m11), c)
-    return a, b, c
-
-
-def _flip(x):
-    """``x + pi`` wrapped to (-pi, pi] for ``x`` in (-pi, pi]."""
-    return np.where(x > 0, x - np.pi, x + np.pi)
 
 
 class SRSArm:
@@ -128,10 +90,7 @@ class SRSArm:
 
     def reference_shoulder(self, sw: np.ndarray, q4: np.ndarray) -> np.ndarray:
         """Unchecked: ``Rz(q1) Ry(q2)`` of the reference arm plane (``q3 = 0``) reaching ``sw``."""
-        v_x, v_z = -self.d_ew * np.sin(q4), self.d_se + self.d_ew * np.cos(q4)
-        q1 = np.arctan2(sw[..., 1], sw[..., 0])
-        q2 = np.arctan2(np.hypot(sw[..., 0], sw[..., 1]), sw[..., 2]) - np.arctan2(v_x, v_z)
-        return _rz(q1) @ _ry(q2)
+        return reference_rotation(sw, q4, self.d_se, self.d_ew)
 
     def coefficients(self, T7: np.ndarray):
         """Unchecked: Shimizu's ``A, B, C`` coefficients for shoulder and wrist, per elbow sign.
@@ -153,7 +112,7 @@ class SRSArm:
         As = K @ R_ref                                            # R_psi = I + sin K + (1 - cos) K^2
         Bs = -(K @ As)
         Cs = R_ref - Bs
-        Rt_Ry4 = _ry(q4)
+        Rt_Ry4 = rot_y(q4)
         Rt = T7[:, None, :3, :3]
         mats = [np.stack([X, Rt_Ry4 @ np.swapaxes(X, -1, -2) @ Rt], 2) for X in (As, Bs, Cs)]
         A, B, C = (X[..., _ROWS, _COLS] for X in mats)
@@ -169,8 +128,8 @@ class SRSArm:
         A, B, C = coeffs[:3]
         s, c = np.sin(psi)[:, None, None, None, :], np.cos(psi)[:, None, None, None, :]
         E = A[..., None] * s + B[..., None] * c + C[..., None]   # (N, 2, 2, 7, K)
-        a, b, cc = _zyz(*(E[..., r, :] for r in range(7)))        # (N, 2, 2, K)
-        return (np.stack([a, _flip(a)], 3), np.stack([b, -b], 3), np.stack([cc, _flip(cc)], 3))
+        a, b, cc = zyz(*(E[..., r, :] for r in range(7)))        # (N, 2, 2, K)
+        return (np.stack([a, flip(a)], 3), np.stack([b, -b], 3), np.stack([cc, flip(cc)], 3))
 
     def joints(self, coeffs, psi: np.ndarray) -> np.ndarray:
         """Unchecked: all 8 branches for arm angles ``psi`` (N, K) -> q of shape (N, K, 8, 7).
@@ -193,7 +152,7 @@ class SRSArm:
         ``psi`` is the angle, about the shoulder-wrist axis, of ``M R_ref^T`` with
         ``M = Rz(q1) Ry(q2) Rz(q3)`` (Shimizu et al. 2008, Eq. (9)).
         """
-        M = _rz(q[:, 0]) @ _ry(q[:, 1]) @ _rz(q[:, 2])
+        M = rot_z(q[:, 0]) @ rot_y(q[:, 1]) @ rot_z(q[:, 2])
         v = np.stack([-self.d_ew * np.sin(q[:, 3]), np.zeros(len(q)), self.d_se + self.d_ew * np.cos(q[:, 3])], -1)
         sw = (M @ v[..., None])[..., 0]
         R = M @ np.swapaxes(self.reference_shoulder(sw, q[:, 3]), -1, -2)

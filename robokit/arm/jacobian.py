@@ -6,9 +6,9 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array
-from .chain import Chain
+from .chain import Chain, chain_from_table
 
-__all__ = ["geometric_jacobian", "manipulability"]
+__all__ = ["geometric_jacobian", "dh_jacobian", "manipulability"]
 
 
 def jacobian_from_frames(chain: Chain, frames: np.ndarray) -> np.ndarray:
@@ -57,6 +57,22 @@ def geometric_jacobian(chain: Chain, q: Any) -> np.ndarray:
         raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
     q = chain.check_q(q, batch=np.ndim(q) == 2)
     return jacobian_from_frames(chain, chain._frames(q))
+
+
+def dh_jacobian(dh: Any, q: Any, *, modified: bool = False) -> np.ndarray:
+    """Geometric Jacobian (6, n) of a chain given as a plain DH table of rows ``[d, a, alpha]``.
+
+    Raises
+    ------
+    ValueError
+        On a malformed table or a joint vector of the wrong length.
+
+    Notes
+    -----
+    Siciliano et al. (2009), Eq. (3.30); see :func:`geometric_jacobian`.
+    """
+    chain = chain_from_table(dh, modified=modified)
+    return geometric_jacobian(chain, chain.check_q(q))
 
 
 def manipulability(J: Any) -> float | np.ndarray:

@@ -1,0 +1,182 @@
+"""The steps of the S-R-S decomposition, one function each (used by the lesson and its exercises).
+
+For an arm whose first three axes meet at a shoulder point ``S``, whose last three meet at a wrist
+centre ``W``, with a revolute elbow between (the KUKA LBR iiwa):
+
+1. :func:`wrist_centre` - ``W`` from the target pose;
+2. :func:`elbow_angle` - the elbow joint from the triangle ``S``-elbow-``W`` (law of cosines);
+3. :func:`shoulder_angles` - the shoulder joints for a chosen arm angle ``psi``.
+
+Angles follow the iiwa's DH frames (:func:`robokit.arm.iiwa14`): ``Rz(q1) Ry(q2) Rz(q3)`` is the
+shoulder rotation, and ``q4 > 0`` bends the forearm towards the upper arm's ``-x`` axis.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..validation import as_array, check_finite_scalar, check_positive
+from .se3 import as_se3, axis_angle_rotation
+
+__all__ = ["wrist_centre", "elbow_angle", "shoulder_angles"]
+
+
+def rot_z(a):
+    """Unchecked: rotations about z by angles ``a`` (any shape) -> (..., 3, 3)."""
+    c, s = np.cos(a), np.sin(a)
+    R = np.zeros(np.shape(a) + (3, 3))
+    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
+    return R
+
+
+def rot_y(a):
+    """Unchecked: rotations about y by angles ``a`` (any shape) -> (..., 3, 3)."""
+    c, s = np.cos(a), np.sin(a)
+    R = np.zeros(np.shape(a) + (3, 3))
+    R[..., 0, 0], R[..., 0, 2], R[..., 2, 0], R[..., 2, 2], R[..., 1, 1] = c, s, -s, c, 1.0
+    return R
+
+
+def zyz(m02, m12, m22, m21, m20, m10, m11):
+    """Unchecked: ZYZ Euler angles (a, b >= 0, c) of ``Rz(a) Ry(b) Rz(c)`` from its entries.
+
+    At ``sin b = 0`` only ``a + c`` (or ``a - c``) is defined; then ``a = 0``. Craig (2005),
+    Sec. 2.8, Z-Y-Z Euler angles.
+    """
+    sb = np.hypot(m02, m12)
+    b = np.arctan2(sb, m22)
+    a = np.arctan2(m12, m02)
+    c = np.arctan2(m21, -m20)
+    sing = sb < 1e-12
+    if np.any(sing):
+        a = np.where(sing, 0.0, a)
+        c = np.where(sing, np.arctan2(m10, m11), c)
+    return a, b, c
+
+
+def flip(x):
+    """Unchecked: ``x + pi`` wrapped to (-pi, pi] for ``x`` in (-pi, pi] (the mirror branch)."""
+    return np.where(x > 0, x - np.pi, x + np.pi)
+
+
+def reference_rotation(sw: np.ndarray, q4: np.ndarray, d_se: float, d_ew: float) -> np.ndarray:
+    """Unchecked: ``Rz(q1) Ry(q2)`` of the reference arm plane (``q3 = 0``) that reaches ``sw``.
+
+    ``q1`` turns the vertical plane through the shoulder-wrist vector ``sw`` and ``q2`` tilts the
+    upper arm in it so that ``Rz(q1) Ry(q2) v = sw`` with ``v = (-d_ew sin q4, 0, d_se + d_ew cos q4)``
+    (Shimizu et al. 2008, Sec. III-A, reference plane).
+    """
+    v_x, v_z = -d_ew * np.sin(q4), d_se + d_ew * np.cos(q4)
+    q1 = np.arctan2(sw[..., 1], sw[..., 0])
+    q2 = np.arctan2(np.hypot(sw[..., 0], sw[..., 1]), sw[..., 2]) - np.arctan2(v_x, v_z)
+    return rot_z(q1) @ rot_y(q2)
+
+
+def wrist_centre(T: Any, d_wf: float) -> np.ndarray:
+    """The wrist centre ``W = p - d_wf z`` of a target flange pose.
+
+    Parameters
+    ----------
+    T : array_like, shape (4, 4)
+        Target flange pose (SE(3)) in the base frame.
+    d_wf : float
+        Distance from the wrist centre to the flange along the flange's z axis [m] (0.126 m on the
+        iiwa 14).
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+
+    Raises
+    ------
+    ValueError
+        If ``T`` is not an SE(3) matrix or ``d_wf`` is negative or not finite.
+
+    Notes
+    -----
+    Separation of position and posture: Huang & Jiang (2013), Sec. 3; Shimizu et al. (2008), Eq. (3).
+    """
+    T = as_se3(T, "T")
+    d = check_positive(d_wf, "d_wf", allow_zero=True)
+    return T[:3, 3] - d * T[:3, 2]
+
+
+def elbow_angle(shoulder: Any, wrist: Any, d_se: float, d_ew: float) -> float:
+    """The elbow joint ``q4 >= 0`` that puts the wrist centre at distance ``|W - S|`` from the shoulder.
+
+    Parameters
+    ----------
+    shoulder, wrist : array_like, shape (3,)
+        Shoulder point ``S`` and wrist centre ``W`` [m].
+    d_se, d_ew : float
+        Upper-arm (shoulder-elbow) and forearm (elbow-wrist) lengths [m], positive.
+
+    Returns
+    -------
+    float
+        ``acos((|W - S|^2 - d_se^2 - d_ew^2) / (2 d_se d_ew))`` in ``[0, pi]``; ``-q4`` is the
+        other elbow branch.
+
+    Raises
+    ------
+    ValueError
+        If the distance is outside ``[|d_se - d_ew|, d_se + d_ew]`` (out of reach), or an input is
+        malformed.
+
+    Notes
+    -----
+    Law of cosines in the shoulder-elbow-wrist triangle, Shimizu et al. (2008), Eq. (4).
+    """
+    S = as_array(shoulder, "shoulder", shape=(3,))
+    W = as_array(wrist, "wrist", shape=(3,))
+    l1, l2 = check_positive(d_se, "d_se"), check_positive(d_ew, "d_ew")
+    L = float(np.linalg.norm(W - S))
+    c = (L**2 - l1**2 - l2**2) / (2 * l1 * l2)
+    if abs(c) > 1.0 + 1e-12:
+        raise ValueError(f"wrist: out of reach, |W - S| = {L:.6g} m is outside [{abs(l1 - l2):.6g}, {l1 + l2:.6g}] m")
+    return float(np.arccos(np.clip(c, -1.0, 1.0)))
+
+
+def shoulder_angles(shoulder: Any, wrist: Any, q4: float, psi: float, d_se: float, d_ew: float) -> np.ndarray:
+    """Shoulder joints ``(q1, q2 >= 0, q3)`` that place the wrist centre, for one arm angle.
+
+    Parameters
+    ----------
+    shoulder, wrist : array_like, shape (3,)
+        Shoulder point and wrist centre [m].
+    q4 : float
+        Elbow joint [rad] consistent with ``|W - S|`` (see :func:`elbow_angle`).
+    psi : float
+        Arm angle [rad]: rotation of the arm plane about the shoulder-wrist axis, from the
+        reference plane in which ``q3 = 0``.
+    d_se, d_ew : float
+        Upper-arm and forearm lengths [m].
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``(q1, q2, q3)`` with ``q2 >= 0``; the mirror branch is ``(q1 + pi, -q2, q3 + pi)``.
+
+    Raises
+    ------
+    ValueError
+        On malformed or non-finite input or a zero shoulder-wrist distance.
+
+    Notes
+    -----
+    Shimizu et al. (2008), Eqs. (9)-(15): ``R_0^3(psi) = R_psi R_0^3(0)`` with ``R_psi`` the
+    rotation by ``psi`` about the unit shoulder-wrist vector (Rodrigues' formula); then the ZYZ
+    decomposition of ``Rz(q1) Ry(q2) Rz(q3)``.
+    """
+    S = as_array(shoulder, "shoulder", shape=(3,))
+    W = as_array(wrist, "wrist", shape=(3,))
+    q4 = check_finite_scalar(q4, "q4")
+    psi = check_finite_scalar(psi, "psi")
+    l1, l2 = check_positive(d_se, "d_se"), check_positive(d_ew, "d_ew")
+    sw = W - S
+    L = float(np.linalg.norm(sw))
+    if L < 1e-12:
+        raise ValueError("wrist: expected a wrist centre away from the shoulder, got |W - S| = 0")
+    M = axis_angle_rotation(sw / L, np.asarray(psi)) @ reference_rotation(sw, np.asarray(q4), l1, l2)
+    return np.array(zyz(M[0, 2], M[1, 2], M[2, 2], M[2, 1], M[2, 0], M[1, 0], M[1, 1]), dtype=float)
