@@ -10,12 +10,14 @@ keypoints (OpenCV's ``remap`` samples the gradients, ``numpy.bincount`` accumula
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import cv2
 import numpy as np
 
 from ..validation import check_choice, check_int, check_positive
 from .features import Features, Keypoints, as_gray_image
-from .plot import PlotParams, detect_plot
+from .plot import PlotParams, detect_plot_levels
 
 __all__ = ["assign_orientations", "gradient_histogram_descriptor", "sift_descriptor",
            "reduced_descriptor", "plot_features", "sift_features", "detect_and_describe"]
@@ -25,37 +27,127 @@ _CELL = 3.0        # descriptor cell width = 3 x keypoint scale (Lowe 2004, Sec.
 _GRID = 16         # samples per side of the sampling grid
 
 
-def _gradient_levels(img: np.ndarray, scales: np.ndarray):
-    """Group keypoints by scale (quarter-octave bins) and return per-group (index, gx, gy)."""
-    key = np.round(4 * np.log2(scales)).astype(int)
-    out = []
-    for q in np.unique(key):
-        idx = np.nonzero(key == q)[0]
-        sigma = float(2.0 ** (q / 4))
+def _quarter_octave_levels(img: np.ndarray, scales: np.ndarray):
+    """Smooth ``img`` at the quarter-octave scales nearest to the keypoints' scales."""
+    sigmas = 2.0 ** (np.unique(np.round(4 * np.log2(scales))) / 4)
+    levels = []
+    for sigma in sigmas:
         size = 2 * int(np.ceil(3 * sigma)) + 1
-        smoothed = cv2.GaussianBlur(img, (size, size), sigma, borderType=cv2.BORDER_REFLECT)
-        gx = cv2.Sobel(smoothed, cv2.CV_32F, 1, 0, ksize=1, scale=0.5)
-        gy = cv2.Sobel(smoothed, cv2.CV_32F, 0, 1, ksize=1, scale=0.5)
-        out.append((idx, gx, gy))
+        levels.append(cv2.GaussianBlur(img, (size, size), float(sigma), borderType=cv2.BORDER_REFLECT))
+    return sigmas, levels
+
+
+def _gradients(sigmas, levels, scales, cache=None):
+    """Per level: (keypoint indices at that level, gx, gy) with each keypoint at its nearest level.
+
+    ``cache`` (a dict) keeps the gradient images between calls on the same levels.
+    """
+    cache = {} if cache is None else cache
+    nearest = np.argmin(np.abs(np.log(scales)[:, None] - np.log(np.asarray(sigmas))[None, :]), axis=1)
+    out = []
+    for n in np.unique(nearest):
+        if n not in cache:
+            cache[n] = (cv2.Sobel(levels[n], cv2.CV_32F, 1, 0, ksize=1, scale=0.5),
+                        cv2.Sobel(levels[n], cv2.CV_32F, 0, 1, ksize=1, scale=0.5))
+        out.append((np.nonzero(nearest == n)[0], *cache[n]))
     return out
 
 
 def _sample(gx, gy, xy, scale, angle, half_width):
-    """Sample the gradient on a rotated _GRID x _GRID grid; return (u, v, gx, gy) per sample.
+    """Sample the gradient on a rotated _GRID x _GRID grid; return (gx, gy) in the keypoint frame.
 
-    ``u, v`` are grid coordinates in [-1, 1] in the keypoint frame; gradients are rotated into it.
+    Grid sample ``s`` sits at ``(u, v) = _grid()[s]`` in [-1, 1]^2 of the keypoint frame.
     """
-    t = (np.arange(_GRID) + 0.5) / _GRID * 2 - 1
-    u, v = np.meshgrid(t, t)
-    u, v = u.ravel()[None, :], v.ravel()[None, :]
+    u, v = _grid()
     r = (half_width * scale)[:, None]
     c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
     mx = (xy[:, :1] + r * (c * u - s * v)).astype(np.float32)
     my = (xy[:, 1:] + r * (s * u + c * v)).astype(np.float32)
     sx = cv2.remap(gx, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
     sy = cv2.remap(gy, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-    # gradient expressed in the keypoint's rotated frame
-    return np.broadcast_to(u, sx.shape), np.broadcast_to(v, sx.shape), c * sx + s * sy, -s * sx + c * sy
+    return c * sx + s * sy, -s * sx + c * sy
+
+
+@lru_cache(maxsize=None)
+def _grid():
+    t = (np.arange(_GRID) + 0.5) / _GRID * 2 - 1
+    u, v = np.meshgrid(t, t)
+    return u.ravel(), v.ravel()
+
+
+@lru_cache(maxsize=None)
+def _cell_weights(cells: int) -> np.ndarray:
+    """Constant (cells^2, samples) matrix: bilinear share of each sample in each spatial cell,
+    times the Gaussian window (sigma = half the window)."""
+    u, v = _grid()
+    cu, cv = (u + 1) * cells / 2 - 0.5, (v + 1) * cells / 2 - 0.5
+    iu, iv = np.floor(cu).astype(int), np.floor(cv).astype(int)
+    w = np.zeros((cells * cells, u.size))
+    gauss = np.exp(-2.0 * (u * u + v * v))
+    for du, wu in ((0, 1 - (cu - iu)), (1, cu - iu)):
+        for dv, wv in ((0, 1 - (cv - iv)), (1, cv - iv)):
+            x, y = iu + du, iv + dv
+            ok = (x >= 0) & (x < cells) & (y >= 0) & (y < cells)
+            w[(y * cells + x)[ok], np.nonzero(ok)[0]] += (wu * wv * gauss)[ok]
+    return w
+
+
+def _orientations(grads, keypoints: Keypoints, ratio: float) -> Keypoints:
+    nbins, n = 36, len(keypoints)
+    hist = np.zeros((n, nbins))
+    u, v = _grid()
+    # window half-width is 3 x the Gaussian sigma, so the weight in grid units is exp(-9 r^2 / 2)
+    gauss = np.exp(-4.5 * (u * u + v * v))
+    for idx, gx, gy in grads:
+        rx, ry = _sample(gx, gy, keypoints.xy[idx], keypoints.scale[idx], np.zeros(idx.size), 3 * _WINDOW)
+        weight = np.hypot(rx, ry) * gauss
+        pos = np.mod(np.arctan2(ry, rx), 2 * np.pi) * (nbins / (2 * np.pi))
+        lo = np.floor(pos).astype(int)
+        frac = pos - lo
+        rows = np.arange(idx.size)[:, None] * nbins
+        h = np.bincount((rows + lo % nbins).ravel(), (weight * (1 - frac)).ravel(), idx.size * nbins)
+        h += np.bincount((rows + (lo + 1) % nbins).ravel(), (weight * frac).ravel(), idx.size * nbins)
+        hist[idx] = h.reshape(idx.size, nbins)
+    for _ in range(2):  # circular [1 1 1]/3 smoothing of the histogram
+        hist = (np.roll(hist, 1, 1) + hist + np.roll(hist, -1, 1)) / 3
+    left, right = np.roll(hist, 1, 1), np.roll(hist, -1, 1)
+    peak = (hist > left) & (hist >= right) & (hist >= ratio * hist.max(1, keepdims=True)) & (hist > 0)
+    kp_idx, bins = np.nonzero(peak)
+    l, c, r = left[kp_idx, bins], hist[kp_idx, bins], right[kp_idx, bins]
+    offset = 0.5 * (l - r) / (l - 2 * c + r)
+    theta = np.mod((bins + offset) * 2 * np.pi / nbins, 2 * np.pi)
+    sel = keypoints.subset(kp_idx)
+    return Keypoints(sel.xy, sel.scale, sel.response, theta)
+
+
+def _histograms(grads, keypoints: Keypoints, cells: int, bins: int, clip: float) -> np.ndarray:
+    n, dim = len(keypoints), cells * cells * bins
+    out = np.zeros((n, dim))
+    weights = _cell_weights(cells)
+    for idx, gx, gy in grads:
+        rx, ry = _sample(gx, gy, keypoints.xy[idx], keypoints.scale[idx], keypoints.orientation[idx], 2 * _CELL)
+        mag = np.hypot(rx, ry).ravel()
+        pos = (np.mod(np.arctan2(ry, rx), 2 * np.pi) * (bins / (2 * np.pi))).ravel()
+        lo = np.floor(pos).astype(int)
+        frac = pos - lo
+        # orientation soft-binning per sample, then one matrix product does the spatial binning
+        per_sample = np.zeros(mag.size * bins)
+        base = np.arange(mag.size) * bins
+        per_sample[base + lo % bins] = mag * (1 - frac)
+        per_sample[base + (lo + 1) % bins] += mag * frac
+        hist = weights @ per_sample.reshape(idx.size, -1, bins)       # (k, cells^2, bins)
+        out[idx] = hist.reshape(idx.size, dim)
+    for _ in range(2):  # normalise, clip large gradients, renormalise (Lowe 2004, Sec. 6.1)
+        norm = np.linalg.norm(out, axis=1, keepdims=True)
+        out = np.divide(out, norm, out=np.zeros_like(out), where=norm > 1e-12)
+        out = np.minimum(out, clip)
+    norm = np.linalg.norm(out, axis=1, keepdims=True)
+    return np.divide(out, norm, out=np.zeros_like(out), where=norm > 1e-12).astype(np.float32)
+
+
+def _check_keypoints(keypoints):
+    if not isinstance(keypoints, Keypoints):
+        raise TypeError(f"keypoints: expected Keypoints, got {type(keypoints).__name__}")
 
 
 def assign_orientations(image, keypoints: Keypoints, *, peak_ratio: float = 0.8) -> Keypoints:
@@ -89,37 +181,14 @@ def assign_orientations(image, keypoints: Keypoints, *, peak_ratio: float = 0.8)
     Gaussian of 1.5 x scale; peaks correspond to dominant directions of local gradients.
     """
     img = as_gray_image(image)
-    if not isinstance(keypoints, Keypoints):
-        raise TypeError(f"keypoints: expected Keypoints, got {type(keypoints).__name__}")
+    _check_keypoints(keypoints)
     ratio = check_positive(peak_ratio, "peak_ratio")
     if ratio > 1:
         raise ValueError(f"peak_ratio: expected a value in (0, 1], got {ratio}")
-    n = len(keypoints)
-    if n == 0:
+    if len(keypoints) == 0:
         return keypoints
-    nbins = 36
-    hist = np.zeros((n, nbins))
-    for idx, gx, gy in _gradient_levels(img, keypoints.scale):
-        u, v, rx, ry = _sample(gx, gy, keypoints.xy[idx], keypoints.scale[idx], np.zeros(idx.size), 3 * _WINDOW)
-        # window half-width is 3 x the Gaussian sigma, so the weight in grid units is exp(-9 r^2 / 2)
-        weight = np.hypot(rx, ry) * np.exp(-4.5 * (u * u + v * v))
-        pos = np.mod(np.arctan2(ry, rx), 2 * np.pi) / (2 * np.pi) * nbins
-        lo = np.floor(pos).astype(int)
-        frac = pos - lo
-        rows = np.arange(idx.size)[:, None] * nbins
-        h = np.bincount((rows + lo % nbins).ravel(), (weight * (1 - frac)).ravel(), idx.size * nbins)
-        h += np.bincount((rows + (lo + 1) % nbins).ravel(), (weight * frac).ravel(), idx.size * nbins)
-        hist[idx] = h.reshape(idx.size, nbins)
-    for _ in range(2):  # circular [1 1 1]/3 smoothing of the histogram
-        hist = (np.roll(hist, 1, 1) + hist + np.roll(hist, -1, 1)) / 3
-    left, right = np.roll(hist, 1, 1), np.roll(hist, -1, 1)
-    peak = (hist > left) & (hist >= right) & (hist >= ratio * hist.max(1, keepdims=True)) & (hist > 0)
-    kp_idx, bins = np.nonzero(peak)
-    l, c, r = left[kp_idx, bins], hist[kp_idx, bins], right[kp_idx, bins]
-    offset = 0.5 * (l - r) / (l - 2 * c + r)
-    theta = np.mod((bins + offset) * 2 * np.pi / nbins, 2 * np.pi)
-    sel = keypoints.subset(kp_idx)
-    return Keypoints(sel.xy, sel.scale, sel.response, theta)
+    sigmas, levels = _quarter_octave_levels(img, keypoints.scale)
+    return _orientations(_gradients(sigmas, levels, keypoints.scale), keypoints, ratio)
 
 
 def gradient_histogram_descriptor(image, keypoints: Keypoints, *, cells: int = 4, bins: int = 8,
@@ -151,40 +220,14 @@ def gradient_histogram_descriptor(image, keypoints: Keypoints, *, cells: int = 4
     accumulated with trilinear interpolation into the spatial cells and orientation bins.
     """
     img = as_gray_image(image)
-    if not isinstance(keypoints, Keypoints):
-        raise TypeError(f"keypoints: expected Keypoints, got {type(keypoints).__name__}")
+    _check_keypoints(keypoints)
     cells = check_int(cells, "cells", minimum=1, maximum=8)
     bins = check_int(bins, "bins", minimum=2, maximum=36)
     clip = check_positive(clip, "clip")
-    n, dim = len(keypoints), cells * cells * bins
-    out = np.zeros((n, dim))
-    half_width = 2 * _CELL  # 4 cells of 3 x scale, whatever the number of cells
-    for idx, gx, gy in _gradient_levels(img, keypoints.scale):
-        u, v, rx, ry = _sample(gx, gy, keypoints.xy[idx], keypoints.scale[idx],
-                               keypoints.orientation[idx], half_width)
-        weight = np.hypot(rx, ry) * np.exp(-2.0 * (u * u + v * v))  # sigma = half the window
-        cu = (u + 1) * cells / 2 - 0.5
-        cv = (v + 1) * cells / 2 - 0.5
-        co = np.mod(np.arctan2(ry, rx), 2 * np.pi) / (2 * np.pi) * bins
-        iu, iv, io = np.floor(cu).astype(int), np.floor(cv).astype(int), np.floor(co).astype(int)
-        fu, fv, fo = cu - iu, cv - iv, co - io
-        rows = np.arange(idx.size)[:, None] * dim
-        acc = np.zeros(idx.size * dim)
-        for du, wu in ((0, 1 - fu), (1, fu)):
-            for dv, wv in ((0, 1 - fv), (1, fv)):
-                x, y = iu + du, iv + dv
-                ok = (x >= 0) & (x < cells) & (y >= 0) & (y < cells)
-                for do, wo in ((0, 1 - fo), (1, fo)):
-                    flat = rows + (np.clip(y, 0, cells - 1) * cells + np.clip(x, 0, cells - 1)) * bins \
-                        + (io + do) % bins
-                    acc += np.bincount(flat.ravel(), (weight * wu * wv * wo * ok).ravel(), acc.size)
-        out[idx] = acc.reshape(idx.size, dim)
-    for _ in range(2):  # normalise, clip large gradients, renormalise (Lowe 2004, Sec. 6.1)
-        norm = np.linalg.norm(out, axis=1, keepdims=True)
-        out = np.divide(out, norm, out=np.zeros_like(out), where=norm > 1e-12)
-        out = np.minimum(out, clip)
-    norm = np.linalg.norm(out, axis=1, keepdims=True)
-    return np.divide(out, norm, out=np.zeros_like(out), where=norm > 1e-12).astype(np.float32)
+    if len(keypoints) == 0:
+        return np.zeros((0, cells * cells * bins), np.float32)
+    sigmas, levels = _quarter_octave_levels(img, keypoints.scale)
+    return _histograms(_gradients(sigmas, levels, keypoints.scale), keypoints, cells, bins, clip)
 
 
 def sift_descriptor(image, keypoints: Keypoints) -> np.ndarray:
@@ -225,12 +268,6 @@ def reduced_descriptor(image, keypoints: Keypoints) -> np.ndarray:
     return gradient_histogram_descriptor(image, keypoints, cells=2, bins=4)
 
 
-def _describe(img, keypoints, descriptor):
-    if descriptor == "sift128":
-        return sift_descriptor(img, keypoints)
-    return reduced_descriptor(img, keypoints)
-
-
 def plot_features(image, params: PlotParams | None = None, *, descriptor: str = "sift128",
                   **overrides) -> Features:
     """Detect PLOT keypoints, assign orientations and describe them (Lin et al. Sec. 2).
@@ -250,12 +287,17 @@ def plot_features(image, params: PlotParams | None = None, *, descriptor: str = 
 
     Notes
     -----
-    Lin et al. Sec. 2.i (detection) and 2.ii (orientation and descriptor).
+    Lin et al. Sec. 2.i (detection) and 2.ii (orientation and descriptor). The gradients are taken
+    from the detector's own smoothed images ``L(x, sigma_n)``, so nothing is filtered twice.
     """
     descriptor = check_choice(descriptor, "descriptor", ("sift128", "reduced16"))
-    img = as_gray_image(image)
-    kp = assign_orientations(img, detect_plot(img, params, **overrides))
-    return Features(kp, _describe(img, kp, descriptor))
+    cells, bins = (4, 8) if descriptor == "sift128" else (2, 4)
+    kp, sigmas, levels = detect_plot_levels(image, params, **overrides)
+    if len(kp) == 0:
+        return Features(kp, np.zeros((0, cells * cells * bins), np.float32))
+    cache: dict = {}
+    kp = _orientations(_gradients(sigmas, levels, kp.scale, cache), kp, 0.8)
+    return Features(kp, _histograms(_gradients(sigmas, levels, kp.scale, cache), kp, cells, bins, 0.2))
 
 
 def sift_features(image, *, n_features: int = 0, descriptor: str = "sift128") -> Features:

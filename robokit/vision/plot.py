@@ -24,7 +24,7 @@ from ..validation import as_array, check_int, check_positive
 from .features import Keypoints, as_gray_image
 
 __all__ = ["PlotParams", "plot_scales", "polynomial_expansion", "orientation_tensor",
-           "tensor_eigenvalues", "junction_strength", "edge_strength", "detect_plot"]
+           "tensor_eigenvalues", "junction_strength", "edge_strength", "detect_plot", "detect_plot_levels"]
 
 
 @dataclass(frozen=True)
@@ -330,6 +330,30 @@ def detect_plot(image, params: PlotParams | None = None, **overrides) -> Keypoin
     adjacent scales, so that each structure is reported at its characteristic scale. Positions and
     scales are refined by parabolas through the peak and its neighbours (in x, y and ``log sigma``).
     """
+    return detect_plot_levels(image, params, **overrides)[0]
+
+
+def detect_plot_levels(image, params: PlotParams | None = None, **overrides):
+    """:func:`detect_plot`, also returning the Gaussian scale space it was computed on.
+
+    Parameters
+    ----------
+    image, params, **overrides
+        As for :func:`detect_plot`.
+
+    Returns
+    -------
+    keypoints : Keypoints
+    sigmas : numpy.ndarray, shape (n_scales,)
+        ``sigma_n = sigma_0 k^n``.
+    smoothed : list of numpy.ndarray
+        The images ``L = G_sigma_n * I`` (float32), reused for orientations and descriptors
+        (Lin et al. Sec. 2.ii computes them "based on the corresponding Gaussian smoothed image").
+
+    Notes
+    -----
+    Lin et al. Sec. 2.i; see :func:`detect_plot`.
+    """
     p = params if params is not None else PlotParams()
     if not isinstance(p, PlotParams):
         raise TypeError(f"params: expected PlotParams, got {type(p).__name__}")
@@ -337,18 +361,19 @@ def detect_plot(image, params: PlotParams | None = None, **overrides) -> Keypoin
         p = PlotParams(**{**p.__dict__, **overrides})
     img = as_gray_image(image)
     sigmas = p.sigma0 * p.k ** np.arange(p.n_scales)
-    responses = []
+    responses, levels = [], []
     smoothed, prev = img, 0.0
     for s in sigmas:
         # incremental smoothing: G_s = G_sqrt(s^2 - prev^2) * G_prev
         smoothed = _blur(smoothed, float(np.sqrt(s * s - prev * prev)))
         prev = s
+        levels.append(smoothed)
         responses.append(_eig_sym(*_tensor_components(smoothed, s, p.gamma, p.integration))[1])
     resp = np.stack(responses)                       # (n_scales, H, W)
     peak = float(resp.max())
     thr = max(p.threshold * peak, p.min_response)
     if peak <= thr:
-        return Keypoints.empty()
+        return Keypoints.empty(), sigmas, levels
     kernel = np.ones((3, 3), np.uint8)
     dil = np.stack([cv2.dilate(r, kernel) for r in resp])
     is_max = (resp >= dil) & (resp > thr)
@@ -358,7 +383,7 @@ def detect_plot(image, params: PlotParams | None = None, **overrides) -> Keypoin
     is_max[:, :b], is_max[:, -b:], is_max[:, :, :b], is_max[:, :, -b:] = False, False, False, False
     lev, rows, cols = np.nonzero(is_max)
     if lev.size == 0:
-        return Keypoints.empty()
+        return Keypoints.empty(), sigmas, levels
     strength = resp[lev, rows, cols]
     order = np.argsort(-strength, kind="stable")[: p.max_keypoints]
     lev, rows, cols, strength = lev[order], rows[order], cols[order], strength[order]
@@ -374,4 +399,4 @@ def detect_plot(image, params: PlotParams | None = None, **overrides) -> Keypoin
     inner = (lev > 0) & (lev < p.n_scales - 1) & (den < 0)
     shift = np.clip(np.divide(0.5 * (below - above), den, out=np.zeros(lev.size), where=inner), -0.5, 0.5)
     scale = p.sigma0 * p.k ** (lev + shift)
-    return Keypoints(np.column_stack([xs, ys]), scale, strength.astype(float), np.zeros(lev.size))
+    return Keypoints(np.column_stack([xs, ys]), scale, strength.astype(float), np.zeros(lev.size)), sigmas, levels
