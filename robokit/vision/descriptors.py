@@ -17,7 +17,7 @@ import numpy as np
 
 from ..validation import check_choice, check_int, check_positive
 from .features import Features, Keypoints, as_gray_image
-from .plot import PlotParams, detect_plot_levels
+from .plot import PlotParams, ScaleSpace, detect_plot_levels
 
 __all__ = ["assign_orientations", "gradient_histogram_descriptor", "sift_descriptor",
            "reduced_descriptor", "plot_features", "sift_features", "detect_and_describe"]
@@ -27,29 +27,29 @@ _CELL = 3.0        # descriptor cell width = 3 x keypoint scale (Lowe 2004, Sec.
 _GRID = 16         # samples per side of the sampling grid
 
 
-def _quarter_octave_levels(img: np.ndarray, scales: np.ndarray):
+def _quarter_octave_levels(img: np.ndarray, scales: np.ndarray) -> ScaleSpace:
     """Smooth ``img`` at the quarter-octave scales nearest to the keypoints' scales."""
     sigmas = 2.0 ** (np.unique(np.round(4 * np.log2(scales))) / 4)
     levels = []
     for sigma in sigmas:
         size = 2 * int(np.ceil(3 * sigma)) + 1
         levels.append(cv2.GaussianBlur(img, (size, size), float(sigma), borderType=cv2.BORDER_REFLECT))
-    return sigmas, levels
+    return ScaleSpace(sigmas, levels, np.ones(sigmas.size, int))
 
 
-def _gradients(sigmas, levels, scales, cache=None):
-    """Per level: (keypoint indices at that level, gx, gy) with each keypoint at its nearest level.
+def _gradients(space: ScaleSpace, scales, cache=None):
+    """Per level: (keypoint indices at that level, gx, gy, step), each keypoint at its nearest level.
 
-    ``cache`` (a dict) keeps the gradient images between calls on the same levels.
+    ``cache`` (a dict) keeps the gradient images between calls on the same scale space.
     """
     cache = {} if cache is None else cache
-    nearest = np.argmin(np.abs(np.log(scales)[:, None] - np.log(np.asarray(sigmas))[None, :]), axis=1)
+    nearest = np.argmin(np.abs(np.log(scales)[:, None] - np.log(np.asarray(space.sigmas))[None, :]), axis=1)
     out = []
     for n in np.unique(nearest):
         if n not in cache:
-            cache[n] = (cv2.Sobel(levels[n], cv2.CV_32F, 1, 0, ksize=1, scale=0.5),
-                        cv2.Sobel(levels[n], cv2.CV_32F, 0, 1, ksize=1, scale=0.5))
-        out.append((np.nonzero(nearest == n)[0], *cache[n]))
+            cache[n] = (cv2.Sobel(space.images[n], cv2.CV_32F, 1, 0, ksize=1, scale=0.5),
+                        cv2.Sobel(space.images[n], cv2.CV_32F, 0, 1, ksize=1, scale=0.5))
+        out.append((np.nonzero(nearest == n)[0], *cache[n], int(space.steps[n])))
     return out
 
 
@@ -63,6 +63,7 @@ def _sample(gx, gy, xy, scale, angle, half_width):
     c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
     mx = (xy[:, :1] + r * (c * u - s * v)).astype(np.float32)
     my = (xy[:, 1:] + r * (s * u + c * v)).astype(np.float32)
+    c, s = c.astype(np.float32), s.astype(np.float32)  # keep the per-sample arithmetic in float32
     sx = cv2.remap(gx, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
     sy = cv2.remap(gy, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
     return c * sx + s * sy, -s * sx + c * sy
@@ -72,17 +73,17 @@ def _sample(gx, gy, xy, scale, angle, half_width):
 def _grid():
     t = (np.arange(_GRID) + 0.5) / _GRID * 2 - 1
     u, v = np.meshgrid(t, t)
-    return u.ravel(), v.ravel()
+    return u.ravel()[None, :], v.ravel()[None, :]
 
 
 @lru_cache(maxsize=None)
 def _cell_weights(cells: int) -> np.ndarray:
     """Constant (cells^2, samples) matrix: bilinear share of each sample in each spatial cell,
     times the Gaussian window (sigma = half the window)."""
-    u, v = _grid()
+    u, v = (g[0] for g in _grid())
     cu, cv = (u + 1) * cells / 2 - 0.5, (v + 1) * cells / 2 - 0.5
     iu, iv = np.floor(cu).astype(int), np.floor(cv).astype(int)
-    w = np.zeros((cells * cells, u.size))
+    w = np.zeros((cells * cells, u.size), np.float32)
     gauss = np.exp(-2.0 * (u * u + v * v))
     for du, wu in ((0, 1 - (cu - iu)), (1, cu - iu)):
         for dv, wv in ((0, 1 - (cv - iv)), (1, cv - iv)):
@@ -97,9 +98,10 @@ def _orientations(grads, keypoints: Keypoints, ratio: float) -> Keypoints:
     hist = np.zeros((n, nbins))
     u, v = _grid()
     # window half-width is 3 x the Gaussian sigma, so the weight in grid units is exp(-9 r^2 / 2)
-    gauss = np.exp(-4.5 * (u * u + v * v))
-    for idx, gx, gy in grads:
-        rx, ry = _sample(gx, gy, keypoints.xy[idx], keypoints.scale[idx], np.zeros(idx.size), 3 * _WINDOW)
+    gauss = np.exp(-4.5 * (u * u + v * v)).astype(np.float32)
+    for idx, gx, gy, step in grads:
+        rx, ry = _sample(gx, gy, keypoints.xy[idx] / step, keypoints.scale[idx] / step, np.zeros(idx.size),
+                         3 * _WINDOW)
         weight = np.hypot(rx, ry) * gauss
         pos = np.mod(np.arctan2(ry, rx), 2 * np.pi) * (nbins / (2 * np.pi))
         lo = np.floor(pos).astype(int)
@@ -124,14 +126,15 @@ def _histograms(grads, keypoints: Keypoints, cells: int, bins: int, clip: float)
     n, dim = len(keypoints), cells * cells * bins
     out = np.zeros((n, dim))
     weights = _cell_weights(cells)
-    for idx, gx, gy in grads:
-        rx, ry = _sample(gx, gy, keypoints.xy[idx], keypoints.scale[idx], keypoints.orientation[idx], 2 * _CELL)
+    for idx, gx, gy, step in grads:
+        rx, ry = _sample(gx, gy, keypoints.xy[idx] / step, keypoints.scale[idx] / step, keypoints.orientation[idx],
+                         2 * _CELL)
         mag = np.hypot(rx, ry).ravel()
         pos = (np.mod(np.arctan2(ry, rx), 2 * np.pi) * (bins / (2 * np.pi))).ravel()
         lo = np.floor(pos).astype(int)
         frac = pos - lo
         # orientation soft-binning per sample, then one matrix product does the spatial binning
-        per_sample = np.zeros(mag.size * bins)
+        per_sample = np.zeros(mag.size * bins, np.float32)
         base = np.arange(mag.size) * bins
         per_sample[base + lo % bins] = mag * (1 - frac)
         per_sample[base + (lo + 1) % bins] += mag * frac
@@ -187,8 +190,7 @@ def assign_orientations(image, keypoints: Keypoints, *, peak_ratio: float = 0.8)
         raise ValueError(f"peak_ratio: expected a value in (0, 1], got {ratio}")
     if len(keypoints) == 0:
         return keypoints
-    sigmas, levels = _quarter_octave_levels(img, keypoints.scale)
-    return _orientations(_gradients(sigmas, levels, keypoints.scale), keypoints, ratio)
+    return _orientations(_gradients(_quarter_octave_levels(img, keypoints.scale), keypoints.scale), keypoints, ratio)
 
 
 def gradient_histogram_descriptor(image, keypoints: Keypoints, *, cells: int = 4, bins: int = 8,
@@ -226,8 +228,8 @@ def gradient_histogram_descriptor(image, keypoints: Keypoints, *, cells: int = 4
     clip = check_positive(clip, "clip")
     if len(keypoints) == 0:
         return np.zeros((0, cells * cells * bins), np.float32)
-    sigmas, levels = _quarter_octave_levels(img, keypoints.scale)
-    return _histograms(_gradients(sigmas, levels, keypoints.scale), keypoints, cells, bins, clip)
+    space = _quarter_octave_levels(img, keypoints.scale)
+    return _histograms(_gradients(space, keypoints.scale), keypoints, cells, bins, clip)
 
 
 def sift_descriptor(image, keypoints: Keypoints) -> np.ndarray:
@@ -292,12 +294,12 @@ def plot_features(image, params: PlotParams | None = None, *, descriptor: str = 
     """
     descriptor = check_choice(descriptor, "descriptor", ("sift128", "reduced16"))
     cells, bins = (4, 8) if descriptor == "sift128" else (2, 4)
-    kp, sigmas, levels = detect_plot_levels(image, params, **overrides)
+    kp, space = detect_plot_levels(image, params, **overrides)
     if len(kp) == 0:
         return Features(kp, np.zeros((0, cells * cells * bins), np.float32))
     cache: dict = {}
-    kp = _orientations(_gradients(sigmas, levels, kp.scale, cache), kp, 0.8)
-    return Features(kp, _histograms(_gradients(sigmas, levels, kp.scale, cache), kp, cells, bins, 0.2))
+    kp = _orientations(_gradients(space, kp.scale, cache), kp, 0.8)
+    return Features(kp, _histograms(_gradients(space, kp.scale, cache), kp, cells, bins, 0.2))
 
 
 def sift_features(image, *, n_features: int = 0, descriptor: str = "sift128") -> Features:

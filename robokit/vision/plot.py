@@ -24,7 +24,7 @@ from ..validation import as_array, check_int, check_positive
 from .features import Keypoints, as_gray_image
 
 __all__ = ["PlotParams", "plot_scales", "polynomial_expansion", "orientation_tensor",
-           "tensor_eigenvalues", "junction_strength", "edge_strength", "detect_plot", "detect_plot_levels"]
+           "tensor_eigenvalues", "junction_strength", "edge_strength", "detect_plot", "detect_plot_levels", "ScaleSpace"]
 
 
 @dataclass(frozen=True)
@@ -75,6 +75,26 @@ class PlotParams:
         check_positive(self.min_response, "min_response", allow_zero=True)
         check_int(self.max_keypoints, "max_keypoints", minimum=1)
         check_int(self.border, "border", minimum=1)
+
+
+@dataclass(frozen=True)
+class ScaleSpace:
+    """Gaussian scale space of an image (Lin et al. Sec. 2.i, multi-scale strategy).
+
+    Attributes
+    ----------
+    sigmas : numpy.ndarray, shape (n,)
+        Scale of each level in pixels of the original image.
+    images : list of numpy.ndarray
+        Smoothed images, float32; level ``n`` is sampled every ``steps[n]`` pixels (coarse levels
+        are subsampled by 2 once the Gaussian is at least ``2 sigma_0`` wide, as in SIFT's octaves).
+    steps : numpy.ndarray of int, shape (n,)
+        Pixel spacing of each level: sample ``(i, j)`` is original pixel ``(steps[n] i, steps[n] j)``.
+    """
+
+    sigmas: np.ndarray
+    images: list
+    steps: np.ndarray
 
 
 def plot_scales(sigma0: float = 1.6, k: float = 2 ** 0.5, n_scales: int = 4) -> np.ndarray:
@@ -344,10 +364,8 @@ def detect_plot_levels(image, params: PlotParams | None = None, **overrides):
     Returns
     -------
     keypoints : Keypoints
-    sigmas : numpy.ndarray, shape (n_scales,)
-        ``sigma_n = sigma_0 k^n``.
-    smoothed : list of numpy.ndarray
-        The images ``L = G_sigma_n * I`` (float32), reused for orientations and descriptors
+    space : ScaleSpace
+        The smoothed images ``L = G_sigma_n * I``, reused for orientations and descriptors
         (Lin et al. Sec. 2.ii computes them "based on the corresponding Gaussian smoothed image").
 
     Notes
@@ -361,19 +379,31 @@ def detect_plot_levels(image, params: PlotParams | None = None, **overrides):
         p = PlotParams(**{**p.__dict__, **overrides})
     img = as_gray_image(image)
     sigmas = p.sigma0 * p.k ** np.arange(p.n_scales)
-    responses, levels = [], []
-    smoothed, prev = img, 0.0
+    responses, levels, steps = [], [], []
+    smoothed, prev, step = img, 0.0, 1
+    full = (img.shape[1], img.shape[0])
     for s in sigmas:
+        local = s / step                      # sigma in pixels of the current grid
         # incremental smoothing: G_s = G_sqrt(s^2 - prev^2) * G_prev
-        smoothed = _blur(smoothed, float(np.sqrt(s * s - prev * prev)))
-        prev = s
+        smoothed = _blur(smoothed, float(np.sqrt(local * local - prev * prev)))
+        if local >= 2 * p.sigma0 - 1e-9 and min(smoothed.shape) >= 32:
+            # a Gaussian this wide leaves nothing at the pixel scale: halve the grid (as SIFT's octaves)
+            smoothed, step, local = smoothed[::2, ::2], step * 2, local / 2
+        prev = local
         levels.append(smoothed)
-        responses.append(_eig_sym(*_tensor_components(smoothed, s, p.gamma, p.integration))[1])
+        steps.append(step)
+        # scale-normalised derivatives make the response independent of the grid spacing
+        r = _eig_sym(*_tensor_components(smoothed, local, p.gamma, p.integration))[1]
+        if step > 1:  # back onto the full grid: sample i of the coarse grid is pixel step * i
+            r = cv2.warpAffine(r, np.float32([[step, 0, 0], [0, step, 0]]), full, flags=cv2.INTER_LINEAR,
+                               borderMode=cv2.BORDER_REPLICATE)
+        responses.append(r)
+    space = ScaleSpace(sigmas, levels, np.array(steps))
     resp = np.stack(responses)                       # (n_scales, H, W)
     peak = float(resp.max())
     thr = max(p.threshold * peak, p.min_response)
     if peak <= thr:
-        return Keypoints.empty(), sigmas, levels
+        return Keypoints.empty(), space
     kernel = np.ones((3, 3), np.uint8)
     dil = np.stack([cv2.dilate(r, kernel) for r in resp])
     is_max = (resp >= dil) & (resp > thr)
@@ -383,7 +413,7 @@ def detect_plot_levels(image, params: PlotParams | None = None, **overrides):
     is_max[:, :b], is_max[:, -b:], is_max[:, :, :b], is_max[:, :, -b:] = False, False, False, False
     lev, rows, cols = np.nonzero(is_max)
     if lev.size == 0:
-        return Keypoints.empty(), sigmas, levels
+        return Keypoints.empty(), space
     strength = resp[lev, rows, cols]
     order = np.argsort(-strength, kind="stable")[: p.max_keypoints]
     lev, rows, cols, strength = lev[order], rows[order], cols[order], strength[order]
@@ -399,4 +429,4 @@ def detect_plot_levels(image, params: PlotParams | None = None, **overrides):
     inner = (lev > 0) & (lev < p.n_scales - 1) & (den < 0)
     shift = np.clip(np.divide(0.5 * (below - above), den, out=np.zeros(lev.size), where=inner), -0.5, 0.5)
     scale = p.sigma0 * p.k ** (lev + shift)
-    return Keypoints(np.column_stack([xs, ys]), scale, strength.astype(float), np.zeros(lev.size)), sigmas, levels
+    return Keypoints(np.column_stack([xs, ys]), scale, strength.astype(float), np.zeros(lev.size)), space
