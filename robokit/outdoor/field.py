@@ -9,6 +9,7 @@ metres, origin at the south-west corner; the field's geodetic origin places it o
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any
 
 import numpy as np
@@ -55,7 +56,12 @@ class Field:
         object.__setattr__(self, "size", (w, h))
         object.__setattr__(self, "circles", circles)
         object.__setattr__(self, "boxes", boxes)
-        object.__setattr__(self, "_corners", _box_corners(boxes))
+        corners = _box_corners(boxes)
+        object.__setattr__(self, "_corners", corners)
+        # box edges as segments p -> p + e, and every obstacle's centre and bounding radius
+        object.__setattr__(self, "_seg_p", corners.reshape(-1, 2))
+        object.__setattr__(self, "_seg_e", (np.roll(corners, -1, axis=1) - corners).reshape(-1, 2))
+        object.__setattr__(self, "_box_r", np.hypot(boxes[:, 2], boxes[:, 3]) / 2)
 
     @property
     def n_obstacles(self) -> int:
@@ -89,44 +95,56 @@ class Field:
         """
         o = as_points(origins, "origins", 2)
         a = as_array(angles, "angles", shape=(o.shape[0],))
-        rmax = check_positive(max_range, "max_range")
+        return self._raycast(o, a, check_positive(max_range, "max_range"))
+
+    def _raycast(self, o: np.ndarray, a: np.ndarray, rmax: float) -> np.ndarray:
+        # unvalidated core of raycast(); only obstacles that can be within rmax of a ray start count
         d = np.stack([np.cos(a), np.sin(a)], axis=1)
         best = np.full(len(o), rmax)
-        if len(self.circles):
-            oc = self.circles[None, :, :2] - o[:, None, :]            # (K, N, 2)
+        lo, hi = o.min(axis=0) - rmax, o.max(axis=0) + rmax
+        circles = self.circles
+        if len(circles):
+            near = np.all((circles[:, :2] + circles[:, 2:3] >= lo) & (circles[:, :2] - circles[:, 2:3] <= hi), axis=1)
+            circles = circles[near]
+        if len(circles):
+            oc = circles[None, :, :2] - o[:, None, :]            # (K, N, 2)
             tca = np.einsum("knj,kj->kn", oc, d)
-            d2 = np.einsum("knj,knj->kn", oc, oc) - tca ** 2
-            r2 = self.circles[None, :, 2] ** 2
+            oc2 = np.einsum("knj,knj->kn", oc, oc)
+            d2 = oc2 - tca ** 2
+            r2 = circles[None, :, 2] ** 2
             with np.errstate(invalid="ignore"):
-                thc = np.sqrt(r2 - d2)
-            t0 = tca - thc
-            inside = np.einsum("knj,knj->kn", oc, oc) <= r2
-            t = np.where(inside, 0.0, np.where((d2 <= r2) & (t0 >= 0), t0, np.inf))
+                t0 = tca - np.sqrt(r2 - d2)
+            t = np.where(oc2 <= r2, 0.0, np.where((d2 <= r2) & (t0 >= 0), t0, np.inf))
             best = np.minimum(best, t.min(axis=1))
         if len(self.boxes):
-            p = self._corners.reshape(-1, 2)
-            q = np.roll(self._corners, -1, axis=1).reshape(-1, 2)
-            e = q - p                                                   # (S, 2)
-            w = p[None] - o[:, None]                                    # (K, S, 2)
-            denom = d[:, None, 0] * e[None, :, 1] - d[:, None, 1] * e[None, :, 0]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t = (w[..., 0] * e[None, :, 1] - w[..., 1] * e[None, :, 0]) / denom
-                u = (w[..., 0] * d[:, None, 1] - w[..., 1] * d[:, None, 0]) / denom
-            hit = (np.abs(denom) > 1e-12) & (t >= 0) & (u >= 0) & (u <= 1)
-            best = np.minimum(best, np.where(hit, t, np.inf).min(axis=1))
-            best = np.where(self.inside_box(o), 0.0, best)
+            near = np.all((self.boxes[:, :2] + self._box_r[:, None] >= lo)
+                          & (self.boxes[:, :2] - self._box_r[:, None] <= hi), axis=1)
+            if np.any(near):
+                sel = np.repeat(near, 4)
+                p, e = self._seg_p[sel], self._seg_e[sel]
+                w = p[None] - o[:, None]                                    # (K, S, 2)
+                denom = d[:, None, 0] * e[None, :, 1] - d[:, None, 1] * e[None, :, 0]
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    t = (w[..., 0] * e[None, :, 1] - w[..., 1] * e[None, :, 0]) / denom
+                    u = (w[..., 0] * d[:, None, 1] - w[..., 1] * d[:, None, 0]) / denom
+                hit = (np.abs(denom) > 1e-12) & (t >= 0) & (u >= 0) & (u <= 1)
+                best = np.minimum(best, np.where(hit, t, np.inf).min(axis=1))
+                best = np.where(self._inside_box(o, self.boxes[near]), 0.0, best)
         return best
 
     def inside_box(self, points: Any) -> np.ndarray:
         """Boolean ``(K,)``: which points lie inside any box."""
-        pts = as_points(points, "points", 2)
-        if not len(self.boxes):
+        return self._inside_box(as_points(points, "points", 2), self.boxes)
+
+    @staticmethod
+    def _inside_box(pts: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+        if not len(boxes):
             return np.zeros(len(pts), dtype=bool)
-        rel = pts[:, None, :] - self.boxes[None, :, :2]
-        c, s = np.cos(self.boxes[:, 4]), np.sin(self.boxes[:, 4])
+        rel = pts[:, None, :] - boxes[None, :, :2]
+        c, s = np.cos(boxes[:, 4]), np.sin(boxes[:, 4])
         lx = rel[..., 0] * c + rel[..., 1] * s
         ly = -rel[..., 0] * s + rel[..., 1] * c
-        return np.any((np.abs(lx) <= self.boxes[:, 2] / 2) & (np.abs(ly) <= self.boxes[:, 3] / 2), axis=1)
+        return np.any((np.abs(lx) <= boxes[:, 2] / 2) & (np.abs(ly) <= boxes[:, 3] / 2), axis=1)
 
     def collides(self, pose: Any, length: float, width: float) -> bool:
         """Whether a ``length`` x ``width`` rectangle at ``pose = [x, y, theta]`` touches an obstacle.
@@ -139,16 +157,19 @@ class Field:
         x, y, th = as_array(pose, "pose", shape=(3,))
         L, W = check_positive(length, "length") / 2, check_positive(width, "width") / 2
         c, s = np.cos(th), np.sin(th)
-        if len(self.circles):
-            rel = self.circles[:, :2] - [x, y]
+        reach = math.hypot(L, W)
+        circles = self.circles[np.abs(self.circles[:, :2] - [x, y]).max(axis=1) <= self.circles[:, 2] + reach] \
+            if len(self.circles) else self.circles
+        if len(circles):
+            rel = circles[:, :2] - [x, y]
             lx = np.clip(rel[:, 0] * c + rel[:, 1] * s, -L, L)
             ly = np.clip(-rel[:, 0] * s + rel[:, 1] * c, -W, W)
             closest = np.stack([x + c * lx - s * ly, y + s * lx + c * ly], axis=1)
-            if np.any(np.hypot(*(closest - self.circles[:, :2]).T) <= self.circles[:, 2]):
+            if np.any(np.hypot(*(closest - circles[:, :2]).T) <= circles[:, 2]):
                 return True
         if len(self.boxes):
-            mine = _box_corners(np.array([[x, y, 2 * L, 2 * W, th]]))[0]
-            near = np.hypot(*(self.boxes[:, :2] - [x, y]).T) <= np.hypot(*self.boxes[:, 2:4].T) / 2 + np.hypot(L, W)
+            near = np.hypot(*(self.boxes[:, :2] - [x, y]).T) <= self._box_r + reach
+            mine = _box_corners(np.array([[x, y, 2 * L, 2 * W, th]]))[0] if np.any(near) else None
             for corners in self._corners[near]:
                 if _rectangles_overlap(mine, corners):
                     return True

@@ -243,7 +243,7 @@ def true_ranges(field: Any, pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYO
     offs = _cone(sensor, k)
     angles = (sp[:, 2:3] + offs[None, :]).ravel()
     origins = np.repeat(sp[:, :2], k, axis=0)
-    d = field.raycast(origins, angles, sensor.max_range * 1.0001).reshape(len(sp), k)
+    d = field._raycast(origins, angles, sensor.max_range * 1.0001).reshape(len(sp), k)
     j = d.argmin(axis=1)
     r = d[np.arange(len(sp)), j]
     hit = r < sensor.max_range
@@ -293,9 +293,14 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
     idx = [check_int(i, "which[i]", minimum=0, maximum=len(mounts) - 1) for i in which]
     times = as_array(ping_times, "ping_times", shape=(len(idx),))
     sigma = check_positive(noise, "noise", allow_zero=True)
-    ranges, hits = true_ranges(field, pose, mounts, sensor)
-    sp = sensor_poses(pose, mounts)
     pending = dict(others or {})
+    if not pending:  # no ping in flight but our own: only the wanted sensors need a ray fan
+        ranges = np.full(len(mounts), np.inf)
+        ranges[idx] = true_ranges(field, pose, [mounts[i] for i in idx], sensor)[0]
+        hits, sp = None, None
+    else:
+        ranges, hits = true_ranges(field, pose, mounts, sensor)
+        sp = sensor_poses(pose, mounts)
     out = np.empty(len(idx))
     for n, (i, t_i) in enumerate(zip(idx, times)):
         arrival = t_i + 2 * ranges[i] / SPEED_OF_SOUND

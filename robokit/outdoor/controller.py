@@ -1,0 +1,208 @@
+"""Heading controller for the skid-steer truck, designed and checked with python-control.
+
+Plant: a yaw-rate command ``u`` reaches the wheels through the motors' first-order lag, so the
+heading obeys ``theta(s) / u(s) = g / (s (tau s + 1))`` (``g`` = 1 when the slip model is right;
+:mod:`robokit.outdoor.truck`). Controller: proportional on the heading error plus rate feedback
+(derivative on the measurement), ``u = kp (theta_ref - theta) - kd dtheta/dt``. The closed loop is
+then exactly second order,
+
+    T(s) = g kp / (tau s^2 + (1 + g kd) s + g kp),
+
+so ``kp`` and ``kd`` place its poles for a chosen overshoot ``M`` and 2 % settling time ``Ts`` with
+the standard relations ``zeta = -ln M / sqrt(pi^2 + ln^2 M)`` and ``omega_n = 4 / (zeta Ts)``
+(Franklin, Powell & Emami-Naeini, *Feedback Control of Dynamic Systems*, 7th ed., Sec. 3.4,
+Eqs. (3.60) and (3.67)). Hamid et al. (seed 000 Q3) steer by the compass bearing but do not give
+their control law; this design is ours.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import control
+import numpy as np
+
+from ..validation import check_finite_scalar, check_positive
+
+__all__ = ["heading_plant", "design_heading_gains", "heading_closed_loop", "heading_loop_gain",
+           "loop_metrics", "HeadingController", "wrap"]
+
+
+def wrap(angle: float) -> float:
+    """Wrap a scalar angle to [-pi, pi) (the identity of :func:`robokit.geometry.wrap_angle`, inlined for speed)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def heading_plant(tau: float, gain: float = 1.0) -> control.TransferFunction:
+    """Transfer function from yaw-rate command to heading, ``g / (s (tau s + 1))``.
+
+    Parameters
+    ----------
+    tau : float
+        Motor time constant (s, > 0).
+    gain : float, default 1
+        Ratio of true to modelled yaw rate (slip and track uncertainty).
+
+    Returns
+    -------
+    control.TransferFunction
+
+    Notes
+    -----
+    First-order actuator plus integrator (Franklin et al., Sec. 3.1); motor lag from
+    :class:`robokit.outdoor.truck.SkidSteerTruck`.
+    """
+    t = check_positive(tau, "tau")
+    g = check_positive(gain, "gain")
+    return control.tf([g], [t, 1.0, 0.0])
+
+
+def design_heading_gains(tau: float, overshoot: float, settling_time: float, gain: float = 1.0) -> np.ndarray:
+    """Gains ``[kp, kd]`` that give the closed loop a chosen overshoot and 2 % settling time.
+
+    Parameters
+    ----------
+    tau : float
+        Motor time constant (s).
+    overshoot : float
+        Fractional overshoot of the step response, in (0, 1) (e.g. 0.05 for 5 %).
+    settling_time : float
+        2 % settling time (s).
+    gain : float, default 1
+        Plant gain ``g``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``[kp, kd]`` with ``kp = tau omega_n^2 / g`` and ``kd = (2 zeta omega_n tau - 1) / g``.
+
+    Raises
+    ------
+    ValueError
+        Out-of-range arguments, or a spec so slow that it would need ``kd < 0`` (positive rate
+        feedback): relax the settling time or use less damping.
+
+    Notes
+    -----
+    Matching ``tau s^2 + (1 + g kd) s + g kp`` with ``tau (s^2 + 2 zeta omega_n s + omega_n^2)``;
+    ``zeta`` and ``omega_n`` from Franklin et al., Sec. 3.4, Eqs. (3.60), (3.67).
+    """
+    t = check_positive(tau, "tau")
+    m = check_positive(overshoot, "overshoot")
+    if not m < 1:
+        raise ValueError(f"overshoot: expected a fraction in (0, 1), got {m}")
+    ts = check_positive(settling_time, "settling_time")
+    g = check_positive(gain, "gain")
+    zeta = -math.log(m) / math.sqrt(math.pi ** 2 + math.log(m) ** 2)
+    wn = 4.0 / (zeta * ts)
+    kp = t * wn ** 2 / g
+    kd = (2 * zeta * wn * t - 1) / g
+    if kd < 0:
+        raise ValueError(f"settling_time: expected a spec the plant cannot meet unaided (kd >= 0), got "
+                         f"settling_time={ts} which needs kd={kd:.3g}; choose a shorter settling time")
+    return np.array([kp, kd])
+
+
+def heading_closed_loop(kp: float, kd: float, tau: float, gain: float = 1.0) -> control.TransferFunction:
+    """Closed loop ``theta / theta_ref`` with rate feedback: ``g kp / (tau s^2 + (1 + g kd) s + g kp)``.
+
+    Notes
+    -----
+    Franklin et al., Sec. 4.3 (derivative on the output avoids the closed-loop zero of PD control).
+    """
+    p = check_positive(kp, "kp")
+    d = check_positive(kd, "kd", allow_zero=True)
+    t = check_positive(tau, "tau")
+    g = check_positive(gain, "gain")
+    return control.tf([g * p], [t, 1 + g * d, g * p])
+
+
+def heading_loop_gain(kp: float, kd: float, tau: float, gain: float = 1.0) -> control.TransferFunction:
+    """Loop gain broken at the plant input, ``L(s) = (kp + kd s) g / (s (tau s + 1))``, for margins."""
+    p = check_positive(kp, "kp")
+    d = check_positive(kd, "kd", allow_zero=True)
+    return control.tf([d, p], [1.0]) * heading_plant(tau, gain)
+
+
+def loop_metrics(kp: float, kd: float, tau: float, gain: float = 1.0, delay: float = 0.0) -> dict:
+    """Step-response and stability-margin figures of the heading loop, from python-control.
+
+    Parameters
+    ----------
+    kp, kd, tau, gain : float
+        As in :func:`heading_closed_loop`.
+    delay : float, default 0
+        Extra loop delay (s), e.g. half the compass sample period, modelled by a first-order Pade
+        approximation; included in both the step response and the margins.
+
+    Returns
+    -------
+    dict
+        ``overshoot`` (fraction), ``settling_time`` and ``rise_time`` (s), ``gain_margin``
+        (ratio, ``inf`` if none), ``phase_margin_deg`` and ``crossover`` (rad/s).
+
+    Notes
+    -----
+    ``control.step_info`` and ``control.stability_margins`` (python-control 0.10).
+    """
+    L = heading_loop_gain(kp, kd, tau, gain)
+    dly = check_positive(delay, "delay", allow_zero=True)
+    if dly > 0:
+        num, den = control.pade(dly, 1)
+        pade = control.tf(num, den)
+        L = L * pade
+        plant = heading_plant(tau, gain) * pade
+        # theta/ref with rate feedback: kp P / (1 + (kp + kd s) P)
+        T = control.feedback(kp * plant, control.tf([kd, kp], [kp]), sign=-1) if kp > 0 else plant
+    else:
+        T = heading_closed_loop(kp, kd, tau, gain)
+    info = control.step_info(T)
+    gm, pm, _, _, wc = control.stability_margins(L)[:5]
+    return {"overshoot": float(info["Overshoot"]) / 100.0, "settling_time": float(info["SettlingTime"]),
+            "rise_time": float(info["RiseTime"]), "gain_margin": float(gm) if gm is not None else math.inf,
+            "phase_margin_deg": float(pm), "crossover": float(wc)}
+
+
+class HeadingController:
+    """Discrete heading controller: ``u = kp * wrap(ref - theta) - kd * rate``, saturated.
+
+    Parameters
+    ----------
+    kp, kd : float
+        Gains from :func:`design_heading_gains`.
+    max_rate : float
+        Saturation of the yaw-rate command (rad/s).
+    rate_filter : float, default 0.1
+        Time constant (s) of the first-order filter on the heading-difference rate estimate.
+
+    Notes
+    -----
+    Rate from successive compass headings (finite difference, low-pass filtered); Franklin et al.,
+    Sec. 8.3 (emulation of a continuous design).
+    """
+
+    def __init__(self, kp: float, kd: float, max_rate: float, rate_filter: float = 0.1) -> None:
+        self.kp = check_positive(kp, "kp")
+        self.kd = check_positive(kd, "kd", allow_zero=True)
+        self.max_rate = check_positive(max_rate, "max_rate")
+        self.rate_filter = check_positive(rate_filter, "rate_filter", allow_zero=True)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the previous heading and rate."""
+        self._last: float | None = None
+        self.rate = 0.0
+
+    def measure(self, heading: float, dt: float) -> None:
+        """Feed a new heading measurement (rad, CCW) taken ``dt`` seconds after the previous one."""
+        h = check_finite_scalar(heading, "heading")
+        if self._last is not None:
+            raw = wrap(h - self._last) / check_positive(dt, "dt")
+            a = dt / (dt + self.rate_filter) if self.rate_filter else 1.0
+            self.rate += a * (raw - self.rate)
+        self._last = h
+
+    def command(self, reference: float, heading: float) -> float:
+        """Yaw-rate command (rad/s) to turn ``heading`` towards ``reference`` (both rad, CCW)."""
+        u = self.kp * wrap(reference - heading) - self.kd * self.rate
+        return float(min(max(u, -self.max_rate), self.max_rate))

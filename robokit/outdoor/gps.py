@@ -1,0 +1,140 @@
+"""A 1 Hz GPS receiver and a magnetic compass that speak NMEA 0183, as on the paper's truck.
+
+Hamid et al. (seed 000 Q3, Sec. 3) read position from a Garmin eTrex Vista ($GPRMC, $GPGGA) and
+heading from its compass ($HCHDG), and note that the position may be wrong by up to about 9 m.
+Consumer GPS errors are not independent from second to second: they wander slowly (satellite
+geometry, atmosphere, multipath). We model each horizontal axis as a first-order Gauss-Markov
+process (standard deviation ``sigma``, correlation time ``tau``) plus a little white noise (Grewal,
+Andrews & Bartone, *Global Navigation Satellite Systems, Inertial Navigation, and Integration*,
+3rd ed., 2013, Sec. 10.2 on time-correlated GNSS errors); with ``sigma`` = 2.5 m the error is a few
+metres and exceeds 9 m well under 1 % of the time.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import math
+from typing import Any
+
+import numpy as np
+
+from ..validation import as_array, as_rng, check_finite_scalar, check_positive
+from .geodesy import LocalTangentPlane
+from .nmea_write import gga_sentence, hdg_sentence, rmc_sentence
+
+__all__ = ["GPSReceiver", "Compass", "heading_to_compass", "compass_to_heading", "MISSION_START"]
+
+#: UTC time the simulated missions start (any fixed time keeps runs reproducible).
+MISSION_START = _dt.datetime(2012, 6, 4, 2, 30, 0)
+
+
+def heading_to_compass(theta: float) -> float:
+    """Field heading (rad, counter-clockwise from east) to compass heading (degrees clockwise from north).
+
+    Notes
+    -----
+    ``psi = 90 deg - theta`` modulo 360 (navigation convention, NMEA 0183 Sec. 6.3 HDG/RMC course).
+    """
+    return (90.0 - math.degrees(check_finite_scalar(theta, "theta"))) % 360.0
+
+
+def compass_to_heading(psi_deg: float) -> float:
+    """Compass heading (degrees clockwise from north) to field heading (rad CCW from east) in [-pi, pi)."""
+    a = math.radians(90.0 - check_finite_scalar(psi_deg, "psi_deg"))
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+class GPSReceiver:
+    """Simulated receiver emitting ``$GPRMC`` and ``$GPGGA`` once per ``period`` seconds.
+
+    Parameters
+    ----------
+    plane : LocalTangentPlane
+        Maps the field's east-north metres to latitude/longitude.
+    sigma : float, default 2.5
+        Standard deviation (m) of the slowly varying error on each axis.
+    tau : float, default 60
+        Correlation time (s) of that error.
+    white : float, default 0.3
+        Standard deviation (m) of the independent per-fix noise.
+    period : float, default 1
+        Seconds between fixes (1 Hz like the eTrex).
+    rng : numpy.random.Generator or int, optional
+
+    Notes
+    -----
+    Gauss-Markov update ``b_k+1 = phi b_k + sqrt(1 - phi^2) sigma n_k``, ``phi = exp(-period/tau)``
+    (Grewal et al. 2013, Sec. 10.2). Sentences built by :mod:`robokit.outdoor.nmea_write`.
+    """
+
+    def __init__(self, plane: LocalTangentPlane, *, sigma: float = 2.5, tau: float = 60.0, white: float = 0.3,
+                 period: float = 1.0, rng: Any = None) -> None:
+        if not isinstance(plane, LocalTangentPlane):
+            raise TypeError(f"plane: expected a LocalTangentPlane, got {type(plane).__name__}")
+        self.plane = plane
+        self.sigma = check_positive(sigma, "sigma", allow_zero=True)
+        self.tau = check_positive(tau, "tau")
+        self.white = check_positive(white, "white", allow_zero=True)
+        self.period = check_positive(period, "period")
+        self.rng = as_rng(rng)
+        self.bias = self.rng.normal(0.0, self.sigma, 2) if self.sigma else np.zeros(2)
+        self.last_error = np.zeros(2)
+
+    def fix(self, t: float, position: Any, speed: float, heading: float) -> list[str]:
+        """Advance the error one period and return the NMEA sentences of a fix at time ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Seconds since :data:`MISSION_START`.
+        position : array_like, shape (2,)
+            True east-north position (m).
+        speed : float
+            True ground speed (m/s).
+        heading : float
+            True heading (rad CCW from east), reported as RMC course over ground.
+
+        Returns
+        -------
+        list of str
+            ``[RMC, GGA]``; :attr:`last_error` holds the position error (m) that went into them.
+        """
+        p = as_array(position, "position", shape=(2,))
+        ts = check_positive(t, "t", allow_zero=True)
+        phi = math.exp(-self.period / self.tau)
+        self.bias = phi * self.bias + math.sqrt(1 - phi * phi) * self.sigma * self.rng.normal(size=2)
+        self.last_error = self.bias + self.white * self.rng.normal(size=2)
+        lat, lon = self.plane.to_geodetic(p + self.last_error)
+        when = MISSION_START + _dt.timedelta(seconds=round(ts, 2))
+        lat_d, lon_d = math.degrees(lat), math.degrees(lon)
+        v = abs(check_finite_scalar(speed, "speed"))
+        hdop = 1.0 + float(np.hypot(*self.bias)) / 4
+        return [rmc_sentence(when, lat_d, lon_d, speed_mps=v, course_deg=heading_to_compass(heading)),
+                gga_sentence(when.time(), lat_d, lon_d, quality=1, satellites=8, hdop=hdop, altitude_m=12.0)]
+
+
+class Compass:
+    """Simulated magnetic compass emitting ``$HCHDG`` (heading, deviation, variation).
+
+    Parameters
+    ----------
+    sigma_deg : float, default 1.0
+        Standard deviation of heading noise in degrees.
+    variation_deg : float, default -0.3
+        Local magnetic variation (east positive) sent in the sentence; the reported heading is the
+        magnetic one, so true = heading + variation (NMEA 0183 Sec. 6.3, HDG).
+    rng : numpy.random.Generator or int, optional
+
+    Notes
+    -----
+    The paper's $HCHDG (Hamid et al., seed 000 Q3, Sec. 3); resolution 0.1 degree in the sentence.
+    """
+
+    def __init__(self, *, sigma_deg: float = 1.0, variation_deg: float = -0.3, rng: Any = None) -> None:
+        self.sigma_deg = check_positive(sigma_deg, "sigma_deg", allow_zero=True)
+        self.variation_deg = check_finite_scalar(variation_deg, "variation_deg")
+        self.rng = as_rng(rng)
+
+    def reading(self, heading: float) -> str:
+        """Return the ``$HCHDG`` sentence for a true field heading (rad CCW from east)."""
+        true_deg = heading_to_compass(heading) + (self.rng.normal(0.0, self.sigma_deg) if self.sigma_deg else 0.0)
+        return hdg_sentence(true_deg - self.variation_deg, deviation_deg=0.0, variation_deg=self.variation_deg)

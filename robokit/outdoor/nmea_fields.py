@@ -1,0 +1,186 @@
+"""NMEA 0183 field conversions and the error hierarchy shared by the parser and the reader.
+
+Latitude/longitude ``ddmm.mmmm``/``dddmm.mmmm`` with hemisphere, UTC time ``hhmmss.ss``, date
+``ddmmyy``, signed values with E/W direction, single-letter flags; empty fields become ``None``
+(NMEA 0183 v4.11, Secs. 6.2-6.3).
+"""
+from __future__ import annotations
+
+import datetime as _dt
+
+__all__ = ["NMEAError", "NMEAChecksumError", "NMEAFormatError",
+           "parse_latitude", "parse_longitude", "parse_time", "parse_date"]
+
+
+class NMEAError(ValueError):
+    """Base class of every NMEA problem (a ``ValueError``, so callers may catch either)."""
+
+
+class NMEAChecksumError(NMEAError):
+    """The checksum is missing (when required), not two hex digits, or does not match."""
+
+
+class NMEAFormatError(NMEAError):
+    """The sentence is malformed: framing, address, too few fields, or a field out of range."""
+
+
+def _float(text: str, name: str) -> float | None:
+    if not text:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        raise NMEAFormatError(f"{name}: expected a number, got {text!r}") from None
+
+
+def _int(text: str, name: str) -> int | None:
+    if not text:
+        return None
+    if not text.isdigit():
+        raise NMEAFormatError(f"{name}: expected a non-negative integer, got {text!r}")
+    return int(text)
+
+
+def _angle(value: str, hemi: str, name: str, max_deg: int, pos: str, neg: str) -> float | None:
+    if not value and not hemi:
+        return None
+    if not value or hemi not in (pos, neg):
+        raise NMEAFormatError(f"{name}: expected a value with hemisphere {pos}/{neg}, got {value!r},{hemi!r}")
+    dot = value.find(".")
+    whole = value if dot < 0 else value[:dot]
+    if len(whole) < 3 or not whole.isdigit():
+        raise NMEAFormatError(f"{name}: expected {'dd' if max_deg == 90 else 'ddd'}mm.mmmm, got {value!r}")
+    try:
+        minutes = float(value[len(whole) - 2:])
+    except ValueError:
+        raise NMEAFormatError(f"{name}: expected {'dd' if max_deg == 90 else 'ddd'}mm.mmmm, got {value!r}") from None
+    degrees = float(whole[:-2]) + minutes / 60.0
+    if minutes >= 60.0 or degrees > max_deg:
+        raise NMEAFormatError(f"{name}: expected at most {max_deg} degrees with minutes < 60, got {value!r}")
+    return -degrees if hemi == neg else degrees
+
+
+def parse_latitude(value: str, hemisphere: str) -> float | None:
+    """Convert an NMEA latitude ``ddmm.mmmm`` and ``N``/``S`` to signed decimal degrees.
+
+    Parameters
+    ----------
+    value : str
+        Degrees (two digits) and decimal minutes, e.g. ``"4807.038"``.
+    hemisphere : str
+        ``"N"`` or ``"S"``.
+
+    Returns
+    -------
+    float or None
+        Degrees in [-90, 90], north positive; ``None`` when both fields are empty.
+
+    Raises
+    ------
+    NMEAFormatError
+        Malformed value, missing or wrong hemisphere, minutes >= 60 or more than 90 degrees.
+
+    Notes
+    -----
+    NMEA 0183 v4.11, Sec. 6.2 (field type "latitude").
+    """
+    return _angle(str(value), str(hemisphere), "latitude", 90, "N", "S")
+
+
+def parse_longitude(value: str, hemisphere: str) -> float | None:
+    """Convert an NMEA longitude ``dddmm.mmmm`` and ``E``/``W`` to signed decimal degrees.
+
+    Parameters
+    ----------
+    value : str
+        Degrees (three digits) and decimal minutes, e.g. ``"01131.000"``.
+    hemisphere : str
+        ``"E"`` or ``"W"``.
+
+    Returns
+    -------
+    float or None
+        Degrees in [-180, 180], east positive; ``None`` when both fields are empty.
+
+    Raises
+    ------
+    NMEAFormatError
+        Malformed value, missing or wrong hemisphere, minutes >= 60 or more than 180 degrees.
+
+    Notes
+    -----
+    NMEA 0183 v4.11, Sec. 6.2 (field type "longitude").
+    """
+    return _angle(str(value), str(hemisphere), "longitude", 180, "E", "W")
+
+
+def parse_time(value: str) -> _dt.time | None:
+    """Convert an NMEA UTC time ``hhmmss.ss`` to a ``datetime.time`` (``None`` when empty).
+
+    Raises
+    ------
+    NMEAFormatError
+        If the field is not ``hhmmss[.s...]`` or hours/minutes/seconds are out of range.
+
+    Notes
+    -----
+    NMEA 0183 v4.11, Sec. 6.2 (field type "time").
+    """
+    if not value:
+        return None
+    head = value[:6]
+    frac = value[6:]
+    if len(head) < 6 or not head.isdigit() or (frac and (frac[0] != "." or not (frac[1:].isdigit() or frac == "."))):
+        raise NMEAFormatError(f"time: expected hhmmss.ss, got {value!r}")
+    h, m, s = int(head[:2]), int(head[2:4]), int(head[4:6])
+    if h > 23 or m > 59 or s > 59:
+        raise NMEAFormatError(f"time: expected hours < 24, minutes < 60, seconds < 60, got {value!r}")
+    us = int(round(float("0" + frac) * 1e6)) if len(frac) > 1 else 0
+    return _dt.time(h, m, s, min(us, 999999))
+
+
+def parse_date(value: str) -> _dt.date | None:
+    """Convert an NMEA date ``ddmmyy`` to a ``datetime.date`` (``None`` when empty).
+
+    Two-digit years 69-99 are 1969-1999 and 00-68 are 2000-2068 (the POSIX ``%y`` rule, as
+    ``time.strptime`` and pynmea2 use).
+
+    Raises
+    ------
+    NMEAFormatError
+        If the field is not six digits or is not a calendar date (e.g. 310299).
+
+    Notes
+    -----
+    NMEA 0183 v4.11, Sec. 6.3 (RMC field 9, "date: ddmmyy").
+    """
+    if not value:
+        return None
+    if len(value) != 6 or not value.isdigit():
+        raise NMEAFormatError(f"date: expected ddmmyy, got {value!r}")
+    yy = int(value[4:])
+    try:
+        return _dt.date(1900 + yy if yy >= 69 else 2000 + yy, int(value[2:4]), int(value[:2]))
+    except ValueError:
+        raise NMEAFormatError(f"date: expected a calendar date ddmmyy, got {value!r}") from None
+
+
+def _signed(value: str, direction: str, name: str, pos: str, neg: str) -> float | None:
+    x = _float(value, name)
+    if x is None:
+        return None
+    if direction == neg:
+        return -x
+    if direction == pos or not direction:
+        return x
+    raise NMEAFormatError(f"{name}: expected direction {pos}/{neg}, got {direction!r}")
+
+
+def _flag(value: str, name: str, allowed: str) -> str | None:
+    if not value:
+        return None
+    if len(value) != 1 or value not in allowed:
+        raise NMEAFormatError(f"{name}: expected one of {list(allowed)}, got {value!r}")
+    return value
+
+

@@ -1,0 +1,102 @@
+"""Avoidance decision, navigator through NMEA, and the paper's experiment over seeded courses."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robokit.outdoor.field import UNIMAP_ORIGIN, open_field, random_course
+from robokit.outdoor.geodesy import LocalTangentPlane
+from robokit.outdoor.gps import Compass, GPSReceiver
+from robokit.outdoor.mission import run_courses, simulate, summarize_runs
+from robokit.outdoor.navigator import Navigator, avoidance_decision
+from robokit.outdoor.truck import PAPER_TRUCK
+
+FAR = 6.45
+
+
+@pytest.mark.parametrize("ranges, want", [
+    ([FAR, FAR, FAR, FAR], "forward"),
+    ([FAR, 0.9, 1.0, FAR], "left"),          # front blocked, equal sides: preferred
+    ([0.5, 0.9, 1.0, FAR], "right"),         # front blocked, less room on the left
+    ([FAR, 0.9, 0.8, 0.6], "left"),
+    ([0.6, FAR, FAR, FAR], "right"),         # only the left side blocked: veer right
+    ([FAR, FAR, FAR, 0.7], "left"),
+    ([0.5, FAR, FAR, 0.5], "left"),          # both sides, front clear: preferred
+])
+def test_avoidance_decision(ranges, want):
+    assert avoidance_decision(ranges) == want
+    if want != "forward" and ranges[0] == ranges[3] and ranges[1] == ranges[2]:
+        assert avoidance_decision(ranges, prefer="right") == "right"
+
+
+@pytest.mark.parametrize("ranges, words", [([1, 2, 3], "ranges"), ([1, 2, float("nan"), 4], "ranges"),
+                                           ([1, 2, -3, 4], "ranges")])
+def test_avoidance_decision_bad_input(ranges, words):
+    with pytest.raises(ValueError, match=words):
+        avoidance_decision(ranges)
+    with pytest.raises(ValueError, match="prefer"):
+        avoidance_decision([FAR] * 4, prefer="up")
+
+
+def test_navigator_needs_nmea_before_moving_and_rejects_bad_text():
+    plane = LocalTangentPlane(*UNIMAP_ORIGIN)
+    wp = np.column_stack(plane.to_geodetic([[20.0, 10.0]]))
+    nav = Navigator(wp, PAPER_TRUCK)
+    assert nav.update([FAR] * 4, 0.05) == (0.0, 0.0)
+    nav.feed("$GPRMC,garbage*00")
+    nav.feed("$HCHDG,90.0,0.0,E,0.0,E*00")
+    assert len(nav.parse_errors) == 2 and nav.heading is None
+    for line in GPSReceiver(plane, sigma=0.0, white=0.0).fix(0.0, [0.0, 10.0], 0.0, 0.0):
+        nav.feed(line)
+    nav.feed(Compass(sigma_deg=0.0).reading(0.0))
+    v, omega = nav.update([FAR] * 4, 0.05)
+    assert v > 0 and abs(omega) < 1e-6                       # facing the waypoint: straight on
+    v, _ = nav.update([FAR, 0.5, 0.5, FAR], 0.05)
+    assert v == 0.0 and nav.state == "AVOID"                  # obstacle: turn on the spot
+    with pytest.raises(ValueError, match="degrees"):
+        Navigator([[6.45, 100.35]], PAPER_TRUCK)
+
+
+def test_single_run_is_deterministic_and_reports_nmea():
+    course = random_course(3, n_waypoints=2)
+    a, b = simulate(course, seed=1), simulate(course, seed=1)
+    assert a.time == b.time and np.array_equal(a.truth, b.truth)
+    assert a.nmea[0].startswith("$GPRMC") and any(s.startswith("$HCHDG") for s in a.nmea)
+    assert a.parse_errors == 0 and a.reached == 2
+    assert np.all(a.gps_errors < 12.0)
+
+
+def test_obstacle_dead_ahead_is_avoided():
+    field = open_field(circles=[[15.0, 10.0, 0.8]])
+    from robokit.outdoor.field import Course
+    course = Course(field, np.array([[30.0, 10.0]]), np.array([2.0, 10.0, 0.0]))
+    run = simulate(course, seed=2, gps_sigma=0.5)
+    assert run.reached == 1 and run.collisions == 0 and run.avoidances >= 1
+    blind = simulate(course, seed=2, gps_sigma=0.5, firing="off")
+    assert blind.collisions == 1
+
+
+@pytest.mark.slow
+def test_paper_experiment_20_courses_all_waypoints_no_collisions():
+    results = run_courses(range(20))
+    summary = summarize_runs(results)
+    print(summary)
+    assert summary["success_rate"] == 1.0, summary
+    assert summary["collisions_total"] == 0
+    assert sum(summary["avoidances_per_run"]) >= 20          # the obstacles were really in the way
+    assert 1.0 <= summary["path_ratio"]["median"] < 1.3
+    assert summary["arrival_error_m"]["max"] < 12.0            # GPS-limited, as in the paper
+
+
+def test_without_sonar_the_same_courses_collide():
+    blind = run_courses(range(4), firing="off")
+    assert sum(r.collisions for r in blind) > 0
+
+
+def test_simulate_bad_input():
+    with pytest.raises(TypeError, match="course"):
+        simulate("course")
+    with pytest.raises(ValueError, match="firing"):
+        simulate(random_course(0), firing="sometimes")
+    with pytest.raises(ValueError, match="results"):
+        summarize_runs([])
