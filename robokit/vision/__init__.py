@@ -3,6 +3,23 @@
 Modules: :mod:`.features` (containers), :mod:`.plot` (Lin et al. Sec. 2.i),
 :mod:`.descriptors` (Lin et al. Sec. 2.ii, Se et al. Sec. 4, OpenCV SIFT), :mod:`.matching`
 (Lin et al. Sec. 3), :mod:`.evaluation` (recall vs 1-precision), :mod:`.stereo` (Lin et al. Sec. 3,
-Se et al. Sec. 2.2 and 3.1). Vision depends only on :mod:`robokit.geometry` and
-:mod:`robokit.validation`.
+Se et al. Sec. 2.2 and 3.1). Vision depends only on :mod:`robokit.validation` (never on ``viz`` or
+``sim``).
 """
+from .descriptors import (assign_orientations, detect_and_describe, gradient_histogram_descriptor,
+                          plot_features, reduced_descriptor, sift_descriptor, sift_features)
+from .evaluation import apply_homography, recall_precision, similarity_homography
+from .features import Features, Keypoints, as_gray_image
+from .matching import Matches, ratio_match, two_nearest
+from .plot import (PlotParams, ScaleSpace, detect_plot, detect_plot_levels, edge_strength, junction_strength,
+                   orientation_tensor, plot_scales, polynomial_expansion, tensor_eigenvalues)
+from .stereo import (NotRectifiedError, StereoMatches, StereoRig, disparity_to_point, match_stereo,
+                     triangulate_svd)
+
+__all__ = ["assign_orientations", "detect_and_describe", "gradient_histogram_descriptor", "plot_features",
+           "reduced_descriptor", "sift_descriptor", "sift_features", "apply_homography", "recall_precision",
+           "similarity_homography", "Features", "Keypoints", "as_gray_image", "Matches", "ratio_match",
+           "two_nearest", "PlotParams", "ScaleSpace", "detect_plot", "detect_plot_levels", "edge_strength",
+           "junction_strength", "orientation_tensor", "plot_scales", "polynomial_expansion",
+           "tensor_eigenvalues", "NotRectifiedError", "StereoMatches", "StereoRig", "disparity_to_point",
+           "match_stereo", "triangulate_svd"]

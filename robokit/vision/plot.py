@@ -23,8 +23,8 @@ import numpy as np
 from ..validation import as_array, check_int, check_positive
 from .features import Keypoints, as_gray_image
 
-__all__ = ["PlotParams", "plot_scales", "polynomial_expansion", "orientation_tensor",
-           "tensor_eigenvalues", "junction_strength", "edge_strength", "detect_plot", "detect_plot_levels", "ScaleSpace"]
+__all__ = ["PlotParams", "ScaleSpace", "plot_scales", "polynomial_expansion", "orientation_tensor",
+           "tensor_eigenvalues", "junction_strength", "edge_strength", "detect_plot", "detect_plot_levels"]
 
 
 @dataclass(frozen=True)
