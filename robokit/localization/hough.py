@@ -145,7 +145,8 @@ def hough_accumulator(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, *,
     dth = check_positive(angle_bin, "angle_bin")
     spread = check_positive(spread, "spread")
     nt = int(round(2 * np.pi / dth))
-    nx, nz = int(np.ceil((b[1] - b[0]) / size)), int(np.ceil((b[3] - b[2]) / size))
+    # sizes rounded up to multiples of 4 bins: the peak search works on 4 x 4 blocks without copying
+    nx, nz = 4 * int(np.ceil((b[1] - b[0]) / size / 4)), 4 * int(np.ceil((b[3] - b[2]) / size / 4))
     if nt * nx * nz > 60_000_000:
         raise ValueError(f"bounds: the Hough space would have {nt * nx * nz} bins; enlarge bin_size or shrink bounds")
     thetas = -np.pi + (np.arange(nt) + 0.5) * 2 * np.pi / nt
@@ -182,13 +183,15 @@ def _peaks(acc, n, radius=(2, 3, 3), block=(2, 4, 4)):
     The maxima of small blocks are ranked first, so only a small array is partially sorted.
     """
     shape = [int(np.ceil(a / k)) * k for a, k in zip(acc.shape, block)]
-    padded = np.zeros(shape, acc.dtype)
-    padded[: acc.shape[0], : acc.shape[1], : acc.shape[2]] = acc
-    nb = [a // k for a, k in zip(shape, block)]
-    # block maxima, one contiguous axis at a time (a joint multi-axis reduce is several times slower)
-    best = padded.reshape(shape[0], shape[1], nb[2], block[2]).max(axis=3)
-    best = best.reshape(shape[0], nb[1], block[1], nb[2]).max(axis=2)
-    best = best.reshape(nb[0], block[0], nb[1], nb[2]).max(axis=1)
+    padded = acc
+    if list(acc.shape) != shape:
+        padded = np.zeros(shape, acc.dtype)
+        padded[: acc.shape[0], : acc.shape[1], : acc.shape[2]] = acc
+    # block maxima as element-wise maxima of strided views (numpy reduces tiny axes slowly)
+    best = padded
+    for axis, k in enumerate(block):
+        views = [best[tuple(slice(i, None, k) if a == axis else slice(None) for a in range(3))] for i in range(k)]
+        best = np.maximum.reduce(views)
     flat = best.ravel()
     top = min(flat.size, 20 * n)
     cand = np.argpartition(-flat, top - 1)[:top]
