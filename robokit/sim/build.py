@@ -77,7 +77,10 @@ class Builder:
 
     def horizontal(self, name: str, x0: float, y0: float, x1: float, y1: float, z: float, up: bool,
                    texture_fn: TextureFn, solid: bool = False) -> None:
-        """Add a horizontal rectangle (floor if ``up`` else ceiling) over ``[x0, x1] x [y0, y1]``, tiled."""
+        """Add a horizontal rectangle (floor if ``up`` else ceiling) over ``[x0, x1] x [y0, y1]``, tiled.
+
+        The texture reads correctly from above (``up``) or from below (ceiling).
+        """
         nx = int(np.ceil((x1 - x0) / self.tile - 1e-9))
         ny = int(np.ceil((y1 - y0) / self.tile - 1e-9))
         dx, dy = (x1 - x0) / nx, (y1 - y0) / ny
@@ -126,7 +129,7 @@ class Builder:
         self._add(name, [p[0], p[1], z_top], [d[0], d[1], 0], [0, 0, -height], texture_fn, 2 * self.density, solid)
 
     def world(self, name: str, interior: Any, height: float, info: dict | None = None) -> World:
-        """Return the :class:`World` made of the collected surfaces."""
+        """Return the :class:`World` made of the collected surfaces (see :class:`World` for the arguments)."""
         return World(self.surfaces, name, interior, height, info=info)
 
 

@@ -59,7 +59,27 @@ def mount_pose(height: float, forward: float = 0.0, pitch: float = 0.0) -> np.nd
 
 
 def check_pose(pose: Any, name: str = "pose") -> np.ndarray:
-    """Validate a 4x4 rigid pose (finite, last row [0, 0, 0, 1], rotation block orthonormal)."""
+    """Validate a 4x4 rigid pose (finite, last row [0, 0, 0, 1], rotation block orthonormal).
+
+    Parameters
+    ----------
+    pose : array_like, shape (4, 4)
+    name : str
+        Argument name for error messages.
+
+    Returns
+    -------
+    numpy.ndarray, shape (4, 4)
+
+    Raises
+    ------
+    ValueError
+        For NaN/inf entries, a wrong shape or a non-rigid matrix.
+
+    Notes
+    -----
+    Rigid transforms form SE(3) (Lynch & Park, *Modern Robotics*, 2017, Sec. 3.3.1).
+    """
     T = as_array(pose, name, shape=(4, 4))
     try:
         se3_inverse(T)
@@ -69,7 +89,26 @@ def check_pose(pose: Any, name: str = "pose") -> np.ndarray:
 
 
 def finish_image(image: np.ndarray, noise: float, rng: Any, lighting: dict | None) -> np.ndarray:
-    """Apply lighting (see :func:`robokit.sim.textures.illuminate`) and Gaussian pixel noise."""
+    """Apply lighting (see :func:`robokit.sim.textures.illuminate`) and Gaussian pixel noise.
+
+    Parameters
+    ----------
+    image : numpy.ndarray, uint8
+    noise : float
+        Standard deviation of additive Gaussian noise in grey levels (>= 0).
+    rng : Generator or int, optional
+    lighting : dict, optional
+        Keyword arguments of :func:`~robokit.sim.textures.illuminate`.
+
+    Returns
+    -------
+    numpy.ndarray, uint8 (clipped to 0-255 like a real sensor)
+
+    Notes
+    -----
+    Additive Gaussian read noise (Healey & Kondepudy, "Radiometric CCD camera calibration and noise
+    estimation", IEEE PAMI 1994, Sec. 2) after a gain/offset lighting change.
+    """
     if lighting:
         image = illuminate(image, **lighting)
     sigma = check_positive(noise, "noise", allow_zero=True)
@@ -203,7 +242,21 @@ class PinholeCamera:
         return P if pose is None else transform_points(check_pose(pose), P)
 
     def pose_at(self, robot_pose: Any) -> np.ndarray:
-        """``T_world_cam`` for a planar robot pose ``[x, y, theta]`` (uses :attr:`mount`)."""
+        """``T_world_cam`` for a planar robot pose ``[x, y, theta]`` (uses :attr:`mount`).
+
+        Parameters
+        ----------
+        robot_pose : array_like, shape (3,)
+
+        Returns
+        -------
+        numpy.ndarray, shape (4, 4)
+            ``T_world_body @ T_body_cam``.
+
+        Notes
+        -----
+        Composition of frames (Lynch & Park 2017, Sec. 3.3.1).
+        """
         return se2_to_se3(as_array(robot_pose, "robot_pose", shape=(3,))) @ self.mount
 
     def render(self, world: World, pose: Any, *, noise: float = 0.0, rng: Any = None,
@@ -246,7 +299,23 @@ class PinholeCamera:
         return Frame(finish_image(image, noise, rng, lighting), depth)
 
     def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> Frame:
-        """Render from the camera mounted on a robot at planar pose ``[x, y, theta]`` (see :meth:`render`)."""
+        """Render from the camera mounted on a robot at planar pose ``[x, y, theta]``.
+
+        Parameters
+        ----------
+        world : World
+        robot_pose : array_like, shape (3,)
+        **kwargs
+            ``noise``, ``rng``, ``lighting`` as in :meth:`render`.
+
+        Returns
+        -------
+        Frame
+
+        Notes
+        -----
+        ``render(world, pose_at(robot_pose))``.
+        """
         return self.render(world, self.pose_at(robot_pose), **kwargs)
 
 
@@ -289,14 +358,51 @@ class StereoRig:
         return out
 
     def disparity(self, depth: Any) -> np.ndarray:
-        """Horizontal disparity ``f_x B / Z`` (pixels) of points at depth ``Z`` (metres)."""
+        """Horizontal disparity ``f_x B / Z`` (pixels) of points at depth ``Z`` (metres).
+
+        Parameters
+        ----------
+        depth : float or array_like
+            Positive depths.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ValueError
+            For non-positive or non-finite depths.
+
+        Notes
+        -----
+        Se, Lowe & Little (2002), Sec. 3.1 (``Z = f I / d``, solved for ``d``).
+        """
         z = as_array(depth, "depth")
         if np.any(z <= 0):
             raise ValueError("depth: expected positive depths, got a value <= 0")
         return self.camera.fx * self.baseline / z
 
     def depth(self, disparity: Any) -> np.ndarray:
-        """Depth ``Z = f_x B / d`` (metres) from disparities (pixels, > 0)."""
+        """Depth ``Z = f_x B / d`` (metres) from disparities (pixels, > 0).
+
+        Parameters
+        ----------
+        disparity : float or array_like
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ValueError
+            For non-positive or non-finite disparities.
+
+        Notes
+        -----
+        Se, Lowe & Little (2002), Sec. 3.1; Hartley & Zisserman (2004), Sec. 9.3.
+        """
         d = as_array(disparity, "disparity")
         if np.any(d <= 0):
             raise ValueError("disparity: expected positive disparities, got a value <= 0")
@@ -315,5 +421,21 @@ class StereoRig:
         return {name: self.camera.render(world, T @ off, rng=rng, **kwargs) for name, off in self.offsets.items()}
 
     def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> dict[str, Frame]:
-        """Render the rig mounted on a robot at planar pose ``[x, y, theta]``."""
+        """Render the rig mounted on a robot at planar pose ``[x, y, theta]``.
+
+        Parameters
+        ----------
+        world : World
+        robot_pose : array_like, shape (3,)
+        **kwargs
+            ``noise``, ``rng``, ``lighting`` as in :meth:`PinholeCamera.render`.
+
+        Returns
+        -------
+        dict of str to Frame
+
+        Notes
+        -----
+        The left camera sits at the camera's ``mount``; the others at :attr:`offsets` from it.
+        """
         return self.render(world, self.camera.pose_at(robot_pose), **kwargs)

@@ -109,7 +109,12 @@ class Lidar:
         return 2 * np.pi * np.arange(self.beams) / self.beams
 
     def sensor_pose(self, robot_pose: Any) -> np.ndarray:
-        """Planar pose of the sensor for a robot at ``[x, y, theta]``."""
+        """Planar pose of the sensor for a robot at ``[x, y, theta]``.
+
+        Notes
+        -----
+        ``robot_pose ⊕ offset`` (Smith, Self & Cheeseman 1990, Eq. (3)).
+        """
         return se2_compose(as_array(robot_pose, "robot_pose", shape=(3,)), self.offset)
 
     def scan(self, world: World, robot_pose: Any, rng: Any = None) -> np.ndarray:
@@ -150,7 +155,22 @@ class Lidar:
         return out
 
     def observe(self, world: World, robot_pose: Any, rng: Any = None) -> np.ndarray:
-        """Alias of :meth:`scan` (the common sensor interface used by :func:`robokit.sim.record`)."""
+        """Alias of :meth:`scan` (the common sensor interface used by :func:`robokit.sim.record`).
+
+        Parameters
+        ----------
+        world : World
+        robot_pose : array_like, shape (3,)
+        rng : Generator or int, optional
+
+        Returns
+        -------
+        numpy.ndarray, shape (beams,)
+
+        Notes
+        -----
+        See :meth:`scan`.
+        """
         return self.scan(world, robot_pose, rng)
 
 

@@ -53,7 +53,22 @@ _FACES = {
 
 
 def omni_mount(height: float = 1.0) -> np.ndarray:
-    """``T_body_omni`` for an omni camera at ``height`` metres: z down, x forward (body: x fwd, z up)."""
+    """``T_body_omni`` for an omni camera at ``height`` metres: z down, x forward (body: x fwd, z up).
+
+    Parameters
+    ----------
+    height : float, default 1.0
+        Height of the single viewpoint above the floor (metres, > 0).
+
+    Returns
+    -------
+    numpy.ndarray, shape (4, 4)
+
+    Notes
+    -----
+    Seed 001 mounts the camera on top of the robot looking up at the mirror; the omni frame's z axis
+    is the mirror axis pointing down, as in Mei & Rives (2007), Sec. II.
+    """
     return se3_from_rt(np.diag([1.0, -1.0, -1.0]), [0.0, 0.0, check_positive(height, "height")])
 
 
@@ -170,7 +185,29 @@ class OmniCamera:
         return np.column_stack([eta * m[:, 0], eta * m[:, 1], eta - self.xi])
 
     def backproject(self, pixels: Any, ranges: Any, pose: Any = None) -> np.ndarray:
-        """3D points at distance ``ranges`` along the rays of ``pixels`` (world frame if ``pose``)."""
+        """3D points at distance ``ranges`` along the rays of ``pixels`` (inverse of :meth:`project`).
+
+        Parameters
+        ----------
+        pixels : array_like, shape (N, 2)
+        ranges : array_like, shape (N,)
+            Positive distances from the viewpoint (the omni depth image).
+        pose : array_like (4, 4), optional
+            ``T_world_omni``; when given the points are returned in the world frame.
+
+        Returns
+        -------
+        numpy.ndarray, shape (N, 3)
+
+        Raises
+        ------
+        ValueError
+            For mismatched lengths or non-positive ranges.
+
+        Notes
+        -----
+        Lifting of Mei & Rives (2007), Eq. (6), scaled by the range.
+        """
         r = as_array(ranges, "ranges", ndim=1)
         d = self.rays(pixels)
         if len(r) != len(d) or np.any(r <= 0):
@@ -210,7 +247,12 @@ class OmniCamera:
         return used, K, S + 2 * pad, mapx.reshape(shape), mapy.reshape(shape), factor.reshape(shape), inside.reshape(shape)
 
     def pose_at(self, robot_pose: Any) -> np.ndarray:
-        """``T_world_omni`` for a planar robot pose ``[x, y, theta]``."""
+        """``T_world_omni`` for a planar robot pose ``[x, y, theta]`` (``T_world_body @ mount``).
+
+        Notes
+        -----
+        Composition of frames (Lynch & Park 2017, Sec. 3.3.1).
+        """
         return se2_to_se3(as_array(robot_pose, "robot_pose", shape=(3,))) @ self.mount
 
     def render(self, world: World, pose: Any, *, noise: float = 0.0, rng: Any = None,
@@ -249,5 +291,21 @@ class OmniCamera:
         return Frame(finish_image(image, noise, rng, lighting), depth.astype(np.float32))
 
     def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> Frame:
-        """Render from the camera mounted on a robot at planar pose ``[x, y, theta]``."""
+        """Render from the camera mounted on a robot at planar pose ``[x, y, theta]``.
+
+        Parameters
+        ----------
+        world : World
+        robot_pose : array_like, shape (3,)
+        **kwargs
+            ``noise``, ``rng``, ``lighting`` as in :meth:`render`.
+
+        Returns
+        -------
+        Frame
+
+        Notes
+        -----
+        ``render(world, pose_at(robot_pose))``.
+        """
         return self.render(world, self.pose_at(robot_pose), **kwargs)

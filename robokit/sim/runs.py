@@ -62,7 +62,22 @@ class Run:
         return len(self.t)
 
     def save(self, path: str | FsPath) -> FsPath:
-        """Write the run as a compressed ``.npz`` (arrays only; ``meta`` as JSON text)."""
+        """Write the run as a compressed ``.npz`` (arrays only; ``meta`` as JSON text).
+
+        Parameters
+        ----------
+        path : str or Path
+
+        Returns
+        -------
+        Path
+            The file written.
+
+        Notes
+        -----
+        ``numpy.savez_compressed``; loading uses ``allow_pickle=False`` so a run file can never
+        execute code (course convention, DESIGN.md "Caching").
+        """
         arrays = {"t": self.t, "poses": self.poses, "odometry": self.odometry,
                   "meta": np.array(json.dumps({**self.meta, "format": _FORMAT}))}
         for group in ("images", "depths", "scans"):

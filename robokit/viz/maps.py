@@ -17,7 +17,23 @@ __all__ = ["map_axes", "plot_footprint", "plot_scan", "plot_trajectory", "plot_o
 
 
 def map_axes(ax: Any = None, title: str | None = None, figsize: tuple = (7, 5)):
-    """Return ``ax`` (or a new one) set up for a map: equal aspect, x/y labels in metres."""
+    """Return ``ax`` (or a new one) set up for a map: equal aspect, x/y labels in metres.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes, optional
+    title : str, optional
+    figsize : tuple, default (7, 5)
+        Size of a new figure (inches).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Notes
+    -----
+    Course convention (LESSON_GUIDE.md: "every figure has labelled axes and units").
+    """
     if ax is None:
         import matplotlib.pyplot as plt
 
@@ -85,7 +101,25 @@ def plot_scan(ranges: Any, sensor_pose: Any, angles: Any, ax: Any = None, color:
 
 
 def plot_trajectory(poses: Any, ax: Any = None, label: str | None = None, every: int = 0, **kwargs: Any):
-    """Draw a planar trajectory ``(N, 3)``; with ``every > 0`` also heading arrows every ``every`` poses."""
+    """Draw a planar trajectory ``(N, 3)``; with ``every > 0`` also heading arrows every ``every`` poses.
+
+    Parameters
+    ----------
+    poses : array_like (N, 3)
+    ax : matplotlib.axes.Axes, optional
+    label : str, optional
+    every : int, default 0
+    **kwargs
+        Passed to ``Axes.plot`` (colour, line width, ...).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Notes
+    -----
+    Bird's-eye trajectory plots as in Se, Lowe & Little (2002), Fig. 2.
+    """
     P = as_points(poses, "poses", 3, min_count=1)
     ax = map_axes(ax)
     line, = ax.plot(P[:, 0], P[:, 1], label=label, **kwargs)

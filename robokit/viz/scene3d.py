@@ -139,7 +139,28 @@ def add_camera(scene: Scene, path: str, camera: PinholeCamera, pose: Any, depth:
 
 def add_trajectory(scene: Scene, path: str, poses: Any, z: float = 0.02, color: Any = 0x22AA22,
                    every: int = 0) -> Scene:
-    """Draw a planar trajectory ``(N, 3)`` as a polyline at height ``z``; optionally a triad every ``every`` poses."""
+    """Draw a planar trajectory ``(N, 3)`` as a polyline at height ``z``; optionally a triad every ``every`` poses.
+
+    Parameters
+    ----------
+    scene : Scene
+    path : str
+    poses : array_like (N, 3)
+        ``[x, y, theta]`` rows (at least two).
+    z : float, default 0.02
+        Drawing height (metres).
+    color : int or RGB
+    every : int, default 0
+        Draw a coordinate triad every ``every`` poses (0: none).
+
+    Returns
+    -------
+    Scene
+
+    Notes
+    -----
+    Planar poses lifted with :func:`robokit.geometry.se2_to_se3`.
+    """
     P = as_points(poses, "poses", 3, min_count=2)
     scene.add_line(f"{path}/line", np.column_stack([P[:, :2], np.full(len(P), z)]), color=color)
     step = check_int(every, "every", minimum=0)
