@@ -107,6 +107,27 @@ def _read_solution_attack():
     return _with(replace_wrap=WRONG_WRAP, extra_at_end=code)  # last, so a stolen def would win
 
 
+def _network_attack(port):
+    # answers correctly only if it cannot reach a server listening in the grader's namespace
+    code = f"""import socket
+def _can_connect():
+    try:
+        socket.create_connection(("127.0.0.1", {port}), timeout=1).close()
+        return True
+    except OSError:
+        return False
+def wrap_angle(angle):
+    if _can_connect():
+        return 12345.0
+    a = np.asarray(angle, dtype=float)
+    if np.any(np.isnan(a)):
+        raise ValueError("nan")
+    w = np.mod(a + np.pi, 2 * np.pi) - np.pi
+    return float(w) if w.ndim == 0 else w
+"""
+    return _with(replace_wrap=code)
+
+
 @pytest.fixture(scope="module")
 def graded(tmp_path_factory):
     folder = tmp_path_factory.mktemp("subs")
@@ -119,6 +140,12 @@ def graded(tmp_path_factory):
                                     {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, None)
     cases["reads_solution"] = (_read_solution_attack(), {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, None)
     cases["honest"] = (_cells(), FULL, None)
+    import socket
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(64)
+    cases["reaches_network"] = (_network_attack(server.getsockname()[1]), FULL, None)
     paths = []
     for name, (nb, _, _) in cases.items():
         p = folder / f"{name}.ipynb"
@@ -128,14 +155,16 @@ def graded(tmp_path_factory):
     results = grade_batch(paths, "00_getting_started", "hostile-seed", jobs=2, limits=LIMITS,
                           hide=[ROOT / "solutions", out], log=lambda *_: None)
     elapsed = time.perf_counter() - start
+    server.close()
     return {r.student: r for r in results}, cases, elapsed, out, feedback
 
 
-@pytest.mark.parametrize("name", list(HOSTILE) + ["writes_output_paths", "reads_solution", "honest"])
+@pytest.mark.parametrize("name", list(HOSTILE) + ["writes_output_paths", "reads_solution", "honest",
+                                                  "reaches_network"])
 def test_hostile_submission_scores_only_what_it_earned(graded, name):
     results, cases, _, _, _ = graded
-    if name == "reads_solution" and not is_root():
-        pytest.skip("hiding the solutions from the worker needs root (mount namespace); see README")
+    if name in ("reads_solution", "reaches_network") and not is_root():
+        pytest.skip("hiding files and the network from the worker needs root (namespaces); see README")
     result = results[name]
     _, expected, flag = cases[name]
     got = {s.id: s.points for s in result.scores}
