@@ -72,6 +72,9 @@ class SubmissionResult:
 
 @dataclasses.dataclass
 class PreparedCases:
+    """The trusted side of a grading run: exercises, their cases for the secret seed, and the
+    reference answers. It stays in the grader's process; workers receive only the case inputs."""
+
     exercises: tuple[Exercise, ...]
     cases: list[list[Case]]
     expected: list[list[Any]]

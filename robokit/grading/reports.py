@@ -9,7 +9,7 @@ from typing import Sequence
 
 from .grader import SubmissionResult
 
-__all__ = ["write_gradebook", "write_feedback", "gradescope_results", "FLAG_TEXT"]
+__all__ = ["write_gradebook", "write_feedback", "feedback_text", "gradescope_results", "write_gradescope", "FLAG_TEXT"]
 
 FLAG_TEXT = {
     "called-reference": "called a disabled reference implementation (that exercise scores zero)",
@@ -82,6 +82,7 @@ def gradescope_results(r: SubmissionResult, assignment: str) -> dict:
 
 
 def write_gradescope(r: SubmissionResult, assignment: str, path: str | Path) -> Path:
+    """Write :func:`gradescope_results` of one submission to ``path`` (Gradescope's results.json)."""
     path = Path(path)
     path.write_text(json.dumps(gradescope_results(r, assignment), indent=2))
     return path

@@ -108,6 +108,12 @@ def _error_record(exc: BaseException) -> dict:
 
 
 def main(job_dir: str) -> None:
+    """Run the job in ``job_dir`` (see the module docstring) and exit the process.
+
+    Notes
+    -----
+    Grading design (DESIGN.md, "Grading"); not from a paper.
+    """
     from IPython.core.interactiveshell import InteractiveShell
 
     from .plain import NotPlainData, to_plain
