@@ -116,3 +116,15 @@ def test_repeatable_under_rotation_and_zoom(photo):
     d, _ = cKDTree(b.xy).query(pa[inside])
     assert inside.sum() > 200
     assert np.mean(d < 2.5) > 0.6
+
+
+def test_scale_space_levels_are_subsampled_consistently(photo):
+    from robokit.vision.plot import detect_plot_levels
+    kp, space = detect_plot_levels(photo)
+    assert np.allclose(space.sigmas, plot_scales())
+    assert space.steps.tolist() == [1, 1, 2, 2]
+    assert space.images[0].shape == (480, 640) and space.images[2].shape == (240, 320)
+    # a coarse level sampled every 2 pixels equals the full-resolution smoothing at those pixels
+    ref = cv2.GaussianBlur(photo.astype(np.float32) / 255, (0, 0), plot_scales()[2])
+    assert np.abs(space.images[2][20:-20, 20:-20] - ref[40:-40:2, 40:-40:2]).max() < 0.01
+    assert np.array_equal(kp.xy, detect_plot(photo).xy)

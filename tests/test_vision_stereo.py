@@ -139,3 +139,26 @@ def test_ambiguous_and_unrectified_input(photo):
     assert len(match_stereo(f, empty)) == 0 and len(match_stereo(empty, f)) == 0
     with pytest.raises(ValueError, match="max_disparity"):
         match_stereo(f, f, min_disparity=10, max_disparity=5)
+
+
+def _one(x, y, scale, theta, desc):
+    from robokit.vision.features import Keypoints
+    return Features(Keypoints([[x, y]], [scale], [1.0], [theta]), np.asarray([desc], np.float32))
+
+
+def test_orientation_scale_and_disparity_constraints():
+    d = np.eye(8)[0]
+    left = _one(100.0, 50.0, 2.0, 0.5, d)
+    assert len(match_stereo(left, _one(90.0, 50.4, 2.2, 0.6, d), check_rectified=False)) == 1
+    assert len(match_stereo(left, _one(90.0, 50.4, 2.2, 1.2, d), check_rectified=False)) == 0  # orientation
+    assert len(match_stereo(left, _one(90.0, 50.4, 4.0, 0.6, d), check_rectified=False)) == 0  # scale
+    assert len(match_stereo(left, _one(90.0, 53.0, 2.2, 0.6, d), check_rectified=False)) == 0  # epipolar
+    assert len(match_stereo(left, _one(110.0, 50.0, 2.2, 0.6, d), check_rectified=False)) == 0  # negative d
+    assert len(match_stereo(left, _one(90.0, 50.0, 2.2, 0.6, np.eye(8)[1]), check_rectified=False)) == 0
+    m = match_stereo(left, _one(90.0, 50.4, 2.2, 0.6, d), check_rectified=False)
+    assert m.disparity[0] == pytest.approx(10.0)
+
+
+def test_project_refuses_points_behind_the_rig():
+    with pytest.raises(ValueError, match="points: expected Z > 0"):
+        RIG.project([[0.0, 0.0, -1.0]])

@@ -23,6 +23,10 @@ def as_pose(pose, name: str = "pose") -> np.ndarray:
     ------
     ValueError
         If it does not have shape (3,) or is not finite.
+
+    Notes
+    -----
+    Lin et al. Sec. 4: "p and q are the sideways and forward translation in X and Z directions".
     """
     return as_array(pose, name, shape=(3,))
 
@@ -53,7 +57,12 @@ def robot_to_world(points, pose) -> np.ndarray:
 
 
 def world_to_robot(points, pose) -> np.ndarray:
-    """Map world points (N, 3) into the robot frame at ``pose`` (inverse of :func:`robot_to_world`)."""
+    """Map world points (N, 3) into the robot frame at ``pose`` (inverse of :func:`robot_to_world`).
+
+    Notes
+    -----
+    Se et al. Sec. 3.2: database landmarks are predicted in the new frame from the odometry pose.
+    """
     pts = as_array(points, "points", shape=(None, 3))
     p = as_pose(pose)
     return (pts - np.array([p[0], 0.0, p[1]])) @ rotation_y(p[2])

@@ -121,6 +121,11 @@ class LandmarkMap:
         ------
         ValueError
             For shapes that do not agree or invalid covariances.
+
+        Notes
+        -----
+        Se et al. Sec. 3.6: "A Kalman Filter is initiated for each landmark"; the descriptor is kept
+        for later matching (Se et al. Sec. 4, Lin et al. Sec. 3).
         """
         pts = as_array(positions, "positions", shape=(None, 3))
         n = pts.shape[0]

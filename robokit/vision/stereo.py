@@ -71,6 +71,11 @@ class StereoRig:
         ------
         ValueError
             If a point is not in front of the cameras.
+
+        Notes
+        -----
+        Inverse of Se et al. Sec. 3.1: ``c = c0 + f X / Z``, ``r = r0 - f Y / Z``, and the right
+        column is ``f I / Z`` smaller.
         """
         pts = as_array(points, "points", shape=(None, 3))
         if np.any(pts[:, 2] <= 0):
