@@ -11,13 +11,8 @@ from robokit.vision.stereo import StereoRig, disparity_to_point
 RIG = StereoRig(focal=400.0, c0=319.5, r0=239.5, baseline=0.12)
 
 
-def lab_map_and_view(rng, pose, n_landmarks=5000, dim=16, clutter=0.3, descriptor_noise=0.05):
-    """A 10 m x 10 m lab with landmarks on its walls, and a noisy stereo view from ``pose``.
-
-    Returns the map and the view (robot-frame points, covariances, descriptors, true landmark row or
-    -1 for clutter). Image noise follows Se et al. Sec. 3.1 (sigma_c = sigma_r = sigma_d = 1 px).
-    """
-    # 60 % on the four walls, 40 % on furniture inside the room
+def lab_landmarks(rng, n_landmarks=5000, dim=16):
+    """True landmark positions and descriptors of a 10 m x 10 m lab (60 % on walls, 40 % furniture)."""
     wall = rng.integers(0, 6, n_landmarks)
     u = rng.uniform(-5, 5, n_landmarks)
     x = np.where(wall == 0, -5.0, np.where(wall == 1, 5.0, u))
@@ -27,10 +22,18 @@ def lab_map_and_view(rng, pose, n_landmarks=5000, dim=16, clutter=0.3, descripto
     world = np.column_stack([x, rng.uniform(-1.0, 1.5, n_landmarks), z])
     desc = rng.normal(size=(n_landmarks, dim)).astype(np.float32)
     desc /= np.linalg.norm(desc, axis=1, keepdims=True)
-    lm = LandmarkMap(dim)
-    lm.add(world, np.stack([np.diag([4e-4, 4e-4, 4e-4])] * n_landmarks), desc)
+    return world, desc
+
+
+def stereo_view(rng, world, desc, pose, clutter=0.3, descriptor_noise=0.05, max_range=8.0):
+    """Noisy stereo observations of the landmarks visible from ``pose`` plus clutter features.
+
+    Returns robot-frame points, covariances, descriptors and the true landmark row (-1 for
+    clutter). Image noise follows Se et al. Sec. 3.1 (sigma_c = sigma_r = sigma_d = 1 px).
+    """
+    dim = desc.shape[1]
     robot = world_to_robot(world, pose)
-    visible = (robot[:, 2] > 0.5) & (robot[:, 2] < 8.0) & (np.abs(robot[:, 0]) < 0.75 * robot[:, 2]) \
+    visible = (robot[:, 2] > 0.5) & (robot[:, 2] < max_range) & (np.abs(robot[:, 0]) < 0.75 * robot[:, 2]) \
         & (np.abs(robot[:, 1]) < 0.55 * robot[:, 2])
     rows = np.nonzero(visible)[0]
     v = robot[rows]
@@ -48,8 +51,16 @@ def lab_map_and_view(rng, pose, n_landmarks=5000, dim=16, clutter=0.3, descripto
                                         RIG.focal * RIG.baseline / cl[:, 2], RIG)
     cd = rng.normal(size=(n_clutter, dim)).astype(np.float32)
     cd /= np.linalg.norm(cd, axis=1, keepdims=True)
-    return lm, (np.vstack([pts, cl_pts]), np.concatenate([cov, cl_cov]), np.vstack([vd, cd]),
-                np.concatenate([rows, -np.ones(n_clutter, int)]))
+    return (np.vstack([pts, cl_pts]), np.concatenate([cov, cl_cov]), np.vstack([vd, cd]),
+            np.concatenate([rows, -np.ones(n_clutter, int)]))
+
+
+def lab_map_and_view(rng, pose, n_landmarks=5000, dim=16, clutter=0.3, descriptor_noise=0.05):
+    """A mapped lab (landmark covariance 2 cm per axis) and a noisy stereo view from ``pose``."""
+    world, desc = lab_landmarks(rng, n_landmarks, dim)
+    lm = LandmarkMap(dim)
+    lm.add(world, np.stack([np.diag([4e-4, 4e-4, 4e-4])] * n_landmarks), desc)
+    return lm, stereo_view(rng, world, desc, pose, clutter, descriptor_noise)
 
 
 # Se et al. Sec. 6 test poses (cm, degrees) converted to metres and radians; signs as printed

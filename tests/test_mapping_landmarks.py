@@ -102,3 +102,24 @@ def test_map_integrates_frames_and_forgets_unseen_landmarks():
         m.integrate(truth[:1], obs_cov[:1], desc[:1], poses[0], np.eye(3) * 1e-6, [99])
     with pytest.raises(ValueError, match="index: expected each landmark at most once"):
         m.fuse([0, 0], truth[:2], obs_cov[:2])
+
+
+def test_association_uses_pose_uncertainty_and_descriptors():
+    rng = np.random.default_rng(9)
+    world = rng.uniform([-3, 0, 1], [3, 2, 6], (40, 3))
+    desc = rng.normal(size=(40, 16)).astype(np.float32)
+    desc /= np.linalg.norm(desc, axis=1, keepdims=True)
+    m = LandmarkMap(16)
+    m.add(world, np.stack([np.eye(3) * 1e-4] * 40), desc)
+    pose = np.array([0.2, 0.1, 0.05])
+    obs = world_to_robot(world, pose) + rng.normal(scale=0.01, size=(40, 3))
+    cov = np.stack([np.eye(3) * 1e-4] * 40)
+    assert np.array_equal(m.associate(obs, cov, desc, pose), np.arange(40))
+    # same geometry, wrong descriptors: nothing associates
+    assert np.all(m.associate(obs, cov, np.roll(desc, 1, axis=0), pose) == -1)
+    # an observation 10 cm off is outside a 1 cm-sigma gate but inside a 10 cm-sigma one
+    off = obs.copy()
+    off[0, 2] += 0.1
+    assert m.associate(off, cov, desc, pose)[0] == -1
+    assert m.associate(off, np.stack([np.eye(3) * 1e-2] * 40), desc, pose)[0] == 0
+    assert np.all(LandmarkMap(16).associate(obs, cov, desc, pose) == -1)

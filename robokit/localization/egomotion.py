@@ -154,18 +154,33 @@ def pose_from_two(robot_points, world_points) -> np.ndarray:
     return _poses_from_pairs(r[:1], r[1:], w[:1], w[1:])[0]
 
 
-def fit_pose(robot_points, world_points) -> tuple[np.ndarray, np.ndarray, float]:
-    """Least-squares pose from N >= 2 correspondences (closed-form planar Procrustes).
+def _xz_covariances(value, name, n):
+    if value is None:
+        return np.zeros((n, 2, 2))
+    cov = as_array(value, name, shape=(n, 3, 3))
+    return cov[:, [0, 2]][:, :, [0, 2]]
+
+
+def fit_pose(robot_points, world_points, robot_covariances=None, world_covariances=None,
+             *, iterations: int = 5) -> tuple[np.ndarray, np.ndarray, float]:
+    """Least-squares pose from N >= 2 correspondences (planar Procrustes, then weighted Gauss-Newton).
 
     Parameters
     ----------
     robot_points, world_points : array_like, shape (N, 3)
+    robot_covariances, world_covariances : array_like, shape (N, 3, 3), optional
+        Covariances of the features (e.g. stereo, Se et al. Sec. 3.1) and of the landmarks. When
+        given, each residual is weighted by the inverse of ``Sigma_world + R Sigma_robot R^T`` on the
+        ground plane, so that distant features with large depth errors count less.
+    iterations : int, default 5
+        Gauss-Newton iterations of the weighted problem.
 
     Returns
     -------
     pose : numpy.ndarray, shape (3,)
     covariance : numpy.ndarray, shape (3, 3)
-        ``s^2 (J^T J)^-1`` with ``s^2`` the residual variance per coordinate (floored at 1 mm^2).
+        Weighted: ``(J^T W J)^-1``; unweighted: ``s^2 (J^T J)^-1`` with ``s^2`` the residual variance
+        per coordinate (floored at 1 mm^2).
     rms : float
         Root-mean-square ground-plane residual (metres).
 
@@ -178,32 +193,54 @@ def fit_pose(robot_points, world_points) -> tuple[np.ndarray, np.ndarray, float]
 
     Notes
     -----
-    Lin et al. Sec. 6 and Se et al. Sec. 2.3 (least-squares refinement); the minimiser of
-    ``sum ||R r_i + t - w_i||^2`` over the plane is the Procrustes solution (Umeyama 1991).
+    Lin et al. Sec. 6 and Se et al. Sec. 2.3 (least-squares refinement). The unweighted minimiser
+    of ``sum ||R r_i + t - w_i||^2`` is the Procrustes solution (Umeyama 1991); it starts the
+    weighted iterations.
     """
     r = as_points(robot_points, "robot_points", 3, min_count=2)[:, [0, 2]]
     w = as_points(world_points, "world_points", 3, min_count=2)
-    if w.shape[0] != r.shape[0]:
-        raise ValueError(f"world_points: expected {r.shape[0]} points, got {w.shape[0]}")
+    n = r.shape[0]
+    if w.shape[0] != n:
+        raise ValueError(f"world_points: expected {n} points, got {w.shape[0]}")
     w = w[:, [0, 2]]
+    iterations = check_int(iterations, "iterations", minimum=0)
+    weighted = robot_covariances is not None or world_covariances is not None
+    rcov = _xz_covariances(robot_covariances, "robot_covariances", n)
+    wcov = _xz_covariances(world_covariances, "world_covariances", n)
     rc, wc = r - r.mean(0), w - w.mean(0)
     if np.sqrt((rc ** 2).sum(1).max()) < _MIN_SEPARATION or np.sqrt((wc ** 2).sum(1).max()) < _MIN_SEPARATION:
         raise DegenerateCorrespondenceError("robot_points, world_points: expected points spread on the ground "
                                             "plane, got (nearly) coincident ones")
     theta = np.arctan2((rc[:, 0] * wc[:, 1] - rc[:, 1] * wc[:, 0]).sum(), (rc * wc).sum())
     c, s = np.cos(theta), np.sin(theta)
-    rot = np.array([[c, -s], [s, c]])
-    t = w.mean(0) - rot @ r.mean(0)
-    res = w - (r @ rot.T + t)
-    n = r.shape[0]
-    s2 = max((res ** 2).sum() / max(2 * n - 3, 1), 1e-6)
-    jac = np.zeros((2 * n, 3))
-    jac[0::2, 0] = 1.0
-    jac[1::2, 1] = 1.0
-    jac[0::2, 2] = -s * r[:, 0] - c * r[:, 1]
-    jac[1::2, 2] = c * r[:, 0] - s * r[:, 1]
-    cov = s2 * np.linalg.pinv(jac.T @ jac)
-    return np.array([t[0], t[1], wrap_angle(theta)]), cov, float(np.sqrt((res ** 2).sum(1).mean()))
+    pose = np.concatenate([w.mean(0) - np.array([[c, -s], [s, c]]) @ r.mean(0), [theta]])
+
+    def linearise(pose):
+        c, s = np.cos(pose[2]), np.sin(pose[2])
+        rot = np.array([[c, -s], [s, c]])
+        res = w - (r @ rot.T + pose[:2])
+        jac = np.zeros((n, 2, 3))
+        jac[:, 0, 0] = jac[:, 1, 1] = 1.0
+        jac[:, 0, 2] = -s * r[:, 0] - c * r[:, 1]
+        jac[:, 1, 2] = c * r[:, 0] - s * r[:, 1]
+        return rot, res, jac
+
+    if weighted:
+        for _ in range(iterations):
+            rot, res, jac = linearise(pose)
+            info = np.linalg.inv(wcov + rot @ rcov @ rot.T + 1e-12 * np.eye(2))
+            jtw = np.swapaxes(jac, 1, 2) @ info
+            hess = jtw @ jac
+            pose = pose + np.linalg.lstsq(hess.sum(0), np.einsum("nij,nj->i", jtw, res), rcond=None)[0]
+        rot, res, jac = linearise(pose)
+        info = np.linalg.inv(wcov + rot @ rcov @ rot.T + 1e-12 * np.eye(2))
+        cov = np.linalg.pinv((np.swapaxes(jac, 1, 2) @ info @ jac).sum(0))
+    else:
+        rot, res, jac = linearise(pose)
+        s2 = max((res ** 2).sum() / max(2 * n - 3, 1), 1e-6)
+        cov = s2 * np.linalg.pinv((np.swapaxes(jac, 1, 2) @ jac).sum(0))
+    pose[2] = wrap_angle(pose[2])
+    return pose, 0.5 * (cov + cov.T), float(np.sqrt((res ** 2).sum(1).mean()))
 
 
 def _fallback(n, odometry, odometry_covariance, iterations, why):
@@ -214,15 +251,17 @@ def _fallback(n, odometry, odometry_covariance, iterations, why):
     return EgomotionResult(as_pose(odometry, "odometry"), cov, np.zeros(n, bool), "odometry", iterations, 0.0)
 
 
-def ransac_pose(robot_points, world_points, *, threshold: float = 0.1, confidence: float = 0.99,
-                min_matches: int = 15, max_iterations: int = 5000, odometry=None, odometry_covariance=None,
-                rng=None) -> EgomotionResult:
+def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_covariances=None,
+                threshold: float = 0.1, confidence: float = 0.99, min_matches: int = 15,
+                max_iterations: int = 5000, odometry=None, odometry_covariance=None, rng=None) -> EgomotionResult:
     """RANSAC over two-point pose hypotheses, then least-squares refinement of the winner.
 
     Parameters
     ----------
     robot_points, world_points : array_like, shape (N, 3)
         Tentative matches: feature in the robot frame, landmark in the world frame.
+    robot_covariances, world_covariances : array_like, shape (N, 3, 3), optional
+        When given, the refinement is weighted by them (see :func:`fit_pose`).
     threshold : float, default 0.1
         ``d_threshold`` (metres): a match supports a pose when its transformed feature lies this
         close to its landmark.
@@ -253,6 +292,10 @@ def ransac_pose(robot_points, world_points, *, threshold: float = 0.1, confidenc
     """
     r = as_array(robot_points, "robot_points", shape=(None, 3))
     w = as_array(world_points, "world_points", shape=(r.shape[0], 3))
+    rcov = None if robot_covariances is None else as_array(robot_covariances, "robot_covariances",
+                                                           shape=(r.shape[0], 3, 3))
+    wcov = None if world_covariances is None else as_array(world_covariances, "world_covariances",
+                                                           shape=(r.shape[0], 3, 3))
     thr = check_positive(threshold, "threshold")
     min_matches = check_int(min_matches, "min_matches", minimum=2)
     max_iterations = check_int(max_iterations, "max_iterations", minimum=1)
@@ -292,13 +335,17 @@ def ransac_pose(robot_points, world_points, *, threshold: float = 0.1, confidenc
         inliers = np.linalg.norm(robot_to_world(r, pose) - w, axis=1) < thr
         if inliers.sum() < 2:
             break
-        pose, cov, rms = fit_pose(r[inliers], w[inliers])
+        pose, cov, rms = _fit_subset(r, w, rcov, wcov, inliers)
     inliers = np.linalg.norm(robot_to_world(r, pose) - w, axis=1) < thr
     if inliers.sum() < min_matches:
         return _fallback(n, odometry, odometry_covariance, drawn,
                          f"only {int(inliers.sum())} matches support the refined pose (need {min_matches})")
-    pose, cov, rms = fit_pose(r[inliers], w[inliers])
+    pose, cov, rms = _fit_subset(r, w, rcov, wcov, inliers)
     return EgomotionResult(pose, cov, inliers, "ransac", drawn, rms)
+
+
+def _fit_subset(r, w, rcov, wcov, mask):
+    return fit_pose(r[mask], w[mask], None if rcov is None else rcov[mask], None if wcov is None else wcov[mask])
 
 
 def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_pose, *, window: float = 0.3,
@@ -356,8 +403,8 @@ def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_
 
 
 def track(points, descriptors, landmarks: LandmarkMap, odometry, odometry_covariance=None, *,
-          window: float = 0.3, min_matches: int = 15, threshold: float = 0.1, ratio: float = 0.8,
-          rng=None) -> tuple[EgomotionResult, np.ndarray, np.ndarray, bool]:
+          covariances=None, window: float = 0.3, min_matches: int = 15, threshold: float = 0.1,
+          ratio: float = 0.8, rng=None) -> tuple[EgomotionResult, np.ndarray, np.ndarray, bool]:
     """Estimate the pose of one frame against the landmark map.
 
     Parameters
@@ -369,6 +416,8 @@ def track(points, descriptors, landmarks: LandmarkMap, odometry, odometry_covari
     odometry : array_like, shape (3,)
         Odometry-predicted pose.
     odometry_covariance : array_like, shape (3, 3), optional
+    covariances : array_like, shape (N, 3, 3), optional
+        Feature covariances; with them (and the landmarks' own) the refinement is weighted.
     window, min_matches, threshold, ratio
         See :func:`continuation_matches` and :func:`ransac_pose`.
     rng : numpy.random.Generator or int, optional
@@ -395,7 +444,9 @@ def track(points, descriptors, landmarks: LandmarkMap, odometry, odometry_covari
     if kidnapped and len(landmarks) >= 2 and pts.shape[0]:
         m = ratio_match(descriptors, landmarks.descriptors, ratio=ratio)
         fi, li = m.query, m.train
-    result = ransac_pose(pts[fi], landmarks.positions[li], threshold=threshold, min_matches=min_matches,
-                         odometry=odo, odometry_covariance=odometry_covariance, rng=rng)
+    cov = None if covariances is None else as_array(covariances, "covariances", shape=(pts.shape[0], 3, 3))[fi]
+    result = ransac_pose(pts[fi], landmarks.positions[li], robot_covariances=cov,
+                         world_covariances=None if cov is None else landmarks.covariances[li], threshold=threshold,
+                         min_matches=min_matches, odometry=odo, odometry_covariance=odometry_covariance, rng=rng)
     keep = result.inliers
     return result, fi[keep], li[keep], kidnapped

@@ -9,9 +9,10 @@ and fused with the landmark by the information-form Kalman update of Sec. 3.5.
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from ..validation import as_array, check_int
-from .frames import transform_covariance
+from ..validation import as_array, check_int, check_positive
+from .frames import as_pose, rotation_y, transform_covariance, world_to_robot
 
 __all__ = ["kalman_fuse", "LandmarkMap"]
 
@@ -199,6 +200,69 @@ class LandmarkMap:
                          "observations", "ids"):
                 setattr(self, name, getattr(self, name)[keep])
         return dropped
+
+    def associate(self, points, covariances, descriptors, pose, *, window: float = 1.0, gate: float = 14.16,
+                  max_distance: float = 0.8) -> np.ndarray:
+        """Data association at a known pose: the landmark each observation re-observes, or -1.
+
+        Parameters
+        ----------
+        points, covariances : array_like, shapes (N, 3), (N, 3, 3)
+            Observations in the robot frame and their covariances.
+        descriptors : array_like, shape (N, D)
+        pose : array_like, shape (3,)
+            Robot pose ``[p, q, theta]`` (e.g. the RANSAC estimate).
+        window : float, default 1.0
+            Landmarks predicted farther than this (metres) are not considered.
+        gate : float, default 14.16
+            Squared Mahalanobis distance gate with covariance
+            ``Sigma_obs + R^T Sigma_landmark R`` (14.16 is the 99.73 % chi-square quantile with 3 dof,
+            the 3-D "3 sigma").
+        max_distance : float, default 0.8
+            Maximum descriptor distance.
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (N,)
+            Landmark row per observation; among the gated candidates the nearest descriptor wins,
+            and a landmark claimed by several observations goes to the nearest descriptor.
+
+        Notes
+        -----
+        Se et al. Sec. 3.2 (predict the database landmarks in the new frame, look for matches in
+        the vicinity, verify them) with the uncertainty of Sec. 3.1 deciding "the vicinity".
+        """
+        pts = as_array(points, "points", shape=(None, 3))
+        n = pts.shape[0]
+        cov = as_array(covariances, "covariances", shape=(n, 3, 3))
+        desc = as_array(descriptors, "descriptors", shape=(n, self.descriptor_size), dtype=np.float32)
+        window = check_positive(window, "window")
+        gate = check_positive(gate, "gate")
+        max_distance = check_positive(max_distance, "max_distance")
+        out = -np.ones(n, int)
+        if n == 0 or len(self) == 0:
+            return out
+        rot = rotation_y(as_pose(pose)[2])
+        predicted = world_to_robot(self.positions, pose)
+        lists = cKDTree(predicted).query_ball_point(pts, window)
+        counts = np.array([len(x) for x in lists])
+        if counts.sum() == 0:
+            return out
+        fi = np.repeat(np.arange(n), counts)
+        li = np.concatenate([np.asarray(x, int) for x in lists if x])
+        err = pts[fi] - predicted[li]
+        joint = cov[fi] + rot.T @ self.covariances[li] @ rot
+        m2 = np.einsum("ni,ni->n", err, np.linalg.solve(joint, err[:, :, None])[:, :, 0])
+        dd = np.linalg.norm(desc[fi] - self.descriptors[li], axis=1)
+        ok = (m2 <= gate) & (dd <= max_distance)
+        fi, li, dd = fi[ok], li[ok], dd[ok]
+        order = np.argsort(dd, kind="stable")
+        taken_f, taken_l = np.zeros(n, bool), np.zeros(len(self), bool)
+        for f, lmk in zip(fi[order], li[order]):  # greedy one-to-one by descriptor distance
+            if not taken_f[f] and not taken_l[lmk]:
+                taken_f[f] = taken_l[lmk] = True
+                out[f] = lmk
+        return out
 
     def integrate(self, points, covariances, descriptors, pose, pose_covariance, landmark,
                   scales=None, orientations=None) -> np.ndarray:
