@@ -127,3 +127,24 @@ def test_tracking_uses_the_window_and_recovers_when_kidnapped():
     res, fi, li, kidnapped = track(robot, other, lm, [3.0, -3.0, 2.0], rng=1)
     assert res.source == "odometry" and np.allclose(res.pose, [3.0, -3.0, 2.0]) and fi.size == 0
     assert np.allclose(robot_to_world(world_to_robot(lm.positions[:3], TRUE), TRUE), lm.positions[:3])
+
+
+def test_weighted_refinement_discounts_depth_uncertain_points():
+    rng = np.random.default_rng(8)
+    errs_w, errs_u, m2 = [], [], []
+    for _ in range(30):
+        world = rng.uniform([-4, 0, -4], [4, 2.5, 4], (60, 3))
+        robot = world_to_robot(world, TRUE)
+        depth_sigma = 0.005 + 0.05 * np.abs(robot[:, 2])          # stereo-like: grows with depth
+        cov = np.zeros((60, 3, 3))
+        cov[:, 0, 0] = cov[:, 1, 1] = 0.005 ** 2
+        cov[:, 2, 2] = depth_sigma ** 2
+        noisy = robot + rng.normal(size=(60, 3)) * np.sqrt(np.diagonal(cov, axis1=1, axis2=2))
+        pw, cw, _ = fit_pose(noisy, world, robot_covariances=cov)
+        pu, _, _ = fit_pose(noisy, world)
+        errs_w.append(np.hypot(*(pw[:2] - TRUE[:2])))
+        errs_u.append(np.hypot(*(pu[:2] - TRUE[:2])))
+        e = pw - TRUE
+        m2.append(e @ np.linalg.solve(cw, e))
+    assert np.mean(errs_w) < 0.7 * np.mean(errs_u)
+    assert 1.5 < np.mean(m2) < 4.5   # chi-square with 3 dof: the covariance is consistent
