@@ -83,5 +83,9 @@ def test_recall_precision_detects_wrong_ground_truth(photo):
     wrong = recall_precision(fa, fb, similarity_homography(photo.shape, 1.0, np.deg2rad(-20)), photo.shape)
     assert good["recall"][-1] > 0.5 and good["one_minus_precision"][-1] < 0.1
     assert wrong["one_minus_precision"][-1] > 0.8
+    with pytest.raises(ValueError, match="image_shape_b: expected"):
+        recall_precision(fa, fb, h, 480)
+    with pytest.raises(TypeError, match="features_b: expected Features"):
+        recall_precision(fa, fb.descriptors, h, photo.shape)
     empty = recall_precision(fa.subset(slice(0, 0)), fb, h, photo.shape)
     assert empty["n_correspondences"] == 0 and not np.any(np.isnan(empty["recall"]))

@@ -125,6 +125,8 @@ def recall_precision(features_a: Features, features_b: Features, homography, ima
     tol = check_positive(tolerance, "tolerance")
     ts = np.linspace(0.15, 0.7, 12) if thresholds is None else as_array(thresholds, "thresholds", ndim=1, min_size=1)
     shape = as_array(image_shape_b, "image_shape_b")
+    if shape.ndim != 1 or shape.size < 2 or np.any(shape[:2] < 1):
+        raise ValueError(f"image_shape_b: expected (H, W) with positive sizes, got {image_shape_b!r}")
     nt = ts.size
     empty = {"thresholds": ts, "recall": np.zeros(nt), "one_minus_precision": np.zeros(nt),
              "n_correct": np.zeros(nt, int), "n_false": np.zeros(nt, int), "n_correspondences": 0}
