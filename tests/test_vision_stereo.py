@@ -162,3 +162,17 @@ def test_orientation_scale_and_disparity_constraints():
 def test_project_refuses_points_behind_the_rig():
     with pytest.raises(ValueError, match="points: expected Z > 0"):
         RIG.project([[0.0, 0.0, -1.0]])
+
+
+def test_observe_stereo_gives_points_in_the_robot_frame(photo):
+    from robokit.vision.stereo import observe_stereo
+    right, (z_near, z_far) = _two_plane_pair(photo)
+    obs = observe_stereo(plot_features(photo), plot_features(right), RIG)
+    assert len(obs) > 150 and obs.covariances.shape == (len(obs), 3, 3)
+    assert len(obs.features) == len(obs) and obs.features.descriptors.shape[1] == 128
+    x = obs.features.keypoints.xy[:, 0]
+    away = np.abs(x - 320) > 30
+    z_true = np.where(x < 320, z_near, z_far)
+    assert np.median(np.abs(obs.points[away, 2] - z_true[away])) < 0.05
+    flat = np.full((480, 640), 100, np.uint8)
+    assert len(observe_stereo(plot_features(flat), plot_features(right), RIG)) == 0

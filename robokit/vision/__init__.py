@@ -13,8 +13,8 @@ from .features import Features, Keypoints, as_gray_image
 from .matching import Matches, ratio_match, two_nearest
 from .plot import (PlotParams, ScaleSpace, detect_plot, detect_plot_levels, edge_strength, junction_strength,
                    orientation_tensor, plot_scales, polynomial_expansion, tensor_eigenvalues)
-from .stereo import (NotRectifiedError, StereoMatches, StereoRig, disparity_to_point, match_stereo,
-                     triangulate_svd)
+from .stereo import (NotRectifiedError, StereoMatches, StereoObservations, StereoRig, disparity_to_point,
+                     match_stereo, observe_stereo, triangulate_svd)
 
 __all__ = ["assign_orientations", "detect_and_describe", "gradient_histogram_descriptor", "plot_features",
            "reduced_descriptor", "sift_descriptor", "sift_features", "apply_homography", "recall_precision",
@@ -22,4 +22,4 @@ __all__ = ["assign_orientations", "detect_and_describe", "gradient_histogram_des
            "two_nearest", "PlotParams", "ScaleSpace", "detect_plot", "detect_plot_levels", "edge_strength",
            "junction_strength", "orientation_tensor", "plot_scales", "polynomial_expansion",
            "tensor_eigenvalues", "NotRectifiedError", "StereoMatches", "StereoRig", "disparity_to_point",
-           "match_stereo", "triangulate_svd"]
+           "match_stereo", "triangulate_svd", "StereoObservations", "observe_stereo"]

@@ -18,8 +18,8 @@ from ..validation import as_array, check_finite_scalar, check_positive
 from .features import Features
 from .matching import ratio_match
 
-__all__ = ["NotRectifiedError", "StereoRig", "StereoMatches", "disparity_to_point", "triangulate_svd",
-           "match_stereo"]
+__all__ = ["NotRectifiedError", "StereoRig", "StereoMatches", "StereoObservations", "disparity_to_point",
+           "triangulate_svd", "match_stereo", "observe_stereo"]
 
 
 class NotRectifiedError(ValueError):
@@ -132,6 +132,28 @@ class StereoMatches:
 
     def __len__(self) -> int:
         return int(self.left.size)
+
+
+@dataclass(frozen=True)
+class StereoObservations:
+    """3-D features of one stereo frame in the robot (left camera) frame.
+
+    Attributes
+    ----------
+    points : numpy.ndarray, shape (M, 3)
+    covariances : numpy.ndarray, shape (M, 3, 3)
+    features : Features
+        The left-image features of the matches (keypoints and descriptors).
+    matches : StereoMatches
+    """
+
+    points: np.ndarray
+    covariances: np.ndarray
+    features: Features
+    matches: StereoMatches
+
+    def __len__(self) -> int:
+        return int(self.points.shape[0])
 
 
 def disparity_to_point(c, r, d, rig: StereoRig, *, sigma_c: float = 1.0, sigma_r: float = 1.0,
@@ -318,3 +340,39 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
     unique = claims[ri] == 1
     li, ri = li[unique], ri[unique]
     return StereoMatches(li, ri, kl.xy[li, 0] - kr.xy[ri, 0], best[keep][unique])
+
+
+def observe_stereo(left: Features, right: Features, rig: StereoRig, *, sigma_c: float = 1.0,
+                   sigma_r: float = 1.0, sigma_d: float = 1.0, **match_options) -> StereoObservations:
+    """Match a rectified pair and turn the matches into 3-D points with covariances.
+
+    Parameters
+    ----------
+    left, right : Features
+    rig : StereoRig
+    sigma_c, sigma_r, sigma_d : float
+        Image noise (pixels) for :func:`disparity_to_point`.
+    **match_options
+        Passed to :func:`match_stereo` (the disparity range defaults to the rig's 0.3 m .. infinity
+        when not given).
+
+    Returns
+    -------
+    StereoObservations
+        Empty (zero rows) when nothing matches.
+
+    Notes
+    -----
+    Lin et al. Sec. 3 (matching, then "the 3D positions of matches relative to the mobile robot")
+    and Se et al. Sec. 2.2 and 3.1.
+    """
+    if not isinstance(rig, StereoRig):
+        raise TypeError(f"rig: expected StereoRig, got {type(rig).__name__}")
+    match_options.setdefault("max_disparity", rig.focal * rig.baseline / 0.3)
+    m = match_stereo(left, right, **match_options)
+    if len(m) == 0:
+        return StereoObservations(np.zeros((0, 3)), np.zeros((0, 3, 3)), left.subset(m.left), m)
+    xy = left.keypoints.xy[m.left]
+    pts, cov = disparity_to_point(xy[:, 0], xy[:, 1], m.disparity, rig, sigma_c=sigma_c, sigma_r=sigma_r,
+                                  sigma_d=sigma_d)
+    return StereoObservations(pts, cov, left.subset(m.left), m)
