@@ -220,8 +220,8 @@ def _peaks(acc, n, radius=(2, 3, 3), block=(2, 4, 4)):
     return t[chosen], x[chosen], z[chosen], flat[cand[chosen]]
 
 
-def _refine(pose, pts, world, fi, li, gates):
-    """Iterated least squares: keep each feature's best match within the gate, refit."""
+def _refine(pose, pts, world, fi, li, gates, pts_cov, world_cov):
+    """Iterated least squares: keep each feature's best match within the gate, refit (weighted)."""
     h = None
     for gate in gates:
         c, s = np.cos(pose[2]), np.sin(pose[2])
@@ -234,7 +234,7 @@ def _refine(pose, pts, world, fi, li, gates):
         keep = first[d[first] <= gate]
         if keep.size < 2 or np.ptp(pts[fi[keep]][:, [0, 2]], axis=0).max() < 1e-3:
             return h
-        pose, cov, rms = fit_pose(pts[fi[keep]], world[li[keep]])
+        pose, cov, rms = fit_pose(pts[fi[keep]], world[li[keep]], pts_cov[fi[keep]], world_cov[li[keep]])
         h = (pose, cov, fi[keep], li[keep], rms)
     return h
 
@@ -264,7 +264,8 @@ def global_localize(points, covariances, descriptors, landmarks: LandmarkMap, *,
     k, max_distance, height_tol
         Candidate matching, see :func:`candidate_matches`.
     gates : sequence of float
-        Match gates (metres) of the successive least-squares iterations.
+        Match gates (metres) of the successive least-squares iterations; each iteration is weighted
+        by the feature and landmark covariances (:func:`robokit.localization.egomotion.fit_pose`).
     min_matches : int, default 5
         The winner must explain at least this many matches.
 
@@ -307,7 +308,7 @@ def global_localize(points, covariances, descriptors, landmarks: LandmarkMap, *,
     hyps = []
     for t, x, z, votes in zip(*_peaks(acc, n_hypotheses)):
         start = np.array([b[0] + (x + 0.5) * bin_size, b[2] + (z + 0.5) * bin_size, thetas[t]])
-        h = _refine(start, pts, world, fi, li, gates)
+        h = _refine(start, pts, world, fi, li, gates, cov, landmarks.covariances)
         if h is not None:
             hyps.append(Hypothesis(h[0], h[1], int(votes), h[2], h[3], float(h[4])))
     hyps.sort(key=lambda h: (-h.n_matches, h.rms))

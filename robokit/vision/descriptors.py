@@ -5,7 +5,8 @@ Lin et al. Sec. 2.ii describe PLOT keypoints with SIFT's descriptor (Lowe 2004, 
 the gradients of a rotated window, accumulated into 4 x 4 cells x 8 orientations, give a 128-element
 vector. Se, Lowe & Little (Sec. 4) found 2 x 2 cells x 4 orientations (16 elements) sufficient in
 their lab. Both are one routine here, :func:`gradient_histogram_descriptor`, vectorised over all
-keypoints (OpenCV's ``remap`` samples the gradients, ``numpy.bincount`` accumulates the histograms).
+keypoints (OpenCV's ``remap`` samples the gradients on a rotated 16 x 16 grid; the orientation
+histograms are accumulated with ``numpy.bincount`` and the spatial cells with one matrix product).
 :func:`sift_features` wraps OpenCV's SIFT, the library reference kept beside the lesson's code.
 """
 from __future__ import annotations
