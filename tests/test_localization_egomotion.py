@@ -148,3 +148,17 @@ def test_weighted_refinement_discounts_depth_uncertain_points():
         m2.append(e @ np.linalg.solve(cw, e))
     assert np.mean(errs_w) < 0.7 * np.mean(errs_u)
     assert 1.5 < np.mean(m2) < 4.5   # chi-square with 3 dof: the covariance is consistent
+
+
+def test_bad_inputs_are_named():
+    rng = np.random.default_rng(10)
+    robot, world = _scene(rng, 20)
+    with pytest.raises(ValueError, match=r"world_points: expected shape \(20, 3\)"):
+        ransac_pose(robot, world[:5])
+    with pytest.raises(ValueError, match="threshold: expected a positive number"):
+        ransac_pose(robot, world, threshold=0.0)
+    with pytest.raises(ValueError, match="odometry: expected shape"):
+        track(robot, np.zeros((20, 16)), LandmarkMap(16), [0.0, 0.0])
+    # an empty map cannot give a pose: odometry is kept
+    res, fi, li, kidnapped = track(robot, np.zeros((20, 16)), LandmarkMap(16), [0.1, 0.2, 0.3])
+    assert res.source == "odometry" and kidnapped and fi.size == 0

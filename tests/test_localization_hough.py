@@ -116,3 +116,14 @@ def test_unknown_scene_raises_instead_of_returning_nan():
         global_localize(pts, cov, other, lm)
     with pytest.raises(InsufficientMatchesError, match="only 0 potential matches"):
         global_localize(pts[:0], cov[:0], desc[:0], lm)
+
+
+def test_hough_inputs_are_validated():
+    rng = np.random.default_rng(3)
+    lm, (pts, cov, desc, _) = lab_map_and_view(rng, np.zeros(3), n_landmarks=300)
+    with pytest.raises(TypeError, match="landmarks: expected LandmarkMap"):
+        global_localize(pts, cov, desc, lm.positions)
+    with pytest.raises(ValueError, match="descriptors: expected shape"):
+        global_localize(pts, cov, desc[:, :8], lm)
+    with pytest.raises(ValueError, match="bounds: the Hough space would have"):
+        global_localize(pts, cov, desc, lm, bounds=(-100, 100, -100, 100))
