@@ -103,8 +103,9 @@ def _orientations(grads, keypoints: Keypoints, ratio: float) -> Keypoints:
     for idx, gx, gy, step in grads:
         rx, ry = _sample(gx, gy, keypoints.xy[idx] / step, keypoints.scale[idx] / step, np.zeros(idx.size),
                          3 * _WINDOW)
-        weight = np.hypot(rx, ry) * gauss
-        pos = np.mod(np.arctan2(ry, rx), 2 * np.pi) * (nbins / (2 * np.pi))
+        mag, ang = cv2.cartToPolar(np.ascontiguousarray(rx), np.ascontiguousarray(ry))  # angle in [0, 2 pi)
+        weight = mag * gauss
+        pos = ang * np.float32(nbins / (2 * np.pi))
         lo = np.floor(pos).astype(int)
         frac = pos - lo
         rows = np.arange(idx.size)[:, None] * nbins
@@ -130,17 +131,19 @@ def _histograms(grads, keypoints: Keypoints, cells: int, bins: int, clip: float)
     for idx, gx, gy, step in grads:
         rx, ry = _sample(gx, gy, keypoints.xy[idx] / step, keypoints.scale[idx] / step, keypoints.orientation[idx],
                          2 * _CELL)
-        mag = np.hypot(rx, ry).ravel()
-        pos = (np.mod(np.arctan2(ry, rx), 2 * np.pi) * (bins / (2 * np.pi))).ravel()
-        lo = np.floor(pos).astype(int)
+        mag, ang = cv2.cartToPolar(np.ascontiguousarray(rx), np.ascontiguousarray(ry))  # angle in [0, 2 pi)
+        mag, ang = mag.T.ravel(), ang.T.ravel()  # sample-major, so the spatial binning is one matrix product
+        pos = ang * np.float32(bins / (2 * np.pi))
+        lo = np.floor(pos).astype(np.intp)
         frac = pos - lo
-        # orientation soft-binning per sample, then one matrix product does the spatial binning
+        # orientation soft-binning per sample ...
         per_sample = np.zeros(mag.size * bins, np.float32)
         base = np.arange(mag.size) * bins
         per_sample[base + lo % bins] = mag * (1 - frac)
         per_sample[base + (lo + 1) % bins] += mag * frac
-        hist = weights @ per_sample.reshape(idx.size, -1, bins)       # (k, cells^2, bins)
-        out[idx] = hist.reshape(idx.size, dim)
+        # ... then (cells^2, samples) @ (samples, k * bins) sums the samples into the spatial cells
+        hist = weights @ per_sample.reshape(weights.shape[1], idx.size * bins)
+        out[idx] = hist.reshape(cells * cells, idx.size, bins).transpose(1, 0, 2).reshape(idx.size, dim)
     for _ in range(2):  # normalise, clip large gradients, renormalise (Lowe 2004, Sec. 6.1)
         norm = np.linalg.norm(out, axis=1, keepdims=True)
         out = np.divide(out, norm, out=np.zeros_like(out), where=norm > 1e-12)
