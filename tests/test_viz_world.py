@@ -10,7 +10,7 @@ import pytest
 import umsgpack
 
 from robokit.sim import Lidar, PinholeCamera, box_room, lab_lap, lab_room
-from robokit.viz import (Scene, add_camera, add_landmarks, add_particles, add_trajectory, add_world, animate_poses,
+from robokit.viz import (Scene, add_camera, add_landmarks, add_particles, add_trajectory, add_world, animate_poses, look_from,
                          plot_covariance, plot_footprint, plot_occupancy, plot_scan, plot_trajectory)
 
 
@@ -54,6 +54,9 @@ def test_helpers_record_their_objects():
     assert anim["animations"][0]["path"] == "/meshcat/robot"
     keys = anim["animations"][0]["clip"]["tracks"][0]["keys"]
     assert len(keys) == len(lab_lap(world).poses[::20])
+    look_from(scene, [-5.0, -4.0, 9.0])
+    cam = decoded(scene)[-1]
+    assert cam["path"] == "/Cameras/default/rotated/<object>" and cam["value"] == [-5.0, 9.0, 4.0]
     ell = next(c for c in cmds if c.get("path") == "/meshcat/lm/ellipsoid0" and c["type"] == "set_transform")
     T = np.array(ell["matrix"]).reshape(4, 4).T
     assert np.allclose(np.abs(np.linalg.det(T[:3, :3])), 1)
@@ -82,6 +85,7 @@ def test_maps_draw_with_labelled_axes():
     (lambda: add_landmarks(Scene(), "lm", np.zeros((2, 3)), np.zeros((3, 3, 3))), "covariances"),
     (lambda: add_particles(Scene(), "pf", np.zeros((3, 3)), weights=[-1, 0, 0]), "weights"),
     (lambda: animate_poses(Scene(), "x", np.zeros((1, 3))), "transforms"),
+    (lambda: look_from(Scene(), [0, 0, 0]), "position"),
     (lambda: plot_occupancy(np.full((3, 3), 2.0), (0, 0), 0.1), "grid"),
 ])
 def test_bad_input_is_named(call, match):

@@ -17,7 +17,8 @@ from ..sim.world import World
 from ..validation import as_array, as_points, check_int, check_positive
 from .scene import Scene, _color
 
-__all__ = ["add_world", "add_camera", "add_trajectory", "add_particles", "add_landmarks", "animate_poses"]
+__all__ = ["add_world", "add_camera", "add_trajectory", "add_particles", "add_landmarks", "animate_poses",
+           "look_from"]
 
 
 def _textured_mesh(vertices: np.ndarray, faces: np.ndarray, uvs: np.ndarray):
@@ -283,4 +284,33 @@ def animate_poses(scene: Scene, path: str, transforms: Any, fps: float = 10.0, r
             return [{"path": Scene._path(path).lower(), "clip": clip.lower()}]
 
     scene._send(SetAnimation(_Animation(), play=True, repetitions=check_int(repetitions, "repetitions", minimum=1)))
+    return scene
+
+
+def look_from(scene: Scene, position: Any) -> Scene:
+    """Place the viewer's camera at world ``position`` (metres, z up), looking at the origin.
+
+    Parameters
+    ----------
+    scene : Scene
+    position : array_like, shape (3,)
+
+    Returns
+    -------
+    Scene
+
+    Notes
+    -----
+    meshcat's default camera lives under ``/Cameras/default/rotated``, a node that turns
+    three.js's y-up convention into robokit's z-up one, so the position is given to it as
+    ``(x, z, -y)``; the orbit controls keep looking at the origin.
+    """
+    from meshcat.commands import SetProperty
+    from meshcat.path import Path as MeshcatPath
+
+    p = as_array(position, "position", shape=(3,))
+    if np.linalg.norm(p) == 0:
+        raise ValueError("position: expected a point away from the origin, got [0, 0, 0]")
+    scene._send(SetProperty("position", [float(p[0]), float(p[2]), float(-p[1])],
+                            MeshcatPath(("Cameras", "default", "rotated", "<object>"))))
     return scene
