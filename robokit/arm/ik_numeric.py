@@ -331,8 +331,9 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     for i in np.flatnonzero(too_far):
         reasons[i] = f"out of reach: target {dist[i]:.3f} m from the base, beyond the arm's reach bound {chain.reach():.3f} m"
     for i in np.flatnonzero(~success & ~too_far):
-        reasons[i] += (f" after {tries[i] + parallel} attempts of up to {max_iter} iterations "
-                       "(target may be unreachable)")
+        reasons[i] += f" after {tries[i] + parallel} attempts of up to {max_iter} iterations"
+        if reasons[i].startswith("pose error"):
+            reasons[i] += " (target may be unreachable)"
     out = IKBatchResult(q=q, success=success, reason=reasons, residual=residual, iterations=iters,
                         position_error=pos, orientation_error=rot, restarts=tries)
     if history:
