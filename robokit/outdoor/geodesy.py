@@ -29,7 +29,7 @@ from ..validation import as_array, check_int, check_positive
 __all__ = [
     "WGS84_A", "WGS84_F", "WGS84_B", "WGS84_E2", "EARTH_MEAN_RADIUS", "GeodesyError",
     "meridian_radius", "prime_vertical_radius", "osculating_radius",
-    "haversine_distance", "initial_bearing", "vincenty_inverse", "distance_bearing", "LocalTangentPlane",
+    "haversine_distance", "initial_bearing", "haversine_distance_bearing", "vincenty_inverse", "distance_bearing", "LocalTangentPlane",
 ]
 
 #: WGS84 semi-major axis (m) and flattening (NIMA TR8350.2, 3rd ed., Table 3.1).
@@ -157,6 +157,33 @@ def initial_bearing(lat1: Any, lon1: Any, lat2: Any, lon2: Any) -> Any:
     y = np.sin(dl) * np.cos(p2)
     x = np.cos(p1) * np.sin(p2) - np.sin(p1) * np.cos(p2) * np.cos(dl)
     return _out(np.mod(np.arctan2(y, x), 2 * np.pi))
+
+
+def haversine_distance_bearing(lat1: float, lon1: float, lat2: float, lon2: float,
+                               radius: float = EARTH_MEAN_RADIUS) -> np.ndarray:
+    """``[distance_m, bearing_rad]`` from point 1 to point 2 on a sphere (scalar points).
+
+    Parameters
+    ----------
+    lat1, lon1, lat2, lon2 : float
+        Radians.
+    radius : float, default EARTH_MEAN_RADIUS
+
+    Returns
+    -------
+    numpy.ndarray, shape (2,)
+        :func:`haversine_distance` and :func:`initial_bearing` together (what $GPRMB reports as
+        range and bearing to the destination, Hamid et al., seed 000 Q3, Sec. 3).
+
+    Raises
+    ------
+    ValueError
+        Non-scalar, non-finite or out-of-range input.
+    """
+    for name, value in (("lat1", lat1), ("lon1", lon1), ("lat2", lat2), ("lon2", lon2)):
+        if np.ndim(value) != 0:
+            raise ValueError(f"{name}: expected a scalar in radians, got shape {np.shape(value)}")
+    return np.array([haversine_distance(lat1, lon1, lat2, lon2, radius), initial_bearing(lat1, lon1, lat2, lon2)])
 
 
 def vincenty_inverse(lat1: Any, lon1: Any, lat2: Any, lon2: Any, *, tol: float = 1e-12,

@@ -27,7 +27,7 @@ from .nmea_records import GGA, HDG, RMB, RMC, Sentence
 __all__ = [
     "NMEAError", "NMEAChecksumError", "NMEAFormatError",
     "RMC", "RMB", "GGA", "HDG", "Sentence",
-    "nmea_checksum", "parse_sentence", "parse_latitude", "parse_longitude", "parse_time", "parse_date",
+    "nmea_checksum", "parse_sentence", "fix_position", "parse_latitude", "parse_longitude", "parse_time", "parse_date",
     "BadSentence", "NMEAReader", "read_nmea",
 ]
 
@@ -210,6 +210,38 @@ def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> R
     if parser is None or len(address) != 5:
         return Sentence(talker, kind, tuple(fields[1:]))
     return parser(talker, fields[1:])
+
+
+def fix_position(sentence: str) -> list[float]:
+    """Latitude and longitude in decimal degrees from a ``$--RMC`` or ``$--GGA`` sentence.
+
+    Parameters
+    ----------
+    sentence : str
+        A complete sentence with checksum, any talker.
+
+    Returns
+    -------
+    list of float
+        ``[latitude, longitude]``, north and east positive.
+
+    Raises
+    ------
+    NMEAChecksumError, NMEAFormatError
+        As :func:`parse_sentence`; also when the sentence is not RMC/GGA or carries no position
+        (a receiver without a fix sends empty fields).
+
+    Notes
+    -----
+    ``ddmm.mmmm`` -> ``dd + mm.mmmm / 60`` (NMEA 0183 v4.11, Sec. 6.2); the position the truck of
+    Hamid et al. reads from $GPRMC/$GPGGA (seed 000 Q3, Sec. 3).
+    """
+    rec = parse_sentence(sentence)
+    if not isinstance(rec, (RMC, GGA)):
+        raise NMEAFormatError(f"sentence: expected an RMC or GGA sentence, got type {rec.kind!r}")
+    if rec.latitude is None or rec.longitude is None:
+        raise NMEAFormatError(f"sentence: expected a position, got empty latitude/longitude (no fix) in {sentence[:30]!r}")
+    return [rec.latitude, rec.longitude]
 
 
 # --- streams ------------------------------------------------------------------------------------

@@ -1,0 +1,198 @@
+"""Exercises of assignment 05 (GPS waypoint navigation and sonar obstacle avoidance, Hamid et al.)."""
+from __future__ import annotations
+
+import datetime as dt
+
+import numpy as np
+
+from ..grading.compare import close, exact
+from ..grading.exercise import Case, Exercise
+from ..outdoor.controller import design_heading_gains, loop_metrics
+from ..outdoor.geodesy import haversine_distance_bearing
+from ..outdoor.navigator import avoidance_decision
+from ..outdoor.nmea import fix_position, nmea_checksum
+from ..outdoor.nmea_write import format_sentence, gga_sentence, hdg_sentence, random_sentences, rmc_sentence
+from ..outdoor.sonar import pulse_width_to_cm_inches
+
+ASSIGNMENT = "05_gps_sonar_truck"
+#: Written (manually graded) questions: id -> points.
+WRITTEN = {"05.gps_accuracy": 2}
+
+
+def _checksum_cases(rng: np.random.Generator) -> list[Case]:
+    sentences = random_sentences(6, rng)
+    return [
+        Case(("GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,",), label="body only"),
+        Case((sentences[0],), label="full sentence: ignore '$' and everything from '*'"),
+        Case((sentences[2],), label="compass sentence"),
+        Case((sentences[3][1:sentences[3].index("*")],), label="body of an RMB"),
+        Case((sentences[4],), label="generic sentence type"),
+        Case(("",), raises="ValueError", label="empty body"),
+        Case(("GPGGA,12\u00e9",), raises="ValueError", label="non-ASCII character"),
+    ]
+
+
+def _position_cases(rng: np.random.Generator) -> list[Case]:
+    lat, lon = rng.uniform(-80, 80, 3), rng.uniform(-179, 179, 3)
+    when = dt.datetime(2012, 6, 4, 2, 30, int(rng.integers(60)))
+    good = [rmc_sentence(when, float(lat[0]), float(lon[0]), speed_mps=1.0, course_deg=45.0),
+            gga_sentence(when.time(), float(lat[1]), float(lon[1]), talker="GN"),
+            rmc_sentence(when, -abs(float(lat[2])), -abs(float(lon[2])), talker="GN")]
+    bad_checksum = good[0][:-2] + ("00" if good[0][-2:] != "00" else "01")
+    too_far = format_sentence("GPGGA", ["023000", "9130.0000", "N", "10021.0300", "E", "1", "08", "1.0",
+                                        "12.0", "M", "", "M", "", ""])
+    return [
+        Case((good[0],), label="RMC, GP talker"),
+        Case((good[1],), label="GGA, GN talker"),
+        Case((good[2],), label="southern and western hemispheres"),
+        Case(("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A",), label="textbook RMC"),
+        Case((bad_checksum,), raises="ValueError", label="wrong checksum"),
+        Case((too_far,), raises="ValueError", label="latitude above 90 degrees"),
+        Case(("$GNRMC,,V,,,,,,,,,,N*4D",), raises="ValueError", label="no fix: empty position"),
+        Case((hdg_sentence(120.0),), raises="ValueError", label="not a position sentence"),
+    ]
+
+
+def _haversine_cases(rng: np.random.Generator) -> list[Case]:
+    lat0, lon0 = np.radians(6.459), np.radians(100.35)
+    near = rng.normal(0, 3e-4, (3, 2))
+    far = rng.uniform([-1.2, -3.0], [1.2, 3.0], (2, 2))
+    cases = [Case((lat0, lon0, lat0 + 1e-5, lon0), label="10 cm north: bearing 0")]
+    for d in near:
+        cases.append(Case((lat0, lon0, float(lat0 + d[0]), float(lon0 + d[1])), label="across a football field"))
+    cases.append(Case((float(far[0, 0]), float(far[0, 1]), float(far[1, 0]), float(far[1, 1])), label="far apart"))
+    cases.append(Case((0.0, 0.0, 0.0, -0.01), label="due west: bearing 3 pi / 2"))
+    cases.append(Case((48.1, 11.5, 48.2, 11.6), raises="ValueError", label="degrees instead of radians"))
+    return cases
+
+
+def _pulse_cases(rng: np.random.Generator) -> list[Case]:
+    widths = rng.uniform(882, 37338, 3)  # 6 to 254 inches
+    return [Case((147.0,), label="one inch"), Case((14700.0,), label="100 inches")] + \
+        [Case((float(w),), label="inside the sensor's range") for w in widths] + \
+        [Case((-10.0,), raises="ValueError", label="negative width"),
+         Case((float("nan"),), raises="ValueError", label="NaN")]
+
+
+def _avoid_cases(rng: np.random.Generator) -> list[Case]:
+    far = 6.45
+    near = [round(float(x), 2) for x in rng.uniform(0.3, 0.75, 4)]
+    return [
+        Case(([far, far, far, far],), label="nothing in range"),
+        Case(([far, near[0], near[1], far],), label="front blocked, sides equal: preferred side"),
+        Case(([far, near[0], near[1], far],), {"prefer": "right"}, label="front blocked, prefer right"),
+        Case(([near[2], 0.9, 1.0, far],), label="front blocked, less room on the left"),
+        Case(([far, 1.1, 0.95, near[3]],), label="front blocked, less room on the right"),
+        Case(([near[1], far, far, far],), label="left side only"),
+        Case(([far, far, far, near[2]],), label="right side only"),
+        Case(([1.0, 2.0, 3.0],), raises="ValueError", label="three ranges"),
+        Case(([1.0, -2.0, 3.0, 4.0],), raises="ValueError", label="negative range"),
+    ]
+
+
+def _gains_cases(rng: np.random.Generator) -> list[Case]:
+    taus = rng.uniform(0.15, 0.4, 3)
+    return [
+        Case((0.3, 0.05, 1.5), label="the lesson's spec"),
+        Case((float(taus[0]), 0.10, 1.0), label="10 % overshoot, 1 s"),
+        Case((float(taus[1]), 0.02, 1.2), label="2 % overshoot"),
+        Case((float(taus[2]), 0.20, 0.8), label="20 % overshoot"),
+        Case((0.3, 1.5, 1.0), raises="ValueError", label="overshoot not a fraction"),
+        Case((0.3, 0.05, -1.0), raises="ValueError", label="negative settling time"),
+        Case((0.3, 0.05, 30.0), raises="ValueError", label="too slow: would need kd < 0"),
+    ]
+
+
+def _metrics_cases(rng: np.random.Generator) -> list[Case]:
+    out = []
+    for tau, os_, ts in [(0.3, 0.05, 1.5), (float(rng.uniform(0.2, 0.4)), 0.1, 1.0),
+                         (float(rng.uniform(0.2, 0.4)), 0.02, 1.3)]:
+        kp, kd = design_heading_gains(tau, os_, ts)
+        out.append(Case((float(kp), float(kd), tau), label=f"designed for {os_:.0%} overshoot"))
+    out.append(Case((2.0, 0.0, 0.3), label="P control only"))
+    out.append(Case((-1.0, 0.5, 0.3), raises="ValueError", label="negative kp"))
+    return out
+
+
+EXERCISES = [
+    Exercise(
+        id="05.nmea_checksum",
+        function="nmea_checksum",
+        signature="nmea_checksum(sentence: str) -> str",
+        points=1,
+        cases=_checksum_cases,
+        reference=nmea_checksum,
+        references=("robokit.outdoor.nmea.nmea_checksum",),
+        compare=exact(),
+        description="XOR of the characters between '$' and '*' as two upper-case hex digits.",
+    ),
+    Exercise(
+        id="05.fix_position",
+        function="fix_position",
+        signature="fix_position(sentence: str) -> list[float]",
+        points=2,
+        cases=_position_cases,
+        reference=fix_position,
+        references=("robokit.outdoor.nmea.fix_position", "robokit.outdoor.nmea.parse_sentence",
+                    "robokit.outdoor.nmea_fields.parse_latitude", "robokit.outdoor.nmea_fields.parse_longitude"),
+        compare=close(rtol=0, atol=1e-9),
+        description="[lat, lon] in degrees from an RMC or GGA sentence; ValueError on bad input.",
+    ),
+    Exercise(
+        id="05.haversine",
+        function="haversine",
+        signature="haversine(lat1, lon1, lat2, lon2) -> numpy.ndarray  # [distance_m, bearing_rad]",
+        points=2,
+        cases=_haversine_cases,
+        reference=haversine_distance_bearing,
+        references=("robokit.outdoor.geodesy.haversine_distance_bearing",
+                    "robokit.outdoor.geodesy.haversine_distance", "robokit.outdoor.geodesy.initial_bearing",
+                    "robokit.outdoor.geodesy.distance_bearing"),
+        compare=close(rtol=1e-9, atol=1e-6),
+        description="Great-circle distance (mean radius) and initial bearing in [0, 2 pi).",
+    ),
+    Exercise(
+        id="05.pulse_to_distance",
+        function="pulse_to_distance",
+        signature="pulse_to_distance(pulse_width_us: float) -> dict  # {'inches': .., 'cm': ..}",
+        points=1,
+        cases=_pulse_cases,
+        reference=pulse_width_to_cm_inches,
+        references=("robokit.outdoor.sonar.pulse_width_to_cm_inches",),
+        compare=close(rtol=1e-9, atol=1e-9),
+        description="LV-MaxSonar-EZ pulse width (147 us per inch) to inches and centimetres.",
+    ),
+    Exercise(
+        id="05.avoidance_decision",
+        function="avoidance_decision",
+        signature="avoidance_decision(ranges, front=1.2, side=0.8, prefer='left') -> str",
+        points=2,
+        cases=_avoid_cases,
+        reference=avoidance_decision,
+        references=("robokit.outdoor.navigator.avoidance_decision",),
+        compare=exact(),
+        description="'forward', 'left' or 'right' from the four sonar ranges.",
+    ),
+    Exercise(
+        id="05.heading_gains",
+        function="heading_gains",
+        signature="heading_gains(tau: float, overshoot: float, settling_time: float) -> numpy.ndarray  # [kp, kd]",
+        points=2,
+        cases=_gains_cases,
+        reference=design_heading_gains,
+        references=("robokit.outdoor.controller.design_heading_gains",),
+        compare=close(rtol=1e-6, atol=1e-9),
+        description="Rate-feedback gains that place the closed-loop poles for an overshoot/settling spec.",
+    ),
+    Exercise(
+        id="05.step_metrics",
+        function="step_metrics",
+        signature="step_metrics(kp: float, kd: float, tau: float) -> dict",
+        points=2,
+        cases=_metrics_cases,
+        reference=loop_metrics,
+        references=("robokit.outdoor.controller.loop_metrics",),
+        compare=close(rtol=1e-3, atol=1e-6),
+        description="Overshoot, settling/rise time, margins and crossover with python-control.",
+    ),
+]

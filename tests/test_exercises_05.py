@@ -1,0 +1,84 @@
+"""Assignment 05: the references pass their own cases, and check() rejects wrong answers."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robokit.exercises import gps_sonar_truck as module
+from robokit.grading import check, exercises_for
+from robokit.grading.exercise import call_student, expected_output, judge
+
+EXERCISES = {ex.id: ex for ex in module.EXERCISES}
+
+
+def test_assignment_is_registered():
+    assert module.ASSIGNMENT == "05_gps_sonar_truck"
+    assert [e.id for e in exercises_for("05_gps_sonar_truck")] == list(EXERCISES)
+    assert len(EXERCISES) >= 6 and module.WRITTEN == {"05.gps_accuracy": 2}
+
+
+@pytest.mark.parametrize("seed", [2024, "instructor-secret"])
+@pytest.mark.parametrize("exercise_id", list(EXERCISES))
+def test_reference_passes_its_own_cases(exercise_id, seed):
+    ex = EXERCISES[exercise_id]
+    cases = ex.make_cases(seed)
+    assert any(c.raises == "ValueError" for c in cases), "every exercise has a bad-input case"
+    for case in cases:
+        outcome = judge(ex, case, expected_output(ex, case), call_student(ex.reference, case))
+        assert outcome.passed, (case.label, outcome.message)
+
+
+def test_cases_differ_between_seeds():
+    ex = EXERCISES["05.fix_position"]
+    assert ex.make_cases(1)[0].args != ex.make_cases(2)[0].args
+
+
+def _wrong_checksum(sentence):
+    return "00"
+
+
+def _wrong_position(sentence):  # forgets that the minutes are minutes
+    fields = sentence.split(",")
+    i = 3 if "RMC" in fields[0] else 2
+    return [float(fields[i]) / 100, float(fields[i + 2]) / 100]
+
+
+def _wrong_haversine(lat1, lon1, lat2, lon2):  # flat Earth, bearing counter-clockwise from east
+    dy, dx = lat2 - lat1, (lon2 - lon1) * np.cos(lat1)
+    return np.array([6371008.8 * np.hypot(dx, dy), np.arctan2(dy, dx) % (2 * np.pi)])
+
+
+def _wrong_pulse(pulse_width_us):
+    inches = pulse_width_us / 148.0
+    return {"inches": inches, "cm": inches * 2.54}
+
+
+def _always_forward(ranges, front=1.2, side=0.8, prefer="left"):
+    return "forward"
+
+
+def _wrong_gains(tau, overshoot, settling_time):
+    return np.array([1.0, 0.1])
+
+
+def _wrong_metrics(kp, kd, tau):
+    return {"overshoot": 0.0, "settling_time": 1.0, "rise_time": 0.5, "gain_margin": np.inf,
+            "phase_margin_deg": 90.0, "crossover": 1.0}
+
+
+WRONG = {"05.nmea_checksum": _wrong_checksum, "05.fix_position": _wrong_position,
+         "05.haversine": _wrong_haversine, "05.pulse_to_distance": _wrong_pulse,
+         "05.avoidance_decision": _always_forward, "05.heading_gains": _wrong_gains,
+         "05.step_metrics": _wrong_metrics}
+
+
+@pytest.mark.parametrize("exercise_id", list(EXERCISES))
+def test_check_fails_a_wrong_implementation(exercise_id, capsys):
+    with pytest.raises(AssertionError, match=exercise_id):
+        check(exercise_id, WRONG[exercise_id])
+    assert "FAIL" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("exercise_id", list(EXERCISES))
+def test_check_passes_the_reference(exercise_id, capsys):
+    assert check(exercise_id, EXERCISES[exercise_id].reference) == len(EXERCISES[exercise_id].make_cases(2024))
