@@ -7,6 +7,7 @@ import pytest
 from scipy.stats import chi2
 
 sim = pytest.importorskip("robokit.sim")
+pytestmark = pytest.mark.slow  # renders six stereo views (~10 s)
 
 from robokit.vision.descriptors import plot_features, sift_features  # noqa: E402
 from robokit.vision.stereo import StereoRig, observe_stereo  # noqa: E402
