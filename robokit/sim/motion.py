@@ -15,7 +15,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..geometry import se2_compose, wrap_angle
+from ..geometry import wrap_angle
 from ..validation import as_array, as_points, as_rng, check_positive
 
 __all__ = ["unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "odometry_increment",
