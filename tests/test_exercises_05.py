@@ -61,15 +61,9 @@ def _wrong_gains(tau, overshoot, settling_time):
     return np.array([1.0, 0.1])
 
 
-def _wrong_metrics(kp, kd, tau):
-    return {"overshoot": 0.0, "settling_time": 1.0, "rise_time": 0.5, "gain_margin": np.inf,
-            "phase_margin_deg": 90.0, "crossover": 1.0}
-
-
 WRONG = {"05.nmea_checksum": _wrong_checksum, "05.fix_position": _wrong_position,
          "05.haversine": _wrong_haversine, "05.pulse_to_distance": _wrong_pulse,
-         "05.avoidance_decision": _always_forward, "05.heading_gains": _wrong_gains,
-         "05.step_metrics": _wrong_metrics}
+         "05.avoidance_decision": _always_forward, "05.heading_gains": _wrong_gains}
 
 
 @pytest.mark.parametrize("exercise_id", list(EXERCISES))

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from robokit.outdoor.controller import (HeadingController, design_heading_gains, heading_closed_loop,
+                                        heading_frequency_response, heading_step_response,
                                         heading_loop_gain, heading_plant, loop_metrics)
 from robokit.outdoor.field import UNIMAP_ORIGIN
 from robokit.outdoor.geodesy import LocalTangentPlane
@@ -130,3 +131,13 @@ def test_gps_emits_parseable_fixes_with_metre_level_error():
     assert abs(rmc.course_deg - 90.0) < 0.1 and rmc.speed_mps == pytest.approx(0.5, abs=0.01)
     with pytest.raises(TypeError, match="plane"):
         GPSReceiver("here")
+
+
+def test_step_and_frequency_response_helpers():
+    kp, kd = design_heading_gains(0.3, 0.05, 1.5)
+    t, y = heading_step_response(kp, kd, 0.3)
+    assert y.max() == pytest.approx(1.05, abs=1e-3) and y[-1] == pytest.approx(1.0, abs=1e-3)
+    m = loop_metrics(kp, kd, 0.3)
+    assert abs(heading_frequency_response(kp, kd, 0.3, [m["crossover"]])[0]) == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="omega"):
+        heading_frequency_response(kp, kd, 0.3, [0.0])

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..grading.compare import close, exact
 from ..grading.exercise import Case, Exercise
-from ..outdoor.controller import design_heading_gains, loop_metrics
+from ..outdoor.controller import design_heading_gains
 from ..outdoor.geodesy import haversine_distance_bearing
 from ..outdoor.navigator import avoidance_decision
 from ..outdoor.nmea import fix_position, nmea_checksum
@@ -103,17 +103,6 @@ def _gains_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
-def _metrics_cases(rng: np.random.Generator) -> list[Case]:
-    out = []
-    for tau, os_, ts in [(0.3, 0.05, 1.5), (float(rng.uniform(0.2, 0.4)), 0.1, 1.0),
-                         (float(rng.uniform(0.2, 0.4)), 0.02, 1.3)]:
-        kp, kd = design_heading_gains(tau, os_, ts)
-        out.append(Case((float(kp), float(kd), tau), label=f"designed for {os_:.0%} overshoot"))
-    out.append(Case((2.0, 0.0, 0.3), label="P control only"))
-    out.append(Case((-1.0, 0.5, 0.3), raises="ValueError", label="negative kp"))
-    return out
-
-
 EXERCISES = [
     Exercise(
         id="05.nmea_checksum",
@@ -183,16 +172,5 @@ EXERCISES = [
         references=("robokit.outdoor.controller.design_heading_gains",),
         compare=close(rtol=1e-6, atol=1e-9),
         description="Rate-feedback gains that place the closed-loop poles for an overshoot/settling spec.",
-    ),
-    Exercise(
-        id="05.step_metrics",
-        function="step_metrics",
-        signature="step_metrics(kp: float, kd: float, tau: float) -> dict",
-        points=2,
-        cases=_metrics_cases,
-        reference=loop_metrics,
-        references=("robokit.outdoor.controller.loop_metrics",),
-        compare=close(rtol=1e-3, atol=1e-6),
-        description="Overshoot, settling/rise time, margins and crossover with python-control.",
     ),
 ]

@@ -25,7 +25,7 @@ import numpy as np
 from ..validation import check_finite_scalar, check_positive
 
 __all__ = ["heading_plant", "design_heading_gains", "heading_closed_loop", "heading_loop_gain",
-           "loop_metrics", "HeadingController", "wrap"]
+           "heading_step_response", "heading_frequency_response", "loop_metrics", "HeadingController", "wrap"]
 
 
 def wrap(angle: float) -> float:
@@ -122,6 +122,35 @@ def heading_loop_gain(kp: float, kd: float, tau: float, gain: float = 1.0) -> co
     p = check_positive(kp, "kp")
     d = check_positive(kd, "kd", allow_zero=True)
     return control.tf([d, p], [1.0]) * heading_plant(tau, gain)
+
+
+def heading_step_response(kp: float, kd: float, tau: float, gain: float = 1.0,
+                          duration: float = 4.0, n: int = 400) -> tuple[np.ndarray, np.ndarray]:
+    """Unit-step response ``(t, theta)`` of :func:`heading_closed_loop` over ``duration`` seconds.
+
+    Notes
+    -----
+    ``control.step_response`` (python-control 0.10) on the closed loop of Franklin et al., Sec. 3.4.
+    """
+    T = heading_closed_loop(kp, kd, tau, gain)
+    t = np.linspace(0.0, check_positive(duration, "duration"), max(int(n), 2))
+    resp = control.step_response(T, t)
+    return np.asarray(resp.time), np.asarray(resp.outputs).ravel()
+
+
+def heading_frequency_response(kp: float, kd: float, tau: float, omega: Any, gain: float = 1.0) -> np.ndarray:
+    """Complex loop gain ``L(j omega)`` of :func:`heading_loop_gain` at frequencies ``omega`` (rad/s), for Bode plots.
+
+    Notes
+    -----
+    Franklin et al., Sec. 6.1 (frequency response).
+    """
+    from ..validation import as_array
+
+    w = as_array(omega, "omega")
+    if np.any(w <= 0):
+        raise ValueError("omega: expected positive frequencies in rad/s")
+    return np.asarray(heading_loop_gain(kp, kd, tau, gain)(1j * w))
 
 
 def loop_metrics(kp: float, kd: float, tau: float, gain: float = 1.0, delay: float = 0.0) -> dict:
