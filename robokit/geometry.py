@@ -465,9 +465,11 @@ def se2_to_pqt(pose: Any) -> np.ndarray:
     """Convert a robokit planar pose ``[x, y, theta]`` to the seeds' ``[p, q, theta]``.
 
     robokit's world is right-handed with z up; a robot at heading 0 faces +x. The seeds (Se, Lowe &
-    Little 2001, Sec. 5; Lin et al., PLOT paper, Sec. 4) use X sideways (to the right), Y up and Z
-    forward, with the robot at heading 0 facing +Z. So ``p = -y`` (sideways), ``q = x`` (forward)
-    and ``theta`` is the same heading, counter-clockwise seen from above.
+    Little 2002, Sec. 5; Lin et al., PLOT paper, Sec. 4) use X sideways (right), Y up and Z forward,
+    with a robot at heading 0 facing +Z and ``theta > 0`` turning left. The course identifies the
+    seeds' ground plane (X, Z) with robokit's (x, y), so bird's-eye plots in both conventions are
+    the same picture: ``p = x``, ``q = y``, ``theta = wrap(theta_robokit - pi/2)``. (This is the
+    one convention of the course; ``robokit.mapping.frames`` works in it.)
 
     Parameters
     ----------
@@ -491,7 +493,7 @@ def se2_to_pqt(pose: Any) -> np.ndarray:
     P = as_array(pose, "pose")
     if P.shape[-1:] != (3,) or P.ndim > 2:
         raise ValueError(f"pose: expected shape (3,) or (N, 3), got shape {P.shape}")
-    return np.stack([-P[..., 1], P[..., 0], P[..., 2]], axis=-1)
+    return np.stack([P[..., 0], P[..., 1], wrap_angle(P[..., 2] - np.pi / 2)], axis=-1)
 
 
 def pqt_to_se2(pqt: Any) -> np.ndarray:
@@ -504,7 +506,7 @@ def pqt_to_se2(pqt: Any) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        ``[x, y, theta] = [q, -p, theta]``.
+        ``[x, y, theta] = [p, q, wrap(theta + pi/2)]``.
 
     Raises
     ------
@@ -518,7 +520,7 @@ def pqt_to_se2(pqt: Any) -> np.ndarray:
     P = as_array(pqt, "pqt")
     if P.shape[-1:] != (3,) or P.ndim > 2:
         raise ValueError(f"pqt: expected shape (3,) or (N, 3), got shape {P.shape}")
-    return np.stack([P[..., 1], -P[..., 0], P[..., 2]], axis=-1)
+    return np.stack([P[..., 0], P[..., 1], wrap_angle(P[..., 2] + np.pi / 2)], axis=-1)
 
 
 def optical_to_seed(points: Any) -> np.ndarray:

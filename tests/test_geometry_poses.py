@@ -64,8 +64,10 @@ def test_se2_se3_lift_agrees_with_planar_compose():
 
 
 def test_pqt_convention():
-    # a robot 2 m ahead (world +x) and 1 m to the left (world +y): forward q = 2, sideways p = -1
-    np.testing.assert_allclose(g.se2_to_pqt([2.0, 1.0, 0.3]), [-1.0, 2.0, 0.3])
+    # the seeds' ground plane (X, Z) is robokit's (x, y); the heading is offset by 90 degrees
+    np.testing.assert_allclose(g.se2_to_pqt([2.0, 1.0, 0.3]), [2.0, 1.0, 0.3 - np.pi / 2])
+    # a robot facing robokit's +y faces the seeds' +Z (heading 0)
+    np.testing.assert_allclose(g.se2_to_pqt([0.0, 0.0, np.pi / 2]), [0.0, 0.0, 0.0], atol=1e-12)
     poses = _random_se2(np.random.default_rng(5), 20)
     np.testing.assert_allclose(g.pqt_to_se2(g.se2_to_pqt(poses)), poses)
     # the body->optical rotation maps forward to optical z and left to optical -x
@@ -87,3 +89,19 @@ def test_pqt_convention():
 def test_bad_input_is_named(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
         call()
+
+
+def test_pqt_convention_agrees_with_mapping_frames():
+    """One convention in the course: geometry's conversion and mapping.frames place a point seen
+    by the robot at the same spot in the world."""
+    from robokit.mapping.frames import robot_to_world
+
+    rng = np.random.default_rng(11)
+    for pose in _random_se2(rng, 10):
+        X, Y, Z = rng.uniform(-3, 3, size=3)        # seeds' robot frame: right, up, forward
+        body = np.array([Z, -X])                     # robokit body frame: forward, left
+        c, s_ = np.cos(pose[2]), np.sin(pose[2])
+        world_xy = pose[:2] + np.array([[c, -s_], [s_, c]]) @ body
+        seeds_world = robot_to_world([[X, Y, Z]], g.se2_to_pqt(pose))[0]
+        np.testing.assert_allclose([seeds_world[0], seeds_world[2]], world_xy, atol=1e-12)
+        assert seeds_world[1] == pytest.approx(Y)
