@@ -187,3 +187,18 @@ def test_plain_table_functions_match_the_chain():
         dh_fk(table[:, :2], q)
     with pytest.raises(ValueError, match="q"):
         dh_fk(table, q[:5])
+
+
+def test_pose_error_is_validated_and_exact_for_known_motions():
+    from robokit.arm import pose_error
+
+    T = np.eye(4)
+    T2 = _rot([0, 0, 1], 0.3)
+    T2[:3, 3] = [0.1, 0.0, 0.0]
+    assert np.allclose(pose_error(T2, T), [0.1, 0, 0, 0, 0, 0.3])
+    near_pi = _rot([1, 1, 0] / np.sqrt(2), np.pi - 1e-9)
+    assert np.isclose(np.linalg.norm(pose_error(near_pi, T)[3:]), np.pi - 1e-9)
+    with pytest.raises(ValueError, match="T_target"):
+        pose_error(np.ones((4, 4)), T)
+    with pytest.raises(ValueError, match="equal length"):
+        pose_error(np.stack([T, T]), np.stack([T, T, T]))

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array, as_rng, check_choice, check_int
-from .dh import link_matrices
+from .dh import _link_matrices
 from .se3 import as_se3
 
 __all__ = ["Chain", "dh_fk", "chain_from_table"]
@@ -70,7 +70,15 @@ class Chain:
         self.convention = check_choice(convention, "convention", ("standard", "modified"))
         self.tool = np.eye(4) if tool is None else as_se3(tool, "tool")
         self.base = np.eye(4) if base is None else as_se3(base, "base")
-        for arr in (self.d, self.a, self.alpha, self.offset, self.qmin, self.qmax, self.tool, self.base):
+        # Each link transform is affine in (cos theta, sin theta): A = K + cos U + sin V. Sampling the
+        # DH formula at theta = 0, pi, +-pi/2 gives K, U, V, so FK needs no trig of the twists.
+        A = {t: _link_matrices(np.full(n, t), self.d, self.a, self.alpha, modified=self.modified)
+             for t in (0.0, np.pi, np.pi / 2, -np.pi / 2)}
+        self._K = 0.5 * (A[0.0] + A[np.pi])
+        self._U = 0.5 * (A[0.0] - A[np.pi])
+        self._V = 0.5 * (A[np.pi / 2] - A[-np.pi / 2])
+        for arr in (self.d, self.a, self.alpha, self.offset, self.qmin, self.qmax, self.tool, self.base,
+                    self._K, self._U, self._V):
             arr.setflags(write=False)
 
     @property
@@ -152,7 +160,8 @@ class Chain:
     # --- kinematics ------------------------------------------------------------------------------
     def _frames(self, q: np.ndarray) -> np.ndarray:
         """Unchecked: poses of frames 0..n for ``q`` of shape (..., n) -> (..., n + 1, 4, 4)."""
-        links = link_matrices(q + self.offset, self.d, self.a, self.alpha, modified=self.modified)
+        th = q + self.offset
+        links = self._K + np.cos(th)[..., None, None] * self._U + np.sin(th)[..., None, None] * self._V
         out = np.empty(q.shape[:-1] + (self.n + 1, 4, 4))
         out[..., 0, :, :] = self.base
         for i in range(self.n):

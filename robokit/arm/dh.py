@@ -11,7 +11,7 @@ import numpy as np
 
 from ..validation import as_array
 
-__all__ = ["dh_transform", "mdh_transform", "link_matrices"]
+__all__ = ["dh_transform", "mdh_transform"]
 
 
 def _params(theta: Any, d: Any, a: Any, alpha: Any):
@@ -52,10 +52,10 @@ def dh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
     Denavit & Hartenberg, "A kinematic notation for lower-pair mechanisms based on matrices" (1955);
     matrix as in Spong, Hutchinson & Vidyasagar, *Robot Modeling and Control* (2006), Eq. (3.10).
     """
-    return link_matrices(*_params(theta, d, a, alpha), modified=False)
+    return _link_matrices(*_params(theta, d, a, alpha), modified=False)
 
 
-def link_matrices(th: np.ndarray, d: np.ndarray, a: np.ndarray, al: np.ndarray, *, modified: bool) -> np.ndarray:
+def _link_matrices(th: np.ndarray, d: np.ndarray, a: np.ndarray, al: np.ndarray, *, modified: bool) -> np.ndarray:
     """Unchecked kernel of :func:`dh_transform` / :func:`mdh_transform` (broadcast float arrays)."""
     ct, st, ca, sa = np.cos(th), np.sin(th), np.cos(al), np.sin(al)
     shape = np.broadcast_shapes(np.shape(th), np.shape(d), np.shape(a), np.shape(al))
@@ -101,4 +101,4 @@ def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
     Craig, *Introduction to Robotics: Mechanics and Control* (3rd ed., 2005), Eq. (3.6). Franka
     Emika publishes the Panda's kinematics in this convention.
     """
-    return link_matrices(*_params(theta, d, a, alpha), modified=True)
+    return _link_matrices(*_params(theta, d, a, alpha), modified=True)

@@ -23,9 +23,9 @@ import numpy as np
 
 from ..validation import as_array, check_int, check_positive
 from .chain import Chain
-from .result import IKBatchResult, IKResult, verify
-from .se3 import as_se3, skew
-from .srs import flip, reference_rotation, rot_y, rot_z, zyz
+from .result import IKBatchResult, IKResult, _verify
+from .se3 import as_se3, _skew
+from .srs import _flip, _reference_rotation, _rot_y, _rot_z, _zyz
 
 __all__ = ["SRSArm", "arm_angle", "ik_srs_branches", "ik_srs", "ik_srs_batch"]
 
@@ -90,7 +90,7 @@ class SRSArm:
 
     def reference_shoulder(self, sw: np.ndarray, q4: np.ndarray) -> np.ndarray:
         """Unchecked: ``Rz(q1) Ry(q2)`` of the reference arm plane (``q3 = 0``) reaching ``sw``."""
-        return reference_rotation(sw, q4, self.d_se, self.d_ew)
+        return _reference_rotation(sw, q4, self.d_se, self.d_ew)
 
     def coefficients(self, T7: np.ndarray):
         """Unchecked: Shimizu's ``A, B, C`` coefficients for shoulder and wrist, per elbow sign.
@@ -108,11 +108,11 @@ class SRSArm:
         q4 = np.stack([a4, -a4], -1)                              # (N, 2)
         R_ref = self.reference_shoulder(sw[:, None, :], q4)       # (N, 2, 3, 3)
         u = sw / np.where(L > 0, L, 1.0)[:, None]
-        K = skew(u)[:, None]
+        K = _skew(u)[:, None]
         As = K @ R_ref                                            # R_psi = I + sin K + (1 - cos) K^2
         Bs = -(K @ As)
         Cs = R_ref - Bs
-        Rt_Ry4 = rot_y(q4)
+        Rt_Ry4 = _rot_y(q4)
         Rt = T7[:, None, :3, :3]
         mats = [np.stack([X, Rt_Ry4 @ np.swapaxes(X, -1, -2) @ Rt], 2) for X in (As, Bs, Cs)]
         A, B, C = (X[..., _ROWS, _COLS] for X in mats)
@@ -128,8 +128,8 @@ class SRSArm:
         A, B, C = coeffs[:3]
         s, c = np.sin(psi)[:, None, None, None, :], np.cos(psi)[:, None, None, None, :]
         E = A[..., None] * s + B[..., None] * c + C[..., None]   # (N, 2, 2, 7, K)
-        a, b, cc = zyz(*(E[..., r, :] for r in range(7)))        # (N, 2, 2, K)
-        return (np.stack([a, flip(a)], 3), np.stack([b, -b], 3), np.stack([cc, flip(cc)], 3))
+        a, b, cc = _zyz(*(E[..., r, :] for r in range(7)))        # (N, 2, 2, K)
+        return (np.stack([a, _flip(a)], 3), np.stack([b, -b], 3), np.stack([cc, _flip(cc)], 3))
 
     def joints(self, coeffs, psi: np.ndarray) -> np.ndarray:
         """Unchecked: all 8 branches for arm angles ``psi`` (N, K) -> q of shape (N, K, 8, 7).
@@ -152,7 +152,7 @@ class SRSArm:
         ``psi`` is the angle, about the shoulder-wrist axis, of ``M R_ref^T`` with
         ``M = Rz(q1) Ry(q2) Rz(q3)`` (Shimizu et al. 2008, Eq. (9)).
         """
-        M = rot_z(q[:, 0]) @ rot_y(q[:, 1]) @ rot_z(q[:, 2])
+        M = _rot_z(q[:, 0]) @ _rot_y(q[:, 1]) @ _rot_z(q[:, 2])
         v = np.stack([-self.d_ew * np.sin(q[:, 3]), np.zeros(len(q)), self.d_se + self.d_ew * np.cos(q[:, 3])], -1)
         sw = (M @ v[..., None])[..., 0]
         R = M @ np.swapaxes(self.reference_shoulder(sw, q[:, 3]), -1, -2)
@@ -385,7 +385,7 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, t
             found[rows[has]] = True
             rows, coeffs = rows[~has], tuple(c[~has] for c in coeffs)
 
-    success, reasons, residual, pos, rot = verify(chain, Tt, q_best, tol, tol)
+    success, reasons, residual, pos, rot = _verify(chain, Tt, q_best, tol, tol)
     for i in np.flatnonzero(~reach):
         L = float(np.linalg.norm(arm.wrist_centre(T7[i]) - [0, 0, arm.d_bs]))
         reasons[i] = (f"out of reach: shoulder-wrist distance {L:.4f} m outside "

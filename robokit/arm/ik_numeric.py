@@ -19,10 +19,10 @@ import numpy as np
 
 from ..validation import as_array, as_rng, check_choice, check_int, check_positive
 from .chain import Chain
-from .jacobian import jacobian_from_frames
-from .limits import limit_gradient_kernel, wln_kernel
-from .result import IKBatchResult, IKResult, verify
-from .se3 import as_se3, pose_error
+from .jacobian import _jacobian_from_frames
+from .limits import _limit_gradient, _wln
+from .result import IKBatchResult, IKResult, _verify
+from .se3 import _pose_error, as_se3
 
 __all__ = ["METHODS", "dls_step", "null_space_step", "ik_numeric", "ik_numeric_batch"]
 
@@ -263,7 +263,7 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     while active.size:
         qa = qr[active]
         frames = chain._frames(qa)
-        e = pose_error(Tr[active], chain._flange(frames))
+        e = _pose_error(Tr[active], chain._flange(frames))
         e2 = e * e
         pos2, rot2 = e2[:, :3].sum(1), e2[:, 3:].sum(1)
         conv = (pos2 < tol * tol) & (rot2 < tol * tol)
@@ -303,7 +303,7 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
         rows = active if everyone else active[stepping]
         if rows.size:
             fr, es, e2s = (frames, e, pos2 + rot2) if everyone else (frames[stepping], e[stepping], (pos2 + rot2)[stepping])
-            J = jacobian_from_frames(chain, fr)
+            J = _jacobian_from_frames(chain, fr)
             lam2 = lam2_0 + 0.5 * e2s
             qs = qa if everyone else qa[stepping]
             if method == "dls":
@@ -311,9 +311,9 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
             elif method == "gradient_projection":
                 # the null-space motion is exact only to first order: fade it out near the target
                 fade = np.minimum(1.0, np.sqrt(e2s) / _FADE)
-                dq = _gp(J, es, limit_gradient_kernel(chain, qs), lam2, gain * fade)
+                dq = _gp(J, es, _limit_gradient(chain, qs), lam2, gain * fade)
             else:
-                w, grad = wln_kernel(chain, qs, prev_w[rows])
+                w, grad = _wln(chain, qs, prev_w[rows])
                 prev_w[rows] = grad
                 dq = _dls(J, es, lam2, 1.0 / w)
             big = np.sqrt((dq * dq).sum(1))
@@ -338,7 +338,7 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     for t in np.flatnonzero(~ok & ~too_far):
         rows_t = np.arange(t * P, (t + 1) * P)
         q[t] = qr[rows_t[np.argmin(best[rows_t])]]
-    success, reasons, residual, pos, rot = verify(chain, Tt, q, tol, tol)
+    success, reasons, residual, pos, rot = _verify(chain, Tt, q, tol, tol)
     for i in np.flatnonzero(too_far):
         reasons[i] = f"out of reach: target {dist[i]:.3f} m from the base, beyond the arm's reach bound {chain.reach():.3f} m"
     for i in np.flatnonzero(~success & ~too_far):

@@ -11,7 +11,7 @@ from .chain import Chain, chain_from_table
 __all__ = ["geometric_jacobian", "dh_jacobian", "manipulability"]
 
 
-def jacobian_from_frames(chain: Chain, frames: np.ndarray) -> np.ndarray:
+def _jacobian_from_frames(chain: Chain, frames: np.ndarray) -> np.ndarray:
     """Unchecked kernel: the 6xn Jacobian from the frames 0..n of ``Chain._frames``."""
     jf = chain.joint_frames(frames)
     z = jf[..., :3, 2]                       # (..., n, 3) joint axes
@@ -56,7 +56,7 @@ def geometric_jacobian(chain: Chain, q: Any) -> np.ndarray:
     if not isinstance(chain, Chain):
         raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
     q = chain.check_q(q, batch=np.ndim(q) == 2)
-    return jacobian_from_frames(chain, chain._frames(q))
+    return _jacobian_from_frames(chain, chain._frames(q))
 
 
 def dh_jacobian(dh: Any, q: Any, *, modified: bool = False) -> np.ndarray:

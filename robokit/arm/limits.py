@@ -46,10 +46,10 @@ def limit_distance_gradient(chain: Chain, q: Any) -> np.ndarray:
     with spherical wrist", ICRA 1988.
     """
     q = _limits(chain, q)
-    return limit_gradient_kernel(chain, q)
+    return _limit_gradient(chain, q)
 
 
-def limit_gradient_kernel(chain: Chain, q: np.ndarray) -> np.ndarray:
+def _limit_gradient(chain: Chain, q: np.ndarray) -> np.ndarray:
     """Unchecked kernel of :func:`limit_distance_gradient`."""
     mid = 0.5 * (chain.qmin + chain.qmax)
     half = np.maximum(0.5 * (chain.qmax - chain.qmin), 1e-9)
@@ -88,17 +88,17 @@ def wln_weights(chain: Chain, q: Any, previous: Any = None) -> tuple[np.ndarray,
     Eq. (13) (the weights).
     """
     q = _limits(chain, q)
-    prev = None if previous is None else as_prev(previous, q.shape)
-    return wln_kernel(chain, q, prev)
+    prev = None if previous is None else _as_previous(previous, q.shape)
+    return _wln(chain, q, prev)
 
 
-def as_prev(previous: Any, shape) -> np.ndarray:
+def _as_previous(previous: Any, shape) -> np.ndarray:
     from ..validation import as_array
 
     return as_array(previous, "previous", shape=shape)
 
 
-def wln_kernel(chain: Chain, q: np.ndarray, previous: np.ndarray | None):
+def _wln(chain: Chain, q: np.ndarray, previous: np.ndarray | None):
     """Unchecked kernel of :func:`wln_weights`."""
     lo, hi = chain.qmin, chain.qmax
     span = hi - lo

@@ -78,15 +78,15 @@ class IKBatchResult:
                         orientation_error=float(self.orientation_error[i]), restarts=int(self.restarts[i]))
 
 
-def verify(chain, T_target: np.ndarray, q: np.ndarray, tol_pos: float, tol_rot: float):
+def _verify(chain, T_target: np.ndarray, q: np.ndarray, tol_pos: float, tol_rot: float):
     """Unchecked: FK-verify joint vectors ``q`` (N, n) against targets (N, 4, 4).
 
     Returns ``(success, reasons, residual, pos_err, rot_err)``; success needs both tolerances met
     and every joint within limits, so no solver can report a false success.
     """
-    from .se3 import pose_error
+    from .se3 import _pose_error
 
-    err = pose_error(T_target, chain._flange(chain._frames(q)))
+    err = _pose_error(T_target, chain._flange(chain._frames(q)))
     pos = np.linalg.norm(err[:, :3], axis=1)
     rot = np.linalg.norm(err[:, 3:], axis=1)
     inside = np.all((q >= chain.qmin) & (q <= chain.qmax), axis=1)

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..validation import as_array
 
-__all__ = ["as_se3", "rotation_log", "pose_error", "skew", "axis_angle_rotation"]
+__all__ = ["as_se3", "pose_error"]
 
 #: Tolerance on ``R^T R = I`` and ``det R = 1`` when checking a user-supplied pose.
 SE3_TOL = 1e-6
@@ -57,8 +57,9 @@ def as_se3(value: Any, name: str, *, batch: bool = False, tol: float = SE3_TOL) 
         raise ValueError(f"{name}: expected an SE(3) matrix with last row [0, 0, 0, 1], got "
                          f"{np.asarray(T[..., 3, :]).reshape(-1, 4)[i].tolist()}" + (f" at index {i}" if batch else ""))
     ortho = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1))
-    # det R = +1 for an orthonormal R <=> (r0 x r1) . r2 = 1
-    det = np.einsum("...i,...i->...", np.cross(R[..., 0, :], R[..., 1, :]), R[..., 2, :])
+    det = (R[..., 0, 0] * (R[..., 1, 1] * R[..., 2, 2] - R[..., 1, 2] * R[..., 2, 1])
+           - R[..., 0, 1] * (R[..., 1, 0] * R[..., 2, 2] - R[..., 1, 2] * R[..., 2, 0])
+           + R[..., 0, 2] * (R[..., 1, 0] * R[..., 2, 1] - R[..., 1, 1] * R[..., 2, 0]))
     bad = (ortho > tol) | (np.abs(det - 1.0) > tol)
     if np.any(bad):
         i = int(np.argmax(np.atleast_1d(bad)))
@@ -68,8 +69,8 @@ def as_se3(value: Any, name: str, *, batch: bool = False, tol: float = SE3_TOL) 
     return T
 
 
-def skew(v: np.ndarray) -> np.ndarray:
-    """Return the skew-symmetric matrix ``[v]x`` of vectors ``v`` with shape ``(..., 3)``.
+def _skew(v: np.ndarray) -> np.ndarray:
+    """Return the _skew-symmetric matrix ``[v]x`` of vectors ``v`` with shape ``(..., 3)``.
 
     Notes
     -----
@@ -82,7 +83,7 @@ def skew(v: np.ndarray) -> np.ndarray:
                      np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
 
 
-def axis_angle_rotation(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+def _axis_angle_rotation(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Rodrigues' formula: rotation by ``angle`` about unit ``axis`` (both broadcastable).
 
     ``axis`` has shape ``(..., 3)`` and must already be a unit vector; ``angle`` has shape ``(...)``.
@@ -91,13 +92,13 @@ def axis_angle_rotation(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     -----
     Lynch & Park (2017), Eq. (3.51). Internal helper: no validation.
     """
-    K = skew(axis)
+    K = _skew(axis)
     s = np.sin(angle)[..., None, None]
     c = np.cos(angle)[..., None, None]
     return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
-def rotation_log(R: np.ndarray) -> np.ndarray:
+def _rotation_log(R: np.ndarray) -> np.ndarray:
     """Return the rotation vector ``omega * theta`` of rotation matrices ``R`` (shape ``(..., 3, 3)``).
 
     The result has norm in ``[0, pi]``. Accurate near 0 (first-order series) and near ``pi``
@@ -134,13 +135,13 @@ def rotation_log(R: np.ndarray) -> np.ndarray:
     return out
 
 
-def pose_error(T_target: np.ndarray, T: np.ndarray) -> np.ndarray:
+def pose_error(T_target: Any, T: Any) -> np.ndarray:
     """Return the 6-vector pose error ``[p_t - p, log(R_t R^T)]`` in the base frame.
 
     Parameters
     ----------
-    T_target, T : numpy.ndarray, shape (..., 4, 4)
-        Desired and current poses (broadcastable).
+    T_target, T : array_like, shape (4, 4) or (N, 4, 4)
+        Desired and current poses (a single pose broadcasts against a stack).
 
     Returns
     -------
@@ -149,12 +150,25 @@ def pose_error(T_target: np.ndarray, T: np.ndarray) -> np.ndarray:
         orientation into the desired one, both expressed in the base frame, so that it matches the
         geometric Jacobian's ``[v; omega]`` ordering.
 
+    Raises
+    ------
+    ValueError
+        If either argument is not an SE(3) matrix (or stack of them) or the stacks differ in length.
+
     Notes
     -----
     The orientation error as the rotation vector of ``R_d R^T`` is one of the choices compared by
-    Siciliano et al., *Robotics: Modelling, Planning and Control* (2009), Sec. 3.7.3; internal
-    helper, no validation.
+    Siciliano et al., *Robotics: Modelling, Planning and Control* (2009), Sec. 3.7.3.
     """
+    Ta = as_se3(T_target, "T_target", batch=np.ndim(T_target) == 3)
+    Tb = as_se3(T, "T", batch=np.ndim(T) == 3)
+    if Ta.ndim == 3 and Tb.ndim == 3 and len(Ta) != len(Tb):
+        raise ValueError(f"T_target, T: expected stacks of equal length, got {len(Ta)} and {len(Tb)}")
+    return _pose_error(Ta, Tb)
+
+
+def _pose_error(T_target: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """Unchecked kernel of :func:`pose_error` (broadcast stacks of 4x4 poses)."""
     dp = T_target[..., :3, 3] - T[..., :3, 3]
-    dw = rotation_log(T_target[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2))
+    dw = _rotation_log(T_target[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2))
     return np.concatenate([dp, dw], axis=-1)

@@ -17,12 +17,12 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array, check_finite_scalar, check_positive
-from .se3 import as_se3, axis_angle_rotation
+from .se3 import as_se3, _axis_angle_rotation
 
 __all__ = ["wrist_centre", "elbow_angle", "shoulder_angles"]
 
 
-def rot_z(a):
+def _rot_z(a):
     """Unchecked: rotations about z by angles ``a`` (any shape) -> (..., 3, 3)."""
     c, s = np.cos(a), np.sin(a)
     R = np.zeros(np.shape(a) + (3, 3))
@@ -30,7 +30,7 @@ def rot_z(a):
     return R
 
 
-def rot_y(a):
+def _rot_y(a):
     """Unchecked: rotations about y by angles ``a`` (any shape) -> (..., 3, 3)."""
     c, s = np.cos(a), np.sin(a)
     R = np.zeros(np.shape(a) + (3, 3))
@@ -38,7 +38,7 @@ def rot_y(a):
     return R
 
 
-def zyz(m02, m12, m22, m21, m20, m10, m11):
+def _zyz(m02, m12, m22, m21, m20, m10, m11):
     """Unchecked: ZYZ Euler angles (a, b >= 0, c) of ``Rz(a) Ry(b) Rz(c)`` from its entries.
 
     At ``sin b = 0`` only ``a + c`` (or ``a - c``) is defined; then ``a = 0``. Craig (2005),
@@ -55,12 +55,12 @@ def zyz(m02, m12, m22, m21, m20, m10, m11):
     return a, b, c
 
 
-def flip(x):
+def _flip(x):
     """Unchecked: ``x + pi`` wrapped to (-pi, pi] for ``x`` in (-pi, pi] (the mirror branch)."""
     return np.where(x > 0, x - np.pi, x + np.pi)
 
 
-def reference_rotation(sw: np.ndarray, q4: np.ndarray, d_se: float, d_ew: float) -> np.ndarray:
+def _reference_rotation(sw: np.ndarray, q4: np.ndarray, d_se: float, d_ew: float) -> np.ndarray:
     """Unchecked: ``Rz(q1) Ry(q2)`` of the reference arm plane (``q3 = 0``) that reaches ``sw``.
 
     ``q1`` turns the vertical plane through the shoulder-wrist vector ``sw`` and ``q2`` tilts the
@@ -70,7 +70,7 @@ def reference_rotation(sw: np.ndarray, q4: np.ndarray, d_se: float, d_ew: float)
     v_x, v_z = -d_ew * np.sin(q4), d_se + d_ew * np.cos(q4)
     q1 = np.arctan2(sw[..., 1], sw[..., 0])
     q2 = np.arctan2(np.hypot(sw[..., 0], sw[..., 1]), sw[..., 2]) - np.arctan2(v_x, v_z)
-    return rot_z(q1) @ rot_y(q2)
+    return _rot_z(q1) @ _rot_y(q2)
 
 
 def wrist_centre(T: Any, d_wf: float) -> np.ndarray:
@@ -178,5 +178,5 @@ def shoulder_angles(shoulder: Any, wrist: Any, q4: float, psi: float, d_se: floa
     L = float(np.linalg.norm(sw))
     if L < 1e-12:
         raise ValueError("wrist: expected a wrist centre away from the shoulder, got |W - S| = 0")
-    M = axis_angle_rotation(sw / L, np.asarray(psi)) @ reference_rotation(sw, np.asarray(q4), l1, l2)
-    return np.array(zyz(M[0, 2], M[1, 2], M[2, 2], M[2, 1], M[2, 0], M[1, 0], M[1, 1]), dtype=float)
+    M = _axis_angle_rotation(sw / L, np.asarray(psi)) @ _reference_rotation(sw, np.asarray(q4), l1, l2)
+    return np.array(_zyz(M[0, 2], M[1, 2], M[2, 2], M[2, 1], M[2, 0], M[1, 0], M[1, 1]), dtype=float)
