@@ -9,6 +9,7 @@ folder hidden, no network.
 """
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -79,8 +80,16 @@ def build_autograder(slug: str, seed: str, output: str | Path, *, root: str | Pa
         raise ValueError("seed: a non-empty secret seed is required")
     output = Path(output)
     with tempfile.TemporaryDirectory() as tmp:
-        proc = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", tmp,
-                               str(Path(root).resolve())], capture_output=True, text=True)
+        # build from a clean copy: an in-tree build leaves build/lib behind, whose stale modules
+        # would end up in later wheels
+        src = Path(tmp) / "src"
+        root = Path(root).resolve()
+        shutil.copytree(root / "robokit", src / "robokit",
+                        ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        for name in ("pyproject.toml", "README.md"):
+            shutil.copy(root / name, src / name)
+        proc = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps",
+                               "--quiet", "-w", tmp, str(src)], capture_output=True, text=True)
         wheels = list(Path(tmp).glob("robokit-*.whl"))
         if proc.returncode != 0 or not wheels:
             raise RuntimeError(f"building the robokit wheel failed: {proc.stderr[-800:]}")
