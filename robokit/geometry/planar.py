@@ -1,0 +1,184 @@
+"""Planar poses (SE(2)): angle wrapping, composition, inverse, relative pose, matrices.
+
+Planar poses are ``[x, y, theta]`` with ``theta`` the heading measured counter-clockwise from
+the x axis (robokit's world is right-handed with z up).
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..validation import as_array
+
+__all__ = ["wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2"]
+
+
+def wrap_angle(angle: Any) -> Any:
+    """Wrap angles to the interval [-pi, pi).
+
+    Parameters
+    ----------
+    angle : float or array_like
+        Angles in radians (finite).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Same shape as the input; a float for scalar input.
+
+    Raises
+    ------
+    ValueError
+        If any angle is NaN or infinite.
+
+    Notes
+    -----
+    Standard identity ``(a + pi) mod 2 pi - pi`` (e.g. Thrun, Burgard & Fox, *Probabilistic
+    Robotics*, 2005, Sec. 5.4); used by every heading computation in the course.
+    """
+    a = as_array(angle, "angle")
+    out = np.mod(a + np.pi, 2 * np.pi) - np.pi
+    return float(out) if out.ndim == 0 else out
+
+
+def se2_compose(a: Any, b: Any) -> np.ndarray:
+    """Compose planar poses: the pose ``b`` expressed in frame ``a``, mapped to the world.
+
+    Parameters
+    ----------
+    a, b : array_like, shape (3,)
+        Poses ``[x, y, theta]``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``a ⊕ b = [x_a + cos(t_a) x_b - sin(t_a) y_b, y_a + sin(t_a) x_b + cos(t_a) y_b,
+        wrap(t_a + t_b)]``.
+
+    Raises
+    ------
+    ValueError
+        If a pose does not have shape (3,) or is not finite.
+
+    Notes
+    -----
+    The compounding operator of Smith, Self & Cheeseman, "Estimating uncertain spatial
+    relationships in robotics" (1990), Eq. (3); it is also Eq. (1)'s composition in Duckett's
+    relaxation used by lesson 02.
+    """
+    pa = as_array(a, "a", shape=(3,))
+    pb = as_array(b, "b", shape=(3,))
+    c, s = np.cos(pa[2]), np.sin(pa[2])
+    return np.array([pa[0] + c * pb[0] - s * pb[1], pa[1] + s * pb[0] + c * pb[1],
+                     wrap_angle(pa[2] + pb[2])])
+
+
+def se2_inverse(a: Any) -> np.ndarray:
+    """Invert a planar pose: the world origin expressed in the frame ``a``.
+
+    Parameters
+    ----------
+    a : array_like, shape (3,)
+        Pose ``[x, y, theta]``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``⊖a = [-x cos t - y sin t, x sin t - y cos t, -t]`` so that ``se2_compose(a, ⊖a) = 0``.
+
+    Raises
+    ------
+    ValueError
+        If the pose does not have shape (3,) or is not finite.
+
+    Notes
+    -----
+    The inverse relationship of Smith, Self & Cheeseman (1990), Eq. (4).
+    """
+    p = as_array(a, "a", shape=(3,))
+    c, s = np.cos(p[2]), np.sin(p[2])
+    return np.array([-c * p[0] - s * p[1], s * p[0] - c * p[1], wrap_angle(-p[2])])
+
+
+def se2_between(a: Any, b: Any) -> np.ndarray:
+    """Return the pose of ``b`` relative to ``a``: ``⊖a ⊕ b`` (e.g. an odometry increment).
+
+    Parameters
+    ----------
+    a, b : array_like, shape (3,)
+        Poses ``[x, y, theta]`` in the same frame.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+
+    Raises
+    ------
+    ValueError
+        If a pose does not have shape (3,) or is not finite.
+
+    Notes
+    -----
+    Smith, Self & Cheeseman (1990), Eqs. (3)-(4) combined; Lu & Milios (1997) call it the relative
+    pose constraint of a pose graph.
+    """
+    return se2_compose(se2_inverse(a), b)
+
+
+def se2_to_matrix(pose: Any) -> np.ndarray:
+    """Return the 3x3 homogeneous matrix of a planar pose ``[x, y, theta]``.
+
+    Parameters
+    ----------
+    pose : array_like, shape (3,)
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3)
+        ``[[cos t, -sin t, x], [sin t, cos t, y], [0, 0, 1]]``.
+
+    Raises
+    ------
+    ValueError
+        If the pose does not have shape (3,) or is not finite.
+
+    Notes
+    -----
+    Lynch & Park, *Modern Robotics* (2017), Sec. 3.3.1 (SE(2) as a matrix group).
+    """
+    p = as_array(pose, "pose", shape=(3,))
+    c, s = np.cos(p[2]), np.sin(p[2])
+    return np.array([[c, -s, p[0]], [s, c, p[1]], [0.0, 0.0, 1.0]])
+
+
+def matrix_to_se2(matrix: Any) -> np.ndarray:
+    """Return ``[x, y, theta]`` from a 3x3 homogeneous planar transform (inverse of :func:`se2_to_matrix`).
+
+    Parameters
+    ----------
+    matrix : array_like, shape (3, 3)
+        A rigid planar transform (rotation block orthonormal within 1e-6).
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+
+    Raises
+    ------
+    ValueError
+        If the shape is wrong or the rotation block is not a rotation.
+
+    Notes
+    -----
+    Lynch & Park, *Modern Robotics* (2017), Sec. 3.3.1.
+    """
+    T = as_array(matrix, "matrix", shape=(3, 3))
+    _check_rotation(T[:2, :2], "matrix")
+    return np.array([T[0, 2], T[1, 2], float(np.arctan2(T[1, 0], T[0, 0]))])
+
+
+def _check_rotation(R: np.ndarray, name: str) -> None:
+    n = R.shape[0]
+    if not np.allclose(R @ R.T, np.eye(n), atol=1e-6) or np.linalg.det(R) <= 0:
+        raise ValueError(f"{name}: expected a proper rotation (orthonormal, det +1), got {R.tolist()}")
