@@ -163,6 +163,8 @@ class SRSArm:
 
 _CHUNK = 256
 _LOCAL = np.linspace(-1.0, 1.0, 9)
+#: Up to this many targets, one dense pass replaces the coarse pass + local refinement.
+_SMALL = 16
 
 
 def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, seeds: np.ndarray):
@@ -339,7 +341,9 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, t
     over the arm angle of Shimizu et al. (2008): (1) evaluate the 8 closed-form branches at
     ``n_psi`` arm angles; keep those inside the limits and take the one nearest the seed; (2)
     refine ``psi`` on a local grid of 9 arm angles spanning one grid step either side, accepting
-    only feasible improvements; (3) targets with no feasible branch are retried on a finer grid. Shimizu et al.
+    only feasible improvements; (3) targets with no feasible branch are retried on a finer grid.
+    For 16 targets or fewer, steps (1)-(2) are one pass over ``4 n_psi`` arm angles (the same
+    spacing as the local grid), which is cheaper when numpy's call overhead dominates. Shimizu et al.
     compute the feasible arm-angle intervals exactly (Sec. IV); the sampled search here is simpler
     and is what the lesson's experiment measures.
     """
@@ -373,13 +377,21 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, t
         for n in (n_psi, n_fine):
             if not rows.size:
                 break
-            psi_grid = psi0[rows, None] + np.arange(n) * (2 * np.pi / n)
-            cost, q, psi = _best_on_grid(arm, coeffs, psi_grid, seeds[rows])
-            # the iteration on the redundancy parameter: a finer local grid around the best psi
-            c2, q2, _ = _best_on_grid(arm, coeffs, psi[:, None] + (2 * np.pi / n) * _LOCAL, seeds[rows])
-            better = c2 < cost
-            cost, q = np.where(better, c2, cost), np.where(better[:, None], q2, q)
-            evals[rows] += 8 * (n + len(_LOCAL))
+            if len(rows) <= _SMALL:
+                # few targets: numpy's per-call overhead dominates, so one pass over a grid as fine
+                # as the local one below costs less than two passes
+                m = 4 * n
+                psi_grid = psi0[rows, None] + np.arange(m) * (2 * np.pi / m)
+                cost, q, _ = _best_on_grid(arm, coeffs, psi_grid, seeds[rows])
+                evals[rows] += 8 * m
+            else:
+                psi_grid = psi0[rows, None] + np.arange(n) * (2 * np.pi / n)
+                cost, q, psi = _best_on_grid(arm, coeffs, psi_grid, seeds[rows])
+                # the iteration on the redundancy parameter: a finer local grid around the best psi
+                c2, q2, _ = _best_on_grid(arm, coeffs, psi[:, None] + (2 * np.pi / n) * _LOCAL, seeds[rows])
+                better = c2 < cost
+                cost, q = np.where(better, c2, cost), np.where(better[:, None], q2, q)
+                evals[rows] += 8 * (n + len(_LOCAL))
             has = np.isfinite(cost)
             q_best[rows[has]] = q[has]
             found[rows[has]] = True
