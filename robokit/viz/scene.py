@@ -216,13 +216,15 @@ class Scene:
                 f"style=\"width:100%;height:{self.height}px;border:1px solid #ccc\" "
                 "title=\"robokit meshcat scene\"></iframe>")
 
-    def show(self):
-        """Display the scene in a notebook (an embedded, offline viewer) and return the display object."""
-        from IPython.display import HTML, display
+    def show(self) -> None:
+        """Display the scene in a notebook as an embedded, offline viewer.
 
-        obj = HTML(self._repr_html_())
-        display(obj)
-        return obj
+        The page is sent as a raw ``text/html`` bundle (an ``<iframe srcdoc>``), which avoids
+        IPython's advice to use ``IFrame`` (that would need a URL, i.e. a server or a file).
+        """
+        from IPython.display import display
+
+        display({"text/html": self._repr_html_()}, raw=True)
 
     def __repr__(self) -> str:
         return f"Scene(title={self.title!r}, commands={len(self._commands)})"
