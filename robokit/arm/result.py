@@ -23,7 +23,8 @@ class IKResult:
     residual : float
         Norm of the final 6-vector pose error ``[dp (m); dtheta (rad)]``.
     iterations : int
-        Iterations used (summed over restarts; grid evaluations for the analytic solver).
+        Iterations used (summed over restarts and parallel attempts; closed-form branch evaluations
+        for the analytic solver).
     position_error : float
         Final flange position error [m].
     orientation_error : float
