@@ -8,7 +8,8 @@ commanded daisy-chain loop.
 
 Submodules
 ----------
-nmea        checksum, typed records, a resynchronising stream reader
+nmea        checksum, typed records, a resynchronising stream reader (fields in nmea_fields,
+            records in nmea_records)
 nmea_write  sentence builders (what a receiver model emits)
 geodesy     haversine, tangent-plane projection, WGS84 inverse problem
 sonar       LV-MaxSonar-EZ model, chained versus free-running firing, the paper's layout
@@ -16,5 +17,35 @@ field       the outdoor field with obstacles
 truck       skid-steer kinematics with slip
 controller  heading controller designed with python-control
 gps         1 Hz GPS receiver and compass models that emit NMEA text
-navigator   waypoint following plus the sonar obstacle-avoidance state machine, and the simulation
+navigator   waypoint following plus the sonar obstacle-avoidance state machine
+mission     the simulated experiment: courses, runs, summaries
 """
+from .controller import (HeadingController, design_heading_gains, heading_closed_loop, heading_frequency_response,
+                         heading_loop_gain, heading_plant, heading_step_response, loop_metrics)
+from .field import Course, Field, open_field, random_course
+from .geodesy import (EARTH_MEAN_RADIUS, LocalTangentPlane, distance_bearing, haversine_distance,
+                      haversine_distance_bearing, initial_bearing, osculating_radius, vincenty_inverse)
+from .gps import Compass, GPSReceiver, compass_to_heading, heading_to_compass
+from .mission import RunResult, run_courses, simulate, summarize_runs
+from .navigator import Navigator, avoidance_decision
+from .nmea import (GGA, HDG, RMB, RMC, BadSentence, NMEAChecksumError, NMEAError, NMEAFormatError, NMEAReader,
+                   Sentence, fix_position, nmea_checksum, parse_sentence, read_nmea)
+from .nmea_write import format_sentence, gga_sentence, hdg_sentence, random_sentences, rmb_sentence, rmc_sentence
+from .sonar import (PAPER_LAYOUT, LVMaxSonarEZ, firing_schedule, pulse_width_to_cm_inches, pulse_width_to_range,
+                    read_sensors, sensor_poses, true_ranges)
+from .truck import PAPER_TRUCK, SkidSteerTruck, TruckState
+
+__all__ = [
+    "HeadingController", "design_heading_gains", "heading_closed_loop", "heading_frequency_response",
+    "heading_loop_gain", "heading_plant", "heading_step_response", "loop_metrics",
+    "Course", "Field", "open_field", "random_course",
+    "EARTH_MEAN_RADIUS", "LocalTangentPlane", "distance_bearing", "haversine_distance",
+    "haversine_distance_bearing", "initial_bearing", "osculating_radius", "vincenty_inverse",
+    "Compass", "GPSReceiver", "compass_to_heading", "heading_to_compass",
+    "RunResult", "run_courses", "simulate", "summarize_runs", "Navigator", "avoidance_decision",
+    "GGA", "HDG", "RMB", "RMC", "BadSentence", "NMEAChecksumError", "NMEAError", "NMEAFormatError", "NMEAReader",
+    "Sentence", "fix_position", "nmea_checksum", "parse_sentence", "read_nmea",
+    "format_sentence", "gga_sentence", "hdg_sentence", "random_sentences", "rmb_sentence", "rmc_sentence",
+    "PAPER_LAYOUT", "LVMaxSonarEZ", "firing_schedule", "pulse_width_to_cm_inches", "pulse_width_to_range",
+    "read_sensors", "sensor_poses", "true_ranges", "PAPER_TRUCK", "SkidSteerTruck", "TruckState",
+]
