@@ -118,8 +118,56 @@ def finish_image(image: np.ndarray, noise: float, rng: Any, lighting: dict | Non
     return image
 
 
+class MountedSensor:
+    """Mixin for a sensor fixed on the robot by a ``mount`` transform ``T_body_sensor``.
+
+    Gives :meth:`pose_at` (the sensor's world pose for a planar robot pose) and :meth:`observe`
+    (render from there); the class provides ``mount`` and ``render(world, pose, **kwargs)``.
+    """
+
+    mount: Any
+
+    def pose_at(self, robot_pose: Any) -> np.ndarray:
+        """``T_world_cam`` for a planar robot pose ``[x, y, theta]`` (uses :attr:`mount`).
+
+        Parameters
+        ----------
+        robot_pose : array_like, shape (3,)
+
+        Returns
+        -------
+        numpy.ndarray, shape (4, 4)
+            ``T_world_body @ T_body_cam``.
+
+        Notes
+        -----
+        Composition of frames (Lynch & Park 2017, Sec. 3.3.1).
+        """
+        return se2_to_se3(as_array(robot_pose, "robot_pose", shape=(3,))) @ self.mount
+
+    def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> Frame:
+        """Render from the camera mounted on a robot at planar pose ``[x, y, theta]``.
+
+        Parameters
+        ----------
+        world : World
+        robot_pose : array_like, shape (3,)
+        **kwargs
+            ``noise``, ``rng``, ``lighting`` as in :meth:`render`.
+
+        Returns
+        -------
+        Frame
+
+        Notes
+        -----
+        ``render(world, pose_at(robot_pose))``.
+        """
+        return self.render(world, self.pose_at(robot_pose), **kwargs)
+
+
 @dataclasses.dataclass
-class PinholeCamera:
+class PinholeCamera(MountedSensor):
     """A distortion-free pinhole camera ``u = fx X/Z + cx``, ``v = fy Y/Z + cy``.
 
     Parameters
@@ -241,24 +289,6 @@ class PinholeCamera:
         P = np.column_stack([(uv[:, 0] - self.cx) / self.fx * z, (uv[:, 1] - self.cy) / self.fy * z, z])
         return P if pose is None else transform_points(check_pose(pose), P)
 
-    def pose_at(self, robot_pose: Any) -> np.ndarray:
-        """``T_world_cam`` for a planar robot pose ``[x, y, theta]`` (uses :attr:`mount`).
-
-        Parameters
-        ----------
-        robot_pose : array_like, shape (3,)
-
-        Returns
-        -------
-        numpy.ndarray, shape (4, 4)
-            ``T_world_body @ T_body_cam``.
-
-        Notes
-        -----
-        Composition of frames (Lynch & Park 2017, Sec. 3.3.1).
-        """
-        return se2_to_se3(as_array(robot_pose, "robot_pose", shape=(3,))) @ self.mount
-
     def render(self, world: World, pose: Any, *, noise: float = 0.0, rng: Any = None,
                lighting: dict | None = None) -> Frame:
         """Render colour and depth of ``world`` from camera pose ``T_world_cam``.
@@ -297,27 +327,6 @@ class PinholeCamera:
         world.check_viewpoint(T[:3, 3], "pose")
         image, depth = render_pinhole(world, self.K, self.width, self.height, T)
         return Frame(finish_image(image, noise, rng, lighting), depth)
-
-    def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> Frame:
-        """Render from the camera mounted on a robot at planar pose ``[x, y, theta]``.
-
-        Parameters
-        ----------
-        world : World
-        robot_pose : array_like, shape (3,)
-        **kwargs
-            ``noise``, ``rng``, ``lighting`` as in :meth:`render`.
-
-        Returns
-        -------
-        Frame
-
-        Notes
-        -----
-        ``render(world, pose_at(robot_pose))``.
-        """
-        return self.render(world, self.pose_at(robot_pose), **kwargs)
-
 
 @dataclasses.dataclass
 class StereoRig:

@@ -33,9 +33,9 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..geometry import se2_to_se3, se3_from_rt
+from ..geometry import se3_from_rt
 from ..validation import as_array, as_points, check_int, check_positive
-from .camera import Frame, check_pose, finish_image
+from .camera import Frame, MountedSensor, check_pose, finish_image
 from .render import render_pinhole
 from .world import World
 
@@ -73,7 +73,7 @@ def omni_mount(height: float = 1.0) -> np.ndarray:
 
 
 @dataclasses.dataclass
-class OmniCamera:
+class OmniCamera(MountedSensor):
     """Unified-model omnidirectional camera (see the module docstring for the model).
 
     Parameters
@@ -246,15 +246,6 @@ class OmniCamera:
         shape = (self.height, self.width)
         return used, K, S + 2 * pad, mapx.reshape(shape), mapy.reshape(shape), factor.reshape(shape), inside.reshape(shape)
 
-    def pose_at(self, robot_pose: Any) -> np.ndarray:
-        """``T_world_omni`` for a planar robot pose ``[x, y, theta]`` (``T_world_body @ mount``).
-
-        Notes
-        -----
-        Composition of frames (Lynch & Park 2017, Sec. 3.3.1).
-        """
-        return se2_to_se3(as_array(robot_pose, "robot_pose", shape=(3,))) @ self.mount
-
     def render(self, world: World, pose: Any, *, noise: float = 0.0, rng: Any = None,
                lighting: dict | None = None) -> Frame:
         """Render colour and range images from ``T_world_omni`` (see :meth:`PinholeCamera.render`).
@@ -289,23 +280,3 @@ class OmniCamera:
         depth[~inside] = np.inf
         image[~inside] = 0
         return Frame(finish_image(image, noise, rng, lighting), depth.astype(np.float32))
-
-    def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> Frame:
-        """Render from the camera mounted on a robot at planar pose ``[x, y, theta]``.
-
-        Parameters
-        ----------
-        world : World
-        robot_pose : array_like, shape (3,)
-        **kwargs
-            ``noise``, ``rng``, ``lighting`` as in :meth:`render`.
-
-        Returns
-        -------
-        Frame
-
-        Notes
-        -----
-        ``render(world, pose_at(robot_pose))``.
-        """
-        return self.render(world, self.pose_at(robot_pose), **kwargs)
