@@ -9,7 +9,6 @@ converted value does, and an object that is not plain data is rejected with a me
 from __future__ import annotations
 
 import math
-import numbers
 from typing import Any
 
 import numpy as np
