@@ -33,29 +33,33 @@ def pynmea2_full(line: str):
     return msg
 
 
-def best(fn, repeat: int) -> float:
-    times = []
+def best_interleaved(fns: dict, repeat: int) -> dict:
+    """Best time of each function over ``repeat`` rounds, run in turn so that load on a shared
+    machine hits every contender alike."""
+    best = {name: float("inf") for name in fns}
     for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            best[name] = min(best[name], time.perf_counter() - t0)
+    return best
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--count", type=int, default=100_000)
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args(argv)
 
     lines = random_sentences(args.count, np.random.default_rng(2026), empty_fraction=0.1)
     blob = ("\r\n".join(lines) + "\r\n").encode("ascii")
     n = len(lines)
 
-    t_ours = best(lambda: [parse_sentence(s) for s in lines], args.repeat)
-    t_stream = best(lambda: list(NMEAReader(blob)), args.repeat)
-    t_theirs = best(lambda: [pynmea2_full(s) for s in lines], args.repeat)
-    t_lazy = best(lambda: [pynmea2.parse(s, check=True) for s in lines], args.repeat)
+    t = best_interleaved({"ours": lambda: [parse_sentence(s) for s in lines],
+                          "stream": lambda: list(NMEAReader(blob)),
+                          "theirs": lambda: [pynmea2_full(s) for s in lines],
+                          "lazy": lambda: [pynmea2.parse(s, check=True) for s in lines]}, args.repeat)
+    t_ours, t_stream, t_theirs, t_lazy = t["ours"], t["stream"], t["theirs"], t["lazy"]
 
     # identical fields, sentence by sentence
     ours = [parse_sentence(s) for s in lines]

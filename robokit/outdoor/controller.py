@@ -22,15 +22,11 @@ from typing import Any
 import control
 import numpy as np
 
+from ..geometry import wrap_angle
 from ..validation import check_finite_scalar, check_positive
 
 __all__ = ["heading_plant", "design_heading_gains", "heading_closed_loop", "heading_loop_gain",
-           "heading_step_response", "heading_frequency_response", "loop_metrics", "HeadingController", "wrap"]
-
-
-def wrap(angle: float) -> float:
-    """Wrap a scalar angle to [-pi, pi) (the identity of :func:`robokit.geometry.wrap_angle`, inlined for speed)."""
-    return (angle + math.pi) % (2 * math.pi) - math.pi
+           "heading_step_response", "heading_frequency_response", "loop_metrics", "HeadingController"]
 
 
 def heading_plant(tau: float, gain: float = 1.0) -> control.TransferFunction:
@@ -226,12 +222,12 @@ class HeadingController:
         """Feed a new heading measurement (rad, CCW) taken ``dt`` seconds after the previous one."""
         h = check_finite_scalar(heading, "heading")
         if self._last is not None:
-            raw = wrap(h - self._last) / check_positive(dt, "dt")
+            raw = wrap_angle(h - self._last) / check_positive(dt, "dt")
             a = dt / (dt + self.rate_filter) if self.rate_filter else 1.0
             self.rate += a * (raw - self.rate)
         self._last = h
 
     def command(self, reference: float, heading: float) -> float:
         """Yaw-rate command (rad/s) to turn ``heading`` towards ``reference`` (both rad, CCW)."""
-        u = self.kp * wrap(reference - heading) - self.kd * self.rate
+        u = self.kp * wrap_angle(reference - heading) - self.kd * self.rate
         return float(min(max(u, -self.max_rate), self.max_rate))

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import wrap_angle
 from ..validation import as_array, check_int, check_positive
 
 __all__ = [
@@ -224,7 +225,7 @@ def vincenty_inverse(lat1: Any, lon1: Any, lat2: Any, lon2: Any, *, tol: float =
     n_iter = check_int(max_iter, "max_iter", minimum=1)
     p1, l1, p2, l2 = np.broadcast_arrays(p1, l1, p2, l2)
     a, b, f = WGS84_A, WGS84_B, WGS84_F
-    L = np.mod(l2 - l1 + np.pi, 2 * np.pi) - np.pi
+    L = np.asarray(wrap_angle(l2 - l1), dtype=float)
     U1, U2 = np.arctan((1 - f) * np.tan(p1)), np.arctan((1 - f) * np.tan(p2))
     sU1, cU1, sU2, cU2 = np.sin(U1), np.cos(U1), np.sin(U2), np.cos(U2)
     lam = L.copy()
@@ -337,7 +338,7 @@ class LocalTangentPlane:
     def to_local(self, lat: Any, lon: Any) -> np.ndarray:
         """Return ``[..., 2]`` east-north metres for geodetic ``lat``, ``lon`` (radians)."""
         la, lo = _latlon(lat, lon)
-        dlon = np.mod(lo - self.lon0 + np.pi, 2 * np.pi) - np.pi
+        dlon = wrap_angle(lo - self.lon0)
         return np.stack(np.broadcast_arrays((dlon * self._ke), (la - self.lat0) * self._kn), axis=-1)
 
     def to_geodetic(self, east_north: Any) -> tuple[Any, Any]:
@@ -346,7 +347,7 @@ class LocalTangentPlane:
         if en.shape[-1:] != (2,):
             raise ValueError(f"east_north: expected shape (2,) or (N, 2), got shape {en.shape}")
         lat = self.lat0 + en[..., 1] / self._kn
-        lon = np.mod(self.lon0 + en[..., 0] / self._ke + np.pi, 2 * np.pi) - np.pi
+        lon = wrap_angle(self.lon0 + en[..., 0] / self._ke)
         return _out(lat), _out(lon)
 
     def __repr__(self) -> str:

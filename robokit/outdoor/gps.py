@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import wrap_angle
 from ..validation import as_array, as_rng, check_finite_scalar, check_positive
 from .geodesy import LocalTangentPlane
 from .nmea_write import gga_sentence, hdg_sentence, rmc_sentence
@@ -39,8 +40,7 @@ def heading_to_compass(theta: float) -> float:
 
 def compass_to_heading(psi_deg: float) -> float:
     """Compass heading (degrees clockwise from north) to field heading (rad CCW from east) in [-pi, pi)."""
-    a = math.radians(90.0 - check_finite_scalar(psi_deg, "psi_deg"))
-    return (a + math.pi) % (2 * math.pi) - math.pi
+    return wrap_angle(math.radians(90.0 - check_finite_scalar(psi_deg, "psi_deg")))
 
 
 class GPSReceiver:

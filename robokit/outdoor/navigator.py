@@ -18,7 +18,8 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..validation import as_array, as_points, check_choice, check_positive
-from .controller import HeadingController, design_heading_gains, wrap
+from ..geometry import wrap_angle
+from .controller import HeadingController, design_heading_gains
 from .geodesy import LocalTangentPlane
 from .gps import compass_to_heading
 from .nmea import GGA, HDG, RMC, NMEAError, parse_sentence
@@ -195,7 +196,7 @@ class Navigator:
             goal = self.waypoints[self.target]
             delta = goal - self.position
         bearing = math.atan2(delta[1], delta[0])
-        side_of_goal = "left" if wrap(bearing - self.heading) > 0 else "right"
+        side_of_goal = "left" if wrap_angle(bearing - self.heading) > 0 else "right"
         decision = avoidance_decision(r, self.front, self.side, prefer=side_of_goal)
         v, reference = self._behave(decision, bearing, r, h)
         omega = self.heading_loop.command(reference, self.heading)
@@ -210,7 +211,7 @@ class Navigator:
             if decision != "forward":
                 self.state, self.turn = "AVOID", decision
             else:
-                err = wrap(bearing - self.heading)
+                err = wrap_angle(bearing - self.heading)
                 return self.cruise_speed * max(0.0, math.cos(err)) ** 2, bearing
         if self.state == "AVOID":
             clear = min(r[1], r[2]) > self.front * 1.3 and r[0 if self.turn == "left" else 3] > self.side

@@ -17,6 +17,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..geometry import wrap_angle
 from ..validation import as_array, as_rng, check_int, check_positive
 
 __all__ = ["INCH", "SECONDS_PER_INCH", "SPEED_OF_SOUND", "LVMaxSonarEZ", "SonarMount", "PAPER_LAYOUT",
@@ -310,7 +311,7 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
             v = hits[j] - sp[i, :2]
             dist = float(np.hypot(*v))
             bearing = np.arctan2(v[1], v[0]) - sp[i, 2]
-            if abs((bearing + np.pi) % (2 * np.pi) - np.pi) > sensor.half_angle or dist > sensor.max_range:
+            if abs(wrap_angle(bearing)) > sensor.half_angle or dist > sensor.max_range:
                 continue
             a = t_j + (ranges[j] + dist) / SPEED_OF_SOUND
             if t_i < a < arrival:

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import wrap_angle
 from ..validation import as_array, check_positive
 
 __all__ = ["SkidSteerTruck", "TruckState", "PAPER_TRUCK"]
@@ -108,7 +109,7 @@ class SkidSteerTruck:
         else:
             x += v / om * (np.sin(th + om * h) - np.sin(th))
             y -= v / om * (np.cos(th + om * h) - np.cos(th))
-        th = (th + om * h + np.pi) % (2 * np.pi) - np.pi
+        th = wrap_angle(th + om * h)
         return TruckState(np.array([x, y, th]), w1, v, om)
 
 
