@@ -70,6 +70,7 @@ class Chain:
         self.convention = check_choice(convention, "convention", ("standard", "modified"))
         self.tool = np.eye(4) if tool is None else as_se3(tool, "tool")
         self.base = np.eye(4) if base is None else as_se3(base, "base")
+        self._has_tool = not np.array_equal(self.tool, np.eye(4))
         # Each link transform is affine in (cos theta, sin theta): A = K + cos U + sin V. Sampling the
         # DH formula at theta = 0, pi, +-pi/2 gives K, U, V, so FK needs no trig of the twists.
         A = {t: _link_matrices(np.full(n, t), self.d, self.a, self.alpha, modified=self.modified)
@@ -170,7 +171,7 @@ class Chain:
 
     def _flange(self, frames: np.ndarray) -> np.ndarray:
         """Unchecked: flange pose from the frames of :meth:`_frames`."""
-        return frames[..., -1, :, :] @ self.tool
+        return frames[..., -1, :, :] @ self.tool if self._has_tool else frames[..., -1, :, :]
 
     def joint_frames(self, frames: np.ndarray) -> np.ndarray:
         """Select, from frames 0..n, the frame whose z axis is each joint's axis -> (..., n, 4, 4).

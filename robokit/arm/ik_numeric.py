@@ -261,9 +261,10 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     trail = [q.copy()] if history else None
     active = np.flatnonzero(alive)
     while active.size:
-        qa = qr[active]
+        full = active.size == R                      # common case: no fancy-index copies
+        qa = qr.copy() if full else qr[active]
         frames = chain._frames(qa)
-        e = _pose_error(Tr[active], chain._flange(frames))
+        e = _pose_error(Tr if full else Tr[active], chain._flange(frames))
         e2 = e * e
         pos2, rot2 = e2[:, :3].sum(1), e2[:, 3:].sum(1)
         conv = (pos2 < tol * tol) & (rot2 < tol * tol)
