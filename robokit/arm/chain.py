@@ -109,7 +109,8 @@ class Chain:
             q = q[None]
         if q.ndim != (2 if batch else 1) or q.shape[-1] != self.n:
             want = f"(N, {self.n})" if batch else f"({self.n},)"
-            raise ValueError(f"{name}: expected {self.n} joint angles for {self.name}, shape {want}, got shape {q.shape}")
+            raise ValueError(f"{name}: expected {self.n} joint angles for {self.name}, shape {want}, "
+                             f"got shape {q.shape}")
         return q
 
     def within_limits(self, q: Any, tol: float = 0.0) -> np.ndarray | bool:

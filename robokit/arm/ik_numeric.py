@@ -303,7 +303,10 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
         everyone = bool(stepping.all())
         rows = active if everyone else active[stepping]
         if rows.size:
-            fr, es, e2s = (frames, e, pos2 + rot2) if everyone else (frames[stepping], e[stepping], (pos2 + rot2)[stepping])
+            e2s = pos2 + rot2
+            fr, es = (frames, e) if everyone else (frames[stepping], e[stepping])
+            if not everyone:
+                e2s = e2s[stepping]
             J = _jacobian_from_frames(chain, fr)
             lam2 = lam2_0 + 0.5 * e2s
             qs = qa if everyone else qa[stepping]
@@ -341,7 +344,8 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
         q[t] = qr[rows_t[np.argmin(best[rows_t])]]
     success, reasons, residual, pos, rot = _verify(chain, Tt, q, tol, tol)
     for i in np.flatnonzero(too_far):
-        reasons[i] = f"out of reach: target {dist[i]:.3f} m from the base, beyond the arm's reach bound {chain.reach():.3f} m"
+        reasons[i] = (f"out of reach: target {dist[i]:.3f} m from the base, beyond the arm's reach "
+                      f"bound {chain.reach():.3f} m")
     for i in np.flatnonzero(~success & ~too_far):
         reasons[i] += f" after {tries[i] + parallel} attempts of up to {max_iter} iterations"
         if reasons[i].startswith("pose error"):

@@ -129,7 +129,8 @@ EXERCISES = [
         reference=dh_fk,
         references=("robokit.arm.chain.dh_fk", "robokit.arm.chain.chain_from_table"),
         compare=close(rtol=0, atol=1e-9),
-        description="Flange pose (4x4) of a standard-DH chain with rows [d, a, alpha]; ValueError on a length mismatch.",
+        description=("Flange pose (4x4) of a standard-DH chain with rows [d, a, alpha]; "
+                     "ValueError on a length mismatch."),
     ),
     Exercise(
         id="06.geometric_jacobian",
