@@ -112,3 +112,8 @@ def test_random_course_is_seeded_and_keeps_waypoints_clear():
 def test_bad_input(call, words):
     with pytest.raises((ValueError, TypeError), match=words):
         call()
+
+
+def test_true_ranges_needs_a_field():
+    with pytest.raises(TypeError, match="field"):
+        true_ranges("a field", [0.0, 0.0, 0.0])

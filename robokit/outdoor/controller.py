@@ -114,7 +114,12 @@ def heading_closed_loop(kp: float, kd: float, tau: float, gain: float = 1.0) -> 
 
 
 def heading_loop_gain(kp: float, kd: float, tau: float, gain: float = 1.0) -> control.TransferFunction:
-    """Loop gain broken at the plant input, ``L(s) = (kp + kd s) g / (s (tau s + 1))``, for margins."""
+    """Loop gain broken at the plant input, ``L(s) = (kp + kd s) g / (s (tau s + 1))``, for margins.
+
+    Notes
+    -----
+    Franklin et al., Sec. 6.4 (gain and phase margins of the loop transfer function).
+    """
     p = check_positive(kp, "kp")
     d = check_positive(kd, "kd", allow_zero=True)
     return control.tf([d, p], [1.0]) * heading_plant(tau, gain)
@@ -168,7 +173,8 @@ def loop_metrics(kp: float, kd: float, tau: float, gain: float = 1.0, delay: flo
 
     Notes
     -----
-    ``control.step_info`` and ``control.stability_margins`` (python-control 0.10).
+    ``control.step_info`` and ``control.stability_margins`` (python-control 0.10); definitions of
+    overshoot, settling time and margins as in Franklin et al., Secs. 3.4 and 6.4.
     """
     L = heading_loop_gain(kp, kd, tau, gain)
     dly = check_positive(delay, "delay", allow_zero=True)
@@ -214,12 +220,17 @@ class HeadingController:
         self.reset()
 
     def reset(self) -> None:
-        """Forget the previous heading and rate."""
+        """Forget the previous heading and rate (start of a new manoeuvre)."""
         self._last: float | None = None
         self.rate = 0.0
 
     def measure(self, heading: float, dt: float) -> None:
-        """Feed a new heading measurement (rad, CCW) taken ``dt`` seconds after the previous one."""
+        """Feed a new heading measurement (rad, CCW) taken ``dt`` seconds after the previous one.
+
+        Notes
+        -----
+        Backward difference plus first-order low-pass (Franklin et al., Sec. 8.3).
+        """
         h = check_finite_scalar(heading, "heading")
         if self._last is not None:
             raw = wrap_angle(h - self._last) / check_positive(dt, "dt")
@@ -228,6 +239,12 @@ class HeadingController:
         self._last = h
 
     def command(self, reference: float, heading: float) -> float:
-        """Yaw-rate command (rad/s) to turn ``heading`` towards ``reference`` (both rad, CCW)."""
+        """Yaw-rate command (rad/s) to turn ``heading`` towards ``reference`` (both rad, CCW).
+
+        Notes
+        -----
+        Proportional action on the wrapped error plus rate feedback, saturated (Franklin et al.,
+        Sec. 4.3).
+        """
         u = self.kp * wrap_angle(reference - heading) - self.kd * self.rate
         return float(min(max(u, -self.max_rate), self.max_rate))

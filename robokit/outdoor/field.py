@@ -69,7 +69,7 @@ class Field:
         return len(self.circles) + len(self.boxes)
 
     def box_corners(self) -> np.ndarray:
-        """Corners of every box, shape ``(M, 4, 2)``, counter-clockwise."""
+        """Corners of every box, shape ``(M, 4, 2)``, counter-clockwise (Ericson 2005, Sec. 4.4)."""
         return self._corners.copy()
 
     def raycast(self, origins: Any, angles: Any, max_range: float) -> np.ndarray:
@@ -133,7 +133,7 @@ class Field:
         return best
 
     def inside_box(self, points: Any) -> np.ndarray:
-        """Boolean ``(K,)``: which points lie inside any box."""
+        """Boolean ``(K,)``: which points lie inside any box (point in oriented box, Ericson 2005, Sec. 5.1.3)."""
         return self._inside_box(as_points(points, "points", 2), self.boxes)
 
     @staticmethod
@@ -176,7 +176,12 @@ class Field:
         return False
 
     def clearance(self, points: Any) -> np.ndarray:
-        """Distance from each point to the nearest obstacle (0 inside one); boxes by their corners' hull."""
+        """Distance from each point to the nearest obstacle (0 inside one).
+
+        Notes
+        -----
+        Point-circle and point-oriented-box distances (Ericson 2005, Secs. 5.1.3-5.1.4).
+        """
         pts = as_points(points, "points", 2)
         out = np.full(len(pts), np.inf)
         if len(self.circles):

@@ -336,13 +336,23 @@ class LocalTangentPlane:
         self._ke = float(prime_vertical_radius(self.lat0)) * np.cos(self.lat0)
 
     def to_local(self, lat: Any, lon: Any) -> np.ndarray:
-        """Return ``[..., 2]`` east-north metres for geodetic ``lat``, ``lon`` (radians)."""
+        """Return ``[..., 2]`` east-north metres for geodetic ``lat``, ``lon`` (radians).
+
+        Notes
+        -----
+        ``east = dlon N(lat0) cos(lat0)``, ``north = dlat M(lat0)`` (Torge & Mueller 2012, Sec. 4.2).
+        """
         la, lo = _latlon(lat, lon)
         dlon = wrap_angle(lo - self.lon0)
         return np.stack(np.broadcast_arrays((dlon * self._ke), (la - self.lat0) * self._kn), axis=-1)
 
     def to_geodetic(self, east_north: Any) -> tuple[Any, Any]:
-        """Return ``(lat, lon)`` in radians for east-north metres of shape ``(2,)`` or ``(N, 2)``."""
+        """Return ``(lat, lon)`` in radians for east-north metres of shape ``(2,)`` or ``(N, 2)``.
+
+        Notes
+        -----
+        Exact inverse of :meth:`to_local` (Torge & Mueller 2012, Sec. 4.2 radii).
+        """
         en = as_array(east_north, "east_north")
         if en.shape[-1:] != (2,):
             raise ValueError(f"east_north: expected shape (2,) or (N, 2), got shape {en.shape}")

@@ -39,7 +39,12 @@ def heading_to_compass(theta: float) -> float:
 
 
 def compass_to_heading(psi_deg: float) -> float:
-    """Compass heading (degrees clockwise from north) to field heading (rad CCW from east) in [-pi, pi)."""
+    """Compass heading (degrees clockwise from north) to field heading (rad CCW from east) in [-pi, pi).
+
+    Notes
+    -----
+    Inverse of :func:`heading_to_compass` (NMEA 0183 Sec. 6.3 heading convention).
+    """
     return wrap_angle(math.radians(90.0 - check_finite_scalar(psi_deg, "psi_deg")))
 
 
@@ -97,6 +102,10 @@ class GPSReceiver:
         -------
         list of str
             ``[RMC, GGA]``; :attr:`last_error` holds the position error (m) that went into them.
+
+        Notes
+        -----
+        Gauss-Markov error (Grewal et al. 2013, Sec. 10.2); sentences per NMEA 0183 v4.11 Sec. 6.3.
         """
         p = as_array(position, "position", shape=(2,))
         ts = check_positive(t, "t", allow_zero=True)
@@ -135,6 +144,11 @@ class Compass:
         self.rng = as_rng(rng)
 
     def reading(self, heading: float) -> str:
-        """Return the ``$HCHDG`` sentence for a true field heading (rad CCW from east)."""
+        """Return the ``$HCHDG`` sentence for a true field heading (rad CCW from east).
+
+        Notes
+        -----
+        HDG layout, NMEA 0183 v4.11 Sec. 6.3; the compass sentence of Hamid et al. (Sec. 3).
+        """
         true_deg = heading_to_compass(heading) + (self.rng.normal(0.0, self.sigma_deg) if self.sigma_deg else 0.0)
         return hdg_sentence(true_deg - self.variation_deg, deviation_deg=0.0, variation_deg=self.variation_deg)

@@ -223,6 +223,10 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     Returns
     -------
     list of RunResult
+
+    Notes
+    -----
+    The seeded repetition of Hamid et al.'s experiment (seed 000 Q3, Sec. 4) used by the lesson.
     """
     seeds = [check_int(s, "seeds[i]", minimum=0) for s in seeds]
     out = []
@@ -242,6 +246,15 @@ def summarize_runs(results: list[RunResult]) -> dict:
     dict
         ``runs``, ``success_rate``, ``waypoints_reached`` (total / total), ``collisions`` (total and
         per run), and ``min``/``median``/``max`` of ``path_ratio``, ``time`` and ``arrival_error``.
+
+    Raises
+    ------
+    ValueError
+        For an empty list.
+
+    Notes
+    -----
+    The figures of the paper's experiment (Hamid et al., seed 000 Q3, Sec. 4) plus the GPS error.
     """
     if not results:
         raise ValueError("results: expected at least one RunResult, got an empty list")

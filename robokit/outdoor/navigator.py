@@ -146,7 +146,12 @@ class Navigator:
     # --- sensing -------------------------------------------------------------------------------
 
     def feed(self, line: str) -> None:
-        """Read one NMEA sentence (GPS fix or compass); bad sentences are kept in :attr:`parse_errors`."""
+        """Read one NMEA sentence (GPS fix or compass); bad sentences are kept in :attr:`parse_errors`.
+
+        Notes
+        -----
+        RMC position and HDG heading, as the truck of Hamid et al. reads them (Sec. 3).
+        """
         try:
             rec = parse_sentence(line)
         except NMEAError as exc:
@@ -179,6 +184,10 @@ class Navigator:
         """One control step: latest sonar ``ranges`` (4,) in metres -> ``(v, omega)`` command.
 
         Returns ``(0, 0)`` until the first GPS fix and compass heading have arrived.
+
+        Notes
+        -----
+        GOTO / AVOID / BYPASS behaviour of Hamid et al. (seed 000 Q3, Sec. 4); see the module docstring.
         """
         r = as_array(ranges, "ranges", shape=(4,), finite=False)
         h = check_positive(dt, "dt")

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..geometry import wrap_angle
 from ..validation import as_array, as_rng, check_int, check_positive
+from .field import Field
 
 __all__ = ["INCH", "SECONDS_PER_INCH", "SPEED_OF_SOUND", "LVMaxSonarEZ", "SonarMount", "PAPER_LAYOUT",
            "pulse_width_to_range", "range_to_pulse_width", "pulse_width_to_cm_inches",
@@ -63,7 +64,12 @@ class LVMaxSonarEZ:
         return 2 * self.max_range / SPEED_OF_SOUND
 
     def quantize(self, distance: Any) -> Any:
-        """Clip to [min_range, max_range] and round to the resolution, as the sensor reports."""
+        """Clip to [min_range, max_range] and round to the resolution, as the sensor reports.
+
+        Notes
+        -----
+        LV-MaxSonar-EZ datasheet: 6-254 inch reported range, 1 inch resolution.
+        """
         d = as_array(distance, "distance", finite=False)
         if np.any(np.isnan(d)):
             raise ValueError("distance: expected numbers or inf, got NaN")
@@ -202,7 +208,13 @@ def firing_schedule(n_sensors: int, duration: float, mode: str = "chained", *, c
 
 
 def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.ndarray:
-    """Field-frame poses ``(n, 3)`` of the sensors for a truck pose ``[x, y, theta]``."""
+    """Field-frame poses ``(n, 3)`` of the sensors for a truck pose ``[x, y, theta]``.
+
+    Notes
+    -----
+    Planar pose composition (Smith, Self & Cheeseman, 1990) of the truck pose and each mount of
+    :data:`PAPER_LAYOUT` (Hamid et al., seed 000 Q3, Sec. 4).
+    """
     x, y, th = as_array(pose, "pose", shape=(3,))
     c, s = np.cos(th), np.sin(th)
     m = np.array([[mt.x, mt.y, mt.yaw] for mt in mounts])
@@ -213,7 +225,7 @@ def _cone(sensor: LVMaxSonarEZ, rays: int) -> np.ndarray:
     return np.linspace(-sensor.half_angle, sensor.half_angle, rays)
 
 
-def true_ranges(field: Any, pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT,
+def true_ranges(field: "Field", pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT,
                 sensor: LVMaxSonarEZ = LVMaxSonarEZ(), rays: int = 9) -> tuple[np.ndarray, np.ndarray]:
     """Nearest obstacle within each sensor's cone, and where it is.
 
@@ -239,6 +251,8 @@ def true_ranges(field: Any, pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYO
     A sonar reports the *first* echo anywhere in its cone, which is why wide beams see obstacles
     off to the side (datasheet beam pattern; Hamid et al., Sec. 4, side sensors at 45 degrees).
     """
+    if not isinstance(field, Field):
+        raise TypeError(f"field: expected a robokit.outdoor.field.Field, got {type(field).__name__}")
     k = check_int(rays, "rays", minimum=1)
     sp = sensor_poses(pose, mounts)
     offs = _cone(sensor, k)

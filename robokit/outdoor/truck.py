@@ -83,6 +83,10 @@ class SkidSteerTruck:
 
         When a side would exceed ``max_wheel_speed`` the forward speed is reduced first, so the turn
         (what keeps the truck off obstacles) is kept.
+
+        Notes
+        -----
+        Inverse of :meth:`body_velocity` (Mandow et al. 2007, Eq. (5)).
         """
         k = 1 - self.slip
         half = omega * self.icr_factor * self.track / (2 * k)
@@ -96,6 +100,11 @@ class SkidSteerTruck:
 
         The motors respond with an exact first-order lag; the pose is integrated along the arc of
         constant ``v`` and ``omega`` over the step (exact for constant body velocity).
+
+        Notes
+        -----
+        Arc integration of the unicycle model (Thrun, Burgard & Fox, *Probabilistic Robotics*, 2005,
+        Sec. 5.3, Eq. 5.9) with the skid-steer velocities of Mandow et al. (2007).
         """
         cmd = np.clip(as_array(command, "command", shape=(2,)), -self.max_wheel_speed, self.max_wheel_speed)
         h = check_positive(dt, "dt")
