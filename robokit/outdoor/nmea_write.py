@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import datetime as _dt
 
-from ..validation import check_finite_scalar, check_int, check_positive, describe
+from ..validation import as_rng, check_finite_scalar, check_int, check_positive, describe
 from .nmea import NMEAFormatError, nmea_checksum
 from .nmea_records import KNOT
 
@@ -280,8 +280,6 @@ def random_sentences(count: int, rng=None, *, empty_fraction: float = 0.1) -> li
     -----
     Field layouts as in NMEA 0183 v4.11, Sec. 6.3.
     """
-    from ..validation import as_rng
-
     n = check_int(count, "count", minimum=0)
     p = check_positive(empty_fraction, "empty_fraction", allow_zero=True)
     if p > 1:
