@@ -173,6 +173,8 @@ def test_hostile_submission_scores_only_what_it_earned(graded, name):
         assert flag in result.flags
     if name != "not_json" and is_root():
         assert "sandbox=limited" not in result.flags
+    if name == "honest":
+        assert result.flags == [] and result.worker_log == ""
 
 
 def test_batch_time_is_bounded(graded):
@@ -203,3 +205,18 @@ def test_no_worker_processes_left(graded):
             except OSError:
                 pass
     assert not left
+
+
+def test_a_crashing_worker_is_explained(tmp_path):
+    """A submission that kills its own process (bypassing the patched os._exit) gets the
+    affected exercises at zero and a feedback section with the worker's last words."""
+    from robokit.grading.reports import feedback_text
+
+    nb = _with(extra_at_end="import posix, sys\nsys.__stderr__.write('about to die\\n')\nsys.__stderr__.flush()\nposix._exit(3)\n")
+    path = tmp_path / "crasher.ipynb"
+    path.write_text(json.dumps(nb))
+    result = grade_batch([path], "00_getting_started", "s", limits=LIMITS, log=lambda *_: None)[0]
+    assert "worker-ended-early" in result.flags
+    assert all(s.points == 0 for s in result.scores)
+    assert "about to die" in result.worker_log
+    assert "Last lines of the grading process" in feedback_text(result, "00_getting_started")

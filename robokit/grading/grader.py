@@ -60,6 +60,7 @@ class SubmissionResult:
     compute_seconds: float = 0.0
     cell_errors: list[str] = dataclasses.field(default_factory=list)
     read_error: bool = False
+    worker_log: str = ""
 
     @property
     def total(self) -> float:
@@ -242,12 +243,18 @@ def _score(job: Path, student: str, path: Path, prepared: PreparedCases, exit_, 
         scores.append(ExerciseScore(ex.id, points, float(ex.points), passed, len(cases), messages))
     if called_reference or any(l.startswith("reference:") for l in flag_lines):
         flags.append("called-reference")
+    log = ""
     if exit_.timed_out:
         flags.append("timeout")
     elif not (out / "done.json").exists():
         flags.append("worker-ended-early")
+        # the last lines the worker process wrote outside Python's captured output (a crash, an
+        # import error) say why; shown to the instructor in the feedback
+        log = "\n".join(exit_.log.strip().splitlines()[-12:])[-1500:]
+        if exit_.returncode is not None and exit_.returncode < 0:
+            log = f"(worker killed by signal {-exit_.returncode})\n" + log
     return SubmissionResult(student, path, scores, flags, seconds=time.perf_counter() - start,
-                            compute_seconds=compute, cell_errors=cell_errors)
+                            compute_seconds=compute, cell_errors=cell_errors, worker_log=log)
 
 
 def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs: int = 1,

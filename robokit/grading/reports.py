@@ -55,6 +55,8 @@ def feedback_text(r: SubmissionResult, assignment: str) -> str:
     notes = [FLAG_TEXT.get(f, f) for f in r.flags]
     if notes:
         lines += ["", "## Notes", *[f"- {n}" for n in notes]]
+    if r.worker_log:
+        lines += ["", "## Last lines of the grading process", "```", r.worker_log, "```"]
     return "\n".join(lines) + "\n"
 
 
