@@ -20,7 +20,7 @@ from .field import Course, random_course
 from .geodesy import LocalTangentPlane
 from .gps import Compass, GPSReceiver
 from .navigator import Navigator
-from .sonar import PAPER_LAYOUT, LVMaxSonarEZ, read_sensors
+from .sonar import LVMaxSonarEZ, read_sensors
 from .truck import PAPER_TRUCK, SkidSteerTruck, TruckState
 
 __all__ = ["RunResult", "simulate", "run_courses", "summarize_runs"]

@@ -13,12 +13,12 @@ then ``GOTO`` again; ``DONE`` after the last waypoint.
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, as_points, check_choice, check_positive
 from ..geometry import wrap_angle
+from ..validation import as_array, as_points, check_choice, check_positive
 from .controller import HeadingController, design_heading_gains
 from .geodesy import LocalTangentPlane
 from .gps import compass_to_heading
