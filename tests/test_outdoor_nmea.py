@@ -326,3 +326,46 @@ def test_reader_validates_its_arguments():
 
     with pytest.raises(TypeError, match="bytes"):
         list(NMEAReader(TextStream()))
+
+
+# --- fuzzing: arbitrary input never crashes the parser or the reader -------------------------------
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import given, settings, strategies as st  # noqa: E402
+
+_GOOD = random_sentences(30, np.random.default_rng(9))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.binary(max_size=200))
+def test_parse_sentence_only_raises_nmea_errors_on_random_bytes(data):
+    try:
+        parse_sentence(b"$" + data)
+    except NMEAError:
+        pass
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.sampled_from(_GOOD), st.integers(min_value=1, max_value=80), st.characters())
+def test_a_mutated_sentence_is_rejected_or_parsed_never_crashes(sentence, position, char):
+    i = min(position, len(sentence) - 1)
+    mutated = sentence[:i] + char + sentence[i + 1:]
+    try:
+        rec = parse_sentence(mutated)
+    except NMEAError:
+        return
+    # a mutation that survives must have kept the checksum valid
+    assert nmea_checksum(mutated) == mutated[-2:].upper()
+    assert rec.talker
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.one_of(st.sampled_from(_GOOD).map(str.encode), st.binary(max_size=40)), max_size=30),
+       st.integers(min_value=1, max_value=64))
+def test_reader_returns_every_intact_sentence_from_a_random_mix(parts, chunk):
+    data = b"\n".join(parts) + b"\n"
+    reader = NMEAReader(data, chunk_size=chunk)
+    records = list(reader)
+    intact = sum(1 for p in parts if p.decode("latin-1") in _GOOD)
+    assert len(records) >= intact
+    assert all(isinstance(b.error, NMEAError) for b in reader.errors)
