@@ -169,13 +169,17 @@ class LandmarkMap:
         self.missed[idx] = 0
         self.observations[idx] += 1
 
-    def end_frame(self, matched) -> np.ndarray:
+    def end_frame(self, matched, expected=None) -> np.ndarray:
         """Count a frame: unmatched landmarks age, those unmatched too long are dropped.
 
         Parameters
         ----------
         matched : array_like of int
             Rows matched in this frame.
+        expected : array_like of bool, shape (N,), optional
+            Landmarks predicted to be in view in this frame. When given, only expected but
+            unmatched landmarks age; the others (behind the robot, out of the field of view) keep
+            their count, so the map of places visited long ago survives. Default: all age.
 
         Returns
         -------
@@ -184,13 +188,15 @@ class LandmarkMap:
 
         Notes
         -----
-        Se et al. Sec. 3.2: "A landmark will be discarded from the database if it has not been
-        matched for more than a predefined number of consecutive frames".
+        Se et al. Sec. 3.2: a landmark is discarded from the database once it has gone unmatched
+        for more than a set number of consecutive frames (here: frames in which it was expected).
         """
         idx = self._index(matched)
+        ages = np.ones(len(self), bool) if expected is None else as_array(expected, "expected", shape=(len(self),),
+                                                                           dtype=bool)
         seen = np.zeros(len(self), bool)
         seen[idx] = True
-        self.missed[~seen] += 1
+        self.missed[~seen & ages] += 1
         self.missed[seen] = 0
         drop = self.missed > self.max_missed
         dropped = self.ids[drop]
@@ -265,7 +271,7 @@ class LandmarkMap:
         return out
 
     def integrate(self, points, covariances, descriptors, pose, pose_covariance, landmark,
-                  scales=None, orientations=None) -> np.ndarray:
+                  scales=None, orientations=None, expected=None) -> np.ndarray:
         """One frame of map building: backward transformation, fusion, insertion and ageing.
 
         Parameters
@@ -278,6 +284,8 @@ class LandmarkMap:
         landmark : array_like of int, shape (N,)
             Row of the matched landmark per observation, or -1 for a new landmark.
         scales, orientations : array_like, shape (N,), optional
+        expected : array_like of bool, shape (len(self),), optional
+            Landmarks (before this update) predicted in view; see :meth:`end_frame`.
 
         Returns
         -------
@@ -293,6 +301,9 @@ class LandmarkMap:
         lm = as_array(landmark, "landmark", shape=(n,), dtype=int)
         if np.any(lm >= len(self)) or np.any(lm < -1):
             raise ValueError(f"landmark: expected -1 or rows in [0, {len(self)}), got {lm.min()}..{lm.max()}")
+        before = len(self)
+        if expected is not None:
+            expected = as_array(expected, "expected", shape=(before,), dtype=bool)
         world, cov = transform_covariance(pts, covariances, pose, pose_covariance)
         old = lm >= 0
         self.fuse(lm[old], world[old], cov[old])
@@ -304,5 +315,7 @@ class LandmarkMap:
         ori = None if orientations is None else as_array(orientations, "orientations", shape=(n,))[new]
         out[new] = self.add(world[new], cov[new], desc[new], sc, ori)
         matched_rows = np.nonzero(np.isin(self.ids, out))[0]
-        self.end_frame(matched_rows)
+        if expected is not None:  # new landmarks were seen now
+            expected = np.concatenate([expected, np.ones(len(self) - before, bool)])
+        self.end_frame(matched_rows, expected)
         return out

@@ -1,0 +1,345 @@
+"""Stereo visual SLAM over a recorded run: track, build the landmark map, localise from scratch.
+
+The pipeline of Se, Lowe & Little (2002) with Lin et al.'s ego-motion, per stereo frame:
+
+1. features (PLOT or SIFT, :func:`robokit.vision.detect_and_describe`) in both images;
+2. rectified stereo matching and 3-D points with covariance (:func:`robokit.vision.observe_stereo`,
+   Se et al. Sec. 2.2 and 3.1);
+3. ego-motion against the map: continuation matches predicted by odometry, RANSAC over two-point
+   poses, least-squares refinement, odometry fall-back with fewer than 15 supporting matches, and
+   whole-database matching when the robot seems kidnapped (:func:`robokit.localization.track`,
+   Lin et al. Sec. 3-7);
+4. map update: data association at the estimated pose, backward transformation with the pose
+   covariance, Kalman fusion, insertion of new landmarks, removal of landmarks unmatched for too
+   many frames (:class:`robokit.mapping.LandmarkMap`, Se et al. Sec. 3.2-3.6).
+
+Global localization of a kidnapped robot against the built map is the Hough transform of Se et al.
+Sec. 5 (:func:`robokit.localization.global_localize`).
+
+This module only orchestrates the library; it never renders (the simulator is used by
+:mod:`robokit.localization.lab_experiment`). Poses are the seeds' ``[p, q, theta]``
+(:mod:`robokit.mapping.frames`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry import se2_between, se2_compose
+from ..mapping.frames import as_pose, world_to_robot
+from ..mapping.landmarks import LandmarkMap
+from ..validation import as_array, as_rng, check_choice, check_int, check_positive
+from ..vision.descriptors import detect_and_describe
+from ..vision.stereo import StereoObservations, StereoRig, observe_stereo
+from .egomotion import track
+from .hough import Hypothesis, global_localize
+
+__all__ = ["FrameReport", "VisualSLAM"]
+
+
+@dataclass(frozen=True)
+class FrameReport:
+    """What one frame of :meth:`VisualSLAM.step` did.
+
+    Attributes
+    ----------
+    pose : numpy.ndarray, shape (3,)
+        Estimated ``[p, q, theta]`` (metres, metres, radians).
+    covariance : numpy.ndarray, shape (3, 3)
+    source : str
+        ``"start"``, ``"ransac"`` or ``"odometry"`` (fall-back).
+    n_observations : int
+        Stereo features with 3-D positions in this frame.
+    n_inliers : int
+        Matches supporting the pose (0 on fall-back).
+    kidnapped : bool
+        True when the continuation constraint found too few matches and the whole database was
+        searched (Lin et al. Sec. 7).
+    n_landmarks : int
+        Size of the map after the update.
+    """
+
+    pose: np.ndarray
+    covariance: np.ndarray
+    source: str
+    n_observations: int
+    n_inliers: int
+    kidnapped: bool
+    n_landmarks: int
+
+
+class VisualSLAM:
+    """Stereo SLAM with a Kalman-filtered landmark database (Se, Lowe & Little 2002; Lin et al.).
+
+    Parameters
+    ----------
+    rig : robokit.vision.StereoRig
+        The calibrated, rectified stereo pair (focal length, image centre, baseline).
+    method : {"sift", "plot"}, default "sift"
+        Feature detector (Lin et al. Sec. 2 or OpenCV's SIFT, Se et al. Sec. 2.1).
+    descriptor : {"reduced16", "sift128"}, default "reduced16"
+        Se et al.'s 16-element local image vector (Sec. 4) or the 128-element SIFT descriptor.
+    max_missed : int, default 20
+        Landmarks unmatched for more consecutive frames are dropped (Se et al. Sec. 3.2).
+    min_matches : int, default 15
+        Fewer supporting matches -> odometry is used (Lin et al. Sec. 7).
+    window : float, default 0.3
+        Continuation-constraint search radius in metres (Lin et al. Sec. 3).
+    threshold : float, default 0.1
+        RANSAC support distance in metres (Lin et al. Sec. 5).
+    odometry_sigma : array_like, shape (3,), default (0.05, 0.05, 0.035)
+        Standard deviation of an odometry increment per metre travelled / per radian turned
+        (``[sideways and forward per metre, heading per radian]``), plus a 5 mm / 0.5 degree floor;
+        it becomes the pose covariance on fall-back.
+    max_range : float, default 6
+        Landmarks farther than this (metres) are not expected to be re-detected, so they do not age.
+    rng : numpy.random.Generator or int, optional
+        Seeds RANSAC.
+    **feature_options
+        Passed to the detector (e.g. ``n_features`` for SIFT).
+
+    Attributes
+    ----------
+    map : LandmarkMap
+    trajectory : numpy.ndarray, shape (K, 3)
+        Estimated poses so far.
+    reports : list of FrameReport
+
+    Notes
+    -----
+    Se et al. Sec. 3 (map building while tracking), Lin et al. Sec. 3-7 (ego-motion). As in the
+    paper, each landmark has its own filter; the correlation with the robot pose is ignored, so
+    re-observed landmarks become overconfident (measured in the lesson).
+    """
+
+    def __init__(self, rig: StereoRig, *, method: str = "sift", descriptor: str = "reduced16", max_missed: int = 20,
+                 min_matches: int = 15, window: float = 0.3, threshold: float = 0.1,
+                 odometry_sigma=(0.05, 0.05, 0.035), max_range: float = 6.0, rng=None, **feature_options):
+        if not isinstance(rig, StereoRig):
+            raise TypeError(f"rig: expected robokit.vision.StereoRig, got {type(rig).__name__}")
+        self.rig = rig
+        self.method = check_choice(method, "method", ("sift", "plot"))
+        self.descriptor = check_choice(descriptor, "descriptor", ("reduced16", "sift128"))
+        self.min_matches = check_int(min_matches, "min_matches", minimum=2)
+        self.window = check_positive(window, "window")
+        self.threshold = check_positive(threshold, "threshold")
+        self.odometry_sigma = as_array(odometry_sigma, "odometry_sigma", shape=(3,))
+        if np.any(self.odometry_sigma < 0):
+            raise ValueError(f"odometry_sigma: expected non-negative values, got {self.odometry_sigma.tolist()}")
+        self.max_range = check_positive(max_range, "max_range")
+        self.feature_options = feature_options
+        self.map = LandmarkMap(16 if self.descriptor == "reduced16" else 128, max_missed=max_missed)
+        self.rng = as_rng(rng)
+        self.reports: list[FrameReport] = []
+        self._last_odometry: np.ndarray | None = None
+
+    @property
+    def trajectory(self) -> np.ndarray:
+        """Estimated poses ``[p, q, theta]`` of the frames processed so far, shape (K, 3)."""
+        return np.array([r.pose for r in self.reports]).reshape(-1, 3)
+
+    def observe(self, left, right) -> StereoObservations:
+        """Features of a rectified pair and their 3-D positions with covariance (robot frame).
+
+        Parameters
+        ----------
+        left, right : array_like, shape (H, W) or (H, W, 3)
+            Rectified images of the same instant.
+
+        Returns
+        -------
+        StereoObservations
+            Empty for textureless images.
+
+        Notes
+        -----
+        Se et al. Sec. 2.1-2.2 and 3.1; Lin et al. Sec. 2-3.
+        """
+        fl = detect_and_describe(left, self.method, descriptor=self.descriptor, **self.feature_options)
+        fr = detect_and_describe(right, self.method, descriptor=self.descriptor, **self.feature_options)
+        return observe_stereo(fl, fr, self.rig)
+
+    def _odometry_covariance(self, increment: np.ndarray) -> np.ndarray:
+        dist, turn = float(np.hypot(increment[0], increment[1])), abs(float(increment[2]))
+        s = self.odometry_sigma
+        sd = np.array([0.005 + s[0] * dist, 0.005 + s[1] * dist, np.deg2rad(0.5) + s[2] * turn])
+        return np.diag(sd ** 2)
+
+    def _update_map(self, obs: StereoObservations, pose, pose_covariance, associate: bool) -> None:
+        desc = obs.features.descriptors
+        if associate:
+            landmark = self.map.associate(obs.points, obs.covariances, desc, pose)
+        else:
+            landmark = -np.ones(len(obs), int)
+        kp = obs.features.keypoints
+        self.map.integrate(obs.points, obs.covariances, desc, pose, pose_covariance, landmark, kp.scale,
+                           kp.orientation, expected=self.in_view(pose))
+
+    def in_view(self, pose) -> np.ndarray:
+        """Which landmarks the left camera should see from ``pose`` (field of view and depth range).
+
+        Parameters
+        ----------
+        pose : array_like, shape (3,)
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (len(map),)
+            True for landmarks projecting into the image at a depth in ``[0.3, max_range]``.
+
+        Notes
+        -----
+        Se et al. Sec. 3.2 predict the database landmarks in the new frame; only landmarks that
+        should have been seen count a missed frame (occlusions aside), so the map of the places
+        visited earlier survives for global localization.
+        """
+        pts = world_to_robot(self.map.positions, as_pose(pose))
+        z = pts[:, 2]
+        ok = (z > 0.3) & (z < self.max_range)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            c = np.abs(self.rig.focal * pts[:, 0] / z)
+            r = np.abs(self.rig.focal * pts[:, 1] / z)
+        return ok & (c < self.rig.c0) & (r < self.rig.r0)
+
+    def start(self, left, right, pose=(0.0, 0.0, 0.0), odometry=None) -> FrameReport:
+        """Initialise the map from the first frame at a known pose.
+
+        Parameters
+        ----------
+        left, right : array_like
+            The first stereo pair.
+        pose : array_like, shape (3,), default (0, 0, 0)
+            ``[p, q, theta]`` of the first frame: the origin of the map (Se et al. use the initial
+            frame as the world frame).
+        odometry : array_like, shape (3,), optional
+            The odometry reading ``[p, q, theta]`` at this frame (increments are taken from it).
+
+        Returns
+        -------
+        FrameReport
+
+        Notes
+        -----
+        Se et al. Sec. 3.3: landmarks are stored in the initial frame.
+        """
+        p = as_pose(pose, "pose")
+        self.map = LandmarkMap(self.map.descriptor_size, max_missed=self.map.max_missed)
+        self.reports = []
+        obs = self.observe(left, right)
+        cov = np.eye(3) * 1e-12
+        self._update_map(obs, p, cov, associate=False)
+        self._last_odometry = p.copy() if odometry is None else as_pose(odometry, "odometry")
+        report = FrameReport(p, cov, "start", len(obs), 0, False, len(self.map))
+        self.reports.append(report)
+        return report
+
+    def step(self, left, right, odometry) -> FrameReport:
+        """Track one stereo frame and update the map.
+
+        Parameters
+        ----------
+        left, right : array_like
+            The stereo pair.
+        odometry : array_like, shape (3,)
+            Odometry reading ``[p, q, theta]`` at this frame (its increment since the previous
+            frame predicts the pose).
+
+        Returns
+        -------
+        FrameReport
+
+        Raises
+        ------
+        RuntimeError
+            If :meth:`start` was not called first.
+
+        Notes
+        -----
+        Lin et al. Sec. 3-7 (:func:`robokit.localization.track`) and Se et al. Sec. 3.2-3.6
+        (:meth:`robokit.mapping.LandmarkMap.associate` and ``integrate``).
+        """
+        if self._last_odometry is None:
+            raise RuntimeError("step: call start() with the first frame before step()")
+        odo = as_pose(odometry, "odometry")
+        increment = se2_between(self._last_odometry, odo)
+        self._last_odometry = odo
+        predicted = se2_compose(self.reports[-1].pose, increment)
+        odo_cov = self.reports[-1].covariance + self._odometry_covariance(increment)
+        obs = self.observe(left, right)
+        desc = obs.features.descriptors
+        if len(obs) == 0:
+            result, kidnapped = None, False
+            pose, cov, source, inliers = predicted, odo_cov, "odometry", 0
+        else:
+            result, _, _, kidnapped = track(obs.points, desc, self.map, predicted, odo_cov,
+                                            covariances=obs.covariances, window=self.window,
+                                            min_matches=self.min_matches, threshold=self.threshold, rng=self.rng)
+            pose, cov, source, inliers = result.pose, result.covariance, result.source, result.n_inliers
+            self._update_map(obs, pose, cov, associate=True)
+        if len(obs) == 0:
+            self.map.end_frame([], self.in_view(pose))
+        report = FrameReport(np.asarray(pose, float), cov, source, len(obs), inliers, kidnapped, len(self.map))
+        self.reports.append(report)
+        return report
+
+    def process(self, lefts, rights, odometry, start_pose=(0.0, 0.0, 0.0), *, progress=None) -> np.ndarray:
+        """Run over a recorded sequence: :meth:`start` on the first frame, :meth:`step` on the rest.
+
+        Parameters
+        ----------
+        lefts, rights : sequence of images, length K
+        odometry : array_like, shape (K, 3)
+            Odometry readings ``[p, q, theta]``.
+        start_pose : array_like, shape (3,), default (0, 0, 0)
+            Pose of the first frame (the map's origin).
+        progress : callable, optional
+            Wraps the frame iterator (e.g. ``tqdm``) to show progress.
+
+        Returns
+        -------
+        numpy.ndarray, shape (K, 3)
+            The estimated trajectory.
+
+        Raises
+        ------
+        ValueError
+            If the sequences differ in length or are empty.
+        """
+        n = len(lefts)
+        odo = as_array(odometry, "odometry", shape=(None, 3))
+        if n == 0 or len(rights) != n or odo.shape[0] != n:
+            raise ValueError(f"lefts, rights, odometry: expected equal non-zero lengths, got {n}, {len(rights)}, "
+                             f"{odo.shape[0]}")
+        self.start(lefts[0], rights[0], start_pose, odo[0])
+        frames = range(1, n) if progress is None else progress(range(1, n))
+        for k in frames:
+            self.step(lefts[k], rights[k], odo[k])
+        return self.trajectory
+
+    def localize(self, left, right, **options) -> tuple[Hypothesis, list[Hypothesis]]:
+        """Global localization of a kidnapped robot against the map (no prior pose).
+
+        Parameters
+        ----------
+        left, right : array_like
+            The current stereo pair.
+        **options
+            Passed to :func:`robokit.localization.global_localize` (bins, spread, N, ...).
+
+        Returns
+        -------
+        best : Hypothesis
+        hypotheses : list of Hypothesis
+
+        Raises
+        ------
+        InsufficientMatchesError
+            If the view cannot be placed in the map.
+
+        Notes
+        -----
+        Se, Lowe & Little Sec. 5 (Hough transform over (X, Z, theta), top 10 refined).
+        """
+        obs = self.observe(left, right)
+        return global_localize(obs.points, obs.covariances, obs.features.descriptors, self.map, **options)

@@ -1,0 +1,75 @@
+"""Assignment 01 exercises: the references pass their own cases, and check() catches wrong answers."""
+import numpy as np
+import pytest
+
+from robokit.exercises import visual_slam
+from robokit.grading import check, exercises_for
+from robokit.grading.exercise import call_student, expected_output, judge
+
+EXERCISES = exercises_for("01_visual_slam")
+
+
+def test_assignment_is_registered():
+    assert visual_slam.ASSIGNMENT == "01_visual_slam"
+    assert set(visual_slam.WRITTEN) == {"01.reduced_descriptor"}
+    assert {e.id for e in EXERCISES} == {"01.junction_strength", "01.match_ratio", "01.triangulate_svd",
+                                         "01.stereo_point", "01.ransac_sample_count", "01.pose_from_two",
+                                         "01.kalman_fuse", "01.hough_votes"}
+
+
+@pytest.mark.parametrize("seed", [7, "instructor-secret"])
+@pytest.mark.parametrize("exercise", EXERCISES, ids=lambda e: e.id)
+def test_reference_passes_its_own_cases(exercise, seed):
+    cases = exercise.make_cases(seed)
+    assert any(c.raises for c in cases), "every exercise has a bad-input case"
+    for case in cases:
+        outcome = judge(exercise, case, expected_output(exercise, case), call_student(exercise.reference, case))
+        assert outcome.passed, f"{exercise.id} {case.label}: {outcome.message}"
+
+
+@pytest.mark.parametrize("exercise", EXERCISES, ids=lambda e: e.id)
+def test_cases_depend_on_the_seed(exercise):
+    assert exercise.make_cases(1) != exercise.make_cases(2)
+
+
+def _shift(value):
+    """A small but real mistake in every number of the answer."""
+    if isinstance(value, (tuple, list)):
+        return type(value)(_shift(v) for v in value)
+    arr = np.asarray(value)
+    return arr + 1 if arr.dtype.kind in "iu" else arr.astype(float) + 1e-3
+
+
+def _wrong(reference):
+    return lambda *args, **kwargs: _shift(reference(*args, **kwargs))
+
+
+@pytest.mark.parametrize("exercise", EXERCISES, ids=lambda e: e.id)
+def test_check_fails_a_wrong_implementation(exercise, capsys):
+    with pytest.raises(AssertionError):
+        check(exercise.id, _wrong(exercise.reference))
+    assert check(exercise.id, exercise.reference) == len(exercise.make_cases(2024))
+
+
+def test_check_fails_an_implementation_without_validation():
+    def sample_count(contamination, sample_size=2, confidence=0.99):
+        good = (1 - contamination) ** sample_size
+        return 1 if good >= 1 else max(1, int(np.ceil(np.log(1 - confidence) / np.log(1 - good))))
+    with pytest.raises((AssertionError, ZeroDivisionError, ValueError)):
+        check("01.ransac_sample_count", sample_count)
+
+
+def test_fusion_of_equal_covariances_is_the_midpoint():
+    s, cov = visual_slam.kalman_fuse([0.0, 0.0, 1.0], np.eye(3), [0.0, 0.0, 3.0], np.eye(3))
+    assert np.allclose(s, [0, 0, 2]) and np.allclose(cov, np.eye(3) / 2)
+
+
+def test_hough_votes_peak_at_the_true_pose():
+    rng = np.random.default_rng(0)
+    args = list(visual_slam._hough_cases(rng)[1].args)
+    args[-1] = float(np.deg2rad(2.0))                      # 2 degree bins as in Se et al.
+    acc = visual_slam.hough_votes(*args)
+    assert acc.max() == 3                                   # all three matches agree somewhere
+    t = int(np.floor((0.3 + np.pi) / np.deg2rad(2.0)))      # the bin holding the true heading
+    assert acc[t, int(0.2 / 0.04), int(0.2 / 0.04)] == 3    # ... and the true position
+    assert acc[(t + 45) % acc.shape[0]].max() < 3           # 90 degrees off, they disagree

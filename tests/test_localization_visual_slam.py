@@ -1,0 +1,122 @@
+"""The stereo visual SLAM pipeline on the simulator's lab (Se, Lowe & Little 2002; Lin et al.).
+
+Small runs only (the first frames of the mapping lap); the full experiment is in the lesson and in
+benchmarks/bench_slam.py.
+"""
+import numpy as np
+import pytest
+
+from robokit.geometry import se2_to_pqt, wrap_angle
+from robokit.localization import VisualSLAM
+from robokit.localization.lab_experiment import LAB_TEST_POSES, calibrated_rig, lab_experiment, mapping_run
+from robokit.mapping import LandmarkMap
+from robokit.vision import StereoRig
+
+
+@pytest.fixture(scope="module")
+def short_map():
+    """Map of the lap's first straight (10 frames at 1 Hz = 3 m), localised from test pose 0."""
+    return lab_experiment(rate=1.0, frames=10, test_poses=LAB_TEST_POSES[:1], seed=0)
+
+
+@pytest.mark.slow
+def test_tracking_follows_the_true_trajectory(short_map):
+    ex = short_map
+    sources = [r.source for r in ex.slam.reports]
+    assert sources == ["start"] + ["ransac"] * 9
+    err = np.hypot(*(ex.slam.trajectory[:, :2] - ex.truth[:, :2]).T)
+    # stereo visual odometry drifts slowly: measured ~4 cm after 3 m (Se et al. Sec. 3.6 report a
+    # few cm over their lab), so stay within 2.5 % of the distance travelled
+    assert err.max() < 0.025 * 3.0
+    assert np.all(np.abs(wrap_angle(ex.slam.trajectory[:, 2] - ex.truth[:, 2])) < np.deg2rad(1.0))
+    assert all(r.n_inliers >= 15 for r in ex.slam.reports[1:])
+
+
+@pytest.mark.slow
+def test_map_fuses_reobserved_landmarks(short_map):
+    lm = short_map.slam.map
+    often = lm.observations >= 4
+    assert often.sum() > 200
+    trace = np.trace(lm.covariances, axis1=1, axis2=2)
+    assert np.median(trace[often]) < 0.5 * np.median(trace[lm.observations == 1])
+
+
+@pytest.mark.slow
+def test_global_localization_from_a_kidnapped_start(short_map):
+    row = short_map.rows[0]
+    assert row["matches"] >= 15
+    assert row["error_m"] < 0.05 and row["error_rad"] < np.deg2rad(1.2)
+    assert np.allclose(row["measured"], se2_to_pqt(LAB_TEST_POSES[0]))
+
+
+@pytest.mark.slow
+def test_kidnapped_frame_falls_back_to_whole_database_matching():
+    run, render_rig = mapping_run(1.0)
+    slam = VisualSLAM(calibrated_rig(render_rig), rng=1)
+    left, right = run.images["stereo/left"], run.images["stereo/right"]
+    truth, odo = se2_to_pqt(run.poses), se2_to_pqt(run.odometry)
+    slam.start(left[0], right[0], truth[0], odo[0])
+    for k in (1, 2, 3):
+        slam.step(left[k], right[k], odo[k])
+    # carried 1 m ahead (frame 3 -> 6) while the odometry claims it turned on the spot to face back:
+    # no landmark is predicted near any feature, so the whole database is searched
+    report = slam.step(left[6], right[6], odo[3] + [0.0, 0.0, np.pi])
+    assert report.kidnapped and report.source == "ransac"
+    assert np.hypot(*(report.pose[:2] - truth[6, :2])) < 0.05
+
+
+def test_textureless_frames_keep_the_odometry():
+    rig = StereoRig(focal=500.0, c0=319.5, r0=239.5, baseline=0.12)
+    slam = VisualSLAM(rig, method="plot")
+    blank = np.full((480, 640), 128, np.uint8)
+    first = slam.start(blank, blank, [1.0, 2.0, 0.1])
+    assert first.n_observations == 0 and len(slam.map) == 0
+    report = slam.step(blank, blank, [1.0, 2.5, 0.1])     # odometry: 0.5 m straight ahead
+    assert report.source == "odometry" and np.all(np.isfinite(report.pose))
+    assert np.allclose(report.pose, [1.0, 2.5, 0.1])
+    assert report.covariance[1, 1] > first.covariance[1, 1]
+    assert slam.trajectory.shape == (2, 3)
+
+
+def test_bad_input_is_rejected():
+    rig = StereoRig(focal=500.0, c0=319.5, r0=239.5, baseline=0.12)
+    with pytest.raises(TypeError, match="rig"):
+        VisualSLAM(object())
+    with pytest.raises(ValueError, match="method"):
+        VisualSLAM(rig, method="orb")
+    with pytest.raises(ValueError, match="odometry_sigma"):
+        VisualSLAM(rig, odometry_sigma=[0.1, -0.1, 0.1])
+    slam = VisualSLAM(rig)
+    blank = np.zeros((48, 64), np.uint8)
+    with pytest.raises(RuntimeError, match="start"):
+        slam.step(blank, blank, [0.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match="lefts, rights, odometry"):
+        slam.process([blank, blank], [blank], [[0.0, 0.0, 0.0]] * 2)
+    with pytest.raises(ValueError, match="test_poses"):
+        lab_experiment(frames=2, test_poses=[[5.0, 5.0, 0.0]])   # inside the lab's table
+    with pytest.raises(TypeError, match="render_rig"):
+        calibrated_rig(rig)
+
+
+def test_only_landmarks_expected_in_view_age():
+    m = LandmarkMap(4, max_missed=1)
+    m.add(np.zeros((3, 3)) + [[0, 0, 1], [0, 0, 2], [0, 0, 3]], np.stack([np.eye(3)] * 3), np.zeros((3, 4)))
+    expected = np.array([True, False, True])
+    m.end_frame([2], expected)
+    assert m.missed.tolist() == [1, 0, 0]
+    dropped = m.end_frame([2], expected)
+    assert dropped.tolist() == [0] and len(m) == 2
+    m.end_frame([])                                       # without a prediction every landmark ages
+    assert m.missed.tolist() == [1, 1]
+    with pytest.raises(ValueError, match="expected"):
+        m.end_frame([], [True])
+
+
+def test_in_view_uses_the_field_of_view_and_range():
+    rig = StereoRig(focal=500.0, c0=320.0, r0=240.0, baseline=0.12)
+    slam = VisualSLAM(rig, max_range=5.0)
+    pts = np.array([[0.0, 0.0, 2.0], [0.0, 0.0, -2.0], [3.0, 0.0, 2.0], [0.0, 0.0, 7.0]])
+    slam.map.add(pts, np.stack([np.eye(3) * 1e-4] * 4), np.zeros((4, 16)))
+    assert slam.in_view([0.0, 0.0, 0.0]).tolist() == [True, False, False, False]
+    # turned around (theta = pi) the robot faces -Z
+    assert slam.in_view([0.0, 0.0, np.pi]).tolist() == [False, True, False, False]
