@@ -120,3 +120,38 @@ def test_in_view_uses_the_field_of_view_and_range():
     assert slam.in_view([0.0, 0.0, 0.0]).tolist() == [True, False, False, False]
     # turned around (theta = pi) the robot faces -Z
     assert slam.in_view([0.0, 0.0, np.pi]).tolist() == [False, True, False, False]
+
+
+def test_warp_image_builds_a_pair_consistent_with_the_homography():
+    from robokit.vision import apply_homography, similarity_homography, warp_image
+
+    img = np.zeros((120, 160), np.uint8)
+    img[40:44, 100:104] = 255                               # a bright square centred at (101.5, 41.5)
+    h = similarity_homography(img.shape, zoom=1.25, angle=np.deg2rad(30.0))
+    out = warp_image(img, h)
+    rows, cols = np.nonzero(out > 128)
+    assert np.allclose([cols.mean(), rows.mean()], apply_homography(h, [[101.5, 41.5]])[0], atol=1.0)
+    assert out.shape == img.shape and out.dtype == np.uint8
+    with pytest.raises(ValueError, match="homography"):
+        warp_image(img, np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="image"):
+        warp_image(np.zeros((0, 5)), np.eye(3))
+
+
+def test_candidate_search_methods_agree():
+    from robokit.localization import candidate_matches
+
+    rng = np.random.default_rng(4)
+    for size in (16, 128):
+        lm = LandmarkMap(size)
+        desc = rng.random((300, size)).astype(np.float32)
+        desc /= np.linalg.norm(desc, axis=1, keepdims=True)
+        lm.add(rng.uniform(-1, 1, (300, 3)), np.stack([np.eye(3) * 1e-4] * 300), desc)
+        query = desc[:40] + rng.normal(scale=0.01, size=(40, size)).astype(np.float32)
+        pts = lm.positions[:40] + rng.normal(scale=0.05, size=(40, 3))
+        a = candidate_matches(pts, query, lm, method="kdtree")
+        b = candidate_matches(pts, query, lm, method="opencv")
+        assert len(a[0]) >= 40
+        assert sorted(zip(*a)) == sorted(zip(*b))
+    with pytest.raises(ValueError, match="method"):
+        candidate_matches(pts, query, lm, method="flann")

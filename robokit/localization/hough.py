@@ -18,7 +18,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..mapping.landmarks import LandmarkMap
-from ..validation import as_array, check_int, check_positive
+from ..validation import as_array, check_choice, check_int, check_positive
 from .egomotion import InsufficientMatchesError, fit_pose
 
 __all__ = ["Hypothesis", "candidate_matches", "hough_accumulator", "global_localize"]
@@ -55,7 +55,7 @@ class Hypothesis:
 
 
 def candidate_matches(points, descriptors, landmarks: LandmarkMap, *, k: int = 3, max_distance: float = 0.5,
-                      height_tol: float = 0.2) -> tuple[np.ndarray, np.ndarray]:
+                      height_tol: float = 0.2, method: str = "auto") -> tuple[np.ndarray, np.ndarray]:
     """Potential matches: the ``k`` nearest landmark descriptors that also agree in height.
 
     Parameters
@@ -70,6 +70,10 @@ def candidate_matches(points, descriptors, landmarks: LandmarkMap, *, k: int = 3
         Maximum descriptor distance (unit-length descriptors).
     height_tol : float, default 0.2
         Maximum height difference in metres.
+    method : {"auto", "kdtree", "opencv"}, default "auto"
+        Exact neighbour search by scipy's KD-tree or OpenCV's brute-force matcher; ``"auto"`` takes
+        the KD-tree for short descriptors (16 elements) and brute force for long ones (128), where a
+        KD-tree degenerates into a slower exhaustive search.
 
     Returns
     -------
@@ -78,7 +82,7 @@ def candidate_matches(points, descriptors, landmarks: LandmarkMap, *, k: int = 3
     Notes
     -----
     Se et al. Sec. 5, step 1: "using the local image vector and the height as the preliminary
-    constraints". Descriptor search by scipy's KD-tree.
+    constraints".
     """
     pts = as_array(points, "points", shape=(None, 3))
     desc = as_array(descriptors, "descriptors", shape=(pts.shape[0], landmarks.descriptor_size), dtype=np.float32)
@@ -87,9 +91,21 @@ def candidate_matches(points, descriptors, landmarks: LandmarkMap, *, k: int = 3
     height_tol = check_positive(height_tol, "height_tol")
     if pts.shape[0] == 0 or len(landmarks) == 0:
         return np.zeros(0, int), np.zeros(0, int)
+    method = check_choice(method, "method", ("auto", "kdtree", "opencv"))
+    if method == "auto":
+        method = "kdtree" if landmarks.descriptor_size <= 32 else "opencv"
     k = min(k, len(landmarks))
-    dist, idx = cKDTree(landmarks.descriptors).query(desc, k=k, distance_upper_bound=max_distance)
-    dist, idx = dist.reshape(pts.shape[0], k), idx.reshape(pts.shape[0], k)
+    if method == "kdtree":
+        dist, idx = cKDTree(landmarks.descriptors).query(desc, k=k, distance_upper_bound=max_distance)
+        dist, idx = dist.reshape(pts.shape[0], k), idx.reshape(pts.shape[0], k)
+    else:
+        found = cv2.BFMatcher(cv2.NORM_L2).knnMatch(np.ascontiguousarray(desc),
+                                                    np.ascontiguousarray(landmarks.descriptors), k=k)
+        dist, idx = np.full((pts.shape[0], k), np.inf), np.zeros((pts.shape[0], k), int)
+        for i, row in enumerate(found):
+            for j, m in enumerate(row):
+                dist[i, j], idx[i, j] = m.distance, m.trainIdx
+        dist[dist > max_distance] = np.inf
     fi = np.repeat(np.arange(pts.shape[0]), k)
     li = idx.ravel()
     ok = np.isfinite(dist.ravel())

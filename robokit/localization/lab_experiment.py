@@ -19,11 +19,16 @@ import numpy as np
 from ..config import FAST
 from ..geometry import se2_to_pqt, wrap_angle
 from ..sim import PinholeCamera, StereoRig as RenderRig, lab_lap, lab_room, record
-from ..validation import as_points, check_int, check_positive
+from ..validation import as_array, as_points, check_int, check_positive
 from ..vision.stereo import StereoRig
 from .visual_slam import VisualSLAM
 
-__all__ = ["LAB_TEST_POSES", "PAPER_RESULT", "LabExperiment", "calibrated_rig", "mapping_run", "lab_experiment"]
+__all__ = ["LAB_TEST_POSES", "PAPER_RESULT", "LabExperiment", "calibrated_rig", "mapping_run", "lab_experiment",
+           "seed_to_lab"]
+
+#: Rows of the permutation taking the seeds' world frame (X east, Y up from the camera, Z north) to
+#: the simulator's (x east, y north, z up from the floor).
+_SEED_TO_LAB = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]])
 
 #: Eight test poses ``[x, y, theta]`` in the simulator's frame, in free space near the lap, with
 #: headings within about 20 degrees of the direction the robot faced when it passed by.
@@ -62,6 +67,36 @@ def calibrated_rig(render_rig: RenderRig) -> StereoRig:
         raise TypeError(f"render_rig: expected robokit.sim.StereoRig, got {type(render_rig).__name__}")
     cam = render_rig.camera
     return StereoRig(focal=float(cam.fx), c0=float(cam.cx), r0=float(cam.cy), baseline=float(render_rig.baseline))
+
+
+def seed_to_lab(points, covariances=None, camera_height: float = 0.8):
+    """Landmarks from the seeds' world frame to the simulator's lab frame (for plots and scenes).
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 3)
+        ``(X, Y, Z)``: X east, Y up relative to the camera, Z north (:mod:`robokit.mapping.frames`).
+    covariances : array_like, shape (N, 3, 3), optional
+    camera_height : float, default 0.8
+        Height of the camera above the floor (metres), the simulator's default mount.
+
+    Returns
+    -------
+    points : numpy.ndarray, shape (N, 3)
+        ``(x, y, z) = (X, Z, Y + camera_height)``.
+    covariances : numpy.ndarray, shape (N, 3, 3) or None
+        Permuted the same way.
+
+    Notes
+    -----
+    The course's one convention, ``p = x``, ``q = y`` (:func:`robokit.geometry.se2_to_pqt`).
+    """
+    pts = as_array(points, "points", shape=(None, 3))
+    out = pts @ _SEED_TO_LAB.T + [0.0, 0.0, check_positive(camera_height, "camera_height")]
+    if covariances is None:
+        return out, None
+    cov = as_array(covariances, "covariances", shape=(pts.shape[0], 3, 3))
+    return out, _SEED_TO_LAB @ cov @ _SEED_TO_LAB.T
 
 
 def mapping_run(rate: float = 1.0, *, baseline: float = 0.12, seed: int = 0):

@@ -8,7 +8,7 @@ Se et al. Sec. 2.2 and 3.1). Vision depends only on :mod:`robokit.validation` (n
 """
 from .descriptors import (assign_orientations, detect_and_describe, gradient_histogram_descriptor,
                           plot_features, reduced_descriptor, sift_descriptor, sift_features)
-from .evaluation import apply_homography, recall_precision, similarity_homography
+from .evaluation import apply_homography, recall_precision, similarity_homography, warp_image
 from .features import Features, Keypoints, as_gray_image
 from .matching import Matches, ratio_match, two_nearest
 from .plot import (PlotParams, ScaleSpace, detect_plot, detect_plot_levels, edge_strength, junction_strength,
@@ -17,7 +17,7 @@ from .stereo import (NotRectifiedError, StereoMatches, StereoObservations, Stere
                      match_stereo, observe_stereo, triangulate_svd)
 
 __all__ = ["assign_orientations", "detect_and_describe", "gradient_histogram_descriptor", "plot_features",
-           "reduced_descriptor", "sift_descriptor", "sift_features", "apply_homography", "recall_precision",
+           "reduced_descriptor", "sift_descriptor", "sift_features", "apply_homography", "recall_precision", "warp_image",
            "similarity_homography", "Features", "Keypoints", "as_gray_image", "Matches", "ratio_match",
            "two_nearest", "PlotParams", "ScaleSpace", "detect_plot", "detect_plot_levels", "edge_strength",
            "junction_strength", "orientation_tensor", "plot_scales", "polynomial_expansion",
