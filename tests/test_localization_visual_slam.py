@@ -155,3 +155,20 @@ def test_candidate_search_methods_agree():
         assert sorted(zip(*a)) == sorted(zip(*b))
     with pytest.raises(ValueError, match="method"):
         candidate_matches(pts, query, lm, method="flann")
+
+
+def test_vectorised_greedy_assignment_equals_the_sequential_scan():
+    from robokit.mapping.landmarks import _greedy_one_to_one
+
+    rng = np.random.default_rng(8)
+    for _ in range(20):
+        fi, li = rng.integers(0, 30, 200), rng.integers(0, 25, 200)
+        order = np.argsort(rng.random(200), kind="stable")
+        fi, li = fi[order], li[order]
+        expected = -np.ones(30, int)
+        taken_f, taken_l = np.zeros(30, bool), np.zeros(25, bool)
+        for f, lmk in zip(fi, li):
+            if not taken_f[f] and not taken_l[lmk]:
+                taken_f[f] = taken_l[lmk] = True
+                expected[f] = lmk
+        assert np.array_equal(_greedy_one_to_one(fi, li, -np.ones(30, int)), expected)

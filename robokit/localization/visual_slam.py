@@ -92,6 +92,9 @@ class VisualSLAM:
         Standard deviation of an odometry increment per metre travelled / per radian turned
         (``[sideways and forward per metre, heading per radian]``), plus a 5 mm / 0.5 degree floor;
         it becomes the pose covariance on fall-back.
+    association_window : float, default 0.5
+        Radius (metres) around each observation in which landmarks are candidates for data
+        association (:meth:`robokit.mapping.LandmarkMap.associate`, then gated by Mahalanobis distance).
     max_range : float, default 6
         Landmarks farther than this (metres) are not expected to be re-detected, so they do not age.
     rng : numpy.random.Generator or int, optional
@@ -115,7 +118,8 @@ class VisualSLAM:
 
     def __init__(self, rig: StereoRig, *, method: str = "sift", descriptor: str = "reduced16", max_missed: int = 20,
                  min_matches: int = 15, window: float = 0.3, threshold: float = 0.1,
-                 odometry_sigma=(0.05, 0.05, 0.035), max_range: float = 6.0, rng=None, **feature_options):
+                 odometry_sigma=(0.05, 0.05, 0.035), association_window: float = 0.5, max_range: float = 6.0,
+                 rng=None, **feature_options):
         if not isinstance(rig, StereoRig):
             raise TypeError(f"rig: expected robokit.vision.StereoRig, got {type(rig).__name__}")
         self.rig = rig
@@ -128,6 +132,7 @@ class VisualSLAM:
         if np.any(self.odometry_sigma < 0):
             raise ValueError(f"odometry_sigma: expected non-negative values, got {self.odometry_sigma.tolist()}")
         self.max_range = check_positive(max_range, "max_range")
+        self.association_window = check_positive(association_window, "association_window")
         self.feature_options = feature_options
         self.map = LandmarkMap(16 if self.descriptor == "reduced16" else 128, max_missed=max_missed)
         self.rng = as_rng(rng)
@@ -169,7 +174,7 @@ class VisualSLAM:
     def _update_map(self, obs: StereoObservations, pose, pose_covariance, associate: bool) -> None:
         desc = obs.features.descriptors
         if associate:
-            landmark = self.map.associate(obs.points, obs.covariances, desc, pose)
+            landmark = self.map.associate(obs.points, obs.covariances, desc, pose, window=self.association_window)
         else:
             landmark = -np.ones(len(obs), int)
         kp = obs.features.keypoints

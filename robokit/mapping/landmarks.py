@@ -72,6 +72,23 @@ def kalman_fuse(s, sigma, r_new, sigma_new) -> tuple[np.ndarray, np.ndarray]:
     return (mean[0], fused[0]) if single else (mean, fused)
 
 
+def _greedy_one_to_one(fi: np.ndarray, li: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """Greedy one-to-one assignment of pairs listed best first; ``out[f] = l`` for the chosen pairs.
+
+    Vectorised in rounds: a pair that comes first for both its feature and its landmark among the
+    pairs left is exactly one the sequential greedy scan would take, so each round takes all of
+    them and drops the pairs they conflict with (same result as the scan, far fewer Python steps).
+    """
+    while fi.size:
+        _, first_f = np.unique(fi, return_index=True)
+        _, first_l = np.unique(li, return_index=True)
+        pick = np.intersect1d(first_f, first_l)
+        out[fi[pick]] = li[pick]
+        keep = ~np.isin(fi, fi[pick]) & ~np.isin(li, li[pick])
+        fi, li = fi[keep], li[keep]
+    return out
+
+
 class LandmarkMap:
     """The database map of 3-D landmarks with uncertainty (Se et al. Sec. 3; Lin et al. Sec. V).
 
@@ -263,12 +280,7 @@ class LandmarkMap:
         ok = (m2 <= gate) & (dd <= max_distance)
         fi, li, dd = fi[ok], li[ok], dd[ok]
         order = np.argsort(dd, kind="stable")
-        taken_f, taken_l = np.zeros(n, bool), np.zeros(len(self), bool)
-        for f, lmk in zip(fi[order], li[order]):  # greedy one-to-one by descriptor distance
-            if not taken_f[f] and not taken_l[lmk]:
-                taken_f[f] = taken_l[lmk] = True
-                out[f] = lmk
-        return out
+        return _greedy_one_to_one(fi[order], li[order], out)
 
     def integrate(self, points, covariances, descriptors, pose, pose_covariance, landmark,
                   scales=None, orientations=None, expected=None) -> np.ndarray:

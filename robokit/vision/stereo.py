@@ -315,7 +315,9 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
                          f"got {right.descriptors.shape[1]}")
     kl, kr = left.keypoints, right.keypoints
     if check_rectified:
-        m = ratio_match(left.descriptors, right.descriptors, ratio=0.6)
+        # exact search either way; OpenCV's brute force is faster than a KD-tree for long descriptors
+        method = "kdtree" if left.descriptors.shape[1] <= 32 else "opencv"
+        m = ratio_match(left.descriptors, right.descriptors, ratio=0.6, method=method)
         if len(m) >= 12:
             dy = np.median(np.abs(kl.xy[m.query, 1] - kr.xy[m.train, 1]))
             if dy > 3 * tol:
@@ -323,15 +325,20 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
                                         f"got a median row difference of {dy:.1f} px")
     disp = kl.xy[:, None, 0] - kr.xy[None, :, 0]
     ok = (np.abs(kl.xy[:, None, 1] - kr.xy[None, :, 1]) <= tol) & (disp >= dmin) & (disp <= dmax)
-    dtheta = np.abs(np.angle(np.exp(1j * (kl.orientation[:, None] - kr.orientation[None, :]))))
+    dtheta = np.abs((kl.orientation[:, None] - kr.orientation[None, :] + np.pi) % (2 * np.pi) - np.pi)
     ok &= dtheta <= dori
     sr = kl.scale[:, None] / kr.scale[None, :]
     ok &= (sr <= srat) & (sr >= 1 / srat)
     dl, dr = left.descriptors.astype(float), right.descriptors.astype(float)
     dist2 = (dl * dl).sum(1)[:, None] + (dr * dr).sum(1)[None, :] - 2 * dl @ dr.T
     dist = np.where(ok, np.sqrt(np.maximum(dist2, 0.0)), np.inf)
-    order = np.argsort(dist, axis=1)[:, :2]
     rows = np.arange(len(kl))
+    if dist.shape[1] > 2:  # the two smallest per row, in order, without sorting whole rows
+        two = np.argpartition(dist, 1, axis=1)[:, :2]
+        swap = dist[rows, two[:, 0]] > dist[rows, two[:, 1]]
+        order = np.where(swap[:, None], two[:, ::-1], two)
+    else:
+        order = np.argsort(dist, axis=1)[:, :2]
     best = dist[rows, order[:, 0]]
     second = dist[rows, order[:, 1]] if dist.shape[1] > 1 else np.full(len(kl), np.inf)
     keep = np.isfinite(best) & (best <= max_distance) & (best < ratio * second)
