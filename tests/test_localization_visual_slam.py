@@ -172,3 +172,31 @@ def test_vectorised_greedy_assignment_equals_the_sequential_scan():
                 taken_f[f] = taken_l[lmk] = True
                 expected[f] = lmk
         assert np.array_equal(_greedy_one_to_one(fi, li, -np.ones(30, int)), expected)
+
+
+@pytest.mark.slow
+def test_ransac_recovers_the_rendered_motion_with_half_the_matches_wrong():
+    from robokit import sim
+    from robokit.localization import ransac_pose
+    from robokit.mapping import robot_to_world
+    from robokit.vision import detect_and_describe, observe_stereo, ratio_match
+
+    world = sim.lab_room()
+    render = sim.StereoRig(sim.PinholeCamera.from_fov(), baseline=0.12)
+    rig = calibrated_rig(render)
+    poses = [np.array([3.0, 2.0, 0.0]), np.array([3.3, 2.05, 0.05])]
+    obs = []
+    for k, pose in enumerate(poses):
+        views = render.observe(world, pose, noise=2.0, rng=k)
+        obs.append(observe_stereo(detect_and_describe(views["left"].image, "sift"),
+                                  detect_and_describe(views["right"].image, "sift"), rig))
+    m = ratio_match(obs[1].features.descriptors, obs[0].features.descriptors)
+    landmarks = robot_to_world(obs[0].points[m.train], se2_to_pqt(poses[0]))
+    rng = np.random.default_rng(2)
+    bad = np.nonzero(rng.random(len(m)) < 0.5)[0]
+    landmarks[bad] = landmarks[rng.permutation(bad)]
+    res = ransac_pose(obs[1].points[m.query], landmarks, robot_covariances=obs[1].covariances[m.query],
+                      world_covariances=obs[0].covariances[m.train], rng=0)
+    truth = se2_to_pqt(poses[1])
+    assert len(bad) > 0.4 * len(m) and res.source == "ransac"
+    assert np.hypot(*(res.pose[:2] - truth[:2])) < 0.02 and abs(wrap_angle(res.pose[2] - truth[2])) < np.deg2rad(0.5)
