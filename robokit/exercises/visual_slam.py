@@ -196,13 +196,15 @@ EXERCISES = [
         id="01.junction_strength", function="junction_strength",
         signature="junction_strength(tensor: array (..., 2, 2)) -> numpy.ndarray (...)", points=1,
         cases=_junction_cases, reference=junction_strength, compare=close(rtol=1e-6, atol=1e-9),
+        references=("robokit.vision.plot.junction_strength", "robokit.vision.plot.tensor_eigenvalues"),
         description="The smaller eigenvalue lambda_2 of each symmetric 2 x 2 tensor (Lin et al. Sec. 2.i); "
                     "ValueError unless the last two axes are 2 x 2."),
     Exercise(
         id="01.match_ratio", function="match_ratio",
         signature="match_ratio(query: (N, D), train: (M, D), ratio: float = 0.65) -> numpy.ndarray (K, 2) of int",
         points=2, cases=_ratio_cases, reference=match_ratio, compare=unordered_rows(atol=0),
-        references=("robokit.vision.matching.ratio_match",),
+        references=("robokit.exercises.visual_slam.match_ratio", "robokit.vision.matching.ratio_match",
+                    "robokit.vision.matching.two_nearest"),
         description="Pairs [query_row, train_row] whose nearest / second-nearest Euclidean distance ratio is below "
                     "`ratio` (Lin et al. Sec. 3); (0, 2) when train has fewer than two rows; ValueError for "
                     "different descriptor lengths or a ratio outside (0, 1]."),
@@ -216,7 +218,7 @@ EXERCISES = [
         id="01.stereo_point", function="stereo_point",
         signature="stereo_point(c, r, d, focal, c0, r0, baseline) -> (points (N, 3), covariances (N, 3, 3))",
         points=2, cases=_stereo_cases, reference=stereo_point, compare=close(rtol=1e-6, atol=1e-9),
-        references=("robokit.vision.stereo.disparity_to_point",),
+        references=("robokit.exercises.visual_slam.stereo_point", "robokit.vision.stereo.disparity_to_point"),
         description="X = (c - c0) I / d, Y = (r0 - r) I / d, Z = f I / d and the first-order covariance with "
                     "sigma_c = sigma_r = sigma_d = 1 px (Se et al. Sec. 3.1); ValueError for d <= 0 or "
                     "arrays of different lengths."),
@@ -244,7 +246,7 @@ EXERCISES = [
         signature="hough_votes(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, bin_size, angle_bin) "
                   "-> numpy.ndarray (T, NX, NZ) of int",
         points=3, cases=_hough_cases, reference=hough_votes, compare=close(rtol=0, atol=0),
-        references=("robokit.localization.hough.hough_accumulator",),
+        references=("robokit.exercises.visual_slam.hough_votes", "robokit.localization.hough.hough_accumulator"),
         description="For each heading bin centre, each match votes for every (X, Z) bin within +-2.8 sigma of the "
                     "position (X, Z) - R(theta) (X', Z') (Se et al. Sec. 5); see the notebook for the bin layout; "
                     "ValueError for empty bounds."),
