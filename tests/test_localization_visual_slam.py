@@ -150,7 +150,7 @@ def test_candidate_search_methods_agree():
         query = desc[:40] + rng.normal(scale=0.01, size=(40, size)).astype(np.float32)
         pts = lm.positions[:40] + rng.normal(scale=0.05, size=(40, 3))
         a = candidate_matches(pts, query, lm, method="kdtree")
-        b = candidate_matches(pts, query, lm, method="opencv")
+        b = candidate_matches(pts, query, lm, method="bruteforce")
         assert len(a[0]) >= 40
         assert sorted(zip(*a)) == sorted(zip(*b))
     with pytest.raises(ValueError, match="method"):
