@@ -192,7 +192,7 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     method, descriptor : str
         Features, see :class:`VisualSLAM`. The default 128-element descriptor keeps the map's
         drift at about 2 cm over the lap; Se et al.'s 16-element vector lets wrong associations
-        through and the lap drifts by about 20 cm (measured; see the lesson).
+        through and the lap drifts by about 25 cm (measured; see the lesson).
     rate : float, default 1
         Mapping frame rate in Hz.
     frames : int, optional
