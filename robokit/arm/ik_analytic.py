@@ -24,8 +24,9 @@ import numpy as np
 from ..validation import as_array, check_int, check_positive
 from .chain import Chain
 from .result import IKBatchResult, IKResult, _verify
-from .se3 import as_se3, _skew
-from .srs import _flip, _reference_rotation, _rot_y, _rot_z, _zyz
+from .se3 import as_se3
+from .srs import _flip, _zyz
+from .srs_geometry import ARRAY, SCALAR, arm_angle_terms, coefficient_terms
 
 __all__ = ["SRSArm", "arm_angle", "ik_srs_branches", "ik_srs", "ik_srs_batch"]
 
@@ -33,7 +34,6 @@ _ALPHA = np.array([-1, 1, 1, -1, -1, 1, 0]) * np.pi / 2
 #: Branch order of the 8 solutions for one arm angle: (elbow, shoulder, wrist) sign flags.
 BRANCHES = [(e, s, w) for e in (0, 1) for s in (0, 1) for w in (0, 1)]
 #: Matrix entries read by the ZYZ decomposition: (0,2) (1,2) (2,2) (2,1) (2,0) (1,0) (1,1).
-_GROUPS = np.array([[0, 1, 2], [4, 5, 6]])
 _ROWS = np.array([0, 1, 2, 2, 2, 1, 1])
 _COLS = np.array([2, 2, 2, 1, 0, 0, 1])
 
@@ -74,91 +74,80 @@ class SRSArm:
         self.d_bs, self.d_se, self.d_ew, self.d_wf = (float(x) for x in chain.d[[0, 2, 4, 6]])
         self._tool_inv = np.linalg.inv(chain.tool)
         self._base_inv = np.linalg.inv(chain.base)
+        self._plain = np.array_equal(chain.tool, np.eye(4)) and np.array_equal(chain.base, np.eye(4))
+        # limits of the spherical joints as (branch, joint-in-group, 1, 1, group): the layout of
+        # the angle arrays in _best_on_grid
+        grp = np.array([[0, 4], [1, 5], [2, 6]])
+        self._lo = chain.qmin[grp][None, :, None, None, None, :]
+        self._hi = chain.qmax[grp][None, :, None, None, None, :]
+        self._grp = grp
+        self.mid = 0.5 * (chain.qmin + chain.qmax)
 
     # --- the decomposition, step by step ---------------------------------------------------------
     def to_link7(self, T: np.ndarray) -> np.ndarray:
         """Unchecked: target flange poses (N, 4, 4) -> link-7 poses in frame 0."""
-        return self._base_inv @ T @ self._tool_inv
+        return T if self._plain else self._base_inv @ T @ self._tool_inv
 
     def wrist_centre(self, T7: np.ndarray) -> np.ndarray:
         """Unchecked: wrist centre ``p - d_wf z_7`` of link-7 poses (Huang & Jiang's step 1)."""
         return T7[..., :3, 3] - self.d_wf * T7[..., :3, 2]
 
-    def elbow_cosine(self, sw_len: np.ndarray) -> np.ndarray:
-        """Unchecked: ``cos q4`` from the shoulder-wrist distance (law of cosines)."""
-        return (sw_len**2 - self.d_se**2 - self.d_ew**2) / (2 * self.d_se * self.d_ew)
-
-    def reference_shoulder(self, sw: np.ndarray, q4: np.ndarray) -> np.ndarray:
-        """Unchecked: ``Rz(q1) Ry(q2)`` of the reference arm plane (``q3 = 0``) reaching ``sw``."""
-        return _reference_rotation(sw, q4, self.d_se, self.d_ew)
-
     def coefficients(self, T7: np.ndarray):
         """Unchecked: Shimizu's ``A, B, C`` coefficients for shoulder and wrist, per elbow sign.
 
-        Returns ``(A, B, C, q4, cos_q4)``. ``A, B, C`` have shape (N, 2, 2, 7): elbow sign (+, -),
-        group (shoulder ``M = Rz(q1) Ry(q2) Rz(q3)``, wrist ``Rz(q5) Ry(q6) Rz(q7)``) and the seven
-        matrix entries that the ZYZ decomposition reads; each entry is
-        ``A sin psi + B cos psi + C``. Shimizu et al. (2008), Eqs. (13)-(17) and (20)-(22), in this
-        chain's frames: ``M(psi) = R_psi M_ref`` and ``R_4^7 = Ry(q4) M^T R_0^7``.
+        ``T7`` is one link-7 pose (4, 4) or a stack (N, 4, 4). Returns ``(G, q4, cos_q4)``: ``G``
+        of shape (N, 3, 28) (coefficient, then elbow sign, group and ZYZ entry flattened, see
+        :func:`robokit.arm.srs_geometry.coefficient_terms`), ``q4`` (N, 2) and ``cos_q4`` (N,).
+        One pose is computed on Python floats, which is several times faster than numpy at N = 1.
         """
-        sw = self.wrist_centre(T7) - np.array([0.0, 0.0, self.d_bs])
-        L = np.linalg.norm(sw, axis=-1)
-        c4 = self.elbow_cosine(L)
-        a4 = np.arccos(np.clip(c4, -1.0, 1.0))
-        q4 = np.stack([a4, -a4], -1)                              # (N, 2)
-        R_ref = self.reference_shoulder(sw[:, None, :], q4)       # (N, 2, 3, 3)
-        u = sw / np.where(L > 0, L, 1.0)[:, None]
-        K = _skew(u)[:, None]
-        As = K @ R_ref                                            # R_psi = I + sin K + (1 - cos) K^2
-        Bs = -(K @ As)
-        Cs = R_ref - Bs
-        Rt_Ry4 = _rot_y(q4)
-        Rt = T7[:, None, :3, :3]
-        mats = [np.stack([X, Rt_Ry4 @ np.swapaxes(X, -1, -2) @ Rt], 2) for X in (As, Bs, Cs)]
-        A, B, C = (X[..., _ROWS, _COLS] for X in mats)
-        return A, B, C, q4, c4
+        if T7.ndim == 2:
+            r = T7.tolist()
+            sw = (r[0][3] - self.d_wf * r[0][2], r[1][3] - self.d_wf * r[1][2],
+                  r[2][3] - self.d_wf * r[2][2] - self.d_bs)
+            terms, q4, c4 = coefficient_terms(r, sw, self.d_se, self.d_ew, SCALAR)
+            return np.array(terms).reshape(1, 3, 28), np.array([q4]), np.array([c4])
+        W = self.wrist_centre(T7)
+        sw = (W[:, 0], W[:, 1], W[:, 2] - self.d_bs)
+        R = [[T7[:, i, j] for j in range(3)] for i in range(3)]
+        terms, q4, c4 = coefficient_terms(R, sw, self.d_se, self.d_ew, ARRAY)
+        return np.stack(terms, -1).reshape(-1, 3, 28), np.stack(q4, -1), c4
 
-    def angles(self, coeffs, psi: np.ndarray):
-        """Unchecked: shoulder and wrist angles of every branch for arm angles ``psi`` (N, K).
+    def angles(self, G: np.ndarray, psi: np.ndarray):
+        """Unchecked: ZYZ angles ``(a, b >= 0, c)`` of shoulder and wrist for arm angles ``psi`` (N, K).
 
-        Returns three arrays (first, second and third ZYZ angle), each of shape (N, 2, 2, 2, K):
-        elbow sign, group (shoulder q1-q3 / wrist q5-q7), branch (``b >= 0`` or its mirror
-        ``(a + pi, -b, c + pi)``), arm angle.
+        Each of the three arrays has shape (N, K, 2, 2): arm angle, elbow sign, group (shoulder
+        q1-q3 / wrist q5-q7). The mirror branch of each group is ``(a + pi, -b, c + pi)``.
         """
-        A, B, C = coeffs[:3]
-        s, c = np.sin(psi)[:, None, None, None, :], np.cos(psi)[:, None, None, None, :]
-        E = A[..., None] * s + B[..., None] * c + C[..., None]   # (N, 2, 2, 7, K)
-        a, b, cc = _zyz(*(E[..., r, :] for r in range(7)))        # (N, 2, 2, K)
-        return (np.stack([a, _flip(a)], 3), np.stack([b, -b], 3), np.stack([cc, _flip(cc)], 3))
+        N, K = psi.shape
+        basis = np.empty((N, K, 3))
+        basis[..., 0], basis[..., 1], basis[..., 2] = np.sin(psi), np.cos(psi), 1.0
+        E = (basis @ G).reshape(N, K, 2, 2, 7)
+        return _zyz(*np.moveaxis(E, -1, 0))
 
     def joints(self, coeffs, psi: np.ndarray) -> np.ndarray:
         """Unchecked: all 8 branches for arm angles ``psi`` (N, K) -> q of shape (N, K, 8, 7).
 
         Branch ``b`` of the 8 is ``BRANCHES[b] = (elbow, shoulder, wrist)`` mirror flags.
         """
-        ang = self.angles(coeffs, psi)
-        q4 = coeffs[3]
+        a, b, c = self.angles(coeffs[0], psi)
+        ang = [(x, y, z) for x, y, z in ((a, b, c), (_flip(a), -b, _flip(c)))]
+        q4 = coeffs[1]
         out = np.empty(psi.shape + (8, 7))
         for k, (e, sh, wr) in enumerate(BRANCHES):
             for j in range(3):
-                out[:, :, k, j] = ang[j][:, e, 0, sh]
-                out[:, :, k, 4 + j] = ang[j][:, e, 1, wr]
+                out[:, :, k, j] = ang[sh][j][:, :, e, 0]
+                out[:, :, k, 4 + j] = ang[wr][j][:, :, e, 1]
             out[:, :, k, 3] = q4[:, e, None]
         return out
 
-    def arm_angle(self, q: np.ndarray) -> np.ndarray:
-        """Unchecked: arm angle ``psi`` of configurations ``q`` (N, 7) -> (N,).
+    def arm_angle(self, q: np.ndarray):
+        """Unchecked: arm angle ``psi`` of one configuration (7,) -> float, or of many (N, 7) -> (N,).
 
-        ``psi`` is the angle, about the shoulder-wrist axis, of ``M R_ref^T`` with
-        ``M = Rz(q1) Ry(q2) Rz(q3)`` (Shimizu et al. 2008, Eq. (9)).
+        Shimizu et al. (2008), Eq. (9); see :func:`robokit.arm.srs_geometry.arm_angle_terms`.
         """
-        M = _rot_z(q[:, 0]) @ _rot_y(q[:, 1]) @ _rot_z(q[:, 2])
-        v = np.stack([-self.d_ew * np.sin(q[:, 3]), np.zeros(len(q)), self.d_se + self.d_ew * np.cos(q[:, 3])], -1)
-        sw = (M @ v[..., None])[..., 0]
-        R = M @ np.swapaxes(self.reference_shoulder(sw, q[:, 3]), -1, -2)
-        u = sw / np.linalg.norm(sw, axis=-1, keepdims=True)
-        vee = 0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], -1)
-        return np.arctan2(np.sum(vee * u, -1), 0.5 * (np.trace(R, axis1=1, axis2=2) - 1.0))
+        if q.ndim == 1:
+            return arm_angle_terms(*q[:4].tolist(), self.d_se, self.d_ew, SCALAR)
+        return arm_angle_terms(*q[:, :4].T, self.d_se, self.d_ew, ARRAY)
 
 
 _CHUNK = 256
@@ -175,33 +164,29 @@ def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, seeds: np.ndarray):
     shoulder and wrist branch are chosen independently for each elbow sign and arm angle.
     """
     chain = arm.chain
-    m = len(psi)
-    ang = arm.angles(coeffs, psi)                                   # 3 x (m, 2e, 2g, 2b, K)
-    mid = 0.5 * (chain.qmin + chain.qmax)
-    half = 0.5 * (chain.qmax - chain.qmin)
-    ok = None
-    cost = 0.0
-    for j in range(3):
-        g = _GROUPS[:, j]
-        x = ang[j]
-        ok_j = np.abs(x - mid[g][:, None, None]) <= half[g][:, None, None]
-        ok = ok_j if ok is None else ok & ok_j
-        cost = cost + (x - seeds[:, g][:, None, :, None, None]) ** 2
-    cost = np.where(ok, cost, np.inf)                                # (m, 2e, 2g, 2b, K)
-    br = (cost[:, :, :, 1] < cost[:, :, :, 0]).astype(np.intp)       # (m, 2e, 2g, K)
-    cmin = np.minimum(cost[:, :, :, 0], cost[:, :, :, 1])
-    q4 = coeffs[3]
-    c4 = np.where(np.abs(q4 - mid[3]) <= half[3], (q4 - seeds[:, 3:4]) ** 2, np.inf)
-    total = cmin[:, :, 0] + cmin[:, :, 1] + c4[:, :, None]           # (m, 2e, K)
+    G, q4 = coeffs[0], coeffs[1]
+    m, K = psi.shape
+    a, b, c = arm.angles(G, psi)                                     # (m, K, 2e, 2g)
+    X = np.empty((2, 3, m, K, 2, 2))                                  # branch, joint in group, ...
+    X[0, 0], X[0, 1], X[0, 2] = a, b, c
+    X[1, 0], X[1, 1], X[1, 2] = _flip(a), -b, _flip(c)
+    ok = ((X >= arm._lo) & (X <= arm._hi)).all(1)                    # (2b, m, K, 2e, 2g)
+    D = X - seeds[:, arm._grp].transpose(1, 0, 2)[None, :, :, None, None, :]
+    cost = np.einsum("bjmkeg,bjmkeg->bmkeg", D, D)
+    cost[~ok] = np.inf
+    br = cost[1] < cost[0]                                           # (m, K, 2e, 2g)
+    cmin = np.minimum(cost[0], cost[1])
+    c4 = (q4 - seeds[:, 3:4]) ** 2
+    c4[(q4 < chain.qmin[3]) | (q4 > chain.qmax[3])] = np.inf
+    total = cmin.sum(-1) + c4[:, None, :]                            # (m, K, 2e)
     flat = total.reshape(m, -1).argmin(1)
-    e, k = np.divmod(flat, psi.shape[1])
+    k, e = np.divmod(flat, 2)
     i = np.arange(m)
     q = np.empty((m, 7))
-    for j in range(3):
-        q[:, j] = ang[j][i, e, 0, br[i, e, 0, k], k]
-        q[:, 4 + j] = ang[j][i, e, 1, br[i, e, 1, k], k]
+    q[:, :3] = X[br[i, k, e, 0].astype(np.intp), :, i, k, e, 0]
+    q[:, 4:] = X[br[i, k, e, 1].astype(np.intp), :, i, k, e, 1]
     q[:, 3] = q4[i, e]
-    return total[i, e, k], q, psi[i, k]
+    return total[i, k, e], q, psi[i, k]
 
 
 def _srs(chain: Chain) -> SRSArm:
@@ -246,9 +231,7 @@ def arm_angle(chain: Chain, q: Any) -> float | np.ndarray:
     with joint limits ...", IEEE T-RO 24(5), 2008, Sec. III-A, Eq. (9).
     """
     arm = _srs(chain)
-    qq = chain.check_q(q, batch=True)
-    out = arm.arm_angle(qq)
-    return float(out[0]) if np.ndim(q) == 1 else out
+    return arm.arm_angle(chain.check_q(q, batch=np.ndim(q) == 2))
 
 
 def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = True) -> np.ndarray:
@@ -282,10 +265,10 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
     and posture.
     """
     arm = _srs(chain)
-    T7 = arm.to_link7(as_se3(T, "T")[None])
+    T7 = arm.to_link7(as_se3(T, "T"))
     p = _check_psi(psi)
     coeffs = arm.coefficients(T7)
-    if abs(coeffs[4][0]) > 1.0 + 1e-12:
+    if abs(coeffs[2][0]) > 1.0 + 1e-12:
         return np.zeros((0, 7))
     q = arm.joints(coeffs, np.array([[p]]))[0, 0]
     if within_limits:
@@ -293,16 +276,74 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
     return q
 
 
-def ik_srs(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, tol: float = 1e-6) -> IKResult:
-    """Analytic IK of an S-R-S arm: the valid solution closest to ``q_seed``.
+def _options(n_psi: Any, n_fine: Any, tol: Any):
+    n_psi = check_int(n_psi, "n_psi", minimum=4)
+    return n_psi, check_int(n_fine, "n_fine", minimum=n_psi), check_positive(tol, "tol")
 
-    See :func:`ik_srs_batch` (this is its one-target form).
+
+def _search(arm: SRSArm, coeffs, psi0: np.ndarray, seeds: np.ndarray, n: int, dense: bool):
+    """Unchecked: one pass of the arm-angle iteration with ``n`` coarse arm angles per target.
+
+    ``dense``: a single grid of ``4 n`` arm angles (few targets, where numpy's per-call overhead
+    dominates); otherwise ``n`` angles, then a local grid of 9 spanning one step either side of
+    the best. Returns ``(cost, q, branch evaluations per target)``.
+    """
+    if dense:
+        m = 4 * n
+        cost, q, _ = _best_on_grid(arm, coeffs, psi0[:, None] + np.arange(m) * (2 * np.pi / m), seeds)
+        return cost, q, 8 * m
+    cost, q, psi = _best_on_grid(arm, coeffs, psi0[:, None] + np.arange(n) * (2 * np.pi / n), seeds)
+    c2, q2, _ = _best_on_grid(arm, coeffs, psi[:, None] + (2 * np.pi / n) * _LOCAL, seeds)
+    better = c2 < cost
+    return np.where(better, c2, cost), np.where(better[:, None], q2, q), 8 * (n + len(_LOCAL))
+
+
+def _finish(arm: SRSArm, T: np.ndarray, c4: np.ndarray, q: np.ndarray, found: np.ndarray, evals,
+            n_psi: int, n_fine: int, tol: float) -> IKBatchResult:
+    """Unchecked: FK-verify ``q`` (N, 7) against targets ``T`` (N, 4, 4) and say why not."""
+    success, reasons, residual, pos, rot = _verify(arm.chain, T, q, tol, tol)
+    reach = np.abs(c4) <= 1.0 + 1e-12
+    for i in np.flatnonzero(~reach):
+        L = np.sqrt(max(0.0, c4[i] * 2 * arm.d_se * arm.d_ew + arm.d_se**2 + arm.d_ew**2))
+        reasons[i] = (f"out of reach: shoulder-wrist distance {L:.4f} m outside "
+                      f"[{abs(arm.d_se - arm.d_ew):.4f}, {arm.d_se + arm.d_ew:.4f}] m")
+    for i in np.flatnonzero(reach & ~found):
+        reasons[i] = f"no arm angle keeps all joints within limits ({n_psi} + {n_fine} arm angles tried)"
+    success &= found
+    N = len(q)
+    return IKBatchResult(q=q, success=success, reason=reasons, residual=residual,
+                         iterations=np.broadcast_to(evals, (N,)).astype(int), position_error=pos,
+                         orientation_error=rot, restarts=np.zeros(N, int))
+
+
+def ik_srs(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, tol: float = 1e-6,
+           n_fine: int = 720) -> IKResult:
+    """Analytic IK of an S-R-S arm for one target: the valid solution closest to ``q_seed``.
+
+    Parameters and result as :func:`ik_srs_batch`, for one pose ``T`` (4, 4) and one seed (7,).
+    The per-target geometry runs on Python floats and the arm-angle search is one dense pass over
+    ``4 n_psi`` arm angles (then ``4 n_fine`` if nothing is feasible), the form of
+    :func:`ik_srs_batch` for few targets.
     """
     if np.ndim(T) != 2:
         raise ValueError(f"T: expected one pose of shape (4, 4), got shape {np.shape(T)}")
     if q_seed is not None and np.ndim(q_seed) != 1:
         raise ValueError(f"q_seed: expected one joint vector of shape (7,), got shape {np.shape(q_seed)}")
-    return ik_srs_batch(chain, T, q_seed, n_psi=n_psi, tol=tol)[0]
+    arm = _srs(chain)
+    Tt = as_se3(T, "T")
+    n_psi, n_fine, tol = _options(n_psi, n_fine, tol)
+    seed = arm.mid if q_seed is None else chain.check_q(q_seed, "q_seed")
+    coeffs = arm.coefficients(arm.to_link7(Tt))
+    seeds, psi0 = seed[None], np.array([arm.arm_angle(seed)])
+    q, found, evals = seeds, np.zeros(1, bool), 0
+    if abs(coeffs[2][0]) <= 1.0 + 1e-12:
+        for n in (n_psi, n_fine):
+            cost, q_n, ev = _search(arm, coeffs, psi0, seeds, n, dense=True)
+            evals += ev
+            if cost[0] < np.inf:
+                q, found[0] = q_n, True
+                break
+    return _finish(arm, Tt[None], coeffs[2], q, found, evals, n_psi, n_fine, tol)[0]
 
 
 def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, tol: float = 1e-6,
@@ -350,11 +391,9 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, t
     arm = _srs(chain)
     Tt = as_se3(T, "T", batch=True)
     N = Tt.shape[0]
-    n_psi = check_int(n_psi, "n_psi", minimum=4)
-    n_fine = check_int(n_fine, "n_fine", minimum=n_psi)
-    tol = check_positive(tol, "tol")
+    n_psi, n_fine, tol = _options(n_psi, n_fine, tol)
     if q_seed is None:
-        seeds = np.broadcast_to(0.5 * (chain.qmin + chain.qmax), (N, 7)).copy()
+        seeds = np.broadcast_to(arm.mid, (N, 7)).copy()
     else:
         seeds = chain.check_q(q_seed, "q_seed", batch=True)
         if seeds.shape[0] == 1 and N > 1:
@@ -362,48 +401,21 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, t
         elif seeds.shape[0] != N:
             raise ValueError(f"q_seed: expected one seed or {N} seeds (one per target), got {seeds.shape[0]}")
 
-    T7 = arm.to_link7(Tt)
+    G, q4, c4 = arm.coefficients(arm.to_link7(Tt))
     psi0 = arm.arm_angle(seeds)
     q_best = seeds.copy()
     found = np.zeros(N, bool)
-    reach = np.zeros(N, bool)
     evals = np.zeros(N, int)
-    for start in range(0, N, _CHUNK):
-        rows = np.arange(start, min(N, start + _CHUNK))
-        coeffs = arm.coefficients(T7[rows])
-        r_ok = np.abs(coeffs[4]) <= 1.0 + 1e-12
-        reach[rows] = r_ok
-        rows, coeffs = rows[r_ok], tuple(c[r_ok] for c in coeffs)
+    reachable = np.flatnonzero(np.abs(c4) <= 1.0 + 1e-12)
+    for start in range(0, len(reachable), _CHUNK):
+        rows = reachable[start:start + _CHUNK]
         for n in (n_psi, n_fine):
             if not rows.size:
                 break
-            if len(rows) <= _SMALL:
-                # few targets: numpy's per-call overhead dominates, so one pass over a grid as fine
-                # as the local one below costs less than two passes
-                m = 4 * n
-                psi_grid = psi0[rows, None] + np.arange(m) * (2 * np.pi / m)
-                cost, q, _ = _best_on_grid(arm, coeffs, psi_grid, seeds[rows])
-                evals[rows] += 8 * m
-            else:
-                psi_grid = psi0[rows, None] + np.arange(n) * (2 * np.pi / n)
-                cost, q, psi = _best_on_grid(arm, coeffs, psi_grid, seeds[rows])
-                # the iteration on the redundancy parameter: a finer local grid around the best psi
-                c2, q2, _ = _best_on_grid(arm, coeffs, psi[:, None] + (2 * np.pi / n) * _LOCAL, seeds[rows])
-                better = c2 < cost
-                cost, q = np.where(better, c2, cost), np.where(better[:, None], q2, q)
-                evals[rows] += 8 * (n + len(_LOCAL))
-            has = np.isfinite(cost)
+            cost, q, ev = _search(arm, (G[rows], q4[rows]), psi0[rows], seeds[rows], n, len(rows) <= _SMALL)
+            evals[rows] += ev
+            has = cost < np.inf
             q_best[rows[has]] = q[has]
             found[rows[has]] = True
-            rows, coeffs = rows[~has], tuple(c[~has] for c in coeffs)
-
-    success, reasons, residual, pos, rot = _verify(chain, Tt, q_best, tol, tol)
-    for i in np.flatnonzero(~reach):
-        L = float(np.linalg.norm(arm.wrist_centre(T7[i]) - [0, 0, arm.d_bs]))
-        reasons[i] = (f"out of reach: shoulder-wrist distance {L:.4f} m outside "
-                      f"[{abs(arm.d_se - arm.d_ew):.4f}, {arm.d_se + arm.d_ew:.4f}] m")
-    for i in np.flatnonzero(reach & ~found):
-        reasons[i] = f"no arm angle keeps all joints within limits ({n_psi} + {n_fine} arm angles tried)"
-    success &= found
-    return IKBatchResult(q=q_best, success=success, reason=reasons, residual=residual, iterations=evals,
-                         position_error=pos, orientation_error=rot, restarts=np.zeros(N, int))
+            rows = rows[~has]
+    return _finish(arm, Tt, c4, q_best, found, evals, n_psi, n_fine, tol)

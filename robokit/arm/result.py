@@ -88,17 +88,17 @@ def _verify(chain, T_target: np.ndarray, q: np.ndarray, tol_pos: float, tol_rot:
     from .se3 import _pose_error
 
     err = _pose_error(T_target, chain._flange(chain._frames(q)))
-    pos = np.linalg.norm(err[:, :3], axis=1)
-    rot = np.linalg.norm(err[:, 3:], axis=1)
-    inside = np.all((q >= chain.qmin) & (q <= chain.qmax), axis=1)
+    err *= err
+    pos2, rot2 = err[:, :3].sum(1), err[:, 3:].sum(1)
+    pos, rot, residual = np.sqrt(pos2), np.sqrt(rot2), np.sqrt(pos2 + rot2)
+    inside = ((q >= chain.qmin) & (q <= chain.qmax)).all(1)
     ok = (pos < tol_pos) & (rot < tol_rot)
-    reasons = []
-    for i in range(len(q)):
-        if ok[i] and inside[i]:
-            reasons.append("converged")
-        elif ok[i]:
+    success = ok & inside
+    reasons = ["converged"] * len(q)
+    for i in np.flatnonzero(~success):
+        if ok[i]:
             j = int(np.argmax(np.maximum(chain.qmin - q[i], q[i] - chain.qmax)))
-            reasons.append(f"pose reached but joint {j + 1} is outside its limits")
+            reasons[i] = f"pose reached but joint {j + 1} is outside its limits"
         else:
-            reasons.append(f"pose error above tolerance (position {pos[i]:.2e} m, orientation {rot[i]:.2e} rad)")
-    return ok & inside, reasons, np.linalg.norm(err, axis=1), pos, rot
+            reasons[i] = f"pose error above tolerance (position {pos[i]:.2e} m, orientation {rot[i]:.2e} rad)"
+    return success, reasons, residual, pos, rot

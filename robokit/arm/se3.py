@@ -15,6 +15,8 @@ __all__ = ["as_se3", "pose_error"]
 
 #: Tolerance on ``R^T R = I`` and ``det R = 1`` when checking a user-supplied pose.
 SE3_TOL = 1e-6
+_LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
+_EYE3 = np.eye(3)
 
 
 def as_se3(value: Any, name: str, *, batch: bool = False, tol: float = SE3_TOL) -> np.ndarray:
@@ -45,21 +47,18 @@ def as_se3(value: Any, name: str, *, batch: bool = False, tol: float = SE3_TOL) 
     -----
     SE(3) as defined in Lynch & Park, *Modern Robotics* (2017), Sec. 3.3.1.
     """
-    T = as_array(value, name)
-    if batch and T.shape == (4, 4):
+    one = not batch or np.ndim(value) == 2
+    T = as_array(value, name, shape=(4, 4) if one else (None, 4, 4))
+    if batch and one:
         T = T[None]
-    want = (None, 4, 4) if batch else (4, 4)
-    T = as_array(T, name, shape=want)
     R = T[..., :3, :3]
-    last_dev = np.abs(T[..., 3, :] - (0.0, 0.0, 0.0, 1.0)).max(axis=-1)
+    last_dev = np.abs(T[..., 3, :] - _LAST_ROW).max(axis=-1)
     if np.any(last_dev > tol):
         i = int(np.argmax(np.atleast_1d(last_dev)))
         raise ValueError(f"{name}: expected an SE(3) matrix with last row [0, 0, 0, 1], got "
                          f"{np.asarray(T[..., 3, :]).reshape(-1, 4)[i].tolist()}" + (f" at index {i}" if batch else ""))
-    ortho = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1))
-    det = (R[..., 0, 0] * (R[..., 1, 1] * R[..., 2, 2] - R[..., 1, 2] * R[..., 2, 1])
-           - R[..., 0, 1] * (R[..., 1, 0] * R[..., 2, 2] - R[..., 1, 2] * R[..., 2, 0])
-           + R[..., 0, 2] * (R[..., 1, 0] * R[..., 2, 1] - R[..., 1, 1] * R[..., 2, 0]))
+    ortho = np.abs(np.swapaxes(R, -1, -2) @ R - _EYE3).max(axis=(-2, -1))
+    det = np.linalg.det(R)
     bad = (ortho > tol) | (np.abs(det - 1.0) > tol)
     if np.any(bad):
         i = int(np.argmax(np.atleast_1d(bad)))
@@ -110,16 +109,20 @@ def _rotation_log(R: np.ndarray) -> np.ndarray:
     Internal helper: no validation.
     """
     R = np.asarray(R, dtype=float)
-    r = R.reshape(R.shape[:-2] + (9,))
-    vee = 0.5 * (r[..., [7, 2, 3]] - r[..., [5, 6, 1]])
-    cos = np.clip(0.5 * (r[..., 0] + r[..., 4] + r[..., 8] - 1.0), -1.0, 1.0)
-    sin = np.sqrt((vee * vee).sum(-1))
+    vee = np.empty(R.shape[:-2] + (3,))
+    np.subtract(R[..., 2, 1], R[..., 1, 2], out=vee[..., 0])
+    np.subtract(R[..., 0, 2], R[..., 2, 0], out=vee[..., 1])
+    np.subtract(R[..., 1, 0], R[..., 0, 1], out=vee[..., 2])
+    vee *= 0.5
+    cos = np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0)
+    sin = np.sqrt(np.einsum("...i,...i->...", vee, vee))
     theta = np.arctan2(sin, cos)
     # theta / sin(theta) -> 1 as theta -> 0; the near-pi case is handled below
     small = sin < 1e-12
-    scale = theta / np.where(small, 1.0, sin)
     if small.any():
-        scale = np.where(small, 1.0 + theta**2 / 6.0, scale)
+        scale = np.where(small, 1.0 + theta**2 / 6.0, theta / np.where(small, 1.0, sin))
+    else:
+        scale = theta / sin
     out = vee * scale[..., None]
     near_pi = cos < -0.99
     if np.any(near_pi):
@@ -169,6 +172,8 @@ def pose_error(T_target: Any, T: Any) -> np.ndarray:
 
 def _pose_error(T_target: np.ndarray, T: np.ndarray) -> np.ndarray:
     """Unchecked kernel of :func:`pose_error` (broadcast stacks of 4x4 poses)."""
-    dp = T_target[..., :3, 3] - T[..., :3, 3]
     dw = _rotation_log(T_target[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2))
-    return np.concatenate([dp, dw], axis=-1)
+    out = np.empty(dw.shape[:-1] + (6,))
+    np.subtract(T_target[..., :3, 3], T[..., :3, 3], out=out[..., :3])
+    out[..., 3:] = dw
+    return out
