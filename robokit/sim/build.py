@@ -57,32 +57,36 @@ class Builder:
         return s
 
     def wall(self, name: str, a: Any, b: Any, z0: float = 0.0, z1: float = 2.8,
-             texture_fn: TextureFn = tx.plaster, solid: bool = True) -> None:
+             texture_fn: TextureFn = tx.plaster, solid: bool = True, *, density: float | None = None,
+             tile: float | None = None) -> None:
         """Add a vertical wall from floor point ``a`` to ``b`` spanning heights ``z0..z1``, tiled.
 
         The texture reads correctly from the side to the right of the direction ``a -> b`` (walk
-        a room clockwise to face its walls inwards).
+        a room clockwise to face its walls inwards). ``density`` and ``tile`` override the
+        builder's (e.g. coarse, large tiles for a far skybox).
         """
         a = as_array(a, "a", shape=(2,))
         b = as_array(b, "b", shape=(2,))
         length = float(np.linalg.norm(b - a))
         if length <= 0 or z1 <= z0:
             raise ValueError(f"a, b, z0, z1: expected a wall of positive size, got {length} m x {z1 - z0} m")
-        n = int(np.ceil(length / self.tile - 1e-9))
+        n = int(np.ceil(length / (tile or self.tile) - 1e-9))
         step = (b - a) / n
         for i in range(n):
             p = a + i * step
             self._add(f"{name}/{i}", [p[0], p[1], z1], [step[0], step[1], 0.0], [0.0, 0.0, z0 - z1],
-                      texture_fn, self.density, solid)
+                      texture_fn, density or self.density, solid)
 
     def horizontal(self, name: str, x0: float, y0: float, x1: float, y1: float, z: float, up: bool,
-                   texture_fn: TextureFn, solid: bool = False) -> None:
+                   texture_fn: TextureFn, solid: bool = False, *, density: float | None = None,
+                   tile: float | None = None) -> None:
         """Add a horizontal rectangle (floor if ``up`` else ceiling) over ``[x0, x1] x [y0, y1]``, tiled.
 
-        The texture reads correctly from above (``up``) or from below (ceiling).
+        The texture reads correctly from above (``up``) or from below (ceiling); ``density`` and
+        ``tile`` override the builder's.
         """
-        nx = int(np.ceil((x1 - x0) / self.tile - 1e-9))
-        ny = int(np.ceil((y1 - y0) / self.tile - 1e-9))
+        nx = int(np.ceil((x1 - x0) / (tile or self.tile) - 1e-9))
+        ny = int(np.ceil((y1 - y0) / (tile or self.tile) - 1e-9))
         dx, dy = (x1 - x0) / nx, (y1 - y0) / ny
         for i in range(nx):
             for j in range(ny):
@@ -90,7 +94,7 @@ class Builder:
                     corner, u, v = [x0 + i * dx, y0 + (j + 1) * dy, z], [dx, 0, 0], [0, -dy, 0]
                 else:
                     corner, u, v = [x0 + i * dx, y0 + j * dy, z], [dx, 0, 0], [0, dy, 0]
-                self._add(f"{name}/{i}-{j}", corner, u, v, texture_fn, self.density, solid)
+                self._add(f"{name}/{i}-{j}", corner, u, v, texture_fn, density or self.density, solid)
 
     def box(self, name: str, centre: Any, size: Any, yaw: float = 0.0,
             texture_fn: TextureFn = tx.wood) -> None:
@@ -106,12 +110,38 @@ class Builder:
             raise ValueError(f"size: expected three positive extents, got {[L, W, H]}")
         R = np.array([[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]])
         quad = (np.array([[-L, -W], [L, -W], [L, W], [-L, W]]) / 2) @ R.T + c  # counter-clockwise
-        for k in range(4):  # walking counter-clockwise, the right side of each edge faces outwards
-            self.wall(f"{name}/side{k}", quad[k], quad[(k + 1) % 4], 0.0, H, texture_fn)
-        d = quad[1] - quad[0]
-        e = quad[0] - quad[3]  # top seen from above: u along the box's x, v along its -y
-        self._add(f"{name}/top", [quad[3][0], quad[3][1], H], [d[0], d[1], 0], [e[0], e[1], 0],
-                  texture_fn, self.density, True)
+        self.prism(name, quad, H, texture_fn, lid=quad)
+
+    def prism(self, name: str, polygon: Any, height: float, texture_fn: TextureFn = tx.wood,
+              lid: Any = None) -> None:
+        """Add an upright prism standing on the floor: outward-facing sides ``{name}/side{k}`` and a lid.
+
+        Parameters
+        ----------
+        polygon : array_like, shape (N, 2)
+            Footprint corners in counter-clockwise order (N >= 3).
+        height : float
+            Height of the sides (metres).
+        lid : array_like, shape (4, 2), optional
+            A counter-clockwise rectangle laid on top as ``{name}/top`` (surfaces are rectangles,
+            so a box's lid is its footprint and a round post's lid is a square inside it).
+
+        Notes
+        -----
+        Walking a counter-clockwise polygon, the right side of each edge is the outside
+        (O'Rourke, *Computational Geometry in C*, 2nd ed., Sec. 1.3).
+        """
+        poly = as_array(polygon, "polygon", shape=(None, 2))
+        if len(poly) < 3:
+            raise ValueError(f"polygon: expected at least 3 corners, got {len(poly)}")
+        h = check_positive(height, "height")
+        for k in range(len(poly)):
+            self.wall(f"{name}/side{k}", poly[k], poly[(k + 1) % len(poly)], 0.0, h, texture_fn)
+        if lid is not None:
+            q = as_array(lid, "lid", shape=(4, 2))
+            d, e = q[1] - q[0], q[0] - q[3]  # seen from above: u along the first edge, v back along the last
+            self._add(f"{name}/top", [q[3][0], q[3][1], h], [d[0], d[1], 0], [e[0], e[1], 0],
+                      texture_fn, self.density, True)
 
     def decal(self, name: str, a: Any, b: Any, z_top: float, height: float, texture_fn: TextureFn,
               solid: bool = False) -> None:
@@ -128,9 +158,9 @@ class Builder:
         d = b - a
         self._add(name, [p[0], p[1], z_top], [d[0], d[1], 0], [0, 0, -height], texture_fn, 2 * self.density, solid)
 
-    def world(self, name: str, interior: Any, height: float, info: dict | None = None) -> World:
+    def world(self, name: str, interior: Any, height: float, info: dict | None = None, **kwargs: Any) -> World:
         """Return the :class:`World` made of the collected surfaces (see :class:`World` for the arguments)."""
-        return World(self.surfaces, name, interior, height, info=info)
+        return World(self.surfaces, name, interior, height, info=info, **kwargs)
 
 
 def random_decoration(rng: np.random.Generator) -> TextureFn:

@@ -132,6 +132,9 @@ class World:
         Height of the horizontal slice that defines :attr:`segments` (a LiDAR's scan plane).
     info : dict, optional
         Builder facts (dimensions, door positions, seed), for lessons and tests.
+    free_resolution : float, default 0.02
+        Cell size (metres) of the free-space grid behind :meth:`is_free` and
+        :meth:`check_viewpoint`; large outdoor worlds use coarser cells to keep the grid small.
 
     Raises
     ------
@@ -145,7 +148,7 @@ class World:
     """
 
     def __init__(self, surfaces: Sequence[Surface], name: str, interior: Any, height: float,
-                 footprint_height: float = 0.25, info: dict | None = None) -> None:
+                 footprint_height: float = 0.25, info: dict | None = None, free_resolution: float = 0.02) -> None:
         surfaces = list(surfaces)
         if not surfaces or not all(isinstance(s, Surface) for s in surfaces):
             raise ValueError(f"surfaces: expected a non-empty list of Surface, got {len(surfaces)} items")
@@ -155,6 +158,7 @@ class World:
         self.footprint_height = check_positive(footprint_height, "footprint_height")
         self.interior = as_array(interior, "interior", shape=(2,))
         self.info = dict(info or {})
+        self.free_resolution = check_positive(free_resolution, "free_resolution")
         self.segments = self.slice(self.footprint_height)
         if len(self.segments) == 0:
             raise ValueError(f"surfaces: expected walls crossing footprint_height={self.footprint_height} m, got none")
@@ -209,13 +213,13 @@ class World:
         return np.array(segs, float).reshape(-1, 2, 2)
 
     @functools.lru_cache(maxsize=4)
-    def free_space(self, resolution: float = 0.02) -> FreeSpace:
+    def free_space(self, resolution: float | None = None) -> FreeSpace:
         """Rasterise the footprint and flood-fill the free floor area from :attr:`interior`.
 
         Parameters
         ----------
-        resolution : float, default 0.02
-            Cell size in metres.
+        resolution : float, optional
+            Cell size in metres; default :attr:`free_resolution` (0.02 m unless the builder chose).
 
         Returns
         -------
@@ -226,7 +230,7 @@ class World:
         Scan-line flood fill (``cv2.floodFill``) and Euclidean distance transform (Felzenszwalb &
         Huttenlocher, "Distance transforms of sampled functions", 2012) for the clearance.
         """
-        res = check_positive(resolution, "resolution")
+        res = check_positive(self.free_resolution if resolution is None else resolution, "resolution")
         origin = self.segments.reshape(-1, 2).min(axis=0) - 4 * res
         size = np.ceil((self.segments.reshape(-1, 2).max(axis=0) + 4 * res - origin) / res).astype(int)
         walls = np.zeros((size[1], size[0]), np.uint8)
@@ -260,7 +264,8 @@ class World:
 
         Notes
         -----
-        Looks up :meth:`free_space` (2 cm cells), so the answer is exact to about one cell.
+        Looks up :meth:`free_space` (cells of :attr:`free_resolution`, 2 cm by default), so the
+        answer is exact to about one cell.
         """
         pts = as_points(xy, "xy", 2)
         c = check_positive(clearance, "clearance", allow_zero=True)
