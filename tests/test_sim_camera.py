@@ -9,6 +9,7 @@ from robokit.geometry import se2_to_se3, se3_from_rt
 from robokit.sim import camera as cm
 from robokit.sim.omni import OmniCamera
 from robokit.sim.world import World
+from robokit.sim.field import open_field
 from robokit.sim.worlds import box_room, lab_room, long_corridor, office_floor
 
 CAM = cm.PinholeCamera.from_fov(np.deg2rad(65), 640, 480)
@@ -116,7 +117,7 @@ def _sift_ratio(world, pose, step):
 
 @pytest.mark.parametrize("builder, pose", [
     (lab_room, [5.0, 2.0, np.pi / 2]), (long_corridor, [3.0, 0.0, 0.0]), (office_floor, [10.0, 4.3, -np.pi / 2]),
-    (box_room, [1.0, 1.0, 0.4]),
+    (box_room, [1.0, 1.0, 0.4]), (open_field, [50.0, 30.0, 0.3]),
 ])
 def test_sift_finds_hundreds_of_keypoints_and_correct_matches(builder, pose):
     n_kp, n_match, inliers = _sift_ratio(builder(), pose, 0.3)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import umsgpack
 
-from robokit.sim import Lidar, PinholeCamera, box_room, lab_lap, lab_room
+from robokit.sim import Lidar, PinholeCamera, box_room, field_world, lab_lap, lab_room
 from robokit.viz import (Scene, add_camera, add_landmarks, add_particles, add_trajectory, add_world, animate_poses, look_from,
                          plot_covariance, plot_footprint, plot_occupancy, plot_scan, plot_trajectory)
 
@@ -32,6 +32,19 @@ def test_world_scene_carries_textured_mesh_and_footprint():
     assert n_faces == 2 * len(visible)
     foot = next(c for c in cmds if c["path"] == "/meshcat/world/footprint")
     assert foot["object"]["object"]["type"] == "LineSegments"
+
+
+def test_outdoor_backdrop_is_hidden_like_a_ceiling():
+    world = field_world((20.0, 12.0), circles=[[5.0, 5.0, 0.5]], seed=0)
+
+    def faces(**kw):
+        mesh = next(c for c in decoded(add_world(Scene(), world, **kw)) if c["path"] == "/meshcat/world/surfaces")
+        return len(mesh["object"]["geometries"][0]["data"]["index"]["array"].data) // 4 // 3
+
+    backdrop = [s for s in world.surfaces if s.name.startswith("backdrop/")]
+    assert len(backdrop) >= 9  # far ground, sky band and zenith
+    assert faces(ceiling=True) == 2 * len(world.surfaces)
+    assert faces() == 2 * (len(world.surfaces) - len(backdrop))
 
 
 def test_helpers_record_their_objects():

@@ -7,6 +7,9 @@ Worlds (textured planar rectangles + 2D footprint; world frame right-handed, z u
     ``long_corridor()``  36.10 m x 2.17 m corridor, 0.07 m door recesses (Ge et al. 2023)
     ``office_floor()``   four rooms R1-R4 and a corridor (seed 001)
     ``box_room()``       a plain rectangular room
+    ``open_field()``     100 m x 60 m grass field with obstacles, a shed, a hedge and a skybox
+                         (seed 000 Q3, Hamid et al.); ``field_world(size, circles, boxes)`` builds
+                         any 2D obstacle layout, ``scatter_obstacles`` draws one
     A :class:`World` has ``surfaces``, ``segments`` (the footprint at ``footprint_height``),
     ``slice(z)``, ``free_space()``, ``is_free(xy)`` and ``info`` (builder facts).
 
@@ -41,6 +44,7 @@ Example
 ((480, 640, 3), dtype('float32'))
 """
 from .camera import Frame, PinholeCamera, StereoRig, mount_pose
+from .field import field_world, open_field, scatter_obstacles
 from .lidar import Lidar, ray_segment_ranges, scan_points
 from .motion import (Path, corridor_path, diff_drive_velocities, lab_lap, noisy_odometry, odometry_increment,
                      sample_motion_model_odometry, skid_steer_velocities, unicycle_step, waypoint_path)
@@ -52,6 +56,7 @@ from .worlds import box_room, lab_room, long_corridor, office_floor
 
 __all__ = [
     "World", "Surface", "FreeSpace", "box_room", "lab_room", "long_corridor", "office_floor",
+    "open_field", "field_world", "scatter_obstacles",
     "Frame", "PinholeCamera", "StereoRig", "mount_pose", "OmniCamera", "omni_mount", "illuminate", "photo",
     "Lidar", "ray_segment_ranges", "scan_points",
     "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "odometry_increment",

@@ -57,7 +57,9 @@ def add_world(scene: Scene, world: World, path: str = "world", cell: int = 48, c
     cell : int, default 48
         Pixels per surface in the texture atlas (small keeps the HTML page light).
     ceiling : bool, default False
-        Draw the ceiling (hidden by default so the scene can be seen from above).
+        Draw the ceiling and an outdoor world's far backdrop (surfaces named ``backdrop/...``: sky
+        band and far ground of :func:`robokit.sim.open_field`); hidden by default so the scene can
+        be seen from above.
 
     Returns
     -------
@@ -77,7 +79,8 @@ def add_world(scene: Scene, world: World, path: str = "world", cell: int = 48, c
     verts, faces, uvs = [], [], []
     size = cols * cell
     for k, s in enumerate(world.surfaces):
-        if not ceiling and s.normal[2] < -0.5 and s.corner[2] >= world.height - 1e-6:
+        if not ceiling and ((s.normal[2] < -0.5 and s.corner[2] >= world.height - 1e-6)
+                            or s.name.startswith("backdrop/")):
             continue
         r, c = divmod(k, cols)
         u0, u1 = (c * cell + 0.5) / size, ((c + 1) * cell - 0.5) / size
