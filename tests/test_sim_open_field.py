@@ -6,9 +6,10 @@ import cv2
 import numpy as np
 import pytest
 
-from robokit.sim import (Lidar, PinholeCamera, field_world, mount_pose, open_field,
+from robokit.outdoor.field import Field, random_course
+from robokit.sim import (Lidar, PinholeCamera, field_world, mount_pose, open_field, ray_segment_ranges,
                          scatter_obstacles)
-from robokit.sim.field import _open_field
+from robokit.sim.field import SIDES, _open_field
 from robokit.sim.world import World
 from tests.test_sim_lidar_motion import analytic_box_ranges
 
@@ -73,6 +74,30 @@ def test_lidar_ranges_equal_analytic_distances_to_box_and_hedge(pose):
     assert np.isfinite(ranges).all()
     np.testing.assert_allclose(ranges, expected, rtol=0, atol=1e-9)
     assert np.isfinite(_slab_distance(pose[:2], ang, BOX)).sum() > 20  # the box is really seen
+
+
+def test_lesson05_course_and_3d_world_share_the_layout():
+    course = random_course(7)
+    world = course.field.world(seed=7)
+    np.testing.assert_array_equal(world.info["boxes"], course.field.boxes)
+    np.testing.assert_array_equal(world.info["circles"], course.field.circles)
+    o = course.start[:2]
+    segs = world.slice(0.25)
+    # boxes are exact: a field of the course's boxes alone ray-casts like the 3D footprint
+    boxes_only = Field(size=course.field.size, boxes=course.field.boxes)
+    aim = np.arctan2(course.field.boxes[:, 1] - o[1], course.field.boxes[:, 0] - o[0])
+    flat = boxes_only.raycast(np.tile(o, (len(aim), 1)), aim, 500.0)
+    hedge = _rect_exit(o, aim, -3, -3, 103, 63)
+    box_world = field_world(course.field.size, boxes=course.field.boxes, seed=7)
+    np.testing.assert_allclose(ray_segment_ranges(o, aim, box_world.slice(0.25)), np.minimum(flat, hedge),
+                               rtol=0, atol=1e-9)
+    # circles are prisms with corners on the circle: hit no earlier, and at most r (1 - cos(pi / SIDES)) later
+    c = course.field.circles
+    aim = np.arctan2(c[:, 1] - o[1], c[:, 0] - o[0])
+    t3 = ray_segment_ranges(o, aim, segs)
+    t2 = np.minimum(course.field.raycast(np.tile(o, (len(aim), 1)), aim, 500.0), _rect_exit(o, aim, -3, -3, 103, 63))
+    assert np.all(t3 >= t2 - 1e-9)
+    assert np.all(t3 - t2 <= 0.8 * (1 - np.cos(np.pi / SIDES)) + 1e-9)
 
 
 def test_point_on_an_obstacle_face_is_painted_where_it_projects():

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ..sim.field import field_world, scatter_obstacles
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 
 __all__ = ["Field", "open_field", "random_course", "Course", "UNIMAP_ORIGIN"]
@@ -67,6 +68,32 @@ class Field:
     def n_obstacles(self) -> int:
         """Number of obstacles (circles plus boxes)."""
         return len(self.circles) + len(self.boxes)
+
+    def world(self, seed: int = 0, border: float = 3.0) -> Any:
+        """The same field as a textured 3D :class:`robokit.sim.World` (cameras, LiDAR, meshcat).
+
+        Parameters
+        ----------
+        seed : int, default 0
+            Seeds textures and obstacle heights (the layout is this field's).
+        border : float, default 3.0
+            Run-off between the field's edge and the surrounding hedge (metres).
+
+        Returns
+        -------
+        robokit.sim.World
+            Boxes are exact; each circle becomes a 12-sided prism with its corners on the circle.
+
+        Raises
+        ------
+        ValueError
+            If an obstacle reaches the hedge.
+
+        Notes
+        -----
+        :func:`robokit.sim.field_world`; Hamid et al. (seed 000 Q3, Sec. 1) test on a football field.
+        """
+        return field_world(self.size, self.circles, self.boxes, seed=seed, border=border)
 
     def box_corners(self) -> np.ndarray:
         """Corners of every box, shape ``(M, 4, 2)``, counter-clockwise (Ericson 2005, Sec. 4.4)."""
@@ -266,7 +293,9 @@ def random_course(seed: Any = 0, *, n_waypoints: int = 4, n_obstacles: int = 14,
     Notes
     -----
     Modelled on the experiment of Hamid et al. (seed 000 Q3, Sec. 4): drive from the first to the
-    last waypoint, avoiding the obstacles met on the way.
+    last waypoint, avoiding the obstacles met on the way. The obstacles come from
+    :func:`robokit.sim.field.scatter_obstacles`, the generator :func:`robokit.sim.open_field` also
+    uses; ``course.field.world()`` is the course as a 3D world.
     """
     rng = as_rng(seed, "seed")
     k = check_int(n_waypoints, "n_waypoints", minimum=1, maximum=20)
@@ -282,30 +311,8 @@ def random_course(seed: Any = 0, *, n_waypoints: int = 4, n_obstacles: int = 14,
         if np.hypot(*(p - points[-1])) >= 12.0 and all(np.hypot(*(p - q)) >= 8.0 for q in points[:-1]):
             points.append(p)
     pts = np.array(points)
-    keep_clear = [(p, 2 * gap) for p in pts]
-    shapes: list[tuple[str, np.ndarray, float]] = []  # (kind, params, bounding radius)
-    tries = 0
-    while len(shapes) < n and tries < 5000:
-        tries += 1
-        if rng.random() < frac:
-            leg = int(rng.integers(k))
-            a, b = pts[leg], pts[leg + 1]
-            centre = a + rng.uniform(0.25, 0.75) * (b - a) + rng.normal(0, 0.4, 2)
-        else:
-            centre = rng.uniform([2, 2], [w - 2, h - 2])
-        if rng.random() < 0.5:
-            params = np.array([*centre, rng.uniform(0.25, 0.8)])
-            kind, radius = "circle", params[2]
-        else:
-            params = np.array([*centre, rng.uniform(0.5, 2.0), rng.uniform(0.5, 1.2), rng.uniform(0, np.pi)])
-            kind, radius = "box", float(np.hypot(params[2], params[3]) / 2)
-        if any(np.hypot(*(centre - p)) < radius + r for p, r in keep_clear):
-            continue
-        if any(np.hypot(*(centre - q[:2])) < radius + rq + gap for _, q, rq in shapes):
-            continue
-        shapes.append((kind, params, radius))
-    circles = np.array([p for kind, p, _ in shapes if kind == "circle"]).reshape(-1, 3)
-    boxes = np.array([p for kind, p, _ in shapes if kind == "box"]).reshape(-1, 5)
+    circles, boxes = scatter_obstacles(rng, n, (w, h), waypoints=pts, on_path=frac,
+                                       keep_clear=[(p, 2 * gap) for p in pts], min_gap=gap)
     first = pts[1] - pts[0]
     start = np.array([pts[0, 0], pts[0, 1], float(np.arctan2(first[1], first[0]) + rng.normal(0, 0.5))])
     return Course(Field(size=(w, h), circles=circles, boxes=boxes), pts[1:].copy(), start)
