@@ -27,6 +27,7 @@ from .se3 import _pose_error, as_se3
 __all__ = ["METHODS", "dls_step", "null_space_step", "ik_numeric", "ik_numeric_batch"]
 
 METHODS = ("dls", "gradient_projection", "wln")
+_EYE6 = np.eye(6)
 
 
 def _jacobian_and_error(J: Any, e: Any):
@@ -81,7 +82,7 @@ def dls_step(J: Any, e: Any, damping: float = 1e-2, weights: Any = None) -> np.n
 def _dls(J, e, lam2, winv=None):
     """Unchecked kernel: ``W^-1 J^T (J W^-1 J^T + lam2 I)^-1 e`` for stacked inputs."""
     JW = J if winv is None else J * winv[..., None, :]
-    A = JW @ np.swapaxes(J, -1, -2) + lam2[..., None, None] * np.eye(6)
+    A = JW @ np.swapaxes(J, -1, -2) + lam2[..., None, None] * _EYE6
     y = np.linalg.solve(A, e[..., None])
     return (np.swapaxes(JW, -1, -2) @ y)[..., 0]
 
@@ -134,9 +135,9 @@ def _gp(J, e, g, lam2, k):
     """Unchecked kernel of :func:`null_space_step`."""
     Jt = np.swapaxes(J, -1, -2)
     JJt = J @ Jt
-    primary = (Jt @ np.linalg.solve(JJt + lam2[..., None, None] * np.eye(6), e[..., None]))[..., 0]
+    primary = (Jt @ np.linalg.solve(JJt + lam2[..., None, None] * _EYE6, e[..., None]))[..., 0]
     Jg = (J @ g[..., None])
-    leak = (Jt @ np.linalg.solve(JJt + _PROJ_EPS * np.eye(6), Jg))[..., 0]
+    leak = (Jt @ np.linalg.solve(JJt + _PROJ_EPS * _EYE6, Jg))[..., 0]
     return primary + k[..., None] * (g - leak) if np.ndim(k) else primary + k * (g - leak)
 
 
@@ -260,33 +261,42 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     prev_w = np.full((R, n), np.nan) if method == "wln" else None
     trail = [q.copy()] if history else None
     active = np.flatnonzero(alive)
+    tol2 = tol * tol
     while active.size:
-        full = active.size == R                      # common case: no fancy-index copies
-        qa = qr.copy() if full else qr[active]
+        full = active.size == R
+        sel = slice(None) if full else active        # common case: views, no fancy-index copies
+        qa = qr[sel]
         frames = chain._frames(qa)
-        e = _pose_error(Tr if full else Tr[active], chain._flange(frames))
+        e = _pose_error(Tr[sel], chain._flange(frames))
         e2 = e * e
         pos2, rot2 = e2[:, :3].sum(1), e2[:, 3:].sum(1)
-        conv = (pos2 < tol * tol) & (rot2 < tol * tol)
-        finished = conv.copy()
-        if conv.any():
+        e2s = pos2 + rot2
+        conv = np.maximum(pos2, rot2) < tol2
+        any_conv = bool(conv.any())
+        finished = conv
+        if any_conv:
+            finished = conv.copy()
             qc = qa[conv]
             finished[conv] = np.all((qc >= chain.qmin) & (qc <= chain.qmax), axis=1)
-        if finished.any():
-            rows = active[finished]
-            t = tgt[rows]
-            first = np.unique(t, return_index=True)[1]
-            winner[t[first]] = rows[first]
-            t_done[t] = True
-        err = np.sqrt(pos2 + rot2)
-        improved = err < 0.5 * best[active]
-        best[active] = np.where(improved, err, best[active])
-        stall_a = np.where(improved, 0, stall[active] + 1)
-        stall[active] = stall_a
+            if finished.any():
+                rows = active[finished]
+                t = tgt[rows]
+                first = np.unique(t, return_index=True)[1]
+                winner[t[first]] = rows[first]
+                t_done[t] = True
+        err = np.sqrt(e2s)
+        b = best[sel]
+        improved = err < 0.5 * b
+        best[sel] = np.where(improved, err, b)
+        stall_a = np.where(improved, 0, stall[sel] + 1)
+        stall[sel] = stall_a
         # an attempt ends after max_iter steps or when its error has not halved for `patience` steps;
         # a pose reached outside the limits (clamp=False) also ends it
-        ended = ~finished & ((steps[active] >= max_iter) | (stall_a >= patience) | conv)
-        if ended.any():
+        ended = (steps[sel] >= max_iter) | (stall_a >= patience)
+        if any_conv:
+            ended = ~finished & (ended | conv)
+        any_ended = bool(ended.any())
+        if any_ended:
             for r in active[ended]:
                 t = tgt[r]
                 if tries[t] < restarts:
@@ -297,19 +307,20 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
                         prev_w[r] = np.nan
                 else:
                     alive[r] = False
-        stepping = ~(finished | ended)
-        if P > 1 and finished.any():
-            stepping &= ~t_done[tgt[active]]
-        everyone = bool(stepping.all())
-        rows = active if everyone else active[stepping]
-        if rows.size:
-            e2s = pos2 + rot2
-            fr, es = (frames, e) if everyone else (frames[stepping], e[stepping])
-            if not everyone:
-                e2s = e2s[stepping]
+        everyone = not (any_conv or any_ended)
+        if not everyone:
+            stepping = ~(finished | ended)
+            if P > 1 and any_conv:
+                stepping &= ~t_done[tgt[active]]
+            everyone = bool(stepping.all())
+        rows = sel if everyone else active[stepping]
+        if everyone or rows.size:
+            if everyone:
+                fr, es, qs = frames, e, qa
+            else:
+                fr, es, qs, e2s = frames[stepping], e[stepping], qa[stepping], e2s[stepping]
             J = _jacobian_from_frames(chain, fr)
             lam2 = lam2_0 + 0.5 * e2s
-            qs = qa if everyone else qa[stepping]
             if method == "dls":
                 dq = _dls(J, es, lam2)
             elif method == "gradient_projection":
@@ -320,20 +331,25 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
                 w, grad = _wln(chain, qs, prev_w[rows])
                 prev_w[rows] = grad
                 dq = _dls(J, es, lam2, 1.0 / w)
-            big = np.sqrt((dq * dq).sum(1))
-            dq *= np.minimum(1.0, max_step / np.maximum(big, 1e-300))[:, None]
+            big = np.sqrt(np.einsum("ij,ij->i", dq, dq))
+            over = big > max_step
+            if over.any():
+                dq[over] *= (max_step / big[over])[:, None]
             qs = qs + dq
             if clamp:
                 qs = np.minimum(np.maximum(qs, chain.qmin), chain.qmax)
             qr[rows] = qs
             steps[rows] += 1
-            if P == 1:
+            if full and everyone:
+                iters += P
+            elif P == 1:
                 iters[tgt[rows]] += 1
             else:
                 iters += np.bincount(tgt[rows], minlength=N)
         if history and tries.max() == 0:
             trail.append(qr[::P].copy())
-        active = np.flatnonzero(alive & ~t_done[tgt])
+        if not everyone:
+            active = np.flatnonzero(alive & ~t_done[tgt])
 
     # failed targets report their attempt with the smallest error
     q = qr[::P].copy()

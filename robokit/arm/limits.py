@@ -103,7 +103,8 @@ def _wln(chain: Chain, q: np.ndarray, previous: np.ndarray | None):
     lo, hi = chain.qmin, chain.qmax
     span = hi - lo
     eps = 1e-9 * np.maximum(span, 1e-9)
-    qc = np.clip(q, lo + eps, hi - eps)
+    qc = np.minimum(np.maximum(q, lo + eps), hi - eps)
     grad = np.abs(span**2 * (2 * qc - hi - lo) / (4 * (hi - qc) ** 2 * (qc - lo) ** 2))
-    growing = np.ones_like(grad, bool) if previous is None else grad >= previous
-    return np.where(growing, 1.0 + grad, 1.0), grad
+    if previous is None:
+        return 1.0 + grad, grad
+    return np.where(grad >= previous, 1.0 + grad, 1.0), grad

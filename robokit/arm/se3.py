@@ -114,18 +114,14 @@ def _rotation_log(R: np.ndarray) -> np.ndarray:
     np.subtract(R[..., 0, 2], R[..., 2, 0], out=vee[..., 1])
     np.subtract(R[..., 1, 0], R[..., 0, 1], out=vee[..., 2])
     vee *= 0.5
-    cos = np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0)
+    cos = 0.5 * (R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2] - 1.0)
     sin = np.sqrt(np.einsum("...i,...i->...", vee, vee))
     theta = np.arctan2(sin, cos)
-    # theta / sin(theta) -> 1 as theta -> 0; the near-pi case is handled below
-    small = sin < 1e-12
-    if small.any():
-        scale = np.where(small, 1.0 + theta**2 / 6.0, theta / np.where(small, 1.0, sin))
-    else:
-        scale = theta / sin
-    out = vee * scale[..., None]
+    # theta / sin(theta) -> 1 as theta -> 0 (and 0 / tiny = 0 at R = I); the near-pi case is
+    # handled below
+    out = vee * (theta / (sin + 1e-300))[..., None]
     near_pi = cos < -0.99
-    if np.any(near_pi):
+    if near_pi.any():
         # axis from R + I = 2 w w^T (largest column), sign from the antisymmetric part
         Rp = R[near_pi]
         B = 0.5 * (Rp + np.eye(3))
