@@ -71,6 +71,7 @@ class Chain:
         self.tool = np.eye(4) if tool is None else as_se3(tool, "tool")
         self.base = np.eye(4) if base is None else as_se3(base, "base")
         self._has_tool = not np.array_equal(self.tool, np.eye(4))
+        self._has_offset = bool(np.any(self.offset != 0))
         # Each link transform is affine in (cos theta, sin theta): A = K + cos U + sin V. Sampling the
         # DH formula at theta = 0, pi, +-pi/2 gives K, U, V, so FK needs no trig of the twists.
         A = {t: _link_matrices(np.full(n, t), self.d, self.a, self.alpha, modified=self.modified)
@@ -162,7 +163,7 @@ class Chain:
     # --- kinematics ------------------------------------------------------------------------------
     def _frames(self, q: np.ndarray) -> np.ndarray:
         """Unchecked: poses of frames 0..n for ``q`` of shape (..., n) -> (..., n + 1, 4, 4)."""
-        th = q + self.offset
+        th = q + self.offset if self._has_offset else q
         links = self._K + np.cos(th)[..., None, None] * self._U + np.sin(th)[..., None, None] * self._V
         out = np.empty(q.shape[:-1] + (self.n + 1, 4, 4))
         out[..., 0, :, :] = self.base

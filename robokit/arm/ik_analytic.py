@@ -172,8 +172,7 @@ def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, seeds: np.ndarray):
     X[1, 0], X[1, 1], X[1, 2] = _flip(a), -b, _flip(c)
     ok = ((X >= arm._lo) & (X <= arm._hi)).all(1)                    # (2b, m, K, 2e, 2g)
     D = X - seeds[:, arm._grp].transpose(1, 0, 2)[None, :, :, None, None, :]
-    cost = np.einsum("bjmkeg,bjmkeg->bmkeg", D, D)
-    cost[~ok] = np.inf
+    cost = np.where(ok, np.einsum("bjmkeg,bjmkeg->bmkeg", D, D), np.inf)
     br = cost[1] < cost[0]                                           # (m, K, 2e, 2g)
     cmin = np.minimum(cost[0], cost[1])
     c4 = (q4 - seeds[:, 3:4]) ** 2

@@ -49,7 +49,7 @@ def _zyz(m02, m12, m22, m21, m20, m10, m11):
     a = np.arctan2(m12, m02)
     c = np.arctan2(m21, -m20)
     sing = sb < 1e-12
-    if np.any(sing):
+    if sing.any():
         a = np.where(sing, 0.0, a)
         c = np.where(sing, np.arctan2(m10, m11), c)
     return a, b, c
