@@ -135,3 +135,16 @@ def test_step_functions_reproduce_the_solver():
         elbow_angle([0, 0, 0.36], [0, 0, 2.0], 0.42, 0.40)
     with pytest.raises(ValueError, match="T"):
         wrist_centre(np.eye(3), 0.126)
+
+
+def test_single_solve_on_floats_matches_the_vectorised_batch():
+    # ik_srs computes the per-target geometry on Python floats, ik_srs_batch on arrays; for at
+    # most 16 targets both run the same dense arm-angle grid, so the answers must agree
+    rng = np.random.default_rng(40)
+    q = IIWA.random_q(12, rng)
+    T, seeds = IIWA.fk(q), IIWA.random_q(12, rng)
+    batch = ik_srs_batch(IIWA, T, seeds)
+    single = np.array([ik_srs(IIWA, Ti, si).q for Ti, si in zip(T, seeds)])
+    assert batch.success.all()
+    assert np.abs(single - batch.q).max() < 1e-9
+    assert np.allclose([arm_angle(IIWA, qi) for qi in q], arm_angle(IIWA, q), atol=1e-12)
