@@ -183,3 +183,15 @@ def test_outdoor_textures_are_seeded_rgb_images():
         assert np.array_equal(t, fn(64, 48, np.random.default_rng(0)))
     with pytest.raises(ValueError, match="width"):
         tox.bark(4, 48)
+
+
+def test_frustum_clipping_of_far_reaching_ground_keeps_the_picture(monkeypatch):
+    import robokit.sim.render as rd
+    world = open_field()
+    T = CAM.pose_at([20.0, 10.0, 2.0])
+    clipped = CAM.render(world, T)
+    monkeypatch.setattr(rd, "_FAR_PIXELS", np.inf)  # rasterise the huge projected polygons as they are
+    plain = CAM.render(world, T)
+    np.testing.assert_array_equal(clipped.depth, plain.depth)
+    # only ties between coplanar neighbouring ground tiles may flip, on their shared edges
+    assert (clipped.image != plain.image).any(axis=2).mean() < 1e-3

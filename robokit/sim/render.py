@@ -23,19 +23,25 @@ from .world import World
 __all__ = ["render_pinhole"]
 
 
-def _clip_near(poly: np.ndarray, near: float) -> np.ndarray:
-    """Sutherland-Hodgman clipping of a 3D polygon (camera frame) against ``z >= near``."""
+def _clip(poly: np.ndarray, normal: np.ndarray, offset: float) -> np.ndarray:
+    """Sutherland-Hodgman clipping of a 3D polygon (camera frame) against ``normal . X >= offset``."""
     out = []
     n = len(poly)
+    s = poly @ normal - offset
     for i in range(n):
-        a, b = poly[i], poly[(i + 1) % n]
-        ina, inb = a[2] >= near, b[2] >= near
-        if ina:
-            out.append(a)
-        if ina != inb:
-            t = (near - a[2]) / (b[2] - a[2])
-            out.append(a + t * (b - a))
-    return np.array(out)
+        j = (i + 1) % n
+        if s[i] >= 0:
+            out.append(poly[i])
+        if (s[i] >= 0) != (s[j] >= 0):
+            out.append(poly[i] + s[i] / (s[i] - s[j]) * (poly[j] - poly[i]))
+    return np.array(out).reshape(-1, 3)
+
+
+#: Pixels beyond which a projected polygon is also clipped to the view frustum's sides: edges
+#: millions of pixels long (an outdoor ground reaching behind the camera) make cv2.fillPoly take
+#: ~25 ms each, and fixed point with shift 4 overflows int32 at 1.3e8. Indoor polygons stay below
+#: ~7e4 px, so their rasterisation is left exactly as it was.
+_FAR_PIXELS = 1e5
 
 
 def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world_cam: np.ndarray,
@@ -80,10 +86,19 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     zinv_buf = np.zeros((height, width), np.float32)
     for idx in np.flatnonzero(keep):
         s = world.surfaces[idx]
-        poly = _clip_near(P[idx], near)
+        poly = _clip(P[idx], np.array([0.0, 0.0, 1.0]), near)
         if len(poly) < 3:
             continue
         uv = np.column_stack([fx * poly[:, 0] / poly[:, 2] + cx, fy * poly[:, 1] / poly[:, 2] + cy])
+        if np.abs(uv).max() > _FAR_PIXELS:
+            # clip to planes through the optical centre 2 px outside the image: what falls inside the
+            # image is unchanged, and projected coordinates stay small
+            for normal in ([fx, 0.0, cx + 2], [-fx, 0.0, width + 1 - cx], [0.0, fy, cy + 2],
+                           [0.0, -fy, height + 1 - cy]):
+                poly = _clip(poly, np.array(normal), 0.0)
+            if len(poly) < 3:
+                continue
+            uv = np.column_stack([fx * poly[:, 0] / poly[:, 2] + cx, fy * poly[:, 1] / poly[:, 2] + cy])
         x0, y0 = np.maximum(np.floor(uv.min(axis=0)).astype(int), 0)
         x1 = min(int(np.ceil(uv[:, 0].max())), width - 1)
         y1 = min(int(np.ceil(uv[:, 1].max())), height - 1)
