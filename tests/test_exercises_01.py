@@ -1,10 +1,9 @@
-"""Assignment 01 exercises: the references pass their own cases, and check() catches wrong answers."""
+"""Assignment 01 exercises: registration and check() catching wrong answers (references: test_exercises_references.py)."""
 import numpy as np
 import pytest
 
 from robokit.exercises import visual_slam
 from robokit.grading import check, exercises_for
-from robokit.grading.exercise import call_student, expected_output, judge
 
 EXERCISES = exercises_for("01_visual_slam")
 
@@ -15,16 +14,6 @@ def test_assignment_is_registered():
     assert {e.id for e in EXERCISES} == {"01.junction_strength", "01.match_ratio", "01.triangulate_svd",
                                          "01.stereo_point", "01.ransac_sample_count", "01.pose_from_two",
                                          "01.kalman_fuse", "01.hough_votes"}
-
-
-@pytest.mark.parametrize("seed", [7, "instructor-secret"])
-@pytest.mark.parametrize("exercise", EXERCISES, ids=lambda e: e.id)
-def test_reference_passes_its_own_cases(exercise, seed):
-    cases = exercise.make_cases(seed)
-    assert any(c.raises for c in cases), "every exercise has a bad-input case"
-    for case in cases:
-        outcome = judge(exercise, case, expected_output(exercise, case), call_student(exercise.reference, case))
-        assert outcome.passed, f"{exercise.id} {case.label}: {outcome.message}"
 
 
 @pytest.mark.parametrize("exercise", EXERCISES, ids=lambda e: e.id)

@@ -1,0 +1,25 @@
+"""Every registered exercise: its reference passes its own cases, bad input included, for any seed.
+
+One test for all assignments (discovered from robokit/exercises/), so a new lesson's exercises are
+covered without copying this test.
+"""
+import pytest
+
+from robokit.grading import assignments
+from robokit.grading.exercise import call_student, expected_output, judge
+
+ALL = [ex for exercises in assignments().values() for ex in exercises]
+
+
+def test_every_assignment_has_exercises():
+    assert len(assignments()) >= 4 and all(assignments().values())
+
+
+@pytest.mark.parametrize("seed", [7, 2024, "instructor-secret"])
+@pytest.mark.parametrize("exercise", ALL, ids=lambda e: e.id)
+def test_reference_passes_its_own_cases(exercise, seed):
+    cases = exercise.make_cases(seed)
+    assert any(c.raises for c in cases), f"{exercise.id}: every exercise needs a bad-input case"
+    for case in cases:
+        outcome = judge(exercise, case, expected_output(exercise, case), call_student(exercise.reference, case))
+        assert outcome.passed, f"{exercise.id} {case.label}: {outcome.message}"
