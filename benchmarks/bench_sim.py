@@ -19,7 +19,8 @@ import time
 import cv2
 import numpy as np
 
-from robokit.sim import Lidar, OmniCamera, PinholeCamera, box_room, lab_room, long_corridor, office_floor, open_field
+from robokit.sim import (Lidar, OmniCamera, PinholeCamera, box_room, lab_room, long_corridor, office_floor, open_field,
+                         sift_view_pair)
 
 
 def median_time(fn, repeats: int) -> float:
@@ -30,21 +31,6 @@ def median_time(fn, repeats: int) -> float:
         fn()
         times.append(time.perf_counter() - t)
     return statistics.median(times)
-
-
-def sift_stats(world, pose, cam, step=0.3):
-    T1 = cam.pose_at(pose)
-    T2 = cam.pose_at([pose[0] + step * np.cos(pose[2]), pose[1] + step * np.sin(pose[2]), pose[2]])
-    f1, f2 = cam.render(world, T1), cam.render(world, T2)
-    sift = cv2.SIFT_create()
-    k1, d1 = sift.detectAndCompute(cv2.cvtColor(f1.image, cv2.COLOR_RGB2GRAY), None)
-    k2, d2 = sift.detectAndCompute(cv2.cvtColor(f2.image, cv2.COLOR_RGB2GRAY), None)
-    good = [m for m, n in cv2.BFMatcher(cv2.NORM_L2).knnMatch(d1, d2, k=2) if m.distance < 0.8 * n.distance]
-    p1 = np.array([k1[m.queryIdx].pt for m in good])
-    p2 = np.array([k2[m.trainIdx].pt for m in good])
-    depth = f1.depth[np.round(p1[:, 1]).astype(int), np.round(p1[:, 0]).astype(int)]
-    pred, _ = cam.project(cam.backproject(p1, depth, T1), T2)
-    return len(k1), len(good), float((np.linalg.norm(pred - p2, axis=1) < 3.0).mean())
 
 
 def main() -> None:
@@ -106,8 +92,8 @@ def main() -> None:
                               ("office_floor", office_floor(), [10.0, 4.3, -np.pi / 2]),
                               ("box_room", box_room(), [1.0, 1.0, 0.4]),
                               ("open_field", field, [50.0, 30.0, 0.3])]:
-        n_kp, n_m, ratio = sift_stats(world, pose, cam)
-        print(f"{name:<16}{n_kp:>10}{n_m:>9}{ratio:>14.3f}")
+        pair = sift_view_pair(world, cam, pose)
+        print(f"{name:<16}{pair.keypoints:>10}{pair.matches:>9}{pair.inlier_ratio:>14.3f}")
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@ from robokit.geometry import se2_to_se3, se3_from_rt
 from robokit.sim import camera as cm
 from robokit.sim.omni import OmniCamera
 from robokit.sim.world import World
+from robokit.sim.feature_check import ground_truth_inliers, sift_view_pair
 from robokit.sim.field import open_field
 from robokit.sim.worlds import box_room, lab_room, long_corridor, office_floor
 
@@ -95,36 +96,36 @@ def test_omni_projection_round_trip_and_renderer():
     assert abs(frame.depth[int(round(c[1])), int(round(c[0]))] - rx[0]) < 0.02
 
 
-def _sift_ratio(world, pose, step):
-    """Keypoints in view 1 and the fraction of ratio-test matches to a view ``step`` metres ahead
-    that agree with the ground-truth geometry (depth back-projection, 3 px)."""
-    T1 = CAM.pose_at(pose)
-    T2 = CAM.pose_at([pose[0] + step * np.cos(pose[2]), pose[1] + step * np.sin(pose[2]), pose[2]])
-    f1, f2 = CAM.render(world, T1), CAM.render(world, T2)
-    sift = cv2.SIFT_create()
-    k1, d1 = sift.detectAndCompute(cv2.cvtColor(f1.image, cv2.COLOR_RGB2GRAY), None)
-    k2, d2 = sift.detectAndCompute(cv2.cvtColor(f2.image, cv2.COLOR_RGB2GRAY), None)
-    pairs = cv2.BFMatcher(cv2.NORM_L2).knnMatch(d1, d2, k=2)
-    good = [m for m, n in pairs if m.distance < 0.8 * n.distance]
-    p1 = np.array([k1[m.queryIdx].pt for m in good])
-    p2 = np.array([k2[m.trainIdx].pt for m in good])
-    depth = f1.depth[np.round(p1[:, 1]).astype(int), np.round(p1[:, 0]).astype(int)]
-    X = CAM.backproject(p1, depth, T1)
-    pred, _ = CAM.project(X, T2)
-    ok = np.linalg.norm(pred - p2, axis=1) < 3.0
-    return len(k1), len(good), ok.mean()
-
-
 @pytest.mark.parametrize("builder, pose", [
     (lab_room, [5.0, 2.0, np.pi / 2]), (long_corridor, [3.0, 0.0, 0.0]), (office_floor, [10.0, 4.3, -np.pi / 2]),
     (box_room, [1.0, 1.0, 0.4]), (open_field, [50.0, 30.0, 0.3]),
 ])
 def test_sift_finds_hundreds_of_keypoints_and_correct_matches(builder, pose):
-    n_kp, n_match, inliers = _sift_ratio(builder(), pose, 0.3)
-    print(f"{builder.__name__}: {n_kp} keypoints, {n_match} matches, inlier ratio {inliers:.3f}")
-    assert n_kp >= 200
-    assert n_match >= 50
-    assert inliers > 0.8
+    pair = sift_view_pair(builder(), CAM, pose, step=0.3)
+    print(f"{builder.__name__}: {pair.keypoints} keypoints, {pair.matches} matches, inlier ratio "
+          f"{pair.inlier_ratio:.3f}")
+    assert pair.keypoints >= 200
+    assert pair.matches >= 50
+    assert pair.inlier_ratio > 0.8
+
+
+def test_ground_truth_inliers_accepts_true_and_rejects_shuffled_correspondences():
+    world = lab_room()
+    T1, T2 = CAM.pose_at([5.0, 2.0, np.pi / 2]), CAM.pose_at([5.0, 2.3, np.pi / 2])
+    depth = CAM.render(world, T1).depth
+    rng = np.random.default_rng(0)
+    uv1 = np.column_stack([rng.uniform(100, 540, 200), rng.uniform(100, 380, 200)])
+    row, col = np.round(uv1[:, 1]).astype(int), np.round(uv1[:, 0]).astype(int)
+    uv2, _ = CAM.project(CAM.backproject(uv1, depth[row, col], T1), T2)
+    assert ground_truth_inliers(CAM, depth, T1, T2, uv1, uv2).all()
+    assert ground_truth_inliers(CAM, depth, T1, T2, uv1, uv2 + [4.0, 0.0]).sum() == 0
+    assert ground_truth_inliers(CAM, depth, T1, T2, uv1, uv2[::-1]).mean() < 0.1
+    with pytest.raises(ValueError, match="uv2"):
+        ground_truth_inliers(CAM, depth, T1, T2, uv1, uv2[:10])
+    with pytest.raises(ValueError, match="uv1"):
+        ground_truth_inliers(CAM, depth, T1, T2, uv1 + [1000.0, 0.0], uv2)
+    with pytest.raises(TypeError, match="camera"):
+        ground_truth_inliers("cam", depth, T1, T2, uv1, uv2)
 
 
 def test_lighting_and_noise_change_the_image_reproducibly():

@@ -34,6 +34,10 @@ Recorded runs
     ``record(world, path, sensors={"cam": cam, "laser": lidar}, rate=5)`` -> :class:`Run`
     (``t``, ``poses``, ``odometry``, ``images``, ``depths``, ``scans``), cached as ``.npz``.
 
+Checks
+    ``sift_view_pair(world, camera, robot_pose)``: OpenCV SIFT between two views, matches judged
+    against the rendered depth (``ground_truth_inliers``).
+
 Example
 -------
 >>> from robokit.sim import lab_room, PinholeCamera, StereoRig
@@ -44,6 +48,7 @@ Example
 ((480, 640, 3), dtype('float32'))
 """
 from .camera import Frame, PinholeCamera, StereoRig, mount_pose
+from .feature_check import ViewPairCheck, ground_truth_inliers, sift_view_pair
 from .field import field_world, open_field, scatter_obstacles
 from .lidar import Lidar, ray_segment_ranges, scan_points
 from .motion import (Path, corridor_path, diff_drive_velocities, lab_lap, noisy_odometry, odometry_increment,
@@ -61,5 +66,5 @@ __all__ = [
     "Lidar", "ray_segment_ranges", "scan_points",
     "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "odometry_increment",
     "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap",
-    "Run", "record",
+    "Run", "record", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair",
 ]
