@@ -33,9 +33,6 @@ __all__ = ["SRSArm", "arm_angle", "ik_srs_branches", "ik_srs", "ik_srs_batch"]
 _ALPHA = np.array([-1, 1, 1, -1, -1, 1, 0]) * np.pi / 2
 #: Branch order of the 8 solutions for one arm angle: (elbow, shoulder, wrist) sign flags.
 BRANCHES = [(e, s, w) for e in (0, 1) for s in (0, 1) for w in (0, 1)]
-#: Matrix entries read by the ZYZ decomposition: (0,2) (1,2) (2,2) (2,1) (2,0) (1,0) (1,1).
-_ROWS = np.array([0, 1, 2, 2, 2, 1, 1])
-_COLS = np.array([2, 2, 2, 1, 0, 0, 1])
 
 
 class SRSArm:
@@ -130,7 +127,7 @@ class SRSArm:
         Branch ``b`` of the 8 is ``BRANCHES[b] = (elbow, shoulder, wrist)`` mirror flags.
         """
         a, b, c = self.angles(coeffs[0], psi)
-        ang = [(x, y, z) for x, y, z in ((a, b, c), (_flip(a), -b, _flip(c)))]
+        ang = ((a, b, c), (_flip(a), -b, _flip(c)))           # branch b >= 0, then its mirror
         q4 = coeffs[1]
         out = np.empty(psi.shape + (8, 7))
         for k, (e, sh, wr) in enumerate(BRANCHES):
