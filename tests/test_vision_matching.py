@@ -7,7 +7,7 @@ from PIL import Image
 
 from robokit.vision.descriptors import plot_features, sift_features
 from robokit.vision.evaluation import apply_homography, recall_precision, similarity_homography
-from robokit.vision.matching import ratio_match, two_nearest
+from robokit.vision.matching import k_nearest, ratio_match, two_nearest
 
 
 @pytest.fixture(scope="module")
@@ -36,6 +36,26 @@ def test_kdtree_and_opencv_agree():
     assert len(a) > 90 and np.array_equal(a.train, a.query)
     d, i = two_nearest(query, train)
     assert d.shape == (100, 2) and np.all(d[:, 0] <= d[:, 1])
+
+
+@pytest.mark.parametrize("dim", [16, 128])
+def test_k_nearest_methods_agree_including_the_distance_bound(dim):
+    rng = np.random.default_rng(5)
+    train = rng.normal(size=(400, dim)).astype(np.float32)
+    query = train[::4] + rng.normal(scale=0.3, size=(100, dim)).astype(np.float32)
+    bound = float(np.median(np.linalg.norm(query - train[::4], axis=1)))   # about half beyond it
+    ref_d = np.sort(np.linalg.norm(query[:, None] - train[None], axis=2), axis=1)[:, :3]
+    for method in ("kdtree", "bruteforce", "opencv"):
+        d, i = k_nearest(query, train, 3, method=method)
+        assert d.shape == i.shape == (100, 3)
+        assert np.allclose(d, ref_d, atol=1e-3), method
+        assert np.allclose(np.linalg.norm(query[:, None] - train[i], axis=2), d, atol=1e-3), method
+        db, _ = k_nearest(query, train, 3, method=method, max_distance=bound)
+        assert np.array_equal(np.isinf(db), ref_d > bound) and 20 < np.isinf(db[:, 0]).sum() < 80, method
+    with pytest.raises(ValueError, match="train: expected at least 3"):
+        k_nearest(query, train[:2], 3)
+    with pytest.raises(ValueError, match="method"):
+        k_nearest(query, train, 3, method="annoy")
 
 
 def test_matching_degenerate_inputs():

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ..mapping.landmarks import LandmarkMap
+from ..vision.matching import k_nearest
 from ..validation import as_array, check_choice, check_int, check_positive
 from .egomotion import InsufficientMatchesError, fit_pose
 
@@ -95,40 +95,13 @@ def candidate_matches(points, descriptors, landmarks: LandmarkMap, *, k: int = 3
     if method == "auto":
         method = "kdtree" if landmarks.descriptor_size <= 32 else "bruteforce"
     k = min(k, len(landmarks))
-    if method == "kdtree":
-        dist, idx = cKDTree(landmarks.descriptors).query(desc, k=k, distance_upper_bound=max_distance)
-        dist, idx = dist.reshape(pts.shape[0], k), idx.reshape(pts.shape[0], k)
-    else:
-        dist, idx = _k_nearest_bruteforce(desc, landmarks.descriptors, k)
-        dist[dist > max_distance] = np.inf
+    dist, idx = k_nearest(desc, landmarks.descriptors, k, method=method, max_distance=max_distance)
     fi = np.repeat(np.arange(pts.shape[0]), k)
     li = idx.ravel()
     ok = np.isfinite(dist.ravel())
     fi, li = fi[ok], li[ok]
     ok = np.abs(pts[fi, 1] - landmarks.positions[li, 1]) <= height_tol
     return fi[ok], li[ok]
-
-
-def _k_nearest_bruteforce(query: np.ndarray, train: np.ndarray, k: int, chunk: int = 256):
-    """Exact ``k`` nearest rows of ``train`` for every ``query`` row, by blocks of matrix products.
-
-    ``||a - b||^2 = ||a||^2 + ||b||^2 - 2 a.b`` turns the search into one GEMM per block; the
-    ``k`` smallest per row come from a partial sort and are ordered afterwards.
-    """
-    q, t = query.astype(np.float32), np.ascontiguousarray(train, np.float32)
-    tn = (t * t).sum(1)
-    dist, idx = np.empty((len(q), k)), np.empty((len(q), k), int)
-    for s in range(0, len(q), chunk):
-        block = q[s:s + chunk]
-        d2 = tn[None, :] - 2.0 * (block @ t.T)                     # + ||a||^2 below, same per row
-        part = np.argpartition(d2, k - 1, axis=1)[:, :k] if k < t.shape[0] else np.tile(np.arange(k), (len(block), 1))
-        rows = np.arange(len(block))[:, None]
-        order = np.argsort(d2[rows, part], axis=1, kind="stable")
-        best = part[rows, order]
-        idx[s:s + chunk] = best
-        diff = block[:, None, :] - t[best]                           # exact distances of the k chosen
-        dist[s:s + chunk] = np.sqrt((diff.astype(np.float64) ** 2).sum(-1))
-    return dist, idx
 
 
 def hough_accumulator(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, *, bin_size: float = 0.04,

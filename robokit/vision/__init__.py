@@ -10,7 +10,7 @@ from .descriptors import (assign_orientations, detect_and_describe, gradient_his
                           plot_features, reduced_descriptor, sift_descriptor, sift_features)
 from .evaluation import apply_homography, recall_precision, similarity_homography, warp_image
 from .features import Features, Keypoints, as_gray_image
-from .matching import Matches, ratio_match, two_nearest
+from .matching import Matches, k_nearest, ratio_match, two_nearest
 from .plot import (PlotParams, ScaleSpace, detect_plot, detect_plot_levels, edge_strength, junction_strength,
                    orientation_tensor, plot_scales, polynomial_expansion, tensor_eigenvalues)
 from .stereo import (NotRectifiedError, StereoMatches, StereoObservations, StereoRig, disparity_to_point,
@@ -19,7 +19,7 @@ from .stereo import (NotRectifiedError, StereoMatches, StereoObservations, Stere
 __all__ = ["assign_orientations", "detect_and_describe", "gradient_histogram_descriptor", "plot_features",
            "reduced_descriptor", "sift_descriptor", "sift_features", "apply_homography", "recall_precision", "warp_image",
            "similarity_homography", "Features", "Keypoints", "as_gray_image", "Matches", "ratio_match",
-           "two_nearest", "PlotParams", "ScaleSpace", "detect_plot", "detect_plot_levels", "edge_strength",
+           "two_nearest", "k_nearest", "PlotParams", "ScaleSpace", "detect_plot", "detect_plot_levels", "edge_strength",
            "junction_strength", "orientation_tensor", "plot_scales", "polynomial_expansion",
            "tensor_eigenvalues", "NotRectifiedError", "StereoMatches", "StereoRig", "disparity_to_point",
            "match_stereo", "triangulate_svd", "StereoObservations", "observe_stereo"]
