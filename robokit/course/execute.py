@@ -86,8 +86,11 @@ def _kernel_env(workdir: Path, fast: bool) -> dict[str, str]:
 
 
 def execute_in_process(src: Path, dst: Path, *, cwd: Path, cell_timeout: int,
-                       allowed_errors: tuple[str, ...] = ()) -> tuple[str, str]:
+                       allowed_errors: tuple[str, ...] = (), runtime_dir: Path | None = None) -> tuple[str, str]:
     """Execute ``src`` with nbclient in this process and write the executed notebook to ``dst``.
+
+    The kernel talks over Unix sockets created in ``runtime_dir`` (default: a new temporary
+    directory), never in ``cwd``, so the notebook starts in an empty directory.
 
     Returns ``(status, error_tail)``. With ``allowed_errors`` every cell runs and the notebook
     fails only on an error whose exception name is not in the list (used for assignments, whose
@@ -97,9 +100,15 @@ def execute_in_process(src: Path, dst: Path, *, cwd: Path, cell_timeout: int,
     from nbclient import NotebookClient
     from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
 
+    from jupyter_client import KernelManager
+
     nb = nbformat.read(src, as_version=4)
+    # Unix-socket (IPC) transport: kernels started side by side by a parallel build cannot race for
+    # the same free TCP ports (seen as "Kernel died before replying to kernel_info")
+    sockets = Path(runtime_dir) if runtime_dir else Path(tempfile.mkdtemp(prefix="robokit-kernel-"))
     client = NotebookClient(
         nb,
+        km=KernelManager(kernel_name="python3", transport="ipc", ip=str(sockets / "kernel")),
         timeout=cell_timeout,
         kernel_name="python3",
         allow_errors=bool(allowed_errors),
@@ -177,7 +186,7 @@ def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
     dst.parent.mkdir(parents=True, exist_ok=True)
     result_file = workdir / "result.json"
     cmd = [sys.executable, "-m", "robokit.course.execute", str(path), str(dst), str(result_file),
-           "--cwd", str(cwd), "--cell-timeout", str(int(max(1, timeout)))]
+           "--cwd", str(cwd), "--runtime-dir", str(workdir), "--cell-timeout", str(int(max(1, timeout)))]
     if assignment:
         cmd += ["--allow-errors", *STUB_ERRORS]
     start = time.perf_counter()
@@ -217,11 +226,12 @@ def _main(argv: list[str] | None = None) -> int:
     parser.add_argument("dst", type=Path)
     parser.add_argument("result", type=Path)
     parser.add_argument("--cwd", type=Path, required=True)
+    parser.add_argument("--runtime-dir", type=Path, default=None)
     parser.add_argument("--cell-timeout", type=int, default=600)
     parser.add_argument("--allow-errors", nargs="*", default=[])
     args = parser.parse_args(argv)
     status, error = execute_in_process(args.src, args.dst, cwd=args.cwd, cell_timeout=args.cell_timeout,
-                                       allowed_errors=tuple(args.allow_errors))
+                                       allowed_errors=tuple(args.allow_errors), runtime_dir=args.runtime_dir)
     args.result.write_text(json.dumps({"status": status, "error": error}))
     return 0
 
