@@ -7,7 +7,7 @@ from PIL import Image
 
 from robokit.vision.descriptors import plot_features, sift_features
 from robokit.vision.evaluation import apply_homography, recall_precision, similarity_homography
-from robokit.vision.matching import k_nearest, ratio_match, two_nearest
+from robokit.vision.matching import distance_ratio, gated_ratio_match, k_nearest, ratio_match, two_nearest
 
 
 @pytest.fixture(scope="module")
@@ -23,6 +23,40 @@ def test_ratio_test_accepts_distinct_and_rejects_ambiguous():
     m = ratio_match(query, train, ratio=0.65)
     assert m.query.tolist() == [0] and m.train.tolist() == [0]
     assert m.ratio[0] == pytest.approx(0.05 / 0.95)
+
+
+def test_gated_matching_with_every_pair_is_plain_ratio_matching():
+    rng = np.random.default_rng(4)
+    train = rng.normal(size=(120, 32)).astype(np.float32)
+    query = train[:60] + rng.normal(scale=0.3, size=(60, 32)).astype(np.float32)
+    qi, ti = np.meshgrid(np.arange(60), np.arange(120), indexing="ij")
+    for ratio in (0.5, 0.65, 0.8):
+        a = ratio_match(query, train, ratio=ratio)
+        b = gated_ratio_match(query, train, qi.ravel(), ti.ravel(), ratio=ratio)
+        assert np.array_equal(a.query, b.query) and np.array_equal(a.train, b.train)
+        assert np.allclose(a.distance, b.distance) and np.allclose(a.ratio, b.ratio)
+    # a gate that leaves each query a single candidate: the ratio passes, max_distance still applies
+    c = gated_ratio_match(query, train, np.arange(60), np.arange(60), max_distance=1.5)
+    assert np.array_equal(c.query, c.train) and np.all(c.distance <= 1.5) and 0 < len(c) < 60
+
+
+def test_exact_duplicates_are_ambiguous_whatever_the_rounding():
+    # large, irregular values: a dot-product distance would leave rounding noise of ~1e-8 and let
+    # one of two identical candidates win the ratio test
+    rng = np.random.default_rng(5)
+    desc = (rng.normal(size=(200, 128)) * 37.3).astype(np.float32)
+    twin = np.vstack([desc, desc])
+    idx = np.arange(200)
+    m = gated_ratio_match(desc, twin, np.r_[idx, idx], np.r_[idx, idx + 200])
+    assert len(m) == 0
+    assert len(ratio_match(desc, twin)) == 0
+    assert distance_ratio([0.0, 1.0, 1.0], [0.0, 2.0, np.inf]).tolist() == [1.0, 0.5, 0.0]
+    with pytest.raises(ValueError, match="query_index, train_index"):
+        gated_ratio_match(desc, twin, [0, 200], [0, 1])
+    with pytest.raises(ValueError, match="train_index"):
+        gated_ratio_match(desc, twin, [0, 1], [0])
+    with pytest.raises(ValueError, match="ratio"):
+        gated_ratio_match(desc, twin, [0], [0], ratio=1.5)
 
 
 def test_kdtree_and_opencv_agree():

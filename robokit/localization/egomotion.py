@@ -21,7 +21,7 @@ from ..geometry import wrap_angle
 from ..mapping.frames import as_pose, robot_to_world, world_to_robot
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
-from ..vision.matching import ratio_match
+from ..vision.matching import gated_ratio_match, ratio_match
 
 __all__ = ["DegenerateCorrespondenceError", "InsufficientMatchesError", "EgomotionResult",
            "ransac_sample_count", "pose_from_two", "fit_pose", "ransac_pose", "continuation_matches",
@@ -390,16 +390,8 @@ def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_
         return none
     fi = np.repeat(np.arange(pts.shape[0]), counts)
     li = np.concatenate([np.asarray(x, int) for x in lists if x])
-    dist = np.linalg.norm(desc[fi] - landmarks.descriptors[li], axis=1)
-    order = np.lexsort((dist, fi))
-    fi, li, dist = fi[order], li[order], dist[order]
-    first = np.r_[True, fi[1:] != fi[:-1]]
-    start = np.nonzero(first)[0]
-    has_second = np.r_[start[1:], fi.size] - start > 1
-    second = np.full(start.size, np.inf)
-    second[has_second] = dist[start[has_second] + 1]
-    keep = (dist[start] <= max_distance) & (dist[start] < ratio * second)
-    return fi[start[keep]], li[start[keep]]
+    m = gated_ratio_match(desc, landmarks.descriptors, fi, li, ratio=ratio, max_distance=max_distance)
+    return m.query, m.train
 
 
 def track(points, descriptors, landmarks: LandmarkMap, odometry, odometry_covariance=None, *,

@@ -14,7 +14,7 @@ from scipy.spatial import cKDTree
 
 from ..validation import as_array, as_points, check_finite_scalar, check_positive
 from .features import Features
-from .matching import two_nearest
+from .matching import distance_ratio, two_nearest
 
 __all__ = ["apply_homography", "warp_image", "similarity_homography", "recall_precision"]
 
@@ -176,7 +176,7 @@ def recall_precision(features_a: Features, features_b: Features, homography, ima
     near, _ = cKDTree(features_b.keypoints.xy).query(warped, k=1)
     n_corr = int(np.sum(inside & (near <= tol)))
     dist, index = two_nearest(features_a.descriptors, features_b.descriptors, method=method)
-    r = np.divide(dist[:, 0], dist[:, 1], out=np.ones(len(dist)), where=dist[:, 1] > 0)
+    r = distance_ratio(dist[:, 0], dist[:, 1])
     correct = np.linalg.norm(warped - features_b.keypoints.xy[index[:, 0]], axis=1) <= tol
     matched = (r[None, :] < ts[:, None]) & inside[None, :]
     n_correct = np.sum(matched & correct[None, :], axis=1)

@@ -16,7 +16,10 @@ from scipy.spatial import cKDTree
 
 from ..validation import as_array, check_choice, check_int, check_positive
 
-__all__ = ["Matches", "k_nearest", "two_nearest", "ratio_match"]
+__all__ = ["Matches", "LIN_RATIO", "k_nearest", "two_nearest", "distance_ratio", "ratio_match", "gated_ratio_match"]
+
+#: Lin et al.'s nearest-neighbour ratio threshold ``t`` (PLOT paper, Sec. 3: "t is set equal to 0.65").
+LIN_RATIO = 0.65
 
 
 @dataclass(frozen=True)
@@ -165,7 +168,38 @@ def two_nearest(query, train, *, method: str = "kdtree") -> tuple[np.ndarray, np
     return k_nearest(query, t, 2, method=method)
 
 
-def ratio_match(query, train, *, ratio: float = 0.65, method: str = "kdtree",
+def distance_ratio(best, second) -> np.ndarray:
+    """Nearest over second-nearest descriptor distance, the quantity the ratio test thresholds.
+
+    Parameters
+    ----------
+    best, second : array_like, shape (N,)
+        Distances to the nearest and the second-nearest candidate (``second`` may be ``inf`` when
+        there is only one candidate).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        ``best / second``; 1 where ``second`` is 0 (two exact duplicates are ambiguous, so a test
+        ``ratio < t`` with ``t <= 1`` rejects them) and 0 where ``second`` is infinite.
+
+    Notes
+    -----
+    Lin et al. Sec. 3, ``||D_A - D_B|| / ||D_A - D_C|| < t``; Lowe (2004), Sec. 7.1.
+    """
+    b = np.asarray(best, dtype=float)
+    c = np.asarray(second, dtype=float)
+    return np.divide(b, c, out=np.ones(np.broadcast(b, c).shape), where=c > 0)
+
+
+def _check_ratio(ratio) -> float:
+    ratio = check_positive(ratio, "ratio")
+    if ratio > 1:
+        raise ValueError(f"ratio: expected a value in (0, 1], got {ratio}")
+    return ratio
+
+
+def ratio_match(query, train, *, ratio: float = LIN_RATIO, method: str = "kdtree",
                 max_distance: float | None = None) -> Matches:
     """Nearest-neighbour distance-ratio matching.
 
@@ -193,16 +227,79 @@ def ratio_match(query, train, *, ratio: float = 0.65, method: str = "kdtree",
     -----
     Lin et al. Sec. 3, "the nearest neighbor ratio"; Lowe 2004, Sec. 7.1.
     """
-    ratio = check_positive(ratio, "ratio")
-    if ratio > 1:
-        raise ValueError(f"ratio: expected a value in (0, 1], got {ratio}")
+    ratio = _check_ratio(ratio)
     q, t = _descriptors(query, "query"), _descriptors(train, "train")
     if q.shape[0] == 0 or t.shape[0] < 2:
         return Matches.empty()
     dist, index = two_nearest(q, t, method=method)
-    r = np.divide(dist[:, 0], dist[:, 1], out=np.ones(len(dist)), where=dist[:, 1] > 0)
+    r = distance_ratio(dist[:, 0], dist[:, 1])
     keep = r < ratio
     if max_distance is not None:
         keep &= dist[:, 0] <= check_positive(max_distance, "max_distance")
     rows = np.nonzero(keep)[0]
     return Matches(rows, index[rows, 0], dist[rows, 0], r[rows])
+
+
+def gated_ratio_match(query, train, query_index, train_index, *, ratio: float = LIN_RATIO,
+                      max_distance: float | None = None) -> Matches:
+    """Distance-ratio matching among the candidate pairs that a geometric gate allows.
+
+    Each query row is matched to its nearest candidate when the ratio to its second-nearest
+    *candidate* passes (a query with a single candidate passes the ratio). Distances are computed
+    exactly (in float64) for the candidate pairs only, so two identical candidates tie at exactly 0
+    and are rejected.
+
+    Parameters
+    ----------
+    query : array_like, shape (N, D)
+    train : array_like, shape (M, D)
+    query_index, train_index : array_like of int, shape (K,)
+        The candidate pairs ``(query_index[k], train_index[k])``, e.g. the features on the same
+        image row within the disparity range (stereo) or the landmarks predicted near a feature
+        (tracking).
+    ratio : float, default 0.65
+    max_distance : float, optional
+        Also reject matches whose nearest distance exceeds this.
+
+    Returns
+    -------
+    Matches
+        One row per matched query, in ascending query order.
+
+    Raises
+    ------
+    ValueError
+        For descriptors of different lengths, candidate indices out of range or of different
+        lengths, or a ratio outside (0, 1].
+
+    Notes
+    -----
+    Lin et al. Sec. 3: the nearest-neighbour ratio combined with the epipolar, disparity,
+    orientation, scale and continuation constraints; Se, Lowe & Little (2002), Sec. 3.2 (search
+    only the landmarks predicted near each feature).
+    """
+    ratio = _check_ratio(ratio)
+    q, t = _descriptors(query, "query"), _descriptors(train, "train")
+    qi = as_array(query_index, "query_index", ndim=1, dtype=int)
+    ti = as_array(train_index, "train_index", shape=(qi.size,), dtype=int)
+    if qi.size == 0 or q.shape[0] == 0 or t.shape[0] == 0:
+        return Matches.empty()
+    if q.shape[1] != t.shape[1]:
+        raise ValueError(f"query: expected descriptors of length {t.shape[1]}, got {q.shape[1]}")
+    if qi.min() < 0 or qi.max() >= q.shape[0] or ti.min() < 0 or ti.max() >= t.shape[0]:
+        raise ValueError(f"query_index, train_index: expected rows of query (< {q.shape[0]}) and train "
+                         f"(< {t.shape[0]}), got {qi.min()}..{qi.max()} and {ti.min()}..{ti.max()}")
+    dist = np.sqrt(((q[qi].astype(np.float64) - t[ti]) ** 2).sum(axis=1))
+    order = np.lexsort((dist, qi))                   # by query, nearest candidate first
+    qi, ti, dist = qi[order], ti[order], dist[order]
+    start = np.flatnonzero(np.r_[True, qi[1:] != qi[:-1]])
+    has_second = np.r_[start[1:], qi.size] - start > 1
+    second = np.full(start.size, np.inf)
+    second[has_second] = dist[start[has_second] + 1]
+    best = dist[start]
+    r = distance_ratio(best, second)
+    keep = r < ratio
+    if max_distance is not None:
+        keep &= best <= check_positive(max_distance, "max_distance")
+    rows = start[keep]
+    return Matches(qi[rows], ti[rows], best[keep], r[keep])

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..validation import as_array, check_finite_scalar, check_positive
 from .features import Features
-from .matching import ratio_match
+from .matching import gated_ratio_match, ratio_match
 
 __all__ = ["NotRectifiedError", "StereoRig", "StereoMatches", "StereoObservations", "disparity_to_point",
            "triangulate_svd", "match_stereo", "observe_stereo"]
@@ -329,24 +329,11 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
     ok &= dtheta <= dori
     sr = kl.scale[:, None] / kr.scale[None, :]
     ok &= (sr <= srat) & (sr >= 1 / srat)
-    dl, dr = left.descriptors.astype(float), right.descriptors.astype(float)
-    dist2 = (dl * dl).sum(1)[:, None] + (dr * dr).sum(1)[None, :] - 2 * dl @ dr.T
-    dist = np.where(ok, np.sqrt(np.maximum(dist2, 0.0)), np.inf)
-    rows = np.arange(len(kl))
-    if dist.shape[1] > 2:  # the two smallest per row, in order, without sorting whole rows
-        two = np.argpartition(dist, 1, axis=1)[:, :2]
-        swap = dist[rows, two[:, 0]] > dist[rows, two[:, 1]]
-        order = np.where(swap[:, None], two[:, ::-1], two)
-    else:
-        order = np.argsort(dist, axis=1)[:, :2]
-    best = dist[rows, order[:, 0]]
-    second = dist[rows, order[:, 1]] if dist.shape[1] > 1 else np.full(len(kl), np.inf)
-    keep = np.isfinite(best) & (best <= max_distance) & (best < ratio * second)
-    li, ri = rows[keep], order[keep, 0]
-    claims = np.bincount(ri, minlength=len(kr))
-    unique = claims[ri] == 1
-    li, ri = li[unique], ri[unique]
-    return StereoMatches(li, ri, kl.xy[li, 0] - kr.xy[ri, 0], best[keep][unique])
+    li, ri = np.nonzero(ok)
+    m = gated_ratio_match(left.descriptors, right.descriptors, li, ri, ratio=ratio, max_distance=max_distance)
+    unique = np.bincount(m.train, minlength=len(kr))[m.train] == 1   # one left feature per right one
+    li, ri = m.query[unique], m.train[unique]
+    return StereoMatches(li, ri, kl.xy[li, 0] - kr.xy[ri, 0], m.distance[unique])
 
 
 def observe_stereo(left: Features, right: Features, rig: StereoRig, *, sigma_c: float = 1.0,
