@@ -65,9 +65,11 @@ class Scene:
     Examples
     --------
     >>> scene = Scene()
-    >>> scene.add_box("robot/body", size=(0.5, 0.25, 0.15), color=0x3366cc)
-    >>> scene.add_triad("world")
+    >>> scene.add_box("robot/body", size=(0.5, 0.25, 0.15), color=0x3366cc).add_triad("world")
+    Scene(title='robokit scene', commands=4)
     >>> page = scene.html()  # a complete, offline HTML page
+    >>> page.startswith("<!DOCTYPE html>")
+    True
     """
 
     def __init__(self, title: str = "robokit scene", height: int = 420, live: bool = False) -> None:
