@@ -20,7 +20,7 @@ import numpy as np
 
 from ..validation import as_array, as_points, check_positive
 
-__all__ = ["Scene", "viewer_javascript"]
+__all__ = ["Scene", "viewer_javascript", "as_color"]
 
 
 @functools.lru_cache(maxsize=1)
@@ -29,8 +29,30 @@ def viewer_javascript() -> str:
     return resources.files("meshcat").joinpath("viewer/dist/main.min.js").read_text(encoding="utf-8")
 
 
-def _color(value: Any, name: str = "color") -> int:
-    """Accept 0xRRGGBB or an (r, g, b) triple of floats in [0, 1]."""
+def as_color(value: Any, name: str = "color") -> int:
+    """Return a colour as meshcat's integer ``0xRRGGBB``.
+
+    Parameters
+    ----------
+    value : int or array_like, shape (3,)
+        ``0xRRGGBB``, or an ``(r, g, b)`` triple of floats in [0, 1] (matplotlib's convention).
+    name : str, default "color"
+        Argument name for error messages.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ValueError, TypeError
+        For anything else.
+
+    Examples
+    --------
+    >>> hex(as_color((1.0, 0.5, 0.0)))
+    '0xff8000'
+    """
     if isinstance(value, (int, np.integer)) and not isinstance(value, bool) and 0 <= int(value) <= 0xFFFFFF:
         return int(value)
     rgb = as_array(value, name, shape=(3,))
@@ -84,17 +106,30 @@ class Scene:
 
     # --- recording -------------------------------------------------------------------------------
     @staticmethod
-    def _path(path: str):
+    def meshcat_path(path: str):
+        """The meshcat path object of a scene path like ``"robot/body"`` (under ``/meshcat``).
+
+        Raises
+        ------
+        ValueError
+            For an empty path or one that is not a string.
+        """
         from meshcat.path import Path as MeshcatPath
 
         if not isinstance(path, str) or not path.strip("/"):
             raise ValueError(f"path: expected a non-empty scene path like 'robot/body', got {path!r}")
         return MeshcatPath(("meshcat",)).append(path.strip("/"))
 
-    def _send(self, command: Any) -> None:
+    def send(self, command: Any) -> "Scene":
+        """Record one meshcat command (``meshcat.commands.*``), the building block of every helper.
+
+        Use it for what the helpers do not cover (animations, camera properties); the command is
+        kept for the offline page and, with ``live=True``, sent to the meshcat server too.
+        """
         self._commands.append(command)
         if self._live is not None:
             self._live.window.send(command)
+        return self
 
     @property
     def commands(self) -> list[dict]:
@@ -105,21 +140,14 @@ class Scene:
         """Place a meshcat geometry (or object) at ``path``; the building block of the helpers."""
         from meshcat.commands import SetObject
 
-        self._send(SetObject(geometry, material, self._path(path)))
+        self.send(SetObject(geometry, material, self.meshcat_path(path)))
         return self
 
     def set_transform(self, path: str, transform: Any) -> "Scene":
         """Set the 4x4 homogeneous pose of ``path`` relative to its parent."""
         from meshcat.commands import SetTransform
 
-        self._send(SetTransform(_transform(transform), self._path(path)))
-        return self
-
-    def delete(self, path: str) -> "Scene":
-        """Remove ``path`` and everything below it."""
-        from meshcat.commands import Delete
-
-        self._send(Delete(self._path(path)))
+        self.send(SetTransform(_transform(transform), self.meshcat_path(path)))
         return self
 
     # --- helpers ---------------------------------------------------------------------------------
@@ -129,7 +157,7 @@ class Scene:
         opacity = check_positive(opacity, "opacity")
         if opacity > 1:
             raise ValueError(f"opacity: expected a value in (0, 1], got {opacity}")
-        return MeshLambertMaterial(color=_color(color), opacity=opacity, transparent=opacity < 1)
+        return MeshLambertMaterial(color=as_color(color), opacity=opacity, transparent=opacity < 1)
 
     def add_box(self, path: str, size: Sequence[float], transform: Any = None, color: Any = 0x8899AA,
                 opacity: float = 1.0) -> "Scene":
@@ -168,7 +196,7 @@ class Scene:
 
         pts = as_points(points, "points", 3).astype(np.float32)
         if colors is None:  # meshcat's PointsMaterial always reads per-vertex colours
-            c = _color(color)
+            c = as_color(color)
             cols = np.tile(np.array([c >> 16, (c >> 8) & 255, c & 255], np.float32) / 255, (len(pts), 1))
         else:
             cols = as_points(colors, "colors", 3).astype(np.float32)
@@ -184,7 +212,7 @@ class Scene:
         from meshcat.geometry import Line, LineBasicMaterial, PointsGeometry
 
         pts = as_points(points, "points", 3, min_count=2).astype(np.float32)
-        return self.set_object(path, Line(PointsGeometry(pts.T), LineBasicMaterial(color=_color(color))))
+        return self.set_object(path, Line(PointsGeometry(pts.T), LineBasicMaterial(color=as_color(color))))
 
     # --- output ----------------------------------------------------------------------------------
     def html(self) -> str:

@@ -15,7 +15,7 @@ from ..geometry import se2_to_se3
 from ..sim.camera import PinholeCamera
 from ..sim.world import World
 from ..validation import as_array, as_points, check_int, check_positive
-from .scene import Scene, _color
+from .scene import Scene, as_color
 
 __all__ = ["add_world", "add_camera", "add_trajectory", "add_particles", "add_landmarks", "animate_poses",
            "look_from"]
@@ -103,7 +103,7 @@ def _segments(scene: Scene, path: str, pts: np.ndarray, color: Any) -> Scene:
     from meshcat.geometry import LineBasicMaterial, LineSegments, PointsGeometry
 
     return scene.set_object(path, LineSegments(PointsGeometry(np.asarray(pts, np.float32).T),
-                                               LineBasicMaterial(color=_color(color))))
+                                               LineBasicMaterial(color=as_color(color))))
 
 
 def add_camera(scene: Scene, path: str, camera: PinholeCamera, pose: Any, depth: float = 0.4,
@@ -284,9 +284,9 @@ def animate_poses(scene: Scene, path: str, transforms: Any, fps: float = 10.0, r
 
     class _Animation:  # meshcat's Animation keyed by our own path object
         def lower(self):
-            return [{"path": Scene._path(path).lower(), "clip": clip.lower()}]
+            return [{"path": Scene.meshcat_path(path).lower(), "clip": clip.lower()}]
 
-    scene._send(SetAnimation(_Animation(), play=True, repetitions=check_int(repetitions, "repetitions", minimum=1)))
+    scene.send(SetAnimation(_Animation(), play=True, repetitions=check_int(repetitions, "repetitions", minimum=1)))
     return scene
 
 
@@ -314,6 +314,6 @@ def look_from(scene: Scene, position: Any) -> Scene:
     p = as_array(position, "position", shape=(3,))
     if np.linalg.norm(p) == 0:
         raise ValueError("position: expected a point away from the origin, got [0, 0, 0]")
-    scene._send(SetProperty("position", [float(p[0]), float(p[2]), float(-p[1])],
+    scene.send(SetProperty("position", [float(p[0]), float(p[2]), float(-p[1])],
                             MeshcatPath(("Cameras", "default", "rotated", "<object>"))))
     return scene
