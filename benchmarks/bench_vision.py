@@ -21,7 +21,7 @@ from PIL import Image
 from robokit.localization.egomotion import ransac_pose
 from robokit.localization.hough import global_localize
 from robokit.mapping.frames import world_to_robot
-from robokit.vision.descriptors import plot_features, sift_features
+from robokit.vision.descriptors import detect_plot_features, detect_sift_features
 from robokit.vision.evaluation import recall_precision, similarity_homography
 from tests.test_localization_hough import POSES, lab_map_and_view
 
@@ -34,11 +34,11 @@ def _photo() -> np.ndarray:
 
 def bench_detect_describe(img: np.ndarray, repeats: int = 9) -> None:
     sift = cv2.SIFT_create()
-    plot_features(img), sift.detectAndCompute(img, None)  # warm-up
+    detect_plot_features(img), sift.detectAndCompute(img, None)  # warm-up
     t_plot, t_sift = [], []
     for _ in range(repeats):  # interleaved so that load from other processes hits both alike
         t0 = time.perf_counter()
-        fp = plot_features(img)
+        fp = detect_plot_features(img)
         t1 = time.perf_counter()
         ks, _ = sift.detectAndCompute(img, None)
         t2 = time.perf_counter()
@@ -54,7 +54,7 @@ def bench_recall(img: np.ndarray) -> None:
     pairs = {"zoom+rotation": (cv2.warpPerspective(img, h, (640, 480)), h),
              "lighting": (np.clip(0.45 * img.astype(float) + 15, 0, 255).astype(np.uint8), np.eye(3))}
     for name, (other, hh) in pairs.items():
-        for label, extract in (("PLOT", plot_features), ("SIFT", sift_features)):
+        for label, extract in (("PLOT", detect_plot_features), ("SIFT", detect_sift_features)):
             r = recall_precision(extract(img), extract(other), hh, other.shape)
             i = int(np.argmin(np.abs(r["thresholds"] - 0.65)))
             print(f"{name:14s} {label}: recall {r['recall'][i]:.3f}, 1-precision {r['one_minus_precision'][i]:.3f} "

@@ -6,9 +6,9 @@ from robokit.localization.egomotion import InsufficientMatchesError
 from robokit.localization.hough import candidate_matches, global_localize, hough_accumulator
 from robokit.mapping.frames import world_to_robot
 from robokit.mapping.landmarks import LandmarkMap
-from robokit.vision.stereo import StereoRig, disparity_to_point
+from robokit.vision.stereo import StereoCalibration, disparity_to_point
 
-RIG = StereoRig(focal=400.0, c0=319.5, r0=239.5, baseline=0.12)
+RIG = StereoCalibration(focal=400.0, c0=319.5, r0=239.5, baseline=0.12)
 
 
 def lab_landmarks(rng, n_landmarks=5000, dim=16):

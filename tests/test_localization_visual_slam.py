@@ -10,7 +10,7 @@ from robokit.geometry import se2_to_pqt, wrap_angle
 from robokit.localization import VisualSLAM
 from robokit.localization.lab_experiment import LAB_TEST_POSES, calibrated_rig, lab_experiment, mapping_run
 from robokit.mapping import LandmarkMap
-from robokit.vision import StereoRig
+from robokit.vision import StereoCalibration
 
 
 @pytest.fixture(scope="module")
@@ -66,7 +66,7 @@ def test_kidnapped_frame_falls_back_to_whole_database_matching():
 
 
 def test_textureless_frames_keep_the_odometry():
-    rig = StereoRig(focal=500.0, c0=319.5, r0=239.5, baseline=0.12)
+    rig = StereoCalibration(focal=500.0, c0=319.5, r0=239.5, baseline=0.12)
     slam = VisualSLAM(rig, method="plot")
     blank = np.full((480, 640), 128, np.uint8)
     first = slam.start(blank, blank, [1.0, 2.0, 0.1])
@@ -79,7 +79,7 @@ def test_textureless_frames_keep_the_odometry():
 
 
 def test_bad_input_is_rejected():
-    rig = StereoRig(focal=500.0, c0=319.5, r0=239.5, baseline=0.12)
+    rig = StereoCalibration(focal=500.0, c0=319.5, r0=239.5, baseline=0.12)
     with pytest.raises(TypeError, match="rig"):
         VisualSLAM(object())
     with pytest.raises(ValueError, match="method"):
@@ -113,7 +113,7 @@ def test_only_landmarks_expected_in_view_age():
 
 
 def test_in_view_uses_the_field_of_view_and_range():
-    rig = StereoRig(focal=500.0, c0=320.0, r0=240.0, baseline=0.12)
+    rig = StereoCalibration(focal=500.0, c0=320.0, r0=240.0, baseline=0.12)
     slam = VisualSLAM(rig, max_range=5.0)
     pts = np.array([[0.0, 0.0, 2.0], [0.0, 0.0, -2.0], [3.0, 0.0, 2.0], [0.0, 0.0, 7.0]])
     slam.map.add(pts, np.stack([np.eye(3) * 1e-4] * 4), np.zeros((4, 16)))

@@ -5,11 +5,11 @@ import pytest
 from matplotlib import cbook
 from PIL import Image
 
-from robokit.vision.descriptors import (assign_orientations, detect_and_describe, plot_features,
-                                        reduced_descriptor, sift_descriptor, sift_features)
+from robokit.vision.descriptors import (assign_orientations, detect_and_describe, detect_plot_features,
+                                        reduced_descriptor, sift_descriptor, detect_sift_features)
 from robokit.vision.evaluation import apply_homography, similarity_homography
 from robokit.vision.features import Features, Keypoints
-from robokit.vision.plot import detect_plot
+from robokit.vision.plot_detector import detect_plot
 
 
 @pytest.fixture(scope="module")
@@ -50,7 +50,7 @@ def test_orientation_follows_image_rotation(photo):
 
 
 def test_descriptors_are_unit_vectors_with_the_papers_sizes(photo):
-    f = plot_features(photo, max_keypoints=200)
+    f = detect_plot_features(photo, max_keypoints=200)
     assert isinstance(f, Features) and f.descriptors.shape == (len(f), 128)
     assert np.allclose(np.linalg.norm(f.descriptors, axis=1), 1, atol=1e-5)
     r = reduced_descriptor(photo, f.keypoints)
@@ -58,7 +58,7 @@ def test_descriptors_are_unit_vectors_with_the_papers_sizes(photo):
 
 
 def test_descriptor_is_rotation_invariant(photo):
-    f = plot_features(photo, max_keypoints=300)
+    f = detect_plot_features(photo, max_keypoints=300)
     h = similarity_homography(photo.shape, 1.0, np.deg2rad(70))
     warped = cv2.warpPerspective(photo, h, (640, 480))
     kp = f.keypoints
@@ -73,7 +73,7 @@ def test_descriptor_is_rotation_invariant(photo):
 
 
 def test_opencv_sift_wrapper_matches_our_conventions(photo):
-    s = sift_features(photo)
+    s = detect_sift_features(photo)
     assert isinstance(s, Features) and s.descriptors.shape[1] == 128 and len(s) > 200
     assert np.allclose(np.linalg.norm(s.descriptors, axis=1), 1, atol=1e-5)
     # our orientation histogram agrees with OpenCV's at OpenCV's own keypoints
@@ -81,7 +81,7 @@ def test_opencv_sift_wrapper_matches_our_conventions(photo):
                                                 np.zeros(len(s))), peak_ratio=1.0)
     strong = s.keypoints.scale > 2.0
     assert np.median(_circ(ours.orientation - s.keypoints.orientation)[strong]) < np.deg2rad(10)
-    r = sift_features(photo, n_features=50, descriptor="reduced16")
+    r = detect_sift_features(photo, n_features=50, descriptor="reduced16")
     assert r.descriptors.shape[1] == 16 and len(r) <= 60
 
 
@@ -94,7 +94,7 @@ def test_interchangeable_and_empty_results():
     with pytest.raises(ValueError, match="method: expected one of"):
         detect_and_describe(flat, "surf")
     with pytest.raises(ValueError, match="descriptor: expected one of"):
-        plot_features(flat, descriptor="128")
+        detect_plot_features(flat, descriptor="128")
     with pytest.raises(TypeError, match="keypoints: expected Keypoints"):
         sift_descriptor(flat, np.zeros((3, 2)))
     with pytest.raises(ValueError, match="scale"):

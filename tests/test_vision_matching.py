@@ -5,7 +5,7 @@ import pytest
 from matplotlib import cbook
 from PIL import Image
 
-from robokit.vision.descriptors import plot_features, sift_features
+from robokit.vision.descriptors import detect_plot_features, detect_sift_features
 from robokit.vision.evaluation import apply_homography, recall_precision, similarity_homography
 from robokit.vision.matching import distance_ratio, gated_ratio_match, k_nearest, ratio_match, two_nearest
 
@@ -114,7 +114,7 @@ def test_similarity_homography_and_bad_homographies():
         apply_homography(np.eye(2), [[1, 2]])
 
 
-@pytest.mark.parametrize("extract", [plot_features, sift_features], ids=["plot", "sift"])
+@pytest.mark.parametrize("extract", [detect_plot_features, detect_sift_features], ids=["plot", "sift"])
 def test_recall_precision_on_boat_and_leuven_like_pairs(photo, extract):
     h = similarity_homography(photo.shape, 1.25, np.deg2rad(30))
     zoomed = cv2.warpPerspective(photo, h, (640, 480))
@@ -130,9 +130,9 @@ def test_recall_precision_on_boat_and_leuven_like_pairs(photo, extract):
 
 
 def test_recall_precision_detects_wrong_ground_truth(photo):
-    fa = sift_features(photo, n_features=300)
+    fa = detect_sift_features(photo, n_features=300)
     h = similarity_homography(photo.shape, 1.0, np.deg2rad(20))
-    fb = sift_features(cv2.warpPerspective(photo, h, (640, 480)), n_features=300)
+    fb = detect_sift_features(cv2.warpPerspective(photo, h, (640, 480)), n_features=300)
     good = recall_precision(fa, fb, h, photo.shape)
     wrong = recall_precision(fa, fb, similarity_homography(photo.shape, 1.0, np.deg2rad(-20)), photo.shape)
     assert good["recall"][-1] > 0.5 and good["one_minus_precision"][-1] < 0.1

@@ -9,8 +9,8 @@ from scipy.stats import chi2
 sim = pytest.importorskip("robokit.sim")
 pytestmark = pytest.mark.slow  # renders six stereo views (~10 s)
 
-from robokit.vision.descriptors import plot_features, sift_features  # noqa: E402
-from robokit.vision.stereo import StereoRig, observe_stereo  # noqa: E402
+from robokit.vision.descriptors import detect_plot_features, detect_sift_features  # noqa: E402
+from robokit.vision.stereo import StereoCalibration, observe_stereo  # noqa: E402
 
 POSES = [(5.0, 2.0, 1.57), (2.5, 7.0, -0.6), (7.5, 5.0, 2.8)]
 
@@ -20,7 +20,7 @@ def lab():
     world = sim.lab_room()
     cam = sim.PinholeCamera.from_fov()
     rig = sim.StereoRig(cam, baseline=0.12)
-    return world, rig, StereoRig(focal=cam.fx, c0=cam.cx, r0=cam.cy, baseline=rig.baseline)
+    return world, rig, StereoCalibration(focal=cam.fx, c0=cam.cx, r0=cam.cy, baseline=rig.baseline)
 
 
 def _truth(depth, xy):
@@ -38,7 +38,7 @@ def _truth(depth, xy):
     return z, smooth
 
 
-@pytest.mark.parametrize("extract", [plot_features, sift_features], ids=["plot", "sift"])
+@pytest.mark.parametrize("extract", [detect_plot_features, detect_sift_features], ids=["plot", "sift"])
 def test_rendered_stereo_points_lie_within_their_three_sigma(lab, extract):
     world, sim_rig, rig = lab
     inside, total, disparity_error = 0, 0, []

@@ -6,13 +6,13 @@ from matplotlib import cbook
 from PIL import Image
 from scipy.stats import chi2
 
-from robokit.vision.descriptors import plot_features, sift_features
+from robokit.vision.descriptors import detect_plot_features, detect_sift_features
 from robokit.vision.evaluation import similarity_homography
 from robokit.vision.features import Features
-from robokit.vision.stereo import (NotRectifiedError, StereoRig, disparity_to_point, match_stereo,
+from robokit.vision.stereo import (NotRectifiedError, StereoCalibration, disparity_to_point, match_stereo,
                                    triangulate_svd)
 
-RIG = StereoRig(focal=400.0, c0=319.5, r0=239.5, baseline=0.12)
+RIG = StereoCalibration(focal=400.0, c0=319.5, r0=239.5, baseline=0.12)
 
 
 @pytest.fixture(scope="module")
@@ -83,16 +83,16 @@ def test_disparity_input_is_validated():
     with pytest.raises(TypeError, match="rig"):
         disparity_to_point([1.0], [2.0], [3.0], "rig")
     with pytest.raises(ValueError, match="baseline"):
-        StereoRig(400.0, 320.0, 240.0, -0.1)
+        StereoCalibration(400.0, 320.0, 240.0, -0.1)
 
 
 def test_rig_from_projections_refuses_unrectified_pairs():
     pl, pr = RIG.projection_matrices()
-    assert StereoRig.from_projections(3 * pl, pr) == RIG
+    assert StereoCalibration.from_projections(3 * pl, pr) == RIG
     bad = pr.copy()
     bad[1, 3] = 20.0  # vertical offset between the cameras
     with pytest.raises(NotRectifiedError, match="rectified"):
-        StereoRig.from_projections(pl, bad)
+        StereoCalibration.from_projections(pl, bad)
     assert issubclass(NotRectifiedError, ValueError)
 
 
@@ -106,7 +106,7 @@ def _two_plane_pair(photo, z_near=2.1, z_far=4.3, split=320):
     return right.astype(np.uint8), (z_near, z_far)
 
 
-@pytest.mark.parametrize("extract", [plot_features, sift_features], ids=["plot", "sift"])
+@pytest.mark.parametrize("extract", [detect_plot_features, detect_sift_features], ids=["plot", "sift"])
 def test_stereo_matching_recovers_depth_of_textured_planes(photo, extract):
     right, (z_near, z_far) = _two_plane_pair(photo)
     fl, fr = extract(photo), extract(right)
@@ -123,7 +123,7 @@ def test_stereo_matching_recovers_depth_of_textured_planes(photo, extract):
 
 
 def test_ambiguous_and_unrectified_input(photo):
-    f = plot_features(photo, max_keypoints=400)
+    f = detect_plot_features(photo, max_keypoints=400)
     # a right image with every feature duplicated is ambiguous everywhere
     kp = f.keypoints
     from robokit.vision.features import Keypoints
@@ -134,7 +134,7 @@ def test_ambiguous_and_unrectified_input(photo):
     h = similarity_homography(photo.shape, 1.0, np.deg2rad(8))
     rotated = cv2.warpPerspective(photo, h, (640, 480))
     with pytest.raises(NotRectifiedError, match="rectified pair"):
-        match_stereo(f, plot_features(rotated, max_keypoints=400))
+        match_stereo(f, detect_plot_features(rotated, max_keypoints=400))
     empty = Features(Keypoints.empty(), np.zeros((0, 128), np.float32))
     assert len(match_stereo(f, empty)) == 0 and len(match_stereo(empty, f)) == 0
     with pytest.raises(ValueError, match="max_disparity"):
@@ -167,7 +167,7 @@ def test_project_refuses_points_behind_the_rig():
 def test_observe_stereo_gives_points_in_the_robot_frame(photo):
     from robokit.vision.stereo import observe_stereo
     right, (z_near, z_far) = _two_plane_pair(photo)
-    obs = observe_stereo(plot_features(photo), plot_features(right), RIG)
+    obs = observe_stereo(detect_plot_features(photo), detect_plot_features(right), RIG)
     assert len(obs) > 150 and obs.covariances.shape == (len(obs), 3, 3)
     assert len(obs.features) == len(obs) and obs.features.descriptors.shape[1] == 128
     x = obs.features.keypoints.xy[:, 0]
@@ -175,4 +175,4 @@ def test_observe_stereo_gives_points_in_the_robot_frame(photo):
     z_true = np.where(x < 320, z_near, z_far)
     assert np.median(np.abs(obs.points[away, 2] - z_true[away])) < 0.05
     flat = np.full((480, 640), 100, np.uint8)
-    assert len(observe_stereo(plot_features(flat), plot_features(right), RIG)) == 0
+    assert len(observe_stereo(detect_plot_features(flat), detect_plot_features(right), RIG)) == 0

@@ -14,8 +14,8 @@ from ..localization.egomotion import pose_from_two, ransac_sample_count
 from ..localization.hough import hough_accumulator
 from ..mapping.landmarks import kalman_fuse
 from ..vision.matching import ratio_match
-from ..vision.plot import junction_strength
-from ..vision.stereo import StereoRig, disparity_to_point, triangulate_svd
+from ..vision.plot_detector import junction_strength
+from ..vision.stereo import StereoCalibration, disparity_to_point, triangulate_svd
 
 ASSIGNMENT = "01_visual_slam"
 #: Written (manually graded) questions: id -> points.
@@ -41,14 +41,14 @@ def stereo_point(c, r, d, focal, c0, r0, baseline) -> tuple[np.ndarray, np.ndarr
     """3-D points ``(N, 3)`` and covariances ``(N, 3, 3)`` from pixels and disparities (1 px sigmas).
 
     Plain-data wrapper of :func:`robokit.vision.disparity_to_point` with a
-    :class:`robokit.vision.StereoRig` built from ``focal, c0, r0, baseline`` (Se et al. Sec. 3.1).
+    :class:`robokit.vision.StereoCalibration` built from ``focal, c0, r0, baseline`` (Se et al. Sec. 3.1).
 
     Raises
     ------
     ValueError
         For non-positive disparities, focal length or baseline, or arrays of different lengths.
     """
-    return disparity_to_point(c, r, d, StereoRig(focal=focal, c0=c0, r0=r0, baseline=baseline))
+    return disparity_to_point(c, r, d, StereoCalibration(focal=focal, c0=c0, r0=r0, baseline=baseline))
 
 
 def hough_votes(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, bin_size, angle_bin) -> np.ndarray:
@@ -96,7 +96,7 @@ def _ratio_cases(rng: np.random.Generator) -> list[Case]:
 
 
 def _rig_projections(focal, c0, r0, baseline):
-    return StereoRig(focal=focal, c0=c0, r0=r0, baseline=baseline).projection_matrices()
+    return StereoCalibration(focal=focal, c0=c0, r0=r0, baseline=baseline).projection_matrices()
 
 
 def _triangulate_cases(rng: np.random.Generator) -> list[Case]:
@@ -196,7 +196,7 @@ EXERCISES = [
         id="01.junction_strength", function="junction_strength",
         signature="junction_strength(tensor: array (..., 2, 2)) -> numpy.ndarray (...)", points=1,
         cases=_junction_cases, reference=junction_strength, compare=close(rtol=1e-6, atol=1e-9),
-        references=("robokit.vision.plot.junction_strength", "robokit.vision.plot.tensor_eigenvalues"),
+        references=("robokit.vision.plot_detector.junction_strength", "robokit.vision.plot_detector.tensor_eigenvalues"),
         description="The smaller eigenvalue lambda_2 of each symmetric 2 x 2 tensor (Lin et al. Sec. 2.i); "
                     "ValueError unless the last two axes are 2 x 2."),
     Exercise(

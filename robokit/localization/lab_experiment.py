@@ -18,9 +18,9 @@ import numpy as np
 
 from ..config import FAST
 from ..geometry import se2_to_pqt, wrap_angle
-from ..sim import PinholeCamera, StereoRig as RenderRig, lab_lap, lab_room, record
+from ..sim import PinholeCamera, StereoRig, lab_lap, lab_room, record
 from ..validation import as_array, as_points, check_int, check_positive
-from ..vision.stereo import StereoRig
+from ..vision.stereo import StereoCalibration
 from .visual_slam import VisualSLAM
 
 __all__ = ["LAB_TEST_POSES", "PAPER_RESULT", "LabExperiment", "MapConsistency", "calibrated_rig", "mapping_run",
@@ -41,8 +41,8 @@ PAPER_RESULT = {"translation_m": 0.06, "rotation_rad": np.deg2rad(1.2), "seconds
                 "hardware": "700 MHz Pentium III"}
 
 
-def calibrated_rig(render_rig: RenderRig) -> StereoRig:
-    """The calibration model (:class:`robokit.vision.StereoRig`) of a simulated stereo rig.
+def calibrated_rig(render_rig: StereoRig) -> StereoCalibration:
+    """The calibration model (:class:`robokit.vision.StereoCalibration`) of a simulated stereo rig.
 
     Parameters
     ----------
@@ -50,7 +50,7 @@ def calibrated_rig(render_rig: RenderRig) -> StereoRig:
 
     Returns
     -------
-    robokit.vision.StereoRig
+    robokit.vision.StereoCalibration
         Focal length, image centre and baseline as a calibration would give them.
 
     Raises
@@ -63,10 +63,10 @@ def calibrated_rig(render_rig: RenderRig) -> StereoRig:
     Se et al. Sec. 3.1 (``f``, ``(c0, r0)`` and ``I``); the simulator's rigs are rectified by
     construction.
     """
-    if not isinstance(render_rig, RenderRig):
+    if not isinstance(render_rig, StereoRig):
         raise TypeError(f"render_rig: expected robokit.sim.StereoRig, got {type(render_rig).__name__}")
     cam = render_rig.camera
-    return StereoRig(focal=float(cam.fx), c0=float(cam.cx), r0=float(cam.cy), baseline=float(render_rig.baseline))
+    return StereoCalibration(focal=float(cam.fx), c0=float(cam.cx), r0=float(cam.cy), baseline=float(render_rig.baseline))
 
 
 def seed_to_lab(points, covariances=None, camera_height: float = 0.8):
@@ -122,7 +122,7 @@ def mapping_run(rate: float = 1.0, *, baseline: float = 0.12, seed: int = 0):
     Se et al. Sec. 3.6: the robot "traverses around" the 10 m x 10 m lab while building the map.
     """
     world = lab_room()
-    rig = RenderRig(PinholeCamera.from_fov(), baseline=check_positive(baseline, "baseline"))
+    rig = StereoRig(PinholeCamera.from_fov(), baseline=check_positive(baseline, "baseline"))
     run = record(world, lab_lap(world), {"stereo": rig}, rate=check_positive(rate, "rate"), seed=seed)
     return run, rig
 

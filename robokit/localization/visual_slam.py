@@ -31,7 +31,7 @@ from ..mapping.frames import as_pose, world_to_robot
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_rng, check_choice, check_int, check_positive
 from ..vision.descriptors import detect_and_describe
-from ..vision.stereo import StereoObservations, StereoRig, observe_stereo
+from ..vision.stereo import StereoObservations, StereoCalibration, observe_stereo
 from .egomotion import track
 from .hough import Hypothesis, global_localize
 
@@ -74,7 +74,7 @@ class VisualSLAM:
 
     Parameters
     ----------
-    rig : robokit.vision.StereoRig
+    rig : robokit.vision.StereoCalibration
         The calibrated, rectified stereo pair (focal length, image centre, baseline).
     method : {"sift", "plot"}, default "sift"
         Feature detector (Lin et al. Sec. 2 or OpenCV's SIFT, Se et al. Sec. 2.1).
@@ -116,12 +116,12 @@ class VisualSLAM:
     re-observed landmarks become overconfident (measured in the lesson).
     """
 
-    def __init__(self, rig: StereoRig, *, method: str = "sift", descriptor: str = "reduced16", max_missed: int = 20,
+    def __init__(self, rig: StereoCalibration, *, method: str = "sift", descriptor: str = "reduced16", max_missed: int = 20,
                  min_matches: int = 15, window: float = 0.3, threshold: float = 0.1,
                  odometry_sigma=(0.05, 0.05, 0.035), association_window: float = 0.5, max_range: float = 6.0,
                  rng=None, **feature_options):
-        if not isinstance(rig, StereoRig):
-            raise TypeError(f"rig: expected robokit.vision.StereoRig, got {type(rig).__name__}")
+        if not isinstance(rig, StereoCalibration):
+            raise TypeError(f"rig: expected robokit.vision.StereoCalibration, got {type(rig).__name__}")
         self.rig = rig
         self.method = check_choice(method, "method", ("sift", "plot"))
         self.descriptor = check_choice(descriptor, "descriptor", ("reduced16", "sift128"))

@@ -7,7 +7,7 @@ vector. Se, Lowe & Little (Sec. 4) found 2 x 2 cells x 4 orientations (16 elemen
 their lab. Both are one routine here, :func:`gradient_histogram_descriptor`, vectorised over all
 keypoints (OpenCV's ``remap`` samples the gradients on a rotated 16 x 16 grid; the orientation
 histograms are accumulated with ``numpy.bincount`` and the spatial cells with one matrix product).
-:func:`sift_features` wraps OpenCV's SIFT, the library reference kept beside the lesson's code.
+:func:`detect_sift_features` wraps OpenCV's SIFT, the library reference kept beside the lesson's code.
 """
 from __future__ import annotations
 
@@ -18,10 +18,10 @@ import numpy as np
 
 from ..validation import check_choice, check_int, check_positive
 from .features import Features, Keypoints, as_gray_image
-from .plot import PlotParams, ScaleSpace, detect_plot_levels
+from .plot_detector import PlotParams, ScaleSpace, detect_plot_levels
 
 __all__ = ["assign_orientations", "gradient_histogram_descriptor", "sift_descriptor",
-           "reduced_descriptor", "plot_features", "sift_features", "detect_and_describe"]
+           "reduced_descriptor", "detect_plot_features", "detect_sift_features", "detect_and_describe"]
 
 _WINDOW = 1.5      # orientation window: Gaussian sigma = 1.5 x keypoint scale (Lowe 2004, Sec. 5)
 _CELL = 3.0        # descriptor cell width = 3 x keypoint scale (Lowe 2004, Sec. 6.1)
@@ -274,7 +274,7 @@ def reduced_descriptor(image, keypoints: Keypoints) -> np.ndarray:
     return gradient_histogram_descriptor(image, keypoints, cells=2, bins=4)
 
 
-def plot_features(image, params: PlotParams | None = None, *, descriptor: str = "sift128",
+def detect_plot_features(image, params: PlotParams | None = None, *, descriptor: str = "sift128",
                   **overrides) -> Features:
     """Detect PLOT keypoints, assign orientations and describe them (Lin et al. Sec. 2).
 
@@ -306,7 +306,7 @@ def plot_features(image, params: PlotParams | None = None, *, descriptor: str = 
     return Features(kp, _histograms(_gradients(space, kp.scale, cache), kp, cells, bins, 0.2))
 
 
-def sift_features(image, *, n_features: int = 0, descriptor: str = "sift128") -> Features:
+def detect_sift_features(image, *, n_features: int = 0, descriptor: str = "sift128") -> Features:
     """OpenCV's SIFT (``cv2.SIFT_create``) returned in robokit's containers.
 
     Parameters
@@ -328,7 +328,7 @@ def sift_features(image, *, n_features: int = 0, descriptor: str = "sift128") ->
     Notes
     -----
     Lowe 2004 (the detector used by Se, Lowe & Little, Sec. 2.1); the library reference beside
-    :func:`plot_features`.
+    :func:`detect_plot_features`.
     """
     descriptor = check_choice(descriptor, "descriptor", ("sift128", "reduced16"))
     n_features = check_int(n_features, "n_features", minimum=0)
@@ -359,7 +359,7 @@ def detect_and_describe(image, method: str = "plot", *, descriptor: str = "sift1
     method : {"plot", "sift"}
     descriptor : {"sift128", "reduced16"}
     **kwargs
-        Passed to :func:`plot_features` or :func:`sift_features`.
+        Passed to :func:`detect_plot_features` or :func:`detect_sift_features`.
 
     Returns
     -------
@@ -371,5 +371,5 @@ def detect_and_describe(image, method: str = "plot", *, descriptor: str = "sift1
     """
     method = check_choice(method, "method", ("plot", "sift"))
     if method == "plot":
-        return plot_features(image, descriptor=descriptor, **kwargs)
-    return sift_features(image, descriptor=descriptor, **kwargs)
+        return detect_plot_features(image, descriptor=descriptor, **kwargs)
+    return detect_sift_features(image, descriptor=descriptor, **kwargs)

@@ -18,7 +18,7 @@ from ..validation import as_array, check_finite_scalar, check_positive
 from .features import Features
 from .matching import gated_ratio_match, ratio_match
 
-__all__ = ["NotRectifiedError", "StereoRig", "StereoMatches", "StereoObservations", "disparity_to_point",
+__all__ = ["NotRectifiedError", "StereoCalibration", "StereoMatches", "StereoObservations", "disparity_to_point",
            "triangulate_svd", "match_stereo", "observe_stereo"]
 
 
@@ -27,8 +27,11 @@ class NotRectifiedError(ValueError):
 
 
 @dataclass(frozen=True)
-class StereoRig:
-    """A rectified stereo pair (Se et al. Sec. 3.1).
+class StereoCalibration:
+    """The calibration of a rectified stereo pair: what triangulation needs (Se et al. Sec. 3.1).
+
+    Not to be confused with :class:`robokit.sim.StereoRig`, the simulated rig that renders images;
+    :func:`robokit.localization.lab_experiment.calibrated_rig` reads one off the other.
 
     Attributes
     ----------
@@ -86,7 +89,7 @@ class StereoRig:
         return pl[:, :2] / pl[:, 2:], pr[:, :2] / pr[:, 2:]
 
     @classmethod
-    def from_projections(cls, p_left, p_right, *, tol: float = 1e-6) -> "StereoRig":
+    def from_projections(cls, p_left, p_right, *, tol: float = 1e-6) -> "StereoCalibration":
         """Recover the rig from projection matrices, refusing a pair that is not rectified.
 
         Parameters
@@ -98,7 +101,7 @@ class StereoRig:
 
         Returns
         -------
-        StereoRig
+        StereoCalibration
 
         Raises
         ------
@@ -156,7 +159,7 @@ class StereoObservations:
         return int(self.points.shape[0])
 
 
-def disparity_to_point(c, r, d, rig: StereoRig, *, sigma_c: float = 1.0, sigma_r: float = 1.0,
+def disparity_to_point(c, r, d, rig: StereoCalibration, *, sigma_c: float = 1.0, sigma_r: float = 1.0,
                        sigma_d: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """3-D position from image coordinates and disparity, with first-order covariance.
 
@@ -166,7 +169,7 @@ def disparity_to_point(c, r, d, rig: StereoRig, *, sigma_c: float = 1.0, sigma_r
         Column and row in the left image (pixels).
     d : array_like, shape (N,)
         Disparity in pixels (> 0).
-    rig : StereoRig
+    rig : StereoCalibration
     sigma_c, sigma_r, sigma_d : float, default 1
         Standard deviations of column, row and disparity in pixels (Se et al. measured 1, 1 and
         ``sigma_d^2 = 1`` for their trinocular average).
@@ -187,8 +190,8 @@ def disparity_to_point(c, r, d, rig: StereoRig, *, sigma_c: float = 1.0, sigma_r
     -----
     Se, Lowe & Little, Sec. 3.1 (the pinhole formulas and first-order error propagation).
     """
-    if not isinstance(rig, StereoRig):
-        raise TypeError(f"rig: expected StereoRig, got {type(rig).__name__}")
+    if not isinstance(rig, StereoCalibration):
+        raise TypeError(f"rig: expected StereoCalibration, got {type(rig).__name__}")
     c = as_array(c, "c", ndim=1)
     r = as_array(r, "r", shape=(c.size,))
     d = as_array(d, "d", shape=(c.size,))
@@ -336,14 +339,14 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
     return StereoMatches(li, ri, kl.xy[li, 0] - kr.xy[ri, 0], m.distance[unique])
 
 
-def observe_stereo(left: Features, right: Features, rig: StereoRig, *, sigma_c: float = 1.0,
+def observe_stereo(left: Features, right: Features, rig: StereoCalibration, *, sigma_c: float = 1.0,
                    sigma_r: float = 1.0, sigma_d: float = 1.0, **match_options) -> StereoObservations:
     """Match a rectified pair and turn the matches into 3-D points with covariances.
 
     Parameters
     ----------
     left, right : Features
-    rig : StereoRig
+    rig : StereoCalibration
     sigma_c, sigma_r, sigma_d : float
         Image noise (pixels) for :func:`disparity_to_point`.
     **match_options
@@ -360,8 +363,8 @@ def observe_stereo(left: Features, right: Features, rig: StereoRig, *, sigma_c: 
     Lin et al. Sec. 3 (matching, then "the 3D positions of matches relative to the mobile robot")
     and Se et al. Sec. 2.2 and 3.1.
     """
-    if not isinstance(rig, StereoRig):
-        raise TypeError(f"rig: expected StereoRig, got {type(rig).__name__}")
+    if not isinstance(rig, StereoCalibration):
+        raise TypeError(f"rig: expected StereoCalibration, got {type(rig).__name__}")
     match_options.setdefault("max_disparity", rig.focal * rig.baseline / 0.3)
     m = match_stereo(left, right, **match_options)
     if len(m) == 0:

@@ -7,7 +7,7 @@ from PIL import Image
 from scipy.spatial import cKDTree
 
 from robokit.vision.evaluation import apply_homography, similarity_homography
-from robokit.vision.plot import (PlotParams, detect_plot, edge_strength, junction_strength,
+from robokit.vision.plot_detector import (PlotParams, detect_plot, edge_strength, junction_strength,
                                  orientation_tensor, plot_scales, polynomial_expansion,
                                  tensor_eigenvalues)
 
@@ -119,7 +119,7 @@ def test_repeatable_under_rotation_and_zoom(photo):
 
 
 def test_scale_space_levels_are_subsampled_consistently(photo):
-    from robokit.vision.plot import detect_plot_levels
+    from robokit.vision.plot_detector import detect_plot_levels
     kp, space = detect_plot_levels(photo)
     assert np.allclose(space.sigmas, plot_scales())
     assert space.steps.tolist() == [1, 1, 2, 2]
