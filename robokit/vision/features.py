@@ -5,6 +5,15 @@ orientations are ``atan2(dy, dx)`` in image axes (x right, y down), in ``[0, 2 p
 of a keypoint is the standard deviation (pixels) of the Gaussian it was found at. PLOT (Lin et al.)
 and OpenCV's SIFT (Lowe 2004; Se, Lowe & Little 2002) both produce :class:`Features`, so every
 pipeline accepts either.
+
+References
+----------
+.. [1] R. Lin, Z. Wang, R. Sun and L. Sun, "Vision-based mobile robot localization and mapping using
+   the PLOT features" (Question 1 of the course's assignment; our copy gives no venue or year).
+.. [2] D. G. Lowe, "Distinctive image features from scale-invariant keypoints", International Journal
+   of Computer Vision 60(2), 91-110, 2004.
+.. [3] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features", Proc.
+   IEEE/RSJ Int. Conf. on Intelligent Robots and Systems (IROS), 2002.
 """
 from __future__ import annotations
 

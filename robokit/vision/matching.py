@@ -5,6 +5,15 @@ A descriptor ``D_A`` is matched to its nearest neighbour ``D_B`` when
 The neighbour search (:func:`k_nearest`) is scipy's KD-tree, exact blocked matrix products (faster
 than a KD-tree for 128-element descriptors) or OpenCV's brute-force matcher (the library
 reference); all give the same matches.
+
+References
+----------
+.. [1] R. Lin, Z. Wang, R. Sun and L. Sun, "Vision-based mobile robot localization and mapping using
+   the PLOT features" (Question 1 of the course's assignment; our copy gives no venue or year).
+.. [2] D. G. Lowe, "Distinctive image features from scale-invariant keypoints", International Journal
+   of Computer Vision 60(2), 91-110, 2004.
+.. [3] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features", Proc.
+   IEEE/RSJ Int. Conf. on Intelligent Robots and Systems (IROS), 2002.
 """
 from __future__ import annotations
 
@@ -226,6 +235,17 @@ def ratio_match(query, train, *, ratio: float = LIN_RATIO, method: str = "kdtree
     Notes
     -----
     Lin et al. Sec. 3, "the nearest neighbor ratio"; Lowe 2004, Sec. 7.1.
+
+    Examples
+    --------
+    >>> from robokit.vision import ratio_match
+    >>> import numpy as np
+    >>> train = np.random.default_rng(0).normal(size=(50, 16)).astype(np.float32)
+    >>> m = ratio_match(train[:5] + 0.01, train)          # five slightly perturbed copies
+    >>> m.query.tolist(), m.train.tolist()
+    ([0, 1, 2, 3, 4], [0, 1, 2, 3, 4])
+    >>> len(ratio_match(np.vstack([train[:1], train[:1]]), np.vstack([train[:1], train[:1]])))  # ambiguous
+    0
     """
     ratio = _check_ratio(ratio)
     q, t = _descriptors(query, "query"), _descriptors(train, "train")

@@ -12,6 +12,13 @@ into an edge part ``lambda_1 - lambda_2`` and a junction part ``lambda_2``. Keyp
 
 OpenCV does the filtering; the tensor, the eigenvalues and the maximum search are the lesson and
 are written here, vectorised with numpy.
+
+References
+----------
+.. [1] R. Lin, Z. Wang, R. Sun and L. Sun, "Vision-based mobile robot localization and mapping using
+   the PLOT features" (Question 1 of the course's assignment; our copy gives no venue or year).
+.. [2] G. Farnebäck, *Polynomial Expansion for Orientation and Motion Estimation*, PhD thesis,
+   Linköping University, 2002.
 """
 from __future__ import annotations
 
