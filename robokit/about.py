@@ -26,6 +26,13 @@ def versions(extra: tuple[str, ...] = ()) -> dict[str, str]:
     Notes
     -----
     Environment check for lesson 00; not from a paper.
+
+    Examples
+    --------
+    >>> from robokit.about import versions
+    >>> v = versions()
+    >>> "python" in v and "numpy" in v and v["robokit"] != "missing"
+    True
     """
     out = {"python": platform.python_version(), "robokit": _version("robokit")}
     for name in REQUIRED + tuple(extra):

@@ -56,6 +56,14 @@ def plot_footprint(world: World, ax: Any = None, color: str = "k", **kwargs: Any
     Notes
     -----
     The footprint is the world sliced at the LiDAR height (:meth:`robokit.sim.World.slice`).
+
+    Examples
+    --------
+    >>> from robokit import sim
+    >>> from robokit.viz import plot_footprint
+    >>> ax = plot_footprint(sim.box_room())          # a 6 m x 4 m room seen from above
+    >>> ax.get_title(), ax.get_xlabel(), bool(ax.get_xlim()[1] > 6)
+    ('box_room: footprint', 'x [m]', True)
     """
     from matplotlib.collections import LineCollection
 
@@ -86,6 +94,15 @@ def plot_scan(ranges: Any, sensor_pose: Any, angles: Any, ax: Any = None, color:
     Returns
     -------
     matplotlib.axes.Axes
+
+    Examples
+    --------
+    >>> from robokit import sim
+    >>> from robokit.viz import plot_scan
+    >>> lidar, world, pose = sim.Lidar(beams=90), sim.box_room(), [2.0, 1.5, 0.0]
+    >>> ax = plot_scan(lidar.scan(world, pose), lidar.sensor_pose(pose), lidar.angles)
+    >>> len(ax.lines[0].get_xdata())                # every beam hits a wall of the closed room
+    90
     """
     pts = scan_points(ranges, sensor_pose, angles)
     p = as_array(sensor_pose, "sensor_pose", shape=(3,))
@@ -119,6 +136,13 @@ def plot_trajectory(poses: Any, ax: Any = None, label: str | None = None, every:
     Notes
     -----
     Bird's-eye trajectory plots as in Se, Lowe & Little (2002), Fig. 2.
+
+    Examples
+    --------
+    >>> from robokit.viz import plot_trajectory
+    >>> ax = plot_trajectory([[0.0, 0.0, 0.0], [1.0, 0.0, 0.5], [2.0, 1.0, 1.0]], label="truth", every=1)
+    >>> ax.lines[0].get_label(), ax.get_aspect()
+    ('truth', 1.0)
     """
     P = as_points(poses, "poses", 3, min_count=1)
     ax = map_axes(ax)
@@ -174,9 +198,37 @@ def plot_occupancy(grid: Any, origin: Any, resolution: float, ax: Any = None, cm
 def plot_covariance(mean: Any, cov: Any, ax: Any = None, nsigma: float = 1.0, **kwargs: Any):
     """Draw the ``nsigma`` ellipse of a 2x2 covariance around ``mean`` (e.g. a landmark's X-Z uncertainty).
 
+    Parameters
+    ----------
+    mean : array_like, shape (2,)
+    cov : array_like, shape (2, 2)
+        Symmetric positive semi-definite.
+    ax : matplotlib.axes.Axes, optional
+    nsigma : float, default 1
+        Ellipse size in standard deviations.
+    **kwargs
+        Passed to ``matplotlib.patches.Ellipse`` (colour, line width, ...).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ValueError
+        For wrong shapes, non-finite values or a covariance with a negative eigenvalue.
+
     Notes
     -----
     Se, Lowe & Little (2002), Sec. 3.6, Fig. 2: one-standard-deviation ellipses in the bird's-eye view.
+
+    Examples
+    --------
+    >>> from robokit.viz import plot_covariance
+    >>> ax = plot_covariance([1.0, 2.0], [[0.04, 0.0], [0.0, 0.01]], nsigma=2)
+    >>> ellipse = ax.patches[0]                      # full axes 2 * 2 sigma: 0.8 m by 0.4 m
+    >>> round(float(ellipse.width), 3), round(float(ellipse.height), 3)
+    (0.8, 0.4)
     """
     from matplotlib.patches import Ellipse
 

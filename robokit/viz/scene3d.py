@@ -69,6 +69,14 @@ def add_world(scene: Scene, world: World, path: str = "world", cell: int = 48, c
     -----
     One ``BufferGeometry`` with ``uv`` coordinates into an atlas image (three.js texture
     mapping); the world's own surfaces, so the 3D view matches what the cameras render.
+
+    Examples
+    --------
+    >>> from robokit import sim
+    >>> from robokit.viz import Scene, add_world
+    >>> scene = add_world(Scene(), sim.box_room())
+    >>> scene.html().count("meshcat") > 0
+    True
     """
     from meshcat.geometry import ImageTexture, Mesh, MeshBasicMaterial, PngImage
 
@@ -106,7 +114,7 @@ def _segments(scene: Scene, path: str, pts: np.ndarray, color: Any) -> Scene:
                                                LineBasicMaterial(color=as_color(color))))
 
 
-def add_camera(scene: Scene, path: str, camera: PinholeCamera, pose: Any, depth: float = 0.4,
+def add_camera(scene: Scene, path: str, camera: PinholeCamera, T_world_cam: Any, depth: float = 0.4,
                color: Any = 0x2255CC) -> Scene:
     """Draw a pinhole camera as a frustum (apex at the optical centre) plus its axes.
 
@@ -115,8 +123,8 @@ def add_camera(scene: Scene, path: str, camera: PinholeCamera, pose: Any, depth:
     scene : Scene
     path : str
     camera : PinholeCamera
-    pose : array_like (4, 4)
-        ``T_world_cam``.
+    T_world_cam : array_like (4, 4)
+        Pose of the camera's optical frame in the world (e.g. ``camera.pose_at(robot_pose)``).
     depth : float, default 0.4
         Distance of the drawn image rectangle from the apex (metres).
 
@@ -127,18 +135,26 @@ def add_camera(scene: Scene, path: str, camera: PinholeCamera, pose: Any, depth:
     Notes
     -----
     The image corners back-projected to depth ``depth`` (Hartley & Zisserman 2004, Sec. 6.2.2).
+
+    Examples
+    --------
+    >>> from robokit import sim
+    >>> from robokit.viz import Scene, add_camera
+    >>> camera = sim.PinholeCamera.from_fov()
+    >>> add_camera(Scene(), "camera", camera, camera.pose_at([1.0, 1.0, 0.0]))   # frustum and axes
+    Scene(title='robokit scene', commands=3)
     """
     if not isinstance(camera, PinholeCamera):
         raise TypeError(f"camera: expected a PinholeCamera, got {type(camera).__name__}")
     d = check_positive(depth, "depth")
     corners = np.array([[0, 0], [camera.width - 1, 0], [camera.width - 1, camera.height - 1], [0, camera.height - 1]], float)
-    P = camera.backproject(corners, np.full(4, d), pose)
-    apex = np.asarray(pose, float)[:3, 3]
+    P = camera.backproject(corners, np.full(4, d), T_world_cam)
+    apex = np.asarray(T_world_cam, float)[:3, 3]
     lines = []
     for k in range(4):
         lines += [apex, P[k], P[k], P[(k + 1) % 4]]
     _segments(scene, f"{path}/frustum", np.array(lines), color)
-    return scene.add_triad(f"{path}/axes", pose, scale=d / 2)
+    return scene.add_triad(f"{path}/axes", T_world_cam, scale=d / 2)
 
 
 def add_trajectory(scene: Scene, path: str, poses: Any, z: float = 0.02, color: Any = 0x22AA22,
@@ -164,6 +180,12 @@ def add_trajectory(scene: Scene, path: str, poses: Any, z: float = 0.02, color: 
     Notes
     -----
     Planar poses lifted with :func:`robokit.geometry.se2_to_se3`.
+
+    Examples
+    --------
+    >>> from robokit.viz import Scene, add_trajectory
+    >>> add_trajectory(Scene(), "path", [[0, 0, 0], [1, 0, 0.5], [2, 1, 1.0]], every=2)   # line + 2 triads
+    Scene(title='robokit scene', commands=5)
     """
     P = as_points(poses, "poses", 3, min_count=2)
     scene.add_line(f"{path}/line", np.column_stack([P[:, :2], np.full(len(P), z)]), color=color)
@@ -199,17 +221,18 @@ def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, 
     return _segments(scene, f"{path}/headings", np.stack([base, tip], axis=1).reshape(-1, 3), color)
 
 
-def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None, sigma: float = 1.0,
+def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None, nsigma: float = 1.0,
                   colors: Any = None, max_ellipsoids: int = 500) -> Scene:
-    """Draw 3D landmarks with optional covariance ellipsoids (``sigma``-standard-deviation surfaces).
+    """Draw 3D landmarks with optional covariance ellipsoids (``nsigma``-standard-deviation surfaces).
 
     Parameters
     ----------
     points : array_like (N, 3)
     covariances : array_like (N, 3, 3), optional
         Symmetric positive semi-definite covariances (m^2).
-    sigma : float, default 1
-        Ellipsoid scale in standard deviations (Se et al. 2002 draw 1 sigma).
+    nsigma : float, default 1
+        Ellipsoid scale in standard deviations (Se et al. 2002 draw 1 sigma), as in
+        :func:`robokit.viz.plot_covariance`.
     colors : array_like (N, 3), optional
         RGB in [0, 1].
     max_ellipsoids : int, default 500
@@ -226,8 +249,16 @@ def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None,
 
     Notes
     -----
-    Principal axes from the eigen-decomposition ``C = V diag(l) V^T``, radii ``sigma sqrt(l)``
+    Principal axes from the eigen-decomposition ``C = V diag(l) V^T``, radii ``nsigma sqrt(l)``
     (Se, Lowe & Little 2002, Sec. 3.6: landmark uncertainty drawn as ellipsoids).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robokit.viz import Scene, add_landmarks
+    >>> points = [[1.0, 0.0, 1.0], [2.0, 0.0, 1.0]]
+    >>> add_landmarks(Scene(), "landmarks", points, np.stack([0.01 * np.eye(3)] * 2))  # points + 2 ellipsoids
+    Scene(title='robokit scene', commands=5)
     """
     from meshcat.geometry import Ellipsoid, MeshLambertMaterial
 
@@ -241,7 +272,7 @@ def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None,
     lam, V = np.linalg.eigh(C)
     if np.any(lam < -1e-12):
         raise ValueError("covariances: expected positive semi-definite matrices, got a negative eigenvalue")
-    s = check_positive(sigma, "sigma")
+    s = check_positive(nsigma, "nsigma")
     for k in range(min(len(P), check_int(max_ellipsoids, "max_ellipsoids", minimum=0))):
         R = V[k] * np.sign(np.linalg.det(V[k]))
         T = np.eye(4)
@@ -267,6 +298,13 @@ def animate_poses(scene: Scene, path: str, transforms: Any, fps: float = 10.0, r
     Notes
     -----
     meshcat's ``set_animation`` command (three.js AnimationClip keyframe tracks).
+
+    Examples
+    --------
+    >>> from robokit.viz import Scene, animate_poses
+    >>> scene = Scene().add_box("robot", size=(0.5, 0.25, 0.15))
+    >>> animate_poses(scene, "robot", [[0.0, 0.0, 0.0], [1.0, 0.0, 0.5], [2.0, 1.0, 1.0]], fps=2)
+    Scene(title='robokit scene', commands=3)
     """
     from meshcat.animation import AnimationClip, js_position, js_quaternion
     from meshcat.commands import SetAnimation
@@ -307,6 +345,12 @@ def look_from(scene: Scene, position: Any) -> Scene:
     meshcat's default camera lives under ``/Cameras/default/rotated``, a node that turns
     three.js's y-up convention into robokit's z-up one, so the position is given to it as
     ``(x, z, -y)``; the orbit controls keep looking at the origin.
+
+    Examples
+    --------
+    >>> from robokit.viz import Scene, look_from
+    >>> look_from(Scene(), [5.0, -5.0, 8.0])          # above and south-east of the origin
+    Scene(title='robokit scene', commands=1)
     """
     from meshcat.commands import SetProperty
     from meshcat.path import Path as MeshcatPath
