@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array
+from .rotations import as_rotation
 
 __all__ = ["wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2"]
 
@@ -174,11 +175,6 @@ def matrix_to_se2(matrix: Any) -> np.ndarray:
     Lynch & Park, *Modern Robotics* (2017), Sec. 3.3.1.
     """
     T = as_array(matrix, "matrix", shape=(3, 3))
-    _check_rotation(T[:2, :2], "matrix")
+    as_rotation(T[:2, :2], "matrix", dim=2)
     return np.array([T[0, 2], T[1, 2], float(np.arctan2(T[1, 0], T[0, 0]))])
 
-
-def _check_rotation(R: np.ndarray, name: str) -> None:
-    n = R.shape[0]
-    if not np.allclose(R @ R.T, np.eye(n), atol=1e-6) or np.linalg.det(R) <= 0:
-        raise ValueError(f"{name}: expected a proper rotation (orthonormal, det +1), got {R.tolist()}")
