@@ -33,9 +33,9 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..geometry import se3_from_rt
+from ..geometry import as_se3, se3_from_rt
 from ..validation import as_array, as_points, check_int, check_positive
-from .camera import Frame, MountedSensor, check_pose, finish_image
+from .camera import Frame, MountedSensor, finish_image
 from .render import render_pinhole
 from .world import World
 
@@ -117,7 +117,7 @@ class OmniCamera(MountedSensor):
             self.f = (min(self.width, self.height) / 2 - 4) / self._radius(hi)
         self.f = check_positive(self.f, "f")
         self.face_size = check_int(self.face_size, "face_size", minimum=16)
-        self.mount = omni_mount() if self.mount is None else check_pose(self.mount, "mount")
+        self.mount = omni_mount() if self.mount is None else as_se3(self.mount, "mount")
 
     def _radius(self, elevation: float) -> float:
         """Normalised image radius of rays at ``elevation`` (z points down, so zs = -sin e)."""
@@ -151,7 +151,7 @@ class OmniCamera(MountedSensor):
         """
         P = as_points(points, "points", 3)
         if pose is not None:
-            T = check_pose(pose)
+            T = as_se3(pose, "pose")
             P = (P - T[:3, 3]) @ T[:3, :3]
         rng_ = np.linalg.norm(P, axis=1)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -215,7 +215,7 @@ class OmniCamera(MountedSensor):
         P = d * r[:, None]
         if pose is None:
             return P
-        T = check_pose(pose)
+        T = as_se3(pose, "pose")
         return P @ T[:3, :3].T + T[:3, 3]
 
     @functools.cached_property
@@ -263,7 +263,7 @@ class OmniCamera(MountedSensor):
         """
         if not isinstance(world, World):
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
-        T = check_pose(pose)
+        T = as_se3(pose, "pose")
         world.check_viewpoint(T[:3, 3], "pose")
         used, K, size, mapx, mapy, factor, inside = self._lookup
         images, depths = [], []
