@@ -19,8 +19,9 @@ from ..geometry import pose_error
 from .chain import Chain, chain_from_table, dh_fk
 from .dh import dh_transform, mdh_transform
 from .ik_analytic import SRSArm, arm_angle, ik_srs, ik_srs_batch, ik_srs_branches
-from .ik_numeric import METHODS, dls_step, ik_numeric, ik_numeric_batch, null_space_step
+from .ik_numeric import ik_numeric, ik_numeric_batch
 from .ik_reference import ik_numeric_reference
+from .ik_steps import METHODS, dls_step, null_space_step
 from .jacobian import dh_jacobian, geometric_jacobian, jacobian_from_frames, manipulability
 from .limits import limit_distance_gradient, wln_weights
 from .result import IKBatchResult, IKResult, verify

@@ -235,7 +235,7 @@ def arm_angle(chain: Chain, q: Any) -> float | np.ndarray:
     --------
     >>> from robokit.arm import iiwa14
     >>> print(round(float(np.degrees(arm_angle(iiwa14(), np.radians([35, 50, -40, -75, 60, 45, 20])))), 3))
-    -28.402
+    -29.971
     """
     arm = _srs(chain)
     return arm.arm_angle(chain.check_q(q, batch=np.ndim(q) == 2))

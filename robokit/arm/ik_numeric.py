@@ -1,39 +1,19 @@
-"""Numerical inverse kinematics for any chain: one search loop, one step rule per method.
+"""Numerical inverse kinematics for any chain: one search loop over the step rules of
+:mod:`robokit.arm.ik_steps` (``"dls"``, ``"gradient_projection"``, ``"wln"``).
 
 The search (:func:`ik_numeric_batch`) runs many attempts side by side (vectorised over targets and
 parallel attempts): each pass evaluates the pose error of every live attempt, ends those that
 converged (pose within tolerance and every joint within its limits), restarts those that stalled
-from a random configuration, and moves the others by one step of the chosen rule:
-
-* ``"dls"``: damped least squares, ``dq = J^T (J J^T + lambda^2 I)^-1 e``;
-* ``"gradient_projection"``: DLS plus the gradient of a joint-range criterion projected into the
-  Jacobian's null space (Liégeois 1977; Dubey, Euler & Babcock 1988);
-* ``"wln"``: weighted least norm, ``dq = W^-1 J^T (J W^-1 J^T + lambda^2 I)^-1 e`` with Chan &
-  Dubey's (1995) joint-limit weights.
-
-Random restarts from configurations drawn inside the limits handle local minima. Success is decided
-by FK verification (:func:`robokit.arm.result.verify`). :mod:`robokit.arm.ik_reference` is the same
+from a random configuration, and moves the others by one step of the chosen rule. Random restarts
+from configurations drawn inside the limits handle local minima. Success is decided by FK
+verification (:func:`robokit.arm.result.verify`). :mod:`robokit.arm.ik_reference` is the same
 algorithm for one target as a plain loop; the tests compare the two iterate by iterate.
 
 References
 ----------
-.. [1] C. W. Wampler, "Manipulator inverse kinematic solutions based on vector formulations and
-   damped least-squares methods", *IEEE Transactions on Systems, Man, and Cybernetics* 16(1),
-   93-101, 1986.
-.. [2] Y. Nakamura and H. Hanafusa, "Inverse kinematic solutions with singularity robustness for
-   robot manipulator control", *Journal of Dynamic Systems, Measurement, and Control* 108(3),
-   163-171, 1986.
-.. [3] A. Liégeois, "Automatic supervisory control of the configuration and behavior of multibody
-   mechanisms", *IEEE Transactions on Systems, Man, and Cybernetics* 7(12), 868-871, 1977.
-.. [4] R. V. Dubey, J. A. Euler and S. M. Babcock, "An efficient gradient projection optimization
-   scheme for a seven-degree-of-freedom redundant robot with spherical wrist", *Proc. IEEE
-   International Conference on Robotics and Automation (ICRA)*, 28-36, 1988.
-.. [5] T. F. Chan and R. V. Dubey, "A weighted least-norm solution based scheme for avoiding joint
-   limits for redundant joint manipulators", *IEEE Transactions on Robotics and Automation* 11(2),
-   286-292, 1995.
-.. [6] T. Sugihara, "Solvability-unconcerned inverse kinematics by the Levenberg-Marquardt method",
+.. [1] T. Sugihara, "Solvability-unconcerned inverse kinematics by the Levenberg-Marquardt method",
    *IEEE Transactions on Robotics* 27(5), 984-991, 2011.
-.. [7] P. Beeson and B. Ames, "TRAC-IK: an open-source library for improved solving of generic
+.. [2] P. Beeson and B. Ames, "TRAC-IK: an open-source library for improved solving of generic
    inverse kinematics", *Proc. IEEE-RAS International Conference on Humanoid Robots*, 2015.
 """
 from __future__ import annotations
@@ -43,200 +23,45 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3, pose_error
-from ..validation import as_array, as_rng, check_choice, check_int, check_positive
+from ..validation import as_rng, check_choice, check_int, check_positive
 from .chain import Chain
+from .ik_steps import METHODS, STEP_RULES
 from .jacobian import jacobian_from_frames
-from .limits import limit_distance_gradient, wln_weights
 from .result import IKBatchResult, IKResult, verify
 
-__all__ = ["METHODS", "NULL_SPACE_FADE", "dls_step", "null_space_step", "ik_numeric", "ik_numeric_batch"]
-
-METHODS = ("dls", "gradient_projection", "wln")
-_EYE6 = np.eye(6)
-#: Regularisation of the null-space projector: ``J^T (J J^T + eps I)^-1 J`` has eigenvalues
-#: ``s^2 / (s^2 + eps)`` in [0, 1], so the projector stays bounded at singularities while leaking
-#: almost nothing of the secondary motion into the hand elsewhere.
-_PROJ_EPS = 1e-9
-#: Pose-error norm [m, rad] below which the null-space gain fades linearly to zero (the projected
-#: motion is exact only to first order).
-NULL_SPACE_FADE = 1e-2
-
-
-# --- one step, checked (the exercises' functions) and unchecked (the solver's kernels) ------------
-def _jacobian_and_error(J: Any, e: Any):
-    J = as_array(J, "J")
-    if J.ndim not in (2, 3) or J.shape[-2] != 6:
-        raise ValueError(f"J: expected a Jacobian of shape (6, n) or (N, 6, n), got shape {J.shape}")
-    e = as_array(e, "e", shape=J.shape[:-2] + (6,))
-    return J, e
-
-
-def dls_step(J: Any, e: Any, damping: float = 1e-2, weights: Any = None) -> np.ndarray:
-    """One damped-least-squares (optionally weighted) joint update.
-
-    Parameters
-    ----------
-    J : array_like, shape (6, n) or (N, 6, n)
-        Geometric Jacobian(s).
-    e : array_like, shape (6,) or (N, 6)
-        Pose error ``[dp; dtheta]`` (see :func:`robokit.geometry.pose_error`).
-    damping : float, default 1e-2
-        Damping factor ``lambda`` (>= 0).
-    weights : array_like, shape (n,) or (N, n), optional
-        Positive joint weights ``W = diag(w)`` (weighted least norm); identity by default.
-
-    Returns
-    -------
-    numpy.ndarray, shape (n,) or (N, n)
-        ``dq = W^-1 J^T (J W^-1 J^T + lambda^2 I)^-1 e``.
-
-    Raises
-    ------
-    ValueError
-        On wrong shapes, NaN, a negative damping or non-positive weights.
-
-    Notes
-    -----
-    Wampler (1986), Eq. (11); Nakamura & Hanafusa (1986). The weighted form is Chan & Dubey (1995),
-    Eq. (7), damped.
-
-    Examples
-    --------
-    >>> J = np.hstack([np.eye(6), np.zeros((6, 1))])
-    >>> print(np.round(dls_step(J, [0.1, 0, 0, 0, 0, 0], damping=0.0), 6))
-    [0.1 0.  0.  0.  0.  0.  0. ]
-    """
-    J, e = _jacobian_and_error(J, e)
-    lam = check_positive(damping, "damping", allow_zero=True)
-    winv = None
-    if weights is not None:
-        w = as_array(weights, "weights", shape=J.shape[:-2] + (J.shape[-1],))
-        if np.any(w <= 0):
-            raise ValueError("weights: expected positive joint weights")
-        winv = 1.0 / w
-    return _dls(J, e, np.full(J.shape[:-2], lam**2), winv)
-
-
-def _dls(J, e, lam2, winv=None):
-    """Unchecked kernel: ``W^-1 J^T (J W^-1 J^T + lam2 I)^-1 e`` for stacked inputs."""
-    JW = J if winv is None else J * winv[..., None, :]
-    A = JW @ np.swapaxes(J, -1, -2) + lam2[..., None, None] * _EYE6      # J W^-1 J^T + lambda^2 I
-    y = np.linalg.solve(A, e[..., None])
-    return (np.swapaxes(JW, -1, -2) @ y)[..., 0]                        # Wampler Eq. (11), Chan & Dubey Eq. (7)
-
-
-def null_space_step(J: Any, e: Any, gradient: Any, damping: float = 1e-2, gain: float = 1.0) -> np.ndarray:
-    """DLS step plus a secondary-task gradient projected into the Jacobian's null space.
-
-    Parameters
-    ----------
-    J : array_like, shape (6, n) or (N, 6, n)
-    e : array_like, shape (6,) or (N, 6)
-        Pose error.
-    gradient : array_like, shape (n,) or (N, n)
-        Gradient of the criterion to *increase* (e.g. :func:`~robokit.arm.limit_distance_gradient`).
-    damping : float, default 1e-2
-    gain : float, default 1.0
-        Step along the projected gradient (>= 0).
-
-    Returns
-    -------
-    numpy.ndarray, shape (n,) or (N, n)
-        ``dq = J# e + gain (I - J# J) gradient`` with the damped pseudo-inverse
-        ``J# = J^T (J J^T + lambda^2 I)^-1``.
-
-    Raises
-    ------
-    ValueError
-        On wrong shapes, NaN or negative damping/gain.
-
-    Notes
-    -----
-    Liégeois (1977), Eq. (9); Dubey, Euler & Babcock (1988), Sec. 2 (gradient projection).
-
-    Examples
-    --------
-    With no pose error the step is pure self-motion: the hand does not move (to first order).
-
-    >>> from robokit.arm import geometric_jacobian, limit_distance_gradient, panda
-    >>> arm = panda()
-    >>> q = arm.random_q(rng=0)
-    >>> J = geometric_jacobian(arm, q)
-    >>> dq = null_space_step(J, np.zeros(6), limit_distance_gradient(arm, q), damping=0.0)
-    >>> bool(np.abs(J @ dq).max() < 1e-6), bool(np.linalg.norm(dq) > 1e-3)
-    (True, True)
-    """
-    J, e = _jacobian_and_error(J, e)
-    g = as_array(gradient, "gradient", shape=J.shape[:-2] + (J.shape[-1],))
-    lam = check_positive(damping, "damping", allow_zero=True)
-    k = check_positive(gain, "gain", allow_zero=True)
-    return _gp(J, e, g, np.full(J.shape[:-2], lam**2), k)
-
-
-def _gp(J, e, g, lam2, k):
-    """Unchecked kernel of :func:`null_space_step`."""
-    Jt = np.swapaxes(J, -1, -2)
-    JJt = J @ Jt
-    primary = (Jt @ np.linalg.solve(JJt + lam2[..., None, None] * _EYE6, e[..., None]))[..., 0]   # J# e
-    Jg = (J @ g[..., None])
-    leak = (Jt @ np.linalg.solve(JJt + _PROJ_EPS * _EYE6, Jg))[..., 0]                           # J# J g
-    return primary + k[..., None] * (g - leak) if np.ndim(k) else primary + k * (g - leak)   # Liégeois Eq. (9)
-
-
-# --- the three step rules of the search ----------------------------------------------------------
-class _DampedLeastSquares:
-    """DLS with Sugihara's damping ``lambda^2 = lambda_0^2 + |e|^2 / 2``; no memory between steps."""
-
-    def __init__(self, chain: Chain, attempts: int, damping: float, gain: float):
-        self.chain, self.lam2_0, self.gain = chain, damping**2, gain
-
-    def restart(self, rows) -> None:
-        """Forget what the step rule remembers about the attempts ``rows`` (none here)."""
-
-    def damping(self, err2: np.ndarray) -> np.ndarray:
-        return self.lam2_0 + 0.5 * err2                                 # Sugihara Eq. (13)
-
-    def __call__(self, J, e, err2, q, rows) -> np.ndarray:
-        """Joint steps of the attempts ``rows`` at ``q`` with Jacobians ``J``, errors ``e``, ``|e|^2``."""
-        return _dls(J, e, self.damping(err2))                           # Wampler Eq. (11)
-
-
-class _GradientProjection(_DampedLeastSquares):
-    """DLS plus the joint-range gradient in the null space (Liégeois Eq. (9); Dubey et al. Sec. 2).
-
-    The null-space motion is exact only to first order, so its gain fades out near the target.
-    """
-
-    def __call__(self, J, e, err2, q, rows) -> np.ndarray:
-        fade = np.minimum(1.0, np.sqrt(err2) / NULL_SPACE_FADE)
-        g = limit_distance_gradient(self.chain, q, check=False)         # Liégeois Eq. (14)
-        return _gp(J, e, g, self.damping(err2), self.gain * fade)
-
-
-class _WeightedLeastNorm(_DampedLeastSquares):
-    """Damped WLN (Chan & Dubey Eq. (7)) with the weights of Eq. (13).
-
-    A weight grows only while its joint moves towards a limit, which needs the previous step's
-    ``|dH/dq|``; an attempt's first step (and the first after a restart) has all weights 1.
-    """
-
-    def __init__(self, chain: Chain, attempts: int, damping: float, gain: float):
-        super().__init__(chain, attempts, damping, gain)
-        self.previous = np.full((attempts, chain.n), np.nan)
-
-    def restart(self, rows) -> None:
-        self.previous[rows] = np.nan
-
-    def __call__(self, J, e, err2, q, rows) -> np.ndarray:
-        w, grad = wln_weights(self.chain, q, self.previous[rows], check=False)   # Eq. (13)
-        self.previous[rows] = grad
-        return _dls(J, e, self.damping(err2), 1.0 / w)                           # Eq. (7), damped
-
-
-_STEPS = {"dls": _DampedLeastSquares, "gradient_projection": _GradientProjection, "wln": _WeightedLeastNorm}
+__all__ = ["ik_numeric", "ik_numeric_batch"]
 
 
 # --- the search -----------------------------------------------------------------------------------
+def _claim_targets(chain: Chain, qa, conv, active, tgt, winner, t_done) -> np.ndarray:
+    """Unchecked: which converged attempts are also within the limits; the first of them per target
+    becomes its winner (``winner``, ``t_done`` updated in place). Returns that mask over ``active``."""
+    finished = conv.copy()
+    qc = qa[conv]
+    finished[conv] = np.all((qc >= chain.qmin) & (qc <= chain.qmax), axis=1)
+    if finished.any():
+        rows = active[finished]
+        t = tgt[rows]
+        first = np.unique(t, return_index=True)[1]
+        winner[t[first]] = rows[first]
+        t_done[t] = True
+    return finished
+
+
+def _restart_or_retire(chain: Chain, rows, tgt, tries, restarts, qr, steps, best, stall, alive, step, gen) -> None:
+    """Unchecked: restart ended attempts ``rows`` from random configurations while their target has
+    restarts left (in row order, which fixes the random draws), retire them otherwise."""
+    for r in rows:
+        t = tgt[r]
+        if tries[t] < restarts:
+            qr[r] = gen.uniform(chain.qmin, chain.qmax)
+            tries[t] += 1
+            steps[r], best[r], stall[r] = 0, np.inf, 0
+            step.restart(r)
+        else:
+            alive[r] = False
+
+
 def _search(chain: Chain, T: np.ndarray, q0: np.ndarray, skip: np.ndarray, step, *, tol: float, max_iter: int,
             restarts: int, patience: int, parallel: int, clamp: bool, max_step: float, gen, history: bool):
     """Unchecked: run the attempts of every target until one converges or all are used up.
@@ -279,17 +104,7 @@ def _search(chain: Chain, T: np.ndarray, q0: np.ndarray, skip: np.ndarray, step,
         # 2. converged: within tolerance; it wins its target if also within the limits
         conv = np.maximum(pos2, rot2) < tol2
         any_conv = bool(conv.any())
-        finished = conv
-        if any_conv:
-            finished = conv.copy()
-            qc = qa[conv]
-            finished[conv] = np.all((qc >= chain.qmin) & (qc <= chain.qmax), axis=1)
-            if finished.any():
-                rows = active[finished]
-                t = tgt[rows]
-                first = np.unique(t, return_index=True)[1]
-                winner[t[first]] = rows[first]
-                t_done[t] = True
+        finished = _claim_targets(chain, qa, conv, active, tgt, winner, t_done) if any_conv else conv
         # 3. an attempt ends after max_iter steps or when its error has not halved for `patience`
         #    steps; a pose reached outside the limits (clamp=False) also ends it
         err = np.sqrt(e2s)
@@ -302,16 +117,8 @@ def _search(chain: Chain, T: np.ndarray, q0: np.ndarray, skip: np.ndarray, step,
         if any_conv:
             ended = ~finished & (ended | conv)
         any_ended = bool(ended.any())
-        if any_ended:                 # restart from a random configuration while restarts are left
-            for r in active[ended]:
-                t = tgt[r]
-                if tries[t] < restarts:
-                    qr[r] = gen.uniform(chain.qmin, chain.qmax)
-                    tries[t] += 1
-                    steps[r], best[r], stall[r] = 0, np.inf, 0
-                    step.restart(r)
-                else:
-                    alive[r] = False
+        if any_ended:
+            _restart_or_retire(chain, active[ended], tgt, tries, restarts, qr, steps, best, stall, alive, step, gen)
         # 4. one step of the method for every attempt still going
         everyone = not (any_conv or any_ended)
         if not everyone:
@@ -405,7 +212,7 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     q0 : array_like, shape (N, n) or (n,), optional
         Initial guesses; the middle of the joint ranges by default.
     method : {"wln", "dls", "gradient_projection"}, default "wln"
-        Step rule (module docstring).
+        Step rule (:mod:`robokit.arm.ik_steps`).
     tol : float, default 1e-6
         Tolerance on the position error [m] and the orientation error [rad].
     max_iter : int, default 60
@@ -483,7 +290,7 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
 
     dist = np.linalg.norm(Tt[:, :3, 3] - chain.base[:3, 3], axis=1)
     too_far = dist > chain.reach()
-    step = _STEPS[method](chain, N * parallel, damping, gain)
+    step = STEP_RULES[method](chain, N * parallel, damping, gain)
     q, iters, tries, trail = _search(chain, Tt, q, too_far, step, tol=tol, max_iter=max_iter, restarts=restarts,
                                      patience=patience, parallel=parallel, clamp=bool(clamp), max_step=max_step,
                                      gen=gen, history=history)

@@ -27,7 +27,7 @@ import numpy as np
 from ..geometry import as_se3, pose_error
 from ..validation import check_choice, check_int, check_positive
 from .chain import Chain
-from .ik_numeric import METHODS, NULL_SPACE_FADE, dls_step, null_space_step
+from .ik_steps import METHODS, NULL_SPACE_FADE, dls_step, null_space_step
 from .jacobian import geometric_jacobian
 from .limits import limit_distance_gradient, wln_weights
 from .result import IKResult, verify
@@ -71,10 +71,11 @@ def ik_numeric_reference(chain: Chain, T: Any, q0: Any, *, method: str = "wln", 
     --------
     >>> from robokit.arm import panda
     >>> arm = panda()
-    >>> T = arm.fk(arm.random_q(rng=3))
-    >>> result, iterates = ik_numeric_reference(arm, T, arm.random_q(rng=4), method="dls")
-    >>> result.success, len(iterates) == result.iterations + 1
-    (True, True)
+    >>> q_target = arm.random_q(rng=3)
+    >>> q0 = np.clip(q_target + 0.2, arm.qmin, arm.qmax)          # a start near the answer
+    >>> result, iterates = ik_numeric_reference(arm, arm.fk(q_target), q0, method="dls")
+    >>> result.success, result.iterations, iterates.shape
+    (True, 4, (5, 7))
     """
     T = as_se3(T, "T")
     q = chain.check_q(q0, "q0")

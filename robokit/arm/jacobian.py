@@ -104,7 +104,7 @@ def geometric_jacobian(chain: Chain, q: Any) -> np.ndarray:
     --------
     >>> from robokit.arm import iiwa14
     >>> J = geometric_jacobian(iiwa14(), np.radians([20, 40, -30, -70, 30, 60, 0]))
-    >>> J.shape, np.linalg.matrix_rank(J)
+    >>> J.shape, int(np.linalg.matrix_rank(J))
     ((6, 7), 6)
     """
     if not isinstance(chain, Chain):
@@ -167,7 +167,7 @@ def manipulability(J: Any) -> float | np.ndarray:
     >>> print(round(manipulability(geometric_jacobian(arm, np.zeros(7))), 12))   # stretched: singular
     0.0
     >>> print(round(manipulability(geometric_jacobian(arm, np.radians([20, 40, -30, -70, 30, 60, 0]))), 4))
-    0.0654
+    0.122
     """
     J = as_array(J, "J")
     if J.ndim not in (2, 3) or J.shape[-2] > J.shape[-1]:

@@ -62,7 +62,7 @@ def limit_distance_gradient(chain: Chain, q: Any, *, check: bool = True) -> np.n
     >>> from robokit.arm import iiwa14
     >>> arm = iiwa14()
     >>> print(np.round(limit_distance_gradient(arm, 0.5 * arm.qmax), 3))
-    [-0.337 -0.477 -0.337 -0.477 -0.337 -0.477 -0.327]
+    [-0.169 -0.239 -0.169 -0.239 -0.169 -0.239 -0.164]
     """
     if check:
         q = _limits(chain, q)

@@ -187,7 +187,7 @@ EXERCISES = [
         points=2,
         cases=_null_space_cases,
         reference=null_space_step,
-        references=("robokit.arm.ik_numeric.null_space_step", "robokit.arm.ik_numeric.dls_step"),
+        references=("robokit.arm.ik_steps.null_space_step", "robokit.arm.ik_steps.dls_step"),
         compare=close(rtol=1e-6, atol=1e-9),
         description="DLS step plus the gradient projected into the null space; ValueError on a bad Jacobian shape.",
     ),

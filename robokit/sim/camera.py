@@ -3,6 +3,17 @@
 Frames: a camera's pose is ``T_world_cam`` (4x4), its frame the OpenCV optical frame (x right,
 y down, z forward). A camera carries a ``mount`` ``T_body_cam`` so that :meth:`PinholeCamera.observe`
 can render from a planar robot pose ``[x, y, theta]``.
+
+References
+----------
+.. [1] R. Hartley and A. Zisserman, *Multiple View Geometry in Computer Vision*, 2nd ed., Cambridge
+   University Press, 2004.
+.. [2] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features", Proc.
+   IEEE/RSJ Int. Conf. on Intelligent Robots and Systems (IROS), 2002.
+.. [3] G. E. Healey and R. Kondepudy, "Radiometric CCD camera calibration and noise estimation",
+   *IEEE Transactions on Pattern Analysis and Machine Intelligence* 16(3), 267-276, 1994.
+.. [4] K. M. Lynch and F. C. Park, *Modern Robotics: Mechanics, Planning, and Control*, Cambridge
+   University Press, 2017.
 """
 from __future__ import annotations
 
@@ -76,8 +87,8 @@ def finish_image(image: np.ndarray, noise: float, rng: Any, lighting: dict | Non
 
     Notes
     -----
-    Additive Gaussian read noise (Healey & Kondepudy, "Radiometric CCD camera calibration and noise
-    estimation", IEEE PAMI 1994, Sec. 2) after a gain/offset lighting change.
+    Additive Gaussian read noise (Healey & Kondepudy 1994, Sec. 2) after a gain/offset lighting
+    change.
     """
     if lighting:
         image = illuminate(image, **lighting)
@@ -153,7 +164,16 @@ class PinholeCamera(MountedSensor):
 
     Notes
     -----
-    Hartley & Zisserman, *Multiple View Geometry* (2004), Eq. (6.4)-(6.5).
+    Hartley & Zisserman (2004), Eq. (6.4)-(6.5).
+
+    Examples
+    --------
+    >>> cam = PinholeCamera.from_fov(np.deg2rad(90.0), width=640, height=480)
+    >>> uv, z = cam.project([[1.0, 0.0, 2.0]])          # camera frame: 1 m right, 2 m ahead
+    >>> print(np.round(uv, 2), z)
+    [[479.5 239.5]] [2.]
+    >>> print(np.round(cam.backproject(uv, z), 6))
+    [[1. 0. 2.]]
     """
 
     fx: float
@@ -317,6 +337,14 @@ class StereoRig:
     In a rectified pair a point at depth Z has disparity ``d = u_left - u_right = f B / Z`` and
     lies on the same row (Hartley & Zisserman 2004, Sec. 9.3; Se, Lowe & Little 2002, Sec. 3.1:
     ``Z = f I / d``).
+
+    Examples
+    --------
+    >>> rig = StereoRig(PinholeCamera.from_fov(np.deg2rad(90.0), width=640), baseline=0.12)
+    >>> print(np.round(rig.disparity([2.0, 4.0]), 2), np.round(rig.depth(19.2), 3))
+    [19.2  9.6] 2.0
+    >>> sorted(rig.offsets)
+    ['left', 'right']
     """
 
     camera: PinholeCamera

@@ -1,8 +1,7 @@
 """An omnidirectional catadioptric camera (a camera looking up at a mirror), 640x480 colour.
 
-Projection model: the unified central catadioptric model (Geyer & Daniilidis, "A unifying theory
-for central panoramic systems", ECCV 2000; Mei & Rives, "Single view point omnidirectional camera
-calibration from planar grids", ICRA 2007, Sec. II). A point ``X`` in the omni frame is first put
+Projection model: the unified central catadioptric model (Geyer & Daniilidis 2000; Mei & Rives
+2007, Sec. II). A point ``X`` in the omni frame is first put
 on the unit sphere, ``Xs = X / |X|``, then projected from a centre ``xi`` above the sphere's centre:
 
     m = (xs / (zs + xi), ys / (zs + xi)),      (u, v) = (f m_x + cx, f m_y + cy).
@@ -21,8 +20,19 @@ and the mirror's rim limits the outside. Outside the annulus the image is black 
 ``inf``. Depth images of this camera hold the *range* ``|X|`` (distance from the viewpoint), not Z.
 
 Rendering: the world is rendered into the faces of a cube around the viewpoint with the pinhole
-renderer, then resampled into the omni image with one ``cv2.remap`` (a cube map, Greene,
-"Environment mapping and other applications of world projections", IEEE CG&A 1986).
+renderer, then resampled into the omni image with one ``cv2.remap`` (a cube map, Greene 1986).
+
+References
+----------
+.. [1] C. Geyer and K. Daniilidis, "A unifying theory for central panoramic systems and practical
+   implications", *Proc. European Conference on Computer Vision (ECCV)*, 445-461, 2000.
+.. [2] C. Mei and P. Rives, "Single view point omnidirectional camera calibration from planar
+   grids", *Proc. IEEE International Conference on Robotics and Automation (ICRA)*, 3945-3950,
+   2007.
+.. [3] N. Greene, "Environment mapping and other applications of world projections", *IEEE
+   Computer Graphics and Applications* 6(11), 21-29, 1986.
+.. [4] *Robust Omnidirectional Vision based Mobile Robot Hierarchical Localization and Autonomous
+   Navigation* (the course's source paper for lesson 02; our copy gives no authors, venue or year).
 """
 from __future__ import annotations
 
@@ -91,6 +101,18 @@ class OmniCamera(MountedSensor):
         ``T_body_omni``; default :func:`omni_mount` at 1.0 m.
     face_size : int, default 400
         Cube-face resolution used for rendering.
+
+    Examples
+    --------
+    A point on the horizon straight ahead (omni frame: x forward, z down) lands on the circle of
+    elevation 0, and lifts back to the same point:
+
+    >>> cam = OmniCamera()
+    >>> uv, r = cam.project([[2.0, 0.0, 0.0]])
+    >>> print(np.round(uv, 2), np.round(r, 3))
+    [[455.75 239.5 ]] [2.]
+    >>> print(np.round(cam.backproject(uv, r), 6))
+    [[2. 0. 0.]]
     """
 
     width: int = 640
