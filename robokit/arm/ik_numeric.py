@@ -268,7 +268,7 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     if not isinstance(chain, Chain):
         raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
     Tt = as_se3(T, "T", batch=True)
-    N, n = Tt.shape[0], chain.n
+    N = Tt.shape[0]
     method = check_choice(method, "method", METHODS)
     tol = check_positive(tol, "tol")
     max_iter = check_int(max_iter, "max_iter", minimum=1)

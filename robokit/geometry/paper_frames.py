@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array, as_points
-from .planar import wrap_angle
+from .planar import as_planar, wrap_angle
 from .rotations import rot_y
 
 __all__ = ["R_BODY_OPTICAL", "as_pqt", "se2_to_pqt", "pqt_to_se2", "pqt_to_se3", "robot_to_world",
@@ -60,13 +60,6 @@ def as_pqt(pqt: Any, name: str = "pqt") -> np.ndarray:
     return as_array(pqt, name, shape=(3,))
 
 
-def _pqts(value: Any, name: str) -> np.ndarray:
-    P = as_array(value, name)
-    if P.shape[-1:] != (3,) or P.ndim > 2:
-        raise ValueError(f"{name}: expected shape (3,) or (N, 3), got shape {P.shape}")
-    return P
-
-
 def se2_to_pqt(pose: Any) -> np.ndarray:
     """Convert robokit planar poses ``[x, y, theta]`` to the papers' ``[p, q, theta]``.
 
@@ -94,7 +87,7 @@ def se2_to_pqt(pose: Any) -> np.ndarray:
     >>> print(np.round(se2_to_pqt([3.0, 2.0, np.pi / 2]), 6))
     [3. 2. 0.]
     """
-    P = _pqts(pose, "pose")
+    P = as_planar(pose, "pose")
     return np.stack([P[..., 0], P[..., 1], wrap_angle(P[..., 2] - np.pi / 2)], axis=-1)
 
 
@@ -124,7 +117,7 @@ def pqt_to_se2(pqt: Any) -> np.ndarray:
     >>> print(np.round(pqt_to_se2([3.0, 2.0, 0.0]), 6))
     [3.       2.       1.570796]
     """
-    P = _pqts(pqt, "pqt")
+    P = as_planar(pqt, "pqt")
     return np.stack([P[..., 0], P[..., 1], wrap_angle(P[..., 2] + np.pi / 2)], axis=-1)
 
 

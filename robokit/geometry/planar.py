@@ -23,7 +23,32 @@ import numpy as np
 from ..validation import as_array
 from .rotations import as_rotation
 
-__all__ = ["wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2"]
+__all__ = ["as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2"]
+
+
+def as_planar(value: Any, name: str) -> np.ndarray:
+    """Validate one planar pose or a stack of them: shape (3,) or (N, 3), finite.
+
+    For robokit's ``[x, y, theta]`` and the papers' ``[p, q, theta]`` alike.
+
+    Raises
+    ------
+    ValueError
+        If the shape is not (3,) or (N, 3) or a value is not finite.
+
+    Notes
+    -----
+    Validation only (DESIGN.md, "Errors"); not from a paper.
+
+    Examples
+    --------
+    >>> as_planar([[0, 0, 0], [1, 2, 3]], "poses").shape
+    (2, 3)
+    """
+    p = as_array(value, name)
+    if p.shape[-1:] != (3,) or p.ndim > 2:
+        raise ValueError(f"{name}: expected shape (3,) or (N, 3), got shape {p.shape}")
+    return p
 
 
 def wrap_angle(angle: Any) -> Any:

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array, as_points, check_finite_scalar
+from .planar import as_planar
 from .rotations import ROTATION_TOL, as_rotation, check_rotation_block, rot_z, so3_log
 
 __all__ = ["as_se3", "se3_from_rt", "se3_inverse", "se3_compose", "transform_points", "se2_to_se3",
@@ -228,13 +229,6 @@ def transform_points(transform: Any, points: Any, *, check: bool = True) -> np.n
     return P @ T[:3, :3].T + T[:3, 3]
 
 
-def _planar(pose: Any, name: str) -> np.ndarray:
-    p = as_array(pose, name)
-    if p.shape[-1:] != (3,) or p.ndim > 2:
-        raise ValueError(f"{name}: expected shape (3,) or (N, 3), got shape {p.shape}")
-    return p
-
-
 def se2_to_se3(pose: Any, z: float = 0.0) -> np.ndarray:
     """Lift planar poses ``[x, y, theta]`` (z up) to 4x4 transforms at height ``z``.
 
@@ -267,7 +261,7 @@ def se2_to_se3(pose: Any, z: float = 0.0) -> np.ndarray:
      [ 0.   0.   1.   0.5]
      [ 0.   0.   0.   1. ]]
     """
-    p = _planar(pose, "pose")
+    p = as_planar(pose, "pose")
     T = np.zeros(p.shape[:-1] + (4, 4))
     T[..., :3, :3] = rot_z(p[..., 2])
     T[..., 0, 3], T[..., 1, 3], T[..., 2, 3], T[..., 3, 3] = p[..., 0], p[..., 1], check_finite_scalar(z, "z"), 1.0

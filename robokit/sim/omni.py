@@ -10,7 +10,7 @@ Its inverse lifts a pixel back to the sphere (Mei & Rives 2007, Eq. (6)):
 
     r2 = m_x^2 + m_y^2,   eta = (xi + sqrt(1 + (1 - xi^2) r2)) / (r2 + 1),   Xs = (eta m_x, eta m_y, eta - xi).
 
-``xi = 1`` is a parabolic mirror with an orthographic camera. The seed's robot (seed 001, Sec.
+``xi = 1`` is a parabolic mirror with an orthographic camera. The robot of lesson 02's paper (Sec.
 "Implementation for omnidirectional vision") uses a spherical mirror, which has no single
 viewpoint; the unified model is the standard central approximation of such systems.
 
@@ -76,7 +76,7 @@ def omni_mount(height: float = 1.0) -> np.ndarray:
 
     Notes
     -----
-    Seed 001 mounts the camera on top of the robot looking up at the mirror; the omni frame's z axis
+    Lesson 02's paper mounts the camera on top of the robot looking up at the mirror; the omni frame's z axis
     is the mirror axis pointing down, as in Mei & Rives (2007), Sec. II.
     """
     return se3_from_rt(np.diag([1.0, -1.0, -1.0]), [0.0, 0.0, check_positive(height, "height")])
@@ -89,7 +89,7 @@ class OmniCamera(MountedSensor):
     Parameters
     ----------
     width, height : int, default 640, 480
-        Image size (seed 001: "full resolution 640x480 pixels", colour).
+        Image size (lesson 02's paper: "full resolution 640x480 pixels", colour).
     xi : float, default 1.0
         Mirror parameter in (0, 1] (1: parabolic).
     elevation_range : (float, float), default (-60 deg, +30 deg)
