@@ -50,7 +50,8 @@ def _claim_targets(chain: Chain, qa, conv, active, tgt, winner, t_done) -> np.nd
 
 def _restart_or_retire(chain: Chain, rows, tgt, tries, restarts, qr, steps, best, stall, alive, step, gen) -> None:
     """Unchecked: restart ended attempts ``rows`` from random configurations while their target has
-    restarts left (in row order, which fixes the random draws), retire them otherwise."""
+    restarts left (in row order, which fixes the random draws), retire them otherwise. Random
+    restarts are TRAC-IK's KDL-RR remedy for local minima (Beeson & Ames 2015)."""
     for r in rows:
         t = tgt[r]
         if tries[t] < restarts:
