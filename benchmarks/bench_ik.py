@@ -3,12 +3,12 @@
 For the KUKA LBR iiwa 14 R820 (analytic arm-angle IK and the numerical solvers) and the Franka
 Panda (numerical solvers) on random reachable targets: each target is the flange pose of a
 configuration drawn uniformly inside the joint limits; each solve starts from another random
-configuration inside the limits (the seed). A solve succeeds when the FK of the answer is within
+configuration inside the limits (``q0``). A solve succeeds when the FK of the answer is within
 1e-6 m and 1e-6 rad of the target and every joint is inside its limits (checked here, not taken
 from the solver).
 
 If roboticstoolbox-python is installed, its C++ Levenberg-Marquardt solver ``ik_LM`` runs on the
-same targets and seeds (its error E = e^T e / 2 below 5e-13, i.e. |e| < 1e-6; joint limits
+same targets and start configurations (its error E = e^T e / 2 below 5e-13, i.e. |e| < 1e-6; joint limits
 on; its default 100 searches), and the
 ratios "time of robokit / time of ik_LM" are printed (below 1 means robokit is faster).
 
@@ -46,9 +46,9 @@ def verified(chain, T, q):
     return ok & chain.within_limits(q), np.linalg.norm(e[:, :3], axis=1), np.linalg.norm(e[:, 3:], axis=1)
 
 
-def run_single(solve, T, seeds):
+def run_single(solve, T, q0s):
     qs, t0 = [], time.perf_counter()
-    for Ti, si in zip(T, seeds):
+    for Ti, si in zip(T, q0s):
         qs.append(solve(Ti, si))
     return np.array(qs), (time.perf_counter() - t0) / len(T)
 
@@ -79,7 +79,7 @@ def main(argv=None):
     for name, chain in (("iiwa14", iiwa14()), ("panda", panda())):
         rng = np.random.default_rng(args.seed)
         T = chain.fk(chain.random_q(args.n, rng))
-        seeds = chain.random_q(args.n, rng)
+        q0s = chain.random_q(args.n, rng)
         ns = min(args.n_single, args.n)
         solvers = []
         if name == "iiwa14":
@@ -99,11 +99,11 @@ def main(argv=None):
         peer_time = None
         results = []
         for label, batch, single in solvers:
-            q1, t_single = run_single(single, T[:ns], seeds[:ns])
+            q1, t_single = run_single(single, T[:ns], q0s[:ns])
             ok1, _, _ = verified(chain, T[:ns], q1)
             if batch is not None:
                 t0 = time.perf_counter()
-                qb = batch(T, seeds)
+                qb = batch(T, q0s)
                 t_batch = (time.perf_counter() - t0) / args.n
                 okb, pos, rot = verified(chain, T, qb)
                 rate, n_eval = okb.mean(), args.n

@@ -20,7 +20,7 @@ from PIL import Image
 
 from robokit.localization.egomotion import ransac_pose
 from robokit.localization.hough import global_localize
-from robokit.mapping.frames import world_to_robot
+from robokit.geometry import world_to_robot
 from robokit.vision.descriptors import detect_plot_features, detect_sift_features
 from robokit.vision.evaluation import recall_precision, similarity_homography
 from tests.test_localization_hough import POSES, lab_map_and_view
@@ -71,7 +71,7 @@ def bench_ransac() -> None:
         bad = rng.permutation(200)[:100]
         world[bad] = rng.uniform([-4, 0, -4], [4, 2.5, 4], (100, 3))
         res = ransac_pose(robot, world, rng=rng)
-        errs.append((np.hypot(*(res.pose[:2] - truth[:2])), abs(res.pose[2] - truth[2])))
+        errs.append((np.hypot(*(res.pqt[:2] - truth[:2])), abs(res.pqt[2] - truth[2])))
     e = np.array(errs)
     print(f"RANSAC, 200 matches with 50 % outliers, 1 cm noise, 20 trials: mean error {e[:, 0].mean() * 100:.2f} cm, "
           f"{np.rad2deg(e[:, 1]).mean():.3f} deg (max {e[:, 0].max() * 100:.2f} cm)")
@@ -85,8 +85,8 @@ def bench_global_localization() -> None:
         t0 = time.perf_counter()
         best, _ = global_localize(pts, cov, desc, lm)
         times.append(time.perf_counter() - t0)
-        et.append(np.hypot(*(best.pose[:2] - pose[:2])))
-        er.append(abs(np.angle(np.exp(1j * (best.pose[2] - pose[2])))))
+        et.append(np.hypot(*(best.pqt[:2] - pose[:2])))
+        er.append(abs(np.angle(np.exp(1j * (best.pqt[2] - pose[2])))))
     print(f"global localization, {len(lm)} landmarks, {len(POSES)} poses of Se et al. Sec. 6: median "
           f"{np.median(times):.3f} s, max {max(times):.3f} s (target < 0.5 s); mean error "
           f"{np.mean(et) * 100:.2f} cm, {np.rad2deg(np.mean(er)):.2f} deg; max {max(et) * 100:.2f} cm")

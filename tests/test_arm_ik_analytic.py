@@ -58,14 +58,14 @@ def test_batch_success_rate_and_accuracy(seed):
     assert all(r == "converged" for r, s in zip(res.reason, res.success) if s)
 
 
-def test_seed_equal_to_a_solution_is_returned():
+def test_q0_equal_to_a_solution_is_returned():
     q = IIWA.random_q(50, rng=12)
     res = ik_srs_batch(IIWA, IIWA.fk(q), q)
     assert res.success.all()
     assert np.abs(res.q - q).max() < 1e-9
 
 
-def test_solution_is_near_the_seed_for_nearby_targets():
+def test_solution_is_near_q0_for_nearby_targets():
     q = IIWA.random_q(200, rng=13)
     q_near = np.clip(q + np.random.default_rng(14).normal(0, 0.02, q.shape), IIWA.qmin, IIWA.qmax)
     res = ik_srs_batch(IIWA, IIWA.fk(q_near), q)
@@ -100,12 +100,14 @@ def test_pose_reachable_only_outside_the_limits_fails():
 
 def test_bad_input():
     T = IIWA.fk(np.zeros(7))
-    with pytest.raises(ValueError, match="T: expected a rotation block"):
+    with pytest.raises(ValueError, match=r"T\[:3, :3\]: expected a rotation matrix"):
         ik_srs(IIWA, T @ np.diag([2, 1, 1, 1]))
     with pytest.raises(ValueError, match="T"):
         ik_srs(IIWA, np.full((4, 4), np.nan))
-    with pytest.raises(ValueError, match="q_seed"):
+    with pytest.raises(ValueError, match="q0"):
         ik_srs(IIWA, T, np.zeros(6))
+    with pytest.raises(ValueError, match="q0: expected one joint vector or 3"):
+        ik_srs_batch(IIWA, np.stack([T] * 3), np.zeros((2, 7)))
     with pytest.raises(ValueError, match="chain"):
         ik_srs(panda(), T)
     with pytest.raises(ValueError, match="psi"):

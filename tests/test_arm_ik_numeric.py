@@ -16,7 +16,9 @@ def _targets(chain, n, seed):
 
 @pytest.mark.parametrize("method", ["dls", "gradient_projection", "wln"])
 def test_panda_success_rate_with_limits(method):
-    q, T, seeds = _targets(PANDA, 400, seed=20)
+    # 1200 targets: a failure rate of 0.1-0.2 % (bench_ik.py) stays far from the 0.5 % bound; with
+    # 400 targets, 3 failures (a 2 % chance at that rate) already broke it
+    q, T, seeds = _targets(PANDA, 1200, seed=20)
     res = ik_numeric_batch(PANDA, T, seeds, method=method, rng=1)
     assert res.success_rate >= 0.995
     e = pose_error(T, PANDA.fk(res.q))
@@ -113,7 +115,7 @@ def test_bad_input():
         ik_numeric(PANDA, T, np.zeros(6))
     with pytest.raises(ValueError, match="T"):
         ik_numeric(PANDA, T[:3])
-    with pytest.raises(ValueError, match="T: expected a rotation block"):
+    with pytest.raises(ValueError, match=r"T\[:3, :3\]: expected a rotation matrix"):
         ik_numeric(PANDA, T @ np.diag([1, 1, -1, 1]))
     with pytest.raises(ValueError, match="damping"):
         ik_numeric(PANDA, T, damping=-1.0)
@@ -121,3 +123,24 @@ def test_bad_input():
         dls_step(np.zeros((5, 7)), np.zeros(6))
     with pytest.raises(ValueError, match="weights"):
         dls_step(np.ones((6, 7)), np.zeros(6), weights=np.zeros(7))
+
+
+@pytest.mark.parametrize("method", ["dls", "gradient_projection", "wln"])
+@pytest.mark.parametrize("clamp", [True, False])
+def test_fast_solver_follows_the_readable_reference_iterate_by_iterate(method, clamp):
+    """The vectorised search (one attempt per target, no restarts) and the plain loop of
+    ik_reference take the same steps: every iterate agrees to rounding (measured up to 1e-12 rad:
+    the reference passes the damping as lambda = sqrt(lambda^2) to the public step functions and
+    takes norms with np.linalg.norm, which round differently in the last bit)."""
+    from robokit.arm import ik_numeric_reference
+
+    q, T, q0 = _targets(PANDA, 12, seed=27)
+    fast = ik_numeric_batch(PANDA, T, q0, method=method, clamp=clamp, restarts=0, history=True, rng=0)
+    for i in range(len(T)):
+        ref, iterates = ik_numeric_reference(PANDA, T[i], q0[i], method=method, clamp=clamp)
+        k = len(iterates)
+        np.testing.assert_allclose(fast.history[:k, i], iterates, rtol=0, atol=1e-10)
+        # after its last step the fast solver only repeats the final iterate
+        np.testing.assert_array_equal(fast.history[k:, i], np.broadcast_to(fast.history[k - 1, i], fast.history[k:, i].shape))
+        assert ref.success == fast.success[i] and ref.iterations == fast.iterations[i]
+        np.testing.assert_allclose(ref.q, fast.q[i], rtol=0, atol=1e-10)

@@ -189,16 +189,48 @@ def test_plain_table_functions_match_the_chain():
         dh_fk(table, q[:5])
 
 
-def test_pose_error_is_validated_and_exact_for_known_motions():
+def test_public_frames_flange_and_jacobian_kernels_match_the_checked_functions():
+    from robokit.arm import jacobian_from_frames
+    from robokit.geometry import pose_error as geometry_pose_error
     from robokit.arm import pose_error
 
-    T = np.eye(4)
-    T2 = _rot([0, 0, 1], 0.3)
-    T2[:3, 3] = [0.1, 0.0, 0.0]
-    assert np.allclose(pose_error(T2, T), [0.1, 0, 0, 0, 0, 0.3])
-    near_pi = _rot([1, 1, 0] / np.sqrt(2), np.pi - 1e-9)
-    assert np.isclose(np.linalg.norm(pose_error(near_pi, T)[3:]), np.pi - 1e-9)
-    with pytest.raises(ValueError, match="T_target"):
-        pose_error(np.ones((4, 4)), T)
-    with pytest.raises(ValueError, match="equal length"):
-        pose_error(np.stack([T, T]), np.stack([T, T, T]))
+    assert pose_error is geometry_pose_error              # lesson 06 calls arm.pose_error
+    chain = panda()
+    q = chain.random_q(6, rng=15)
+    frames = chain.frames(q)
+    assert frames.shape == (6, 8, 4, 4)
+    np.testing.assert_array_equal(chain.frames(q, check=False), frames)
+    np.testing.assert_array_equal(chain.flange_pose(frames), chain.fk(q))
+    np.testing.assert_array_equal(jacobian_from_frames(chain, frames), geometric_jacobian(chain, q))
+    np.testing.assert_array_equal(jacobian_from_frames(chain, frames, check=False), geometric_jacobian(chain, q))
+    with pytest.raises(ValueError, match=r"frames: expected shape \(\.\.\., 8, 4, 4\)"):
+        chain.flange_pose(frames[:, :5])
+    with pytest.raises(ValueError, match="frames"):
+        jacobian_from_frames(chain, frames[:, :, :3])
+    with pytest.raises(TypeError, match="chain"):
+        jacobian_from_frames("panda", frames)
+    with pytest.raises(ValueError, match="q"):
+        chain.frames(q[:, :6])
+
+
+def test_verify_needs_the_pose_and_the_limits():
+    from robokit.arm import verify
+
+    chain = panda()
+    q = chain.random_q(3, rng=16)
+    T = chain.fk(q)
+    bad = q.copy()
+    bad[1, 0] += 0.05                                      # pose off
+    r = verify(chain, T, bad)
+    assert r.success.tolist() == [True, False, True]
+    assert r.reason[1].startswith("pose error above tolerance")
+    assert r.position_error[1] > 1e-3 and r.position_error[0] < 1e-12
+    # the flange pose reached with a joint outside its limits is no success
+    outside = chain.qmax.copy()
+    outside[3] = 0.5                                       # the Panda's elbow cannot reach +0.5 rad
+    r = verify(chain, chain.fk(outside)[None], outside[None])
+    assert not r.success[0] and "joint 4 is outside its limits" in r.reason[0]
+    with pytest.raises(ValueError, match="one per target"):
+        verify(chain, T, q[:2])
+    with pytest.raises(ValueError, match="tol"):
+        verify(chain, T, q, tol=0.0)

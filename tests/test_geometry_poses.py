@@ -1,4 +1,4 @@
-"""SE(2)/SE(3) poses, rotations and the seeds' [p, q, theta] convention."""
+"""SE(2)/SE(3) poses: composition, inverse, points, the planar embedding, the SE(3) validator and pose error."""
 import numpy as np
 import pytest
 
@@ -37,20 +37,13 @@ def test_se2_matrix_agrees_with_compose():
 
 def test_se3_compose_inverse_and_points():
     rng = np.random.default_rng(3)
-    R = g.rotation_matrix(rng.normal(size=3))
+    R = g.so3_exp(rng.normal(size=3))
     T = g.se3_from_rt(R, rng.normal(size=3))
     np.testing.assert_allclose(g.se3_compose(T, g.se3_inverse(T)), np.eye(4), atol=1e-12)
     pts = rng.normal(size=(10, 3))
     back = g.transform_points(g.se3_inverse(T), g.transform_points(T, pts))
     np.testing.assert_allclose(back, pts, atol=1e-12)
     np.testing.assert_allclose(g.transform_points(T, pts), pts @ R.T + T[:3, 3], atol=1e-12)
-
-
-def test_rotation_vector_round_trip_and_euler():
-    v = np.array([0.3, -0.2, 1.1])
-    np.testing.assert_allclose(g.rotation_vector(g.rotation_matrix(v)), v, atol=1e-12)
-    Rz = g.euler_matrix([0, 0, np.pi / 2])
-    np.testing.assert_allclose(Rz @ [1, 0, 0], [0, 1, 0], atol=1e-12)
 
 
 def test_se2_se3_lift_agrees_with_planar_compose():
@@ -63,19 +56,6 @@ def test_se2_se3_lift_agrees_with_planar_compose():
     assert g.wrap_angle(got[2] - ref[2]) == pytest.approx(0, abs=1e-12)
 
 
-def test_pqt_convention():
-    # the seeds' ground plane (X, Z) is robokit's (x, y); the heading is offset by 90 degrees
-    np.testing.assert_allclose(g.se2_to_pqt([2.0, 1.0, 0.3]), [2.0, 1.0, 0.3 - np.pi / 2])
-    # a robot facing robokit's +y faces the seeds' +Z (heading 0)
-    np.testing.assert_allclose(g.se2_to_pqt([0.0, 0.0, np.pi / 2]), [0.0, 0.0, 0.0], atol=1e-12)
-    poses = _random_se2(np.random.default_rng(5), 20)
-    np.testing.assert_allclose(g.pqt_to_se2(g.se2_to_pqt(poses)), poses)
-    # the body->optical rotation maps forward to optical z and left to optical -x
-    np.testing.assert_allclose(g.R_BODY_OPTICAL @ [0, 0, 1], [1, 0, 0])
-    np.testing.assert_allclose(g.R_BODY_OPTICAL.T @ [0, 1, 0], [-1, 0, 0])
-    np.testing.assert_allclose(g.optical_to_seed([[1, 2, 3]]), [[1, -2, 3]])
-
-
 @pytest.mark.parametrize("call, match", [
     (lambda: g.se2_inverse([0, 0]), "a"),
     (lambda: g.se2_to_matrix([0, np.nan, 0]), "pose"),
@@ -85,23 +65,70 @@ def test_pqt_convention():
     (lambda: g.transform_points(np.eye(4), [[1, 2]]), "points"),
     (lambda: g.euler_matrix([0, 0, 0], seq="xq"), "seq"),
     (lambda: g.se2_to_pqt([[1, 2]]), "pose"),
+    (lambda: g.matrix_to_se2(np.diag([1.0, -1.0, 1.0])), "matrix"),
+    (lambda: g.se3_to_se2(np.ones((4, 4))), "transform"),
+    (lambda: g.se2_to_se3([0, 0, 0], z=np.inf), "z"),
 ])
 def test_bad_input_is_named(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
         call()
 
 
-def test_pqt_convention_agrees_with_mapping_frames():
-    """One convention in the course: geometry's conversion and mapping.frames place a point seen
-    by the robot at the same spot in the world."""
-    from robokit.mapping.frames import robot_to_world
+def test_as_se3_accepts_rigid_transforms_and_promotes_batches():
+    T = g.se3_from_rt(g.rot_z(0.4), [1.0, 2.0, 3.0])
+    assert g.as_se3(T, "T").shape == (4, 4)
+    assert g.as_se3(T, "T", batch=True).shape == (1, 4, 4)
+    assert g.as_se3(np.stack([T, T]), "T", batch=True).shape == (2, 4, 4)
+    # a rotation off by 1e-8 passes the default tolerance, not a tight one
+    R = T.copy()
+    R[0, 0] += 1e-8
+    g.as_se3(R, "T")
+    with pytest.raises(ValueError, match=r"tolerance 1e-10"):
+        g.as_se3(R, "T", tol=1e-10)
 
-    rng = np.random.default_rng(11)
-    for pose in _random_se2(rng, 10):
-        X, Y, Z = rng.uniform(-3, 3, size=3)        # seeds' robot frame: right, up, forward
-        body = np.array([Z, -X])                     # robokit body frame: forward, left
-        c, s_ = np.cos(pose[2]), np.sin(pose[2])
-        world_xy = pose[:2] + np.array([[c, -s_], [s_, c]]) @ body
-        seeds_world = robot_to_world([[X, Y, Z]], g.se2_to_pqt(pose))[0]
-        np.testing.assert_allclose([seeds_world[0], seeds_world[2]], world_xy, atol=1e-12)
-        assert seeds_world[1] == pytest.approx(Y)
+
+@pytest.mark.parametrize("value, kwargs, match", [
+    (np.eye(3), {}, r"T: expected shape \(4, 4\)"),
+    (np.full((4, 4), np.nan), {}, r"T: .*finite"),
+    (np.diag([1.0, 1.0, 1.0, 2.0]), {}, r"T: expected an SE\(3\) matrix with last row \[0, 0, 0, 1\], got \[0.0, 0.0, 0.0, 2.0\]"),
+    (np.diag([1.0, 1.0, -1.0, 1.0]), {}, r"T\[:3, :3\]: expected a rotation matrix .* det = -1"),
+    (np.diag([2.0, 1.0, 1.0, 1.0]), {}, r"max \|R\^T R - I\| = 3"),
+    (np.stack([np.eye(4), np.diag([1.0, 1.0, -1.0, 1.0])]), {"batch": True}, r"at index 1"),
+    (np.stack([np.eye(4)] * 2), {}, r"T: expected shape \(4, 4\)"),
+])
+def test_as_se3_errors_name_the_argument_and_the_defect(value, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        g.as_se3(value, "T", **kwargs)
+
+
+def test_se3_functions_on_stacks_equal_the_single_transform_results():
+    rng = np.random.default_rng(6)
+    R = g.so3_exp(rng.normal(size=(5, 3)))
+    t = rng.normal(size=(5, 3))
+    T = g.se3_from_rt(R, t)
+    assert T.shape == (5, 4, 4)
+    poses = _random_se2(rng, 5)
+    lifted = g.se2_to_se3(poses, z=0.3)
+    for i in range(5):
+        np.testing.assert_array_equal(T[i], g.se3_from_rt(R[i], t[i]))
+        np.testing.assert_allclose(g.se3_inverse(T)[i], g.se3_inverse(T[i]), atol=1e-15)
+        np.testing.assert_allclose(g.se3_compose(T, T[0])[i], T[i] @ T[0], atol=1e-15)
+        np.testing.assert_array_equal(lifted[i], g.se2_to_se3(poses[i], z=0.3))
+        np.testing.assert_allclose(g.se3_to_se2(lifted)[i], g.se3_to_se2(lifted[i]), atol=1e-15)
+    np.testing.assert_allclose(g.se3_inverse(T) @ T, np.broadcast_to(np.eye(4), (5, 4, 4)), atol=1e-12)
+
+
+def test_pose_error_is_validated_and_exact_for_known_motions():
+    T = np.eye(4)
+    T2 = g.se3_from_rt(g.rot_z(0.3), [0.1, 0.0, 0.0])
+    np.testing.assert_allclose(g.pose_error(T2, T), [0.1, 0, 0, 0, 0, 0.3], atol=1e-15)
+    near_pi = g.se3_from_rt(g.so3_exp(np.array([1, 1, 0]) / np.sqrt(2) * (np.pi - 1e-9)), np.zeros(3))
+    assert np.isclose(np.linalg.norm(g.pose_error(near_pi, T)[3:]), np.pi - 1e-9)
+    # a stack against one transform, and the unchecked fast path gives the same numbers
+    stack = np.stack([T2, near_pi, T])
+    np.testing.assert_array_equal(g.pose_error(stack, T), g.pose_error(stack, T, check=False))
+    assert g.pose_error(stack, T).shape == (3, 6)
+    with pytest.raises(ValueError, match="T_target"):
+        g.pose_error(np.ones((4, 4)), T)
+    with pytest.raises(ValueError, match="equal length"):
+        g.pose_error(np.stack([T, T]), np.stack([T, T, T]))

@@ -5,7 +5,7 @@ import pytest
 from robokit.localization.egomotion import (DegenerateCorrespondenceError, InsufficientMatchesError,
                                             continuation_matches, fit_pose, pose_from_two,
                                             ransac_pose, ransac_sample_count, track)
-from robokit.mapping.frames import robot_to_world, world_to_robot
+from robokit.geometry import robot_to_world, world_to_robot
 from robokit.mapping.landmarks import LandmarkMap
 
 TRUE = np.array([0.35, 1.20, np.deg2rad(17.0)])
@@ -64,7 +64,7 @@ def test_ransac_recovers_the_pose_with_half_outliers():
     bad = rng.permutation(200)[:100]
     world[bad] = rng.uniform([-4, 0, -4], [4, 2.5, 4], (100, 3))
     res = ransac_pose(robot, world, rng=3)
-    dt, dth = _err(res.pose)
+    dt, dth = _err(res.pqt)
     assert res.source == "ransac"
     assert dt < 0.01 and dth < np.deg2rad(0.3)
     truly_good = np.ones(200, bool)
@@ -79,14 +79,14 @@ def test_too_few_or_degenerate_matches_fall_back_to_odometry():
     robot, world = _scene(rng, 10)
     odo = TRUE + [0.05, -0.05, 0.01]
     res = ransac_pose(robot, world, odometry=odo)
-    assert res.source == "odometry" and np.allclose(res.pose, odo) and res.n_inliers == 0
+    assert res.source == "odometry" and np.allclose(res.pqt, odo) and res.n_inliers == 0
     with pytest.raises(InsufficientMatchesError, match="only 10 matches"):
         ransac_pose(robot, world)
     with pytest.raises(InsufficientMatchesError, match="only 1 matches"):
         ransac_pose(robot[:1], world[:1])
     same = np.tile(robot[:1], (30, 1))
     res = ransac_pose(same, np.tile(world[:1], (30, 1)), odometry=odo)
-    assert res.source == "odometry" and np.all(np.isfinite(res.pose))
+    assert res.source == "odometry" and np.all(np.isfinite(res.pqt))
     # pure outliers: nothing reaches 15 supporting matches
     res = ransac_pose(robot, rng.permutation(world), min_matches=8, odometry=odo)
     assert res.source == "odometry"
@@ -117,15 +117,15 @@ def test_tracking_uses_the_window_and_recovers_when_kidnapped():
     rng = np.random.default_rng(6)
     lm, robot, desc = _map_and_view(rng)
     res, fi, li, kidnapped = track(robot, desc, lm, TRUE + [0.05, -0.04, 0.02], rng=1)
-    assert not kidnapped and res.source == "ransac" and max(_err(res.pose)) < 0.01
+    assert not kidnapped and res.source == "ransac" and max(_err(res.pqt)) < 0.01
     res, fi, li, kidnapped = track(robot, desc, lm, [3.0, -3.0, 2.0], rng=1)
     assert kidnapped and res.source == "ransac"
-    dt, dth = _err(res.pose)
+    dt, dth = _err(res.pqt)
     assert dt < 0.01 and dth < np.deg2rad(0.5) and np.all(fi == li)
     # scene changed completely: odometry is kept, no NaN
     other = rng.normal(size=desc.shape).astype(np.float32)
     res, fi, li, kidnapped = track(robot, other, lm, [3.0, -3.0, 2.0], rng=1)
-    assert res.source == "odometry" and np.allclose(res.pose, [3.0, -3.0, 2.0]) and fi.size == 0
+    assert res.source == "odometry" and np.allclose(res.pqt, [3.0, -3.0, 2.0]) and fi.size == 0
     assert np.allclose(robot_to_world(world_to_robot(lm.positions[:3], TRUE), TRUE), lm.positions[:3])
 
 

@@ -4,7 +4,7 @@ import pytest
 
 from robokit.localization.egomotion import InsufficientMatchesError
 from robokit.localization.hough import candidate_matches, global_localize, hough_accumulator
-from robokit.mapping.frames import world_to_robot
+from robokit.geometry import world_to_robot
 from robokit.mapping.landmarks import LandmarkMap
 from robokit.vision.stereo import StereoCalibration, disparity_to_point
 
@@ -99,8 +99,8 @@ def test_global_localization_in_a_synthetic_lab(case):
     rng = np.random.default_rng(100 + case)
     lm, (pts, cov, desc, truth) = lab_map_and_view(rng, pose)
     best, hyps = global_localize(pts, cov, desc, lm)
-    err_t = np.hypot(*(best.pose[:2] - pose[:2]))
-    err_r = abs(np.angle(np.exp(1j * (best.pose[2] - pose[2]))))
+    err_t = np.hypot(*(best.pqt[:2] - pose[:2]))
+    err_r = abs(np.angle(np.exp(1j * (best.pqt[2] - pose[2]))))
     assert err_t < 0.05 and err_r < np.deg2rad(1.2), (err_t, np.rad2deg(err_r))
     assert best.n_matches >= 15 and len(hyps) <= 10
     assert np.mean(truth[best.feature_index] == best.landmark_row) > 0.95

@@ -10,8 +10,8 @@ from robokit.sim import box_room
 HEIGHT = 0.8
 
 
-def _lab_to_seed(points):
-    """Inverse of seed_to_lab: (x, y, z) -> (X, Y, Z) = (x, z - h, y)."""
+def _lab_to_paper(points):
+    """Inverse of paper_to_lab: (x, y, z) -> (X, Y, Z) = (x, z - h, y)."""
     p = np.asarray(points, float)
     return np.stack([p[:, 0], p[:, 2] - HEIGHT, p[:, 1]], axis=1)
 
@@ -27,8 +27,8 @@ def _map_on_surface(offsets, sigma_normal, sigma_other=0.5):
     basis = np.stack([wall.normal, wall.u / np.linalg.norm(wall.u), wall.v / np.linalg.norm(wall.v)], axis=1)
     cov_lab = basis @ np.diag([sigma_normal ** 2, sigma_other ** 2, sigma_other ** 2]) @ basis.T
     perm = np.array([[1.0, 0, 0], [0, 0, 1], [0, 1, 0]])
-    cov_seed = np.repeat((perm @ cov_lab @ perm.T)[None], len(offsets), axis=0)
-    lm = SimpleNamespace(positions=_lab_to_seed(pts), covariances=cov_seed,
+    cov_paper = np.repeat((perm @ cov_lab @ perm.T)[None], len(offsets), axis=0)
+    lm = SimpleNamespace(positions=_lab_to_paper(pts), covariances=cov_paper,
                          observations=np.arange(1, len(offsets) + 1))
     return lm, world
 
@@ -64,7 +64,7 @@ def test_overconfident_map_is_flagged():
 def test_landmark_beyond_every_surface_is_left_out():
     world = box_room()
     far = np.array([[100.0, 100.0, 50.0]])
-    lm = SimpleNamespace(positions=_lab_to_seed(far), covariances=np.eye(3)[None] * 1e-4,
+    lm = SimpleNamespace(positions=_lab_to_paper(far), covariances=np.eye(3)[None] * 1e-4,
                          observations=np.array([1]))
     assert not map_consistency(lm, world).on_surface[0]
 
@@ -75,3 +75,19 @@ def test_bad_input_is_named():
     lm, world = _map_on_surface(np.zeros(2), 0.01)
     with pytest.raises(ValueError, match="margin"):
         map_consistency(lm, world, margin=-1.0)
+
+
+def test_paper_to_lab_permutes_points_and_covariances():
+    from robokit.localization.lab_experiment import paper_to_lab
+
+    rng = np.random.default_rng(5)
+    lab = rng.uniform(0, 5, size=(6, 3))
+    m = rng.normal(size=(6, 3, 3))
+    cov = m @ np.swapaxes(m, 1, 2)
+    perm = np.array([[1.0, 0, 0], [0, 0, 1], [0, 1, 0]])
+    pts, covs = paper_to_lab(_lab_to_paper(lab), perm @ cov @ perm.T, camera_height=HEIGHT)
+    np.testing.assert_allclose(pts, lab, atol=1e-12)
+    np.testing.assert_allclose(covs, cov, atol=1e-12)
+    assert paper_to_lab(_lab_to_paper(lab))[1] is None
+    with pytest.raises(ValueError, match="camera_height"):
+        paper_to_lab(lab, camera_height=0.0)

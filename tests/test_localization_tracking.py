@@ -36,9 +36,9 @@ def test_tracking_and_map_building_over_a_run():
         res, fi, li, kidnapped = track(pts, d, lm, odometry, odo_cov, covariances=cov, rng=k)
         sources.append(res.source)
         assert not kidnapped
-        landmark = lm.associate(pts, cov, d, res.pose)
-        pairs += zip(lm.integrate(pts, cov, d, res.pose, res.covariance, landmark), rows)
-        est = res.pose
+        landmark = lm.associate(pts, cov, d, res.pqt)
+        pairs += zip(lm.integrate(pts, cov, d, res.pqt, res.covariance, landmark), rows)
+        est = res.pqt
         errors.append(np.hypot(*(est[:2] - pose[:2])))
     assert sources == ["ransac"] * 15
     # visual odometry drifts: stay within 3 % of the 3.75 m travelled (measured ~1.8 %, mostly along
@@ -69,5 +69,5 @@ def test_tracking_and_map_building_over_a_run():
     pose = truth[7]
     pts, cov, d, _ = stereo_view(rng, world, desc, pose)
     best, _ = global_localize(pts, cov, d, lm)
-    assert np.hypot(*(best.pose[:2] - pose[:2])) < 0.05
-    assert abs(np.angle(np.exp(1j * (best.pose[2] - pose[2])))) < np.deg2rad(1.2)
+    assert np.hypot(*(best.pqt[:2] - pose[:2])) < 0.05
+    assert abs(np.angle(np.exp(1j * (best.pqt[2] - pose[2])))) < np.deg2rad(1.2)

@@ -62,7 +62,7 @@ def test_kidnapped_frame_falls_back_to_whole_database_matching():
     # no landmark is predicted near any feature, so the whole database is searched
     report = slam.step(left[6], right[6], odo[3] + [0.0, 0.0, np.pi])
     assert report.kidnapped and report.source == "ransac"
-    assert np.hypot(*(report.pose[:2] - truth[6, :2])) < 0.05
+    assert np.hypot(*(report.pqt[:2] - truth[6, :2])) < 0.05
 
 
 def test_textureless_frames_keep_the_odometry():
@@ -72,8 +72,8 @@ def test_textureless_frames_keep_the_odometry():
     first = slam.start(blank, blank, [1.0, 2.0, 0.1])
     assert first.n_observations == 0 and len(slam.map) == 0
     report = slam.step(blank, blank, [1.0, 2.5, 0.1])     # odometry: 0.5 m straight ahead
-    assert report.source == "odometry" and np.all(np.isfinite(report.pose))
-    assert np.allclose(report.pose, [1.0, 2.5, 0.1])
+    assert report.source == "odometry" and np.all(np.isfinite(report.pqt))
+    assert np.allclose(report.pqt, [1.0, 2.5, 0.1])
     assert report.covariance[1, 1] > first.covariance[1, 1]
     assert slam.trajectory.shape == (2, 3)
 
@@ -178,7 +178,7 @@ def test_vectorised_greedy_assignment_equals_the_sequential_scan():
 def test_ransac_recovers_the_rendered_motion_with_half_the_matches_wrong():
     from robokit import sim
     from robokit.localization import ransac_pose
-    from robokit.mapping import robot_to_world
+    from robokit.geometry import robot_to_world
     from robokit.vision import detect_and_describe, observe_stereo, ratio_match
 
     world = sim.lab_room()
@@ -199,4 +199,4 @@ def test_ransac_recovers_the_rendered_motion_with_half_the_matches_wrong():
                       world_covariances=obs[0].covariances[m.train], rng=0)
     truth = se2_to_pqt(poses[1])
     assert len(bad) > 0.4 * len(m) and res.source == "ransac"
-    assert np.hypot(*(res.pose[:2] - truth[:2])) < 0.02 and abs(wrap_angle(res.pose[2] - truth[2])) < np.deg2rad(0.5)
+    assert np.hypot(*(res.pqt[:2] - truth[:2])) < 0.02 and abs(wrap_angle(res.pqt[2] - truth[2])) < np.deg2rad(0.5)

@@ -2,28 +2,13 @@
 import numpy as np
 import pytest
 
-from robokit.geometry import se2_compose
-from robokit.mapping.frames import robot_to_world, rotation_y, transform_covariance, world_to_robot
-from robokit.mapping.landmarks import LandmarkMap, kalman_fuse
+from robokit.geometry import robot_to_world, world_to_robot
+from robokit.mapping import LandmarkMap, kalman_fuse, transform_covariance
 
 
 def _spd(rng, n, scale=0.01):
     m = rng.normal(size=(n, 3, 3)) * np.sqrt(scale)
     return m @ np.swapaxes(m, 1, 2) + 1e-4 * np.eye(3)
-
-
-def test_pose_convention_matches_se2_on_the_ground_plane():
-    rng = np.random.default_rng(0)
-    pose = np.array([0.4, -1.2, 0.7])
-    pts = rng.normal(size=(10, 3))
-    world = robot_to_world(pts, pose)
-    for r, w in zip(pts, world):
-        assert np.allclose(se2_compose(pose, [r[0], r[2], 0.0])[:2], w[[0, 2]])
-    assert np.allclose(world[:, 1], pts[:, 1])
-    assert np.allclose(world_to_robot(world, pose), pts)
-    # theta = +90 degrees: the robot looks along -X (it has turned left)
-    assert np.allclose(robot_to_world([[0, 0, 1.0]], [0, 0, np.pi / 2]), [[-1, 0, 0]])
-    assert np.allclose(rotation_y(0.3) @ rotation_y(-0.3), np.eye(3))
 
 
 def test_kalman_fusion_formula_and_shrinking_uncertainty():
@@ -59,12 +44,12 @@ def test_backward_transformation_covariance_matches_monte_carlo():
     rng = np.random.default_rng(2)
     pt = np.array([[0.5, 0.3, 3.0]])
     cov = np.diag([0.001, 0.001, 0.02])[None]
-    pose = np.array([1.0, 2.0, 0.4])
-    pose_cov = np.diag([0.01 ** 2, 0.02 ** 2, np.deg2rad(1.0) ** 2])
-    world, wcov = transform_covariance(pt, cov, pose, pose_cov)
-    assert np.allclose(world, robot_to_world(pt, pose))
+    pqt = np.array([1.0, 2.0, 0.4])
+    pqt_cov = np.diag([0.01 ** 2, 0.02 ** 2, np.deg2rad(1.0) ** 2])
+    world, wcov = transform_covariance(pt, cov, pqt, pqt_cov)
+    assert np.allclose(world, robot_to_world(pt, pqt))
     n = 40000
-    samples_p = rng.multivariate_normal(pose, pose_cov, n)
+    samples_p = rng.multivariate_normal(pqt, pqt_cov, n)
     samples_r = rng.multivariate_normal(pt[0], cov[0], n)
     c, s = np.cos(samples_p[:, 2]), np.sin(samples_p[:, 2])
     out = np.column_stack([c * samples_r[:, 0] - s * samples_r[:, 2] + samples_p[:, 0], samples_r[:, 1],
@@ -72,7 +57,7 @@ def test_backward_transformation_covariance_matches_monte_carlo():
     emp = np.cov(out.T)
     assert np.allclose(emp, wcov[0], rtol=0.05, atol=5e-5)
     # without the pose term the covariance would be too small
-    _, only_obs = transform_covariance(pt, cov, pose, np.zeros((3, 3)))
+    _, only_obs = transform_covariance(pt, cov, pqt, np.zeros((3, 3)))
     assert np.trace(wcov[0]) > np.trace(only_obs[0])
 
 
@@ -84,10 +69,10 @@ def test_map_integrates_frames_and_forgets_unseen_landmarks():
     obs_cov = np.stack([np.diag([1e-3, 1e-3, 1e-2])] * 30)
     poses = [np.array([0.0, 0.0, 0.0]), np.array([0.1, 0.3, 0.05]), np.array([0.2, 0.6, 0.1])]
     ids = None
-    for k, pose in enumerate(poses):
-        robot = world_to_robot(truth, pose) + rng.normal(size=(30, 3)) * [0.03, 0.03, 0.1]
+    for k, pqt in enumerate(poses):
+        robot = world_to_robot(truth, pqt) + rng.normal(size=(30, 3)) * [0.03, 0.03, 0.1]
         lm = -np.ones(30, int) if k == 0 else np.searchsorted(m.ids, ids)
-        ids = m.integrate(robot, obs_cov, desc, pose, np.diag([1e-6, 1e-6, 1e-8]), lm)
+        ids = m.integrate(robot, obs_cov, desc, pqt, np.diag([1e-6, 1e-6, 1e-8]), lm)
     assert len(m) == 30 and np.all(m.observations == 3)
     first_cov = np.trace(obs_cov[0])
     assert np.all(np.trace(m.covariances, axis1=1, axis2=2) < 0.5 * first_cov)
@@ -111,15 +96,15 @@ def test_association_uses_pose_uncertainty_and_descriptors():
     desc /= np.linalg.norm(desc, axis=1, keepdims=True)
     m = LandmarkMap(16)
     m.add(world, np.stack([np.eye(3) * 1e-4] * 40), desc)
-    pose = np.array([0.2, 0.1, 0.05])
-    obs = world_to_robot(world, pose) + rng.normal(scale=0.01, size=(40, 3))
+    pqt = np.array([0.2, 0.1, 0.05])
+    obs = world_to_robot(world, pqt) + rng.normal(scale=0.01, size=(40, 3))
     cov = np.stack([np.eye(3) * 1e-4] * 40)
-    assert np.array_equal(m.associate(obs, cov, desc, pose), np.arange(40))
+    assert np.array_equal(m.associate(obs, cov, desc, pqt), np.arange(40))
     # same geometry, wrong descriptors: nothing associates
-    assert np.all(m.associate(obs, cov, np.roll(desc, 1, axis=0), pose) == -1)
+    assert np.all(m.associate(obs, cov, np.roll(desc, 1, axis=0), pqt) == -1)
     # an observation 10 cm off is outside a 1 cm-sigma gate but inside a 10 cm-sigma one
     off = obs.copy()
     off[0, 2] += 0.1
-    assert m.associate(off, cov, desc, pose)[0] == -1
-    assert m.associate(off, np.stack([np.eye(3) * 1e-2] * 40), desc, pose)[0] == 0
-    assert np.all(LandmarkMap(16).associate(obs, cov, desc, pose) == -1)
+    assert m.associate(off, cov, desc, pqt)[0] == -1
+    assert m.associate(off, np.stack([np.eye(3) * 1e-2] * 40), desc, pqt)[0] == 0
+    assert np.all(LandmarkMap(16).associate(obs, cov, desc, pqt) == -1)

@@ -1,6 +1,7 @@
 """Robot-arm kinematics: DH chains, Jacobians, analytic and numerical inverse kinematics.
 
-Lesson 06 (redundant 7-DOF arms, seed 000 Q4: Huang & Jiang's separation of position and posture).
+Lesson 06 (redundant 7-DOF arms; Huang & Jiang 2013: separation of position and posture). Rigid
+transforms, rotations and the pose error come from :mod:`robokit.geometry`.
 
 * :class:`Chain`, :func:`dh_transform`, :func:`mdh_transform` - DH / modified-DH forward kinematics.
 * :func:`iiwa14`, :func:`panda` - two real arms with their published parameters.
@@ -11,20 +12,25 @@ Lesson 06 (redundant 7-DOF arms, seed 000 Q4: Huang & Jiang's separation of posi
   arm-angle IK of S-R-S arms (KUKA LBR iiwa).
 * :func:`ik_numeric`, :func:`ik_numeric_batch` - damped least squares with null-space gradient
   projection (Dubey) or weighted least norm (Chan), random restarts; any chain.
+  :func:`ik_numeric_reference` is the same for one target as a plain loop.
+* :func:`pose_error` - :func:`robokit.geometry.pose_error`, re-exported for the lesson.
 """
+from ..geometry import pose_error
 from .chain import Chain, chain_from_table, dh_fk
 from .dh import dh_transform, mdh_transform
 from .ik_analytic import SRSArm, arm_angle, ik_srs, ik_srs_batch, ik_srs_branches
-from .ik_numeric import METHODS, dls_step, ik_numeric, ik_numeric_batch, null_space_step
-from .jacobian import dh_jacobian, geometric_jacobian, manipulability
+from .ik_numeric import ik_numeric, ik_numeric_batch
+from .ik_reference import ik_numeric_reference
+from .ik_steps import METHODS, dls_step, null_space_step
+from .jacobian import dh_jacobian, geometric_jacobian, jacobian_from_frames, manipulability
 from .limits import limit_distance_gradient, wln_weights
-from .result import IKBatchResult, IKResult
+from .result import IKBatchResult, IKResult, verify
 from .robots import iiwa14, panda
-from .se3 import pose_error
 from .srs import elbow_angle, shoulder_angles, wrist_centre
 
 __all__ = ["Chain", "dh_transform", "mdh_transform", "iiwa14", "panda", "geometric_jacobian",
-           "manipulability", "SRSArm", "arm_angle", "ik_srs", "ik_srs_batch", "ik_srs_branches",
-           "IKResult", "IKBatchResult", "pose_error", "METHODS", "dls_step", "null_space_step",
-           "ik_numeric", "ik_numeric_batch", "limit_distance_gradient", "wln_weights", "chain_from_table",
-           "dh_fk", "dh_jacobian", "elbow_angle", "shoulder_angles", "wrist_centre"]
+           "jacobian_from_frames", "manipulability", "SRSArm", "arm_angle", "ik_srs", "ik_srs_batch",
+           "ik_srs_branches", "IKResult", "IKBatchResult", "verify", "pose_error", "METHODS", "dls_step",
+           "null_space_step", "ik_numeric", "ik_numeric_batch", "ik_numeric_reference",
+           "limit_distance_gradient", "wln_weights", "chain_from_table", "dh_fk", "dh_jacobian", "elbow_angle",
+           "shoulder_angles", "wrist_centre"]

@@ -3,6 +3,13 @@
 A :class:`Chain` knows its link parameters, joint offsets and limits, a fixed tool (flange)
 transform and a base transform. It computes the pose of every link frame in one vectorised pass,
 for one configuration or a batch of them.
+
+References
+----------
+.. [1] J. Denavit and R. S. Hartenberg, "A kinematic notation for lower-pair mechanisms based on
+   matrices", *Journal of Applied Mechanics* 22(2), 215-221, 1955.
+.. [2] M. W. Spong, S. Hutchinson and M. Vidyasagar, *Robot Modeling and Control*, Wiley, 2006.
+.. [3] J. J. Craig, *Introduction to Robotics: Mechanics and Control*, 3rd ed., Pearson, 2005.
 """
 from __future__ import annotations
 
@@ -10,9 +17,9 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import as_se3
 from ..validation import as_array, as_rng, check_choice, check_int
-from .dh import _link_matrices
-from .se3 import as_se3
+from .dh import dh_transform, mdh_transform
 
 __all__ = ["Chain", "dh_fk", "chain_from_table"]
 
@@ -74,8 +81,8 @@ class Chain:
         self._has_offset = bool(np.any(self.offset != 0))
         # Each link transform is affine in (cos theta, sin theta): A = K + cos U + sin V. Sampling the
         # DH formula at theta = 0, pi, +-pi/2 gives K, U, V, so FK needs no trig of the twists.
-        A = {t: _link_matrices(np.full(n, t), self.d, self.a, self.alpha, modified=self.modified)
-             for t in (0.0, np.pi, np.pi / 2, -np.pi / 2)}
+        link = mdh_transform if self.modified else dh_transform
+        A = {t: link(np.full(n, t), self.d, self.a, self.alpha, check=False) for t in (0.0, np.pi, np.pi / 2, -np.pi / 2)}
         self._K = 0.5 * (A[0.0] + A[np.pi])
         self._U = 0.5 * (A[0.0] - A[np.pi])
         self._V = 0.5 * (A[np.pi / 2] - A[-np.pi / 2])
@@ -161,8 +168,38 @@ class Chain:
         return float(np.sum(np.hypot(self.a, self.d)) + np.linalg.norm(self.tool[:3, 3]))
 
     # --- kinematics ------------------------------------------------------------------------------
-    def _frames(self, q: np.ndarray) -> np.ndarray:
-        """Unchecked: poses of frames 0..n for ``q`` of shape (..., n) -> (..., n + 1, 4, 4)."""
+    def frames(self, q: Any, *, check: bool = True) -> np.ndarray:
+        """Poses of frames 0..n (base, then every link) in the world, in one vectorised pass.
+
+        Parameters
+        ----------
+        q : array_like, shape (..., n)
+            Joint angles [rad]; with ``check=True`` one ``(n,)`` vector or a batch ``(N, n)``.
+        check : bool, default True
+            Validate ``q``; ``False`` skips it (solvers' inner loops, float arrays).
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n + 1, 4, 4)
+
+        Raises
+        ------
+        ValueError
+            On a wrong-length or non-finite joint vector.
+
+        Notes
+        -----
+        Product of link transforms, Spong et al. (2006), Eq. (3.5). Each link transform is affine
+        in ``(cos theta, sin theta)``: ``A = K + cos(theta) U + sin(theta) V``, precomputed per chain.
+
+        Examples
+        --------
+        >>> from robokit.arm import iiwa14
+        >>> iiwa14().frames([0.0] * 7)[-1, :3, 3].tolist()
+        [0.0, 0.0, 1.306]
+        """
+        if check:
+            q = self.check_q(q, batch=np.ndim(q) == 2)
         th = q + self.offset if self._has_offset else q
         links = self._K + np.cos(th)[..., None, None] * self._U + np.sin(th)[..., None, None] * self._V
         out = np.empty(q.shape[:-1] + (self.n + 1, 4, 4))
@@ -171,8 +208,40 @@ class Chain:
             np.matmul(out[..., i, :, :], links[..., i, :, :], out=out[..., i + 1, :, :])
         return out
 
-    def _flange(self, frames: np.ndarray) -> np.ndarray:
-        """Unchecked: flange pose from the frames of :meth:`_frames`."""
+    def flange_pose(self, frames: Any, *, check: bool = True) -> np.ndarray:
+        """The flange's transform (last link frame times the tool) from the frames of :meth:`frames`.
+
+        Parameters
+        ----------
+        frames : array_like, shape (..., n + 1, 4, 4)
+        check : bool, default True
+            Check the shape and values of ``frames``; ``False`` skips it.
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., 4, 4)
+
+        Raises
+        ------
+        ValueError
+            If ``frames`` does not have shape (..., n + 1, 4, 4) or is not finite.
+
+        Notes
+        -----
+        Spong et al. (2006), Eq. (3.5), followed by the fixed tool transform.
+
+        Examples
+        --------
+        >>> from robokit.arm import panda
+        >>> arm = panda()
+        >>> arm.flange_pose(arm.frames(arm.random_q(rng=0))).shape
+        (4, 4)
+        """
+        if check:
+            frames = as_array(frames, "frames")
+            if frames.shape[-3:] != (self.n + 1, 4, 4):
+                raise ValueError(f"frames: expected shape (..., {self.n + 1}, 4, 4) from Chain.frames, "
+                                 f"got shape {frames.shape}")
         return frames[..., -1, :, :] @ self.tool if self._has_tool else frames[..., -1, :, :]
 
     def joint_frames(self, frames: np.ndarray) -> np.ndarray:
@@ -205,9 +274,8 @@ class Chain:
         -----
         Product of link transforms, Spong et al. (2006), Eq. (3.5).
         """
-        q = self.check_q(q, batch=np.ndim(q) == 2)
-        frames = self._frames(q)
-        return np.concatenate([frames, self._flange(frames)[..., None, :, :]], axis=-3)
+        frames = self.frames(q)
+        return np.concatenate([frames, self.flange_pose(frames, check=False)[..., None, :, :]], axis=-3)
 
     def fk(self, q: Any) -> np.ndarray:
         """Pose of the flange for joint angles ``q`` (one ``(n,)`` vector or a batch ``(N, n)``).
@@ -225,8 +293,7 @@ class Chain:
         -----
         Spong et al. (2006), Eq. (3.5), followed by the fixed tool transform.
         """
-        q = self.check_q(q, batch=np.ndim(q) == 2)
-        return self._flange(self._frames(q))
+        return self.flange_pose(self.frames(q), check=False)
 
 
 def chain_from_table(dh: Any, *, modified: bool = False) -> Chain:

@@ -2,6 +2,13 @@
 
 Both functions broadcast over their arguments, so one call builds every link transform of a chain,
 or of a whole batch of configurations, at once.
+
+References
+----------
+.. [1] J. Denavit and R. S. Hartenberg, "A kinematic notation for lower-pair mechanisms based on
+   matrices", *Journal of Applied Mechanics* 22(2), 215-221, 1955.
+.. [2] M. W. Spong, S. Hutchinson and M. Vidyasagar, *Robot Modeling and Control*, Wiley, 2006.
+.. [3] J. J. Craig, *Introduction to Robotics: Mechanics and Control*, 3rd ed., Pearson, 2005.
 """
 from __future__ import annotations
 
@@ -23,7 +30,7 @@ def _params(theta: Any, d: Any, a: Any, alpha: Any):
         raise ValueError(f"theta, d, a, alpha: expected broadcastable shapes, got {shapes}") from None
 
 
-def dh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
+def dh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, check: bool = True) -> np.ndarray:
     """Standard DH link transform ``Rz(theta) Tz(d) Tx(a) Rx(alpha)``.
 
     Parameters
@@ -36,6 +43,8 @@ def dh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
         Link length along ``x_i`` [m].
     alpha : float or array_like
         Link twist about ``x_i`` [rad].
+    check : bool, default True
+        Validate and broadcast the inputs; ``False`` skips it (float arrays that broadcast).
 
     Returns
     -------
@@ -49,10 +58,18 @@ def dh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
 
     Notes
     -----
-    Denavit & Hartenberg, "A kinematic notation for lower-pair mechanisms based on matrices" (1955);
-    matrix as in Spong, Hutchinson & Vidyasagar, *Robot Modeling and Control* (2006), Eq. (3.10).
+    Denavit & Hartenberg (1955); matrix as in Spong et al. (2006), Eq. (3.10).
+
+    Examples
+    --------
+    >>> print(np.round(dh_transform(np.pi / 2, 0.36, 0.0, -np.pi / 2), 3) + 0.0)   # + 0.0: no "-0."
+    [[ 0.    0.   -1.    0.  ]
+     [ 1.    0.    0.    0.  ]
+     [ 0.   -1.    0.    0.36]
+     [ 0.    0.    0.    1.  ]]
     """
-    return _link_matrices(*_params(theta, d, a, alpha), modified=False)
+    args = _params(theta, d, a, alpha) if check else (theta, d, a, alpha)
+    return _link_matrices(*args, modified=False)
 
 
 def _link_matrices(th: np.ndarray, d: np.ndarray, a: np.ndarray, al: np.ndarray, *, modified: bool) -> np.ndarray:
@@ -72,7 +89,7 @@ def _link_matrices(th: np.ndarray, d: np.ndarray, a: np.ndarray, al: np.ndarray,
     return T
 
 
-def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
+def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, check: bool = True) -> np.ndarray:
     """Modified (Craig) DH link transform ``Rx(alpha) Tx(a) Rz(theta) Tz(d)``.
 
     Parameters
@@ -85,6 +102,8 @@ def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
         Link length ``a_{i-1}`` along ``x_{i-1}`` [m].
     alpha : float or array_like
         Link twist ``alpha_{i-1}`` about ``x_{i-1}`` [rad].
+    check : bool, default True
+        Validate and broadcast the inputs; ``False`` skips it.
 
     Returns
     -------
@@ -98,7 +117,12 @@ def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
 
     Notes
     -----
-    Craig, *Introduction to Robotics: Mechanics and Control* (3rd ed., 2005), Eq. (3.6). Franka
-    Emika publishes the Panda's kinematics in this convention.
+    Craig (2005), Eq. (3.6). Franka Emika publishes the Panda's kinematics in this convention.
+
+    Examples
+    --------
+    >>> mdh_transform(0.0, 0.333, 0.0, 0.0)[:3, 3].tolist()
+    [0.0, 0.0, 0.333]
     """
-    return _link_matrices(*_params(theta, d, a, alpha), modified=True)
+    args = _params(theta, d, a, alpha) if check else (theta, d, a, alpha)
+    return _link_matrices(*args, modified=True)

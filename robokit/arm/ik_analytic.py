@@ -1,18 +1,25 @@
 """Analytic inverse kinematics of S-R-S 7-DOF arms (e.g. the KUKA LBR iiwa) with the arm angle.
 
-The method is the separation of position and posture of Huang & Jiang ("A new method of inverse
-kinematics solution for industrial 7DOF robot", Proc. 32nd Chinese Control Conference, 2013):
+The method is the separation of position and posture of Huang & Jiang (2013):
 
 1. the wrist centre ``W = p - d_wf z_7`` depends only on the target pose;
 2. joints 1-4 place the wrist centre: a position problem of a 4-DOF arm, redundant by one. The
    elbow angle ``q4`` follows from the triangle shoulder-elbow-wrist (law of cosines); the
    remaining freedom is the rotation of that triangle about the shoulder-wrist line, the *arm
-   angle* ``psi`` of Shimizu et al. (IEEE T-RO 24(5), 2008, Sec. III);
+   angle* ``psi`` of Shimizu et al. (2008), Sec. III;
 3. joints 5-7 produce the orientation in closed form (a ZYZ Euler decomposition);
 4. an iteration over the redundancy parameter ``psi`` finds values that keep every joint inside
-   its limits and picks the solution closest to a seed configuration.
+   its limits and picks the solution closest to a preferred configuration ``q0``.
 
 Every function here is vectorised over many targets at once.
+
+References
+----------
+.. [1] L. Huang and R. Jiang, "A new method of inverse kinematics solution for industrial 7DOF
+   robot", *Proc. 32nd Chinese Control Conference*, 2013.
+.. [2] M. Shimizu, H. Kakuya, W.-K. Yoon, K. Kitagaki and K. Kosuge, "Analytical inverse kinematic
+   computation for 7-DOF redundant manipulators with joint limits and its application to redundancy
+   resolution", *IEEE Transactions on Robotics* 24(5), 1131-1142, 2008.
 """
 from __future__ import annotations
 
@@ -21,12 +28,11 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import as_se3
 from ..validation import as_array, check_int, check_positive
 from .chain import Chain
-from .result import IKBatchResult, IKResult, _verify
-from .se3 import as_se3
-from .srs import _flip, _zyz
-from .srs_geometry import ARRAY, SCALAR, arm_angle_terms, coefficient_terms
+from .result import IKBatchResult, IKResult, verify
+from .srs_geometry import ARRAY, SCALAR, arm_angle_terms, coefficient_terms, mirror_angle, zyz_angles
 
 __all__ = ["SRSArm", "arm_angle", "ik_srs_branches", "ik_srs", "ik_srs_batch"]
 
@@ -119,7 +125,7 @@ class SRSArm:
         basis = np.empty((N, K, 3))
         basis[..., 0], basis[..., 1], basis[..., 2] = np.sin(psi), np.cos(psi), 1.0
         E = (basis @ G).reshape(N, K, 2, 2, 7)
-        return _zyz(*np.moveaxis(E, -1, 0))
+        return zyz_angles(*np.moveaxis(E, -1, 0))
 
     def joints(self, coeffs, psi: np.ndarray) -> np.ndarray:
         """Unchecked: all 8 branches for arm angles ``psi`` (N, K) -> q of shape (N, K, 8, 7).
@@ -127,7 +133,7 @@ class SRSArm:
         Branch ``b`` of the 8 is ``BRANCHES[b] = (elbow, shoulder, wrist)`` mirror flags.
         """
         a, b, c = self.angles(coeffs[0], psi)
-        ang = ((a, b, c), (_flip(a), -b, _flip(c)))           # branch b >= 0, then its mirror
+        ang = ((a, b, c), (mirror_angle(a), -b, mirror_angle(c)))           # branch b >= 0, then its mirror
         q4 = coeffs[1]
         out = np.empty(psi.shape + (8, 7))
         for k, (e, sh, wr) in enumerate(BRANCHES):
@@ -153,11 +159,11 @@ _LOCAL = np.linspace(-1.0, 1.0, 9)
 _SMALL = 16
 
 
-def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, seeds: np.ndarray):
+def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, q0: np.ndarray):
     """Unchecked: over arm angles ``psi`` (m, K) and all 8 branches, the feasible solution nearest
-    ``seeds`` (m, 7). Returns ``(cost, q, psi)``; cost is ``inf`` where nothing is feasible.
+    ``q0`` (m, 7). Returns ``(cost, q, psi)``; cost is ``inf`` where nothing is feasible.
 
-    The squared distance to the seed separates into shoulder, elbow and wrist terms, so the best
+    The squared distance to ``q0`` separates into shoulder, elbow and wrist terms, so the best
     shoulder and wrist branch are chosen independently for each elbow sign and arm angle.
     """
     chain = arm.chain
@@ -166,13 +172,13 @@ def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, seeds: np.ndarray):
     a, b, c = arm.angles(G, psi)                                     # (m, K, 2e, 2g)
     X = np.empty((2, 3, m, K, 2, 2))                                  # branch, joint in group, ...
     X[0, 0], X[0, 1], X[0, 2] = a, b, c
-    X[1, 0], X[1, 1], X[1, 2] = _flip(a), -b, _flip(c)
+    X[1, 0], X[1, 1], X[1, 2] = mirror_angle(a), -b, mirror_angle(c)
     ok = ((X >= arm._lo) & (X <= arm._hi)).all(1)                    # (2b, m, K, 2e, 2g)
-    D = X - seeds[:, arm._grp].transpose(1, 0, 2)[None, :, :, None, None, :]
+    D = X - q0[:, arm._grp].transpose(1, 0, 2)[None, :, :, None, None, :]
     cost = np.where(ok, np.einsum("bjmkeg,bjmkeg->bmkeg", D, D), np.inf)
     br = cost[1] < cost[0]                                           # (m, K, 2e, 2g)
     cmin = np.minimum(cost[0], cost[1])
-    c4 = (q4 - seeds[:, 3:4]) ** 2
+    c4 = (q4 - q0[:, 3:4]) ** 2
     c4[(q4 < chain.qmin[3]) | (q4 > chain.qmax[3])] = np.inf
     total = cmin.sum(-1) + c4[:, None, :]                            # (m, K, 2e)
     flat = total.reshape(m, -1).argmin(1)
@@ -223,8 +229,13 @@ def arm_angle(chain: Chain, q: Any) -> float | np.ndarray:
 
     Notes
     -----
-    Shimizu et al., "Analytical inverse kinematic computation for 7-DOF redundant manipulators
-    with joint limits ...", IEEE T-RO 24(5), 2008, Sec. III-A, Eq. (9).
+    Shimizu et al. (2008), Sec. III-A, Eq. (9).
+
+    Examples
+    --------
+    >>> from robokit.arm import iiwa14
+    >>> print(round(float(np.degrees(arm_angle(iiwa14(), np.radians([35, 50, -40, -75, 60, 45, 20])))), 3))
+    -29.971
     """
     arm = _srs(chain)
     return arm.arm_angle(chain.check_q(q, batch=np.ndim(q) == 2))
@@ -259,6 +270,15 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
     -----
     Shimizu et al. (2008), Sec. III-B, Eqs. (13)-(22); Huang & Jiang (2013) separation of position
     and posture.
+
+    Examples
+    --------
+    >>> from robokit.arm import iiwa14
+    >>> arm = iiwa14()
+    >>> q = np.radians([35, 50, -40, -75, 60, 45, 20])
+    >>> branches = ik_srs_branches(arm, arm.fk(q), arm_angle(arm, q), within_limits=False)
+    >>> len(branches), bool(np.abs(branches - q).max(axis=1).min() < 1e-9)
+    (8, True)
     """
     arm = _srs(chain)
     T7 = arm.to_link7(as_se3(T, "T"))
@@ -277,7 +297,7 @@ def _options(n_psi: Any, n_fine: Any, tol: Any):
     return n_psi, check_int(n_fine, "n_fine", minimum=n_psi), check_positive(tol, "tol")
 
 
-def _search(arm: SRSArm, coeffs, psi0: np.ndarray, seeds: np.ndarray, n: int, dense: bool):
+def _search(arm: SRSArm, coeffs, psi0: np.ndarray, q0: np.ndarray, n: int, dense: bool):
     """Unchecked: one pass of the arm-angle iteration with ``n`` coarse arm angles per target.
 
     ``dense``: a single grid of ``4 n`` arm angles (few targets, where numpy's per-call overhead
@@ -286,10 +306,10 @@ def _search(arm: SRSArm, coeffs, psi0: np.ndarray, seeds: np.ndarray, n: int, de
     """
     if dense:
         m = 4 * n
-        cost, q, _ = _best_on_grid(arm, coeffs, psi0[:, None] + np.arange(m) * (2 * np.pi / m), seeds)
+        cost, q, _ = _best_on_grid(arm, coeffs, psi0[:, None] + np.arange(m) * (2 * np.pi / m), q0)
         return cost, q, 8 * m
-    cost, q, psi = _best_on_grid(arm, coeffs, psi0[:, None] + np.arange(n) * (2 * np.pi / n), seeds)
-    c2, q2, _ = _best_on_grid(arm, coeffs, psi[:, None] + (2 * np.pi / n) * _LOCAL, seeds)
+    cost, q, psi = _best_on_grid(arm, coeffs, psi0[:, None] + np.arange(n) * (2 * np.pi / n), q0)
+    c2, q2, _ = _best_on_grid(arm, coeffs, psi[:, None] + (2 * np.pi / n) * _LOCAL, q0)
     better = c2 < cost
     return np.where(better, c2, cost), np.where(better[:, None], q2, q), 8 * (n + len(_LOCAL))
 
@@ -297,7 +317,8 @@ def _search(arm: SRSArm, coeffs, psi0: np.ndarray, seeds: np.ndarray, n: int, de
 def _finish(arm: SRSArm, T: np.ndarray, c4: np.ndarray, q: np.ndarray, found: np.ndarray, evals,
             n_psi: int, n_fine: int, tol: float) -> IKBatchResult:
     """Unchecked: FK-verify ``q`` (N, 7) against targets ``T`` (N, 4, 4) and say why not."""
-    success, reasons, residual, pos, rot = _verify(arm.chain, T, q, tol, tol)
+    out = verify(arm.chain, T, q, tol, check=False)
+    reasons = out.reason
     reach = np.abs(c4) <= 1.0 + 1e-12
     for i in np.flatnonzero(~reach):
         L = np.sqrt(max(0.0, c4[i] * 2 * arm.d_se * arm.d_ew + arm.d_se**2 + arm.d_ew**2))
@@ -305,36 +326,52 @@ def _finish(arm: SRSArm, T: np.ndarray, c4: np.ndarray, q: np.ndarray, found: np
                       f"[{abs(arm.d_se - arm.d_ew):.4f}, {arm.d_se + arm.d_ew:.4f}] m")
     for i in np.flatnonzero(reach & ~found):
         reasons[i] = f"no arm angle keeps all joints within limits ({n_psi} + {n_fine} arm angles tried)"
-    success &= found
-    N = len(q)
-    return IKBatchResult(q=q, success=success, reason=reasons, residual=residual,
-                         iterations=np.broadcast_to(evals, (N,)).astype(int), position_error=pos,
-                         orientation_error=rot, restarts=np.zeros(N, int))
+    out.success &= found
+    out.iterations = np.broadcast_to(evals, (len(q),)).astype(int)
+    return out
 
 
-def ik_srs(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, tol: float = 1e-6,
+def ik_srs(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: float = 1e-6,
            n_fine: int = 720) -> IKResult:
-    """Analytic IK of an S-R-S arm for one target: the valid solution closest to ``q_seed``.
+    """Analytic IK of an S-R-S arm for one target: the valid solution closest to ``q0``.
 
-    Parameters and result as :func:`ik_srs_batch`, for one pose ``T`` (4, 4) and one seed (7,).
-    The per-target geometry runs on Python floats and the arm-angle search is one dense pass over
-    ``4 n_psi`` arm angles (then ``4 n_fine`` if nothing is feasible), the form of
-    :func:`ik_srs_batch` for few targets.
+    Parameters and result as :func:`ik_srs_batch`, for one transform ``T`` (4, 4) and one preferred
+    configuration ``q0`` (7,). The per-target geometry runs on Python floats and the arm-angle
+    search is one dense pass over ``4 n_psi`` arm angles (then ``4 n_fine`` if nothing is
+    feasible), the form of :func:`ik_srs_batch` for few targets.
+
+    Raises
+    ------
+    ValueError
+        On a non-SE(3) target, a ``q0`` of the wrong shape or a chain that is not S-R-S.
+
+    Notes
+    -----
+    Huang & Jiang (2013) with the arm angle of Shimizu et al. (2008), Sec. III.
+
+    Examples
+    --------
+    >>> from robokit.arm import iiwa14
+    >>> arm = iiwa14()
+    >>> T = arm.fk(np.radians([35, 50, -40, -75, 60, 45, 20]))
+    >>> r = ik_srs(arm, T, np.radians([0, 30, 0, -60, 0, 60, 0]))
+    >>> r.success, r.reason, r.position_error < 1e-9
+    (True, 'converged', True)
     """
     if np.ndim(T) != 2:
         raise ValueError(f"T: expected one pose of shape (4, 4), got shape {np.shape(T)}")
-    if q_seed is not None and np.ndim(q_seed) != 1:
-        raise ValueError(f"q_seed: expected one joint vector of shape (7,), got shape {np.shape(q_seed)}")
+    if q0 is not None and np.ndim(q0) != 1:
+        raise ValueError(f"q0: expected one joint vector of shape (7,), got shape {np.shape(q0)}")
     arm = _srs(chain)
     Tt = as_se3(T, "T")
     n_psi, n_fine, tol = _options(n_psi, n_fine, tol)
-    seed = arm.mid if q_seed is None else chain.check_q(q_seed, "q_seed")
+    near = arm.mid if q0 is None else chain.check_q(q0, "q0")
     coeffs = arm.coefficients(arm.to_link7(Tt))
-    seeds, psi0 = seed[None], np.array([arm.arm_angle(seed)])
-    q, found, evals = seeds, np.zeros(1, bool), 0
+    near, psi0 = near[None], np.array([arm.arm_angle(near)])
+    q, found, evals = near, np.zeros(1, bool), 0
     if abs(coeffs[2][0]) <= 1.0 + 1e-12:
         for n in (n_psi, n_fine):
-            cost, q_n, ev = _search(arm, coeffs, psi0, seeds, n, dense=True)
+            cost, q_n, ev = _search(arm, coeffs, psi0, near, n, dense=True)
             evals += ev
             if cost[0] < np.inf:
                 q, found[0] = q_n, True
@@ -342,7 +379,7 @@ def ik_srs(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, tol: fl
     return _finish(arm, Tt[None], coeffs[2], q, found, evals, n_psi, n_fine, tol)[0]
 
 
-def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, tol: float = 1e-6,
+def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: float = 1e-6,
                  n_fine: int = 720) -> IKBatchResult:
     """Analytic IK of an S-R-S arm for many targets, with joint limits and a preferred solution.
 
@@ -352,10 +389,11 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, t
         An S-R-S chain (see :class:`SRSArm`), e.g. :func:`~robokit.arm.iiwa14`.
     T : array_like, shape (N, 4, 4) or (4, 4)
         Target flange poses.
-    q_seed : array_like, shape (N, 7) or (7,), optional
-        Preferred configurations; the middle of the joint ranges by default.
+    q0 : array_like, shape (N, 7) or (7,), optional
+        Preferred configurations (the solution nearest each is kept); the middle of the joint
+        ranges by default.
     n_psi : int, default 12
-        Arm angles tried in the first pass (evenly spaced, starting at each seed's own arm angle).
+        Arm angles tried in the first pass (evenly spaced, starting at each ``q0``'s own arm angle).
     tol : float, default 1e-6
         Tolerance on the FK-verified position error [m] and orientation error [rad].
     n_fine : int, default 720
@@ -370,36 +408,45 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, t
     Raises
     ------
     ValueError
-        On non-SE(3) targets, a wrong-shaped seed or a chain that is not S-R-S.
+        On non-SE(3) targets, a wrong-shaped ``q0`` or a chain that is not S-R-S.
 
     Notes
     -----
     The iteration over the redundancy parameter (Huang & Jiang 2013, "algebraic iteration") runs
     over the arm angle of Shimizu et al. (2008): (1) evaluate the 8 closed-form branches at
-    ``n_psi`` arm angles; keep those inside the limits and take the one nearest the seed; (2)
+    ``n_psi`` arm angles; keep those inside the limits and take the one nearest ``q0``; (2)
     refine ``psi`` on a local grid of 9 arm angles spanning one grid step either side, accepting
     only feasible improvements; (3) targets with no feasible branch are retried on a finer grid.
     For 16 targets or fewer, steps (1)-(2) are one pass over ``4 n_psi`` arm angles (the same
     spacing as the local grid), which is cheaper when numpy's call overhead dominates. Shimizu et al.
     compute the feasible arm-angle intervals exactly (Sec. IV); the sampled search here is simpler
     and is what the lesson's experiment measures.
+
+    Examples
+    --------
+    >>> from robokit.arm import iiwa14
+    >>> arm = iiwa14()
+    >>> T = arm.fk(arm.random_q(50, rng=1))
+    >>> res = ik_srs_batch(arm, T, arm.random_q(50, rng=2))
+    >>> res.success_rate, bool(res.position_error.max() < 1e-9)
+    (1.0, True)
     """
     arm = _srs(chain)
     Tt = as_se3(T, "T", batch=True)
     N = Tt.shape[0]
     n_psi, n_fine, tol = _options(n_psi, n_fine, tol)
-    if q_seed is None:
-        seeds = np.broadcast_to(arm.mid, (N, 7)).copy()
+    if q0 is None:
+        near = np.broadcast_to(arm.mid, (N, 7)).copy()
     else:
-        seeds = chain.check_q(q_seed, "q_seed", batch=True)
-        if seeds.shape[0] == 1 and N > 1:
-            seeds = np.broadcast_to(seeds, (N, 7)).copy()
-        elif seeds.shape[0] != N:
-            raise ValueError(f"q_seed: expected one seed or {N} seeds (one per target), got {seeds.shape[0]}")
+        near = chain.check_q(q0, "q0", batch=True)
+        if near.shape[0] == 1 and N > 1:
+            near = np.broadcast_to(near, (N, 7)).copy()
+        elif near.shape[0] != N:
+            raise ValueError(f"q0: expected one joint vector or {N} (one per target), got {near.shape[0]}")
 
     G, q4, c4 = arm.coefficients(arm.to_link7(Tt))
-    psi0 = arm.arm_angle(seeds)
-    q_best = seeds.copy()
+    psi0 = arm.arm_angle(near)
+    q_best = near.copy()
     found = np.zeros(N, bool)
     evals = np.zeros(N, int)
     reachable = np.flatnonzero(np.abs(c4) <= 1.0 + 1e-12)
@@ -408,7 +455,7 @@ def ik_srs_batch(chain: Chain, T: Any, q_seed: Any = None, *, n_psi: int = 12, t
         for n in (n_psi, n_fine):
             if not rows.size:
                 break
-            cost, q, ev = _search(arm, (G[rows], q4[rows]), psi0[rows], seeds[rows], n, len(rows) <= _SMALL)
+            cost, q, ev = _search(arm, (G[rows], q4[rows]), psi0[rows], near[rows], n, len(rows) <= _SMALL)
             evals[rows] += ev
             has = cost < np.inf
             q_best[rows[has]] = q[has]

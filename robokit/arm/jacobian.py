@@ -1,4 +1,12 @@
-"""The geometric Jacobian of a serial chain and Yoshikawa's manipulability."""
+"""The geometric Jacobian of a serial chain and Yoshikawa's manipulability.
+
+References
+----------
+.. [1] B. Siciliano, L. Sciavicco, L. Villani and G. Oriolo, *Robotics: Modelling, Planning and
+   Control*, Springer, 2009.
+.. [2] T. Yoshikawa, "Manipulability of robotic mechanisms", *The International Journal of Robotics
+   Research* 4(2), 3-9, 1985.
+"""
 from __future__ import annotations
 
 from typing import Any
@@ -8,18 +16,58 @@ import numpy as np
 from ..validation import as_array
 from .chain import Chain, chain_from_table
 
-__all__ = ["geometric_jacobian", "dh_jacobian", "manipulability"]
+__all__ = ["geometric_jacobian", "jacobian_from_frames", "dh_jacobian", "manipulability"]
 
 
-def _jacobian_from_frames(chain: Chain, frames: np.ndarray) -> np.ndarray:
-    """Unchecked kernel: the 6xn Jacobian from the frames 0..n of ``Chain._frames``."""
+def jacobian_from_frames(chain: Chain, frames: Any, *, check: bool = True) -> np.ndarray:
+    """The geometric Jacobian from link frames already computed (e.g. for FK in the same step).
+
+    Parameters
+    ----------
+    chain : Chain
+    frames : array_like, shape (..., n + 1, 4, 4)
+        Frames 0..n of :meth:`Chain.frames`.
+    check : bool, default True
+        Check ``chain`` and the shape of ``frames``; ``False`` skips it (solvers' inner loops).
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 6, n)
+        As :func:`geometric_jacobian`.
+
+    Raises
+    ------
+    TypeError
+        If ``chain`` is not a :class:`Chain`.
+    ValueError
+        If ``frames`` has the wrong shape or is not finite.
+
+    Notes
+    -----
+    Siciliano et al. (2009), Eq. (3.30): column ``i`` is ``[z_i x (p_e - p_i); z_i]``.
+
+    Examples
+    --------
+    >>> from robokit.arm import iiwa14
+    >>> arm = iiwa14()
+    >>> J = jacobian_from_frames(arm, arm.frames(np.zeros(7)))
+    >>> print(np.round(J[:, 1], 3) + 0.0)    # joint 2 tilts the straight arm forward
+    [0.946 0.    0.    0.    1.    0.   ]
+    """
+    if check:
+        if not isinstance(chain, Chain):
+            raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
+        frames = as_array(frames, "frames")
+        if frames.shape[-3:] != (chain.n + 1, 4, 4):
+            raise ValueError(f"frames: expected shape (..., {chain.n + 1}, 4, 4) from Chain.frames, "
+                             f"got shape {frames.shape}")
     jf = chain.joint_frames(frames)
     z = jf[..., :3, 2]                       # (..., n, 3) joint axes
     p = jf[..., :3, 3]                       # (..., n, 3) points on the axes
-    p_e = chain._flange(frames)[..., None, :3, 3]
+    p_e = chain.flange_pose(frames, check=False)[..., None, :3, 3]
     r = p_e - p
     J = np.empty(z.shape[:-2] + (6, z.shape[-2]))
-    J[..., 0, :] = z[..., 1] * r[..., 2] - z[..., 2] * r[..., 1]   # z x (p_e - p)
+    J[..., 0, :] = z[..., 1] * r[..., 2] - z[..., 2] * r[..., 1]   # z x (p_e - p), Eq. (3.30)
     J[..., 1, :] = z[..., 2] * r[..., 0] - z[..., 0] * r[..., 2]
     J[..., 2, :] = z[..., 0] * r[..., 1] - z[..., 1] * r[..., 0]
     J[..., 3:, :] = np.swapaxes(z, -1, -2)
@@ -50,13 +98,18 @@ def geometric_jacobian(chain: Chain, q: Any) -> np.ndarray:
 
     Notes
     -----
-    Siciliano et al., *Robotics: Modelling, Planning and Control* (2009), Eq. (3.30) for revolute
-    joints.
+    Siciliano et al. (2009), Eq. (3.30) for revolute joints.
+
+    Examples
+    --------
+    >>> from robokit.arm import iiwa14
+    >>> J = geometric_jacobian(iiwa14(), np.radians([20, 40, -30, -70, 30, 60, 0]))
+    >>> J.shape, int(np.linalg.matrix_rank(J))
+    ((6, 7), 6)
     """
     if not isinstance(chain, Chain):
         raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
-    q = chain.check_q(q, batch=np.ndim(q) == 2)
-    return _jacobian_from_frames(chain, chain._frames(q))
+    return jacobian_from_frames(chain, chain.frames(q), check=False)
 
 
 def dh_jacobian(dh: Any, q: Any, *, modified: bool = False) -> np.ndarray:
@@ -70,6 +123,16 @@ def dh_jacobian(dh: Any, q: Any, *, modified: bool = False) -> np.ndarray:
     Notes
     -----
     Siciliano et al. (2009), Eq. (3.30); see :func:`geometric_jacobian`.
+
+    Examples
+    --------
+    >>> print(np.round(dh_jacobian([[0.0, 1.0, 0.0], [0.0, 0.5, 0.0]], [0.0, 0.0]), 3) + 0.0)
+    [[0.  0. ]
+     [1.5 0.5]
+     [0.  0. ]
+     [0.  0. ]
+     [0.  0. ]
+     [1.  1. ]]
     """
     chain = chain_from_table(dh, modified=modified)
     return geometric_jacobian(chain, chain.check_q(q))
@@ -95,7 +158,16 @@ def manipulability(J: Any) -> float | np.ndarray:
 
     Notes
     -----
-    Yoshikawa, "Manipulability of robotic mechanisms", IJRR 4(2), 1985, Eq. (7).
+    Yoshikawa (1985), Eq. (7).
+
+    Examples
+    --------
+    >>> from robokit.arm import iiwa14
+    >>> arm = iiwa14()
+    >>> print(round(manipulability(geometric_jacobian(arm, np.zeros(7))), 12))   # stretched: singular
+    0.0
+    >>> print(round(manipulability(geometric_jacobian(arm, np.radians([20, 40, -30, -70, 30, 60, 0]))), 4))
+    0.122
     """
     J = as_array(J, "J")
     if J.ndim not in (2, 3) or J.shape[-2] > J.shape[-1]:

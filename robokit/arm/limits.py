@@ -1,10 +1,23 @@
-"""Joint-limit performance criteria used by the redundancy-resolution schemes of lesson 06."""
+"""Joint-limit performance criteria used by the redundancy-resolution schemes of lesson 06.
+
+References
+----------
+.. [1] A. Liégeois, "Automatic supervisory control of the configuration and behavior of multibody
+   mechanisms", *IEEE Transactions on Systems, Man, and Cybernetics* 7(12), 868-871, 1977.
+.. [2] R. V. Dubey, J. A. Euler and S. M. Babcock, "An efficient gradient projection optimization
+   scheme for a seven-degree-of-freedom redundant robot with spherical wrist", *Proc. IEEE
+   International Conference on Robotics and Automation (ICRA)*, 28-36, 1988.
+.. [3] T. F. Chan and R. V. Dubey, "A weighted least-norm solution based scheme for avoiding joint
+   limits for redundant joint manipulators", *IEEE Transactions on Robotics and Automation* 11(2),
+   286-292, 1995.
+"""
 from __future__ import annotations
 
 from typing import Any
 
 import numpy as np
 
+from ..validation import as_array
 from .chain import Chain
 
 __all__ = ["limit_distance_gradient", "wln_weights"]
@@ -16,7 +29,7 @@ def _limits(chain: Chain, q: Any, name: str = "q") -> np.ndarray:
     return chain.check_q(q, name, batch=np.ndim(q) == 2)
 
 
-def limit_distance_gradient(chain: Chain, q: Any) -> np.ndarray:
+def limit_distance_gradient(chain: Chain, q: Any, *, check: bool = True) -> np.ndarray:
     """Gradient of the joint-range criterion ``H(q) = -1/2 sum(((q_i - mid_i) / half_i)^2)``.
 
     Ascending this gradient moves every joint towards the middle of its range; projected into the
@@ -26,6 +39,8 @@ def limit_distance_gradient(chain: Chain, q: Any) -> np.ndarray:
     ----------
     chain : Chain
     q : array_like, shape (n,) or (N, n)
+    check : bool, default True
+        Validate ``chain`` and ``q``; ``False`` skips it (solvers' inner loops).
 
     Returns
     -------
@@ -39,24 +54,24 @@ def limit_distance_gradient(chain: Chain, q: Any) -> np.ndarray:
 
     Notes
     -----
-    The criterion of Liégeois, "Automatic supervisory control of the configuration and behavior of
-    multibody mechanisms", IEEE T-SMC 7(12), 1977, Eq. (14) (normalised by the half range here),
-    as used for joint-limit avoidance by gradient projection in Dubey, Euler & Babcock, "An
-    efficient gradient projection optimization scheme for a seven-degree-of-freedom redundant robot
-    with spherical wrist", ICRA 1988.
+    The criterion of Liégeois (1977), Eq. (14) (normalised by the half range here), as used for
+    joint-limit avoidance by gradient projection in Dubey, Euler & Babcock (1988).
+
+    Examples
+    --------
+    >>> from robokit.arm import iiwa14
+    >>> arm = iiwa14()
+    >>> print(np.round(limit_distance_gradient(arm, 0.5 * arm.qmax), 3))
+    [-0.169 -0.239 -0.169 -0.239 -0.169 -0.239 -0.164]
     """
-    q = _limits(chain, q)
-    return _limit_gradient(chain, q)
-
-
-def _limit_gradient(chain: Chain, q: np.ndarray) -> np.ndarray:
-    """Unchecked kernel of :func:`limit_distance_gradient`."""
+    if check:
+        q = _limits(chain, q)
     mid = 0.5 * (chain.qmin + chain.qmax)
     half = np.maximum(0.5 * (chain.qmax - chain.qmin), 1e-9)
-    return -(q - mid) / half**2
+    return -(q - mid) / half**2                                 # dH/dq, Liégeois Eq. (14)
 
 
-def wln_weights(chain: Chain, q: Any, previous: Any = None) -> tuple[np.ndarray, np.ndarray]:
+def wln_weights(chain: Chain, q: Any, previous: Any = None, *, check: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """Diagonal weights of Chan & Dubey's weighted least-norm (WLN) solution.
 
     Parameters
@@ -66,7 +81,10 @@ def wln_weights(chain: Chain, q: Any, previous: Any = None) -> tuple[np.ndarray,
         Joint angles, strictly inside the limits for finite weights.
     previous : array_like, optional
         ``|dH/dq|`` of the previous step (same shape as ``q``); without it every joint counts as
-        moving towards its limit.
+        moving towards its limit. (With ``check=False`` a NaN entry gives that joint weight 1,
+        which the numerical solver uses for the first step of an attempt.)
+    check : bool, default True
+        Validate the arguments; ``False`` skips it (solvers' inner loops).
 
     Returns
     -------
@@ -83,28 +101,25 @@ def wln_weights(chain: Chain, q: Any, previous: Any = None) -> tuple[np.ndarray,
 
     Notes
     -----
-    Chan & Dubey, "A weighted least-norm solution based scheme for avoiding joint limits for
-    redundant joint manipulators", IEEE T-RA 11(2), 1995, Eqs. (9)-(11) (the criterion ``H``) and
-    Eq. (13) (the weights).
+    Chan & Dubey (1995), Eqs. (9)-(11) (the criterion ``H``) and Eq. (13) (the weights).
+
+    Examples
+    --------
+    >>> from robokit.arm import panda
+    >>> arm = panda()
+    >>> w, g = wln_weights(arm, 0.5 * (arm.qmin + arm.qmax))
+    >>> print(np.round(w, 3))
+    [1. 1. 1. 1. 1. 1. 1.]
     """
-    q = _limits(chain, q)
-    prev = None if previous is None else _as_previous(previous, q.shape)
-    return _wln(chain, q, prev)
-
-
-def _as_previous(previous: Any, shape) -> np.ndarray:
-    from ..validation import as_array
-
-    return as_array(previous, "previous", shape=shape)
-
-
-def _wln(chain: Chain, q: np.ndarray, previous: np.ndarray | None):
-    """Unchecked kernel of :func:`wln_weights`."""
+    if check:
+        q = _limits(chain, q)
+        if previous is not None:
+            previous = as_array(previous, "previous", shape=q.shape)
     lo, hi = chain.qmin, chain.qmax
     span = hi - lo
     eps = 1e-9 * np.maximum(span, 1e-9)
     qc = np.minimum(np.maximum(q, lo + eps), hi - eps)
-    grad = np.abs(span**2 * (2 * qc - hi - lo) / (4 * (hi - qc) ** 2 * (qc - lo) ** 2))
+    grad = np.abs(span**2 * (2 * qc - hi - lo) / (4 * (hi - qc) ** 2 * (qc - lo) ** 2))   # |dH/dq|, Eq. (11)
     if previous is None:
         return 1.0 + grad, grad
-    return np.where(grad >= previous, 1.0 + grad, 1.0), grad
+    return np.where(grad >= previous, 1.0 + grad, 1.0), grad                          # Eq. (13)

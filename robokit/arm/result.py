@@ -1,11 +1,23 @@
-"""Result objects returned by every IK solver in :mod:`robokit.arm`."""
+"""Result objects returned by every IK solver in :mod:`robokit.arm`, and the FK verification that
+decides their success.
+
+References
+----------
+.. [1] B. Siciliano, L. Sciavicco, L. Villani and G. Oriolo, *Robotics: Modelling, Planning and
+   Control*, Springer, 2009.
+"""
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 
-__all__ = ["IKResult", "IKBatchResult"]
+from ..geometry import as_se3, pose_error
+from ..validation import check_positive
+from .chain import Chain
+
+__all__ = ["IKResult", "IKBatchResult", "verify"]
 
 
 @dataclasses.dataclass
@@ -79,20 +91,61 @@ class IKBatchResult:
                         orientation_error=float(self.orientation_error[i]), restarts=int(self.restarts[i]))
 
 
-def _verify(chain, T_target: np.ndarray, q: np.ndarray, tol_pos: float, tol_rot: float):
-    """Unchecked: FK-verify joint vectors ``q`` (N, n) against targets (N, 4, 4).
+def verify(chain, T_target: Any, q: Any, tol: float = 1e-6, *, check: bool = True) -> IKBatchResult:
+    """FK-verify joint vectors against their targets: success needs the pose AND the joint limits.
 
-    Returns ``(success, reasons, residual, pos_err, rot_err)``; success needs both tolerances met
-    and every joint within limits, so no solver can report a false success.
+    Parameters
+    ----------
+    chain : Chain
+    T_target : array_like, shape (N, 4, 4)
+        Targets.
+    q : array_like, shape (N, n)
+        Candidate solutions.
+    tol : float, default 1e-6
+        Tolerance on the position error [m] and on the orientation error [rad].
+    check : bool, default True
+        Validate the arguments; ``False`` skips it (the solvers, on their own checked arrays).
+
+    Returns
+    -------
+    IKBatchResult
+        ``success``, ``reason``, the errors and ``residual``; ``iterations`` and ``restarts`` are
+        zero for the caller to fill in. No solver can report a false success this way.
+
+    Raises
+    ------
+    TypeError
+        If ``chain`` is not a :class:`~robokit.arm.Chain`.
+    ValueError
+        On non-SE(3) targets, joint vectors of the wrong shape or a non-positive tolerance.
+
+    Notes
+    -----
+    The pose error is :func:`robokit.geometry.pose_error` (Siciliano et al. 2009, Sec. 3.7.3).
+
+    Examples
+    --------
+    >>> from robokit.arm import iiwa14
+    >>> arm = iiwa14()
+    >>> q = arm.random_q(2, rng=0)
+    >>> r = verify(arm, arm.fk(q), q + [[0.0] * 7, [0.1] + [0.0] * 6])
+    >>> r.success.tolist(), r.reason[0]
+    ([True, False], 'converged')
     """
-    from .se3 import _pose_error
-
-    err = _pose_error(T_target, chain._flange(chain._frames(q)))
+    if check:
+        if not isinstance(chain, Chain):
+            raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
+        T_target = as_se3(T_target, "T_target", batch=True)
+        q = chain.check_q(q, batch=True)
+        if len(q) != len(T_target):
+            raise ValueError(f"q: expected {len(T_target)} joint vectors (one per target), got {len(q)}")
+        tol = check_positive(tol, "tol")
+    err = pose_error(T_target, chain.flange_pose(chain.frames(q, check=False), check=False), check=False)
     err *= err
     pos2, rot2 = err[:, :3].sum(1), err[:, 3:].sum(1)
     pos, rot, residual = np.sqrt(pos2), np.sqrt(rot2), np.sqrt(pos2 + rot2)
     inside = ((q >= chain.qmin) & (q <= chain.qmax)).all(1)
-    ok = (pos < tol_pos) & (rot < tol_rot)
+    ok = (pos < tol) & (rot < tol)
     success = ok & inside
     reasons = ["converged"] * len(q)
     for i in np.flatnonzero(~success):
@@ -101,4 +154,6 @@ def _verify(chain, T_target: np.ndarray, q: np.ndarray, tol_pos: float, tol_rot:
             reasons[i] = f"pose reached but joint {j + 1} is outside its limits"
         else:
             reasons[i] = f"pose error above tolerance (position {pos[i]:.2e} m, orientation {rot[i]:.2e} rad)"
-    return success, reasons, residual, pos, rot
+    N = len(q)
+    return IKBatchResult(q=q, success=success, reason=reasons, residual=residual, iterations=np.zeros(N, int),
+                         position_error=pos, orientation_error=rot, restarts=np.zeros(N, int))

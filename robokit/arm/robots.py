@@ -3,6 +3,19 @@
 * KUKA LBR iiwa 14 R820: an S-R-S arm (spherical shoulder, revolute elbow, spherical wrist).
 * Franka Emika Panda: not S-R-S (its elbow and wrist have link offsets), so only numerical IK
   applies to it.
+
+References
+----------
+.. [1] KUKA Roboter GmbH, *LBR iiwa 7 R800, LBR iiwa 14 R820 Specification*, Spez LBR iiwa V7,
+   2016.
+.. [2] M. Shimizu, H. Kakuya, W.-K. Yoon, K. Kitagaki and K. Kosuge, "Analytical inverse kinematic
+   computation for 7-DOF redundant manipulators with joint limits and its application to redundancy
+   resolution", *IEEE Transactions on Robotics* 24(5), 1131-1142, 2008.
+.. [3] C. Faria, F. Ferreira, W. Erlhagen, S. Monteiro and E. Bicho, "Position-based kinematics for
+   7-DoF serial manipulators with global configuration control, joint limit and singularity
+   avoidance", *Mechanism and Machine Theory* 121, 317-334, 2018.
+.. [4] Franka Emika, *Franka Control Interface (FCI) documentation*, "Robot and interface
+   specifications", https://frankaemika.github.io/docs/control_parameters.html.
 """
 from __future__ import annotations
 
@@ -28,13 +41,15 @@ def iiwa14() -> Chain:
 
     Notes
     -----
-    Dimensions and axis ranges: KUKA Roboter GmbH, *LBR iiwa 7 R800, LBR iiwa 14 R820
-    Specification* (Spez LBR iiwa V7, 2016), Sec. 4 (principal dimensions, axis data). The DH
-    assignment is the S-R-S form used by Shimizu et al., "Analytical inverse kinematic computation
-    for 7-DOF redundant manipulators with joint limits and its application to redundancy
-    resolution", IEEE T-RO 24(5), 2008, Table I (with the iiwa's link lengths), and by Faria et al.,
-    "Position-based kinematics for 7-DoF serial manipulators with global configuration control,
-    joint limit and singularity avoidance", Mech. Mach. Theory 121, 2018, Table 1.
+    Dimensions and axis ranges: KUKA (2016), Sec. 4 (principal dimensions, axis data). The DH
+    assignment is the S-R-S form used by Shimizu et al. (2008), Table I (with the iiwa's link
+    lengths), and by Faria et al. (2018), Table 1.
+
+    Examples
+    --------
+    >>> arm = iiwa14()
+    >>> arm.n, arm.convention, arm.fk(np.zeros(7))[:3, 3].tolist()
+    (7, 'standard', [0.0, 0.0, 1.306])
     """
     deg = np.pi / 180.0
     lim = np.array([170, 120, 170, 120, 170, 120, 175]) * deg
@@ -62,9 +77,16 @@ def panda() -> Chain:
 
     Notes
     -----
-    Franka Emika, *Franka Control Interface (FCI) documentation*, "Robot and interface
-    specifications": Denavit-Hartenberg parameters (Craig's convention) and joint space limits,
-    https://frankaemika.github.io/docs/control_parameters.html.
+    Franka Emika, FCI documentation, "Robot and interface specifications": Denavit-Hartenberg
+    parameters (Craig's convention) and joint space limits.
+
+    Examples
+    --------
+    >>> arm = panda()
+    >>> arm.convention
+    'modified'
+    >>> print(np.round(arm.fk(np.zeros(7))[:3, 3], 3) + 0.0)    # the flange at q = 0 (+ 0.0: no "-0.")
+    [0.088 0.    0.926]
     """
     T_flange = np.eye(4)
     T_flange[2, 3] = 0.107

@@ -9,6 +9,14 @@ centre ``W``, with a revolute elbow between (the KUKA LBR iiwa):
 
 Angles follow the iiwa's DH frames (:func:`robokit.arm.iiwa14`): ``Rz(q1) Ry(q2) Rz(q3)`` is the
 shoulder rotation, and ``q4 > 0`` bends the forearm towards the upper arm's ``-x`` axis.
+
+References
+----------
+.. [1] L. Huang and R. Jiang, "A new method of inverse kinematics solution for industrial 7DOF
+   robot", *Proc. 32nd Chinese Control Conference*, 2013.
+.. [2] M. Shimizu, H. Kakuya, W.-K. Yoon, K. Kitagaki and K. Kosuge, "Analytical inverse kinematic
+   computation for 7-DOF redundant manipulators with joint limits and its application to redundancy
+   resolution", *IEEE Transactions on Robotics* 24(5), 1131-1142, 2008.
 """
 from __future__ import annotations
 
@@ -16,48 +24,11 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import as_se3, rot_y, rot_z, so3_exp
 from ..validation import as_array, check_finite_scalar, check_positive
-from .se3 import as_se3, _axis_angle_rotation
+from .srs_geometry import ENTRIES, zyz_angles
 
 __all__ = ["wrist_centre", "elbow_angle", "shoulder_angles"]
-
-
-def _rot_z(a):
-    """Unchecked: rotations about z by angles ``a`` (any shape) -> (..., 3, 3)."""
-    c, s = np.cos(a), np.sin(a)
-    R = np.zeros(np.shape(a) + (3, 3))
-    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
-    return R
-
-
-def _rot_y(a):
-    """Unchecked: rotations about y by angles ``a`` (any shape) -> (..., 3, 3)."""
-    c, s = np.cos(a), np.sin(a)
-    R = np.zeros(np.shape(a) + (3, 3))
-    R[..., 0, 0], R[..., 0, 2], R[..., 2, 0], R[..., 2, 2], R[..., 1, 1] = c, s, -s, c, 1.0
-    return R
-
-
-def _zyz(m02, m12, m22, m21, m20, m10, m11):
-    """Unchecked: ZYZ Euler angles (a, b >= 0, c) of ``Rz(a) Ry(b) Rz(c)`` from its entries.
-
-    At ``sin b = 0`` only ``a + c`` (or ``a - c``) is defined; then ``a = 0``. Craig (2005),
-    Sec. 2.8, Z-Y-Z Euler angles.
-    """
-    sb = np.hypot(m02, m12)
-    b = np.arctan2(sb, m22)
-    a = np.arctan2(m12, m02)
-    c = np.arctan2(m21, -m20)
-    sing = sb < 1e-12
-    if sing.any():
-        a = np.where(sing, 0.0, a)
-        c = np.where(sing, np.arctan2(m10, m11), c)
-    return a, b, c
-
-
-def _flip(x):
-    """Unchecked: ``x + pi`` wrapped to (-pi, pi] for ``x`` in (-pi, pi] (the mirror branch)."""
-    return np.where(x > 0, x - np.pi, x + np.pi)
 
 
 def _reference_rotation(sw: np.ndarray, q4: np.ndarray, d_se: float, d_ew: float) -> np.ndarray:
@@ -70,7 +41,7 @@ def _reference_rotation(sw: np.ndarray, q4: np.ndarray, d_se: float, d_ew: float
     v_x, v_z = -d_ew * np.sin(q4), d_se + d_ew * np.cos(q4)
     q1 = np.arctan2(sw[..., 1], sw[..., 0])
     q2 = np.arctan2(np.hypot(sw[..., 0], sw[..., 1]), sw[..., 2]) - np.arctan2(v_x, v_z)
-    return _rot_z(q1) @ _rot_y(q2)
+    return rot_z(q1) @ rot_y(q2)
 
 
 def wrist_centre(T: Any, d_wf: float) -> np.ndarray:
@@ -96,6 +67,13 @@ def wrist_centre(T: Any, d_wf: float) -> np.ndarray:
     Notes
     -----
     Separation of position and posture: Huang & Jiang (2013), Sec. 3; Shimizu et al. (2008), Eq. (3).
+
+    Examples
+    --------
+    >>> T = np.eye(4)
+    >>> T[:3, 3] = [0.5, 0.0, 0.8]
+    >>> print(np.round(wrist_centre(T, 0.126), 3))
+    [0.5   0.    0.674]
     """
     T = as_se3(T, "T")
     d = check_positive(d_wf, "d_wf", allow_zero=True)
@@ -127,6 +105,13 @@ def elbow_angle(shoulder: Any, wrist: Any, d_se: float, d_ew: float) -> float:
     Notes
     -----
     Law of cosines in the shoulder-elbow-wrist triangle, Shimizu et al. (2008), Eq. (4).
+
+    Examples
+    --------
+    >>> print(round(np.degrees(elbow_angle([0, 0, 0.36], [0.0, 0.0, 1.18], 0.42, 0.40)), 6))   # stretched
+    0.0
+    >>> print(round(np.degrees(elbow_angle([0, 0, 0.36], [0.5, 0.0, 0.36], 0.42, 0.40)), 2))
+    104.9
     """
     S = as_array(shoulder, "shoulder", shape=(3,))
     W = as_array(wrist, "wrist", shape=(3,))
@@ -168,6 +153,16 @@ def shoulder_angles(shoulder: Any, wrist: Any, q4: float, psi: float, d_se: floa
     Shimizu et al. (2008), Eqs. (9)-(15): ``R_0^3(psi) = R_psi R_0^3(0)`` with ``R_psi`` the
     rotation by ``psi`` about the unit shoulder-wrist vector (Rodrigues' formula); then the ZYZ
     decomposition of ``Rz(q1) Ry(q2) Rz(q3)``.
+
+    Examples
+    --------
+    The shoulder of the iiwa at a configuration, recovered from its wrist centre and arm angle:
+
+    >>> from robokit.arm import arm_angle, iiwa14
+    >>> arm, q = iiwa14(), np.radians([35, 50, -40, -75, 60, 45, 20])
+    >>> W = arm.link_frames(q)[5, :3, 3]
+    >>> print(np.round(np.degrees(shoulder_angles([0, 0, 0.36], W, q[3], arm_angle(arm, q), 0.42, 0.40)), 4))
+    [ 35.  50. -40.]
     """
     S = as_array(shoulder, "shoulder", shape=(3,))
     W = as_array(wrist, "wrist", shape=(3,))
@@ -178,5 +173,6 @@ def shoulder_angles(shoulder: Any, wrist: Any, q4: float, psi: float, d_se: floa
     L = float(np.linalg.norm(sw))
     if L < 1e-12:
         raise ValueError("wrist: expected a wrist centre away from the shoulder, got |W - S| = 0")
-    M = _axis_angle_rotation(sw / L, np.asarray(psi)) @ _reference_rotation(sw, np.asarray(q4), l1, l2)
-    return np.array(_zyz(M[0, 2], M[1, 2], M[2, 2], M[2, 1], M[2, 0], M[1, 0], M[1, 1]), dtype=float)
+    R_psi = so3_exp(psi * sw / L, check=False)                 # rotation by psi about S-W (Rodrigues)
+    M = R_psi @ _reference_rotation(sw, np.asarray(q4), l1, l2)   # R_0^3(psi) = R_psi R_0^3(0), Eqs. (9)-(15)
+    return np.array(zyz_angles(*(M[i, j] for i, j in ENTRIES)), dtype=float)

@@ -4,11 +4,19 @@ The arm angle of a configuration and Shimizu's coefficients of a target are shor
 They are written here in plain arithmetic on 3-vectors held as triples, so the same code runs on
 Python floats (one target: no numpy call overhead, which dominates at that size) and on numpy
 arrays of shape (N,) (many targets). ``xp`` selects the elementary functions: :data:`SCALAR` or
-:data:`ARRAY`.
+:data:`ARRAY`. Every function here is an unchecked kernel of :mod:`robokit.arm.srs` and
+:mod:`robokit.arm.ik_analytic`, which validate their inputs.
 
 Frames and conventions are those of :mod:`robokit.arm.srs`: ``Rz(q1) Ry(q2) Rz(q3)`` is the
 shoulder rotation ``M``, ``v = (-d_ew sin q4, 0, d_se + d_ew cos q4)`` the shoulder-wrist vector in
 the frame of ``M`` and ``R_4^7 = Ry(q4) M^T R_0^7`` the wrist rotation.
+
+References
+----------
+.. [1] M. Shimizu, H. Kakuya, W.-K. Yoon, K. Kitagaki and K. Kosuge, "Analytical inverse kinematic
+   computation for 7-DOF redundant manipulators with joint limits and its application to redundancy
+   resolution", *IEEE Transactions on Robotics* 24(5), 1131-1142, 2008.
+.. [2] J. J. Craig, *Introduction to Robotics: Mechanics and Control*, 3rd ed., Pearson, 2005.
 """
 from __future__ import annotations
 
@@ -59,7 +67,45 @@ def arm_angle_terms(q1, q2, q3, q4, d_se: float, d_ew: float, xp=ARRAY):
     return xp.atan2(_dot(sw, _cross(n_ref, n)) / xp.sqrt(xp.where(L2 > 0, L2, 1.0)), _dot(n_ref, n))
 
 
-#: Entries (row, column) of a rotation read by the ZYZ decomposition (see ``srs._zyz``).
+def zyz_angles(m02, m12, m22, m21, m20, m10, m11):
+    """Unchecked: ZYZ Euler angles (a, b >= 0, c) of ``Rz(a) Ry(b) Rz(c)`` from its entries.
+
+    The entries are the rotation's ``(row, column)`` elements named by the arguments (those of
+    :data:`ENTRIES`), as floats or arrays of one shape. At ``sin b = 0`` only ``a + c`` is defined;
+    then ``a = 0``. Craig (2005), Sec. 2.8, Z-Y-Z Euler angles.
+
+    Examples
+    --------
+    >>> from robokit.geometry import rot_y, rot_z
+    >>> M = rot_z(0.3) @ rot_y(0.5) @ rot_z(-0.2)
+    >>> print(np.round(zyz_angles(*(M[i, j] for i, j in ENTRIES)), 6))
+    [ 0.3  0.5 -0.2]
+    """
+    sb = np.hypot(m02, m12)
+    b = np.arctan2(sb, m22)
+    a = np.arctan2(m12, m02)
+    c = np.arctan2(m21, -m20)
+    sing = sb < 1e-12
+    if sing.any():
+        a = np.where(sing, 0.0, a)
+        c = np.where(sing, np.arctan2(m10, m11), c)
+    return a, b, c
+
+
+def mirror_angle(x):
+    """Unchecked: ``x + pi`` wrapped to (-pi, pi] for ``x`` in (-pi, pi]: the ZYZ mirror branch.
+
+    ``Rz(a) Ry(b) Rz(c) = Rz(a + pi) Ry(-b) Rz(c + pi)`` (Craig 2005, Sec. 2.8).
+
+    Examples
+    --------
+    >>> print(np.round(mirror_angle(np.array([0.5, -0.5])), 6))
+    [-2.641593  2.641593]
+    """
+    return np.where(x > 0, x - np.pi, x + np.pi)
+
+
+#: Entries (row, column) of a rotation read by the ZYZ decomposition (:func:`zyz_angles`).
 ENTRIES = ((0, 2), (1, 2), (2, 2), (2, 1), (2, 0), (1, 0), (1, 1))
 
 

@@ -2,6 +2,17 @@
 
 Planar poses are ``[x, y, theta]`` with ``theta`` the heading measured counter-clockwise from
 the x axis (robokit's world is right-handed with z up).
+
+References
+----------
+.. [1] R. Smith, M. Self and P. Cheeseman, "Estimating uncertain spatial relationships in
+   robotics", in *Autonomous Robot Vehicles*, I. J. Cox and G. T. Wilfong (eds.), Springer,
+   167-193, 1990.
+.. [2] K. M. Lynch and F. C. Park, *Modern Robotics: Mechanics, Planning, and Control*, Cambridge
+   University Press, 2017.
+.. [3] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
+.. [4] F. Lu and E. Milios, "Globally consistent range scan alignment for environment mapping",
+   *Autonomous Robots* 4(4), 333-349, 1997.
 """
 from __future__ import annotations
 
@@ -10,8 +21,34 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array
+from .rotations import as_rotation
 
-__all__ = ["wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2"]
+__all__ = ["as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2"]
+
+
+def as_planar(value: Any, name: str) -> np.ndarray:
+    """Validate one planar pose or a stack of them: shape (3,) or (N, 3), finite.
+
+    For robokit's ``[x, y, theta]`` and the papers' ``[p, q, theta]`` alike.
+
+    Raises
+    ------
+    ValueError
+        If the shape is not (3,) or (N, 3) or a value is not finite.
+
+    Notes
+    -----
+    Validation only (DESIGN.md, "Errors"); not from a paper.
+
+    Examples
+    --------
+    >>> as_planar([[0, 0, 0], [1, 2, 3]], "poses").shape
+    (2, 3)
+    """
+    p = as_array(value, name)
+    if p.shape[-1:] != (3,) or p.ndim > 2:
+        raise ValueError(f"{name}: expected shape (3,) or (N, 3), got shape {p.shape}")
+    return p
 
 
 def wrap_angle(angle: Any) -> Any:
@@ -36,6 +73,11 @@ def wrap_angle(angle: Any) -> Any:
     -----
     Standard identity ``(a + pi) mod 2 pi - pi`` (e.g. Thrun, Burgard & Fox, *Probabilistic
     Robotics*, 2005, Sec. 5.4); used by every heading computation in the course.
+
+    Examples
+    --------
+    >>> print(round(wrap_angle(3 * np.pi / 2), 6))
+    -1.570796
     """
     a = as_array(angle, "angle")
     out = np.mod(a + np.pi, 2 * np.pi) - np.pi
@@ -63,9 +105,13 @@ def se2_compose(a: Any, b: Any) -> np.ndarray:
 
     Notes
     -----
-    The compounding operator of Smith, Self & Cheeseman, "Estimating uncertain spatial
-    relationships in robotics" (1990), Eq. (3); it is also Eq. (1)'s composition in Duckett's
-    relaxation used by lesson 02.
+    The compounding operator of Smith, Self & Cheeseman (1990), Eq. (3); it is also the
+    composition of Duckett's relaxation, Eq. (1), used by lesson 02.
+
+    Examples
+    --------
+    >>> print(np.round(se2_compose([1.0, 2.0, np.pi / 2], [1.0, 0.0, 0.0]), 6))
+    [1.       3.       1.570796]
     """
     pa = as_array(a, "a", shape=(3,))
     pb = as_array(b, "b", shape=(3,))
@@ -95,6 +141,12 @@ def se2_inverse(a: Any) -> np.ndarray:
     Notes
     -----
     The inverse relationship of Smith, Self & Cheeseman (1990), Eq. (4).
+
+    Examples
+    --------
+    >>> a = [1.0, 2.0, 0.5]
+    >>> print(np.round(se2_compose(a, se2_inverse(a)), 12) + 0.0)
+    [0. 0. 0.]
     """
     p = as_array(a, "a", shape=(3,))
     c, s = np.cos(p[2]), np.sin(p[2])
@@ -122,6 +174,11 @@ def se2_between(a: Any, b: Any) -> np.ndarray:
     -----
     Smith, Self & Cheeseman (1990), Eqs. (3)-(4) combined; Lu & Milios (1997) call it the relative
     pose constraint of a pose graph.
+
+    Examples
+    --------
+    >>> print(np.round(se2_between([1.0, 0.0, np.pi / 2], [1.0, 1.0, np.pi / 2]), 6) + 0.0)
+    [1. 0. 0.]
     """
     return se2_compose(se2_inverse(a), b)
 
@@ -145,7 +202,14 @@ def se2_to_matrix(pose: Any) -> np.ndarray:
 
     Notes
     -----
-    Lynch & Park, *Modern Robotics* (2017), Sec. 3.3.1 (SE(2) as a matrix group).
+    Lynch & Park (2017), Sec. 3.3.1 (SE(2) as a matrix group).
+
+    Examples
+    --------
+    >>> print(np.round(se2_to_matrix([1.0, 2.0, 0.0]), 3) + 0.0)
+    [[1. 0. 1.]
+     [0. 1. 2.]
+     [0. 0. 1.]]
     """
     p = as_array(pose, "pose", shape=(3,))
     c, s = np.cos(p[2]), np.sin(p[2])
@@ -171,14 +235,14 @@ def matrix_to_se2(matrix: Any) -> np.ndarray:
 
     Notes
     -----
-    Lynch & Park, *Modern Robotics* (2017), Sec. 3.3.1.
+    Lynch & Park (2017), Sec. 3.3.1.
+
+    Examples
+    --------
+    >>> print(np.round(matrix_to_se2(se2_to_matrix([1.0, 2.0, 0.3])), 6))
+    [1.  2.  0.3]
     """
     T = as_array(matrix, "matrix", shape=(3, 3))
-    _check_rotation(T[:2, :2], "matrix")
+    as_rotation(T[:2, :2], "matrix", dim=2)
     return np.array([T[0, 2], T[1, 2], float(np.arctan2(T[1, 0], T[0, 0]))])
 
-
-def _check_rotation(R: np.ndarray, name: str) -> None:
-    n = R.shape[0]
-    if not np.allclose(R @ R.T, np.eye(n), atol=1e-6) or np.linalg.det(R) <= 0:
-        raise ValueError(f"{name}: expected a proper rotation (orthonormal, det +1), got {R.tolist()}")

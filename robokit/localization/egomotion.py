@@ -8,7 +8,7 @@ odometry is used. Matches come from the continuation constraint (landmarks predi
 searched within a window; Lin et al. Sec. 3, Se et al. Sec. 3.2) or, when that finds too few (the
 robot seems kidnapped), from the whole database.
 
-Frames and pose convention: :mod:`robokit.mapping.frames`.
+Frames and pose convention (``pqt``): :mod:`robokit.geometry.paper_frames`.
 """
 from __future__ import annotations
 
@@ -17,8 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..geometry import wrap_angle
-from ..mapping.frames import as_pose, robot_to_world, world_to_robot
+from ..geometry import as_pqt, robot_to_world, world_to_robot, wrap_angle
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from ..vision.matching import gated_ratio_match, ratio_match
@@ -44,8 +43,8 @@ class EgomotionResult:
 
     Attributes
     ----------
-    pose : numpy.ndarray, shape (3,)
-        ``[p, q, theta]`` (metres, metres, radians); always finite.
+    pqt : numpy.ndarray, shape (3,)
+        Pose ``[p, q, theta]`` (metres, metres, radians); always finite.
     covariance : numpy.ndarray, shape (3, 3)
         Least-squares covariance, or the odometry covariance on fall-back.
     inliers : numpy.ndarray of bool, shape (N,)
@@ -58,7 +57,7 @@ class EgomotionResult:
         Root-mean-square 3-D residual of the inliers (metres; 0 on fall-back).
     """
 
-    pose: np.ndarray
+    pqt: np.ndarray
     covariance: np.ndarray
     inliers: np.ndarray
     source: str
@@ -177,7 +176,8 @@ def fit_pose(robot_points, world_points, robot_covariances=None, world_covarianc
 
     Returns
     -------
-    pose : numpy.ndarray, shape (3,)
+    pqt : numpy.ndarray, shape (3,)
+        Pose ``[p, q, theta]``.
     covariance : numpy.ndarray, shape (3, 3)
         Weighted: ``(J^T W J)^-1``; unweighted: ``s^2 (J^T J)^-1`` with ``s^2`` the residual variance
         per coordinate (floored at 1 mm^2).
@@ -213,12 +213,12 @@ def fit_pose(robot_points, world_points, robot_covariances=None, world_covarianc
                                             "plane, got (nearly) coincident ones")
     theta = np.arctan2((rc[:, 0] * wc[:, 1] - rc[:, 1] * wc[:, 0]).sum(), (rc * wc).sum())
     c, s = np.cos(theta), np.sin(theta)
-    pose = np.concatenate([w.mean(0) - np.array([[c, -s], [s, c]]) @ r.mean(0), [theta]])
+    pqt = np.concatenate([w.mean(0) - np.array([[c, -s], [s, c]]) @ r.mean(0), [theta]])
 
-    def linearise(pose):
-        c, s = np.cos(pose[2]), np.sin(pose[2])
+    def linearise(pqt):
+        c, s = np.cos(pqt[2]), np.sin(pqt[2])
         rot = np.array([[c, -s], [s, c]])
-        res = w - (r @ rot.T + pose[:2])
+        res = w - (r @ rot.T + pqt[:2])
         jac = np.zeros((n, 2, 3))
         jac[:, 0, 0] = jac[:, 1, 1] = 1.0
         jac[:, 0, 2] = -s * r[:, 0] - c * r[:, 1]
@@ -227,20 +227,20 @@ def fit_pose(robot_points, world_points, robot_covariances=None, world_covarianc
 
     if weighted:
         for _ in range(iterations):
-            rot, res, jac = linearise(pose)
+            rot, res, jac = linearise(pqt)
             info = np.linalg.inv(wcov + rot @ rcov @ rot.T + 1e-12 * np.eye(2))
             jtw = np.swapaxes(jac, 1, 2) @ info
             hess = jtw @ jac
-            pose = pose + np.linalg.lstsq(hess.sum(0), np.einsum("nij,nj->i", jtw, res), rcond=None)[0]
-        rot, res, jac = linearise(pose)
+            pqt = pqt + np.linalg.lstsq(hess.sum(0), np.einsum("nij,nj->i", jtw, res), rcond=None)[0]
+        rot, res, jac = linearise(pqt)
         info = np.linalg.inv(wcov + rot @ rcov @ rot.T + 1e-12 * np.eye(2))
         cov = np.linalg.pinv((np.swapaxes(jac, 1, 2) @ info @ jac).sum(0))
     else:
-        rot, res, jac = linearise(pose)
+        rot, res, jac = linearise(pqt)
         s2 = max((res ** 2).sum() / max(2 * n - 3, 1), 1e-6)
         cov = s2 * np.linalg.pinv((np.swapaxes(jac, 1, 2) @ jac).sum(0))
-    pose[2] = wrap_angle(pose[2])
-    return pose, 0.5 * (cov + cov.T), float(np.sqrt((res ** 2).sum(1).mean()))
+    pqt[2] = wrap_angle(pqt[2])
+    return pqt, 0.5 * (cov + cov.T), float(np.sqrt((res ** 2).sum(1).mean()))
 
 
 def _fallback(n, odometry, odometry_covariance, iterations, why):
@@ -248,7 +248,7 @@ def _fallback(n, odometry, odometry_covariance, iterations, why):
         raise InsufficientMatchesError(f"{why}, and no odometry was given to fall back on")
     cov = np.eye(3) * 1e-2 if odometry_covariance is None else as_array(odometry_covariance, "odometry_covariance",
                                                                           shape=(3, 3))
-    return EgomotionResult(as_pose(odometry, "odometry"), cov, np.zeros(n, bool), "odometry", iterations, 0.0)
+    return EgomotionResult(as_pqt(odometry, "odometry"), cov, np.zeros(n, bool), "odometry", iterations, 0.0)
 
 
 def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_covariances=None,
@@ -330,25 +330,25 @@ def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_cov
     if best is None or best_count < min_matches:
         return _fallback(n, odometry, odometry_covariance, drawn,
                          f"only {max(best_count, 0)} matches support a pose (need {min_matches})")
-    pose, inliers = best, None
+    pqt, inliers = best, None
     for _ in range(3):  # refit on the support, recompute the support
-        inliers = np.linalg.norm(robot_to_world(r, pose) - w, axis=1) < thr
+        inliers = np.linalg.norm(robot_to_world(r, pqt) - w, axis=1) < thr
         if inliers.sum() < 2:
             break
-        pose, cov, rms = _fit_subset(r, w, rcov, wcov, inliers)
-    inliers = np.linalg.norm(robot_to_world(r, pose) - w, axis=1) < thr
+        pqt, cov, rms = _fit_subset(r, w, rcov, wcov, inliers)
+    inliers = np.linalg.norm(robot_to_world(r, pqt) - w, axis=1) < thr
     if inliers.sum() < min_matches:
         return _fallback(n, odometry, odometry_covariance, drawn,
                          f"only {int(inliers.sum())} matches support the refined pose (need {min_matches})")
-    pose, cov, rms = _fit_subset(r, w, rcov, wcov, inliers)
-    return EgomotionResult(pose, cov, inliers, "ransac", drawn, rms)
+    pqt, cov, rms = _fit_subset(r, w, rcov, wcov, inliers)
+    return EgomotionResult(pqt, cov, inliers, "ransac", drawn, rms)
 
 
 def _fit_subset(r, w, rcov, wcov, mask):
     return fit_pose(r[mask], w[mask], None if rcov is None else rcov[mask], None if wcov is None else wcov[mask])
 
 
-def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_pose, *, window: float = 0.3,
+def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_pqt, *, window: float = 0.3,
                          ratio: float = 0.8, max_distance: float = 0.8) -> tuple[np.ndarray, np.ndarray]:
     """Match features to landmarks predicted (by odometry) to lie within a window around them.
 
@@ -358,8 +358,8 @@ def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_
         Feature positions in the robot frame.
     descriptors : array_like, shape (N, D)
     landmarks : LandmarkMap
-    predicted_pose : array_like, shape (3,)
-        Odometry prediction of the pose.
+    predicted_pqt : array_like, shape (3,)
+        Odometry prediction of the pose ``[p, q, theta]``.
     window : float, default 0.3
         Search radius (metres) around each feature.
     ratio : float, default 0.8
@@ -383,7 +383,7 @@ def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_
     none = (np.zeros(0, int), np.zeros(0, int))
     if len(landmarks) == 0 or pts.shape[0] == 0:
         return none
-    predicted = world_to_robot(landmarks.positions, predicted_pose)
+    predicted = world_to_robot(landmarks.positions, predicted_pqt)
     lists = cKDTree(predicted).query_ball_point(pts, rad)
     counts = np.array([len(x) for x in lists])
     if counts.sum() == 0:
@@ -406,7 +406,7 @@ def track(points, descriptors, landmarks: LandmarkMap, odometry, odometry_covari
     descriptors : array_like, shape (N, D)
     landmarks : LandmarkMap
     odometry : array_like, shape (3,)
-        Odometry-predicted pose.
+        Odometry-predicted pose ``[p, q, theta]``.
     odometry_covariance : array_like, shape (3, 3), optional
     covariances : array_like, shape (N, 3, 3), optional
         Feature covariances; with them (and the landmarks' own) the refinement is weighted.
@@ -429,7 +429,7 @@ def track(points, descriptors, landmarks: LandmarkMap, odometry, odometry_covari
     kidnapped or the scene changed, so the features are matched against the whole database (a
     higher contamination, hence more RANSAC samples); too few supporting matches -> odometry.
     """
-    odo = as_pose(odometry, "odometry")
+    odo = as_pqt(odometry, "odometry")
     pts = as_array(points, "points", shape=(None, 3))
     fi, li = continuation_matches(pts, descriptors, landmarks, odo, window=window, ratio=ratio)
     kidnapped = fi.size < min_matches

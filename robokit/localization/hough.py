@@ -30,7 +30,7 @@ class Hypothesis:
 
     Attributes
     ----------
-    pose : numpy.ndarray, shape (3,)
+    pqt : numpy.ndarray, shape (3,)
         ``[p, q, theta]`` (metres, metres, radians).
     covariance : numpy.ndarray, shape (3, 3)
     votes : int
@@ -41,7 +41,7 @@ class Hypothesis:
         Root-mean-square ground-plane residual of those matches (metres).
     """
 
-    pose: np.ndarray
+    pqt: np.ndarray
     covariance: np.ndarray
     votes: int
     feature_index: np.ndarray
@@ -226,22 +226,22 @@ def _peaks(acc, n, radius=(2, 3, 3), block=(2, 4, 4)):
     return t[chosen], x[chosen], z[chosen], flat[cand[chosen]]
 
 
-def _refine(pose, pts, world, fi, li, gates, pts_cov, world_cov):
+def _refine(pqt, pts, world, fi, li, gates, pts_cov, world_cov):
     """Iterated least squares: keep each feature's best match within the gate, refit (weighted)."""
     h = None
     for gate in gates:
-        c, s = np.cos(pose[2]), np.sin(pose[2])
+        c, s = np.cos(pqt[2]), np.sin(pqt[2])
         rx, rz = pts[fi, 0], pts[fi, 2]
-        ex = world[li, 0] - (c * rx - s * rz + pose[0])
-        ez = world[li, 2] - (s * rx + c * rz + pose[1])
+        ex = world[li, 0] - (c * rx - s * rz + pqt[0])
+        ez = world[li, 2] - (s * rx + c * rz + pqt[1])
         d = np.hypot(ex, ez)
         order = np.lexsort((d, fi))
         first = order[np.r_[True, fi[order][1:] != fi[order][:-1]]]
         keep = first[d[first] <= gate]
         if keep.size < 2 or np.ptp(pts[fi[keep]][:, [0, 2]], axis=0).max() < 1e-3:
             return h
-        pose, cov, rms = fit_pose(pts[fi[keep]], world[li[keep]], pts_cov[fi[keep]], world_cov[li[keep]])
-        h = (pose, cov, fi[keep], li[keep], rms)
+        pqt, cov, rms = fit_pose(pts[fi[keep]], world[li[keep]], pts_cov[fi[keep]], world_cov[li[keep]])
+        h = (pqt, cov, fi[keep], li[keep], rms)
     return h
 
 

@@ -17,8 +17,8 @@ Global localization of a kidnapped robot against the built map is the Hough tran
 Sec. 5 (:func:`robokit.localization.global_localize`).
 
 This module only orchestrates the library; it never renders (the simulator is used by
-:mod:`robokit.localization.lab_experiment`). Poses are the seeds' ``[p, q, theta]``
-(:mod:`robokit.mapping.frames`).
+:mod:`robokit.localization.lab_experiment`). Poses are the papers' ``[p, q, theta]``
+(``pqt``, :mod:`robokit.geometry.paper_frames`).
 """
 from __future__ import annotations
 
@@ -26,8 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import se2_between, se2_compose
-from ..mapping.frames import as_pose, world_to_robot
+from ..geometry import as_pqt, se2_between, se2_compose, world_to_robot
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_rng, check_choice, check_int, check_positive
 from ..vision.descriptors import detect_and_describe
@@ -44,8 +43,8 @@ class FrameReport:
 
     Attributes
     ----------
-    pose : numpy.ndarray, shape (3,)
-        Estimated ``[p, q, theta]`` (metres, metres, radians).
+    pqt : numpy.ndarray, shape (3,)
+        Estimated pose ``[p, q, theta]`` (metres, metres, radians).
     covariance : numpy.ndarray, shape (3, 3)
     source : str
         ``"start"``, ``"ransac"`` or ``"odometry"`` (fall-back).
@@ -60,7 +59,7 @@ class FrameReport:
         Size of the map after the update.
     """
 
-    pose: np.ndarray
+    pqt: np.ndarray
     covariance: np.ndarray
     source: str
     n_observations: int
@@ -142,7 +141,7 @@ class VisualSLAM:
     @property
     def trajectory(self) -> np.ndarray:
         """Estimated poses ``[p, q, theta]`` of the frames processed so far, shape (K, 3)."""
-        return np.array([r.pose for r in self.reports]).reshape(-1, 3)
+        return np.array([r.pqt for r in self.reports]).reshape(-1, 3)
 
     def observe(self, left, right) -> StereoObservations:
         """Features of a rectified pair and their 3-D positions with covariance (robot frame).
@@ -171,22 +170,23 @@ class VisualSLAM:
         sd = np.array([0.005 + s[0] * dist, 0.005 + s[1] * dist, np.deg2rad(0.5) + s[2] * turn])
         return np.diag(sd ** 2)
 
-    def _update_map(self, obs: StereoObservations, pose, pose_covariance, associate: bool) -> None:
+    def _update_map(self, obs: StereoObservations, pqt, pqt_covariance, associate: bool) -> None:
         desc = obs.features.descriptors
         if associate:
-            landmark = self.map.associate(obs.points, obs.covariances, desc, pose, window=self.association_window)
+            landmark = self.map.associate(obs.points, obs.covariances, desc, pqt, window=self.association_window)
         else:
             landmark = -np.ones(len(obs), int)
         kp = obs.features.keypoints
-        self.map.integrate(obs.points, obs.covariances, desc, pose, pose_covariance, landmark, kp.scale,
-                           kp.orientation, expected=self.in_view(pose))
+        self.map.integrate(obs.points, obs.covariances, desc, pqt, pqt_covariance, landmark, kp.scale,
+                           kp.orientation, expected=self.in_view(pqt))
 
-    def in_view(self, pose) -> np.ndarray:
-        """Which landmarks the left camera should see from ``pose`` (field of view and depth range).
+    def in_view(self, pqt) -> np.ndarray:
+        """Which landmarks the left camera should see from pose ``pqt`` (field of view and depth range).
 
         Parameters
         ----------
-        pose : array_like, shape (3,)
+        pqt : array_like, shape (3,)
+            Pose ``[p, q, theta]``.
 
         Returns
         -------
@@ -199,7 +199,7 @@ class VisualSLAM:
         should have been seen count a missed frame (occlusions aside), so the map of the places
         visited earlier survives for global localization.
         """
-        pts = world_to_robot(self.map.positions, as_pose(pose))
+        pts = world_to_robot(self.map.positions, as_pqt(pqt))
         z = pts[:, 2]
         ok = (z > 0.3) & (z < self.max_range)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -207,15 +207,15 @@ class VisualSLAM:
             r = np.abs(self.rig.focal * pts[:, 1] / z)
         return ok & (c < self.rig.c0) & (r < self.rig.r0)
 
-    def start(self, left, right, pose=(0.0, 0.0, 0.0), odometry=None) -> FrameReport:
+    def start(self, left, right, pqt=(0.0, 0.0, 0.0), odometry=None) -> FrameReport:
         """Initialise the map from the first frame at a known pose.
 
         Parameters
         ----------
         left, right : array_like
             The first stereo pair.
-        pose : array_like, shape (3,), default (0, 0, 0)
-            ``[p, q, theta]`` of the first frame: the origin of the map (Se et al. use the initial
+        pqt : array_like, shape (3,), default (0, 0, 0)
+            Pose ``[p, q, theta]`` of the first frame: the origin of the map (Se et al. use the initial
             frame as the world frame).
         odometry : array_like, shape (3,), optional
             The odometry reading ``[p, q, theta]`` at this frame (increments are taken from it).
@@ -228,13 +228,13 @@ class VisualSLAM:
         -----
         Se et al. Sec. 3.3: landmarks are stored in the initial frame.
         """
-        p = as_pose(pose, "pose")
+        p = as_pqt(pqt)
         self.map = LandmarkMap(self.map.descriptor_size, max_missed=self.map.max_missed)
         self.reports = []
         obs = self.observe(left, right)
         cov = np.eye(3) * 1e-12
         self._update_map(obs, p, cov, associate=False)
-        self._last_odometry = p.copy() if odometry is None else as_pose(odometry, "odometry")
+        self._last_odometry = p.copy() if odometry is None else as_pqt(odometry, "odometry")
         report = FrameReport(p, cov, "start", len(obs), 0, False, len(self.map))
         self.reports.append(report)
         return report
@@ -266,29 +266,29 @@ class VisualSLAM:
         """
         if self._last_odometry is None:
             raise RuntimeError("step: call start() with the first frame before step()")
-        odo = as_pose(odometry, "odometry")
+        odo = as_pqt(odometry, "odometry")
         increment = se2_between(self._last_odometry, odo)
         self._last_odometry = odo
-        predicted = se2_compose(self.reports[-1].pose, increment)
+        predicted = se2_compose(self.reports[-1].pqt, increment)
         odo_cov = self.reports[-1].covariance + self._odometry_covariance(increment)
         obs = self.observe(left, right)
         desc = obs.features.descriptors
         if len(obs) == 0:
             result, kidnapped = None, False
-            pose, cov, source, inliers = predicted, odo_cov, "odometry", 0
+            pqt, cov, source, inliers = predicted, odo_cov, "odometry", 0
         else:
             result, _, _, kidnapped = track(obs.points, desc, self.map, predicted, odo_cov,
                                             covariances=obs.covariances, window=self.window,
                                             min_matches=self.min_matches, threshold=self.threshold, rng=self.rng)
-            pose, cov, source, inliers = result.pose, result.covariance, result.source, result.n_inliers
-            self._update_map(obs, pose, cov, associate=True)
+            pqt, cov, source, inliers = result.pqt, result.covariance, result.source, result.n_inliers
+            self._update_map(obs, pqt, cov, associate=True)
         if len(obs) == 0:
-            self.map.end_frame([], self.in_view(pose))
-        report = FrameReport(np.asarray(pose, float), cov, source, len(obs), inliers, kidnapped, len(self.map))
+            self.map.end_frame([], self.in_view(pqt))
+        report = FrameReport(np.asarray(pqt, float), cov, source, len(obs), inliers, kidnapped, len(self.map))
         self.reports.append(report)
         return report
 
-    def process(self, lefts, rights, odometry, start_pose=(0.0, 0.0, 0.0), *, progress=None) -> np.ndarray:
+    def process(self, lefts, rights, odometry, start_pqt=(0.0, 0.0, 0.0), *, progress=None) -> np.ndarray:
         """Run over a recorded sequence: :meth:`start` on the first frame, :meth:`step` on the rest.
 
         Parameters
@@ -296,8 +296,8 @@ class VisualSLAM:
         lefts, rights : sequence of images, length K
         odometry : array_like, shape (K, 3)
             Odometry readings ``[p, q, theta]``.
-        start_pose : array_like, shape (3,), default (0, 0, 0)
-            Pose of the first frame (the map's origin).
+        start_pqt : array_like, shape (3,), default (0, 0, 0)
+            Pose ``[p, q, theta]`` of the first frame (the map's origin).
         progress : callable, optional
             Wraps the frame iterator (e.g. ``tqdm``) to show progress.
 
@@ -316,7 +316,7 @@ class VisualSLAM:
         if n == 0 or len(rights) != n or odo.shape[0] != n:
             raise ValueError(f"lefts, rights, odometry: expected equal non-zero lengths, got {n}, {len(rights)}, "
                              f"{odo.shape[0]}")
-        self.start(lefts[0], rights[0], start_pose, odo[0])
+        self.start(lefts[0], rights[0], start_pqt, odo[0])
         frames = range(1, n) if progress is None else progress(range(1, n))
         for k in frames:
             self.step(lefts[k], rights[k], odo[k])

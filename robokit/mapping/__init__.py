@@ -1,10 +1,10 @@
-"""Mapping: the seeds' planar pose acting on 3-D points, and the Kalman-filtered landmark database.
+"""Mapping: the Kalman-filtered landmark database of Se, Lowe & Little (Sec. 3).
 
-Modules: :mod:`.frames` (pose ``[p, q, theta]``, backward transformation with covariance) and
-:mod:`.landmarks` (Se, Lowe & Little Sec. 3). Never imports ``viz`` or ``sim``.
+:mod:`.landmarks` holds the backward transformation with first-order covariance
+(:func:`transform_covariance`) and the database (:class:`LandmarkMap`). The papers' pose
+``[p, q, theta]`` acting on points (``robot_to_world``, ``world_to_robot``) is in
+:mod:`robokit.geometry`. Never imports ``viz`` or ``sim``.
 """
-from .frames import as_pose, robot_to_world, rotation_y, transform_covariance, world_to_robot
-from .landmarks import LandmarkMap, kalman_fuse
+from .landmarks import LandmarkMap, kalman_fuse, transform_covariance
 
-__all__ = ["as_pose", "robot_to_world", "rotation_y", "transform_covariance", "world_to_robot", "LandmarkMap",
-           "kalman_fuse"]
+__all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse"]

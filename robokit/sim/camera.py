@@ -3,6 +3,17 @@
 Frames: a camera's pose is ``T_world_cam`` (4x4), its frame the OpenCV optical frame (x right,
 y down, z forward). A camera carries a ``mount`` ``T_body_cam`` so that :meth:`PinholeCamera.observe`
 can render from a planar robot pose ``[x, y, theta]``.
+
+References
+----------
+.. [1] R. Hartley and A. Zisserman, *Multiple View Geometry in Computer Vision*, 2nd ed., Cambridge
+   University Press, 2004.
+.. [2] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features", Proc.
+   IEEE/RSJ Int. Conf. on Intelligent Robots and Systems (IROS), 2002.
+.. [3] G. E. Healey and R. Kondepudy, "Radiometric CCD camera calibration and noise estimation",
+   *IEEE Transactions on Pattern Analysis and Machine Intelligence* 16(3), 267-276, 1994.
+.. [4] K. M. Lynch and F. C. Park, *Modern Robotics: Mechanics, Planning, and Control*, Cambridge
+   University Press, 2017.
 """
 from __future__ import annotations
 
@@ -11,13 +22,13 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..geometry import R_BODY_OPTICAL, euler_matrix, se2_to_se3, se3_from_rt, se3_inverse, transform_points
+from ..geometry import R_BODY_OPTICAL, as_se3, euler_matrix, se2_to_se3, se3_from_rt, se3_inverse, transform_points
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .render import render_pinhole
 from .textures import illuminate
 from .world import World
 
-__all__ = ["Frame", "mount_pose", "PinholeCamera", "StereoRig", "finish_image", "check_pose"]
+__all__ = ["Frame", "mount_pose", "PinholeCamera", "StereoRig", "finish_image"]
 
 
 class Frame(NamedTuple):
@@ -58,36 +69,6 @@ def mount_pose(height: float, forward: float = 0.0, pitch: float = 0.0) -> np.nd
     return se3_from_rt(R, [as_array(forward, "forward", shape=()).item(), 0.0, h])
 
 
-def check_pose(pose: Any, name: str = "pose") -> np.ndarray:
-    """Validate a 4x4 rigid pose (finite, last row [0, 0, 0, 1], rotation block orthonormal).
-
-    Parameters
-    ----------
-    pose : array_like, shape (4, 4)
-    name : str
-        Argument name for error messages.
-
-    Returns
-    -------
-    numpy.ndarray, shape (4, 4)
-
-    Raises
-    ------
-    ValueError
-        For NaN/inf entries, a wrong shape or a non-rigid matrix.
-
-    Notes
-    -----
-    Rigid transforms form SE(3) (Lynch & Park, *Modern Robotics*, 2017, Sec. 3.3.1).
-    """
-    T = as_array(pose, name, shape=(4, 4))
-    try:
-        se3_inverse(T)
-    except ValueError as exc:
-        raise ValueError(f"{name}: expected a rigid 4x4 transform; {exc}") from None
-    return T
-
-
 def finish_image(image: np.ndarray, noise: float, rng: Any, lighting: dict | None) -> np.ndarray:
     """Apply lighting (see :func:`robokit.sim.textures.illuminate`) and Gaussian pixel noise.
 
@@ -106,8 +87,8 @@ def finish_image(image: np.ndarray, noise: float, rng: Any, lighting: dict | Non
 
     Notes
     -----
-    Additive Gaussian read noise (Healey & Kondepudy, "Radiometric CCD camera calibration and noise
-    estimation", IEEE PAMI 1994, Sec. 2) after a gain/offset lighting change.
+    Additive Gaussian read noise (Healey & Kondepudy 1994, Sec. 2) after a gain/offset lighting
+    change.
     """
     if lighting:
         image = illuminate(image, **lighting)
@@ -183,7 +164,16 @@ class PinholeCamera(MountedSensor):
 
     Notes
     -----
-    Hartley & Zisserman, *Multiple View Geometry* (2004), Eq. (6.4)-(6.5).
+    Hartley & Zisserman (2004), Eq. (6.4)-(6.5).
+
+    Examples
+    --------
+    >>> cam = PinholeCamera.from_fov(np.deg2rad(90.0), width=640, height=480)
+    >>> uv, z = cam.project([[1.0, 0.0, 2.0]])          # camera frame: 1 m right, 2 m ahead
+    >>> print(np.round(uv, 2), z)
+    [[479.5 239.5]] [2.]
+    >>> print(np.round(cam.backproject(uv, z), 6))
+    [[1. 0. 2.]]
     """
 
     fx: float
@@ -201,7 +191,7 @@ class PinholeCamera(MountedSensor):
         self.height = check_int(self.height, "height", minimum=8)
         self.cx = float(as_array(self.cx, "cx", shape=()))
         self.cy = float(as_array(self.cy, "cy", shape=()))
-        self.mount = mount_pose(0.8) if self.mount is None else check_pose(self.mount, "mount")
+        self.mount = mount_pose(0.8) if self.mount is None else as_se3(self.mount, "mount")
 
     @classmethod
     def from_fov(cls, hfov: float = np.deg2rad(65.0), width: int = 640, height: int = 480,
@@ -249,7 +239,7 @@ class PinholeCamera(MountedSensor):
         """
         P = as_points(points, "points", 3)
         if pose is not None:
-            P = transform_points(se3_inverse(check_pose(pose)), P)
+            P = transform_points(se3_inverse(as_se3(pose, "pose")), P)
         z = P[:, 2]
         with np.errstate(divide="ignore", invalid="ignore"):
             uv = np.column_stack([self.fx * P[:, 0] / z + self.cx, self.fy * P[:, 1] / z + self.cy])
@@ -287,7 +277,7 @@ class PinholeCamera(MountedSensor):
         if np.any(z <= 0):
             raise ValueError("depth: expected positive depths, got a value <= 0")
         P = np.column_stack([(uv[:, 0] - self.cx) / self.fx * z, (uv[:, 1] - self.cy) / self.fy * z, z])
-        return P if pose is None else transform_points(check_pose(pose), P)
+        return P if pose is None else transform_points(as_se3(pose, "pose"), P)
 
     def render(self, world: World, pose: Any, *, noise: float = 0.0, rng: Any = None,
                lighting: dict | None = None) -> Frame:
@@ -323,7 +313,7 @@ class PinholeCamera(MountedSensor):
         """
         if not isinstance(world, World):
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
-        T = check_pose(pose)
+        T = as_se3(pose, "pose")
         world.check_viewpoint(T[:3, 3], "pose")
         image, depth = render_pinhole(world, self.K, self.width, self.height, T)
         return Frame(finish_image(image, noise, rng, lighting), depth)
@@ -347,6 +337,14 @@ class StereoRig:
     In a rectified pair a point at depth Z has disparity ``d = u_left - u_right = f B / Z`` and
     lies on the same row (Hartley & Zisserman 2004, Sec. 9.3; Se, Lowe & Little 2002, Sec. 3.1:
     ``Z = f I / d``).
+
+    Examples
+    --------
+    >>> rig = StereoRig(PinholeCamera.from_fov(np.deg2rad(90.0), width=640), baseline=0.12)
+    >>> print(np.round(rig.disparity([2.0, 4.0]), 2), np.round(rig.depth(19.2), 3))
+    [19.2  9.6] 2.0
+    >>> sorted(rig.offsets)
+    ['left', 'right']
     """
 
     camera: PinholeCamera
@@ -425,7 +423,7 @@ class StereoRig:
         dict of str to Frame
             ``"left"``, ``"right"`` (and ``"top"``); noise uses independent draws per camera.
         """
-        T = check_pose(pose)
+        T = as_se3(pose, "pose")
         rng = as_rng(kwargs.pop("rng", None))
         return {name: self.camera.render(world, T @ off, rng=rng, **kwargs) for name, off in self.offsets.items()}
 

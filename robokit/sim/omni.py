@@ -1,8 +1,7 @@
 """An omnidirectional catadioptric camera (a camera looking up at a mirror), 640x480 colour.
 
-Projection model: the unified central catadioptric model (Geyer & Daniilidis, "A unifying theory
-for central panoramic systems", ECCV 2000; Mei & Rives, "Single view point omnidirectional camera
-calibration from planar grids", ICRA 2007, Sec. II). A point ``X`` in the omni frame is first put
+Projection model: the unified central catadioptric model (Geyer & Daniilidis 2000; Mei & Rives
+2007, Sec. II). A point ``X`` in the omni frame is first put
 on the unit sphere, ``Xs = X / |X|``, then projected from a centre ``xi`` above the sphere's centre:
 
     m = (xs / (zs + xi), ys / (zs + xi)),      (u, v) = (f m_x + cx, f m_y + cy).
@@ -11,7 +10,7 @@ Its inverse lifts a pixel back to the sphere (Mei & Rives 2007, Eq. (6)):
 
     r2 = m_x^2 + m_y^2,   eta = (xi + sqrt(1 + (1 - xi^2) r2)) / (r2 + 1),   Xs = (eta m_x, eta m_y, eta - xi).
 
-``xi = 1`` is a parabolic mirror with an orthographic camera. The seed's robot (seed 001, Sec.
+``xi = 1`` is a parabolic mirror with an orthographic camera. The robot of lesson 02's paper (Sec.
 "Implementation for omnidirectional vision") uses a spherical mirror, which has no single
 viewpoint; the unified model is the standard central approximation of such systems.
 
@@ -21,8 +20,19 @@ and the mirror's rim limits the outside. Outside the annulus the image is black 
 ``inf``. Depth images of this camera hold the *range* ``|X|`` (distance from the viewpoint), not Z.
 
 Rendering: the world is rendered into the faces of a cube around the viewpoint with the pinhole
-renderer, then resampled into the omni image with one ``cv2.remap`` (a cube map, Greene,
-"Environment mapping and other applications of world projections", IEEE CG&A 1986).
+renderer, then resampled into the omni image with one ``cv2.remap`` (a cube map, Greene 1986).
+
+References
+----------
+.. [1] C. Geyer and K. Daniilidis, "A unifying theory for central panoramic systems and practical
+   implications", *Proc. European Conference on Computer Vision (ECCV)*, 445-461, 2000.
+.. [2] C. Mei and P. Rives, "Single view point omnidirectional camera calibration from planar
+   grids", *Proc. IEEE International Conference on Robotics and Automation (ICRA)*, 3945-3950,
+   2007.
+.. [3] N. Greene, "Environment mapping and other applications of world projections", *IEEE
+   Computer Graphics and Applications* 6(11), 21-29, 1986.
+.. [4] *Robust Omnidirectional Vision based Mobile Robot Hierarchical Localization and Autonomous
+   Navigation* (the course's source paper for lesson 02; our copy gives no authors, venue or year).
 """
 from __future__ import annotations
 
@@ -33,9 +43,9 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..geometry import se3_from_rt
+from ..geometry import as_se3, se3_from_rt
 from ..validation import as_array, as_points, check_int, check_positive
-from .camera import Frame, MountedSensor, check_pose, finish_image
+from .camera import Frame, MountedSensor, finish_image
 from .render import render_pinhole
 from .world import World
 
@@ -66,7 +76,7 @@ def omni_mount(height: float = 1.0) -> np.ndarray:
 
     Notes
     -----
-    Seed 001 mounts the camera on top of the robot looking up at the mirror; the omni frame's z axis
+    Lesson 02's paper mounts the camera on top of the robot looking up at the mirror; the omni frame's z axis
     is the mirror axis pointing down, as in Mei & Rives (2007), Sec. II.
     """
     return se3_from_rt(np.diag([1.0, -1.0, -1.0]), [0.0, 0.0, check_positive(height, "height")])
@@ -79,7 +89,7 @@ class OmniCamera(MountedSensor):
     Parameters
     ----------
     width, height : int, default 640, 480
-        Image size (seed 001: "full resolution 640x480 pixels", colour).
+        Image size (lesson 02's paper: "full resolution 640x480 pixels", colour).
     xi : float, default 1.0
         Mirror parameter in (0, 1] (1: parabolic).
     elevation_range : (float, float), default (-60 deg, +30 deg)
@@ -91,6 +101,18 @@ class OmniCamera(MountedSensor):
         ``T_body_omni``; default :func:`omni_mount` at 1.0 m.
     face_size : int, default 400
         Cube-face resolution used for rendering.
+
+    Examples
+    --------
+    A point on the horizon straight ahead (omni frame: x forward, z down) lands on the circle of
+    elevation 0, and lifts back to the same point:
+
+    >>> cam = OmniCamera()
+    >>> uv, r = cam.project([[2.0, 0.0, 0.0]])
+    >>> print(np.round(uv, 2), np.round(r, 3))
+    [[455.75 239.5 ]] [2.]
+    >>> print(np.round(cam.backproject(uv, r), 6))
+    [[2. 0. 0.]]
     """
 
     width: int = 640
@@ -117,7 +139,7 @@ class OmniCamera(MountedSensor):
             self.f = (min(self.width, self.height) / 2 - 4) / self._radius(hi)
         self.f = check_positive(self.f, "f")
         self.face_size = check_int(self.face_size, "face_size", minimum=16)
-        self.mount = omni_mount() if self.mount is None else check_pose(self.mount, "mount")
+        self.mount = omni_mount() if self.mount is None else as_se3(self.mount, "mount")
 
     def _radius(self, elevation: float) -> float:
         """Normalised image radius of rays at ``elevation`` (z points down, so zs = -sin e)."""
@@ -151,7 +173,7 @@ class OmniCamera(MountedSensor):
         """
         P = as_points(points, "points", 3)
         if pose is not None:
-            T = check_pose(pose)
+            T = as_se3(pose, "pose")
             P = (P - T[:3, 3]) @ T[:3, :3]
         rng_ = np.linalg.norm(P, axis=1)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -215,7 +237,7 @@ class OmniCamera(MountedSensor):
         P = d * r[:, None]
         if pose is None:
             return P
-        T = check_pose(pose)
+        T = as_se3(pose, "pose")
         return P @ T[:3, :3].T + T[:3, 3]
 
     @functools.cached_property
@@ -263,7 +285,7 @@ class OmniCamera(MountedSensor):
         """
         if not isinstance(world, World):
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
-        T = check_pose(pose)
+        T = as_se3(pose, "pose")
         world.check_viewpoint(T[:3, 3], "pose")
         used, K, size, mapx, mapy, factor, inside = self._lookup
         images, depths = [], []

@@ -1,17 +1,23 @@
 """Rasterise a world of textured rectangles through a pinhole camera (colour and depth).
 
 Each surface is a plane, so the map from its texture to the image is a homography
-``H = K [r1, r2, t]`` (Hartley & Zisserman, *Multiple View Geometry*, 2nd ed., Sec. 8.1.1 and
-Eq. (13.2)); OpenCV's ``warpPerspective`` applies it to the texture, and a z-buffer keeps the
+``H = K [r1, r2, t]`` (Hartley & Zisserman 2004, Sec. 8.1.1 and Eq. (13.2)); OpenCV's ``warpPerspective`` applies it to the texture, and a z-buffer keeps the
 nearest surface per pixel. On a plane ``n . X = d`` (camera frame), inverse depth is an affine
 function of the pixel, ``1/Z = n . K^-1 [u, v, 1]^T / d``, so the depth image costs one multiply-add
 per pixel. Surfaces outside the view frustum are culled before any pixel work, polygons are clipped
 against a near plane (so no point behind the camera is ever projected) and far, small-looking
-textures are read from a coarser mip-map level (Williams, "Pyramidal parametrics", SIGGRAPH 1983)
-to avoid aliasing.
+textures are read from a coarser mip-map level (Williams 1983) to avoid aliasing.
 
 Pixel convention (OpenCV): the centre of pixel ``(col, row)`` is at image coordinates
 ``(u, v) = (col, row)``.
+
+References
+----------
+.. [1] R. Hartley and A. Zisserman, *Multiple View Geometry in Computer Vision*, 2nd ed., Cambridge
+   University Press, 2004.
+.. [2] L. Williams, "Pyramidal parametrics", *Computer Graphics (Proc. SIGGRAPH)* 17(3), 1-11, 1983.
+.. [3] E. Catmull, *A subdivision algorithm for computer display of curved surfaces*, PhD thesis,
+   University of Utah, 1974.
 """
 from __future__ import annotations
 
