@@ -8,6 +8,11 @@ matches it explains; the winner has the most matches and the lowest residual.
 
 Variable-size rectangular votes are added in O(1) each with a 2-D difference array (four corner
 increments) that OpenCV's integral image turns into the accumulator.
+
+References
+----------
+.. [1] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features", Proc.
+   IEEE/RSJ Int. Conf. on Intelligent Robots and Systems (IROS), 2002.
 """
 from __future__ import annotations
 

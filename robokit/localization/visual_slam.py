@@ -19,6 +19,13 @@ Sec. 5 (:func:`robokit.localization.global_localize`).
 This module only orchestrates the library; it never renders (the simulator is used by
 :mod:`robokit.localization.lab_experiment`). Poses are the papers' ``[p, q, theta]``
 (``pqt``, :mod:`robokit.geometry.paper_frames`).
+
+References
+----------
+.. [1] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features", Proc.
+   IEEE/RSJ Int. Conf. on Intelligent Robots and Systems (IROS), 2002.
+.. [2] R. Lin, Z. Wang, R. Sun and L. Sun, "Vision-based mobile robot localization and mapping using
+   the PLOT features" (Question 1 of the course's assignment; our copy gives no venue or year).
 """
 from __future__ import annotations
 
