@@ -1,10 +1,14 @@
-"""``check(exercise_id, fn)``: immediate feedback on public cases inside the student's notebook."""
+"""``check(exercise_id, fn)``: immediate feedback on public cases inside the student's notebook.
+
+The official grade comes from :mod:`robokit.grading.grader` on hidden cases; while it grades, the
+worker replaces ``check`` by a function that only prints that it is skipped.
+"""
 from __future__ import annotations
 
 from typing import Any, Callable
 
-from .exercise import call_student, expected_output, judge
-from .registry import get_exercise
+from ..exercises.catalog import get_exercise
+from .judge import call_student, expected_output, judge
 
 __all__ = ["check", "PUBLIC_SEED"]
 
@@ -42,10 +46,38 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
         If any case fails, so the cell shows red.
     TypeError
         If ``fn`` is not callable.
+    robokit.exercises.UnknownExerciseError
+        If no assignment declares ``exercise_id``.
 
     Notes
     -----
     Grading design (DESIGN.md, "Grading"); not from a paper.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> def wrap_angle(angle):
+    ...     a = np.asarray(angle, dtype=float)
+    ...     if np.isnan(a).any():
+    ...         raise ValueError("angle: expected finite angles, got NaN")
+    ...     wrapped = np.mod(a + np.pi, 2 * np.pi) - np.pi
+    ...     return float(wrapped) if wrapped.ndim == 0 else wrapped
+    >>> check("00.wrap_angle", wrap_angle)
+    check 00.wrap_angle: 6/6 public cases passed (feedback only; your grade comes from hidden cases)
+      pass  case 1 (already inside)
+      pass  case 2 (+pi maps to -pi)
+      pass  case 3 (-pi stays)
+      pass  case 4 (large positive or negative)
+      pass  case 5 (a list of angles)
+      pass  case 6 (NaN is rejected)
+    6
+
+    A wrong answer fails the cell, and the report says which cases and why:
+
+    >>> check("00.wrap_angle", lambda angle: angle, verbose=False)
+    Traceback (most recent call last):
+    ...
+    AssertionError: 00.wrap_angle: 4 of 6 public cases failed (see above)
     """
     exercise = get_exercise(exercise_id)
     if not callable(fn):

@@ -18,8 +18,9 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any, Sequence
 
-from .exercise import Case, Exercise, expected_output, judge
-from .registry import exercises_for
+from ..exercises.catalog import UnknownAssignmentError, exercises_for
+from ..exercises.spec import Case, Exercise
+from .judge import expected_output, judge
 from .sandbox import Limits, is_root, run_sandboxed
 from .transport import TransportError, read_plain, write_plain
 
@@ -266,8 +267,6 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
     GradingError
         Only for problems with the request (unknown assignment, missing seed, no submissions).
     """
-    from .registry import UnknownAssignmentError
-
     try:
         prepared = prepare_cases(assignment, seed)
     except UnknownAssignmentError as exc:

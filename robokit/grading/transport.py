@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from .plain import NotPlainData, to_plain
+from ..exercises.plain import NotPlainData, to_plain
 
 __all__ = ["write_plain", "read_plain", "TransportError"]
 

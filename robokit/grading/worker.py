@@ -116,7 +116,7 @@ def main(job_dir: str) -> None:
     """
     from IPython.core.interactiveshell import InteractiveShell
 
-    from .plain import NotPlainData, to_plain
+    from ..exercises.plain import NotPlainData, to_plain
     from .transport import read_plain, write_plain
 
     job = Path(job_dir)
