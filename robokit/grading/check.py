@@ -86,13 +86,13 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
     lines, failed = [], 0
     for i, case in enumerate(cases, 1):
         result = call_student(fn, case)
-        if result.get("error", {}).get("type") == "NotImplementedError":
+        if result.error is not None and result.error.type == "NotImplementedError":
             print(f"{exercise.id}: not implemented yet — replace `raise NotImplementedError` in "
                   f"{exercise.function} with your code, then run this cell again.")
             raise NotImplementedError(f"{exercise.id} is not implemented yet")
         outcome = judge(exercise, case, expected_output(exercise, case), result)
         mark = "pass" if outcome.passed else "FAIL"
-        where = f" [{result['error'].get('line')}]" if not outcome.passed and result.get("error", {}).get("line") else ""
+        where = f" [{result.error.line}]" if not outcome.passed and result.error and result.error.line else ""
         text = f"  {mark}  case {i}" + (f" ({case.label})" if case.label else "")
         if not outcome.passed:
             failed += 1

@@ -5,11 +5,14 @@ The same three steps serve ``check()`` (in the student's notebook, public cases)
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
+import traceback
 from typing import Any, Callable
 
-from ..exercises.plain import NotPlainData, summarize, to_plain
+from ..exercises.plain import summarize, to_plain
 from ..exercises.spec import Case, Exercise
+from .protocol import CallResult
 
 __all__ = ["Outcome", "judge", "expected_output", "call_student"]
 
@@ -30,47 +33,59 @@ def expected_output(exercise: Exercise, case: Case) -> Any:
     return to_plain(exercise.reference(*case.args, **case.kwargs))
 
 
-def judge(exercise: Exercise, case: Case, expected: Any, result: dict) -> Outcome:
+def judge(exercise: Exercise, case: Case, expected: Any, result: CallResult) -> Outcome:
     """Judge one student result against the expected answer.
 
-    ``result`` is what running the student's function produced, as plain data:
-    ``{"value": ...}`` on return, or ``{"error": {"type": name, "mro": [names], "message": str}}``.
+    Parameters
+    ----------
+    exercise : Exercise
+        Supplies the comparison.
+    case : Case
+        The case; ``case.raises`` names the exception a bad-input case must raise.
+    expected : plain data
+        :func:`expected_output` of the case.
+    result : CallResult
+        What the student's function gave on the case (see :func:`call_student`).
+
+    Returns
+    -------
+    Outcome
+        Passed or not, with a one-line message for the feedback.
+
+    Notes
+    -----
+    Grading design (DESIGN.md, "Grading"); not from a paper.
     """
     label = f" ({case.label})" if case.label else ""
-    if "error" in result:
-        err = result["error"]
-        mro = err.get("mro") or [err.get("type")]
-        if case.raises and case.raises in mro:
-            return Outcome(case, True, f"raised {err.get('type')} as expected{label}")
-        if err.get("type") == "NotImplementedError":
+    err = result.error
+    if err is not None:
+        if case.raises and case.raises in (err.classes or (err.type,)):
+            return Outcome(case, True, f"raised {err.type} as expected{label}")
+        if err.type == "NotImplementedError":
             return Outcome(case, False, "not implemented yet")
         want = f"expected {case.raises}" if case.raises else "expected a result"
-        return Outcome(case, False, f"{want}{label}, but it raised {err.get('type')}: {err.get('message', '')}")
+        return Outcome(case, False, f"{want}{label}, but it raised {err.type}: {err.message}")
     if case.raises:
-        return Outcome(case, False, f"expected {case.raises} for bad input{label}, got {summarize(result.get('value'))}")
-    msg = exercise.compare(expected, result.get("value"))
+        return Outcome(case, False, f"expected {case.raises} for bad input{label}, got {summarize(result.value)}")
+    msg = exercise.compare(expected, result.value)
     return Outcome(case, msg is None, msg or f"ok{label}")
 
 
-def call_student(fn: Callable[..., Any], case: Case) -> dict:
-    """Call ``fn`` on a case in this process and return its result as plain data (see :func:`judge`)."""
-    import copy
+def call_student(fn: Callable[..., Any], case: Case) -> CallResult:
+    """Call ``fn`` on copies of a case's inputs in this process; the result as plain data.
 
+    An exception from ``fn`` is data here (with the student's line for the feedback); a
+    ``KeyboardInterrupt`` still stops the notebook.
+    """
     try:
         value = fn(*copy.deepcopy(case.args), **copy.deepcopy(case.kwargs))
     except Exception as exc:  # the student's exception is data here
-        return {"error": {"type": type(exc).__name__, "mro": [c.__name__ for c in type(exc).__mro__],
-                          "message": str(exc)[:500], "line": _student_line(exc)}}
-    try:
-        return {"value": to_plain(value)}
-    except NotPlainData as exc:
-        return {"error": {"type": "NotPlainData", "mro": ["NotPlainData"], "message": str(exc)}}
+        return CallResult.raised(exc, line=_student_line(exc))
+    return CallResult.returned(value)
 
 
 def _student_line(exc: BaseException) -> str:
-    """Return "line N: source" of the innermost frame outside robokit's grading code."""
-    import traceback
-
+    """Return ``"line N: source"`` of the innermost frame outside robokit's grading code."""
     for frame in reversed(traceback.extract_tb(exc.__traceback__)):
         if "/robokit/grading/" not in frame.filename.replace("\\", "/"):
             return f"line {frame.lineno}: {frame.line}" if frame.line else f"line {frame.lineno}"
