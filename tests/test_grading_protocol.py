@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from robokit.exercises import Assignment, Case, Exercise, catalog
-from robokit.grading.protocol import (MAX_FLAG_LINES, MAX_MESSAGE, CallResult, CellsReport, ErrorRecord,
-                                      ExerciseJob, ExerciseReport, JobDir, JobSpec, log_reference_call)
+from robokit.grading.protocol import (MAX_FLAG_LINES, MAX_MESSAGE, CallResult, DoneReport, ErrorRecord, ExerciseReport,
+                                      JobDir, JobSpec, log_reference_call)
 from robokit.grading.submission import (NotANotebook, UnreadableSubmission, WrongAssignment, read_submission)
 from robokit.grading.transport import TransportError, write_plain
 
@@ -26,18 +26,31 @@ def job(tmp_path):
     return JobDir.create(tmp_path)
 
 
-def test_job_spec_round_trip_carries_inputs_only(job):
-    cases = (Case((np.arange(3.0),), {"k": 2}, raises="ValueError", label="secret label"),)
+def test_job_spec_round_trip(job):
+    case = Case((np.arange(3.0), [1, "a"]), {"k": 2})
     spec = JobSpec(("x = 1",), (False,), ("robokit.geometry.wrap_angle",), 4.0, 3.0,
-                   (ExerciseJob("00.double", "double", cases),))
+                   (("double", ((case.args, case.kwargs),)),))
     job.write_spec(spec)
     back = job.read_spec()
-    assert back.cells == ("x = 1",) and back.references == ("robokit.geometry.wrap_angle",)
-    case = back.exercises[0].cases[0]
-    assert np.array_equal(case.args[0], np.arange(3.0)) and case.kwargs == {"k": 2}
-    assert case.raises is None and case.label == ""
+    assert back.cells == ("x = 1",) and back.skip == (False,) and back.call_seconds == 3.0
+    assert back.references == ("robokit.geometry.wrap_angle",)
+    function, ((args, kwargs),) = back.exercises[0]
+    assert function == "double" and np.array_equal(args[0], np.arange(3.0)) and args[1] == [1, "a"]
+    assert kwargs == {"k": 2}
+
+
+def test_the_worker_gets_case_inputs_only(job):
+    from robokit.grading.grader import job_spec, prepare_cases
+    from robokit.grading.sandbox import Limits
+    from robokit.grading.submission import Submission
+
+    prepared = prepare_cases("00_getting_started", "secret")
+    job.write_spec(job_spec(Submission(("x = 1",), (False,)), prepared, Limits()))
     text = (job.inbox / "job.json").read_text()
-    assert "ValueError" not in text and "secret label" not in text
+    assert "wrap_angle" in text and "se2_compose" in text
+    labels = [c.label for cs in prepared.cases for c in cs]
+    assert "ValueError" not in text and "secret" not in text and not any(label in text for label in labels)
+    assert [len(inputs) for _, inputs in job.read_spec().exercises] == [len(cs) for cs in prepared.cases]
 
 
 def test_exercise_report_round_trip(job):
@@ -54,7 +67,7 @@ def test_exercise_report_round_trip(job):
     assert job.read_exercise(1, 3) is None  # never written
 
 
-def test_a_report_too_large_to_write_says_why(job, monkeypatch):
+def test_results_too_large_to_write_read_as_unusable(job, monkeypatch):
     import robokit.grading.protocol as protocol
 
     real = protocol.write_plain
@@ -70,16 +83,17 @@ def test_a_report_too_large_to_write_says_why(job, monkeypatch):
     job.write_exercise(0, ExerciseReport(True, (CallResult(value=1.0),), 0.5))
     with pytest.raises(TransportError, match="expected 1 results, got 0"):
         job.read_exercise(0, 1)
-    raw = json.loads(job.exercise_file(0).with_suffix(".json").read_text())
-    assert raw["write_error"]["type"] == "OSError"
+    assert len(calls) == 2
 
 
 @pytest.mark.parametrize("raw, message", [
     ([1, 2], "malformed results"),
     ({"defined": True, "results": "xx"}, "malformed results"),
-    ({"defined": True, "results": [{"value": 1}]}, "expected 2 results, got 1"),
-    ({"defined": True, "results": [{"value": 1}, {"value": 1, "error": {}}]}, "malformed result entry"),
-    ({"defined": True, "results": [{"value": 1}, {"error": "boom"}]}, "malformed result entry"),
+    ({"defined": True, "results": [{"value": 1, "error": None}]}, "expected 2 results, got 1"),
+    ({"defined": True, "results": [{"value": 1, "error": None}, {"value": 1}]}, "malformed result entry"),
+    ({"defined": True, "results": [{"value": 1, "error": None}, {"value": 1, "error": {}}]}, "malformed result entry"),
+    ({"defined": True, "results": [{"value": 1, "error": None}, {"value": None, "error": "boom"}]},
+     "malformed result entry"),
 ])
 def test_malformed_exercise_reports_are_refused(job, raw, message):
     write_plain(raw, job.exercise_file(0))
@@ -88,8 +102,9 @@ def test_malformed_exercise_reports_are_refused(job, raw, message):
 
 
 def test_worker_values_are_bounded(job):
-    error = {"type": "E" * 10_000, "mro": ["M" * 10_000] * 1000, "message": "m" * 10**6, "line": "hidden"}
-    write_plain({"defined": True, "results": [{"error": error}], "seconds": float("nan")}, job.exercise_file(0))
+    error = {"type": "E" * 10_000, "classes": ["M" * 10_000] * 1000, "message": "m" * 10**6, "line": "hidden"}
+    write_plain({"defined": True, "results": [{"value": None, "error": error}], "seconds": float("nan")},
+                job.exercise_file(0))
     report = job.read_exercise(0, 1)
     err = report.results[0].error
     assert len(err.type) == 100 and len(err.classes) == 12 and len(err.message) == MAX_MESSAGE
@@ -98,21 +113,21 @@ def test_worker_values_are_bounded(job):
     assert job.read_exercise(1, 5) == ExerciseReport(defined=False)
 
 
-@pytest.mark.parametrize("raw", [5, {"cells": 5}, {"cells": "abc"}, {"other": []}])
+@pytest.mark.parametrize("raw", [5, {"cells": 5}, "abc", {"other": []}])
 def test_malformed_cells_reports_read_as_missing(job, raw):
     write_plain(raw, job.outbox / "cells")
     assert job.read_cells() is None
 
 
-def test_cells_report_keeps_well_formed_records(job):
-    good = {"cell": 1, "status": "error", "error": {"type": "NameError", "mro": [], "message": "x"}}
-    bad = [{"cell": "1" * 10**5, "status": "error", "error": {}}, {"cell": 2, "status": "???"}, 7]
-    write_plain({"cells": [good, *bad], "output": "o" * 10**6, "output_dropped": -3}, job.outbox / "cells")
-    report = job.read_cells()
-    assert [c.cell for c in report.cells] == [1] and report.cells[0].error.type == "NameError"
-    assert len(report.output) == 20_000 and report.output_dropped == 0
-    assert CellsReport.from_plain({"cells": [good] * 600}).cells[499].cell == 1
-    assert len(CellsReport.from_plain({"cells": [good] * 600}).cells) == 500
+def test_cells_report_keeps_the_first_well_formed_records(job):
+    good = {"cell": 1, "status": "error", "error": {"type": "NameError", "classes": [], "message": "x"}}
+    bad = [{"cell": "1" * 10**5, "status": "error", "error": None}, {"cell": 2, "status": "???"}, 7,
+           {"cell": 3, "status": "error", "error": "x"}]
+    write_plain([good, *bad], job.outbox / "cells")
+    cells = job.read_cells()
+    assert [c.cell for c in cells] == [1] and cells[0].error.type == "NameError"
+    write_plain([good] * 600, job.outbox / "cells")
+    assert len(job.read_cells()) == 500
 
 
 def test_reference_calls_are_read_from_the_flags_log_only_so_far(job):
@@ -127,6 +142,8 @@ def test_reference_calls_are_read_from_the_flags_log_only_so_far(job):
 
 def test_done_report(job):
     assert job.read_done() is None
+    job.write_done(DoneReport(1.5))
+    assert job.read_done() == DoneReport(1.5)
     write_plain({"compute_seconds": -1.0}, job.outbox / "done")
     assert job.read_done().compute_seconds == 0.0
     (job.outbox / "done.json").write_text("not json")

@@ -49,13 +49,9 @@ class Assignment:
     Raises
     ------
     ValueError
-        For a malformed slug, an exercise that is not an :class:`~robokit.exercises.spec.Exercise`,
-        duplicate ids (exercises and written questions share one id space), an id of another
-        lesson, or a written question with a malformed id or non-positive points.
-
-    Notes
-    -----
-    Course convention (DESIGN.md, "Grading"); not from a paper.
+        For a malformed slug, an exercise that is not an :class:`~.spec.Exercise`, duplicate ids
+        (exercises and written questions share one id space), an id of another lesson, or a
+        written question with a malformed id or non-positive points.
 
     Examples
     --------
@@ -91,8 +87,7 @@ class Assignment:
         foreign = [i for i in ids if i[:2] != self.slug[:2]]
         if foreign:
             raise ValueError(f"{self.slug}: ids must start with the lesson number {self.slug[:2]}, got {foreign}")
-        bad_points = {q: p for q, p in written.items() if isinstance(p, bool) or not isinstance(p, (int, float))
-                      or not p > 0}
+        bad_points = {q: p for q, p in written.items() if type(p) not in (int, float) or not p > 0}
         if bad_points:
             raise ValueError(f"{self.slug}: WRITTEN points must be positive numbers, got {bad_points}")
         object.__setattr__(self, "exercises", exercises)
@@ -105,12 +100,7 @@ def catalog() -> Mapping[str, Assignment]:
 
     The modules are imported on the first call only (not when :mod:`robokit.exercises` is), so
     the grading worker can disable reference functions before any exercise module binds them.
-
-    Raises
-    ------
-    ValueError
-        If a module declares a malformed assignment (see :class:`Assignment`) or two modules
-        declare the same slug.
+    Raises ``ValueError`` for a malformed declaration (see :class:`Assignment`) or a slug declared twice.
 
     Examples
     --------
@@ -136,11 +126,6 @@ def get_assignment(slug: str) -> Assignment:
     ------
     UnknownAssignmentError
         With the list of known assignments.
-
-    Examples
-    --------
-    >>> dict(get_assignment("00_getting_started").written)
-    {'00.why_seeds': 1}
     """
     known = catalog()
     if slug not in known:
@@ -149,13 +134,7 @@ def get_assignment(slug: str) -> Assignment:
 
 
 def assignments() -> dict[str, tuple[Exercise, ...]]:
-    """Return ``{"NN_slug": (Exercise, ...)}`` for every assignment, sorted by slug.
-
-    Examples
-    --------
-    >>> "00_getting_started" in assignments()
-    True
-    """
+    """Return ``{"NN_slug": (Exercise, ...)}`` for every assignment, sorted by slug."""
     return {slug: a.exercises for slug, a in catalog().items()}
 
 
@@ -166,11 +145,6 @@ def exercises_for(assignment: str) -> tuple[Exercise, ...]:
     ------
     UnknownAssignmentError
         With the list of known assignments.
-
-    Examples
-    --------
-    >>> [e.points for e in exercises_for("00_getting_started")]
-    [1, 2]
     """
     return get_assignment(assignment).exercises
 
@@ -180,15 +154,8 @@ def get_exercise(exercise_id: str) -> Exercise:
 
     Raises
     ------
-    TypeError
-        If ``exercise_id`` is not a string.
     UnknownExerciseError
-        If no assignment declares it.
-
-    Examples
-    --------
-    >>> get_exercise("00.se2_compose").function
-    'se2_compose'
+        If no assignment declares it (``TypeError`` if ``exercise_id`` is not a string).
     """
     if not isinstance(exercise_id, str):
         raise TypeError(f"exercise_id: expected a string like '00.wrap_angle', got {type(exercise_id).__name__}")

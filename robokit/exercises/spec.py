@@ -26,28 +26,12 @@ EXERCISE_ID = re.compile(r"^\d\d\.[a-z][a-z0-9_]*$")
 
 @dataclasses.dataclass(frozen=True)
 class Case:
-    """One input case: positional ``args`` and keyword ``kwargs``, converted to plain data.
+    """One input case: positional ``args`` and keyword ``kwargs`` (plain data only).
 
-    Parameters
-    ----------
-    args : tuple
-        Positional arguments (plain data: numbers, strings, lists, dicts, numeric arrays).
-    kwargs : dict
-        Keyword arguments (plain data).
-    raises : str, optional
-        Name of the exception class the function must raise (e.g. ``"ValueError"``) for a
-        bad-input case; a subclass is accepted.
-    label : str
-        What the case tests, shown in the feedback.
-
-    Raises
-    ------
-    robokit.exercises.plain.NotPlainData
-        If an argument is not plain data.
-
-    Notes
-    -----
-    Grading design (DESIGN.md, "Grading"); not from a paper.
+    ``raises`` names the exception class the function must raise (e.g. ``"ValueError"``), for
+    bad-input cases; a subclass is accepted. ``label`` says what the case tests, for feedback.
+    The inputs are converted to plain data; anything else raises
+    :class:`~robokit.exercises.plain.NotPlainData`.
 
     Examples
     --------
@@ -95,10 +79,6 @@ class Exercise:
     ------
     ValueError
         For a malformed ``id``, a ``function`` that is not an identifier or non-positive ``points``.
-
-    Notes
-    -----
-    Grading design (DESIGN.md, "Grading"); not from a paper.
 
     Examples
     --------

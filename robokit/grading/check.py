@@ -62,14 +62,8 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
     ...         raise ValueError("angle: expected finite angles, got NaN")
     ...     wrapped = np.mod(a + np.pi, 2 * np.pi) - np.pi
     ...     return float(wrapped) if wrapped.ndim == 0 else wrapped
-    >>> check("00.wrap_angle", wrap_angle)
+    >>> check("00.wrap_angle", wrap_angle, verbose=False)
     check 00.wrap_angle: 6/6 public cases passed (feedback only; your grade comes from hidden cases)
-      pass  case 1 (already inside)
-      pass  case 2 (+pi maps to -pi)
-      pass  case 3 (-pi stays)
-      pass  case 4 (large positive or negative)
-      pass  case 5 (a list of angles)
-      pass  case 6 (NaN is rejected)
     6
 
     A wrong answer fails the cell, and the report says which cases and why:
@@ -101,7 +95,8 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
             lines.append(text)
     print(f"check {exercise.id}: {len(cases) - failed}/{len(cases)} public cases passed "
           "(feedback only; your grade comes from hidden cases)")
-    print("\n".join(lines))
+    if lines:
+        print("\n".join(lines))
     if failed:
         raise AssertionError(f"{exercise.id}: {failed} of {len(cases)} public cases failed (see above)")
     return len(cases)

@@ -21,12 +21,12 @@ from typing import Any, Sequence
 from ..exercises.catalog import UnknownAssignmentError, exercises_for
 from ..exercises.spec import Case, Exercise
 from .judge import expected_output, judge
-from .protocol import CallResult, ExerciseJob, JobDir, JobSpec, ReferenceSolutionDisabled
+from .protocol import CallResult, JobDir, JobSpec, ReferenceSolutionDisabled
 from .sandbox import Limits, WorkerExit, is_root, run_sandboxed
 from .submission import Submission, SubmissionRejected, read_submission, student_name
 from .transport import TransportError
 
-__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "grade_submission",
+__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "job_spec", "grade_submission",
            "grade_batch", "GradingError", "isolation_note"]
 
 
@@ -100,12 +100,13 @@ def _zero(prepared: PreparedCases, message: str) -> list[ExerciseScore]:
     return [ExerciseScore.zero(ex, len(cs), message) for ex, cs in zip(prepared.exercises, prepared.cases)]
 
 
-def _job_spec(submission: Submission, prepared: PreparedCases, limits: Limits) -> JobSpec:
-    """The worker's request: cells, references to disable, limits and the case inputs only."""
+def job_spec(submission: Submission, prepared: PreparedCases, limits: Limits) -> JobSpec:
+    """The worker's request: cells, references to disable, limits, and the case inputs only (never
+    the seed, the expected answers, what a case expects or its label)."""
     return JobSpec(submission.sources, submission.skip,
                    tuple(sorted({r for ex in prepared.exercises for r in ex.references})),
                    limits.cell_seconds, limits.call_seconds,
-                   tuple(ExerciseJob(ex.id, ex.function, tuple(cs))
+                   tuple((ex.function, tuple((c.args, c.kwargs) for c in cs))
                          for ex, cs in zip(prepared.exercises, prepared.cases)))
 
 
@@ -130,7 +131,7 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
                                 read_error=exc.read_error)
     job = JobDir.create(work_root)
     try:
-        job.write_spec(_job_spec(submission, prepared, limits))
+        job.write_spec(job_spec(submission, prepared, limits))
         exit_ = run_sandboxed(["-m", "robokit.grading.worker", str(job.root)], job.root, limits, slot=slot,
                               hide=[*hide, path.resolve().parent])
         return _score(job, student, path, prepared, exit_, start)
@@ -159,9 +160,8 @@ def _score(job: JobDir, student: str, path: Path, prepared: PreparedCases, exit_
            start: float) -> SubmissionResult:
     """Read what the worker wrote (through the protocol's validating readers) and score it."""
     flags = [] if exit_.isolated else ["sandbox=limited"]
-    cells = job.read_cells()
     cell_errors = [f"code cell {c.cell}: {c.status}: {c.error.type[:80]}: {c.error.message[:200]}"
-                   for c in (cells.cells if cells else ()) if c.status in ("error", "timeout") and c.error]
+                   for c in job.read_cells() or () if c.status in ("error", "timeout") and c.error]
     ended = "the grader stopped your notebook at its time limit" if exit_.timed_out else \
         "your notebook ended the grading process early"
     scores, compute, called_reference = [], 0.0, False

@@ -34,27 +34,10 @@ def expected_output(exercise: Exercise, case: Case) -> Any:
 
 
 def judge(exercise: Exercise, case: Case, expected: Any, result: CallResult) -> Outcome:
-    """Judge one student result against the expected answer.
+    """Judge what the student's function gave on ``case`` (``result``) against ``expected``.
 
-    Parameters
-    ----------
-    exercise : Exercise
-        Supplies the comparison.
-    case : Case
-        The case; ``case.raises`` names the exception a bad-input case must raise.
-    expected : plain data
-        :func:`expected_output` of the case.
-    result : CallResult
-        What the student's function gave on the case (see :func:`call_student`).
-
-    Returns
-    -------
-    Outcome
-        Passed or not, with a one-line message for the feedback.
-
-    Notes
-    -----
-    Grading design (DESIGN.md, "Grading"); not from a paper.
+    A bad-input case passes when the function raised ``case.raises`` (or a subclass); any other
+    case when ``exercise.compare`` accepts the value. Grading design (DESIGN.md, "Grading").
     """
     label = f" ({case.label})" if case.label else ""
     err = result.error

@@ -2,23 +2,18 @@
 
 A job directory (:class:`JobDir`) holds::
 
-    in/job         JobSpec        the grader's request: code cells, skip flags, reference names to
-                                  disable, time limits, each exercise's function name and case
-                                  inputs (never the seed, never the expected answers)
-    work/                         the worker's current and home directory
-    out/cells      CellsReport    written after the last notebook cell
-    out/ex<k>      ExerciseReport written right after exercise k ran, so a submission that kills
-                                  its process loses only what had not run yet
-    out/done       DoneReport     written last: the worker finished
-    out/flags.log                 one line per event reported while student code runs
-                                  (``reference:<dotted name>``: graded code called a disabled
-                                  reference function)
+    in/job         JobSpec         the request: cells, skip flags, references to disable, time
+                                   limits, each exercise's function and case inputs (only those)
+    work/                          the worker's current and home directory
+    out/cells      CellRecord...   written after the last notebook cell
+    out/ex<k>      ExerciseReport  written as soon as exercise k has run
+    out/done       DoneReport      written last: the worker finished
+    out/flags.log                  ``reference:<name>``: graded code called a disabled reference
 
-Records travel as plain data (:mod:`~robokit.grading.transport`). Everything under ``out/`` is
-written by untrusted code, so the grader reads it only through the ``read_*`` methods of
-:class:`JobDir`, which bound what they read and validate every field; they return clean records
-(or ``None`` for a file the worker never wrote) and raise
-:class:`~robokit.grading.transport.TransportError` for a malformed one.
+Records are dataclasses, stored as their fields in plain data (:mod:`.transport`). ``out/`` is
+written by untrusted code: the grader reads it only through :class:`JobDir`'s ``read_*`` methods,
+which bound and validate every field and return clean records, ``None`` for a file never written,
+or raise :class:`~.transport.TransportError`.
 """
 from __future__ import annotations
 
@@ -30,14 +25,13 @@ from pathlib import Path
 from typing import Any
 
 from ..exercises.plain import NotPlainData, to_plain
-from ..exercises.spec import Case
 from .transport import TransportError, read_plain, write_plain
 
-__all__ = ["JobDir", "JobSpec", "ExerciseJob", "CellRecord", "CellsReport", "CallResult", "ErrorRecord",
-           "ExerciseReport", "DoneReport", "ReferenceSolutionDisabled", "log_reference_call", "CELL_STATUSES"]
+__all__ = ["JobDir", "JobSpec", "CellRecord", "CallResult", "ErrorRecord", "ExerciseReport", "DoneReport",
+           "ReferenceSolutionDisabled", "log_reference_call", "CELL_STATUSES"]
 
-#: Bounds on what the grader accepts from the worker (names, messages, MRO length, cells, flags).
-MAX_NAME, MAX_MESSAGE, MAX_MRO, MAX_CELLS, MAX_OUTPUT = 100, 500, 12, 500, 20_000
+#: Bounds on what the grader takes from the worker.
+MAX_NAME, MAX_MESSAGE, MAX_CLASSES, MAX_CELLS = 100, 500, 12, 500
 MAX_FLAG_BYTES, MAX_FLAG_LINES = 64 * 1024, 100
 CELL_STATUSES = ("ok", "error", "timeout", "skipped")
 _REFERENCE_FLAG = "reference:"
@@ -47,39 +41,34 @@ class ReferenceSolutionDisabled(Exception):
     """Raised in the worker when graded code calls a robokit reference implementation directly."""
 
 
-def _seconds(value: Any) -> float:
-    """A duration reported by the worker: a finite non-negative number, else 0."""
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
-    return float(value) if ok else 0.0
-
-
 def log_reference_call(fd: int, dotted: str) -> None:
-    """Append ``reference:<dotted>`` to the flags log open as ``fd`` (never raises).
-
-    Called by the worker when graded code calls the disabled reference ``dotted``; the grader reads
-    it back with :meth:`JobDir.read_reference_calls`.
-    """
+    """Append ``reference:<dotted>`` to the flags log open as ``fd`` (never raises)."""
     try:
         os.write(fd, f"{_REFERENCE_FLAG}{dotted}\n".encode())
     except OSError:
         pass
 
 
+def _plain(record: Any) -> Any:
+    """A record as plain data: its fields by name, nested records likewise, tuples as lists."""
+    if dataclasses.is_dataclass(record):
+        return {f.name: _plain(getattr(record, f.name)) for f in dataclasses.fields(record)}
+    return [_plain(v) for v in record] if isinstance(record, tuple) else record
+
+
+def _seconds(value: Any) -> float:
+    """A duration reported by the worker: a finite non-negative number, else 0."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
+    return float(value) if ok else 0.0
+
+
 @dataclasses.dataclass(frozen=True)
 class ErrorRecord:
     """An exception raised by student code, as data.
 
-    Attributes
-    ----------
-    type : str
-        The exception's class name.
-    classes : tuple of str
-        Class names of its method resolution order, ``"mro"`` on the wire (so that
-        ``raises="ValueError"`` accepts a subclass).
-    message : str
-        ``str(exc)``, truncated.
-    line : str
-        ``"line N: source"`` of the student's innermost frame, where known (``check()`` only).
+    ``type`` is the class name, ``classes`` the names of its method resolution order (so that
+    ``raises="ValueError"`` accepts a subclass), ``message`` is ``str(exc)`` truncated, and
+    ``line`` the student's ``"line N: source"`` where known (``check()`` only; the grader drops it).
     """
 
     type: str
@@ -94,27 +83,17 @@ class ErrorRecord:
             message = str(exc)[:MAX_MESSAGE]
         except BaseException:
             message = "<unprintable exception>"
-        mro = tuple(c.__name__ for c in type(exc).__mro__)[:MAX_MRO]
-        return cls(type(exc).__name__[:MAX_NAME], mro, message, line)
-
-    @classmethod
-    def not_plain(cls, exc: NotPlainData) -> ErrorRecord:
-        """The value a function returned is not plain data (never accepted as any ``raises``)."""
-        return cls("NotPlainData", ("NotPlainData",), str(exc)[:MAX_MESSAGE])
+        classes = tuple(c.__name__ for c in type(exc).__mro__)[:MAX_CLASSES]
+        return cls(type(exc).__name__[:MAX_NAME], classes, message, line)
 
     @classmethod
     def from_plain(cls, raw: Any) -> ErrorRecord:
-        """Validate an error record read from the worker (``line`` is not taken)."""
+        """Validate an error record read from the worker."""
         if not isinstance(raw, dict):
             raise TransportError("malformed error record")
-        mro = raw.get("mro") if isinstance(raw.get("mro"), list) else []
-        return cls(str(raw.get("type"))[:MAX_NAME], tuple(str(m)[:MAX_NAME] for m in mro[:MAX_MRO]),
+        classes = raw.get("classes") if isinstance(raw.get("classes"), list) else []
+        return cls(str(raw.get("type"))[:MAX_NAME], tuple(str(c)[:MAX_NAME] for c in classes[:MAX_CLASSES]),
                    str(raw.get("message"))[:MAX_MESSAGE])
-
-    def to_plain(self) -> dict:
-        """The record as plain data (``line`` only when known)."""
-        out = {"type": self.type, "mro": list(self.classes), "message": self.message}
-        return {**out, "line": self.line} if self.line else out
 
 
 @dataclasses.dataclass(frozen=True)
@@ -126,11 +105,12 @@ class CallResult:
 
     @classmethod
     def returned(cls, value: Any) -> CallResult:
-        """The function returned ``value``: keep it converted to plain data, or say why not."""
+        """The function returned ``value``: kept as plain data; anything else is a ``NotPlainData``
+        error, which no ``raises`` of a case accepts."""
         try:
             return cls(value=to_plain(value))
         except NotPlainData as exc:
-            return cls(error=ErrorRecord.not_plain(exc))
+            return cls(error=ErrorRecord("NotPlainData", ("NotPlainData",), str(exc)[:MAX_MESSAGE]))
 
     @classmethod
     def raised(cls, exc: BaseException, *, line: str = "") -> CallResult:
@@ -139,57 +119,38 @@ class CallResult:
 
     @classmethod
     def from_plain(cls, raw: Any) -> CallResult:
-        """Validate one result read from the worker: exactly ``{"value": ...}`` or ``{"error": {...}}``."""
-        if isinstance(raw, dict) and set(raw) == {"value"}:
+        """Validate one result read from the worker: a value, or an error record, not both."""
+        if not isinstance(raw, dict) or set(raw) != {"value", "error"}:
+            raise TransportError("malformed result entry")
+        if raw["error"] is None:
             return cls(value=raw["value"])
-        if isinstance(raw, dict) and set(raw) == {"error"} and isinstance(raw["error"], dict):
+        if raw["value"] is None and isinstance(raw["error"], dict):
             return cls(error=ErrorRecord.from_plain(raw["error"]))
         raise TransportError("malformed result entry")
-
-    def to_plain(self) -> dict:
-        """``{"value": ...}`` or ``{"error": {...}}``."""
-        return {"value": self.value} if self.error is None else {"error": self.error.to_plain()}
-
-
-@dataclasses.dataclass(frozen=True)
-class ExerciseJob:
-    """One exercise as the worker sees it: the function to look up and the inputs to call it on."""
-
-    id: str
-    function: str
-    cases: tuple[Case, ...]
-
-    def to_plain(self) -> dict:
-        """Plain data; a case travels as its inputs only (not what it expects, not its label)."""
-        return {"id": self.id, "function": self.function,
-                "cases": [{"args": list(c.args), "kwargs": c.kwargs} for c in self.cases]}
 
 
 @dataclasses.dataclass(frozen=True)
 class JobSpec:
-    """The grader's request to the worker (trusted: the worker cannot write ``in/``)."""
+    """The grader's request to the worker (trusted: the worker cannot write ``in/``).
+
+    ``exercises`` holds ``(function name, ((args, kwargs), ...))`` per exercise: the inputs of its
+    cases only, neither what a case expects nor its label.
+    """
 
     cells: tuple[str, ...]
     skip: tuple[bool, ...]
     references: tuple[str, ...]
     cell_seconds: float
     call_seconds: float
-    exercises: tuple[ExerciseJob, ...]
+    exercises: tuple[tuple[str, tuple[tuple[tuple, dict], ...]], ...]
 
     @classmethod
     def from_plain(cls, raw: dict) -> JobSpec:
-        """Rebuild the request written by :meth:`to_plain`."""
-        exercises = tuple(ExerciseJob(e["id"], e["function"], tuple(Case(tuple(c["args"]), c["kwargs"])
-                                                                    for c in e["cases"]))
-                          for e in raw["exercises"])
-        return cls(tuple(raw["cells"]), tuple(raw["skip"]), tuple(raw["references"]),
-                   raw["cell_seconds"], raw["call_seconds"], exercises)
-
-    def to_plain(self) -> dict:
-        """Plain data for :func:`~robokit.grading.transport.write_plain`."""
-        return {"cells": list(self.cells), "skip": list(self.skip), "references": list(self.references),
-                "cell_seconds": self.cell_seconds, "call_seconds": self.call_seconds,
-                "exercises": [e.to_plain() for e in self.exercises]}
+        """Rebuild the request as :meth:`JobDir.write_spec` wrote it."""
+        exercises = tuple((fn, tuple((tuple(args), kwargs) for args, kwargs in inputs))
+                          for fn, inputs in raw["exercises"])
+        return cls(tuple(raw["cells"]), tuple(raw["skip"]), tuple(raw["references"]), raw["cell_seconds"],
+                   raw["call_seconds"], exercises)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -203,60 +164,20 @@ class CellRecord:
     @classmethod
     def from_plain(cls, raw: Any) -> CellRecord:
         """Validate one cell record read from the worker."""
-        if (not isinstance(raw, dict) or type(raw.get("cell")) is not int
-                or raw.get("status") not in CELL_STATUSES):
+        if not isinstance(raw, dict) or type(raw.get("cell")) is not int or raw.get("status") not in CELL_STATUSES:
             raise TransportError("malformed cell record")
-        error = raw.get("error")
-        return cls(raw["cell"], raw["status"], None if error is None else ErrorRecord.from_plain(error))
-
-    def to_plain(self) -> dict:
-        """Plain data."""
-        return {"cell": self.cell, "status": self.status,
-                "error": None if self.error is None else self.error.to_plain()}
-
-
-@dataclasses.dataclass(frozen=True)
-class CellsReport:
-    """The notebook's cells as run by the worker, and the first characters they printed."""
-
-    cells: tuple[CellRecord, ...]
-    output: str = ""
-    output_dropped: int = 0
-
-    @classmethod
-    def from_plain(cls, raw: Any) -> CellsReport:
-        """Validate the report; keeps the first ``MAX_CELLS`` well-formed cell records."""
-        if not isinstance(raw, dict) or not isinstance(raw.get("cells"), list):
-            raise TransportError("malformed cells report")
-        cells = []
-        for entry in raw["cells"][:MAX_CELLS]:
-            try:
-                cells.append(CellRecord.from_plain(entry))
-            except TransportError:
-                continue
-        dropped = raw.get("output_dropped")
-        return cls(tuple(cells), str(raw.get("output", ""))[:MAX_OUTPUT],
-                   dropped if type(dropped) is int and dropped >= 0 else 0)
-
-    def to_plain(self) -> dict:
-        """Plain data."""
-        return {"cells": [c.to_plain() for c in self.cells], "output": self.output,
-                "output_dropped": self.output_dropped}
+        return cls(raw["cell"], raw["status"], None if raw.get("error") is None else ErrorRecord.from_plain(raw["error"]))
 
 
 @dataclasses.dataclass(frozen=True)
 class ExerciseReport:
-    """One exercise as run by the worker.
-
-    ``defined`` is false when the notebook has no such function; ``results`` holds one
-    :class:`CallResult` per case; ``seconds`` is the time spent in the calls; ``write_error`` says
-    why the results could not be written (they are then empty, and the grader calls them unusable).
+    """One exercise as run by the worker: ``defined`` is false when the notebook has no such
+    function; ``results`` holds one :class:`CallResult` per case; ``seconds`` is the time the calls took.
     """
 
     defined: bool
     results: tuple[CallResult, ...] = ()
     seconds: float = 0.0
-    write_error: ErrorRecord | None = None
 
     @classmethod
     def from_plain(cls, raw: Any, n_cases: int) -> ExerciseReport:
@@ -269,82 +190,61 @@ class ExerciseReport:
             raise TransportError(f"expected {n_cases} results, got {len(raw['results'])}")
         return cls(True, tuple(CallResult.from_plain(r) for r in raw["results"]), _seconds(raw.get("seconds")))
 
-    def to_plain(self) -> dict:
-        """Plain data."""
-        out = {"defined": self.defined, "results": [r.to_plain() for r in self.results], "seconds": self.seconds}
-        return out if self.write_error is None else {**out, "write_error": self.write_error.to_plain()}
-
 
 @dataclasses.dataclass(frozen=True)
 class DoneReport:
-    """The worker's last word: time spent in the student's cells and calls."""
+    """The worker's last word: the time spent in the student's cells and calls."""
 
     compute_seconds: float
 
-    @classmethod
-    def from_plain(cls, raw: Any) -> DoneReport:
-        """Validate the report (a bad duration reads as 0)."""
-        if not isinstance(raw, dict):
-            raise TransportError("malformed done report")
-        return cls(_seconds(raw.get("compute_seconds")))
 
-    def to_plain(self) -> dict:
-        """Plain data."""
-        return {"compute_seconds": self.compute_seconds}
-
-
-@dataclasses.dataclass(frozen=True)
 class JobDir:
     """The directory of one grading job (layout in the module docstring).
 
     Examples
     --------
-    >>> job = JobDir(Path("/tmp/job-x"))
+    >>> job = JobDir("/tmp/job-x")
     >>> job.work.name, job.exercise_file(2).name
     ('work', 'ex2')
     """
 
-    root: Path
+    def __init__(self, root: str | Path):
+        self.root = Path(root)
+        self.inbox, self.work, self.outbox = self.root / "in", self.root / "work", self.root / "out"
 
     @classmethod
     def create(cls, parent: str | Path | None = None) -> JobDir:
         """Make a fresh job directory (with ``in/``, ``work/`` and ``out/``) under ``parent``."""
-        job = cls(Path(tempfile.mkdtemp(prefix="job-", dir=parent)))
+        job = cls(tempfile.mkdtemp(prefix="job-", dir=parent))
         for sub in (job.inbox, job.work, job.outbox):
             sub.mkdir()
         return job
-
-    @property
-    def inbox(self) -> Path:
-        """``in/``: written by the grader, read-only to the worker."""
-        return self.root / "in"
-
-    @property
-    def work(self) -> Path:
-        """``work/``: the worker's current and home directory."""
-        return self.root / "work"
-
-    @property
-    def outbox(self) -> Path:
-        """``out/``: written by the worker, read by the grader."""
-        return self.root / "out"
 
     def exercise_file(self, k: int) -> Path:
         """Stem of the report of exercise ``k`` (``out/ex<k>``)."""
         return self.outbox / f"ex{k}"
 
-    # -- the grader's side ------------------------------------------------------------------------
+    # -- the grader's side: write the request, read (bounded, validated) what the worker wrote ----
 
     def write_spec(self, spec: JobSpec) -> None:
         """Write the request ``in/job``."""
-        write_plain(spec.to_plain(), self.inbox / "job")
+        write_plain(_plain(spec), self.inbox / "job")
 
-    def read_cells(self) -> CellsReport | None:
-        """The cells report, or ``None`` if it is missing or malformed."""
+    def read_cells(self) -> tuple[CellRecord, ...] | None:
+        """The first ``MAX_CELLS`` well-formed cell records; ``None`` if missing or malformed."""
         try:
-            return CellsReport.from_plain(read_plain(self.outbox / "cells"))
+            raw = read_plain(self.outbox / "cells")
         except TransportError:
             return None
+        if not isinstance(raw, list):
+            return None
+        cells = []
+        for entry in raw[:MAX_CELLS]:
+            try:
+                cells.append(CellRecord.from_plain(entry))
+            except TransportError:
+                continue
+        return tuple(cells)
 
     def read_exercise(self, k: int, n_cases: int) -> ExerciseReport | None:
         """The report of exercise ``k``; ``None`` if the worker never wrote it.
@@ -360,19 +260,18 @@ class JobDir:
         return ExerciseReport.from_plain(read_plain(stem), n_cases)
 
     def read_done(self) -> DoneReport | None:
-        """The final report; ``None`` if the worker did not get that far.
-
-        A malformed report still says that the worker finished; its duration then reads as 0.
-        """
+        """The final report; ``None`` if the worker did not get that far. A malformed report still
+        says that the worker finished; its duration then reads as 0."""
         if not (self.outbox / "done.json").exists():
             return None
         try:
-            return DoneReport.from_plain(read_plain(self.outbox / "done"))
+            raw = read_plain(self.outbox / "done")
         except TransportError:
-            return DoneReport(0.0)
+            raw = None
+        return DoneReport(_seconds(raw.get("compute_seconds") if isinstance(raw, dict) else None))
 
     def read_reference_calls(self) -> list[str]:
-        """Dotted names of the disabled references graded code called (first lines of the log only)."""
+        """Dotted names of the disabled references graded code called (the log's first lines)."""
         try:
             with open(self.outbox / "flags.log", "rb") as f:
                 text = f.read(MAX_FLAG_BYTES).decode(errors="replace")
@@ -391,18 +290,18 @@ class JobDir:
         """Open ``out/flags.log`` for appending; return the file descriptor."""
         return os.open(self.outbox / "flags.log", os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
 
-    def write_cells(self, report: CellsReport) -> None:
+    def write_cells(self, cells: tuple[CellRecord, ...]) -> None:
         """Write ``out/cells``."""
-        write_plain(report.to_plain(), self.outbox / "cells")
+        write_plain(_plain(cells), self.outbox / "cells")
 
     def write_exercise(self, k: int, report: ExerciseReport) -> None:
-        """Write ``out/ex<k>``; if the results cannot be written (e.g. too large), write the reason."""
+        """Write ``out/ex<k>``; results that cannot be written (e.g. too large) are left out, and
+        the grader then calls them unusable."""
         try:
-            write_plain(report.to_plain(), self.exercise_file(k))
-        except Exception as exc:
-            failed = ExerciseReport(report.defined, (), report.seconds, ErrorRecord.from_exception(exc))
-            write_plain(failed.to_plain(), self.exercise_file(k))
+            write_plain(_plain(report), self.exercise_file(k))
+        except Exception:
+            write_plain(_plain(dataclasses.replace(report, results=())), self.exercise_file(k))
 
     def write_done(self, report: DoneReport) -> None:
         """Write ``out/done``, the worker's last act."""
-        write_plain(report.to_plain(), self.outbox / "done")
+        write_plain(_plain(report), self.outbox / "done")

@@ -3,7 +3,7 @@
 Started by :mod:`robokit.grading.sandbox` as ``python -m robokit.grading.worker JOB_DIR``. It works
 in four phases, one function each:
 
-1. :func:`set_up`: capture the output, silence ``check()``, disable the reference functions, and
+1. :func:`set_up`: discard the output, silence ``check()``, disable the reference functions, and
    make ``os._exit`` end a cell rather than the grading;
 2. :func:`run_cells`: run the code cells in order in an IPython shell (magics work; a failing cell
    is recorded and the next one runs), each under a time limit;
@@ -26,9 +26,8 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-from ..exercises.spec import Case
-from .protocol import (MAX_OUTPUT, CallResult, CellRecord, CellsReport, DoneReport, ErrorRecord, ExerciseReport,
-                       JobDir, JobSpec, ReferenceSolutionDisabled, log_reference_call)
+from .protocol import (CallResult, CellRecord, DoneReport, ErrorRecord, ExerciseReport, JobDir, JobSpec,
+                       ReferenceSolutionDisabled, log_reference_call)
 
 __all__ = ["main", "set_up", "run_cells", "run_exercises", "finish", "GraderTimeout"]
 
@@ -40,27 +39,14 @@ class GraderTimeout(BaseException):
     """Raised inside the worker when a cell or a call runs past its time limit."""
 
 
-class CappedText(io.TextIOBase):
-    """A text stream that keeps the first ``cap`` characters written and counts the rest."""
-
-    def __init__(self, cap: int = MAX_OUTPUT):
-        self.cap, self.kept, self.dropped = cap, [], 0
-        self._size = 0
+class _Discard(io.TextIOBase):
+    """Where graded code's prints go: nowhere (the worker's own log must stay the grader's)."""
 
     def writable(self):
         return True
 
     def write(self, text):
-        text = str(text)
-        room = self.cap - self._size
-        if room > 0:
-            self.kept.append(text[:room])
-            self._size += min(room, len(text))
-        self.dropped += max(0, len(text) - max(room, 0))
         return len(text)
-
-    def flush(self):
-        pass
 
 
 def _alarm(seconds: float) -> None:
@@ -113,13 +99,14 @@ def install_traps(references: tuple[str, ...], flag_fd: int) -> None:
                 setattr(mod, attr, trap)
 
 
-def set_up(spec: JobSpec, job: JobDir) -> CappedText:
-    """Prepare the process for graded code; return the stream that now captures its output.
+def set_up(spec: JobSpec, job: JobDir) -> None:
+    """Prepare the process for graded code.
 
     In order: the time-limit signal; ``check()`` silenced (``robokit.grading.check`` and the
     module's own name); the reference functions trapped (:func:`install_traps`); ``os._exit``
     turned into ``SystemExit`` (a notebook calling it ends its cell, not the grading); and
-    ``sys.stdout``/``sys.stderr`` replaced by a :class:`CappedText`.
+    ``sys.stdout``/``sys.stderr`` discarded, so graded code cannot write into the worker's log,
+    whose tail the instructor's feedback shows when the worker ends early.
     """
     flag_fd = job.open_flags()
     signal.signal(signal.SIGALRM, _on_alarm)
@@ -132,9 +119,7 @@ def set_up(spec: JobSpec, job: JobDir) -> CappedText:
         raise SystemExit(code)
 
     os._exit = _no_exit
-    stream = CappedText()
-    sys.stdout = sys.stderr = stream
-    return stream
+    sys.stdout = sys.stderr = _Discard()
 
 
 # -- phase 2: the notebook's cells -----------------------------------------------------------------
@@ -156,8 +141,8 @@ def run_cell(shell, source: str, seconds: float) -> tuple[str, ErrorRecord | Non
         return "error", ErrorRecord.from_exception(exc)
 
 
-def run_cells(shell, spec: JobSpec, output: CappedText) -> tuple[CellsReport, float]:
-    """Run the code cells not marked skip, in order; return the report and the seconds they took."""
+def run_cells(shell, spec: JobSpec) -> tuple[tuple[CellRecord, ...], float]:
+    """Run the code cells not marked skip, in order; return their records and the seconds they took."""
     records, seconds = [], 0.0
     for index, (source, skip) in enumerate(zip(spec.cells, spec.skip)):
         if skip:
@@ -168,14 +153,14 @@ def run_cells(shell, spec: JobSpec, output: CappedText) -> tuple[CellsReport, fl
         _leave_if_forked()
         seconds += time.perf_counter() - start
         records.append(CellRecord(index, status, error))
-    return CellsReport(tuple(records), "".join(output.kept), output.dropped), seconds
+    return tuple(records), seconds
 
 
 # -- phase 3: the exercises ------------------------------------------------------------------------
 
-def call_case(fn: Callable[..., Any], case: Case, seconds: float) -> CallResult:
+def call_case(fn: Callable[..., Any], args: tuple, kwargs: dict, seconds: float) -> CallResult:
     """Call ``fn`` on copies of a case's inputs under a time limit; any exception is data."""
-    args, kwargs = copy.deepcopy(case.args), copy.deepcopy(case.kwargs)
+    args, kwargs = copy.deepcopy(args), copy.deepcopy(kwargs)
     try:
         _alarm(seconds)
         value = fn(*args, **kwargs)
@@ -192,15 +177,15 @@ def run_exercises(namespace: dict, spec: JobSpec, job: JobDir) -> float:
     Returns the seconds spent in the calls.
     """
     total = 0.0
-    for k, exercise in enumerate(spec.exercises):
-        fn = namespace.get(exercise.function)
+    for k, (function, inputs) in enumerate(spec.exercises):
+        fn = namespace.get(function)
         if not callable(fn):
             job.write_exercise(k, ExerciseReport(defined=False))
             continue
         results, seconds = [], 0.0
-        for case in exercise.cases:
+        for args, kwargs in inputs:
             start = time.perf_counter()
-            results.append(call_case(fn, case, spec.call_seconds))
+            results.append(call_case(fn, args, kwargs, spec.call_seconds))
             _leave_if_forked()
             seconds += time.perf_counter() - start
         total += seconds
@@ -227,9 +212,9 @@ def main(job_dir: str) -> None:
 
     job = JobDir(Path(job_dir))
     spec = job.read_spec()
-    output = set_up(spec, job)
+    set_up(spec, job)
     shell = InteractiveShell.instance(colors="NoColor")
-    cells, cell_seconds = run_cells(shell, spec, output)
+    cells, cell_seconds = run_cells(shell, spec)
     job.write_cells(cells)
     finish(job, cell_seconds + run_exercises(shell.user_ns, spec, job))
 
