@@ -47,7 +47,7 @@ def _cmd_course_check(args: argparse.Namespace) -> int:
 
 
 def _cmd_assign(args: argparse.Namespace) -> int:
-    from .exercises.catalog import assignments
+    from .exercises.discovery import assignments
     from .grading.assign import AssignmentError, write_assignment
 
     root = Path(args.root)
@@ -122,7 +122,7 @@ def _cmd_grade(args: argparse.Namespace) -> int:
 def _cmd_gradescope(args: argparse.Namespace) -> int:
     import os
 
-    from .exercises.catalog import UnknownAssignmentError
+    from .exercises.discovery import UnknownAssignmentError
     from .grading.gradescope import build_autograder
 
     seed = args.seed or os.environ.get("ROBOKIT_GRADING_SEED", "")

@@ -7,7 +7,7 @@ import pytest
 from robokit.cli import main
 from robokit.grading import Case, check, close, exact, unordered_rows
 from robokit.grading.assign import AssignmentError, make_assignment, write_assignment
-from robokit.exercises.catalog import UnknownExerciseError, assignments, get_exercise
+from robokit.exercises.discovery import UnknownExerciseError, assignments, get_exercise
 from robokit.exercises.plain import NotPlainData, to_plain
 from robokit.grading.transport import TransportError, read_plain, write_plain
 from tests.conftest import ROOT

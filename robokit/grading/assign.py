@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..course.hygiene import strip_notebook
-from ..exercises.catalog import get_assignment
+from ..exercises.discovery import get_assignment
 
 __all__ = ["make_assignment", "write_assignment", "AssignmentError"]
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
-from ..exercises.catalog import get_exercise
+from ..exercises.discovery import get_exercise
 from .judge import call_student, expected_output, judge
 
 __all__ = ["check", "PUBLIC_SEED"]

@@ -18,7 +18,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any, Sequence
 
-from ..exercises.catalog import UnknownAssignmentError, exercises_for
+from ..exercises.discovery import UnknownAssignmentError, exercises_for
 from ..exercises.spec import Case, Exercise
 from .judge import expected_output, judge
 from .protocol import CallResult, JobDir, JobSpec, ReferenceSolutionDisabled

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from ..exercises.plain import NotPlainData, to_plain
-from .transport import TransportError, read_plain, write_plain
+from .transport import TransportError, read_plain, was_written, write_plain
 
 __all__ = ["JobDir", "JobSpec", "CellRecord", "CallResult", "ErrorRecord", "ExerciseReport", "DoneReport",
            "ReferenceSolutionDisabled", "log_reference_call", "CELL_STATUSES"]
@@ -254,15 +254,14 @@ class JobDir:
         TransportError
             If it was written but is malformed, too large or unsafe.
         """
-        stem = self.exercise_file(k)
-        if not stem.with_suffix(".json").exists():
+        if not was_written(self.exercise_file(k)):
             return None
-        return ExerciseReport.from_plain(read_plain(stem), n_cases)
+        return ExerciseReport.from_plain(read_plain(self.exercise_file(k)), n_cases)
 
     def read_done(self) -> DoneReport | None:
         """The final report; ``None`` if the worker did not get that far. A malformed report still
         says that the worker finished; its duration then reads as 0."""
-        if not (self.outbox / "done.json").exists():
+        if not was_written(self.outbox / "done"):
             return None
         try:
             raw = read_plain(self.outbox / "done")

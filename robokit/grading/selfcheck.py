@@ -7,7 +7,7 @@ import csv
 import html
 from pathlib import Path
 
-from ..exercises.catalog import assignments
+from ..exercises.discovery import assignments
 from .grader import grade_batch
 from .sandbox import Limits
 
