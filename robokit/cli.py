@@ -47,8 +47,8 @@ def _cmd_course_check(args: argparse.Namespace) -> int:
 
 
 def _cmd_assign(args: argparse.Namespace) -> int:
+    from .exercises.discovery import assignments
     from .grading.assign import AssignmentError, write_assignment
-    from .grading.registry import assignments
 
     root = Path(args.root)
     slugs = args.slugs or sorted(p.stem for p in (root / "solutions").glob("*.ipynb"))
@@ -122,8 +122,8 @@ def _cmd_grade(args: argparse.Namespace) -> int:
 def _cmd_gradescope(args: argparse.Namespace) -> int:
     import os
 
+    from .exercises.discovery import UnknownAssignmentError
     from .grading.gradescope import build_autograder
-    from .grading.registry import UnknownAssignmentError
 
     seed = args.seed or os.environ.get("ROBOKIT_GRADING_SEED", "")
     try:

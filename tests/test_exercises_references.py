@@ -6,7 +6,7 @@ covered without copying this test.
 import pytest
 
 from robokit.grading import assignments
-from robokit.grading.exercise import call_student, expected_output, judge
+from robokit.grading.judge import call_student, expected_output, judge
 
 ALL = [ex for exercises in assignments().values() for ex in exercises]
 

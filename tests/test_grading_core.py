@@ -1,4 +1,4 @@
-"""check(), plain-data conversion, comparisons, the exercise registry and assignment generation."""
+"""check(), plain-data conversion, comparisons, the exercise catalog and assignment generation."""
 import json
 
 import numpy as np
@@ -7,8 +7,8 @@ import pytest
 from robokit.cli import main
 from robokit.grading import Case, check, close, exact, unordered_rows
 from robokit.grading.assign import AssignmentError, make_assignment, write_assignment
-from robokit.grading.plain import NotPlainData, to_plain
-from robokit.grading.registry import UnknownExerciseError, assignments, get_exercise
+from robokit.exercises.discovery import UnknownExerciseError, assignments, get_exercise
+from robokit.exercises.plain import NotPlainData, to_plain
 from robokit.grading.transport import TransportError, read_plain, write_plain
 from tests.conftest import ROOT
 
@@ -85,7 +85,7 @@ def test_case_inputs_are_plain():
 
 @pytest.mark.parametrize("slug", list(assignments()))
 def test_reference_passes_its_own_cases(slug):
-    from robokit.grading.exercise import call_student, expected_output, judge
+    from robokit.grading.judge import call_student, expected_output, judge
 
     for ex in assignments()[slug]:
         for seed in ("public", 12345):
@@ -135,7 +135,7 @@ def test_assign_rejects_broken_markers():
         make_assignment(nb, "00_getting_started")
 
 
-def test_registry_lookup():
+def test_catalog_lookup():
     assert get_exercise("00.se2_compose").points == 2
     with pytest.raises(UnknownExerciseError):
         get_exercise("00.nope")

@@ -140,6 +140,8 @@ def graded(tmp_path_factory):
                                     {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, None)
     cases["reads_solution"] = (_read_solution_attack(), {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, None)
     cases["honest"] = (_cells(), FULL, None)
+    cases["check_from_its_module"] = (_with(extra_at_end="from robokit.grading.check import check\n"
+                                                         "check('00.wrap_angle', lambda angle: angle)\n"), FULL, None)
     import socket
 
     server = socket.socket()
@@ -160,7 +162,7 @@ def graded(tmp_path_factory):
 
 
 @pytest.mark.parametrize("name", list(HOSTILE) + ["writes_output_paths", "reads_solution", "honest",
-                                                  "reaches_network"])
+                                                  "reaches_network", "check_from_its_module"])
 def test_hostile_submission_scores_only_what_it_earned(graded, name):
     results, cases, _, _, _ = graded
     if name in ("reads_solution", "reaches_network") and not is_root():
@@ -175,6 +177,13 @@ def test_hostile_submission_scores_only_what_it_earned(graded, name):
         assert "sandbox=limited" not in result.flags
     if name == "honest":
         assert result.flags == [] and result.worker_log == ""
+
+
+def test_check_is_silenced_however_it_is_imported(graded):
+    # check() on public cases would fail this lambda and raise in the cell; under grading it only
+    # prints that it is skipped, whether imported from robokit.grading or robokit.grading.check
+    results, _, _, _, _ = graded
+    assert results["check_from_its_module"].cell_errors == []
 
 
 def test_batch_time_is_bounded(graded):

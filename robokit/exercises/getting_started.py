@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import se2_compose, wrap_angle
-from ..grading.compare import close
-from ..grading.exercise import Case, Exercise
+from .compare import close
+from .spec import Case, Exercise
 
 ASSIGNMENT = "00_getting_started"
 #: Written (manually graded) questions: id -> points.

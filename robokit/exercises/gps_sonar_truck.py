@@ -5,8 +5,8 @@ import datetime as dt
 
 import numpy as np
 
-from ..grading.compare import close, exact
-from ..grading.exercise import Case, Exercise
+from .compare import close, exact
+from .spec import Case, Exercise
 from ..outdoor.controller import design_heading_gains
 from ..outdoor.geodesy import haversine_distance_bearing
 from ..outdoor.navigator import avoidance_decision

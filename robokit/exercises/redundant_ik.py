@@ -9,8 +9,8 @@ import numpy as np
 
 from ..arm import (dh_fk, dh_jacobian, dh_transform, elbow_angle, geometric_jacobian, iiwa14,
                    limit_distance_gradient, null_space_step, panda, shoulder_angles, wrist_centre)
-from ..grading.compare import close
-from ..grading.exercise import Case, Exercise
+from .compare import close
+from .spec import Case, Exercise
 
 ASSIGNMENT = "06_redundant_ik"
 #: Written (manually graded) questions: id -> points.

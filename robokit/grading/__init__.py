@@ -1,8 +1,10 @@
-"""Grading: exercises, in-notebook ``check()``, assignment generation and the sandboxed grader."""
+"""Grading: in-notebook ``check()``, assignment generation and the sandboxed grader.
+
+The exercise vocabulary and the assignments live one layer down, in :mod:`robokit.exercises`;
+they are re-exported here because notebooks and instructors know them as ``robokit.grading``.
+"""
+from ..exercises import Case, Exercise, assignments, close, exact, exercises_for, get_exercise, unordered_rows
 from .check import PUBLIC_SEED, check
-from .compare import close, exact, unordered_rows
-from .exercise import Case, Exercise
-from .registry import assignments, exercises_for, get_exercise
 
 __all__ = ["check", "PUBLIC_SEED", "Case", "Exercise", "close", "exact", "unordered_rows",
            "assignments", "exercises_for", "get_exercise"]

@@ -18,16 +18,15 @@ The output is deterministic (same input, same bytes) and carries nbgrader metada
 from __future__ import annotations
 
 import copy
-import importlib
 import json
 import re
 from pathlib import Path
 from typing import Any
 
 from ..course.hygiene import strip_notebook
-from .registry import assignments, exercises_for
+from ..exercises.discovery import get_assignment
 
-__all__ = ["make_assignment", "write_assignment", "written_points", "AssignmentError"]
+__all__ = ["make_assignment", "write_assignment", "AssignmentError"]
 
 _BEGIN = re.compile(r"^(\s*)#+\s*BEGIN SOLUTION\s*$")
 _END = re.compile(r"^\s*#+\s*END SOLUTION\s*$")
@@ -39,24 +38,6 @@ _DEF = re.compile(r"^def\s+([A-Za-z_]\w*)\s*\(", re.M)
 
 class AssignmentError(ValueError):
     """The solution notebook breaks the conventions (unbalanced markers, unknown exercise, ...)."""
-
-
-def written_points(slug: str) -> dict[str, float]:
-    """Return ``{"NN.name": points}`` for the written questions of an assignment."""
-    exercises_for(slug)  # raises UnknownAssignmentError with the known list
-    for info_module in _exercise_modules():
-        if getattr(info_module, "ASSIGNMENT", None) == slug:
-            return dict(getattr(info_module, "WRITTEN", {}))
-    return {}
-
-
-def _exercise_modules():
-    import pkgutil
-
-    import robokit.exercises as pkg
-
-    for info in pkgutil.iter_modules(pkg.__path__):
-        yield importlib.import_module(f"{pkg.__name__}.{info.name}")
 
 
 def _source(cell: dict) -> str:
@@ -102,9 +83,10 @@ def make_assignment(solution: dict[str, Any], slug: str) -> dict[str, Any]:
         If markers are unbalanced, a check cell names an unknown exercise, or an exercise of the
         assignment has no solution or no check cell.
     """
-    exercises = {ex.id: ex for ex in exercises_for(slug)}
+    assignment = get_assignment(slug)
+    exercises = {ex.id: ex for ex in assignment.exercises}
     by_function = {ex.function: ex for ex in exercises.values()}
-    written = written_points(slug)
+    written = assignment.written
     nb = strip_notebook(copy.deepcopy(solution))
     seen_checks, seen_solutions, seen_written = set(), set(), set()
     for i, cell in enumerate(nb.get("cells", [])):
@@ -169,9 +151,3 @@ def write_assignment(root: str | Path, slug: str, *, check_only: bool = False) -
         dst.parent.mkdir(exist_ok=True)
         dst.write_text(text, encoding="utf-8")
     return old != text
-
-
-def known_slugs(root: str | Path) -> list[str]:
-    """Slugs that have both a solution notebook and an exercise module."""
-    have = {p.stem for p in (Path(root) / "solutions").glob("*.ipynb")}
-    return [s for s in assignments() if s in have]

@@ -1,10 +1,14 @@
-"""``check(exercise_id, fn)``: immediate feedback on public cases inside the student's notebook."""
+"""``check(exercise_id, fn)``: immediate feedback on public cases inside the student's notebook.
+
+The official grade comes from :mod:`robokit.grading.grader` on hidden cases; while it grades, the
+worker replaces ``check`` by a function that only prints that it is skipped.
+"""
 from __future__ import annotations
 
 from typing import Any, Callable
 
-from .exercise import call_student, expected_output, judge
-from .registry import get_exercise
+from ..exercises.discovery import get_exercise
+from .judge import call_student, expected_output, judge
 
 __all__ = ["check", "PUBLIC_SEED"]
 
@@ -42,10 +46,32 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
         If any case fails, so the cell shows red.
     TypeError
         If ``fn`` is not callable.
+    robokit.exercises.UnknownExerciseError
+        If no assignment declares ``exercise_id``.
 
     Notes
     -----
     Grading design (DESIGN.md, "Grading"); not from a paper.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> def wrap_angle(angle):
+    ...     a = np.asarray(angle, dtype=float)
+    ...     if np.isnan(a).any():
+    ...         raise ValueError("angle: expected finite angles, got NaN")
+    ...     wrapped = np.mod(a + np.pi, 2 * np.pi) - np.pi
+    ...     return float(wrapped) if wrapped.ndim == 0 else wrapped
+    >>> check("00.wrap_angle", wrap_angle, verbose=False)
+    check 00.wrap_angle: 6/6 public cases passed (feedback only; your grade comes from hidden cases)
+    6
+
+    A wrong answer fails the cell, and the report says which cases and why:
+
+    >>> check("00.wrap_angle", lambda angle: angle, verbose=False)
+    Traceback (most recent call last):
+    ...
+    AssertionError: 00.wrap_angle: 4 of 6 public cases failed (see above)
     """
     exercise = get_exercise(exercise_id)
     if not callable(fn):
@@ -54,13 +80,13 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
     lines, failed = [], 0
     for i, case in enumerate(cases, 1):
         result = call_student(fn, case)
-        if result.get("error", {}).get("type") == "NotImplementedError":
+        if result.error is not None and result.error.type == "NotImplementedError":
             print(f"{exercise.id}: not implemented yet — replace `raise NotImplementedError` in "
                   f"{exercise.function} with your code, then run this cell again.")
             raise NotImplementedError(f"{exercise.id} is not implemented yet")
         outcome = judge(exercise, case, expected_output(exercise, case), result)
         mark = "pass" if outcome.passed else "FAIL"
-        where = f" [{result['error'].get('line')}]" if not outcome.passed and result.get("error", {}).get("line") else ""
+        where = f" [{result.error.line}]" if not outcome.passed and result.error and result.error.line else ""
         text = f"  {mark}  case {i}" + (f" ({case.label})" if case.label else "")
         if not outcome.passed:
             failed += 1
@@ -69,7 +95,8 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
             lines.append(text)
     print(f"check {exercise.id}: {len(cases) - failed}/{len(cases)} public cases passed "
           "(feedback only; your grade comes from hidden cases)")
-    print("\n".join(lines))
+    if lines:
+        print("\n".join(lines))
     if failed:
         raise AssertionError(f"{exercise.id}: {failed} of {len(cases)} public cases failed (see above)")
     return len(cases)

@@ -1,15 +1,15 @@
 """``robokit grade``: grade a folder of notebooks safely.
 
-The trusted parent (this module) reads each submission, generates the input cases from the
-instructor's secret seed, computes the reference answers, and starts one sandboxed worker per
-submission (:mod:`robokit.grading.sandbox`, :mod:`robokit.grading.worker`) that receives only the
-code cells and the inputs. The worker's replies are plain data (JSON + ``.npz`` without pickle)
-that the parent validates before judging; student objects never reach the parent.
+The trusted parent (this module) reads each submission (:mod:`~robokit.grading.submission`),
+generates the input cases from the instructor's secret seed, computes the reference answers, and
+starts one sandboxed worker per submission (:mod:`~robokit.grading.sandbox`,
+:mod:`~robokit.grading.worker`) that receives only the code cells and the inputs. The worker's
+replies are plain data that :mod:`~robokit.grading.protocol` bounds and validates before anything
+here judges them; student objects never reach the parent.
 """
 from __future__ import annotations
 
 import dataclasses
-import json
 import queue
 import shutil
 import tempfile
@@ -18,17 +18,16 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any, Sequence
 
-from .exercise import Case, Exercise, expected_output, judge
-from .registry import exercises_for
-from .sandbox import Limits, is_root, run_sandboxed
-from .transport import TransportError, read_plain, write_plain
+from ..exercises.discovery import UnknownAssignmentError, exercises_for
+from ..exercises.spec import Case, Exercise
+from .judge import expected_output, judge
+from .protocol import CallResult, JobDir, JobSpec, ReferenceSolutionDisabled
+from .sandbox import Limits, WorkerExit, is_root, run_sandboxed
+from .submission import Submission, SubmissionRejected, read_submission, student_name
+from .transport import TransportError
 
-__all__ = ["SubmissionResult", "ExerciseScore", "prepare_cases", "grade_submission", "grade_batch",
-           "GradingError", "SKIP_TAGS", "MAX_NOTEBOOK_BYTES"]
-
-#: Cells with one of these tags are not run by the grader (plots, 3D scenes, slow demos).
-SKIP_TAGS = {"demo", "visualisation", "visualization", "skip-grading"}
-MAX_NOTEBOOK_BYTES = 20_000_000
+__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "job_spec", "grade_submission",
+           "grade_batch", "GradingError", "isolation_note"]
 
 
 class GradingError(ValueError):
@@ -45,6 +44,11 @@ class ExerciseScore:
     passed: int
     total: int
     messages: list[str]
+
+    @classmethod
+    def zero(cls, ex: Exercise, n_cases: int, message: str) -> ExerciseScore:
+        """No points for ``ex``, for the reason ``message``."""
+        return cls(ex.id, 0.0, float(ex.points), 0, n_cases, [message])
 
 
 @dataclasses.dataclass
@@ -91,71 +95,27 @@ def prepare_cases(assignment: str, seed: str) -> PreparedCases:
     return PreparedCases(exercises, cases, expected)
 
 
-def student_name(path: Path, assignment: str) -> str:
-    """``alice.ipynb`` -> ``alice``; ``alice/01_visual_slam.ipynb`` -> ``alice``."""
-    return path.parent.name if path.stem == assignment else path.stem
-
-
-def _read_submission(path: Path, assignment: str) -> tuple[list[str], list[bool]] | str:
-    """Return (cell sources, skip flags) or a reason string for a zero."""
-    try:
-        size = path.stat().st_size
-        if size > MAX_NOTEBOOK_BYTES:
-            return f"the file is larger than {MAX_NOTEBOOK_BYTES // 1_000_000} MB"
-        if size == 0:
-            return "the file is empty"
-        nb = json.loads(path.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError):
-        return "the file is not a Jupyter notebook (it is not valid JSON)"
-    if not isinstance(nb, dict) or not isinstance(nb.get("cells"), list):
-        return "the file is not a Jupyter notebook (no list of cells)"
-    meta = nb.get("metadata") if isinstance(nb.get("metadata"), dict) else {}
-    declared = (meta.get("robokit") or {}).get("assignment") if isinstance(meta.get("robokit"), dict) else None
-    if declared and declared != assignment:
-        return f"this notebook is assignment {declared!r}, not {assignment!r}"
-    sources, skips = [], []
-    for cell in nb["cells"]:
-        if not isinstance(cell, dict) or cell.get("cell_type") != "code":
-            continue
-        src = cell.get("source", "")
-        src = "".join(src) if isinstance(src, list) else src
-        if not isinstance(src, str):
-            continue
-        tags = (cell.get("metadata") or {}).get("tags") or []
-        sources.append(src)
-        skips.append(bool(isinstance(tags, list) and SKIP_TAGS.intersection(map(str, tags))))
-    return sources, skips
-
-
 def _zero(prepared: PreparedCases, message: str) -> list[ExerciseScore]:
-    return [ExerciseScore(ex.id, 0.0, float(ex.points), 0, len(cs), [message])
-            for ex, cs in zip(prepared.exercises, prepared.cases)]
+    """Every exercise at zero, with one message."""
+    return [ExerciseScore.zero(ex, len(cs), message) for ex, cs in zip(prepared.exercises, prepared.cases)]
 
 
-def _validate_results(raw: Any, n_cases: int) -> list[dict]:
-    if not isinstance(raw, dict) or not isinstance(raw.get("results"), list):
-        raise TransportError("malformed results")
-    results = raw["results"]
-    if len(results) != n_cases:
-        raise TransportError(f"expected {n_cases} results, got {len(results)}")
-    clean = []
-    for r in results:
-        if isinstance(r, dict) and set(r) == {"value"}:
-            clean.append({"value": r["value"]})
-        elif isinstance(r, dict) and set(r) == {"error"} and isinstance(r["error"], dict):
-            e = r["error"]
-            mro = e.get("mro") if isinstance(e.get("mro"), list) else []
-            clean.append({"error": {"type": str(e.get("type"))[:100], "mro": [str(m)[:100] for m in mro[:12]],
-                                    "message": str(e.get("message"))[:500]}})
-        else:
-            raise TransportError("malformed result entry")
-    return clean
+def job_spec(submission: Submission, prepared: PreparedCases, limits: Limits) -> JobSpec:
+    """The worker's request: cells, references to disable, limits, and the case inputs only (never
+    the seed, the expected answers, what a case expects or its label)."""
+    return JobSpec(submission.sources, submission.skip,
+                   tuple(sorted({r for ex in prepared.exercises for r in ex.references})),
+                   limits.cell_seconds, limits.call_seconds,
+                   tuple((ex.function, tuple((c.args, c.kwargs) for c in cs))
+                         for ex, cs in zip(prepared.exercises, prepared.cases)))
 
 
 def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases, *,
                      limits: Limits = Limits(), slot: int = 0, hide: Sequence[Path] = (),
                      work_root: Path | None = None) -> SubmissionResult:
     """Grade one notebook in a sandboxed worker; never raises for a bad submission.
+
+    A file that cannot be graded scores zero with the rejection's flag and reason.
 
     Notes
     -----
@@ -165,88 +125,70 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
     student = student_name(path, assignment)
     start = time.perf_counter()
     try:
-        read = _read_submission(path, assignment)
-    except OSError as exc:
-        reason = f"the file could not be read ({exc.strerror or exc})"
-        return SubmissionResult(student, path, _zero(prepared, reason), ["unreadable"], reason, read_error=True)
-    if isinstance(read, str):
-        flag = "wrong-assignment" if "not '" in read else "not-a-notebook"
-        return SubmissionResult(student, path, _zero(prepared, read), [flag], read,
-                                read_error=flag == "wrong-assignment")
-    sources, skips = read
-    job = Path(tempfile.mkdtemp(prefix="job-", dir=work_root))
+        submission = read_submission(path, assignment)
+    except SubmissionRejected as exc:
+        return SubmissionResult(student, path, _zero(prepared, str(exc)), [exc.flag], str(exc),
+                                read_error=exc.read_error)
+    job = JobDir.create(work_root)
     try:
-        for sub in ("in", "work", "out"):
-            (job / sub).mkdir()
-        references = sorted({r for ex in prepared.exercises for r in ex.references})
-        write_plain({
-            "cells": sources, "skip": skips, "references": references,
-            "cell_seconds": limits.cell_seconds, "call_seconds": limits.call_seconds,
-            "exercises": [{"id": ex.id, "function": ex.function,
-                           "cases": [{"args": list(c.args), "kwargs": c.kwargs} for c in cs]}
-                          for ex, cs in zip(prepared.exercises, prepared.cases)],
-        }, job / "in" / "job")
-        exit_ = run_sandboxed(["-m", "robokit.grading.worker", str(job)], job, limits, slot=slot,
+        job.write_spec(job_spec(submission, prepared, limits))
+        exit_ = run_sandboxed(["-m", "robokit.grading.worker", str(job.root)], job.root, limits, slot=slot,
                               hide=[*hide, path.resolve().parent])
         return _score(job, student, path, prepared, exit_, start)
     finally:
-        shutil.rmtree(job, ignore_errors=True)
+        shutil.rmtree(job.root, ignore_errors=True)
 
 
-def _score(job: Path, student: str, path: Path, prepared: PreparedCases, exit_, start: float) -> SubmissionResult:
-    out = job / "out"
-    flags: list[str] = []
-    if not exit_.isolated:
-        flags.append("sandbox=limited")
-    try:
-        flag_lines = (out / "flags.log").read_text(errors="replace").splitlines()[:100]
-    except OSError:
-        flag_lines = []
-    cell_errors: list[str] = []
-    try:
-        cells = read_plain(out / "cells")
-        for c in cells.get("cells", [])[:500]:
-            if isinstance(c, dict) and c.get("status") in ("error", "timeout") and isinstance(c.get("error"), dict):
-                cell_errors.append(f"code cell {c.get('cell')}: {c['status']}: "
-                                   f"{str(c['error'].get('type'))[:80]}: {str(c['error'].get('message'))[:200]}")
-    except (TransportError, AttributeError):
-        cells = None
+def _score_exercise(ex: Exercise, cases: list[Case], expected: list[Any],
+                    results: Sequence[CallResult]) -> tuple[ExerciseScore, bool]:
+    """Judge one exercise's results; return its score and whether it called a disabled reference."""
+    passed, messages, cheated = 0, [], False
+    for i, (case, exp, res) in enumerate(zip(cases, expected, results), 1):
+        cheated |= res.error is not None and res.error.type == ReferenceSolutionDisabled.__name__
+        outcome = judge(ex, case, exp, res)
+        passed += outcome.passed
+        if not outcome.passed and len(messages) < 5:
+            messages.append(f"case {i}" + (f" ({case.label})" if case.label else "") + f": {outcome.message}")
+    if cheated:
+        passed = 0
+        messages.insert(0, "you called the course's reference implementation, which is not allowed")
+    points = round(float(ex.points) * passed / len(cases), 4)
+    return ExerciseScore(ex.id, points, float(ex.points), passed, len(cases), messages), cheated
+
+
+def _score(job: JobDir, student: str, path: Path, prepared: PreparedCases, exit_: WorkerExit,
+           start: float) -> SubmissionResult:
+    """Read what the worker wrote (through the protocol's validating readers) and score it."""
+    flags = [] if exit_.isolated else ["sandbox=limited"]
+    cell_errors = [f"code cell {c.cell}: {c.status}: {c.error.type[:80]}: {c.error.message[:200]}"
+                   for c in job.read_cells() or () if c.status in ("error", "timeout") and c.error]
     ended = "the grader stopped your notebook at its time limit" if exit_.timed_out else \
         "your notebook ended the grading process early"
     scores, compute, called_reference = [], 0.0, False
     for k, (ex, cases, expected) in enumerate(zip(prepared.exercises, prepared.cases, prepared.expected)):
         try:
-            raw = read_plain(out / f"ex{k}")
-            if isinstance(raw, dict) and raw.get("defined") is False:
-                scores.append(ExerciseScore(ex.id, 0.0, float(ex.points), 0, len(cases),
-                                            [f"function not defined: no function named {ex.function!r} in the notebook"]))
-                continue
-            results = _validate_results(raw, len(cases))
-            if isinstance(raw.get("seconds"), (int, float)):
-                compute += float(raw["seconds"])
+            report = job.read_exercise(k, len(cases))
         except TransportError as exc:
-            why = ended if not (out / f"ex{k}.json").exists() else f"its results were unusable ({exc})"
-            scores.append(ExerciseScore(ex.id, 0.0, float(ex.points), 0, len(cases), [f"not graded: {why}"]))
-            continue
-        passed, messages, ex_cheated = 0, [], False
-        for i, (case, exp, res) in enumerate(zip(cases, expected, results), 1):
-            if res.get("error", {}).get("type") == "ReferenceSolutionDisabled":
-                ex_cheated = called_reference = True
-            outcome = judge(ex, case, exp, res)
-            passed += outcome.passed
-            if not outcome.passed and len(messages) < 5:
-                messages.append(f"case {i}" + (f" ({case.label})" if case.label else "") + f": {outcome.message}")
-        if ex_cheated:
-            passed = 0
-            messages.insert(0, "you called the course's reference implementation, which is not allowed")
-        points = round(float(ex.points) * passed / len(cases), 4)
-        scores.append(ExerciseScore(ex.id, points, float(ex.points), passed, len(cases), messages))
-    if called_reference or any(l.startswith("reference:") for l in flag_lines):
+            report, why = None, f"its results were unusable ({exc})"
+        else:
+            why = ended
+        if report is None:
+            scores.append(ExerciseScore.zero(ex, len(cases), f"not graded: {why}"))
+        elif not report.defined:
+            scores.append(ExerciseScore.zero(ex, len(cases), f"function not defined: no function named "
+                                                             f"{ex.function!r} in the notebook"))
+        else:
+            compute += report.seconds
+            score, cheated = _score_exercise(ex, cases, expected, report.results)
+            scores.append(score)
+            called_reference |= cheated
+    if called_reference or job.read_reference_calls():
         flags.append("called-reference")
+    done = job.read_done()
     log = ""
     if exit_.timed_out:
         flags.append("timeout")
-    elif not (out / "done.json").exists():
+    elif done is None:
         flags.append("worker-ended-early")
         # the last lines the worker process wrote outside Python's captured output (a crash, an
         # import error) say why; shown to the instructor in the feedback
@@ -254,7 +196,8 @@ def _score(job: Path, student: str, path: Path, prepared: PreparedCases, exit_, 
         if exit_.returncode is not None and exit_.returncode < 0:
             log = f"(worker killed by signal {-exit_.returncode})\n" + log
     return SubmissionResult(student, path, scores, flags, seconds=time.perf_counter() - start,
-                            compute_seconds=compute, cell_errors=cell_errors, worker_log=log)
+                            compute_seconds=done.compute_seconds if done else compute,
+                            cell_errors=cell_errors, worker_log=log)
 
 
 def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs: int = 1,
@@ -266,8 +209,6 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
     GradingError
         Only for problems with the request (unknown assignment, missing seed, no submissions).
     """
-    from .registry import UnknownAssignmentError
-
     try:
         prepared = prepare_cases(assignment, seed)
     except UnknownAssignmentError as exc:

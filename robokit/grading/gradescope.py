@@ -16,7 +16,7 @@ import tempfile
 import zipfile
 from pathlib import Path
 
-from .registry import exercises_for
+from ..exercises.discovery import exercises_for
 
 __all__ = ["build_autograder"]
 

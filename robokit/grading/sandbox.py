@@ -28,6 +28,8 @@ import time
 from pathlib import Path
 from typing import Sequence
 
+from .protocol import JobDir
+
 __all__ = ["Limits", "WorkerExit", "run_sandboxed", "is_root", "JOB_UID_BASE"]
 
 #: Jobs run as uid/gid JOB_UID_BASE + slot (no passwd entry is needed).
@@ -196,7 +198,7 @@ def _launch(config_path: str) -> None:
         os.setgroups([])
         os.setgid(uid)
         os.setuid(uid)
-    os.chdir(job_dir / "work")
+    os.chdir(JobDir(job_dir).work)
     _limits(limits, uid)
     os.execve(sys.executable, [sys.executable, *cfg["args"]], cfg["env"])
 
@@ -223,35 +225,36 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, slot: i
                   hide: Sequence[Path] = (), env_extra: dict[str, str] | None = None) -> WorkerExit:
     """Run ``python args...`` in ``job_dir/work`` under the limits; see the module docstring.
 
-    ``job_dir`` must contain ``work/`` (the worker's cwd and HOME) and ``out/`` (where it writes);
-    both are handed to the job uid when running as root.
+    ``job_dir`` is a :class:`~robokit.grading.protocol.JobDir` root: the job uid (when running as
+    root) gets ``work/`` (its cwd and HOME) and ``out/`` (where it writes), and may only read ``in/``.
     """
     root = is_root()
     uid = JOB_UID_BASE + slot if root else None
+    job = JobDir(job_dir)
     if uid is not None:
-        for sub in ("work", "out"):
-            os.chown(job_dir / sub, uid, uid)
-            os.chmod(job_dir / sub, 0o700)  # concurrent jobs (other uids) cannot look in
+        for sub in (job.work, job.outbox):
+            os.chown(sub, uid, uid)
+            os.chmod(sub, 0o700)  # concurrent jobs (other uids) cannot look in
         os.chmod(job_dir, 0o711)
-        os.chmod(job_dir / "in", 0o755)
-        for f in (job_dir / "in").iterdir():
+        os.chmod(job.inbox, 0o755)
+        for f in job.inbox.iterdir():
             os.chmod(f, 0o644)
     expose = sorted({Path(sys.base_prefix).resolve(), Path(sys.prefix).resolve(),
                      Path(sys.executable).resolve().parent, Path(__file__).resolve().parents[2]})
     env = {
         "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin",
-        "HOME": str(job_dir / "work"),
-        "TMPDIR": str(job_dir / "work"),
+        "HOME": str(job.work),
+        "TMPDIR": str(job.work),
         "LANG": "C.UTF-8",
         "PYTHONHASHSEED": "0",
         "PYTHONDONTWRITEBYTECODE": "1",
         "MPLBACKEND": "Agg",
-        "MPLCONFIGDIR": str(job_dir / "work"),
+        "MPLCONFIGDIR": str(job.work),
         "OPENBLAS_NUM_THREADS": "1",
         "OMP_NUM_THREADS": "1",
         "MKL_NUM_THREADS": "1",
         "ROBOKIT_FAST": "1",
-        "ROBOKIT_CACHE": str(job_dir / "work" / ".cache"),
+        "ROBOKIT_CACHE": str(job.work / ".cache"),
     }
     env.update(env_extra or {})
     import json

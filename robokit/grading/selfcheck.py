@@ -7,8 +7,8 @@ import csv
 import html
 from pathlib import Path
 
+from ..exercises.discovery import assignments
 from .grader import grade_batch
-from .registry import assignments
 from .sandbox import Limits
 
 __all__ = ["grade_course", "course_grading_step"]

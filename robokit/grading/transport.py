@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from .plain import NotPlainData, to_plain
+from ..exercises.plain import NotPlainData, to_plain
 
-__all__ = ["write_plain", "read_plain", "TransportError"]
+__all__ = ["write_plain", "read_plain", "was_written", "TransportError"]
 
 MAX_JSON_BYTES = 20_000_000
 MAX_NPZ_BYTES = 200_000_000
@@ -50,6 +50,11 @@ def write_plain(value: Any, stem: str | Path) -> None:
     if arrays:
         np.savez(stem.with_suffix(".npz"), **arrays)
     stem.with_suffix(".json").write_text(json.dumps(doc, allow_nan=False))
+
+
+def was_written(stem: str | Path) -> bool:
+    """Whether :func:`write_plain` wrote ``stem`` (its JSON, which it writes last, exists)."""
+    return Path(stem).with_suffix(".json").exists()
 
 
 def _decode(value: Any, arrays: Any, depth: int = 0) -> Any:

@@ -1,11 +1,18 @@
 """The grading worker: runs a submission's cells, then its exercise functions, inside the sandbox.
 
-Started by :mod:`robokit.grading.sandbox` as ``python -m robokit.grading.worker JOB_DIR``. It
-reads ``JOB_DIR/in/job`` (cells and input cases — never the seed or the expected answers), runs the
-code cells in order in an IPython shell (magics work; a failing cell is recorded and the next one
-runs), then calls each exercise function on each case and writes ``JOB_DIR/out/ex<k>`` right after
-each exercise, so a submission that kills its process loses only what had not run yet. Everything
-it writes is untrusted data to the grader, which validates it and does all the judging.
+Started by :mod:`robokit.grading.sandbox` as ``python -m robokit.grading.worker JOB_DIR``. It works
+in four phases, one function each:
+
+1. :func:`set_up`: discard the output, silence ``check()``, disable the reference functions, and
+   make ``os._exit`` end a cell rather than the grading;
+2. :func:`run_cells`: run the code cells in order in an IPython shell (magics work; a failing cell
+   is recorded and the next one runs), each under a time limit;
+3. :func:`run_exercises`: call each exercise function on each case, writing each exercise's report
+   as soon as it is done, so a submission that kills its process loses only what had not run yet;
+4. :func:`finish`: write the final report and exit.
+
+The files it reads and writes are described in :mod:`robokit.grading.protocol`. Everything it
+writes is untrusted data to the grader, which validates it and does all the judging.
 """
 from __future__ import annotations
 
@@ -17,41 +24,29 @@ import signal
 import sys
 import time
 from pathlib import Path
+from typing import Any, Callable
+
+from .protocol import (CallResult, CellRecord, DoneReport, ErrorRecord, ExerciseReport, JobDir, JobSpec,
+                       ReferenceSolutionDisabled, log_reference_call)
+
+__all__ = ["main", "set_up", "run_cells", "run_exercises", "finish", "GraderTimeout"]
 
 _real_exit = os._exit
 _MAIN_PID = os.getpid()
-_OUTPUT_CAP = 20_000
 
 
 class GraderTimeout(BaseException):
     """Raised inside the worker when a cell or a call runs past its time limit."""
 
 
-class ReferenceSolutionDisabled(Exception):
-    """Raised when graded code calls a robokit reference implementation directly."""
-
-
-class _CappedText(io.TextIOBase):
-    """A text stream that keeps the first characters written and counts the rest."""
-
-    def __init__(self, cap: int = _OUTPUT_CAP):
-        self.cap, self.kept, self.dropped = cap, [], 0
-        self._size = 0
+class _Discard(io.TextIOBase):
+    """Where graded code's prints go: nowhere (the worker's own log must stay the grader's)."""
 
     def writable(self):
         return True
 
     def write(self, text):
-        text = str(text)
-        room = self.cap - self._size
-        if room > 0:
-            self.kept.append(text[:room])
-            self._size += min(room, len(text))
-        self.dropped += max(0, len(text) - max(room, 0))
         return len(text)
-
-    def flush(self):
-        pass
 
 
 def _alarm(seconds: float) -> None:
@@ -62,12 +57,26 @@ def _on_alarm(signum, frame):
     raise GraderTimeout("time limit exceeded")
 
 
-def _install_traps(references: list[str], flag_fd: int) -> None:
+def _leave_if_forked() -> None:
+    """A fork of the worker (e.g. a fork bomb) stops here instead of grading a second time."""
+    if os.getpid() != _MAIN_PID:
+        _real_exit(0)
+
+
+# -- phase 1: set-up -------------------------------------------------------------------------------
+
+def _quiet_check(*args, **kwargs):
+    print("(check() is skipped during official grading)")
+
+
+def install_traps(references: tuple[str, ...], flag_fd: int) -> None:
     """Replace each reference function so that a direct call from graded code fails and is flagged.
 
     Calls made from inside robokit itself (a library function that uses a helper which happens to
     be a reference) pass through, so legitimate use of other robokit functions keeps working.
+    A dotted name that does not resolve is skipped.
     """
+    package_dir = str(Path(importlib.import_module("robokit").__file__).parent)
     for dotted in references:
         module_name, _, attr = dotted.rpartition(".")
         try:
@@ -75,16 +84,12 @@ def _install_traps(references: list[str], flag_fd: int) -> None:
             real = getattr(module, attr)
         except (ImportError, AttributeError):
             continue
-        package_dir = str(Path(importlib.import_module("robokit").__file__).parent)
 
         def trap(*args, __real=real, __name=dotted, **kwargs):
             caller = sys._getframe(1).f_code.co_filename
             if caller.startswith(package_dir) and "/grading/" not in caller:
                 return __real(*args, **kwargs)
-            try:
-                os.write(flag_fd, f"reference:{__name}\n".encode())
-            except OSError:
-                pass
+            log_reference_call(flag_fd, __name)
             raise ReferenceSolutionDisabled(f"{__name} is the reference solution and is disabled while grading")
 
         trap.__name__ = getattr(real, "__name__", attr)
@@ -94,17 +99,106 @@ def _install_traps(references: list[str], flag_fd: int) -> None:
                 setattr(mod, attr, trap)
 
 
-def _quiet_check(*args, **kwargs):
-    print("(check() is skipped during official grading)")
+def set_up(spec: JobSpec, job: JobDir) -> None:
+    """Prepare the process for graded code.
+
+    In order: the time-limit signal; ``check()`` silenced (``robokit.grading.check`` and the
+    module's own name); the reference functions trapped (:func:`install_traps`); ``os._exit``
+    turned into ``SystemExit`` (a notebook calling it ends its cell, not the grading); and
+    ``sys.stdout``/``sys.stderr`` discarded, so graded code cannot write into the worker's log,
+    whose tail the instructor's feedback shows when the worker ends early.
+    """
+    flag_fd = job.open_flags()
+    signal.signal(signal.SIGALRM, _on_alarm)
+
+    for name in ("robokit.grading", "robokit.grading.check"):  # both are loaded: this module is in the package
+        sys.modules[name].check = _quiet_check
+    install_traps(spec.references, flag_fd)
+
+    def _no_exit(code=0):
+        raise SystemExit(code)
+
+    os._exit = _no_exit
+    sys.stdout = sys.stderr = _Discard()
 
 
-def _error_record(exc: BaseException) -> dict:
+# -- phase 2: the notebook's cells -----------------------------------------------------------------
+
+def run_cell(shell, source: str, seconds: float) -> tuple[str, ErrorRecord | None]:
+    """Run one cell under a time limit; return its status and error record."""
     try:
-        message = str(exc)[:500]
-    except BaseException:
-        message = "<unprintable exception>"
-    mro = [c.__name__ for c in type(exc).__mro__][:12]
-    return {"type": type(exc).__name__[:100], "mro": mro, "message": message}
+        _alarm(seconds)
+        result = shell.run_cell(source, store_history=False, silent=False)
+        _alarm(0)
+        exc = result.error_in_exec or result.error_before_exec
+        if exc is None:
+            return "ok", None
+        return ("timeout" if isinstance(exc, GraderTimeout) else "error"), ErrorRecord.from_exception(exc)
+    except GraderTimeout as exc:
+        return "timeout", ErrorRecord.from_exception(exc)
+    except BaseException as exc:  # the shell itself failed on this cell
+        _alarm(0)
+        return "error", ErrorRecord.from_exception(exc)
+
+
+def run_cells(shell, spec: JobSpec) -> tuple[tuple[CellRecord, ...], float]:
+    """Run the code cells not marked skip, in order; return their records and the seconds they took."""
+    records, seconds = [], 0.0
+    for index, (source, skip) in enumerate(zip(spec.cells, spec.skip)):
+        if skip:
+            records.append(CellRecord(index, "skipped"))
+            continue
+        start = time.perf_counter()
+        status, error = run_cell(shell, source, spec.cell_seconds)
+        _leave_if_forked()
+        seconds += time.perf_counter() - start
+        records.append(CellRecord(index, status, error))
+    return tuple(records), seconds
+
+
+# -- phase 3: the exercises ------------------------------------------------------------------------
+
+def call_case(fn: Callable[..., Any], args: tuple, kwargs: dict, seconds: float) -> CallResult:
+    """Call ``fn`` on copies of a case's inputs under a time limit; any exception is data."""
+    args, kwargs = copy.deepcopy(args), copy.deepcopy(kwargs)
+    try:
+        _alarm(seconds)
+        value = fn(*args, **kwargs)
+        _alarm(0)
+        return CallResult.returned(value)
+    except BaseException as exc:  # includes GraderTimeout and SystemExit from student code
+        _alarm(0)
+        return CallResult.raised(exc)
+
+
+def run_exercises(namespace: dict, spec: JobSpec, job: JobDir) -> float:
+    """Call each exercise's function (looked up in ``namespace``) on its cases; write each report.
+
+    Returns the seconds spent in the calls.
+    """
+    total = 0.0
+    for k, (function, inputs) in enumerate(spec.exercises):
+        fn = namespace.get(function)
+        if not callable(fn):
+            job.write_exercise(k, ExerciseReport(defined=False))
+            continue
+        results, seconds = [], 0.0
+        for args, kwargs in inputs:
+            start = time.perf_counter()
+            results.append(call_case(fn, args, kwargs, spec.call_seconds))
+            _leave_if_forked()
+            seconds += time.perf_counter() - start
+        total += seconds
+        job.write_exercise(k, ExerciseReport(True, tuple(results), seconds))
+    return total
+
+
+# -- phase 4: finish -------------------------------------------------------------------------------
+
+def finish(job: JobDir, compute_seconds: float) -> None:
+    """Write the final report and end the process at once (skipping any exit handlers it set)."""
+    job.write_done(DoneReport(compute_seconds))
+    _real_exit(0)
 
 
 def main(job_dir: str) -> None:
@@ -116,90 +210,13 @@ def main(job_dir: str) -> None:
     """
     from IPython.core.interactiveshell import InteractiveShell
 
-    from .plain import NotPlainData, to_plain
-    from .transport import read_plain, write_plain
-
-    job = Path(job_dir)
-    spec = read_plain(job / "in" / "job")
-    out = job / "out"
-    flag_fd = os.open(out / "flags.log", os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
-    signal.signal(signal.SIGALRM, _on_alarm)
-
-    import robokit.grading
-    import robokit.grading.check as check_module
-
-    robokit.grading.check = _quiet_check
-    check_module.check = _quiet_check
-    _install_traps(spec["references"], flag_fd)
-
-    def _no_exit(code=0):
-        raise SystemExit(code)
-
-    os._exit = _no_exit  # a notebook calling os._exit ends its cell, not the grading
-    stream = _CappedText()
-    sys.stdout = sys.stderr = stream
+    job = JobDir(Path(job_dir))
+    spec = job.read_spec()
+    set_up(spec, job)
     shell = InteractiveShell.instance(colors="NoColor")
-    compute = 0.0
-    cells = []
-    for index, (source, skip) in enumerate(zip(spec["cells"], spec["skip"])):
-        if skip:
-            cells.append({"cell": index, "status": "skipped"})
-            continue
-        start = time.perf_counter()
-        status, error = "ok", None
-        try:
-            _alarm(spec["cell_seconds"])
-            result = shell.run_cell(source, store_history=False, silent=False)
-            _alarm(0)
-            exc = result.error_in_exec or result.error_before_exec
-            if exc is not None:
-                status = "timeout" if isinstance(exc, GraderTimeout) else "error"
-                error = _error_record(exc)
-        except GraderTimeout as exc:
-            status, error = "timeout", _error_record(exc)
-        except BaseException as exc:  # the shell itself failed on this cell
-            _alarm(0)
-            status, error = "error", _error_record(exc)
-        if os.getpid() != _MAIN_PID:  # a fork of the worker (e.g. a fork bomb) stops here
-            _real_exit(0)
-        compute += time.perf_counter() - start
-        cells.append({"cell": index, "status": status, "error": error})
-    write_plain({"cells": cells, "output": "".join(stream.kept), "output_dropped": stream.dropped},
-                out / "cells")
-    user_ns = shell.user_ns
-    for k, exercise in enumerate(spec["exercises"]):
-        fn = user_ns.get(exercise["function"])
-        results = []
-        if not callable(fn):
-            write_plain({"defined": False, "results": [], "seconds": 0.0}, out / f"ex{k}")
-            continue
-        ex_time = 0.0
-        for case in exercise["cases"]:
-            args, kwargs = copy.deepcopy(case["args"]), copy.deepcopy(case["kwargs"])
-            start = time.perf_counter()
-            try:
-                _alarm(spec["call_seconds"])
-                value = fn(*args, **kwargs)
-                _alarm(0)
-                record = {"value": to_plain(value)}
-            except NotPlainData as exc:
-                _alarm(0)
-                record = {"error": {"type": "NotPlainData", "mro": ["NotPlainData"], "message": str(exc)[:300]}}
-            except BaseException as exc:  # includes GraderTimeout and SystemExit from student code
-                _alarm(0)
-                record = {"error": _error_record(exc)}
-            if os.getpid() != _MAIN_PID:
-                _real_exit(0)
-            ex_time += time.perf_counter() - start
-            results.append(record)
-        compute += ex_time
-        try:
-            write_plain({"defined": True, "results": results, "seconds": ex_time}, out / f"ex{k}")
-        except Exception as exc:  # e.g. a value too large to write
-            write_plain({"defined": True, "results": [], "seconds": ex_time,
-                         "write_error": _error_record(exc)}, out / f"ex{k}")
-    write_plain({"compute_seconds": compute}, out / "done")
-    _real_exit(0)
+    cells, cell_seconds = run_cells(shell, spec)
+    job.write_cells(cells)
+    finish(job, cell_seconds + run_exercises(shell.user_ns, spec, job))
 
 
 if __name__ == "__main__":

@@ -30,9 +30,17 @@ def to_plain(value: Any, *, _depth: int = 0) -> Any:
     override comparison) are rejected. Tuples become lists; numpy scalars become Python numbers;
     numpy arrays are copied into fresh arrays of a standard dtype.
 
+    Raises ``NotPlainData`` for anything else, non-string dict keys, nesting deeper than 20 or a
+    list longer than a million items.
+
     Notes
     -----
     Grader design (DESIGN.md, "Grading"); not from a paper.
+
+    Examples
+    --------
+    >>> to_plain((np.float32(1.5), [np.int64(2)]))
+    [1.5, [2]]
     """
     if _depth > _MAX_DEPTH:
         raise NotPlainData("value is nested too deeply")
@@ -74,7 +82,13 @@ def to_plain(value: Any, *, _depth: int = 0) -> Any:
 
 
 def summarize(value: Any, limit: int = 160) -> str:
-    """Return a short human-readable summary of a plain value for feedback messages."""
+    """Return a short human-readable summary of a plain value for feedback messages.
+
+    Examples
+    --------
+    >>> summarize(np.arange(20.0))
+    'array(20,) [ 0., 1., ..., 18., 19.]'
+    """
     if isinstance(value, np.ndarray):
         with np.printoptions(precision=4, suppress=True, threshold=12, edgeitems=2):
             text = f"array{value.shape} {np.array2string(value, separator=', ')}"

@@ -39,6 +39,11 @@ def close(rtol: float = 1e-6, atol: float = 1e-9, *, shape: bool = True) -> Comp
 
     Nested lists and dicts are compared element by element with the same tolerance; strings,
     booleans and ``None`` must be equal. With ``shape=True`` array shapes must match exactly.
+
+    Examples
+    --------
+    >>> close(rtol=0, atol=1e-9)([1.0, 2.0], [1.0, 2.1])
+    'result: values differ at index (1,): expected 2, got 2.1 (tolerance 1e-09 + 0*|expected|)'
     """
 
     def compare(expected: Any, got: Any, where: str = "") -> str | None:
@@ -87,7 +92,13 @@ def close(rtol: float = 1e-6, atol: float = 1e-9, *, shape: bool = True) -> Comp
 
 
 def exact() -> Comparison:
-    """Accept only an identical value (strings, integers, booleans, lists of them)."""
+    """Accept only an identical value (strings, integers, booleans, lists of them).
+
+    Examples
+    --------
+    >>> exact()("2A", "2a")
+    "expected '2A', got '2a'"
+    """
 
     def compare(expected: Any, got: Any) -> str | None:
         if isinstance(expected, np.ndarray):
@@ -102,7 +113,14 @@ def exact() -> Comparison:
 
 
 def unordered_rows(rtol: float = 1e-6, atol: float = 1e-9) -> Comparison:
-    """Accept an (N, k) array whose rows equal the expected rows in any order (within tolerance)."""
+    """Accept an (N, k) array whose rows equal the expected rows in any order (within tolerance).
+
+    Examples
+    --------
+    >>> rows = [[0.0, 1.0], [2.0, 3.0]]
+    >>> unordered_rows()(rows, rows[::-1]) is None
+    True
+    """
     inner = close(rtol, atol)
 
     def compare(expected: Any, got: Any) -> str | None:

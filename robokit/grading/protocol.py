@@ -1,0 +1,306 @@
+"""What the grader and its sandboxed worker exchange: the job directory and the records in it.
+
+A job directory (:class:`JobDir`) holds::
+
+    in/job         JobSpec         the request: cells, skip flags, references to disable, time
+                                   limits, each exercise's function and case inputs (only those)
+    work/                          the worker's current and home directory
+    out/cells      CellRecord...   written after the last notebook cell
+    out/ex<k>      ExerciseReport  written as soon as exercise k has run
+    out/done       DoneReport      written last: the worker finished
+    out/flags.log                  ``reference:<name>``: graded code called a disabled reference
+
+Records are dataclasses, stored as their fields in plain data (:mod:`.transport`). ``out/`` is
+written by untrusted code: the grader reads it only through :class:`JobDir`'s ``read_*`` methods,
+which bound and validate every field and return clean records, ``None`` for a file never written,
+or raise :class:`~.transport.TransportError`.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from ..exercises.plain import NotPlainData, to_plain
+from .transport import TransportError, read_plain, was_written, write_plain
+
+__all__ = ["JobDir", "JobSpec", "CellRecord", "CallResult", "ErrorRecord", "ExerciseReport", "DoneReport",
+           "ReferenceSolutionDisabled", "log_reference_call", "CELL_STATUSES"]
+
+#: Bounds on what the grader takes from the worker.
+MAX_NAME, MAX_MESSAGE, MAX_CLASSES, MAX_CELLS = 100, 500, 12, 500
+MAX_FLAG_BYTES, MAX_FLAG_LINES = 64 * 1024, 100
+CELL_STATUSES = ("ok", "error", "timeout", "skipped")
+_REFERENCE_FLAG = "reference:"
+
+
+class ReferenceSolutionDisabled(Exception):
+    """Raised in the worker when graded code calls a robokit reference implementation directly."""
+
+
+def log_reference_call(fd: int, dotted: str) -> None:
+    """Append ``reference:<dotted>`` to the flags log open as ``fd`` (never raises)."""
+    try:
+        os.write(fd, f"{_REFERENCE_FLAG}{dotted}\n".encode())
+    except OSError:
+        pass
+
+
+def _plain(record: Any) -> Any:
+    """A record as plain data: its fields by name, nested records likewise, tuples as lists."""
+    if dataclasses.is_dataclass(record):
+        return {f.name: _plain(getattr(record, f.name)) for f in dataclasses.fields(record)}
+    return [_plain(v) for v in record] if isinstance(record, tuple) else record
+
+
+def _seconds(value: Any) -> float:
+    """A duration reported by the worker: a finite non-negative number, else 0."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
+    return float(value) if ok else 0.0
+
+
+@dataclasses.dataclass(frozen=True)
+class ErrorRecord:
+    """An exception raised by student code, as data.
+
+    ``type`` is the class name, ``classes`` the names of its method resolution order (so that
+    ``raises="ValueError"`` accepts a subclass), ``message`` is ``str(exc)`` truncated, and
+    ``line`` the student's ``"line N: source"`` where known (``check()`` only; the grader drops it).
+    """
+
+    type: str
+    classes: tuple[str, ...]
+    message: str
+    line: str = ""
+
+    @classmethod
+    def from_exception(cls, exc: BaseException, *, line: str = "") -> ErrorRecord:
+        """Describe ``exc``, whose ``__str__`` may itself be hostile."""
+        try:
+            message = str(exc)[:MAX_MESSAGE]
+        except BaseException:
+            message = "<unprintable exception>"
+        classes = tuple(c.__name__ for c in type(exc).__mro__)[:MAX_CLASSES]
+        return cls(type(exc).__name__[:MAX_NAME], classes, message, line)
+
+    @classmethod
+    def from_plain(cls, raw: Any) -> ErrorRecord:
+        """Validate an error record read from the worker."""
+        if not isinstance(raw, dict):
+            raise TransportError("malformed error record")
+        classes = raw.get("classes") if isinstance(raw.get("classes"), list) else []
+        return cls(str(raw.get("type"))[:MAX_NAME], tuple(str(c)[:MAX_NAME] for c in classes[:MAX_CLASSES]),
+                   str(raw.get("message"))[:MAX_MESSAGE])
+
+
+@dataclasses.dataclass(frozen=True)
+class CallResult:
+    """What one call of a student function gave: a plain ``value``, or an ``error``."""
+
+    value: Any = None
+    error: ErrorRecord | None = None
+
+    @classmethod
+    def returned(cls, value: Any) -> CallResult:
+        """The function returned ``value``: kept as plain data; anything else is a ``NotPlainData``
+        error, which no ``raises`` of a case accepts."""
+        try:
+            return cls(value=to_plain(value))
+        except NotPlainData as exc:
+            return cls(error=ErrorRecord("NotPlainData", ("NotPlainData",), str(exc)[:MAX_MESSAGE]))
+
+    @classmethod
+    def raised(cls, exc: BaseException, *, line: str = "") -> CallResult:
+        """The function raised ``exc``."""
+        return cls(error=ErrorRecord.from_exception(exc, line=line))
+
+    @classmethod
+    def from_plain(cls, raw: Any) -> CallResult:
+        """Validate one result read from the worker: a value, or an error record, not both."""
+        if not isinstance(raw, dict) or set(raw) != {"value", "error"}:
+            raise TransportError("malformed result entry")
+        if raw["error"] is None:
+            return cls(value=raw["value"])
+        if raw["value"] is None and isinstance(raw["error"], dict):
+            return cls(error=ErrorRecord.from_plain(raw["error"]))
+        raise TransportError("malformed result entry")
+
+
+@dataclasses.dataclass(frozen=True)
+class JobSpec:
+    """The grader's request to the worker (trusted: the worker cannot write ``in/``).
+
+    ``exercises`` holds ``(function name, ((args, kwargs), ...))`` per exercise: the inputs of its
+    cases only, neither what a case expects nor its label.
+    """
+
+    cells: tuple[str, ...]
+    skip: tuple[bool, ...]
+    references: tuple[str, ...]
+    cell_seconds: float
+    call_seconds: float
+    exercises: tuple[tuple[str, tuple[tuple[tuple, dict], ...]], ...]
+
+    @classmethod
+    def from_plain(cls, raw: dict) -> JobSpec:
+        """Rebuild the request as :meth:`JobDir.write_spec` wrote it."""
+        exercises = tuple((fn, tuple((tuple(args), kwargs) for args, kwargs in inputs))
+                          for fn, inputs in raw["exercises"])
+        return cls(tuple(raw["cells"]), tuple(raw["skip"]), tuple(raw["references"]), raw["cell_seconds"],
+                   raw["call_seconds"], exercises)
+
+
+@dataclasses.dataclass(frozen=True)
+class CellRecord:
+    """How one code cell ran: its index among the code cells, a status and the error, if any."""
+
+    cell: int
+    status: str
+    error: ErrorRecord | None = None
+
+    @classmethod
+    def from_plain(cls, raw: Any) -> CellRecord:
+        """Validate one cell record read from the worker."""
+        if not isinstance(raw, dict) or type(raw.get("cell")) is not int or raw.get("status") not in CELL_STATUSES:
+            raise TransportError("malformed cell record")
+        return cls(raw["cell"], raw["status"], None if raw.get("error") is None else ErrorRecord.from_plain(raw["error"]))
+
+
+@dataclasses.dataclass(frozen=True)
+class ExerciseReport:
+    """One exercise as run by the worker: ``defined`` is false when the notebook has no such
+    function; ``results`` holds one :class:`CallResult` per case; ``seconds`` is the time the calls took.
+    """
+
+    defined: bool
+    results: tuple[CallResult, ...] = ()
+    seconds: float = 0.0
+
+    @classmethod
+    def from_plain(cls, raw: Any, n_cases: int) -> ExerciseReport:
+        """Validate the report of an exercise with ``n_cases`` cases."""
+        if isinstance(raw, dict) and raw.get("defined") is False:
+            return cls(defined=False)
+        if not isinstance(raw, dict) or not isinstance(raw.get("results"), list):
+            raise TransportError("malformed results")
+        if len(raw["results"]) != n_cases:
+            raise TransportError(f"expected {n_cases} results, got {len(raw['results'])}")
+        return cls(True, tuple(CallResult.from_plain(r) for r in raw["results"]), _seconds(raw.get("seconds")))
+
+
+@dataclasses.dataclass(frozen=True)
+class DoneReport:
+    """The worker's last word: the time spent in the student's cells and calls."""
+
+    compute_seconds: float
+
+
+class JobDir:
+    """The directory of one grading job (layout in the module docstring).
+
+    Examples
+    --------
+    >>> job = JobDir("/tmp/job-x")
+    >>> job.work.name, job.exercise_file(2).name
+    ('work', 'ex2')
+    """
+
+    def __init__(self, root: str | Path):
+        self.root = Path(root)
+        self.inbox, self.work, self.outbox = self.root / "in", self.root / "work", self.root / "out"
+
+    @classmethod
+    def create(cls, parent: str | Path | None = None) -> JobDir:
+        """Make a fresh job directory (with ``in/``, ``work/`` and ``out/``) under ``parent``."""
+        job = cls(tempfile.mkdtemp(prefix="job-", dir=parent))
+        for sub in (job.inbox, job.work, job.outbox):
+            sub.mkdir()
+        return job
+
+    def exercise_file(self, k: int) -> Path:
+        """Stem of the report of exercise ``k`` (``out/ex<k>``)."""
+        return self.outbox / f"ex{k}"
+
+    # -- the grader's side: write the request, read (bounded, validated) what the worker wrote ----
+
+    def write_spec(self, spec: JobSpec) -> None:
+        """Write the request ``in/job``."""
+        write_plain(_plain(spec), self.inbox / "job")
+
+    def read_cells(self) -> tuple[CellRecord, ...] | None:
+        """The first ``MAX_CELLS`` well-formed cell records; ``None`` if missing or malformed."""
+        try:
+            raw = read_plain(self.outbox / "cells")
+        except TransportError:
+            return None
+        if not isinstance(raw, list):
+            return None
+        cells = []
+        for entry in raw[:MAX_CELLS]:
+            try:
+                cells.append(CellRecord.from_plain(entry))
+            except TransportError:
+                continue
+        return tuple(cells)
+
+    def read_exercise(self, k: int, n_cases: int) -> ExerciseReport | None:
+        """The report of exercise ``k``; ``None`` if the worker never wrote it.
+
+        Raises
+        ------
+        TransportError
+            If it was written but is malformed, too large or unsafe.
+        """
+        if not was_written(self.exercise_file(k)):
+            return None
+        return ExerciseReport.from_plain(read_plain(self.exercise_file(k)), n_cases)
+
+    def read_done(self) -> DoneReport | None:
+        """The final report; ``None`` if the worker did not get that far. A malformed report still
+        says that the worker finished; its duration then reads as 0."""
+        if not was_written(self.outbox / "done"):
+            return None
+        try:
+            raw = read_plain(self.outbox / "done")
+        except TransportError:
+            raw = None
+        return DoneReport(_seconds(raw.get("compute_seconds") if isinstance(raw, dict) else None))
+
+    def read_reference_calls(self) -> list[str]:
+        """Dotted names of the disabled references graded code called (the log's first lines)."""
+        try:
+            with open(self.outbox / "flags.log", "rb") as f:
+                text = f.read(MAX_FLAG_BYTES).decode(errors="replace")
+        except OSError:
+            return []
+        return [line[len(_REFERENCE_FLAG):][:MAX_NAME] for line in text.splitlines()[:MAX_FLAG_LINES]
+                if line.startswith(_REFERENCE_FLAG)]
+
+    # -- the worker's side ------------------------------------------------------------------------
+
+    def read_spec(self) -> JobSpec:
+        """Read the request ``in/job``."""
+        return JobSpec.from_plain(read_plain(self.inbox / "job"))
+
+    def open_flags(self) -> int:
+        """Open ``out/flags.log`` for appending; return the file descriptor."""
+        return os.open(self.outbox / "flags.log", os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
+
+    def write_cells(self, cells: tuple[CellRecord, ...]) -> None:
+        """Write ``out/cells``."""
+        write_plain(_plain(cells), self.outbox / "cells")
+
+    def write_exercise(self, k: int, report: ExerciseReport) -> None:
+        """Write ``out/ex<k>``; results that cannot be written (e.g. too large) are left out, and
+        the grader then calls them unusable."""
+        try:
+            write_plain(_plain(report), self.exercise_file(k))
+        except Exception:
+            write_plain(_plain(dataclasses.replace(report, results=())), self.exercise_file(k))
+
+    def write_done(self, report: DoneReport) -> None:
+        """Write ``out/done``, the worker's last act."""
+        write_plain(_plain(report), self.outbox / "done")
