@@ -17,9 +17,9 @@ from typing import Any
 
 import numpy as np
 
+from ..controllers import HeadingController, design_heading_gains
 from ..geometry import wrap_angle
 from ..validation import as_array, as_points, check_choice, check_positive
-from .controller import HeadingController, design_heading_gains
 from .geodesy import LocalTangentPlane
 from .gps import compass_to_heading
 from .nmea import GGA, HDG, RMC, NMEAError, parse_sentence

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..geometry import wrap_angle
 from ..validation import as_array, as_rng, check_int, check_positive
-from .field import Field
+from ..sim.layout import Layout
 
 __all__ = ["INCH", "SECONDS_PER_INCH", "SPEED_OF_SOUND", "LVMaxSonarEZ", "SonarMount", "PAPER_LAYOUT",
            "pulse_width_to_range", "range_to_pulse_width", "pulse_width_to_cm_inches",
@@ -225,7 +225,7 @@ def _cone(sensor: LVMaxSonarEZ, rays: int) -> np.ndarray:
     return np.linspace(-sensor.half_angle, sensor.half_angle, rays)
 
 
-def true_ranges(field: "Field", pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT,
+def true_ranges(field: Layout, pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT,
                 sensor: LVMaxSonarEZ = LVMaxSonarEZ(), rays: int = 9) -> tuple[np.ndarray, np.ndarray]:
     """Nearest obstacle within each sensor's cone, and where it is.
 
@@ -251,14 +251,15 @@ def true_ranges(field: "Field", pose: Any, mounts: Sequence[SonarMount] = PAPER_
     A sonar reports the *first* echo anywhere in its cone, which is why wide beams see obstacles
     off to the side (datasheet beam pattern; Hamid et al., Sec. 4, side sensors at 45 degrees).
     """
-    if not isinstance(field, Field):
-        raise TypeError(f"field: expected a robokit.outdoor.field.Field, got {type(field).__name__}")
+    if not isinstance(field, Layout):
+        raise TypeError(f"field: expected a robokit.outdoor.Field (or any robokit.sim.Layout), got "
+                        f"{type(field).__name__}")
     k = check_int(rays, "rays", minimum=1)
     sp = sensor_poses(pose, mounts)
     offs = _cone(sensor, k)
     angles = (sp[:, 2:3] + offs[None, :]).ravel()
     origins = np.repeat(sp[:, :2], k, axis=0)
-    d = field._raycast(origins, angles, sensor.max_range * 1.0001).reshape(len(sp), k)
+    d = field.raycast(origins, angles, sensor.max_range * 1.0001, check=False).reshape(len(sp), k)
     j = d.argmin(axis=1)
     r = d[np.arange(len(sp)), j]
     hit = r < sensor.max_range

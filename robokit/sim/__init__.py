@@ -50,12 +50,14 @@ Example
 from .camera import Frame, PinholeCamera, StereoRig, mount_pose
 from .feature_check import ViewPairCheck, ground_truth_inliers, sift_view_pair
 from .field import field_world, open_field, scatter_obstacles
-from .lidar import Lidar, ray_segment_ranges, scan_points
-from .motion import (Path, corridor_path, diff_drive_velocities, lab_lap, noisy_odometry, odometry_increment,
-                     sample_motion_model_odometry, skid_steer_velocities, unicycle_step, waypoint_path)
+from .layout import Layout, box_corners, obstacle_array
+from .lidar import Lidar, scan_points
+from .motion import (Path, corridor_path, lab_lap, noisy_odometry, odometry_increment, sample_motion_model_odometry,
+                     waypoint_path)
 from .omni import OmniCamera, omni_mount
 from .runs import Run, record
 from .textures import illuminate, photo
+from .vehicle import diff_drive_velocities, skid_steer_velocities, skid_steer_wheel_speeds, unicycle_step
 from .world import FreeSpace, Surface, World
 from .worlds import box_room, lab_room, long_corridor, office_floor
 
@@ -63,8 +65,9 @@ __all__ = [
     "World", "Surface", "FreeSpace", "box_room", "lab_room", "long_corridor", "office_floor",
     "open_field", "field_world", "scatter_obstacles",
     "Frame", "PinholeCamera", "StereoRig", "mount_pose", "OmniCamera", "omni_mount", "illuminate", "photo",
-    "Lidar", "ray_segment_ranges", "scan_points",
-    "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "odometry_increment",
+    "Layout", "box_corners", "obstacle_array", "Lidar", "scan_points",
+    "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
+    "odometry_increment",
     "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap",
     "Run", "record", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair",
 ]

@@ -30,6 +30,7 @@ from ..validation import as_array, as_rng, check_int, check_positive
 from . import textures as tx
 from . import textures_outdoor as tox
 from .build import Builder
+from .layout import obstacle_array
 from .world import World
 
 __all__ = ["scatter_obstacles", "field_world", "open_field", "SIDES"]
@@ -106,7 +107,7 @@ def scatter_obstacles(rng: Any, n_obstacles: int, size: Any = (100.0, 60.0), *, 
     k = len(pts) - 1
     clear = [(as_array(p, "keep_clear point", shape=(2,)), check_positive(r, "keep_clear radius", allow_zero=True))
              for p, r in keep_clear]
-    pre = np.zeros((0, 5)) if boxes is None or not np.size(boxes) else as_array(boxes, "boxes").reshape(-1, 5)
+    pre = obstacle_array(boxes, "boxes")
     shapes: list[tuple[str, np.ndarray, float]] = [("box", q, float(np.hypot(q[2], q[3]) / 2)) for q in pre]
     added = 0
     while added < n and tries > 0:
@@ -134,24 +135,14 @@ def scatter_obstacles(rng: Any, n_obstacles: int, size: Any = (100.0, 60.0), *, 
     return circles, out_boxes
 
 
-def _obstacles(value: Any, name: str, cols: int, size_cols: slice, lo: float, hi: tuple) -> np.ndarray:
-    """Validate an obstacle array: shape (N, cols), positive sizes, inside the hedge."""
-    arr = np.zeros((0, cols)) if value is None or not np.size(value) else as_array(value, name)
-    if arr.ndim == 1 and arr.shape[0] == cols:
-        arr = arr[None]
-    if arr.ndim != 2 or arr.shape[1] != cols:
-        raise ValueError(f"{name}: expected shape (N, {cols}), got shape {arr.shape}")
-    if np.any(arr[:, size_cols] <= 0):
-        raise ValueError(f"{name}: expected positive sizes in columns {size_cols.start}-{size_cols.stop - 1}, "
-                         f"got {arr[:, size_cols].min():.3g}")
-    reach = arr[:, 2] if cols == 3 else np.hypot(arr[:, 2], arr[:, 3]) / 2
+def _inside_hedge(arr: np.ndarray, reach: np.ndarray, name: str, lo: float, hi: tuple) -> None:
+    """Raise unless every obstacle (centre +- reach) stays strictly inside the hedge."""
     bad = (arr[:, 0] - reach <= lo) | (arr[:, 1] - reach <= lo) | (arr[:, 0] + reach >= hi[0]) \
         | (arr[:, 1] + reach >= hi[1])
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(f"{name}: expected obstacles inside the hedge [{lo:g}, {hi[0]:g}] x [{lo:g}, {hi[1]:g}] m, "
                          f"got one at ({arr[i, 0]:.2f}, {arr[i, 1]:.2f}) reaching {reach[i]:.2f} m")
-    return arr
 
 
 def _free_point(w: float, h: float, circles: np.ndarray, boxes: np.ndarray) -> np.ndarray:
@@ -209,8 +200,9 @@ def field_world(size: Any = (100.0, 60.0), circles: Any = None, boxes: Any = Non
     bd = check_positive(border, "border")
     rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
     x0, y0, x1, y1 = -bd, -bd, w + bd, h + bd
-    circles = _obstacles(circles, "circles", 3, slice(2, 3), -bd, (x1, y1))
-    boxes = _obstacles(boxes, "boxes", 5, slice(2, 4), -bd, (x1, y1))
+    circles, boxes = obstacle_array(circles, "circles"), obstacle_array(boxes, "boxes")
+    _inside_hedge(circles, circles[:, 2], "circles", -bd, (x1, y1))
+    _inside_hedge(boxes, np.hypot(boxes[:, 2], boxes[:, 3]) / 2, "boxes", -bd, (x1, y1))
     b = Builder(rng, density=100)
     b.horizontal("ground", x0, y0, x1, y1, 0.0, True, tox.grass, density=40, tile=6.0)
     corners = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]  # clockwise: the hedge faces inwards

@@ -1,13 +1,22 @@
-"""Robot motion: unicycle / differential-drive and skid-steer kinematics, odometry noise, paths.
+"""Robot motion: odometry noise and the paths the lessons drive (kinematics: :mod:`robokit.sim.vehicle`).
 
 Planar poses are ``[x, y, theta]`` (see :mod:`robokit.geometry`). The odometry noise model is the
-four-parameter model of Thrun, Burgard & Fox, *Probabilistic Robotics* (2005), Sec. 5.4: a motion
-between two poses is decomposed into a rotation ``delta_rot1``, a translation ``delta_trans`` and a
-rotation ``delta_rot2`` (Table 5.5), each corrupted by zero-mean Gaussian noise whose variance
-grows with the motion (Table 5.6, ``sample_motion_model_odometry``):
+four-parameter model of Thrun, Burgard & Fox (2005), Sec. 5.4: a motion between two poses is
+decomposed into a rotation ``delta_rot1``, a translation ``delta_trans`` and a rotation
+``delta_rot2`` (Table 5.5), each corrupted by zero-mean Gaussian noise whose variance grows with
+the motion (Table 5.6, ``sample_motion_model_odometry``):
 
     var(rot1) = a1 rot1^2 + a2 trans^2,  var(trans) = a3 trans^2 + a4 (rot1^2 + rot2^2),
     var(rot2) = a1 rot2^2 + a2 trans^2.
+
+References
+----------
+.. [1] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
+.. [2] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features",
+   IEEE/RSJ International Conference on Intelligent Robots and Systems (IROS), 2002.
+.. [3] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
+   environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
+   doi:10.1631/FITEE.2200208.
 """
 from __future__ import annotations
 
@@ -18,90 +27,8 @@ import numpy as np
 from ..geometry import wrap_angle
 from ..validation import as_array, as_points, as_rng, check_positive
 
-__all__ = ["unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "odometry_increment",
-           "sample_motion_model_odometry", "noisy_odometry", "Path", "waypoint_path", "corridor_path",
-           "lab_lap"]
-
-
-def unicycle_step(pose: Any, v: Any, omega: Any, dt: float) -> np.ndarray:
-    """Advance poses by driving at speed ``v`` and turn rate ``omega`` for ``dt`` seconds (exact arc).
-
-    Parameters
-    ----------
-    pose : array_like, shape (3,) or (N, 3)
-    v, omega : float or array_like (N,)
-        Forward speed (m/s) and turn rate (rad/s).
-    dt : float
-        Duration (s, >= 0).
-
-    Returns
-    -------
-    numpy.ndarray, same shape as ``pose``
-
-    Notes
-    -----
-    Thrun, Burgard & Fox (2005), Eq. (5.9) (circular arc of radius ``v / omega``); the straight
-    line when ``omega = 0``.
-    """
-    P = as_array(pose, "pose")
-    single = P.ndim == 1
-    P = as_points(P, "pose", 3)
-    v = np.broadcast_to(as_array(v, "v"), (len(P),))
-    w = np.broadcast_to(as_array(omega, "omega"), (len(P),))
-    dt = check_positive(dt, "dt", allow_zero=True)
-    th = P[:, 2]
-    small = np.abs(w * dt) < 1e-9
-    ws = np.where(small, 1.0, w)
-    dx = np.where(small, v * dt * np.cos(th + w * dt / 2), v / ws * (np.sin(th + w * dt) - np.sin(th)))
-    dy = np.where(small, v * dt * np.sin(th + w * dt / 2), v / ws * (np.cos(th) - np.cos(th + w * dt)))
-    out = np.column_stack([P[:, 0] + dx, P[:, 1] + dy, wrap_angle(th + w * dt)])
-    return out[0] if single else out
-
-
-def diff_drive_velocities(omega_left: Any, omega_right: Any, wheel_radius: float, track: float) -> tuple:
-    """Body speed and turn rate of a differential drive from wheel angular speeds.
-
-    Returns
-    -------
-    (v, omega) : ``v = r (w_r + w_l) / 2``, ``omega = r (w_r - w_l) / track``.
-
-    Notes
-    -----
-    Siegwart, Nourbakhsh & Scaramuzza, *Introduction to Autonomous Mobile Robots* (2011), Sec. 3.2.
-    """
-    r = check_positive(wheel_radius, "wheel_radius")
-    b = check_positive(track, "track")
-    wl, wr = as_array(omega_left, "omega_left"), as_array(omega_right, "omega_right")
-    return r * (wr + wl) / 2, r * (wr - wl) / b
-
-
-def skid_steer_velocities(v_left: Any, v_right: Any, track: float, chi: float = 1.5) -> tuple:
-    """Body speed and turn rate of a skid-steer vehicle from its left/right track (wheel) speeds.
-
-    Parameters
-    ----------
-    v_left, v_right : float or array_like
-        Linear speeds of the left and right wheel sets (m/s).
-    track : float
-        Distance between left and right wheels (m).
-    chi : float, default 1.5
-        Expansion factor (>= 1): skidding makes the vehicle turn as if its track were ``chi * track``.
-
-    Returns
-    -------
-    (v, omega)
-
-    Notes
-    -----
-    Mandow et al., "Experimental kinematics for wheeled skid-steer mobile robots" (IROS 2007),
-    Eq. (12): ``omega = (v_r - v_l) / (chi B)``; ``chi = 1`` is the ideal differential drive.
-    """
-    b = check_positive(track, "track")
-    c = check_positive(chi, "chi")
-    if c < 1:
-        raise ValueError(f"chi: expected an expansion factor >= 1, got {c}")
-    vl, vr = as_array(v_left, "v_left"), as_array(v_right, "v_right")
-    return (vr + vl) / 2, (vr - vl) / (c * b)
+__all__ = ["odometry_increment", "sample_motion_model_odometry", "noisy_odometry", "Path", "waypoint_path",
+           "corridor_path", "lab_lap"]
 
 
 def odometry_increment(previous: Any, current: Any) -> np.ndarray:

@@ -19,6 +19,7 @@ import cv2
 import numpy as np
 
 from ..validation import as_array, as_points, check_finite_scalar, check_positive
+from .layout import Layout
 
 __all__ = ["Surface", "World", "FreeSpace"]
 
@@ -211,6 +212,32 @@ class World:
             if len(pts) >= 2 and np.linalg.norm(pts[0] - pts[1]) > 1e-12:
                 segs.append(pts[:2])
         return np.array(segs, float).reshape(-1, 2, 2)
+
+    @functools.lru_cache(maxsize=8)
+    def layout(self, z: float) -> Layout:
+        """The walls at height ``z`` as a :class:`~robokit.sim.layout.Layout` (cached per height).
+
+        Parameters
+        ----------
+        z : float
+            Height of the plane (metres), e.g. a LiDAR's scan height.
+
+        Returns
+        -------
+        Layout
+            ``Layout(segments=self.slice(z))``: what a 2D scanner at that height casts over.
+
+        Notes
+        -----
+        Cached so a scan pays only for its rays (DESIGN.md, "Speed").
+
+        Examples
+        --------
+        >>> from robokit.sim import box_room
+        >>> box_room().layout(0.25).raycast([1.0, 1.0], [np.pi]).tolist()   # the west wall at x = 0
+        [1.0]
+        """
+        return Layout(segments=self.slice(z))
 
     @functools.lru_cache(maxsize=4)
     def free_space(self, resolution: float | None = None) -> FreeSpace:
