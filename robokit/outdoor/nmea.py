@@ -2,14 +2,23 @@
 
 A sentence looks like ``$GPRMC,123519,A,4807.038,N,...*6A\\r\\n``: a ``$``, an address (a two-letter
 talker such as ``GP``, ``GN``, ``GL`` or ``HC``, then a three-letter sentence type), comma separated
-fields, ``*`` and a two-hex-digit checksum (NMEA 0183 v4.11, Sec. 5.2-5.3). Hamid et al. (seed 000
-Q3, Sec. 3) drive their truck from ``$GPRMC``, ``$GPRMB``, ``$GPGGA`` and ``$HCHDG``; those four get
-typed records (:class:`RMC`, :class:`RMB`, :class:`GGA`, :class:`HDG`) for any talker, and every other
-type is returned as a :class:`Sentence` (never an error).
+fields, ``*`` and a two-hex-digit checksum (NMEA 0183 v4.11, Sec. 5.2-5.3). Hamid et al. (2009,
+Sec. 3) drive their truck from ``$GPRMC``, ``$GPRMB``, ``$GPGGA`` and ``$HCHDG``; those four get
+typed records (:class:`RMC`, :class:`RMB`, :class:`GGA`, :class:`HDG`) for any talker, and every
+other type is returned as a :class:`Sentence` (never an error).
 
 Conventions: empty fields become ``None``; latitude and longitude are signed decimal degrees (north
 and east positive) as the fields carry them; the records keep NMEA's own units (knots, degrees) in
 their field names and offer SI properties (``speed_mps``, ``course_rad``, ...).
+
+References
+----------
+.. [1] National Marine Electronics Association, *NMEA 0183 Standard for Interfacing Marine
+   Electronic Devices*, version 4.11, 2018.
+.. [2] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
 """
 from __future__ import annotations
 
@@ -64,8 +73,13 @@ def nmea_checksum(sentence: str) -> str:
 
     Notes
     -----
-    NMEA 0183 v4.11, Sec. 5.2.1 (checksum field); the example in Hamid et al. (seed 000 Q3, Sec. 3)
+    NMEA 0183 v4.11, Sec. 5.2.1 (checksum field); the example in Hamid et al. (2009, Sec. 3)
     reads the receiver's ASCII output in exactly this form.
+
+    Examples
+    --------
+    >>> nmea_checksum("GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,")
+    '47'
     """
     if not isinstance(sentence, str):
         raise TypeError(f"sentence: expected a str, got {describe(sentence)}")
@@ -111,7 +125,15 @@ def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> R
     Notes
     -----
     Framing and checksum: NMEA 0183 v4.11, Sec. 5.2-5.3; field layouts: Sec. 6.3 (RMC, RMB, GGA,
-    HDG), the four sentences Hamid et al. read (seed 000 Q3, Sec. 3).
+    HDG), the four sentences Hamid et al. (2009, Sec. 3) read.
+
+    Examples
+    --------
+    >>> rec = parse_sentence("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A")
+    >>> rec.talker, rec.status, rec.latitude, round(rec.longitude, 6), rec.speed_knots
+    ('GP', 'A', 48.1173, 11.516667, 22.4)
+    >>> parse_sentence("$GPZDA,201530.00,04,07,2002,00,00*60").kind         # any other type: generic
+    'ZDA'
     """
     if type(sentence) is not str:
         if isinstance(sentence, (bytes, bytearray)):
@@ -182,7 +204,12 @@ def fix_position(sentence: str) -> list[float]:
     Notes
     -----
     ``ddmm.mmmm`` -> ``dd + mm.mmmm / 60`` (NMEA 0183 v4.11, Sec. 6.2); the position the truck of
-    Hamid et al. reads from $GPRMC/$GPGGA (seed 000 Q3, Sec. 3).
+    Hamid et al. (2009, Sec. 3) reads from $GPRMC/$GPGGA.
+
+    Examples
+    --------
+    >>> [round(x, 6) for x in fix_position("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A")]
+    [48.1173, 11.516667]
     """
     rec = parse_sentence(sentence)
     if not isinstance(rec, (RMC, GGA)):
@@ -235,6 +262,12 @@ class NMEAReader:
     -----
     Resynchronising on ``$`` is how a receiver's listener recovers after noise or a lost
     character (NMEA 0183 v4.11, Sec. 5.3: ``$`` only ever starts a sentence).
+
+    Examples
+    --------
+    >>> reader = NMEAReader(b"junk$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A\\r\\n$GPGGA,12*00\\r\\n")
+    >>> [rec.kind for rec in reader], reader.junk_bytes, [type(bad.error).__name__ for bad in reader.errors]
+    (['RMC'], 4, ['NMEAChecksumError'])
     """
 
     def __init__(self, source: Any, *, require_checksum: bool = True,

@@ -1,7 +1,7 @@
-"""The outdoor field of seed 000 Q3 as a textured 3D world, and the obstacle layout it shares with lesson 05.
+"""Hamid et al.'s outdoor field as a textured 3D world, and the obstacle layout it shares with lesson 05.
 
-Hamid et al. test their GPS + sonar skid-steer truck on "semi-rugged terrain such a football
-field" (seed 000 Q3, Sec. 1) and let it avoid obstacles met between GPS waypoints (Sec. 4).
+Hamid et al. (2009) test their GPS + sonar skid-steer truck on "semi-rugged terrain such a
+football field" (Sec. 1) and let it avoid obstacles met between GPS waypoints (Sec. 4).
 
 * :func:`scatter_obstacles` draws such a layout in the plane: circles (posts, bins, trunks) and
   rotated boxes (bales, crates), kept ``min_gap`` apart. It is the one obstacle generator of the
@@ -18,6 +18,17 @@ boxes as hay bales or crates, and any box with a side of at least 2.5 m as a she
 something); and a skybox far outside the hedge (a sky band, a sky ceiling and far grass), not
 solid, so the LiDAR ignores it while every camera pixel gets a colour and a finite depth.
 Frame: x east, y north, metres, origin at the field's south-west corner (as in lesson 05).
+
+References
+----------
+.. [1] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
+.. [2] J. Feder, "Random sequential adsorption", *Journal of Theoretical Biology* 87(2), 1980,
+   pp. 237-254.
+.. [3] N. Greene, "Environment mapping and other applications of world projections", *IEEE
+   Computer Graphics and Applications* 6(11), 1986, pp. 21-29.
 """
 from __future__ import annotations
 
@@ -93,9 +104,15 @@ def scatter_obstacles(rng: Any, n_obstacles: int, size: Any = (100.0, 60.0), *, 
 
     Notes
     -----
-    Rejection sampling of non-overlapping discs (random sequential adsorption; Feder, "Random
-    sequential adsorption", J. Theor. Biol. 1980) around the experiment of Hamid et al. (seed 000
-    Q3, Sec. 4): obstacles lie on the way between waypoints so the truck must avoid them.
+    Rejection sampling of non-overlapping discs (random sequential adsorption, Feder 1980) around
+    the experiment of Hamid et al. (2009, Sec. 4): obstacles lie on the way between waypoints so
+    the truck must avoid them.
+
+    Examples
+    --------
+    >>> circles, boxes = scatter_obstacles(0, 4, (30.0, 20.0))
+    >>> circles.shape, boxes.shape
+    ((3, 3), (1, 5))
     """
     rng = as_rng(rng, "rng")
     n = check_int(n_obstacles, "n_obstacles", minimum=0)
@@ -193,8 +210,14 @@ def field_world(size: Any = (100.0, 60.0), circles: Any = None, boxes: Any = Non
 
     Notes
     -----
-    Test site of Hamid et al. (seed 000 Q3, Sec. 1, a football field); world representation of
-    the course (DESIGN.md, "Simulation"); skybox after Greene (IEEE CG&A 1986).
+    Test site of Hamid et al. (2009, Sec. 1, a football field); world representation of
+    the course (DESIGN.md, "Simulation"); skybox after Greene (1986).
+
+    Examples
+    --------
+    >>> world = field_world((20.0, 12.0), circles=[[5.0, 5.0, 0.5]], boxes=[[12.0, 6.0, 2.0, 1.0, 0.3]])
+    >>> world.info["hedge"], [kind for _, kind, _ in world.info["obstacles"]]
+    ((-3.0, -3.0, 23.0, 15.0), ['tree', 'crate'])
     """
     w, h = _size(size)
     bd = check_positive(border, "border")
@@ -260,7 +283,7 @@ def _skybox(b: Builder, X0: float, Y0: float, X1: float, Y1: float, hedge: tuple
 
 def open_field(seed: int = 0, *, size: Any = (100.0, 60.0), n_obstacles: int = 14, shed: bool = True,
                border: float = 3.0) -> World:
-    """The outdoor field of seed 000 Q3: about 100 m x 60 m of grass with obstacles, a shed and a hedge.
+    """Hamid et al.'s outdoor field: about 100 m x 60 m of grass with obstacles, a shed and a hedge.
 
     Parameters
     ----------
@@ -290,11 +313,16 @@ def open_field(seed: int = 0, *, size: Any = (100.0, 60.0), n_obstacles: int = 1
 
     Notes
     -----
-    Hamid et al., "Navigation of mobile robot using GPS and obstacle avoidance system with
-    commanded loop daisy chaining application method" (seed 000 Q3), Sec. 1: the truck runs on
-    "semi-rugged terrain such a football field"; obstacles as in their Sec. 4 experiment. Not to be
-    confused with :func:`robokit.outdoor.open_field`, lesson 05's 2D field with given obstacles.
-    Worlds are cached per parameter set.
+    Hamid et al. (2009), Sec. 1: the truck runs on "semi-rugged terrain such a football field";
+    obstacles as in their Sec. 4 experiment. Worlds are cached per parameter set.
+
+    Examples
+    --------
+    >>> field = open_field(seed=0, size=(20.0, 12.0), n_obstacles=2)
+    >>> field
+    World('open_field', 99 surfaces, 68 wall segments, 26.00 m x 18.00 m)
+    >>> [kind for _, kind, _ in field.info["obstacles"]], field.info["circles"].shape
+    (['tree', 'shed', 'bale'], (1, 3))
     """
     w, h = _size(size)
     if not isinstance(shed, (bool, np.bool_)):

@@ -49,8 +49,17 @@ class Lidar:
     Notes
     -----
     Beam ``i`` points at ``2 pi i / beams`` counter-clockwise from the sensor's forward axis.
-    Range model: Thrun, Burgard & Fox, *Probabilistic Robotics* (2005), Sec. 6.3.1 (the Gaussian
-    ``p_hit`` part of the beam model; max-range readings reported as ``inf``).
+    Range model: Thrun et al. (2005), Sec. 6.3.1 (the Gaussian ``p_hit`` part of the beam model;
+    max-range readings reported as ``inf``).
+
+    Examples
+    --------
+    >>> from robokit.sim import long_corridor
+    >>> corridor = long_corridor()
+    >>> door = corridor.info["doors"][0]                    # ('north', x0, x1)
+    >>> ranges = Lidar().scan(corridor, [(door[1] + door[2]) / 2, 0.0, 0.0])
+    >>> round(float(ranges[90]), 3), round(float(ranges[270]), 3)   # half width 1.085 m + 0.07 m recess
+    (1.155, 1.155)
     """
 
     beams: int = 360

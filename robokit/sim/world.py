@@ -8,6 +8,14 @@ vertical surfaces by a horizontal plane, so what the LiDAR measures and what the
 from the same geometry and cannot disagree.
 
 World frame: right-handed, z up, the floor at z = 0 (see :mod:`robokit.geometry`).
+
+References
+----------
+.. [1] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
+   environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
+   doi:10.1631/FITEE.2200208.
+.. [2] P. F. Felzenszwalb and D. P. Huttenlocher, "Distance transforms of sampled functions",
+   *Theory of Computing* 8, 2012, pp. 415-428.
 """
 from __future__ import annotations
 
@@ -255,7 +263,7 @@ class World:
         Notes
         -----
         Scan-line flood fill (``cv2.floodFill``) and Euclidean distance transform (Felzenszwalb &
-        Huttenlocher, "Distance transforms of sampled functions", 2012) for the clearance.
+        Huttenlocher 2012) for the clearance.
         """
         res = check_positive(self.free_resolution if resolution is None else resolution, "resolution")
         origin = self.segments.reshape(-1, 2).min(axis=0) - 4 * res
