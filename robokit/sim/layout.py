@@ -153,13 +153,17 @@ class Layout:
         self.corners = box_corners(self.boxes)
         sides = np.stack([self.corners, np.roll(self.corners, -1, axis=1)], axis=2).reshape(-1, 2, 2)
         edges = np.concatenate([self.segments, sides])
-        self.edge_low, self.edge_high = edges.min(axis=1), edges.max(axis=1)
         self.box_radius = np.hypot(self.boxes[:, 2], self.boxes[:, 3]) / 2
-        # p + s e per edge as contiguous columns, and |e| PARALLEL: the kernel's inputs
+        # the kernel's inputs: p + s e per edge as contiguous columns, |e| PARALLEL, and the bounding
+        # boxes of edges, circles and boxes (in that order) for culling by max_range
         self._edges = np.ascontiguousarray(np.column_stack([edges[:, 0], edges[:, 1] - edges[:, 0]]).T)
         self._parallel = PARALLEL * np.hypot(self._edges[2], self._edges[3])
-        for arr in (self.segments, self.circles, self.boxes, self.corners, self.edge_low, self.edge_high,
-                    self.box_radius):
+        reach = np.concatenate([self.circles[:, 2], self.box_radius])[:, None]
+        centres = np.concatenate([self.circles[:, :2], self.boxes[:, :2]])
+        self._low = np.concatenate([edges.min(axis=1), centres - reach])
+        self._high = np.concatenate([edges.max(axis=1), centres + reach])
+        self._split = (len(edges), len(edges) + len(self.circles))
+        for arr in (self.segments, self.circles, self.boxes, self.corners, self.box_radius):
             arr.flags.writeable = False
 
     def __repr__(self) -> str:
@@ -241,18 +245,15 @@ class Layout:
             rmax = math.inf if max_range == math.inf else check_positive(max_range, "max_range")
         else:
             o, a, rmax = np.reshape(origins, (-1, 2)), angles, max_range
-        c, sn = np.cos(a)[:, None], np.sin(a)[:, None]                  # ray directions d, (K, 1)
+        d = np.stack([np.cos(a), np.sin(a)], axis=1)                    # ray directions, (K, 2)
+        c, sn = d[:, :1], d[:, 1:]
         best = np.full(len(a), float(rmax))
         edges, par = self._edges, self._parallel
         circles, boxes = self.circles, self.boxes
-        if rmax < math.inf:  # only what can be within rmax of some origin
-            lo, hi = o.min(axis=0) - rmax, o.max(axis=0) + rmax
-            near = np.all((self.edge_high >= lo) & (self.edge_low <= hi), axis=1)
-            edges, par = edges[:, near], par[near]
-            circles = circles[np.all((circles[:, :2] + circles[:, 2:3] >= lo)
-                                     & (circles[:, :2] - circles[:, 2:3] <= hi), axis=1)]
-            boxes = boxes[np.all((boxes[:, :2] + self.box_radius[:, None] >= lo)
-                                 & (boxes[:, :2] - self.box_radius[:, None] <= hi), axis=1)]
+        if rmax < math.inf:  # only what can be within rmax of some origin (bounding boxes overlap)
+            near = np.all((self._high >= o.min(axis=0) - rmax) & (self._low <= o.max(axis=0) + rmax), axis=1)
+            ne, nc = self._split
+            edges, par, circles, boxes = edges[:, near[:ne]], par[near[:ne]], circles[near[ne:nc]], boxes[near[nc:]]
         if edges.shape[1]:
             px, py, ex, ey = edges
             wx, wy = px - o[:, :1], py - o[:, 1:]                       # a = p - o, (K or 1, S)
@@ -266,7 +267,6 @@ class Layout:
             hit &= s <= 1
             best = np.minimum(best, np.where(hit, t, np.inf).min(axis=1))
         if len(circles):
-            d = np.column_stack([c[:, 0], sn[:, 0]])
             oc = np.broadcast_to(circles[None, :, :2] - o[:, None, :], (len(d), len(circles), 2))  # c - o
             tca = np.einsum("knj,kj->kn", oc, d)                         # (c - o) . d
             oc2 = np.einsum("knj,knj->kn", oc, oc)
@@ -387,13 +387,17 @@ class Layout:
             closest = np.stack([x + c * lx - s * ly, y + s * lx + c * ly], axis=1)
             if np.any(np.hypot(*(closest - circles[:, :2]).T) <= circles[:, 2]):
                 return True
-        near = np.hypot(*(self.boxes[:, :2] - [x, y]).T) <= self.box_radius + reach
-        walls = np.all((self.segments.max(axis=1) >= [x - reach, y - reach])
-                       & (self.segments.min(axis=1) <= [x + reach, y + reach]), axis=1)
-        if not (np.any(near) or np.any(walls)):
+        others = []
+        if len(self.boxes):
+            near = np.hypot(*(self.boxes[:, :2] - [x, y]).T) <= self.box_radius + reach
+            others += list(self.corners[near])
+        if len(self.segments):
+            walls = np.all((self.segments.max(axis=1) >= [x - reach, y - reach])
+                           & (self.segments.min(axis=1) <= [x + reach, y + reach]), axis=1)
+            others += [seg[[0, 1, 1, 0]] for seg in self.segments[walls]]        # a wall: a flat box
+        if not others:
             return False
         mine = box_corners([[x, y, 2 * L, 2 * W, th]])[0]
-        others = list(self.corners[near]) + [seg[[0, 1, 1, 0]] for seg in self.segments[walls]]  # a wall: a flat box
         return any(_convex_overlap(mine, poly) for poly in others)
 
 

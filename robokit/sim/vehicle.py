@@ -78,6 +78,14 @@ def unicycle_step(pose: Any, v: Any, omega: Any, dt: float, *, check: bool = Tru
         P = np.asarray(pose, dtype=float)
         single = P.ndim == 1
         P, w = P.reshape(-1, 3), omega
+    if single and np.ndim(v) == 0 and np.ndim(w) == 0:   # one pose: the same formulas on scalars, for speed
+        x, y, th = P[0]
+        turn = w * dt
+        if abs(turn) < 1e-9:
+            dx, dy = v * dt * np.cos(th + turn / 2), v * dt * np.sin(th + turn / 2)
+        else:
+            dx, dy = v / w * (np.sin(th + turn) - np.sin(th)), v / w * (np.cos(th) - np.cos(th + turn))
+        return np.array([x + dx, y + dy, wrap_angle(th + turn)])
     th = P[:, 2]
     small = np.abs(w * dt) < 1e-9
     ws = np.where(small, 1.0, w)
@@ -229,4 +237,5 @@ def skid_steer_wheel_speeds(v: Any, omega: Any, track: float, max_wheel_speed: f
     half = np.clip(omega * icr_factor * track / (2 * k), -max_wheel_speed, max_wheel_speed)  # (v_r - v_l) / 2
     room = max_wheel_speed - np.abs(half)
     fwd = np.clip(v / k, -room, room)                                                      # (v_r + v_l) / 2
-    return np.stack([fwd - half, fwd + half], axis=-1)
+    left, right = fwd - half, fwd + half
+    return np.stack([left, right], axis=-1) if np.ndim(left) else np.array([left, right])
