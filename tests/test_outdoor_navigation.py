@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robokit.outdoor.field import UNIMAP_ORIGIN, open_field, random_course
+from robokit.outdoor.field import UNIMAP_ORIGIN, Course, Field, random_course
 from robokit.outdoor.geodesy import LocalTangentPlane
 from robokit.outdoor.gps import Compass, GPSReceiver
 from robokit.outdoor.mission import run_courses, simulate, summarize_runs
@@ -68,8 +68,7 @@ def test_single_run_is_deterministic_and_reports_nmea():
 
 
 def test_obstacle_dead_ahead_is_avoided():
-    field = open_field(circles=[[15.0, 10.0, 0.8]])
-    from robokit.outdoor.field import Course
+    field = Field(circles=[[15.0, 10.0, 0.8]])
     course = Course(field, np.array([[30.0, 10.0]]), np.array([2.0, 10.0, 0.0]))
     run = simulate(course, seed=2, gps_sigma=0.5)
     assert run.reached == 1 and run.collisions == 0 and run.avoidances >= 1

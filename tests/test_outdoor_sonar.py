@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robokit.outdoor.field import Field, open_field, random_course
+from robokit.outdoor.field import Field, random_course
 from robokit.outdoor.sonar import (INCH, PAPER_LAYOUT, SPEED_OF_SOUND, LVMaxSonarEZ, firing_schedule,
                                    pulse_width_to_cm_inches, pulse_width_to_range, range_to_pulse_width,
                                    read_sensors, sensor_poses, true_ranges)
@@ -60,7 +60,7 @@ def test_schedules():
 
 
 def test_true_ranges_sees_obstacles_in_cone_only():
-    field = open_field(circles=[[3.0, 0.0, 0.4]])
+    field = Field(circles=[[3.0, 0.0, 0.4]])
     r, hits = true_ranges(field, [0.0, 0.0, 0.0])
     assert r[1] == pytest.approx(3.0 - 0.4 - 0.25, abs=0.05) and r[2] == pytest.approx(r[1], abs=0.01)
     assert np.isinf(r[3]) and np.isnan(hits[3]).all()
@@ -69,7 +69,7 @@ def test_true_ranges_sees_obstacles_in_cone_only():
 
 
 def test_chained_has_no_crosstalk_free_running_does():
-    field = open_field(circles=[[2.5, 0.0, 0.3], [1.2, 1.2, 0.3]])
+    field = Field(circles=[[2.5, 0.0, 0.3], [1.2, 1.2, 0.3]])
     pose = [0.0, 0.0, 0.0]
     truth = LVMaxSonarEZ().quantize(true_ranges(field, pose)[0])
     chained = read_sensors(field, pose, [0, 1, 2, 3], [0.0, 0.049, 0.098, 0.147], noise=0.0)
@@ -84,7 +84,7 @@ def test_chained_has_no_crosstalk_free_running_does():
 
 
 def test_field_raycast_and_collision():
-    field = open_field(circles=[[10.0, 0.0, 1.0]], boxes=[[20.0, 0.0, 2.0, 2.0, 0.0]])
+    field = Field(circles=[[10.0, 0.0, 1.0]], boxes=[[20.0, 0.0, 2.0, 2.0, 0.0]])
     d = field.raycast([[0.0, 0.0], [15.0, 0.0], [0.0, 5.0], [20.0, 0.0]], [0.0, 0.0, 0.0, 0.0], 30.0)
     np.testing.assert_allclose(d, [9.0, 4.0, 30.0, 0.0])
     assert field.collides([8.8, 0.0, 0.0], 0.5, 0.25) and not field.collides([8.7, 0.0, 0.0], 0.5, 0.25)
@@ -105,7 +105,8 @@ def test_random_course_is_seeded_and_keeps_waypoints_clear():
 @pytest.mark.parametrize("call, words", [
     (lambda: Field(size=(0, 10)), "size"),
     (lambda: Field(circles=[[1, 1, -1]]), "radii"),
-    (lambda: open_field().raycast([[0, 0]], [0, 1], 5.0), "angles"),
+    (lambda: Field(origin=(0.1,)), "origin"),
+    (lambda: Field().raycast([[0, 0], [1, 1]], [0, 1, 2], 5.0), "origins"),
     (lambda: random_course(0, n_waypoints=0), "n_waypoints"),
     (lambda: sensor_poses([0, 0]), "pose"),
 ])

@@ -1,10 +1,11 @@
-"""LiDAR against closed-form ranges; motion models and the odometry noise statistics."""
+"""LiDAR against closed-form ranges; odometry noise statistics and paths (kinematics: test_sim_vehicle.py)."""
 import numpy as np
 import pytest
 
 from robokit.geometry import wrap_angle
 from robokit.sim import motion as mo
-from robokit.sim.lidar import Lidar, ray_segment_ranges, scan_points
+from robokit.sim.layout import Layout
+from robokit.sim.lidar import Lidar, scan_points
 from robokit.sim.worlds import box_room, lab_room, long_corridor
 
 
@@ -57,28 +58,18 @@ def test_scan_points_lie_on_walls():
 
 
 def test_ray_segment_misses_give_inf():
-    r = ray_segment_ranges([0, 0], [0.0, np.pi], [[[1, -1], [1, 1]]])
+    r = Layout(segments=[[[1, -1], [1, 1]]]).raycast([0, 0], [0.0, np.pi])
     assert r[0] == pytest.approx(1.0) and np.isinf(r[1])
 
 
-def test_unicycle_matches_small_step_integration():
-    pose = np.array([1.0, 2.0, 0.3])
-    exact = mo.unicycle_step(pose, 0.5, 0.4, 2.0)
-    p = pose.copy()
-    for _ in range(20000):
-        p = p + 1e-4 * np.array([0.5 * np.cos(p[2]), 0.5 * np.sin(p[2]), 0.4])
-    np.testing.assert_allclose(exact[:2], p[:2], atol=1e-4)
-    assert wrap_angle(exact[2] - p[2]) == pytest.approx(0, abs=1e-6)
-    np.testing.assert_allclose(mo.unicycle_step(pose, 1.0, 0.0, 1.0), [1 + np.cos(0.3), 2 + np.sin(0.3), 0.3])
-
-
-def test_drive_kinematics():
-    v, w = mo.diff_drive_velocities(1.0, 3.0, wheel_radius=0.05, track=0.25)
-    assert v == pytest.approx(0.1) and w == pytest.approx(0.4)
-    v, w = mo.skid_steer_velocities(0.2, 0.4, track=0.3, chi=2.0)
-    assert v == pytest.approx(0.3) and w == pytest.approx(0.2 / 0.6)
-    with pytest.raises(ValueError, match="chi"):
-        mo.skid_steer_velocities(0.2, 0.4, track=0.3, chi=0.5)
+def test_scan_uses_the_cached_layout_of_the_world_slice():
+    world = long_corridor()
+    assert world.layout(0.25) is world.layout(0.25)
+    lidar = Lidar(beams=90)
+    sensor = lidar.sensor_pose([5.0, 0.2, 0.4])
+    true = world.layout(lidar.height).raycast(sensor[:2], lidar.angles + sensor[2])
+    expected = np.where((true >= lidar.r_min) & (true <= lidar.r_max), true, np.inf)
+    np.testing.assert_array_equal(lidar.scan(world, [5.0, 0.2, 0.4]), expected)
 
 
 def test_odometry_noise_statistics_match_the_model():
@@ -122,7 +113,6 @@ def test_paths_stay_in_free_space(make, world):
     (lambda: Lidar().scan(box_room(), [9.0, 1, 0]), "robot_pose"),
     (lambda: mo.sample_motion_model_odometry([0, 0, 0], [1, 0, 0], [0, 0, 0], [-1, 0, 0, 0]), "alphas"),
     (lambda: mo.waypoint_path([[0, 0]]), "waypoints"),
-    (lambda: mo.unicycle_step([0, 0, 0], 1.0, 0.0, -1.0), "dt"),
 ])
 def test_bad_input_is_named(call, match):
     with pytest.raises((ValueError, TypeError), match=match):

@@ -7,8 +7,7 @@ import numpy as np
 import pytest
 
 from robokit.outdoor.field import Field, random_course
-from robokit.sim import (Lidar, PinholeCamera, field_world, mount_pose, open_field, ray_segment_ranges,
-                         scatter_obstacles)
+from robokit.sim import Layout, Lidar, PinholeCamera, field_world, mount_pose, open_field, scatter_obstacles
 from robokit.sim.field import SIDES, _open_field
 from robokit.sim.world import World
 from tests.test_sim_lidar_motion import analytic_box_ranges
@@ -76,28 +75,49 @@ def test_lidar_ranges_equal_analytic_distances_to_box_and_hedge(pose):
     assert np.isfinite(_slab_distance(pose[:2], ang, BOX)).sum() > 20  # the box is really seen
 
 
+def _hedge(x0, y0, x1, y1):
+    c = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]
+    return [[c[k], c[(k + 1) % 4]] for k in range(4)]
+
+
 def test_lesson05_course_and_3d_world_share_the_layout():
     course = random_course(7)
     world = course.field.world(seed=7)
     np.testing.assert_array_equal(world.info["boxes"], course.field.boxes)
     np.testing.assert_array_equal(world.info["circles"], course.field.circles)
     o = course.start[:2]
-    segs = world.slice(0.25)
     # boxes are exact: a field of the course's boxes alone ray-casts like the 3D footprint
     boxes_only = Field(size=course.field.size, boxes=course.field.boxes)
     aim = np.arctan2(course.field.boxes[:, 1] - o[1], course.field.boxes[:, 0] - o[0])
     flat = boxes_only.raycast(np.tile(o, (len(aim), 1)), aim, 500.0)
     hedge = _rect_exit(o, aim, -3, -3, 103, 63)
     box_world = field_world(course.field.size, boxes=course.field.boxes, seed=7)
-    np.testing.assert_allclose(ray_segment_ranges(o, aim, box_world.slice(0.25)), np.minimum(flat, hedge),
-                               rtol=0, atol=1e-9)
+    np.testing.assert_allclose(box_world.layout(0.25).raycast(o, aim), np.minimum(flat, hedge), rtol=0, atol=1e-9)
     # circles are prisms with corners on the circle: hit no earlier, and at most r (1 - cos(pi / SIDES)) later
     c = course.field.circles
     aim = np.arctan2(c[:, 1] - o[1], c[:, 0] - o[0])
-    t3 = ray_segment_ranges(o, aim, segs)
+    t3 = world.layout(0.25).raycast(o, aim)
     t2 = np.minimum(course.field.raycast(np.tile(o, (len(aim), 1)), aim, 500.0), _rect_exit(o, aim, -3, -3, 103, 63))
     assert np.all(t3 >= t2 - 1e-9)
     assert np.all(t3 - t2 <= 0.8 * (1 - np.cos(np.pi / SIDES)) + 1e-9)
+
+
+@pytest.mark.parametrize("seed", [3, 7])
+def test_lidar_and_the_field_agree_on_the_same_geometry(seed):
+    """A LiDAR scanning the 3D world of a field of boxes reads what the field's own ray caster
+    (the sonars') returns for the same rays with the hedge added as walls: one geometry, one tie rule."""
+    course = random_course(seed)
+    field = Field(size=course.field.size, boxes=course.field.boxes)
+    world = field.world(seed=seed)
+    both = Layout(segments=_hedge(*world.info["hedge"]), boxes=field.boxes)
+    lidar = Lidar(beams=720, r_min=0.0, r_max=500.0)
+    for pose in [course.start, [*course.waypoints[0], 1.0], [*course.waypoints[-1], -2.0]]:
+        sensor = lidar.sensor_pose(pose)
+        np.testing.assert_allclose(lidar.scan(world, pose), both.raycast(sensor[:2], lidar.angles + sensor[2]),
+                                   rtol=0, atol=1e-9)
+        sonar_rays = field.raycast(np.tile(sensor[:2], (720, 1)), lidar.angles + sensor[2], 6.45)
+        np.testing.assert_allclose(np.minimum(lidar.scan(world, pose), 6.45), np.minimum(sonar_rays, np.minimum(
+            _rect_exit(sensor[:2], lidar.angles + sensor[2], *world.info["hedge"]), 6.45)), rtol=0, atol=1e-9)
 
 
 def test_point_on_an_obstacle_face_is_painted_where_it_projects():
@@ -161,6 +181,7 @@ def test_scatter_obstacles_respects_gaps_and_keep_clear():
     (lambda: open_field(border=0.0), r"border: expected a positive number, got 0"),
     (lambda: open_field(shed="yes"), r"shed: expected True or False, got 'yes'"),
     (lambda: field_world(circles=[[5.0, 5.0, -1.0]]), r"circles: expected positive sizes .* got -1"),
+    (lambda: scatter_obstacles(0, 3, boxes=[[5.0, 5.0, 0.0, 1.0, 0.0]]), r"boxes: expected positive sizes"),
     (lambda: field_world(boxes=[[5.0, 5.0, 1.0, 1.0]]), r"boxes: expected shape \(N, 5\), got shape \(1, 4\)"),
     (lambda: field_world(circles=[[0.0, 0.0, 4.0]]), r"circles: expected obstacles inside the hedge"),
     (lambda: field_world(boxes=[[5.0, np.nan, 1.0, 1.0, 0.0]]), r"boxes: expected finite values"),

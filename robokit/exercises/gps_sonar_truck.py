@@ -5,9 +5,9 @@ import datetime as dt
 
 import numpy as np
 
+from ..controllers.heading import design_heading_gains
 from .compare import close, exact
 from .spec import Case, Exercise
-from ..outdoor.controller import design_heading_gains
 from ..outdoor.geodesy import haversine_distance_bearing
 from ..outdoor.navigator import avoidance_decision
 from ..outdoor.nmea import fix_position, nmea_checksum
@@ -169,7 +169,7 @@ EXERCISES = [
         points=2,
         cases=_gains_cases,
         reference=design_heading_gains,
-        references=("robokit.outdoor.controller.design_heading_gains",),
+        references=("robokit.controllers.heading.design_heading_gains",),
         compare=close(rtol=1e-6, atol=1e-9),
         description="Rate-feedback gains that place the closed-loop poles for an overshoot/settling spec.",
     ),

@@ -2,27 +2,30 @@
 
 Follows Hamid, Adom, Rahim and Rahiman, "Navigation of mobile robot using Global Positioning
 System (GPS) and obstacle avoidance system with commanded loop daisy chaining application method"
-(seed 000, question 3): an RC truck that drives GPS waypoints read from NMEA sentences ($GPRMC,
-$GPRMB, $GPGGA, $HCHDG) and avoids obstacles with four LV-MaxSonar-EZ sensors fired in a
+(CSPA 2009; seed 000, question 3): an RC truck that drives GPS waypoints read from NMEA sentences
+($GPRMC, $GPRMB, $GPGGA, $HCHDG) and avoids obstacles with four LV-MaxSonar-EZ sensors fired in a
 commanded daisy-chain loop.
 
 Submodules
 ----------
-nmea        checksum, typed records, a resynchronising stream reader (fields in nmea_fields,
-            records in nmea_records)
+nmea        checksum, typed records, a resynchronising stream reader (fields and record builders
+            in nmea_fields, record types in nmea_records)
 nmea_write  sentence builders (what a receiver model emits)
 geodesy     haversine, tangent-plane projection, WGS84 inverse problem
 sonar       LV-MaxSonar-EZ model, chained versus free-running firing, the paper's layout
-field       the outdoor field with obstacles
-truck       skid-steer kinematics with slip
-controller  heading controller designed with python-control
+field       the field: a :class:`robokit.sim.Layout` of obstacles with a size and a geodetic
+            origin, and seeded courses
+truck       the paper's truck on :mod:`robokit.sim.vehicle`'s skid-steer kinematics, with motor lag
 gps         1 Hz GPS receiver and compass models that emit NMEA text
 navigator   waypoint following plus the sonar obstacle-avoidance state machine
 mission     the simulated experiment: courses, runs, summaries
+
+The heading loop (designed with python-control) lives in :mod:`robokit.controllers`; its names
+are re-exported here (``from robokit.outdoor import loop_metrics``).
 """
-from .controller import (HeadingController, design_heading_gains, heading_closed_loop, heading_frequency_response,
-                         heading_loop_gain, heading_plant, heading_step_response, loop_metrics)
-from .field import Course, Field, open_field, random_course
+from ..controllers import (HeadingController, design_heading_gains, heading_closed_loop, heading_frequency_response,
+                           heading_loop_gain, heading_plant, heading_step_response, loop_metrics)
+from .field import Course, Field, random_course
 from .geodesy import (EARTH_MEAN_RADIUS, LocalTangentPlane, distance_bearing, haversine_distance,
                       haversine_distance_bearing, initial_bearing, osculating_radius, vincenty_inverse)
 from .gps import Compass, GPSReceiver, compass_to_heading, heading_to_compass
@@ -38,7 +41,7 @@ from .truck import PAPER_TRUCK, SkidSteerTruck, TruckState
 __all__ = [
     "HeadingController", "design_heading_gains", "heading_closed_loop", "heading_frequency_response",
     "heading_loop_gain", "heading_plant", "heading_step_response", "loop_metrics",
-    "Course", "Field", "open_field", "random_course",
+    "Course", "Field", "random_course",
     "EARTH_MEAN_RADIUS", "LocalTangentPlane", "distance_bearing", "haversine_distance",
     "haversine_distance_bearing", "initial_bearing", "osculating_radius", "vincenty_inverse",
     "Compass", "GPSReceiver", "compass_to_heading", "heading_to_compass",

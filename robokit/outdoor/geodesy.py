@@ -1,22 +1,34 @@
 """Distances, bearings and a local east-north plane on the Earth, spherical and WGS84.
 
-Hamid et al. (seed 000 Q3, Sec. 3) steer their truck by the bearing and distance from the GPS fix
+Hamid et al. (2009, Sec. 3) steer their truck by the bearing and distance from the GPS fix
 to the next waypoint. Three models, from simplest to exact:
 
-* **sphere** - haversine distance and initial bearing on a sphere of radius ``R`` (Sinnott, "Virtues
-  of the haversine", Sky & Telescope 68(2), 1984). With the IUGG mean radius the error against the
+* **sphere** - haversine distance and initial bearing on a sphere of radius ``R`` (Sinnott 1984). With the IUGG mean radius the error against the
   ellipsoid is up to about 0.56 % (north-south near the equator); with the *osculating* radius
   ``sqrt(M N)`` at the mean latitude (the default here) it is below 0.34 % in any direction.
 * **tangent plane** - east/north metres around a reference point from the meridian (``M``) and
-  prime-vertical (``N``) radii of curvature of WGS84 (Torge & Mueller, *Geodesy*, 4th ed., 2012,
-  Sec. 4.2); errors grow with the square of the distance from the reference (below 0.5 mm at
+  prime-vertical (``N``) radii of curvature of WGS84 (Torge & Mueller 2012, Sec. 4.2); errors grow with the square of the distance from the reference (below 0.5 mm at
   100 m, 5 cm at 1 km, up to latitude 60 degrees) - ample for a 100 m field.
-* **wgs84** - Vincenty's inverse formula on the WGS84 ellipsoid (Vincenty, "Direct and inverse
-  solutions of geodesics on the ellipsoid", Survey Review 23(176), 1975, Eqs. 13-21), accurate to
+* **wgs84** - Vincenty's inverse formula on the WGS84 ellipsoid (Vincenty 1975, Eqs. 13-21), accurate to
   well below a millimetre except for nearly antipodal points, where it may not converge.
 
 All angles are radians (latitude north positive, longitude east positive, bearings clockwise from
 true north in [0, 2 pi)); distances are metres. Functions broadcast over numpy arrays.
+
+References
+----------
+.. [1] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
+.. [2] R. W. Sinnott, "Virtues of the haversine", *Sky & Telescope* 68(2), 1984, p. 159.
+.. [3] W. Torge and J. Mueller, *Geodesy*, 4th ed., de Gruyter, 2012.
+.. [4] T. Vincenty, "Direct and inverse solutions of geodesics on the ellipsoid with application
+   of nested equations", *Survey Review* 23(176), 1975, pp. 88-93.
+.. [5] J. P. Snyder, *Map Projections - A Working Manual*, USGS Professional Paper 1395, 1987.
+.. [6] H. Moritz, "Geodetic Reference System 1980", *Bulletin Geodesique* 54, 1980.
+.. [7] National Imagery and Mapping Agency, *Department of Defense World Geodetic System 1984*,
+   TR8350.2, 3rd ed., 2000.
 """
 from __future__ import annotations
 
@@ -149,8 +161,8 @@ def initial_bearing(lat1: Any, lon1: Any, lat2: Any, lon2: Any) -> Any:
 
     Notes
     -----
-    Spherical trigonometry (e.g. Snyder, *Map Projections - A Working Manual*, USGS 1987, Eq. 5-4b);
-    the "bearing" field of $GPRMB in Hamid et al. (seed 000 Q3, Sec. 3).
+    Spherical trigonometry (e.g. Snyder 1987, Eq. 5-4b); the "bearing" field of $GPRMB in Hamid
+    et al. (2009, Sec. 3).
     """
     p1, l1 = _latlon(lat1, lon1, "1")
     p2, l2 = _latlon(lat2, lon2, "2")
@@ -174,12 +186,22 @@ def haversine_distance_bearing(lat1: float, lon1: float, lat2: float, lon2: floa
     -------
     numpy.ndarray, shape (2,)
         :func:`haversine_distance` and :func:`initial_bearing` together (what $GPRMB reports as
-        range and bearing to the destination, Hamid et al., seed 000 Q3, Sec. 3).
+        range and bearing to the destination, Hamid et al. 2009, Sec. 3).
 
     Raises
     ------
     ValueError
         Non-scalar, non-finite or out-of-range input.
+
+    Notes
+    -----
+    Haversine formula (Sinnott 1984) and the initial great-circle bearing (Snyder 1987, Eq. 5-4b).
+
+    Examples
+    --------
+    >>> lat1, lon1, lat2, lon2 = np.radians([6.4590, 100.3505, 6.4594, 100.3509])
+    >>> np.round(haversine_distance_bearing(lat1, lon1, lat2, lon2), 4).tolist()   # 62.7 m to the north-east
+    [62.7021, 0.7822]
     """
     for name, value in (("lat1", lat1), ("lon1", lon1), ("lat2", lat2), ("lon2", lon2)):
         if np.ndim(value) != 0:
@@ -218,6 +240,12 @@ def vincenty_inverse(lat1: Any, lon1: Any, lat2: Any, lon2: Any, *, tol: float =
     -----
     Vincenty (1975), Eqs. (13)-(21) with the auxiliary sphere of reduced latitudes
     ``tan U = (1 - f) tan lat``; written for this course from the paper's equations.
+
+    Examples
+    --------
+    >>> s12, az1, az2 = vincenty_inverse(*np.radians([6.4590, 100.3505, 6.4594, 100.3509]))
+    >>> round(float(s12), 4), round(float(az1), 4)
+    (62.5665, 0.7855)
     """
     p1, l1 = _latlon(lat1, lon1, "1")
     p2, l2 = _latlon(lat2, lon2, "2")
@@ -284,8 +312,17 @@ def distance_bearing(lat1: Any, lon1: Any, lat2: Any, lon2: Any, model: str = "s
 
     Notes
     -----
-    What a GPS receiver reports in $GPRMB (range, bearing to destination), Hamid et al. (seed 000
-    Q3, Sec. 3); formulas as in :func:`haversine_distance`, :func:`vincenty_inverse`.
+    What a GPS receiver reports in $GPRMB (range, bearing to destination), Hamid et al. (2009,
+    Sec. 3); formulas as in :func:`haversine_distance`, :func:`vincenty_inverse`.
+
+    Examples
+    --------
+    >>> lat1, lon1, lat2, lon2 = np.radians([6.4590, 100.3505, 6.4594, 100.3509])
+    >>> for model in ("sphere", "wgs84"):
+    ...     d, b = distance_bearing(lat1, lon1, lat2, lon2, model=model)
+    ...     print(model, round(float(d), 3), round(float(b), 4))
+    sphere 62.567 0.7822
+    wgs84 62.567 0.7855
     """
     if model == "wgs84":
         s, az1, _ = vincenty_inverse(lat1, lon1, lat2, lon2)
@@ -323,6 +360,14 @@ class LocalTangentPlane:
     reference in this plane agree with the WGS84 geodesic to better than 0.5 mm at 100 m, 5 cm at
     1 km and 4.5 m at 10 km (the error grows with the square of the distance; measured against
     geographiclib in tests/test_outdoor_geodesy.py); the inverse is exact by construction.
+
+    Examples
+    --------
+    >>> plane = LocalTangentPlane(*np.radians([6.4590, 100.3505]))
+    >>> np.round(plane.to_local(*np.radians([6.4594, 100.3509])), 3).tolist()   # east, north (m)
+    [44.247, 44.235]
+    >>> np.round(np.degrees(plane.to_geodetic([44.247, 44.235])), 6).tolist()
+    [6.4594, 100.3509]
     """
 
     def __init__(self, lat0: float, lon0: float) -> None:

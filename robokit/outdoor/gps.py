@@ -1,13 +1,23 @@
 """A 1 Hz GPS receiver and a magnetic compass that speak NMEA 0183, as on the paper's truck.
 
-Hamid et al. (seed 000 Q3, Sec. 3) read position from a Garmin eTrex Vista ($GPRMC, $GPGGA) and
+Hamid et al. (2009, Sec. 3) read position from a Garmin eTrex Vista ($GPRMC, $GPGGA) and
 heading from its compass ($HCHDG), and note that the position may be wrong by up to about 9 m.
 Consumer GPS errors are not independent from second to second: they wander slowly (satellite
 geometry, atmosphere, multipath). We model each horizontal axis as a first-order Gauss-Markov
-process (standard deviation ``sigma``, correlation time ``tau``) plus a little white noise (Grewal,
-Andrews & Bartone, *Global Navigation Satellite Systems, Inertial Navigation, and Integration*,
-3rd ed., 2013, Sec. 10.2 on time-correlated GNSS errors); with ``sigma`` = 2.5 m the error is a few
+process (standard deviation ``sigma``, correlation time ``tau``) plus a little white noise (Grewal
+et al. 2013, Sec. 10.2 on time-correlated GNSS errors); with ``sigma`` = 2.5 m the error is a few
 metres and exceeds 9 m well under 1 % of the time.
+
+References
+----------
+.. [1] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
+.. [2] M. S. Grewal, A. P. Andrews and C. G. Bartone, *Global Navigation Satellite Systems,
+   Inertial Navigation, and Integration*, 3rd ed., Wiley, 2013.
+.. [3] National Marine Electronics Association, *NMEA 0183 Standard for Interfacing Marine
+   Electronic Devices*, version 4.11, 2018.
 """
 from __future__ import annotations
 
@@ -69,6 +79,16 @@ class GPSReceiver:
     -----
     Gauss-Markov update ``b_k+1 = phi b_k + sqrt(1 - phi^2) sigma n_k``, ``phi = exp(-period/tau)``
     (Grewal et al. 2013, Sec. 10.2). Sentences built by :mod:`robokit.outdoor.nmea_write`.
+
+    Examples
+    --------
+    >>> from robokit.outdoor.field import UNIMAP_ORIGIN
+    >>> gps = GPSReceiver(LocalTangentPlane(*UNIMAP_ORIGIN), rng=1)
+    >>> rmc, gga = gps.fix(0.0, [50.0, 30.0], speed=0.7, heading=0.0)
+    >>> rmc
+    '$GPRMC,023000.00,A,0627.5571,N,10021.0578,E,1.36,90.0,040612,,,A*5E'
+    >>> np.round(gps.last_error, 2).tolist()      # east, north error (m) in that fix
+    [1.27, 1.56]
     """
 
     def __init__(self, plane: LocalTangentPlane, *, sigma: float = 2.5, tau: float = 60.0, white: float = 0.3,
@@ -110,7 +130,7 @@ class GPSReceiver:
         p = as_array(position, "position", shape=(2,))
         ts = check_positive(t, "t", allow_zero=True)
         phi = math.exp(-self.period / self.tau)
-        self.bias = phi * self.bias + math.sqrt(1 - phi * phi) * self.sigma * self.rng.normal(size=2)
+        self.bias = phi * self.bias + math.sqrt(1 - phi * phi) * self.sigma * self.rng.normal(size=2)  # Gauss-Markov
         self.last_error = self.bias + self.white * self.rng.normal(size=2)
         lat, lon = self.plane.to_geodetic(p + self.last_error)
         when = MISSION_START + _dt.timedelta(seconds=round(ts, 2))
@@ -135,7 +155,7 @@ class Compass:
 
     Notes
     -----
-    The paper's $HCHDG (Hamid et al., seed 000 Q3, Sec. 3); resolution 0.1 degree in the sentence.
+    The paper's $HCHDG (Hamid et al. 2009, Sec. 3); resolution 0.1 degree in the sentence.
     """
 
     def __init__(self, *, sigma_deg: float = 1.0, variation_deg: float = -0.3, rng: Any = None) -> None:
@@ -148,7 +168,7 @@ class Compass:
 
         Notes
         -----
-        HDG layout, NMEA 0183 v4.11 Sec. 6.3; the compass sentence of Hamid et al. (Sec. 3).
+        HDG layout, NMEA 0183 v4.11 Sec. 6.3; the compass sentence of Hamid et al. (2009, Sec. 3).
         """
         true_deg = heading_to_compass(heading) + (self.rng.normal(0.0, self.sigma_deg) if self.sigma_deg else 0.0)
         return hdg_sentence(true_deg - self.variation_deg, deviation_deg=0.0, variation_deg=self.variation_deg)

@@ -4,8 +4,15 @@ Every control step (one sonar slot, 49 ms) the true truck moves, one sonar of th
 (or all four free-run with cross-talk), the compass sends ``$HCHDG`` every other step, the GPS sends
 ``$GPRMC`` and ``$GPGGA`` once a second, and the :class:`~robokit.outdoor.navigator.Navigator` -
 which sees only that text and the sonar ranges - answers with a speed and yaw rate. Results follow
-the experiment of Hamid et al. (seed 000 Q3, Sec. 4): waypoints reached, collisions, path length
+the experiment of Hamid et al. (2009, Sec. 4): waypoints reached, collisions, path length
 relative to the straight legs, and time.
+
+References
+----------
+.. [1] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
 """
 from __future__ import annotations
 
@@ -120,89 +127,136 @@ def simulate(course: Course, seed: Any = 0, *, firing: str = "chained", truck: S
     -------
     RunResult
 
+    Raises
+    ------
+    TypeError, ValueError
+        For a course that is not a :class:`Course`, an unknown firing mode or a non-positive step.
+
     Notes
     -----
-    The loop is the system of Hamid et al. (seed 000 Q3, Secs. 3-4) with our sensor models:
-    :class:`~robokit.outdoor.gps.GPSReceiver`, :class:`~robokit.outdoor.gps.Compass`,
-    :func:`~robokit.outdoor.sonar.read_sensors`, :class:`~robokit.outdoor.truck.SkidSteerTruck`.
+    The loop is the system of Hamid et al. (2009, Secs. 3-4) with our sensor models, one phase
+    per method of :class:`_Mission`: set-up, sensors (GPS and compass as NMEA text, sonars),
+    navigator, truck, bookkeeping, result.
+
+    Examples
+    --------
+    >>> from robokit.outdoor import Course, Field
+    >>> course = Course(Field(circles=[[7.0, 10.0, 0.4]]), np.array([[14.0, 10.0]]), np.array([2.0, 10.0, 0.0]))
+    >>> run = simulate(course, seed=2, gps_sigma=0.5)
+    >>> run.reached, run.collisions, run.avoidances >= 1
+    (1, 0, True)
     """
     if not isinstance(course, Course):
         raise TypeError(f"course: expected a Course from random_course(), got {type(course).__name__}")
     rng = as_rng(seed, "seed")
     check_choice(firing, "firing", ("chained", "free", "off"))
-    h = check_positive(dt, "dt")
-    keep = check_int(keep_nmea, "keep_nmea", minimum=0)
-    real = truck if truck is not None else dataclasses.replace(
-        PAPER_TRUCK, slip=float(rng.uniform(0.02, 0.12)), icr_factor=float(rng.uniform(1.3, 1.8)))
-    field = course.field
-    plane = LocalTangentPlane(*field.origin)
-    legs = np.vstack([course.start[:2], course.waypoints])
-    straight = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
-    opts = dict(navigator_options or {})
-    nav = Navigator(np.column_stack(plane.to_geodetic(course.waypoints)), PAPER_TRUCK, **opts)
-    offset = plane.to_local(nav.plane.lat0, nav.plane.lon0)  # navigator's frame -> field frame
-    limit = 3 * straight / nav.cruise_speed + 120.0 if max_time is None else check_positive(max_time, "max_time")
-    gps = GPSReceiver(plane, sigma=gps_sigma, rng=rng)
-    compass = Compass(rng=rng)
-    sonar = LVMaxSonarEZ()
-    state = TruckState(np.array(course.start, dtype=float))
-    ranges = np.full(4, sonar.max_range)
-    phases = rng.uniform(0, h, 4)
-    truth, est, states, rlog, fixes, gps_err, nmea = [], [], [], [], [], [], []
-    collisions, contact, length, t, k = 0, False, 0.0, 0.0, 0
-    arrival_true: list[float] = []
-    arrival_points = [np.array(course.start[:2], dtype=float)]
-    avoidances, previous = 0, nav.state
-    while t < limit and not nav.done:
-        if k % 20 == 0:
-            lines = gps.fix(t, state.pose[:2], state.v, state.pose[2])
-            fixes.append(state.pose[:2] + gps.last_error)
-            gps_err.append(float(np.hypot(*gps.last_error)))
-        else:
-            lines = []
-        if k % 2 == 0:
-            lines.append(compass.reading(state.pose[2]))
+    mission = _Mission(course, rng, firing, truck, check_positive(dt, "dt"), check_int(keep_nmea, "keep_nmea", minimum=0),
+                       gps_sigma, navigator_options, max_time)
+    while mission.t < mission.limit and not mission.nav.done:
+        mission.send_nmea()
+        mission.ping_sonars()
+        v, omega = mission.navigate()
+        mission.drive(v, omega)
+        mission.log()
+    return mission.result()
+
+
+class _Mission:
+    """One mission's state, advanced one control step at a time by :func:`simulate`'s phases."""
+
+    def __init__(self, course: Course, rng: np.random.Generator, firing: str, truck: SkidSteerTruck | None,
+                 dt: float, keep: int, gps_sigma: float, navigator_options: dict | None, max_time: float | None):
+        # set-up; the order of the random draws below is part of every seeded result
+        self.course, self.field, self.rng, self.firing, self.dt, self.keep = course, course.field, rng, firing, dt, keep
+        self.real = truck if truck is not None else dataclasses.replace(
+            PAPER_TRUCK, slip=float(rng.uniform(0.02, 0.12)), icr_factor=float(rng.uniform(1.3, 1.8)))
+        plane = LocalTangentPlane(*self.field.origin)
+        legs = np.vstack([course.start[:2], course.waypoints])
+        straight = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
+        self.nav = Navigator(np.column_stack(plane.to_geodetic(course.waypoints)), PAPER_TRUCK,
+                             **dict(navigator_options or {}))
+        self.offset = plane.to_local(self.nav.plane.lat0, self.nav.plane.lon0)  # navigator's frame -> field frame
+        self.limit = (3 * straight / self.nav.cruise_speed + 120.0 if max_time is None
+                      else check_positive(max_time, "max_time"))
+        self.gps = GPSReceiver(plane, sigma=gps_sigma, rng=rng)
+        self.compass = Compass(rng=rng)
+        self.sonar = LVMaxSonarEZ()
+        self.state = TruckState(np.array(course.start, dtype=float))
+        self.ranges = np.full(4, self.sonar.max_range)
+        self.phases = rng.uniform(0, dt, 4)                 # free-running sensors' power-up phases
+        self.t, self.k, self.length, self.collisions, self.contact, self.avoidances = 0.0, 0, 0.0, 0, False, 0
+        self.previous = self.nav.state
+        self.truth, self.estimate, self.states, self.range_log = [], [], [], []
+        self.fixes, self.gps_errors, self.nmea = [], [], []
+        self.arrival_errors: list[float] = []
+        self.arrival_points = [np.array(course.start[:2], dtype=float)]
+
+    def send_nmea(self) -> None:
+        """Sensors, text: a GPS fix (RMC + GGA) every 20 steps (1 Hz), a compass HDG every other step."""
+        lines = []
+        if self.k % 20 == 0:
+            lines = self.gps.fix(self.t, self.state.pose[:2], self.state.v, self.state.pose[2])
+            self.fixes.append(self.state.pose[:2] + self.gps.last_error)
+            self.gps_errors.append(float(np.hypot(*self.gps.last_error)))
+        if self.k % 2 == 0:
+            lines.append(self.compass.reading(self.state.pose[2]))
         for line in lines:
-            nav.feed(line)
-            if len(nmea) < keep:
-                nmea.append(line)
-        if firing == "off":
-            pass
-        elif firing == "chained":
-            i = k % 4
-            ranges[i] = read_sensors(field, state.pose, [i], [t], sensor=sonar, rng=rng)[0]
-        else:
-            times = t + phases
-            ranges[:] = read_sensors(field, state.pose, [0, 1, 2, 3], times, sensor=sonar,
-                                     others=dict(enumerate(times)), rng=rng)
-        before = nav.target
-        v, omega = nav.update(ranges, h)
-        if nav.target > before:  # arrival declared: how far is the truck really?
-            arrival_true.append(math.hypot(*(state.pose[:2] - course.waypoints[before])))
-            arrival_points.append(state.pose[:2].copy())
-        avoidances += nav.state == "AVOID" and previous != "AVOID"
-        previous = nav.state
-        command = nav.truck.wheel_commands(v, omega)
-        new = real.step(state, command, h)
-        length += math.hypot(*(new.pose[:2] - state.pose[:2]))
-        state = new
-        hit = field.collides(state.pose, real.length, real.width)
-        collisions += hit and not contact
-        contact = hit
-        t += h
-        k += 1
-        truth.append(state.pose.copy())
-        est.append(nav.position + offset if nav.position is not None else state.pose[:2] * np.nan)
-        states.append(nav.state)
-        rlog.append(ranges.copy())
-    legs = np.vstack(arrival_points + ([state.pose[:2]] if not nav.done else []))
-    direct = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
-    return RunResult(reached=len(nav.arrivals), n_waypoints=len(course.waypoints), collisions=int(collisions),
-                     avoidances=int(avoidances), time=t, path_length=length,
-                     path_ratio=length / direct if direct > 0 else math.nan,
-                     arrival_errors=np.array(arrival_true), gps_errors=np.array(gps_err),
-                     truth=np.array(truth), estimate=np.array(est), fixes=np.array(fixes).reshape(-1, 2),
-                     states=states, ranges=np.array(rlog), nmea=nmea, parse_errors=len(nav.parse_errors))
+            self.nav.feed(line)
+            if len(self.nmea) < self.keep:
+                self.nmea.append(line)
+
+    def ping_sonars(self) -> None:
+        """Sensors, sonar: one sensor of the daisy chain per step, or all four free-running."""
+        if self.firing == "chained":
+            i = self.k % 4
+            self.ranges[i] = read_sensors(self.field, self.state.pose, [i], [self.t], sensor=self.sonar,
+                                          rng=self.rng)[0]
+        elif self.firing == "free":
+            times = self.t + self.phases
+            self.ranges[:] = read_sensors(self.field, self.state.pose, [0, 1, 2, 3], times, sensor=self.sonar,
+                                          others=dict(enumerate(times)), rng=self.rng)
+
+    def navigate(self) -> tuple[float, float]:
+        """Navigator: ``(v, omega)`` from the latest text and ranges; note arrivals and avoidances."""
+        before = self.nav.target
+        v, omega = self.nav.update(self.ranges, self.dt)
+        if self.nav.target > before:  # arrival declared: how far is the truck really?
+            self.arrival_errors.append(math.hypot(*(self.state.pose[:2] - self.course.waypoints[before])))
+            self.arrival_points.append(self.state.pose[:2].copy())
+        self.avoidances += self.nav.state == "AVOID" and self.previous != "AVOID"
+        self.previous = self.nav.state
+        return v, omega
+
+    def drive(self, v: float, omega: float) -> None:
+        """Truck: the nominal model's wheel commands drive the real truck; count new contacts."""
+        new = self.real.step(self.state, self.nav.truck.wheel_commands(v, omega), self.dt)
+        self.length += math.hypot(*(new.pose[:2] - self.state.pose[:2]))
+        self.state = new
+        hit = self.field.collides(self.state.pose, self.real.length, self.real.width)
+        self.collisions += hit and not self.contact
+        self.contact = hit
+        self.t += self.dt
+        self.k += 1
+
+    def log(self) -> None:
+        """Bookkeeping: true pose, the navigator's estimate (field frame), state and ranges."""
+        self.truth.append(self.state.pose.copy())
+        self.estimate.append(self.nav.position + self.offset if self.nav.position is not None
+                             else self.state.pose[:2] * np.nan)
+        self.states.append(self.nav.state)
+        self.range_log.append(self.ranges.copy())
+
+    def result(self) -> RunResult:
+        """The figures of Hamid et al.'s experiment (Sec. 4), path ratio over the legs actually driven."""
+        legs = np.vstack(self.arrival_points + ([self.state.pose[:2]] if not self.nav.done else []))
+        direct = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
+        return RunResult(reached=len(self.nav.arrivals), n_waypoints=len(self.course.waypoints),
+                         collisions=int(self.collisions), avoidances=int(self.avoidances), time=self.t,
+                         path_length=self.length, path_ratio=self.length / direct if direct > 0 else math.nan,
+                         arrival_errors=np.array(self.arrival_errors), gps_errors=np.array(self.gps_errors),
+                         truth=np.array(self.truth), estimate=np.array(self.estimate),
+                         fixes=np.array(self.fixes).reshape(-1, 2), states=self.states, ranges=np.array(self.range_log),
+                         nmea=self.nmea, parse_errors=len(self.nav.parse_errors))
 
 
 def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | None = None,
@@ -224,9 +278,21 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     -------
     list of RunResult
 
+    Raises
+    ------
+    ValueError, TypeError
+        For a negative or non-integer seed, or bad options (see :func:`simulate`).
+
     Notes
     -----
-    The seeded repetition of Hamid et al.'s experiment (seed 000 Q3, Sec. 4) used by the lesson.
+    The seeded repetition of Hamid et al.'s experiment (2009, Sec. 4) used by the lesson; course
+    ``s`` is driven with ``simulate(..., seed=10_000 + s)``.
+
+    Examples
+    --------
+    >>> small = {"n_waypoints": 1, "size": (30.0, 20.0), "n_obstacles": 2}
+    >>> [(r.reached, r.collisions) for r in run_courses([0], course_options=small)]
+    [(1, 0)]
     """
     seeds = [check_int(s, "seeds[i]", minimum=0) for s in seeds]
     out = []
@@ -254,13 +320,20 @@ def summarize_runs(results: list[RunResult]) -> dict:
 
     Notes
     -----
-    The figures of the paper's experiment (Hamid et al., seed 000 Q3, Sec. 4) plus the GPS error.
+    The figures of the paper's experiment (Hamid et al. 2009, Sec. 4) plus the GPS error.
+
+    Examples
+    --------
+    >>> runs = run_courses([0], course_options={"n_waypoints": 1, "size": (30.0, 20.0), "n_obstacles": 2})
+    >>> summary = summarize_runs(runs)
+    >>> summary["waypoints_reached"], summary["collisions_total"], summary["success_rate"]
+    ('1/1', 0, 1.0)
     """
     if not results:
         raise ValueError("results: expected at least one RunResult, got an empty list")
     ratio = np.array([r.path_ratio for r in results])
     time = np.array([r.time for r in results])
-    arr = np.concatenate([r.arrival_errors for r in results]) if results else np.array([])
+    arr = np.concatenate([r.arrival_errors for r in results])
 
     def stats(x):
         x = np.asarray(x, dtype=float)

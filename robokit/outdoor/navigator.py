@@ -1,6 +1,6 @@
 """Waypoint navigation from NMEA text, with the four-sonar obstacle-avoidance state machine.
 
-Hamid et al. (seed 000 Q3, Sec. 4): the truck follows GPS waypoints; when a sonar sees an obstacle
+Hamid et al. (2009, Sec. 4): the truck follows GPS waypoints; when a sonar sees an obstacle
 it turns left or right (it has no rear sensor, so it never backs up), and once past the obstacle it
 re-computes the bearing to the waypoint from its current position. :class:`Navigator` does exactly
 that, reading only what the real truck reads - NMEA sentences from the GPS and compass (parsed with
@@ -9,6 +9,14 @@ that, reading only what the real truck reads - NMEA sentences from the GPS and c
 States: ``GOTO`` (steer the bearing to the waypoint), ``AVOID`` (turn on the spot away from the
 obstacle until the front is clear), ``BYPASS`` (drive straight a short distance to get past it),
 then ``GOTO`` again; ``DONE`` after the last waypoint.
+
+References
+----------
+.. [1] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
+.. [2] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
 """
 from __future__ import annotations
 
@@ -17,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
+from ..controllers import HeadingController, design_heading_gains
 from ..geometry import wrap_angle
 from ..validation import as_array, as_points, check_choice, check_positive
-from .controller import HeadingController, design_heading_gains
 from .geodesy import LocalTangentPlane
 from .gps import compass_to_heading
 from .nmea import GGA, HDG, RMC, NMEAError, parse_sentence
@@ -58,7 +66,7 @@ def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefe
 
     Notes
     -----
-    Hamid et al. (seed 000 Q3, Sec. 4): the outer sensors watch the sides, the middle pair the
+    Hamid et al. (2009, Sec. 4): the outer sensors watch the sides, the middle pair the
     front; the robot avoids by moving left or right only.
     """
     r = as_array(ranges, "ranges", shape=(4,), finite=False)
@@ -109,8 +117,8 @@ class Navigator:
     Notes
     -----
     Position estimate: dead reckoning with the compass heading and the commanded speed, pulled
-    towards each GPS fix (a complementary filter; e.g. Thrun, Burgard & Fox, *Probabilistic
-    Robotics*, 2005, Sec. 3.2 in its steady-state, fixed-gain form).
+    towards each GPS fix (a complementary filter; e.g. Thrun et al. 2005, Sec. 3.2 in its
+    steady-state, fixed-gain form).
     """
 
     def __init__(self, waypoints: Any, truck: SkidSteerTruck, *, cruise_speed: float = 0.7,
@@ -150,7 +158,7 @@ class Navigator:
 
         Notes
         -----
-        RMC position and HDG heading, as the truck of Hamid et al. reads them (Sec. 3).
+        RMC position and HDG heading, as the truck of Hamid et al. reads them (2009, Sec. 3).
         """
         try:
             rec = parse_sentence(line)
@@ -187,7 +195,7 @@ class Navigator:
 
         Notes
         -----
-        GOTO / AVOID / BYPASS behaviour of Hamid et al. (seed 000 Q3, Sec. 4); see the module docstring.
+        GOTO / AVOID / BYPASS behaviour of Hamid et al. (2009, Sec. 4); see the module docstring.
         """
         r = as_array(ranges, "ranges", shape=(4,), finite=False)
         h = check_positive(dt, "dt")

@@ -2,14 +2,23 @@
 
 A sentence looks like ``$GPRMC,123519,A,4807.038,N,...*6A\\r\\n``: a ``$``, an address (a two-letter
 talker such as ``GP``, ``GN``, ``GL`` or ``HC``, then a three-letter sentence type), comma separated
-fields, ``*`` and a two-hex-digit checksum (NMEA 0183 v4.11, Sec. 5.2-5.3). Hamid et al. (seed 000
-Q3, Sec. 3) drive their truck from ``$GPRMC``, ``$GPRMB``, ``$GPGGA`` and ``$HCHDG``; those four get
-typed records (:class:`RMC`, :class:`RMB`, :class:`GGA`, :class:`HDG`) for any talker, and every other
-type is returned as a :class:`Sentence` (never an error).
+fields, ``*`` and a two-hex-digit checksum (NMEA 0183 v4.11, Sec. 5.2-5.3). Hamid et al. (2009,
+Sec. 3) drive their truck from ``$GPRMC``, ``$GPRMB``, ``$GPGGA`` and ``$HCHDG``; those four get
+typed records (:class:`RMC`, :class:`RMB`, :class:`GGA`, :class:`HDG`) for any talker, and every
+other type is returned as a :class:`Sentence` (never an error).
 
 Conventions: empty fields become ``None``; latitude and longitude are signed decimal degrees (north
 and east positive) as the fields carry them; the records keep NMEA's own units (knots, degrees) in
 their field names and offer SI properties (``speed_mps``, ``course_rad``, ...).
+
+References
+----------
+.. [1] National Marine Electronics Association, *NMEA 0183 Standard for Interfacing Marine
+   Electronic Devices*, version 4.11, 2018.
+.. [2] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
 """
 from __future__ import annotations
 
@@ -20,8 +29,8 @@ from operator import xor
 from typing import Any, BinaryIO, Callable, Iterator, NamedTuple
 
 from ..validation import check_int, describe
-from .nmea_fields import (NMEAChecksumError, NMEAError, NMEAFormatError, _angle, _flag, _float, _int, _signed,
-                          parse_date, parse_latitude, parse_longitude, parse_time)
+from .nmea_fields import (RECORD_PARSERS, NMEAChecksumError, NMEAError, NMEAFormatError, parse_date, parse_latitude,
+                          parse_longitude, parse_time)
 from .nmea_records import GGA, HDG, RMB, RMC, Sentence
 
 __all__ = [
@@ -64,8 +73,13 @@ def nmea_checksum(sentence: str) -> str:
 
     Notes
     -----
-    NMEA 0183 v4.11, Sec. 5.2.1 (checksum field); the example in Hamid et al. (seed 000 Q3, Sec. 3)
+    NMEA 0183 v4.11, Sec. 5.2.1 (checksum field); the example in Hamid et al. (2009, Sec. 3)
     reads the receiver's ASCII output in exactly this form.
+
+    Examples
+    --------
+    >>> nmea_checksum("GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,")
+    '47'
     """
     if not isinstance(sentence, str):
         raise TypeError(f"sentence: expected a str, got {describe(sentence)}")
@@ -80,58 +94,6 @@ def nmea_checksum(sentence: str) -> str:
     except UnicodeEncodeError:
         raise NMEAFormatError(f"sentence: expected ASCII characters only, got {sentence!r}") from None
     return "%02X" % _xor(data)
-
-
-# --- typed sentences ------------------------------------------------------------------------------
-
-def _need(f: list, n: int, kind: str) -> None:
-    if len(f) < n:
-        raise NMEAFormatError(f"{kind}: expected at least {n} fields, got {len(f)}")
-
-
-def _rmc(talker: str, f: list) -> RMC:
-    _need(f, 9, "RMC")
-    f = f + [""] * (13 - len(f)) if len(f) < 13 else f
-    return RMC(talker, parse_time(f[0]), _flag(f[1], "RMC status", "AV"),
-               _angle(f[2], f[3], "RMC latitude", 90, "N", "S"),
-               _angle(f[4], f[5], "RMC longitude", 180, "E", "W"),
-               _float(f[6], "RMC speed"), _float(f[7], "RMC course"), parse_date(f[8]),
-               _signed(f[9], f[10], "RMC magnetic variation", "E", "W"), f[11] or None)
-
-
-def _rmb(talker: str, f: list) -> RMB:
-    _need(f, 13, "RMB")
-    xte = _float(f[1], "RMB cross-track error")
-    steer = _flag(f[2], "RMB steer direction", "LR")
-    return RMB(talker, _flag(f[0], "RMB status", "AV"), xte, steer, f[3] or None, f[4] or None,
-               _angle(f[5], f[6], "RMB destination latitude", 90, "N", "S"),
-               _angle(f[7], f[8], "RMB destination longitude", 180, "E", "W"),
-               _float(f[9], "RMB range"), _float(f[10], "RMB bearing"),
-               _float(f[11], "RMB closing velocity"), _flag(f[12], "RMB arrival", "AV"),
-               f[13] or None if len(f) > 13 else None)
-
-
-def _gga(talker: str, f: list) -> GGA:
-    _need(f, 9, "GGA")
-    f = f + [""] * (14 - len(f)) if len(f) < 14 else f
-    return GGA(talker, parse_time(f[0]),
-               _angle(f[1], f[2], "GGA latitude", 90, "N", "S"),
-               _angle(f[3], f[4], "GGA longitude", 180, "E", "W"),
-               _int(f[5], "GGA quality"), _int(f[6], "GGA satellites"), _float(f[7], "GGA HDOP"),
-               _float(f[8], "GGA altitude"), _float(f[10], "GGA geoid separation"),
-               _float(f[12], "GGA DGPS age"), f[13] or None)
-
-
-def _hdg(talker: str, f: list) -> HDG:
-    _need(f, 5, "HDG")
-    heading = _float(f[0], "HDG heading")
-    if heading is not None and not 0.0 <= heading <= 360.0:
-        raise NMEAFormatError(f"HDG heading: expected degrees in [0, 360], got {f[0]!r}")
-    return HDG(talker, heading, _signed(f[1], f[2], "HDG deviation", "E", "W"),
-               _signed(f[3], f[4], "HDG variation", "E", "W"))
-
-
-_TYPED: dict[str, Callable[[str, list], Any]] = {"RMC": _rmc, "RMB": _rmb, "GGA": _gga, "HDG": _hdg}
 
 
 def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> RMC | RMB | GGA | HDG | Sentence:
@@ -163,7 +125,15 @@ def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> R
     Notes
     -----
     Framing and checksum: NMEA 0183 v4.11, Sec. 5.2-5.3; field layouts: Sec. 6.3 (RMC, RMB, GGA,
-    HDG), the four sentences Hamid et al. read (seed 000 Q3, Sec. 3).
+    HDG), the four sentences Hamid et al. (2009, Sec. 3) read.
+
+    Examples
+    --------
+    >>> rec = parse_sentence("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A")
+    >>> rec.talker, rec.status, rec.latitude, round(rec.longitude, 6), rec.speed_knots
+    ('GP', 'A', 48.1173, 11.516667, 22.4)
+    >>> parse_sentence("$GPZDA,201530.00,04,07,2002,00,00*60").kind         # any other type: generic
+    'ZDA'
     """
     if type(sentence) is not str:
         if isinstance(sentence, (bytes, bytearray)):
@@ -206,7 +176,7 @@ def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> R
         talker, kind = "P", address[1:]
     else:
         talker, kind = address[:2], address[2:]
-    parser = _TYPED.get(kind)
+    parser = RECORD_PARSERS.get(kind)
     if parser is None or len(address) != 5:
         return Sentence(talker, kind, tuple(fields[1:]))
     return parser(talker, fields[1:])
@@ -234,7 +204,12 @@ def fix_position(sentence: str) -> list[float]:
     Notes
     -----
     ``ddmm.mmmm`` -> ``dd + mm.mmmm / 60`` (NMEA 0183 v4.11, Sec. 6.2); the position the truck of
-    Hamid et al. reads from $GPRMC/$GPGGA (seed 000 Q3, Sec. 3).
+    Hamid et al. (2009, Sec. 3) reads from $GPRMC/$GPGGA.
+
+    Examples
+    --------
+    >>> [round(x, 6) for x in fix_position("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A")]
+    [48.1173, 11.516667]
     """
     rec = parse_sentence(sentence)
     if not isinstance(rec, (RMC, GGA)):
@@ -287,6 +262,12 @@ class NMEAReader:
     -----
     Resynchronising on ``$`` is how a receiver's listener recovers after noise or a lost
     character (NMEA 0183 v4.11, Sec. 5.3: ``$`` only ever starts a sentence).
+
+    Examples
+    --------
+    >>> reader = NMEAReader(b"junk$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A\\r\\n$GPGGA,12*00\\r\\n")
+    >>> [rec.kind for rec in reader], reader.junk_bytes, [type(bad.error).__name__ for bad in reader.errors]
+    (['RMC'], 4, ['NMEAChecksumError'])
     """
 
     def __init__(self, source: Any, *, require_checksum: bool = True,

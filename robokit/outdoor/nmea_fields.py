@@ -1,15 +1,25 @@
-"""NMEA 0183 field conversions and the error hierarchy shared by the parser and the reader.
+"""NMEA 0183 fields: conversions, the builders of the typed records, and the error hierarchy.
 
 Latitude/longitude ``ddmm.mmmm``/``dddmm.mmmm`` with hemisphere, UTC time ``hhmmss.ss``, date
 ``ddmmyy``, signed values with E/W direction, single-letter flags; empty fields become ``None``
-(NMEA 0183 v4.11, Secs. 6.2-6.3).
+(NMEA 0183 v4.11, Secs. 6.2-6.3). :data:`RECORD_PARSERS` turns the fields of an RMC, RMB, GGA or
+HDG sentence into its record (:mod:`robokit.outdoor.nmea_records`); :func:`robokit.outdoor.nmea.parse_sentence`
+frames and checks a sentence and hands its fields over.
+
+References
+----------
+.. [1] National Marine Electronics Association, *NMEA 0183 Standard for Interfacing Marine
+   Electronic Devices*, version 4.11, 2018.
 """
 from __future__ import annotations
 
 import datetime as _dt
+from typing import Any, Callable
+
+from .nmea_records import GGA, HDG, RMB, RMC
 
 __all__ = ["NMEAError", "NMEAChecksumError", "NMEAFormatError",
-           "parse_latitude", "parse_longitude", "parse_time", "parse_date"]
+           "parse_latitude", "parse_longitude", "parse_time", "parse_date", "RECORD_PARSERS"]
 
 
 class NMEAError(ValueError):
@@ -184,3 +194,52 @@ def _flag(value: str, name: str, allowed: str) -> str | None:
     return value
 
 
+def _need(f: list, n: int, kind: str) -> None:
+    if len(f) < n:
+        raise NMEAFormatError(f"{kind}: expected at least {n} fields, got {len(f)}")
+
+
+def _rmc(talker: str, f: list) -> RMC:
+    _need(f, 9, "RMC")
+    f = f + [""] * (13 - len(f)) if len(f) < 13 else f
+    return RMC(talker, parse_time(f[0]), _flag(f[1], "RMC status", "AV"),
+               _angle(f[2], f[3], "RMC latitude", 90, "N", "S"),
+               _angle(f[4], f[5], "RMC longitude", 180, "E", "W"),
+               _float(f[6], "RMC speed"), _float(f[7], "RMC course"), parse_date(f[8]),
+               _signed(f[9], f[10], "RMC magnetic variation", "E", "W"), f[11] or None)
+
+
+def _rmb(talker: str, f: list) -> RMB:
+    _need(f, 13, "RMB")
+    xte = _float(f[1], "RMB cross-track error")
+    steer = _flag(f[2], "RMB steer direction", "LR")
+    return RMB(talker, _flag(f[0], "RMB status", "AV"), xte, steer, f[3] or None, f[4] or None,
+               _angle(f[5], f[6], "RMB destination latitude", 90, "N", "S"),
+               _angle(f[7], f[8], "RMB destination longitude", 180, "E", "W"),
+               _float(f[9], "RMB range"), _float(f[10], "RMB bearing"),
+               _float(f[11], "RMB closing velocity"), _flag(f[12], "RMB arrival", "AV"),
+               f[13] or None if len(f) > 13 else None)
+
+
+def _gga(talker: str, f: list) -> GGA:
+    _need(f, 9, "GGA")
+    f = f + [""] * (14 - len(f)) if len(f) < 14 else f
+    return GGA(talker, parse_time(f[0]),
+               _angle(f[1], f[2], "GGA latitude", 90, "N", "S"),
+               _angle(f[3], f[4], "GGA longitude", 180, "E", "W"),
+               _int(f[5], "GGA quality"), _int(f[6], "GGA satellites"), _float(f[7], "GGA HDOP"),
+               _float(f[8], "GGA altitude"), _float(f[10], "GGA geoid separation"),
+               _float(f[12], "GGA DGPS age"), f[13] or None)
+
+
+def _hdg(talker: str, f: list) -> HDG:
+    _need(f, 5, "HDG")
+    heading = _float(f[0], "HDG heading")
+    if heading is not None and not 0.0 <= heading <= 360.0:
+        raise NMEAFormatError(f"HDG heading: expected degrees in [0, 360], got {f[0]!r}")
+    return HDG(talker, heading, _signed(f[1], f[2], "HDG deviation", "E", "W"),
+               _signed(f[3], f[4], "HDG variation", "E", "W"))
+
+
+#: Builders of the typed records from a sentence's fields (after the address), by sentence type.
+RECORD_PARSERS: dict[str, Callable[[str, list], Any]] = {"RMC": _rmc, "RMB": _rmb, "GGA": _gga, "HDG": _hdg}

@@ -2,7 +2,16 @@
 
 Immutable named tuples (cheap to build, compare and print). Field names carry NMEA's own units
 (``speed_knots``, ``course_deg``); SI properties convert them (DESIGN.md: SI units in APIs).
-Layouts follow NMEA 0183 v4.11, Sec. 6.3, for the sentences Hamid et al. read (seed 000 Q3, Sec. 3).
+Layouts follow NMEA 0183 v4.11, Sec. 6.3, for the sentences Hamid et al. (2009, Sec. 3) read.
+
+References
+----------
+.. [1] National Marine Electronics Association, *NMEA 0183 Standard for Interfacing Marine
+   Electronic Devices*, version 4.11, 2018.
+.. [2] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
 """
 from __future__ import annotations
 

@@ -1,8 +1,17 @@
 """Build NMEA 0183 sentences: what the simulated GPS receiver and compass emit.
 
 The simulation talks to the navigator in the same text a Garmin eTrex sends over its serial port
-(Hamid et al., seed 000 Q3, Sec. 3), so the whole stack runs through :mod:`robokit.outdoor.nmea`.
+(Hamid et al. 2009, Sec. 3), so the whole stack runs through :mod:`robokit.outdoor.nmea`.
 Formats follow NMEA 0183 v4.11, Sec. 5.3 (framing) and 6.3 (RMC, RMB, GGA, HDG).
+
+References
+----------
+.. [1] National Marine Electronics Association, *NMEA 0183 Standard for Interfacing Marine
+   Electronic Devices*, version 4.11, 2018.
+.. [2] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
 """
 from __future__ import annotations
 
@@ -146,6 +155,15 @@ def rmc_sentence(when: _dt.datetime, latitude: float | None, longitude: float | 
     ------
     TypeError, ValueError
         For a non-datetime ``when`` or out-of-range values.
+    Notes
+    -----
+    RMC field layout, NMEA 0183 v4.11 Sec. 6.3 (the fix sentence of Hamid et al. 2009, Sec. 3).
+
+    Examples
+    --------
+    >>> import datetime as dt
+    >>> rmc_sentence(dt.datetime(2012, 6, 4, 2, 30, 15), 6.4590, 100.3505, speed_mps=0.7, course_deg=37.5)
+    '$GPRMC,023015.00,A,0627.5400,N,10021.0300,E,1.36,37.5,040612,,,A*5C'
     """
     if not isinstance(when, _dt.datetime):
         raise TypeError(f"when: expected a datetime.datetime, got {describe(when)}")
@@ -183,6 +201,15 @@ def gga_sentence(when: _dt.time, latitude: float | None, longitude: float | None
     Returns
     -------
     str
+    Notes
+    -----
+    GGA field layout, NMEA 0183 v4.11 Sec. 6.3.
+
+    Examples
+    --------
+    >>> import datetime as dt
+    >>> gga_sentence(dt.time(2, 30, 15), 6.4590, 100.3505, satellites=8, hdop=1.2, altitude_m=12.0)
+    '$GPGGA,023015.00,0627.5400,N,10021.0300,E,1,08,1.2,12.0,M,,M,,*4C'
     """
     lat, ns = format_latitude(latitude)
     lon, ew = format_longitude(longitude)
@@ -208,6 +235,14 @@ def hdg_sentence(heading_deg: float, *, deviation_deg: float | None = None,
     Returns
     -------
     str
+    Notes
+    -----
+    HDG field layout, NMEA 0183 v4.11 Sec. 6.3 (``$HCHDG``, the compass of Hamid et al. 2009, Sec. 3).
+
+    Examples
+    --------
+    >>> hdg_sentence(36.8, deviation_deg=0.0, variation_deg=-0.3)
+    '$HCHDG,36.8,0.0,E,0.3,W*6E'
     """
     h = round(check_finite_scalar(heading_deg, "heading_deg"), 1) % 360.0
 
@@ -244,6 +279,14 @@ def rmb_sentence(destination_latitude: float, destination_longitude: float, rang
     Returns
     -------
     str
+    Notes
+    -----
+    RMB field layout, NMEA 0183 v4.11 Sec. 6.3 (range and bearing to the destination waypoint).
+
+    Examples
+    --------
+    >>> rmb_sentence(6.4594, 100.3509, range_m=65.0, bearing_deg=44.0, destination_id="002")
+    '$GPRMB,A,0.000,L,000,002,0627.5640,N,10021.0540,E,0.035,44.0,0.0,V,A*58'
     """
     lat, ns = format_latitude(destination_latitude)
     lon, ew = format_longitude(destination_longitude)
@@ -279,6 +322,10 @@ def random_sentences(count: int, rng=None, *, empty_fraction: float = 0.1) -> li
     Notes
     -----
     Field layouts as in NMEA 0183 v4.11, Sec. 6.3.
+    Examples
+    --------
+    >>> random_sentences(3, rng=5)[2]
+    '$HCHDG,97.7,,,,*7B'
     """
     n = check_int(count, "count", minimum=0)
     p = check_positive(empty_fraction, "empty_fraction", allow_zero=True)

@@ -1,6 +1,6 @@
 """LV-MaxSonar-EZ ultrasonic rangers: pulse-width output, beam, timing, and chained versus free firing.
 
-Hamid et al. (seed 000 Q3, Sec. 4) mount four MaxBotix LV-MaxSonar-EZ sensors on the front of the
+Hamid et al. (2009, Sec. 4) mount four MaxBotix LV-MaxSonar-EZ sensors on the front of the
 truck, read their pulse-width output and convert it to centimetres or inches (their Eqs. (1), (2)),
 and fire them in a commanded daisy-chain loop so that they never hear each other. Sensor facts from
 the MaxBotix LV-MaxSonar-EZ datasheet: 147 us of pulse width per inch, 6 to 254 inch reported
@@ -9,6 +9,18 @@ chaining application note "Using multiple sensors in a single system" (RX/BW/TX 
 
 Frames: a sensor mount is ``[x, y, yaw]`` in the truck frame (x forward, y left, metres, radians);
 the field frame is x east, y north (see :mod:`robokit.outdoor.field`).
+
+References
+----------
+.. [1] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
+.. [2] MaxBotix Inc., *LV-MaxSonar-EZ Series High Performance Sonar Range Finder* (datasheet,
+   MB1000-MB1040).
+.. [3] MaxBotix Inc., *Using Multiple Sensors in a Single System* (application note).
+.. [4] R. Smith, M. Self and P. Cheeseman, "Estimating uncertain spatial relationships in
+   robotics", in *Autonomous Robot Vehicles*, Springer, 1990, pp. 167-193.
 """
 from __future__ import annotations
 
@@ -19,7 +31,7 @@ import numpy as np
 
 from ..geometry import wrap_angle
 from ..validation import as_array, as_rng, check_int, check_positive
-from .field import Field
+from ..sim.layout import Layout
 
 __all__ = ["INCH", "SECONDS_PER_INCH", "SPEED_OF_SOUND", "LVMaxSonarEZ", "SonarMount", "PAPER_LAYOUT",
            "pulse_width_to_range", "range_to_pulse_width", "pulse_width_to_cm_inches",
@@ -50,6 +62,14 @@ class LVMaxSonarEZ:
         (20 deg) is our approximation of the EZ1's pattern for a large target.
     resolution : float
         Range resolution, 1 inch.
+
+    Examples
+    --------
+    >>> sensor = LVMaxSonarEZ()
+    >>> round(sensor.max_range, 4), round(sensor.listen_time * 1000, 2)     # 254 inch; echo time in ms
+    (6.4516, 37.62)
+    >>> round(sensor.quantize(1.0), 4), round(sensor.quantize(0.01), 4)       # 1-inch steps, 6-inch floor
+    (0.9906, 0.1524)
     """
 
     min_range: float = 6 * INCH
@@ -97,13 +117,13 @@ def pulse_width_to_range(pulse_width: Any) -> Any:
 
     Notes
     -----
-    Hamid et al. (seed 000 Q3, Sec. 4), Eqs. (1)-(2); scale factor from the LV-MaxSonar-EZ
+    Hamid et al. (2009, Sec. 4), Eqs. (1)-(2); scale factor from the LV-MaxSonar-EZ
     datasheet (147 us per inch).
     """
     pw = as_array(pulse_width, "pulse_width")
     if np.any(pw < 0):
         raise ValueError(f"pulse_width: expected non-negative seconds, got {float(pw.min()):g}")
-    out = pw / SECONDS_PER_INCH * INCH
+    out = pw / SECONDS_PER_INCH * INCH                    # Eqs. (1)-(2), in metres
     return float(out) if out.ndim == 0 else out
 
 
@@ -136,13 +156,18 @@ def pulse_width_to_cm_inches(pulse_width_us: float) -> dict:
 
     Notes
     -----
-    Hamid et al. (seed 000 Q3, Sec. 4), Eqs. (1)-(2); the datasheet scale is 147 us per inch.
+    Hamid et al. (2009, Sec. 4), Eqs. (1)-(2); the datasheet scale is 147 us per inch.
+
+    Examples
+    --------
+    >>> pulse_width_to_cm_inches(1470)
+    {'inches': 10.0, 'cm': 25.4}
     """
     pw = check_positive(pulse_width_us, "pulse_width_us", allow_zero=True)
     if pw > 60000:
         raise ValueError(f"pulse_width_us: expected at most 60000 us (one reading cycle), got {pw:g}")
-    inches = pw / 147.0
-    return {"inches": inches, "cm": inches * 2.54}
+    inches = pw / 147.0                                   # Eq. (1)
+    return {"inches": inches, "cm": inches * 2.54}        # Eq. (2)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -157,7 +182,7 @@ class SonarMount:
 
 #: The paper's layout on the 50 cm truck's front bumper (x = 0.25 m from the centre): the outer pair
 #: 20 cm apart turned 45 degrees outwards, the middle pair 10 cm apart facing forward
-#: (Hamid et al., seed 000 Q3, Sec. 4). Order: outer left, middle left, middle right, outer right.
+#: (Hamid et al. 2009, Sec. 4). Order: outer left, middle left, middle right, outer right.
 PAPER_LAYOUT = (
     SonarMount("outer_left", 0.25, 0.10, np.pi / 4),
     SonarMount("middle_left", 0.25, 0.05, 0.0),
@@ -190,11 +215,21 @@ def firing_schedule(n_sensors: int, duration: float, mode: str = "chained", *, c
     list of numpy.ndarray
         One array of start times per sensor.
 
+    Raises
+    ------
+    ValueError
+        For a bad count, duration, cycle or mode.
+
     Notes
     -----
     MaxBotix application note on chaining (RX of the first sensor triggered once, each TX output
-    triggering the next RX, the last fed back to the first); Hamid et al. (seed 000 Q3) call it the
+    triggering the next RX, the last fed back to the first); Hamid et al. (2009) call it the
     commanded loop daisy chaining method.
+
+    Examples
+    --------
+    >>> [np.round(t, 3).tolist() for t in firing_schedule(4, 0.4)]      # one ping at a time
+    [[0.0, 0.196, 0.392], [0.049, 0.245], [0.098, 0.294], [0.147, 0.343]]
     """
     n = check_int(n_sensors, "n_sensors", minimum=1)
     T = check_positive(duration, "duration")
@@ -212,20 +247,25 @@ def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.n
 
     Notes
     -----
-    Planar pose composition (Smith, Self & Cheeseman, 1990) of the truck pose and each mount of
-    :data:`PAPER_LAYOUT` (Hamid et al., seed 000 Q3, Sec. 4).
+    Planar pose composition (Smith, Self & Cheeseman 1990) of the truck pose and each mount of
+    :data:`PAPER_LAYOUT` (Hamid et al. 2009, Sec. 4).
+
+    Examples
+    --------
+    >>> np.round(sensor_poses([0.0, 0.0, 0.0]), 3).tolist()     # x forward, y left, yaw
+    [[0.25, 0.1, 0.785], [0.25, 0.05, 0.0], [0.25, -0.05, 0.0], [0.25, -0.1, -0.785]]
     """
     x, y, th = as_array(pose, "pose", shape=(3,))
     c, s = np.cos(th), np.sin(th)
     m = np.array([[mt.x, mt.y, mt.yaw] for mt in mounts])
-    return np.stack([x + c * m[:, 0] - s * m[:, 1], y + s * m[:, 0] + c * m[:, 1], th + m[:, 2]], axis=1)
+    return np.stack([x + c * m[:, 0] - s * m[:, 1], y + s * m[:, 0] + c * m[:, 1], th + m[:, 2]], axis=1)  # pose + mount
 
 
 def _cone(sensor: LVMaxSonarEZ, rays: int) -> np.ndarray:
     return np.linspace(-sensor.half_angle, sensor.half_angle, rays)
 
 
-def true_ranges(field: "Field", pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT,
+def true_ranges(field: Layout, pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT,
                 sensor: LVMaxSonarEZ = LVMaxSonarEZ(), rays: int = 9) -> tuple[np.ndarray, np.ndarray]:
     """Nearest obstacle within each sensor's cone, and where it is.
 
@@ -249,16 +289,25 @@ def true_ranges(field: "Field", pose: Any, mounts: Sequence[SonarMount] = PAPER_
     Notes
     -----
     A sonar reports the *first* echo anywhere in its cone, which is why wide beams see obstacles
-    off to the side (datasheet beam pattern; Hamid et al., Sec. 4, side sensors at 45 degrees).
+    off to the side (datasheet beam pattern; Hamid et al. 2009, Sec. 4, side sensors at 45 degrees).
+    The rays are cast with :meth:`robokit.sim.Layout.raycast` (its tie rule applies).
+
+    Examples
+    --------
+    >>> from robokit.outdoor import Field
+    >>> ranges, hits = true_ranges(Field(circles=[[2.5, 0.0, 0.3]]), [0.0, 0.0, 0.0])
+    >>> np.round(ranges, 3).tolist()                 # a post 2.5 m ahead: only the middle pair sees it
+    [inf, 1.954, 1.954, inf]
     """
-    if not isinstance(field, Field):
-        raise TypeError(f"field: expected a robokit.outdoor.field.Field, got {type(field).__name__}")
+    if not isinstance(field, Layout):
+        raise TypeError(f"field: expected a robokit.outdoor.Field (or any robokit.sim.Layout), got "
+                        f"{type(field).__name__}")
     k = check_int(rays, "rays", minimum=1)
     sp = sensor_poses(pose, mounts)
     offs = _cone(sensor, k)
     angles = (sp[:, 2:3] + offs[None, :]).ravel()
     origins = np.repeat(sp[:, :2], k, axis=0)
-    d = field._raycast(origins, angles, sensor.max_range * 1.0001).reshape(len(sp), k)
+    d = field.raycast(origins, angles, sensor.max_range * 1.0001, check=False).reshape(len(sp), k)
     j = d.argmin(axis=1)
     r = d[np.arange(len(sp)), j]
     hit = r < sensor.max_range
@@ -301,8 +350,15 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
 
     Notes
     -----
-    Cross-talk is the reason for the chained, commanded-loop firing in Hamid et al. (seed 000 Q3,
+    Cross-talk is the reason for the chained, commanded-loop firing in Hamid et al. (2009,
     Sec. 4) and in the MaxBotix multi-sensor application note.
+
+    Examples
+    --------
+    >>> from robokit.outdoor import Field
+    >>> post = Field(circles=[[2.5, 0.0, 0.3]])
+    >>> read_sensors(post, [0.0, 0.0, 0.0], [1, 2], [0.0, 0.049], noise=0.0).round(4).tolist()   # chained
+    [1.9558, 1.9558]
     """
     g = as_rng(rng)
     idx = [check_int(i, "which[i]", minimum=0, maximum=len(mounts) - 1) for i in which]

@@ -1,15 +1,24 @@
 """The skid-steer RC truck of Hamid et al.: body, four driven wheels, slip, and motor lag.
 
-Hamid et al. (seed 000 Q3, Sec. 2) use a 50 x 25 x 15 cm RC truck whose four wheels are driven
+Hamid et al. (2009, Sec. 2) use a 50 x 25 x 15 cm RC truck whose four wheels are driven
 independently, so it steers by driving its left and right sides at different speeds and can turn on
-the spot. A skid-steer vehicle turns less than a differential drive of the same track would,
-because its wheels must slide sideways; a common model keeps differential-drive kinematics with an
-*effective* track ``chi * B`` (``chi > 1``, the instantaneous-centre-of-rotation expansion of Mandow
-et al., "Experimental kinematics for wheeled skid-steer mobile robots", IROS 2007, Sec. III) and a
-longitudinal slip ratio ``s`` that scales the wheel speeds. Each side's motor follows its speed
-command with a first-order lag ``tau``.
+the spot. Its kinematics are the skid-steer model of :mod:`robokit.sim.vehicle` (Mandow et al.
+2007): differential-drive form with an effective track ``icr_factor * B`` (``icr_factor > 1``, the
+expansion of the instantaneous centres of rotation) and a longitudinal slip ratio ``s`` that
+scales the wheel speeds. Each side's motor follows its speed command with a first-order lag ``tau``.
 
 Pose ``[x, y, theta]``: field frame x east, y north, ``theta`` counter-clockwise from east.
+
+References
+----------
+.. [1] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
+.. [2] A. Mandow, J. L. Martinez, J. Morales, J. L. Blanco, A. Garcia-Cerezo and J. Gonzalez,
+   "Experimental kinematics for wheeled skid-steer mobile robots", IEEE/RSJ International
+   Conference on Intelligent Robots and Systems (IROS), 2007, pp. 1222-1227.
+.. [3] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
 """
 from __future__ import annotations
 
@@ -18,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import wrap_angle
+from ..sim.vehicle import skid_steer_velocities, skid_steer_wheel_speeds, unicycle_step
 from ..validation import as_array, check_positive
 
 __all__ = ["SkidSteerTruck", "TruckState", "PAPER_TRUCK"]
@@ -39,7 +48,7 @@ class SkidSteerTruck:
     motor_tau : float
         Time constant of the first-order motor lag (s).
     icr_factor : float
-        Track expansion ``chi`` (>= 1) from side skidding; 1 is an ideal differential drive.
+        ICR expansion factor (in [1, 5]) from side skidding; 1 is an ideal differential drive.
     slip : float
         Longitudinal slip ratio in [0, 0.5): ground speed = (1 - slip) * wheel speed.
     """
@@ -64,19 +73,24 @@ class SkidSteerTruck:
     @property
     def max_turn_rate(self) -> float:
         """Yaw rate (rad/s) when the two sides run at full speed in opposite directions."""
-        return 2 * (1 - self.slip) * self.max_wheel_speed / (self.icr_factor * self.track)
+        return self.body_velocity([-self.max_wheel_speed, self.max_wheel_speed])[1]
 
     def body_velocity(self, wheel_speeds: Any) -> tuple[float, float]:
         """Forward speed ``v`` (m/s) and yaw rate ``omega`` (rad/s) from ``[left, right]`` wheel speeds.
 
         Notes
         -----
-        ``v = (1 - s)(w_L + w_R) / 2``, ``omega = (1 - s)(w_R - w_L) / (chi B)`` (Mandow et al. 2007,
-        Eq. (5) with a symmetric ICR and slip ratio ``s``).
+        :func:`robokit.sim.vehicle.skid_steer_velocities` with this truck's track, ICR expansion
+        factor and slip (Mandow et al. 2007, Eq. (12)).
+
+        Examples
+        --------
+        >>> v, omega = PAPER_TRUCK.body_velocity([0.3, 0.5])
+        >>> round(float(v), 3), round(float(omega), 3)
+        (0.38, 0.603)
         """
         wl, wr = as_array(wheel_speeds, "wheel_speeds", shape=(2,))
-        k = 1 - self.slip
-        return k * (wl + wr) / 2, k * (wr - wl) / (self.icr_factor * self.track)
+        return skid_steer_velocities(wl, wr, self.track, self.icr_factor, self.slip, check=False)
 
     def wheel_commands(self, v: float, omega: float) -> np.ndarray:
         """``[left, right]`` wheel speeds that give ``v`` and ``omega`` under this model, saturated.
@@ -86,40 +100,41 @@ class SkidSteerTruck:
 
         Notes
         -----
-        Inverse of :meth:`body_velocity` (Mandow et al. 2007, Eq. (5)).
+        :func:`robokit.sim.vehicle.skid_steer_wheel_speeds` (Mandow et al. 2007, Eq. (12) inverted).
+
+        Examples
+        --------
+        >>> np.round(PAPER_TRUCK.wheel_commands(0.5, 0.0), 3).tolist()
+        [0.526, 0.526]
         """
-        k = 1 - self.slip
-        half = omega * self.icr_factor * self.track / (2 * k)
-        half = float(np.clip(half, -self.max_wheel_speed, self.max_wheel_speed))
-        room = self.max_wheel_speed - abs(half)
-        fwd = float(np.clip(v / k, -room, room))
-        return np.array([fwd - half, fwd + half])
+        return skid_steer_wheel_speeds(v, omega, self.track, self.max_wheel_speed, self.icr_factor, self.slip,
+                                       check=False)
 
     def step(self, state: "TruckState", command: Any, dt: float) -> "TruckState":
         """Advance ``dt`` seconds with ``command = [left, right]`` wheel-speed set points.
 
-        The motors respond with an exact first-order lag; the pose is integrated along the arc of
-        constant ``v`` and ``omega`` over the step (exact for constant body velocity).
+        The motors respond with an exact first-order lag; the pose moves along the arc of constant
+        ``v`` and ``omega`` (those of the mean wheel speed over the step).
 
         Notes
         -----
-        Arc integration of the unicycle model (Thrun, Burgard & Fox, *Probabilistic Robotics*, 2005,
-        Sec. 5.3, Eq. 5.9) with the skid-steer velocities of Mandow et al. (2007).
+        First-order lag ``w1 = w0 + (cmd - w0)(1 - exp(-dt / tau))`` (exact for a constant command);
+        arc integration of Thrun, Burgard & Fox (2005), Eq. (5.9) (:func:`robokit.sim.vehicle.unicycle_step`)
+        with the skid-steer velocities of Mandow et al. (2007), Eq. (12).
+
+        Examples
+        --------
+        >>> s = PAPER_TRUCK.step(TruckState(np.zeros(3)), [0.5, 0.5], 1.0)
+        >>> np.round(s.pose, 3).tolist(), np.round(s.wheels, 3).tolist()
+        ([0.229, 0.0, 0.0], [0.482, 0.482])
         """
         cmd = np.clip(as_array(command, "command", shape=(2,)), -self.max_wheel_speed, self.max_wheel_speed)
         h = check_positive(dt, "dt")
         a = 1 - np.exp(-h / self.motor_tau)
         w0 = state.wheels
-        w1 = w0 + (cmd - w0) * a
+        w1 = w0 + (cmd - w0) * a                                    # exact first-order lag
         v, om = self.body_velocity((w0 + w1) / 2)
-        x, y, th = state.pose
-        if abs(om) < 1e-9:
-            x, y = x + v * h * np.cos(th), y + v * h * np.sin(th)
-        else:
-            x += v / om * (np.sin(th + om * h) - np.sin(th))
-            y -= v / om * (np.cos(th + om * h) - np.cos(th))
-        th = wrap_angle(th + om * h)
-        return TruckState(np.array([x, y, th]), w1, v, om)
+        return TruckState(unicycle_step(state.pose, v, om, h, check=False), w1, v, om)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

@@ -5,13 +5,20 @@ Everything a lesson needs to produce images, depth, scans and ground truth witho
 Worlds (textured planar rectangles + 2D footprint; world frame right-handed, z up, floor z = 0)
     ``lab_room()``       10 m x 10 m lab with furniture and posters (Se, Lowe & Little 2002)
     ``long_corridor()``  36.10 m x 2.17 m corridor, 0.07 m door recesses (Ge et al. 2023)
-    ``office_floor()``   four rooms R1-R4 and a corridor (seed 001)
+    ``office_floor()``   four rooms R1-R4 and a corridor (the environment of lesson 02's paper)
     ``box_room()``       a plain rectangular room
     ``open_field()``     100 m x 60 m grass field with obstacles, a shed, a hedge and a skybox
-                         (seed 000 Q3, Hamid et al.); ``field_world(size, circles, boxes)`` builds
+                         (Hamid et al. 2009); ``field_world(size, circles, boxes)`` builds
                          any 2D obstacle layout, ``scatter_obstacles`` draws one
     A :class:`World` has ``surfaces``, ``segments`` (the footprint at ``footprint_height``),
-    ``slice(z)``, ``free_space()``, ``is_free(xy)`` and ``info`` (builder facts).
+    ``slice(z)``, ``layout(z)``, ``free_space()``, ``is_free(xy)`` and ``info`` (builder facts).
+
+The 2D world (:mod:`robokit.sim.layout`)
+    ``Layout(segments, circles, boxes)``: walls, circles ``[x, y, r]`` and rotated boxes
+    ``[cx, cy, length, width, yaw]``, with the course's one ray caster ``.raycast(origins, angles,
+    max_range, check=True)`` (one documented tie rule), ``.contains``, ``.clearance`` and
+    ``.collides(pose, length, width)``; ``obstacle_array`` checks obstacle arrays, ``box_corners``.
+    The LiDAR, lesson 05's field (``robokit.outdoor.Field`` is a Layout) and its sonars use it.
 
 Cameras (poses are 4x4 ``T_world_cam``; optical frame x right, y down, z forward)
     ``PinholeCamera.from_fov(hfov, width, height)``; ``.K``, ``.project(points, pose)``,
@@ -24,15 +31,19 @@ Cameras (poses are 4x4 ``T_world_cam``; optical frame x right, y down, z forward
     ``illuminate(image, gain, offset, gradient)`` or ``render(..., lighting={...})`` for
     lighting changes; ``render(..., noise=sigma, rng=seed)`` for pixel noise.
 
-LiDAR and motion
+LiDAR, vehicles and motion
     ``Lidar(beams=360, r_min=0.15, r_max=8.0, noise=0.0).scan(world, robot_pose)``;
-    ``unicycle_step``, ``diff_drive_velocities``, ``skid_steer_velocities``,
-    ``odometry_increment``, ``sample_motion_model_odometry``, ``noisy_odometry``
-    (Thrun et al. 2005, Table 5.6); paths ``waypoint_path``, ``corridor_path``, ``lab_lap``.
+    vehicle kinematics (:mod:`robokit.sim.vehicle`): ``unicycle_step`` (exact arcs),
+    ``diff_drive_velocities``, ``skid_steer_velocities`` (ICR expansion ``icr_factor`` and slip,
+    Mandow et al. 2007) and its saturating inverse ``skid_steer_wheel_speeds``; odometry noise
+    (:mod:`robokit.sim.motion`, Thrun et al. 2005, Tables 5.5-5.6): ``odometry_increment``,
+    ``sample_motion_model_odometry``, ``noisy_odometry``; paths ``waypoint_path``,
+    ``corridor_path``, ``lab_lap``.
 
 Recorded runs
     ``record(world, path, sensors={"cam": cam, "laser": lidar}, rate=5)`` -> :class:`Run`
-    (``t``, ``poses``, ``odometry``, ``images``, ``depths``, ``scans``), cached as ``.npz``.
+    (``t``, ``poses``, ``odometry``, ``images``, ``depths``, ``scans``), cached as ``.npz``; every
+    sensor is driven through ``observe(world, robot_pose, rng=...)``.
 
 Checks
     ``sift_view_pair(world, camera, robot_pose)``: OpenCV SIFT between two views, matches judged
@@ -50,12 +61,14 @@ Example
 from .camera import Frame, PinholeCamera, StereoRig, mount_pose
 from .feature_check import ViewPairCheck, ground_truth_inliers, sift_view_pair
 from .field import field_world, open_field, scatter_obstacles
-from .lidar import Lidar, ray_segment_ranges, scan_points
-from .motion import (Path, corridor_path, diff_drive_velocities, lab_lap, noisy_odometry, odometry_increment,
-                     sample_motion_model_odometry, skid_steer_velocities, unicycle_step, waypoint_path)
+from .layout import Layout, box_corners, obstacle_array
+from .lidar import Lidar, scan_points
+from .motion import (Path, corridor_path, lab_lap, noisy_odometry, odometry_increment, sample_motion_model_odometry,
+                     waypoint_path)
 from .omni import OmniCamera, omni_mount
 from .runs import Run, record
 from .textures import illuminate, photo
+from .vehicle import diff_drive_velocities, skid_steer_velocities, skid_steer_wheel_speeds, unicycle_step
 from .world import FreeSpace, Surface, World
 from .worlds import box_room, lab_room, long_corridor, office_floor
 
@@ -63,8 +76,9 @@ __all__ = [
     "World", "Surface", "FreeSpace", "box_room", "lab_room", "long_corridor", "office_floor",
     "open_field", "field_world", "scatter_obstacles",
     "Frame", "PinholeCamera", "StereoRig", "mount_pose", "OmniCamera", "omni_mount", "illuminate", "photo",
-    "Lidar", "ray_segment_ranges", "scan_points",
-    "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "odometry_increment",
+    "Layout", "box_corners", "obstacle_array", "Lidar", "scan_points",
+    "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
+    "odometry_increment",
     "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap",
     "Run", "record", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair",
 ]

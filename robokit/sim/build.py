@@ -3,6 +3,12 @@
 A :class:`Builder` collects :class:`~robokit.sim.world.Surface` objects. Long walls, floors and
 ceilings are cut into tiles of at most ``tile`` metres, each with its own seeded texture, so that
 no texture gets huge and no two stretches of wall look exactly alike.
+
+References
+----------
+.. [1] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
+   environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
+   doi:10.1631/FITEE.2200208.
 """
 from __future__ import annotations
 

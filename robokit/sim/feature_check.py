@@ -3,6 +3,13 @@
 The simulator knows the depth of every pixel, so a feature match between two rendered views can be
 judged without any homography or hand labelling: lift the first pixel to 3D with its rendered
 depth, project it into the second view, and see whether it lands on the matched pixel.
+
+References
+----------
+.. [1] R. Hartley and A. Zisserman, *Multiple View Geometry in Computer Vision*, 2nd ed.,
+   Cambridge University Press, 2004.
+.. [2] D. G. Lowe, "Distinctive image features from scale-invariant keypoints", *International
+   Journal of Computer Vision* 60(2), 2004, pp. 91-110.
 """
 from __future__ import annotations
 
@@ -50,8 +57,8 @@ def ground_truth_inliers(camera: PinholeCamera, depth: Any, pose1: Any, pose2: A
 
     Notes
     -----
-    Back-projection ``X = Z K^-1 [u, v, 1]^T`` and projection ``u = K X / Z`` (Hartley & Zisserman,
-    *Multiple View Geometry*, 2004, Eq. 6.5); the depth is read at the nearest pixel.
+    Back-projection ``X = Z K^-1 [u, v, 1]^T`` and projection ``u = K X / Z`` (Hartley & Zisserman
+    2004, Eq. 6.5); the depth is read at the nearest pixel.
     """
     if not isinstance(camera, PinholeCamera):
         raise TypeError(f"camera: expected robokit.sim.PinholeCamera, got {type(camera).__name__}")

@@ -1,7 +1,7 @@
-"""The outdoor field of seed 000 Q3 as a textured 3D world, and the obstacle layout it shares with lesson 05.
+"""Hamid et al.'s outdoor field as a textured 3D world, and the obstacle layout it shares with lesson 05.
 
-Hamid et al. test their GPS + sonar skid-steer truck on "semi-rugged terrain such a football
-field" (seed 000 Q3, Sec. 1) and let it avoid obstacles met between GPS waypoints (Sec. 4).
+Hamid et al. (2009) test their GPS + sonar skid-steer truck on "semi-rugged terrain such a
+football field" (Sec. 1) and let it avoid obstacles met between GPS waypoints (Sec. 4).
 
 * :func:`scatter_obstacles` draws such a layout in the plane: circles (posts, bins, trunks) and
   rotated boxes (bales, crates), kept ``min_gap`` apart. It is the one obstacle generator of the
@@ -18,6 +18,17 @@ boxes as hay bales or crates, and any box with a side of at least 2.5 m as a she
 something); and a skybox far outside the hedge (a sky band, a sky ceiling and far grass), not
 solid, so the LiDAR ignores it while every camera pixel gets a colour and a finite depth.
 Frame: x east, y north, metres, origin at the field's south-west corner (as in lesson 05).
+
+References
+----------
+.. [1] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
+.. [2] J. Feder, "Random sequential adsorption", *Journal of Theoretical Biology* 87(2), 1980,
+   pp. 237-254.
+.. [3] N. Greene, "Environment mapping and other applications of world projections", *IEEE
+   Computer Graphics and Applications* 6(11), 1986, pp. 21-29.
 """
 from __future__ import annotations
 
@@ -30,6 +41,7 @@ from ..validation import as_array, as_rng, check_int, check_positive
 from . import textures as tx
 from . import textures_outdoor as tox
 from .build import Builder
+from .layout import obstacle_array
 from .world import World
 
 __all__ = ["scatter_obstacles", "field_world", "open_field", "SIDES"]
@@ -92,9 +104,15 @@ def scatter_obstacles(rng: Any, n_obstacles: int, size: Any = (100.0, 60.0), *, 
 
     Notes
     -----
-    Rejection sampling of non-overlapping discs (random sequential adsorption; Feder, "Random
-    sequential adsorption", J. Theor. Biol. 1980) around the experiment of Hamid et al. (seed 000
-    Q3, Sec. 4): obstacles lie on the way between waypoints so the truck must avoid them.
+    Rejection sampling of non-overlapping discs (random sequential adsorption, Feder 1980) around
+    the experiment of Hamid et al. (2009, Sec. 4): obstacles lie on the way between waypoints so
+    the truck must avoid them.
+
+    Examples
+    --------
+    >>> circles, boxes = scatter_obstacles(0, 4, (30.0, 20.0))
+    >>> circles.shape, boxes.shape
+    ((3, 3), (1, 5))
     """
     rng = as_rng(rng, "rng")
     n = check_int(n_obstacles, "n_obstacles", minimum=0)
@@ -106,7 +124,7 @@ def scatter_obstacles(rng: Any, n_obstacles: int, size: Any = (100.0, 60.0), *, 
     k = len(pts) - 1
     clear = [(as_array(p, "keep_clear point", shape=(2,)), check_positive(r, "keep_clear radius", allow_zero=True))
              for p, r in keep_clear]
-    pre = np.zeros((0, 5)) if boxes is None or not np.size(boxes) else as_array(boxes, "boxes").reshape(-1, 5)
+    pre = obstacle_array(boxes, "boxes")
     shapes: list[tuple[str, np.ndarray, float]] = [("box", q, float(np.hypot(q[2], q[3]) / 2)) for q in pre]
     added = 0
     while added < n and tries > 0:
@@ -134,24 +152,14 @@ def scatter_obstacles(rng: Any, n_obstacles: int, size: Any = (100.0, 60.0), *, 
     return circles, out_boxes
 
 
-def _obstacles(value: Any, name: str, cols: int, size_cols: slice, lo: float, hi: tuple) -> np.ndarray:
-    """Validate an obstacle array: shape (N, cols), positive sizes, inside the hedge."""
-    arr = np.zeros((0, cols)) if value is None or not np.size(value) else as_array(value, name)
-    if arr.ndim == 1 and arr.shape[0] == cols:
-        arr = arr[None]
-    if arr.ndim != 2 or arr.shape[1] != cols:
-        raise ValueError(f"{name}: expected shape (N, {cols}), got shape {arr.shape}")
-    if np.any(arr[:, size_cols] <= 0):
-        raise ValueError(f"{name}: expected positive sizes in columns {size_cols.start}-{size_cols.stop - 1}, "
-                         f"got {arr[:, size_cols].min():.3g}")
-    reach = arr[:, 2] if cols == 3 else np.hypot(arr[:, 2], arr[:, 3]) / 2
+def _inside_hedge(arr: np.ndarray, reach: np.ndarray, name: str, lo: float, hi: tuple) -> None:
+    """Raise unless every obstacle (centre +- reach) stays strictly inside the hedge."""
     bad = (arr[:, 0] - reach <= lo) | (arr[:, 1] - reach <= lo) | (arr[:, 0] + reach >= hi[0]) \
         | (arr[:, 1] + reach >= hi[1])
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(f"{name}: expected obstacles inside the hedge [{lo:g}, {hi[0]:g}] x [{lo:g}, {hi[1]:g}] m, "
                          f"got one at ({arr[i, 0]:.2f}, {arr[i, 1]:.2f}) reaching {reach[i]:.2f} m")
-    return arr
 
 
 def _free_point(w: float, h: float, circles: np.ndarray, boxes: np.ndarray) -> np.ndarray:
@@ -202,15 +210,22 @@ def field_world(size: Any = (100.0, 60.0), circles: Any = None, boxes: Any = Non
 
     Notes
     -----
-    Test site of Hamid et al. (seed 000 Q3, Sec. 1, a football field); world representation of
-    the course (DESIGN.md, "Simulation"); skybox after Greene (IEEE CG&A 1986).
+    Test site of Hamid et al. (2009, Sec. 1, a football field); world representation of
+    the course (DESIGN.md, "Simulation"); skybox after Greene (1986).
+
+    Examples
+    --------
+    >>> world = field_world((20.0, 12.0), circles=[[5.0, 5.0, 0.5]], boxes=[[12.0, 6.0, 2.0, 1.0, 0.3]])
+    >>> world.info["hedge"], [kind for _, kind, _ in world.info["obstacles"]]
+    ((-3.0, -3.0, 23.0, 15.0), ['tree', 'crate'])
     """
     w, h = _size(size)
     bd = check_positive(border, "border")
     rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
     x0, y0, x1, y1 = -bd, -bd, w + bd, h + bd
-    circles = _obstacles(circles, "circles", 3, slice(2, 3), -bd, (x1, y1))
-    boxes = _obstacles(boxes, "boxes", 5, slice(2, 4), -bd, (x1, y1))
+    circles, boxes = obstacle_array(circles, "circles"), obstacle_array(boxes, "boxes")
+    _inside_hedge(circles, circles[:, 2], "circles", -bd, (x1, y1))
+    _inside_hedge(boxes, np.hypot(boxes[:, 2], boxes[:, 3]) / 2, "boxes", -bd, (x1, y1))
     b = Builder(rng, density=100)
     b.horizontal("ground", x0, y0, x1, y1, 0.0, True, tox.grass, density=40, tile=6.0)
     corners = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]  # clockwise: the hedge faces inwards
@@ -268,7 +283,7 @@ def _skybox(b: Builder, X0: float, Y0: float, X1: float, Y1: float, hedge: tuple
 
 def open_field(seed: int = 0, *, size: Any = (100.0, 60.0), n_obstacles: int = 14, shed: bool = True,
                border: float = 3.0) -> World:
-    """The outdoor field of seed 000 Q3: about 100 m x 60 m of grass with obstacles, a shed and a hedge.
+    """Hamid et al.'s outdoor field: about 100 m x 60 m of grass with obstacles, a shed and a hedge.
 
     Parameters
     ----------
@@ -298,11 +313,16 @@ def open_field(seed: int = 0, *, size: Any = (100.0, 60.0), n_obstacles: int = 1
 
     Notes
     -----
-    Hamid et al., "Navigation of mobile robot using GPS and obstacle avoidance system with
-    commanded loop daisy chaining application method" (seed 000 Q3), Sec. 1: the truck runs on
-    "semi-rugged terrain such a football field"; obstacles as in their Sec. 4 experiment. Not to be
-    confused with :func:`robokit.outdoor.open_field`, lesson 05's 2D field with given obstacles.
-    Worlds are cached per parameter set.
+    Hamid et al. (2009), Sec. 1: the truck runs on "semi-rugged terrain such a football field";
+    obstacles as in their Sec. 4 experiment. Worlds are cached per parameter set.
+
+    Examples
+    --------
+    >>> field = open_field(seed=0, size=(20.0, 12.0), n_obstacles=2)
+    >>> field
+    World('open_field', 99 surfaces, 68 wall segments, 26.00 m x 18.00 m)
+    >>> [kind for _, kind, _ in field.info["obstacles"]], field.info["circles"].shape
+    (['tree', 'shed', 'bale'], (1, 3))
     """
     w, h = _size(size)
     if not isinstance(shed, (bool, np.bool_)):

@@ -1,10 +1,18 @@
 """A 2D scanning LiDAR (defaults like an RPLIDAR A2) over a world's footprint.
 
-Every beam is intersected with every wall segment at once (numpy broadcasting), using the 2D
-cross-product form of the ray-segment intersection: for a ray ``o + t d`` and a segment
-``a + s e``, ``t = (a - o) x e / (d x e)`` and ``s = (a - o) x d / (d x e)``; the beam's range is the
-smallest ``t > 0`` with ``0 <= s <= 1`` (Goldman, "Intersection of two lines in three-space",
-Graphics Gems, 1990; O'Rourke, *Computational Geometry in C*, 2nd ed., Sec. 7.2).
+A scan casts every beam over the layout of the world's walls at the scan height
+(:meth:`robokit.sim.World.layout`, cached per world and height) with the course's one ray caster,
+:meth:`robokit.sim.Layout.raycast`, so the LiDAR, lesson 05's sonars and the field share one
+geometry and one tie rule.
+
+References
+----------
+.. [1] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
+.. [2] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
+   environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
+   doi:10.1631/FITEE.2200208.
+.. [3] R. Smith, M. Self and P. Cheeseman, "Estimating uncertain spatial relationships in
+   robotics", in *Autonomous Robot Vehicles*, Springer, 1990, pp. 167-193.
 """
 from __future__ import annotations
 
@@ -17,48 +25,7 @@ from ..geometry import se2_compose
 from ..validation import as_array, as_rng, check_int, check_positive
 from .world import World
 
-__all__ = ["Lidar", "ray_segment_ranges", "scan_points"]
-
-
-def ray_segment_ranges(origin: Any, angles: Any, segments: Any) -> np.ndarray:
-    """Distance along each ray to the nearest segment (``inf`` where no segment is hit).
-
-    Parameters
-    ----------
-    origin : array_like, shape (2,)
-        Ray origin (metres).
-    angles : array_like, shape (B,)
-        Ray directions in radians (world frame, counter-clockwise from +x).
-    segments : array_like, shape (M, 2, 2)
-        Segment end points.
-
-    Returns
-    -------
-    numpy.ndarray, shape (B,)
-
-    Raises
-    ------
-    ValueError
-        For wrong shapes or non-finite values.
-
-    Notes
-    -----
-    Ray-segment intersection via 2D cross products (O'Rourke 1998, Sec. 7.2), vectorised over
-    all ``B x M`` pairs.
-    """
-    o = as_array(origin, "origin", shape=(2,))
-    ang = as_array(angles, "angles", ndim=1)
-    seg = as_array(segments, "segments", shape=(None, 2, 2))
-    d = np.column_stack([np.cos(ang), np.sin(ang)])  # (B, 2)
-    a = seg[:, 0] - o  # (M, 2)
-    e = seg[:, 1] - seg[:, 0]
-    denom = d[:, None, 0] * e[None, :, 1] - d[:, None, 1] * e[None, :, 0]  # d x e, (B, M)
-    axe = a[:, 0] * e[:, 1] - a[:, 1] * e[:, 0]  # (a - o) x e, (M,)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = axe[None, :] / denom
-        s = (a[None, :, 0] * d[:, None, 1] - a[None, :, 1] * d[:, None, 0]) / denom
-    hit = (denom != 0) & (t > 0) & (s >= 0) & (s <= 1)
-    return np.where(hit, t, np.inf).min(axis=1) if len(seg) else np.full(len(ang), np.inf)
+__all__ = ["Lidar", "scan_points"]
 
 
 @dataclasses.dataclass
@@ -82,8 +49,17 @@ class Lidar:
     Notes
     -----
     Beam ``i`` points at ``2 pi i / beams`` counter-clockwise from the sensor's forward axis.
-    Range model: Thrun, Burgard & Fox, *Probabilistic Robotics* (2005), Sec. 6.3.1 (the Gaussian
-    ``p_hit`` part of the beam model; max-range readings reported as ``inf``).
+    Range model: Thrun et al. (2005), Sec. 6.3.1 (the Gaussian ``p_hit`` part of the beam model;
+    max-range readings reported as ``inf``).
+
+    Examples
+    --------
+    >>> from robokit.sim import long_corridor
+    >>> corridor = long_corridor()
+    >>> door = corridor.info["doors"][0]                    # ('north', x0, x1)
+    >>> ranges = Lidar().scan(corridor, [(door[1] + door[2]) / 2, 0.0, 0.0])
+    >>> round(float(ranges[90]), 3), round(float(ranges[270]), 3)   # half width 1.085 m + 0.07 m recess
+    (1.155, 1.155)
     """
 
     beams: int = 360
@@ -141,13 +117,21 @@ class Lidar:
 
         Notes
         -----
-        Uses :func:`ray_segment_ranges` on ``world.slice(height)``.
+        :meth:`robokit.sim.Layout.raycast` over ``world.layout(height)``; noise is the Gaussian
+        ``p_hit`` part of the beam model (Thrun et al. 2005, Sec. 6.3.1).
+
+        Examples
+        --------
+        >>> from robokit.sim import box_room
+        >>> r = Lidar(beams=4, r_max=20.0).scan(box_room(), [2.0, 1.0, 0.0])   # 6 m x 4 m room
+        >>> np.round(r, 3).tolist()
+        [4.0, 3.0, 2.0, 1.0]
         """
         if not isinstance(world, World):
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
         sp = self.sensor_pose(robot_pose)
         world.check_viewpoint([sp[0], sp[1], self.height], "robot_pose", clearance=0.0)
-        true = ray_segment_ranges(sp[:2], self.angles + sp[2], world.slice(self.height))
+        true = world.layout(self.height).raycast(sp[:2], self.angles + sp[2], check=False)
         out = true.copy()
         if self.noise > 0:
             out = out + as_rng(rng).normal(0.0, self.noise, self.beams)

@@ -1,13 +1,22 @@
-"""Robot motion: unicycle / differential-drive and skid-steer kinematics, odometry noise, paths.
+"""Robot motion: odometry noise and the paths the lessons drive (kinematics: :mod:`robokit.sim.vehicle`).
 
 Planar poses are ``[x, y, theta]`` (see :mod:`robokit.geometry`). The odometry noise model is the
-four-parameter model of Thrun, Burgard & Fox, *Probabilistic Robotics* (2005), Sec. 5.4: a motion
-between two poses is decomposed into a rotation ``delta_rot1``, a translation ``delta_trans`` and a
-rotation ``delta_rot2`` (Table 5.5), each corrupted by zero-mean Gaussian noise whose variance
-grows with the motion (Table 5.6, ``sample_motion_model_odometry``):
+four-parameter model of Thrun et al. (2005), Sec. 5.4: a motion between two poses is
+decomposed into a rotation ``delta_rot1``, a translation ``delta_trans`` and a rotation
+``delta_rot2`` (Table 5.5), each corrupted by zero-mean Gaussian noise whose variance grows with
+the motion (Table 5.6, ``sample_motion_model_odometry``):
 
     var(rot1) = a1 rot1^2 + a2 trans^2,  var(trans) = a3 trans^2 + a4 (rot1^2 + rot2^2),
     var(rot2) = a1 rot2^2 + a2 trans^2.
+
+References
+----------
+.. [1] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
+.. [2] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features",
+   IEEE/RSJ International Conference on Intelligent Robots and Systems (IROS), 2002.
+.. [3] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
+   environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
+   doi:10.1631/FITEE.2200208.
 """
 from __future__ import annotations
 
@@ -18,90 +27,8 @@ import numpy as np
 from ..geometry import wrap_angle
 from ..validation import as_array, as_points, as_rng, check_positive
 
-__all__ = ["unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "odometry_increment",
-           "sample_motion_model_odometry", "noisy_odometry", "Path", "waypoint_path", "corridor_path",
-           "lab_lap"]
-
-
-def unicycle_step(pose: Any, v: Any, omega: Any, dt: float) -> np.ndarray:
-    """Advance poses by driving at speed ``v`` and turn rate ``omega`` for ``dt`` seconds (exact arc).
-
-    Parameters
-    ----------
-    pose : array_like, shape (3,) or (N, 3)
-    v, omega : float or array_like (N,)
-        Forward speed (m/s) and turn rate (rad/s).
-    dt : float
-        Duration (s, >= 0).
-
-    Returns
-    -------
-    numpy.ndarray, same shape as ``pose``
-
-    Notes
-    -----
-    Thrun, Burgard & Fox (2005), Eq. (5.9) (circular arc of radius ``v / omega``); the straight
-    line when ``omega = 0``.
-    """
-    P = as_array(pose, "pose")
-    single = P.ndim == 1
-    P = as_points(P, "pose", 3)
-    v = np.broadcast_to(as_array(v, "v"), (len(P),))
-    w = np.broadcast_to(as_array(omega, "omega"), (len(P),))
-    dt = check_positive(dt, "dt", allow_zero=True)
-    th = P[:, 2]
-    small = np.abs(w * dt) < 1e-9
-    ws = np.where(small, 1.0, w)
-    dx = np.where(small, v * dt * np.cos(th + w * dt / 2), v / ws * (np.sin(th + w * dt) - np.sin(th)))
-    dy = np.where(small, v * dt * np.sin(th + w * dt / 2), v / ws * (np.cos(th) - np.cos(th + w * dt)))
-    out = np.column_stack([P[:, 0] + dx, P[:, 1] + dy, wrap_angle(th + w * dt)])
-    return out[0] if single else out
-
-
-def diff_drive_velocities(omega_left: Any, omega_right: Any, wheel_radius: float, track: float) -> tuple:
-    """Body speed and turn rate of a differential drive from wheel angular speeds.
-
-    Returns
-    -------
-    (v, omega) : ``v = r (w_r + w_l) / 2``, ``omega = r (w_r - w_l) / track``.
-
-    Notes
-    -----
-    Siegwart, Nourbakhsh & Scaramuzza, *Introduction to Autonomous Mobile Robots* (2011), Sec. 3.2.
-    """
-    r = check_positive(wheel_radius, "wheel_radius")
-    b = check_positive(track, "track")
-    wl, wr = as_array(omega_left, "omega_left"), as_array(omega_right, "omega_right")
-    return r * (wr + wl) / 2, r * (wr - wl) / b
-
-
-def skid_steer_velocities(v_left: Any, v_right: Any, track: float, chi: float = 1.5) -> tuple:
-    """Body speed and turn rate of a skid-steer vehicle from its left/right track (wheel) speeds.
-
-    Parameters
-    ----------
-    v_left, v_right : float or array_like
-        Linear speeds of the left and right wheel sets (m/s).
-    track : float
-        Distance between left and right wheels (m).
-    chi : float, default 1.5
-        Expansion factor (>= 1): skidding makes the vehicle turn as if its track were ``chi * track``.
-
-    Returns
-    -------
-    (v, omega)
-
-    Notes
-    -----
-    Mandow et al., "Experimental kinematics for wheeled skid-steer mobile robots" (IROS 2007),
-    Eq. (12): ``omega = (v_r - v_l) / (chi B)``; ``chi = 1`` is the ideal differential drive.
-    """
-    b = check_positive(track, "track")
-    c = check_positive(chi, "chi")
-    if c < 1:
-        raise ValueError(f"chi: expected an expansion factor >= 1, got {c}")
-    vl, vr = as_array(v_left, "v_left"), as_array(v_right, "v_right")
-    return (vr + vl) / 2, (vr - vl) / (c * b)
+__all__ = ["odometry_increment", "sample_motion_model_odometry", "noisy_odometry", "Path", "waypoint_path",
+           "corridor_path", "lab_lap"]
 
 
 def odometry_increment(previous: Any, current: Any) -> np.ndarray:
@@ -117,16 +44,21 @@ def odometry_increment(previous: Any, current: Any) -> np.ndarray:
 
     Notes
     -----
-    Thrun, Burgard & Fox (2005), Table 5.5 lines 2-4 (``rot1 = 0`` for a pure rotation).
+    Thrun et al. (2005), Table 5.5 lines 2-4 (``rot1 = 0`` for a pure rotation).
+
+    Examples
+    --------
+    >>> np.round(odometry_increment([0.0, 0.0, 0.0], [1.0, 1.0, 0.0]), 4).tolist()   # turn, drive, turn back
+    [0.7854, 1.4142, -0.7854]
     """
     a = as_array(previous, "previous")
     b = as_array(current, "current")
     if a.shape != b.shape or a.shape[-1:] != (3,):
         raise ValueError(f"current: expected the shape of previous {a.shape} with 3 columns, got {b.shape}")
     dx, dy = b[..., 0] - a[..., 0], b[..., 1] - a[..., 1]
-    trans = np.hypot(dx, dy)
-    rot1 = np.where(trans > 1e-12, wrap_angle(np.arctan2(dy, dx) - a[..., 2]), 0.0)
-    rot2 = wrap_angle(b[..., 2] - a[..., 2] - rot1)
+    trans = np.hypot(dx, dy)                                                          # Table 5.5, line 3
+    rot1 = np.where(trans > 1e-12, wrap_angle(np.arctan2(dy, dx) - a[..., 2]), 0.0)  # line 2
+    rot2 = wrap_angle(b[..., 2] - a[..., 2] - rot1)                                   # line 4
     return np.stack([rot1, trans, rot2], axis=-1)
 
 
@@ -139,15 +71,15 @@ def _alphas(alphas: Any) -> np.ndarray:
 
 def _perturb(delta: np.ndarray, a: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     r1, t, r2 = delta[..., 0], delta[..., 1], delta[..., 2]
-    sd1 = np.sqrt(a[0] * r1 ** 2 + a[1] * t ** 2)
-    sdt = np.sqrt(a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2))
-    sd2 = np.sqrt(a[0] * r2 ** 2 + a[1] * t ** 2)
+    sd1 = np.sqrt(a[0] * r1 ** 2 + a[1] * t ** 2)                     # Table 5.6, line 5
+    sdt = np.sqrt(a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2))        # line 6
+    sd2 = np.sqrt(a[0] * r2 ** 2 + a[1] * t ** 2)                     # line 7
     noise = rng.standard_normal(delta.shape)
     return np.stack([r1 - sd1 * noise[..., 0], t - sdt * noise[..., 1], r2 - sd2 * noise[..., 2]], axis=-1)
 
 
 def _apply(pose: np.ndarray, d: np.ndarray) -> np.ndarray:
-    th = pose[..., 2] + d[..., 0]
+    th = pose[..., 2] + d[..., 0]                                     # Table 5.6, lines 8-10
     return np.stack([pose[..., 0] + d[..., 1] * np.cos(th), pose[..., 1] + d[..., 1] * np.sin(th),
                      wrap_angle(th + d[..., 2])], axis=-1)
 
@@ -171,8 +103,15 @@ def sample_motion_model_odometry(odom_prev: Any, odom_now: Any, poses: Any, alph
 
     Notes
     -----
-    Thrun, Burgard & Fox (2005), Table 5.6 (``sample(b^2)`` draws a zero-mean Gaussian of
+    Thrun et al. (2005), Table 5.6 (``sample(b^2)`` draws a zero-mean Gaussian of
     variance ``b^2``).
+
+    Examples
+    --------
+    >>> particles = sample_motion_model_odometry([0, 0, 0], [1, 0, 0], np.zeros((3, 3)), [0.01, 0.001, 0.01, 0.001],
+    ...                                          rng=0)
+    >>> np.round(particles, 3).tolist()       # three particles, each about 1 m ahead
+    [[1.013, -0.004, -0.024], [1.054, -0.003, -0.015], [0.905, -0.037, -0.019]]
     """
     delta = odometry_increment(odom_prev, odom_now)
     P = as_array(poses, "poses")
@@ -201,7 +140,15 @@ def noisy_odometry(poses: Any, alphas: Any, rng: Any = None) -> np.ndarray:
 
     Notes
     -----
-    Thrun, Burgard & Fox (2005), Sec. 5.4.
+    Thrun et al. (2005), Sec. 5.4.
+
+    Examples
+    --------
+    >>> from robokit.sim import lab_lap, lab_room
+    >>> lap = lab_lap(lab_room())
+    >>> odo = noisy_odometry(lap.poses, [0.01, 0.001, 0.01, 0.001], rng=3)
+    >>> np.round(odo[-1] - lap.poses[-1], 3).tolist()      # drift after one lap (m, m, rad)
+    [-0.565, 0.162, -0.098]
     """
     P = as_points(poses, "poses", 3, min_count=1)
     a = _alphas(alphas)
@@ -214,7 +161,14 @@ def noisy_odometry(poses: Any, alphas: Any, rng: Any = None) -> np.ndarray:
 
 
 class Path(NamedTuple):
-    """A timed trajectory: ``t`` (N,) seconds and ``poses`` (N, 3)."""
+    """A timed trajectory: ``t`` (N,) seconds and ``poses`` (N, 3) ``[x, y, theta]``.
+
+    Examples
+    --------
+    >>> path = Path(np.array([0.0, 1.0]), np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0]]))
+    >>> path.t.tolist(), path.poses[-1].tolist()
+    ([0.0, 1.0], [0.3, 0.0, 0.0])
+    """
 
     t: np.ndarray
     poses: np.ndarray
@@ -242,6 +196,12 @@ def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, ra
     -----
     Piecewise unicycle motion (Thrun et al. 2005, Sec. 5.3) with ``omega = 0`` or ``v = 0``;
     Ge et al. (2023, Sec. 3.4) drive their robot by remote control along the corridor's middle line.
+
+    Examples
+    --------
+    >>> path = waypoint_path([[0.0, 0.0], [1.0, 0.0]], speed=0.5, rate=2)
+    >>> path.t.tolist(), path.poses[:, 0].tolist()
+    ([0.0, 0.5, 1.0, 1.5, 2.0], [0.0, 0.25, 0.5, 0.75, 1.0])
     """
     W = as_points(waypoints, "waypoints", 2, min_count=2)
     v = check_positive(speed, "speed")
@@ -285,6 +245,13 @@ def lab_lap(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
     Notes
     -----
     Se, Lowe & Little (2002), Sec. 3.6: the robot "traverses around our 10m by 10m lab".
+
+    Examples
+    --------
+    >>> from robokit.sim import lab_room
+    >>> lap = lab_lap(lab_room())
+    >>> len(lap.t), round(float(lap.t[-1]), 1), lap.poses[0].tolist()     # 10 Hz, 78 s at 0.3 m/s
+    (784, 78.3, [3.0, 2.0, 0.0])
     """
     lap = [[3.0, 2.0], [7.5, 2.0], [7.8, 5.0], [7.5, 8.0], [3.0, 8.0], [2.6, 5.0], [3.0, 2.0]]
     return waypoint_path(lap, speed, rate=rate)

@@ -2,7 +2,17 @@
 
 A :class:`Run` is plain arrays (no pickled objects), saved as one compressed ``.npz`` file and
 cached under ``robokit.cache_dir("runs")`` keyed by every parameter of the recording, so a lesson
-that records the same run twice renders it once.
+that records the same run twice renders it once. Every sensor is driven through one interface,
+``observe(world, robot_pose, rng=...)``.
+
+References
+----------
+.. [1] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
+.. [2] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features",
+   IEEE/RSJ International Conference on Intelligent Robots and Systems (IROS), 2002.
+.. [3] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
+   environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
+   doi:10.1631/FITEE.2200208.
 """
 from __future__ import annotations
 
@@ -17,10 +27,7 @@ import numpy as np
 
 from ..config import cache_dir, cache_key
 from ..validation import as_array, as_points, as_rng, check_positive
-from .camera import PinholeCamera, StereoRig
-from .lidar import Lidar
 from .motion import Path, noisy_odometry
-from .omni import OmniCamera
 from .world import World
 
 __all__ = ["Run", "record"]
@@ -114,7 +121,7 @@ def _describe(sensor: Any) -> dict:
     out = {"type": type(sensor).__name__}
     for field in dataclasses.fields(sensor):
         value = getattr(sensor, field.name)
-        if isinstance(value, (PinholeCamera,)):
+        if dataclasses.is_dataclass(value):          # e.g. the camera of a stereo rig
             value = _describe(value)
         elif isinstance(value, np.ndarray):
             value = np.round(value, 12).tolist()
@@ -122,6 +129,42 @@ def _describe(sensor: Any) -> dict:
             value = [float(v) for v in value]
         out[field.name] = value
     return out
+
+
+def _readings(name: str, observation: Any) -> list[tuple[str, str, np.ndarray]]:
+    """``(group, key, array)`` entries of a :class:`Run` from one sensor's ``observe`` output.
+
+    The sensor interface: ``observe(world, robot_pose, rng=...)`` returns a range scan (an array,
+    a LiDAR), a frame with ``image`` and ``depth`` (a camera) or a dict of frames (a stereo rig:
+    ``name/left``, ``name/right``, ...).
+    """
+    if isinstance(observation, np.ndarray):
+        return [("scans", name, observation)]
+    views = observation.items() if isinstance(observation, dict) else [("", observation)]
+    out = []
+    for sub, frame in views:
+        key = f"{name}/{sub}" if sub else name
+        out += [("images", key, frame.image), ("depths", key, frame.depth)]
+    return out
+
+
+def _timed_poses(path: Any, rate: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """Timestamps and poses of ``path``, resampled at ``rate`` (linear, heading unwrapped) if given."""
+    if isinstance(path, tuple) and len(path) == 2 and not isinstance(path, Path):
+        path = Path(*path)
+    if isinstance(path, Path):
+        t0, p0 = as_array(path.t, "path.t", ndim=1), as_points(path.poses, "path.poses", 3, min_count=1)
+    else:
+        p0 = as_points(path, "path", 3, min_count=1)
+        t0 = np.arange(len(p0)) / check_positive(rate if rate is not None else 10.0, "rate")
+    if len(t0) != len(p0) or np.any(np.diff(t0) <= 0):
+        raise ValueError("path: expected strictly increasing timestamps, one per pose")
+    if rate is None:
+        return t0, p0
+    t = np.arange(t0[0], t0[-1] + 1e-9, 1.0 / check_positive(rate, "rate"))
+    unwrapped = np.unwrap(p0[:, 2])
+    return t, np.column_stack([np.interp(t, t0, p0[:, 0]), np.interp(t, t0, p0[:, 1]),
+                               np.angle(np.exp(1j * np.interp(t, t0, unwrapped)))])
 
 
 def record(world: World, path: Path, sensors: dict, rate: float | None = None, *,
@@ -134,8 +177,8 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     path : Path, (t, poses) tuple or array_like (N, 3)
         Timed ground-truth trajectory (a bare pose array is taken as sampled at ``rate``).
     sensors : dict of str to sensor
-        ``PinholeCamera``, ``StereoRig``, ``OmniCamera`` or ``Lidar`` objects (their mounts define
-        where they sit on the robot).
+        Sensor dataclasses with ``observe(world, robot_pose, rng=...)``: ``PinholeCamera``,
+        ``StereoRig``, ``OmniCamera`` or ``Lidar`` (their mounts define where they sit on the robot).
     rate : float, optional
         Recording rate in Hz; the path is resampled (linear interpolation). Default: the path's
         own samples.
@@ -159,31 +202,26 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     -----
     Ge et al. (2023, Sec. 3.4) record scans and keyframes with timestamps while the robot is
     remote-controlled; Se, Lowe & Little (2002, Sec. 3.6) record stereo frames and odometry
-    around the lab. Deterministic, hence cacheable (DESIGN.md, "Caching").
+    around the lab. Every sensor goes through the one interface ``observe`` (see
+    :func:`_readings`); deterministic, hence cacheable (DESIGN.md, "Caching").
+
+    Examples
+    --------
+    >>> from robokit.sim import Lidar, box_room, waypoint_path
+    >>> path = waypoint_path([[1.0, 1.0], [2.0, 1.0]], rate=2)
+    >>> run = record(box_room(), path, {"laser": Lidar(beams=8)}, rate=1.0, cache=False)
+    >>> len(run), run.scans["laser"].shape
+    (4, (4, 8))
     """
     if not isinstance(world, World):
         raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
     if not isinstance(sensors, dict) or not sensors:
         raise ValueError(f"sensors: expected a non-empty dict name -> sensor, got {sensors!r}")
     for name, s in sensors.items():
-        if not isinstance(s, (PinholeCamera, StereoRig, OmniCamera, Lidar)) or "/" in str(name) or ":" in str(name):
+        if not (dataclasses.is_dataclass(s) and callable(getattr(s, "observe", None))) or "/" in str(name) \
+                or ":" in str(name):
             raise TypeError(f"sensors: expected camera/LiDAR objects under plain names, got {name!r}: {type(s).__name__}")
-    if isinstance(path, tuple) and len(path) == 2 and not isinstance(path, Path):
-        path = Path(*path)
-    if isinstance(path, Path):
-        t0, p0 = as_array(path.t, "path.t", ndim=1), as_points(path.poses, "path.poses", 3, min_count=1)
-    else:
-        p0 = as_points(path, "path", 3, min_count=1)
-        t0 = np.arange(len(p0)) / check_positive(rate if rate is not None else 10.0, "rate")
-    if len(t0) != len(p0) or np.any(np.diff(t0) <= 0):
-        raise ValueError("path: expected strictly increasing timestamps, one per pose")
-    if rate is not None:
-        t = np.arange(t0[0], t0[-1] + 1e-9, 1.0 / check_positive(rate, "rate"))
-        unwrapped = np.unwrap(p0[:, 2])
-        poses = np.column_stack([np.interp(t, t0, p0[:, 0]), np.interp(t, t0, p0[:, 1]),
-                                 np.angle(np.exp(1j * np.interp(t, t0, unwrapped)))])
-    else:
-        t, poses = t0, p0
+    t, poses = _timed_poses(path, rate)
     bad = ~world.is_free(poses[:, :2], clearance=0.05)
     if bad.any():
         raise ValueError(f"path: expected poses inside the free space of {world.name!r}, got {bad.sum()} outside "
@@ -199,22 +237,13 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
         return Run.load(target)
     rng = as_rng(int(seed))
     odometry = noisy_odometry(poses, alphas, rng)
-    images: dict[str, list] = {}
-    depths: dict[str, list] = {}
-    scans: dict[str, list] = {}
+    logs: dict[str, dict[str, list]] = {"images": {}, "depths": {}, "scans": {}}
     for pose in poses:
         for name, sensor in sensors.items():
-            if isinstance(sensor, Lidar):
-                scans.setdefault(name, []).append(sensor.scan(world, pose, rng=rng))
-                continue
-            out = sensor.observe(world, pose, rng=rng)
-            views = out.items() if isinstance(out, dict) else [("", out)]
-            for sub, frame in views:
-                key = f"{name}/{sub}" if sub else name
-                images.setdefault(key, []).append(frame.image)
-                depths.setdefault(key, []).append(frame.depth)
-    run = Run(t, poses, odometry, {k: np.stack(v) for k, v in images.items()},
-              {k: np.stack(v) for k, v in depths.items()}, {k: np.stack(v) for k, v in scans.items()}, meta)
+            for group, key, array in _readings(name, sensor.observe(world, pose, rng=rng)):
+                logs[group].setdefault(key, []).append(array)
+    stacked = {group: {k: np.stack(v) for k, v in arrays.items()} for group, arrays in logs.items()}
+    run = Run(t, poses, odometry, stacked["images"], stacked["depths"], stacked["scans"], meta)
     if target is not None:
         tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp")
         run.save(tmp)

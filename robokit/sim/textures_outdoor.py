@@ -3,9 +3,19 @@
 Grass, hedge, tree bark, straw (hay bales), shed planks, painted posts and sky. Like the indoor
 textures in :mod:`robokit.sim.textures` they are ``(H, W, 3)`` uint8 RGB images built from a
 ``numpy.random.Generator`` and carry structure at several scales (leaf blobs, blades, knots,
-twine) so that SIFT and ORB find keypoints on them. All are vectorised value noise (Perlin,
-"An image synthesizer", SIGGRAPH 1985, Sec. 4: sums of smoothly interpolated noise octaves) plus a
-few OpenCV drawing calls; no pictures are downloaded.
+twine) so that SIFT and ORB find keypoints on them. All are vectorised value noise (Perlin 1985,
+Sec. 4: sums of smoothly interpolated noise octaves) plus a few OpenCV drawing calls; no pictures
+are downloaded.
+
+References
+----------
+.. [1] K. Perlin, "An image synthesizer", *SIGGRAPH Computer Graphics* 19(3), 1985, pp. 287-296.
+.. [2] N. Greene, "Environment mapping and other applications of world projections", *IEEE
+   Computer Graphics and Applications* 6(11), 1986, pp. 21-29.
+.. [3] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
 """
 from __future__ import annotations
 
@@ -60,7 +70,7 @@ def grass(width: int, height: int, rng: Any = None) -> np.ndarray:
 
     Notes
     -----
-    The ground of Hamid et al.'s test site (seed 000 Q3, Sec. 1: "semi-rugged terrain such as a
+    The ground of Hamid et al.'s test site (2009, Sec. 1: "semi-rugged terrain such as a
     football field"); procedural, no paper equation.
     """
     rng = as_rng(rng)
@@ -174,8 +184,7 @@ def sky(width: int, height: int, rng: Any = None, top: float = 1.0, bottom: floa
 
     Notes
     -----
-    A skybox (Greene, "Environment mapping and other applications of world projections", IEEE
-    CG&A 1986): the sky is painted on far surfaces rather than left empty, so every pixel has a
+    A skybox (Greene 1986): the sky is painted on far surfaces rather than left empty, so every pixel has a
     colour and a finite depth.
     """
     rng = as_rng(rng)

@@ -8,6 +8,14 @@ vertical surfaces by a horizontal plane, so what the LiDAR measures and what the
 from the same geometry and cannot disagree.
 
 World frame: right-handed, z up, the floor at z = 0 (see :mod:`robokit.geometry`).
+
+References
+----------
+.. [1] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
+   environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
+   doi:10.1631/FITEE.2200208.
+.. [2] P. F. Felzenszwalb and D. P. Huttenlocher, "Distance transforms of sampled functions",
+   *Theory of Computing* 8, 2012, pp. 415-428.
 """
 from __future__ import annotations
 
@@ -19,6 +27,7 @@ import cv2
 import numpy as np
 
 from ..validation import as_array, as_points, check_finite_scalar, check_positive
+from .layout import Layout
 
 __all__ = ["Surface", "World", "FreeSpace"]
 
@@ -212,6 +221,32 @@ class World:
                 segs.append(pts[:2])
         return np.array(segs, float).reshape(-1, 2, 2)
 
+    @functools.lru_cache(maxsize=8)
+    def layout(self, z: float) -> Layout:
+        """The walls at height ``z`` as a :class:`~robokit.sim.layout.Layout` (cached per height).
+
+        Parameters
+        ----------
+        z : float
+            Height of the plane (metres), e.g. a LiDAR's scan height.
+
+        Returns
+        -------
+        Layout
+            ``Layout(segments=self.slice(z))``: what a 2D scanner at that height casts over.
+
+        Notes
+        -----
+        Cached so a scan pays only for its rays (DESIGN.md, "Speed").
+
+        Examples
+        --------
+        >>> from robokit.sim import box_room
+        >>> box_room().layout(0.25).raycast([1.0, 1.0], [np.pi]).tolist()   # the west wall at x = 0
+        [1.0]
+        """
+        return Layout(segments=self.slice(z))
+
     @functools.lru_cache(maxsize=4)
     def free_space(self, resolution: float | None = None) -> FreeSpace:
         """Rasterise the footprint and flood-fill the free floor area from :attr:`interior`.
@@ -228,7 +263,7 @@ class World:
         Notes
         -----
         Scan-line flood fill (``cv2.floodFill``) and Euclidean distance transform (Felzenszwalb &
-        Huttenlocher, "Distance transforms of sampled functions", 2012) for the clearance.
+        Huttenlocher 2012) for the clearance.
         """
         res = check_positive(self.free_resolution if resolution is None else resolution, "resolution")
         origin = self.segments.reshape(-1, 2).min(axis=0) - 4 * res

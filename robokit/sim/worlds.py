@@ -1,13 +1,24 @@
-"""World builders following the seeds' environments (all seeded, deterministic).
+"""World builders following the source papers' environments (all seeded, deterministic).
 
 * :func:`box_room` - a plain rectangular room (tests, first experiments);
 * :func:`lab_room` - the 10 m x 10 m lab of Se, Lowe & Little (2002, Sec. 3.6) with furniture
   and posters;
 * :func:`long_corridor` - the 36.10 m x 2.17 m corridor of Ge et al. (2023, Sec. 4.1) with 0.07 m
   door recesses, 1.00 m and 2.25 m doors, facing and staggered layouts;
-* :func:`office_floor` - four rooms and a horizontal corridor (seed 001, Fig. 6a).
+* :func:`office_floor` - four rooms and a horizontal corridor (the omnidirectional-vision paper
+  of lesson 02, Fig. 6a).
 
 Worlds are cached per parameter set (they are immutable), so calling a builder twice is cheap.
+
+References
+----------
+.. [1] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features",
+   IEEE/RSJ International Conference on Intelligent Robots and Systems (IROS), 2002.
+.. [2] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
+   environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
+   doi:10.1631/FITEE.2200208.
+.. [3] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
+   navigation" (course source 001; README.md, "References").
 """
 from __future__ import annotations
 
@@ -58,6 +69,11 @@ def box_room(width: float = 6.0, depth: float = 4.0, height: float = 2.5, seed: 
     Notes
     -----
     The simplest test world: LiDAR ranges have closed-form values (ray-line intersection).
+
+    Examples
+    --------
+    >>> box_room()
+    World('box_room', 22 surfaces, 10 wall segments, 6.00 m x 4.00 m)
     """
     w, d, h = (check_positive(v, n) for v, n in ((width, "width"), (depth, "depth"), (height, "height")))
     b = Builder(check_int(seed, "seed", minimum=0), density=100)
@@ -69,7 +85,7 @@ def box_room(width: float = 6.0, depth: float = 4.0, height: float = 2.5, seed: 
 
 @functools.lru_cache(maxsize=4)
 def lab_room(seed: int = 3) -> World:
-    """The 10 m x 10 m robotics lab of seed 003: desks, cabinets, shelves, posters and boards.
+    """The 10 m x 10 m robotics lab of Se, Lowe & Little (2002): desks, cabinets, shelves, posters, boards.
 
     Parameters
     ----------
@@ -82,10 +98,23 @@ def lab_room(seed: int = 3) -> World:
         ``[0, 10] x [0, 10]`` m, ceiling 2.8 m; ``info["furniture"]`` lists the boxes
         ``(name, centre, size, yaw)``.
 
+    Raises
+    ------
+    ValueError, TypeError
+        For a negative or non-integer seed.
+
     Notes
     -----
-    Se, Lowe & Little, "Global localization using distinctive visual features" (IROS 2002),
-    Sec. 3.6: the robot maps "our 10m by 10m lab"; the furniture and posters give SIFT texture.
+    Se, Lowe & Little (2002), Sec. 3.6: the robot maps "our 10m by 10m lab"; the furniture and
+    posters give SIFT texture.
+
+    Examples
+    --------
+    >>> lab = lab_room()
+    >>> lab
+    World('lab_room', 123 surfaces, 52 wall segments, 10.00 m x 10.00 m)
+    >>> bool(lab.is_free([5.0, 2.0])[0])      # where lesson 01's robot stands
+    True
     """
     rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
     H = 2.8
@@ -135,7 +164,7 @@ def _door_plan(layout: str) -> tuple[list, list]:
 
 @functools.lru_cache(maxsize=6)
 def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
-    """The long corridor of seed 002: 36.10 m x 2.17 m, 0.07 m door recesses, 1.00/2.25 m doors.
+    """The long corridor of Ge et al. (2023): 36.10 m x 2.17 m, 0.07 m door recesses, 1.00/2.25 m doors.
 
     Parameters
     ----------
@@ -151,12 +180,22 @@ def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
         The corridor runs along +x from 0 to 36.10 m with its middle line on y = 0; walls at
         y = +-1.085 m; ``info`` has ``length``, ``width``, ``recess``, ``doors`` (side, x0, x1).
 
+    Raises
+    ------
+    ValueError, TypeError
+        For an unknown layout or a bad seed.
+
     Notes
     -----
-    Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor environment"
-    (FITEE 2023), Sec. 4.1 (dimensions) and Sec. 3.1, Fig. 3 and Eqs. (1)-(3) (door recesses in
-    facing and staggered layouts). The door geometry repeats every 4.5 m, so LiDAR scans alias;
+    Ge et al. (2023), Sec. 4.1 (dimensions) and Sec. 3.1, Fig. 3 and Eqs. (1)-(3) (door recesses
+    in facing and staggered layouts). The door geometry repeats every 4.5 m, so LiDAR scans alias;
     plates, posters and boards make each stretch look different to a camera (their Sec. 3.2).
+
+    Examples
+    --------
+    >>> corridor = long_corridor()
+    >>> corridor.info["length"], corridor.info["width"], corridor.info["doors"][0]
+    (36.1, 2.17, ('north', 2.5, 3.5))
     """
     layout = check_choice(layout, "layout", ["mixed", "facing", "staggered"])
     rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
@@ -198,7 +237,7 @@ def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
 
 @functools.lru_cache(maxsize=4)
 def office_floor(seed: int = 1) -> World:
-    """Four rooms R1-R4 and a horizontal corridor (seed 001's test environment).
+    """Four rooms R1-R4 and a horizontal corridor (the test environment of lesson 02's paper).
 
     Parameters
     ----------
@@ -210,11 +249,22 @@ def office_floor(seed: int = 1) -> World:
         ``[0, 16] x [0, 12]`` m: corridor ``y in [5, 7]``; R1 lower right, R2 lower left, R3 upper
         left, R4 upper right (``info["rooms"]``), each opening onto the corridor by a 1 m doorway.
 
+    Raises
+    ------
+    ValueError, TypeError
+        For a negative or non-integer seed.
+
     Notes
     -----
     "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
     navigation", Sec. "Experimental results", Fig. 6a: "four rooms R1, R2, R3, R4 and a horizontal
     corridor". Dimensions are our choice (the paper gives none).
+
+    Examples
+    --------
+    >>> office = office_floor()
+    >>> sorted(office.info["rooms"]), office.info["corridor"]
+    (['R1', 'R2', 'R3', 'R4'], (5.0, 7.0))
     """
     rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
     H = 2.7

@@ -10,9 +10,19 @@ then exactly second order,
 
 so ``kp`` and ``kd`` place its poles for a chosen overshoot ``M`` and 2 % settling time ``Ts`` with
 the standard relations ``zeta = -ln M / sqrt(pi^2 + ln^2 M)`` and ``omega_n = 4 / (zeta Ts)``
-(Franklin, Powell & Emami-Naeini, *Feedback Control of Dynamic Systems*, 7th ed., Sec. 3.4,
-Eqs. (3.60) and (3.67)). Hamid et al. (seed 000 Q3) steer by the compass bearing but do not give
-their control law; this design is ours.
+(Franklin, Powell & Emami-Naeini 2015, Sec. 3.4, Eqs. (3.60) and (3.67)). Hamid et al. (2009)
+steer by the compass bearing but do not give their control law; this design is ours.
+
+References
+----------
+.. [1] G. F. Franklin, J. D. Powell and A. Emami-Naeini, *Feedback Control of Dynamic Systems*,
+   7th ed., Pearson, 2015.
+.. [2] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
+.. [3] The python-control developers, *python-control: the Python Control Systems Library*,
+   version 0.10, https://python-control.org.
 """
 from __future__ import annotations
 
@@ -23,7 +33,7 @@ import control
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import check_finite_scalar, check_positive
+from ..validation import as_array, check_finite_scalar, check_positive
 
 __all__ = ["heading_plant", "design_heading_gains", "heading_closed_loop", "heading_loop_gain",
            "heading_step_response", "heading_frequency_response", "loop_metrics", "HeadingController"]
@@ -45,8 +55,13 @@ def heading_plant(tau: float, gain: float = 1.0) -> control.TransferFunction:
 
     Notes
     -----
-    First-order actuator plus integrator (Franklin et al., Sec. 3.1); motor lag from
+    First-order actuator plus integrator (Franklin et al. 2015, Sec. 3.1); motor lag from
     :class:`robokit.outdoor.truck.SkidSteerTruck`.
+
+    Examples
+    --------
+    >>> heading_plant(0.3).den[0][0].tolist()      # 0.3 s^2 + s
+    [0.3, 1.0, 0.0]
     """
     t = check_positive(tau, "tau")
     g = check_positive(gain, "gain")
@@ -81,7 +96,12 @@ def design_heading_gains(tau: float, overshoot: float, settling_time: float, gai
     Notes
     -----
     Matching ``tau s^2 + (1 + g kd) s + g kp`` with ``tau (s^2 + 2 zeta omega_n s + omega_n^2)``;
-    ``zeta`` and ``omega_n`` from Franklin et al., Sec. 3.4, Eqs. (3.60), (3.67).
+    ``zeta`` and ``omega_n`` from Franklin et al. (2015), Sec. 3.4, Eqs. (3.60), (3.67).
+
+    Examples
+    --------
+    >>> np.round(design_heading_gains(0.3, overshoot=0.05, settling_time=1.5), 3).tolist()
+    [4.479, 0.6]
     """
     t = check_positive(tau, "tau")
     m = check_positive(overshoot, "overshoot")
@@ -89,10 +109,10 @@ def design_heading_gains(tau: float, overshoot: float, settling_time: float, gai
         raise ValueError(f"overshoot: expected a fraction in (0, 1), got {m}")
     ts = check_positive(settling_time, "settling_time")
     g = check_positive(gain, "gain")
-    zeta = -math.log(m) / math.sqrt(math.pi ** 2 + math.log(m) ** 2)
-    wn = 4.0 / (zeta * ts)
-    kp = t * wn ** 2 / g
-    kd = (2 * zeta * wn * t - 1) / g
+    zeta = -math.log(m) / math.sqrt(math.pi ** 2 + math.log(m) ** 2)    # Eq. (3.67)
+    wn = 4.0 / (zeta * ts)                                              # Eq. (3.60), 2 % settling
+    kp = t * wn ** 2 / g                                                # tau omega_n^2 = g kp
+    kd = (2 * zeta * wn * t - 1) / g                                    # 2 zeta omega_n tau = 1 + g kd
     if kd < 0:
         raise ValueError(f"settling_time: expected a spec the plant cannot meet unaided (kd >= 0), got "
                          f"settling_time={ts} which needs kd={kd:.3g}; choose a shorter settling time")
@@ -104,7 +124,13 @@ def heading_closed_loop(kp: float, kd: float, tau: float, gain: float = 1.0) -> 
 
     Notes
     -----
-    Franklin et al., Sec. 4.3 (derivative on the output avoids the closed-loop zero of PD control).
+    Franklin et al. (2015), Sec. 4.3 (derivative on the output avoids the closed-loop zero of PD
+    control).
+
+    Examples
+    --------
+    >>> heading_closed_loop(4.0, 0.5, 0.3).den[0][0].tolist()
+    [0.3, 1.5, 4.0]
     """
     p = check_positive(kp, "kp")
     d = check_positive(kd, "kd", allow_zero=True)
@@ -118,7 +144,12 @@ def heading_loop_gain(kp: float, kd: float, tau: float, gain: float = 1.0) -> co
 
     Notes
     -----
-    Franklin et al., Sec. 6.4 (gain and phase margins of the loop transfer function).
+    Franklin et al. (2015), Sec. 6.4 (gain and phase margins of the loop transfer function).
+
+    Examples
+    --------
+    >>> heading_loop_gain(4.0, 0.5, 0.3).num[0][0].tolist()    # (0.5 s + 4) / (0.3 s^2 + s)
+    [0.5, 4.0]
     """
     p = check_positive(kp, "kp")
     d = check_positive(kd, "kd", allow_zero=True)
@@ -131,7 +162,14 @@ def heading_step_response(kp: float, kd: float, tau: float, gain: float = 1.0,
 
     Notes
     -----
-    ``control.step_response`` (python-control 0.10) on the closed loop of Franklin et al., Sec. 3.4.
+    ``control.step_response`` (python-control 0.10) on the closed loop of Franklin et al. (2015),
+    Sec. 3.4.
+
+    Examples
+    --------
+    >>> t, theta = heading_step_response(4.479, 0.6, 0.3)
+    >>> len(t), round(float(theta.max()), 3), round(float(theta[-1]), 3)     # 5 % overshoot, settled
+    (400, 1.05, 1.0)
     """
     T = heading_closed_loop(kp, kd, tau, gain)
     t = np.linspace(0.0, check_positive(duration, "duration"), max(int(n), 2))
@@ -144,10 +182,13 @@ def heading_frequency_response(kp: float, kd: float, tau: float, omega: Any, gai
 
     Notes
     -----
-    Franklin et al., Sec. 6.1 (frequency response).
-    """
-    from ..validation import as_array
+    Franklin et al. (2015), Sec. 6.1 (frequency response).
 
+    Examples
+    --------
+    >>> np.round(np.abs(heading_frequency_response(4.479, 0.6, 0.3, [3.434])), 3).tolist()   # at crossover
+    [1.0]
+    """
     w = as_array(omega, "omega")
     if np.any(w <= 0):
         raise ValueError("omega: expected positive frequencies in rad/s")
@@ -174,7 +215,16 @@ def loop_metrics(kp: float, kd: float, tau: float, gain: float = 1.0, delay: flo
     Notes
     -----
     ``control.step_info`` and ``control.stability_margins`` (python-control 0.10); definitions of
-    overshoot, settling time and margins as in Franklin et al., Secs. 3.4 and 6.4.
+    overshoot, settling time and margins as in Franklin et al. (2015), Secs. 3.4 and 6.4.
+
+    Examples
+    --------
+    >>> kp, kd = design_heading_gains(0.3, overshoot=0.05, settling_time=1.5)
+    >>> m = loop_metrics(kp, kd, 0.3)
+    >>> round(m["overshoot"], 3), round(m["phase_margin_deg"]), m["gain_margin"]
+    (0.05, 69, inf)
+    >>> round(loop_metrics(kp, kd, 0.3, delay=0.05)["phase_margin_deg"])    # a 50 ms delay costs margin
+    59
     """
     L = heading_loop_gain(kp, kd, tau, gain)
     dly = check_positive(delay, "delay", allow_zero=True)
@@ -208,8 +258,14 @@ class HeadingController:
 
     Notes
     -----
-    Rate from successive compass headings (finite difference, low-pass filtered); Franklin et al.,
-    Sec. 8.3 (emulation of a continuous design).
+    Rate from successive compass headings (finite difference, low-pass filtered); Franklin et al.
+    (2015), Sec. 8.3 (emulation of a continuous design).
+
+    Examples
+    --------
+    >>> ctl = HeadingController(4.479, 0.6, max_rate=3.0)
+    >>> ctl.command(reference=0.5, heading=0.0), ctl.command(reference=2.0, heading=0.0)   # saturated
+    (2.2395, 3.0)
     """
 
     def __init__(self, kp: float, kd: float, max_rate: float, rate_filter: float = 0.1) -> None:
@@ -229,7 +285,7 @@ class HeadingController:
 
         Notes
         -----
-        Backward difference plus first-order low-pass (Franklin et al., Sec. 8.3).
+        Backward difference plus first-order low-pass (Franklin et al. 2015, Sec. 8.3).
         """
         h = check_finite_scalar(heading, "heading")
         if self._last is not None:
@@ -243,8 +299,8 @@ class HeadingController:
 
         Notes
         -----
-        Proportional action on the wrapped error plus rate feedback, saturated (Franklin et al.,
-        Sec. 4.3).
+        Proportional action on the wrapped error plus rate feedback, saturated (Franklin et al.
+        2015, Sec. 4.3).
         """
         u = self.kp * wrap_angle(reference - heading) - self.kd * self.rate
         return float(min(max(u, -self.max_rate), self.max_rate))
