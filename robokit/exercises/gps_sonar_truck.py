@@ -6,13 +6,13 @@ import datetime as dt
 import numpy as np
 
 from ..controllers.heading import design_heading_gains
-from .compare import close, exact
-from .spec import Case, Exercise
 from ..outdoor.geodesy import haversine_distance_bearing
 from ..outdoor.navigator import avoidance_decision
 from ..outdoor.nmea import fix_position, nmea_checksum
 from ..outdoor.nmea_write import format_sentence, gga_sentence, hdg_sentence, random_sentences, rmc_sentence
 from ..outdoor.sonar import pulse_width_to_cm_inches
+from .compare import close, exact
+from .spec import Case, Exercise
 
 ASSIGNMENT = "05_gps_sonar_truck"
 #: Written (manually graded) questions: id -> points.
