@@ -40,7 +40,7 @@ def bright_centroid(image):
 @pytest.mark.parametrize("pose", [[3.0, 1.0, np.pi / 2], [2.0, 2.0, 1.2], [4.2, 1.5, 2.0]])
 def test_point_on_wall_is_painted_where_it_projects(pose):
     world, X = dot_world()
-    T = CAM.pose_at(pose)
+    T = CAM.transform_at(pose)
     frame = CAM.render(world, T)
     uv, z = CAM.project(X, T)
     assert np.linalg.norm(bright_centroid(frame.image) - uv[0]) < 1.0
@@ -48,7 +48,7 @@ def test_point_on_wall_is_painted_where_it_projects(pose):
 
 def test_rendered_depth_backprojects_to_the_wall_within_1mm():
     world = box_room()
-    T = CAM.pose_at([2.0, 1.5, 0.7])
+    T = CAM.transform_at([2.0, 1.5, 0.7])
     frame = CAM.render(world, T)
     rng = np.random.default_rng(0)
     pix = np.column_stack([rng.integers(0, 640, 300), rng.integers(0, 480, 300)]).astype(float)
@@ -65,7 +65,7 @@ def test_rendered_depth_backprojects_to_the_wall_within_1mm():
 def test_stereo_disparity_is_f_b_over_z():
     world, X = dot_world()
     rig = cm.StereoRig(CAM, baseline=0.2, trinocular=True)
-    T = CAM.pose_at([3.0, 1.2, np.pi / 2])
+    T = CAM.transform_at([3.0, 1.2, np.pi / 2])
     views = rig.render(world, T)
     uv_l, Z = CAM.project(X, T)
     cl, cr, ct = (bright_centroid(views[k].image) for k in ("left", "right", "top"))
@@ -88,7 +88,7 @@ def test_omni_projection_round_trip_and_renderer():
     np.testing.assert_allclose(cam.backproject(uv, ranges), P, atol=1e-9)
     # renderer: the dot appears where the model projects it, at the right range
     world, X = dot_world()
-    T = cam.pose_at([3.0, 2.0, 0.3])
+    T = cam.transform_at([3.0, 2.0, 0.3])
     frame = cam.render(world, T)
     uvx, rx = cam.project(X, T)
     c = bright_centroid(frame.image)
@@ -111,7 +111,7 @@ def test_sift_finds_hundreds_of_keypoints_and_correct_matches(builder, pose):
 
 def test_ground_truth_inliers_accepts_true_and_rejects_shuffled_correspondences():
     world = lab_room()
-    T1, T2 = CAM.pose_at([5.0, 2.0, np.pi / 2]), CAM.pose_at([5.0, 2.3, np.pi / 2])
+    T1, T2 = CAM.transform_at([5.0, 2.0, np.pi / 2]), CAM.transform_at([5.0, 2.3, np.pi / 2])
     depth = CAM.render(world, T1).depth
     rng = np.random.default_rng(0)
     uv1 = np.column_stack([rng.uniform(100, 540, 200), rng.uniform(100, 380, 200)])
@@ -130,7 +130,7 @@ def test_ground_truth_inliers_accepts_true_and_rejects_shuffled_correspondences(
 
 def test_lighting_and_noise_change_the_image_reproducibly():
     world = box_room()
-    T = CAM.pose_at([3.0, 2.0, 0.0])
+    T = CAM.transform_at([3.0, 2.0, 0.0])
     a = CAM.render(world, T).image
     dark = CAM.render(world, T, lighting={"gain": 0.5}).image
     assert dark.mean() < 0.6 * a.mean()
@@ -145,16 +145,18 @@ def test_lighting_and_noise_change_the_image_reproducibly():
     (lambda: cm.PinholeCamera(500, -1.0, 320, 240), "fy"),
     (lambda: cm.StereoRig(CAM, baseline=0.0), "baseline"),
     (lambda: cm.StereoRig(CAM, baseline=-0.1), "baseline"),
-    (lambda: CAM.render(box_room(), np.full((4, 4), np.nan)), "pose"),
+    (lambda: CAM.render(box_room(), np.full((4, 4), np.nan)), "T_world_cam"),
     (lambda: CAM.observe(box_room(), [np.nan, 1.0, 0.0]), "robot_pose"),
-    (lambda: CAM.observe(box_room(), [-1.0, 1.0, 0.0]), "pose"),       # outside the world
-    (lambda: CAM.observe(box_room(), [0.01, 1.0, 0.0]), "pose"),       # inside a wall
-    (lambda: CAM.observe(lab_room(), [5.5, 5.0, 0.0]), "pose"),        # inside the table
-    (lambda: CAM.render(box_room(), se3_from_rt(np.eye(3), [3, 2, 3.0])), "pose"),  # above the ceiling
+    (lambda: CAM.observe(box_room(), [-1.0, 1.0, 0.0]), "robot_pose"),       # outside the world
+    (lambda: CAM.observe(box_room(), [0.01, 1.0, 0.0]), "robot_pose"),       # inside a wall
+    (lambda: CAM.observe(lab_room(), [5.5, 5.0, 0.0]), "robot_pose"),        # inside the table
+    (lambda: CAM.render(box_room(), se3_from_rt(np.eye(3), [3, 2, 3.0])), "T_world_cam"),  # above the ceiling
+    (lambda: cm.StereoRig(CAM).observe(box_room(), [0.01, 1.0, 0.0]), "robot_pose"),
     (lambda: CAM.render("world", se2_to_se3([1, 1, 0], 1)), "world"),
     (lambda: World([], "empty", (0, 0), 2.5), "surfaces"),
     (lambda: OmniCamera(xi=0.0), "xi"),
-    (lambda: OmniCamera().observe(box_room(), [7.0, 1.0, 0.0]), "pose"),
+    (lambda: OmniCamera().observe(box_room(), [7.0, 1.0, 0.0]), "robot_pose"),
+    (lambda: OmniCamera().render(box_room(), se3_from_rt(np.eye(3), [7.0, 1.0, 1.0])), "T_world_omni"),
 ])
 def test_bad_input_is_named(call, match):
     with pytest.raises((ValueError, TypeError), match=match):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from robokit.outdoor.field import Field, random_course
-from robokit.sim import Layout, Lidar, PinholeCamera, field_world, mount_pose, open_field, scatter_obstacles
+from robokit.sim import Layout, Lidar, PinholeCamera, field_world, camera_mount, open_field, scatter_obstacles
 from robokit.sim.field import SIDES, _open_field
 from robokit.sim.world import World
 from tests.test_sim_lidar_motion import analytic_box_ranges
@@ -134,7 +134,7 @@ def test_point_on_an_obstacle_face_is_painted_where_it_projects():
     assert abs(n[2]) < 1e-12
     for dist, side in [(3.0, 0.0), (5.0, 0.6), (2.5, -0.5)]:
         eye = X[:2] + dist * n[:2] + side * np.array([-n[1], n[0]])
-        T = CAM.pose_at([eye[0], eye[1], np.arctan2(X[1] - eye[1], X[0] - eye[0])])
+        T = CAM.transform_at([eye[0], eye[1], np.arctan2(X[1] - eye[1], X[0] - eye[0])])
         frame = CAM.render(world, T)
         g = frame.image.astype(float)
         uv, z = CAM.project(X, T)
@@ -152,7 +152,7 @@ def test_point_on_an_obstacle_face_is_painted_where_it_projects():
 def test_every_pixel_sees_something_with_finite_depth():
     world = open_field()
     for pose, pitch in [([1.0, 1.0, np.pi * 1.25], 0.0), ([50.0, 30.0, 0.0], -0.7), ([99.0, 59.0, 0.8], 0.5)]:
-        cam = PinholeCamera.from_fov(mount=mount_pose(1.5, pitch=pitch))
+        cam = PinholeCamera.from_fov(mount=camera_mount(1.5, pitch=pitch))
         frame = cam.observe(world, pose)
         assert np.isfinite(frame.depth).all() and frame.depth.max() < 500  # every pixel hit a surface
 
@@ -187,9 +187,9 @@ def test_scatter_obstacles_respects_gaps_and_keep_clear():
     (lambda: field_world(boxes=[[5.0, np.nan, 1.0, 1.0, 0.0]]), r"boxes: expected finite values"),
     (lambda: scatter_obstacles(0, 3, (0.0, 10.0)), r"size\[0\]: expected a positive number"),
     (lambda: scatter_obstacles(0, 3, min_gap=0.0), r"min_gap: expected a positive number"),
-    (lambda: CAM.observe(open_field(), [-10.0, 30.0, 0.0]), r"pose: expected a position inside 'open_field'"),
+    (lambda: CAM.observe(open_field(), [-10.0, 30.0, 0.0]), r"robot_pose: expected a position inside 'open_field'"),
     (lambda: CAM.render(open_field(), np.diag([1.0, 1.0, 1.0, 1.0]) + np.array(
-        [[0, 0, 0, 50], [0, 0, 0, 30], [0, 0, 0, 70], [0, 0, 0, 0]])), r"pose: expected a height"),
+        [[0, 0, 0, 50], [0, 0, 0, 30], [0, 0, 0, 70], [0, 0, 0, 0]])), r"T_world_cam: expected a height"),
 ])
 def test_bad_input_is_named(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
@@ -209,7 +209,7 @@ def test_outdoor_textures_are_seeded_rgb_images():
 def test_frustum_clipping_of_far_reaching_ground_keeps_the_picture(monkeypatch):
     import robokit.sim.render as rd
     world = open_field()
-    T = CAM.pose_at([20.0, 10.0, 2.0])
+    T = CAM.transform_at([20.0, 10.0, 2.0])
     clipped = CAM.render(world, T)
     monkeypatch.setattr(rd, "_FAR_PIXELS", np.inf)  # rasterise the huge projected polygons as they are
     plain = CAM.render(world, T)

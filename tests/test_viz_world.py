@@ -51,7 +51,7 @@ def test_helpers_record_their_objects():
     world = lab_room()
     cam = PinholeCamera.from_fov()
     scene = Scene()
-    add_camera(scene, "cam", cam, cam.pose_at([5, 2, 1.57]))
+    add_camera(scene, "cam", cam, cam.transform_at([5, 2, 1.57]))
     add_trajectory(scene, "traj", lab_lap(world).poses, every=50)
     add_particles(scene, "pf", np.random.default_rng(0).normal([5, 5, 0], 0.3, (50, 3)), weights=np.ones(50))
     cov = np.tile(np.diag([0.01, 0.04, 0.02]), (4, 1, 1))

@@ -20,16 +20,17 @@ The 2D world (:mod:`robokit.sim.layout`)
     ``.collides(pose, length, width)``; ``obstacle_array`` checks obstacle arrays, ``box_corners``.
     The LiDAR, lesson 05's field (``robokit.outdoor.Field`` is a Layout) and its sonars use it.
 
-Cameras (poses are 4x4 ``T_world_cam``; optical frame x right, y down, z forward)
-    ``PinholeCamera.from_fov(hfov, width, height)``; ``.K``, ``.project(points, pose)``,
-    ``.backproject(pixels, depth, pose)``, ``.render(world, pose) -> Frame(image, depth)``,
-    ``.observe(world, robot_pose)`` (uses ``.mount``, default 0.8 m high, level).
+Cameras (placed by a 4x4 ``T_world_cam``; optical frame x right, y down, z forward)
+    ``PinholeCamera.from_fov(hfov, width, height)``; ``.K``, ``.project(points, T_world_cam)``,
+    ``.backproject(pixels, depth, T_world_cam)``, ``.render(world, T_world_cam) -> Frame(image, depth)``,
+    ``.observe(world, robot_pose)`` and ``.transform_at(robot_pose)`` (use ``.mount``, by default
+    :func:`camera_mount` 0.8 m high, level).
     ``StereoRig(camera, baseline, trinocular=False)``: ``.render``/``.observe`` return
     ``{"left", "right"[, "top"]}`` frames; ``.disparity(Z) = f B / Z``.
     ``OmniCamera()``: 640x480 unified-model catadioptric camera; ``.project``, ``.rays``,
     ``.backproject``, ``.render`` (depth = range). See :mod:`robokit.sim.omni` for the model.
     ``illuminate(image, gain, offset, gradient)`` or ``render(..., lighting={...})`` for
-    lighting changes; ``render(..., noise=sigma, rng=seed)`` for pixel noise.
+    lighting changes; ``render(..., noise=2.0, rng=0)`` for pixel noise (grey levels).
 
 LiDAR, vehicles and motion
     ``Lidar(beams=360, r_min=0.15, r_max=8.0, noise=0.0).scan(world, robot_pose)``;
@@ -58,7 +59,7 @@ Example
 >>> views["left"].image.shape, views["left"].depth.dtype
 ((480, 640, 3), dtype('float32'))
 """
-from .camera import Frame, PinholeCamera, StereoRig, mount_pose
+from .camera import Frame, PinholeCamera, StereoRig, camera_mount
 from .feature_check import ViewPairCheck, ground_truth_inliers, sift_view_pair
 from .field import field_world, open_field, scatter_obstacles
 from .layout import Layout, box_corners, obstacle_array
@@ -75,7 +76,7 @@ from .worlds import box_room, lab_room, long_corridor, office_floor
 __all__ = [
     "World", "Surface", "FreeSpace", "box_room", "lab_room", "long_corridor", "office_floor",
     "open_field", "field_world", "scatter_obstacles",
-    "Frame", "PinholeCamera", "StereoRig", "mount_pose", "OmniCamera", "omni_mount", "illuminate", "photo",
+    "Frame", "PinholeCamera", "StereoRig", "camera_mount", "OmniCamera", "omni_mount", "illuminate", "photo",
     "Layout", "box_corners", "obstacle_array", "Lidar", "scan_points",
     "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
     "odometry_increment",

@@ -1,6 +1,6 @@
 """Pinhole cameras and a rectified stereo rig (optionally trinocular, like the Triclops).
 
-Frames: a camera's pose is ``T_world_cam`` (4x4), its frame the OpenCV optical frame (x right,
+Frames: a camera's placement is ``T_world_cam`` (4x4), its frame the OpenCV optical frame (x right,
 y down, z forward). A camera carries a ``mount`` ``T_body_cam`` so that :meth:`PinholeCamera.observe`
 can render from a planar robot pose ``[x, y, theta]``.
 
@@ -28,7 +28,7 @@ from .render import render_pinhole
 from .textures import illuminate
 from .world import World
 
-__all__ = ["Frame", "mount_pose", "PinholeCamera", "StereoRig", "finish_image"]
+__all__ = ["Frame", "camera_mount", "PinholeCamera", "StereoRig", "finish_image"]
 
 
 class Frame(NamedTuple):
@@ -38,7 +38,7 @@ class Frame(NamedTuple):
     depth: np.ndarray
 
 
-def mount_pose(height: float, forward: float = 0.0, pitch: float = 0.0) -> np.ndarray:
+def camera_mount(height: float, forward: float = 0.0, pitch: float = 0.0) -> np.ndarray:
     """Return ``T_body_cam`` of a forward-looking camera on a robot (body: x forward, y left, z up).
 
     Parameters
@@ -102,32 +102,48 @@ def finish_image(image: np.ndarray, noise: float, rng: Any, lighting: dict | Non
 class MountedSensor:
     """Mixin for a sensor fixed on the robot by a ``mount`` transform ``T_body_sensor``.
 
-    Gives :meth:`pose_at` (the sensor's world pose for a planar robot pose) and :meth:`observe`
-    (render from there); the class provides ``mount`` and ``render(world, pose, **kwargs)``.
+    Gives :meth:`transform_at` (the sensor's ``T_world_sensor`` for a planar robot pose) and
+    :meth:`observe` (render from there); the class provides ``mount`` and
+    ``render(world, T_world_sensor, **kwargs)``.
     """
 
     mount: Any
 
-    def pose_at(self, robot_pose: Any) -> np.ndarray:
-        """``T_world_cam`` for a planar robot pose ``[x, y, theta]`` (uses :attr:`mount`).
+    def transform_at(self, robot_pose: Any, world: World | None = None) -> np.ndarray:
+        """``T_world_sensor`` for a planar robot pose ``[x, y, theta]`` (uses :attr:`mount`).
 
         Parameters
         ----------
         robot_pose : array_like, shape (3,)
+        world : World, optional
+            When given, also check that the sensor is inside the world's free space and below its
+            ceiling (errors name ``robot_pose``).
 
         Returns
         -------
         numpy.ndarray, shape (4, 4)
-            ``T_world_body @ T_body_cam``.
+            ``T_world_body @ T_body_sensor``.
+
+        Raises
+        ------
+        TypeError
+            If ``world`` is given and is not a World.
+        ValueError
+            For a malformed pose, or one that puts the sensor inside a wall or outside the world.
 
         Notes
         -----
         Composition of frames (Lynch & Park 2017, Sec. 3.3.1).
         """
-        return se2_to_se3(as_array(robot_pose, "robot_pose", shape=(3,))) @ self.mount
+        T = se2_to_se3(as_array(robot_pose, "robot_pose", shape=(3,))) @ self.mount
+        if world is not None:
+            if not isinstance(world, World):
+                raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
+            world.check_viewpoint(T[:3, 3], "robot_pose")
+        return T
 
     def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> Frame:
-        """Render from the camera mounted on a robot at planar pose ``[x, y, theta]``.
+        """Render from the sensor mounted on a robot at planar pose ``[x, y, theta]``.
 
         Parameters
         ----------
@@ -142,9 +158,9 @@ class MountedSensor:
 
         Notes
         -----
-        ``render(world, pose_at(robot_pose))``.
+        ``render(world, transform_at(robot_pose))``.
         """
-        return self.render(world, self.pose_at(robot_pose), **kwargs)
+        return self.render(world, self.transform_at(robot_pose, world), **kwargs)
 
 
 @dataclasses.dataclass
@@ -160,7 +176,7 @@ class PinholeCamera(MountedSensor):
     width, height : int
         Image size.
     mount : array_like (4, 4), optional
-        ``T_body_cam``; default :func:`mount_pose` at 0.8 m height, level.
+        ``T_body_cam``; default :func:`camera_mount` at 0.8 m height, level.
 
     Notes
     -----
@@ -191,7 +207,7 @@ class PinholeCamera(MountedSensor):
         self.height = check_int(self.height, "height", minimum=8)
         self.cx = float(as_array(self.cx, "cx", shape=()))
         self.cy = float(as_array(self.cy, "cy", shape=()))
-        self.mount = mount_pose(0.8) if self.mount is None else as_se3(self.mount, "mount")
+        self.mount = camera_mount(0.8) if self.mount is None else as_se3(self.mount, "mount")
 
     @classmethod
     def from_fov(cls, hfov: float = np.deg2rad(65.0), width: int = 640, height: int = 480,
@@ -215,15 +231,15 @@ class PinholeCamera(MountedSensor):
         """Intrinsic matrix (3, 3)."""
         return np.array([[self.fx, 0, self.cx], [0, self.fy, self.cy], [0, 0, 1.0]])
 
-    def project(self, points: Any, pose: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    def project(self, points: Any, T_world_cam: Any = None) -> tuple[np.ndarray, np.ndarray]:
         """Project 3D points to pixels.
 
         Parameters
         ----------
         points : array_like, shape (N, 3)
-            World points if ``pose`` is given, else camera-frame points.
-        pose : array_like (4, 4), optional
-            ``T_world_cam``.
+            World points if ``T_world_cam`` is given, else camera-frame points.
+        T_world_cam : array_like (4, 4), optional
+            The camera's placement in the world.
 
         Returns
         -------
@@ -238,15 +254,15 @@ class PinholeCamera(MountedSensor):
         painted at its projected pixel with this depth.
         """
         P = as_points(points, "points", 3)
-        if pose is not None:
-            P = transform_points(se3_inverse(as_se3(pose, "pose")), P)
+        if T_world_cam is not None:
+            P = transform_points(se3_inverse(as_se3(T_world_cam, "T_world_cam")), P)
         z = P[:, 2]
         with np.errstate(divide="ignore", invalid="ignore"):
             uv = np.column_stack([self.fx * P[:, 0] / z + self.cx, self.fy * P[:, 1] / z + self.cy])
         uv[z <= 0] = np.nan
         return uv, z
 
-    def backproject(self, pixels: Any, depth: Any, pose: Any = None) -> np.ndarray:
+    def backproject(self, pixels: Any, depth: Any, T_world_cam: Any = None) -> np.ndarray:
         """Lift pixels with known depth ``Z`` to 3D points (inverse of :meth:`project`).
 
         Parameters
@@ -254,8 +270,8 @@ class PinholeCamera(MountedSensor):
         pixels : array_like, shape (N, 2)
         depth : array_like, shape (N,)
             Positive ``Z`` values (e.g. read from the rendered depth image).
-        pose : array_like (4, 4), optional
-            ``T_world_cam``; when given the points are returned in the world frame.
+        T_world_cam : array_like (4, 4), optional
+            The camera's placement; when given the points are returned in the world frame.
 
         Returns
         -------
@@ -277,17 +293,17 @@ class PinholeCamera(MountedSensor):
         if np.any(z <= 0):
             raise ValueError("depth: expected positive depths, got a value <= 0")
         P = np.column_stack([(uv[:, 0] - self.cx) / self.fx * z, (uv[:, 1] - self.cy) / self.fy * z, z])
-        return P if pose is None else transform_points(as_se3(pose, "pose"), P)
+        return P if T_world_cam is None else transform_points(as_se3(T_world_cam, "T_world_cam"), P)
 
-    def render(self, world: World, pose: Any, *, noise: float = 0.0, rng: Any = None,
+    def render(self, world: World, T_world_cam: Any, *, noise: float = 0.0, rng: Any = None,
                lighting: dict | None = None) -> Frame:
-        """Render colour and depth of ``world`` from camera pose ``T_world_cam``.
+        """Render colour and depth of ``world`` seen by the camera placed at ``T_world_cam``.
 
         Parameters
         ----------
         world : World
-        pose : array_like (4, 4)
-            ``T_world_cam``; must be inside the world's free space, below the ceiling.
+        T_world_cam : array_like (4, 4)
+            Must be inside the world's free space, below the ceiling.
         noise : float, default 0
             Standard deviation of additive Gaussian pixel noise (grey levels).
         rng : Generator or int, optional
@@ -305,7 +321,7 @@ class PinholeCamera(MountedSensor):
         TypeError
             If ``world`` is not a World.
         ValueError
-            For a NaN or non-rigid pose, or a camera inside a wall or outside the world.
+            For a NaN or non-rigid transform, or a camera inside a wall or outside the world.
 
         Notes
         -----
@@ -313,8 +329,8 @@ class PinholeCamera(MountedSensor):
         """
         if not isinstance(world, World):
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
-        T = as_se3(pose, "pose")
-        world.check_viewpoint(T[:3, 3], "pose")
+        T = as_se3(T_world_cam, "T_world_cam")
+        world.check_viewpoint(T[:3, 3], "T_world_cam")
         image, depth = render_pinhole(world, self.K, self.width, self.height, T)
         return Frame(finish_image(image, noise, rng, lighting), depth)
 
@@ -415,15 +431,15 @@ class StereoRig:
             raise ValueError("disparity: expected positive disparities, got a value <= 0")
         return self.camera.fx * self.baseline / d
 
-    def render(self, world: World, pose: Any, **kwargs: Any) -> dict[str, Frame]:
-        """Render every camera of the rig; ``pose`` is the left camera's ``T_world_cam``.
+    def render(self, world: World, T_world_cam: Any, **kwargs: Any) -> dict[str, Frame]:
+        """Render every camera of the rig; ``T_world_cam`` places the left camera.
 
         Returns
         -------
         dict of str to Frame
             ``"left"``, ``"right"`` (and ``"top"``); noise uses independent draws per camera.
         """
-        T = as_se3(pose, "pose")
+        T = as_se3(T_world_cam, "T_world_cam")
         rng = as_rng(kwargs.pop("rng", None))
         return {name: self.camera.render(world, T @ off, rng=rng, **kwargs) for name, off in self.offsets.items()}
 
@@ -445,4 +461,4 @@ class StereoRig:
         -----
         The left camera sits at the camera's ``mount``; the others at :attr:`offsets` from it.
         """
-        return self.render(world, self.camera.pose_at(robot_pose), **kwargs)
+        return self.render(world, self.camera.transform_at(robot_pose, world), **kwargs)

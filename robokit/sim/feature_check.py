@@ -26,7 +26,7 @@ from .world import World
 __all__ = ["ViewPairCheck", "ground_truth_inliers", "sift_view_pair"]
 
 
-def ground_truth_inliers(camera: PinholeCamera, depth: Any, pose1: Any, pose2: Any, uv1: Any, uv2: Any,
+def ground_truth_inliers(camera: PinholeCamera, depth: Any, T1: Any, T2: Any, uv1: Any, uv2: Any,
                          tol: float = 3.0) -> np.ndarray:
     """Which correspondences ``uv1 -> uv2`` agree with the true geometry of two rendered views.
 
@@ -36,7 +36,7 @@ def ground_truth_inliers(camera: PinholeCamera, depth: Any, pose1: Any, pose2: A
         The camera that rendered both views.
     depth : array_like, shape (H, W)
         Rendered depth ``Z`` of the first view.
-    pose1, pose2 : array_like, shape (4, 4)
+    T1, T2 : array_like, shape (4, 4)
         ``T_world_cam`` of the two views.
     uv1, uv2 : array_like, shape (N, 2)
         Matched pixel coordinates ``(u, v) = (col, row)`` in view 1 and view 2.
@@ -75,7 +75,7 @@ def ground_truth_inliers(camera: PinholeCamera, depth: Any, pose1: Any, pose2: A
     known = np.isfinite(z) & (z > 0)          # pixels without a surface (no depth) cannot be judged
     ok = np.zeros(len(uv1), bool)
     if known.any():
-        predicted, _ = camera.project(camera.backproject(uv1[known], z[known], pose1), pose2)
+        predicted, _ = camera.project(camera.backproject(uv1[known], z[known], T1), T2)
         ok[known] = np.linalg.norm(predicted - uv2[known], axis=1) < tol
     return ok
 
@@ -98,7 +98,7 @@ def sift_view_pair(world: World, camera: PinholeCamera, robot_pose: Any, step: f
     ----------
     world : World
     camera : PinholeCamera
-        Rendered at its mount on the robot (:meth:`PinholeCamera.pose_at`).
+        Rendered at its mount on the robot (:meth:`PinholeCamera.transform_at`).
     robot_pose : array_like, shape (3,)
         Planar pose ``[x, y, theta]`` of the first view; the second is ``step`` metres ahead.
     step : float, default 0.3
@@ -124,9 +124,9 @@ def sift_view_pair(world: World, camera: PinholeCamera, robot_pose: Any, step: f
     step = check_positive(step, "step")
     ratio = check_positive(ratio, "ratio")
     pose = as_array(robot_pose, "robot_pose", shape=(3,))
-    pose1 = camera.pose_at(pose)
-    pose2 = camera.pose_at(pose + [step * np.cos(pose[2]), step * np.sin(pose[2]), 0.0])
-    frame1, frame2 = camera.render(world, pose1), camera.render(world, pose2)
+    T1 = camera.transform_at(pose)
+    T2 = camera.transform_at(pose + [step * np.cos(pose[2]), step * np.sin(pose[2]), 0.0])
+    frame1, frame2 = camera.render(world, T1), camera.render(world, T2)
     sift = cv2.SIFT_create()
     k1, d1 = sift.detectAndCompute(cv2.cvtColor(frame1.image, cv2.COLOR_RGB2GRAY), None)
     k2, d2 = sift.detectAndCompute(cv2.cvtColor(frame2.image, cv2.COLOR_RGB2GRAY), None)
@@ -137,5 +137,5 @@ def sift_view_pair(world: World, camera: PinholeCamera, robot_pose: Any, step: f
         return ViewPairCheck(len(k1), 0, 0.0)
     uv1 = np.array([k1[m.queryIdx].pt for m in good])
     uv2 = np.array([k2[m.trainIdx].pt for m in good])
-    inliers = ground_truth_inliers(camera, frame1.depth, pose1, pose2, uv1, uv2, tol)
+    inliers = ground_truth_inliers(camera, frame1.depth, T1, T2, uv1, uv2, tol)
     return ViewPairCheck(len(k1), len(good), float(inliers.mean()))

@@ -151,14 +151,14 @@ class OmniCamera(MountedSensor):
         lo, hi = self.elevation_range
         return self.f * self._radius(lo), self.f * self._radius(hi)
 
-    def project(self, points: Any, pose: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    def project(self, points: Any, T_world_omni: Any = None) -> tuple[np.ndarray, np.ndarray]:
         """Project points to omni pixels.
 
         Parameters
         ----------
         points : array_like, shape (N, 3)
-            World points if ``pose`` (``T_world_omni``) is given, else omni-frame points.
-        pose : array_like (4, 4), optional
+            World points if ``T_world_omni`` is given, else omni-frame points.
+        T_world_omni : array_like (4, 4), optional
 
         Returns
         -------
@@ -172,8 +172,8 @@ class OmniCamera(MountedSensor):
         Unified model, Mei & Rives (2007), Eqs. (1)-(3) without distortion.
         """
         P = as_points(points, "points", 3)
-        if pose is not None:
-            T = as_se3(pose, "pose")
+        if T_world_omni is not None:
+            T = as_se3(T_world_omni, "T_world_omni")
             P = (P - T[:3, 3]) @ T[:3, :3]
         rng_ = np.linalg.norm(P, axis=1)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -206,7 +206,7 @@ class OmniCamera(MountedSensor):
         eta = (self.xi + np.sqrt(1 + (1 - self.xi ** 2) * r2)) / (r2 + 1)
         return np.column_stack([eta * m[:, 0], eta * m[:, 1], eta - self.xi])
 
-    def backproject(self, pixels: Any, ranges: Any, pose: Any = None) -> np.ndarray:
+    def backproject(self, pixels: Any, ranges: Any, T_world_omni: Any = None) -> np.ndarray:
         """3D points at distance ``ranges`` along the rays of ``pixels`` (inverse of :meth:`project`).
 
         Parameters
@@ -214,7 +214,7 @@ class OmniCamera(MountedSensor):
         pixels : array_like, shape (N, 2)
         ranges : array_like, shape (N,)
             Positive distances from the viewpoint (the omni depth image).
-        pose : array_like (4, 4), optional
+        T_world_omni : array_like (4, 4), optional
             ``T_world_omni``; when given the points are returned in the world frame.
 
         Returns
@@ -235,9 +235,9 @@ class OmniCamera(MountedSensor):
         if len(r) != len(d) or np.any(r <= 0):
             raise ValueError(f"ranges: expected {len(d)} positive values, got {len(r)} (min {r.min() if len(r) else None})")
         P = d * r[:, None]
-        if pose is None:
+        if T_world_omni is None:
             return P
-        T = as_se3(pose, "pose")
+        T = as_se3(T_world_omni, "T_world_omni")
         return P @ T[:3, :3].T + T[:3, 3]
 
     @functools.cached_property
@@ -268,7 +268,7 @@ class OmniCamera(MountedSensor):
         shape = (self.height, self.width)
         return used, K, S + 2 * pad, mapx.reshape(shape), mapy.reshape(shape), factor.reshape(shape), inside.reshape(shape)
 
-    def render(self, world: World, pose: Any, *, noise: float = 0.0, rng: Any = None,
+    def render(self, world: World, T_world_omni: Any, *, noise: float = 0.0, rng: Any = None,
                lighting: dict | None = None) -> Frame:
         """Render colour and range images from ``T_world_omni`` (see :meth:`PinholeCamera.render`).
 
@@ -281,12 +281,12 @@ class OmniCamera(MountedSensor):
         Raises
         ------
         TypeError, ValueError
-            For a non-World, a bad pose or a viewpoint inside a wall / outside the world.
+            For a non-World, a bad transform or a viewpoint inside a wall / outside the world.
         """
         if not isinstance(world, World):
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
-        T = as_se3(pose, "pose")
-        world.check_viewpoint(T[:3, 3], "pose")
+        T = as_se3(T_world_omni, "T_world_omni")
+        world.check_viewpoint(T[:3, 3], "T_world_omni")
         used, K, size, mapx, mapy, factor, inside = self._lookup
         images, depths = [], []
         for name in used:

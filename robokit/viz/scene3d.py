@@ -124,7 +124,7 @@ def add_camera(scene: Scene, path: str, camera: PinholeCamera, T_world_cam: Any,
     path : str
     camera : PinholeCamera
     T_world_cam : array_like (4, 4)
-        Pose of the camera's optical frame in the world (e.g. ``camera.pose_at(robot_pose)``).
+        Pose of the camera's optical frame in the world (e.g. ``camera.transform_at(robot_pose)``).
     depth : float, default 0.4
         Distance of the drawn image rectangle from the apex (metres).
 
@@ -141,7 +141,7 @@ def add_camera(scene: Scene, path: str, camera: PinholeCamera, T_world_cam: Any,
     >>> from robokit import sim
     >>> from robokit.viz import Scene, add_camera
     >>> camera = sim.PinholeCamera.from_fov()
-    >>> add_camera(Scene(), "camera", camera, camera.pose_at([1.0, 1.0, 0.0]))   # frustum and axes
+    >>> add_camera(Scene(), "camera", camera, camera.transform_at([1.0, 1.0, 0.0]))   # frustum and axes
     Scene(title='robokit scene', commands=3)
     """
     if not isinstance(camera, PinholeCamera):
