@@ -47,9 +47,9 @@ def test_navigator_needs_nmea_before_moving_and_rejects_bad_text():
     nav.feed("$GPRMC,garbage*00")
     nav.feed("$HCHDG,90.0,0.0,E,0.0,E*00")
     assert len(nav.parse_errors) == 2 and nav.heading is None
-    for line in GPSReceiver(plane, sigma=0.0, white=0.0).fix(0.0, [0.0, 10.0], 0.0, 0.0):
+    for line in GPSReceiver(plane, noise=0.0, white_noise=0.0).fix(0.0, [0.0, 10.0], 0.0, 0.0):
         nav.feed(line)
-    nav.feed(Compass(sigma_deg=0.0).reading(0.0))
+    nav.feed(Compass(noise_deg=0.0).reading(0.0))
     v, omega = nav.update([FAR] * 4, 0.05)
     assert v > 0 and abs(omega) < 0.05      # facing the waypoint (to the 0.2 m resolution of the fix)
     v, _ = nav.update([FAR, 0.5, 0.5, FAR], 0.05)
@@ -70,9 +70,9 @@ def test_single_run_is_deterministic_and_reports_nmea():
 def test_obstacle_dead_ahead_is_avoided():
     field = Field(circles=[[15.0, 10.0, 0.8]])
     course = Course(field, np.array([[30.0, 10.0]]), np.array([2.0, 10.0, 0.0]))
-    run = simulate(course, seed=2, gps_sigma=0.5)
+    run = simulate(course, seed=2, gps_noise=0.5)
     assert run.reached == 1 and run.collisions == 0 and run.avoidances >= 1
-    blind = simulate(course, seed=2, gps_sigma=0.5, firing="off")
+    blind = simulate(course, seed=2, gps_noise=0.5, firing="off")
     assert blind.collisions == 1
 
 
@@ -100,3 +100,8 @@ def test_simulate_bad_input():
         simulate(random_course(0), firing="sometimes")
     with pytest.raises(ValueError, match="results"):
         summarize_runs([])
+    # a seed is a non-negative integer (pass a Generator's draws, not the Generator)
+    with pytest.raises(TypeError, match="seed"):
+        simulate(random_course(0), seed=np.random.default_rng(0))
+    with pytest.raises(ValueError, match="seed"):
+        random_course(-1)

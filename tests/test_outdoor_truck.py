@@ -84,7 +84,7 @@ def test_compass_convention():
     assert compass_to_heading(270.0) == pytest.approx(-np.pi) or compass_to_heading(270.0) == pytest.approx(np.pi)
     for th in np.linspace(-3, 3, 7):
         assert compass_to_heading(heading_to_compass(th)) == pytest.approx(th)
-    rec = parse_sentence(Compass(sigma_deg=0.0, rng=1).reading(0.3))
+    rec = parse_sentence(Compass(noise_deg=0.0, rng=1).reading(0.3))
     assert isinstance(rec, HDG) and rec.talker == "HC"
     assert compass_to_heading(rec.true_heading_deg) == pytest.approx(0.3, abs=np.radians(0.1))
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..sim.field import field_world, scatter_obstacles
 from ..sim.layout import Layout
-from ..validation import as_array, as_rng, check_int, check_positive
+from ..validation import as_array, check_int, check_positive
 
 __all__ = ["Field", "random_course", "Course", "UNIMAP_ORIGIN"]
 
@@ -123,14 +123,14 @@ class Course:
     start: np.ndarray
 
 
-def random_course(seed: Any = 0, *, n_waypoints: int = 4, n_obstacles: int = 14, on_path: float = 0.5,
+def random_course(seed: int = 0, *, n_waypoints: int = 4, n_obstacles: int = 14, on_path: float = 0.5,
                   size: tuple[float, float] = (100.0, 60.0), min_gap: float = 2.5) -> Course:
     """Generate a waypoint course with obstacles, some of them on the legs between waypoints.
 
     Parameters
     ----------
-    seed : int or numpy.random.Generator
-        Randomness (see :func:`robokit.validation.as_rng`).
+    seed : int, default 0
+        Non-negative integer that seeds the layout: course ``seed`` is always the same course.
     n_waypoints : int, default 4
         Waypoints after the start, at least 12 m apart.
     n_obstacles : int, default 14
@@ -167,7 +167,7 @@ def random_course(seed: Any = 0, *, n_waypoints: int = 4, n_obstacles: int = 14,
     >>> bool(np.all(course.field.clearance(course.waypoints) >= 2 * 2.5))   # waypoints kept clear
     True
     """
-    rng = as_rng(seed, "seed")
+    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
     k = check_int(n_waypoints, "n_waypoints", minimum=1, maximum=20)
     n = check_int(n_obstacles, "n_obstacles", minimum=0, maximum=200)
     frac = check_positive(on_path, "on_path", allow_zero=True)

@@ -4,8 +4,8 @@ Hamid et al. (2009, Sec. 3) read position from a Garmin eTrex Vista ($GPRMC, $GP
 heading from its compass ($HCHDG), and note that the position may be wrong by up to about 9 m.
 Consumer GPS errors are not independent from second to second: they wander slowly (satellite
 geometry, atmosphere, multipath). We model each horizontal axis as a first-order Gauss-Markov
-process (standard deviation ``sigma``, correlation time ``tau``) plus a little white noise (Grewal
-et al. 2013, Sec. 10.2 on time-correlated GNSS errors); with ``sigma`` = 2.5 m the error is a few
+process (standard deviation ``noise``, correlation time ``tau``) plus a little white noise (Grewal
+et al. 2013, Sec. 10.2 on time-correlated GNSS errors); with ``noise`` = 2.5 m the error is a few
 metres and exceeds 9 m well under 1 % of the time.
 
 References
@@ -65,11 +65,11 @@ class GPSReceiver:
     ----------
     plane : LocalTangentPlane
         Maps the field's east-north metres to latitude/longitude.
-    sigma : float, default 2.5
+    noise : float, default 2.5
         Standard deviation (m) of the slowly varying error on each axis.
     tau : float, default 60
         Correlation time (s) of that error.
-    white : float, default 0.3
+    white_noise : float, default 0.3
         Standard deviation (m) of the independent per-fix noise.
     period : float, default 1
         Seconds between fixes (1 Hz like the eTrex).
@@ -77,7 +77,7 @@ class GPSReceiver:
 
     Notes
     -----
-    Gauss-Markov update ``b_k+1 = phi b_k + sqrt(1 - phi^2) sigma n_k``, ``phi = exp(-period/tau)``
+    Gauss-Markov update ``b_k+1 = phi b_k + sqrt(1 - phi^2) noise n_k``, ``phi = exp(-period/tau)``
     (Grewal et al. 2013, Sec. 10.2). Sentences built by :mod:`robokit.outdoor.nmea_write`.
 
     Examples
@@ -91,17 +91,17 @@ class GPSReceiver:
     [1.27, 1.56]
     """
 
-    def __init__(self, plane: LocalTangentPlane, *, sigma: float = 2.5, tau: float = 60.0, white: float = 0.3,
+    def __init__(self, plane: LocalTangentPlane, *, noise: float = 2.5, tau: float = 60.0, white_noise: float = 0.3,
                  period: float = 1.0, rng: Any = None) -> None:
         if not isinstance(plane, LocalTangentPlane):
             raise TypeError(f"plane: expected a LocalTangentPlane, got {type(plane).__name__}")
         self.plane = plane
-        self.sigma = check_positive(sigma, "sigma", allow_zero=True)
+        self.noise = check_positive(noise, "noise", allow_zero=True)
         self.tau = check_positive(tau, "tau")
-        self.white = check_positive(white, "white", allow_zero=True)
+        self.white_noise = check_positive(white_noise, "white_noise", allow_zero=True)
         self.period = check_positive(period, "period")
         self.rng = as_rng(rng)
-        self.bias = self.rng.normal(0.0, self.sigma, 2) if self.sigma else np.zeros(2)
+        self.bias = self.rng.normal(0.0, self.noise, 2) if self.noise else np.zeros(2)
         self.last_error = np.zeros(2)
 
     def fix(self, t: float, position: Any, speed: float, heading: float) -> list[str]:
@@ -130,8 +130,8 @@ class GPSReceiver:
         p = as_array(position, "position", shape=(2,))
         ts = check_positive(t, "t", allow_zero=True)
         phi = math.exp(-self.period / self.tau)
-        self.bias = phi * self.bias + math.sqrt(1 - phi * phi) * self.sigma * self.rng.normal(size=2)  # Gauss-Markov
-        self.last_error = self.bias + self.white * self.rng.normal(size=2)
+        self.bias = phi * self.bias + math.sqrt(1 - phi * phi) * self.noise * self.rng.normal(size=2)  # Gauss-Markov
+        self.last_error = self.bias + self.white_noise * self.rng.normal(size=2)
         lat, lon = self.plane.to_geodetic(p + self.last_error)
         when = MISSION_START + _dt.timedelta(seconds=round(ts, 2))
         lat_d, lon_d = math.degrees(lat), math.degrees(lon)
@@ -146,7 +146,7 @@ class Compass:
 
     Parameters
     ----------
-    sigma_deg : float, default 1.0
+    noise_deg : float, default 1.0
         Standard deviation of heading noise in degrees.
     variation_deg : float, default -0.3
         Local magnetic variation (east positive) sent in the sentence; the reported heading is the
@@ -158,8 +158,8 @@ class Compass:
     The paper's $HCHDG (Hamid et al. 2009, Sec. 3); resolution 0.1 degree in the sentence.
     """
 
-    def __init__(self, *, sigma_deg: float = 1.0, variation_deg: float = -0.3, rng: Any = None) -> None:
-        self.sigma_deg = check_positive(sigma_deg, "sigma_deg", allow_zero=True)
+    def __init__(self, *, noise_deg: float = 1.0, variation_deg: float = -0.3, rng: Any = None) -> None:
+        self.noise_deg = check_positive(noise_deg, "noise_deg", allow_zero=True)
         self.variation_deg = check_finite_scalar(variation_deg, "variation_deg")
         self.rng = as_rng(rng)
 
@@ -170,5 +170,5 @@ class Compass:
         -----
         HDG layout, NMEA 0183 v4.11 Sec. 6.3; the compass sentence of Hamid et al. (2009, Sec. 3).
         """
-        true_deg = heading_to_compass(heading) + (self.rng.normal(0.0, self.sigma_deg) if self.sigma_deg else 0.0)
+        true_deg = heading_to_compass(heading) + (self.rng.normal(0.0, self.noise_deg) if self.noise_deg else 0.0)
         return hdg_sentence(true_deg - self.variation_deg, deviation_deg=0.0, variation_deg=self.variation_deg)

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_rng, check_choice, check_int, check_positive
+from ..validation import check_choice, check_int, check_positive
 from .field import Course, random_course
 from .geodesy import LocalTangentPlane
 from .gps import Compass, GPSReceiver
@@ -95,17 +95,17 @@ class RunResult:
         return self.reached == self.n_waypoints and self.collisions == 0
 
 
-def simulate(course: Course, seed: Any = 0, *, firing: str = "chained", truck: SkidSteerTruck | None = None,
+def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: SkidSteerTruck | None = None,
              max_time: float | None = None, dt: float = 0.049, keep_nmea: int = 200,
-             gps_sigma: float = 2.5, navigator_options: dict | None = None) -> RunResult:
+             gps_noise: float = 2.5, navigator_options: dict | None = None) -> RunResult:
     """Run one mission on ``course`` and return its :class:`RunResult`.
 
     Parameters
     ----------
     course : Course
         From :func:`robokit.outdoor.field.random_course`.
-    seed : int or numpy.random.Generator
-        Randomness of the GPS, compass, sonar noise and the real truck's slip.
+    seed : int, default 0
+        Non-negative integer that seeds the GPS, compass and sonar noise and the real truck's slip.
     firing : {"chained", "free", "off"}, default "chained"
         Sonar firing: one sensor per 49 ms slot in a loop, all free-running with cross-talk, or
         no sonar at all (the baseline that shows what the sonars are for).
@@ -118,7 +118,7 @@ def simulate(course: Course, seed: Any = 0, *, firing: str = "chained", truck: S
         Control step = one sonar reading cycle (datasheet: 49 ms).
     keep_nmea : int, default 200
         Number of sentences kept in the result (for display).
-    gps_sigma : float, default 2.5
+    gps_noise : float, default 2.5
         Standard deviation (m) of the wandering GPS error per axis.
     navigator_options : dict, optional
         Extra keyword arguments for :class:`~robokit.outdoor.navigator.Navigator`.
@@ -142,16 +142,16 @@ def simulate(course: Course, seed: Any = 0, *, firing: str = "chained", truck: S
     --------
     >>> from robokit.outdoor import Course, Field
     >>> course = Course(Field(circles=[[7.0, 10.0, 0.4]]), np.array([[14.0, 10.0]]), np.array([2.0, 10.0, 0.0]))
-    >>> run = simulate(course, seed=2, gps_sigma=0.5)
+    >>> run = simulate(course, seed=2, gps_noise=0.5)
     >>> run.reached, run.collisions, run.avoidances >= 1
     (1, 0, True)
     """
     if not isinstance(course, Course):
         raise TypeError(f"course: expected a Course from random_course(), got {type(course).__name__}")
-    rng = as_rng(seed, "seed")
+    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
     check_choice(firing, "firing", ("chained", "free", "off"))
     mission = _Mission(course, rng, firing, truck, check_positive(dt, "dt"), check_int(keep_nmea, "keep_nmea", minimum=0),
-                       gps_sigma, navigator_options, max_time)
+                       gps_noise, navigator_options, max_time)
     while mission.t < mission.limit and not mission.nav.done:
         mission.send_nmea()
         mission.ping_sonars()
@@ -165,7 +165,7 @@ class _Mission:
     """One mission's state, advanced one control step at a time by :func:`simulate`'s phases."""
 
     def __init__(self, course: Course, rng: np.random.Generator, firing: str, truck: SkidSteerTruck | None,
-                 dt: float, keep: int, gps_sigma: float, navigator_options: dict | None, max_time: float | None):
+                 dt: float, keep: int, gps_noise: float, navigator_options: dict | None, max_time: float | None):
         # set-up; the order of the random draws below is part of every seeded result
         self.course, self.field, self.rng, self.firing, self.dt, self.keep = course, course.field, rng, firing, dt, keep
         self.real = truck if truck is not None else dataclasses.replace(
@@ -178,7 +178,7 @@ class _Mission:
         self.offset = plane.to_local(self.nav.plane.lat0, self.nav.plane.lon0)  # navigator's frame -> field frame
         self.limit = (3 * straight / self.nav.cruise_speed + 120.0 if max_time is None
                       else check_positive(max_time, "max_time"))
-        self.gps = GPSReceiver(plane, sigma=gps_sigma, rng=rng)
+        self.gps = GPSReceiver(plane, noise=gps_noise, rng=rng)
         self.compass = Compass(rng=rng)
         self.sonar = LVMaxSonarEZ()
         self.state = TruckState(np.array(course.start, dtype=float))
