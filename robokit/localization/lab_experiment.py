@@ -237,7 +237,7 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     seed : int, default 0
         Seeds odometry, image noise and RANSAC.
     progress : callable, optional
-        Wraps the mapping loop (e.g. ``tqdm``).
+        ``progress(done, total)`` after every mapping frame (see :meth:`VisualSLAM.process`).
 
     Returns
     -------

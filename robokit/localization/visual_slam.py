@@ -306,7 +306,7 @@ class VisualSLAM:
         start_pqt : array_like, shape (3,), default (0, 0, 0)
             Pose ``[p, q, theta]`` of the first frame (the map's origin).
         progress : callable, optional
-            Wraps the frame iterator (e.g. ``tqdm``) to show progress.
+            ``progress(done, total)`` after every frame (frames done so far, out of ``K``).
 
         Returns
         -------
@@ -324,9 +324,10 @@ class VisualSLAM:
             raise ValueError(f"lefts, rights, odometry: expected equal non-zero lengths, got {n}, {len(rights)}, "
                              f"{odo.shape[0]}")
         self.start(lefts[0], rights[0], start_pqt, odo[0])
-        frames = range(1, n) if progress is None else progress(range(1, n))
-        for k in frames:
+        for k in range(1, n):
             self.step(lefts[k], rights[k], odo[k])
+            if progress is not None:
+                progress(k + 1, n)
         return self.trajectory
 
     def localize(self, left, right, **options) -> tuple[Hypothesis, list[Hypothesis]]:
