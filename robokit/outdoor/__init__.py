@@ -2,7 +2,7 @@
 
 Follows Hamid, Adom, Rahim and Rahiman, "Navigation of mobile robot using Global Positioning
 System (GPS) and obstacle avoidance system with commanded loop daisy chaining application method"
-(CSPA 2009; seed 000, question 3): an RC truck that drives GPS waypoints read from NMEA sentences
+(CSPA 2009; question 3 of the course's assignment): an RC truck that drives GPS waypoints read from NMEA sentences
 ($GPRMC, $GPRMB, $GPGGA, $HCHDG) and avoids obstacles with four LV-MaxSonar-EZ sensors fired in a
 commanded daisy-chain loop.
 

@@ -273,12 +273,12 @@ class World:
         for (a, b) in pix:
             cv2.line(walls, tuple(np.floor(a).astype(int)), tuple(np.floor(b).astype(int)), 255, 1)
         mask = np.zeros((size[1] + 2, size[0] + 2), np.uint8)
-        seed = np.floor((self.interior - origin) / res).astype(int)
-        if not (0 <= seed[0] < size[0] and 0 <= seed[1] < size[1]) or walls[seed[1], seed[0]]:
+        start = np.floor((self.interior - origin) / res).astype(int)      # the flood fill's start cell
+        if not (0 <= start[0] < size[0] and 0 <= start[1] < size[1]) or walls[start[1], start[0]]:
             raise ValueError(f"interior: expected a point inside the walls of {self.name!r}, got "
                              f"{self.interior.tolist()}")
         fill = walls.copy()
-        cv2.floodFill(fill, mask, (int(seed[0]), int(seed[1])), 128, flags=4)
+        cv2.floodFill(fill, mask, (int(start[0]), int(start[1])), 128, flags=4)
         free = fill == 128
         if free[0, :].any() or free[-1, :].any() or free[:, 0].any() or free[:, -1].any():
             raise ValueError(f"surfaces: the walls do not enclose the interior point of {self.name!r}")
