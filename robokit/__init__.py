@@ -1,8 +1,9 @@
 """robokit: the reference library of the robokit courseware.
 
 Mobile-robot perception, localization and robot kinematics, built from the course's source papers
-(see ``README.md``). Topic subpackages: ``geometry``, ``sim``, ``vision``, ``mapping``,
-``localization``, ``controllers``, ``legged``, ``outdoor``, ``arm``, ``viz``, ``grading``.
+(see ``README.md``). Subpackages, bottom layer first (``docs/DESIGN.md``; ``tests/test_layers.py``
+enforces the order): ``geometry``; ``sim``, ``vision``; ``mapping``; ``localization``,
+``controllers``; ``outdoor``, ``arm``; ``viz``; ``exercises``; ``grading``.
 
 ``robokit.FAST`` is true when ``ROBOKIT_FAST=1`` asks experiments to shrink (tests, course build);
 ``robokit.cache_dir()`` is where deterministic generated data are cached.

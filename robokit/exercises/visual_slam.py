@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compare import close, exact, unordered_rows
-from .spec import Case, Exercise
 from ..localization.egomotion import pose_from_two, ransac_sample_count
 from ..localization.hough import hough_accumulator
 from ..mapping.landmarks import kalman_fuse
 from ..vision.matching import ratio_match
 from ..vision.plot_detector import junction_strength
 from ..vision.stereo import StereoCalibration, disparity_to_point, triangulate_svd
+from .compare import close, exact, unordered_rows
+from .spec import Case, Exercise
 
 ASSIGNMENT = "01_visual_slam"
 #: Written (manually graded) questions: id -> points.
