@@ -23,3 +23,40 @@ def test_reference_passes_its_own_cases(exercise, seed):
     for case in cases:
         outcome = judge(exercise, case, expected_output(exercise, case), call_student(exercise.reference, case))
         assert outcome.passed, f"{exercise.id} {case.label}: {outcome.message}"
+
+
+def _same_module_callees(fn) -> set[str]:
+    """Dotted names of the functions of ``fn``'s own module that ``fn`` calls, directly or through
+    each other (the kernels behind a reference)."""
+    import ast
+    import importlib
+    import inspect
+    import textwrap
+
+    module = importlib.import_module(fn.__module__)
+    found, todo = set(), [fn]
+    while todo:
+        tree = ast.parse(textwrap.dedent(inspect.getsource(todo.pop())))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+                callee = getattr(module, node.func.id, None)
+                name = f"{module.__name__}.{node.func.id}"
+                if inspect.isfunction(callee) and callee.__module__ == module.__name__ and name not in found:
+                    found.add(name)
+                    todo.append(callee)
+    return found
+
+
+@pytest.mark.parametrize("slug", sorted(assignments()))
+def test_the_trap_covers_the_kernels_behind_each_reference(slug):
+    # the grader disables every name an assignment's exercises list (grading.worker.install_traps); a
+    # helper in the reference's module that computes the answer must be on that list too, or a
+    # submission can call it instead of the reference (06's _link_matrices and 05's _xor could)
+    import importlib
+
+    trapped = {r for ex in assignments()[slug] for r in ex.references}
+    for name in trapped:
+        module, _, attr = name.rpartition(".")
+        assert hasattr(importlib.import_module(module), attr), f"{slug}: {name} does not exist"
+    missing = {ex.id: sorted(_same_module_callees(ex.reference) - trapped) for ex in assignments()[slug]}
+    assert not any(missing.values()), f"{slug}: kernels a submission could call untrapped: {missing}"

@@ -196,7 +196,8 @@ EXERCISES = [
         id="01.junction_strength", function="junction_strength",
         signature="junction_strength(tensor: array (..., 2, 2)) -> numpy.ndarray (...)", points=1,
         cases=_junction_cases, reference=junction_strength, compare=close(rtol=1e-6, atol=1e-9),
-        references=("robokit.vision.plot_detector.junction_strength", "robokit.vision.plot_detector.tensor_eigenvalues"),
+        references=("robokit.vision.plot_detector.junction_strength", "robokit.vision.plot_detector.tensor_eigenvalues",
+                    "robokit.vision.plot_detector._eig_sym"),
         description="The smaller eigenvalue lambda_2 of each symmetric 2 x 2 tensor (Lin et al. Sec. 2.i); "
                     "ValueError unless the last two axes are 2 x 2."),
     Exercise(
@@ -232,12 +233,14 @@ EXERCISES = [
         id="01.pose_from_two", function="pose_from_two",
         signature="pose_from_two(robot_points: (2, 3), world_points: (2, 3)) -> numpy.ndarray [p, q, theta]",
         points=2, cases=_two_point_cases, reference=pose_from_two, compare=close(rtol=1e-6, atol=1e-9),
+        references=("robokit.localization.egomotion.pose_from_two", "robokit.localization.egomotion._poses_from_pairs"),
         description="Heading from the direction between the two points on the ground plane (X, Z), translation "
                     "from the midpoints (Lin et al. Sec. 5); ValueError for coincident points or not 2 x 3."),
     Exercise(
         id="01.kalman_fuse", function="kalman_fuse",
         signature="kalman_fuse(s, sigma, r_new, sigma_new) -> (s_fused, sigma_fused)", points=2,
         cases=_fuse_cases, reference=kalman_fuse, compare=close(rtol=1e-6, atol=1e-9),
+        references=("robokit.mapping.landmarks.kalman_fuse", "robokit.mapping.landmarks._covariances"),
         description="Information-form fusion Sigma' = (Sigma^-1 + Sigma_new^-1)^-1, "
                     "s' = Sigma' (Sigma^-1 s + Sigma_new^-1 r_new) for one (3,) or N (N, 3) landmarks (Se et al. "
                     "Sec. 3.5); ValueError for covariances that are not symmetric positive definite."),
