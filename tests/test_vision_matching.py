@@ -51,6 +51,14 @@ def test_exact_duplicates_are_ambiguous_whatever_the_rounding():
     assert len(m) == 0
     assert len(ratio_match(desc, twin)) == 0
     assert distance_ratio([0.0, 1.0, 1.0], [0.0, 2.0, np.inf]).tolist() == [1.0, 0.5, 0.0]
+    for best, second in [([np.nan], [1.0]), ([-1.0], [1.0]), ([2.0], [1.0]), ([1.0], [np.nan]), ([1.0, 2.0], [3.0])]:
+        with pytest.raises(ValueError, match="best|second"):
+            distance_ratio(best, second)
+    everything = gated_ratio_match(desc, twin, np.r_[idx], np.r_[idx], max_distance=np.inf)
+    assert len(everything) == 200                      # inf is "no bound", like None
+    for bad in (0.0, -1.0, np.nan):
+        with pytest.raises(ValueError, match="max_distance"):
+            gated_ratio_match(desc, twin, [0], [0], max_distance=bad)
     with pytest.raises(ValueError, match="query_index, train_index"):
         gated_ratio_match(desc, twin, [0, 200], [0, 1])
     with pytest.raises(ValueError, match="train_index"):

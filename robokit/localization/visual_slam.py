@@ -323,9 +323,11 @@ class VisualSLAM:
         if n == 0 or len(rights) != n or odo.shape[0] != n:
             raise ValueError(f"lefts, rights, odometry: expected equal non-zero lengths, got {n}, {len(rights)}, "
                              f"{odo.shape[0]}")
-        self.start(lefts[0], rights[0], start_pqt, odo[0])
-        for k in range(1, n):
-            self.step(lefts[k], rights[k], odo[k])
+        for k in range(n):
+            if k == 0:
+                self.start(lefts[0], rights[0], start_pqt, odo[0])
+            else:
+                self.step(lefts[k], rights[k], odo[k])
             if progress is not None:
                 progress(k + 1, n)
         return self.trajectory

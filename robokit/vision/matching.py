@@ -130,7 +130,7 @@ def k_nearest(query, train, k: int = 2, *, method: str = "kdtree",
         raise ValueError(f"train: expected at least {k} descriptors, got {t.shape[0]}")
     if q.shape[0] and q.shape[1] != t.shape[1]:
         raise ValueError(f"query: expected descriptors of length {t.shape[1]}, got {q.shape[1]}")
-    bound = np.inf if max_distance is None else check_positive(max_distance, "max_distance")
+    bound = _distance_bound(max_distance)
     if q.shape[0] == 0:
         return np.zeros((0, k)), np.zeros((0, k), int)
     if method == "kdtree":
@@ -192,13 +192,32 @@ def distance_ratio(best, second) -> np.ndarray:
         ``best / second``; 1 where ``second`` is 0 (two exact duplicates are ambiguous, so a test
         ``ratio < t`` with ``t <= 1`` rejects them) and 0 where ``second`` is infinite.
 
+    Raises
+    ------
+    ValueError
+        For different shapes, NaN, a negative ``best``, an infinite ``best`` or ``second < best``.
+
     Notes
     -----
     Lin et al. Sec. 3, ``||D_A - D_B|| / ||D_A - D_C|| < t``; Lowe (2004), Sec. 7.1.
     """
-    b = np.asarray(best, dtype=float)
-    c = np.asarray(second, dtype=float)
-    return np.divide(b, c, out=np.ones(np.broadcast(b, c).shape), where=c > 0)
+    b = as_array(best, "best")
+    c = as_array(second, "second", finite=False)
+    if b.shape != c.shape:
+        raise ValueError(f"second: expected the shape of best {b.shape}, got {c.shape}")
+    if np.any(b < 0) or np.any(np.isnan(c)) or np.any(c < b):
+        raise ValueError("best, second: expected distances 0 <= best <= second (second may be inf)")
+    return np.divide(b, c, out=np.ones(b.shape), where=c > 0)
+
+
+def _distance_bound(max_distance) -> float:
+    """``max_distance`` as a bound: ``None`` or ``inf`` mean none; otherwise a positive number."""
+    if max_distance is None:
+        return np.inf
+    bound = as_array(max_distance, "max_distance", shape=(), finite=False).item()
+    if not bound > 0:        # also catches NaN
+        raise ValueError(f"max_distance: expected a positive number or inf, got {bound}")
+    return bound
 
 
 def _check_ratio(ratio) -> float:
@@ -220,7 +239,7 @@ def ratio_match(query, train, *, ratio: float = LIN_RATIO, method: str = "kdtree
         Threshold ``t`` on ``||D_A - D_B|| / ||D_A - D_C||`` (Lin et al. use 0.65).
     method : {"kdtree", "opencv"}
     max_distance : float, optional
-        Also reject matches whose nearest distance exceeds this.
+        Also reject matches whose nearest distance exceeds this (``None`` or ``inf``: no bound).
 
     Returns
     -------
@@ -254,8 +273,7 @@ def ratio_match(query, train, *, ratio: float = LIN_RATIO, method: str = "kdtree
     dist, index = two_nearest(q, t, method=method)
     r = distance_ratio(dist[:, 0], dist[:, 1])
     keep = r < ratio
-    if max_distance is not None:
-        keep &= dist[:, 0] <= check_positive(max_distance, "max_distance")
+    keep &= dist[:, 0] <= _distance_bound(max_distance)
     rows = np.nonzero(keep)[0]
     return Matches(rows, index[rows, 0], dist[rows, 0], r[rows])
 
@@ -279,7 +297,7 @@ def gated_ratio_match(query, train, query_index, train_index, *, ratio: float = 
         (tracking).
     ratio : float, default 0.65
     max_distance : float, optional
-        Also reject matches whose nearest distance exceeds this.
+        Also reject matches whose nearest distance exceeds this (``None`` or ``inf``: no bound).
 
     Returns
     -------
@@ -319,7 +337,6 @@ def gated_ratio_match(query, train, query_index, train_index, *, ratio: float = 
     best = dist[start]
     r = distance_ratio(best, second)
     keep = r < ratio
-    if max_distance is not None:
-        keep &= best <= check_positive(max_distance, "max_distance")
+    keep &= best <= _distance_bound(max_distance)
     rows = start[keep]
     return Matches(qi[rows], ti[rows], best[keep], r[keep])
