@@ -4,9 +4,10 @@
   lower layer, or itself. Lazy imports inside functions and ``importlib.import_module("robokit...")``
   calls with a literal name count like any other import.
 * No cycles between modules, lazy imports included.
-* No private names across modules: ``from .x import _name`` and ``thing._name`` (where ``thing`` is not
-  ``self`` or ``cls`` and ``_name`` is not defined in the same file) are reach-ins; make the name public
-  or give the other module a public way to do what it needs.
+* No private names across modules: ``from .x import _name``, ``thing._name`` and
+  ``getattr(thing, "_name")`` (where ``thing`` is not ``self`` or ``cls`` and the file does not define
+  ``_name`` itself at module or class level or on ``self``) are reach-ins; make the name public or
+  give the other module a public way to do what it needs.
 
 A new subpackage must be placed in ``LAYERS`` (and in DESIGN.md's picture), or this test fails.
 """
@@ -155,18 +156,35 @@ def test_no_import_cycles():
     assert not cycles, "import cycles:\n" + "\n".join(cycles)
 
 
-def _defined_private(tree: ast.AST) -> set[str]:
+def _defined_private(tree: ast.Module) -> set[str]:
+    """Private names this file defines for itself: module- and class-level functions, classes and
+    assignments, and attributes it sets (``self._x = ...``, a marker like ``socket._x = True``, or
+    ``object.__setattr__(self, "_x", ...)``); arguments and local variables do not count."""
     names = set()
+    scopes = [tree.body] + [n.body for n in ast.walk(tree) if isinstance(n, ast.ClassDef)]
+    for body in scopes:
+        for node in body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                names.add(node.name)
+            elif isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                names.update(n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name))
     for node in ast.walk(tree):
-        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
-            names.add(node.name)
-        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
-            names.add(node.id)
-        elif isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store):
+        if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store):
             names.add(node.attr)
-        elif isinstance(node, ast.arg):
-            names.add(node.arg)
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "__setattr__"
+              and len(node.args) >= 2 and isinstance(node.args[1], ast.Constant)):
+            names.add(str(node.args[1].value))
     return {n for n in names if n.startswith("_")}
+
+
+def _getattr_names(tree: ast.Module):
+    """(line, name) of ``getattr(x, "_name")`` / ``setattr`` / ``hasattr`` with a literal private name."""
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                and node.func.id in ("getattr", "setattr", "hasattr") and len(node.args) >= 2
+                and isinstance(node.args[1], ast.Constant) and isinstance(node.args[1].value, str)):
+            yield node.lineno, node.args[1].value
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))
@@ -183,4 +201,6 @@ def test_no_private_names_across_modules(module):
                 and node.attr not in own and node.attr not in STDLIB_PRIVATE
                 and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))):
             bad.append(f"line {node.lineno}: uses {ast.unparse(node)}")
+    bad += [f"line {line}: uses the attribute {name!r} by name" for line, name in _getattr_names(tree)
+            if name.startswith("_") and not name.startswith("__") and name not in own and name not in STDLIB_PRIVATE]
     assert not bad, f"{path.relative_to(PACKAGE.parent)} reaches into other modules' private names:\n" + "\n".join(bad)
