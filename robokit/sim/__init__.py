@@ -35,8 +35,8 @@ Cameras (placed by a 4x4 ``T_world_cam``; optical frame x right, y down, z forwa
 LiDAR, vehicles and motion
     ``Lidar(beams=360, r_min=0.15, r_max=8.0, noise=0.0).scan(world, robot_pose)``;
     vehicle kinematics (:mod:`robokit.sim.vehicle`): ``unicycle_step`` (exact arcs),
-    ``diff_drive_velocities``, ``skid_steer_velocities`` (ICR expansion ``icr_factor`` and slip,
-    Mandow et al. 2007) and its saturating inverse ``skid_steer_wheel_speeds``; odometry noise
+    ``diff_drive_velocities``, ``skid_steer_velocities`` (ICR expansion ``icr_factor``, Mandow et
+    al. 2007, and our slip ratio) and its saturating inverse ``skid_steer_wheel_speeds``; odometry noise
     (:mod:`robokit.sim.motion`, Thrun et al. 2005, Tables 5.5-5.6): ``odometry_increment``,
     ``sample_motion_model_odometry``, ``noisy_odometry``; paths ``waypoint_path``,
     ``corridor_path``, ``lab_lap``.
@@ -61,7 +61,7 @@ Example
 """
 from .camera import Frame, PinholeCamera, StereoRig, camera_mount
 from .feature_check import ViewPairCheck, ground_truth_inliers, sift_view_pair
-from .field import field_world, open_field, scatter_obstacles
+from .worlds_outdoor import field_world, open_field, scatter_obstacles
 from .layout import Layout, box_corners, obstacle_array
 from .lidar import Lidar, scan_points
 from .motion import (Path, corridor_path, lab_lap, noisy_odometry, odometry_increment, sample_motion_model_odometry,
