@@ -5,7 +5,8 @@ independently, so it steers by driving its left and right sides at different spe
 the spot. Its kinematics are the skid-steer model of :mod:`robokit.sim.vehicle`: the ICR
 kinematics of Mandow et al. (2007, Sec. III), a differential-drive form with an effective track
 ``icr_factor * B`` (``icr_factor > 1``, the expansion of the instantaneous centres of rotation),
-and our longitudinal slip ratio ``s`` that scales the wheel speeds (not part of their model). Each side's motor follows its speed command with a first-order lag ``tau``.
+and our longitudinal slip ratio ``s`` that scales the wheel speeds (not part of their model).
+Each side's motor follows its speed command with a first-order lag ``tau``.
 
 Pose ``[x, y, theta]``: field frame x east, y north, ``theta`` counter-clockwise from east.
 

@@ -9,9 +9,8 @@ ICR kinematics of Mandow et al. (2007, Sec. III) keep the differential-drive for
 *effective* track ``icr_factor * B`` (the expansion of the instantaneous centres of rotation,
 ``icr_factor >= 1``; ``chi`` in the paper). We add a longitudinal slip ratio that scales both wheel
 speeds by ``1 - slip`` (our addition, not part of their model) in :func:`skid_steer_velocities`;
-:func:`skid_steer_wheel_speeds` inverts it for a controller,
-saturating the wheels without giving up the turn. Odometry noise and paths are in
-:mod:`robokit.sim.motion`.
+:func:`skid_steer_wheel_speeds` inverts it for a controller, saturating the wheels without giving
+up the turn. Odometry noise and paths are in :mod:`robokit.sim.motion`.
 
 References
 ----------
