@@ -27,6 +27,19 @@ def test_designed_gains_meet_the_spec_in_python_control(overshoot, settling):
     assert 0.7 * settling < info["SettlingTime"] < 1.05 * settling
     wn, zeta, _ = control.damp(T, doprint=False)
     assert zeta[0] == pytest.approx(-math.log(overshoot) / math.hypot(math.pi, math.log(overshoot)))
+    # the criterion is 2 % (Nise Sec. 4.6: 4 / (zeta omega_n)), not Franklin et al.'s 1 % (4.6 / (zeta omega_n)):
+    # at the asked-for time the decay envelope exp(-zeta omega_n t) is inside 2 % but not yet inside 1 %
+    envelope = math.exp(-zeta[0] * wn[0] * settling)
+    assert 0.01 < envelope <= 0.02
+    assert control.step_info(T, SettlingTimeThreshold=0.01)["SettlingTime"] > info["SettlingTime"]
+
+
+def test_rate_feedback_turns_negative_beyond_eight_motor_time_constants():
+    # kd = (8 tau / settling_time - 1) / gain, whatever the overshoot (the docstring's bound)
+    for overshoot in (0.02, 0.2):
+        assert design_heading_gains(0.3, overshoot, 2.39)[1] == pytest.approx(8 * 0.3 / 2.39 - 1)
+        with pytest.raises(ValueError, match="settling_time"):
+            design_heading_gains(0.3, overshoot, 2.41)
 
 
 def test_margins_and_delay():

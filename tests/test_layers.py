@@ -24,7 +24,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "robokit"
 LAYERS: list[set[str]] = [
     {"validation", "config", "about", "course"},   # base: input checks, settings, notebook tooling
     {"geometry"},                                   # SE(2)/SE(3)/SO(3), the papers' frames
-    {"sim", "vision"},                              # worlds, sensors, motion / detectors, matching
+    {"vision"},                                     # detectors, descriptors, matching
+    {"sim"},                                        # worlds, sensors, motion (its feature check uses vision)
     {"mapping"},                                    # grids, landmark maps, topological maps
     {"localization", "controllers"},                # pose estimation / control loops
     {"legged", "outdoor", "arm"},                   # the system lessons

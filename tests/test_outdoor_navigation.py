@@ -49,7 +49,7 @@ def test_navigator_needs_nmea_before_moving_and_rejects_bad_text():
     assert len(nav.parse_errors) == 2 and nav.heading is None
     for line in GPSReceiver(plane, noise=0.0, white_noise=0.0).fix(0.0, [0.0, 10.0], 0.0, 0.0):
         nav.feed(line)
-    nav.feed(Compass(noise_deg=0.0).reading(0.0))
+    nav.feed(Compass(noise=0.0).reading(0.0))
     v, omega = nav.update([FAR] * 4, 0.05)
     assert v > 0 and abs(omega) < 0.05      # facing the waypoint (to the 0.2 m resolution of the fix)
     v, _ = nav.update([FAR, 0.5, 0.5, FAR], 0.05)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from robokit.outdoor.field import Field, random_course
-from robokit.outdoor.sonar import (INCH, PAPER_LAYOUT, SPEED_OF_SOUND, LVMaxSonarEZ, firing_schedule,
+from robokit.outdoor.sonar import (INCH, PAPER_LAYOUT, SPEED_OF_SOUND, LVMaxSonarEZ, SonarMount, firing_schedule,
                                    pulse_width_to_cm_inches, pulse_width_to_range, range_to_pulse_width,
                                    read_sensors, sensor_poses, true_ranges)
 
@@ -118,3 +118,62 @@ def test_bad_input(call, words):
 def test_true_ranges_needs_a_field():
     with pytest.raises(TypeError, match="field"):
         true_ranges("a field", [0.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"max_range": -1.0}, r"max_range: expected a positive number, got -1"),
+    ({"max_range": 0.1}, r"max_range: expected a value above min_range"),
+    ({"min_range": float("nan")}, r"min_range: expected a finite number"),
+    ({"cycle": 0.0}, r"cycle: expected a positive number"),
+    ({"resolution": float("inf")}, r"resolution: expected a finite number"),
+    ({"half_angle": float("nan")}, r"half_angle: expected a finite number"),
+    ({"half_angle": 2.0}, r"half_angle: expected radians in \[0, pi/2\)"),
+    ({"half_angle": "wide"}, r"half_angle: expected a real number"),
+])
+def test_sensor_parameters_are_checked_when_made(kwargs, match):
+    # true_ranges casts with check=False using max_range: a bad sensor must not get that far
+    with pytest.raises((ValueError, TypeError), match=match):
+        LVMaxSonarEZ(**kwargs)
+
+
+@pytest.mark.parametrize("args, match", [
+    (("left", 0.25, 0.1, float("nan")), r"yaw: expected a finite number"),
+    (("left", "front", 0.1, 0.0), r"x: expected a real number"),
+    ((3, 0.25, 0.1, 0.0), r"name: expected a string"),
+])
+def test_mounts_are_checked_when_made(args, match):
+    with pytest.raises((ValueError, TypeError), match=match):
+        SonarMount(*args)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"mounts": ()}, r"mounts: expected a non-empty sequence of SonarMount"),
+    ({"mounts": PAPER_LAYOUT[0]}, r"mounts: expected a non-empty sequence"),
+    ({"mounts": [PAPER_LAYOUT[0], (0.25, 0.0, 0.0)]}, r"mounts\[1\]: expected a SonarMount, got tuple"),
+    ({"sensor": "EZ1"}, r"sensor: expected an LVMaxSonarEZ, got str"),
+    ({"rays": 0}, r"rays: expected an integer >= 1"),
+])
+def test_true_ranges_names_bad_sensors_and_mounts(kwargs, match):
+    with pytest.raises((ValueError, TypeError), match=match):
+        true_ranges(Field(circles=[[2.5, 0.0, 0.3]]), [0.0, 0.0, 0.0], **kwargs)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"others": {7: 0.0}}, r"others key: expected an integer <= 3, got 7"),
+    ({"others": {0: float("nan")}}, r"others\[0\]: expected a finite number"),
+    ({"others": [(0, 0.0)]}, r"others: expected a dict"),
+    ({"mounts": ()}, r"mounts: expected a non-empty sequence"),
+    ({"sensor": None}, r"sensor: expected an LVMaxSonarEZ"),
+])
+def test_read_sensors_names_bad_input(kwargs, match):
+    with pytest.raises((ValueError, TypeError), match=match):
+        read_sensors(Field(circles=[[2.5, 0.0, 0.3]]), [0.0, 0.0, 0.0], [1], [0.0], **kwargs)
+
+
+def test_a_shorter_sensor_and_custom_mounts_are_honoured():
+    post = Field(circles=[[2.5, 0.0, 0.3]])
+    r, _ = true_ranges(post, [0.0, 0.0, 0.0], sensor=LVMaxSonarEZ(max_range=1.5))
+    assert np.isinf(r).all()                                   # the post is 1.95 m from the sensors
+    ahead = (SonarMount("nose", 0.5, 0.0, 0.0),)
+    r, hits = true_ranges(post, [0.0, 0.0, 0.0], mounts=ahead, rays=1)   # one ray: the axis, not the cone's edge
+    assert r.tolist() == pytest.approx([2.5 - 0.3 - 0.5]) and hits[0] == pytest.approx([2.2, 0.0])

@@ -61,10 +61,40 @@ def test_arc_is_exact_for_constant_velocity():
 
 
 @pytest.mark.parametrize("kwargs, words", [({"slip": 0.6}, "slip"), ({"icr_factor": 0.5}, "icr_factor"),
-                                           ({"length": -1}, "length")])
+                                           ({"length": -1}, "length"), ({"slip": float("nan")}, "slip"),
+                                           ({"icr_factor": "wide"}, "icr_factor: expected a real number")])
 def test_truck_validation(kwargs, words):
-    with pytest.raises(ValueError, match=words):
+    with pytest.raises((ValueError, TypeError), match=words):
         SkidSteerTruck(**kwargs)
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda: PAPER_TRUCK.wheel_commands(float("nan"), 0.0), r"v: expected finite values"),
+    (lambda: PAPER_TRUCK.wheel_commands(0.3, math.inf), r"omega: expected finite values"),
+    (lambda: PAPER_TRUCK.wheel_commands("fast", 0.0), r"v: expected an array of float64, got 'fast'"),
+    (lambda: PAPER_TRUCK.step(np.zeros(3), [0.1, 0.1], 0.1), r"state: expected a TruckState, got ndarray"),
+    (lambda: PAPER_TRUCK.step(TruckState(np.zeros(2)), [0.1, 0.1], 0.1), r"state.pose: expected shape \(3\), got shape \(2,\)"),
+    (lambda: PAPER_TRUCK.step(TruckState(np.zeros(3), [0.0, np.nan]), [0.1, 0.1], 0.1), r"state.wheels: expected finite"),
+    (lambda: PAPER_TRUCK.step(TruckState(np.zeros(3)), [0.1, np.nan], 0.1), r"command: expected finite"),
+    (lambda: PAPER_TRUCK.step(TruckState(np.zeros(3)), [0.1, 0.1], 0.0), r"dt: expected a positive number"),
+])
+def test_truck_methods_name_bad_input(call, words):
+    # both methods pass their values on with check=False: bad input must stop at the boundary
+    with pytest.raises((ValueError, TypeError), match=words):
+        call()
+
+
+def test_wheel_commands_take_arrays_and_the_fast_paths_agree():
+    v, om = np.array([0.2, 0.4, 5.0]), np.array([0.0, 0.5, 2.0])
+    batch = PAPER_TRUCK.wheel_commands(v, om)
+    assert batch.shape == (3, 2)
+    np.testing.assert_array_equal(batch, [PAPER_TRUCK.wheel_commands(a, b) for a, b in zip(v, om)])
+    np.testing.assert_array_equal(PAPER_TRUCK.wheel_commands(0.4, 0.8, check=False), PAPER_TRUCK.wheel_commands(0.4, 0.8))
+    s0 = TruckState(np.array([1.0, 2.0, 0.3]), np.array([0.1, 0.2]))
+    a, b = PAPER_TRUCK.step(s0, [0.5, 0.7], 0.049), PAPER_TRUCK.step(s0, np.array([0.5, 0.7]), 0.049, check=False)
+    np.testing.assert_array_equal(a.pose, b.pose)
+    np.testing.assert_array_equal(a.wheels, b.wheels)
+    assert (a.v, a.omega) == (b.v, b.omega)
 
 
 def test_heading_controller_turns_the_truck():
@@ -84,9 +114,22 @@ def test_compass_convention():
     assert compass_to_heading(270.0) == pytest.approx(-np.pi) or compass_to_heading(270.0) == pytest.approx(np.pi)
     for th in np.linspace(-3, 3, 7):
         assert compass_to_heading(heading_to_compass(th)) == pytest.approx(th)
-    rec = parse_sentence(Compass(noise_deg=0.0, rng=1).reading(0.3))
+    rec = parse_sentence(Compass(noise=0.0, rng=1).reading(0.3))
     assert isinstance(rec, HDG) and rec.talker == "HC"
     assert compass_to_heading(rec.true_heading_deg) == pytest.approx(0.3, abs=np.radians(0.1))
+
+
+def test_compass_takes_radians_and_writes_degrees():
+    rec = parse_sentence(Compass(noise=0.0, variation=math.radians(2.5)).reading(0.3))
+    assert rec.variation_deg == pytest.approx(2.5)                  # NMEA keeps degrees
+    assert compass_to_heading(rec.true_heading_deg) == pytest.approx(0.3, abs=np.radians(0.1))
+    compass = Compass(noise=math.radians(2.0), rng=5)
+    err = [compass_to_heading(parse_sentence(compass.reading(0.3)).true_heading_deg) - 0.3 for _ in range(2000)]
+    assert np.std(err) == pytest.approx(math.radians(2.0), rel=0.1)   # a standard deviation in radians
+    with pytest.raises(ValueError, match="noise: expected a non-negative number"):
+        Compass(noise=-0.1)
+    with pytest.raises(ValueError, match="variation: expected a finite number"):
+        Compass(variation=math.nan)
 
 
 def test_gps_emits_parseable_fixes_with_metre_level_error():

@@ -10,7 +10,7 @@ from robokit.sim import camera as cm
 from robokit.sim.omni import OmniCamera
 from robokit.sim.world import World
 from robokit.sim.feature_check import ground_truth_inliers, sift_view_pair
-from robokit.sim.field import open_field
+from robokit.sim.worlds_outdoor import open_field
 from robokit.sim.worlds import box_room, lab_room, long_corridor, office_floor
 
 CAM = cm.PinholeCamera.from_fov(np.deg2rad(65), 640, 480)
@@ -107,6 +107,12 @@ def test_sift_finds_hundreds_of_keypoints_and_correct_matches(builder, pose):
     assert pair.keypoints >= 200
     assert pair.matches >= 50
     assert pair.inlier_ratio > 0.8
+
+
+def test_sift_check_uses_the_vision_ratio_test():
+    # the one Lowe ratio test (robokit.vision.ratio_match) with its range check, not a third copy
+    with pytest.raises(ValueError, match=r"ratio: expected a value in \(0, 1\], got 1.5"):
+        sift_view_pair(box_room(), CAM, [1.0, 1.0, 0.4], ratio=1.5)
 
 
 def test_ground_truth_inliers_accepts_true_and_rejects_shuffled_correspondences():

@@ -1,6 +1,9 @@
 """The outdoor field of seed 000 Q3 as a 3D world (issue 4): closed, LiDAR-exact, camera-consistent,
 and built from the same obstacle layout as lesson 05's 2D field."""
 import dataclasses
+import importlib
+import inspect
+import pkgutil
 
 import cv2
 import numpy as np
@@ -8,7 +11,7 @@ import pytest
 
 from robokit.outdoor.field import Field, random_course
 from robokit.sim import Layout, Lidar, PinholeCamera, field_world, camera_mount, open_field, scatter_obstacles
-from robokit.sim.field import SIDES, _open_field
+from robokit.sim.worlds_outdoor import SIDES, _open_field
 from robokit.sim.world import World
 from tests.test_sim_lidar_motion import analytic_box_ranges
 
@@ -216,3 +219,17 @@ def test_frustum_clipping_of_far_reaching_ground_keeps_the_picture(monkeypatch):
     np.testing.assert_array_equal(clipped.depth, plain.depth)
     # only ties between coplanar neighbouring ground tiles may flip, on their shared edges
     assert (clipped.image != plain.image).any(axis=2).mean() < 1e-3
+
+
+def test_module_names_are_unique_and_not_shadowed():
+    # sim/field.py (the 3D field world) once sat beside outdoor/field.py (the 2D Field); and a module
+    # named like a function it exports is shadowed by it (``import robokit.sim.field_world`` would
+    # give the function), so worlds_outdoor.py holds field_world, open_field and scatter_obstacles
+    names = {}
+    for package in ("robokit.sim", "robokit.outdoor", "robokit.controllers"):
+        pkg = importlib.import_module(package)
+        for sub in pkgutil.iter_modules(pkg.__path__):
+            assert inspect.ismodule(getattr(pkg, sub.name, pkg)), f"{package}.{sub.name} is shadowed"
+            assert sub.name not in names, f"{package}.{sub.name} and {names.get(sub.name)}.{sub.name}"
+            names[sub.name] = package
+    assert inspect.ismodule(importlib.import_module("robokit.sim.worlds_outdoor"))

@@ -8,20 +8,23 @@ then exactly second order,
 
     T(s) = g kp / (tau s^2 + (1 + g kd) s + g kp),
 
-so ``kp`` and ``kd`` place its poles for a chosen overshoot ``M`` and 2 % settling time ``Ts`` with
-the standard relations ``zeta = -ln M / sqrt(pi^2 + ln^2 M)`` and ``omega_n = 4 / (zeta Ts)``
-(Franklin, Powell & Emami-Naeini 2015, Sec. 3.4, Eqs. (3.60) and (3.67)). Hamid et al. (2009)
-steer by the compass bearing but do not give their control law; this design is ours.
+so ``kp`` and ``kd`` place its poles for a chosen overshoot ``M`` and settling time ``Ts`` with
+the standard relations ``zeta = -ln M / sqrt(pi^2 + ln^2 M)`` and ``omega_n = 4 / (zeta Ts)``, the
+settling time to within 2 % of the final value (Nise 2015, Sec. 4.6; Franklin, Powell &
+Emami-Naeini 2015, Sec. 3.4, use the 1 % criterion ``4.6 / (zeta omega_n)`` instead). The 2 %
+criterion is also python-control's default in :func:`loop_metrics`. Hamid et al. (2009) steer by
+the compass bearing but do not give their control law; this design is ours.
 
 References
 ----------
 .. [1] G. F. Franklin, J. D. Powell and A. Emami-Naeini, *Feedback Control of Dynamic Systems*,
    7th ed., Pearson, 2015.
-.. [2] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+.. [2] N. S. Nise, *Control Systems Engineering*, 7th ed., Wiley, 2015.
+.. [3] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
    using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
    chaining application method", 5th International Colloquium on Signal Processing & Its
    Applications (CSPA), 2009.
-.. [3] The python-control developers, *python-control: the Python Control Systems Library*,
+.. [4] The python-control developers, *python-control: the Python Control Systems Library*,
    version 0.10, https://python-control.org.
 """
 from __future__ import annotations
@@ -90,13 +93,15 @@ def design_heading_gains(tau: float, overshoot: float, settling_time: float, gai
     Raises
     ------
     ValueError
-        Out-of-range arguments, or a spec so slow that it would need ``kd < 0`` (positive rate
-        feedback): relax the settling time or use less damping.
+        Out-of-range arguments, or a spec so slow (``settling_time > 8 tau``) that it would need
+        ``kd = (8 tau / settling_time - 1) / gain < 0`` (positive rate feedback): ask for a shorter
+        settling time.
 
     Notes
     -----
     Matching ``tau s^2 + (1 + g kd) s + g kp`` with ``tau (s^2 + 2 zeta omega_n s + omega_n^2)``;
-    ``zeta`` and ``omega_n`` from Franklin et al. (2015), Sec. 3.4, Eqs. (3.60), (3.67).
+    ``zeta`` from the overshoot and ``omega_n`` from the 2 % settling time ``4 / (zeta omega_n)``
+    (Nise 2015, Sec. 4.6).
 
     Examples
     --------
@@ -109,8 +114,8 @@ def design_heading_gains(tau: float, overshoot: float, settling_time: float, gai
         raise ValueError(f"overshoot: expected a fraction in (0, 1), got {m}")
     ts = check_positive(settling_time, "settling_time")
     g = check_positive(gain, "gain")
-    zeta = -math.log(m) / math.sqrt(math.pi ** 2 + math.log(m) ** 2)    # Eq. (3.67)
-    wn = 4.0 / (zeta * ts)                                              # Eq. (3.60), 2 % settling
+    zeta = -math.log(m) / math.sqrt(math.pi ** 2 + math.log(m) ** 2)    # Nise Sec. 4.6, overshoot
+    wn = 4.0 / (zeta * ts)                                              # Nise Sec. 4.6, 2 % settling
     kp = t * wn ** 2 / g                                                # tau omega_n^2 = g kp
     kd = (2 * zeta * wn * t - 1) / g                                    # 2 zeta omega_n tau = 1 + g kd
     if kd < 0:
@@ -214,8 +219,9 @@ def loop_metrics(kp: float, kd: float, tau: float, gain: float = 1.0, delay: flo
 
     Notes
     -----
-    ``control.step_info`` and ``control.stability_margins`` (python-control 0.10); definitions of
-    overshoot, settling time and margins as in Franklin et al. (2015), Secs. 3.4 and 6.4.
+    ``control.step_info`` and ``control.stability_margins`` (python-control 0.10); overshoot and
+    margins as in Franklin et al. (2015), Secs. 3.4 and 6.4; the settling time is to within 2 %
+    (python-control's default; Nise 2015, Sec. 4.6), the criterion :func:`design_heading_gains` uses.
 
     Examples
     --------

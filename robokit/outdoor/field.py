@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ..sim.field import field_world, scatter_obstacles
+from ..sim.worlds_outdoor import field_world, scatter_obstacles
 from ..sim.layout import Layout
 from ..validation import as_array, check_int, check_positive
 

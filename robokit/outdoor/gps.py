@@ -146,21 +146,33 @@ class Compass:
 
     Parameters
     ----------
-    noise_deg : float, default 1.0
-        Standard deviation of heading noise in degrees.
-    variation_deg : float, default -0.3
-        Local magnetic variation (east positive) sent in the sentence; the reported heading is the
-        magnetic one, so true = heading + variation (NMEA 0183 Sec. 6.3, HDG).
+    noise : float, default ``radians(1.0)``
+        Standard deviation of the heading noise (rad).
+    variation : float, default ``radians(-0.3)``
+        Local magnetic variation (rad, east positive) sent in the sentence; the reported heading is
+        the magnetic one, so true = heading + variation (NMEA 0183 Sec. 6.3, HDG). The sentence
+        carries both in degrees, as NMEA does.
     rng : numpy.random.Generator or int, optional
+
+    Raises
+    ------
+    ValueError, TypeError
+        For a negative or non-finite ``noise`` or a non-finite ``variation``.
 
     Notes
     -----
     The paper's $HCHDG (Hamid et al. 2009, Sec. 3); resolution 0.1 degree in the sentence.
+
+    Examples
+    --------
+    >>> Compass(noise=0.0).reading(np.pi / 2)          # facing north; variation 0.3 deg west
+    '$HCHDG,0.3,0.0,E,0.3,W*50'
     """
 
-    def __init__(self, *, noise_deg: float = 1.0, variation_deg: float = -0.3, rng: Any = None) -> None:
-        self.noise_deg = check_positive(noise_deg, "noise_deg", allow_zero=True)
-        self.variation_deg = check_finite_scalar(variation_deg, "variation_deg")
+    def __init__(self, *, noise: float = math.radians(1.0), variation: float = math.radians(-0.3),
+                 rng: Any = None) -> None:
+        self.noise = check_positive(noise, "noise", allow_zero=True)
+        self.variation = check_finite_scalar(variation, "variation")
         self.rng = as_rng(rng)
 
     def reading(self, heading: float) -> str:
@@ -170,5 +182,6 @@ class Compass:
         -----
         HDG layout, NMEA 0183 v4.11 Sec. 6.3; the compass sentence of Hamid et al. (2009, Sec. 3).
         """
-        true_deg = heading_to_compass(heading) + (self.rng.normal(0.0, self.noise_deg) if self.noise_deg else 0.0)
-        return hdg_sentence(true_deg - self.variation_deg, deviation_deg=0.0, variation_deg=self.variation_deg)
+        noise_deg, variation_deg = math.degrees(self.noise), math.degrees(self.variation)   # NMEA's unit
+        true_deg = heading_to_compass(heading) + (self.rng.normal(0.0, noise_deg) if noise_deg else 0.0)
+        return hdg_sentence(true_deg - variation_deg, deviation_deg=0.0, variation_deg=variation_deg)

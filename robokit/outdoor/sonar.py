@@ -30,7 +30,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, as_rng, check_int, check_positive
+from ..validation import as_array, as_rng, check_finite_scalar, check_int, check_positive
 from ..sim.layout import Layout
 
 __all__ = ["INCH", "SECONDS_PER_INCH", "SPEED_OF_SOUND", "LVMaxSonarEZ", "SonarMount", "PAPER_LAYOUT",
@@ -63,6 +63,12 @@ class LVMaxSonarEZ:
     resolution : float
         Range resolution, 1 inch.
 
+    Raises
+    ------
+    ValueError, TypeError
+        For a non-positive range, cycle or resolution, ``max_range <= min_range``, or a half-angle
+        outside [0, pi/2).
+
     Examples
     --------
     >>> sensor = LVMaxSonarEZ()
@@ -77,6 +83,14 @@ class LVMaxSonarEZ:
     cycle: float = 0.049
     half_angle: float = 0.35
     resolution: float = INCH
+
+    def __post_init__(self) -> None:
+        for name in ("min_range", "max_range", "cycle", "resolution"):
+            check_positive(getattr(self, name), name)
+        if not self.max_range > self.min_range:
+            raise ValueError(f"max_range: expected a value above min_range = {self.min_range}, got {self.max_range}")
+        if not 0.0 <= check_finite_scalar(self.half_angle, "half_angle") < np.pi / 2:
+            raise ValueError(f"half_angle: expected radians in [0, pi/2), got {self.half_angle}")
 
     @property
     def listen_time(self) -> float:
@@ -172,12 +186,24 @@ def pulse_width_to_cm_inches(pulse_width_us: float) -> dict:
 
 @dataclasses.dataclass(frozen=True)
 class SonarMount:
-    """Where a sensor sits on the truck: ``name`` and ``[x, y, yaw]`` (m, m, rad; x forward, y left)."""
+    """Where a sensor sits on the truck: ``name`` and ``[x, y, yaw]`` (m, m, rad; x forward, y left).
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a name that is not a string or a coordinate that is not a finite number.
+    """
 
     name: str
     x: float
     y: float
     yaw: float
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise TypeError(f"name: expected a string, got {self.name!r}")
+        for field in ("x", "y", "yaw"):
+            check_finite_scalar(getattr(self, field), field)
 
 
 #: The paper's layout on the 50 cm truck's front bumper (x = 0.25 m from the centre): the outer pair
@@ -262,7 +288,20 @@ def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.n
 
 
 def _cone(sensor: LVMaxSonarEZ, rays: int) -> np.ndarray:
-    return np.linspace(-sensor.half_angle, sensor.half_angle, rays)
+    """Ray offsets across the cone; one ray is the axis (``linspace`` would give its edge)."""
+    return np.linspace(-sensor.half_angle, sensor.half_angle, rays) if rays > 1 else np.zeros(1)
+
+
+def _check_sensors(mounts: Any, sensor: Any) -> tuple:
+    """``mounts`` as a non-empty tuple of :class:`SonarMount` (each checked when it was made); ``sensor`` typed."""
+    if not isinstance(sensor, LVMaxSonarEZ):
+        raise TypeError(f"sensor: expected an LVMaxSonarEZ, got {type(sensor).__name__}")
+    if isinstance(mounts, SonarMount) or not isinstance(mounts, Sequence) or not mounts:
+        raise TypeError(f"mounts: expected a non-empty sequence of SonarMount, got {mounts!r}")
+    for i, m in enumerate(mounts):
+        if not isinstance(m, SonarMount):
+            raise TypeError(f"mounts[{i}]: expected a SonarMount, got {type(m).__name__}")
+    return tuple(mounts)
 
 
 def true_ranges(field: Layout, pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT,
@@ -286,6 +325,12 @@ def true_ranges(field: Layout, pose: Any, mounts: Sequence[SonarMount] = PAPER_L
     hits : numpy.ndarray, shape (n, 2)
         Field coordinates of the reflecting point (NaN when nothing is hit).
 
+    Raises
+    ------
+    TypeError, ValueError
+        For a ``field`` that is not a layout, a bad pose, an empty ``mounts`` or one that is not
+        made of :class:`SonarMount`, a ``sensor`` that is not an :class:`LVMaxSonarEZ`, or ``rays < 1``.
+
     Notes
     -----
     A sonar reports the *first* echo anywhere in its cone, which is why wide beams see obstacles
@@ -303,7 +348,7 @@ def true_ranges(field: Layout, pose: Any, mounts: Sequence[SonarMount] = PAPER_L
         raise TypeError(f"field: expected a robokit.outdoor.Field (or any robokit.sim.Layout), got "
                         f"{type(field).__name__}")
     k = check_int(rays, "rays", minimum=1)
-    sp = sensor_poses(pose, mounts)
+    sp = sensor_poses(pose, _check_sensors(mounts, sensor))
     offs = _cone(sensor, k)
     angles = (sp[:, 2:3] + offs[None, :]).ravel()
     origins = np.repeat(sp[:, :2], k, axis=0)
@@ -348,6 +393,13 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
     numpy.ndarray
         Reported ranges in metres, quantised to 1 inch and clipped to the sensor limits.
 
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`true_ranges`, and for sensor indices outside ``mounts``, ping times that are not
+        one finite number per sensor, ``others`` that is not ``{index: finite time}``, or a
+        negative ``noise``.
+
     Notes
     -----
     Cross-talk is the reason for the chained, commanded-loop firing in Hamid et al. (2009,
@@ -361,10 +413,14 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
     [1.9558, 1.9558]
     """
     g = as_rng(rng)
+    mounts = _check_sensors(mounts, sensor)
     idx = [check_int(i, "which[i]", minimum=0, maximum=len(mounts) - 1) for i in which]
     times = as_array(ping_times, "ping_times", shape=(len(idx),))
     sigma = check_positive(noise, "noise", allow_zero=True)
-    pending = dict(others or {})
+    if not isinstance(others, (dict, type(None))):
+        raise TypeError(f"others: expected a dict {{sensor index: ping time}}, got {type(others).__name__}")
+    pending = {check_int(j, "others key", minimum=0, maximum=len(mounts) - 1): check_finite_scalar(t, f"others[{j}]")
+               for j, t in (others or {}).items()}
     if not pending:  # no ping in flight but our own: only the wanted sensors need a ray fan
         ranges = np.full(len(mounts), np.inf)
         ranges[idx] = true_ranges(field, pose, [mounts[i] for i in idx], sensor)[0]

@@ -2,10 +2,11 @@
 
 Hamid et al. (2009, Sec. 2) use a 50 x 25 x 15 cm RC truck whose four wheels are driven
 independently, so it steers by driving its left and right sides at different speeds and can turn on
-the spot. Its kinematics are the skid-steer model of :mod:`robokit.sim.vehicle` (Mandow et al.
-2007): differential-drive form with an effective track ``icr_factor * B`` (``icr_factor > 1``, the
-expansion of the instantaneous centres of rotation) and a longitudinal slip ratio ``s`` that
-scales the wheel speeds. Each side's motor follows its speed command with a first-order lag ``tau``.
+the spot. Its kinematics are the skid-steer model of :mod:`robokit.sim.vehicle`: the ICR
+kinematics of Mandow et al. (2007, Sec. III), a differential-drive form with an effective track
+``icr_factor * B`` (``icr_factor > 1``, the expansion of the instantaneous centres of rotation),
+and our longitudinal slip ratio ``s`` that scales the wheel speeds (not part of their model).
+Each side's motor follows its speed command with a first-order lag ``tau``.
 
 Pose ``[x, y, theta]``: field frame x east, y north, ``theta`` counter-clockwise from east.
 
@@ -28,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from ..sim.vehicle import skid_steer_velocities, skid_steer_wheel_speeds, unicycle_step
-from ..validation import as_array, check_positive
+from ..validation import as_array, check_finite_scalar, check_positive
 
 __all__ = ["SkidSteerTruck", "TruckState", "PAPER_TRUCK"]
 
@@ -51,6 +52,12 @@ class SkidSteerTruck:
         ICR expansion factor (in [1, 5]) from side skidding; 1 is an ideal differential drive.
     slip : float
         Longitudinal slip ratio in [0, 0.5): ground speed = (1 - slip) * wheel speed.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a size, speed or time constant that is not a positive number, ``icr_factor`` outside
+        [1, 5] or ``slip`` outside [0, 0.5).
     """
 
     length: float = 0.50
@@ -65,9 +72,9 @@ class SkidSteerTruck:
     def __post_init__(self):
         for name in ("length", "width", "height", "track", "max_wheel_speed", "motor_tau"):
             check_positive(getattr(self, name), name)
-        if not 1.0 <= float(self.icr_factor) <= 5.0:
+        if not 1.0 <= check_finite_scalar(self.icr_factor, "icr_factor") <= 5.0:
             raise ValueError(f"icr_factor: expected a number in [1, 5], got {self.icr_factor!r}")
-        if not 0.0 <= float(self.slip) < 0.5:
+        if not 0.0 <= check_finite_scalar(self.slip, "slip") < 0.5:
             raise ValueError(f"slip: expected a ratio in [0, 0.5), got {self.slip!r}")
 
     @property
@@ -81,7 +88,7 @@ class SkidSteerTruck:
         Notes
         -----
         :func:`robokit.sim.vehicle.skid_steer_velocities` with this truck's track, ICR expansion
-        factor and slip (Mandow et al. 2007, Eq. (12)).
+        factor and slip (Mandow et al. 2007, Sec. III; the slip factor is ours).
 
         Examples
         --------
@@ -92,35 +99,67 @@ class SkidSteerTruck:
         wl, wr = as_array(wheel_speeds, "wheel_speeds", shape=(2,))
         return skid_steer_velocities(wl, wr, self.track, self.icr_factor, self.slip, check=False)
 
-    def wheel_commands(self, v: float, omega: float) -> np.ndarray:
+    def wheel_commands(self, v: float, omega: float, *, check: bool = True) -> np.ndarray:
         """``[left, right]`` wheel speeds that give ``v`` and ``omega`` under this model, saturated.
 
         When a side would exceed ``max_wheel_speed`` the forward speed is reduced first, so the turn
         (what keeps the truck off obstacles) is kept.
 
+        Parameters
+        ----------
+        v, omega : float or array_like
+            Wanted forward speed (m/s) and yaw rate (rad/s); arrays give ``(..., 2)`` speeds.
+        check : bool, default True
+            Validate ``v`` and ``omega``; ``False`` is the fast path for a control loop whose
+            navigator computed them (:func:`robokit.outdoor.simulate`).
+
+        Raises
+        ------
+        TypeError, ValueError
+            For a ``v`` or ``omega`` that is not a number (or numeric array), or is NaN or infinite.
+
         Notes
         -----
-        :func:`robokit.sim.vehicle.skid_steer_wheel_speeds` (Mandow et al. 2007, Eq. (12) inverted).
+        :func:`robokit.sim.vehicle.skid_steer_wheel_speeds` (Mandow et al. 2007, Sec. III, inverted).
 
         Examples
         --------
         >>> np.round(PAPER_TRUCK.wheel_commands(0.5, 0.0), 3).tolist()
         [0.526, 0.526]
         """
+        if check:
+            v, omega = as_array(v, "v"), as_array(omega, "omega")
         return skid_steer_wheel_speeds(v, omega, self.track, self.max_wheel_speed, self.icr_factor, self.slip,
                                        check=False)
 
-    def step(self, state: "TruckState", command: Any, dt: float) -> "TruckState":
+    def step(self, state: "TruckState", command: Any, dt: float, *, check: bool = True) -> "TruckState":
         """Advance ``dt`` seconds with ``command = [left, right]`` wheel-speed set points.
 
         The motors respond with an exact first-order lag; the pose moves along the arc of constant
         ``v`` and ``omega`` (those of the mean wheel speed over the step).
 
+        Parameters
+        ----------
+        state : TruckState
+        command : array_like, shape (2,)
+            Wheel-speed set points (m/s), clipped to ``max_wheel_speed``.
+        dt : float
+            Step (s, > 0).
+        check : bool, default True
+            Validate the inputs; ``False`` is the fast path for a simulation loop whose states come
+            from this method and whose commands come from :meth:`wheel_commands`.
+
+        Raises
+        ------
+        TypeError, ValueError
+            For a ``state`` that is not a :class:`TruckState` with a finite pose ``(3,)`` and wheel
+            speeds ``(2,)``, a bad ``command`` or a non-positive ``dt``.
+
         Notes
         -----
         First-order lag ``w1 = w0 + (cmd - w0)(1 - exp(-dt / tau))`` (exact for a constant command);
         arc integration of Thrun, Burgard & Fox (2005), Eq. (5.9) (:func:`robokit.sim.vehicle.unicycle_step`)
-        with the skid-steer velocities of Mandow et al. (2007), Eq. (12).
+        with the skid-steer velocities of Mandow et al. (2007), Sec. III.
 
         Examples
         --------
@@ -128,18 +167,26 @@ class SkidSteerTruck:
         >>> np.round(s.pose, 3).tolist(), np.round(s.wheels, 3).tolist()
         ([0.229, 0.0, 0.0], [0.482, 0.482])
         """
-        cmd = np.clip(as_array(command, "command", shape=(2,)), -self.max_wheel_speed, self.max_wheel_speed)
-        h = check_positive(dt, "dt")
-        a = 1 - np.exp(-h / self.motor_tau)
-        w0 = state.wheels
+        if check:
+            if not isinstance(state, TruckState):
+                raise TypeError(f"state: expected a TruckState, got {type(state).__name__}")
+            pose, w0 = as_array(state.pose, "state.pose", shape=(3,)), as_array(state.wheels, "state.wheels", shape=(2,))
+            command, dt = as_array(command, "command", shape=(2,)), check_positive(dt, "dt")
+        else:
+            pose, w0 = state.pose, state.wheels
+        cmd = np.clip(command, -self.max_wheel_speed, self.max_wheel_speed)
+        a = 1 - np.exp(-dt / self.motor_tau)
         w1 = w0 + (cmd - w0) * a                                    # exact first-order lag
-        v, om = self.body_velocity((w0 + w1) / 2)
-        return TruckState(unicycle_step(state.pose, v, om, h, check=False), w1, v, om)
+        v, om = skid_steer_velocities(*((w0 + w1) / 2), self.track, self.icr_factor, self.slip, check=False)
+        return TruckState(unicycle_step(pose, v, om, dt, check=False), w1, v, om)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class TruckState:
-    """Pose ``[x, y, theta]``, wheel speeds ``[left, right]`` and the body ``v``, ``omega`` of the last step."""
+    """Pose ``[x, y, theta]``, wheel speeds ``[left, right]`` and the body ``v``, ``omega`` of the last step.
+
+    A plain record: :meth:`SkidSteerTruck.step` checks the state it is given.
+    """
 
     pose: np.ndarray
     wheels: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(2))

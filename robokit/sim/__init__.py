@@ -10,6 +10,7 @@ Worlds (textured planar rectangles + 2D footprint; world frame right-handed, z u
     ``open_field()``     100 m x 60 m grass field with obstacles, a shed, a hedge and a skybox
                          (Hamid et al. 2009); ``field_world(size, circles, boxes)`` builds
                          any 2D obstacle layout, ``scatter_obstacles`` draws one
+                         (:mod:`robokit.sim.worlds_outdoor`)
     A :class:`World` has ``surfaces``, ``segments`` (the footprint at ``footprint_height``),
     ``slice(z)``, ``layout(z)``, ``free_space()``, ``is_free(xy)`` and ``info`` (builder facts).
 
@@ -35,8 +36,8 @@ Cameras (placed by a 4x4 ``T_world_cam``; optical frame x right, y down, z forwa
 LiDAR, vehicles and motion
     ``Lidar(beams=360, r_min=0.15, r_max=8.0, noise=0.0).scan(world, robot_pose)``;
     vehicle kinematics (:mod:`robokit.sim.vehicle`): ``unicycle_step`` (exact arcs),
-    ``diff_drive_velocities``, ``skid_steer_velocities`` (ICR expansion ``icr_factor`` and slip,
-    Mandow et al. 2007) and its saturating inverse ``skid_steer_wheel_speeds``; odometry noise
+    ``diff_drive_velocities``, ``skid_steer_velocities`` (ICR expansion ``icr_factor``, Mandow et
+    al. 2007, and our slip ratio) and its saturating inverse ``skid_steer_wheel_speeds``; odometry noise
     (:mod:`robokit.sim.motion`, Thrun et al. 2005, Tables 5.5-5.6): ``odometry_increment``,
     ``sample_motion_model_odometry``, ``noisy_odometry``; paths ``waypoint_path``,
     ``corridor_path``, ``lab_lap``.
@@ -61,7 +62,6 @@ Example
 """
 from .camera import Frame, PinholeCamera, StereoRig, camera_mount
 from .feature_check import ViewPairCheck, ground_truth_inliers, sift_view_pair
-from .field import field_world, open_field, scatter_obstacles
 from .layout import Layout, box_corners, obstacle_array
 from .lidar import Lidar, scan_points
 from .motion import (Path, corridor_path, lab_lap, noisy_odometry, odometry_increment, sample_motion_model_odometry,
@@ -72,6 +72,7 @@ from .textures import illuminate, photo
 from .vehicle import diff_drive_velocities, skid_steer_velocities, skid_steer_wheel_speeds, unicycle_step
 from .world import FreeSpace, Surface, World
 from .worlds import box_room, lab_room, long_corridor, office_floor
+from .worlds_outdoor import field_world, open_field, scatter_obstacles
 
 __all__ = [
     "World", "Surface", "FreeSpace", "box_room", "lab_room", "long_corridor", "office_floor",

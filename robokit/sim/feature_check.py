@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 
 from ..validation import as_array, as_points, check_positive
+from ..vision.matching import ratio_match
 from .camera import PinholeCamera
 from .world import World
 
@@ -103,7 +104,8 @@ def sift_view_pair(world: World, camera: PinholeCamera, robot_pose: Any, step: f
         Planar pose ``[x, y, theta]`` of the first view; the second is ``step`` metres ahead.
     step : float, default 0.3
     ratio : float, default 0.8
-        Lowe's nearest/second-nearest distance ratio (Lowe 2004, Sec. 7.1).
+        Lowe's nearest/second-nearest distance ratio (Lowe 2004, Sec. 7.1), in (0, 1], applied by
+        :func:`robokit.vision.ratio_match` on OpenCV's brute-force matcher.
     tol : float, default 3
         Reprojection tolerance in pixels.
 
@@ -130,12 +132,12 @@ def sift_view_pair(world: World, camera: PinholeCamera, robot_pose: Any, step: f
     sift = cv2.SIFT_create()
     k1, d1 = sift.detectAndCompute(cv2.cvtColor(frame1.image, cv2.COLOR_RGB2GRAY), None)
     k2, d2 = sift.detectAndCompute(cv2.cvtColor(frame2.image, cv2.COLOR_RGB2GRAY), None)
-    if d1 is None or d2 is None or len(k2) < 2:
+    if d1 is None or d2 is None:
         return ViewPairCheck(len(k1), 0, 0.0)
-    good = [m for m, n in cv2.BFMatcher(cv2.NORM_L2).knnMatch(d1, d2, k=2) if m.distance < ratio * n.distance]
-    if not good:
+    good = ratio_match(d1, d2, ratio=ratio, method="opencv")
+    if not len(good):
         return ViewPairCheck(len(k1), 0, 0.0)
-    uv1 = np.array([k1[m.queryIdx].pt for m in good])
-    uv2 = np.array([k2[m.trainIdx].pt for m in good])
+    uv1 = np.array([k1[i].pt for i in good.query])
+    uv2 = np.array([k2[j].pt for j in good.train])
     inliers = ground_truth_inliers(camera, frame1.depth, T1, T2, uv1, uv2, tol)
     return ViewPairCheck(len(k1), len(good), float(inliers.mean()))

@@ -225,7 +225,7 @@ class Layout:
         -----
         Ray-segment intersection in 2D cross products (Goldman 1990; O'Rourke 1998, Sec. 7.2):
         with ``a = p - o``, ``t = (a x e) / (d x e)`` and ``s = (a x d) / (d x e)``; ray-circle
-        intersection and point in oriented box (Ericson 2005, Secs. 5.3.2 and 5.1.3). Vectorised
+        intersection and point in oriented box (Ericson 2005, Secs. 5.3.2 and 5.1.4). Vectorised
         over all ray-obstacle pairs.
 
         Examples
@@ -294,7 +294,7 @@ class Layout:
 
         Notes
         -----
-        Point in disc and point in oriented box (Ericson 2005, Sec. 5.1.3).
+        Point in disc and point in oriented box (Ericson 2005, Sec. 5.1.4).
 
         Examples
         --------

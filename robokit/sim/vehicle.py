@@ -5,12 +5,12 @@ constant forward speed ``v`` and turn rate ``omega`` for ``dt`` seconds drives a
 (:func:`unicycle_step`). A differential drive gets ``v`` and ``omega`` from its wheel speeds
 (:func:`diff_drive_velocities`). A skid-steer vehicle (four or more driven wheels, no steering)
 must slide sideways to turn, so it turns less than a differential drive of the same track: the
-model of Mandow et al. (2007) keeps the differential-drive form with an *effective* track
-``icr_factor * B`` (the expansion of the instantaneous centres of rotation, ``icr_factor >= 1``;
-``chi`` in the paper) and scales the wheel speeds by ``1 - slip`` for longitudinal slip
-(:func:`skid_steer_velocities`); :func:`skid_steer_wheel_speeds` inverts it for a controller,
-saturating the wheels without giving up the turn. Odometry noise and paths are in
-:mod:`robokit.sim.motion`.
+ICR kinematics of Mandow et al. (2007, Sec. III) keep the differential-drive form with an
+*effective* track ``icr_factor * B`` (the expansion of the instantaneous centres of rotation,
+``icr_factor >= 1``; ``chi`` in the paper). We add a longitudinal slip ratio that scales both wheel
+speeds by ``1 - slip`` (our addition, not part of their model) in :func:`skid_steer_velocities`;
+:func:`skid_steer_wheel_speeds` inverts it for a controller, saturating the wheels without giving
+up the turn. Odometry noise and paths are in :mod:`robokit.sim.motion`.
 
 References
 ----------
@@ -173,8 +173,9 @@ def skid_steer_velocities(v_left: Any, v_right: Any, track: float, icr_factor: f
 
     Notes
     -----
-    Mandow et al. (2007), Eq. (12): the symmetric-ICR skid-steer model with expansion factor
-    ``chi`` and a common longitudinal correction ``1 - s``.
+    The symmetric-ICR skid-steer kinematics with expansion factor ``chi`` (Mandow et al. 2007,
+    Sec. III). The common longitudinal slip factor ``1 - s`` is our addition, not part of their
+    model (``slip=0`` gives theirs).
 
     Examples
     --------
@@ -186,7 +187,7 @@ def skid_steer_velocities(v_left: Any, v_right: Any, track: float, icr_factor: f
         track, icr_factor, slip = _skid_parameters(track, icr_factor, slip)
         v_left, v_right = as_array(v_left, "v_left"), as_array(v_right, "v_right")
     k = 1 - slip
-    return k * (v_left + v_right) / 2, k * (v_right - v_left) / (icr_factor * track)   # Eq. (12)
+    return k * (v_left + v_right) / 2, k * (v_right - v_left) / (icr_factor * track)   # Mandow Sec. III, times 1 - s
 
 
 def skid_steer_wheel_speeds(v: Any, omega: Any, track: float, max_wheel_speed: float, icr_factor: float = 1.5,
@@ -219,8 +220,8 @@ def skid_steer_wheel_speeds(v: Any, omega: Any, track: float, max_wheel_speed: f
 
     Notes
     -----
-    Mandow et al. (2007), Eq. (12) solved for the wheel speeds:
-    ``v_r,l = v / (1 - s) +- omega chi B / (2 (1 - s))``.
+    :func:`skid_steer_velocities` (Mandow et al. 2007, Sec. III, with our slip factor) solved for
+    the wheel speeds: ``v_r,l = v / (1 - s) +- omega chi B / (2 (1 - s))``.
 
     Examples
     --------
