@@ -29,7 +29,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..geometry import wrap_angle
+from ..geometry import se2_compose, wrap_angle
 from ..validation import as_array, as_rng, check_int, check_positive
 from ..sim.layout import Layout
 
@@ -243,7 +243,8 @@ def firing_schedule(n_sensors: int, duration: float, mode: str = "chained", *, c
 
 
 def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.ndarray:
-    """Field-frame poses ``(n, 3)`` of the sensors for a truck pose ``[x, y, theta]``.
+    """Field-frame poses ``(n, 3)`` of the sensors for a truck pose ``[x, y, theta]`` (headings wrapped
+    to [-pi, pi)).
 
     Notes
     -----
@@ -255,10 +256,8 @@ def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.n
     >>> np.round(sensor_poses([0.0, 0.0, 0.0]), 3).tolist()     # x forward, y left, yaw
     [[0.25, 0.1, 0.785], [0.25, 0.05, 0.0], [0.25, -0.05, 0.0], [0.25, -0.1, -0.785]]
     """
-    x, y, th = as_array(pose, "pose", shape=(3,))
-    c, s = np.cos(th), np.sin(th)
     m = np.array([[mt.x, mt.y, mt.yaw] for mt in mounts])
-    return np.stack([x + c * m[:, 0] - s * m[:, 1], y + s * m[:, 0] + c * m[:, 1], th + m[:, 2]], axis=1)  # pose + mount
+    return se2_compose(as_array(pose, "pose", shape=(3,)), m, check=False)    # pose ⊕ mount
 
 
 def _cone(sensor: LVMaxSonarEZ, rays: int) -> np.ndarray:
