@@ -98,7 +98,7 @@ def _search(chain: Chain, T: np.ndarray, q0: np.ndarray, skip: np.ndarray, step,
         qa = qr[sel]
         # 1. pose error of every live attempt
         frames = chain.frames(qa, check=False)
-        e = pose_error(Tr[sel], chain.flange_pose(frames, check=False), check=False)
+        e = pose_error(Tr[sel], chain.flange_transform(frames, check=False), check=False)
         e2 = e * e
         pos2, rot2 = e2[:, :3].sum(1), e2[:, 3:].sum(1)
         e2s = pos2 + rot2
