@@ -16,14 +16,14 @@ from .paper_frames import (R_BODY_OPTICAL, as_pqt, optical_to_y_up, pqt_to_se2, 
                            se2_to_pqt, world_to_robot)
 from .planar import as_planar, matrix_to_se2, se2_between, se2_compose, se2_inverse, se2_to_matrix, wrap_angle
 from .rotations import (ROTATION_TOL, as_rotation, check_rotation_block, euler_matrix, rot_x, rot_y, rot_z, skew,
-                        so3_exp, so3_log)
+                        so3_exp, so3_log, zyz_angles)
 from .spatial import (as_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, se3_inverse, se3_to_se2,
                       transform_points)
 
 __all__ = [
     "as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
     "ROTATION_TOL", "as_rotation", "check_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y",
-    "rot_z", "euler_matrix",
+    "rot_z", "euler_matrix", "zyz_angles",
     "as_se3", "se3_from_rt", "se3_inverse", "se3_compose", "transform_points", "se2_to_se3", "se3_to_se2",
     "pose_error",
     "R_BODY_OPTICAL", "as_pqt", "se2_to_pqt", "pqt_to_se2", "pqt_to_se3", "robot_to_world", "world_to_robot",
