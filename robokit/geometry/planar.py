@@ -115,8 +115,7 @@ def se2_compose(a: Any, b: Any, *, check: bool = True) -> np.ndarray:
 
     Notes
     -----
-    The compounding operator of Smith, Self & Cheeseman (1990), Eq. (3); it is also the
-    composition of Duckett's relaxation, Eq. (1), used by lesson 02.
+    The compounding operation ``⊕`` of Smith, Self & Cheeseman (1990).
 
     Examples
     --------
@@ -153,7 +152,7 @@ def se2_inverse(a: Any) -> np.ndarray:
 
     Notes
     -----
-    The inverse relationship of Smith, Self & Cheeseman (1990), Eq. (4).
+    The inverse relationship ``⊖`` of Smith, Self & Cheeseman (1990).
 
     Examples
     --------
@@ -188,8 +187,8 @@ def se2_between(a: Any, b: Any) -> np.ndarray:
 
     Notes
     -----
-    Smith, Self & Cheeseman (1990), Eqs. (3)-(4) combined; Lu & Milios (1997) call it the relative
-    pose constraint of a pose graph.
+    ``⊖a ⊕ b`` in the notation of Smith, Self & Cheeseman (1990); Lu & Milios (1997) call it the
+    relative pose constraint of a pose graph.
 
     Examples
     --------
