@@ -217,8 +217,8 @@ def so3_log(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.ndar
     -------
     numpy.ndarray, shape (..., 3)
         Accurate near 0 (``theta / sin theta -> 1``) and near pi, where the axis comes from the
-        symmetric part ``(R + I) / 2 = w w^T`` and its sign from the antisymmetric part; this
-        matters for pose errors of 1e-6 rad.
+        symmetric part ``(R + R^T) / 2 - cos(theta) I = (1 - cos theta) w w^T`` and its sign from
+        the antisymmetric part; this matters for pose errors of 1e-6 rad.
 
     Raises
     ------
