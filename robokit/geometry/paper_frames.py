@@ -211,7 +211,7 @@ def pqt_rotate_xz(theta: Any, xz: Any, *, check: bool = True) -> np.ndarray:
 
     Examples
     --------
-    A robot that turned left by 90 degrees sees the world's -X straight ahead (+Z):
+    For a robot that has turned left by 90 degrees, straight ahead (Z = 1) is the world's -X:
 
     >>> print(np.round(pqt_rotate_xz(np.pi / 2, [0.0, 1.0]), 6) + 0.0)
     [-1.  0.]
