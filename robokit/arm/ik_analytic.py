@@ -124,8 +124,8 @@ class SRSArm:
         N, K = psi.shape
         basis = np.empty((N, K, 3))
         basis[..., 0], basis[..., 1], basis[..., 2] = np.sin(psi), np.cos(psi), 1.0
-        R = (basis @ G).reshape(N, K, 2, 2, 3, 3)                  # R(psi) = A sin psi + B cos psi + C
-        return np.moveaxis(zyz_angles(R, check=False), -1, 0)
+        abc = zyz_angles((basis @ G).reshape(N, K, 2, 2, 3, 3), check=False)   # of A sin psi + B cos psi + C
+        return abc[..., 0], abc[..., 1], abc[..., 2]
 
     def joints(self, coeffs, psi: np.ndarray) -> np.ndarray:
         """Unchecked: all 8 branches for arm angles ``psi`` (N, K) -> q of shape (N, K, 8, 7).

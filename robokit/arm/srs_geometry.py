@@ -131,9 +131,10 @@ def coefficient_terms(R, sw, d_se: float, d_ew: float, xp=ARRAY):
         B = [(m[0] - c[0], m[1] - c[1], m[2] - c[2]) for m, c in zip(cols, C)]
         ce, se = cc, sign * s4                                       # cos, sin of this q4
         for k, X in enumerate((A, B, C)):
-            out[k].extend(X[j][i] for i in range(3) for j in range(3))     # shoulder (X holds columns)
+            for row in zip(*X):                                      # shoulder (X holds columns)
+                out[k].extend(row)
             P = [[_dot(X[i], Rc[j]) for j in range(3)] for i in range(3)]   # X^T R
-            W = (tuple(ce * P[0][j] + se * P[2][j] for j in range(3)), P[1],
-                 tuple(ce * P[2][j] - se * P[0][j] for j in range(3)))     # Ry(q4) X^T R
-            out[k].extend(W[i][j] for i in range(3) for j in range(3))
+            out[k].extend([ce * P[0][j] + se * P[2][j] for j in range(3)])  # Ry(q4) X^T R, row by row
+            out[k].extend(P[1])
+            out[k].extend([ce * P[2][j] - se * P[0][j] for j in range(3)])
     return out[0] + out[1] + out[2], (a4, -a4), c4

@@ -408,11 +408,12 @@ def zyz_angles(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.n
     R = _rotations(R, tol) if check else np.asarray(R, dtype=float)
     m02, m12 = R[..., 0, 2], R[..., 1, 2]
     sb = np.hypot(m02, m12)
-    b = np.arctan2(sb, R[..., 2, 2])
-    a = np.arctan2(m12, m02)
-    c = np.arctan2(R[..., 2, 1], -R[..., 2, 0])
+    out = np.empty((3,) + sb.shape)                  # a, b, c: each a contiguous block
+    np.arctan2(m12, m02, out=out[0, ...])
+    np.arctan2(sb, R[..., 2, 2], out=out[1, ...])
+    np.arctan2(R[..., 2, 1], -R[..., 2, 0], out=out[2, ...])
     sing = sb < 1e-12
     if sing.any():
-        a = np.where(sing, 0.0, a)
-        c = np.where(sing, np.arctan2(R[..., 1, 0], R[..., 1, 1]), c)
-    return np.stack([a, b, c], axis=-1)
+        out[0] = np.where(sing, 0.0, out[0])
+        out[2] = np.where(sing, np.arctan2(R[..., 1, 0], R[..., 1, 1]), out[2])
+    return out.transpose(*range(1, out.ndim), 0)
