@@ -92,14 +92,15 @@ def test_ground_plane_action_is_batched_over_poses_and_points():
 def test_ground_plane_jacobian_matches_finite_differences():
     rng = np.random.default_rng(8)
     pqt, xz = np.array([0.5, -1.0, 2.5]), rng.normal(size=(5, 2))
-    J = g.pqt_jacobian_xz(pqt, xz)
+    moved, J = g.pqt_transform_xz(pqt, xz, jacobian=True)
+    np.testing.assert_array_equal(moved, g.pqt_transform_xz(pqt, xz))
     h = 1e-6
     for k in range(3):
         d = np.zeros(3)
         d[k] = h
         fd = (g.pqt_transform_xz(pqt + d, xz) - g.pqt_transform_xz(pqt - d, xz)) / (2 * h)
         np.testing.assert_allclose(J[..., k], fd, atol=1e-8)
-    assert g.pqt_jacobian_xz(np.zeros((4, 1, 3)), xz).shape == (4, 5, 2, 3)
+    assert g.pqt_transform_xz(np.zeros((4, 1, 3)), xz, jacobian=True)[1].shape == (4, 5, 2, 3)
 
 
 def test_paper_world_to_robokit_is_the_course_identification():
@@ -127,7 +128,8 @@ def test_paper_world_to_robokit_is_the_course_identification():
     (lambda: g.pqt_transform_xz([0, 0, 0], [[1, 2, 3]]), "xz"),
     (lambda: g.pqt_transform_xz(np.zeros((4, 3)), np.zeros((5, 2))), "pqt, xz"),
     (lambda: g.pqt_rotate_xz(np.zeros(4), np.zeros((5, 2))), "theta, xz"),
-    (lambda: g.pqt_jacobian_xz([0, 0, np.inf], [1, 2]), "pqt"),
+    (lambda: g.pqt_transform_xz([0, 0, np.inf], [1, 2], jacobian=True), "pqt"),
+    (lambda: g.pqt_transform_xz([0, 0, 0], [1, 2], jacobian=True, inverse=True), "inverse, jacobian"),
     (lambda: g.pqt_robot_to_world(np.zeros((5, 3)), np.zeros((4, 3))), "pqt, points"),
     (lambda: g.paper_world_to_robokit([[1, 2, 3]], camera_height=0.0), "camera_height"),
     (lambda: g.paper_world_to_robokit([[1, 2, 3]], np.eye(3)), "covariances"),

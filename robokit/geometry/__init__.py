@@ -13,7 +13,7 @@ Submodules: :mod:`~robokit.geometry.planar` (SE(2)), :mod:`~robokit.geometry.rot
 :mod:`~robokit.geometry.spatial` (SE(3)), :mod:`~robokit.geometry.paper_frames` (the papers'
 ``[p, q, theta]`` and camera frame).
 """
-from .paper_frames import (R_BODY_OPTICAL, as_pqt, optical_to_y_up, paper_world_to_robokit, pqt_jacobian_xz,
+from .paper_frames import (R_BODY_OPTICAL, as_pqt, optical_to_y_up, paper_world_to_robokit,
                            pqt_robot_to_world, pqt_rotate_xz, pqt_to_se2, pqt_to_se3, pqt_transform_xz,
                            pqt_world_to_robot, se2_to_pqt)
 from .planar import as_planar, matrix_to_se2, se2_between, se2_compose, se2_inverse, se2_to_matrix, wrap_angle
@@ -29,5 +29,5 @@ __all__ = [
     "as_se3", "se3_from_rt", "se3_inverse", "se3_compose", "transform_points", "se2_to_se3", "se3_to_se2",
     "pose_error",
     "R_BODY_OPTICAL", "as_pqt", "se2_to_pqt", "pqt_to_se2", "pqt_to_se3", "pqt_rotate_xz", "pqt_transform_xz",
-    "pqt_jacobian_xz", "pqt_robot_to_world", "pqt_world_to_robot", "paper_world_to_robokit", "optical_to_y_up",
+    "pqt_robot_to_world", "pqt_world_to_robot", "paper_world_to_robokit", "optical_to_y_up",
 ]

@@ -10,9 +10,9 @@ that takes robot-frame points to the world is the right-handed elementary rotati
 ``Z_w = sin(theta) X + cos(theta) Z``, which on the (X, Z) plane is exactly the SE(2) rotation of
 :func:`robokit.geometry.se2_compose`. The pose ``[p, q, theta]`` is the robot's sideways (X) and
 forward (Z) position in the world (the first pose's frame) and its heading; height Y is unchanged.
-That action is written once, :func:`pqt_transform_xz` (vectorised over poses and points, its
-Jacobian :func:`pqt_jacobian_xz`); :func:`pqt_robot_to_world` and :func:`pqt_world_to_robot` apply
-it to 3-D points.
+That action is written once, :func:`pqt_transform_xz` (vectorised over poses and points, with its
+Jacobian on request); :func:`pqt_robot_to_world` and :func:`pqt_world_to_robot` apply it to 3-D
+points.
 
 The course identifies the papers' ground plane (X, Z) with robokit's (x, y), so bird's-eye plots in
 both conventions are the same picture: ``p = x``, ``q = y``, ``theta = theta_robokit - pi/2``
@@ -37,7 +37,7 @@ from .planar import as_planar, wrap_angle
 from .rotations import rot_y
 
 __all__ = ["R_BODY_OPTICAL", "as_pqt", "se2_to_pqt", "pqt_to_se2", "pqt_to_se3", "pqt_rotate_xz",
-           "pqt_transform_xz", "pqt_jacobian_xz", "pqt_robot_to_world", "pqt_world_to_robot",
+           "pqt_transform_xz", "pqt_robot_to_world", "pqt_world_to_robot",
            "paper_world_to_robokit", "optical_to_y_up"]
 
 #: Rotation from a robot body frame (x forward, y left, z up) to the OpenCV optical frame of a
@@ -236,7 +236,7 @@ def pqt_rotate_xz(theta: Any, xz: Any, *, check: bool = True) -> np.ndarray:
     return out.transpose(*range(1, out.ndim), 0)
 
 
-def pqt_transform_xz(pqt: Any, xz: Any, *, inverse: bool = False, check: bool = True) -> np.ndarray:
+def pqt_transform_xz(pqt: Any, xz: Any, *, inverse: bool = False, jacobian: bool = False, check: bool = True):
     """The papers' pose ``[p, q, theta]`` acting on ground-plane points: robot ``(X', Z')`` to world.
 
     Parameters
@@ -247,24 +247,31 @@ def pqt_transform_xz(pqt: Any, xz: Any, *, inverse: bool = False, check: bool = 
         Ground-plane points ``(X, Z)``: in the robot frame, or in the world with ``inverse``.
     inverse : bool, default False
         Map world points into the robot frame instead: ``R(theta)^T ((X, Z) - (p, q))``.
+    jacobian : bool, default False
+        Also return the derivative with respect to ``[p, q, theta]`` (not with ``inverse``).
     check : bool, default True
         Validate the inputs; ``False`` skips it (solvers' inner loops).
 
     Returns
     -------
-    numpy.ndarray, shape (broadcast, 2)
+    moved : numpy.ndarray, shape (broadcast, 2)
         ``R(theta) (X', Z') + (p, q)`` (see :func:`pqt_rotate_xz`).
+    J : numpy.ndarray, shape (broadcast, 2, 3)
+        With ``jacobian``: ``[[1, 0, -Z_r], [0, 1, X_r]]`` where ``(X_r, Z_r) = R(theta) (X', Z')``
+        (turning moves a point at right angles to its rotated position).
 
     Raises
     ------
     ValueError
-        If the last axes are not 3 and 2, the leading shapes do not broadcast or a value is not
-        finite.
+        If the last axes are not 3 and 2, the leading shapes do not broadcast, a value is not
+        finite, or both ``inverse`` and ``jacobian`` are asked for.
 
     Notes
     -----
     Lin et al., Sec. 5: ``(X_i, Z_i) = R(theta) (X'_i, Z'_i) + (p, q)``, the ground-plane part of
-    Se et al. (2002), Sec. 3.3, ``r_new = P(r_obs) + V``.
+    Se et al. (2002), Sec. 3.3, ``r_new = P(r_obs) + V``. The Jacobian is the first-order term of
+    Se et al. (2002), Sec. 3.4 (pose uncertainty propagated to a landmark) and of the
+    least-squares refinement of Lin et al., Sec. 6.
 
     Examples
     --------
@@ -280,62 +287,28 @@ def pqt_transform_xz(pqt: Any, xz: Any, *, inverse: bool = False, check: bool = 
      [[0. 2.]
       [1. 3.]
       [1. 2.]]]
-    """
-    if check:
-        pqt, xz = _stack(pqt, "pqt", 3), _stack(xz, "xz", 2)
-        _broadcast(pqt, xz, "xz")
-    if inverse:
-        return pqt_rotate_xz(-pqt[..., 2], xz - pqt[..., :2], check=False)
-    out = pqt_rotate_xz(pqt[..., 2], xz, check=False)
-    out[..., 0] += pqt[..., 0]                                  # in place: X and Z are contiguous blocks
-    out[..., 1] += pqt[..., 1]
-    return out
 
-
-def pqt_jacobian_xz(pqt: Any, xz: Any, *, check: bool = True) -> np.ndarray:
-    """Jacobian of :func:`pqt_transform_xz` with respect to ``[p, q, theta]``.
-
-    Parameters
-    ----------
-    pqt : array_like, shape (..., 3)
-    xz : array_like, shape (..., 2)
-        Robot-frame ground-plane points ``(X', Z')``.
-    check : bool, default True
-        Validate the inputs; ``False`` skips it.
-
-    Returns
-    -------
-    numpy.ndarray, shape (broadcast, 2, 3)
-        ``[[1, 0, -sin(theta) X' - cos(theta) Z'], [0, 1, cos(theta) X' - sin(theta) Z']]``.
-
-    Raises
-    ------
-    ValueError
-        As :func:`pqt_transform_xz`.
-
-    Notes
-    -----
-    The first-order term of Se et al. (2002), Sec. 3.4 (pose uncertainty propagated to a landmark)
-    and of the least-squares refinement of Lin et al., Sec. 6.
-
-    Examples
-    --------
     Turning moves a point 2 m straight ahead sideways by 2 m per radian (to the left, -X):
 
-    >>> print(pqt_jacobian_xz([0.0, 0.0, 0.0], [0.0, 2.0]).tolist())
+    >>> print(pqt_transform_xz([0.0, 0.0, 0.0], [0.0, 2.0], jacobian=True)[1].tolist())
     [[1.0, 0.0, -2.0], [0.0, 1.0, 0.0]]
     """
     if check:
         pqt, xz = _stack(pqt, "pqt", 3), _stack(xz, "xz", 2)
         _broadcast(pqt, xz, "xz")
-    c, s = np.cos(pqt[..., 2]), np.sin(pqt[..., 2])
-    x, z = xz[..., 0], xz[..., 1]
-    dx = -s * x - c * z                                         # d X / d theta
-    jac = np.zeros(dx.shape + (2, 3))
-    jac[..., 0, 0] = jac[..., 1, 1] = 1.0
-    jac[..., 0, 2] = dx
-    jac[..., 1, 2] = c * x - s * z                              # d Z / d theta
-    return jac
+        if inverse and jacobian:
+            raise ValueError("inverse, jacobian: expected at most one of them, got both")
+    if inverse:
+        return pqt_rotate_xz(-pqt[..., 2], xz - pqt[..., :2], check=False)
+    out = pqt_rotate_xz(pqt[..., 2], xz, check=False)
+    if jacobian:
+        J = np.zeros(out.shape[:-1] + (2, 3))
+        J[..., 0, 0] = J[..., 1, 1] = 1.0
+        J[..., 0, 2] = -out[..., 1]                             # d X / d theta = -Z_r
+        J[..., 1, 2] = out[..., 0]                              # d Z / d theta = X_r
+    out[..., 0] += pqt[..., 0]                                  # in place: X and Z are contiguous blocks
+    out[..., 1] += pqt[..., 1]
+    return (out, J) if jacobian else out
 
 
 def pqt_robot_to_world(points: Any, pqt: Any, *, check: bool = True) -> np.ndarray:

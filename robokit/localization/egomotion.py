@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..geometry import (as_pqt, pqt_jacobian_xz, pqt_robot_to_world, pqt_rotate_xz,
+from ..geometry import (as_pqt, pqt_robot_to_world, pqt_rotate_xz,
                         pqt_transform_xz, pqt_world_to_robot, wrap_angle)
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
@@ -234,8 +234,8 @@ def fit_pose(robot_points, world_points, robot_covariances=None, world_covarianc
     pqt = np.concatenate([w.mean(0) - pqt_rotate_xz(theta, r.mean(0), check=False), [theta]])
 
     def linearise(pqt):
-        res = w - pqt_transform_xz(pqt, r, check=False)                # Lin et al. Sec. 6 residuals
-        return res, pqt_jacobian_xz(pqt, r, check=False)
+        moved, jac = pqt_transform_xz(pqt, r, jacobian=True, check=False)
+        return w - moved, jac                                          # Lin et al. Sec. 6 residuals
 
     def information(pqt):                                              # (Sigma_w + R Sigma_r R^T)^-1
         rot = pqt_rotate_xz(pqt[2], _EYE2, check=False).T              # R(theta): columns R e_X, R e_Z

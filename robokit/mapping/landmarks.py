@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..geometry import as_pqt, pqt_robot_to_world, pqt_jacobian_xz, pqt_to_se3, pqt_world_to_robot
+from ..geometry import as_pqt, pqt_robot_to_world, pqt_to_se3, pqt_transform_xz, pqt_world_to_robot
 from ..validation import as_array, check_int, check_positive
 
 __all__ = ["transform_covariance", "kalman_fuse", "LandmarkMap"]
@@ -72,7 +72,7 @@ def transform_covariance(points, covariances, pqt, pqt_covariance) -> tuple[np.n
     rot = pqt_to_se3(p)[:3, :3]
     world = pqt_robot_to_world(pts, p, check=False)              # r_new = P(r_obs) + V, Sec. 3.3
     jac = np.zeros((pts.shape[0], 3, 3))                       # d r_new / d(p, q, theta); Y is fixed
-    jac[:, ::2] = pqt_jacobian_xz(p, pts[:, ::2], check=False)
+    jac[:, ::2] = pqt_transform_xz(p, pts[:, ::2], jacobian=True, check=False)[1]
     out = rot @ cov @ rot.T + jac @ pcov @ np.swapaxes(jac, 1, 2)   # first-order propagation, Sec. 3.4
     return world, out
 
