@@ -20,7 +20,7 @@ from PIL import Image
 
 from robokit.localization.egomotion import ransac_pose
 from robokit.localization.hough import global_localize
-from robokit.geometry import world_to_robot
+from robokit.geometry import pqt_world_to_robot
 from robokit.vision.descriptors import detect_plot_features, detect_sift_features
 from robokit.vision.evaluation import recall_precision, similarity_homography
 from tests.test_localization_hough import POSES, lab_map_and_view
@@ -67,7 +67,7 @@ def bench_ransac() -> None:
     errs = []
     for _ in range(20):
         world = rng.uniform([-4, 0, -4], [4, 2.5, 4], (200, 3))
-        robot = world_to_robot(world, truth) + rng.normal(scale=0.01, size=(200, 3))
+        robot = pqt_world_to_robot(world, truth) + rng.normal(scale=0.01, size=(200, 3))
         bad = rng.permutation(200)[:100]
         world[bad] = rng.uniform([-4, 0, -4], [4, 2.5, 4], (100, 3))
         res = ransac_pose(robot, world, rng=rng)

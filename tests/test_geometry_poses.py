@@ -25,6 +25,24 @@ def test_se2_inverse_and_between_round_trip():
         assert g.wrap_angle(back[2] - b[2]) == pytest.approx(0, abs=1e-12)
 
 
+def test_se2_functions_take_stacks_and_broadcast_one_pose():
+    rng = np.random.default_rng(5)
+    a, b = _random_se2(rng, 7), _random_se2(rng, 7)
+    np.testing.assert_array_equal(g.se2_compose(a, b), [g.se2_compose(x, y) for x, y in zip(a, b)])
+    np.testing.assert_array_equal(g.se2_inverse(a), [g.se2_inverse(x) for x in a])
+    np.testing.assert_array_equal(g.se2_between(a, b), [g.se2_between(x, y) for x, y in zip(a, b)])
+    np.testing.assert_array_equal(g.se2_compose(a[0], b), [g.se2_compose(a[0], y) for y in b])
+    np.testing.assert_array_equal(g.se2_compose(a, b[:1]), [g.se2_compose(x, b[0]) for x in a])
+    np.testing.assert_array_equal(g.se2_compose(a, b, check=False), g.se2_compose(a, b))
+    assert g.se2_compose(a[0], b[0]).shape == g.se2_inverse(a[0]).shape == (3,)
+    out = g.se2_compose([[0.0, 0.0, 3.0]] * 2, [[0.0, 0.0, 0.5], [0.0, 0.0, -0.5]])
+    np.testing.assert_allclose(out[:, 2], [3.5 - 2 * np.pi, 2.5])          # headings wrapped
+    with pytest.raises(ValueError, match="a, b: expected one pose or stacks of equal length"):
+        g.se2_compose(a, b[:3])
+    with pytest.raises(ValueError, match="b"):
+        g.se2_between(a, np.zeros((2, 2, 3)))
+
+
 def test_se2_matrix_agrees_with_compose():
     rng = np.random.default_rng(2)
     a, b = _random_se2(rng, 2)

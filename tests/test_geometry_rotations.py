@@ -99,7 +99,29 @@ def test_as_rotation_accepts_rotations_and_names_the_defect():
         g.as_rotation(np.eye(2), "R")
 
 
+def test_zyz_angles_agree_with_scipy_and_are_batched():
+    rng = np.random.default_rng(9)
+    R = Rotation.random(200, random_state=3).as_matrix()
+    got = g.zyz_angles(R)
+    assert got.shape == (200, 3) and np.all((got[:, 1] >= 0) & (got[:, 1] <= np.pi))
+    np.testing.assert_allclose(got, Rotation.from_matrix(R).as_euler("ZYZ"), atol=1e-9)
+    np.testing.assert_array_equal(g.zyz_angles(R[:5].reshape(5, 1, 3, 3))[:, 0], got[:5])
+    np.testing.assert_array_equal(g.zyz_angles(R, check=False), got)
+    a, b, c = got.T
+    np.testing.assert_allclose(g.rot_z(a) @ g.rot_y(b) @ g.rot_z(c), R, atol=1e-12)
+    # gimbal lock: b = 0 or pi, only a + c (or c - a) is defined; a = 0 and c carries it
+    for b in (0.0, np.pi, 1e-14):
+        a0, c0 = rng.uniform(-np.pi, np.pi, 2)
+        M = g.rot_z(a0) @ g.rot_y(b) @ g.rot_z(c0)
+        za, zb, zc = g.zyz_angles(M)
+        assert za == 0.0 and zb == pytest.approx(b, abs=1e-12)
+        np.testing.assert_allclose(g.rot_z(za) @ g.rot_y(zb) @ g.rot_z(zc), M, atol=1e-12)
+
+
 @pytest.mark.parametrize("call, match", [
+    (lambda: g.zyz_angles(np.eye(2)), r"R: expected rotation matrices"),
+    (lambda: g.zyz_angles(np.diag([1.0, 1.0, -1.0])), r"R: expected a rotation matrix"),
+    (lambda: g.zyz_angles(np.stack([np.eye(3), 2 * np.eye(3)])), "at index 1"),
     (lambda: g.skew([1.0, 2.0]), r"v: expected 3-vectors"),
     (lambda: g.so3_exp([np.nan, 0.0, 0.0]), "rotvec"),
     (lambda: g.so3_exp(1.0), r"rotvec: expected 3-vectors"),

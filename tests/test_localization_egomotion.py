@@ -5,7 +5,7 @@ import pytest
 from robokit.localization.egomotion import (DegenerateCorrespondenceError, InsufficientMatchesError,
                                             continuation_matches, fit_pose, pose_from_two,
                                             ransac_pose, ransac_sample_count, track)
-from robokit.geometry import robot_to_world, world_to_robot
+from robokit.geometry import pqt_robot_to_world, pqt_world_to_robot
 from robokit.mapping.landmarks import LandmarkMap
 
 TRUE = np.array([0.35, 1.20, np.deg2rad(17.0)])
@@ -13,7 +13,7 @@ TRUE = np.array([0.35, 1.20, np.deg2rad(17.0)])
 
 def _scene(rng, n=200, noise=0.01):
     world = rng.uniform([-4, 0, -4], [4, 2.5, 4], (n, 3))
-    robot = world_to_robot(world, TRUE) + rng.normal(scale=noise, size=(n, 3))
+    robot = pqt_world_to_robot(world, TRUE) + rng.normal(scale=noise, size=(n, 3))
     return robot, world
 
 
@@ -98,7 +98,7 @@ def _map_and_view(rng, n=300, dim=16):
     desc /= np.linalg.norm(desc, axis=1, keepdims=True)
     lm = LandmarkMap(dim)
     lm.add(world, np.stack([np.eye(3) * 1e-4] * n), desc)
-    robot = world_to_robot(world, TRUE) + rng.normal(scale=0.01, size=(n, 3))
+    robot = pqt_world_to_robot(world, TRUE) + rng.normal(scale=0.01, size=(n, 3))
     noisy = desc + rng.normal(scale=0.03, size=desc.shape).astype(np.float32)
     return lm, robot, noisy
 
@@ -126,7 +126,7 @@ def test_tracking_uses_the_window_and_recovers_when_kidnapped():
     other = rng.normal(size=desc.shape).astype(np.float32)
     res, fi, li, kidnapped = track(robot, other, lm, [3.0, -3.0, 2.0], rng=1)
     assert res.source == "odometry" and np.allclose(res.pqt, [3.0, -3.0, 2.0]) and fi.size == 0
-    assert np.allclose(robot_to_world(world_to_robot(lm.positions[:3], TRUE), TRUE), lm.positions[:3])
+    assert np.allclose(pqt_robot_to_world(pqt_world_to_robot(lm.positions[:3], TRUE), TRUE), lm.positions[:3])
 
 
 def test_weighted_refinement_discounts_depth_uncertain_points():
@@ -134,7 +134,7 @@ def test_weighted_refinement_discounts_depth_uncertain_points():
     errs_w, errs_u, m2 = [], [], []
     for _ in range(30):
         world = rng.uniform([-4, 0, -4], [4, 2.5, 4], (60, 3))
-        robot = world_to_robot(world, TRUE)
+        robot = pqt_world_to_robot(world, TRUE)
         depth_sigma = 0.005 + 0.05 * np.abs(robot[:, 2])          # stereo-like: grows with depth
         cov = np.zeros((60, 3, 3))
         cov[:, 0, 0] = cov[:, 1, 1] = 0.005 ** 2

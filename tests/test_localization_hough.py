@@ -4,7 +4,7 @@ import pytest
 
 from robokit.localization.egomotion import InsufficientMatchesError
 from robokit.localization.hough import candidate_matches, global_localize, hough_accumulator
-from robokit.geometry import world_to_robot
+from robokit.geometry import pqt_world_to_robot
 from robokit.mapping.landmarks import LandmarkMap
 from robokit.vision.stereo import StereoCalibration, disparity_to_point
 
@@ -32,7 +32,7 @@ def stereo_view(rng, world, desc, pose, clutter=0.3, descriptor_noise=0.05, max_
     clutter). Image noise follows Se et al. Sec. 3.1 (sigma_c = sigma_r = sigma_d = 1 px).
     """
     dim = desc.shape[1]
-    robot = world_to_robot(world, pose)
+    robot = pqt_world_to_robot(world, pose)
     visible = (robot[:, 2] > 0.5) & (robot[:, 2] < max_range) & (np.abs(robot[:, 0]) < 0.75 * robot[:, 2]) \
         & (np.abs(robot[:, 1]) < 0.55 * robot[:, 2])
     rows = np.nonzero(visible)[0]

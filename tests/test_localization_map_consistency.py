@@ -11,7 +11,7 @@ HEIGHT = 0.8
 
 
 def _lab_to_paper(points):
-    """Inverse of paper_to_lab: (x, y, z) -> (X, Y, Z) = (x, z - h, y)."""
+    """Inverse of geometry.paper_world_to_robokit: (x, y, z) -> (X, Y, Z) = (x, z - h, y)."""
     p = np.asarray(points, float)
     return np.stack([p[:, 0], p[:, 2] - HEIGHT, p[:, 1]], axis=1)
 
@@ -75,19 +75,3 @@ def test_bad_input_is_named():
     lm, world = _map_on_surface(np.zeros(2), 0.01)
     with pytest.raises(ValueError, match="margin"):
         map_consistency(lm, world, margin=-1.0)
-
-
-def test_paper_to_lab_permutes_points_and_covariances():
-    from robokit.localization.lab_experiment import paper_to_lab
-
-    rng = np.random.default_rng(5)
-    lab = rng.uniform(0, 5, size=(6, 3))
-    m = rng.normal(size=(6, 3, 3))
-    cov = m @ np.swapaxes(m, 1, 2)
-    perm = np.array([[1.0, 0, 0], [0, 0, 1], [0, 1, 0]])
-    pts, covs = paper_to_lab(_lab_to_paper(lab), perm @ cov @ perm.T, camera_height=HEIGHT)
-    np.testing.assert_allclose(pts, lab, atol=1e-12)
-    np.testing.assert_allclose(covs, cov, atol=1e-12)
-    assert paper_to_lab(_lab_to_paper(lab))[1] is None
-    with pytest.raises(ValueError, match="camera_height"):
-        paper_to_lab(lab, camera_height=0.0)

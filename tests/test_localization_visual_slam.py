@@ -183,7 +183,7 @@ def test_vectorised_greedy_assignment_equals_the_sequential_scan():
 def test_ransac_recovers_the_rendered_motion_with_half_the_matches_wrong():
     from robokit import sim
     from robokit.localization import ransac_pose
-    from robokit.geometry import robot_to_world
+    from robokit.geometry import pqt_robot_to_world
     from robokit.vision import detect_and_describe, observe_stereo, ratio_match
 
     world = sim.lab_room()
@@ -196,7 +196,7 @@ def test_ransac_recovers_the_rendered_motion_with_half_the_matches_wrong():
         obs.append(observe_stereo(detect_and_describe(views["left"].image, "sift"),
                                   detect_and_describe(views["right"].image, "sift"), rig))
     m = ratio_match(obs[1].features.descriptors, obs[0].features.descriptors)
-    landmarks = robot_to_world(obs[0].points[m.train], se2_to_pqt(poses[0]))
+    landmarks = pqt_robot_to_world(obs[0].points[m.train], se2_to_pqt(poses[0]))
     rng = np.random.default_rng(2)
     bad = np.nonzero(rng.random(len(m)) < 0.5)[0]
     landmarks[bad] = landmarks[rng.permutation(bad)]

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from robokit.geometry import robot_to_world, world_to_robot
+from robokit.geometry import pqt_robot_to_world, pqt_world_to_robot
 from robokit.mapping import LandmarkMap, kalman_fuse, transform_covariance
 
 
@@ -47,7 +47,7 @@ def test_backward_transformation_covariance_matches_monte_carlo():
     pqt = np.array([1.0, 2.0, 0.4])
     pqt_cov = np.diag([0.01 ** 2, 0.02 ** 2, np.deg2rad(1.0) ** 2])
     world, wcov = transform_covariance(pt, cov, pqt, pqt_cov)
-    assert np.allclose(world, robot_to_world(pt, pqt))
+    assert np.allclose(world, pqt_robot_to_world(pt, pqt))
     n = 40000
     samples_p = rng.multivariate_normal(pqt, pqt_cov, n)
     samples_r = rng.multivariate_normal(pt[0], cov[0], n)
@@ -70,7 +70,7 @@ def test_map_integrates_frames_and_forgets_unseen_landmarks():
     poses = [np.array([0.0, 0.0, 0.0]), np.array([0.1, 0.3, 0.05]), np.array([0.2, 0.6, 0.1])]
     ids = None
     for k, pqt in enumerate(poses):
-        robot = world_to_robot(truth, pqt) + rng.normal(size=(30, 3)) * [0.03, 0.03, 0.1]
+        robot = pqt_world_to_robot(truth, pqt) + rng.normal(size=(30, 3)) * [0.03, 0.03, 0.1]
         lm = -np.ones(30, int) if k == 0 else np.searchsorted(m.ids, ids)
         ids = m.integrate(robot, obs_cov, desc, pqt, np.diag([1e-6, 1e-6, 1e-8]), lm)
     assert len(m) == 30 and np.all(m.observations == 3)
@@ -97,7 +97,7 @@ def test_association_uses_pose_uncertainty_and_descriptors():
     m = LandmarkMap(16)
     m.add(world, np.stack([np.eye(3) * 1e-4] * 40), desc)
     pqt = np.array([0.2, 0.1, 0.05])
-    obs = world_to_robot(world, pqt) + rng.normal(scale=0.01, size=(40, 3))
+    obs = pqt_world_to_robot(world, pqt) + rng.normal(scale=0.01, size=(40, 3))
     cov = np.stack([np.eye(3) * 1e-4] * 40)
     assert np.array_equal(m.associate(obs, cov, desc, pqt), np.arange(40))
     # same geometry, wrong descriptors: nothing associates

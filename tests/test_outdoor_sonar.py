@@ -45,6 +45,10 @@ def test_paper_layout_geometry():
     assert mid_l.yaw == mid_r.yaw == 0.0
     poses = sensor_poses([1.0, 2.0, np.pi / 2])
     np.testing.assert_allclose(poses[0], [1.0 - 0.10, 2.25, np.pi / 2 + np.pi / 4])
+    # facing west, the left sensor's heading wraps past pi (it did not when sonar composed by hand)
+    west = sensor_poses([1.0, 2.0, 0.9 * np.pi])
+    assert np.all((-np.pi <= west[:, 2]) & (west[:, 2] < np.pi))
+    np.testing.assert_allclose(west[0, 2], 0.9 * np.pi + np.pi / 4 - 2 * np.pi)
 
 
 def test_schedules():

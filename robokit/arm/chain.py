@@ -1,7 +1,7 @@
 """Serial chains of revolute joints described by DH or modified-DH parameters.
 
 A :class:`Chain` knows its link parameters, joint offsets and limits, a fixed tool (flange)
-transform and a base transform. It computes the pose of every link frame in one vectorised pass,
+transform and a base transform. It computes the transform of every link frame in one vectorised pass,
 for one configuration or a batch of them.
 
 References
@@ -41,9 +41,9 @@ class Chain:
     offset : array_like, shape (n,), optional
         Constant added to each joint variable (``theta_i = q_i + offset_i``); zeros by default.
     tool : array_like, shape (4, 4), optional
-        Pose of the flange (end-effector) in the last link frame; identity by default.
+        Transform of the flange (end-effector) in the last link frame; identity by default.
     base : array_like, shape (4, 4), optional
-        Pose of frame 0 in the world; identity by default.
+        Transform of frame 0 in the world; identity by default.
 
     Raises
     ------
@@ -169,7 +169,7 @@ class Chain:
 
     # --- kinematics ------------------------------------------------------------------------------
     def frames(self, q: Any, *, check: bool = True) -> np.ndarray:
-        """Poses of frames 0..n (base, then every link) in the world, in one vectorised pass.
+        """Transforms of frames 0..n (base, then every link) in the world, in one vectorised pass.
 
         Parameters
         ----------
@@ -208,7 +208,21 @@ class Chain:
             np.matmul(out[..., i, :, :], links[..., i, :, :], out=out[..., i + 1, :, :])
         return out
 
-    def flange_pose(self, frames: Any, *, check: bool = True) -> np.ndarray:
+    def check_frames(self, frames: Any) -> np.ndarray:
+        """Return ``frames`` (of :meth:`frames`) as a finite float array of shape ``(..., n + 1, 4, 4)``.
+
+        Raises
+        ------
+        ValueError
+            If the shape is not (..., n + 1, 4, 4) or a value is not finite.
+        """
+        frames = as_array(frames, "frames")
+        if frames.shape[-3:] != (self.n + 1, 4, 4):
+            raise ValueError(f"frames: expected shape (..., {self.n + 1}, 4, 4) from Chain.frames, "
+                             f"got shape {frames.shape}")
+        return frames
+
+    def flange_transform(self, frames: Any, *, check: bool = True) -> np.ndarray:
         """The flange's transform (last link frame times the tool) from the frames of :meth:`frames`.
 
         Parameters
@@ -232,28 +246,62 @@ class Chain:
 
         Examples
         --------
+        The Panda's flange sits 0.107 m beyond its last link frame (the tool transform):
+
         >>> from robokit.arm import panda
         >>> arm = panda()
-        >>> arm.flange_pose(arm.frames(arm.random_q(rng=0))).shape
-        (4, 4)
+        >>> frames = arm.frames(arm.random_q(rng=0))
+        >>> T = arm.flange_transform(frames)
+        >>> print(round(float(np.linalg.norm(T[:3, 3] - frames[-1, :3, 3])), 3))
+        0.107
         """
         if check:
-            frames = as_array(frames, "frames")
-            if frames.shape[-3:] != (self.n + 1, 4, 4):
-                raise ValueError(f"frames: expected shape (..., {self.n + 1}, 4, 4) from Chain.frames, "
-                                 f"got shape {frames.shape}")
+            frames = self.check_frames(frames)
         return frames[..., -1, :, :] @ self.tool if self._has_tool else frames[..., -1, :, :]
 
-    def joint_frames(self, frames: np.ndarray) -> np.ndarray:
-        """Select, from frames 0..n, the frame whose z axis is each joint's axis -> (..., n, 4, 4).
+    def joint_frames(self, frames: Any, *, check: bool = True) -> np.ndarray:
+        """Select, from frames 0..n of :meth:`frames`, the frame whose z axis is each joint's axis.
 
+        Parameters
+        ----------
+        frames : array_like, shape (..., n + 1, 4, 4)
+        check : bool, default True
+            Check the shape and values of ``frames``; ``False`` skips it (the Jacobian's kernel).
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n, 4, 4)
+
+        Raises
+        ------
+        ValueError
+            If ``frames`` does not have shape (..., n + 1, 4, 4) or is not finite.
+
+        Notes
+        -----
         Standard DH: joint ``i`` turns about ``z_{i-1}``; modified DH: about ``z_i`` (Craig 2005,
         Sec. 3.4).
+
+        Examples
+        --------
+        >>> from robokit.arm import iiwa14
+        >>> arm = iiwa14()
+        >>> axes = arm.joint_frames(arm.frames(np.zeros(7)))[:, :3, 2]     # joint axes, stretched arm
+        >>> print(np.round(axes, 3) + 0.0)
+        [[ 0.  0.  1.]
+         [ 0.  1.  0.]
+         [ 0.  0.  1.]
+         [ 0. -1.  0.]
+         [ 0.  0.  1.]
+         [ 0.  1.  0.]
+         [ 0.  0.  1.]]
         """
+        if check:
+            frames = self.check_frames(frames)
         return frames[..., 1:, :, :] if self.modified else frames[..., :-1, :, :]
 
     def link_frames(self, q: Any) -> np.ndarray:
-        """Poses of every link frame 0..n and of the flange in the world frame.
+        """Transforms of every link frame 0..n and of the flange in the world frame.
 
         Parameters
         ----------
@@ -275,10 +323,10 @@ class Chain:
         Product of link transforms, Spong et al. (2006), Eq. (3.5).
         """
         frames = self.frames(q)
-        return np.concatenate([frames, self.flange_pose(frames, check=False)[..., None, :, :]], axis=-3)
+        return np.concatenate([frames, self.flange_transform(frames, check=False)[..., None, :, :]], axis=-3)
 
     def fk(self, q: Any) -> np.ndarray:
-        """Pose of the flange for joint angles ``q`` (one ``(n,)`` vector or a batch ``(N, n)``).
+        """Transform of the flange for joint angles ``q`` (one ``(n,)`` vector or a batch ``(N, n)``).
 
         Returns
         -------
@@ -293,7 +341,7 @@ class Chain:
         -----
         Spong et al. (2006), Eq. (3.5), followed by the fixed tool transform.
         """
-        return self.flange_pose(self.frames(q), check=False)
+        return self.flange_transform(self.frames(q), check=False)
 
 
 def chain_from_table(dh: Any, *, modified: bool = False) -> Chain:
@@ -312,7 +360,7 @@ def chain_from_table(dh: Any, *, modified: bool = False) -> Chain:
 
 
 def dh_fk(dh: Any, q: Any, *, modified: bool = False) -> np.ndarray:
-    """Flange pose of a chain given as a plain DH table.
+    """Flange transform of a chain given as a plain DH table.
 
     Parameters
     ----------

@@ -49,7 +49,7 @@ def dh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, check: bool = True) 
     Returns
     -------
     numpy.ndarray, shape (..., 4, 4)
-        The pose of frame ``i`` in frame ``i-1``; leading axes are the broadcast shape of the inputs.
+        The transform of frame ``i`` in frame ``i-1``; leading axes are the broadcast shape of the inputs.
 
     Raises
     ------
@@ -108,7 +108,7 @@ def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, check: bool = True)
     Returns
     -------
     numpy.ndarray, shape (..., 4, 4)
-        The pose of frame ``i`` in frame ``i-1``.
+        The transform of frame ``i`` in frame ``i-1``.
 
     Raises
     ------

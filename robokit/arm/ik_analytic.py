@@ -2,7 +2,7 @@
 
 The method is the separation of position and posture of Huang & Jiang (2013):
 
-1. the wrist centre ``W = p - d_wf z_7`` depends only on the target pose;
+1. the wrist centre ``W = p - d_wf z_7`` depends only on the target transform;
 2. joints 1-4 place the wrist centre: a position problem of a 4-DOF arm, redundant by one. The
    elbow angle ``q4`` follows from the triangle shoulder-elbow-wrist (law of cosines); the
    remaining freedom is the rotation of that triangle about the shoulder-wrist line, the *arm
@@ -28,11 +28,11 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import as_se3
+from ..geometry import as_se3, zyz_angles
 from ..validation import as_array, check_int, check_positive
 from .chain import Chain
 from .result import IKBatchResult, IKResult, verify
-from .srs_geometry import ARRAY, SCALAR, arm_angle_terms, coefficient_terms, mirror_angle, zyz_angles
+from .srs_geometry import ARRAY, SCALAR, arm_angle_terms, coefficient_terms, mirror_angle
 
 __all__ = ["SRSArm", "arm_angle", "ik_srs_branches", "ik_srs", "ik_srs_batch"]
 
@@ -88,32 +88,32 @@ class SRSArm:
 
     # --- the decomposition, step by step ---------------------------------------------------------
     def to_link7(self, T: np.ndarray) -> np.ndarray:
-        """Unchecked: target flange poses (N, 4, 4) -> link-7 poses in frame 0."""
+        """Unchecked: target flange transforms (N, 4, 4) -> link-7 transforms in frame 0."""
         return T if self._plain else self._base_inv @ T @ self._tool_inv
 
     def wrist_centre(self, T7: np.ndarray) -> np.ndarray:
-        """Unchecked: wrist centre ``p - d_wf z_7`` of link-7 poses (Huang & Jiang's step 1)."""
+        """Unchecked: wrist centre ``p - d_wf z_7`` of link-7 transforms (Huang & Jiang's step 1)."""
         return T7[..., :3, 3] - self.d_wf * T7[..., :3, 2]
 
     def coefficients(self, T7: np.ndarray):
         """Unchecked: Shimizu's ``A, B, C`` coefficients for shoulder and wrist, per elbow sign.
 
-        ``T7`` is one link-7 pose (4, 4) or a stack (N, 4, 4). Returns ``(G, q4, cos_q4)``: ``G``
-        of shape (N, 3, 28) (coefficient, then elbow sign, group and ZYZ entry flattened, see
+        ``T7`` is one link-7 transform (4, 4) or a stack (N, 4, 4). Returns ``(G, q4, cos_q4)``: ``G``
+        of shape (N, 3, 36) (coefficient, then elbow sign, group and rotation entry flattened, see
         :func:`robokit.arm.srs_geometry.coefficient_terms`), ``q4`` (N, 2) and ``cos_q4`` (N,).
-        One pose is computed on Python floats, which is several times faster than numpy at N = 1.
+        One transform is computed on Python floats, which is several times faster than numpy at N = 1.
         """
         if T7.ndim == 2:
             r = T7.tolist()
             sw = (r[0][3] - self.d_wf * r[0][2], r[1][3] - self.d_wf * r[1][2],
                   r[2][3] - self.d_wf * r[2][2] - self.d_bs)
             terms, q4, c4 = coefficient_terms(r, sw, self.d_se, self.d_ew, SCALAR)
-            return np.array(terms).reshape(1, 3, 28), np.array([q4]), np.array([c4])
+            return np.array(terms).reshape(1, 3, 36), np.array([q4]), np.array([c4])
         W = self.wrist_centre(T7)
         sw = (W[:, 0], W[:, 1], W[:, 2] - self.d_bs)
         R = [[T7[:, i, j] for j in range(3)] for i in range(3)]
         terms, q4, c4 = coefficient_terms(R, sw, self.d_se, self.d_ew, ARRAY)
-        return np.stack(terms, -1).reshape(-1, 3, 28), np.stack(q4, -1), c4
+        return np.stack(terms, -1).reshape(-1, 3, 36), np.stack(q4, -1), c4
 
     def angles(self, G: np.ndarray, psi: np.ndarray):
         """Unchecked: ZYZ angles ``(a, b >= 0, c)`` of shoulder and wrist for arm angles ``psi`` (N, K).
@@ -124,8 +124,8 @@ class SRSArm:
         N, K = psi.shape
         basis = np.empty((N, K, 3))
         basis[..., 0], basis[..., 1], basis[..., 2] = np.sin(psi), np.cos(psi), 1.0
-        E = (basis @ G).reshape(N, K, 2, 2, 7)
-        return zyz_angles(*np.moveaxis(E, -1, 0))
+        abc = zyz_angles((basis @ G).reshape(N, K, 2, 2, 3, 3), check=False)   # of A sin psi + B cos psi + C
+        return abc[..., 0], abc[..., 1], abc[..., 2]
 
     def joints(self, coeffs, psi: np.ndarray) -> np.ndarray:
         """Unchecked: all 8 branches for arm angles ``psi`` (N, K) -> q of shape (N, K, 8, 7).
@@ -249,7 +249,7 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
     chain : Chain
         An S-R-S chain (see :class:`SRSArm`).
     T : array_like, shape (4, 4)
-        Target flange pose (SE(3), metres).
+        Target flange transform (SE(3), metres).
     psi : float
         Arm angle [rad].
     within_limits : bool, default True
@@ -359,7 +359,7 @@ def ik_srs(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: float 
     (True, 'converged', True)
     """
     if np.ndim(T) != 2:
-        raise ValueError(f"T: expected one pose of shape (4, 4), got shape {np.shape(T)}")
+        raise ValueError(f"T: expected one transform of shape (4, 4), got shape {np.shape(T)}")
     if q0 is not None and np.ndim(q0) != 1:
         raise ValueError(f"q0: expected one joint vector of shape (7,), got shape {np.shape(q0)}")
     arm = _srs(chain)
@@ -388,7 +388,7 @@ def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: 
     chain : Chain
         An S-R-S chain (see :class:`SRSArm`), e.g. :func:`~robokit.arm.iiwa14`.
     T : array_like, shape (N, 4, 4) or (4, 4)
-        Target flange poses.
+        Target flange transforms.
     q0 : array_like, shape (N, 7) or (7,), optional
         Preferred configurations (the solution nearest each is kept); the middle of the joint
         ranges by default.

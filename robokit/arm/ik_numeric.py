@@ -33,135 +33,159 @@ __all__ = ["ik_numeric", "ik_numeric_batch"]
 
 
 # --- the search -----------------------------------------------------------------------------------
-def _claim_targets(chain: Chain, qa, conv, active, tgt, winner, t_done) -> np.ndarray:
-    """Unchecked: which converged attempts are also within the limits; the first of them per target
-    becomes its winner (``winner``, ``t_done`` updated in place). Returns that mask over ``active``."""
-    finished = conv.copy()
-    qc = qa[conv]
-    finished[conv] = np.all((qc >= chain.qmin) & (qc <= chain.qmax), axis=1)
-    if finished.any():
-        rows = active[finished]
-        t = tgt[rows]
-        first = np.unique(t, return_index=True)[1]
-        winner[t[first]] = rows[first]
-        t_done[t] = True
-    return finished
+class _Attempts:
+    """Unchecked: the search's bookkeeping, ``parallel`` attempts (rows) per target side by side.
 
+    Row ``r`` works on target ``r // parallel``; row ``r % parallel == 0`` starts at ``q0``, the
+    others at random configurations. Per row: the joints ``q``, ``steps`` taken, the ``best`` error
+    so far, the steps since it last halved (``stall``) and whether it is ``alive``. Per target: the
+    winning row (``winner``, -1 while none), ``iterations``, ``restarts`` used and ``done``.
+    """
 
-def _restart_or_retire(chain: Chain, rows, tgt, tries, restarts, qr, steps, best, stall, alive, step, gen) -> None:
-    """Unchecked: restart ended attempts ``rows`` from random configurations while their target has
-    restarts left (in row order, which fixes the random draws), retire them otherwise. Random
-    restarts are TRAC-IK's KDL-RR remedy for local minima (Beeson & Ames 2015)."""
-    for r in rows:
-        t = tgt[r]
-        if tries[t] < restarts:
-            qr[r] = gen.uniform(chain.qmin, chain.qmax)
-            tries[t] += 1
-            steps[r], best[r], stall[r] = 0, np.inf, 0
-            step.restart(r)
+    def __init__(self, chain: Chain, q0: np.ndarray, skip: np.ndarray, parallel: int, gen):
+        N, n = q0.shape
+        self.chain, self.gen, self.P, self.N = chain, gen, parallel, N
+        self.rows = N * parallel
+        self.target = np.repeat(np.arange(N), parallel)
+        self.q = np.repeat(q0, parallel, axis=0)
+        if parallel > 1:
+            extra = np.arange(self.rows) % parallel != 0
+            self.q[extra] = gen.uniform(chain.qmin, chain.qmax, size=(int(extra.sum()), n))
+        self.steps = np.zeros(self.rows, int)
+        self.best = np.full(self.rows, np.inf)
+        self.stall = np.zeros(self.rows, int)
+        self.alive = ~skip[self.target]
+        self.skip = skip
+        self.done = skip.copy()
+        self.winner = np.full(N, -1)
+        self.iterations = np.zeros(N, int)
+        self.restarts = np.zeros(N, int)
+
+    def live(self) -> np.ndarray:
+        """Rows still searching: alive, on a target nobody has won."""
+        return np.flatnonzero(self.alive & ~self.done[self.target])
+
+    def claim(self, active: np.ndarray, q: np.ndarray, converged: np.ndarray) -> np.ndarray:
+        """Converged attempts (mask over ``active``) at joints ``q`` finish if within the limits; the
+        first of them per target wins it. Returns the finished mask over ``active``."""
+        finished = converged.copy()
+        qc = q[converged]
+        finished[converged] = np.all((qc >= self.chain.qmin) & (qc <= self.chain.qmax), axis=1)
+        if finished.any():
+            rows = active[finished]
+            t = self.target[rows]
+            first = np.unique(t, return_index=True)[1]
+            self.winner[t[first]] = rows[first]
+            self.done[t] = True
+        return finished
+
+    def ended(self, sel, err: np.ndarray, max_iter: int, patience: int) -> np.ndarray:
+        """Record the errors ``err`` of rows ``sel``; True where an attempt has taken ``max_iter``
+        steps or its error has not halved for ``patience`` steps."""
+        b = self.best[sel]
+        improved = err < 0.5 * b
+        self.best[sel] = np.where(improved, err, b)
+        stall = np.where(improved, 0, self.stall[sel] + 1)
+        self.stall[sel] = stall
+        return (self.steps[sel] >= max_iter) | (stall >= patience)
+
+    def restart_or_retire(self, rows: np.ndarray, restarts: int, step) -> None:
+        """Restart ended attempts from random configurations while their target has restarts left
+        (in row order, which fixes the random draws), retire them otherwise. Random restarts are
+        TRAC-IK's KDL-RR remedy for local minima (Beeson & Ames 2015)."""
+        for r in rows:
+            t = self.target[r]
+            if self.restarts[t] < restarts:
+                self.q[r] = self.gen.uniform(self.chain.qmin, self.chain.qmax)
+                self.restarts[t] += 1
+                self.steps[r], self.best[r], self.stall[r] = 0, np.inf, 0
+                step.restart(r)
+            else:
+                self.alive[r] = False
+
+    def moved(self, rows, q: np.ndarray, everyone: bool) -> None:
+        """Store the new joints ``q`` of ``rows`` and count the step."""
+        self.q[rows] = q
+        self.steps[rows] += 1
+        if everyone:
+            self.iterations += self.P
+        elif self.P == 1:
+            self.iterations[self.target[rows]] += 1
         else:
-            alive[r] = False
+            self.iterations += np.bincount(self.target[rows], minlength=self.N)
+
+    def answers(self) -> np.ndarray:
+        """Per target the winning joints or, failing that, the attempt with the smallest error."""
+        P = self.P
+        q = self.q[::P].copy()
+        ok = self.winner >= 0
+        q[ok] = self.q[self.winner[ok]]
+        for t in np.flatnonzero(~ok & ~self.skip):
+            rows = np.arange(t * P, (t + 1) * P)
+            q[t] = self.q[rows[np.argmin(self.best[rows])]]
+        return q
+
+
+def _step(chain: Chain, step, frames, e, err2, q, rows, max_step: float, clamp: bool) -> np.ndarray:
+    """Unchecked: the joints after one step of the rule ``step``, scaled down to ``max_step`` (as a
+    whole, not per joint) and clipped to the limits with ``clamp``."""
+    dq = step(jacobian_from_frames(chain, frames, check=False), e, err2, q, rows)
+    big = np.sqrt(np.einsum("ij,ij->i", dq, dq))
+    over = big > max_step
+    if over.any():
+        dq[over] *= (max_step / big[over])[:, None]
+    q = q + dq
+    return np.minimum(np.maximum(q, chain.qmin), chain.qmax) if clamp else q
 
 
 def _search(chain: Chain, T: np.ndarray, q0: np.ndarray, skip: np.ndarray, step, *, tol: float, max_iter: int,
             restarts: int, patience: int, parallel: int, clamp: bool, max_step: float, gen, history: bool):
-    """Unchecked: run the attempts of every target until one converges or all are used up.
-
-    ``parallel`` attempts per target run side by side: row ``r`` works on target ``r // parallel``
-    and row ``r % parallel == 0`` starts at ``q0``, the others at random configurations. Targets
-    marked ``skip`` are not attempted. Returns ``(q, iterations, restarts, trail)``: per target the
-    winning attempt's joints or, failing that, the attempt with the smallest error; ``trail`` holds
-    the first attempts' iterates (with ``history``).
-    """
-    N, n = q0.shape
-    P, R = parallel, N * parallel
-    tgt = np.repeat(np.arange(N), P)
-    qr = np.repeat(q0, P, axis=0)
-    if P > 1:
-        extra = np.arange(R) % P != 0
-        qr[extra] = gen.uniform(chain.qmin, chain.qmax, size=(int(extra.sum()), n))
-    Tr = T[tgt]
-    t_done = skip.copy()
-    alive = ~skip[tgt]
-    winner = np.full(N, -1)
-    iters = np.zeros(N, int)
-    tries = np.zeros(N, int)          # restarts used per target
-    steps = np.zeros(R, int)
-    best = np.full(R, np.inf)
-    stall = np.zeros(R, int)
+    """Unchecked: run the attempts of every target (see :class:`_Attempts`) until one converges or
+    all are used up; targets marked ``skip`` are not attempted. Returns the :class:`_Attempts` and
+    the first attempts' iterates (with ``history``)."""
+    att = _Attempts(chain, q0, skip, parallel, gen)
+    Tr = T[att.target]
     trail = [q0.copy()] if history else None
-    active = np.flatnonzero(alive)
-    tol2 = tol * tol
+    active = att.live()
     while active.size:
-        full = active.size == R
-        sel = slice(None) if full else active        # common case: views, no fancy-index copies
-        qa = qr[sel]
+        full = active.size == att.rows
+        sel = slice(None) if full else active            # common case: views, no fancy-index copies
+        q = att.q[sel]
         # 1. pose error of every live attempt
-        frames = chain.frames(qa, check=False)
-        e = pose_error(Tr[sel], chain.flange_pose(frames, check=False), check=False)
+        frames = chain.frames(q, check=False)
+        e = pose_error(Tr[sel], chain.flange_transform(frames, check=False), check=False)
         e2 = e * e
         pos2, rot2 = e2[:, :3].sum(1), e2[:, 3:].sum(1)
-        e2s = pos2 + rot2
-        # 2. converged: within tolerance; it wins its target if also within the limits
-        conv = np.maximum(pos2, rot2) < tol2
+        err2 = pos2 + rot2
+        # 2. converged attempts (position and orientation within tol) claim their targets
+        conv = np.maximum(pos2, rot2) < tol * tol
         any_conv = bool(conv.any())
-        finished = _claim_targets(chain, qa, conv, active, tgt, winner, t_done) if any_conv else conv
-        # 3. an attempt ends after max_iter steps or when its error has not halved for `patience`
-        #    steps; a pose reached outside the limits (clamp=False) also ends it
-        err = np.sqrt(e2s)
-        b = best[sel]
-        improved = err < 0.5 * b
-        best[sel] = np.where(improved, err, b)
-        stall_a = np.where(improved, 0, stall[sel] + 1)
-        stall[sel] = stall_a
-        ended = (steps[sel] >= max_iter) | (stall_a >= patience)
+        finished = att.claim(active, q, conv) if any_conv else conv
+        # 3. ended attempts (out of steps, stalled, or converged outside the limits) restart or retire
+        ended = att.ended(sel, np.sqrt(err2), max_iter, patience)
         if any_conv:
             ended = ~finished & (ended | conv)
         any_ended = bool(ended.any())
         if any_ended:
-            _restart_or_retire(chain, active[ended], tgt, tries, restarts, qr, steps, best, stall, alive, step, gen)
-        # 4. one step of the method for every attempt still going
+            att.restart_or_retire(active[ended], restarts, step)
+        # 4. the others (of targets still open) take one step of the rule
         everyone = not (any_conv or any_ended)
         if not everyone:
-            stepping = ~(finished | ended)
-            if P > 1 and any_conv:
-                stepping &= ~t_done[tgt[active]]
-            everyone = bool(stepping.all())
-        rows = sel if everyone else active[stepping]
-        if everyone or rows.size:
-            if everyone:
-                fr, es, qs = frames, e, qa
-            else:
-                fr, es, qs, e2s = frames[stepping], e[stepping], qa[stepping], e2s[stepping]
-            dq = step(jacobian_from_frames(chain, fr, check=False), es, e2s, qs, rows)
-            big = np.sqrt(np.einsum("ij,ij->i", dq, dq))
-            over = big > max_step
-            if over.any():
-                dq[over] *= (max_step / big[over])[:, None]
-            qs = qs + dq
-            if clamp:
-                qs = np.minimum(np.maximum(qs, chain.qmin), chain.qmax)
-            qr[rows] = qs
-            steps[rows] += 1
-            if full and everyone:
-                iters += P
-            elif P == 1:
-                iters[tgt[rows]] += 1
-            else:
-                iters += np.bincount(tgt[rows], minlength=N)
-        if history and tries.max() == 0:
-            trail.append(qr[::P].copy())
+            going = ~(finished | ended)
+            if parallel > 1 and any_conv:
+                going &= ~att.done[att.target[active]]
+            everyone = bool(going.all())
+        if everyone:
+            att.moved(sel, _step(chain, step, frames, e, err2, q, sel, max_step, clamp), full)
+        elif going.any():
+            rows = active[going]
+            att.moved(rows, _step(chain, step, frames[going], e[going], err2[going], q[going], rows, max_step, clamp),
+                      False)
+        if history and att.restarts.max() == 0:
+            trail.append(att.q[::parallel].copy())
         if not everyone:
-            active = np.flatnonzero(alive & ~t_done[tgt])
-
-    # failed targets report their attempt with the smallest error
-    q = qr[::P].copy()
-    ok = winner >= 0
-    q[ok] = qr[winner[ok]]
-    for t in np.flatnonzero(~ok & ~skip):
-        rows_t = np.arange(t * P, (t + 1) * P)
-        q[t] = qr[rows_t[np.argmin(best[rows_t])]]
-    return q, iters, tries, trail
+            active = att.live()
+    return att, trail
 
 
 # --- the solvers ----------------------------------------------------------------------------------
@@ -292,18 +316,18 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     dist = np.linalg.norm(Tt[:, :3, 3] - chain.base[:3, 3], axis=1)
     too_far = dist > chain.reach()
     step = STEP_RULES[method](chain, N * parallel, damping, gain)
-    q, iters, tries, trail = _search(chain, Tt, q, too_far, step, tol=tol, max_iter=max_iter, restarts=restarts,
-                                     patience=patience, parallel=parallel, clamp=bool(clamp), max_step=max_step,
-                                     gen=gen, history=history)
-    out = verify(chain, Tt, q, tol, check=False)
+    att, trail = _search(chain, Tt, q, too_far, step, tol=tol, max_iter=max_iter, restarts=restarts,
+                         patience=patience, parallel=parallel, clamp=bool(clamp), max_step=max_step, gen=gen,
+                         history=history)
+    out = verify(chain, Tt, att.answers(), tol, check=False)
     for i in np.flatnonzero(too_far):
         out.reason[i] = (f"out of reach: target {dist[i]:.3f} m from the base, beyond the arm's reach "
                          f"bound {chain.reach():.3f} m")
     for i in np.flatnonzero(~out.success & ~too_far):
-        out.reason[i] += f" after {tries[i] + parallel} attempts of up to {max_iter} iterations"
+        out.reason[i] += f" after {att.restarts[i] + parallel} attempts of up to {max_iter} iterations"
         if out.reason[i].startswith("pose error"):
             out.reason[i] += " (target may be unreachable)"
-    out.iterations, out.restarts = iters, tries
+    out.iterations, out.restarts = att.iterations, att.restarts
     if history:
         out.history = np.array(trail)
     return out

@@ -248,9 +248,20 @@ class GradientProjection(DampedLeastSquares):
 
     Examples
     --------
-    >>> from robokit.arm import panda
-    >>> GradientProjection(panda(), attempts=4, damping=1e-3, gain=0.5).gain
-    0.5
+    The step is the DLS step plus a motion that leaves the hand where DLS puts it (to first order)
+    and moves the joints towards the middle of their ranges:
+
+    >>> from robokit.arm import geometric_jacobian, limit_distance_gradient, panda
+    >>> arm = panda()
+    >>> q = arm.random_q(1, rng=0)
+    >>> J, e = geometric_jacobian(arm, q), np.array([[0.05, 0.0, 0.0, 0.0, 0.0, 0.0]])
+    >>> args = (J, e, (e * e).sum(1), q, slice(None))
+    >>> extra = (GradientProjection(arm, attempts=1, damping=1e-3, gain=0.5)(*args)
+    ...          - DampedLeastSquares(arm, attempts=1, damping=1e-3, gain=0.5)(*args))
+    >>> print(np.round(J[0] @ extra[0], 6) + 0.0)                  # no hand motion
+    [0. 0. 0. 0. 0. 0.]
+    >>> bool(limit_distance_gradient(arm, q[0]) @ extra[0] > 0)    # away from the limits
+    True
     """
 
     def __call__(self, J, e, err2, q, rows) -> np.ndarray:
@@ -272,9 +283,28 @@ class WeightedLeastNorm(DampedLeastSquares):
 
     Examples
     --------
-    >>> from robokit.arm import panda
-    >>> WeightedLeastNorm(panda(), attempts=4, damping=1e-3, gain=0.0).previous.shape
-    (4, 7)
+    Joint 4 of the Panda starts 0.3 rad below its upper limit; the first step is plain DLS, but once
+    the joint has moved towards its limit its weight grows and it moves far less than under DLS:
+
+    >>> from robokit.arm import geometric_jacobian, panda
+    >>> arm = panda()
+    >>> wln = WeightedLeastNorm(arm, attempts=1, damping=1e-3, gain=0.0)
+    >>> dls = DampedLeastSquares(arm, attempts=1, damping=1e-3, gain=0.0)
+    >>> def steps(q):
+    ...     J, e = geometric_jacobian(arm, q), np.array([[0.0, 0.0, 0.05, 0.0, 0.0, 0.0]])
+    ...     return wln(J, e, (e * e).sum(1), q, slice(None)), dls(J, e, (e * e).sum(1), q, slice(None))
+    >>> q = 0.5 * (arm.qmin + arm.qmax)[None]
+    >>> q[0, 3] = arm.qmax[3] - 0.3
+    >>> first_wln, first_dls = steps(q)
+    >>> bool(np.allclose(first_wln, first_dls))                     # all weights 1
+    True
+    >>> q[0, 3] += 0.1                                              # joint 4 nears its limit
+    >>> second_wln, second_dls = steps(q)
+    >>> print(round(second_wln[0, 3], 3), round(second_dls[0, 3], 3))
+    -0.065 -0.554
+    >>> wln.restart(0)                                              # a restart forgets the history
+    >>> bool(np.allclose(steps(q)[0], second_dls))
+    True
     """
 
     def __init__(self, chain: Chain, attempts: int, damping: float, gain: float):

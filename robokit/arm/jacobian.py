@@ -57,14 +57,11 @@ def jacobian_from_frames(chain: Chain, frames: Any, *, check: bool = True) -> np
     if check:
         if not isinstance(chain, Chain):
             raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
-        frames = as_array(frames, "frames")
-        if frames.shape[-3:] != (chain.n + 1, 4, 4):
-            raise ValueError(f"frames: expected shape (..., {chain.n + 1}, 4, 4) from Chain.frames, "
-                             f"got shape {frames.shape}")
-    jf = chain.joint_frames(frames)
+        frames = chain.check_frames(frames)
+    jf = chain.joint_frames(frames, check=False)
     z = jf[..., :3, 2]                       # (..., n, 3) joint axes
     p = jf[..., :3, 3]                       # (..., n, 3) points on the axes
-    p_e = chain.flange_pose(frames, check=False)[..., None, :3, 3]
+    p_e = chain.flange_transform(frames, check=False)[..., None, :3, 3]
     r = p_e - p
     J = np.empty(z.shape[:-2] + (6, z.shape[-2]))
     J[..., 0, :] = z[..., 1] * r[..., 2] - z[..., 2] * r[..., 1]   # z x (p_e - p), Eq. (3.30)

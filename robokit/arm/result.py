@@ -140,7 +140,7 @@ def verify(chain, T_target: Any, q: Any, tol: float = 1e-6, *, check: bool = Tru
         if len(q) != len(T_target):
             raise ValueError(f"q: expected {len(T_target)} joint vectors (one per target), got {len(q)}")
         tol = check_positive(tol, "tol")
-    err = pose_error(T_target, chain.flange_pose(chain.frames(q, check=False), check=False), check=False)
+    err = pose_error(T_target, chain.flange_transform(chain.frames(q, check=False), check=False), check=False)
     err *= err
     pos2, rot2 = err[:, :3].sum(1), err[:, 3:].sum(1)
     pos, rot, residual = np.sqrt(pos2), np.sqrt(rot2), np.sqrt(pos2 + rot2)

@@ -3,7 +3,7 @@
 For an arm whose first three axes meet at a shoulder point ``S``, whose last three meet at a wrist
 centre ``W``, with a revolute elbow between (the KUKA LBR iiwa):
 
-1. :func:`wrist_centre` - ``W`` from the target pose;
+1. :func:`wrist_centre` - ``W`` from the target transform;
 2. :func:`elbow_angle` - the elbow joint from the triangle ``S``-elbow-``W`` (law of cosines);
 3. :func:`shoulder_angles` - the shoulder joints for a chosen arm angle ``psi``.
 
@@ -24,9 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import as_se3, rot_y, rot_z, so3_exp
+from ..geometry import as_se3, rot_y, rot_z, so3_exp, zyz_angles
 from ..validation import as_array, check_finite_scalar, check_positive
-from .srs_geometry import ENTRIES, zyz_angles
 
 __all__ = ["wrist_centre", "elbow_angle", "shoulder_angles"]
 
@@ -45,12 +44,12 @@ def _reference_rotation(sw: np.ndarray, q4: np.ndarray, d_se: float, d_ew: float
 
 
 def wrist_centre(T: Any, d_wf: float) -> np.ndarray:
-    """The wrist centre ``W = p - d_wf z`` of a target flange pose.
+    """The wrist centre ``W = p - d_wf z`` of a target flange transform.
 
     Parameters
     ----------
     T : array_like, shape (4, 4)
-        Target flange pose (SE(3)) in the base frame.
+        Target flange transform (SE(3)) in the base frame.
     d_wf : float
         Distance from the wrist centre to the flange along the flange's z axis [m] (0.126 m on the
         iiwa 14).
@@ -175,4 +174,4 @@ def shoulder_angles(shoulder: Any, wrist: Any, q4: float, psi: float, d_se: floa
         raise ValueError("wrist: expected a wrist centre away from the shoulder, got |W - S| = 0")
     R_psi = so3_exp(psi * sw / L, check=False)                 # rotation by psi about S-W (Rodrigues)
     M = R_psi @ _reference_rotation(sw, np.asarray(q4), l1, l2)   # R_0^3(psi) = R_psi R_0^3(0), Eqs. (9)-(15)
-    return np.array(zyz_angles(*(M[i, j] for i, j in ENTRIES)), dtype=float)
+    return zyz_angles(M, check=False)

@@ -67,31 +67,6 @@ def arm_angle_terms(q1, q2, q3, q4, d_se: float, d_ew: float, xp=ARRAY):
     return xp.atan2(_dot(sw, _cross(n_ref, n)) / xp.sqrt(xp.where(L2 > 0, L2, 1.0)), _dot(n_ref, n))
 
 
-def zyz_angles(m02, m12, m22, m21, m20, m10, m11):
-    """Unchecked: ZYZ Euler angles (a, b >= 0, c) of ``Rz(a) Ry(b) Rz(c)`` from its entries.
-
-    The entries are the rotation's ``(row, column)`` elements named by the arguments (those of
-    :data:`ENTRIES`), as floats or arrays of one shape. At ``sin b = 0`` only ``a + c`` is defined;
-    then ``a = 0``. Craig (2005), Sec. 2.8, Z-Y-Z Euler angles.
-
-    Examples
-    --------
-    >>> from robokit.geometry import rot_y, rot_z
-    >>> M = rot_z(0.3) @ rot_y(0.5) @ rot_z(-0.2)
-    >>> print(np.round(zyz_angles(*(M[i, j] for i, j in ENTRIES)), 6))
-    [ 0.3  0.5 -0.2]
-    """
-    sb = np.hypot(m02, m12)
-    b = np.arctan2(sb, m22)
-    a = np.arctan2(m12, m02)
-    c = np.arctan2(m21, -m20)
-    sing = sb < 1e-12
-    if sing.any():
-        a = np.where(sing, 0.0, a)
-        c = np.where(sing, np.arctan2(m10, m11), c)
-    return a, b, c
-
-
 def mirror_angle(x):
     """Unchecked: ``x + pi`` wrapped to (-pi, pi] for ``x`` in (-pi, pi]: the ZYZ mirror branch.
 
@@ -103,10 +78,6 @@ def mirror_angle(x):
     [-2.641593  2.641593]
     """
     return np.where(x > 0, x - np.pi, x + np.pi)
-
-
-#: Entries (row, column) of a rotation read by the ZYZ decomposition (:func:`zyz_angles`).
-ENTRIES = ((0, 2), (1, 2), (2, 2), (2, 1), (2, 0), (1, 0), (1, 1))
 
 
 def coefficient_terms(R, sw, d_se: float, d_ew: float, xp=ARRAY):
@@ -121,9 +92,10 @@ def coefficient_terms(R, sw, d_se: float, d_ew: float, xp=ARRAY):
 
     Returns
     -------
-    terms : list of 84
-        Coefficient (``A``, ``B``, ``C``), elbow sign (+, -), group (shoulder, wrist), entry (the
-        7 of :data:`ENTRIES`), in that nesting order; entry ``= A sin psi + B cos psi + C``.
+    terms : list of 108
+        Coefficient (``A``, ``B``, ``C``), elbow sign (+, -), group (shoulder, wrist), entry of the
+        group's 3 x 3 rotation (row-major), in that nesting order; entry
+        ``= A sin psi + B cos psi + C``.
     q4 : tuple
         Elbow angles ``(+acos c4, -acos c4)``.
     c4 : float or array
@@ -159,9 +131,10 @@ def coefficient_terms(R, sw, d_se: float, d_ew: float, xp=ARRAY):
         B = [(m[0] - c[0], m[1] - c[1], m[2] - c[2]) for m, c in zip(cols, C)]
         ce, se = cc, sign * s4                                       # cos, sin of this q4
         for k, X in enumerate((A, B, C)):
-            out[k].extend(X[j][i] for i, j in ENTRIES)              # shoulder: column-major X
+            for row in zip(*X):                                      # shoulder (X holds columns)
+                out[k].extend(row)
             P = [[_dot(X[i], Rc[j]) for j in range(3)] for i in range(3)]   # X^T R
-            W = (tuple(ce * P[0][j] + se * P[2][j] for j in range(3)), P[1],
-                 tuple(ce * P[2][j] - se * P[0][j] for j in range(3)))     # Ry(q4) X^T R
-            out[k].extend(W[i][j] for i, j in ENTRIES)
+            out[k].extend([ce * P[0][j] + se * P[2][j] for j in range(3)])  # Ry(q4) X^T R, row by row
+            out[k].extend(P[1])
+            out[k].extend([ce * P[2][j] - se * P[0][j] for j in range(3)])
     return out[0] + out[1] + out[2], (a4, -a4), c4

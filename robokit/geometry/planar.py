@@ -84,73 +84,88 @@ def wrap_angle(angle: Any) -> Any:
     return float(out) if out.ndim == 0 else out
 
 
-def se2_compose(a: Any, b: Any) -> np.ndarray:
+def _pair(a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
+    pa, pb = as_planar(a, "a"), as_planar(b, "b")
+    if pa.ndim == pb.ndim == 2 and len(pa) != len(pb) and 1 not in (len(pa), len(pb)):
+        raise ValueError(f"a, b: expected one pose or stacks of equal length, got {len(pa)} and {len(pb)} poses")
+    return pa, pb
+
+
+def se2_compose(a: Any, b: Any, *, check: bool = True) -> np.ndarray:
     """Compose planar poses: the pose ``b`` expressed in frame ``a``, mapped to the world.
 
     Parameters
     ----------
-    a, b : array_like, shape (3,)
-        Poses ``[x, y, theta]``.
+    a, b : array_like, shape (3,) or (N, 3)
+        Poses ``[x, y, theta]``; a single pose broadcasts against a stack.
+    check : bool, default True
+        Validate both; ``False`` skips it (float arrays only).
 
     Returns
     -------
-    numpy.ndarray, shape (3,)
+    numpy.ndarray, shape (3,) or (N, 3)
         ``a ⊕ b = [x_a + cos(t_a) x_b - sin(t_a) y_b, y_a + sin(t_a) x_b + cos(t_a) y_b,
         wrap(t_a + t_b)]``.
 
     Raises
     ------
     ValueError
-        If a pose does not have shape (3,) or is not finite.
+        If a pose does not have shape (3,) or (N, 3), the stacks differ in length or a value is
+        not finite.
 
     Notes
     -----
-    The compounding operator of Smith, Self & Cheeseman (1990), Eq. (3); it is also the
-    composition of Duckett's relaxation, Eq. (1), used by lesson 02.
+    The compounding operation ``⊕`` of Smith, Self & Cheeseman (1990).
 
     Examples
     --------
     >>> print(np.round(se2_compose([1.0, 2.0, np.pi / 2], [1.0, 0.0, 0.0]), 6))
     [1.       3.       1.570796]
+    >>> mounts = [[0.2, 0.1, 0.5], [0.2, -0.1, -0.5]]                  # two sensors on a robot
+    >>> print(np.round(se2_compose([1.0, 2.0, np.pi / 2], mounts), 6))
+    [[0.9      2.2      2.070796]
+     [1.1      2.2      1.070796]]
     """
-    pa = as_array(a, "a", shape=(3,))
-    pb = as_array(b, "b", shape=(3,))
-    c, s = np.cos(pa[2]), np.sin(pa[2])
-    return np.array([pa[0] + c * pb[0] - s * pb[1], pa[1] + s * pb[0] + c * pb[1],
-                     wrap_angle(pa[2] + pb[2])])
+    pa, pb = _pair(a, b) if check else (a, b)
+    c, s = np.cos(pa[..., 2]), np.sin(pa[..., 2])
+    return np.stack([pa[..., 0] + c * pb[..., 0] - s * pb[..., 1], pa[..., 1] + s * pb[..., 0] + c * pb[..., 1],
+                     wrap_angle(pa[..., 2] + pb[..., 2])], axis=-1)
 
 
 def se2_inverse(a: Any) -> np.ndarray:
-    """Invert a planar pose: the world origin expressed in the frame ``a``.
+    """Invert planar poses: the world origin expressed in the frame ``a``.
 
     Parameters
     ----------
-    a : array_like, shape (3,)
-        Pose ``[x, y, theta]``.
+    a : array_like, shape (3,) or (N, 3)
+        Poses ``[x, y, theta]``.
 
     Returns
     -------
-    numpy.ndarray, shape (3,)
+    numpy.ndarray, shape (3,) or (N, 3)
         ``⊖a = [-x cos t - y sin t, x sin t - y cos t, -t]`` so that ``se2_compose(a, ⊖a) = 0``.
 
     Raises
     ------
     ValueError
-        If the pose does not have shape (3,) or is not finite.
+        If the poses do not have shape (3,) or (N, 3) or are not finite.
 
     Notes
     -----
-    The inverse relationship of Smith, Self & Cheeseman (1990), Eq. (4).
+    The inverse relationship ``⊖`` of Smith, Self & Cheeseman (1990).
 
     Examples
     --------
     >>> a = [1.0, 2.0, 0.5]
+    >>> print(np.round(se2_inverse(a), 6))
+    [-1.836434 -1.27574  -0.5     ]
     >>> print(np.round(se2_compose(a, se2_inverse(a)), 12) + 0.0)
     [0. 0. 0.]
     """
-    p = as_array(a, "a", shape=(3,))
-    c, s = np.cos(p[2]), np.sin(p[2])
-    return np.array([-c * p[0] - s * p[1], s * p[0] - c * p[1], wrap_angle(-p[2])])
+    p = as_planar(a, "a")
+    c, s = np.cos(p[..., 2]), np.sin(p[..., 2])
+    return np.stack([-c * p[..., 0] - s * p[..., 1], s * p[..., 0] - c * p[..., 1],
+                     wrap_angle(-p[..., 2])], axis=-1)
 
 
 def se2_between(a: Any, b: Any) -> np.ndarray:
@@ -158,29 +173,34 @@ def se2_between(a: Any, b: Any) -> np.ndarray:
 
     Parameters
     ----------
-    a, b : array_like, shape (3,)
-        Poses ``[x, y, theta]`` in the same frame.
+    a, b : array_like, shape (3,) or (N, 3)
+        Poses ``[x, y, theta]`` in the same frame; a single pose broadcasts against a stack.
 
     Returns
     -------
-    numpy.ndarray, shape (3,)
+    numpy.ndarray, shape (3,) or (N, 3)
 
     Raises
     ------
     ValueError
-        If a pose does not have shape (3,) or is not finite.
+        As :func:`se2_compose`.
 
     Notes
     -----
-    Smith, Self & Cheeseman (1990), Eqs. (3)-(4) combined; Lu & Milios (1997) call it the relative
-    pose constraint of a pose graph.
+    ``⊖a ⊕ b`` in the notation of Smith, Self & Cheeseman (1990); Lu & Milios (1997) call it the
+    relative pose constraint of a pose graph.
 
     Examples
     --------
     >>> print(np.round(se2_between([1.0, 0.0, np.pi / 2], [1.0, 1.0, np.pi / 2]), 6) + 0.0)
     [1. 0. 0.]
+    >>> path = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.1], [2.0, 0.1, 0.2]])
+    >>> print(np.round(se2_between(path[:-1], path[1:]), 3) + 0.0)    # odometry increments
+    [[1.    0.    0.1  ]
+     [1.005 0.    0.1  ]]
     """
-    return se2_compose(se2_inverse(a), b)
+    pa, pb = _pair(a, b)
+    return se2_compose(se2_inverse(pa), pb, check=False)
 
 
 def se2_to_matrix(pose: Any) -> np.ndarray:

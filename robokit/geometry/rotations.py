@@ -21,7 +21,7 @@ from scipy.spatial.transform import Rotation
 from ..validation import as_array
 
 __all__ = ["ROTATION_TOL", "as_rotation", "check_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y", "rot_z",
-           "euler_matrix"]
+           "euler_matrix", "zyz_angles"]
 
 #: Default tolerance on ``|R^T R - I|`` and ``|det R - 1|`` when a rotation is checked.
 ROTATION_TOL = 1e-6
@@ -92,7 +92,12 @@ def check_rotation_block(R: np.ndarray, name: str, tol: float = ROTATION_TOL, *,
 
     Examples
     --------
-    >>> check_rotation_block(np.eye(2), "R")
+    A stack whose second matrix is scaled by 1.01 (a shear or scale, not a rotation):
+
+    >>> check_rotation_block(np.stack([np.eye(3), 1.01 * np.eye(3)]), "R", indexed=True)
+    Traceback (most recent call last):
+    ...
+    ValueError: R: expected a rotation matrix with R^T R = I and det R = 1 (tolerance 1e-06), got max |R^T R - I| = 0.0201 and det = 1.0303 at index 1
     """
     eye = _EYE[R.shape[-1]] if R.shape[-1] in _EYE else np.eye(R.shape[-1])
     ortho = np.abs(np.swapaxes(R, -1, -2) @ R - eye).max(axis=(-2, -1))
@@ -144,6 +149,14 @@ def _vectors(v: Any, name: str) -> np.ndarray:
     if v.ndim == 0 or v.shape[-1] != 3:
         raise ValueError(f"{name}: expected 3-vectors, shape (..., 3), got shape {v.shape}")
     return v
+
+
+def _rotations(R: Any, tol: float) -> np.ndarray:
+    R = as_array(R, "R")
+    if R.ndim < 2 or R.shape[-2:] != (3, 3):
+        raise ValueError(f"R: expected rotation matrices, shape (..., 3, 3), got shape {R.shape}")
+    check_rotation_block(R, "R", tol, indexed=R.ndim > 2)
+    return R
 
 
 def so3_exp(rotvec: Any, *, check: bool = True) -> np.ndarray:
@@ -204,8 +217,8 @@ def so3_log(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.ndar
     -------
     numpy.ndarray, shape (..., 3)
         Accurate near 0 (``theta / sin theta -> 1``) and near pi, where the axis comes from the
-        symmetric part ``(R + I) / 2 = w w^T`` and its sign from the antisymmetric part; this
-        matters for pose errors of 1e-6 rad.
+        symmetric part ``(R + R^T) / 2 - cos(theta) I = (1 - cos theta) w w^T`` and its sign from
+        the antisymmetric part; this matters for pose errors of 1e-6 rad.
 
     Raises
     ------
@@ -223,13 +236,7 @@ def so3_log(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.ndar
     >>> print(np.round(np.linalg.norm(so3_log(rot_x(np.pi))), 6))
     3.141593
     """
-    if check:
-        R = as_array(R, "R")
-        if R.ndim < 2 or R.shape[-2:] != (3, 3):
-            raise ValueError(f"R: expected rotation matrices, shape (..., 3, 3), got shape {R.shape}")
-        check_rotation_block(R, "R", tol, indexed=R.ndim > 2)
-    else:
-        R = np.asarray(R, dtype=float)
+    R = _rotations(R, tol) if check else np.asarray(R, dtype=float)
     vee = np.empty(R.shape[:-2] + (3,))
     np.subtract(R[..., 2, 1], R[..., 1, 2], out=vee[..., 0])
     np.subtract(R[..., 0, 2], R[..., 2, 0], out=vee[..., 1])
@@ -275,7 +282,7 @@ def rot_x(angle: Any) -> np.ndarray:
 
     Notes
     -----
-    Craig (2005), Eq. (2.74): ``[[1, 0, 0], [0, c, -s], [0, s, c]]``.
+    ``[[1, 0, 0], [0, c, -s], [0, s, c]]``, ``Rot(x, angle)`` of Lynch & Park (2017), Sec. 3.2.1.
 
     Examples
     --------
@@ -295,7 +302,7 @@ def rot_y(angle: Any) -> np.ndarray:
 
     Notes
     -----
-    Craig (2005), Eq. (2.75): ``[[c, 0, s], [0, 1, 0], [-s, 0, c]]``.
+    ``[[c, 0, s], [0, 1, 0], [-s, 0, c]]``, ``Rot(y, angle)`` of Lynch & Park (2017), Sec. 3.2.1.
 
     Examples
     --------
@@ -315,7 +322,7 @@ def rot_z(angle: Any) -> np.ndarray:
 
     Notes
     -----
-    Craig (2005), Eq. (2.76): ``[[c, -s, 0], [s, c, 0], [0, 0, 1]]``.
+    ``[[c, -s, 0], [s, c, 0], [0, 0, 1]]``, ``Rot(z, angle)`` of Lynch & Park (2017), Sec. 3.2.1.
 
     Examples
     --------
@@ -359,3 +366,54 @@ def euler_matrix(angles: Any, seq: str = "xyz") -> np.ndarray:
     if not isinstance(seq, str) or len(seq) != 3 or not (set(seq) <= set("xyz") or set(seq) <= set("XYZ")):
         raise ValueError(f"seq: expected three axes like 'xyz' or 'ZYX', got {seq!r}")
     return Rotation.from_euler(seq, a).as_matrix()
+
+
+def zyz_angles(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.ndarray:
+    """ZYZ Euler angles ``(a, b, c)`` of rotations ``R = rot_z(a) @ rot_y(b) @ rot_z(c)``.
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+    check : bool, default True
+        Check that every matrix is a rotation (within ``tol``); ``False`` skips it (the analytic IK
+        calls it on thousands of arm angles per target).
+    tol : float, default :data:`ROTATION_TOL`
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        ``a, c`` in [-pi, pi] and ``b`` in [0, pi]; the other solution is
+        ``(a + pi, -b, c + pi)``. Where ``sin b < 1e-12`` (``b = 0`` or ``pi``, gimbal lock) only
+        ``a + c`` (``b = 0``) or ``c - a`` (``b = pi``) is defined: then ``a = 0`` and ``c`` carries
+        the whole rotation about z (scipy's ``as_euler("ZYZ")`` sets ``c = 0`` instead, with a
+        warning).
+
+    Raises
+    ------
+    ValueError
+        If the shape is wrong or a matrix is not a rotation.
+
+    Notes
+    -----
+    Z-Y-Z Euler angles, Craig (2005), Sec. 2.8: ``b = atan2(sqrt(r13^2 + r23^2), r33)``,
+    ``a = atan2(r23, r13)``, ``c = atan2(r32, -r31)`` (1-based entries).
+
+    Examples
+    --------
+    >>> print(np.round(zyz_angles(rot_z(0.3) @ rot_y(0.5) @ rot_z(-0.2)), 6))
+    [ 0.3  0.5 -0.2]
+    >>> print(np.round(zyz_angles(rot_z(0.3) @ rot_z(0.4)), 6))       # b = 0: a + c only
+    [0.  0.  0.7]
+    """
+    R = _rotations(R, tol) if check else np.asarray(R, dtype=float)
+    m02, m12 = R[..., 0, 2], R[..., 1, 2]
+    sb = np.hypot(m02, m12)
+    out = np.empty((3,) + sb.shape)                  # a, b, c: each a contiguous block
+    np.arctan2(m12, m02, out=out[0, ...])
+    np.arctan2(sb, R[..., 2, 2], out=out[1, ...])
+    np.arctan2(R[..., 2, 1], -R[..., 2, 0], out=out[2, ...])
+    sing = sb < 1e-12
+    if sing.any():
+        out[0] = np.where(sing, 0.0, out[0])
+        out[2] = np.where(sing, np.arctan2(R[..., 1, 0], R[..., 1, 1]), out[2])
+    return out.transpose(*range(1, out.ndim), 0)

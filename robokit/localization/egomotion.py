@@ -29,7 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..geometry import as_pqt, robot_to_world, world_to_robot, wrap_angle
+from ..geometry import (as_pqt, pqt_robot_to_world, pqt_rotate_xz,
+                        pqt_transform_xz, pqt_world_to_robot, wrap_angle)
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from ..vision.matching import gated_ratio_match, ratio_match
@@ -39,6 +40,7 @@ __all__ = ["DegenerateCorrespondenceError", "InsufficientMatchesError", "Egomoti
            "track"]
 
 _MIN_SEPARATION = 1e-3  # metres: two points closer than this on the ground plane fix no heading
+_EYE2 = np.eye(2)
 
 
 class DegenerateCorrespondenceError(ValueError):
@@ -134,11 +136,8 @@ def _poses_from_pairs(r1, r2, w1, w2):
     """Vectorised two-point poses; inputs (K, 2) ground-plane (X, Z) coordinates."""
     dr, dw = r2 - r1, w2 - w1
     theta = np.arctan2(dr[:, 0] * dw[:, 1] - dr[:, 1] * dw[:, 0], (dr * dw).sum(1))
-    c, s = np.cos(theta), np.sin(theta)
-    mid_r, mid_w = 0.5 * (r1 + r2), 0.5 * (w1 + w2)
-    p = mid_w[:, 0] - (c * mid_r[:, 0] - s * mid_r[:, 1])
-    q = mid_w[:, 1] - (s * mid_r[:, 0] + c * mid_r[:, 1])
-    return np.column_stack([p, q, theta])
+    pq = 0.5 * (w1 + w2) - pqt_rotate_xz(theta, 0.5 * (r1 + r2), check=False)    # midpoints align, Sec. 5
+    return np.column_stack([pq, theta])
 
 
 def pose_from_two(robot_points, world_points) -> np.ndarray:
@@ -232,31 +231,25 @@ def fit_pose(robot_points, world_points, robot_covariances=None, world_covarianc
         raise DegenerateCorrespondenceError("robot_points, world_points: expected points spread on the ground "
                                             "plane, got (nearly) coincident ones")
     theta = np.arctan2((rc[:, 0] * wc[:, 1] - rc[:, 1] * wc[:, 0]).sum(), (rc * wc).sum())
-    c, s = np.cos(theta), np.sin(theta)
-    pqt = np.concatenate([w.mean(0) - np.array([[c, -s], [s, c]]) @ r.mean(0), [theta]])
+    pqt = np.concatenate([w.mean(0) - pqt_rotate_xz(theta, r.mean(0), check=False), [theta]])
 
     def linearise(pqt):
-        c, s = np.cos(pqt[2]), np.sin(pqt[2])
-        rot = np.array([[c, -s], [s, c]])
-        res = w - (r @ rot.T + pqt[:2])
-        jac = np.zeros((n, 2, 3))
-        jac[:, 0, 0] = jac[:, 1, 1] = 1.0
-        jac[:, 0, 2] = -s * r[:, 0] - c * r[:, 1]
-        jac[:, 1, 2] = c * r[:, 0] - s * r[:, 1]
-        return rot, res, jac
+        moved, jac = pqt_transform_xz(pqt, r, jacobian=True, check=False)
+        return w - moved, jac                                          # Lin et al. Sec. 6 residuals
+
+    def information(pqt):                                              # (Sigma_w + R Sigma_r R^T)^-1
+        rot = pqt_rotate_xz(pqt[2], _EYE2, check=False).T              # R(theta): columns R e_X, R e_Z
+        return np.linalg.inv(wcov + rot @ rcov @ rot.T + 1e-12 * _EYE2)
 
     if weighted:
         for _ in range(iterations):
-            rot, res, jac = linearise(pqt)
-            info = np.linalg.inv(wcov + rot @ rcov @ rot.T + 1e-12 * np.eye(2))
-            jtw = np.swapaxes(jac, 1, 2) @ info
-            hess = jtw @ jac
-            pqt = pqt + np.linalg.lstsq(hess.sum(0), np.einsum("nij,nj->i", jtw, res), rcond=None)[0]
-        rot, res, jac = linearise(pqt)
-        info = np.linalg.inv(wcov + rot @ rcov @ rot.T + 1e-12 * np.eye(2))
-        cov = np.linalg.pinv((np.swapaxes(jac, 1, 2) @ info @ jac).sum(0))
+            res, jac = linearise(pqt)
+            jtw = np.swapaxes(jac, 1, 2) @ information(pqt)
+            pqt = pqt + np.linalg.lstsq((jtw @ jac).sum(0), np.einsum("nij,nj->i", jtw, res), rcond=None)[0]
+        res, jac = linearise(pqt)
+        cov = np.linalg.pinv((np.swapaxes(jac, 1, 2) @ information(pqt) @ jac).sum(0))
     else:
-        rot, res, jac = linearise(pqt)
+        res, jac = linearise(pqt)
         s2 = max((res ** 2).sum() / max(2 * n - 3, 1), 1e-6)
         cov = s2 * np.linalg.pinv((np.swapaxes(jac, 1, 2) @ jac).sum(0))
     pqt[2] = wrap_angle(pqt[2])
@@ -315,11 +308,11 @@ def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_cov
     Sixty matches of which a third are wrong; the robot stands at ``[p, q, theta] = [1, 2, 0.3]``:
 
     >>> import numpy as np
-    >>> from robokit.geometry import robot_to_world
+    >>> from robokit.geometry import pqt_robot_to_world
     >>> from robokit.localization import ransac_pose
     >>> rng = np.random.default_rng(0)
     >>> robot = rng.uniform([-3.0, -1.0, 1.0], [3.0, 1.0, 6.0], (60, 3))   # features, robot frame
-    >>> world = robot_to_world(robot, [1.0, 2.0, 0.3])                      # their landmarks
+    >>> world = pqt_robot_to_world(robot, [1.0, 2.0, 0.3])                  # their landmarks
     >>> world[:20] += rng.uniform(-2.0, 2.0, (20, 3))                       # 20 wrong matches
     >>> result = ransac_pose(robot, world, rng=0)
     >>> print(np.round(result.pqt, 3), result.n_inliers)
@@ -351,9 +344,8 @@ def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_cov
         if not ok.any():
             continue
         poses = _poses_from_pairs(rg[i[ok]], rg[j[ok]], wg[i[ok]], wg[j[ok]])
-        c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
-        px = c * rg[None, :, 0] - s * rg[None, :, 1] + poses[:, :1] - wg[None, :, 0]
-        pz = s * rg[None, :, 0] + c * rg[None, :, 1] + poses[:, 1:2] - wg[None, :, 1]
+        moved = pqt_transform_xz(poses[:, None, :], rg, check=False)      # (hypotheses, matches, 2)
+        px, pz = moved[..., 0] - wg[:, 0], moved[..., 1] - wg[:, 1]
         dist = np.sqrt(px * px + pz * pz + (r[None, :, 1] - w[None, :, 1]) ** 2)
         support = dist < thr
         count = support.sum(1)
@@ -367,11 +359,11 @@ def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_cov
                          f"only {max(best_count, 0)} matches support a pose (need {min_matches})")
     pqt, inliers = best, None
     for _ in range(3):  # refit on the support, recompute the support
-        inliers = np.linalg.norm(robot_to_world(r, pqt) - w, axis=1) < thr
+        inliers = np.linalg.norm(pqt_robot_to_world(r, pqt) - w, axis=1) < thr
         if inliers.sum() < 2:
             break
         pqt, cov, rms = _fit_subset(r, w, rcov, wcov, inliers)
-    inliers = np.linalg.norm(robot_to_world(r, pqt) - w, axis=1) < thr
+    inliers = np.linalg.norm(pqt_robot_to_world(r, pqt) - w, axis=1) < thr
     if inliers.sum() < min_matches:
         return _fallback(n, odometry, odometry_covariance, drawn,
                          f"only {int(inliers.sum())} matches support the refined pose (need {min_matches})")
@@ -418,7 +410,7 @@ def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_
     none = (np.zeros(0, int), np.zeros(0, int))
     if len(landmarks) == 0 or pts.shape[0] == 0:
         return none
-    predicted = world_to_robot(landmarks.positions, predicted_pqt)
+    predicted = pqt_world_to_robot(landmarks.positions, predicted_pqt)
     lists = cKDTree(predicted).query_ball_point(pts, rad)
     counts = np.array([len(x) for x in lists])
     if counts.sum() == 0:

@@ -21,12 +21,15 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from ..geometry import pqt_rotate_xz, pqt_transform_xz
 from ..mapping.landmarks import LandmarkMap
 from ..vision.matching import k_nearest
 from ..validation import as_array, check_choice, check_int, check_positive
 from .egomotion import InsufficientMatchesError, fit_pose
 
 __all__ = ["Hypothesis", "candidate_matches", "hough_accumulator", "global_localize"]
+
+_BLOCK = 256  # matches voted at once: small (matches, headings) arrays stay in cache
 
 
 @dataclass(frozen=True)
@@ -163,13 +166,15 @@ def hough_accumulator(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, *,
     thetas = -np.pi + (np.arange(nt) + 0.5) * 2 * np.pi / nt
     # float32 holds vote counts exactly (< 2^24) and lets OpenCV's integral image do the sums
     diff = np.zeros((nt, nx + 1, nz + 1), np.float32)
-    if m:
-        c, s = np.cos(thetas)[None, :], np.sin(thetas)[None, :]
-        px = w[:, :1] - (c * r[:, :1] - s * r[:, 1:])
-        pz = w[:, 1:] - (s * r[:, :1] + c * r[:, 1:])
-        sxx, sxz, szz = rc[:, 0, 0, None], rc[:, 0, 1, None], rc[:, 1, 1, None]
-        var_x = wc[:, 0, 0, None] + c * c * sxx - 2 * c * s * sxz + s * s * szz
-        var_z = wc[:, 1, 1, None] + s * s * sxx + 2 * c * s * sxz + c * c * szz
+    c, s = np.cos(thetas)[None, :], np.sin(thetas)[None, :]
+    flat = lambda ti, xi, zi: (ti * (nx + 1) + xi) * (nz + 1) + zi  # noqa: E731
+    for k in range(0, m, _BLOCK):  # blocks of matches keep the (matches, headings) arrays small
+        r_, w_, rc_, wc_ = r[k:k + _BLOCK], w[k:k + _BLOCK], rc[k:k + _BLOCK], wc[k:k + _BLOCK]
+        rr = pqt_rotate_xz(thetas, r_[:, None, :], check=False)          # (matches, headings, 2)
+        px, pz = w_[:, :1] - rr[..., 0], w_[:, 1:] - rr[..., 1]          # (p, q) aligning each match
+        sxx, sxz, szz = rc_[:, 0, 0, None], rc_[:, 0, 1, None], rc_[:, 1, 1, None]
+        var_x = wc_[:, 0, 0, None] + c * c * sxx - 2 * c * s * sxz + s * s * szz
+        var_z = wc_[:, 1, 1, None] + s * s * sxx + 2 * c * s * sxz + c * c * szz
         hx, hz = spread * np.sqrt(var_x), spread * np.sqrt(var_z)
         x0 = np.clip(np.floor((px - hx - b[0]) / size), 0, nx).astype(int)
         x1 = np.clip(np.floor((px + hx - b[0]) / size) + 1, 0, nx).astype(int)
@@ -178,7 +183,6 @@ def hough_accumulator(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, *,
         t = np.broadcast_to(np.arange(nt)[None, :], x0.shape)
         ok = (x1 > x0) & (z1 > z0)
         t, x0, x1, z0, z1 = t[ok], x0[ok], x1[ok], z0[ok], z1[ok]
-        flat = lambda ti, xi, zi: (ti * (nx + 1) + xi) * (nz + 1) + zi  # noqa: E731
         idx = np.concatenate([flat(t, x0, z0), flat(t, x1, z1), flat(t, x0, z1), flat(t, x1, z0)])
         val = np.concatenate([np.ones(2 * t.size, np.float32), -np.ones(2 * t.size, np.float32)])
         np.add.at(diff.ravel(), idx, val)
@@ -235,11 +239,8 @@ def _refine(pqt, pts, world, fi, li, gates, pts_cov, world_cov):
     """Iterated least squares: keep each feature's best match within the gate, refit (weighted)."""
     h = None
     for gate in gates:
-        c, s = np.cos(pqt[2]), np.sin(pqt[2])
-        rx, rz = pts[fi, 0], pts[fi, 2]
-        ex = world[li, 0] - (c * rx - s * rz + pqt[0])
-        ez = world[li, 2] - (s * rx + c * rz + pqt[1])
-        d = np.hypot(ex, ez)
+        e = world[li][:, ::2] - pqt_transform_xz(pqt, pts[fi][:, ::2], check=False)
+        d = np.hypot(e[:, 0], e[:, 1])
         order = np.lexsort((d, fi))
         first = order[np.r_[True, fi[order][1:] != fi[order][:-1]]]
         keep = first[d[first] <= gate]

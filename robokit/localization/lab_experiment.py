@@ -26,18 +26,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..config import FAST
-from ..geometry import se2_to_pqt, wrap_angle
+from ..geometry import paper_world_to_robokit, se2_to_pqt, wrap_angle
 from ..sim import PinholeCamera, StereoRig, lab_lap, lab_room, record
-from ..validation import as_array, as_points, check_int, check_positive
+from ..validation import as_points, check_int, check_positive
 from ..vision.stereo import StereoCalibration
 from .visual_slam import VisualSLAM
 
 __all__ = ["LAB_TEST_POSES", "PAPER_RESULT", "LabExperiment", "MapConsistency", "calibrated_rig", "mapping_run",
-           "lab_experiment", "map_consistency", "paper_to_lab"]
-
-#: Rows of the permutation taking the papers' world frame (X east, Y up from the camera, Z north) to
-#: the simulator's (x east, y north, z up from the floor).
-_PAPER_TO_LAB = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]])
+           "lab_experiment", "map_consistency"]
 
 #: Eight test poses ``[x, y, theta]`` in the simulator's frame, in free space near the lap, with
 #: headings within about 20 degrees of the direction the robot faced when it passed by.
@@ -84,51 +80,6 @@ def calibrated_rig(render_rig: StereoRig) -> StereoCalibration:
         raise TypeError(f"render_rig: expected robokit.sim.StereoRig, got {type(render_rig).__name__}")
     cam = render_rig.camera
     return StereoCalibration(focal=float(cam.fx), c0=float(cam.cx), r0=float(cam.cy), baseline=float(render_rig.baseline))
-
-
-def paper_to_lab(points, covariances=None, camera_height: float = 0.8):
-    """Landmarks from the papers' world frame to the simulator's lab frame (for plots and scenes).
-
-    Parameters
-    ----------
-    points : array_like, shape (N, 3)
-        ``(X, Y, Z)``: X east, Y up relative to the camera, Z north
-        (:mod:`robokit.geometry.paper_frames`).
-    covariances : array_like, shape (N, 3, 3), optional
-    camera_height : float, default 0.8
-        Height of the camera above the floor (metres), the simulator's default mount.
-
-    Returns
-    -------
-    points : numpy.ndarray, shape (N, 3)
-        ``(x, y, z) = (X, Z, Y + camera_height)``.
-    covariances : numpy.ndarray, shape (N, 3, 3) or None
-        Permuted the same way.
-
-    Raises
-    ------
-    ValueError
-        For malformed or non-finite points or covariances, or a non-positive camera height.
-
-    Notes
-    -----
-    The course's one convention, ``p = x``, ``q = y`` (:func:`robokit.geometry.se2_to_pqt`); the
-    papers' frame is left-handed, so the permutation has determinant -1.
-
-    Examples
-    --------
-    A landmark 0.2 m above the camera, at X = 3 m east and Z = 5 m north:
-
-    >>> points, _ = paper_to_lab([[3.0, 0.2, 5.0]])
-    >>> print(np.round(points, 3))
-    [[3. 5. 1.]]
-    """
-    pts = as_array(points, "points", shape=(None, 3))
-    out = pts @ _PAPER_TO_LAB.T + [0.0, 0.0, check_positive(camera_height, "camera_height")]
-    if covariances is None:
-        return out, None
-    cov = as_array(covariances, "covariances", shape=(pts.shape[0], 3, 3))
-    return out, _PAPER_TO_LAB @ cov @ _PAPER_TO_LAB.T
 
 
 def mapping_run(rate: float = 1.0, *, baseline: float = 0.12, seed: int = 0):
@@ -368,7 +319,7 @@ def map_consistency(landmark_map, world=None, *, camera_height: float = 0.8,
     world : robokit.sim.World, optional
         Default :func:`robokit.sim.lab_room`.
     camera_height : float, default 0.8
-        Camera height above the floor (metres), see :func:`paper_to_lab`.
+        Camera height above the floor (metres), see :func:`robokit.geometry.paper_world_to_robokit`.
     margin : float, default 0.02
         How far (metres) beyond a rectangle's edges a landmark may lie and still count as over it.
 
@@ -410,7 +361,7 @@ def map_consistency(landmark_map, world=None, *, camera_height: float = 0.8,
             raise TypeError(f"landmark_map: expected a LandmarkMap with .{attr}, got {type(landmark_map).__name__}")
     margin = check_positive(margin, "margin", allow_zero=True)
     world = lab_room() if world is None else world
-    points, covs = paper_to_lab(landmark_map.positions, landmark_map.covariances, camera_height)
+    points, covs = paper_world_to_robokit(landmark_map.positions, landmark_map.covariances, camera_height)
     n = len(points)
     best = np.full(n, np.inf)
     errors, sigmas = np.zeros(n), np.ones(n)

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import as_pqt, se2_between, se2_compose, world_to_robot
+from ..geometry import as_pqt, pqt_world_to_robot, se2_between, se2_compose
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_rng, check_choice, check_int, check_positive
 from ..vision.descriptors import detect_and_describe
@@ -206,7 +206,7 @@ class VisualSLAM:
         should have been seen count a missed frame (occlusions aside), so the map of the places
         visited earlier survives for global localization.
         """
-        pts = world_to_robot(self.map.positions, as_pqt(pqt))
+        pts = pqt_world_to_robot(self.map.positions, as_pqt(pqt))
         z = pts[:, 2]
         ok = (z > 0.3) & (z < self.max_range)
         with np.errstate(divide="ignore", invalid="ignore"):

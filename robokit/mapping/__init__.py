@@ -2,7 +2,7 @@
 
 :mod:`.landmarks` holds the backward transformation with first-order covariance
 (:func:`transform_covariance`) and the database (:class:`LandmarkMap`). The papers' pose
-``[p, q, theta]`` acting on points (``robot_to_world``, ``world_to_robot``) is in
+``[p, q, theta]`` acting on points (``pqt_robot_to_world``, ``pqt_transform_xz`` ...) is in
 :mod:`robokit.geometry`. Never imports ``viz`` or ``sim``.
 """
 from .landmarks import LandmarkMap, kalman_fuse, transform_covariance

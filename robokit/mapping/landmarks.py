@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..geometry import as_pqt, pqt_to_se3, world_to_robot
+from ..geometry import as_pqt, pqt_robot_to_world, pqt_to_se3, pqt_transform_xz, pqt_world_to_robot
 from ..validation import as_array, check_int, check_positive
 
 __all__ = ["transform_covariance", "kalman_fuse", "LandmarkMap"]
@@ -69,15 +69,10 @@ def transform_covariance(points, covariances, pqt, pqt_covariance) -> tuple[np.n
     cov = as_array(covariances, "covariances", shape=(pts.shape[0], 3, 3))
     p = as_pqt(pqt)
     pcov = as_array(pqt_covariance, "pqt_covariance", shape=(3, 3))
-    T = pqt_to_se3(p)
-    rot = T[:3, :3]
-    world = pts @ rot.T + T[:3, 3]                              # r_new = P(r_obs) + V, Sec. 3.3
-    c, s = np.cos(p[2]), np.sin(p[2])
-    jac = np.zeros((pts.shape[0], 3, 3))                       # d r_new / d(p, q, theta)
-    jac[:, 0, 0] = 1.0
-    jac[:, 2, 1] = 1.0
-    jac[:, 0, 2] = -s * pts[:, 0] - c * pts[:, 2]
-    jac[:, 2, 2] = c * pts[:, 0] - s * pts[:, 2]
+    rot = pqt_to_se3(p)[:3, :3]
+    world = pqt_robot_to_world(pts, p, check=False)              # r_new = P(r_obs) + V, Sec. 3.3
+    jac = np.zeros((pts.shape[0], 3, 3))                       # d r_new / d(p, q, theta); Y is fixed
+    jac[:, ::2] = pqt_transform_xz(p, pts[:, ::2], jacobian=True, check=False)[1]
     out = rot @ cov @ rot.T + jac @ pcov @ np.swapaxes(jac, 1, 2)   # first-order propagation, Sec. 3.4
     return world, out
 
@@ -331,7 +326,7 @@ class LandmarkMap:
         if n == 0 or len(self) == 0:
             return out
         rot = pqt_to_se3(pqt)[:3, :3]
-        predicted = world_to_robot(self.positions, pqt)
+        predicted = pqt_world_to_robot(self.positions, pqt)
         lists = cKDTree(predicted).query_ball_point(pts, window)
         counts = np.array([len(x) for x in lists])
         if counts.sum() == 0:

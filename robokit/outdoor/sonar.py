@@ -29,7 +29,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..geometry import wrap_angle
+from ..geometry import se2_compose, wrap_angle
 from ..validation import as_array, as_rng, check_finite_scalar, check_int, check_positive
 from ..sim.layout import Layout
 
@@ -269,7 +269,23 @@ def firing_schedule(n_sensors: int, duration: float, mode: str = "chained", *, c
 
 
 def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.ndarray:
-    """Field-frame poses ``(n, 3)`` of the sensors for a truck pose ``[x, y, theta]``.
+    """Field-frame poses ``(n, 3)`` of the sensors for a truck pose ``[x, y, theta]`` (headings wrapped
+    to [-pi, pi)).
+
+    Parameters
+    ----------
+    pose : array_like, shape (3,)
+        Truck pose in the field.
+    mounts : sequence of SonarMount, default :data:`PAPER_LAYOUT`
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, 3)
+
+    Raises
+    ------
+    ValueError, TypeError
+        For a malformed pose, or ``mounts`` that is empty or holds something else than SonarMount.
 
     Notes
     -----
@@ -281,10 +297,8 @@ def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.n
     >>> np.round(sensor_poses([0.0, 0.0, 0.0]), 3).tolist()     # x forward, y left, yaw
     [[0.25, 0.1, 0.785], [0.25, 0.05, 0.0], [0.25, -0.05, 0.0], [0.25, -0.1, -0.785]]
     """
-    x, y, th = as_array(pose, "pose", shape=(3,))
-    c, s = np.cos(th), np.sin(th)
-    m = np.array([[mt.x, mt.y, mt.yaw] for mt in mounts])
-    return np.stack([x + c * m[:, 0] - s * m[:, 1], y + s * m[:, 0] + c * m[:, 1], th + m[:, 2]], axis=1)  # pose + mount
+    m = np.array([[mt.x, mt.y, mt.yaw] for mt in _check_sensors(mounts)])
+    return se2_compose(as_array(pose, "pose", shape=(3,)), m, check=False)    # pose ⊕ mount
 
 
 def _cone(sensor: LVMaxSonarEZ, rays: int) -> np.ndarray:
@@ -292,7 +306,7 @@ def _cone(sensor: LVMaxSonarEZ, rays: int) -> np.ndarray:
     return np.linspace(-sensor.half_angle, sensor.half_angle, rays) if rays > 1 else np.zeros(1)
 
 
-def _check_sensors(mounts: Any, sensor: Any) -> tuple:
+def _check_sensors(mounts: Any, sensor: Any = LVMaxSonarEZ()) -> tuple:
     """``mounts`` as a non-empty tuple of :class:`SonarMount` (each checked when it was made); ``sensor`` typed."""
     if not isinstance(sensor, LVMaxSonarEZ):
         raise TypeError(f"sensor: expected an LVMaxSonarEZ, got {type(sensor).__name__}")
@@ -348,7 +362,8 @@ def true_ranges(field: Layout, pose: Any, mounts: Sequence[SonarMount] = PAPER_L
         raise TypeError(f"field: expected a robokit.outdoor.Field (or any robokit.sim.Layout), got "
                         f"{type(field).__name__}")
     k = check_int(rays, "rays", minimum=1)
-    sp = sensor_poses(pose, _check_sensors(mounts, sensor))
+    mounts = _check_sensors(mounts, sensor)
+    sp = sensor_poses(pose, mounts)
     offs = _cone(sensor, k)
     angles = (sp[:, 2:3] + offs[None, :]).ravel()
     origins = np.repeat(sp[:, :2], k, axis=0)
