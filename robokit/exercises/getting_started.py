@@ -54,6 +54,8 @@ EXERCISES = [
         points=2,
         cases=_compose_cases,
         reference=se2_compose,
+        references=("robokit.geometry.planar.se2_compose", "robokit.geometry.planar._pair",
+                    "robokit.geometry.planar.as_planar"),
         compare=close(rtol=0, atol=1e-9),
         description="Compose planar poses [x, y, theta]; raise ValueError on a wrong shape.",
     ),
