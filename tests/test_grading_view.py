@@ -129,3 +129,31 @@ def test_runtime_paths_leave_out_project_directories(monkeypatch):
     finally:
         runtime_paths.cache_clear()
     assert not any(p == str(ROOT) or p.startswith(str(ROOT) + "/") and "/.venv" not in p for p in paths), paths
+
+
+SHARE = """
+import ctypes, json, os, sys
+libc = ctypes.CDLL(None, use_errno=True)
+key, create = 0x526F626F, sys.argv[1] == "create"
+sysv = libc.shmget(key, 4096, 0o1666 if create else 0o666)   # IPC_CREAT = 0o1000
+try:
+    fd = os.open("/dev/shm/robokit-collude", (os.O_CREAT | os.O_RDWR) if create else os.O_RDONLY, 0o666)
+    posix = True
+except OSError:
+    posix = False
+with open(os.path.join(os.environ["HOME"], "..", "out", "share.json"), "w") as f:
+    json.dump({"sysv": sysv >= 0, "posix": posix}, f)
+"""
+
+
+def test_jobs_share_no_memory(base):
+    # alice leaves her answers in shared memory, bob's job looks for them
+    kit = build_kit(get_assignment("00_getting_started"), base / "kit")
+    seen = {}
+    for role in ("create", "open"):
+        job = JobDir.create(base)
+        exit_ = run_sandboxed(["-c", SHARE, role], job.root, LIMITS, view=worker_view(kit))
+        assert exit_.returncode == 0, exit_.log
+        seen[role] = json.loads((job.outbox / "share.json").read_text())
+    assert seen["create"] == {"sysv": True, "posix": True}
+    assert seen["open"] == {"sysv": False, "posix": False}

@@ -36,7 +36,7 @@ DEVICES = ("null", "zero", "full", "random", "urandom")
 _MS_RDONLY, _MS_NOSUID, _MS_NODEV, _MS_NOEXEC, _MS_REMOUNT, _MS_BIND, _MS_MOVE, _MS_REC, _MS_PRIVATE = (
     1, 2, 4, 8, 32, 4096, 8192, 16384, 1 << 18)
 _MNT_DETACH = 2
-_CLONE_NEWNS, _CLONE_NEWNET = 0x00020000, 0x40000000
+_CLONE_NEWNS, _CLONE_NEWIPC, _CLONE_NEWNET = 0x00020000, 0x08000000, 0x40000000
 _SYS_PIVOT_ROOT = {"x86_64": 155, "aarch64": 41, "riscv64": 41, "ppc64le": 203, "s390x": 217}
 
 
@@ -199,12 +199,13 @@ class _NewRoot:
 
 
 def enter_view(view: View, top: Path, job_dirs: Sequence[tuple[str, bool]]) -> None:
-    """Unshare mounts and the network, build the new root at ``top`` and enter it (root only).
+    """Unshare mounts, System V IPC and the network, build the new root at ``top`` and enter it
+    (root only). With its own IPC namespace and ``/dev/shm``, a job cannot leave data for another.
 
     ``job_dirs`` are ``(path, writable)`` pairs: the job's ``in/``, ``work/`` and ``out/``.
     """
     libc = _libc()
-    _check(libc.unshare(_CLONE_NEWNS | _CLONE_NEWNET), "unshare")
+    _check(libc.unshare(_CLONE_NEWNS | _CLONE_NEWIPC | _CLONE_NEWNET), "unshare")
     _check(libc.mount(b"none", b"/", None, _MS_REC | _MS_PRIVATE, None), "make mounts private")
     top.mkdir(mode=0o755, exist_ok=True)
     root = _NewRoot(top)
