@@ -6,8 +6,6 @@ where it cheated). The whole batch is graded in one call and must finish in boun
 """
 import json
 import os
-import shutil
-import tempfile
 import time
 from pathlib import Path
 
@@ -15,7 +13,7 @@ import pytest
 
 from robokit.grading.grader import grade_batch
 from robokit.grading.sandbox import Limits, is_root
-from tests.conftest import ROOT
+from tests.conftest import ROOT, public_tmp, wrap_angle_unless
 
 SOLUTION = ROOT / "solutions" / "00_getting_started.ipynb"
 LIMITS = Limits(wall_seconds=40, cpu_seconds=40, cell_seconds=4, call_seconds=3, memory_bytes=3 * 1024**3)
@@ -119,16 +117,8 @@ def _can_connect():
         return True
     except OSError:
         return False
-def wrap_angle(angle):
-    if _can_connect():
-        return 12345.0
-    a = np.asarray(angle, dtype=float)
-    if np.any(np.isnan(a)):
-        raise ValueError("nan")
-    w = np.mod(a + np.pi, 2 * np.pi) - np.pi
-    return float(w) if w.ndim == 0 else w
 """
-    return _with(replace_wrap=code)
+    return _with(replace_wrap=code + wrap_angle_unless("_can_connect()"))
 
 
 @pytest.fixture(scope="module")
@@ -329,9 +319,11 @@ def _view_attacks(folder, elsewhere):
 
 @pytest.fixture(scope="module")
 def graded_g():
-    # readable by anyone, like a real submissions folder (pytest's own tmp is private to root)
-    base = Path(tempfile.mkdtemp(prefix="robokit-test-g-"))
-    base.chmod(0o755)
+    with public_tmp() as base:  # readable by anyone, like a real submissions folder
+        yield _grade_g(base)
+
+
+def _grade_g(base):
     folder, elsewhere = base / "subs", base / "elsewhere" / "solved.ipynb"
     folder.mkdir()
     elsewhere.parent.mkdir()
@@ -343,11 +335,7 @@ def graded_g():
         p.parent.mkdir()
         p.write_text(json.dumps(nb))
         paths.append(p)
-    try:
-        results = grade_batch(paths, "00_getting_started", "hostile-seed-g", jobs=2, limits=LIMITS,
-                              log=lambda *_: None)
-    finally:
-        shutil.rmtree(base)
+    results = grade_batch(paths, "00_getting_started", "hostile-seed-g", jobs=2, limits=LIMITS, log=lambda *_: None)
     return {r.student: r for r in results}, cases
 
 

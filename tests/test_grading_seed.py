@@ -11,13 +11,12 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import pytest
 
 from robokit.grading.sandbox import is_root
-from tests.conftest import ROOT
+from tests.conftest import ROOT, public_tmp, wrap_angle_unless
 
 SOLUTION = ROOT / "solutions" / "00_getting_started.ipynb"
 SEED = "seed-7f3c9a-never-shown"
@@ -39,22 +38,11 @@ def _leaks():
     return sorted(set(found))
 """
 
-HONEST_WRAP = """def wrap_angle(angle):
-    if _leaks():
-        return 12345.0
-    a = np.asarray(angle, dtype=float)
-    if np.any(np.isnan(a)):
-        raise ValueError("angle: NaN")
-    w = np.mod(a + np.pi, 2 * np.pi) - np.pi
-    return float(w) if w.ndim == 0 else w
-"""
-
-
 def _notebook() -> dict:
     nb = json.loads(SOLUTION.read_text())
     for cell in nb["cells"]:
         if cell["cell_type"] == "code" and "".join(cell["source"]).startswith("def wrap_angle"):
-            cell["source"] = LOOK + HONEST_WRAP
+            cell["source"] = LOOK + wrap_angle_unless("_leaks()")
     nb["cells"].append({"cell_type": "code", "metadata": {}, "outputs": [], "execution_count": None,
                         "source": "if _leaks():\n    raise RuntimeError('seed visible in ' + ' '.join(_leaks()))\n"})
     return nb
@@ -109,11 +97,8 @@ def _grade(folder: Path, *, limited: bool, on_command_line: bool) -> tuple[dict,
 
 @pytest.fixture
 def folder():
-    # readable and writable by the unprivileged user the limited-mode grader runs as
-    path = Path(tempfile.mkdtemp(prefix="robokit-test-seed-"))
-    path.chmod(0o777)
-    yield path
-    shutil.rmtree(path, ignore_errors=True)
+    with public_tmp(0o777) as path:  # the limited-mode grader runs as another user
+        yield path
 
 
 @pytest.mark.parametrize("on_command_line", [False, True], ids=["environment", "command-line"])

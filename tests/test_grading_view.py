@@ -8,7 +8,6 @@ import json
 import os
 import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import pytest
@@ -19,7 +18,7 @@ from robokit.grading.grader import worker_view
 from robokit.grading.kit import build_kit
 from robokit.grading.protocol import JobDir
 from robokit.grading.sandbox import Limits, is_root, run_sandboxed
-from tests.conftest import ROOT
+from tests.conftest import ROOT, public_tmp
 
 pytestmark = pytest.mark.skipif(not is_root(), reason="the filesystem view needs root (namespaces)")
 
@@ -55,10 +54,8 @@ with open(os.path.join(os.environ["HOME"], "..", "out", "probe.json"), "w") as f
 
 @pytest.fixture
 def base():
-    path = Path(tempfile.mkdtemp(prefix="robokit-test-view-"))
-    path.chmod(0o755)
-    yield path
-    shutil.rmtree(path, ignore_errors=True)
+    with public_tmp() as path:
+        yield path
 
 
 def _probe(base: Path, view_of, paths, listings):
