@@ -196,8 +196,8 @@ def lease_job_uid() -> Iterator[int]:
         try:
             _sweep_uid(uid)
             yield uid
-            _sweep_uid(uid)
         finally:
+            _sweep_uid(uid)
             os.close(fd)
         return
     raise RuntimeError(f"no free job uid: all {len(JOB_UIDS)} of {JOB_UIDS} are leased")
