@@ -279,7 +279,7 @@ def _reference_attacks():
             " or getattr(type(f), '__module__', '').startswith(('_frozen', '__editable__'))]\n"
             "for _k in [k for k in sys.modules if k == 'robokit' or k.startswith('robokit.')]:\n"
             "    del sys.modules[_k]\n"
-            f"sys.path.insert(0, {str(ROOT)!r})\n"
+            f"sys.path[:0] = [{str(ROOT)!r}]\n"
             "from robokit.geometry import wrap_angle as _ref\n" + through)), wrong_only, None),
         # another library function that calls the reference inside robokit
         "g_library_calls_it": (_with(replace_wrap=(

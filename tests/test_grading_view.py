@@ -20,7 +20,7 @@ from robokit.grading.protocol import JobDir
 from robokit.grading.sandbox import Limits, is_root, run_sandboxed
 from tests.conftest import ROOT, public_tmp
 
-pytestmark = pytest.mark.skipif(not is_root(), reason="the filesystem view needs root (namespaces)")
+needs_root = pytest.mark.skipif(not is_root(), reason="the filesystem view needs root (namespaces)")
 
 LIMITS = Limits(wall_seconds=60, cpu_seconds=60)
 
@@ -70,6 +70,7 @@ def _probe(base: Path, view_of, paths, listings):
     return json.loads((job.outbox / "probe.json").read_text()), kit, job, other
 
 
+@needs_root
 def test_the_worker_sees_only_the_allowlist(base):
     submission = base / "alice" / "00_getting_started.ipynb"
     submission.parent.mkdir()
@@ -98,6 +99,7 @@ def test_the_worker_sees_only_the_allowlist(base):
                                    "opt", "home", "srv", "var"}
 
 
+@needs_root
 def test_an_installed_robokit_shows_as_the_kit(base):
     # a wheel install (Gradescope, a container) puts robokit's whole source in site-packages,
     # which the view shows: the kit's robokit must stand in its place
@@ -143,6 +145,7 @@ with open(os.path.join(os.environ["HOME"], "..", "out", "share.json"), "w") as f
 """
 
 
+@needs_root
 def test_jobs_share_no_memory(base):
     # alice leaves her answers in shared memory, bob's job looks for them
     kit = build_kit(get_assignment("00_getting_started"), base / "kit")
@@ -154,3 +157,30 @@ def test_jobs_share_no_memory(base):
         seen[role] = json.loads((job.outbox / "share.json").read_text())
     assert seen["create"] == {"sysv": True, "posix": True}
     assert seen["open"] == {"sysv": False, "posix": False}
+
+
+def test_a_replaced_worker_log_is_not_followed(tmp_path):
+    # in the limited mode the worker runs as the grader's user and can replace the log the grader
+    # reads after it ends (a link to /dev/zero was read without bound)
+    from robokit.grading.sandbox import WORKER_LOG, log_tail
+
+    job = JobDir.create(tmp_path)
+    (job.root / WORKER_LOG).symlink_to("/dev/zero")
+    assert log_tail(job) == ""
+    (job.root / WORKER_LOG).unlink()
+    os.mkfifo(job.root / WORKER_LOG)
+    assert log_tail(job) == ""  # a FIFO with no writer: not opened for a blocking read
+    (job.root / WORKER_LOG).unlink()
+    (job.root / WORKER_LOG).write_bytes(b"x" * 10_000 + b"the end")
+    assert log_tail(job).endswith("the end") and len(log_tail(job)) == 4000
+
+
+def test_a_planted_launch_file_costs_only_that_job(tmp_path):
+    # a worker of the grader's own user (limited mode) may plant files in a job folder it can list
+    job = JobDir.create(tmp_path)
+    victim = tmp_path / "instructor-notes.txt"
+    victim.write_text("keep me")
+    (job.root / "launch.json").symlink_to(victim)
+    exit_ = run_sandboxed(["-c", "pass"], job.root, LIMITS, view=View(()))
+    assert exit_.returncode is None and "could not start the worker" in exit_.log
+    assert victim.read_text() == "keep me"

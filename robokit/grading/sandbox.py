@@ -31,6 +31,7 @@ import pwd
 import random
 import resource
 import signal
+import stat
 import subprocess
 import sys
 import time
@@ -40,13 +41,15 @@ from typing import Iterator, Sequence
 from .filesystem_view import View, enter_view
 from .protocol import JobDir
 
-__all__ = ["Limits", "WorkerExit", "run_sandboxed", "is_root", "lease_job_uid", "conceal_secret", "JOB_UIDS",
-           "UID_LEASE_DIR"]
+__all__ = ["Limits", "WorkerExit", "run_sandboxed", "is_root", "lease_job_uid", "conceal_secret", "log_tail",
+           "JOB_UIDS", "UID_LEASE_DIR", "WORKER_LOG"]
 
 #: Job uids/gids (no passwd entry is needed; uids that have one are skipped).
 JOB_UIDS = range(61000, 65000)
 #: Root-only directory of the lock files that lease job uids to grading runs on this host.
 UID_LEASE_DIR = Path("/run/robokit-grading/uids")
+#: The worker's stdout and stderr, in the job directory (its tail explains a worker that ended early).
+WORKER_LOG = "worker.log"
 _PR_SET_DUMPABLE = 4
 
 
@@ -295,10 +298,16 @@ def _prepare_job_dir(job: JobDir, uid: int | None) -> None:
         os.chmod(f, 0o644)
 
 
+def _create(path: Path):
+    """Open a new file of the grader's for writing (mode 0600), never through a link or over an
+    existing file: in the limited mode a worker of the same user could plant one in a job folder."""
+    return os.fdopen(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600), "wb")
+
+
 def _run(config: Path, job: JobDir, limits: Limits, path_env: str) -> tuple[int | None, bool]:
     """Start the launcher, wait for it up to the wall-clock limit, kill its process group."""
     timed_out = False
-    with open(job.root / "worker.log", "wb") as log:
+    with _create(job.root / WORKER_LOG) as log:
         proc = subprocess.Popen(
             [sys.executable, "-m", "robokit.grading.sandbox", str(config)], cwd=job.root,
             env={"PATH": path_env, "LANG": "C.UTF-8"}, stdin=subprocess.DEVNULL, stdout=log,
@@ -318,14 +327,24 @@ def _run(config: Path, job: JobDir, limits: Limits, path_env: str) -> tuple[int 
     return proc.returncode, timed_out
 
 
-def _log_tail(job: JobDir) -> str:
-    log_path = job.root / "worker.log"
+def log_tail(job: JobDir, limit: int = 4000) -> str:
+    """The last ``limit`` bytes of the job's ``worker.log``, as text.
+
+    In the limited mode the worker runs as the grader's user and could replace the log: a link is
+    not followed, and anything but a regular file reads as empty (never a blocking or endless read).
+    """
     try:
-        with open(log_path, "rb") as f:
-            f.seek(max(0, log_path.stat().st_size - 4000))
-            return f.read().decode(errors="replace")
+        fd = os.open(job.root / WORKER_LOG, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
     except OSError:
         return ""
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            return ""
+        os.lseek(fd, max(0, info.st_size - limit), os.SEEK_SET)
+        return os.read(fd, limit).decode(errors="replace")
+    finally:
+        os.close(fd)
 
 
 def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, view: View,
@@ -342,15 +361,18 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, view: V
         _prepare_job_dir(job, uid)
         env = _worker_env(job, env_extra)
         config = job.root / "launch.json"  # root-only: the job uid never reads it
-        config.write_text(json.dumps({
-            "job_dir": str(job.root), "limits": dataclasses.asdict(limits), "uid": uid, "python": sys.executable,
-            "view": dataclasses.asdict(view), "args": list(args), "env": env,
-        }))
-        os.chmod(config, 0o600)
         start = time.perf_counter()
-        returncode, timed_out = _run(config, job, limits, env["PATH"])
+        try:
+            with _create(config) as f:
+                f.write(json.dumps({
+                    "job_dir": str(job.root), "limits": dataclasses.asdict(limits), "uid": uid,
+                    "python": sys.executable, "view": dataclasses.asdict(view), "args": list(args), "env": env,
+                }).encode())
+            returncode, timed_out = _run(config, job, limits, env["PATH"])
+        except OSError as exc:  # e.g. a file planted in the job folder (limited mode)
+            return WorkerExit(None, False, 0.0, uid is not None, f"the grader could not start the worker: {exc}")
         seconds = time.perf_counter() - start
-    return WorkerExit(returncode, timed_out, seconds, uid is not None, _log_tail(job))
+    return WorkerExit(returncode, timed_out, seconds, uid is not None, log_tail(job))
 
 
 if __name__ == "__main__":
