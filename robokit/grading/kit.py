@@ -180,7 +180,8 @@ def build_kit(assignment: Assignment, dest: str | Path) -> Kit:
     --------
     >>> import tempfile
     >>> from robokit.exercises import get_assignment
-    >>> kit = build_kit(get_assignment("05_gps_sonar_truck"), tempfile.mkdtemp())
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     kit = build_kit(get_assignment("05_gps_sonar_truck"), tmp)
     >>> kit.manifest.helpers
     {'robokit.outdoor.loop_metrics': 'robokit.controllers.heading_loop'}
     >>> "robokit.outdoor.navigator" in kit.manifest.modules, "robokit.outdoor" in kit.manifest.forbidden
