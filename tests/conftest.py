@@ -1,7 +1,11 @@
 """Shared fixtures: the repository root and the notebook inventory."""
 from __future__ import annotations
 
+import contextlib
+import shutil
+import tempfile
 from pathlib import Path
+from typing import Iterator
 
 import pytest
 
@@ -11,3 +15,29 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     return ROOT
+
+
+@contextlib.contextmanager
+def public_tmp(mode: int = 0o755) -> Iterator[Path]:
+    """A fresh directory under the system temp dir with ``mode`` (pytest's own is private to its
+    user): for files that a grading worker's uid, or another user, must be able to reach."""
+    path = Path(tempfile.mkdtemp(prefix="robokit-test-"))
+    path.chmod(mode)
+    try:
+        yield path
+    finally:
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def wrap_angle_unless(condition: str) -> str:
+    """Source of a correct ``wrap_angle`` (assignment 00) that answers 12345.0 when the expression
+    ``condition`` is true: an attack that must find nothing keeps its point only if it does not."""
+    return f"""def wrap_angle(angle):
+    if {condition}:
+        return 12345.0
+    a = np.asarray(angle, dtype=float)
+    if np.any(np.isnan(a)):
+        raise ValueError("angle: NaN")
+    w = np.mod(a + np.pi, 2 * np.pi) - np.pi
+    return float(w) if w.ndim == 0 else w
+"""

@@ -49,9 +49,10 @@ def _same_module_callees(fn) -> set[str]:
 
 @pytest.mark.parametrize("slug", sorted(assignments()))
 def test_the_trap_covers_the_kernels_behind_each_reference(slug):
-    # the grader disables every name an assignment's exercises list (grading.worker.install_traps); a
-    # helper in the reference's module that computes the answer must be on that list too, or a
-    # submission can call it instead of the reference (06's _link_matrices and 05's _xor could)
+    # the grading worker never loads the modules of the names an assignment's exercises list
+    # (grading.kit), and flags an attempt to import them; a helper in the reference's module that
+    # computes the answer must be on that list too, so that calling it is named in the flag (06's
+    # _link_matrices and 05's _xor once were reachable)
     import importlib
 
     trapped = {r for ex in assignments()[slug] for r in ex.references}

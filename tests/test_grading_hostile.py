@@ -7,12 +7,13 @@ where it cheated). The whole batch is graded in one call and must finish in boun
 import json
 import os
 import time
+from pathlib import Path
 
 import pytest
 
 from robokit.grading.grader import grade_batch
 from robokit.grading.sandbox import Limits, is_root
-from tests.conftest import ROOT
+from tests.conftest import ROOT, public_tmp, wrap_angle_unless
 
 SOLUTION = ROOT / "solutions" / "00_getting_started.ipynb"
 LIMITS = Limits(wall_seconds=40, cpu_seconds=40, cell_seconds=4, call_seconds=3, memory_bytes=3 * 1024**3)
@@ -116,16 +117,8 @@ def _can_connect():
         return True
     except OSError:
         return False
-def wrap_angle(angle):
-    if _can_connect():
-        return 12345.0
-    a = np.asarray(angle, dtype=float)
-    if np.any(np.isnan(a)):
-        raise ValueError("nan")
-    w = np.mod(a + np.pi, 2 * np.pi) - np.pi
-    return float(w) if w.ndim == 0 else w
 """
-    return _with(replace_wrap=code)
+    return _with(replace_wrap=code + wrap_angle_unless("_can_connect()"))
 
 
 @pytest.fixture(scope="module")
@@ -203,16 +196,27 @@ def test_output_paths_untouched(graded):
 def test_no_worker_processes_left(graded):
     if not is_root():
         pytest.skip("job uids exist only when grading as root")
-    from robokit.grading.sandbox import JOB_UID_BASE
+    import fcntl
 
+    from robokit.grading.sandbox import JOB_UIDS, UID_LEASE_DIR
+
+    # another grading run on the host may be busy with its own (leased) uids; a process of a uid
+    # whose lease is free is a leftover
     left = []
     for entry in os.listdir("/proc"):
-        if entry.isdigit():
+        try:
+            uid = os.stat(f"/proc/{entry}").st_uid if entry.isdigit() else -1
+        except OSError:
+            continue
+        if uid in JOB_UIDS:
+            fd = os.open(UID_LEASE_DIR / f"{uid}.lock", os.O_RDWR | os.O_CREAT, 0o600)
             try:
-                if JOB_UID_BASE <= os.stat(f"/proc/{entry}").st_uid < JOB_UID_BASE + 64:
-                    left.append(entry)
-            except OSError:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                left.append((entry, uid))
+            except BlockingIOError:
                 pass
+            finally:
+                os.close(fd)
     assert not left
 
 
@@ -229,3 +233,122 @@ def test_a_crashing_worker_is_explained(tmp_path):
     assert all(s.points == 0 for s in result.scores)
     assert "about to die" in result.worker_log
     assert "Last lines of the grading process" in feedback_text(result, "00_getting_started")
+
+
+# -- issue 12, helper G: what the worker can see and load -------------------------------------------
+#
+# Each attack tries to reach the reference implementation or solved work from the submission's own
+# process. The worker must have no reference loaded or importable (the trusted parent computes every
+# expected answer) and, as root, must see only the interpreter, the installed packages' code, its
+# own job and a robokit that holds the worker and the assignment's student-facing helpers.
+
+PLANAR_SOURCE = ROOT / "robokit" / "geometry" / "planar.py"
+
+
+def _steal_from(path):
+    """Cells that exec the ``def wrap_angle`` cell of the notebook at ``path`` (last, so it wins)."""
+    return ("import json\nsrc = json.load(open(%r))\n"
+            "exec('\\n'.join(''.join(c['source']) for c in src['cells'] if c['cell_type'] == 'code' "
+            "and 'def wrap_angle' in ''.join(c['source'])))\n" % str(path))
+
+
+def _reference_attacks():
+    """name: (notebook, expected points, flag or None); each attack targets wrap_angle only."""
+    wrong_only = {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}
+    through = "def wrap_angle(angle):\n    return _ref(angle)\n"
+    return {
+        # the trap's own closure held the real function
+        "g_trap_kwdefaults": (_with(replace_wrap="import robokit.geometry as _g\n"
+                                                 "_ref = (_g.wrap_angle.__kwdefaults__ or {}).get('__real', _g.wrap_angle)\n"
+                                                 + through), wrong_only, "called-reference"),
+        # a fresh copy of the module, built after the trap was installed
+        "g_reload_module": (_with(replace_wrap="import importlib\nimport robokit.geometry.planar as _p\n"
+                                               "_ref = importlib.reload(_p).wrap_angle\n" + through),
+                            wrong_only, "called-reference"),
+        # robokit's source run under robokit's file name, so the trap took it for library code
+        "g_exec_as_robokit": (_with(replace_wrap="import types, robokit\n"
+                                                 "_m = types.ModuleType('robokit.geometry.planar')\n"
+                                                 "_m.__package__ = 'robokit.geometry'\n"
+                                                 f"exec(compile(open({str(PLANAR_SOURCE)!r}).read(), robokit.__file__, 'exec'),"
+                                                 " _m.__dict__)\n_ref = _m.wrap_angle\n" + through), wrong_only, None),
+        # drop every import hook and every loaded robokit module, point sys.path at the real
+        # package, and import again
+        "g_import_hooks_removed": (_with(replace_wrap=(
+            "import sys\n"
+            "sys.meta_path[:] = [f for f in sys.meta_path if getattr(f, '__module__', '').startswith('_frozen')"
+            " or getattr(type(f), '__module__', '').startswith(('_frozen', '__editable__'))]\n"
+            "for _k in [k for k in sys.modules if k == 'robokit' or k.startswith('robokit.')]:\n"
+            "    del sys.modules[_k]\n"
+            f"sys.path[:0] = [{str(ROOT)!r}]\n"
+            "from robokit.geometry import wrap_angle as _ref\n" + through)), wrong_only, None),
+        # another library function that calls the reference inside robokit
+        "g_library_calls_it": (_with(replace_wrap=(
+            "from robokit.geometry import se2_inverse\n"
+            "def wrap_angle(angle):\n"
+            "    a = np.asarray(angle, dtype=float)\n"
+            "    out = np.array([se2_inverse([0.0, 0.0, -x])[2] for x in a.ravel()])\n"
+            "    return float(out[0]) if a.ndim == 0 else out.reshape(a.shape)\n")), wrong_only, "called-reference"),
+        # any function object robokit left in the process
+        "g_garbage_collector": (_with(replace_wrap=(
+            "import gc\n"
+            "_found = [o for o in gc.get_objects() if type(o).__name__ == 'function' and o.__name__ == 'wrap_angle'"
+            " and (o.__module__ or '').startswith('robokit') and '__real' not in (o.__kwdefaults__ or {})]\n"
+            "def wrap_angle(angle):\n"
+            "    return _found[0](angle) if _found else 12345.0\n")), wrong_only, None),
+    }
+
+
+def _view_attacks(folder, elsewhere):
+    """Attacks on the worker's filesystem view: solved work in the course, the batch and the disk."""
+    wrong_only = {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}
+    git = ("import json, subprocess\n"
+           f"_out = subprocess.run(['git', '-c', 'safe.directory=*', '-C', {str(ROOT)!r}, 'show',"
+           " 'HEAD:solutions/00_getting_started.ipynb'], capture_output=True, text=True, timeout=20).stdout\n"
+           "exec('\\n'.join(''.join(c['source']) for c in json.loads(_out)['cells'] if c['cell_type'] == 'code'"
+           " and 'def wrap_angle' in ''.join(c['source'])))\n")
+    return {
+        "g_git_show_solution": (_with(replace_wrap=WRONG_WRAP, extra_at_end=git), wrong_only, None),
+        "g_course_solutions": (_with(replace_wrap=WRONG_WRAP, extra_at_end=_steal_from(SOLUTION)), wrong_only, None),
+        "g_other_student": (_with(replace_wrap=WRONG_WRAP,
+                                  extra_at_end=_steal_from(folder / "g_honest" / "00_getting_started.ipynb")),
+                            wrong_only, None),
+        "g_solved_elsewhere": (_with(replace_wrap=WRONG_WRAP, extra_at_end=_steal_from(elsewhere)), wrong_only, None),
+        "g_honest": (_cells(), FULL, None),
+    }
+
+
+@pytest.fixture(scope="module")
+def graded_g():
+    with public_tmp() as base:  # readable by anyone, like a real submissions folder
+        yield _grade_g(base)
+
+
+def _grade_g(base):
+    folder, elsewhere = base / "subs", base / "elsewhere" / "solved.ipynb"
+    folder.mkdir()
+    elsewhere.parent.mkdir()
+    elsewhere.write_text(SOLUTION.read_text())
+    cases = {**_reference_attacks(), **_view_attacks(folder, elsewhere)}
+    paths = []
+    for name, (nb, _, _) in cases.items():
+        p = folder / name / "00_getting_started.ipynb"  # one folder per student, as in the README
+        p.parent.mkdir()
+        p.write_text(json.dumps(nb))
+        paths.append(p)
+    results = grade_batch(paths, "00_getting_started", "hostile-seed-g", jobs=2, limits=LIMITS, log=lambda *_: None)
+    return {r.student: r for r in results}, cases
+
+
+@pytest.mark.parametrize("name", sorted({**_reference_attacks(), **_view_attacks(Path("/x"), Path("/y"))}))
+def test_worker_cannot_reach_the_reference_or_solved_work(graded_g, name):
+    results, cases = graded_g
+    _, expected, flag = cases[name]
+    if not is_root() and (name.startswith(("g_git", "g_course", "g_other", "g_solved", "g_exec", "g_import_hooks"))):
+        pytest.skip("without root the worker sees the disk (README: run the grader in a container)")
+    result = results[name]
+    got = {s.id: s.points for s in result.scores}
+    assert got == expected, (result.flags, [m for s in result.scores for m in s.messages][:6], result.cell_errors[:4])
+    if flag:
+        assert flag in result.flags
+    if name == "g_honest":
+        assert result.flags == ([] if is_root() else ["sandbox=limited"]) and result.worker_log == ""

@@ -1,9 +1,11 @@
 """Find the assignments: every module in :mod:`robokit.exercises` that declares one.
 
 A module ``robokit/exercises/<slug>.py`` sets ``ASSIGNMENT = "NN_slug"`` (the notebook name in
-``solutions/`` and ``assignments/``), ``EXERCISES = [Exercise(...), ...]`` and ``WRITTEN =
-{"NN.name": points}`` (manually graded questions). Modules are found automatically, so a new lesson
-adds its file and touches nothing else. They are read once, on first use, and checked once: an
+``solutions/`` and ``assignments/``), ``EXERCISES = [Exercise(...), ...]``, ``WRITTEN =
+{"NN.name": points}`` (manually graded questions) and, if its notebook imports robokit functions
+besides ``check``, ``HELPERS = ("robokit.pkg.name", ...)``: while grading, student code can import
+only those (the grading worker holds no other robokit code). Modules are found automatically, so a
+new lesson adds its file and touches nothing else. They are read once, on first use, and checked once: an
 :class:`Assignment` refuses duplicate ids and ids of another lesson.
 """
 from __future__ import annotations
@@ -23,6 +25,7 @@ __all__ = ["Assignment", "catalog", "get_assignment", "assignments", "exercises_
            "UnknownAssignmentError", "UnknownExerciseError"]
 
 _SLUG = re.compile(r"^\d\d_[a-z][a-z0-9_]*$")
+_HELPER = re.compile(r"^robokit(\.[A-Za-z_][A-Za-z0-9_]*){2,}$")
 
 
 class UnknownAssignmentError(ValueError):
@@ -45,13 +48,19 @@ class Assignment:
         The check-cell exercises, in notebook order; ids unique and starting with ``NN``.
     written : mapping of str to float
         Manually graded questions: id ``"NN.name"`` -> positive points (read-only).
+    helpers : tuple of str
+        The robokit functions the notebook imports besides ``check``, as the notebook names them
+        (``"robokit.outdoor.loop_metrics"`` for ``from robokit.outdoor import loop_metrics``). The
+        grading worker provides exactly these; they must not live in a module that holds one of the
+        assignment's references (``robokit.grading.kit`` refuses such a helper).
 
     Raises
     ------
     ValueError
         For a malformed slug, an exercise that is not an :class:`~.spec.Exercise`, duplicate ids
-        (exercises and written questions share one id space), an id of another lesson, or a
-        written question with a malformed id or non-positive points.
+        (exercises and written questions share one id space), an id of another lesson, a
+        written question with a malformed id or non-positive points, or a helper that is not a
+        dotted ``robokit.`` name of a function in a subpackage.
 
     Examples
     --------
@@ -70,6 +79,7 @@ class Assignment:
     slug: str
     exercises: tuple[Exercise, ...]
     written: Mapping[str, float] = dataclasses.field(default_factory=dict)
+    helpers: tuple[str, ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.slug, str) or not _SLUG.match(self.slug):
@@ -90,8 +100,16 @@ class Assignment:
         bad_points = {q: p for q, p in written.items() if type(p) not in (int, float) or not p > 0}
         if bad_points:
             raise ValueError(f"{self.slug}: WRITTEN points must be positive numbers, got {bad_points}")
+        if isinstance(self.helpers, str):
+            raise ValueError(f"{self.slug}: HELPERS must be a tuple of names, got the string {self.helpers!r}")
+        helpers = tuple(self.helpers)
+        bad_helpers = [h for h in helpers if not isinstance(h, str) or not _HELPER.match(h)]
+        if bad_helpers:
+            raise ValueError(f"{self.slug}: HELPERS must be dotted names like 'robokit.outdoor.loop_metrics', "
+                             f"got {bad_helpers}")
         object.__setattr__(self, "exercises", exercises)
         object.__setattr__(self, "written", MappingProxyType(written))
+        object.__setattr__(self, "helpers", helpers)
 
 
 @functools.lru_cache(maxsize=1)
@@ -115,7 +133,8 @@ def catalog() -> Mapping[str, Assignment]:
             continue
         if slug in found:
             raise ValueError(f"{module.__name__}: assignment {slug!r} is declared twice")
-        found[slug] = Assignment(slug, tuple(module.EXERCISES), getattr(module, "WRITTEN", {}))
+        found[slug] = Assignment(slug, tuple(module.EXERCISES), getattr(module, "WRITTEN", {}),
+                                 getattr(module, "HELPERS", ()))
     return MappingProxyType(dict(sorted(found.items())))
 
 

@@ -17,6 +17,8 @@ from .spec import Case, Exercise
 ASSIGNMENT = "05_gps_sonar_truck"
 #: Written (manually graded) questions: id -> points.
 WRITTEN = {"05.gps_accuracy": 2}
+#: What the notebook imports from robokit besides check(): the grading worker provides only these.
+HELPERS = ("robokit.outdoor.loop_metrics",)
 
 
 def _checksum_cases(rng: np.random.Generator) -> list[Case]:

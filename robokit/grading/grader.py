@@ -3,14 +3,16 @@
 The trusted parent (this module) reads each submission (:mod:`~robokit.grading.submission`),
 generates the input cases from the instructor's secret seed, computes the reference answers, and
 starts one sandboxed worker per submission (:mod:`~robokit.grading.sandbox`,
-:mod:`~robokit.grading.worker`) that receives only the code cells and the inputs. The worker's
-replies are plain data that :mod:`~robokit.grading.protocol` bounds and validates before anything
-here judges them; student objects never reach the parent.
+:mod:`~robokit.grading.worker`) that receives only the code cells and the inputs. The worker runs
+from a kit (:mod:`~robokit.grading.kit`), a robokit without the assignment's references, and as
+root sees nothing else of the disk but the interpreter and the installed packages' code
+(:mod:`~robokit.grading.filesystem_view`). The worker's replies are plain data that
+:mod:`~robokit.grading.protocol` bounds and validates before anything here judges them; student
+objects never reach the parent.
 """
 from __future__ import annotations
 
 import dataclasses
-import queue
 import shutil
 import tempfile
 import time
@@ -18,16 +20,18 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any, Sequence
 
-from ..exercises.discovery import UnknownAssignmentError, exercises_for
+from ..exercises.discovery import UnknownAssignmentError, get_assignment
 from ..exercises.spec import Case, Exercise
+from .filesystem_view import View, installed_robokit_dirs, runtime_paths
 from .judge import expected_output, judge
+from .kit import WORKER, Kit, KitError, build_kit
 from .protocol import CallResult, JobDir, JobSpec, ReferenceSolutionDisabled
-from .sandbox import Limits, WorkerExit, is_root, run_sandboxed
+from .sandbox import Limits, WorkerExit, conceal_secret, is_root, run_sandboxed
 from .submission import Submission, SubmissionRejected, read_submission, student_name
 from .transport import TransportError
 
-__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "job_spec", "grade_submission",
-           "grade_batch", "GradingError", "isolation_note"]
+__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "job_spec", "worker_view",
+           "grade_submission", "grade_batch", "GradingError", "isolation_note"]
 
 
 class GradingError(ValueError):
@@ -89,7 +93,7 @@ def prepare_cases(assignment: str, seed: str) -> PreparedCases:
     """Generate every exercise's cases from ``seed`` and compute the reference answers (trusted)."""
     if not isinstance(seed, str) or not seed:
         raise GradingError("seed: a non-empty secret seed is required (--seed or ROBOKIT_GRADING_SEED)")
-    exercises = exercises_for(assignment)
+    exercises = get_assignment(assignment).exercises
     cases = [ex.make_cases(seed) for ex in exercises]
     expected = [[expected_output(ex, c) for c in cs] for ex, cs in zip(exercises, cases)]
     return PreparedCases(exercises, cases, expected)
@@ -110,12 +114,21 @@ def job_spec(submission: Submission, prepared: PreparedCases, limits: Limits) ->
                          for ex, cs in zip(prepared.exercises, prepared.cases)))
 
 
+def worker_view(kit: Kit, hide: Sequence[Path] = ()) -> View:
+    """What a worker's filesystem shows as root: the interpreter and the installed packages' code,
+    the kit (also in place of every installed robokit), and nothing of ``hide``."""
+    installed = installed_robokit_dirs(runtime_paths())
+    return View((*runtime_paths(), str(kit.root)), tuple((d, str(kit.package)) for d in installed),
+                tuple(str(Path(h).resolve()) for h in hide))
+
+
 def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases, *,
-                     limits: Limits = Limits(), slot: int = 0, hide: Sequence[Path] = (),
+                     limits: Limits = Limits(), kit: Kit | None = None, hide: Sequence[Path] = (),
                      work_root: Path | None = None) -> SubmissionResult:
     """Grade one notebook in a sandboxed worker; never raises for a bad submission.
 
-    A file that cannot be graded scores zero with the rejection's flag and reason.
+    A file that cannot be graded scores zero with the rejection's flag and reason. ``kit`` is the
+    worker's robokit (:func:`~robokit.grading.kit.build_kit`; written into the job if not given).
 
     Notes
     -----
@@ -132,8 +145,9 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
     job = JobDir.create(work_root)
     try:
         job.write_spec(job_spec(submission, prepared, limits))
-        exit_ = run_sandboxed(["-m", "robokit.grading.worker", str(job.root)], job.root, limits, slot=slot,
-                              hide=[*hide, path.resolve().parent])
+        kit = kit or build_kit(get_assignment(assignment), job.root / "kit")
+        exit_ = run_sandboxed(["-m", WORKER, str(job.root)], job.root, limits, view=worker_view(kit, hide),
+                              env_extra={"PYTHONPATH": str(kit.root), "PYTHONSAFEPATH": "1"})
         return _score(job, student, path, prepared, exit_, start)
     finally:
         shutil.rmtree(job.root, ignore_errors=True)
@@ -204,35 +218,38 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
                 limits: Limits = Limits(), hide: Sequence[Path] = (), log=print) -> list[SubmissionResult]:
     """Grade many submissions, ``jobs`` at a time; the batch always completes.
 
+    The seed is concealed from other processes first (:func:`~robokit.grading.sandbox.conceal_secret`);
+    one kit serves the whole batch.
+
     Raises
     ------
     GradingError
-        Only for problems with the request (unknown assignment, missing seed, no submissions).
+        Only for problems with the request (unknown assignment, missing seed, no submissions) or
+        with the course (a helper that would bring a reference into the worker).
     """
+    if isinstance(seed, str) and seed:
+        conceal_secret(seed)
     try:
         prepared = prepare_cases(assignment, seed)
     except UnknownAssignmentError as exc:
         raise GradingError(str(exc)) from None
     if not paths:
         raise GradingError("submissions: expected at least one notebook")
-    slots: "queue.Queue[int]" = queue.Queue()
-    for s in range(max(1, jobs)):
-        slots.put(s)
     work_root = Path(tempfile.mkdtemp(prefix="robokit-grade-"))
     work_root.chmod(0o711)
 
     def one(path):
-        slot = slots.get()
-        try:
-            result = grade_submission(path, assignment, prepared, limits=limits, slot=slot, hide=hide,
-                                      work_root=work_root)
-        finally:
-            slots.put(slot)
+        result = grade_submission(path, assignment, prepared, limits=limits, kit=kit, hide=hide,
+                                  work_root=work_root)
         log(f"  {result.student:<24} {result.total:6.2f} / {result.max_total:<6.2f} "
             f"{result.seconds:5.1f}s  {' '.join(result.flags)}")
         return result
 
     try:
+        try:
+            kit = build_kit(get_assignment(assignment), work_root / "kit")
+        except KitError as exc:
+            raise GradingError(str(exc)) from None
         with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
             return list(pool.map(one, [Path(p) for p in paths]))
     finally:
@@ -241,5 +258,6 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
 
 def isolation_note() -> str:
     """One line saying how strongly this run can isolate student code."""
-    return ("full isolation (namespaces, private uid, hidden paths, no network)" if is_root()
-            else "limited isolation (not root: resource limits and timeouts only)")
+    if is_root():
+        return "full isolation (namespaces, private uid, only the interpreter and packages visible, no network)"
+    return "limited isolation (not root: resource limits and timeouts only)"

@@ -5,39 +5,52 @@ What is enforced, and where:
 * Always (any user): a fresh process session killed as a group at the wall-clock limit;
   ``RLIMIT_CPU`` (CPU seconds), ``RLIMIT_AS`` (address space), ``RLIMIT_FSIZE`` (largest file),
   ``RLIMIT_NOFILE``, ``RLIMIT_CORE = 0``; a scrubbed environment (no inherited variables, ``HOME``
-  and the working directory an empty job directory); single-threaded numeric libraries.
-* As root (CI, Gradescope, a grading container): additionally a private mount namespace in which
-  the protected paths (solutions, submissions, grader outputs, the instructor's home) are covered
-  by empty read-only tmpfs mounts — only the Python installation and robokit are mounted back —,
-  an empty network namespace (no interface but a down loopback), a private ``/proc`` mounted
-  with ``hidepid=2`` (other users' processes, the grader's included, are invisible), a unique unprivileged uid/gid
-  per job (so ``RLIMIT_NPROC`` caps a fork bomb and leftover processes can be swept by uid), and no
-  supplementary groups.
+  and the working directory an empty job directory); single-threaded numeric libraries; and a
+  grader whose secret cannot be read through ``/proc`` by a process of the same user
+  (:func:`conceal_secret`).
+* As root (CI, Gradescope, a grading container): additionally a private mount namespace whose
+  root holds only what :mod:`.filesystem_view` allows (the interpreter, the installed packages'
+  code, the worker's robokit kit, the job's own directories), an empty network namespace (no
+  interface but a down loopback), a private ``/proc`` mounted with ``hidepid=2`` (other users'
+  processes, the grader's included, are invisible), a unique unprivileged uid/gid per job, leased
+  across every grading run on the host (:func:`lease_job_uid`; so ``RLIMIT_NPROC`` caps a fork
+  bomb and leftover processes can be swept by uid without touching another run's workers), and
+  no supplementary groups.
 * Not root: the namespace and uid steps are skipped; the report marks the run ``sandbox=limited``.
 """
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import dataclasses
+import errno
+import fcntl
+import json
 import os
+import pwd
+import random
 import resource
 import signal
+import stat
 import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Sequence
+from typing import Iterator, Sequence
 
+from .filesystem_view import View, enter_view
 from .protocol import JobDir
 
-__all__ = ["Limits", "WorkerExit", "run_sandboxed", "is_root", "JOB_UID_BASE"]
+__all__ = ["Limits", "WorkerExit", "run_sandboxed", "is_root", "lease_job_uid", "conceal_secret", "log_tail",
+           "JOB_UIDS", "UID_LEASE_DIR", "WORKER_LOG"]
 
-#: Jobs run as uid/gid JOB_UID_BASE + slot (no passwd entry is needed).
-JOB_UID_BASE = 61000
-
-_CLONE_NEWNS = 0x00020000
-_CLONE_NEWNET = 0x40000000
-_MS_RDONLY, _MS_NOSUID, _MS_NODEV, _MS_BIND, _MS_REC, _MS_PRIVATE = 1, 2, 4, 4096, 16384, 1 << 18
+#: Job uids/gids (no passwd entry is needed; uids that have one are skipped).
+JOB_UIDS = range(61000, 65000)
+#: Root-only directory of the lock files that lease job uids to grading runs on this host.
+UID_LEASE_DIR = Path("/run/robokit-grading/uids")
+#: The worker's stdout and stderr, in the job directory (its tail explains a worker that ended early).
+WORKER_LOG = "worker.log"
+_PR_SET_DUMPABLE = 4
 
 
 @dataclasses.dataclass(frozen=True)
@@ -85,92 +98,6 @@ def is_root() -> bool:
     return os.geteuid() == 0
 
 
-def _libc():
-    libc = ctypes.CDLL(None, use_errno=True)
-    libc.mount.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_ulong, ctypes.c_char_p]
-    return libc
-
-
-def _check(ret: int, what: str) -> None:
-    if ret != 0:
-        err = ctypes.get_errno()
-        raise OSError(err, f"{what}: {os.strerror(err)}")
-
-
-def _blocked_ancestor(path: Path) -> tuple[Path, Path] | None:
-    """Return (ancestor, child) where ``ancestor`` denies traversal to others on the way to path."""
-    parts = path.parts
-    for i in range(1, len(parts)):
-        anc = Path(*parts[:i])
-        try:
-            if not os.stat(anc).st_mode & 0o001:
-                return anc, Path(*parts[: i + 1])
-        except OSError:
-            return None
-    return None
-
-
-def _isolate(job_dir: Path, hide: Sequence[Path], expose: Sequence[Path]) -> None:
-    """Runs in the child before exec (root only): namespaces, hidden paths, exposed interpreter."""
-    libc = _libc()
-    _check(libc.unshare(_CLONE_NEWNS | _CLONE_NEWNET), "unshare")
-    _check(libc.mount(b"none", b"/", None, _MS_REC | _MS_PRIVATE, None), "make mounts private")
-    # 1. where an ancestor (e.g. /root, mode 0700) blocks the interpreter or robokit, cover the
-    #    ancestor with an empty tmpfs and mount back only the children that are needed
-    needed: dict[Path, set[Path]] = {}
-    for path in expose:
-        blocked = _blocked_ancestor(path)
-        if blocked is not None:
-            needed.setdefault(blocked[0], set()).add(blocked[1])
-    stash = job_dir / ".stash"
-    for a, (ancestor, children) in enumerate(sorted(needed.items())):
-        kept = []
-        for c, child in enumerate(sorted(children)):
-            keep = stash / f"{a}-{c}"
-            keep.mkdir(parents=True, exist_ok=True)
-            _check(libc.mount(str(child).encode(), str(keep).encode(), None, _MS_BIND | _MS_REC, None),
-                   f"stash {child}")
-            kept.append((keep, child))
-        _check(libc.mount(b"tmpfs", str(ancestor).encode(), b"tmpfs", _MS_NOSUID | _MS_NODEV,
-                          b"mode=0755,size=64k"), f"cover {ancestor}")
-        for keep, child in kept:
-            target = ancestor / child.name
-            target.mkdir(exist_ok=True)
-            _check(libc.mount(str(keep).encode(), str(target).encode(), None, _MS_BIND | _MS_REC, None),
-                   f"expose {child}")
-    # 2. cover protected paths, keeping the interpreter, robokit and the job directory visible
-    keep = [Path(p) for p in expose] + [job_dir]
-    for path in hide:
-        _hide(libc, Path(path), keep, depth=0)
-    # 3. a private /proc that shows only the job's own processes (the grader's command line, which
-    #    may hold --seed, stays invisible)
-    _check(libc.mount(b"proc", b"/proc", b"proc", _MS_NOSUID | _MS_NODEV, b"hidepid=2"), "mount /proc")
-
-
-def _hide(libc, path: Path, keep: Sequence[Path], depth: int) -> None:
-    """Cover ``path`` with an empty read-only tmpfs (a directory) or /dev/null (a file).
-
-    A directory that contains a kept path is not covered itself: its other entries are, one level
-    further down.
-    """
-    if any(path == k for k in keep):
-        return
-    if path.is_symlink() or not path.exists():
-        return
-    if path.is_file():
-        _check(libc.mount(b"/dev/null", str(path).encode(), None, _MS_BIND, None), f"hide {path}")
-        return
-    if not path.is_dir():
-        return
-    if any(path in k.parents for k in keep):
-        if depth < 8:
-            for entry in sorted(path.iterdir()):
-                _hide(libc, entry, keep, depth + 1)
-        return
-    _check(libc.mount(b"tmpfs", str(path).encode(), b"tmpfs", _MS_NOSUID | _MS_NODEV | _MS_RDONLY,
-                      b"mode=0555,size=4k"), f"hide {path}")
-
-
 def _limits(limits: Limits, uid: int | None) -> None:
     resource.setrlimit(resource.RLIMIT_CPU, (limits.cpu_seconds, limits.cpu_seconds + 5))
     resource.setrlimit(resource.RLIMIT_AS, (limits.memory_bytes, limits.memory_bytes))
@@ -186,21 +113,36 @@ def _launch(config_path: str) -> None:
 
     It runs as a fresh single-threaded process (never as a ``preexec_fn`` of a threaded grader).
     """
-    import json
-
     cfg = json.loads(Path(config_path).read_text())
-    job_dir = Path(cfg["job_dir"])
+    job = JobDir(cfg["job_dir"])
     limits = Limits(**cfg["limits"])
     uid = cfg["uid"]
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # an oversized write fails instead of killing
     if uid is not None:
-        _isolate(job_dir, [Path(p) for p in cfg["hide"]], [Path(p) for p in cfg["expose"]])
+        view = View(tuple(cfg["view"]["read_only"]), tuple(map(tuple, cfg["view"]["replace"])),
+                    tuple(cfg["view"]["hide"]))
+        enter_view(view, job.root / "root", [(str(job.inbox), False), (str(job.work), True), (str(job.outbox), True)])
         os.setgroups([])
         os.setgid(uid)
         os.setuid(uid)
-    os.chdir(JobDir(job_dir).work)
+    os.chdir(job.work)
     _limits(limits, uid)
-    os.execve(sys.executable, [sys.executable, *cfg["args"]], cfg["env"])
+    os.execve(cfg["python"], [cfg["python"], *cfg["args"]], cfg["env"])
+
+
+# -- job uids: leased per job, unique across every grading run on the host -------------------------
+
+def _lease_dir() -> Path:
+    """``UID_LEASE_DIR``, created root-only; refused if anyone else could have planted it."""
+    for d in (UID_LEASE_DIR.parent, UID_LEASE_DIR):
+        try:
+            d.mkdir(mode=0o700)
+        except FileExistsError:
+            pass
+        st = os.lstat(d)
+        if not os.path.isdir(d) or os.path.islink(d) or st.st_uid != 0 or st.st_mode & 0o022:
+            raise RuntimeError(f"{d}: expected a directory owned by root and writable only by it")
+    return UID_LEASE_DIR
 
 
 def _sweep_uid(uid: int) -> None:
@@ -221,26 +163,108 @@ def _sweep_uid(uid: int) -> None:
         time.sleep(0.05)
 
 
-def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, slot: int = 0,
-                  hide: Sequence[Path] = (), env_extra: dict[str, str] | None = None) -> WorkerExit:
-    """Run ``python args...`` in ``job_dir/work`` under the limits; see the module docstring.
+@contextlib.contextmanager
+def lease_job_uid() -> Iterator[int]:
+    """Lease a job uid for one worker (root only): no other grading run on this host gets it until
+    the lease ends.
 
-    ``job_dir`` is a :class:`~robokit.grading.protocol.JobDir` root: the job uid (when running as
-    root) gets ``work/`` (its cwd and HOME) and ``out/`` (where it writes), and may only read ``in/``.
+    A lease is an exclusive ``flock`` on ``UID_LEASE_DIR/<uid>.lock``, held by this process and
+    released by the kernel if the grader dies, so a crashed run never blocks a uid. Candidates are
+    tried from a random point of ``JOB_UIDS``; uids with a passwd entry are skipped. Processes left
+    running as the uid (by a run that crashed) are killed when the lease starts, and the worker's
+    leftovers when it ends.
+
+    Raises
+    ------
+    RuntimeError
+        If every uid of ``JOB_UIDS`` is leased.
     """
-    root = is_root()
-    uid = JOB_UID_BASE + slot if root else None
-    job = JobDir(job_dir)
-    if uid is not None:
-        for sub in (job.work, job.outbox):
-            os.chown(sub, uid, uid)
-            os.chmod(sub, 0o700)  # concurrent jobs (other uids) cannot look in
-        os.chmod(job_dir, 0o711)
-        os.chmod(job.inbox, 0o755)
-        for f in job.inbox.iterdir():
-            os.chmod(f, 0o644)
-    expose = sorted({Path(sys.base_prefix).resolve(), Path(sys.prefix).resolve(),
-                     Path(sys.executable).resolve().parent, Path(__file__).resolve().parents[2]})
+    folder = _lease_dir()
+    start = random.randrange(len(JOB_UIDS))
+    for k in range(len(JOB_UIDS)):
+        uid = JOB_UIDS[(start + k) % len(JOB_UIDS)]
+        try:
+            pwd.getpwuid(uid)
+            continue
+        except KeyError:
+            pass
+        fd = os.open(folder / f"{uid}.lock", os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            os.close(fd)
+            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
+                continue
+            raise
+        try:
+            _sweep_uid(uid)
+            yield uid
+        finally:
+            _sweep_uid(uid)
+            os.close(fd)
+        return
+    raise RuntimeError(f"no free job uid: all {len(JOB_UIDS)} of {JOB_UIDS} are leased")
+
+
+# -- the secret ------------------------------------------------------------------------------------
+
+def _overwrite(region_start: int, region_end: int, keep) -> None:
+    """Overwrite, in this process's memory, the NUL-separated strings of [start, end) for which
+    ``keep(text)`` returns the number of leading bytes to keep (``None``: leave it alone)."""
+    if not 0 < region_start < region_end:
+        return
+    data = ctypes.string_at(region_start, region_end - region_start)
+    offset = 0
+    for item in data.split(b"\0"):
+        kept = keep(item)
+        if kept is not None and kept < len(item):
+            ctypes.memset(region_start + offset + kept, ord("*"), len(item) - kept)
+        offset += len(item) + 1
+
+
+def conceal_secret(secret: str) -> None:
+    """Keep ``secret`` (the grading seed) from every other process of this user, workers included.
+
+    The grader becomes non-dumpable (``PR_SET_DUMPABLE = 0``), so ``/proc/<grader>/environ`` and
+    ``mem`` are closed to processes of the same uid (what a worker is in the limited mode), and
+    the seed's copies in the memory the kernel shows as ``/proc/<grader>/cmdline`` and ``environ``
+    are overwritten (``--seed SECRET``, ``--seed=SECRET``, abbreviated as argparse allows, and
+    ``ROBOKIT_GRADING_SEED=SECRET``).
+    Python's own copies (``sys.argv``, ``os.environ``) are unchanged. Best effort on Linux; a
+    no-op elsewhere.
+    """
+    libc = ctypes.CDLL(None, use_errno=True)
+    if hasattr(libc, "prctl"):
+        libc.prctl(_PR_SET_DUMPABLE, 0, 0, 0, 0)
+    try:
+        with open("/proc/self/stat", "rb") as f:
+            fields = f.read().rsplit(b")", 1)[1].split()
+        arg_start, arg_end, env_start, env_end = (int(v) for v in fields[45:49])
+    except (OSError, ValueError, IndexError):
+        return
+    value = secret.encode()
+    previous = [b""]
+
+    def is_seed_option(item: bytes) -> bool:  # --seed, or a prefix argparse accepts
+        return len(item) >= 3 and b"--seed".startswith(item)
+
+    def in_argv(item: bytes):
+        before, previous[0] = previous[0], item
+        option, eq, rest = item.partition(b"=")
+        if eq and rest == value and is_seed_option(option):
+            return len(option) + 1
+        return 0 if item == value and is_seed_option(before) else None
+
+    _overwrite(arg_start, arg_end, in_argv)
+    _overwrite(env_start, env_end, lambda item: len(b"ROBOKIT_GRADING_SEED=")
+               if item == b"ROBOKIT_GRADING_SEED=" + value else None)
+
+
+# -- running one worker ----------------------------------------------------------------------------
+
+def _worker_env(job: JobDir, env_extra: dict[str, str] | None) -> dict[str, str]:
+    """The worker's whole environment: built from nothing, so no variable of the grader (the seed
+    above all) can reach it."""
     env = {
         "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin",
         "HOME": str(job.work),
@@ -248,6 +272,7 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, slot: i
         "LANG": "C.UTF-8",
         "PYTHONHASHSEED": "0",
         "PYTHONDONTWRITEBYTECODE": "1",
+        "PYTHONNOUSERSITE": "1",
         "MPLBACKEND": "Agg",
         "MPLCONFIGDIR": str(job.work),
         "OPENBLAS_NUM_THREADS": "1",
@@ -257,22 +282,35 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, slot: i
         "ROBOKIT_CACHE": str(job.work / ".cache"),
     }
     env.update(env_extra or {})
-    import json
+    return env
 
-    config = job_dir / "launch.json"  # root-only: the job uid never reads it
-    config.write_text(json.dumps({
-        "job_dir": str(job_dir), "limits": dataclasses.asdict(limits), "uid": uid,
-        "hide": [str(Path(p).resolve()) for p in hide], "expose": [str(p) for p in expose],
-        "args": list(args), "env": env,
-    }))
-    os.chmod(config, 0o600)
-    log_path = job_dir / "worker.log"
-    start = time.perf_counter()
+
+def _prepare_job_dir(job: JobDir, uid: int | None) -> None:
+    """Give the job uid ``work/`` and ``out/`` (its own) and read access to ``in/``."""
+    if uid is None:
+        return
+    for sub in (job.work, job.outbox):
+        os.chown(sub, uid, uid)
+        os.chmod(sub, 0o700)  # concurrent jobs (other uids) cannot look in
+    os.chmod(job.root, 0o711)
+    os.chmod(job.inbox, 0o755)
+    for f in job.inbox.iterdir():
+        os.chmod(f, 0o644)
+
+
+def _create(path: Path):
+    """Open a new file of the grader's for writing (mode 0600), never through a link or over an
+    existing file: in the limited mode a worker of the same user could plant one in a job folder."""
+    return os.fdopen(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600), "wb")
+
+
+def _run(config: Path, job: JobDir, limits: Limits, path_env: str) -> tuple[int | None, bool]:
+    """Start the launcher, wait for it up to the wall-clock limit, kill its process group."""
     timed_out = False
-    with open(log_path, "wb") as log:
+    with _create(job.root / WORKER_LOG) as log:
         proc = subprocess.Popen(
-            [sys.executable, "-m", "robokit.grading.sandbox", str(config)], cwd=job_dir,
-            env={"PATH": env["PATH"], "LANG": "C.UTF-8"}, stdin=subprocess.DEVNULL, stdout=log,
+            [sys.executable, "-m", "robokit.grading.sandbox", str(config)], cwd=job.root,
+            env={"PATH": path_env, "LANG": "C.UTF-8"}, stdin=subprocess.DEVNULL, stdout=log,
             stderr=subprocess.STDOUT, close_fds=True, start_new_session=True,
         )
         try:
@@ -286,16 +324,55 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, slot: i
         if proc.poll() is None:
             proc.kill()
         proc.wait()
-    if uid is not None:
-        _sweep_uid(uid)
-    seconds = time.perf_counter() - start
+    return proc.returncode, timed_out
+
+
+def log_tail(job: JobDir, limit: int = 4000) -> str:
+    """The last ``limit`` bytes of the job's ``worker.log``, as text.
+
+    In the limited mode the worker runs as the grader's user and could replace the log: a link is
+    not followed, and anything but a regular file reads as empty (never a blocking or endless read).
+    """
     try:
-        with open(log_path, "rb") as f:
-            f.seek(max(0, log_path.stat().st_size - 4000))
-            tail = f.read().decode(errors="replace")
+        fd = os.open(job.root / WORKER_LOG, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
     except OSError:
-        tail = ""
-    return WorkerExit(proc.returncode, timed_out, seconds, uid is not None, tail)
+        return ""
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            return ""
+        os.lseek(fd, max(0, info.st_size - limit), os.SEEK_SET)
+        return os.read(fd, limit).decode(errors="replace")
+    finally:
+        os.close(fd)
+
+
+def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, view: View,
+                  env_extra: dict[str, str] | None = None) -> WorkerExit:
+    """Run ``python args...`` in ``job_dir/work`` under the limits; see the module docstring.
+
+    ``job_dir`` is a :class:`~robokit.grading.protocol.JobDir` root: the job uid (when running as
+    root) gets ``work/`` (its cwd and HOME) and ``out/`` (where it writes), and may only read
+    ``in/``. ``view`` is what else its filesystem shows (root only); ``env_extra`` adds to its
+    otherwise empty environment.
+    """
+    job = JobDir(job_dir)
+    with (lease_job_uid() if is_root() else contextlib.nullcontext(None)) as uid:
+        _prepare_job_dir(job, uid)
+        env = _worker_env(job, env_extra)
+        config = job.root / "launch.json"  # root-only: the job uid never reads it
+        start = time.perf_counter()
+        try:
+            with _create(config) as f:
+                f.write(json.dumps({
+                    "job_dir": str(job.root), "limits": dataclasses.asdict(limits), "uid": uid,
+                    "python": sys.executable, "view": dataclasses.asdict(view), "args": list(args), "env": env,
+                }).encode())
+            returncode, timed_out = _run(config, job, limits, env["PATH"])
+        except OSError as exc:  # e.g. a file planted in the job folder (limited mode)
+            return WorkerExit(None, False, 0.0, uid is not None, f"the grader could not start the worker: {exc}")
+        seconds = time.perf_counter() - start
+    return WorkerExit(returncode, timed_out, seconds, uid is not None, log_tail(job))
 
 
 if __name__ == "__main__":

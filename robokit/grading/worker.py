@@ -1,10 +1,12 @@
 """The grading worker: runs a submission's cells, then its exercise functions, inside the sandbox.
 
-Started by :mod:`robokit.grading.sandbox` as ``python -m robokit.grading.worker JOB_DIR``. It works
-in four phases, one function each:
+Started by :mod:`robokit.grading.sandbox` as ``python -m robokit.grading.worker JOB_DIR``, from a
+kit (:mod:`robokit.grading.kit`): a robokit that holds this module, what it imports and the
+assignment's helpers, and no reference implementation. It works in four phases, one function each:
 
-1. :func:`set_up`: discard the output, silence ``check()``, disable the reference functions, and
-   make ``os._exit`` end a cell rather than the grading;
+1. :func:`set_up`: discard the output, seal the kit's robokit (:func:`.barrier.seal`: ``check()``
+   silenced, the helpers provided, every other robokit name refused) and make ``os._exit`` end a
+   cell rather than the grading;
 2. :func:`run_cells`: run the code cells in order in an IPython shell (magics work; a failing cell
    is recorded and the next one runs), each under a time limit;
 3. :func:`run_exercises`: call each exercise function on each case, writing each exercise's report
@@ -17,7 +19,6 @@ writes is untrusted data to the grader, which validates it and does all the judg
 from __future__ import annotations
 
 import copy
-import importlib
 import io
 import os
 import signal
@@ -26,8 +27,8 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-from .protocol import (CallResult, CellRecord, DoneReport, ErrorRecord, ExerciseReport, JobDir, JobSpec,
-                       ReferenceSolutionDisabled, log_reference_call)
+from .barrier import Manifest, seal
+from .protocol import CallResult, CellRecord, DoneReport, ErrorRecord, ExerciseReport, JobDir, JobSpec, log_reference_call
 
 __all__ = ["main", "set_up", "run_cells", "run_exercises", "finish", "GraderTimeout"]
 
@@ -65,55 +66,19 @@ def _leave_if_forked() -> None:
 
 # -- phase 1: set-up -------------------------------------------------------------------------------
 
-def _quiet_check(*args, **kwargs):
-    print("(check() is skipped during official grading)")
-
-
-def install_traps(references: tuple[str, ...], flag_fd: int) -> None:
-    """Replace each reference function so that a direct call from graded code fails and is flagged.
-
-    Calls made from inside robokit itself (a library function that uses a helper which happens to
-    be a reference) pass through, so legitimate use of other robokit functions keeps working.
-    A dotted name that does not resolve is skipped.
-    """
-    package_dir = str(Path(importlib.import_module("robokit").__file__).parent)
-    for dotted in references:
-        module_name, _, attr = dotted.rpartition(".")
-        try:
-            module = importlib.import_module(module_name)
-            real = getattr(module, attr)
-        except (ImportError, AttributeError):
-            continue
-
-        def trap(*args, __real=real, __name=dotted, **kwargs):
-            caller = sys._getframe(1).f_code.co_filename
-            if caller.startswith(package_dir) and "/grading/" not in caller:
-                return __real(*args, **kwargs)
-            log_reference_call(flag_fd, __name)
-            raise ReferenceSolutionDisabled(f"{__name} is the reference solution and is disabled while grading")
-
-        trap.__name__ = getattr(real, "__name__", attr)
-        trap.__doc__ = getattr(real, "__doc__", None)
-        for mod in list(sys.modules.values()):  # also names re-exported by packages
-            if getattr(mod, "__name__", "").startswith("robokit") and getattr(mod, attr, None) is real:
-                setattr(mod, attr, trap)
-
-
-def set_up(spec: JobSpec, job: JobDir) -> None:
+def set_up(job: JobDir, kit_root: Path) -> None:
     """Prepare the process for graded code.
 
-    In order: the time-limit signal; ``check()`` silenced (``robokit.grading.check`` and the
-    module's own name); the reference functions trapped (:func:`install_traps`); ``os._exit``
-    turned into ``SystemExit`` (a notebook calling it ends its cell, not the grading); and
-    ``sys.stdout``/``sys.stderr`` discarded, so graded code cannot write into the worker's log,
-    whose tail the instructor's feedback shows when the worker ends early.
+    In order: the time-limit signal; the kit's robokit sealed (:func:`.barrier.seal`, with the
+    manifest in ``kit_root``): ``check()`` silenced, the helpers provided, every other robokit
+    name refused and an attempt on a reference logged for the grader's ``called-reference`` flag;
+    ``os._exit`` turned into ``SystemExit`` (a notebook calling it ends its cell, not the
+    grading); and ``sys.stdout``/``sys.stderr`` discarded, so graded code cannot write into the
+    worker's log, whose tail the instructor's feedback shows when the worker ends early.
     """
     flag_fd = job.open_flags()
     signal.signal(signal.SIGALRM, _on_alarm)
-
-    for name in ("robokit.grading", "robokit.grading.check"):  # both are loaded: this module is in the package
-        sys.modules[name].check = _quiet_check
-    install_traps(spec.references, flag_fd)
+    seal(Manifest.read(kit_root), lambda name: log_reference_call(flag_fd, name))
 
     def _no_exit(code=0):
         raise SystemExit(code)
@@ -212,7 +177,7 @@ def main(job_dir: str) -> None:
 
     job = JobDir(Path(job_dir))
     spec = job.read_spec()
-    set_up(spec, job)
+    set_up(job, Path(__file__).resolve().parents[2])
     shell = InteractiveShell.instance(colors="NoColor")
     cells, cell_seconds = run_cells(shell, spec)
     job.write_cells(cells)

@@ -1,0 +1,186 @@
+"""The worker's filesystem view as root (issue 12): an allowlist of the interpreter, the installed
+packages' code, the kit and the job's own directories; nothing else of the disk.
+
+Each test runs a small probe in the real sandbox (``run_sandboxed``) that writes what it can see
+into the job's ``out/``.
+"""
+import json
+import os
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+from robokit.exercises import get_assignment
+from robokit.grading.filesystem_view import View, installed_robokit_dirs, runtime_paths
+from robokit.grading.grader import worker_view
+from robokit.grading.kit import build_kit
+from robokit.grading.protocol import JobDir
+from robokit.grading.sandbox import Limits, is_root, run_sandboxed
+from tests.conftest import ROOT, public_tmp
+
+needs_root = pytest.mark.skipif(not is_root(), reason="the filesystem view needs root (namespaces)")
+
+LIMITS = Limits(wall_seconds=60, cpu_seconds=60)
+
+PROBE = """
+import glob, json, os, sys
+out = {"root": sorted(os.listdir("/")), "robokit": None, "exists": {}, "readable": {}, "listing": {}}
+for p in json.loads(sys.argv[1]):
+    out["exists"][p] = os.path.lexists(p)
+    try:
+        with open(p, "rb") as f:
+            f.read(1)
+        out["readable"][p] = True
+    except OSError:
+        out["readable"][p] = False
+for d in json.loads(sys.argv[2]):
+    try:
+        out["listing"][d] = sorted(os.listdir(d))
+    except OSError as e:
+        out["listing"][d] = str(e)
+out["uids"] = sorted({os.stat(p).st_uid for p in glob.glob("/proc/[0-9]*")})
+out["me"] = os.getuid()
+try:
+    import robokit
+    out["robokit"] = robokit.__file__
+except ImportError as e:
+    out["robokit"] = str(e)
+with open(os.path.join(os.environ["HOME"], "..", "out", "probe.json"), "w") as f:
+    json.dump(out, f)
+"""
+
+
+@pytest.fixture
+def base():
+    with public_tmp() as path:
+        yield path
+
+
+def _probe(base: Path, view_of, paths, listings):
+    kit = build_kit(get_assignment("00_getting_started"), base / "kit")
+    other = JobDir.create(base)  # another job of the same run
+    (other.inbox / "job").write_text("bob's cells")
+    job = JobDir.create(base)
+    exit_ = run_sandboxed(["-c", PROBE, json.dumps([str(p) for p in paths]),
+                           json.dumps([str(d) for d in listings(job)])], job.root, LIMITS, view=view_of(kit),
+                          env_extra={"PYTHONPATH": str(kit.root), "PYTHONSAFEPATH": "1"})
+    assert exit_.returncode == 0 and exit_.isolated, exit_.log
+    return json.loads((job.outbox / "probe.json").read_text()), kit, job, other
+
+
+@needs_root
+def test_the_worker_sees_only_the_allowlist(base):
+    submission = base / "alice" / "00_getting_started.ipynb"
+    submission.parent.mkdir()
+    shutil.copy(ROOT / "solutions" / "00_getting_started.ipynb", submission)
+    secret_paths = [ROOT / "solutions" / "00_getting_started.ipynb", ROOT / ".git", ROOT / "README.md",
+                    ROOT / "robokit" / "geometry" / "planar.py", ROOT / "robokit" / "grading" / "grader.py",
+                    submission, Path.home() / ".bashrc", Path("/etc/shadow"), Path("/etc/passwd"),
+                    Path("/usr/bin/git"), Path("/bin/sh"), Path(sys.executable).resolve().parent / "pip"]
+    checks = [str(p) for p in secret_paths]
+    visible_needed = [sys.executable, str(Path(sys.executable).resolve())]
+    result, kit, job, other = _probe(
+        base, lambda kit: worker_view(kit), [*checks, *visible_needed],
+        lambda job: [job.root.parent, job.root, "/tmp", str(ROOT), "/root"])
+    assert not any(result["exists"][p] for p in checks), {p: result["exists"][p] for p in checks}
+    assert all(result["readable"][p] for p in visible_needed)
+    listing = result["listing"]
+    # the run's folder shows the kit and this job only (not the other job, not alice/); the job
+    # shows no launch file or log
+    assert listing[str(base)] == sorted(["kit", job.root.name]), listing[str(base)]
+    assert listing[str(job.root)] == ["in", "out", "work"]
+    assert listing["/tmp"] == [base.name]
+    assert not isinstance(listing[str(ROOT)], list) or listing[str(ROOT)] == [".venv"], listing[str(ROOT)]
+    assert result["uids"] == [result["me"]] and result["me"] != 0
+    assert result["robokit"] == str(kit.package / "__init__.py")
+    assert set(result["root"]) <= {"dev", "etc", "lib", "lib32", "lib64", "proc", "tmp", "usr", "root", "work",
+                                   "opt", "home", "srv", "var"}
+
+
+@needs_root
+def test_an_installed_robokit_shows_as_the_kit(base):
+    # a wheel install (Gradescope, a container) puts robokit's whole source in site-packages,
+    # which the view shows: the kit's robokit must stand in its place
+    site = base / "venv" / "lib" / "site-packages"
+    shutil.copytree(ROOT / "robokit", site / "robokit", ignore=shutil.ignore_patterns("__pycache__"))
+    assert installed_robokit_dirs([str(site)]) == [str(site / "robokit")]
+
+    def view_of(kit):
+        return View((*runtime_paths(), str(kit.root), str(site)), ((str(site / "robokit"), str(kit.package)),))
+
+    planar = site / "robokit" / "geometry" / "planar.py"
+    result, kit, _, _ = _probe(base, view_of, [planar, site / "robokit" / "grading" / "worker.py"],
+                               lambda job: [site / "robokit"])
+    assert not result["exists"][str(planar)]
+    assert result["readable"][str(site / "robokit" / "grading" / "worker.py")]
+    assert result["listing"][str(site / "robokit")] == sorted(os.listdir(kit.package))
+
+
+def test_runtime_paths_leave_out_project_directories(monkeypatch):
+    # an old-style editable install or PYTHONPATH puts a project directory (with its .git and
+    # solutions) on sys.path: only site-packages and the standard library count
+    runtime_paths.cache_clear()
+    monkeypatch.setattr(sys, "path", [*sys.path, str(ROOT), str(ROOT / "tests")])
+    try:
+        paths = runtime_paths()
+    finally:
+        runtime_paths.cache_clear()
+    assert not any(p == str(ROOT) or p.startswith(str(ROOT) + "/") and "/.venv" not in p for p in paths), paths
+
+
+SHARE = """
+import ctypes, json, os, sys
+libc = ctypes.CDLL(None, use_errno=True)
+key, create = 0x526F626F, sys.argv[1] == "create"
+sysv = libc.shmget(key, 4096, 0o1666 if create else 0o666)   # IPC_CREAT = 0o1000
+try:
+    fd = os.open("/dev/shm/robokit-collude", (os.O_CREAT | os.O_RDWR) if create else os.O_RDONLY, 0o666)
+    posix = True
+except OSError:
+    posix = False
+with open(os.path.join(os.environ["HOME"], "..", "out", "share.json"), "w") as f:
+    json.dump({"sysv": sysv >= 0, "posix": posix}, f)
+"""
+
+
+@needs_root
+def test_jobs_share_no_memory(base):
+    # alice leaves her answers in shared memory, bob's job looks for them
+    kit = build_kit(get_assignment("00_getting_started"), base / "kit")
+    seen = {}
+    for role in ("create", "open"):
+        job = JobDir.create(base)
+        exit_ = run_sandboxed(["-c", SHARE, role], job.root, LIMITS, view=worker_view(kit))
+        assert exit_.returncode == 0, exit_.log
+        seen[role] = json.loads((job.outbox / "share.json").read_text())
+    assert seen["create"] == {"sysv": True, "posix": True}
+    assert seen["open"] == {"sysv": False, "posix": False}
+
+
+def test_a_replaced_worker_log_is_not_followed(tmp_path):
+    # in the limited mode the worker runs as the grader's user and can replace the log the grader
+    # reads after it ends (a link to /dev/zero was read without bound)
+    from robokit.grading.sandbox import WORKER_LOG, log_tail
+
+    job = JobDir.create(tmp_path)
+    (job.root / WORKER_LOG).symlink_to("/dev/zero")
+    assert log_tail(job) == ""
+    (job.root / WORKER_LOG).unlink()
+    os.mkfifo(job.root / WORKER_LOG)
+    assert log_tail(job) == ""  # a FIFO with no writer: not opened for a blocking read
+    (job.root / WORKER_LOG).unlink()
+    (job.root / WORKER_LOG).write_bytes(b"x" * 10_000 + b"the end")
+    assert log_tail(job).endswith("the end") and len(log_tail(job)) == 4000
+
+
+def test_a_planted_launch_file_costs_only_that_job(tmp_path):
+    # a worker of the grader's own user (limited mode) may plant files in a job folder it can list
+    job = JobDir.create(tmp_path)
+    victim = tmp_path / "instructor-notes.txt"
+    victim.write_text("keep me")
+    (job.root / "launch.json").symlink_to(victim)
+    exit_ = run_sandboxed(["-c", "pass"], job.root, LIMITS, view=View(()))
+    assert exit_.returncode is None and "could not start the worker" in exit_.log
+    assert victim.read_text() == "keep me"
