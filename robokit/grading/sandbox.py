@@ -266,10 +266,9 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, slot: i
         "args": list(args), "env": env,
     }))
     os.chmod(config, 0o600)
-    log_path = job_dir / "worker.log"
     start = time.perf_counter()
     timed_out = False
-    with open(log_path, "wb") as log:
+    with open(job.log_file, "wb") as log:
         proc = subprocess.Popen(
             [sys.executable, "-m", "robokit.grading.sandbox", str(config)], cwd=job_dir,
             env={"PATH": env["PATH"], "LANG": "C.UTF-8"}, stdin=subprocess.DEVNULL, stdout=log,
@@ -289,13 +288,7 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, slot: i
     if uid is not None:
         _sweep_uid(uid)
     seconds = time.perf_counter() - start
-    try:
-        with open(log_path, "rb") as f:
-            f.seek(max(0, log_path.stat().st_size - 4000))
-            tail = f.read().decode(errors="replace")
-    except OSError:
-        tail = ""
-    return WorkerExit(proc.returncode, timed_out, seconds, uid is not None, tail)
+    return WorkerExit(proc.returncode, timed_out, seconds, uid is not None, job.read_log_tail())
 
 
 if __name__ == "__main__":
