@@ -296,7 +296,7 @@ def _grader_failed(path: Path, student: str, prepared: PreparedCases, exc: Excep
 
 def needs_review(results: Sequence[SubmissionResult]) -> list[str]:
     """One line per submission that makes ``robokit grade`` exit 1: not graded, or a duplicate name."""
-    return [f"{r.path}: " + (r.reason if r.reason else "; ".join(r.notes))
+    return [f"{r.path}: " + "; ".join(filter(None, [r.reason, *r.notes]))
             for r in results if not r.graded or "duplicate-name" in r.flags]
 
 

@@ -43,7 +43,7 @@ def write_gradebook(results: Sequence[SubmissionResult], path: str | Path) -> Pa
         for r in sorted(results, key=lambda r: r.student):
             w.writerow([csv_cell(r.student), csv_cell(r.path.name), *[f"{s.points:g}" for s in r.scores],
                         f"{r.total:g}", f"{r.max_total:g}", csv_cell(" ".join(r.flags)),
-                        csv_cell(r.reason or "; ".join(r.notes), 1000)])
+                        csv_cell(r.reason or "; ".join(r.notes + r.problems), 1000)])
     return path
 
 
