@@ -124,3 +124,17 @@ def test_a_failure_of_the_grader_on_one_file_costs_only_that_file(tmp_path, monk
     assert code == 1 and "disk full" in capsys.readouterr().err
     rows = {r["student"]: r for r in csv.DictReader(open(tmp_path / "g.csv"))}
     assert rows["broken"]["flags"] == "grader-error" and rows["other"]["flags"] == "not-a-notebook"
+
+
+def test_a_file_name_that_is_not_utf8_still_gives_a_gradebook(tmp_path, capsys):
+    import os
+
+    name = os.fsdecode(b"\xff\xfe\x1b[31m=evil.ipynb")  # a name the student chose, not valid UTF-8
+    (tmp_path / name).write_text("{}")
+    code = main(["grade", str(tmp_path / name), "--assignment", "00_getting_started", "--seed", "s",
+                 "--out", str(tmp_path / "g.csv"), "--feedback", str(tmp_path / "fb")])
+    captured = capsys.readouterr()
+    assert code == 1 and "Traceback" not in captured.err and "\x1b" not in captured.err + captured.out
+    (row,) = csv.DictReader(open(tmp_path / "g.csv", encoding="utf-8"))
+    assert row["flags"] == "not-a-notebook" and "\x1b" not in row["student"]
+    assert len(list((tmp_path / "fb").glob("*.md"))) == 1
