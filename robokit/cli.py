@@ -79,8 +79,9 @@ def _cmd_assign(args: argparse.Namespace) -> int:
 def _cmd_grade(args: argparse.Namespace) -> int:
     import os
 
-    from .grading.grader import GradingError, grade_batch, isolation_note
+    from .grading.grader import GradingError, grade_batch, isolation_note, needs_review
     from .grading.reports import write_feedback, write_gradebook, write_gradescope
+    from .grading.safetext import clean
     from .grading.sandbox import Limits
 
     seed = args.seed or os.environ.get("ROBOKIT_GRADING_SEED", "")
@@ -113,9 +114,9 @@ def _cmd_grade(args: argparse.Namespace) -> int:
     if args.gradescope:
         write_gradescope(results[0], args.assignment, args.gradescope)
         print(f"gradescope results: {args.gradescope}")
-    problems = [r for r in results if r.read_error]
-    for r in problems:
-        print(f"robokit grade: {r.path}: {r.reason}", file=sys.stderr)
+    problems = needs_review(results)  # files not graded, duplicate student names
+    for line in problems:
+        print(f"robokit grade: {clean(line, 1000)}", file=sys.stderr)
     return 1 if problems else 0
 
 

@@ -68,3 +68,73 @@ def test_unreadable_and_wrong_assignment_exit_nonzero_but_batch_completes(tmp_pa
     assert "could not be read" in captured.err and "not '00_getting_started'" in captured.err
     rows = {r["student"]: r for r in csv.DictReader(open(tmp_path / "g.csv"))}
     assert rows["good"]["total"] == "3" and rows["wrong"]["total"] == "0" and rows["missing"]["total"] == "0"
+
+
+def test_every_file_that_could_not_be_graded_makes_the_exit_code_1(tmp_path, capsys):
+    # the README: exit 1 when a file could not be graded; a 200 MB notebook used to exit 0
+    big = tmp_path / "big.ipynb"
+    with open(big, "wb") as f:
+        f.write(b'{"cells": [')
+        f.truncate(200_000_000)
+    (tmp_path / "garbage.ipynb").write_text("this is not a notebook {")
+    for path in (big, tmp_path / "garbage.ipynb"):
+        code = main(["grade", str(path), "--assignment", "00_getting_started", "--seed", "s",
+                     "--out", str(tmp_path / "g.csv")])
+        captured = capsys.readouterr()
+        assert code == 1 and path.name in captured.err and "Traceback" not in captured.err
+        (row,) = csv.DictReader(open(tmp_path / "g.csv"))
+        assert row["total"] == "0" and row["flags"] == "not-a-notebook" and row["note"]
+
+
+def test_duplicate_names_are_numbered_flagged_and_exit_1(tmp_path, monkeypatch, capsys):
+    # without workers: every path here is rejected, which is enough to check the bookkeeping
+    from robokit.grading.grader import unique_students
+
+    paths = [tmp_path / "alice.ipynb", tmp_path / "alice" / "00_getting_started.ipynb", tmp_path / "sec2" / "alice.ipynb",
+             tmp_path / "Alice.ipynb", tmp_path / "a b.ipynb", tmp_path / "a_b.ipynb", tmp_path / "bob.ipynb"]
+    names = [n for n, _ in unique_students(paths, "00_getting_started")]
+    assert names == ["alice#1", "alice#2", "alice#3", "Alice#4", "a b#1", "a_b#2", "bob"]
+    for p in paths:
+        p.parent.mkdir(exist_ok=True)
+        p.write_text("{}")
+    code = main(["grade", *map(str, paths), "--assignment", "00_getting_started", "--seed", "s",
+                 "--out", str(tmp_path / "g.csv"), "--feedback", str(tmp_path / "fb")])
+    assert code == 1 and "4 files map to student 'alice'" in capsys.readouterr().err
+    rows = {r["student"]: r for r in csv.DictReader(open(tmp_path / "g.csv"))}
+    assert set(rows) == set(names) and "duplicate-name" in rows["alice#2"]["flags"] and rows["bob"]["flags"] == \
+        "not-a-notebook"
+    assert len(list((tmp_path / "fb").glob("*.md"))) == len(paths)
+
+
+def test_a_failure_of_the_grader_on_one_file_costs_only_that_file(tmp_path, monkeypatch, capsys):
+    import robokit.grading.grader as grader
+
+    real = grader.grade_submission
+
+    def flaky(path, *args, **kwargs):
+        if path.name == "broken.ipynb":
+            raise RuntimeError("disk full")
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(grader, "grade_submission", flaky)
+    shutil.copy(SOL, tmp_path / "broken.ipynb")
+    (tmp_path / "other.ipynb").write_text("{}")
+    code = main(["grade", str(tmp_path / "broken.ipynb"), str(tmp_path / "other.ipynb"), "--assignment",
+                 "00_getting_started", "--seed", "s", "--out", str(tmp_path / "g.csv")])
+    assert code == 1 and "disk full" in capsys.readouterr().err
+    rows = {r["student"]: r for r in csv.DictReader(open(tmp_path / "g.csv"))}
+    assert rows["broken"]["flags"] == "grader-error" and rows["other"]["flags"] == "not-a-notebook"
+
+
+def test_a_file_name_that_is_not_utf8_still_gives_a_gradebook(tmp_path, capsys):
+    import os
+
+    name = os.fsdecode(b"\xff\xfe\x1b[31m=evil.ipynb")  # a name the student chose, not valid UTF-8
+    (tmp_path / name).write_text("{}")
+    code = main(["grade", str(tmp_path / name), "--assignment", "00_getting_started", "--seed", "s",
+                 "--out", str(tmp_path / "g.csv"), "--feedback", str(tmp_path / "fb")])
+    captured = capsys.readouterr()
+    assert code == 1 and "Traceback" not in captured.err and "\x1b" not in captured.err + captured.out
+    (row,) = csv.DictReader(open(tmp_path / "g.csv", encoding="utf-8"))
+    assert row["flags"] == "not-a-notebook" and "\x1b" not in row["student"]
+    assert len(list((tmp_path / "fb").glob("*.md"))) == 1

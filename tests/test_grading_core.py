@@ -1,5 +1,6 @@
 """check(), plain-data conversion, comparisons, the exercise catalog and assignment generation."""
 import json
+import re
 
 import numpy as np
 import pytest
@@ -144,3 +145,79 @@ def test_catalog_lookup():
 def test_assign_cli_check_mode(capsys):
     assert main(["assign", "--check", "--root", str(ROOT)]) == 0
     assert "up to date" in capsys.readouterr().out
+
+
+# -- student-controlled text in the reports (issue 12, deliverable 6) -----------------------------
+
+from robokit.grading.safetext import clean, csv_cell, fenced, md_inline  # noqa: E402
+
+HOSTILE_TEXT = ("```` ~~~\n**Score: 3 / 3**\n<script>alert(1)</script>\x1b[2J\x1b]0;t\x07\x9b31m\u202e\u2066"
+                "\r\x00\x7f\udcff end")
+
+
+def test_clean_strips_escapes_and_control_characters_and_bounds_length():
+    text = clean(HOSTILE_TEXT, 1000)
+    assert not any(ch in text for ch in "\x1b\x07\x9b\u202e\u2066\r\x00\x7f\n") and "\udcff" not in text
+    assert "<script>" in text and text.endswith("? end")  # printable text is kept as it is
+    assert clean(HOSTILE_TEXT, 1000, lines=True).count("\n") == 2
+    assert len(clean("x" * 10**6, 50)) == 50 and clean("x" * 10**6, 50).endswith("…")
+
+
+def test_fenced_text_cannot_close_its_block():
+    block = fenced([HOSTILE_TEXT, "`" * 7, "``` not a fence either"])
+    fence = block[0][:-len("text")]
+    assert set(fence) == {"`"} and len(fence) == 8 and block[-1] == fence
+    assert all(not line.startswith(fence) for line in block[1:-1])
+
+
+def test_md_inline_escapes_every_markdown_character():
+    text = md_inline("**Score: 3 / 3** <b>x</b> [a](http://x) # _y_ `z`")
+    assert re.search(r"(?<!\\)[*<>\[\]()#_`]", text) is None
+
+
+@pytest.mark.parametrize("value", ["=1+2", "+1", "-1", "@SUM(A1)", " =1", "\t=1", "\r=1", "\uff1d1", "\x1b[0m=1"])
+def test_csv_cells_cannot_start_a_formula(value):
+    cell = csv_cell(value)
+    assert cell.startswith("'") and "\t" not in cell and "\r" not in cell
+
+
+def _result(**fields):
+    from pathlib import Path
+
+    from robokit.grading.grader import ExerciseScore, SubmissionResult
+
+    base = dict(student="eve", path=Path("eve.ipynb"), flags=[],
+                scores=[ExerciseScore("00.wrap_angle", 0.0, 1.0, 0, 6, [f"case 1: raised {HOSTILE_TEXT}"])],
+                cell_errors=[f"code cell 1: error: ValueError: {HOSTILE_TEXT}"], worker_log=HOSTILE_TEXT * 3,
+                notes=[HOSTILE_TEXT], problems=[HOSTILE_TEXT])
+    return SubmissionResult(**{**base, **fields})
+
+
+def test_feedback_keeps_student_text_inside_code_blocks(tmp_path):
+    from robokit.grading.reports import feedback_text, gradescope_results, write_feedback
+
+    for r in (_result(), _result(student=HOSTILE_TEXT, reason=HOSTILE_TEXT)):
+        text = feedback_text(r, "00_getting_started")
+        assert not re.search(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069\udc80-\udcff]", text)
+        outside, fence = [], None
+        for line in text.split("\n"):
+            if fence is None and re.match(r"^`{3,}text$", line):
+                fence = line[:-4]
+            elif fence is not None and line == fence:
+                fence = None
+            elif fence is None:
+                outside.append(line)
+        outside = "\n".join(outside)
+        assert outside.count("**Score:") == 1 and not re.search(r"(?<!\\)[<>]", outside) and "~~~" not in outside
+        (written,) = write_feedback([r], tmp_path / "fb", "00_getting_started")  # no UnicodeEncodeError
+        assert written.read_text(encoding="utf-8") == text
+    gs = gradescope_results(_result(), "00_getting_started")
+    assert gs["output_format"] == "md" and gs["test_output_format"] == "text"
+    assert "\x1b" not in json.dumps(gs)
+
+
+def test_feedback_files_are_never_shared(tmp_path):
+    from robokit.grading.reports import write_feedback
+
+    with pytest.raises(ValueError, match="share a feedback file"):
+        write_feedback([_result(student="a b"), _result(student="A_b")], tmp_path, "00_getting_started")

@@ -352,3 +352,258 @@ def test_worker_cannot_reach_the_reference_or_solved_work(graded_g, name):
         assert flag in result.flags
     if name == "g_honest":
         assert result.flags == ([] if is_root() else ["sandbox=limited"]) and result.worker_log == ""
+
+
+# ---- issue 12, helper F: the grader trusts nothing the worker or the submission gives it ---------
+# These batches run `robokit grade` in a child process with a bounded address space, so that a
+# grader that follows /dev/zero or waits on a FIFO fails the test (MemoryError, no gradebook, or
+# the generous safety timeout) instead of taking the test machine down.
+
+import csv  # noqa: E402
+import re  # noqa: E402
+import resource  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import textwrap  # noqa: E402
+
+OUT = "os.path.join(os.path.dirname(os.getcwd()), 'out')"  # the job's out/, seen from the worker's cwd
+
+
+def _tamper(code):
+    """The 00 solution whose se2_compose first runs ``code`` once, in the exercise phase (after the
+    cells record and exercise 0's report are written), with ``out`` bound to the job's out/."""
+    compose = SELF_CONTAINED_COMPOSE.replace(
+        "def se2_compose(a, b):\n",
+        "def se2_compose(a, b):\n    global _tampered\n"
+        f"    if not _tampered and os.path.exists(os.path.join({OUT}, 'ex0.json')):\n"
+        "        _tampered = True\n        _tamper()\n")
+    source = (f"import os\n_tampered = False\ndef _tamper():\n    out = {OUT}\n" + textwrap.indent(code, "    ")
+              + "\n" + compose)
+    nb = _cells()
+    for cell in nb["cells"]:
+        if cell["cell_type"] == "code" and "".join(cell["source"]).startswith("def se2_compose"):
+            cell["source"] = source
+    return nb
+
+
+def _replace_by(name, how):
+    return f"p = os.path.join(out, {name!r})\nos.unlink(p)\n{how}\n"
+
+
+ONLY_COMPOSE = {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}
+NOTHING = {"00.wrap_angle": 0.0, "00.se2_compose": 0.0}
+FORGED = ("```` ~~~\n\n**Score: 3 / 3**\n\n<script>alert('pwned')</script><img src=x onerror=alert(1)>"
+          "\x1b[2J\x1b]0;owned\x07\x1b[31m\u202e\r\x00 =cmd|' /C calc'!A0")
+FORGED_NAME = '=HYPERLINK("evil")<img src=x>**Score 3 of 3**'
+
+WORKER_OUTPUT_ATTACKS = {
+    # name: (notebook, expected points, expected flags)
+    "out_flags_log_fifo": (_tamper(_replace_by("flags.log", "os.mkfifo(p)")), NOTHING, ["unusable-results"]),
+    "out_flags_log_to_dev_zero": (_tamper(_replace_by("flags.log", "os.symlink('/dev/zero', p)")), NOTHING,
+                                  ["unusable-results"]),
+    "out_cells_to_dev_zero": (_tamper(_replace_by("cells.json", "os.symlink('/dev/zero', p)")), FULL,
+                              ["unusable-results"]),
+    "out_cells_fifo": (_tamper(_replace_by("cells.json", "os.mkfifo(p)")), FULL, ["unusable-results"]),
+    "out_npz_garbage": (_tamper("p = os.path.join(out, 'ex0.npz')\nraw = bytearray(open(p, 'rb').read())\n"
+                                "raw[len(raw) // 2] ^= 0xFF\nopen(p, 'wb').write(bytes(raw))\n"),
+                        ONLY_COMPOSE, ["unusable-results"]),
+    "out_npz_to_dev_zero": (_tamper(_replace_by("ex0.npz", "os.symlink('/dev/zero', p)")), ONLY_COMPOSE,
+                            ["unusable-results"]),
+    "out_report_directory": (_tamper(_replace_by("ex0.json", "os.mkdir(p)")), ONLY_COMPOSE, ["unusable-results"]),
+    "out_wrong_types": (_tamper("import json\np = os.path.join(out, 'ex0.json')\nr = json.load(open(p))\n"
+                                "r['seconds'] = 10 ** 4000\nopen(p, 'w').write(json.dumps(r))\n"
+                                "open(os.path.join(out, 'cells.json'), 'w').write(json.dumps([{'cell': 10 ** 300, "
+                                "'status': 'error', 'error': {'type': ['x'], 'classes': 5, 'message': {}}}]))\n"),
+                        ONLY_COMPOSE, ["unusable-results"]),
+    "returns_huge_int": (_with(replace_wrap="def wrap_angle(angle):\n    return 10 ** 400\n"), ONLY_COMPOSE, []),
+    "forged_feedback": (_with(f"raise RuntimeError({FORGED!r})\n",
+                              replace_wrap=f"def wrap_angle(angle):\n    raise RuntimeError({FORGED!r})\n"),
+                        ONLY_COMPOSE, []),
+}
+
+
+def _grade_cli(paths, out):
+    """Run `robokit grade` on ``paths`` in a child process; return (exit code, stdout, stderr)."""
+    def bounded():  # the grader's own address space; workers set theirs below it
+        hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+        soft = 3 * 1024**3 if hard == resource.RLIM_INFINITY else min(3 * 1024**3, hard)
+        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+
+    cmd = [sys.executable, "-c", "import sys; from robokit.cli import main; sys.exit(main())", "grade",
+           *map(str, paths), "--assignment", "00_getting_started", "--seed", "hostile-seed", "--jobs", "2",
+           "--out", str(out / "grades.csv"), "--feedback", str(out / "feedback"), "--timeout", "40",
+           "--memory-mb", "2048", "--root", str(ROOT)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, errors="replace", timeout=900, preexec_fn=bounded,
+                          cwd=out, env={**os.environ, "OPENBLAS_NUM_THREADS": "1",  # the robokit under test:
+                                        "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])})
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+def _gradebook(out):
+    with open(out / "grades.csv", newline="", encoding="utf-8") as f:
+        return list(csv.DictReader(f))
+
+
+@pytest.fixture(scope="module")
+def worker_output_batch(tmp_path_factory):
+    subs, out = tmp_path_factory.mktemp("subs-worker-output"), tmp_path_factory.mktemp("out-worker-output")
+    cases = {**WORKER_OUTPUT_ATTACKS, "honest": (_cells(), FULL, []), FORGED_NAME: (_cells(), FULL, [])}
+    paths = []
+    for name, (nb, _, _) in cases.items():
+        paths.append(subs / f"{name}.ipynb")
+        paths[-1].write_text(json.dumps(nb))
+    code, stdout, stderr = _grade_cli(paths, out)
+    return code, stdout, stderr, out, cases
+
+
+def test_worker_output_batch_completes_with_exit_0(worker_output_batch):
+    code, _, stderr, out, cases = worker_output_batch
+    assert code == 0, stderr[-3000:]
+    assert len(_gradebook(out)) == len(cases) and "Traceback" not in stderr
+
+
+@pytest.mark.parametrize("name", list(WORKER_OUTPUT_ATTACKS) + ["honest"])
+def test_hostile_worker_output_costs_only_what_it_touches(worker_output_batch, name):
+    _, _, stderr, out, cases = worker_output_batch
+    rows = {r["file"]: r for r in _gradebook(out)}
+    row = rows[f"{name}.ipynb"]
+    _, expected, flags = cases[name]
+    assert {k: float(row[k]) for k in expected} == expected, (row, stderr[-2000:])
+    assert [f for f in row["flags"].split() if f != "sandbox=limited"] == flags, row
+
+
+def _outside_code_blocks(markdown):
+    """The lines of ``markdown`` outside fenced code blocks, by CommonMark's rules for fences."""
+    outside, fence = [], None
+    for line in markdown.split("\n"):
+        m = re.match(r"^ {0,3}(`{3,}|~{3,})(.*)$", line)
+        if fence is None:
+            if m and not (m.group(1)[0] == "`" and "`" in m.group(2)):
+                fence = m.group(1)
+            else:
+                outside.append(line)
+        elif m and m.group(1)[0] == fence[0] and len(m.group(1)) >= len(fence) and not m.group(2).strip():
+            fence = None
+    return outside
+
+
+def test_feedback_shows_student_text_only_as_inert_text(worker_output_batch):
+    _, stdout, _, out, _ = worker_output_batch
+    feedback = list((out / "feedback").glob("*.md"))
+    text = (out / "feedback" / "forged_feedback.md").read_text(encoding="utf-8")
+    assert "RuntimeError" in text and "pwned" in text  # the student's message is shown ...
+    outside = "\n".join(_outside_code_blocks(text))
+    assert outside.count("**Score:") == 1 and "**Score: 2 / 3**" in outside  # ... but cannot forge a score
+    assert "<script" not in outside and "<img" not in outside
+    for page in feedback:  # no control characters or terminal escapes anywhere, in any feedback
+        body = page.read_text(encoding="utf-8")
+        assert not re.search(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]", body), page.name
+        assert all(not re.search(r"(?<!\\)[<>*]", line) for line in _outside_code_blocks(body)
+                   if line.startswith("# Feedback")), page.name
+    assert "\x1b" not in stdout
+
+
+def test_gradebook_cells_cannot_start_a_formula(worker_output_batch):
+    _, _, _, out, _ = worker_output_batch
+    with open(out / "grades.csv", newline="", encoding="utf-8") as f:
+        cells = [c for row in csv.reader(f) for c in row]
+    assert not [c for c in cells if c[:1] in ("=", "+", "-", "@", "\t", "\r")]
+    assert any(c.startswith("'=HYPERLINK") for c in cells)
+
+
+def _sparse(path, size):
+    with open(path, "wb") as f:
+        f.write(b'{"cells": [')
+        f.truncate(size)
+
+
+@pytest.fixture(scope="module")
+def submission_batch(tmp_path_factory):
+    subs, out = tmp_path_factory.mktemp("subs-submissions"), tmp_path_factory.mktemp("out-submissions")
+    code_cell = {"cell_type": "code", "source": "x = 1", "metadata": {}, "outputs": [], "execution_count": None}
+    bad = {
+        "meta_not_dict": json.dumps({"cells": [{**code_cell, "metadata": [1]}]}),
+        "source_not_strings": json.dumps({"cells": [{**code_cell, "source": ["x = 1\n", 5]}]}),
+        "digits_5000": '{"cells": [], "metadata": {"n": ' + "7" * 5000 + "}}",
+        "invalid_utf8": b'{"cells": [{"cell_type": "code", "source": "\xff", "metadata": {}}]}',
+    }
+    paths = []
+    for name, content in bad.items():
+        paths.append(subs / f"{name}.ipynb")
+        paths[-1].write_bytes(content if isinstance(content, bytes) else content.encode())
+    paths.append(subs / "huge_200mb.ipynb")
+    _sparse(paths[-1], 200_000_000)
+    paths.append(subs / "symlink_file.ipynb")
+    paths[-1].symlink_to(SOLUTION)  # would be graded as the instructor's solution
+    (subs / "symlink_folder").symlink_to(SOLUTION.parent)
+    paths.append(subs / "symlink_folder" / "00_getting_started.ipynb")
+    honest = json.dumps(_cells())
+    for rel in ("honest.ipynb", "alice.ipynb", "alice/00_getting_started.ipynb", "sec2/alice.ipynb"):
+        paths.append(subs / rel)
+        paths[-1].parent.mkdir(exist_ok=True)
+        paths[-1].write_text(honest)
+    code, stdout, stderr = _grade_cli(paths, out)
+    return code, stdout, stderr, out
+
+
+EXPECTED_REJECTIONS = {"meta_not_dict": "not-a-notebook", "source_not_strings": "not-a-notebook",
+                       "digits_5000": "not-a-notebook", "invalid_utf8": "not-a-notebook",
+                       "huge_200mb": "not-a-notebook", "symlink_file": "symlink", "symlink_folder": "symlink"}
+
+
+def test_submission_batch_completes_and_exits_1(submission_batch):
+    code, _, stderr, out = submission_batch
+    assert code == 1 and "Traceback" not in stderr, stderr[-3000:]
+    rows = {r["student"]: r for r in _gradebook(out)}
+    assert rows["honest"]["total"] == "3" and rows["honest"]["flags"] in ("", "sandbox=limited")
+    for name in EXPECTED_REJECTIONS:
+        assert name in stderr  # robokit grade names every file it could not grade
+
+
+@pytest.mark.parametrize("name", list(EXPECTED_REJECTIONS))
+def test_a_bad_submission_is_rejected_with_its_flag(submission_batch, name):
+    _, _, _, out = submission_batch
+    row = {r["student"]: r for r in _gradebook(out)}[name]
+    assert row["total"] == "0" and row["flags"] == EXPECTED_REJECTIONS[name] and row["note"], row
+
+
+def test_duplicate_student_names_are_graded_apart_and_flagged(submission_batch):
+    code, _, stderr, out = submission_batch
+    rows = [r for r in _gradebook(out) if r["student"].startswith("alice")]
+    assert sorted(r["student"] for r in rows) == ["alice#1", "alice#2", "alice#3"]
+    assert all(r["total"] == "3" and "duplicate-name" in r["flags"].split() and "3 files" in r["note"] for r in rows)
+    pages = sorted(p.name for p in (out / "feedback").glob("alice*.md"))
+    assert pages == ["alice_1.md", "alice_2.md", "alice_3.md"]
+    assert code == 1 and "3 files map to student 'alice'" in stderr
+
+
+@pytest.fixture
+def limited(monkeypatch):
+    """Grade without the root-only isolation, whoever runs the test: the worker then runs as the
+    grader's own user and can replace anything in its job directory, not only out/."""
+    import robokit.grading.sandbox as sandbox
+
+    monkeypatch.setattr(sandbox, "is_root", lambda: False)
+
+
+LIMITED_ATTACKS = {
+    # replaces the worker log the grader reads after the worker ends
+    "log_fifo": (_tamper("log = os.path.join(os.path.dirname(out), 'worker.log')\nos.unlink(log)\nos.mkfifo(log)\n"),
+                 FULL, []),
+    # replaces out/ itself by a link to a folder of forged reports
+    "outbox_link": (_tamper("import shutil\nforged = out + '-forged'\nshutil.copytree(out, forged)\n"
+                            "shutil.rmtree(out)\nos.symlink(forged, out)\n"), NOTHING, ["unusable-results"]),
+}
+
+
+def test_without_root_the_job_directory_is_hostile_too(tmp_path, limited):
+    paths = []
+    for name, (nb, _, _) in LIMITED_ATTACKS.items():
+        paths.append(tmp_path / f"{name}.ipynb")
+        paths[-1].write_text(json.dumps(nb))
+    results = {r.student: r for r in grade_batch(paths, "00_getting_started", "s", jobs=2, limits=LIMITS,
+                                                 log=lambda *_: None)}
+    for name, (_, expected, flags) in LIMITED_ATTACKS.items():
+        r = results[name]
+        assert {s.id: s.points for s in r.scores} == expected, (name, r.flags, r.problems)
+        assert r.flags[0] == "sandbox=limited" and r.flags[1:] == flags, (name, r.flags)

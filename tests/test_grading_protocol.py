@@ -12,7 +12,8 @@ import pytest
 from robokit.exercises import Assignment, Case, Exercise, catalog
 from robokit.grading.protocol import (MAX_FLAG_LINES, MAX_MESSAGE, CallResult, DoneReport, ErrorRecord, ExerciseReport,
                                       JobDir, JobSpec, log_reference_call)
-from robokit.grading.submission import (NotANotebook, UnreadableSubmission, WrongAssignment, read_submission)
+from robokit.grading.submission import (NotANotebook, SymlinkedSubmission, UnreadableSubmission, WrongAssignment,
+                                        read_submission)
 from robokit.grading.transport import TransportError, write_plain
 
 
@@ -103,31 +104,40 @@ def test_malformed_exercise_reports_are_refused(job, raw, message):
 
 def test_worker_values_are_bounded(job):
     error = {"type": "E" * 10_000, "classes": ["M" * 10_000] * 1000, "message": "m" * 10**6, "line": "hidden"}
-    write_plain({"defined": True, "results": [{"value": None, "error": error}], "seconds": float("nan")},
-                job.exercise_file(0))
+    write_plain({"defined": True, "results": [{"value": None, "error": error}], "seconds": 0.5}, job.exercise_file(0))
     report = job.read_exercise(0, 1)
     err = report.results[0].error
     assert len(err.type) == 100 and len(err.classes) == 12 and len(err.message) == MAX_MESSAGE
-    assert err.line == "" and report.seconds == 0.0
+    assert err.line == "" and report.seconds == 0.5
     write_plain({"defined": False, "results": ["anything"]}, job.exercise_file(1))
     assert job.read_exercise(1, 5) == ExerciseReport(defined=False)
 
 
 @pytest.mark.parametrize("raw", [5, {"cells": 5}, "abc", {"other": []}])
-def test_malformed_cells_reports_read_as_missing(job, raw):
+def test_malformed_cells_reports_are_refused(job, raw):
     write_plain(raw, job.outbox / "cells")
-    assert job.read_cells() is None
+    with pytest.raises(TransportError):
+        job.read_cells()
 
 
-def test_cells_report_keeps_the_first_well_formed_records(job):
+@pytest.mark.parametrize("bad", [{"cell": "1" * 10**5, "status": "error", "error": None}, {"cell": 2, "status": "???"},
+                                 7, {"cell": 3, "status": "error", "error": "x"}, {"cell": True, "status": "ok"},
+                                 {"cell": -1, "status": "ok"}])
+def test_one_malformed_cell_record_makes_the_report_unusable(job, bad):
     good = {"cell": 1, "status": "error", "error": {"type": "NameError", "classes": [], "message": "x"}}
-    bad = [{"cell": "1" * 10**5, "status": "error", "error": None}, {"cell": 2, "status": "???"}, 7,
-           {"cell": 3, "status": "error", "error": "x"}]
-    write_plain([good, *bad], job.outbox / "cells")
+    write_plain([good, bad], job.outbox / "cells")
+    with pytest.raises(TransportError):
+        job.read_cells()
+
+
+def test_cells_report_keeps_the_first_records(job):
+    good = {"cell": 1, "status": "error", "error": {"type": "NameError", "classes": [], "message": "x"}}
+    write_plain([good], job.outbox / "cells")
     cells = job.read_cells()
     assert [c.cell for c in cells] == [1] and cells[0].error.type == "NameError"
     write_plain([good] * 600, job.outbox / "cells")
     assert len(job.read_cells()) == 500
+    assert JobDir.create(job.root).read_cells() is None  # never written
 
 
 def test_reference_calls_are_read_from_the_flags_log_only_so_far(job):
@@ -144,10 +154,10 @@ def test_done_report(job):
     assert job.read_done() is None
     job.write_done(DoneReport(1.5))
     assert job.read_done() == DoneReport(1.5)
-    write_plain({"compute_seconds": -1.0}, job.outbox / "done")
-    assert job.read_done().compute_seconds == 0.0
-    (job.outbox / "done.json").write_text("not json")
-    assert job.read_done() is not None  # written, so the worker finished, whatever it says
+    for raw in ({"compute_seconds": -1.0}, {"compute_seconds": float("nan")}, {"compute_seconds": "1"}, [1.0]):
+        write_plain(raw, job.outbox / "done")
+        with pytest.raises(TransportError):
+            job.read_done()
 
 
 def test_error_record_survives_a_hostile_str():
@@ -158,21 +168,107 @@ def test_error_record_survives_a_hostile_str():
     assert ErrorRecord.from_exception(Hostile()).message == "<unprintable exception>"
 
 
-@pytest.mark.parametrize("content, kind, flag, read_error", [
-    (None, UnreadableSubmission, "unreadable", True),
-    ("", NotANotebook, "not-a-notebook", False),
-    ("{not json", NotANotebook, "not-a-notebook", False),
-    (json.dumps({"cells": {}}), NotANotebook, "not-a-notebook", False),
+@pytest.mark.parametrize("content, kind, flag", [
+    (None, UnreadableSubmission, "unreadable"),
+    ("", NotANotebook, "not-a-notebook"),
+    ("{not json", NotANotebook, "not-a-notebook"),
+    (json.dumps({"cells": {}}), NotANotebook, "not-a-notebook"),
     (json.dumps({"cells": [], "metadata": {"robokit": {"assignment": "05_gps_sonar_truck"}}}),
-     WrongAssignment, "wrong-assignment", True),
+     WrongAssignment, "wrong-assignment"),
 ])
-def test_rejections_carry_their_flag(tmp_path, content, kind, flag, read_error):
+def test_rejections_carry_their_flag(tmp_path, content, kind, flag):
     path = tmp_path / "sub.ipynb"
     if content is not None:
         path.write_text(content)
     with pytest.raises(kind) as info:
         read_submission(path, "00_getting_started")
-    assert info.value.flag == flag and info.value.read_error == read_error and str(info.value)
+    assert info.value.flag == flag and str(info.value)
+
+
+def _code(**fields):
+    return {"cell_type": "code", "source": "x = 1", "metadata": {}, **fields}
+
+
+# every way a notebook can be malformed is a rejection with a flag (issue 12, deliverable 1/6)
+MALFORMED_NOTEBOOKS = {
+    "code cell metadata not a dict": json.dumps({"cells": [_code(metadata=[1, 2])]}),
+    "code cell metadata a string": json.dumps({"cells": [_code(metadata="tags")]}),
+    "source a list holding non-strings": json.dumps({"cells": [_code(source=["x = 1\n", 2, None])]}),
+    "source a number": json.dumps({"cells": [_code(source=5)]}),
+    "tags not a list": json.dumps({"cells": [_code(metadata={"tags": "demo"})]}),
+    "tags holding non-strings": json.dumps({"cells": [_code(metadata={"tags": [["demo"]]})]}),
+    "a cell that is not an object": json.dumps({"cells": [_code(), 5]}),
+    "notebook metadata not a dict": json.dumps({"cells": [], "metadata": []}),
+    "robokit metadata not a dict": json.dumps({"cells": [], "metadata": {"robokit": "00"}}),
+    "declared assignment not a string": json.dumps({"cells": [], "metadata": {"robokit": {"assignment": [1] * 10**5}}}),
+    "5000-digit integer": '{"cells": [], "metadata": {"n": ' + "7" * 5000 + "}}",
+    "deeply nested": '{"cells": [], "x": ' + "[" * 100_000 + "]" * 100_000 + "}",
+    "invalid UTF-8": b'{"cells": [{"cell_type": "code", "source": "\xff\xfe", "metadata": {}}]}',
+    "UTF-16": json.dumps({"cells": []}).encode("utf-16"),
+    "only whitespace": "   \n",
+}
+
+
+@pytest.mark.parametrize("name", list(MALFORMED_NOTEBOOKS))
+def test_a_malformed_notebook_is_rejected_with_a_flag(tmp_path, name):
+    content = MALFORMED_NOTEBOOKS[name]
+    path = tmp_path / "sub.ipynb"
+    path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    with pytest.raises(NotANotebook) as info:
+        read_submission(path, "00_getting_started")
+    assert info.value.flag == "not-a-notebook" and len(str(info.value)) < 200
+
+
+def test_a_notebook_larger_than_the_limit_is_rejected_without_reading_it(tmp_path):
+    path = tmp_path / "big.ipynb"
+    with open(path, "wb") as f:
+        f.write(b'{"cells": [')
+        f.truncate(200_000_000)  # sparse: 200 MB
+    with pytest.raises(NotANotebook, match="larger than 20 MB"):
+        read_submission(path, "00_getting_started")
+
+
+def _solution_copy(folder):
+    folder.mkdir(parents=True, exist_ok=True)
+    target = folder / "00_getting_started.ipynb"
+    target.write_text(json.dumps({"cells": [_code(source="SOLVED = True")]}))
+    return target
+
+
+def test_a_symlinked_submission_is_refused_not_followed(tmp_path):
+    solution = _solution_copy(tmp_path / "solutions")
+    (tmp_path / "subs").mkdir()
+    link = tmp_path / "subs" / "mallory.ipynb"
+    link.symlink_to(solution)
+    with pytest.raises(SymlinkedSubmission) as info:
+        read_submission(link, "00_getting_started")
+    assert info.value.flag == "symlink"
+
+
+def test_a_symlinked_student_folder_is_refused_not_followed(tmp_path):
+    _solution_copy(tmp_path / "solutions")
+    (tmp_path / "subs").mkdir()
+    (tmp_path / "subs" / "mallory").symlink_to(tmp_path / "solutions")
+    with pytest.raises(SymlinkedSubmission, match="folder 'mallory'"):
+        read_submission(tmp_path / "subs" / "mallory" / "00_getting_started.ipynb", "00_getting_started")
+
+
+def test_a_symlinked_folder_above_the_students_is_the_instructors(tmp_path):
+    # the instructor may keep submissions behind a link (e.g. /tmp on macOS, a mounted drive)
+    _solution_copy(tmp_path / "real" / "alice")
+    (tmp_path / "subs").symlink_to(tmp_path / "real")
+    sub = read_submission(tmp_path / "subs" / "alice" / "00_getting_started.ipynb", "00_getting_started")
+    assert sub.sources == ("SOLVED = True",)
+    (tmp_path / "real" / "bob.ipynb").write_text(json.dumps({"cells": []}))
+    assert read_submission(tmp_path / "subs" / "bob.ipynb", "00_getting_started").sources == ()
+
+
+@pytest.mark.parametrize("kind", ["fifo", "directory"])
+def test_a_submission_that_is_not_a_regular_file_is_unreadable(tmp_path, kind):
+    path = tmp_path / "sub.ipynb"
+    os.mkfifo(path) if kind == "fifo" else path.mkdir()
+    with pytest.raises(UnreadableSubmission):
+        read_submission(path, "00_getting_started")
 
 
 def test_submission_cells_and_skip_tags(tmp_path):
@@ -204,3 +300,178 @@ def test_catalog_is_read_once_and_read_only():
     assert catalog() is catalog()
     with pytest.raises(TypeError):
         catalog()["00_getting_started"].written["00.why_seeds"] = 5
+
+
+# -- everything under out/ is hostile: links, FIFOs, directories, garbage, wrong types ------------
+# (issue 12, deliverable 1). Each reader must refuse it with a TransportError, at once: no link
+# followed, no FIFO waited on, no unbounded read, no other exception.
+
+GOOD_EXERCISE = {"defined": True, "results": [{"value": 1.0, "error": None}], "seconds": 0.1}
+READERS = {  # file the worker writes -> how the grader reads it
+    "cells.json": lambda job: job.read_cells(),
+    "ex0.json": lambda job: job.read_exercise(0, 1),
+    "done.json": lambda job: job.read_done(),
+    "flags.log": lambda job: job.read_reference_calls(),
+}
+
+
+def _elsewhere(job):
+    other = job.work / "elsewhere.json"
+    other.write_text(json.dumps(GOOD_EXERCISE))
+    return other
+
+
+FILE_ATTACKS = {  # the file is replaced by something that is not a regular file of its own
+    "symlink to /dev/zero": lambda job, p: p.symlink_to("/dev/zero"),
+    "symlink to a valid file": lambda job, p: p.symlink_to(_elsewhere(job)),
+    "fifo": lambda job, p: os.mkfifo(p),
+    "directory": lambda job, p: p.mkdir(),
+    "hard link": lambda job, p: os.link(_elsewhere(job), p),
+}
+CONTENT_ATTACKS = {  # a regular file with bad content
+    "garbage bytes": lambda job, p: p.write_bytes(bytes(range(256)) * 40),
+    "truncated JSON": lambda job, p: p.write_text(json.dumps(GOOD_EXERCISE)[:25]),
+    "invalid UTF-8": lambda job, p: p.write_bytes(b'{"defined": true, "x": "\xff\xfe"}'),
+    "5000-digit integer": lambda job, p: p.write_text('{"seconds": ' + "9" * 5000 + "}"),
+    "deeply nested": lambda job, p: p.write_text("[" * 100_000 + "]" * 100_000),
+    "larger than the bound": lambda job, p: os.truncate(p.write_text("") or p, 30_000_000),
+}
+
+
+def _plant(job, name, attack):
+    path = job.outbox / name
+    if path.exists() or path.is_symlink():
+        path.unlink()
+    attack(job, path)
+
+
+@pytest.mark.parametrize("name", list(READERS))
+@pytest.mark.parametrize("attack", list(FILE_ATTACKS))
+def test_a_result_file_that_is_not_a_regular_file_is_refused(job, name, attack):
+    _plant(job, name, FILE_ATTACKS[attack])
+    with pytest.raises(TransportError):
+        READERS[name](job)
+
+
+@pytest.mark.parametrize("name", ["cells.json", "ex0.json", "done.json"])
+@pytest.mark.parametrize("attack", list(CONTENT_ATTACKS))
+def test_a_result_file_with_bad_content_is_refused(job, name, attack):
+    _plant(job, name, CONTENT_ATTACKS[attack])
+    with pytest.raises(TransportError):
+        READERS[name](job)
+
+
+@pytest.mark.parametrize("raw", [
+    {**GOOD_EXERCISE, "seconds": 10**4000}, {**GOOD_EXERCISE, "seconds": "0.1"}, {**GOOD_EXERCISE, "seconds": -1},
+    {**GOOD_EXERCISE, "seconds": None}, {**GOOD_EXERCISE, "defined": "yes"},
+    {**GOOD_EXERCISE, "results": [{"value": None, "error": {"type": ["E"], "classes": [], "message": "m"}}]},
+    {**GOOD_EXERCISE, "results": [{"value": None, "error": {"type": "E", "classes": "E", "message": "m"}}]},
+    {**GOOD_EXERCISE, "results": [{"value": None, "error": {"type": "E", "classes": [], "message": 10**4000}}]},
+])
+def test_an_exercise_report_with_a_wrong_type_is_refused(job, raw):
+    (job.outbox / "ex0.json").write_text(json.dumps(raw))
+    with pytest.raises(TransportError):
+        job.read_exercise(0, 1)
+
+
+@pytest.mark.parametrize("raw", [{"compute_seconds": 10**4000}, {"compute_seconds": None}, "done", [],
+                                 {"compute_seconds": True}])
+def test_a_final_report_with_a_wrong_type_is_refused(job, raw):
+    (job.outbox / "done.json").write_text(json.dumps(raw))
+    with pytest.raises(TransportError):
+        job.read_done()
+
+
+def _npy_bytes(header: dict, data: bytes) -> bytes:
+    import io
+
+    f = io.BytesIO()
+    np.lib.format.write_array_header_1_0(f, header)
+    return f.getvalue() + data
+
+
+def _zip(members: dict[str, bytes], compression=None) -> bytes:
+    import io
+    import zipfile
+
+    f = io.BytesIO()
+    with zipfile.ZipFile(f, "w", compression or zipfile.ZIP_STORED) as z:
+        for name, data in members.items():
+            z.writestr(name, data)
+    return f.getvalue()
+
+
+def _bad_crc(job):
+    write_plain({"a": np.arange(1000.0)}, job.outbox / "tmp")
+    raw = bytearray((job.outbox / "tmp.npz").read_bytes())
+    raw[len(raw) // 2] ^= 0xFF
+    return bytes(raw)
+
+
+NPZ_ATTACKS = {
+    "bad CRC (BadZipFile)": _bad_crc,
+    "not a zip": lambda job: b"PK\x03\x04" + bytes(range(256)) * 10,
+    "zip bomb": lambda job: _zip({"a0.npy": _npy_bytes({"descr": "<f8", "fortran_order": False, "shape": (9 * 2**20,)},
+                                                       bytes(72 * 2**20))}, compression=8),
+    "shape larger than the data": lambda job: _zip({"a0.npy": _npy_bytes(
+        {"descr": "<f8", "fortran_order": False, "shape": (10**12,)}, bytes(8))}),
+    "object dtype (a pickle)": lambda job: _zip({"a0.npy": _npy_bytes(
+        {"descr": "|O", "fortran_order": False, "shape": (1,)}, b"\x80\x04N.")}),
+    "structured dtype": lambda job: _zip({"a0.npy": _npy_bytes(
+        {"descr": [("x", "<f8")], "fortran_order": False, "shape": (1,)}, bytes(8))}),
+    "string dtype": lambda job: _zip({"a0.npy": _npy_bytes({"descr": "<U1", "fortran_order": False, "shape": (1,)},
+                                                           bytes(4))}),
+    "member that is not an array": lambda job: _zip({"a0.npy": bytes(8), "evil.txt": b"x"}),
+    "array missing": lambda job: _zip({"a1.npy": _npy_bytes({"descr": "<f8", "fortran_order": False, "shape": (1,)},
+                                                            bytes(8))}),
+}
+
+
+@pytest.mark.parametrize("attack", list(NPZ_ATTACKS))
+def test_a_hostile_npz_is_refused(job, attack):
+    report = {"defined": True, "results": [{"value": {"__robokit_array__": "a0"}, "error": None}], "seconds": 0.1}
+    (job.outbox / "ex0.json").write_text(json.dumps(report))
+    (job.outbox / "ex0.npz").write_bytes(NPZ_ATTACKS[attack](job))
+    with pytest.raises(TransportError):
+        job.read_exercise(0, 1)
+
+
+@pytest.mark.parametrize("attack", ["symlink to /dev/zero", "fifo", "directory"])
+def test_an_npz_that_is_not_a_regular_file_is_refused(job, attack):
+    write_plain(GOOD_EXERCISE, job.exercise_file(0))
+    FILE_ATTACKS[attack](job, job.outbox / "ex0.npz")
+    with pytest.raises(TransportError):
+        job.read_exercise(0, 1)
+
+
+def test_arrays_of_every_layout_survive_the_checked_reader(job):
+    arrays = [np.arange(6.0).reshape(2, 3).T, np.asfortranarray(np.eye(3)), np.array(2.5), np.zeros((0, 3)),
+              np.array([True, False]), np.arange(4, dtype=">i4"), np.arange(3, dtype=np.uint8)]
+    results = tuple(CallResult.returned(a) for a in arrays)
+    job.write_exercise(0, ExerciseReport(True, results, 0.1))
+    back = job.read_exercise(0, len(arrays))
+    for a, r in zip(arrays, back.results):
+        assert r.value.shape == a.shape and np.array_equal(r.value, a)
+
+
+def test_an_outbox_replaced_by_a_link_is_not_followed(job, tmp_path):
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    write_plain(GOOD_EXERCISE, elsewhere / "ex0")
+    job.outbox.rmdir()
+    job.outbox.symlink_to(elsewhere)
+    with pytest.raises(TransportError):
+        job.read_exercise(0, 1)
+    with pytest.raises(TransportError):
+        job.read_reference_calls()
+
+
+@pytest.mark.parametrize("attack", ["symlink to /dev/zero", "fifo", "directory"])
+def test_the_worker_log_is_read_like_the_results(job, attack):
+    FILE_ATTACKS[attack](job, job.log_file)
+    assert "unusable" in job.read_log_tail()
+    job.log_file.unlink() if job.log_file.is_symlink() or job.log_file.is_file() or job.log_file.is_fifo() \
+        else job.log_file.rmdir()
+    job.log_file.write_bytes(b"x" * 10_000 + b"the end\n")
+    tail = job.read_log_tail()
+    assert tail.endswith("the end\n") and len(tail) <= 4000

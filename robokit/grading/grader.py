@@ -9,29 +9,37 @@ root sees nothing else of the disk but the interpreter and the installed package
 (:mod:`~robokit.grading.filesystem_view`). The worker's replies are plain data that
 :mod:`~robokit.grading.protocol` bounds and validates before anything here judges them; student
 objects never reach the parent.
+
+Nothing the worker or the submission gives is trusted: a file that cannot be read is a rejection
+with its flag (:mod:`~robokit.grading.submission`); worker output that is unusable costs only the
+part it concerns and flags ``unusable-results``; any other failure on one submission is that
+submission's ``grader-error``. The batch always completes, and names every student once.
 """
 from __future__ import annotations
 
+import collections
 import dataclasses
 import shutil
 import tempfile
 import time
+import traceback
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 from ..exercises.discovery import UnknownAssignmentError, get_assignment
 from ..exercises.spec import Case, Exercise
 from .filesystem_view import View, installed_robokit_dirs, runtime_paths
 from .judge import expected_output, judge
 from .kit import WORKER, Kit, KitError, build_kit
-from .protocol import CallResult, JobDir, JobSpec, ReferenceSolutionDisabled
+from .protocol import CallResult, CellRecord, DoneReport, JobDir, JobSpec, ReferenceSolutionDisabled
+from .safetext import clean
 from .sandbox import Limits, WorkerExit, conceal_secret, is_root, run_sandboxed
-from .submission import Submission, SubmissionRejected, read_submission, student_name
+from .submission import Submission, SubmissionRejected, feedback_stem, read_submission, student_name
 from .transport import TransportError
 
 __all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "job_spec", "worker_view",
-           "grade_submission", "grade_batch", "GradingError", "isolation_note"]
+           "grade_submission", "grade_batch", "GradingError", "isolation_note", "unique_students", "needs_review"]
 
 
 class GradingError(ValueError):
@@ -57,7 +65,13 @@ class ExerciseScore:
 
 @dataclasses.dataclass
 class SubmissionResult:
-    """Everything the gradebook and the feedback need about one submission."""
+    """Everything the gradebook and the feedback need about one submission.
+
+    ``reason`` is set when the file was not graded (a rejection, a grader error); ``notes`` are
+    remarks for the instructor (e.g. a duplicate student name); ``problems`` say which of the
+    worker's files were unusable. Strings that come from the student (names, messages, the log)
+    are raw here: the reports escape them.
+    """
 
     student: str
     path: Path
@@ -67,8 +81,14 @@ class SubmissionResult:
     seconds: float = 0.0
     compute_seconds: float = 0.0
     cell_errors: list[str] = dataclasses.field(default_factory=list)
-    read_error: bool = False
     worker_log: str = ""
+    notes: list[str] = dataclasses.field(default_factory=list)
+    problems: list[str] = dataclasses.field(default_factory=list)
+
+    @property
+    def graded(self) -> bool:
+        """Whether the file was graded (``robokit grade`` exits 1 otherwise)."""
+        return not self.reason
 
     @property
     def total(self) -> float:
@@ -140,8 +160,7 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
     try:
         submission = read_submission(path, assignment)
     except SubmissionRejected as exc:
-        return SubmissionResult(student, path, _zero(prepared, str(exc)), [exc.flag], str(exc),
-                                read_error=exc.read_error)
+        return SubmissionResult(student, path, _zero(prepared, str(exc)), [exc.flag], str(exc))
     job = JobDir.create(work_root)
     try:
         job.write_spec(job_spec(submission, prepared, limits))
@@ -170,24 +189,35 @@ def _score_exercise(ex: Exercise, cases: list[Case], expected: list[Any],
     return ExerciseScore(ex.id, points, float(ex.points), passed, len(cases), messages), cheated
 
 
-def _score(job: JobDir, student: str, path: Path, prepared: PreparedCases, exit_: WorkerExit,
-           start: float) -> SubmissionResult:
-    """Read what the worker wrote (through the protocol's validating readers) and score it."""
-    flags = [] if exit_.isolated else ["sandbox=limited"]
-    cell_errors = [f"code cell {c.cell}: {c.status}: {c.error.type[:80]}: {c.error.message[:200]}"
-                   for c in job.read_cells() or () if c.status in ("error", "timeout") and c.error]
-    ended = "the grader stopped your notebook at its time limit" if exit_.timed_out else \
-        "your notebook ended the grading process early"
+_UNUSABLE = object()  # what _Reading.get returns for a file that was written but is unusable
+
+
+class _Reading:
+    """Reads the worker's files through the protocol, noting each one that is unusable."""
+
+    def __init__(self, job: JobDir):
+        self.job, self.problems = job, []
+
+    def get(self, what: str, read: Callable[[], Any]) -> Any:
+        """``read()``, or ``_UNUSABLE`` (with a problem noted) if it raises a TransportError."""
+        try:
+            return read()
+        except TransportError as exc:
+            self.problems.append(f"{what}: {exc}")
+            return _UNUSABLE
+
+
+def _score_exercises(reading: _Reading, prepared: PreparedCases, ended: str) -> tuple[list[ExerciseScore], float, bool]:
+    """Every exercise's score from its report; return the scores, the seconds of the calls, and
+    whether a disabled reference was called."""
     scores, compute, called_reference = [], 0.0, False
     for k, (ex, cases, expected) in enumerate(zip(prepared.exercises, prepared.cases, prepared.expected)):
-        try:
-            report = job.read_exercise(k, len(cases))
-        except TransportError as exc:
-            report, why = None, f"its results were unusable ({exc})"
-        else:
-            why = ended
-        if report is None:
-            scores.append(ExerciseScore.zero(ex, len(cases), f"not graded: {why}"))
+        report = reading.get(f"the results of {ex.id}", lambda: reading.job.read_exercise(k, len(cases)))
+        if report is _UNUSABLE:
+            scores.append(ExerciseScore.zero(ex, len(cases), f"not graded: its results were unusable "
+                                                             f"({reading.problems[-1]})"))
+        elif report is None:
+            scores.append(ExerciseScore.zero(ex, len(cases), f"not graded: {ended}"))
         elif not report.defined:
             scores.append(ExerciseScore.zero(ex, len(cases), f"function not defined: no function named "
                                                              f"{ex.function!r} in the notebook"))
@@ -196,9 +226,37 @@ def _score(job: JobDir, student: str, path: Path, prepared: PreparedCases, exit_
             score, cheated = _score_exercise(ex, cases, expected, report.results)
             scores.append(score)
             called_reference |= cheated
-    if called_reference or job.read_reference_calls():
+    return scores, compute, called_reference
+
+
+def _cell_errors(cells: Sequence[CellRecord]) -> list[str]:
+    return [f"code cell {c.cell}: {c.status}: {c.error.type[:80]}: {c.error.message[:200]}"
+            for c in cells if c.status in ("error", "timeout") and c.error]
+
+
+def _score(job: JobDir, student: str, path: Path, prepared: PreparedCases, exit_: WorkerExit,
+           start: float) -> SubmissionResult:
+    """Read what the worker wrote (through the protocol's validating readers) and score it.
+
+    A file that is unusable costs what it holds: an exercise's report that exercise; the log of
+    reference calls every exercise (the grader can no longer tell whether a reference was called).
+    """
+    flags = [] if exit_.isolated else ["sandbox=limited"]
+    reading = _Reading(job)
+    cells = reading.get("the record of your cells", job.read_cells)
+    ended = "the grader stopped your notebook at its time limit" if exit_.timed_out else \
+        "your notebook ended the grading process early"
+    scores, compute, called_reference = _score_exercises(reading, prepared, ended)
+    calls = reading.get("the log of reference calls", job.read_reference_calls)
+    if calls is _UNUSABLE:
+        scores = _zero(prepared, "not graded: the grading process's log of reference calls was unusable")
+    elif calls:
+        called_reference = True
+    if called_reference:
         flags.append("called-reference")
-    done = job.read_done()
+    done = reading.get("the final report", job.read_done)
+    if reading.problems:
+        flags.append("unusable-results")
     log = ""
     if exit_.timed_out:
         flags.append("timeout")
@@ -210,8 +268,50 @@ def _score(job: JobDir, student: str, path: Path, prepared: PreparedCases, exit_
         if exit_.returncode is not None and exit_.returncode < 0:
             log = f"(worker killed by signal {-exit_.returncode})\n" + log
     return SubmissionResult(student, path, scores, flags, seconds=time.perf_counter() - start,
-                            compute_seconds=done.compute_seconds if done else compute,
-                            cell_errors=cell_errors, worker_log=log)
+                            compute_seconds=done.compute_seconds if isinstance(done, DoneReport) else compute,
+                            cell_errors=_cell_errors(cells if isinstance(cells, tuple) else ()), worker_log=log,
+                            problems=reading.problems)
+
+
+def unique_students(paths: Sequence[Path], assignment: str) -> list[tuple[str, str]]:
+    """Each path's student name, and a note: names that would share a feedback file (same
+    :func:`~.submission.feedback_stem`, ignoring case) are all numbered ``name#1``, ``name#2``, ...
+    in the order given, none keeping the bare name, with a note that lists the files.
+
+    Examples
+    --------
+    >>> unique_students([Path("alice.ipynb"), Path("alice/00_x.ipynb"), Path("bob.ipynb")], "00_x")[1]
+    ('alice#2', "2 files map to student 'alice': alice.ipynb, alice/00_x.ipynb")
+    """
+    names = [student_name(p, assignment) for p in paths]
+    groups = collections.defaultdict(list)
+    for i, name in enumerate(names):
+        groups[feedback_stem(name).casefold()].append(i)
+    taken = set(groups)
+    out = [(name, "") for name in names]
+    for members in (m for m in groups.values() if len(m) > 1):
+        note = (f"{len(members)} files map to student {names[members[0]]!r}: "
+                + ", ".join(str(paths[i]) for i in members))
+        for n, i in enumerate(members, 1):
+            name = f"{names[i]}#{n}"
+            while feedback_stem(name).casefold() in taken:
+                name += "#"
+            taken.add(feedback_stem(name).casefold())
+            out[i] = (name, note)
+    return out
+
+
+def _grader_failed(path: Path, student: str, prepared: PreparedCases, exc: Exception) -> SubmissionResult:
+    """The result of a submission on which the grader itself failed (a bug, a broken environment)."""
+    what = "".join(traceback.format_exception_only(type(exc), exc)).strip()[-300:]
+    return SubmissionResult(student, path, _zero(prepared, "not graded: the grader failed on this file"),
+                            ["grader-error"], f"the grader failed on this file ({what})")
+
+
+def needs_review(results: Sequence[SubmissionResult]) -> list[str]:
+    """One line per submission that makes ``robokit grade`` exit 1: not graded, or a duplicate name."""
+    return [f"{r.path}: " + "; ".join(filter(None, [r.reason, *r.notes]))
+            for r in results if not r.graded or "duplicate-name" in r.flags]
 
 
 def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs: int = 1,
@@ -235,13 +335,22 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
         raise GradingError(str(exc)) from None
     if not paths:
         raise GradingError("submissions: expected at least one notebook")
+    paths = [Path(p) for p in paths]
+    names = unique_students(paths, assignment)
     work_root = Path(tempfile.mkdtemp(prefix="robokit-grade-"))
     work_root.chmod(0o711)
 
-    def one(path):
-        result = grade_submission(path, assignment, prepared, limits=limits, kit=kit, hide=hide,
-                                  work_root=work_root)
-        log(f"  {result.student:<24} {result.total:6.2f} / {result.max_total:<6.2f} "
+    def one(path: Path, name: tuple[str, str]) -> SubmissionResult:
+        try:
+            result = grade_submission(path, assignment, prepared, limits=limits, kit=kit, hide=hide,
+                                      work_root=work_root)
+        except Exception as exc:  # one submission's failure, whatever it is, must not cost the batch
+            result = _grader_failed(path, name[0], prepared, exc)
+        result.student = name[0]
+        if name[1]:
+            result.flags.append("duplicate-name")
+            result.notes.append(name[1])
+        log(f"  {clean(result.student, 40):<24} {result.total:6.2f} / {result.max_total:<6.2f} "
             f"{result.seconds:5.1f}s  {' '.join(result.flags)}")
         return result
 
@@ -251,7 +360,7 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
         except KitError as exc:
             raise GradingError(str(exc)) from None
         with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-            return list(pool.map(one, [Path(p) for p in paths]))
+            return list(pool.map(one, paths, names))
     finally:
         shutil.rmtree(work_root, ignore_errors=True)
 

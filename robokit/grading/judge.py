@@ -37,8 +37,19 @@ def judge(exercise: Exercise, case: Case, expected: Any, result: CallResult) -> 
     """Judge what the student's function gave on ``case`` (``result``) against ``expected``.
 
     A bad-input case passes when the function raised ``case.raises`` (or a subclass); any other
-    case when ``exercise.compare`` accepts the value. Grading design (DESIGN.md, "Grading").
+    case when ``exercise.compare`` accepts the value. A value that cannot even be compared (e.g. an
+    integer too large for a float) fails its case; it never raises. Grading design (DESIGN.md,
+    "Grading").
     """
+    try:
+        return _judge(exercise, case, expected, result)
+    except Exception as exc:  # the value came from student code; whatever it does to a comparison fails the case
+        label = f" ({case.label})" if case.label else ""
+        return Outcome(case, False, f"your result could not be compared with the expected one{label} "
+                                    f"({type(exc).__name__})")
+
+
+def _judge(exercise: Exercise, case: Case, expected: Any, result: CallResult) -> Outcome:
     label = f" ({case.label})" if case.label else ""
     err = result.error
     if err is not None:

@@ -9,32 +9,41 @@ A job directory (:class:`JobDir`) holds::
     out/ex<k>      ExerciseReport  written as soon as exercise k has run
     out/done       DoneReport      written last: the worker finished
     out/flags.log                  ``reference:<name>``: graded code called a disabled reference
+    worker.log                     the worker process's own stdout and stderr
 
-Records are dataclasses, stored as their fields in plain data (:mod:`.transport`). ``out/`` is
-written by untrusted code: the grader reads it only through :class:`JobDir`'s ``read_*`` methods,
-which bound and validate every field and return clean records, ``None`` for a file never written,
-or raise :class:`~.transport.TransportError`.
+Records are dataclasses, stored as their fields in plain data (:mod:`.transport`). ``out/`` (and,
+without root, the whole job directory) is writable by untrusted code, which may replace any file
+in it by a link, a FIFO, a directory or garbage, before or after the grader looks. The grader reads
+it only through :class:`JobDir`'s ``read_*`` methods, and nothing else opens those files: they open
+``out/`` itself without following a link and each file with
+:func:`~.transport.read_untrusted` (no link followed, no FIFO waited on, regular files only, bounded
+reads), validate every field strictly, and return clean records, ``None`` for a file never written,
+or raise :class:`~.transport.TransportError`: a record with one wrong field is unusable as a whole.
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import os
 import tempfile
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 from ..exercises.plain import NotPlainData, to_plain
-from .transport import TransportError, read_plain, was_written, write_plain
+from .transport import NotWritten, TransportError, read_plain, read_untrusted, write_plain
 
 __all__ = ["JobDir", "JobSpec", "CellRecord", "CallResult", "ErrorRecord", "ExerciseReport", "DoneReport",
            "ReferenceSolutionDisabled", "log_reference_call", "CELL_STATUSES"]
 
 #: Bounds on what the grader takes from the worker.
 MAX_NAME, MAX_MESSAGE, MAX_CLASSES, MAX_CELLS = 100, 500, 12, 500
-MAX_FLAG_BYTES, MAX_FLAG_LINES = 64 * 1024, 100
+MAX_FLAG_BYTES, MAX_FLAG_LINES, MAX_LOG_BYTES = 64 * 1024, 100, 4000
+#: A duration (s) or a cell index beyond these is malformed, not just large.
+MAX_SECONDS, MAX_CELL_INDEX = 1e7, 10**6
 CELL_STATUSES = ("ok", "error", "timeout", "skipped")
 _REFERENCE_FLAG = "reference:"
+_DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC
 
 
 class ReferenceSolutionDisabled(Exception):
@@ -57,9 +66,19 @@ def _plain(record: Any) -> Any:
 
 
 def _seconds(value: Any) -> float:
-    """A duration reported by the worker: a finite non-negative number, else 0."""
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
-    return float(value) if ok else 0.0
+    """A duration reported by the worker: a number in [0, MAX_SECONDS], else a TransportError."""
+    if type(value) is int and 0 <= value <= MAX_SECONDS:
+        return float(value)
+    if type(value) is float and math.isfinite(value) and 0 <= value <= MAX_SECONDS:
+        return value
+    raise TransportError("malformed duration")
+
+
+def _text(raw: Any, limit: int) -> str:
+    """A string field read from the worker, truncated to ``limit``; anything else is malformed."""
+    if type(raw) is not str:
+        raise TransportError("malformed text field")
+    return raw[:limit]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -88,12 +107,11 @@ class ErrorRecord:
 
     @classmethod
     def from_plain(cls, raw: Any) -> ErrorRecord:
-        """Validate an error record read from the worker."""
-        if not isinstance(raw, dict):
+        """Validate an error record read from the worker (its ``line`` is dropped)."""
+        if not isinstance(raw, dict) or not isinstance(raw.get("classes"), list):
             raise TransportError("malformed error record")
-        classes = raw.get("classes") if isinstance(raw.get("classes"), list) else []
-        return cls(str(raw.get("type"))[:MAX_NAME], tuple(str(c)[:MAX_NAME] for c in classes[:MAX_CLASSES]),
-                   str(raw.get("message"))[:MAX_MESSAGE])
+        return cls(_text(raw.get("type"), MAX_NAME), tuple(_text(c, MAX_NAME) for c in raw["classes"][:MAX_CLASSES]),
+                   _text(raw.get("message"), MAX_MESSAGE))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -164,7 +182,8 @@ class CellRecord:
     @classmethod
     def from_plain(cls, raw: Any) -> CellRecord:
         """Validate one cell record read from the worker."""
-        if not isinstance(raw, dict) or type(raw.get("cell")) is not int or raw.get("status") not in CELL_STATUSES:
+        if not isinstance(raw, dict) or type(raw.get("cell")) is not int or not 0 <= raw["cell"] < MAX_CELL_INDEX \
+                or raw.get("status") not in CELL_STATUSES:
             raise TransportError("malformed cell record")
         return cls(raw["cell"], raw["status"], None if raw.get("error") is None else ErrorRecord.from_plain(raw["error"]))
 
@@ -184,7 +203,7 @@ class ExerciseReport:
         """Validate the report of an exercise with ``n_cases`` cases."""
         if isinstance(raw, dict) and raw.get("defined") is False:
             return cls(defined=False)
-        if not isinstance(raw, dict) or not isinstance(raw.get("results"), list):
+        if not isinstance(raw, dict) or raw.get("defined") is not True or not isinstance(raw.get("results"), list):
             raise TransportError("malformed results")
         if len(raw["results"]) != n_cases:
             raise TransportError(f"expected {n_cases} results, got {len(raw['results'])}")
@@ -230,21 +249,38 @@ class JobDir:
         """Write the request ``in/job``."""
         write_plain(_plain(spec), self.inbox / "job")
 
-    def read_cells(self) -> tuple[CellRecord, ...] | None:
-        """The first ``MAX_CELLS`` well-formed cell records; ``None`` if missing or malformed."""
+    @contextlib.contextmanager
+    def _outbox_fd(self) -> Iterator[int]:
+        """``out/`` opened as a directory, never through a link (the worker may have replaced it)."""
         try:
-            raw = read_plain(self.outbox / "cells")
-        except TransportError:
+            fd = os.open(self.outbox, _DIR_FLAGS)
+        except OSError as exc:
+            raise TransportError(f"out/ could not be opened ({exc.strerror})") from None
+        try:
+            yield fd
+        finally:
+            os.close(fd)
+
+    def _read_out(self, stem: str) -> Any:
+        """The plain data of ``out/<stem>`` (see :func:`~.transport.read_plain`)."""
+        with self._outbox_fd() as fd:
+            return read_plain(stem, dir_fd=fd)
+
+    def read_cells(self) -> tuple[CellRecord, ...] | None:
+        """The first ``MAX_CELLS`` cell records; ``None`` if the worker never wrote them.
+
+        Raises
+        ------
+        TransportError
+            If the file is unsafe, too large or holds a malformed record.
+        """
+        try:
+            raw = self._read_out("cells")
+        except NotWritten:
             return None
         if not isinstance(raw, list):
-            return None
-        cells = []
-        for entry in raw[:MAX_CELLS]:
-            try:
-                cells.append(CellRecord.from_plain(entry))
-            except TransportError:
-                continue
-        return tuple(cells)
+            raise TransportError("malformed cell records")
+        return tuple(CellRecord.from_plain(entry) for entry in raw[:MAX_CELLS])
 
     def read_exercise(self, k: int, n_cases: int) -> ExerciseReport | None:
         """The report of exercise ``k``; ``None`` if the worker never wrote it.
@@ -254,30 +290,61 @@ class JobDir:
         TransportError
             If it was written but is malformed, too large or unsafe.
         """
-        if not was_written(self.exercise_file(k)):
+        try:
+            raw = self._read_out(f"ex{k}")
+        except NotWritten:
             return None
-        return ExerciseReport.from_plain(read_plain(self.exercise_file(k)), n_cases)
+        return ExerciseReport.from_plain(raw, n_cases)
 
     def read_done(self) -> DoneReport | None:
-        """The final report; ``None`` if the worker did not get that far. A malformed report still
-        says that the worker finished; its duration then reads as 0."""
-        if not was_written(self.outbox / "done"):
-            return None
+        """The final report; ``None`` if the worker did not get that far.
+
+        Raises
+        ------
+        TransportError
+            If it was written but is malformed, too large or unsafe.
+        """
         try:
-            raw = read_plain(self.outbox / "done")
-        except TransportError:
-            raw = None
-        return DoneReport(_seconds(raw.get("compute_seconds") if isinstance(raw, dict) else None))
+            raw = self._read_out("done")
+        except NotWritten:
+            return None
+        if not isinstance(raw, dict):
+            raise TransportError("malformed final report")
+        return DoneReport(_seconds(raw.get("compute_seconds")))
 
     def read_reference_calls(self) -> list[str]:
-        """Dotted names of the disabled references graded code called (the log's first lines)."""
+        """Dotted names of the disabled references graded code called (the log's first lines);
+        empty if the log was never written.
+
+        Raises
+        ------
+        TransportError
+            If the log is unsafe (a link, a FIFO, ...) or unreadable.
+        """
         try:
-            with open(self.outbox / "flags.log", "rb") as f:
-                text = f.read(MAX_FLAG_BYTES).decode(errors="replace")
-        except OSError:
+            with self._outbox_fd() as fd:
+                data = read_untrusted("flags.log", MAX_FLAG_BYTES, dir_fd=fd, keep="head")
+        except NotWritten:
             return []
+        text = data.decode(errors="replace")
         return [line[len(_REFERENCE_FLAG):][:MAX_NAME] for line in text.splitlines()[:MAX_FLAG_LINES]
                 if line.startswith(_REFERENCE_FLAG)]
+
+    @property
+    def log_file(self) -> Path:
+        """``worker.log``: where the sandbox sends the worker process's stdout and stderr."""
+        return self.root / "worker.log"
+
+    def read_log_tail(self) -> str:
+        """The last ``MAX_LOG_BYTES`` of ``worker.log`` as text ("" if never written); without root
+        the worker can replace that file too, so it is read like the files in ``out/``."""
+        try:
+            data = read_untrusted(self.log_file, MAX_LOG_BYTES, keep="tail")
+        except NotWritten:
+            return ""
+        except TransportError as exc:
+            return f"(the worker's log is unusable: {exc})"
+        return data.decode(errors="replace")
 
     # -- the worker's side ------------------------------------------------------------------------
 

@@ -31,7 +31,6 @@ import pwd
 import random
 import resource
 import signal
-import stat
 import subprocess
 import sys
 import time
@@ -41,15 +40,13 @@ from typing import Iterator, Sequence
 from .filesystem_view import View, enter_view
 from .protocol import JobDir
 
-__all__ = ["Limits", "WorkerExit", "run_sandboxed", "is_root", "lease_job_uid", "conceal_secret", "log_tail",
-           "JOB_UIDS", "UID_LEASE_DIR", "WORKER_LOG"]
+__all__ = ["Limits", "WorkerExit", "run_sandboxed", "is_root", "lease_job_uid", "conceal_secret",
+           "JOB_UIDS", "UID_LEASE_DIR"]
 
 #: Job uids/gids (no passwd entry is needed; uids that have one are skipped).
 JOB_UIDS = range(61000, 65000)
 #: Root-only directory of the lock files that lease job uids to grading runs on this host.
 UID_LEASE_DIR = Path("/run/robokit-grading/uids")
-#: The worker's stdout and stderr, in the job directory (its tail explains a worker that ended early).
-WORKER_LOG = "worker.log"
 _PR_SET_DUMPABLE = 4
 
 
@@ -307,7 +304,7 @@ def _create(path: Path):
 def _run(config: Path, job: JobDir, limits: Limits, path_env: str) -> tuple[int | None, bool]:
     """Start the launcher, wait for it up to the wall-clock limit, kill its process group."""
     timed_out = False
-    with _create(job.root / WORKER_LOG) as log:
+    with _create(job.log_file) as log:
         proc = subprocess.Popen(
             [sys.executable, "-m", "robokit.grading.sandbox", str(config)], cwd=job.root,
             env={"PATH": path_env, "LANG": "C.UTF-8"}, stdin=subprocess.DEVNULL, stdout=log,
@@ -325,26 +322,6 @@ def _run(config: Path, job: JobDir, limits: Limits, path_env: str) -> tuple[int 
             proc.kill()
         proc.wait()
     return proc.returncode, timed_out
-
-
-def log_tail(job: JobDir, limit: int = 4000) -> str:
-    """The last ``limit`` bytes of the job's ``worker.log``, as text.
-
-    In the limited mode the worker runs as the grader's user and could replace the log: a link is
-    not followed, and anything but a regular file reads as empty (never a blocking or endless read).
-    """
-    try:
-        fd = os.open(job.root / WORKER_LOG, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
-    except OSError:
-        return ""
-    try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            return ""
-        os.lseek(fd, max(0, info.st_size - limit), os.SEEK_SET)
-        return os.read(fd, limit).decode(errors="replace")
-    finally:
-        os.close(fd)
 
 
 def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, view: View,
@@ -372,7 +349,7 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, view: V
         except OSError as exc:  # e.g. a file planted in the job folder (limited mode)
             return WorkerExit(None, False, 0.0, uid is not None, f"the grader could not start the worker: {exc}")
         seconds = time.perf_counter() - start
-    return WorkerExit(returncode, timed_out, seconds, uid is not None, log_tail(job))
+    return WorkerExit(returncode, timed_out, seconds, uid is not None, job.read_log_tail())
 
 
 if __name__ == "__main__":
