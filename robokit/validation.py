@@ -82,7 +82,7 @@ def _whole(raw: np.ndarray, name: str) -> None:
 def _convert(value: Any, name: str, target: np.dtype | None) -> np.ndarray:
     """``value`` as an array of ``target`` (``None``: its own numeric dtype), refusing what is not
     a number of that kind (see the module docstring)."""
-    if isinstance(value, np.ndarray):
+    if type(value) is np.ndarray:     # a subclass (matrix, masked array) becomes a plain array, as before
         raw = value
     else:
         try:

@@ -21,6 +21,12 @@ from typing import NamedTuple
 
 __all__ = ["RMC", "RMB", "GGA", "HDG", "Sentence", "KNOT", "NAUTICAL_MILE"]
 
+def _repr(record: tuple) -> str:
+    """The named tuple's usual repr, without ``bad_fields`` when it is empty (an intact sentence)."""
+    items = [(k, v) for k, v in zip(record._fields, record) if k != "bad_fields" or v]
+    return f"{type(record).__name__}(" + ", ".join(f"{k}={v!r}" for k, v in items) + ")"
+
+
 #: One knot in metres per second (1852 m per hour).
 KNOT = 1852.0 / 3600.0
 #: One international nautical mile in metres.
@@ -52,7 +58,8 @@ class RMC(NamedTuple):
         Mode indicator (NMEA 2.3+): ``A`` autonomous, ``D`` differential, ``N`` not valid, ...
     bad_fields : tuple of str
         Attributes whose field was corrupt (not a number, NaN, infinite, out of range) and is
-        therefore ``None``; empty for an intact sentence (see :func:`~robokit.outdoor.nmea_fields.salvage_record`).
+        therefore ``None``; empty for an intact sentence, and then left out of the repr (see
+        :func:`~robokit.outdoor.nmea_fields.salvage_record`).
     """
 
     talker: str
@@ -66,6 +73,8 @@ class RMC(NamedTuple):
     magnetic_variation_deg: float | None
     mode: str | None
     bad_fields: tuple = ()
+
+    __repr__ = _repr
 
     @property
     def kind(self) -> str:
@@ -123,7 +132,8 @@ class RMB(NamedTuple):
         Mode indicator (NMEA 2.3+).
     bad_fields : tuple of str
         Attributes whose field was corrupt (not a number, NaN, infinite, out of range) and is
-        therefore ``None``; empty for an intact sentence (see :func:`~robokit.outdoor.nmea_fields.salvage_record`).
+        therefore ``None``; empty for an intact sentence, and then left out of the repr (see
+        :func:`~robokit.outdoor.nmea_fields.salvage_record`).
     """
 
     talker: str
@@ -140,6 +150,8 @@ class RMB(NamedTuple):
     arrival: str | None
     mode: str | None
     bad_fields: tuple = ()
+
+    __repr__ = _repr
 
     @property
     def kind(self) -> str:
@@ -183,7 +195,8 @@ class GGA(NamedTuple):
         Differential reference station id.
     bad_fields : tuple of str
         Attributes whose field was corrupt (not a number, NaN, infinite, out of range) and is
-        therefore ``None``; empty for an intact sentence (see :func:`~robokit.outdoor.nmea_fields.salvage_record`).
+        therefore ``None``; empty for an intact sentence, and then left out of the repr (see
+        :func:`~robokit.outdoor.nmea_fields.salvage_record`).
     """
 
     talker: str
@@ -198,6 +211,8 @@ class GGA(NamedTuple):
     dgps_age_s: float | None
     dgps_station: str | None
     bad_fields: tuple = ()
+
+    __repr__ = _repr
 
     @property
     def kind(self) -> str:
@@ -225,7 +240,8 @@ class HDG(NamedTuple):
         Magnetic variation, signed (east positive).
     bad_fields : tuple of str
         Attributes whose field was corrupt (not a number, NaN, infinite, out of range) and is
-        therefore ``None``; empty for an intact sentence (see :func:`~robokit.outdoor.nmea_fields.salvage_record`).
+        therefore ``None``; empty for an intact sentence, and then left out of the repr (see
+        :func:`~robokit.outdoor.nmea_fields.salvage_record`).
 
     Notes
     -----
@@ -237,6 +253,8 @@ class HDG(NamedTuple):
     deviation_deg: float | None
     variation_deg: float | None
     bad_fields: tuple = ()
+
+    __repr__ = _repr
 
     @property
     def kind(self) -> str:
