@@ -76,7 +76,7 @@ def _is_number(x: Any) -> bool:
 def _whole(raw: np.ndarray, name: str) -> None:
     ok = np.isfinite(raw) & (raw == np.round(raw)) & (np.abs(raw) < 2.0 ** 63)
     if not np.all(ok):
-        raise ValueError(f"{name}: expected whole numbers, got {raw[~ok].flat[0]!r}")
+        raise ValueError(f"{name}: expected whole numbers, got {float(raw[~ok].flat[0])!r}")
 
 
 def _convert(value: Any, name: str, target: np.dtype | None) -> np.ndarray:
