@@ -23,6 +23,12 @@ def versions(extra: tuple[str, ...] = ()) -> dict[str, str]:
     dict
         Name to version string; ``"missing"`` for a package that is not installed.
 
+    Raises
+    ------
+    TypeError
+        If ``extra`` is not a tuple or list of non-empty strings (a lone string would be read
+        letter by letter).
+
     Notes
     -----
     Environment check for lesson 00; not from a paper.
@@ -34,6 +40,8 @@ def versions(extra: tuple[str, ...] = ()) -> dict[str, str]:
     >>> "python" in v and "numpy" in v and v["robokit"] != "missing"
     True
     """
+    if not isinstance(extra, (tuple, list)) or not all(isinstance(n, str) and n for n in extra):
+        raise TypeError(f"extra: expected a tuple of distribution names, got {extra!r:.60}")
     out = {"python": platform.python_version(), "robokit": _version("robokit")}
     for name in REQUIRED + tuple(extra):
         out[name] = _version(name)

@@ -9,9 +9,10 @@ import pytest
 
 pynmea2 = pytest.importorskip("pynmea2")
 
-from robokit.outdoor.nmea import (GGA, HDG, RMB, RMC, NMEAChecksumError, NMEAError, NMEAFormatError,
-                                  NMEAReader, Sentence, nmea_checksum, parse_date, parse_latitude,
+from robokit.outdoor.nmea import (GGA, HDG, RMB, RMC, BadFields, NMEAChecksumError, NMEAError, NMEAFieldError,
+                                  NMEAFormatError, NMEAReader, Sentence, nmea_checksum, parse_date, parse_latitude,
                                   parse_longitude, parse_sentence, parse_time, read_nmea)
+from robokit.outdoor.nmea_fields import RECORD_PARSERS
 from robokit.outdoor.nmea_write import (format_latitude, format_longitude, format_sentence, gga_sentence,
                                         hdg_sentence, random_sentences, rmb_sentence, rmc_sentence)
 
@@ -157,19 +158,110 @@ def test_error_hierarchy_is_valueerror():
     ("$GPRMC,123519,A,4867.038,N,01131.000,E,022.4,084.4,230394,003.1,W", NMEAFormatError, "minutes"),
     ("$GPRMC,123519,A,4807.038,X,01131.000,E,022.4,084.4,230394,003.1,W", NMEAFormatError, "hemisphere"),
     ("$GPRMC,123519,A,4807.038,,01131.000,E,022.4,084.4,230394,003.1,W", NMEAFormatError, "hemisphere"),
-    ("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,310294,003.1,W", NMEAFormatError, "date"),
-    ("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,2303,003.1,W", NMEAFormatError, "ddmmyy"),
-    ("$GPRMC,256019,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W", NMEAFormatError, "hours"),
-    ("$GPRMC,123519,A,4807.038,N,01131.000,E,fast,084.4,230394,003.1,W", NMEAFormatError, "speed"),
     ("$GPRMC,123519,A,4807.038,N", NMEAFormatError, "RMC"),
-    ("$GPGGA,123519,4807.038,N,01131.000,E,x,08,0.9,545.4,M", NMEAFormatError, "quality"),
     ("$HCHDG,400.0,,,7.1,W", NMEAFormatError, "heading"),
+    ("$HCHDG,nan,,,7.1,W", NMEAFieldError, "heading_deg: expected a finite number"),
+    ("$GPGGA,123519,48nan,N,01131.000,E,1,08,0.9,545.4,M", NMEAFieldError, "GGA latitude"),
+    ("$GPRMB,A,0.66,L,003,004,4917.24,N,inf,W,001.3,052.5,000.5,V", NMEAFieldError, "destination_longitude"),
     ("$GPRMB,A,0.66,L,003", NMEAFormatError, "RMB"),
     ("$g?,1,2", NMEAFormatError, "address"),
 ])
 def test_bad_sentences_raise_clear_errors(text, err, words):
     with pytest.raises(err, match=words):
         parse_sentence(text, require_checksum=err is NMEAChecksumError)
+
+
+@pytest.mark.parametrize("text, words, bad", [
+    ("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,310294,003.1,W", "date", ("date",)),
+    ("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,2303,003.1,W", "ddmmyy", ("date",)),
+    ("$GPRMC,256019,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W", "hours", ("time",)),
+    ("$GPRMC,123519,A,4807.038,N,01131.000,E,fast,084.4,230394,003.1,W", "speed_knots", ("speed_knots",)),
+    ("$GPRMC,123519,A,4807.038,N,01131.000,E,X.138,nan,230394,003.1,W", "speed_knots", ("speed_knots", "course_deg")),
+    ("$GPGGA,123519,4807.038,N,01131.000,E,x,08,0.9,545.4,M", "quality", ("quality",)),
+])
+def test_a_corrupt_optional_field_is_emptied_and_named_not_fatal(text, words, bad):
+    rec = parse_sentence(text, require_checksum=False)
+    assert rec.bad_fields == bad and all(getattr(rec, name) is None for name in bad)
+    assert rec.latitude == pytest.approx(48.1173)        # the position survives
+    with pytest.raises(NMEAFieldError, match=words) as info:  # the field on its own says why
+        RECORD_PARSERS[rec.kind](rec.talker, text.split(",")[1:])
+    assert info.value.field == bad[0]
+
+
+# --- every field corrupted on its own: emptied and named, or (essential) the sentence rejected ------
+
+FULL = [rmc_sentence(dt.datetime(2012, 6, 4, 2, 30, 5, 250000), 6.45, 100.35, speed_mps=1.2, course_deg=45.0,
+                     magnetic_variation_deg=-0.5),
+        format_sentence("GNGGA", "023005.00,0627.0000,S,10021.0000,W,2,08,0.9,12.5,M,-3.2,M,1.5,0120".split(",")),
+        hdg_sentence(120.0, deviation_deg=1.5, variation_deg=-0.5),
+        rmb_sentence(6.46, 100.36, 120.0, 45.0, cross_track_m=-3.0, closing_velocity_mps=1.0)]
+#: What the records exist to carry: a corrupt one rejects the sentence.
+ESSENTIAL = {"latitude", "longitude", "destination_latitude", "destination_longitude", "heading_deg"}
+#: Not numbers: what a sentence's text may hold, ``nan`` included, and what a fuzz of any field tries.
+CORRUPTIONS = ["nan", "NaN", "-nan", "inf", "-inf", "+Infinity", "1e999", "X.138", "1.2.3", "?"]
+
+
+def _corrupted():
+    for full in FULL:
+        address, fields = full[1:full.index("*")].split(",", 1)
+        fields = fields.split(",")
+        for i in range(len(fields)):
+            for bad in CORRUPTIONS:
+                yield pytest.param(full, format_sentence(address, fields[:i] + [bad] + fields[i + 1:]), bad,
+                                   id=f"{address}-field{i + 1}-{bad}")
+
+
+def _numeric_attributes(rec):
+    return {k for k, v in rec._asdict().items() if isinstance(v, float)}
+
+
+@pytest.mark.parametrize("full, text, bad", list(_corrupted()))
+def test_every_field_corrupted_on_its_own_is_emptied_and_named_or_rejects_the_sentence(full, text, bad):
+    intact = parse_sentence(full)
+    try:
+        rec = parse_sentence(text)
+    except NMEAFieldError as exc:
+        assert exc.field in ESSENTIAL and exc.field in str(exc) and repr(bad) in str(exc)
+        return
+    assert not any(isinstance(v, float) and not np.isfinite(v) for v in rec), rec     # no NaN, no inf
+    changed = [k for k in rec._fields if k != "bad_fields" and getattr(rec, k) != getattr(intact, k)]
+    if rec.bad_fields:   # the corrupt field, and nothing else, emptied and named
+        assert changed == list(rec.bad_fields) and all(getattr(rec, k) is None for k in changed)
+        assert not ESSENTIAL & set(changed)
+    else:                # free text (waypoint ids, mode, station) or a field the record does not read (units)
+        assert all(getattr(rec, k) == bad for k in changed) and len(changed) <= 1
+
+
+def test_corruption_reaches_every_numeric_field_of_every_record():
+    """The generated cases above do cover each float field (read off the records, not listed)."""
+    emptied = {}
+    for param in _corrupted():
+        full, text, _ = param.values
+        try:
+            rec = parse_sentence(text)
+        except NMEAFieldError as exc:
+            emptied.setdefault(full, set()).add(exc.field)
+            continue
+        emptied.setdefault(full, set()).update(rec.bad_fields)
+    for full in FULL:
+        assert _numeric_attributes(parse_sentence(full)) <= emptied[full], full
+
+
+def test_the_reader_keeps_a_sentence_with_a_corrupt_field_and_counts_it():
+    speed = format_sentence("GPRMC", ["123519", "A", "4807.038", "N", "01131.000", "E", "X.138", "84.4", "230394", "", ""])
+    position = format_sentence("GPRMC", ["123519", "A", "4807.038", "N", "nan", "E", "22.4", "84.4", "230394", "", ""])
+    data = "\r\n".join([HAND_WRITTEN[0], speed, position, HAND_WRITTEN[2].replace("7.1", "inf")]).encode()
+    seen = []
+    reader = NMEAReader(data, on_error=seen.append)
+    records = list(reader)
+    assert [r.kind for r in records] == ["RMC", "RMC"]      # the position fix survives its speed
+    assert records[1].latitude == pytest.approx(48.1173) and records[1].speed_knots is None
+    assert [(b.line, b.fields) for b in reader.field_errors] == [(2, ("speed_knots",))]
+    assert isinstance(reader.field_errors[0], BadFields) and reader.field_errors[0].text == speed.encode()
+    assert [b.line for b in reader.errors] == [3, 4] and seen == reader.errors   # rejected: still counted
+    assert "longitude" in str(reader.errors[0].error) and isinstance(reader.errors[1].error, NMEAChecksumError)
+    records, bad = read_nmea(data)
+    assert len(records) == 2 and len(bad) == 2
 
 
 def test_checksum_optional_when_asked():
@@ -264,7 +356,7 @@ def _dirty_stream(rng):
         else:
             lines.append(s.encode() + b"\r\n")
     bad_values = [format_sentence("GPRMC", ["123519", "A", "9107.038", "N", "01131.000", "E", "1", "2", "230394", "", ""]),
-                  format_sentence("GPRMC", ["123519", "A", "4807.038", "N", "01131.000", "E", "1", "2", "320194", "", ""])]
+                  format_sentence("GPRMC", ["123519", "A", "4807.038", "N", "18131.000", "E", "1", "2", "230394", "", ""])]
     lines += [b.encode() + b"\r\n" for b in bad_values]
     expect_bad += 2
     return good, b"".join(lines), expect_bad

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3
-from ..validation import as_array, as_rng, check_choice, check_int
+from ..validation import array_ndim, as_array, as_rng, check_choice, check_int
 from .dh import dh_transform, mdh_transform
 
 __all__ = ["Chain", "dh_fk", "chain_from_table"]
@@ -135,7 +135,7 @@ class Chain:
         -------
         bool or numpy.ndarray of bool, shape (N,)
         """
-        q = self.check_q(q, batch=np.ndim(q) == 2)
+        q = self.check_q(q, batch=array_ndim(q, "q") == 2)
         ok = np.all((q >= self.qmin - tol) & (q <= self.qmax + tol), axis=-1)
         return bool(ok) if ok.ndim == 0 else ok
 
@@ -199,7 +199,7 @@ class Chain:
         [0.0, 0.0, 1.306]
         """
         if check:
-            q = self.check_q(q, batch=np.ndim(q) == 2)
+            q = self.check_q(q, batch=array_ndim(q, "q") == 2)
         th = q + self.offset if self._has_offset else q
         links = self._K + np.cos(th)[..., None, None] * self._U + np.sin(th)[..., None, None] * self._V
         out = np.empty(q.shape[:-1] + (self.n + 1, 4, 4))

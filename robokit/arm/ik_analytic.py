@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3, zyz_angles
-from ..validation import as_array, check_int, check_positive
+from ..validation import array_ndim, as_array, check_int, check_positive
 from .chain import Chain
 from .result import IKBatchResult, IKResult, verify
 from .srs_geometry import ARRAY, SCALAR, arm_angle_terms, coefficient_terms, mirror_angle
@@ -238,7 +238,7 @@ def arm_angle(chain: Chain, q: Any) -> float | np.ndarray:
     -29.971
     """
     arm = _srs(chain)
-    return arm.arm_angle(chain.check_q(q, batch=np.ndim(q) == 2))
+    return arm.arm_angle(chain.check_q(q, batch=array_ndim(q, "q") == 2))
 
 
 def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = True) -> np.ndarray:
@@ -358,9 +358,9 @@ def ik_srs(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: float 
     >>> r.success, r.reason, r.position_error < 1e-9
     (True, 'converged', True)
     """
-    if np.ndim(T) != 2:
+    if array_ndim(T, "T") != 2:
         raise ValueError(f"T: expected one transform of shape (4, 4), got shape {np.shape(T)}")
-    if q0 is not None and np.ndim(q0) != 1:
+    if q0 is not None and array_ndim(q0, "q0") != 1:
         raise ValueError(f"q0: expected one joint vector of shape (7,), got shape {np.shape(q0)}")
     arm = _srs(chain)
     Tt = as_se3(T, "T")

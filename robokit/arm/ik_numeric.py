@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3, pose_error
-from ..validation import as_rng, check_choice, check_int, check_positive
+from ..validation import array_ndim, as_rng, check_choice, check_int, check_positive
 from .chain import Chain
 from .ik_steps import METHODS, STEP_RULES
 from .jacobian import jacobian_from_frames
@@ -214,9 +214,9 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
     >>> r.success, r.reason, bool(r.position_error < 1e-6)
     (True, 'converged', True)
     """
-    if np.ndim(T) != 2:
+    if array_ndim(T, "T") != 2:
         raise ValueError(f"T: expected one pose of shape (4, 4), got shape {np.shape(T)}")
-    if q0 is not None and np.ndim(q0) != 1:
+    if q0 is not None and array_ndim(q0, "q0") != 1:
         raise ValueError(f"q0: expected one joint vector, got shape {np.shape(q0)}")
     options.setdefault("parallel", 16)
     return ik_numeric_batch(chain, T, q0, **options)[0]

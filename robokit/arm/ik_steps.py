@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_positive
+from ..validation import as_array, check_finite_result, check_positive
 from .chain import Chain
 from .limits import limit_distance_gradient, wln_weights
 
@@ -60,7 +60,9 @@ def _jacobian_and_error(J: Any, e: Any):
     J = as_array(J, "J")
     if J.ndim not in (2, 3) or J.shape[-2] != 6:
         raise ValueError(f"J: expected a Jacobian of shape (6, n) or (N, 6, n), got shape {J.shape}")
-    e = as_array(e, "e", shape=J.shape[:-2] + (6,))
+    e = as_array(e, "e")
+    if e.shape != J.shape[:-2] + (6,):
+        raise ValueError(f"e: expected shape {J.shape[:-2] + (6,)} to match J of shape {J.shape}, got shape {e.shape}")
     return J, e
 
 
@@ -160,10 +162,15 @@ def null_space_step(J: Any, e: Any, gradient: Any, damping: float = 1e-2, gain: 
     (True, True)
     """
     J, e = _jacobian_and_error(J, e)
-    g = as_array(gradient, "gradient", shape=J.shape[:-2] + (J.shape[-1],))
+    g = as_array(gradient, "gradient")
+    if g.shape != J.shape[:-2] + (J.shape[-1],):
+        raise ValueError(f"gradient: expected shape {J.shape[:-2] + (J.shape[-1],)} to match J of shape {J.shape}, "
+                         f"got shape {g.shape}")
     lam = check_positive(damping, "damping", allow_zero=True)
     k = check_positive(gain, "gain", allow_zero=True)
-    return _gp(J, e, g, np.full(J.shape[:-2], lam**2), k)
+    dq = _gp(J, e, g, np.full(J.shape[:-2], np.square(lam)), k)
+    check_finite_result("J, e, gradient, damping, gain", dq)
+    return dq
 
 
 def _gp(J, e, g, lam2, k):

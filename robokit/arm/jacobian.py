@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array
+from ..validation import as_array, check_finite_result
 from .chain import Chain, chain_from_table
 
 __all__ = ["geometric_jacobian", "jacobian_from_frames", "dh_jacobian", "manipulability"]
@@ -167,8 +167,9 @@ def manipulability(J: Any) -> float | np.ndarray:
     0.122
     """
     J = as_array(J, "J")
-    if J.ndim not in (2, 3) or J.shape[-2] > J.shape[-1]:
-        raise ValueError(f"J: expected a Jacobian of shape (m, n) or (N, m, n) with m <= n, got shape {J.shape}")
+    if J.ndim not in (2, 3) or not 1 <= J.shape[-2] <= J.shape[-1]:
+        raise ValueError(f"J: expected a Jacobian of shape (m, n) or (N, m, n) with 1 <= m <= n, got shape {J.shape}")
     det = np.linalg.det(J @ np.swapaxes(J, -1, -2))
+    check_finite_result("J", det)
     w = np.sqrt(np.clip(det, 0.0, None))
     return float(w) if w.ndim == 0 else w

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array
+from ..validation import array_ndim, as_array
 from .chain import Chain
 
 __all__ = ["limit_distance_gradient", "wln_weights"]
@@ -26,7 +26,7 @@ __all__ = ["limit_distance_gradient", "wln_weights"]
 def _limits(chain: Chain, q: Any, name: str = "q") -> np.ndarray:
     if not isinstance(chain, Chain):
         raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
-    return chain.check_q(q, name, batch=np.ndim(q) == 2)
+    return chain.check_q(q, name, batch=array_ndim(q, name) == 2)
 
 
 def limit_distance_gradient(chain: Chain, q: Any, *, check: bool = True) -> np.ndarray:

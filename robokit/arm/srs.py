@@ -20,12 +20,13 @@ References
 """
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
 from ..geometry import as_se3, rot_y, rot_z, so3_exp, zyz_angles
-from ..validation import as_array, check_finite_scalar, check_positive
+from ..validation import as_array, check_finite_result, check_finite_scalar, check_positive
 
 __all__ = ["wrist_centre", "elbow_angle", "shoulder_angles"]
 
@@ -116,9 +117,13 @@ def elbow_angle(shoulder: Any, wrist: Any, d_se: float, d_ew: float) -> float:
     W = as_array(wrist, "wrist", shape=(3,))
     l1, l2 = check_positive(d_se, "d_se"), check_positive(d_ew, "d_ew")
     L = float(np.linalg.norm(W - S))
-    c = (L**2 - l1**2 - l2**2) / (2 * l1 * l2)
-    if abs(c) > 1.0 + 1e-12:
-        raise ValueError(f"wrist: out of reach, |W - S| = {L:.6g} m is outside [{abs(l1 - l2):.6g}, {l1 + l2:.6g}] m")
+    try:
+        c = (L**2 - l1**2 - l2**2) / (2 * l1 * l2)
+    except OverflowError:
+        c = math.inf
+    if not abs(c) <= 1.0 + 1e-12:
+        raise ValueError(f"shoulder, wrist: out of reach, |W - S| = {L:.6g} m is outside [{abs(l1 - l2):.6g}, "
+                         f"{l1 + l2:.6g}] m for d_se = {l1:.6g} m and d_ew = {l2:.6g} m")
     return float(np.arccos(np.clip(c, -1.0, 1.0)))
 
 
@@ -174,4 +179,5 @@ def shoulder_angles(shoulder: Any, wrist: Any, q4: float, psi: float, d_se: floa
         raise ValueError("wrist: expected a wrist centre away from the shoulder, got |W - S| = 0")
     R_psi = so3_exp(psi * sw / L, check=False)                 # rotation by psi about S-W (Rodrigues)
     M = R_psi @ _reference_rotation(sw, np.asarray(q4), l1, l2)   # R_0^3(psi) = R_psi R_0^3(0), Eqs. (9)-(15)
+    check_finite_result("shoulder, wrist, q4, psi, d_se, d_ew", M)
     return zyz_angles(M, check=False)

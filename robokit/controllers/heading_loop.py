@@ -27,7 +27,7 @@ from typing import Any
 import control
 import numpy as np
 
-from ..validation import as_array, check_positive
+from ..validation import as_array, check_int, check_positive
 
 __all__ = ["heading_plant", "heading_closed_loop", "heading_loop_gain", "heading_step_response",
            "heading_frequency_response", "loop_metrics"]
@@ -98,6 +98,9 @@ def heading_loop_gain(kp: float, kd: float, tau: float, gain: float = 1.0) -> co
     return control.tf([d, p], [1.0]) * heading_plant(tau, gain)
 
 
+_UNSIMULATED = "{names}: expected a loop python-control can simulate, got a NaN step response (values too large?)"
+
+
 def heading_step_response(kp: float, kd: float, tau: float, gain: float = 1.0,
                           duration: float = 4.0, n: int = 400) -> tuple[np.ndarray, np.ndarray]:
     """Unit-step response ``(t, theta)`` of :func:`heading_closed_loop` over ``duration`` seconds.
@@ -114,9 +117,12 @@ def heading_step_response(kp: float, kd: float, tau: float, gain: float = 1.0,
     (400, 1.05, 1.0)
     """
     T = heading_closed_loop(kp, kd, tau, gain)
-    t = np.linspace(0.0, check_positive(duration, "duration"), max(int(n), 2))
+    t = np.linspace(0.0, check_positive(duration, "duration"), max(check_int(n, "n", minimum=0), 2))
     resp = control.step_response(T, t)
-    return np.asarray(resp.time), np.asarray(resp.outputs).ravel()
+    y = np.asarray(resp.outputs).ravel()
+    if np.isnan(y).any():
+        raise ValueError(_UNSIMULATED.format(names="kp, kd, tau, gain, duration"))
+    return np.asarray(resp.time), y
 
 
 def heading_frequency_response(kp: float, kd: float, tau: float, omega: Any, gain: float = 1.0) -> np.ndarray:
@@ -132,6 +138,8 @@ def heading_frequency_response(kp: float, kd: float, tau: float, omega: Any, gai
     [1.0]
     """
     w = as_array(omega, "omega")
+    if w.ndim > 1:
+        raise ValueError(f"omega: expected a frequency or a 1-D array of them, got shape {w.shape}")
     if np.any(w <= 0):
         raise ValueError("omega: expected positive frequencies in rad/s")
     return np.asarray(heading_loop_gain(kp, kd, tau, gain)(1j * w))
@@ -180,7 +188,10 @@ def loop_metrics(kp: float, kd: float, tau: float, gain: float = 1.0, delay: flo
         T = control.feedback(kp * plant, control.tf([kd, kp], [kp]), sign=-1) if kp > 0 else plant
     else:
         T = heading_closed_loop(kp, kd, tau, gain)
-    info = control.step_info(T)
+    try:
+        info = control.step_info(T)
+    except IndexError:      # python-control's step_info on a response that is NaN throughout
+        raise ValueError(_UNSIMULATED.format(names="kp, kd, tau, gain, delay")) from None
     gm, pm, _, _, wc = control.stability_margins(L)[:5]
     return {"overshoot": float(info["Overshoot"]) / 100.0, "settling_time": float(info["SettlingTime"]),
             "rise_time": float(info["RiseTime"]), "gain_margin": float(gm) if gm is not None else math.inf,

@@ -137,6 +137,7 @@ EXERCISES = [
         cases=_haversine_cases,
         reference=haversine_distance_bearing,
         references=("robokit.outdoor.geodesy.haversine_distance_bearing", "robokit.outdoor.geodesy._latlon",
+                    "robokit.outdoor.geodesy._two_points",
                     "robokit.outdoor.geodesy._out",
                     "robokit.outdoor.geodesy.haversine_distance", "robokit.outdoor.geodesy.initial_bearing",
                     "robokit.outdoor.geodesy.distance_bearing"),

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..validation import as_array
+from ..validation import array_ndim, as_array
 
 __all__ = ["ROTATION_TOL", "as_rotation", "check_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y", "rot_z",
            "euler_matrix", "zyz_angles"]
@@ -66,7 +66,7 @@ def as_rotation(value: Any, name: str, *, dim: int = 3, batch: bool = False, tol
     ...
     ValueError: R: expected a rotation matrix with R^T R = I and det R = 1 (tolerance 1e-06), got max |R^T R - I| = 3 and det = 8
     """
-    one = not batch or np.ndim(value) == 2
+    one = not batch or array_ndim(value, name) == 2
     R = as_array(value, name, shape=(dim, dim) if one else (None, dim, dim))
     if batch and one:
         R = R[None]

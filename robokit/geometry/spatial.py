@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, as_points, check_finite_scalar
+from ..validation import array_ndim, as_array, as_points, check_finite_scalar
 from .planar import as_planar
 from .rotations import ROTATION_TOL, as_rotation, check_rotation_block, rot_z, so3_log
 
@@ -68,7 +68,7 @@ def as_se3(value: Any, name: str, *, batch: bool = False, tol: float = ROTATION_
     ...
     ValueError: T[:3, :3]: expected a rotation matrix with R^T R = I and det R = 1 (tolerance 1e-06), got max |R^T R - I| = 0 and det = -1
     """
-    one = not batch or np.ndim(value) == 2
+    one = not batch or array_ndim(value, name) == 2
     T = as_array(value, name, shape=(4, 4) if one else (None, 4, 4))
     if batch and one:
         T = T[None]
@@ -109,7 +109,7 @@ def se3_from_rt(rotation: Any, translation: Any) -> np.ndarray:
     >>> se3_from_rt(np.eye(3), [1.0, 2.0, 3.0])[:3, 3].tolist()
     [1.0, 2.0, 3.0]
     """
-    R = as_rotation(rotation, "rotation", batch=np.ndim(rotation) == 3)
+    R = as_rotation(rotation, "rotation", batch=array_ndim(rotation, "rotation") == 3)
     t = as_array(translation, "translation", shape=R.shape[:-2] + (3,))
     T = np.zeros(R.shape[:-2] + (4, 4))
     T[..., :3, :3], T[..., :3, 3], T[..., 3, 3] = R, t, 1.0
@@ -143,7 +143,7 @@ def se3_inverse(transform: Any) -> np.ndarray:
     >>> print(np.round(se3_inverse(T) @ T, 12).tolist() == np.eye(4).tolist())
     True
     """
-    T = as_se3(transform, "transform", batch=np.ndim(transform) == 3)
+    T = as_se3(transform, "transform", batch=array_ndim(transform, "transform") == 3)
     Rt = np.swapaxes(T[..., :3, :3], -1, -2)
     out = np.zeros(T.shape)
     out[..., :3, :3] = Rt
@@ -187,7 +187,7 @@ def se3_compose(*transforms: Any) -> np.ndarray:
         raise ValueError("transforms: expected at least one 4x4 transform, got none")
     out = np.eye(4)
     for i, T in enumerate(transforms):
-        out = out @ as_se3(T, f"transforms[{i}]", batch=np.ndim(T) == 3)
+        out = out @ as_se3(T, f"transforms[{i}]", batch=array_ndim(T, f"transforms[{i}]") == 3)
     return out
 
 
@@ -294,7 +294,7 @@ def se3_to_se2(transform: Any) -> np.ndarray:
     >>> print(np.round(se3_to_se2(se2_to_se3([1.0, 2.0, 0.3])), 6))
     [1.  2.  0.3]
     """
-    T = as_se3(transform, "transform", batch=np.ndim(transform) == 3)
+    T = as_se3(transform, "transform", batch=array_ndim(transform, "transform") == 3)
     return np.stack([T[..., 0, 3], T[..., 1, 3], np.arctan2(T[..., 1, 0], T[..., 0, 0])], axis=-1)
 
 
@@ -332,8 +332,8 @@ def pose_error(T_target: Any, T: Any, *, check: bool = True) -> np.ndarray:
     [0.1 0.  0.  0.  0.  0.3]
     """
     if check:
-        T_target = as_se3(T_target, "T_target", batch=np.ndim(T_target) == 3)
-        T = as_se3(T, "T", batch=np.ndim(T) == 3)
+        T_target = as_se3(T_target, "T_target", batch=array_ndim(T_target, "T_target") == 3)
+        T = as_se3(T, "T", batch=array_ndim(T, "T") == 3)
         if T_target.ndim == 3 and T.ndim == 3 and len(T_target) != len(T):
             raise ValueError(f"T_target, T: expected stacks of equal length, got {len(T_target)} and {len(T)}")
     dw = so3_log(T_target[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2), check=False)

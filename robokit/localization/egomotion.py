@@ -129,7 +129,12 @@ def ransac_sample_count(contamination: float, sample_size: int = 2, confidence: 
     good = (1 - eps) ** p
     if good >= 1:
         return 1
-    return max(1, int(np.ceil(np.log(1 - conf) / np.log(1 - good))))
+    with np.errstate(divide="ignore"):
+        samples = np.log(1 - conf) / np.log(1 - good)
+    if not samples < 2.0 ** 63:   # a clean sample is so unlikely that no count is enough
+        raise ValueError(f"sample_size: expected a sample that can be clean, got {p} matches at contamination {eps} "
+                         f"(probability {good:.3g} per sample)")
+    return max(1, int(np.ceil(samples)))
 
 
 def _poses_from_pairs(r1, r2, w1, w2):
@@ -259,9 +264,8 @@ def fit_pose(robot_points, world_points, robot_covariances=None, world_covarianc
 def _fallback(n, odometry, odometry_covariance, iterations, why):
     if odometry is None:
         raise InsufficientMatchesError(f"{why}, and no odometry was given to fall back on")
-    cov = np.eye(3) * 1e-2 if odometry_covariance is None else as_array(odometry_covariance, "odometry_covariance",
-                                                                          shape=(3, 3))
-    return EgomotionResult(as_pqt(odometry, "odometry"), cov, np.zeros(n, bool), "odometry", iterations, 0.0)
+    cov = np.eye(3) * 1e-2 if odometry_covariance is None else odometry_covariance
+    return EgomotionResult(odometry, cov, np.zeros(n, bool), "odometry", iterations, 0.0)
 
 
 def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_covariances=None,
@@ -328,12 +332,16 @@ def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_cov
     min_matches = check_int(min_matches, "min_matches", minimum=2)
     max_iterations = check_int(max_iterations, "max_iterations", minimum=1)
     gen = as_rng(rng)
+    # the fall-back is checked now, not when (rarely) it is needed
+    odometry = None if odometry is None else as_pqt(odometry, "odometry")
+    if odometry_covariance is not None:
+        odometry_covariance = as_array(odometry_covariance, "odometry_covariance", shape=(3, 3))
+    needed, drawn = ransac_sample_count(0.99, 2, confidence), 0     # also checks confidence
     n = r.shape[0]
     if n < max(2, min_matches):
         return _fallback(n, odometry, odometry_covariance, 0, f"only {n} matches (need {min_matches})")
     rg, wg = r[:, [0, 2]], w[:, [0, 2]]
     best, best_count, best_cost = None, -1, np.inf
-    needed, drawn = ransac_sample_count(0.99, 2, confidence), 0
     while drawn < min(needed, max_iterations):
         k = min(64, max_iterations - drawn)
         i = gen.integers(0, n, k)

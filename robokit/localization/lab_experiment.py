@@ -27,10 +27,10 @@ import numpy as np
 
 from ..config import FAST
 from ..geometry import paper_world_to_robokit, se2_to_pqt, wrap_angle
-from ..sim import PinholeCamera, StereoRig, lab_lap, lab_room, record
-from ..validation import as_points, check_int, check_positive
+from ..sim import PinholeCamera, StereoRig, World, lab_lap, lab_room, record
+from ..validation import as_points, check_callable, check_choice, check_int, check_positive, describe
 from ..vision.stereo import StereoCalibration
-from .visual_slam import VisualSLAM
+from .visual_slam import DESCRIPTORS, FEATURE_METHODS, VisualSLAM
 
 __all__ = ["LAB_TEST_POSES", "PAPER_RESULT", "LabExperiment", "MapConsistency", "calibrated_rig", "mapping_run",
            "lab_experiment", "map_consistency"]
@@ -213,17 +213,22 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     >>> len(e.rows), bool(e.mean_error_m < 0.05)
     (1, True)
     """
+    # every argument is checked before the (long) mapping run
+    method = check_choice(method, "method", FEATURE_METHODS)
+    descriptor = check_choice(descriptor, "descriptor", DESCRIPTORS)
     rate = check_positive(rate, "rate")
-    run, render_rig = mapping_run(rate, seed=seed)
-    if frames is None:
-        frames = 6 if FAST else len(run)
-    k = min(check_int(frames, "frames", minimum=2), len(run))
+    frames = None if frames is None else check_int(frames, "frames", minimum=2)
     if test_poses is None:
         test_poses = LAB_TEST_POSES[:1] if FAST else LAB_TEST_POSES
     poses = as_points(test_poses, "test_poses", 3, min_count=1)
+    noise = check_positive(noise, "noise", allow_zero=True)
+    seed = check_int(seed, "seed", minimum=0)
+    progress = check_callable(progress, "progress")
     world = lab_room()
     if not np.all(world.is_free(poses[:, :2], clearance=0.05)):
         raise ValueError("test_poses: expected poses in the lab's free space, got one inside furniture or walls")
+    run, render_rig = mapping_run(rate, seed=seed)
+    k = min(frames or (6 if FAST else len(run)), len(run))
     slam = VisualSLAM(calibrated_rig(render_rig), method=method, descriptor=descriptor, rng=seed)
     corners = world.corner_array.reshape(-1, 3)
     lo, hi = corners[:, :2].min(0), corners[:, :2].max(0)
@@ -361,6 +366,8 @@ def map_consistency(landmark_map, world=None, *, camera_height: float = 0.8,
             raise TypeError(f"landmark_map: expected a LandmarkMap with .{attr}, got {type(landmark_map).__name__}")
     margin = check_positive(margin, "margin", allow_zero=True)
     world = lab_room() if world is None else world
+    if not isinstance(world, World):
+        raise TypeError(f"world: expected a robokit.sim.World or None, got {describe(world)}")
     points, covs = paper_world_to_robokit(landmark_map.positions, landmark_map.covariances, camera_height)
     n = len(points)
     best = np.full(n, np.inf)

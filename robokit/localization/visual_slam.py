@@ -41,7 +41,11 @@ from ..vision.stereo import StereoObservations, StereoCalibration, observe_stere
 from .egomotion import track
 from .hough import Hypothesis, global_localize
 
-__all__ = ["FrameReport", "VisualSLAM"]
+__all__ = ["FrameReport", "VisualSLAM", "FEATURE_METHODS", "DESCRIPTORS"]
+
+#: Feature detectors a :class:`VisualSLAM` can use, and the descriptors it can match.
+FEATURE_METHODS = ("sift", "plot")
+DESCRIPTORS = ("reduced16", "sift128")
 
 
 @dataclass(frozen=True)
@@ -129,8 +133,8 @@ class VisualSLAM:
         if not isinstance(rig, StereoCalibration):
             raise TypeError(f"rig: expected robokit.vision.StereoCalibration, got {type(rig).__name__}")
         self.rig = rig
-        self.method = check_choice(method, "method", ("sift", "plot"))
-        self.descriptor = check_choice(descriptor, "descriptor", ("reduced16", "sift128"))
+        self.method = check_choice(method, "method", FEATURE_METHODS)
+        self.descriptor = check_choice(descriptor, "descriptor", DESCRIPTORS)
         self.min_matches = check_int(min_matches, "min_matches", minimum=2)
         self.window = check_positive(window, "window")
         self.threshold = check_positive(threshold, "threshold")

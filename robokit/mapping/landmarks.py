@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..geometry import as_pqt, pqt_robot_to_world, pqt_to_se3, pqt_transform_xz, pqt_world_to_robot
-from ..validation import as_array, check_int, check_positive
+from ..validation import array_ndim, as_array, check_int, check_positive
 
 __all__ = ["transform_covariance", "kalman_fuse", "LandmarkMap"]
 
@@ -117,7 +117,7 @@ def kalman_fuse(s, sigma, r_new, sigma_new) -> tuple[np.ndarray, np.ndarray]:
     Se, Lowe & Little, Sec. 3.5 ("Filter update"). The fused covariance is never larger than
     either input, so a landmark's uncertainty ellipse shrinks as it is re-observed (Sec. 3.6).
     """
-    single = np.ndim(s) == 1
+    single = array_ndim(s, "s") == 1
     pts = as_array(s, "s", shape=(3,) if single else (None, 3))
     n = 1 if single else pts.shape[0]
     cshape = (3, 3) if single else (n, 3, 3)

@@ -31,8 +31,8 @@ from .geodesy import (EARTH_MEAN_RADIUS, LocalTangentPlane, distance_bearing, ha
 from .gps import Compass, GPSReceiver, compass_to_heading, heading_to_compass
 from .mission import RunResult, run_courses, simulate, summarize_runs
 from .navigator import Navigator, avoidance_decision
-from .nmea import (GGA, HDG, RMB, RMC, BadSentence, NMEAChecksumError, NMEAError, NMEAFormatError, NMEAReader,
-                   Sentence, fix_position, nmea_checksum, parse_sentence, read_nmea)
+from .nmea import (GGA, HDG, RMB, RMC, BadFields, BadSentence, NMEAChecksumError, NMEAError, NMEAFieldError,
+                   NMEAFormatError, NMEAReader, Sentence, fix_position, nmea_checksum, parse_sentence, read_nmea)
 from .nmea_write import format_sentence, gga_sentence, hdg_sentence, random_sentences, rmb_sentence, rmc_sentence
 from .sonar import (PAPER_LAYOUT, LVMaxSonarEZ, firing_schedule, pulse_width_to_cm_inches, pulse_width_to_range,
                     read_sensors, sensor_poses, true_ranges)
@@ -46,7 +46,8 @@ __all__ = [
     "haversine_distance_bearing", "initial_bearing", "osculating_radius", "vincenty_inverse",
     "Compass", "GPSReceiver", "compass_to_heading", "heading_to_compass",
     "RunResult", "run_courses", "simulate", "summarize_runs", "Navigator", "avoidance_decision",
-    "GGA", "HDG", "RMB", "RMC", "BadSentence", "NMEAChecksumError", "NMEAError", "NMEAFormatError", "NMEAReader",
+    "GGA", "HDG", "RMB", "RMC", "BadFields", "BadSentence", "NMEAChecksumError", "NMEAError", "NMEAFieldError",
+    "NMEAFormatError", "NMEAReader",
     "Sentence", "fix_position", "nmea_checksum", "parse_sentence", "read_nmea",
     "format_sentence", "gga_sentence", "hdg_sentence", "random_sentences", "rmb_sentence", "rmc_sentence",
     "PAPER_LAYOUT", "LVMaxSonarEZ", "firing_schedule", "pulse_width_to_cm_inches", "pulse_width_to_range",

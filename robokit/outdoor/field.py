@@ -172,7 +172,8 @@ def random_course(seed: int = 0, *, n_waypoints: int = 4, n_obstacles: int = 14,
     n = check_int(n_obstacles, "n_obstacles", minimum=0, maximum=200)
     frac = check_positive(on_path, "on_path", allow_zero=True)
     gap = check_positive(min_gap, "min_gap")
-    w, h = check_positive(size[0], "size[0]"), check_positive(size[1], "size[1]")
+    sz = as_array(size, "size", shape=(2,))
+    w, h = check_positive(sz[0], "size[0]"), check_positive(sz[1], "size[1]")
     margin = 6.0
     start_xy = np.array([margin, rng.uniform(margin, h - margin)])
     points = [start_xy]

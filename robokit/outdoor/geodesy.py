@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, check_int, check_positive
+from ..validation import array_ndim, as_array, check_choice, check_int, check_positive
 
 __all__ = [
     "WGS84_A", "WGS84_F", "WGS84_B", "WGS84_E2", "EARTH_MEAN_RADIUS", "GeodesyError",
@@ -66,6 +66,16 @@ def _latlon(lat: Any, lon: Any, suffix: str = "") -> tuple[np.ndarray, np.ndarra
         bad = la.flat[int(np.argmax(np.abs(la)))]
         raise ValueError(f"lat{suffix}: expected radians in [-pi/2, pi/2] (did you pass degrees?), got {bad:g}")
     return la, lo
+
+
+def _two_points(lat1: Any, lon1: Any, lat2: Any, lon2: Any) -> list[np.ndarray]:
+    p1, l1 = _latlon(lat1, lon1, "1")
+    p2, l2 = _latlon(lat2, lon2, "2")
+    try:
+        return np.broadcast_arrays(p1, l1, p2, l2)
+    except ValueError:
+        raise ValueError(f"lat1, lon1, lat2, lon2: expected shapes that broadcast together, got "
+                         f"{', '.join(str(x.shape) for x in (p1, l1, p2, l2))}") from None
 
 
 def _out(x: np.ndarray) -> Any:
@@ -138,8 +148,7 @@ def haversine_distance(lat1: Any, lon1: Any, lat2: Any, lon2: Any, radius: float
     -----
     Sinnott (1984); well conditioned for short distances, unlike the spherical law of cosines.
     """
-    p1, l1 = _latlon(lat1, lon1, "1")
-    p2, l2 = _latlon(lat2, lon2, "2")
+    p1, l1, p2, l2 = _two_points(lat1, lon1, lat2, lon2)
     r = check_positive(radius, "radius")
     h = np.sin((p2 - p1) / 2) ** 2 + np.cos(p1) * np.cos(p2) * np.sin((l2 - l1) / 2) ** 2
     return _out(2 * r * np.arcsin(np.sqrt(np.clip(h, 0.0, 1.0))))
@@ -164,8 +173,7 @@ def initial_bearing(lat1: Any, lon1: Any, lat2: Any, lon2: Any) -> Any:
     Spherical trigonometry (e.g. Snyder 1987, Eq. 5-4b); the "bearing" field of $GPRMB in Hamid
     et al. (2009, Sec. 3).
     """
-    p1, l1 = _latlon(lat1, lon1, "1")
-    p2, l2 = _latlon(lat2, lon2, "2")
+    p1, l1, p2, l2 = _two_points(lat1, lon1, lat2, lon2)
     dl = l2 - l1
     y = np.sin(dl) * np.cos(p2)
     x = np.cos(p1) * np.sin(p2) - np.sin(p1) * np.cos(p2) * np.cos(dl)
@@ -204,7 +212,7 @@ def haversine_distance_bearing(lat1: float, lon1: float, lat2: float, lon2: floa
     [62.7021, 0.7822]
     """
     for name, value in (("lat1", lat1), ("lon1", lon1), ("lat2", lat2), ("lon2", lon2)):
-        if np.ndim(value) != 0:
+        if array_ndim(value, name) != 0:
             raise ValueError(f"{name}: expected a scalar in radians, got shape {np.shape(value)}")
     return np.array([haversine_distance(lat1, lon1, lat2, lon2, radius), initial_bearing(lat1, lon1, lat2, lon2)])
 
@@ -247,11 +255,9 @@ def vincenty_inverse(lat1: Any, lon1: Any, lat2: Any, lon2: Any, *, tol: float =
     >>> round(float(s12), 4), round(float(az1), 4)
     (62.5665, 0.7855)
     """
-    p1, l1 = _latlon(lat1, lon1, "1")
-    p2, l2 = _latlon(lat2, lon2, "2")
+    p1, l1, p2, l2 = _two_points(lat1, lon1, lat2, lon2)
     check_positive(tol, "tol")
     n_iter = check_int(max_iter, "max_iter", minimum=1)
-    p1, l1, p2, l2 = np.broadcast_arrays(p1, l1, p2, l2)
     a, b, f = WGS84_A, WGS84_B, WGS84_F
     L = np.asarray(wrap_angle(l2 - l1), dtype=float)
     U1, U2 = np.arctan((1 - f) * np.tan(p1)), np.arctan((1 - f) * np.tan(p2))
@@ -274,9 +280,9 @@ def vincenty_inverse(lat1: Any, lon1: Any, lat2: Any, lon2: Any, *, tol: float =
             if np.all(done):
                 break
     if not np.all(done) or not np.all(np.isfinite(lam)):
-        idx = np.argwhere(~done)[:3].tolist()
-        raise GeodesyError(f"vincenty_inverse: expected convergence within {n_iter} iterations, "
-                           f"got none at index {idx} (nearly antipodal points)")
+        where = "" if L.ndim == 0 else " at index " + ", ".join(str(tuple(i)) for i in np.argwhere(~done)[:3].tolist())
+        raise GeodesyError(f"lat1, lon1, lat2, lon2: expected points that are not nearly antipodal, got no convergence "
+                           f"of Vincenty's iteration within {n_iter} iterations{where}")
     u2 = c2_alpha * (a * a - b * b) / (b * b)
     A = 1 + u2 / 16384 * (4096 + u2 * (-768 + u2 * (320 - 175 * u2)))
     B = u2 / 1024 * (256 + u2 * (-128 + u2 * (74 - 47 * u2)))
@@ -324,18 +330,16 @@ def distance_bearing(lat1: Any, lon1: Any, lat2: Any, lon2: Any, model: str = "s
     sphere 62.567 0.7822
     wgs84 62.567 0.7855
     """
+    check_choice(model, "model", ("sphere", "mean_sphere", "wgs84"))
     if model == "wgs84":
         s, az1, _ = vincenty_inverse(lat1, lon1, lat2, lon2)
         return s, az1
     if model == "sphere":
-        p1, _ = _latlon(lat1, lon1, "1")
-        p2, _ = _latlon(lat2, lon2, "2")
+        p1, _, p2, _ = _two_points(lat1, lon1, lat2, lon2)
         radius = np.asarray(osculating_radius((p1 + p2) / 2))
         d = np.asarray(haversine_distance(lat1, lon1, lat2, lon2, radius=1.0)) * radius
         return _out(d), initial_bearing(lat1, lon1, lat2, lon2)
-    if model == "mean_sphere":
-        return haversine_distance(lat1, lon1, lat2, lon2), initial_bearing(lat1, lon1, lat2, lon2)
-    raise ValueError(f"model: expected one of ['sphere', 'mean_sphere', 'wgs84'], got {model!r}")
+    return haversine_distance(lat1, lon1, lat2, lon2), initial_bearing(lat1, lon1, lat2, lon2)
 
 
 class LocalTangentPlane:

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import check_choice, check_int, check_positive
+from ..validation import check_callable, check_choice, check_int, check_mapping, check_positive, describe
 from .field import Course, random_course
 from .geodesy import LocalTangentPlane
 from .gps import Compass, GPSReceiver
@@ -150,6 +150,11 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: S
         raise TypeError(f"course: expected a Course from random_course(), got {type(course).__name__}")
     rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
     check_choice(firing, "firing", ("chained", "free", "off"))
+    if truck is not None and not isinstance(truck, SkidSteerTruck):
+        raise TypeError(f"truck: expected a SkidSteerTruck or None, got {describe(truck)}")
+    max_time = None if max_time is None else check_positive(max_time, "max_time")
+    gps_noise = check_positive(gps_noise, "gps_noise", allow_zero=True)
+    navigator_options = check_mapping(navigator_options, "navigator_options")
     mission = _Mission(course, rng, firing, truck, check_positive(dt, "dt"), check_int(keep_nmea, "keep_nmea", minimum=0),
                        gps_noise, navigator_options, max_time)
     while mission.t < mission.limit and not mission.nav.done:
@@ -176,8 +181,7 @@ class _Mission:
         self.nav = Navigator(np.column_stack(plane.to_geodetic(course.waypoints)), PAPER_TRUCK,
                              **dict(navigator_options or {}))
         self.offset = plane.to_local(self.nav.plane.lat0, self.nav.plane.lon0)  # navigator's frame -> field frame
-        self.limit = (3 * straight / self.nav.cruise_speed + 120.0 if max_time is None
-                      else check_positive(max_time, "max_time"))
+        self.limit = 3 * straight / self.nav.cruise_speed + 120.0 if max_time is None else max_time
         self.gps = GPSReceiver(plane, noise=gps_noise, rng=rng)
         self.compass = Compass(rng=rng)
         self.sonar = LVMaxSonarEZ()
@@ -294,7 +298,15 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     >>> [(r.reached, r.collisions) for r in run_courses([0], course_options=small)]
     [(1, 0)]
     """
-    seeds = [check_int(s, "seeds[i]", minimum=0) for s in seeds]
+    try:
+        items = None if isinstance(seeds, (str, bytes)) else list(seeds)
+    except TypeError:   # not iterable (a number, a 0-d array, None)
+        items = None
+    if items is None:
+        raise TypeError(f"seeds: expected an iterable of non-negative integers, got {describe(seeds)}")
+    seeds = [check_int(s, f"seeds[{i}]", minimum=0) for i, s in enumerate(items)]
+    course_options = check_mapping(course_options, "course_options")
+    progress = check_callable(progress, "progress")
     out = []
     for i, s in enumerate(seeds):
         course = random_course(s, **(course_options or {}))
@@ -329,6 +341,8 @@ def summarize_runs(results: list[RunResult]) -> dict:
     >>> summary["waypoints_reached"], summary["collisions_total"], summary["success_rate"]
     ('1/1', 0, 1.0)
     """
+    if not isinstance(results, (list, tuple)) or not all(isinstance(r, RunResult) for r in results):
+        raise TypeError(f"results: expected a list of RunResult (from simulate or run_courses), got {describe(results)}")
     if not results:
         raise ValueError("results: expected at least one RunResult, got an empty list")
     ratio = np.array([r.path_ratio for r in results])

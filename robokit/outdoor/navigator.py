@@ -45,7 +45,8 @@ def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefe
     Parameters
     ----------
     ranges : array_like, shape (4,)
-        Metres, in the order of :data:`robokit.outdoor.sonar.PAPER_LAYOUT`.
+        Metres, in the order of :data:`robokit.outdoor.sonar.PAPER_LAYOUT`; ``inf`` (nothing in
+        range) is accepted, NaN and negative ranges are not.
     front : float, default 1.2
         The front is blocked when a middle sensor reads less than this.
     side : float, default 0.8

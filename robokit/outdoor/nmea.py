@@ -11,6 +11,12 @@ Conventions: empty fields become ``None``; latitude and longitude are signed dec
 and east positive) as the fields carry them; the records keep NMEA's own units (knots, degrees) in
 their field names and offer SI properties (``speed_mps``, ``course_rad``, ...).
 
+A sentence with a good checksum and a corrupt field is still read when the record can do without
+that field (a speed of ``X.138`` or ``nan``): the field becomes ``None`` and the record names it in
+``bad_fields``; a corrupt essential field (the position of RMC/GGA, the destination of RMB, the
+heading of HDG) rejects the sentence (:func:`~robokit.outdoor.nmea_fields.salvage_record`). Numbers
+must be finite: ``nan`` and ``inf`` are corrupt.
+
 References
 ----------
 .. [1] National Marine Electronics Association, *NMEA 0183 Standard for Interfacing Marine
@@ -28,16 +34,16 @@ from functools import reduce
 from operator import xor
 from typing import Any, BinaryIO, Callable, Iterator, NamedTuple
 
-from ..validation import check_int, describe
-from .nmea_fields import (RECORD_PARSERS, NMEAChecksumError, NMEAError, NMEAFormatError, parse_date, parse_latitude,
-                          parse_longitude, parse_time)
+from ..validation import check_callable, check_int, describe
+from .nmea_fields import (RECORD_PARSERS, NMEAChecksumError, NMEAError, NMEAFieldError, NMEAFormatError, parse_date,
+                          parse_latitude, parse_longitude, parse_time, salvage_record)
 from .nmea_records import GGA, HDG, RMB, RMC, Sentence
 
 __all__ = [
-    "NMEAError", "NMEAChecksumError", "NMEAFormatError",
+    "NMEAError", "NMEAChecksumError", "NMEAFormatError", "NMEAFieldError",
     "RMC", "RMB", "GGA", "HDG", "Sentence",
     "nmea_checksum", "parse_sentence", "fix_position", "parse_latitude", "parse_longitude", "parse_time", "parse_date",
-    "BadSentence", "NMEAReader", "read_nmea",
+    "BadSentence", "BadFields", "NMEAReader", "read_nmea",
 ]
 
 
@@ -111,6 +117,8 @@ def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> R
     -------
     RMC, RMB, GGA, HDG or Sentence
         A typed record for those four types (any talker), otherwise a generic :class:`Sentence`.
+        A corrupt field the record can do without (not a number, NaN, infinite, out of range, an
+        unknown letter, an invalid date, ...) is ``None`` and named in the record's ``bad_fields``.
 
     Raises
     ------
@@ -119,8 +127,10 @@ def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> R
     NMEAChecksumError
         Missing (when required), malformed or wrong checksum.
     NMEAFormatError
-        No leading ``$``, non-ASCII characters, a bad address, too few fields or a field out of
-        range (latitude > 90 degrees, invalid date, ...).
+        No leading ``$``, non-ASCII characters, a bad address or too few fields.
+    NMEAFieldError
+        A corrupt essential field: the position of RMC/GGA (e.g. latitude > 90 degrees), the
+        destination of RMB, the heading of HDG (an ``NMEAFormatError``).
 
     Notes
     -----
@@ -134,6 +144,9 @@ def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> R
     ('GP', 'A', 48.1173, 11.516667, 22.4)
     >>> parse_sentence("$GPZDA,201530.00,04,07,2002,00,00*60").kind         # any other type: generic
     'ZDA'
+    >>> rec = parse_sentence("$GPRMC,123519,A,4807.038,N,01131.000,E,X.138,084.4,230394,003.1,W*0C")
+    >>> rec.latitude, rec.speed_knots, rec.bad_fields                      # a corrupt speed is emptied
+    (48.1173, None, ('speed_knots',))
     """
     if type(sentence) is not str:
         if isinstance(sentence, (bytes, bytearray)):
@@ -179,7 +192,11 @@ def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> R
     parser = RECORD_PARSERS.get(kind)
     if parser is None or len(address) != 5:
         return Sentence(talker, kind, tuple(fields[1:]))
-    return parser(talker, fields[1:])
+    try:
+        return parser(talker, fields[1:])
+    except NMEAFieldError:
+        pass   # rebuilt outside the handler, so that an essential field's error is not chained to this one
+    return salvage_record(kind, talker, fields[1:])
 
 
 def fix_position(sentence: str) -> list[float]:
@@ -229,13 +246,24 @@ class BadSentence(NamedTuple):
     error: NMEAError
 
 
+class BadFields(NamedTuple):
+    """A sentence the reader kept with corrupt fields emptied: ``line`` (1-based), the raw ``text``
+    and the names of the emptied ``fields`` (the record's ``bad_fields``)."""
+
+    line: int
+    text: bytes
+    fields: tuple
+
+
 class NMEAReader:
     """Read NMEA sentences from a byte stream, skipping junk and reporting bad sentences.
 
     Iterating yields parsed records in order. Bytes before a ``$`` (binary junk, the tail of a
     partial line) are skipped and counted in :attr:`junk_bytes`; every candidate sentence that fails
     to parse is appended to :attr:`errors` as a :class:`BadSentence` with its line number (and passed
-    to ``on_error`` if given), and reading continues with the next ``$``.
+    to ``on_error`` if given), and reading continues with the next ``$``. A sentence read with
+    corrupt fields emptied (see :func:`parse_sentence`) is yielded and also logged in
+    :attr:`field_errors` as a :class:`BadFields`; :attr:`lines` counts the lines read.
 
     Parameters
     ----------
@@ -284,10 +312,11 @@ class NMEAReader:
         else:
             raise TypeError(f"source: expected bytes, a path or a binary file-like, got {describe(source)}")
         self.require_checksum = bool(require_checksum)
-        self.on_error = on_error
+        self.on_error = check_callable(on_error, "on_error")
         self.chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
         self.max_line = check_int(max_line, "max_line", minimum=82)
         self.errors: list[BadSentence] = []
+        self.field_errors: list[BadFields] = []
         self.junk_bytes = 0
         self.lines = 0
 
@@ -307,12 +336,16 @@ class NMEAReader:
         for piece in pieces[1:]:
             text = b"$" + piece.rstrip(b"\r\n \t\x00")
             try:
-                yield parse_sentence(text.decode("ascii"), require_checksum=self.require_checksum)
+                rec = parse_sentence(text.decode("ascii"), require_checksum=self.require_checksum)
             except UnicodeDecodeError as exc:
                 self._bad(number, text, NMEAFormatError(
                     f"sentence: expected ASCII bytes, got byte 0x{text[exc.start]:02X} at position {exc.start}"))
             except NMEAError as exc:
                 self._bad(number, text, exc)
+            else:
+                if rec.bad_fields:
+                    self.field_errors.append(BadFields(number, text, rec.bad_fields))
+                yield rec
 
     def __iter__(self) -> Iterator[RMC | RMB | GGA | HDG | Sentence]:
         rest = b""

@@ -21,6 +21,12 @@ from typing import NamedTuple
 
 __all__ = ["RMC", "RMB", "GGA", "HDG", "Sentence", "KNOT", "NAUTICAL_MILE"]
 
+def _repr(record: tuple) -> str:
+    """The named tuple's usual repr, without ``bad_fields`` when it is empty (an intact sentence)."""
+    items = [(k, v) for k, v in zip(record._fields, record) if k != "bad_fields" or v]
+    return f"{type(record).__name__}(" + ", ".join(f"{k}={v!r}" for k, v in items) + ")"
+
+
 #: One knot in metres per second (1852 m per hour).
 KNOT = 1852.0 / 3600.0
 #: One international nautical mile in metres.
@@ -50,6 +56,10 @@ class RMC(NamedTuple):
         Signed, east positive.
     mode : str or None
         Mode indicator (NMEA 2.3+): ``A`` autonomous, ``D`` differential, ``N`` not valid, ...
+    bad_fields : tuple of str
+        Attributes whose field was corrupt (not a number, NaN, infinite, out of range) and is
+        therefore ``None``; empty for an intact sentence, and then left out of the repr (see
+        :func:`~robokit.outdoor.nmea_fields.salvage_record`).
     """
 
     talker: str
@@ -62,6 +72,9 @@ class RMC(NamedTuple):
     date: _dt.date | None
     magnetic_variation_deg: float | None
     mode: str | None
+    bad_fields: tuple = ()
+
+    __repr__ = _repr
 
     @property
     def kind(self) -> str:
@@ -117,6 +130,10 @@ class RMB(NamedTuple):
         ``A`` when the arrival circle was entered.
     mode : str or None
         Mode indicator (NMEA 2.3+).
+    bad_fields : tuple of str
+        Attributes whose field was corrupt (not a number, NaN, infinite, out of range) and is
+        therefore ``None``; empty for an intact sentence, and then left out of the repr (see
+        :func:`~robokit.outdoor.nmea_fields.salvage_record`).
     """
 
     talker: str
@@ -132,6 +149,9 @@ class RMB(NamedTuple):
     closing_velocity_knots: float | None
     arrival: str | None
     mode: str | None
+    bad_fields: tuple = ()
+
+    __repr__ = _repr
 
     @property
     def kind(self) -> str:
@@ -173,6 +193,10 @@ class GGA(NamedTuple):
         Age of differential corrections (seconds).
     dgps_station : str or None
         Differential reference station id.
+    bad_fields : tuple of str
+        Attributes whose field was corrupt (not a number, NaN, infinite, out of range) and is
+        therefore ``None``; empty for an intact sentence, and then left out of the repr (see
+        :func:`~robokit.outdoor.nmea_fields.salvage_record`).
     """
 
     talker: str
@@ -186,6 +210,9 @@ class GGA(NamedTuple):
     geoid_separation_m: float | None
     dgps_age_s: float | None
     dgps_station: str | None
+    bad_fields: tuple = ()
+
+    __repr__ = _repr
 
     @property
     def kind(self) -> str:
@@ -211,6 +238,10 @@ class HDG(NamedTuple):
         Magnetic deviation, signed (east positive).
     variation_deg : float or None
         Magnetic variation, signed (east positive).
+    bad_fields : tuple of str
+        Attributes whose field was corrupt (not a number, NaN, infinite, out of range) and is
+        therefore ``None``; empty for an intact sentence, and then left out of the repr (see
+        :func:`~robokit.outdoor.nmea_fields.salvage_record`).
 
     Notes
     -----
@@ -221,6 +252,9 @@ class HDG(NamedTuple):
     heading_deg: float | None
     deviation_deg: float | None
     variation_deg: float | None
+    bad_fields: tuple = ()
+
+    __repr__ = _repr
 
     @property
     def kind(self) -> str:
@@ -241,3 +275,8 @@ class Sentence(NamedTuple):
     talker: str
     kind: str
     fields: tuple
+
+    @property
+    def bad_fields(self) -> tuple:
+        """Always empty: the fields of a generic sentence are kept as text, never judged."""
+        return ()

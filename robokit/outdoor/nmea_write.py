@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import datetime as _dt
 
-from ..validation import as_rng, check_finite_scalar, check_int, check_positive, describe
+from ..validation import as_rng, check_finite_scalar, check_int, check_positive, check_text, describe
 from .nmea import NMEAFormatError, nmea_checksum
 from .nmea_records import KNOT
 
@@ -74,7 +74,7 @@ def _angle(deg: float | None, name: str, width: int, limit: float, pos: str, neg
     return f"{d:0{width}d}{m:0{3 + decimals}.{decimals}f}", neg if x < 0 else pos
 
 
-def format_latitude(deg: float | None, decimals: int = 4) -> tuple[str, str]:
+def format_latitude(deg: float | None, decimals: int = 4, *, name: str = "deg") -> tuple[str, str]:
     """Return ``(ddmm.mmmm, "N"|"S")`` for signed degrees (``("", "")`` for ``None``).
 
     Raises
@@ -86,10 +86,10 @@ def format_latitude(deg: float | None, decimals: int = 4) -> tuple[str, str]:
     -----
     NMEA 0183 v4.11, Sec. 6.2 (latitude field). Four decimals of a minute are about 0.2 m.
     """
-    return _angle(deg, "deg", 2, 90.0, "N", "S", check_int(decimals, "decimals", minimum=0, maximum=8))
+    return _angle(deg, name, 2, 90.0, "N", "S", check_int(decimals, "decimals", minimum=0, maximum=8))
 
 
-def format_longitude(deg: float | None, decimals: int = 4) -> tuple[str, str]:
+def format_longitude(deg: float | None, decimals: int = 4, *, name: str = "deg") -> tuple[str, str]:
     """Return ``(dddmm.mmmm, "E"|"W")`` for signed degrees (``("", "")`` for ``None``).
 
     Raises
@@ -101,15 +101,18 @@ def format_longitude(deg: float | None, decimals: int = 4) -> tuple[str, str]:
     -----
     NMEA 0183 v4.11, Sec. 6.2 (longitude field).
     """
-    return _angle(deg, "deg", 3, 180.0, "E", "W", check_int(decimals, "decimals", minimum=0, maximum=8))
+    return _angle(deg, name, 3, 180.0, "E", "W", check_int(decimals, "decimals", minimum=0, maximum=8))
 
 
-def format_time(t: _dt.time | None) -> str:
-    """Return ``hhmmss.ss`` for a ``datetime.time`` (``""`` for ``None``); NMEA 0183 Sec. 6.2."""
+def format_time(t: _dt.time | None, *, name: str = "t") -> str:
+    """Return ``hhmmss.ss`` for a ``datetime.time`` (``""`` for ``None``); NMEA 0183 Sec. 6.2.
+
+    ``name`` is the argument named in the error (the caller's own argument).
+    """
     if t is None:
         return ""
     if not isinstance(t, _dt.time):
-        raise TypeError(f"t: expected a datetime.time, got {describe(t)}")
+        raise TypeError(f"{name}: expected a datetime.time, got {describe(t)}")
     return f"{t.hour:02d}{t.minute:02d}{t.second:02d}.{t.microsecond // 10000:02d}"
 
 
@@ -124,6 +127,13 @@ def format_date(d: _dt.date | None) -> str:
 
 def _num(x: float | None, name: str, fmt: str) -> str:
     return "" if x is None else format(check_finite_scalar(x, name), fmt)
+
+
+def _talker(talker: str) -> str:
+    if not (isinstance(talker, str) and len(talker) == 2 and talker.isalnum() and talker.isupper()):
+        raise (ValueError if isinstance(talker, str) else TypeError)(
+            f"talker: expected two upper-case letters like 'GP', got {describe(talker)}")
+    return talker
 
 
 def rmc_sentence(when: _dt.datetime, latitude: float | None, longitude: float | None, *,
@@ -146,6 +156,7 @@ def rmc_sentence(when: _dt.datetime, latitude: float | None, longitude: float | 
     magnetic_variation_deg : float, optional
         Signed, east positive.
     talker : str, default "GP"
+        Two upper-case letters (GP, GN, GL, ...).
 
     Returns
     -------
@@ -167,8 +178,9 @@ def rmc_sentence(when: _dt.datetime, latitude: float | None, longitude: float | 
     """
     if not isinstance(when, _dt.datetime):
         raise TypeError(f"when: expected a datetime.datetime, got {describe(when)}")
-    lat, ns = format_latitude(latitude)
-    lon, ew = format_longitude(longitude)
+    talker = _talker(talker)
+    lat, ns = format_latitude(latitude, name="latitude")
+    lon, ew = format_longitude(longitude, name="longitude")
     speed = None if speed_mps is None else check_positive(speed_mps, "speed_mps", allow_zero=True) / KNOT
     course = None if course_deg is None else round(check_finite_scalar(course_deg, "course_deg"), 1) % 360.0
     var = None if magnetic_variation_deg is None else check_finite_scalar(magnetic_variation_deg, "magnetic_variation_deg")
@@ -186,17 +198,19 @@ def gga_sentence(when: _dt.time, latitude: float | None, longitude: float | None
 
     Parameters
     ----------
-    when : datetime.time
-        UTC time of the fix.
+    when : datetime.time or None
+        UTC time of the fix (``None`` leaves the field empty).
     latitude, longitude : float or None
         Signed decimal degrees.
     quality : int, default 1
         Fix quality (0 invalid, 1 GPS, 2 DGPS, ...).
     satellites : int, default 8
     hdop : float, default 1.0
-    altitude_m : float, default 0.0
+    altitude_m : float or None, default 0.0
+        ``None`` leaves the field empty.
     geoid_separation_m : float, optional
     talker : str, default "GP"
+        Two upper-case letters (GP, GN, GL, ...).
 
     Returns
     -------
@@ -211,12 +225,14 @@ def gga_sentence(when: _dt.time, latitude: float | None, longitude: float | None
     >>> gga_sentence(dt.time(2, 30, 15), 6.4590, 100.3505, satellites=8, hdop=1.2, altitude_m=12.0)
     '$GPGGA,023015.00,0627.5400,N,10021.0300,E,1,08,1.2,12.0,M,,M,,*4C'
     """
-    lat, ns = format_latitude(latitude)
-    lon, ew = format_longitude(longitude)
+    talker = _talker(talker)
+    when_text = format_time(when, name="when")
+    lat, ns = format_latitude(latitude, name="latitude")
+    lon, ew = format_longitude(longitude, name="longitude")
     q = check_int(quality, "quality", minimum=0, maximum=9)
     n = check_int(satellites, "satellites", minimum=0, maximum=99)
     return format_sentence(talker + "GGA", [
-        format_time(when), lat, ns, lon, ew, q, f"{n:02d}", _num(check_positive(hdop, "hdop"), "hdop", ".1f"),
+        when_text, lat, ns, lon, ew, q, f"{n:02d}", _num(check_positive(hdop, "hdop"), "hdop", ".1f"),
         _num(altitude_m, "altitude_m", ".1f"), "M", _num(geoid_separation_m, "geoid_separation_m", ".1f"), "M", "", ""])
 
 
@@ -231,6 +247,7 @@ def hdg_sentence(heading_deg: float, *, deviation_deg: float | None = None,
     deviation_deg, variation_deg : float, optional
         Signed, east positive.
     talker : str, default "HC"
+        Two upper-case letters (HC: magnetic compass).
 
     Returns
     -------
@@ -244,6 +261,7 @@ def hdg_sentence(heading_deg: float, *, deviation_deg: float | None = None,
     >>> hdg_sentence(36.8, deviation_deg=0.0, variation_deg=-0.3)
     '$HCHDG,36.8,0.0,E,0.3,W*6E'
     """
+    talker = _talker(talker)
     h = round(check_finite_scalar(heading_deg, "heading_deg"), 1) % 360.0
 
     def signed(x, name):
@@ -263,8 +281,8 @@ def rmb_sentence(destination_latitude: float, destination_longitude: float, rang
 
     Parameters
     ----------
-    destination_latitude, destination_longitude : float
-        Signed decimal degrees of the active waypoint.
+    destination_latitude, destination_longitude : float or None
+        Signed decimal degrees of the active waypoint (``None`` leaves the fields empty).
     range_m : float
         Range to it in metres (written in nautical miles).
     bearing_deg : float
@@ -275,6 +293,7 @@ def rmb_sentence(destination_latitude: float, destination_longitude: float, rang
     closing_velocity_mps : float, default 0
     arrived : bool, default False
     talker : str, default "GP"
+        Two upper-case letters (GP, GN, GL, ...).
 
     Returns
     -------
@@ -288,8 +307,10 @@ def rmb_sentence(destination_latitude: float, destination_longitude: float, rang
     >>> rmb_sentence(6.4594, 100.3509, range_m=65.0, bearing_deg=44.0, destination_id="002")
     '$GPRMB,A,0.000,L,000,002,0627.5640,N,10021.0540,E,0.035,44.0,0.0,V,A*58'
     """
-    lat, ns = format_latitude(destination_latitude)
-    lon, ew = format_longitude(destination_longitude)
+    talker = _talker(talker)
+    lat, ns = format_latitude(destination_latitude, name="destination_latitude")
+    lon, ew = format_longitude(destination_longitude, name="destination_longitude")
+    origin_id, destination_id = check_text(origin_id, "origin_id"), check_text(destination_id, "destination_id")
     xte = check_finite_scalar(cross_track_m, "cross_track_m") / 1852.0
     rng = check_positive(range_m, "range_m", allow_zero=True) / 1852.0
     brg = round(check_finite_scalar(bearing_deg, "bearing_deg"), 1) % 360.0

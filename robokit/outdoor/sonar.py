@@ -30,7 +30,8 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..geometry import se2_compose, wrap_angle
-from ..validation import as_array, as_rng, check_finite_scalar, check_int, check_positive
+from ..validation import (as_array, as_rng, check_choice, check_finite_scalar, check_int, check_positive,
+                          check_sample_count)
 from ..sim.layout import Layout
 
 __all__ = ["INCH", "SECONDS_PER_INCH", "SPEED_OF_SOUND", "LVMaxSonarEZ", "SonarMount", "PAPER_LAYOUT",
@@ -260,12 +261,12 @@ def firing_schedule(n_sensors: int, duration: float, mode: str = "chained", *, c
     n = check_int(n_sensors, "n_sensors", minimum=1)
     T = check_positive(duration, "duration")
     c = check_positive(cycle, "cycle")
+    check_choice(mode, "mode", ("chained", "free"))
+    g = as_rng(rng)     # checked in either mode; only "free" draws from it
+    check_sample_count((1 if mode == "chained" else n) * T / c + n, "n_sensors, duration, cycle")
     if mode == "chained":
         return [np.arange(k * c, T, n * c) for k in range(n)]
-    if mode == "free":
-        g = as_rng(rng)
-        return [np.arange(p, T, c) for p in g.uniform(0, c, n)]
-    raise ValueError(f"mode: expected one of ['chained', 'free'], got {mode!r}")
+    return [np.arange(p, T, c) for p in g.uniform(0, c, n)]
 
 
 def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.ndarray:
@@ -429,7 +430,8 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
     """
     g = as_rng(rng)
     mounts = _check_sensors(mounts, sensor)
-    idx = [check_int(i, "which[i]", minimum=0, maximum=len(mounts) - 1) for i in which]
+    idx = [check_int(int(i), f"which[{k}]", minimum=0, maximum=len(mounts) - 1)
+           for k, i in enumerate(as_array(which, "which", ndim=1, dtype=int))]
     times = as_array(ping_times, "ping_times", shape=(len(idx),))
     sigma = check_positive(noise, "noise", allow_zero=True)
     if not isinstance(others, (dict, type(None))):

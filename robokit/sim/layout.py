@@ -71,16 +71,17 @@ def obstacle_array(value: Any, kind: str, name: str | None = None) -> np.ndarray
     (0, 5)
     """
     name = name or kind
-    if kind == "segments":
-        if value is None or not np.size(value):
-            return np.zeros((0, 2, 2))
-        return as_array(value, name, shape=(None, 2, 2))
-    if kind not in _COLUMNS:
+    if kind != "segments" and kind not in _COLUMNS:
         raise ValueError(f"kind: expected 'segments', 'circles' or 'boxes', got {kind!r}")
+    arr = None if value is None else as_array(value, name)
+    if kind == "segments":
+        if arr is None or not arr.size:
+            return np.zeros((0, 2, 2))
+        return as_array(arr, name, shape=(None, 2, 2))
     cols, sizes, what = _COLUMNS[kind]
-    if value is None or not np.size(value):
+    if arr is None or not arr.size:
         return np.zeros((0, cols))
-    arr = as_points(value, name, cols)
+    arr = as_points(arr, name, cols)
     if np.any(arr[:, sizes] <= 0):
         raise ValueError(f"{name}: expected positive sizes ({what}), got {arr[:, sizes].min():.3g}")
     return arr

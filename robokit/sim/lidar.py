@@ -164,6 +164,7 @@ def scan_points(ranges: Any, pose: Any, angles: Any) -> np.ndarray:
     Parameters
     ----------
     ranges : array_like, shape (B,)
+        Metres; ``inf`` marks a beam without a return (skipped). NaN and negative ranges are refused.
     pose : array_like, shape (3,)
         Sensor pose (see :meth:`Lidar.sensor_pose`).
     angles : array_like, shape (B,)
@@ -178,6 +179,8 @@ def scan_points(ranges: Any, pose: Any, angles: Any) -> np.ndarray:
     Polar to Cartesian conversion (Thrun et al. 2005, Eq. (6.32) endpoint model).
     """
     r = as_array(ranges, "ranges", ndim=1, finite=False)
+    if np.any(np.isnan(r) | (r < 0)):
+        raise ValueError(f"ranges: expected non-negative ranges or inf (no return), got {r[np.isnan(r) | (r < 0)][0]}")
     a = as_array(angles, "angles", ndim=1)
     p = as_array(pose, "pose", shape=(3,))
     if len(r) != len(a):

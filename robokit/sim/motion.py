@@ -25,7 +25,8 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, as_points, as_rng, check_positive
+from ..validation import as_array, as_points, as_rng, check_positive, check_sample_count, describe
+from .world import World
 
 __all__ = ["odometry_increment", "sample_motion_model_odometry", "noisy_odometry", "Path", "waypoint_path",
            "corridor_path", "lab_lap"]
@@ -220,6 +221,7 @@ def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, ra
             knots_t.append(knots_t[-1] + length / v)
             knots.append(np.array([b[0], b[1], knots[-1][2]]))
     kt, kp = np.array(knots_t), np.array(knots)
+    check_sample_count(kt[-1] / dt, "speed, turn_rate, rate")
     t = np.arange(0.0, kt[-1] + 1e-9, dt)
     poses = np.column_stack([np.interp(t, kt, kp[:, i]) for i in range(3)])
     poses[:, 2] = wrap_angle(poses[:, 2])
@@ -253,5 +255,7 @@ def lab_lap(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
     >>> len(lap.t), round(float(lap.t[-1]), 1), lap.poses[0].tolist()     # 10 Hz, 78 s at 0.3 m/s
     (784, 78.3, [3.0, 2.0, 0.0])
     """
+    if not isinstance(world, World):
+        raise TypeError(f"world: expected the lab World (lab_room()), got {describe(world)}")
     lap = [[3.0, 2.0], [7.5, 2.0], [7.8, 5.0], [7.5, 8.0], [3.0, 8.0], [2.6, 5.0], [3.0, 2.0]]
     return waypoint_path(lap, speed, rate=rate)

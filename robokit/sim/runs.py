@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from ..config import cache_dir, cache_key
-from ..validation import as_array, as_points, as_rng, check_positive
+from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .motion import Path, noisy_odometry
 from .world import World
 
@@ -227,6 +227,7 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
         raise ValueError(f"path: expected poses inside the free space of {world.name!r}, got {bad.sum()} outside "
                          f"(first at {poses[np.argmax(bad), :2].round(3).tolist()})")
     alphas = as_array(odometry_alphas, "odometry_alphas", shape=(4,))
+    seed = check_int(seed, "seed", minimum=0)
     digest = hashlib.sha256(np.ascontiguousarray(poses).tobytes() + t.tobytes()).hexdigest()[:16]
     geometry = hashlib.sha256(np.round(world.corner_array, 9).tobytes()).hexdigest()[:16]
     meta = {"world": world.name, "world_info": json.loads(json.dumps(world.info, default=str)), "geometry": geometry,

@@ -402,8 +402,8 @@ def illuminate(image: Any, gain: float = 1.0, offset: float = 0.0, gradient: Any
     >>> illuminate(grey, gradient=(0.5, 0.0))[0, :, 0].tolist()       # darker left, brighter right
     [75, 87, 100, 112]
     """
-    img = np.asarray(image)
-    if img.dtype != np.uint8 or img.ndim not in (2, 3):
+    img = as_array(image, "image", dtype=None)
+    if img.dtype != np.uint8 or img.ndim not in (2, 3) or img.ndim == 3 and img.shape[2] != 3:
         raise TypeError(f"image: expected a uint8 image of shape (H, W) or (H, W, 3), got {img.dtype} {img.shape}")
     g = check_positive(gain, "gain")
     b = check_finite_scalar(offset, "offset")

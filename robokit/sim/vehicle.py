@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, as_points, check_positive
+from ..validation import as_array, as_points, broadcast_to, check_positive
 
 __all__ = ["unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds"]
 
@@ -71,8 +71,8 @@ def unicycle_step(pose: Any, v: Any, omega: Any, dt: float, *, check: bool = Tru
         P = as_array(pose, "pose")
         single = P.ndim == 1
         P = as_points(P, "pose", 3)
-        v = np.broadcast_to(as_array(v, "v"), (len(P),))
-        w = np.broadcast_to(as_array(omega, "omega"), (len(P),))
+        v = broadcast_to(as_array(v, "v"), (len(P),), "v", "one per pose")
+        w = broadcast_to(as_array(omega, "omega"), (len(P),), "omega", "one per pose")
         dt = check_positive(dt, "dt", allow_zero=True)
     else:
         P = np.asarray(pose, dtype=float)

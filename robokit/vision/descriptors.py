@@ -289,7 +289,7 @@ def detect_plot_features(image, params: PlotParams | None = None, *, descriptor:
 
     Parameters
     ----------
-    image : array_like, shape (H, W) or (H, W, 3)
+    image : array_like, shape (H, W), (H, W, 3) or (H, W, 4)
     params : PlotParams, optional
         Detector parameters; ``overrides`` replace single fields.
     descriptor : {"sift128", "reduced16"}
@@ -332,7 +332,7 @@ def detect_sift_features(image, *, n_features: int = 0, descriptor: str = "sift1
 
     Parameters
     ----------
-    image : array_like, shape (H, W) or (H, W, 3)
+    image : array_like, shape (H, W), (H, W, 3) or (H, W, 4)
     n_features : int, default 0
         Keep the best ``n_features`` (0 keeps all), as OpenCV's ``nfeatures``.
     descriptor : {"sift128", "reduced16"}
@@ -386,7 +386,7 @@ def detect_and_describe(image, method: str = "plot", *, descriptor: str = "sift1
 
     Parameters
     ----------
-    image : array_like
+    image : array_like, shape (H, W), (H, W, 3) or (H, W, 4)
     method : {"plot", "sift"}
     descriptor : {"sift128", "reduced16"}
     **kwargs

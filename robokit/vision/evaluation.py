@@ -64,16 +64,19 @@ def apply_homography(homography, points) -> np.ndarray:
     return hom[:, :2] / hom[:, 2:]
 
 
+_MAX_SIDE = 32767   # far above any image of the course; a larger side would only exhaust memory
+
+
 def warp_image(image, homography, shape=None) -> np.ndarray:
     """Warp an image by a homography (image B of a test pair, pixels outside filled with 0).
 
     Parameters
     ----------
-    image : numpy.ndarray, shape (H, W) or (H, W, 3), uint8 or float32
+    image : numpy.ndarray, shape (H, W), (H, W, 3) or (H, W, 4), uint8 or float32
     homography : array_like, shape (3, 3)
         Maps pixels ``(x, y)`` of ``image`` to the output.
     shape : tuple (H', W'), optional
-        Output size; default the input's.
+        Output size, integers between 1 and 32767; default the input's.
 
     Returns
     -------
@@ -101,15 +104,17 @@ def warp_image(image, homography, shape=None) -> np.ndarray:
     >>> turned.shape, bool(np.ptp(rows) > np.ptp(cols))   # the horizontal bar now stands upright
     ((60, 80), True)
     """
-    img = np.asarray(image)
-    if img.ndim not in (2, 3) or img.shape[0] == 0 or img.shape[1] == 0:
-        raise ValueError(f"image: expected a non-empty (H, W) or (H, W, 3) array, got shape {img.shape}")
+    img = as_array(image, "image", dtype=None)
+    if img.ndim not in (2, 3) or img.shape[0] == 0 or img.shape[1] == 0 or img.ndim == 3 and img.shape[2] not in (3, 4):
+        raise ValueError(f"image: expected a non-empty (H, W), (H, W, 3) or (H, W, 4) array, got shape {img.shape}")
     h = _homography(homography)
-    out = img.shape[:2] if shape is None else tuple(int(v) for v in as_array(shape, "shape", shape=(2,)))
-    if min(out) < 1:
-        raise ValueError(f"shape: expected positive (H, W), got {out}")
+    out = img.shape[:2] if shape is None else tuple(int(v) for v in as_array(shape, "shape", shape=(2,), dtype=int))
+    if min(out) < 1 or max(out) > _MAX_SIDE:
+        raise ValueError(f"shape: expected (H, W) between 1 and {_MAX_SIDE}, got {out}")
     if img.dtype not in (np.uint8, np.float32):
         img = img.astype(np.float32)
+        if not np.all(np.isfinite(img)):
+            raise ValueError("image: expected values that fit float32 (|x| < 3.4e38), got larger ones")
     return cv2.warpPerspective(np.ascontiguousarray(img), h, (out[1], out[0]), flags=cv2.INTER_LINEAR)
 
 
@@ -119,7 +124,7 @@ def similarity_homography(shape, zoom: float = 1.0, angle: float = 0.0) -> np.nd
     Parameters
     ----------
     shape : tuple (H, W)
-        Image shape.
+        Image shape (an image's full ``shape`` will do: its first two entries are used).
     zoom : float, default 1
         Scale factor (> 0).
     angle : float, default 0
@@ -163,7 +168,8 @@ def recall_precision(features_a: Features, features_b: Features, homography, ima
     homography : array_like, shape (3, 3)
         Ground truth mapping pixels of image A to image B.
     image_shape_b : tuple (H, W)
-        Shape of image B; keypoints of A that map outside it have no possible correspondence.
+        Shape of image B (an image's full ``shape`` will do: its first two entries are used);
+        keypoints of A that map outside it have no possible correspondence.
     thresholds : array_like, optional
         Ratio thresholds; default ``numpy.linspace(0.15, 0.7, 12)`` (Lin et al. Sec. 2.iii).
     tolerance : float, default 2.5

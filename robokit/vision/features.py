@@ -32,8 +32,9 @@ def as_gray_image(image, name: str = "image") -> np.ndarray:
     Parameters
     ----------
     image : array_like, shape (H, W) or (H, W, 3|4)
-        Grey or RGB(A) image. Integer images are divided by their dtype's maximum; float images
-        are kept as they are (expected in [0, 1]).
+        Grey or RGB(A) image (the alpha channel is ignored). Integer images are divided by their
+        dtype's maximum; float images are kept as they are (expected in [0, 1]). Boolean and
+        complex images are refused: convert a mask on purpose (``mask.astype(np.uint8) * 255``).
     name : str
         Argument name for error messages.
 
@@ -44,7 +45,7 @@ def as_gray_image(image, name: str = "image") -> np.ndarray:
     Raises
     ------
     TypeError
-        If the input is not a numeric array.
+        If the input is not an array of real numbers (strings, booleans, complex, ragged lists).
     ValueError
         If it is empty, smaller than 3 x 3, has the wrong number of dimensions or channels, or
         holds NaN/infinity.
@@ -53,9 +54,7 @@ def as_gray_image(image, name: str = "image") -> np.ndarray:
     -----
     Course convention (DESIGN.md "Errors"); the luminance weights are ITU-R BT.601, as in OpenCV.
     """
-    raw = np.asarray(image)
-    if raw.dtype == object or not (np.issubdtype(raw.dtype, np.number) or raw.dtype == bool):
-        raise TypeError(f"{name}: expected a numeric image array, got {describe(image)}")
+    raw = as_array(image, name, dtype=None, finite=False)
     if raw.size == 0:
         raise ValueError(f"{name}: expected a non-empty image, got shape {raw.shape}")
     if raw.ndim == 3 and raw.shape[2] in (3, 4):
@@ -66,7 +65,7 @@ def as_gray_image(image, name: str = "image") -> np.ndarray:
         scale = np.iinfo(raw.dtype).max if np.issubdtype(raw.dtype, np.integer) else 1.0
         gray = raw.astype(np.float32) / np.float32(scale)
     else:
-        raise ValueError(f"{name}: expected shape (H, W) or (H, W, 3), got shape {raw.shape}")
+        raise ValueError(f"{name}: expected shape (H, W), (H, W, 3) or (H, W, 4), got shape {raw.shape}")
     if min(gray.shape) < 3:
         raise ValueError(f"{name}: expected an image of at least 3 x 3 pixels, got shape {gray.shape}")
     if not np.all(np.isfinite(gray)):

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..validation import as_array, check_finite_scalar, check_positive
+from ..validation import as_array, check_finite_result, check_finite_scalar, check_positive
 from .features import Features
 from .matching import gated_ratio_match, ratio_match
 
@@ -206,9 +206,9 @@ def disparity_to_point(c, r, d, rig: StereoCalibration, *, sigma_c: float = 1.0,
     d = as_array(d, "d", shape=(c.size,))
     if np.any(d <= 0):
         raise ValueError("d: expected positive disparities (points in front of the rig), got d <= 0")
-    var = np.array([check_positive(sigma_c, "sigma_c", allow_zero=True) ** 2,
-                    check_positive(sigma_r, "sigma_r", allow_zero=True) ** 2,
-                    check_positive(sigma_d, "sigma_d", allow_zero=True) ** 2])
+    var = np.square([check_positive(sigma_c, "sigma_c", allow_zero=True),
+                     check_positive(sigma_r, "sigma_r", allow_zero=True),
+                     check_positive(sigma_d, "sigma_d", allow_zero=True)])
     ib = rig.baseline / d
     pts = np.column_stack([(c - rig.c0) * ib, (rig.r0 - r) * ib, rig.focal * ib])
     jac = np.zeros((c.size, 3, 3))
@@ -216,6 +216,7 @@ def disparity_to_point(c, r, d, rig: StereoCalibration, *, sigma_c: float = 1.0,
     jac[:, 1, 1] = -ib
     jac[:, :, 2] = -pts / d[:, None]          # d(X, Y, Z)/dd = -(X, Y, Z)/d
     cov = np.einsum("nij,j,nkj->nik", jac, var, jac)
+    check_finite_result("c, r, d, rig (focal, c0, r0, baseline), sigma_c, sigma_r, sigma_d", pts, cov)
     return pts, cov
 
 
@@ -236,27 +237,50 @@ def triangulate_svd(p_left, p_right, uv_left, uv_right) -> np.ndarray:
     Raises
     ------
     ValueError
-        For mismatched shapes, or a point at infinity (zero disparity), which has no finite
-        position.
+        For mismatched shapes, or zero disparity: two cameras with the same centre (no baseline,
+        every match), a match whose rays are parallel (a point at infinity) or coincide (a point
+        on the baseline); none has one finite position.
 
     Notes
     -----
     Lin et al. Sec. 3: rows ``u P^3 - P^1`` and ``v P^3 - P^2`` for each camera; the solution is
     the right singular vector of the smallest singular value (last column of ``V``), normalised by
-    its last element (Hartley & Zisserman 2004, Sec. 12.2).
+    its last element (Hartley & Zisserman 2004, Sec. 12.2). Two solutions (a second zero singular
+    value) mean the rays coincide; the camera centres are the null vectors of ``P`` (Sec. 6.2.4).
+
+    Examples
+    --------
+    >>> K = np.array([[100.0, 0.0, 80.0], [0.0, 100.0, 60.0], [0.0, 0.0, 1.0]])
+    >>> p_left, p_right = K @ np.eye(3, 4), K @ np.hstack([np.eye(3), [[-0.12], [0.0], [0.0]]])
+    >>> triangulate_svd(p_left, p_right, [[80.0, 60.0]], [[70.0, 60.0]]).round(6).tolist()
+    [[0.0, 0.0, 1.2]]
+    >>> triangulate_svd(p_left, p_left, [[80.0, 60.0]], [[70.0, 60.0]])
+    Traceback (most recent call last):
+    ...
+    ValueError: p_left, p_right: expected two camera centres (a baseline), got one centre: every match has zero disparity
     """
     pl = as_array(p_left, "p_left", shape=(3, 4))
     pr = as_array(p_right, "p_right", shape=(3, 4))
     ul = as_array(uv_left, "uv_left", shape=(None, 2))
     ur = as_array(uv_right, "uv_right", shape=(ul.shape[0], 2))
+    cl, cr = np.linalg.svd(pl)[2][-1], np.linalg.svd(pr)[2][-1]    # the centres, homogeneous, unit length
+    wedge = np.outer(cl, cr)
+    if np.linalg.norm(wedge - wedge.T) < 1e-12:
+        raise ValueError("p_left, p_right: expected two camera centres (a baseline), got one centre: "
+                         "every match has zero disparity")
     a = np.stack([ul[:, :1] * pl[2] - pl[0], ul[:, 1:] * pl[2] - pl[1],
                   ur[:, :1] * pr[2] - pr[0], ur[:, 1:] * pr[2] - pr[1]], axis=1)
     # condition each row so the smallest singular vector is not dominated by pixel magnitudes
     a /= np.linalg.norm(a, axis=2, keepdims=True)
-    x = np.linalg.svd(a)[2][:, -1, :]
+    _, sv, vt = np.linalg.svd(a)
+    x = vt[:, -1, :]
     w = x[:, 3]
+    if np.any(sv[:, 2] < 1e-12 * sv[:, 0]):
+        raise ValueError("uv_left, uv_right: a match has zero disparity (its rays through p_left and p_right coincide: "
+                         "a point on the baseline)")
     if np.any(np.abs(w) < 1e-12 * np.abs(x[:, :3]).max(axis=1, initial=1.0)):
-        raise ValueError("uv_left, uv_right: a match has zero disparity (point at infinity)")
+        raise ValueError("uv_left, uv_right: a match has zero disparity (its rays through p_left and p_right are "
+                         "parallel: a point at infinity)")
     return x[:, :3] / w[:, None]
 
 
@@ -389,6 +413,8 @@ def observe_stereo(left: Features, right: Features, rig: StereoCalibration, *, s
     """
     if not isinstance(rig, StereoCalibration):
         raise TypeError(f"rig: expected StereoCalibration, got {type(rig).__name__}")
+    for name, sigma in (("sigma_c", sigma_c), ("sigma_r", sigma_r), ("sigma_d", sigma_d)):
+        check_positive(sigma, name, allow_zero=True)      # now, not only when there are matches
     match_options.setdefault("max_disparity", rig.focal * rig.baseline / 0.3)
     m = match_stereo(left, right, **match_options)
     if len(m) == 0:

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..sim.lidar import scan_points
 from ..sim.world import World
-from ..validation import as_array, as_points, check_positive
+from ..validation import as_array, as_points, check_int, check_positive, check_text
 
 __all__ = ["map_axes", "plot_footprint", "plot_scan", "plot_trajectory", "plot_occupancy", "plot_covariance"]
 
@@ -104,8 +104,8 @@ def plot_scan(ranges: Any, sensor_pose: Any, angles: Any, ax: Any = None, color:
     >>> len(ax.lines[0].get_xdata())                # every beam hits a wall of the closed room
     90
     """
-    pts = scan_points(ranges, sensor_pose, angles)
     p = as_array(sensor_pose, "sensor_pose", shape=(3,))
+    pts = scan_points(ranges, p, angles)
     ax = map_axes(ax)
     if rays and len(pts):
         from matplotlib.collections import LineCollection
@@ -145,10 +145,12 @@ def plot_trajectory(poses: Any, ax: Any = None, label: str | None = None, every:
     ('truth', 1.0)
     """
     P = as_points(poses, "poses", 3, min_count=1)
+    label = None if label is None else check_text(label, "label")
+    every = check_int(every, "every", minimum=0)
     ax = map_axes(ax)
     line, = ax.plot(P[:, 0], P[:, 1], label=label, **kwargs)
     if every:
-        sel = P[::int(every)]
+        sel = P[::every]
         ax.quiver(sel[:, 0], sel[:, 1], np.cos(sel[:, 2]), np.sin(sel[:, 2]), color=line.get_color(),
                   angles="xy", scale_units="xy", scale=4, width=0.004)
     return ax

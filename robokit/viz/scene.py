@@ -18,9 +18,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..validation import as_array, as_points, check_positive
+from ..validation import as_array, as_points, check_int, check_positive, check_text, describe
 
-__all__ = ["Scene", "viewer_javascript", "as_color"]
+__all__ = ["Scene", "viewer_javascript", "as_color", "check_scene"]
 
 
 @functools.lru_cache(maxsize=1)
@@ -95,8 +95,8 @@ class Scene:
     """
 
     def __init__(self, title: str = "robokit scene", height: int = 420, live: bool = False) -> None:
-        self.title = str(title)
-        self.height = int(check_positive(height, "height"))
+        self.title = check_text(title, "title")
+        self.height = check_int(height, "height", minimum=1)
         self._commands: list[Any] = []
         self._live = None
         if live:
@@ -258,3 +258,29 @@ class Scene:
 
     def __repr__(self) -> str:
         return f"Scene(title={self.title!r}, commands={len(self._commands)})"
+
+
+def check_scene(scene: Any, *paths: Any) -> Scene:
+    """Return ``scene`` if it is a :class:`Scene`, and check each of ``paths`` as a scene path.
+
+    For the drawing helpers, whose first two arguments these are: a wrong one would otherwise fail
+    deep inside (or, for a number as the path, silently become a path).
+
+    Raises
+    ------
+    TypeError
+        If ``scene`` is not a Scene or a path not a string.
+    ValueError
+        If a path is empty.
+
+    Examples
+    --------
+    >>> check_scene(Scene(), "robot/body")
+    Scene(title='robokit scene', commands=0)
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene: expected a robokit.viz.Scene, got {describe(scene)}")
+    for path in paths:
+        check_text(path, "path")
+        Scene.meshcat_path(path)
+    return scene

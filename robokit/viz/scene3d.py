@@ -11,11 +11,11 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..geometry import se2_to_se3
+from ..geometry import as_se3, se2_to_se3
 from ..sim.camera import PinholeCamera
 from ..sim.world import World
-from ..validation import as_array, as_points, check_int, check_positive
-from .scene import Scene, as_color
+from ..validation import as_array, as_points, check_finite_scalar, check_int, check_positive
+from .scene import Scene, as_color, check_scene
 
 __all__ = ["add_world", "add_camera", "add_trajectory", "add_particles", "add_landmarks", "animate_poses",
            "look_from"]
@@ -78,6 +78,7 @@ def add_world(scene: Scene, world: World, path: str = "world", cell: int = 48, c
     >>> scene.html().count("meshcat") > 0
     True
     """
+    check_scene(scene, path)
     from meshcat.geometry import ImageTexture, Mesh, MeshBasicMaterial, PngImage
 
     if not isinstance(world, World):
@@ -144,9 +145,11 @@ def add_camera(scene: Scene, path: str, camera: PinholeCamera, T_world_cam: Any,
     >>> add_camera(Scene(), "camera", camera, camera.transform_at([1.0, 1.0, 0.0]))   # frustum and axes
     Scene(title='robokit scene', commands=3)
     """
+    check_scene(scene, path)
     if not isinstance(camera, PinholeCamera):
         raise TypeError(f"camera: expected a PinholeCamera, got {type(camera).__name__}")
     d = check_positive(depth, "depth")
+    T_world_cam = as_se3(T_world_cam, "T_world_cam")
     corners = np.array([[0, 0], [camera.width - 1, 0], [camera.width - 1, camera.height - 1], [0, camera.height - 1]], float)
     P = camera.backproject(corners, np.full(4, d), T_world_cam)
     apex = np.asarray(T_world_cam, float)[:3, 3]
@@ -187,9 +190,11 @@ def add_trajectory(scene: Scene, path: str, poses: Any, z: float = 0.02, color: 
     >>> add_trajectory(Scene(), "path", [[0, 0, 0], [1, 0, 0.5], [2, 1, 1.0]], every=2)   # line + 2 triads
     Scene(title='robokit scene', commands=5)
     """
+    check_scene(scene, path)
     P = as_points(poses, "poses", 3, min_count=2)
-    scene.add_line(f"{path}/line", np.column_stack([P[:, :2], np.full(len(P), z)]), color=color)
+    z = check_finite_scalar(z, "z")
     step = check_int(every, "every", minimum=0)
+    scene.add_line(f"{path}/line", np.column_stack([P[:, :2], np.full(len(P), z)]), color=color)
     if step:
         for k in range(0, len(P), step):
             scene.add_triad(f"{path}/pose{k}", se2_to_se3(P[k], z), scale=0.2)
@@ -206,6 +211,7 @@ def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, 
     -----
     The usual display of Monte Carlo localization (Thrun et al. 2005, Sec. 8.3, Fig. 8.11).
     """
+    check_scene(scene, path)
     P = as_points(particles, "particles", 3, min_count=1)
     if weights is None:
         w = np.ones(len(P))
@@ -260,6 +266,7 @@ def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None,
     >>> add_landmarks(Scene(), "landmarks", points, np.stack([0.01 * np.eye(3)] * 2))  # points + 2 ellipsoids
     Scene(title='robokit scene', commands=5)
     """
+    check_scene(scene, path)
     from meshcat.geometry import Ellipsoid, MeshLambertMaterial
 
     P = as_points(points, "points", 3, min_count=1)
@@ -306,12 +313,13 @@ def animate_poses(scene: Scene, path: str, transforms: Any, fps: float = 10.0, r
     >>> animate_poses(scene, "robot", [[0.0, 0.0, 0.0], [1.0, 0.0, 0.5], [2.0, 1.0, 1.0]], fps=2)
     Scene(title='robokit scene', commands=3)
     """
+    check_scene(scene, path)
     from meshcat.animation import AnimationClip, js_position, js_quaternion
     from meshcat.commands import SetAnimation
 
-    T = np.asarray(transforms, float)
+    T = as_array(transforms, "transforms")
     if T.ndim == 2 and T.shape[1] == 3:
-        T = np.stack([se2_to_se3(p) for p in as_points(T, "transforms", 3)])
+        T = np.stack([se2_to_se3(p) for p in T])
     T = as_array(T, "transforms", shape=(None, 4, 4))
     if len(T) < 2:
         raise ValueError(f"transforms: expected at least 2 poses, got {len(T)}")
@@ -352,6 +360,7 @@ def look_from(scene: Scene, position: Any) -> Scene:
     >>> look_from(Scene(), [5.0, -5.0, 8.0])          # above and south-east of the origin
     Scene(title='robokit scene', commands=1)
     """
+    check_scene(scene)
     from meshcat.commands import SetProperty
     from meshcat.path import Path as MeshcatPath
 

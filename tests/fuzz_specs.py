@@ -1,0 +1,457 @@
+"""A valid call of every fuzzed public function, with the kind of each argument (tests/fuzz_kinds.py).
+
+The fuzz replaces one argument of the valid call at a time by an invalid value of its kind. Every
+parameter of a fuzzed function appears here (the test checks it), so a new parameter needs a kind.
+"""
+from __future__ import annotations
+
+import datetime as dt
+import functools
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from tests.fuzz_kinds import Array, Choice, Flag, Func, Given, Int, Kind, Mapping, Obj, Options, Real, Rng, Text
+
+
+@dataclass
+class Call:
+    """How to call one function: the kind of each parameter (by name)."""
+
+    kinds: dict[str, Kind]
+    #: ``*args`` parameter fuzzed as one more positional kind list (e.g. se3_compose's transforms)
+    star: str | None = None
+    #: other names an error may use for a parameter (``{"transforms": "transforms[0]"}``)
+    aliases: dict[str, str] = field(default_factory=dict)
+    #: a valid call is fast: huge values may be tried (they run the function to the end)
+    cheap: bool = True
+
+
+# --- shared valid values (built once) ---------------------------------------------------------
+
+@functools.cache
+def iiwa():
+    from robokit.arm import iiwa14
+    return iiwa14()
+
+
+@functools.cache
+def panda_arm():
+    from robokit.arm import panda
+    return panda()
+
+
+@functools.cache
+def lab():
+    from robokit.sim import lab_room
+    return lab_room()
+
+
+@functools.cache
+def camera():
+    from robokit.sim import PinholeCamera
+    return PinholeCamera.from_fov(np.deg2rad(65), 160, 120)
+
+
+@functools.cache
+def stereo_rig():
+    from robokit.sim import StereoRig
+    return StereoRig(camera(), baseline=0.12)
+
+
+@functools.cache
+def calibration():
+    from robokit.localization.lab_experiment import calibrated_rig
+    return calibrated_rig(stereo_rig())
+
+
+@functools.cache
+def image():
+    from robokit.sim import photo
+    return photo("grace_hopper")[200:320, 180:340].copy()
+
+
+@functools.cache
+def features():
+    from robokit.vision import detect_sift_features
+    return detect_sift_features(image())
+
+
+@functools.cache
+def course():
+    from robokit.outdoor import random_course
+    return random_course(0, n_waypoints=2)
+
+
+@functools.cache
+def field_():
+    from robokit.outdoor import Field
+    return Field(circles=[[2.5, 0.0, 0.3], [1.2, 1.2, 0.3]])
+
+
+@functools.cache
+def plane():
+    from robokit.outdoor import LocalTangentPlane
+    return LocalTangentPlane(0.1127, 1.7514)
+
+
+@functools.cache
+def scene():
+    from robokit.viz import Scene
+    return Scene()
+
+
+@functools.cache
+def axes():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt.subplots()[1]
+
+
+@functools.cache
+def lap():
+    from robokit.sim import lab_lap
+    return lab_lap(lab())
+
+
+@functools.cache
+def landmark_map():      # map_consistency takes anything with positions, covariances, observations
+    import types
+    return types.SimpleNamespace(positions=np.array([[10.01, 0.2, 5.0], [0.0, 0.7, 5.0]]),
+                                 covariances=np.stack([1e-4 * np.eye(3)] * 2), observations=np.array([3, 1]))
+
+
+@functools.cache
+def run_results():
+    from robokit.outdoor import simulate
+    return [simulate(course(), seed=0, max_time=2.0)]
+
+
+def target_T():
+    return iiwa().fk(np.radians([35, 50, -40, -75, 60, 45, 20]))
+
+
+def q7():
+    return np.radians([0, 30, 0, -60, 0, 60, 0])
+
+
+def points(n=20, seed=0):
+    return np.random.default_rng(seed).uniform(-3, 3, (n, 3)) + [0, 0, 5]
+
+
+def covs(n=20):
+    return np.tile(np.eye(3) * 1e-3, (n, 1, 1))
+
+
+def when():
+    return dt.datetime(2012, 6, 4, 2, 30, 5)
+
+
+UV = np.array([[80.0, 60.0], [90.0, 50.0]])
+P_LEFT = np.hstack([np.array([[100.0, 0, 80], [0, 100, 60], [0, 0, 1]]), np.zeros((3, 1))])
+P_RIGHT = P_LEFT - np.hstack([np.zeros((3, 3)), np.array([[12.0], [0], [0]])])
+DH = np.array([[0.34, 0.0, -np.pi / 2], [0.0, 0.0, np.pi / 2], [0.4, 0.0, np.pi / 2]])
+LAT, LON = np.radians(6.459), np.radians(100.35)
+
+
+def T_(valid=target_T, **kw):      # one SE(3) transform
+    return Array(valid, "4,4", **kw)
+
+
+def Ts(valid=target_T, **kw):      # one or a stack
+    return Array(valid, "4,4|N,4,4", **kw)
+
+
+def _sensors():
+    from robokit.sim import Lidar
+    return {"laser": Lidar(beams=36)}
+
+
+def _mounts():
+    from robokit.outdoor.sonar import PAPER_LAYOUT
+    return PAPER_LAYOUT
+
+
+def _sonar():
+    from robokit.outdoor import LVMaxSonarEZ
+    return LVMaxSonarEZ()
+
+
+def _truck():
+    from robokit.outdoor import PAPER_TRUCK
+    return PAPER_TRUCK
+
+
+SPECS: dict[str, Call] = {
+    # --- about, geometry --------------------------------------------------------------------
+    "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
+    "robokit.geometry.planar.wrap_angle": Call({"angle": Array(np.array([0.5, 4.0]), "|N|N,N", min_rows=0)}),
+    "robokit.geometry.planar.se2_compose": Call({"a": Array(np.array([1.0, 2.0, 0.5]), "3|N,3"),
+                                                 "b": Array(np.array([0.5, -1.0, 3.0]), "3|N,3"), "check": Flag(True)}),
+    "robokit.geometry.paper_frames.paper_world_to_robokit": Call({
+        "points": Array(lambda: points(5), "N,3", min_rows=0), "covariances": Array(lambda: covs(5), "N,3,3", optional=True),
+        "camera_height": Real(0.8)}),
+    "robokit.geometry.paper_frames.pqt_robot_to_world": Call({
+        "points": Array(lambda: points(5), "3|N,3|N,N,3", min_rows=0), "pqt": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"),
+        "check": Flag(True)}),
+    "robokit.geometry.paper_frames.pqt_to_se2": Call({"pqt": Array(np.array([0.1, 0.2, 0.3]), "3|N,3")}),
+    "robokit.geometry.paper_frames.pqt_to_se3": Call({"pqt": Array(np.array([0.1, 0.2, 0.3]), "3")}),
+    "robokit.geometry.paper_frames.se2_to_pqt": Call({"pose": Array(np.array([0.1, 0.2, 0.3]), "3|N,3")}),
+    "robokit.geometry.spatial.pose_error": Call({"T_target": Ts(), "T": Ts(lambda: iiwa().fk(q7())), "check": Flag(True)}),
+    "robokit.geometry.spatial.se2_to_se3": Call({"pose": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"), "z": Real(0.0)}),
+    "robokit.geometry.spatial.se3_compose": Call({"transforms": Ts()}, star="transforms",
+                                                 aliases={"transforms": "transforms[0]"}),
+    # --- arm -------------------------------------------------------------------------------
+    "robokit.arm.ik_analytic.arm_angle": Call({"chain": Obj(iiwa), "q": Array(q7, "7|N,7")}),
+    "robokit.arm.ik_analytic.ik_srs": Call({"chain": Obj(iiwa), "T": T_(), "q0": Array(q7, "7", optional=True),
+                                            "n_psi": Int(12), "tol": Real(1e-6), "n_fine": Int(720)}),
+    "robokit.arm.ik_analytic.ik_srs_batch": Call({"chain": Obj(iiwa), "T": Ts(), "q0": Array(q7, "7|N,7", optional=True),
+                                                  "n_psi": Int(12), "tol": Real(1e-6), "n_fine": Int(720)}),
+    "robokit.arm.ik_analytic.ik_srs_branches": Call({"chain": Obj(iiwa), "T": T_(), "psi": Real(0.3),
+                                                     "within_limits": Flag(True)}),
+    "robokit.arm.ik_numeric.ik_numeric": Call({"chain": Obj(panda_arm), "T": T_(lambda: panda_arm().fk(panda_arm().random_q(rng=3))),
+                                               "q0": Array(lambda: panda_arm().random_q(rng=4), "7", optional=True),
+                                               "options": Options({"rng": 1})}, cheap=False),
+    "robokit.arm.ik_numeric.ik_numeric_batch": Call({
+        "chain": Obj(panda_arm), "T": Ts(lambda: panda_arm().fk(panda_arm().random_q(2, rng=3))),
+        "q0": Array(lambda: panda_arm().random_q(2, rng=4), "7|N,7", optional=True), "method": Choice("wln"),
+        "tol": Real(1e-6), "max_iter": Int(20), "restarts": Int(1), "damping": Real(1e-3), "gain": Real(0.5),
+        "clamp": Flag(True), "max_step": Real(0.5), "patience": Int(15), "parallel": Int(1), "rng": Rng(1),
+        "history": Flag(False)}, cheap=False),
+    "robokit.arm.jacobian.geometric_jacobian": Call({"chain": Obj(iiwa), "q": Array(q7, "7|N,7")}),
+    "robokit.arm.jacobian.manipulability": Call({"J": Array(lambda: np.eye(6, 7) + 0.1, "6,7|N,6,7|6,N")}),
+    "robokit.arm.robots.iiwa14": Call({}),
+    "robokit.arm.robots.panda": Call({}),
+    "robokit.arm.srs.elbow_angle": Call({"shoulder": Array(np.array([0.0, 0.0, 0.36]), "3"),
+                                         "wrist": Array(np.array([0.3, 0.2, 0.7]), "3"), "d_se": Real(0.42), "d_ew": Real(0.40)}),
+    "robokit.arm.srs.shoulder_angles": Call({"shoulder": Array(np.array([0.0, 0.0, 0.36]), "3"),
+                                             "wrist": Array(np.array([0.3, 0.2, 0.7]), "3"), "q4": Real(1.2),
+                                             "psi": Real(0.3), "d_se": Real(0.42), "d_ew": Real(0.40)}),
+    "robokit.arm.srs.wrist_centre": Call({"T": T_(), "d_wf": Real(0.126)}),
+    "robokit.arm.dh.dh_transform": Call({"theta": Array(np.array([0.1, 0.2]), "*"), "d": Array(np.array([0.3, 0.0]), "*"),
+                                         "a": Array(np.array([0.0, 0.1]), "*"), "alpha": Array(np.array([0.5, -0.5]), "*"),
+                                         "check": Flag(True)}),
+    "robokit.arm.chain.dh_fk": Call({"dh": Array(DH, "N,3"), "q": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"),
+                                     "modified": Flag(False)}),
+    "robokit.arm.jacobian.dh_jacobian": Call({"dh": Array(DH, "N,3"), "q": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"),
+                                              "modified": Flag(False)}),
+    "robokit.arm.ik_steps.null_space_step": Call({"J": Array(lambda: np.eye(6, 7) + 0.1, "6,N|N,6,N"),
+                                                  "e": Array(np.full(6, 0.01), "6"), "gradient": Array(np.full(7, 0.1), "7"),
+                                                  "damping": Real(0.01), "gain": Real(1.0)}),
+    # --- controllers -----------------------------------------------------------------------
+    "robokit.controllers.heading.design_heading_gains": Call({"tau": Real(0.3), "overshoot": Real(0.05),
+                                                              "settling_time": Real(1.5), "gain": Real(1.0)}),
+    "robokit.controllers.heading.heading_frequency_response": Call({
+        "kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3), "omega": Array(np.array([0.1, 1.0, 10.0]), "N|"), "gain": Real(1.0)}),
+    "robokit.controllers.heading.heading_step_response": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+                                                               "gain": Real(1.0), "duration": Real(2.0), "n": Int(50)}),
+    "robokit.controllers.heading.loop_metrics": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+                                                      "gain": Real(1.0), "delay": Real(0.0)}),
+    # --- localization, mapping -------------------------------------------------------------
+    "robokit.localization.egomotion.ransac_pose": Call({
+        "robot_points": Array(lambda: points(20, 1), "N,3"), "world_points": Array(lambda: points(20, 1), "N,3"),
+        "robot_covariances": Array(covs, "N,3,3", optional=True), "world_covariances": Array(covs, "N,3,3", optional=True),
+        "threshold": Real(0.1), "confidence": Real(0.99), "min_matches": Int(5), "max_iterations": Int(100),
+        "odometry": Array(np.zeros(3), "3", optional=True), "odometry_covariance": Array(np.eye(3) * 0.01, "3,3", optional=True),
+        "rng": Rng(0)}),
+    "robokit.localization.egomotion.ransac_sample_count": Call({"contamination": Real(0.3), "sample_size": Int(2),
+                                                                "confidence": Real(0.99)}),
+    "robokit.localization.egomotion.pose_from_two": Call({"robot_points": Array(lambda: points(2, 2), "2,3"),
+                                                          "world_points": Array(lambda: points(2, 3), "2,3")}),
+    "robokit.localization.lab_experiment.calibrated_rig": Call({"render_rig": Obj(stereo_rig)}),
+    "robokit.localization.lab_experiment.lab_experiment": Call({
+        "method": Choice("sift"), "descriptor": Choice("sift128"), "rate": Real(1.0), "frames": Int(2, optional=True),
+        "test_poses": Array(np.array([[1.0, 1.0, 0.0]]), "N,3", optional=True), "noise": Real(2.0), "seed": Int(0),
+        "progress": Func(None, optional=True)}, cheap=False),
+    "robokit.localization.lab_experiment.map_consistency": Call({
+        "landmark_map": Obj(landmark_map), "world": Obj(lab, optional=True), "camera_height": Real(0.8),
+        "margin": Real(0.02)}),
+    "robokit.mapping.landmarks.kalman_fuse": Call({"s": Array(np.array([1.0, 2.0, 3.0]), "3|N,3"),
+                                                   "sigma": Array(np.eye(3) * 0.1, "3,3|N,3,3"),
+                                                   "r_new": Array(np.array([1.1, 2.0, 2.9]), "3|N,3"),
+                                                   "sigma_new": Array(np.eye(3) * 0.2, "3,3|N,3,3")}),
+    # --- outdoor ---------------------------------------------------------------------------
+    "robokit.outdoor.field.Field": Call({"size": Array(np.array([100.0, 60.0]), "2"),
+                                         "circles": Array(np.array([[2.5, 0.0, 0.3]]), "N,3", optional=True, min_rows=0),
+                                         "boxes": Array(np.array([[5.0, 5.0, 1.0, 0.5, 0.2]]), "N,5", optional=True, min_rows=0),
+                                         "origin": Array(np.array([0.11, 1.75]), "2")}),
+    "robokit.outdoor.field.random_course": Call({"seed": Int(0), "n_waypoints": Int(2), "n_obstacles": Int(4),
+                                                 "on_path": Real(0.5), "size": Array(np.array([100.0, 60.0]), "2"),
+                                                 "min_gap": Real(2.5)}),
+    "robokit.outdoor.geodesy.LocalTangentPlane": Call({"lat0": Real(LAT), "lon0": Real(LON)}),
+    "robokit.outdoor.geodesy.distance_bearing": Call({
+        "lat1": Array(np.array([LAT, 0.2]), "*"), "lon1": Array(np.array([LON, 0.3]), "*"),
+        "lat2": Array(np.array([LAT + 1e-4, 0.25]), "*"), "lon2": Array(np.array([LON, 0.2]), "*"), "model": Choice("sphere")}),
+    "robokit.outdoor.geodesy.haversine_distance_bearing": Call({"lat1": Real(LAT), "lon1": Real(LON), "lat2": Real(LAT + 1e-4),
+                                                                "lon2": Real(LON + 1e-4), "radius": Real(6371008.8)}),
+    "robokit.outdoor.geodesy.vincenty_inverse": Call({
+        "lat1": Array(np.array([LAT, 0.2]), "*"), "lon1": Array(np.array([LON, 0.3]), "*"),
+        "lat2": Array(np.array([LAT + 1e-4, 0.25]), "*"), "lon2": Array(np.array([LON, 0.2]), "*"),
+        "tol": Real(1e-12), "max_iter": Int(200)}),
+    "robokit.outdoor.gps.GPSReceiver": Call({"plane": Obj(plane), "noise": Real(2.5), "tau": Real(60.0),
+                                             "white_noise": Real(0.3), "period": Real(1.0), "rng": Rng(2)}),
+    "robokit.outdoor.mission.run_courses": Call({"seeds": Array(np.array([0]), "N"), "firing": Choice("chained"),
+                                                 "course_options": Mapping({"n_waypoints": 1}, optional=True),
+                                                 "progress": Func(None, optional=True),
+                                                 "options": Options({"max_time": 2.0})}, cheap=False),
+    "robokit.outdoor.mission.simulate": Call({
+        "course": Obj(course), "seed": Int(0), "firing": Choice("chained"), "truck": Obj(_truck, optional=True),
+        "max_time": Real(2.0, optional=True), "dt": Real(0.049), "keep_nmea": Int(20), "gps_noise": Real(2.5),
+        "navigator_options": Mapping(None, optional=True)}, cheap=False),
+    "robokit.outdoor.mission.summarize_runs": Call({"results": Obj(run_results)}),
+    "robokit.outdoor.navigator.avoidance_decision": Call({
+        "ranges": Array(np.array([6.45, 0.5, 0.6, 6.45]), "4", inf_ok=True), "front": Real(1.2), "side": Real(0.8),
+        "prefer": Choice("left")}),
+    "robokit.outdoor.nmea.NMEAReader": Call({"source": Obj(b"$GPGGA,1*00\r\n", accepts=("a string",)), "require_checksum": Flag(True),
+                                             "on_error": Func(None, optional=True), "chunk_size": Int(64),
+                                             "max_line": Int(4096)}),
+    "robokit.outdoor.nmea.fix_position": Call({"sentence": Text(
+        "$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A")}),
+    "robokit.outdoor.nmea.nmea_checksum": Call({"sentence": Text("GPGGA,123519")}),
+    "robokit.outdoor.nmea.parse_sentence": Call({"sentence": Text(
+        "$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A"), "require_checksum": Flag(True)}),
+    "robokit.outdoor.nmea_write.gga_sentence": Call({
+        "when": Obj(lambda: when().time(), optional=True), "latitude": Real(6.45, optional=True), "longitude": Real(100.35, optional=True),
+        "quality": Int(1), "satellites": Int(8), "hdop": Real(1.0), "altitude_m": Real(12.0, optional=True),
+        "geoid_separation_m": Real(-3.0, optional=True), "talker": Text("GP")}),
+    "robokit.outdoor.nmea_write.hdg_sentence": Call({"heading_deg": Real(36.8), "deviation_deg": Real(0.0, optional=True),
+                                                     "variation_deg": Real(-0.3, optional=True), "talker": Text("HC")}),
+    "robokit.outdoor.nmea_write.random_sentences": Call({"count": Int(3), "rng": Rng(5), "empty_fraction": Real(0.1)}),
+    "robokit.outdoor.nmea_write.rmb_sentence": Call({
+        "destination_latitude": Real(6.4594, optional=True), "destination_longitude": Real(100.3509, optional=True), "range_m": Real(65.0),
+        "bearing_deg": Real(44.0), "cross_track_m": Real(0.0), "origin_id": Text("000"), "destination_id": Text("002"),
+        "closing_velocity_mps": Real(0.5), "arrived": Flag(False), "talker": Text("GP")}),
+    "robokit.outdoor.nmea_write.rmc_sentence": Call({
+        "when": Obj(when), "latitude": Real(6.45, optional=True), "longitude": Real(100.35, optional=True),
+        "speed_mps": Real(0.7, optional=True), "course_deg": Real(37.5, optional=True), "valid": Flag(True),
+        "magnetic_variation_deg": Real(-0.3, optional=True), "talker": Text("GP")}),
+    "robokit.outdoor.sonar.LVMaxSonarEZ": Call({"min_range": Real(0.1524), "max_range": Real(6.4516), "cycle": Real(0.049),
+                                                "half_angle": Real(0.35), "resolution": Real(0.0254)}),
+    "robokit.outdoor.sonar.firing_schedule": Call({"n_sensors": Int(4), "duration": Real(0.4), "mode": Choice("chained"),
+                                                   "cycle": Real(0.049), "rng": Rng(3)}),
+    "robokit.outdoor.sonar.pulse_width_to_cm_inches": Call({"pulse_width_us": Real(1470.0)}),
+    "robokit.outdoor.sonar.read_sensors": Call({
+        "field": Obj(field_), "pose": Array(np.array([0.0, 0.0, 0.0]), "3"), "which": Array(np.array([0, 1, 2, 3]), "N"),
+        "ping_times": Array(np.array([0.0, 0.049, 0.098, 0.147]), "N"), "mounts": Obj(_mounts), "sensor": Obj(_sonar),
+        "others": Mapping(None, optional=True), "rng": Rng(0), "noise": Real(0.0)}),
+    "robokit.outdoor.sonar.sensor_poses": Call({"pose": Array(np.array([1.0, 2.0, 0.3]), "3"), "mounts": Obj(_mounts)}),
+    "robokit.outdoor.sonar.true_ranges": Call({"field": Obj(field_), "pose": Array(np.array([0.0, 0.0, 0.0]), "3"),
+                                               "mounts": Obj(_mounts), "sensor": Obj(_sonar), "rays": Int(9)}),
+    # --- sim -------------------------------------------------------------------------------
+    "robokit.sim.camera.PinholeCamera": Call({"fx": Real(100.0), "fy": Real(100.0), "cx": Real(80.0), "cy": Real(60.0),
+                                              "width": Int(160), "height": Int(120),
+                                              "mount": T_(lambda: np.eye(4), optional=True)}),
+    "robokit.sim.camera.StereoRig": Call({"camera": Obj(camera), "baseline": Real(0.12), "trinocular": Flag(False)}),
+    "robokit.sim.lidar.Lidar": Call({"beams": Int(36), "r_min": Real(0.15), "r_max": Real(8.0), "noise": Real(0.0),
+                                     "height": Real(0.25), "offset": Array(np.zeros(3), "3")}),
+    "robokit.sim.motion.lab_lap": Call({"world": Obj(lab), "speed": Real(0.3), "rate": Real(10.0)}),
+    "robokit.sim.motion.noisy_odometry": Call({"poses": Array(lambda: lap().poses[:20], "N,3"),
+                                               "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"), "rng": Rng(0)}),
+    "robokit.sim.omni.OmniCamera": Call({"width": Int(64), "height": Int(48), "xi": Real(1.0),
+                                         "elevation_range": Array(np.array([-1.0, 0.5]), "2"), "f": Real(20.0, optional=True),
+                                         "mount": T_(lambda: np.eye(4), optional=True), "face_size": Int(40)}),
+    "robokit.sim.runs.record": Call({"world": Obj(lab), "path": Obj(lambda: lap()._replace(t=lap().t[:3], poses=lap().poses[:3])),
+                                     "sensors": Mapping(_sensors), "rate": Real(1.0, optional=True),
+                                     "odometry_alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"), "seed": Int(0),
+                                     "cache": Flag(False)}, cheap=False),
+    "robokit.sim.textures.illuminate": Call({"image": Array(image, "N,N|N,N,3"), "gain": Real(0.5), "offset": Real(0.0),
+                                             "gradient": Array(np.array([0.4, 0.0]), "2")}),
+    "robokit.sim.textures.photo": Call({"name": Choice("grace_hopper")}),
+    "robokit.sim.vehicle.unicycle_step": Call({"pose": Array(np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]), "3|N,3"),
+                                               "v": Array(np.array([1.0, 0.5]), "|N"), "omega": Array(np.array([0.3, 0.0]), "|N"),
+                                               "dt": Real(0.1), "check": Flag(True)}),
+    "robokit.sim.worlds.lab_room": Call({"seed": Int(3)}, cheap=False),
+    "robokit.sim.worlds.long_corridor": Call({"layout": Choice("mixed"), "seed": Int(2)}, cheap=False),
+    "robokit.sim.worlds.office_floor": Call({"seed": Int(1)}, cheap=False),
+    "robokit.sim.worlds_outdoor.open_field": Call({"seed": Int(0), "size": Array(np.array([30.0, 20.0]), "2"),
+                                                   "n_obstacles": Int(2), "shed": Flag(True), "border": Real(3.0)}, cheap=False),
+    # --- vision ----------------------------------------------------------------------------
+    "robokit.vision.descriptors.detect_and_describe": Call({"image": Array(image, "N,N|N,N,3|N,N,4"), "method": Choice("sift"),
+                                                            "descriptor": Choice("sift128"), "kwargs": Options({})}),
+    "robokit.vision.descriptors.detect_plot_features": Call({"image": Array(image, "N,N|N,N,3|N,N,4"),
+                                                             "params": Obj(None, optional=True), "descriptor": Choice("sift128"),
+                                                             "overrides": Options({})}),
+    "robokit.vision.descriptors.detect_sift_features": Call({"image": Array(image, "N,N|N,N,3|N,N,4"), "n_features": Int(0),
+                                                             "descriptor": Choice("sift128")}),
+    "robokit.vision.evaluation.recall_precision": Call({
+        "features_a": Obj(features), "features_b": Obj(features), "homography": Array(np.eye(3), "3,3"),
+        "image_shape_b": Array(np.array([120, 160]), "2|3"), "thresholds": Array(np.array([0.5, 0.6]), "N", optional=True),
+        "tolerance": Real(2.5), "method": Choice("kdtree")}),
+    "robokit.vision.evaluation.similarity_homography": Call({"shape": Array(np.array([120, 160]), "2|3"), "zoom": Real(1.25),
+                                                             "angle": Real(0.5)}),
+    "robokit.vision.evaluation.warp_image": Call({"image": Array(image, "N,N|N,N,3|N,N,4"), "homography": Array(np.eye(3), "3,3"),
+                                                  "shape": Array(np.array([120, 160]), "2", optional=True)}),
+    "robokit.vision.matching.ratio_match": Call({"query": Array(lambda: features().descriptors[:20], "N,N", min_rows=0),
+                                                 "train": Array(lambda: features().descriptors[10:40], "N,N", min_rows=0),
+                                                 "ratio": Real(0.65), "method": Choice("kdtree"),
+                                                 "max_distance": Real(0.8, optional=True, inf_ok=True)}),
+    "robokit.vision.plot_detector.junction_strength": Call({"tensor": Array(np.tile([[1.0, 0.1], [0.1, 2.0]], (4, 5, 1, 1)),
+                                                                            "...,2,2")}),
+    "robokit.vision.stereo.observe_stereo": Call({"left": Obj(features), "right": Obj(features), "rig": Obj(calibration),
+                                                  "sigma_c": Real(1.0), "sigma_r": Real(1.0), "sigma_d": Real(1.0),
+                                                  "match_options": Options({})}),
+    "robokit.vision.stereo.triangulate_svd": Call({"p_left": Array(P_LEFT, "3,4"), "p_right": Array(P_RIGHT, "3,4"),
+                                                   "uv_left": Array(UV, "N,2"), "uv_right": Array(UV - [[10.0, 0.0]], "N,2")}),
+    # --- the exercises' own plain-data references --------------------------------------------
+    "robokit.exercises.visual_slam.match_ratio": Call({"query": Array(lambda: features().descriptors[:20], "N,N", min_rows=0),
+                                                       "train": Array(lambda: features().descriptors[10:40], "N,N", min_rows=0),
+                                                       "ratio": Real(0.65)}),
+    "robokit.exercises.visual_slam.stereo_point": Call({
+        "c": Array(np.array([320.0, 100.0]), "N"), "r": Array(np.array([240.0, 50.0]), "N"),
+        "d": Array(np.array([10.0, 20.0]), "N"), "focal": Real(500.0), "c0": Real(320.0), "r0": Real(240.0),
+        "baseline": Real(0.12)}),
+    "robokit.exercises.visual_slam.hough_votes": Call({
+        "robot_xz": Array(np.array([[0.0, 1.0], [0.5, 2.0]]), "N,2"), "robot_cov_xz": Array(np.tile(np.eye(2) * 1e-3, (2, 1, 1)), "N,2,2"),
+        "world_xz": Array(np.array([[0.2, 1.2], [0.7, 2.2]]), "N,2"), "world_cov_xz": Array(np.tile(np.eye(2) * 1e-3, (2, 1, 1)), "N,2,2"),
+        "bounds": Array(np.array([0.0, 0.4, 0.0, 0.4]), "4"), "bin_size": Real(0.04), "angle_bin": Real(0.5)}),
+    # --- viz -------------------------------------------------------------------------------
+    "robokit.viz.maps.plot_covariance": Call({"mean": Array(np.zeros(2), "2"), "cov": Array(np.eye(2) * 0.1, "2,2"),
+                                              "ax": Given(axes), "nsigma": Real(1.0), "kwargs": Given({})}),
+    "robokit.viz.maps.plot_footprint": Call({"world": Obj(lab), "ax": Given(axes), "color": Given("k"), "kwargs": Given({})}),
+    "robokit.viz.maps.plot_scan": Call({"ranges": Array(np.array([1.0, np.inf, 2.0]), "N", inf_ok=True),
+                                        "sensor_pose": Array(np.zeros(3), "3"),
+                                        "angles": Array(np.array([0.0, 1.0, 2.0]), "N"), "ax": Given(axes),
+                                        "color": Given("tab:red"), "rays": Flag(False)}),
+    "robokit.viz.maps.plot_trajectory": Call({"poses": Array(lambda: lap().poses[:10], "N,3"), "ax": Given(axes),
+                                              "label": Text("x", optional=True), "every": Int(0), "kwargs": Given({})}),
+    "robokit.viz.scene.Scene": Call({"title": Text("t"), "height": Int(300), "live": Flag(False)}),
+    "robokit.viz.scene3d.add_camera": Call({"scene": Obj(scene), "path": Text("camera"), "camera": Obj(camera),
+                                            "T_world_cam": T_(lambda: np.eye(4)), "depth": Real(0.4), "color": Given(0x2255CC)}),
+    "robokit.viz.scene3d.add_landmarks": Call({"scene": Obj(scene), "path": Text("landmarks"),
+                                               "points": Array(lambda: points(4), "N,3", min_rows=0),
+                                               "covariances": Array(lambda: covs(4), "N,3,3", optional=True),
+                                               "nsigma": Real(1.0), "colors": Array(np.full((4, 3), 0.5), "N,3", optional=True),
+                                               "max_ellipsoids": Int(10)}),
+    "robokit.viz.scene3d.add_trajectory": Call({"scene": Obj(scene), "path": Text("lap"),
+                                                "poses": Array(lambda: lap().poses[:10], "N,3"), "z": Real(0.02),
+                                                "color": Given(0x22AA22), "every": Int(0)}),
+    "robokit.viz.scene3d.add_world": Call({"scene": Obj(scene), "world": Obj(lab), "path": Text("world"), "cell": Int(8),
+                                           "ceiling": Flag(False)}, cheap=False),
+    "robokit.viz.scene3d.animate_poses": Call({"scene": Obj(scene), "path": Text("truck"),
+                                               "transforms": Array(lambda: lap().poses[:5], "N,3|N,4,4"), "fps": Real(10.0),
+                                               "repetitions": Int(1)}),
+    "robokit.viz.scene3d.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3")}),
+}
+
+#: Public functions a lesson uses that the fuzz leaves out, and why.
+NOT_FUZZED: dict[str, str] = {
+    "robokit.sim.motion.Path": "a plain record (NamedTuple) of t and poses; the functions that take one validate it",
+    "robokit.grading.check.check": "the notebook's checker of a student's function (grading's own tests cover it)",
+}
+
+#: Besides the lessons' API: the exercises' references (students reproduce their contracts) and
+#: the functions the issue's fuzz named.
+EXTRA: tuple[str, ...] = ("robokit.sim.vehicle.unicycle_step",)
+
+
+def resolve(dotted: str) -> Callable[..., Any]:
+    """The function or class a dotted name means."""
+    import importlib
+    module, _, name = dotted.rpartition(".")
+    try:
+        return getattr(importlib.import_module(module), name)
+    except ImportError:
+        outer, _, cls = module.rpartition(".")
+        return getattr(getattr(importlib.import_module(outer), cls), name)
