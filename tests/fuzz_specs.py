@@ -243,11 +243,11 @@ SPECS: dict[str, Call] = {
     # --- controllers -----------------------------------------------------------------------
     "robokit.controllers.heading.design_heading_gains": Call({"tau": Real(0.3), "overshoot": Real(0.05),
                                                               "settling_time": Real(1.5), "gain": Real(1.0)}),
-    "robokit.controllers.heading.heading_frequency_response": Call({
+    "robokit.controllers.heading_loop.heading_frequency_response": Call({
         "kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3), "omega": Array(np.array([0.1, 1.0, 10.0]), "N|"), "gain": Real(1.0)}),
-    "robokit.controllers.heading.heading_step_response": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+    "robokit.controllers.heading_loop.heading_step_response": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
                                                                "gain": Real(1.0), "duration": Real(2.0), "n": Int(50)}),
-    "robokit.controllers.heading.loop_metrics": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+    "robokit.controllers.heading_loop.loop_metrics": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
                                                       "gain": Real(1.0), "delay": Real(0.0)}),
     # --- localization, mapping -------------------------------------------------------------
     "robokit.localization.egomotion.ransac_pose": Call({
