@@ -181,7 +181,7 @@ def build_parser() -> argparse.ArgumentParser:
     grade.add_argument("--gradescope", help="also write Gradescope's results.json (one submission)")
     grade.add_argument("--timeout", type=float, default=300, help="seconds per submission (default: 300)")
     grade.add_argument("--memory-mb", type=int, default=4096, help="address-space limit (default: 4096)")
-    grade.add_argument("--root", default=".", help="course root; its solutions/ is hidden from workers")
+    grade.add_argument("--root", default=".", help="course root; its solutions/ is covered if a folder the worker sees holds it")
     grade.add_argument("--hide", action="append", default=[], metavar="PATH",
                        help="another path student code must not see (repeatable)")
     grade.set_defaults(func=_cmd_grade)

@@ -2,6 +2,7 @@
 import csv
 import json
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -138,3 +139,14 @@ def test_a_file_name_that_is_not_utf8_still_gives_a_gradebook(tmp_path, capsys):
     (row,) = csv.DictReader(open(tmp_path / "g.csv", encoding="utf-8"))
     assert row["flags"] == "not-a-notebook" and "\x1b" not in row["student"]
     assert len(list((tmp_path / "fb").glob("*.md"))) == 1
+
+
+def test_long_duplicate_names_are_numbered_within_the_file_name_bound():
+    # names that agree in the part a feedback file name keeps used to loop forever
+    from robokit.grading.grader import unique_students
+    from robokit.grading.submission import feedback_stem
+
+    paths = [Path("x" * 100 + "a.ipynb"), Path("x" * 100 + "b.ipynb"), Path("x" * 99 + "#1.ipynb")]
+    names = [n for n, _ in unique_students(paths, "00_getting_started")]
+    stems = [feedback_stem(n).casefold() for n in names]
+    assert len(set(stems)) == 3 and all(len(s) <= 100 for s in stems), names

@@ -29,12 +29,11 @@ def job(tmp_path):
 
 def test_job_spec_round_trip(job):
     case = Case((np.arange(3.0), [1, "a"]), {"k": 2})
-    spec = JobSpec(("x = 1",), (False,), ("robokit.geometry.wrap_angle",), 4.0, 3.0,
+    spec = JobSpec(("x = 1",), (False,), 4.0, 3.0,
                    (("double", ((case.args, case.kwargs),)),))
     job.write_spec(spec)
     back = job.read_spec()
     assert back.cells == ("x = 1",) and back.skip == (False,) and back.call_seconds == 3.0
-    assert back.references == ("robokit.geometry.wrap_angle",)
     function, ((args, kwargs),) = back.exercises[0]
     assert function == "double" and np.array_equal(args[0], np.arange(3.0)) and args[1] == [1, "a"]
     assert kwargs == {"k": 2}
@@ -408,6 +407,20 @@ def _bad_crc(job):
     return bytes(raw)
 
 
+def _overlapping(job, copies=20):
+    """One stored member whose central-directory entry is repeated: every entry points at the same
+    bytes (a small file that would cost ``copies`` full reads; zipfile reads each)."""
+    import struct
+
+    one = _zip({"a0.npy": _npy_bytes({"descr": "<f8", "fortran_order": False, "shape": (1000,)}, bytes(8000))})
+    end = one[-22:]
+    cd_size, cd_offset = struct.unpack("<II", end[12:20])
+    entry = one[cd_offset:cd_offset + cd_size]
+    directory = entry * copies
+    return (one[:cd_offset] + directory + end[:8] + struct.pack("<HHII", copies, copies, len(directory), cd_offset)
+            + end[20:])
+
+
 NPZ_ATTACKS = {
     "bad CRC (BadZipFile)": _bad_crc,
     "not a zip": lambda job: b"PK\x03\x04" + bytes(range(256)) * 10,
@@ -424,6 +437,12 @@ NPZ_ATTACKS = {
     "member that is not an array": lambda job: _zip({"a0.npy": bytes(8), "evil.txt": b"x"}),
     "array missing": lambda job: _zip({"a1.npy": _npy_bytes({"descr": "<f8", "fortran_order": False, "shape": (1,)},
                                                             bytes(8))}),
+    # members that share their bytes: each costs a full read (a 1 MB file, hours of CPU)
+    "overlapping members": _overlapping,
+    # more members than the reader allows: refused from the end record, before zipfile lists them
+    "too many members": lambda job: _zip({f"a{k}.npy": b"" for k in range(10_001)}),
+    "compressed member": lambda job: _zip({"a0.npy": _npy_bytes({"descr": "<f8", "fortran_order": False,
+                                                                 "shape": (1,)}, bytes(8))}, compression=8),
 }
 
 
@@ -475,3 +494,15 @@ def test_the_worker_log_is_read_like_the_results(job, attack):
     job.log_file.write_bytes(b"x" * 10_000 + b"the end\n")
     tail = job.read_log_tail()
     assert tail.endswith("the end\n") and len(tail) <= 4000
+
+
+def test_an_array_named_twice_is_refused(job):
+    # one small int8 array named by every entry of a long list widens to int64 once per name: the
+    # grader's memory would grow without bound (100 kB on disk took hundreds of MB)
+    write_plain({"a": np.zeros(100_000, dtype=np.int8)}, job.exercise_file(0))
+    doc = json.loads(job.exercise_file(0).with_suffix(".json").read_text())
+    ref = doc["a"]
+    report = {"defined": True, "results": [{"value": [ref, ref], "error": None}], "seconds": 0.1}
+    (job.outbox / "ex0.json").write_text(json.dumps(report))
+    with pytest.raises(TransportError, match="referenced twice"):
+        job.read_exercise(0, 1)

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from robokit.exercises import get_assignment
-from robokit.grading.filesystem_view import View, installed_robokit_dirs, runtime_paths
+from robokit.grading.filesystem_view import View, bounded_space, installed_robokit_dirs, runtime_paths
 from robokit.grading.grader import worker_view
 from robokit.grading.kit import build_kit
 from robokit.grading.protocol import JobDir
@@ -91,7 +91,9 @@ def test_the_worker_sees_only_the_allowlist(base):
     # shows no launch file or log
     assert listing[str(base)] == sorted(["kit", job.root.name]), listing[str(base)]
     assert listing[str(job.root)] == ["in", "out", "work"]
-    assert listing["/tmp"] == [base.name]
+    # /tmp shows this run's folder, and nothing else but where the interpreter lives if it is there
+    runtime_in_tmp = {Path(p).parts[2] for p in runtime_paths() if Path(p).parts[1:2] == ("tmp",) and len(Path(p).parts) > 2}
+    assert set(listing["/tmp"]) == {base.name, *runtime_in_tmp}, listing["/tmp"]
     assert not isinstance(listing[str(ROOT)], list) or listing[str(ROOT)] == [".venv"], listing[str(ROOT)]
     assert result["uids"] == [result["me"]] and result["me"] != 0
     assert result["robokit"] == str(kit.package / "__init__.py")
@@ -133,6 +135,36 @@ def test_runtime_paths_leave_out_project_directories(monkeypatch):
     assert not any(p == str(ROOT) or p.startswith(str(ROOT) + "/") and "/.venv" not in p for p in paths), paths
 
 
+def test_runtime_paths_show_a_prefix_s_lib_not_its_checkouts(tmp_path, monkeypatch):
+    # `pip install -e git+...#egg=robokit` checks the course out into <venv>/src: the worker read
+    # solutions/ and imported the real reference from there while the whole prefix was shown
+    venv = tmp_path / "venv"
+    site = venv / "lib" / "python3.11" / "site-packages"
+    (venv / "src" / "robokit" / "solutions").mkdir(parents=True)
+    site.mkdir(parents=True)
+    (venv / "pyvenv.cfg").write_text("home = /usr/bin\n")
+    runtime_paths.cache_clear()
+    monkeypatch.setattr(sys, "prefix", str(venv))
+    try:
+        paths = runtime_paths()
+    finally:
+        runtime_paths.cache_clear()
+    inside = sorted(p for p in paths if p == str(venv) or p.startswith(str(venv) + "/"))
+    assert inside == [str(venv / "lib"), str(venv / "pyvenv.cfg")], inside
+
+
+def test_a_robokit_in_the_base_interpreter_s_packages_is_found(tmp_path):
+    # a venv's base interpreter shows its lib/ (shared libraries); a robokit installed in its
+    # site-packages must be covered by the kit too, as must one in a system dist-packages or an egg
+    lib = tmp_path / "base" / "lib"
+    found = [lib / "python3.11" / "site-packages" / "robokit", tmp_path / "usr" / "python3" / "dist-packages" / "robokit",
+             tmp_path / "usr" / "python3" / "dist-packages" / "robokit-1.0.egg" / "robokit"]
+    for d in found:
+        d.mkdir(parents=True)
+        (d / "__init__.py").write_text("")
+    assert installed_robokit_dirs([str(lib), str(tmp_path / "usr")]) == sorted(map(str, found))
+
+
 SHARE = """
 import ctypes, json, os, sys
 libc = ctypes.CDLL(None, use_errno=True)
@@ -171,3 +203,42 @@ def test_a_planted_launch_file_costs_only_that_job(tmp_path):
     exit_ = run_sandboxed(["-c", "pass"], job.root, LIMITS, view=View(()))
     assert exit_.returncode is None and "could not start the worker" in exit_.log
     assert victim.read_text() == "keep me"
+
+
+FILL = """
+import json, os
+written = {}
+for where in ("work", "out"):
+    n = 0
+    try:
+        for i in range(100):
+            with open(os.path.join(os.environ["HOME"], "..", where, f"fill{i}"), "wb") as f:
+                f.write(bytes(1024 * 1024))
+            n += 1
+    except OSError:
+        pass
+    written[where] = n
+files = 0
+try:
+    for i in range(10_000):
+        open(os.path.join(os.environ["HOME"], f"empty{i}"), "w").close()
+        files += 1
+except OSError:
+    pass
+os.remove(os.path.join(os.environ["HOME"], "..", "out", "fill0"))
+with open(os.path.join(os.environ["HOME"], "..", "out", "fill.json"), "w") as f:
+    json.dump({"written": written, "files": files}, f)
+"""
+
+
+@needs_root
+def test_a_worker_cannot_fill_the_disk(base):
+    # RLIMIT_FSIZE bounds each file, not how many: work/ and out/ get a bounded tmpfs each
+    job = JobDir.create(base)
+    with bounded_space((job.work, job.outbox), 8 * 1024**2, max_files=500):
+        exit_ = run_sandboxed(["-c", FILL], job.root, LIMITS, view=View(runtime_paths()))
+        assert exit_.returncode == 0, exit_.log
+        report = json.loads((job.outbox / "fill.json").read_text())  # the grader reads out/ inside the block
+    assert 4 <= report["written"]["work"] <= 8 and 4 <= report["written"]["out"] <= 8, report  # of 100 tried
+    assert report["files"] < 500, report
+    assert not (job.outbox / "fill.json").exists()  # gone with the mount

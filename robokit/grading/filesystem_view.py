@@ -15,17 +15,19 @@ sandbox launcher (root, in a fresh mount namespace) and switches the process int
 """
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import dataclasses
 import functools
+import glob
 import os
 import platform
 import sys
 import sysconfig
 from pathlib import Path
-from typing import Sequence
+from typing import Iterator, Sequence
 
-__all__ = ["View", "runtime_paths", "installed_robokit_dirs", "enter_view"]
+__all__ = ["View", "runtime_paths", "installed_robokit_dirs", "enter_view", "bounded_space"]
 
 #: Shared libraries and what the dynamic loader and time functions read.
 SYSTEM_PATHS = ("/lib", "/lib32", "/lib64", "/usr/lib", "/usr/lib32", "/usr/lib64", "/usr/share/zoneinfo",
@@ -73,14 +75,19 @@ def _link_chain(path: str) -> list[str]:
 def runtime_paths() -> tuple[str, ...]:
     """The interpreter, its standard library and the installed packages' code (this process's).
 
-    A ``sys.path`` entry counts only if it is the standard library or a ``site-packages`` /
-    ``dist-packages`` directory: a project directory on the path (an old-style editable install,
-    ``PYTHONPATH``) holds its ``.git`` and everything else beside the package, so it is left out.
+    Of an installation prefix (the interpreter's, a virtual environment's, a conda environment's)
+    only ``lib``/``lib64`` (packages and shared libraries) and a venv's ``pyvenv.cfg`` are shown,
+    never the whole prefix: ``pip install -e git+...`` checks a project out, ``.git`` and
+    solutions included, into ``<prefix>/src``. A ``sys.path`` entry counts only if it is the
+    standard library or a ``site-packages`` / ``dist-packages`` directory: a project directory on
+    the path (an old-style editable install, ``PYTHONPATH``) holds its ``.git`` and everything else
+    beside the package, so it is left out.
     """
-    paths = {*_link_chain(sys.executable), *SYSTEM_PATHS,
-             os.path.join(sys.base_prefix, "lib"), os.path.join(sys.base_prefix, "lib64")}
+    paths = {*_link_chain(sys.executable), *SYSTEM_PATHS}
+    for prefix in {sys.base_prefix, sys.prefix}:
+        paths.update(os.path.join(prefix, lib) for lib in ("lib", "lib64"))
     if sys.prefix != sys.base_prefix:
-        paths.add(sys.prefix)  # a virtual environment: its packages and pyvenv.cfg
+        paths.add(os.path.join(sys.prefix, "pyvenv.cfg"))  # a virtual environment's configuration
     for scheme_path in ("stdlib", "platstdlib", "purelib", "platlib"):
         paths.add(sysconfig.get_paths()[scheme_path])
     for entry in sys.path:
@@ -90,9 +97,19 @@ def runtime_paths() -> tuple[str, ...]:
 
 
 def installed_robokit_dirs(paths: Sequence[str]) -> list[str]:
-    """The ``robokit`` package directories directly inside ``paths`` (installed copies to replace)."""
-    return sorted({os.path.join(p, "robokit") for p in paths
-                   if os.path.isfile(os.path.join(p, "robokit", "__init__.py"))})
+    """The ``robokit`` packages installed in ``paths`` (copies the kit must stand in for).
+
+    A package counts directly inside a path, in a ``python*/site-packages`` or ``dist-packages``
+    below one (the base interpreter's packages beside a virtual environment, a system Python's in
+    ``/usr/lib``), or in an ``.egg`` there.
+    """
+    sites: set[str] = set()
+    for path in paths:
+        if os.path.isdir(path):
+            for site in (path, *glob.glob(os.path.join(glob.escape(path), "python*", "*-packages"))):
+                sites.update((site, *glob.glob(os.path.join(glob.escape(site), "*.egg"))))
+    return sorted({os.path.join(site, "robokit") for site in sites
+                   if os.path.isfile(os.path.join(site, "robokit", "__init__.py"))})
 
 
 # -- the launcher's side (root, in its own mount namespace) ---------------------------------------
@@ -224,3 +241,28 @@ def enter_view(view: View, top: Path, job_dirs: Sequence[tuple[str, bool]]) -> N
     for path in view.hide:
         root.cover(path)
     root.switch()
+
+
+@contextlib.contextmanager
+def bounded_space(paths: Sequence[Path], size_bytes: int, max_files: int = 10_000) -> Iterator[None]:
+    """Give each directory of ``paths`` its own tmpfs of ``size_bytes`` and ``max_files`` files
+    (root only) while the block runs; what was written there is gone afterwards.
+
+    ``RLIMIT_FSIZE`` bounds each file a worker writes but not how many: without this a worker
+    could fill the host's disk (its ``work/`` and ``out/`` live in the grader's temporary folder).
+    The mounts are made in the grader's namespace before the worker starts, so the worker's view
+    shows them and the grader reads ``out/`` from them after it ends.
+    """
+    libc = _libc()
+    mounted: list[bytes] = []
+    try:
+        for path in paths:
+            target = os.fsencode(path)
+            _check(libc.mount(b"tmpfs", target, b"tmpfs", _MS_NOSUID | _MS_NODEV,
+                              f"mode=0700,size={int(size_bytes)},nr_inodes={int(max_files)}".encode()),
+                   f"bound the space of {path}")
+            mounted.append(target)
+        yield
+    finally:
+        for target in reversed(mounted):
+            libc.umount2(target, _MNT_DETACH)

@@ -34,7 +34,7 @@ from .judge import expected_output, judge
 from .kit import WORKER, Kit, KitError, build_kit
 from .protocol import CallResult, CellRecord, DoneReport, JobDir, JobSpec, ReferenceSolutionDisabled
 from .safetext import clean
-from .sandbox import Limits, WorkerExit, conceal_secret, is_root, run_sandboxed
+from .sandbox import Limits, WorkerExit, conceal_secret, is_root, job_space, run_sandboxed
 from .submission import Submission, SubmissionRejected, feedback_stem, read_submission, student_name
 from .transport import TransportError
 
@@ -125,11 +125,9 @@ def _zero(prepared: PreparedCases, message: str) -> list[ExerciseScore]:
 
 
 def job_spec(submission: Submission, prepared: PreparedCases, limits: Limits) -> JobSpec:
-    """The worker's request: cells, references to disable, limits, and the case inputs only (never
-    the seed, the expected answers, what a case expects or its label)."""
-    return JobSpec(submission.sources, submission.skip,
-                   tuple(sorted({r for ex in prepared.exercises for r in ex.references})),
-                   limits.cell_seconds, limits.call_seconds,
+    """The worker's request: cells, limits, and the case inputs only (never the seed, the
+    references, the expected answers, what a case expects or its label)."""
+    return JobSpec(submission.sources, submission.skip, limits.cell_seconds, limits.call_seconds,
                    tuple((ex.function, tuple((c.args, c.kwargs) for c in cs))
                          for ex, cs in zip(prepared.exercises, prepared.cases)))
 
@@ -165,9 +163,10 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
     try:
         job.write_spec(job_spec(submission, prepared, limits))
         kit = kit or build_kit(get_assignment(assignment), job.root / "kit")
-        exit_ = run_sandboxed(["-m", WORKER, str(job.root)], job.root, limits, view=worker_view(kit, hide),
-                              env_extra={"PYTHONPATH": str(kit.root), "PYTHONSAFEPATH": "1"})
-        return _score(job, student, path, prepared, exit_, start)
+        with job_space(job, limits):
+            exit_ = run_sandboxed(["-m", WORKER, str(job.root)], job.root, limits, view=worker_view(kit, hide),
+                                  env_extra={"PYTHONPATH": str(kit.root), "PYTHONSAFEPATH": "1"})
+            return _score(job, student, path, prepared, exit_, start)
     finally:
         shutil.rmtree(job.root, ignore_errors=True)
 
@@ -292,13 +291,21 @@ def unique_students(paths: Sequence[Path], assignment: str) -> list[tuple[str, s
     for members in (m for m in groups.values() if len(m) > 1):
         note = (f"{len(members)} files map to student {names[members[0]]!r}: "
                 + ", ".join(str(paths[i]) for i in members))
-        for n, i in enumerate(members, 1):
-            name = f"{names[i]}#{n}"
-            while feedback_stem(name).casefold() in taken:
-                name += "#"
+        n = 0
+        for i in members:
+            n += 1
+            while feedback_stem(_numbered(names[i], n)).casefold() in taken:
+                n += 1
+            name = _numbered(names[i], n)
             taken.add(feedback_stem(name).casefold())
             out[i] = (name, note)
     return out
+
+
+def _numbered(name: str, n: int) -> str:
+    """``name#n``, shortened when the number would fall past the feedback file name's length bound."""
+    numbered = f"{name}#{n}"
+    return numbered if feedback_stem(numbered).endswith(f"_{n}") else f"{feedback_stem(name)[:80]}#{n}"
 
 
 def _grader_failed(path: Path, student: str, prepared: PreparedCases, exc: Exception) -> SubmissionResult:

@@ -2,13 +2,13 @@
 
 A job directory (:class:`JobDir`) holds::
 
-    in/job         JobSpec         the request: cells, skip flags, references to disable, time
-                                   limits, each exercise's function and case inputs (only those)
+    in/job         JobSpec         the request: cells, skip flags, time limits, each exercise's
+                                   function and case inputs (only those)
     work/                          the worker's current and home directory
     out/cells      CellRecord...   written after the last notebook cell
     out/ex<k>      ExerciseReport  written as soon as exercise k has run
     out/done       DoneReport      written last: the worker finished
-    out/flags.log                  ``reference:<name>``: graded code called a disabled reference
+    out/flags.log                  ``reference:<name>``: graded code tried to import a reference
     worker.log                     the worker process's own stdout and stderr
 
 Records are dataclasses, stored as their fields in plain data (:mod:`.transport`). ``out/`` (and,
@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, Iterator
 
 from ..exercises.plain import NotPlainData, to_plain
-from .transport import NotWritten, TransportError, read_plain, read_untrusted, write_plain
+from .transport import NotWritten, TransportError, open_directory, read_plain, read_untrusted, write_plain
 
 __all__ = ["JobDir", "JobSpec", "CellRecord", "CallResult", "ErrorRecord", "ExerciseReport", "DoneReport",
            "ReferenceSolutionDisabled", "log_reference_call", "CELL_STATUSES"]
@@ -43,11 +43,11 @@ MAX_FLAG_BYTES, MAX_FLAG_LINES, MAX_LOG_BYTES = 64 * 1024, 100, 4000
 MAX_SECONDS, MAX_CELL_INDEX = 1e7, 10**6
 CELL_STATUSES = ("ok", "error", "timeout", "skipped")
 _REFERENCE_FLAG = "reference:"
-_DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC
 
 
 class ReferenceSolutionDisabled(Exception):
-    """Raised in the worker when graded code calls a robokit reference implementation directly."""
+    """Raised in the worker when graded code imports a name that holds one of the assignment's
+    reference implementations (the worker's kit does not have them; :mod:`.barrier`)."""
 
 
 def log_reference_call(fd: int, dotted: str) -> None:
@@ -157,7 +157,6 @@ class JobSpec:
 
     cells: tuple[str, ...]
     skip: tuple[bool, ...]
-    references: tuple[str, ...]
     cell_seconds: float
     call_seconds: float
     exercises: tuple[tuple[str, tuple[tuple[tuple, dict], ...]], ...]
@@ -167,7 +166,7 @@ class JobSpec:
         """Rebuild the request as :meth:`JobDir.write_spec` wrote it."""
         exercises = tuple((fn, tuple((tuple(args), kwargs) for args, kwargs in inputs))
                           for fn, inputs in raw["exercises"])
-        return cls(tuple(raw["cells"]), tuple(raw["skip"]), tuple(raw["references"]), raw["cell_seconds"],
+        return cls(tuple(raw["cells"]), tuple(raw["skip"]), raw["cell_seconds"],
                    raw["call_seconds"], exercises)
 
 
@@ -253,7 +252,7 @@ class JobDir:
     def _outbox_fd(self) -> Iterator[int]:
         """``out/`` opened as a directory, never through a link (the worker may have replaced it)."""
         try:
-            fd = os.open(self.outbox, _DIR_FLAGS)
+            fd = open_directory(self.outbox)
         except OSError as exc:
             raise TransportError(f"out/ could not be opened ({exc.strerror})") from None
         try:
@@ -313,7 +312,7 @@ class JobDir:
         return DoneReport(_seconds(raw.get("compute_seconds")))
 
     def read_reference_calls(self) -> list[str]:
-        """Dotted names of the disabled references graded code called (the log's first lines);
+        """Dotted names of the references graded code tried to import (the log's first lines);
         empty if the log was never written.
 
         Raises

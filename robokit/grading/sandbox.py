@@ -37,11 +37,11 @@ import time
 from pathlib import Path
 from typing import Iterator, Sequence
 
-from .filesystem_view import View, enter_view
+from .filesystem_view import View, bounded_space, enter_view
 from .protocol import JobDir
 
 __all__ = ["Limits", "WorkerExit", "run_sandboxed", "is_root", "lease_job_uid", "conceal_secret",
-           "JOB_UIDS", "UID_LEASE_DIR"]
+           "job_space", "JOB_UIDS", "UID_LEASE_DIR"]
 
 #: Job uids/gids (no passwd entry is needed; uids that have one are skipped).
 JOB_UIDS = range(61000, 65000)
@@ -66,6 +66,9 @@ class Limits:
         ``RLIMIT_NPROC`` for the job uid (root only; a per-user count otherwise meaningless).
     file_bytes : int
         ``RLIMIT_FSIZE``: the largest file the worker may write (stdout/stderr included).
+    disk_bytes : int
+        All the worker may write in its ``work/`` and in its ``out/`` (each; root only, see
+        :func:`~.filesystem_view.bounded_space`).
     cell_seconds, call_seconds : float
         Per notebook cell and per exercise call, enforced inside the worker by an interval timer.
     """
@@ -75,6 +78,7 @@ class Limits:
     memory_bytes: int = 4 * 1024**3
     max_processes: int = 64
     file_bytes: int = 64 * 1024**2
+    disk_bytes: int = 256 * 1024**2
     cell_seconds: float = 60.0
     call_seconds: float = 20.0
 
@@ -322,6 +326,17 @@ def _run(config: Path, job: JobDir, limits: Limits, path_env: str) -> tuple[int 
             proc.kill()
         proc.wait()
     return proc.returncode, timed_out
+
+
+@contextlib.contextmanager
+def job_space(job: JobDir, limits: Limits) -> Iterator[None]:
+    """While the block runs (the worker, then the grader reading ``out/``), the job's ``work/`` and
+    ``out/`` hold at most ``limits.disk_bytes`` each (root only; :func:`~.filesystem_view.bounded_space`)."""
+    if not is_root():
+        yield
+        return
+    with bounded_space((job.work, job.outbox), limits.disk_bytes):
+        yield
 
 
 def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, view: View,

@@ -19,7 +19,7 @@ import unicodedata
 from pathlib import Path
 from typing import Any
 
-from .transport import NotWritten, SymlinkRefused, TooLarge, TransportError, read_untrusted
+from .transport import NotWritten, SymlinkRefused, TooLarge, TransportError, open_directory, read_untrusted
 
 __all__ = ["Submission", "read_submission", "student_name", "feedback_stem", "SubmissionRejected", "NotANotebook",
            "WrongAssignment", "UnreadableSubmission", "SymlinkedSubmission", "SKIP_TAGS", "MAX_NOTEBOOK_BYTES"]
@@ -27,7 +27,6 @@ __all__ = ["Submission", "read_submission", "student_name", "feedback_stem", "Su
 #: Cells with one of these tags are not run by the grader (plots, 3D scenes, slow demos).
 SKIP_TAGS = {"demo", "visualisation", "visualization", "skip-grading"}
 MAX_NOTEBOOK_BYTES = 20_000_000
-_DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC
 
 
 class SubmissionRejected(ValueError):
@@ -100,7 +99,7 @@ def _read_bytes(path: Path, assignment: str) -> bytes:
     dir_fd = None
     try:
         if path.stem == assignment:
-            dir_fd = os.open(path.parent, _DIR_FLAGS)
+            dir_fd = open_directory(path.parent)
         return read_untrusted(path.name if dir_fd is not None else path, MAX_NOTEBOOK_BYTES, dir_fd=dir_fd,
                               links_ok=True)
     except SymlinkRefused:

@@ -28,7 +28,8 @@ import numpy as np
 
 from ..exercises.plain import NotPlainData, to_plain
 
-__all__ = ["write_plain", "read_plain", "read_untrusted", "TransportError", "NotWritten", "SymlinkRefused",
+__all__ = ["write_plain", "read_plain", "read_untrusted", "open_directory", "TransportError", "NotWritten",
+           "SymlinkRefused",
            "TooLarge", "MAX_JSON_BYTES", "MAX_NPZ_BYTES"]
 
 MAX_JSON_BYTES = 20_000_000
@@ -87,6 +88,12 @@ def write_plain(value: Any, stem: str | Path) -> None:
 
 
 # -- reading (the grader's side) ------------------------------------------------------------------
+
+def open_directory(path: str | Path) -> int:
+    """Open the directory ``path`` for :func:`read_untrusted`'s ``dir_fd``, never through a link
+    in its last component; the caller closes the descriptor (``OSError`` as from :func:`os.open`)."""
+    return os.open(path, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC)
+
 
 def read_untrusted(path: str | Path, limit: int, *, dir_fd: int | None = None, keep: str = "all",
                    links_ok: bool = False) -> bytes:
@@ -174,13 +181,52 @@ def _read_npy(raw: bytes, name: str) -> np.ndarray:
     return np.frombuffer(body, dtype=dtype, count=count).reshape(shape, order="F" if fortran else "C")
 
 
+def _check_directory_end(data: bytes, name: str) -> None:
+    """Check an ``.npz``'s layout before :mod:`zipfile` parses it: what :func:`numpy.savez` writes
+    and nothing else.
+
+    The end-of-directory record (no comment) bounds the member count; every member must be stored
+    (not compressed, so its size on disk is its size), named once, and lie between the previous
+    member and the central directory, so that no byte is read twice (overlapping members would make
+    a small file cost a large read per member).
+    """
+    end = data[-22:]
+    if len(data) < 22 or end[:4] != b"PK\x05\x06":
+        raise TransportError(f"{name} is not an archive written by numpy.savez")
+    count = int.from_bytes(end[10:12], "little")
+    if count > MAX_ARRAYS:
+        raise TooLarge(f"{name} holds more than {MAX_ARRAYS} arrays")
+
+
+def _check_layout(members: list[zipfile.ZipInfo], data: bytes, name: str) -> None:
+    """Members stored, named once, in order and not overlapping (see :func:`_check_directory_end`)."""
+    seen: set[str] = set()
+    position = 0
+    for member in sorted(members, key=lambda m: m.header_offset):
+        if member.compress_type != zipfile.ZIP_STORED or member.compress_size != member.file_size:
+            raise TransportError(f"{name}: member {member.filename[:40]!r} is compressed or its sizes disagree")
+        if member.filename in seen:
+            raise TransportError(f"{name}: member {member.filename[:40]!r} appears twice")
+        seen.add(member.filename)
+        start = member.header_offset
+        header = data[start:start + 30]
+        if start < position or len(header) < 30 or header[:4] != b"PK\x03\x04":
+            raise TransportError(f"{name}: members overlap or are misplaced")
+        position = (start + 30 + int.from_bytes(header[26:28], "little") + int.from_bytes(header[28:30], "little")
+                    + member.compress_size)
+    if position > len(data):
+        raise TransportError(f"{name}: a member runs past the end of the file")
+
+
 def _parse_npz(data: bytes, name: str) -> dict[str, np.ndarray]:
-    """The arrays of an ``.npz`` held in memory; its members' sizes are bounded before reading."""
+    """The arrays of an ``.npz`` held in memory; its layout and members' sizes are checked before reading."""
+    _check_directory_end(data, name)
     try:
         with zipfile.ZipFile(io.BytesIO(data)) as archive:
             members = archive.infolist()
-            if len(members) > MAX_ARRAYS or sum(m.file_size for m in members) > MAX_NPZ_BYTES:
-                raise TooLarge(f"{name} expands to more than {MAX_NPZ_BYTES} bytes")
+            if len(members) > MAX_ARRAYS:
+                raise TooLarge(f"{name} holds more than {MAX_ARRAYS} arrays")
+            _check_layout(members, data, name)
             arrays = {}
             for member in members:
                 if not member.filename.endswith(".npy"):
@@ -193,7 +239,9 @@ def _parse_npz(data: bytes, name: str) -> dict[str, np.ndarray]:
         raise TransportError(f"{name} is unreadable ({type(exc).__name__})") from None
 
 
-def _decode(value: Any, arrays: dict[str, np.ndarray], depth: int = 0) -> Any:
+def _decode(value: Any, arrays: dict[str, np.ndarray], used: set[str], depth: int = 0) -> Any:
+    """Rebuild plain data from the JSON ``value``; each array of ``arrays`` may be named once, so
+    the decoded data is at most the (bounded) archive widened to 8-byte numbers."""
     if depth > MAX_DEPTH:
         raise TransportError("data nested too deeply")
     if isinstance(value, dict):
@@ -201,15 +249,18 @@ def _decode(value: Any, arrays: dict[str, np.ndarray], depth: int = 0) -> Any:
             name = value[_ARRAY_KEY]
             if not isinstance(name, str) or name not in arrays:
                 raise TransportError("an array is missing")
+            if name in used:
+                raise TransportError(f"array {name[:40]!r} is referenced twice")
+            used.add(name)
             return to_plain(arrays[name])
         if set(value) == {_FLOAT_KEY}:
             text = value[_FLOAT_KEY]
             if text not in ("nan", "inf", "-inf"):
                 raise TransportError("malformed special float")
             return float(text)
-        return {k: _decode(v, arrays, depth + 1) for k, v in value.items()}
+        return {k: _decode(v, arrays, used, depth + 1) for k, v in value.items()}
     if isinstance(value, list):
-        return [_decode(v, arrays, depth + 1) for v in value]
+        return [_decode(v, arrays, used, depth + 1) for v in value]
     return value  # JSON gives only None, bool, int, float and str here
 
 
@@ -234,6 +285,6 @@ def read_plain(stem: str | Path, *, dir_fd: int | None = None) -> Any:
     except NotWritten:
         arrays = {}
     try:
-        return _decode(doc, arrays)
+        return _decode(doc, arrays, set())
     except NotPlainData as exc:
         raise TransportError(str(exc)) from None
