@@ -150,3 +150,27 @@ def test_single_solve_on_floats_matches_the_vectorised_batch():
     assert batch.success.all()
     assert np.abs(single - batch.q).max() < 1e-9
     assert np.allclose([arm_angle(IIWA, qi) for qi in q], arm_angle(IIWA, q), atol=1e-12)
+
+
+@pytest.mark.parametrize("joint", [3, 1, 5])
+def test_a_target_with_a_joint_exactly_on_its_limit_solves(joint):
+    # poses from clamped trajectories put a joint exactly on its limit; the closed-form angle then
+    # lands a rounding error either side of it, and a strict limit test refused every branch
+    # (67 % of q4-on-limit targets solved before the tolerance)
+    from robokit.arm import LIMIT_TOL
+
+    arm = iiwa14()
+    q = arm.random_q(400, rng=np.random.default_rng(joint))
+    q[:200, joint], q[200:, joint] = arm.qmax[joint], arm.qmin[joint]
+    res = ik_srs_batch(arm, arm.fk(q), q0=q)
+    assert res.success.all(), res.reason[int(np.argmin(res.success))]
+    assert np.all(res.q >= arm.qmin) and np.all(res.q <= arm.qmax)  # clipped onto the limit, not past it
+    single = [ik_srs(arm, T) for T in arm.fk(q[::40])]
+    assert all(r.success for r in single)
+    branches = ik_srs_branches(arm, arm.fk(q[0]), arm_angle(arm, q[0]))
+    assert len(branches) and np.abs(branches - q[0]).max(axis=1).min() < 1e-9
+    past = q[0].copy()
+    past[joint] = arm.qmax[joint] + LIMIT_TOL / 2
+    assert arm.within_limits(past)
+    past[joint] = arm.qmax[joint] + 1e-9
+    assert not arm.within_limits(past)

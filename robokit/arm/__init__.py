@@ -16,7 +16,7 @@ transforms, rotations and the pose error come from :mod:`robokit.geometry`.
 * :func:`pose_error` - :func:`robokit.geometry.pose_error`, re-exported for the lesson.
 """
 from ..geometry import pose_error
-from .chain import Chain, chain_from_table, dh_fk
+from .chain import LIMIT_TOL, Chain, chain_from_table, dh_fk
 from .dh import dh_transform, mdh_transform
 from .ik_analytic import SRSArm, arm_angle, ik_srs, ik_srs_batch, ik_srs_branches
 from .ik_numeric import ik_numeric, ik_numeric_batch
@@ -33,4 +33,4 @@ __all__ = ["Chain", "dh_transform", "mdh_transform", "iiwa14", "panda", "geometr
            "ik_srs_branches", "IKResult", "IKBatchResult", "verify", "pose_error", "METHODS", "dls_step",
            "null_space_step", "ik_numeric", "ik_numeric_batch", "ik_numeric_reference",
            "limit_distance_gradient", "wln_weights", "chain_from_table", "dh_fk", "dh_jacobian", "elbow_angle",
-           "shoulder_angles", "wrist_centre"]
+           "shoulder_angles", "wrist_centre", "LIMIT_TOL"]

@@ -21,7 +21,13 @@ from ..geometry import as_se3
 from ..validation import array_ndim, as_array, as_rng, check_choice, check_int
 from .dh import dh_transform, mdh_transform
 
-__all__ = ["Chain", "dh_fk", "chain_from_table"]
+__all__ = ["Chain", "dh_fk", "chain_from_table", "LIMIT_TOL"]
+
+#: Slack [rad] of every joint-limit test in robokit.arm. An angle computed in closed form for a
+#: target whose joint sits exactly on its limit (a pose from a clamped trajectory) lands a rounding
+#: error (a few 1e-16 rad) on either side of it; without slack such targets were refused. Solvers
+#: clip what they return to the exact limits.
+LIMIT_TOL = 1e-12
 
 
 class Chain:
@@ -121,14 +127,14 @@ class Chain:
                              f"got shape {q.shape}")
         return q
 
-    def within_limits(self, q: Any, tol: float = 0.0) -> np.ndarray | bool:
+    def within_limits(self, q: Any, tol: float = LIMIT_TOL) -> np.ndarray | bool:
         """Return whether each configuration lies inside ``[qmin - tol, qmax + tol]``.
 
         Parameters
         ----------
         q : array_like, shape (n,) or (N, n)
             Joint angles [rad].
-        tol : float, default 0
+        tol : float, default :data:`LIMIT_TOL`
             Slack [rad] (for rounding).
 
         Returns

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..geometry import as_se3, zyz_angles
 from ..validation import array_ndim, as_array, check_int, check_positive
-from .chain import Chain
+from .chain import LIMIT_TOL, Chain
 from .result import IKBatchResult, IKResult, verify
 from .srs_geometry import ARRAY, SCALAR, arm_angle_terms, coefficient_terms, mirror_angle
 
@@ -81,8 +81,8 @@ class SRSArm:
         # limits of the spherical joints as (branch, joint-in-group, 1, 1, group): the layout of
         # the angle arrays in _best_on_grid
         grp = np.array([[0, 4], [1, 5], [2, 6]])
-        self._lo = chain.qmin[grp][None, :, None, None, None, :]
-        self._hi = chain.qmax[grp][None, :, None, None, None, :]
+        self._lo = chain.qmin[grp][None, :, None, None, None, :] - LIMIT_TOL
+        self._hi = chain.qmax[grp][None, :, None, None, None, :] + LIMIT_TOL
         self._grp = grp
         self.mid = 0.5 * (chain.qmin + chain.qmax)
 
@@ -179,7 +179,7 @@ def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, q0: np.ndarray):
     br = cost[1] < cost[0]                                           # (m, K, 2e, 2g)
     cmin = np.minimum(cost[0], cost[1])
     c4 = (q4 - q0[:, 3:4]) ** 2
-    c4[(q4 < chain.qmin[3]) | (q4 > chain.qmax[3])] = np.inf
+    c4[(q4 < chain.qmin[3] - LIMIT_TOL) | (q4 > chain.qmax[3] + LIMIT_TOL)] = np.inf
     total = cmin.sum(-1) + c4[:, None, :]                            # (m, K, 2e)
     flat = total.reshape(m, -1).argmin(1)
     k, e = np.divmod(flat, 2)
@@ -188,6 +188,7 @@ def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, q0: np.ndarray):
     q[:, :3] = X[br[i, k, e, 0].astype(np.intp), :, i, k, e, 0]
     q[:, 4:] = X[br[i, k, e, 1].astype(np.intp), :, i, k, e, 1]
     q[:, 3] = q4[i, e]
+    np.clip(q, chain.qmin, chain.qmax, out=q)   # a joint within LIMIT_TOL of a limit lands on it
     return total[i, k, e], q, psi[i, k]
 
 
@@ -288,7 +289,8 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
         return np.zeros((0, 7))
     q = arm.joints(coeffs, np.array([[p]]))[0, 0]
     if within_limits:
-        q = q[np.all((q >= chain.qmin) & (q <= chain.qmax), axis=1)]
+        q = np.clip(q[np.all((q >= chain.qmin - LIMIT_TOL) & (q <= chain.qmax + LIMIT_TOL), axis=1)],
+                    chain.qmin, chain.qmax)
     return q
 
 

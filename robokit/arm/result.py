@@ -15,7 +15,7 @@ import numpy as np
 
 from ..geometry import as_se3, pose_error
 from ..validation import check_positive
-from .chain import Chain
+from .chain import LIMIT_TOL, Chain
 
 __all__ = ["IKResult", "IKBatchResult", "verify"]
 
@@ -144,7 +144,7 @@ def verify(chain, T_target: Any, q: Any, tol: float = 1e-6, *, check: bool = Tru
     err *= err
     pos2, rot2 = err[:, :3].sum(1), err[:, 3:].sum(1)
     pos, rot, residual = np.sqrt(pos2), np.sqrt(rot2), np.sqrt(pos2 + rot2)
-    inside = ((q >= chain.qmin) & (q <= chain.qmax)).all(1)
+    inside = ((q >= chain.qmin - LIMIT_TOL) & (q <= chain.qmax + LIMIT_TOL)).all(1)
     ok = (pos < tol) & (rot < tol)
     success = ok & inside
     reasons = ["converged"] * len(q)
