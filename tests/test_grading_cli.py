@@ -150,3 +150,20 @@ def test_long_duplicate_names_are_numbered_within_the_file_name_bound():
     names = [n for n, _ in unique_students(paths, "00_getting_started")]
     stems = [feedback_stem(n).casefold() for n in names]
     assert len(set(stems)) == 3 and all(len(s) <= 100 for s in stems), names
+
+
+def test_names_that_differ_only_by_invisible_characters_are_one_name():
+    # 'bob' and 'bob' + a zero-width space both read 'bob' in the gradebook: numbered and flagged
+    from robokit.grading.grader import unique_students
+
+    names = unique_students([Path("bob/00_getting_started.ipynb"), Path("bob\u200b/00_getting_started.ipynb")],
+                            "00_getting_started")
+    assert [n for n, _ in names] == ["bob#1", "bob#2"] and all(note for _, note in names)
+
+
+def test_a_feedback_file_name_stays_within_the_file_system_limit():
+    # NFC turns U+FAD7 (3 bytes) into U+27ED3 (4 bytes): 84 of them made a 336-byte file name
+    from robokit.grading.submission import feedback_stem
+
+    stem = feedback_stem("\ufad7" * 84)
+    assert stem and len(stem.encode()) <= 200

@@ -9,6 +9,7 @@ import os
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from robokit.grading.grader import grade_batch
@@ -63,6 +64,9 @@ WRONG_WRAP = "def wrap_angle(angle):\n    return 12345.0\n"  # wrong on every ca
 
 HOSTILE = {
     # name: (notebook, expected points per exercise, flag expected or None)
+    # raising on everything passes every bad-input case; they count only after a right result
+    "always_raises": (_with(replace_wrap="def wrap_angle(*args, **kwargs):\n    raise ValueError('no')\n"),
+                      {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, None),
     "infinite_loop_in_cell": (_with("while True:\n    pass\n"), FULL, None),
     "infinite_loop_in_function": (_with(replace_wrap="def wrap_angle(angle):\n    while True:\n        pass\n"),
                                   {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, None),
@@ -232,7 +236,7 @@ def test_a_crashing_worker_is_explained(tmp_path):
     assert "worker-ended-early" in result.flags
     assert all(s.points == 0 for s in result.scores)
     assert "about to die" in result.worker_log
-    assert "Last lines of the grading process" in feedback_text(result, "00_getting_started")
+    assert "Last lines the worker process wrote" in feedback_text(result, "00_getting_started")
 
 
 # -- issue 12, helper G: what the worker can see and load -------------------------------------------
@@ -607,3 +611,59 @@ def test_without_root_the_job_directory_is_hostile_too(tmp_path, limited):
         r = results[name]
         assert {s.id: s.points for s in r.scores} == expected, (name, r.flags, r.problems)
         assert r.flags[0] == "sandbox=limited" and r.flags[1:] == flags, (name, r.flags)
+
+
+# -- issue 12 review: hidden inputs learnt from feedback -------------------------------------------
+
+PROBE_WRAP = """import json
+def wrap_angle(angle):
+    raise RuntimeError('INPUT=' + json.dumps(np.asarray(angle, dtype=float).tolist()))
+"""
+
+
+def _lookup_wrap(table):
+    return ("import json\n_TABLE = " + repr(table) + "\n"
+            "def wrap_angle(angle):\n"
+            "    key = json.dumps(np.asarray(angle, dtype=float).tolist())\n"
+            "    if key not in _TABLE:\n"
+            "        raise ValueError('not in the table')\n"
+            "    return np.asarray(_TABLE[key]) if isinstance(_TABLE[key], list) else _TABLE[key]\n")
+
+
+def test_inputs_learnt_from_feedback_do_not_score_the_next_submission(tmp_path):
+    # a probe submission prints each hidden input in its error messages; the student computes the
+    # answers with the public reference and submits a lookup table (3/3 when every submission
+    # got the same cases)
+    import re
+
+    from robokit.geometry import wrap_angle
+    from robokit.grading.reports import feedback_text
+
+    seed = "one-seed-per-term"
+    probe = tmp_path / "probe" / "00_getting_started.ipynb"
+    probe.parent.mkdir()
+    probe.write_text(json.dumps(_with(replace_wrap=PROBE_WRAP)))
+    (first,) = grade_batch([probe], "00_getting_started", seed, limits=LIMITS, log=lambda *_: None)
+    learnt = re.findall(r"INPUT=(\[[^\]]*\]|[-0-9.eE+]+|NaN)", feedback_text(first, "00_getting_started"))
+    table = {}
+    for text in learnt:
+        value = json.loads(text)
+        answer = wrap_angle(value) if "NaN" not in text else None
+        if answer is not None:
+            table[json.dumps(value)] = np.asarray(answer).tolist() if np.ndim(answer) else float(answer)
+    assert len(table) >= 3, learnt  # the feedback did show the inputs
+    lookup = tmp_path / "lookup" / "00_getting_started.ipynb"
+    lookup.parent.mkdir()
+    lookup.write_text(json.dumps(_with(replace_wrap=_lookup_wrap(table))))
+    (second,) = grade_batch([lookup], "00_getting_started", seed, limits=LIMITS, log=lambda *_: None)
+    # the hand-picked edge cases are the same under every seed and a table can hold them; every
+    # drawn case is new for the new submission, so the table misses all of those
+    from robokit.exercises import get_assignment
+
+    (exercise,) = [e for e in get_assignment("00_getting_started").exercises if e.id == "00.wrap_angle"]
+    drawn = sum(a != b for a, b in zip(map(repr, exercise.make_cases("a")), map(repr, exercise.make_cases("b"))))
+    score = {s.id: s for s in second.scores}["00.wrap_angle"]
+    assert drawn >= 2 and score.passed == score.total - drawn, (drawn, score)
+    assert all("not in the table" in m for m in score.messages), score.messages
+    again = grade_batch([probe], "00_getting_started", seed, limits=LIMITS, log=lambda *_: None)[0]
+    assert feedback_text(again, "00_getting_started") == feedback_text(first, "00_getting_started")  # regrades identically

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import hashlib
+import json
 import shutil
 import tempfile
 import time
@@ -38,8 +40,8 @@ from .sandbox import Limits, WorkerExit, conceal_secret, is_root, job_space, run
 from .submission import Submission, SubmissionRejected, feedback_stem, read_submission, student_name
 from .transport import TransportError
 
-__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "job_spec", "worker_view",
-           "grade_submission", "grade_batch", "GradingError", "isolation_note", "unique_students", "needs_review"]
+__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "cases_seed", "job_spec",
+           "worker_view", "grade_submission", "grade_batch", "GradingError", "isolation_note", "unique_students", "needs_review"]
 
 
 class GradingError(ValueError):
@@ -107,6 +109,27 @@ class PreparedCases:
     exercises: tuple[Exercise, ...]
     cases: list[list[Case]]
     expected: list[list[Any]]
+    assignment: str = ""
+    seed: str = dataclasses.field(default="", repr=False)
+
+    def for_submission(self, submission: Submission) -> PreparedCases:
+        """The cases one submission is graded on: drawn from the secret seed and a hash of the
+        submission's code cells (:func:`cases_seed`)."""
+        return prepare_cases(self.assignment, cases_seed(self.seed, submission))
+
+
+def cases_seed(seed: str, submission: Submission) -> str:
+    """The seed of one submission's hidden cases: the secret ``seed`` and a SHA-256 of its code
+    cells and skip flags.
+
+    Feedback shows a case's input when the student's code raised on it (their own message may
+    even print it). With one set of cases per seed, a student could collect those inputs, compute
+    the answers at home with robokit's public reference and submit a lookup table. Any change to
+    the code draws new cases, so what one submission learns is worthless to the next; the same
+    file still regrades identically under the same seed.
+    """
+    code = json.dumps([list(submission.sources), list(submission.skip)]).encode()
+    return f"{seed}\x00{hashlib.sha256(code).hexdigest()}"
 
 
 def prepare_cases(assignment: str, seed: str) -> PreparedCases:
@@ -116,7 +139,7 @@ def prepare_cases(assignment: str, seed: str) -> PreparedCases:
     exercises = get_assignment(assignment).exercises
     cases = [ex.make_cases(seed) for ex in exercises]
     expected = [[expected_output(ex, c) for c in cs] for ex, cs in zip(exercises, cases)]
-    return PreparedCases(exercises, cases, expected)
+    return PreparedCases(exercises, cases, expected, assignment, seed)
 
 
 def _zero(prepared: PreparedCases, message: str) -> list[ExerciseScore]:
@@ -159,6 +182,7 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
         submission = read_submission(path, assignment)
     except SubmissionRejected as exc:
         return SubmissionResult(student, path, _zero(prepared, str(exc)), [exc.flag], str(exc))
+    prepared = prepared.for_submission(submission)
     job = JobDir.create(work_root)
     try:
         job.write_spec(job_spec(submission, prepared, limits))
@@ -173,14 +197,27 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
 
 def _score_exercise(ex: Exercise, cases: list[Case], expected: list[Any],
                     results: Sequence[CallResult]) -> tuple[ExerciseScore, bool]:
-    """Judge one exercise's results; return its score and whether it called a disabled reference."""
+    """Judge one exercise's results; return its score and whether it called a disabled reference.
+
+    A bad-input case (one that expects an exception) counts only if the function returned a right
+    value on at least one valid input: a function that always raises must not earn the
+    validation marks.
+    """
     passed, messages, cheated = 0, [], False
+    errors_passed, values_passed = 0, 0
     for i, (case, exp, res) in enumerate(zip(cases, expected, results), 1):
         cheated |= res.error is not None and res.error.type == ReferenceSolutionDisabled.__name__
         outcome = judge(ex, case, exp, res)
-        passed += outcome.passed
+        if case.raises:
+            errors_passed += outcome.passed
+        else:
+            values_passed += outcome.passed
         if not outcome.passed and len(messages) < 5:
             messages.append(f"case {i}" + (f" ({case.label})" if case.label else "") + f": {outcome.message}")
+    passed = values_passed + errors_passed
+    if errors_passed and not values_passed and any(not c.raises for c in cases):
+        passed = 0
+        messages.insert(0, "bad-input cases count once the function returns a right result for a valid input")
     if cheated:
         passed = 0
         messages.insert(0, "you called the course's reference implementation, which is not allowed")
@@ -282,7 +319,9 @@ def unique_students(paths: Sequence[Path], assignment: str) -> list[tuple[str, s
     >>> unique_students([Path("alice.ipynb"), Path("alice/00_x.ipynb"), Path("bob.ipynb")], "00_x")[1]
     ('alice#2', "2 files map to student 'alice': alice.ipynb, alice/00_x.ipynb")
     """
-    names = [student_name(p, assignment) for p in paths]
+    # the name as the gradebook and the terminal show it (invisible characters dropped), so that
+    # 'bob' and 'bob' + a zero-width space are one name, numbered, not two rows that read 'bob'
+    names = [clean(student_name(p, assignment), 200) or 'student' for p in paths]
     groups = collections.defaultdict(list)
     for i, name in enumerate(names):
         groups[feedback_stem(name).casefold()].append(i)

@@ -66,7 +66,8 @@ def feedback_text(r: SubmissionResult, assignment: str) -> str:
     if notes:
         lines += ["", "## Notes", *[f"- {n}" for n in notes]]
     if r.worker_log:
-        lines += ["", "## Last lines of the grading process", "", *fenced(r.worker_log.splitlines(), max_lines=20)]
+        lines += ["", "## Last lines the worker process wrote (the submission's own code may have written them too)",
+                  "", *fenced(r.worker_log.splitlines(), max_lines=20)]
     return "\n".join(lines) + "\n"
 
 

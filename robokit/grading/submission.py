@@ -81,7 +81,7 @@ def student_name(path: Path, assignment: str) -> str:
 
 def feedback_stem(student: str) -> str:
     """The name (without ``.md``) of a student's feedback file: letters, digits, ``_``, ``.`` and
-    ``-`` only, at most 100 characters, never hidden. Two students with the same stem (compared
+    ``-`` only, at most 100 characters and 200 bytes (a file name may have 255), never hidden. Two students with the same stem (compared
     case-insensitively) would share a feedback file, so the grader treats them as duplicates.
 
     Examples
@@ -90,6 +90,8 @@ def feedback_stem(student: str) -> str:
     '_Zoë_b_'
     """
     stem = re.sub(r"[^\w.-]+", "_", unicodedata.normalize("NFC", student))[:100].lstrip(".")
+    while len(stem.encode("utf-8", "surrogatepass")) > 200:  # NFC can turn 3-byte characters into 4-byte ones
+        stem = stem[:-1]
     return stem or "student"
 
 
