@@ -242,3 +242,35 @@ def test_a_worker_cannot_fill_the_disk(base):
     assert 4 <= report["written"]["work"] <= 8 and 4 <= report["written"]["out"] <= 8, report  # of 100 tried
     assert report["files"] < 500, report
     assert not (job.outbox / "fill.json").exists()  # gone with the mount
+
+
+HOG = """
+import json, os, time
+children = []
+for _ in range(4):
+    pid = os.fork()
+    if pid == 0:
+        os.setsid()                         # its own session: no help against a job's group
+        block = b"\\1" * (150 * 1024 * 1024)  # resident, each well inside the per-process limit
+        time.sleep(1.0)
+        os._exit(0)
+    children.append(pid)
+ends = [os.waitpid(pid, 0)[1] for pid in children]
+with open(os.path.join(os.environ["HOME"], "..", "out", "hog.json"), "w") as f:
+    json.dump({"killed": sum(os.WIFSIGNALED(s) for s in ends), "ok": sum(os.WIFEXITED(s) and os.WEXITSTATUS(s) == 0 for s in ends)}, f)
+"""
+
+
+@needs_root
+def test_a_job_as_a_whole_stays_within_its_memory(base):
+    # RLIMIT_AS bounds each process: four children of 150 MB each fit a 400 MB per-process limit
+    # but not a 400 MB job; the job's control group stops them together
+    from robokit.grading.job_cgroup import cgroup_note
+
+    if cgroup_note() != "a control group per job":
+        pytest.skip("this host does not let the grader make control groups")
+    job = JobDir.create(base)
+    exit_ = run_sandboxed(["-c", HOG], job.root, Limits(wall_seconds=60, cpu_seconds=60, memory_bytes=400 * 1024**2),
+                          view=View(runtime_paths()))
+    report = json.loads((job.outbox / "hog.json").read_text())
+    assert exit_.returncode == 0 and report["killed"] >= 1 and report["ok"] <= 2, (report, exit_.log)

@@ -32,6 +32,7 @@ from typing import Any, Callable, Sequence
 from ..exercises.discovery import UnknownAssignmentError, get_assignment
 from ..exercises.spec import Case, Exercise
 from .filesystem_view import View, installed_robokit_dirs, runtime_paths
+from .job_cgroup import cgroup_note
 from .judge import expected_output, judge
 from .kit import WORKER, Kit, KitError, build_kit
 from .protocol import CallResult, CellRecord, DoneReport, JobDir, JobSpec, ReferenceSolutionDisabled
@@ -414,5 +415,6 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
 def isolation_note() -> str:
     """One line saying how strongly this run can isolate student code."""
     if is_root():
-        return "full isolation (namespaces, private uid, only the interpreter and packages visible, no network)"
+        return ("full isolation (namespaces, private uid, only the interpreter and packages visible, no network; "
+                f"{cgroup_note()})")
     return "limited isolation (not root: resource limits and timeouts only)"

@@ -37,6 +37,7 @@ import time
 from pathlib import Path
 from typing import Iterator, Sequence
 
+from . import job_cgroup
 from .filesystem_view import View, bounded_space, enter_view
 from .protocol import JobDir
 
@@ -120,6 +121,8 @@ def _launch(config_path: str) -> None:
     uid = cfg["uid"]
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # an oversized write fails instead of killing
     if uid is not None:
+        if cfg.get("cgroup"):
+            job_cgroup.JobCgroup(tuple(cfg["cgroup"])).join()  # before /sys is out of view
         view = View(tuple(cfg["view"]["read_only"]), tuple(map(tuple, cfg["view"]["replace"])),
                     tuple(cfg["view"]["hide"]))
         enter_view(view, job.root / "root", [(str(job.inbox), False), (str(job.work), True), (str(job.outbox), True)])
@@ -349,21 +352,29 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, view: V
     otherwise empty environment.
     """
     job = JobDir(job_dir)
-    with (lease_job_uid() if is_root() else contextlib.nullcontext(None)) as uid:
-        _prepare_job_dir(job, uid)
-        env = _worker_env(job, env_extra)
-        config = job.root / "launch.json"  # root-only: the job uid never reads it
-        start = time.perf_counter()
-        try:
-            with _create(config) as f:
-                f.write(json.dumps({
-                    "job_dir": str(job.root), "limits": dataclasses.asdict(limits), "uid": uid,
-                    "python": sys.executable, "view": dataclasses.asdict(view), "args": list(args), "env": env,
-                }).encode())
-            returncode, timed_out = _run(config, job, limits, env["PATH"])
-        except OSError as exc:  # e.g. a file planted in the job folder (limited mode)
-            return WorkerExit(None, False, 0.0, uid is not None, f"the grader could not start the worker: {exc}")
-        seconds = time.perf_counter() - start
+    group = None
+    try:
+        with (lease_job_uid() if is_root() else contextlib.nullcontext(None)) as uid:
+            _prepare_job_dir(job, uid)
+            env = _worker_env(job, env_extra)
+            if uid is not None:  # the job as a whole (job_cgroup); the uid makes the name unique
+                group = job_cgroup.create(f"robokit-job-{uid}", limits.memory_bytes, limits.max_processes)
+            config = job.root / "launch.json"  # root-only: the job uid never reads it
+            start = time.perf_counter()
+            try:
+                with _create(config) as f:
+                    f.write(json.dumps({
+                        "job_dir": str(job.root), "limits": dataclasses.asdict(limits), "uid": uid,
+                        "python": sys.executable, "view": dataclasses.asdict(view), "args": list(args),
+                        "env": env, "cgroup": list(group.dirs) if group else [],
+                    }).encode())
+                returncode, timed_out = _run(config, job, limits, env["PATH"])
+            except OSError as exc:  # e.g. a file planted in the job folder (limited mode)
+                return WorkerExit(None, False, 0.0, uid is not None, f"the grader could not start the worker: {exc}")
+            seconds = time.perf_counter() - start
+    finally:
+        if group is not None:  # after the lease's sweep has killed what was left of the job
+            group.remove()
     return WorkerExit(returncode, timed_out, seconds, uid is not None, job.read_log_tail())
 
 
