@@ -122,7 +122,10 @@ def _launch(config_path: str) -> None:
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # an oversized write fails instead of killing
     if uid is not None:
         if cfg.get("cgroup"):
-            job_cgroup.JobCgroup(tuple(cfg["cgroup"])).join()  # before /sys is out of view
+            try:
+                job_cgroup.JobCgroup(tuple(cfg["cgroup"])).join()  # before /sys is out of view
+            except OSError as exc:  # the host refused: the per-process limits still hold
+                print(f"robokit sandbox: the job runs without its control group ({exc})", file=sys.stderr)
         view = View(tuple(cfg["view"]["read_only"]), tuple(map(tuple, cfg["view"]["replace"])),
                     tuple(cfg["view"]["hide"]))
         enter_view(view, job.root / "root", [(str(job.inbox), False), (str(job.work), True), (str(job.outbox), True)])
