@@ -50,6 +50,23 @@ def test_cache_is_keyed_by_parameters(cache):
     assert np.array_equal(a.odometry, c.odometry)  # deterministic
 
 
+def test_a_corrupt_or_stale_cache_file_is_rebuilt_not_loaded(cache):
+    world = box_room()
+    path = waypoint_path([[1.0, 1.0], [2.0, 1.0]], rate=2)
+    fresh = record(world, path, small_sensors(), seed=1, cache=False)
+    record(world, path, small_sensors(), seed=1)
+    (target,) = (cache / "runs").glob("*.npz")
+    target.write_bytes(target.read_bytes()[:1000])  # a write cut short
+    again = record(world, path, small_sensors(), seed=1)
+    assert np.array_equal(again.images["cam"], fresh.images["cam"])
+    # a run stored under this key by other code (another simulator version) is not served either
+    stale = Run(fresh.t, fresh.poses, fresh.odometry + 1.0, fresh.images, fresh.depths, fresh.scans,
+                {**fresh.meta, "code": {**fresh.meta["code"], "robokit": "0" * 16}})
+    stale.save(target)
+    assert np.array_equal(record(world, path, small_sensors(), seed=1).odometry, fresh.odometry)
+    assert fresh.meta["code"]["numpy"] == np.__version__
+
+
 def test_record_omni_and_lab_lap(cache):
     world = lab_room()
     lap = lab_lap(world, rate=1.0)

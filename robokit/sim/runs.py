@@ -1,8 +1,9 @@
 """Recorded runs: drive a path through a world, log ground truth, odometry, images and scans.
 
 A :class:`Run` is plain arrays (no pickled objects), saved as one compressed ``.npz`` file and
-cached under ``robokit.cache_dir("runs")`` keyed by every parameter of the recording, so a lesson
-that records the same run twice renders it once. Every sensor is driven through one interface,
+cached under ``robokit.cache_dir("runs")`` keyed by every parameter of the recording and by the
+code that renders it, so a lesson that records the same run twice renders it once, and a change
+to the simulator never serves an old rendering. Every sensor is driven through one interface,
 ``observe(world, robot_pose, rng=...)``.
 
 References
@@ -17,12 +18,15 @@ References
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import os
+import zipfile
 from pathlib import Path as FsPath
 from typing import Any
 
+import cv2
 import numpy as np
 
 from ..config import cache_dir, cache_key
@@ -116,6 +120,33 @@ class Run:
                        groups["scans"], json.loads(str(data["meta"])))
 
 
+@functools.lru_cache(maxsize=1)
+def _code_version() -> dict:
+    """What else decides a recording besides its parameters: a hash of the source of
+    ``robokit.sim`` and ``robokit.geometry`` (renderer, textures, sensors, noise, poses) and the
+    numpy and OpenCV versions (their numerics changed results before). A run cached by other code
+    is never reused."""
+    root = FsPath(__file__).resolve().parent.parent
+    digest = hashlib.sha256()
+    for package in ("sim", "geometry"):
+        for source in sorted((root / package).glob("*.py")):
+            digest.update(source.name.encode() + b"\0" + source.read_bytes())
+    return {"robokit": digest.hexdigest()[:16], "numpy": np.__version__, "opencv": cv2.__version__}
+
+
+def _cached(target: FsPath, meta: dict) -> Run | None:
+    """The run cached at ``target`` if it is readable and was made with exactly ``meta``; ``None``
+    for a missing, corrupt (a killed write, a damaged disk) or foreign file, which is then rebuilt."""
+    if not target.exists():
+        return None
+    try:
+        run = Run.load(target)
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+        return None
+    stored = {k: v for k, v in run.meta.items() if k != "format"}
+    return run if stored == json.loads(json.dumps(meta)) else None
+
+
 def _describe(sensor: Any) -> dict:
     """JSON description of a sensor's parameters (for the cache key)."""
     out = {"type": type(sensor).__name__}
@@ -187,7 +218,8 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     seed : int, default 0
         Seeds odometry, image and LiDAR noise.
     cache : bool, default True
-        Load from / save to ``robokit.cache_dir("runs")``, keyed by all parameters.
+        Load from / save to ``robokit.cache_dir("runs")``, keyed by all parameters and the code
+        that renders (a corrupt or foreign cache file is rebuilt, never loaded).
 
     Returns
     -------
@@ -232,10 +264,10 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     geometry = hashlib.sha256(np.round(world.corner_array, 9).tobytes()).hexdigest()[:16]
     meta = {"world": world.name, "world_info": json.loads(json.dumps(world.info, default=str)), "geometry": geometry,
             "rate": rate, "path": digest, "sensors": {k: _describe(s) for k, s in sensors.items()},
-            "odometry_alphas": alphas.tolist(), "seed": int(seed)}
+            "odometry_alphas": alphas.tolist(), "seed": int(seed), "code": _code_version()}
     target = cache_dir("runs") / f"{world.name}-{cache_key(**meta)}.npz" if cache else None
-    if target is not None and target.exists():
-        return Run.load(target)
+    if target is not None and (cached := _cached(target, meta)) is not None:
+        return cached
     rng = as_rng(int(seed))
     odometry = noisy_odometry(poses, alphas, rng)
     logs: dict[str, dict[str, list]] = {"images": {}, "depths": {}, "scans": {}}
