@@ -289,8 +289,7 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
         return np.zeros((0, 7))
     q = arm.joints(coeffs, np.array([[p]]))[0, 0]
     if within_limits:
-        q = np.clip(q[np.all((q >= chain.qmin - LIMIT_TOL) & (q <= chain.qmax + LIMIT_TOL), axis=1)],
-                    chain.qmin, chain.qmax)
+        q = np.clip(q[chain.within_limits(q)], chain.qmin, chain.qmax)
     return q
 
 
