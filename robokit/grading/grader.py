@@ -42,7 +42,8 @@ from .submission import Submission, SubmissionRejected, feedback_stem, read_subm
 from .transport import TransportError
 
 __all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "cases_seed", "job_spec",
-           "worker_view", "grade_submission", "grade_batch", "GradingError", "isolation_note", "unique_students", "needs_review"]
+           "worker_view", "grade_submission", "grade_batch", "GradingError", "isolation_note", "unique_students",
+           "needs_review"]
 
 
 class GradingError(ValueError):
@@ -204,7 +205,7 @@ def _score_exercise(ex: Exercise, cases: list[Case], expected: list[Any],
     value on at least one valid input: a function that always raises must not earn the
     validation marks.
     """
-    passed, messages, cheated = 0, [], False
+    messages, cheated = [], False
     errors_passed, values_passed = 0, 0
     for i, (case, exp, res) in enumerate(zip(cases, expected, results), 1):
         cheated |= res.error is not None and res.error.type == ReferenceSolutionDisabled.__name__
@@ -221,7 +222,7 @@ def _score_exercise(ex: Exercise, cases: list[Case], expected: list[Any],
         messages.insert(0, "bad-input cases count once the function returns a right result for a valid input")
     if cheated:
         passed = 0
-        messages.insert(0, "you called the course's reference implementation, which is not allowed")
+        messages.insert(0, "your code reached for the course's reference implementation, which is not allowed")
     points = round(float(ex.points) * passed / len(cases), 4)
     return ExerciseScore(ex.id, points, float(ex.points), passed, len(cases), messages), cheated
 

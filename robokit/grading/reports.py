@@ -19,7 +19,8 @@ from .submission import feedback_stem
 __all__ = ["write_gradebook", "write_feedback", "feedback_text", "gradescope_results", "write_gradescope", "FLAG_TEXT"]
 
 FLAG_TEXT = {
-    "called-reference": "tried to import a reference implementation the grader withholds (an exercise that failed for it scores zero)",
+    "called-reference": ("tried to import a reference implementation the grader withholds "
+                         "(an exercise that failed for it scores zero)"),
     "timeout": "stopped at the time limit",
     "worker-ended-early": "the notebook ended the grading process before it finished",
     "unusable-results": "the grading process left results the grader could not use (those parts score zero)",

@@ -81,8 +81,9 @@ def student_name(path: Path, assignment: str) -> str:
 
 def feedback_stem(student: str) -> str:
     """The name (without ``.md``) of a student's feedback file: letters, digits, ``_``, ``.`` and
-    ``-`` only, at most 100 characters and 200 bytes (a file name may have 255), never hidden. Two students with the same stem (compared
-    case-insensitively) would share a feedback file, so the grader treats them as duplicates.
+    ``-`` only, at most 100 characters and 200 bytes (a file name may have 255), never hidden.
+    Two students with the same stem (compared case-insensitively) would share a feedback file, so
+    the grader treats them as duplicates.
 
     Examples
     --------
