@@ -28,7 +28,7 @@ LAYERS: list[set[str]] = [
     {"sim"},                                        # worlds, sensors, motion (its feature check uses vision)
     {"mapping"},                                    # grids, landmark maps, topological maps
     {"localization", "controllers"},                # pose estimation / control loops
-    {"legged", "outdoor", "arm"},                   # the system lessons
+    {"legged", "outdoor", "arm", "navigation"},     # the system lessons; closed-loop navigation
     {"viz"},                                        # meshcat scenes and figures
     {"exercises"},                                  # one module per assignment, and their discovery
     {"grading"},                                    # check(), assignments, the sandboxed grader
