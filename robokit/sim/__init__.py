@@ -40,7 +40,7 @@ LiDAR, vehicles and motion
     al. 2007, and our slip ratio) and its saturating inverse ``skid_steer_wheel_speeds``; odometry noise
     (:mod:`robokit.sim.motion`, Thrun et al. 2005, Tables 5.5-5.6): ``odometry_increment``,
     ``sample_motion_model_odometry``, ``noisy_odometry``; paths ``waypoint_path``,
-    ``corridor_path``, ``lab_lap``.
+    ``corridor_path``, ``lab_lap``, ``office_tour``.
 
 Recorded runs
     ``record(world, path, sensors={"cam": cam, "laser": lidar}, rate=5)`` -> :class:`Run`
@@ -64,8 +64,8 @@ from .camera import Frame, PinholeCamera, StereoRig, camera_mount
 from .feature_check import ViewPairCheck, ground_truth_inliers, sift_view_pair
 from .layout import Layout, box_corners, obstacle_array
 from .lidar import Lidar, scan_points
-from .motion import (Path, corridor_path, lab_lap, noisy_odometry, odometry_increment, sample_motion_model_odometry,
-                     waypoint_path)
+from .motion import (Path, corridor_path, lab_lap, noisy_odometry, odometry_increment, office_tour,
+                     sample_motion_model_odometry, waypoint_path)
 from .omni import OmniCamera, omni_mount
 from .runs import Run, record
 from .textures import illuminate, photo
@@ -81,6 +81,6 @@ __all__ = [
     "Layout", "box_corners", "obstacle_array", "Lidar", "scan_points",
     "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
     "odometry_increment",
-    "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap",
+    "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap", "office_tour",
     "Run", "record", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair",
 ]

@@ -17,6 +17,8 @@ References
 .. [3] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
    environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
    doi:10.1631/FITEE.2200208.
+.. [4] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
+   navigation" (course source 001; README.md, "References").
 """
 from __future__ import annotations
 
@@ -29,7 +31,7 @@ from ..validation import as_array, as_points, as_rng, check_positive, check_samp
 from .world import World
 
 __all__ = ["odometry_increment", "sample_motion_model_odometry", "noisy_odometry", "Path", "waypoint_path",
-           "corridor_path", "lab_lap"]
+           "corridor_path", "lab_lap", "office_tour"]
 
 
 def odometry_increment(previous: Any, current: Any) -> np.ndarray:
@@ -259,3 +261,65 @@ def lab_lap(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
         raise TypeError(f"world: expected the lab World (lab_room()), got {describe(world)}")
     lap = [[3.0, 2.0], [7.5, 2.0], [7.8, 5.0], [7.5, 8.0], [3.0, 8.0], [2.6, 5.0], [3.0, 2.0]]
     return waypoint_path(lap, speed, rate=rate)
+
+
+#: Waypoints of :func:`office_tour` in :func:`robokit.sim.office_floor`: a lap of R1, then R2, R3
+#: and R4 each walked round their table through the doorways at x = 4 and x = 12, and back to R1.
+OFFICE_TOUR = ((14.5, 4.0), (10.0, 4.0), (10.0, 1.0), (14.8, 0.8), (14.8, 4.0), (12.0, 4.0),   # R1, a loop
+               (12.0, 6.0), (4.0, 6.0),                                                       # corridor west
+               (4.0, 4.2), (6.2, 4.2), (6.2, 1.0), (1.6, 1.0), (1.6, 4.2), (4.0, 4.2), (4.0, 6.0),  # R2
+               (4.0, 8.0), (5.8, 8.0), (5.8, 11.0), (1.6, 11.0), (1.6, 8.0), (4.0, 8.0), (4.0, 6.0),  # R3
+               (12.0, 6.0),                                                                   # corridor east
+               (12.0, 8.0), (14.6, 8.0), (14.6, 11.2), (10.0, 11.2), (10.0, 8.0), (12.0, 8.0),  # R4
+               (12.0, 6.0), (12.0, 4.0), (14.5, 4.0))                                         # back into R1
+
+
+def office_tour(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
+    """The exploration drive of :func:`robokit.sim.office_floor`: every room and the corridor, with loops.
+
+    Parameters
+    ----------
+    world : World
+        ``office_floor()``. The walls are the same for every seed, the tables are not: the tour
+        keeps 0.3 m from everything for the default seed (1), and from walls only for others
+        (:func:`robokit.sim.record` refuses a pose closer than 0.05 m).
+    speed : float, default 0.3
+        Forward speed (m/s).
+    rate : float, default 10
+        Sampling rate of the returned poses (Hz).
+
+    Returns
+    -------
+    Path
+        Starts in R1 (lower right) at ``(14.5, 4.0)`` facing west, laps R1, crosses the corridor
+        to R2, R3 and R4, each walked round its table, and returns to R1: it closes the R1 lap and
+        the whole-floor loop (work for loop closure), about 98 m in all.
+
+    Raises
+    ------
+    TypeError
+        If ``world`` is not the office floor.
+    ValueError
+        For a non-positive speed or rate.
+
+    Notes
+    -----
+    Lesson 02's paper, Sec. "Experimental results": "We firstly drive the robot to move along the
+    path as shown in Fig. 6a" through "four rooms R1, R2, R3, R4 and a horizontal corridor",
+    recording images "at a constant rate" (Sec. "System overview"). The waypoints are ours (the
+    paper's figure is not reproduced in our copy); every pose keeps at least 0.3 m from walls,
+    tables and cabinets of the default office (tests/test_sim_lidar_motion.py checks it with
+    ``World.is_free``). The robot
+    turns on the spot at each waypoint (:func:`waypoint_path`), as a robot "lead through all parts
+    of the environment by hand" would.
+
+    Examples
+    --------
+    >>> from robokit.sim import office_floor
+    >>> tour = office_tour(office_floor())
+    >>> len(tour.t), round(float(tour.t[-1]), 1), tour.poses[0].round(3).tolist()
+    (4000, 399.9, [14.5, 4.0, -3.142])
+    """
+    if not isinstance(world, World) or world.name != "office_floor":
+        raise TypeError(f"world: expected the office floor World (office_floor()), got {describe(world)}")
+    return waypoint_path(OFFICE_TOUR, speed, rate=rate)
