@@ -256,8 +256,6 @@ SPECS: dict[str, Call] = {
         "threshold": Real(0.1), "confidence": Real(0.99), "min_matches": Int(5), "max_iterations": Int(100),
         "odometry": Array(np.zeros(3), "3", optional=True), "odometry_covariance": Array(np.eye(3) * 0.01, "3,3", optional=True),
         "rng": Rng(0)}),
-    "robokit.localization.egomotion.ransac_sample_count": Call({"contamination": Real(0.3), "sample_size": Int(2),
-                                                                "confidence": Real(0.99)}),
     "robokit.localization.egomotion.pose_from_two": Call({"robot_points": Array(lambda: points(2, 2), "2,3"),
                                                           "world_points": Array(lambda: points(2, 3), "2,3")}),
     "robokit.localization.lab_experiment.calibrated_rig": Call({"render_rig": Obj(stereo_rig)}),
