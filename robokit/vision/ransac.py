@@ -75,8 +75,7 @@ def ransac_sample_count(contamination: float, sample_size: int = 2, confidence: 
     good = (1 - eps) ** p
     if good >= 1:
         return 1
-    with np.errstate(divide="ignore"):
-        samples = np.log(1 - conf) / np.log(1 - good)
+    samples = np.log1p(-conf) / np.log1p(-good)      # log1p: a tiny clean-sample probability stays nonzero
     if not samples < 2.0 ** 63:   # a clean sample is so unlikely that no count is enough
         raise ValueError(f"sample_size: expected a sample that can be clean, got {p} matches at contamination {eps} "
                          f"(probability {good:.3g} per sample)")
