@@ -72,6 +72,10 @@ def image():
     return photo("grace_hopper")[200:320, 180:340].copy()
 
 
+def image_mask():
+    return np.ones(image().shape[:2], bool)
+
+
 @functools.cache
 def features():
     from robokit.vision import detect_sift_features
@@ -431,6 +435,23 @@ SPECS: dict[str, Call] = {
                                                "transforms": Array(lambda: lap().poses[:5], "N,3|N,4,4"), "fps": Real(10.0),
                                                "repetitions": Int(1)}),
     "robokit.viz.scene3d.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3")}),
+    # --- robokit.vision.colour (lesson 02: HSI hue histograms) --------------------------------
+    "robokit.vision.colour.rgb_to_hsi": Call({"image": Array(image, "...,3|...,4")}),
+    "robokit.vision.colour.hue_mask": Call({"image": Array(image, "N,N,3|N,N,4"), "min_saturation": Real(0.04),
+                                            "min_intensity": Real(0.04), "max_intensity": Real(0.98)}),
+    "robokit.vision.colour.hue_histogram": Call({"image": Array(image, "N,N,3|N,N,4"), "bins": Int(32),
+                                                 "min_saturation": Real(0.04), "min_intensity": Real(0.04),
+                                                 "max_intensity": Real(0.98),
+                                                 "mask": Array(image_mask, "N,N", optional=True, accepts=("booleans",))}),
+    "robokit.vision.colour.hue_histogram_opencv": Call({"image": Array(image, "N,N,3|N,N,4"), "bins": Int(32),
+                                                        "min_saturation": Real(0.04), "min_intensity": Real(0.04),
+                                                        "max_intensity": Real(0.98),
+                                                        "mask": Array(image_mask, "N,N", optional=True,
+                                                                      accepts=("booleans",))}),
+    "robokit.vision.colour.histogram_distance": Call({"h": Array(np.full(8, 0.125), "N"),
+                                                      "H": Array(np.eye(8)[:3], "N|N,N")}),
+    "robokit.vision.colour.histogram_intersection": Call({"h": Array(np.full(8, 0.125), "N"),
+                                                          "H": Array(np.eye(8)[:3], "N|N,N")}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -441,7 +462,11 @@ NOT_FUZZED: dict[str, str] = {
 
 #: Besides the lessons' API: the exercises' references (students reproduce their contracts) and
 #: the functions the issue's fuzz named.
-EXTRA: tuple[str, ...] = ("robokit.sim.vehicle.unicycle_step",)
+EXTRA: tuple[str, ...] = ("robokit.sim.vehicle.unicycle_step",
+                          # robokit.vision.colour (lesson 02)
+                          "robokit.vision.colour.rgb_to_hsi", "robokit.vision.colour.hue_mask",
+                          "robokit.vision.colour.hue_histogram", "robokit.vision.colour.hue_histogram_opencv",
+                          "robokit.vision.colour.histogram_distance", "robokit.vision.colour.histogram_intersection")
 
 
 def resolve(dotted: str) -> Callable[..., Any]:
