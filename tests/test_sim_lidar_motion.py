@@ -137,3 +137,17 @@ def test_office_tour_visits_every_room_and_closes_loops():
     assert len(visits) >= 2
     length = np.linalg.norm(np.diff(xy, axis=0), axis=1).sum()
     assert 90.0 < length < 110.0
+
+
+def test_odometry_covariance_matches_monte_carlo_of_the_noise_model():
+    from robokit.geometry import se2_between, wrap_angle
+    truth = mo.waypoint_path([[0, 0], [2, 0], [2, 1.5]], speed=0.5, rate=2).poses
+    alphas = [0.02, 0.002, 0.02, 0.002]
+    cov = mo.odometry_covariance(truth, alphas)
+    assert cov.shape == (len(truth), 3, 3) and np.all(cov[0] == 0)
+    rng = np.random.default_rng(0)
+    ends = np.array([se2_between(o[0], o[-1]) for o in (mo.noisy_odometry(truth, alphas, rng) for _ in range(3000))])
+    ends[:, 2] = wrap_angle(ends[:, 2] - np.mean(ends[:, 2]))
+    empirical = np.cov(ends.T)
+    assert np.allclose(empirical, cov[-1], rtol=0.15, atol=2e-4), (empirical, cov[-1])
+    assert np.allclose(mo.increment_variances(np.zeros(3), alphas), 0.0)

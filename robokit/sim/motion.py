@@ -30,7 +30,8 @@ from ..geometry import wrap_angle
 from ..validation import as_array, as_points, as_rng, check_positive, check_sample_count, describe
 from .world import World
 
-__all__ = ["odometry_increment", "sample_motion_model_odometry", "noisy_odometry", "Path", "waypoint_path",
+__all__ = ["odometry_increment", "increment_variances", "odometry_covariance", "sample_motion_model_odometry",
+           "noisy_odometry", "Path", "waypoint_path",
            "corridor_path", "lab_lap", "office_tour"]
 
 
@@ -72,13 +73,106 @@ def _alphas(alphas: Any) -> np.ndarray:
     return a
 
 
+def increment_variances(delta: Any, alphas: Any, *, check: bool = True) -> np.ndarray:
+    """Variances of the noise on odometry increments ``[delta_rot1, delta_trans, delta_rot2]``.
+
+    Parameters
+    ----------
+    delta : array_like, shape (3,) or (N, 3)
+        Increments from :func:`odometry_increment`.
+    alphas : array_like, shape (4,)
+        Noise parameters ``a1..a4`` (non-negative).
+    check : bool, default True
+        Validate; ``False`` is the fast path (float arrays).
+
+    Returns
+    -------
+    numpy.ndarray, same shape as ``delta``
+        ``[a1 rot1^2 + a2 trans^2, a3 trans^2 + a4 (rot1^2 + rot2^2), a1 rot2^2 + a2 trans^2]``.
+
+    Notes
+    -----
+    Thrun et al. (2005), Table 5.6, lines 5-7 (the arguments of ``sample``).
+
+    Examples
+    --------
+    >>> increment_variances([0.0, 1.0, 0.5], [0.01, 0.001, 0.01, 0.001]).tolist()
+    [0.001, 0.01025, 0.0035]
+    """
+    d = as_array(delta, "delta") if check else delta
+    a = _alphas(alphas) if check else alphas
+    if check and d.shape[-1:] != (3,):
+        raise ValueError(f"delta: expected shape (3,) or (N, 3), got shape {d.shape}")
+    r1, t, r2 = d[..., 0], d[..., 1], d[..., 2]
+    return np.stack([a[0] * r1 ** 2 + a[1] * t ** 2,                    # Table 5.6, line 5
+                     a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2),         # line 6
+                     a[0] * r2 ** 2 + a[1] * t ** 2], axis=-1)           # line 7
+
+
 def _perturb(delta: np.ndarray, a: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    r1, t, r2 = delta[..., 0], delta[..., 1], delta[..., 2]
-    sd1 = np.sqrt(a[0] * r1 ** 2 + a[1] * t ** 2)                     # Table 5.6, line 5
-    sdt = np.sqrt(a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2))        # line 6
-    sd2 = np.sqrt(a[0] * r2 ** 2 + a[1] * t ** 2)                     # line 7
+    sd = np.sqrt(increment_variances(delta, a, check=False))
     noise = rng.standard_normal(delta.shape)
-    return np.stack([r1 - sd1 * noise[..., 0], t - sdt * noise[..., 1], r2 - sd2 * noise[..., 2]], axis=-1)
+    return np.stack([delta[..., 0] - sd[..., 0] * noise[..., 0], delta[..., 1] - sd[..., 1] * noise[..., 1],
+                     delta[..., 2] - sd[..., 2] * noise[..., 2]], axis=-1)
+
+
+def odometry_covariance(odometry: Any, alphas: Any) -> np.ndarray:
+    """Covariance of each odometry pose relative to the first, propagated to first order.
+
+    Parameters
+    ----------
+    odometry : array_like, shape (N, 3)
+        Consecutive odometry poses ``[x, y, theta]`` (N >= 1).
+    alphas : array_like, shape (4,)
+        The noise parameters an estimator assumes for them (Table 5.6).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3, 3)
+        ``Sigma_k``: covariance of ``se2_between(odometry[0], odometry[k])``; ``Sigma_0 = 0``.
+
+    Raises
+    ------
+    ValueError
+        For bad shapes, NaN/inf or negative alphas.
+
+    Notes
+    -----
+    Each step's increment ``u = (trans cos rot1, trans sin rot1, rot1 + rot2)`` (Thrun et al. 2005,
+    Table 5.5) has the covariance ``J diag(var) J^T`` of the variances of Table 5.6; composing
+    ``r_{k+1} = r_k (+) u`` (Smith, Self & Cheeseman's compounding) propagates
+    ``Sigma_{k+1} = A Sigma_k A^T + B Q_u B^T`` with ``A, B`` its Jacobians.
+
+    Examples
+    --------
+    Two metres straight ahead in two steps: the heading's uncertainty spreads sideways (y):
+
+    >>> odo = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
+    >>> print(np.round(odometry_covariance(odo, [0.01, 0.001, 0.01, 0.001])[-1], 4))
+    [[0.02  0.    0.   ]
+     [0.    0.006 0.004]
+     [0.    0.004 0.004]]
+    """
+    P = as_points(odometry, "odometry", 3, min_count=1)
+    a = _alphas(alphas)
+    delta = odometry_increment(P[:-1], P[1:])
+    var = increment_variances(delta, a, check=False)
+    r1, t = delta[:, 0], delta[:, 1]
+    c1, s1 = np.cos(r1), np.sin(r1)
+    zeros, ones = np.zeros_like(t), np.ones_like(t)
+    J = np.stack([np.stack([-t * s1, c1, zeros], -1), np.stack([t * c1, s1, zeros], -1),
+                  np.stack([ones, zeros, ones], -1)], 1)                 # d u / d (rot1, trans, rot2)
+    Q = J @ (var[:, :, None] * np.swapaxes(J, 1, 2))
+    u = np.stack([t * c1, t * s1, wrap_angle(r1 + delta[:, 2])], -1)
+    out = np.zeros((len(P), 3, 3))
+    r = np.zeros(3)
+    for k in range(len(delta)):   # sequential by nature: each step composes onto the last
+        c, s = np.cos(r[2]), np.sin(r[2])
+        A = np.array([[1.0, 0.0, -s * u[k, 0] - c * u[k, 1]], [0.0, 1.0, c * u[k, 0] - s * u[k, 1]], [0.0, 0.0, 1.0]])
+        B = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        out[k + 1] = A @ out[k] @ A.T + B @ Q[k] @ B.T
+        r = np.array([r[0] + c * u[k, 0] - s * u[k, 1], r[1] + s * u[k, 0] + c * u[k, 1], r[2] + u[k, 2]])
+    return 0.5 * (out + np.swapaxes(out, 1, 2))
 
 
 def _apply(pose: np.ndarray, d: np.ndarray) -> np.ndarray:
