@@ -137,6 +137,10 @@ def test_office_tour_visits_every_room_and_closes_loops():
     assert len(visits) >= 2
     length = np.linalg.norm(np.diff(xy, axis=0), axis=1).sum()
     assert 90.0 < length < 110.0
+    tests = np.array(mo.OFFICE_TEST_POSES)
+    assert len(tests) == 11 and np.all(w.is_free(tests[:, :2], clearance=0.3))
+    off_path = np.linalg.norm(tests[:, None, :2] - xy[None], axis=2).min(axis=1)
+    assert np.all((off_path > 0.15) & (off_path < 0.35)), off_path
 
 
 def test_odometry_covariance_matches_monte_carlo_of_the_noise_model():

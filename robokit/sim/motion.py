@@ -32,7 +32,7 @@ from .world import World
 
 __all__ = ["odometry_increment", "increment_variances", "odometry_covariance", "sample_motion_model_odometry",
            "noisy_odometry", "Path", "waypoint_path",
-           "corridor_path", "lab_lap", "office_tour"]
+           "corridor_path", "lab_lap", "office_tour", "OFFICE_TOUR", "OFFICE_TEST_POSES"]
 
 
 def odometry_increment(previous: Any, current: Any) -> np.ndarray:
@@ -366,6 +366,15 @@ OFFICE_TOUR = ((14.5, 4.0), (10.0, 4.0), (10.0, 1.0), (14.8, 0.8), (14.8, 4.0), 
                (12.0, 6.0),                                                                   # corridor east
                (12.0, 8.0), (14.6, 8.0), (14.6, 11.2), (10.0, 11.2), (10.0, 8.0), (12.0, 8.0),  # R4
                (12.0, 6.0), (12.0, 4.0), (14.5, 4.0))                                         # back into R1
+
+
+#: Eleven test poses ``[x, y, theta]`` in :func:`robokit.sim.office_floor`, spread like the test
+#: locations of lesson 02's paper (Sec. "Experimental results", Fig. 8): three in R1, two in the
+#: corridor (the paper's cases 4 and 5), two in each of R2, R3 and R4; each 0.2-0.3 m off
+#: :func:`office_tour`'s path, at a heading the tour never drove, and 0.3 m clear of everything.
+OFFICE_TEST_POSES = ((13.0, 3.7, 2.0), (10.3, 2.2, -1.2), (14.5, 1.1, 0.8), (9.0, 6.3, 3.0), (6.5, 5.8, 0.2),
+                     (3.0, 1.3, 0.5), (6.0, 3.0, 2.0), (2.2, 10.75, -0.4), (1.9, 9.0, 1.4), (12.5, 8.3, 0.8),
+                     (14.3, 10.0, -2.5))
 
 
 def office_tour(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
