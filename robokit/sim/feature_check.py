@@ -26,6 +26,7 @@ from typing import Any
 import cv2
 import numpy as np
 
+from ..geometry import as_se3
 from ..validation import as_array, as_points, check_positive
 from ..vision.matching import LOWE_RATIO, DescriptorIndex, ratio_match
 from ..vision.omni_features import omni_sift
@@ -209,6 +210,7 @@ def omni_ground_truth_inliers(camera: OmniCamera, ranges: Any, T1: Any, T2: Any,
     ranges = as_array(ranges, "ranges", shape=(camera.height, camera.width), finite=False)
     if np.isnan(ranges).any():
         raise ValueError("ranges: expected ranges or inf (no surface), got NaN")
+    T1, T2 = as_se3(T1, "T1"), as_se3(T2, "T2")
     tol = check_positive(tol, "tol")
     uv1 = as_points(uv1, "uv1", 2)
     uv2 = as_points(uv2, "uv2", 2)
@@ -272,10 +274,15 @@ def omni_view_pair(world: World, camera: OmniCamera, pose1: Any, pose2: Any, *, 
     >>> check.matches > 100, check.inlier_ratio > 0.8
     (True, True)
     """
+    if not isinstance(world, World):
+        raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
     if not isinstance(camera, OmniCamera):
         raise TypeError(f"camera: expected robokit.sim.OmniCamera, got {type(camera).__name__}")
     tol = check_positive(tol, "tol")
-    T1, T2 = camera.transform_at(pose1, world), camera.transform_at(pose2, world)
+    T1 = camera.transform_at(as_array(pose1, "pose1", shape=(3,)))
+    T2 = camera.transform_at(as_array(pose2, "pose2", shape=(3,)))
+    world.check_viewpoint(T1[:3, 3], "pose1")
+    world.check_viewpoint(T2[:3, 3], "pose2")
     frame1, frame2 = camera.render(world, T1), camera.render(world, T2)
     centre = (camera.cx, camera.cy)
     f1 = omni_sift(frame1.image, centre, camera.radii, orientation=orientation)

@@ -170,7 +170,7 @@ class DescriptorIndex:
     def __init__(self, descriptors, method: str = "kdtree", *, checks: int = FLANN_CHECKS,
                  trees: int = FLANN_TREES, seed: int = 0) -> None:
         self.method = check_choice(method, "method", METHODS)
-        self.checks = check_int(checks, "checks", minimum=1)
+        self.checks = check_int(checks, "checks", minimum=1, maximum=1 << 20)
         self.trees = check_int(trees, "trees", minimum=1, maximum=64)
         seed = check_int(seed, "seed", minimum=0, maximum=2 ** 31 - 1)
         self.descriptors = np.ascontiguousarray(_descriptors(descriptors, "descriptors"))
@@ -435,6 +435,10 @@ def ratio_test(dist, index, *, ratio: float = LIN_RATIO, max_distance: float | N
     ratio = _check_ratio(ratio)
     d = as_array(dist, "dist", shape=(None, 2), finite=False)
     idx = as_array(index, "index", shape=(d.shape[0], 2), dtype=int)
+    if not (np.all(np.isfinite(d[:, 0])) and np.all(d[:, 0] >= 0) and np.all(d[:, 1] >= d[:, 0])):
+        raise ValueError("dist: expected rows 0 <= nearest <= second (finite nearest; second may be inf)")
+    if idx.size and idx.min() < 0:
+        raise ValueError(f"index: expected non-negative indices, got {idx.min()}")
     r = distance_ratio(d[:, 0], d[:, 1])
     keep = (r < ratio) & (d[:, 0] <= _distance_bound(max_distance))
     rows = np.nonzero(keep)[0]
