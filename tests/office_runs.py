@@ -55,5 +55,6 @@ def room_of(xy) -> list[str]:
         if 5.0 <= y <= 7.0:
             out.append("corridor")
         else:
-            out.append({(True, True): "R1", (False, True): "R2", (False, False): "R3", (True, False): "R4"}[(x >= 8, y < 5)])
+            rooms = {(True, True): "R1", (False, True): "R2", (False, False): "R3", (True, False): "R4"}
+            out.append(rooms[(bool(x >= 8), bool(y < 5))])
     return out

@@ -36,9 +36,8 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import wrap_angle
 from ..sim.omni import OmniCamera
-from ..validation import as_array, check_int, check_positive, describe
+from ..validation import as_array, as_rng, check_int, check_mapping, check_positive, check_text, describe
 from ..vision.colour import hue_histogram
 from ..vision.features import Features, Keypoints
 from ..vision.matching import Matches
@@ -72,6 +71,7 @@ def check_omni_image(image: Any, camera: OmniCamera, name: str = "image") -> np.
     >>> check_omni_image(np.zeros((48, 64, 3), np.uint8), cam).shape
     (48, 64, 3)
     """
+    name = check_text(name, "name", empty=False)
     if not isinstance(camera, OmniCamera):
         raise TypeError(f"camera: expected a robokit.sim.OmniCamera, got {describe(camera)}")
     img = as_array(image, name, dtype=None)
@@ -156,6 +156,7 @@ def omni_view(image: Any, camera: OmniCamera, *, bins: int = 32, n_features: int
     img = check_omni_image(image, camera)
     n_features = check_int(n_features, "n_features", minimum=0)
     bins = check_int(bins, "bins", minimum=1)
+    times = check_mapping(times, "times")
     t0 = time.perf_counter()
     histogram = hue_histogram(img[::HISTOGRAM_STEP, ::HISTOGRAM_STEP], bins)
     t1 = time.perf_counter()
@@ -281,9 +282,16 @@ def relative_pose(query: OmniView, node: OmniView, matches: Matches, camera: Omn
     if len(qi) and (qi.min() < 0 or qi.max() >= len(query.bearings) or ni.min() < 0 or ni.max() >= len(node.bearings)):
         raise ValueError(f"matches: expected indices of the query's {len(query.bearings)} and the node's "
                          f"{len(node.bearings)} features, got up to {qi.max()} and {ni.max()}")
-    check_positive(direction_tolerance, "direction_tolerance")
-    check_positive(min_baseline, "min_baseline", allow_zero=True)
+    threshold_epipolar = check_positive(threshold_epipolar, "threshold_epipolar")
+    threshold_floor = check_positive(threshold_floor, "threshold_floor")
+    min_epipolar = check_int(min_epipolar, "min_epipolar", minimum=8)
     min_floor = check_int(min_floor, "min_floor", minimum=2)
+    min_depression = check_positive(min_depression, "min_depression")
+    if min_depression >= np.pi / 2:
+        raise ValueError(f"min_depression: expected an angle in (0, pi/2), got {min_depression}")
+    direction_tolerance = check_positive(direction_tolerance, "direction_tolerance")
+    min_baseline = check_positive(min_baseline, "min_baseline", allow_zero=True)
+    rng = as_rng(rng)
     bq, bn = query.bearings[qi], node.bearings[ni]
     M = camera.mount[:3, :3]
     heading_e, direction_e, n_e, epipolar = 0.0, None, 0, False

@@ -106,12 +106,24 @@ def appearance_changed(distance: Any, matches: Any, *, similarity: float = 0.05,
     >>> appearance_changed([0.05, 0.3, 0.3], [20, 80, 20]).tolist()
     [False, False, True]
     """
-    d = as_array(distance, "distance")
-    m = as_array(matches, "matches")
+    d, m = _paired(distance, "distance", matches, "matches")
     s = check_positive(similarity, "similarity")
     mm = check_int(min_matches, "min_matches", minimum=0)
     out = (d > s) & (m < mm)
     return bool(out) if out.ndim == 0 else out
+
+
+def _paired(a: Any, a_name: str, b: Any, b_name: str) -> tuple[np.ndarray, np.ndarray]:
+    """Two non-negative scalars or 1-D arrays of one length (a scalar pairs with any length)."""
+    x, y = as_array(a, a_name), as_array(b, b_name)
+    for arr, name in ((x, a_name), (y, b_name)):
+        if arr.ndim > 1:
+            raise ValueError(f"{name}: expected a number or a 1-D array, got shape {arr.shape}")
+        if np.any(arr < 0):
+            raise ValueError(f"{name}: expected non-negative values, got {arr.min()}")
+    if x.ndim and y.ndim and x.shape != y.shape:
+        raise ValueError(f"{b_name}: expected the shape of {a_name} {x.shape}, got {y.shape}")
+    return x, y
 
 
 def local_map_full(n_features: Any, variance: Any, *, max_features: int = 930, max_variance: float = 0.1) -> Any:
@@ -144,8 +156,7 @@ def local_map_full(n_features: Any, variance: Any, *, max_features: int = 930, m
     >>> local_map_full([100, 2500, 100], [0.001, 0.001, 0.5]).tolist()
     [False, True, True]
     """
-    n = as_array(n_features, "n_features")
-    v = as_array(variance, "variance")
+    n, v = _paired(n_features, "n_features", variance, "variance")
     mf = check_int(max_features, "max_features", minimum=1)
     mv = check_positive(max_variance, "max_variance")
     out = (n >= mf) | (v >= mv)
@@ -321,7 +332,8 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
         if current["key"] != key:
             key_frames.add(key)
             features = view(key).features
-            current["key"], current["index"] = key, DescriptorIndex(features.descriptors) if len(features) >= 2 else None
+            current["key"] = key
+            current["index"] = DescriptorIndex(features.descriptors) if len(features) >= 2 else None
         for f in [f for f in cache if f not in key_frames and f != k]:
             del cache[f]
         v = view(k)

@@ -27,7 +27,8 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, as_points, as_rng, check_positive, check_sample_count, describe
+from ..validation import (as_array, as_points, as_rng, check_finite_result, check_positive, check_sample_count,
+                          describe)
 from .world import World
 
 __all__ = ["odometry_increment", "increment_variances", "odometry_covariance", "sample_motion_model_odometry",
@@ -101,12 +102,15 @@ def increment_variances(delta: Any, alphas: Any, *, check: bool = True) -> np.nd
     """
     d = as_array(delta, "delta") if check else delta
     a = _alphas(alphas) if check else alphas
-    if check and d.shape[-1:] != (3,):
+    if check and (d.shape[-1:] != (3,) or d.ndim > 2):
         raise ValueError(f"delta: expected shape (3,) or (N, 3), got shape {d.shape}")
     r1, t, r2 = d[..., 0], d[..., 1], d[..., 2]
-    return np.stack([a[0] * r1 ** 2 + a[1] * t ** 2,                    # Table 5.6, line 5
-                     a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2),         # line 6
-                     a[0] * r2 ** 2 + a[1] * t ** 2], axis=-1)           # line 7
+    out = np.stack([a[0] * r1 ** 2 + a[1] * t ** 2,                     # Table 5.6, line 5
+                    a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2),          # line 6
+                    a[0] * r2 ** 2 + a[1] * t ** 2], axis=-1)            # line 7
+    if check:
+        check_finite_result("delta, alphas", out)
+    return out
 
 
 def _perturb(delta: np.ndarray, a: np.ndarray, rng: np.random.Generator) -> np.ndarray:
