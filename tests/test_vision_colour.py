@@ -67,8 +67,8 @@ def test_histogram_counts_the_masked_pixels_only():
     img = np.zeros((4, 4, 3), np.uint8)
     img[0] = [255, 0, 0]                       # 4 red
     img[1, :2] = [0, 255, 0]                   # 2 green
-    img[2, :2] = [250, 250, 255]               # nearly white: S = 5/255 < 0.04, left out
-    img[3, :1] = [0, 0, 60]                    # dark blue: I = 0.078 >= 0.04, counted
+    img[2, :2] = [250, 250, 255]               # nearly white: S = 5/255 < 0.15, left out
+    img[3, :1] = [0, 0, 60]                    # dark blue: S = 0.235, I = 0.078 >= 0.04, counted
     h = hue_histogram(img, bins=3)             # 120-degree bins: red | green | blue
     assert h.tolist() == pytest.approx([4 / 7, 2 / 7, 1 / 7])
     mask = np.ones((4, 4), bool)
@@ -120,13 +120,13 @@ def test_hue_histogram_is_invariant_to_heading_and_drifts_with_position(views):
     h0 = hue_histogram(turned[0])
     turn = histogram_distance(h0, np.array([hue_histogram(im) for im in turned[1:]]))
     drift = histogram_distance(h0, np.array([hue_histogram(im) for im in moved]))
-    # measured: turning 0.002-0.003 (resampling of the cube map); moving 0.5 / 1 / 2 m: 0.03 / 0.05 / 0.10
+    # measured: turning 0.009-0.014 (resampling of the cube map); moving 0.5 / 1 / 2 m: 0.07 / 0.28 / 0.46
     assert turn.max() < 0.2 * drift[1]
     assert np.all(np.diff(drift) > 0)                               # drifts further with distance
     # intersection tells the same story: near 1 when turning, lower and falling when moving
     sim_turn = histogram_intersection(h0, np.array([hue_histogram(im) for im in turned[1:]]))
     sim_move = histogram_intersection(h0, np.array([hue_histogram(im) for im in moved]))
-    assert sim_turn.min() > 0.99 and sim_move[-1] < sim_move[0] < sim_turn.min()
+    assert sim_turn.min() > 0.97 and sim_move[-1] < sim_move[0] < sim_turn.min()   # measured 0.98; 0.93 .. 0.60
 
 
 def test_opencv_reference_histogram_agrees_on_rendered_views(views):
@@ -137,7 +137,7 @@ def test_opencv_reference_histogram_agrees_on_rendered_views(views):
         off = (np.floor(ours).astype(int) - np.floor(ref).astype(int)) % 32
         assert np.isin(off, [0, 1, 31]).all()                       # never more than one bin apart
         moved = (off != 0).mean()
-        assert moved < 0.1                      # measured 0.052 and 0.083 (0.10 at worst over 80 views)
+        assert moved < 0.03                     # measured 0.010 and 0.011 (0.06 at worst over 80 views)
         # the reference histogram is ours with that share of pixels moved by one bin: the running
         # sums differ by at most the share, the Euclidean distance (Eq. (5)) by at most twice it
         a, b = hue_histogram(img), hue_histogram_opencv(img)
