@@ -603,7 +603,10 @@ SPECS: dict[str, Call] = {
                                   ("covariances", "N,3,3", 0), ("kinds", "N", 0)]}),
     "robokit.localization.hierarchical.HierarchicalLocalizer": Call({
         "map": Obj(office_map), "camera": Obj(small_omni), "top_k": Int(2), "ratio": Real(0.7), "min_matches": Int(25),
-        "ambiguity": Real(0.8), "n_features": Int(100), "mode": Choice("hierarchical")}),
+        "ambiguity": Real(0.8), "n_features": Int(100), "mode": Choice("hierarchical"), "min_crossing": Real(0.26),
+        "max_range": Real(4.0)}),
+    "robokit.geometry.planar.intersect_lines": Call({"origins": Array(np.array([[0.0, 0.0], [4.0, 0.0]]), "N,2"),
+                                                     "directions": Array(np.array([[1.0, 1.0], [-1.0, 1.0]]), "N,2")}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -626,7 +629,8 @@ EXTRA: tuple[str, ...] = ("robokit.sim.vehicle.unicycle_step",
                           "robokit.sim.feature_check.omni_ground_truth_inliers",
                           "robokit.sim.feature_check.omni_view_pair",
                           # lesson 02's topological map and hierarchical localization (helper D)
-                          "robokit.geometry.planar.fit_se2", "robokit.vision.ransac.ransac_sample_count",
+                          "robokit.geometry.planar.fit_se2", "robokit.geometry.planar.intersect_lines",
+                          "robokit.vision.ransac.ransac_sample_count",
                           "robokit.vision.ransac.ransac_se2", "robokit.vision.spherical.essential_from_bearings",
                           "robokit.vision.spherical.epipolar_error", "robokit.vision.spherical.ransac_essential",
                           "robokit.vision.spherical.decompose_essential", "robokit.vision.spherical.floor_points",

@@ -150,3 +150,30 @@ def test_pose_error_is_validated_and_exact_for_known_motions():
         g.pose_error(np.ones((4, 4)), T)
     with pytest.raises(ValueError, match="equal length"):
         g.pose_error(np.stack([T, T]), np.stack([T, T, T]))
+
+
+def test_intersect_lines_least_squares_point_and_cheirality():
+    from robokit.geometry import intersect_lines
+    rng = np.random.default_rng(0)
+    target = np.array([1.5, -0.5])
+    origins = rng.uniform(-3, 3, (4, 2))
+    dirs = (target - origins) * rng.uniform(0.5, 2.0, (4, 1))          # any length
+    point, along = intersect_lines(origins, dirs)
+    assert np.allclose(point, target) and np.allclose(along, np.linalg.norm(target - origins, axis=1))
+    # noisy lines: the normal equations' solution is the brute-force minimum of squared distances
+    noisy = dirs + rng.normal(0, 0.05, dirs.shape)
+    point, _ = intersect_lines(origins, noisy)
+    u = noisy / np.linalg.norm(noisy, axis=1, keepdims=True)
+
+    def cost(p):
+        r = p - origins
+        return ((r ** 2).sum(1) - (r * u).sum(1) ** 2).sum()
+    grid = point + np.stack(np.meshgrid(np.linspace(-0.01, 0.01, 21), np.linspace(-0.01, 0.01, 21)), -1).reshape(-1, 2)
+    assert cost(point) <= min(cost(g) for g in grid) + 1e-12
+    # a line pointing away has the point behind it
+    _, along = intersect_lines([[0.0, 0.0], [4.0, 0.0]], [[-1.0, -1.0], [-1.0, 1.0]])
+    assert along[0] < 0 < along[1]
+    with pytest.raises(ValueError, match="parallel"):
+        intersect_lines([[0.0, 0.0], [0.0, 1.0]], [[1.0, 0.0], [2.0, 0.0]])
+    with pytest.raises(ValueError, match="origins"):
+        intersect_lines([[0.0, 0.0]], [[1.0, 0.0]])

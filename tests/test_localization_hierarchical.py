@@ -39,6 +39,17 @@ def test_a_query_near_a_node_is_recognised_with_a_metric_pose(node):
     assert np.hypot(node_only[0], node_only[1]) > 0.15
 
 
+def test_far_from_every_node_the_directions_from_two_nodes_cross_at_the_robot():
+    # 1.36 m from the nearest node: too far for floor matches, but two nodes see the way to it
+    tmap = true_node_map()
+    pose = np.array([11.6, 2.0, 2.5])
+    result = HierarchicalLocalizer(tmap, camera()).localize(camera().observe(office(), pose).image)
+    assert result.method == "bearings" and result.verified and result.metric
+    assert np.hypot(*(result.pose - pose)[:2]) < 0.3          # measured 0.11 m (0.05-0.34 m on the tour)
+    assert abs(wrap_angle(result.pose[2] - pose[2])) < HEADING_BOUND
+    assert np.linalg.norm(tmap.poses[:, :2] - pose[:2], axis=1).min() > 1.3
+
+
 def test_relative_pose_of_rendered_views_matches_the_known_transform():
     cam = camera()
     node_pose = np.array([13.5, 3.6, np.pi])

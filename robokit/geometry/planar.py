@@ -26,7 +26,7 @@ from ..validation import as_array
 from .rotations import as_rotation
 
 __all__ = ["as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
-           "fit_se2"]
+           "fit_se2", "intersect_lines"]
 
 
 def as_planar(value: Any, name: str) -> np.ndarray:
@@ -335,3 +335,55 @@ def fit_se2(source: Any, target: Any, weights: Any = None, *, check: bool = True
     x = tc[..., 0] - (c * sc[..., 0] - si * sc[..., 1])
     y = tc[..., 1] - (si * sc[..., 0] + c * sc[..., 1])
     return np.stack([x, y, wrap_angle(theta)], axis=-1)
+
+
+def intersect_lines(origins: Any, directions: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The point nearest (least squares) to N >= 2 lines in the plane, and where it lies along each.
+
+    Parameters
+    ----------
+    origins : array_like, shape (N, 2)
+        A point of each line.
+    directions : array_like, shape (N, 2)
+        Each line's direction (any non-zero length).
+
+    Returns
+    -------
+    point : numpy.ndarray, shape (2,)
+        Minimises the sum of squared perpendicular distances to the lines.
+    along : numpy.ndarray, shape (N,)
+        Signed distance from each origin to the point's foot along its unit direction (negative:
+        behind the origin, so a ray from it would miss).
+
+    Raises
+    ------
+    ValueError
+        For shapes that differ, fewer than two lines, zero directions, or lines that are all
+        parallel (within 1e-9), which leave the point undetermined.
+
+    Notes
+    -----
+    ``sum_i (I - u_i u_i^T) (p - o_i) = 0`` with ``u_i`` the unit directions: the normal equations
+    of the perpendicular distances (Hartley & Zisserman's mid-point triangulation, in 2-D).
+    Lesson 02 intersects the directions of travel that two map nodes' essential matrices give.
+
+    Examples
+    --------
+    >>> p, along = intersect_lines([[0.0, 0.0], [4.0, 0.0]], [[1.0, 1.0], [-1.0, 1.0]])
+    >>> print(np.round(p, 6) + 0.0, np.round(along, 6))
+    [2. 2.] [2.828427 2.828427]
+    """
+    o = as_array(origins, "origins", shape=(None, 2))
+    d = as_array(directions, "directions", shape=(len(o), 2))
+    if len(o) < 2:
+        raise ValueError(f"origins: expected at least two lines, got {len(o)}")
+    norm = np.linalg.norm(d, axis=1)
+    if np.any(norm < 1e-12):
+        raise ValueError("directions: expected non-zero directions, got a zero vector")
+    u = d / norm[:, None]
+    P = np.eye(2) - u[:, :, None] * u[:, None, :]                  # projections off each line
+    A, b = P.sum(0), np.einsum("nij,nj->i", P, o)
+    if np.linalg.det(A) < 1e-9 * len(o):
+        raise ValueError("directions: expected lines that are not all parallel, got parallel ones")
+    point = np.linalg.solve(A, b)
+    return point, ((point - o) * u).sum(1)

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import se2_compose
+from ..geometry import intersect_lines, se2_compose, wrap_angle
 from ..mapping.omni_views import OmniView, RelativePose, omni_view, relative_pose
 from ..mapping.topological import EmptyMapError, TopologicalMap
 from ..sim.omni import OmniCamera
@@ -50,9 +50,7 @@ class Localization:
     node : int
         The recognised node (the best candidate even when not ``recognised``).
     pose : numpy.ndarray, shape (3,)
-        Estimated robot pose ``[x, y, theta]`` in the map's frame: the node's pose composed with the
-        relative pose (when ``metric``; otherwise the node's own pose, heading corrected when the
-        essential matrix gave one).
+        Estimated robot pose ``[x, y, theta]`` in the map's frame, see ``method``.
     node_pose : numpy.ndarray, shape (3,)
         The recognised node's pose.
     relative : RelativePose or None
@@ -69,14 +67,20 @@ class Localization:
         The runner-up has at least ``ambiguity`` times the best count, so epipolar verification
         decided between them.
     verified : bool
-        The relative pose passed the epipolar check (:attr:`RelativePose.verified`).
+        The relative pose passed the epipolar check (:attr:`RelativePose.verified`), or the
+        directions of travel from two or more nodes crossed ahead of each (``method="bearings"``).
     metric : bool
-        The relative pose is metric (the floor fit held).
+        ``method`` is ``"floor"`` or ``"bearings"``.
     mode : str
     times : dict of str to float
         Seconds per stage: ``"histogram"`` and ``"sift"`` (the query's own features),
         ``"coarse"`` (ranking every node, Eq. (5)), ``"matching"`` (SIFT against the candidates),
-        ``"verification"`` (epipolar and floor) and ``"total"``.
+        ``"verification"`` (epipolar, floor, crossing) and ``"total"``.
+    method : str
+        How ``pose`` was found: ``"floor"`` (the node's pose composed with the floor-scaled
+        relative pose), ``"bearings"`` (where the essential matrices' directions from two or more
+        nodes cross, heading from the recognised node's), or ``"node"`` (the node's own pose,
+        its heading corrected when the essential matrix gave one).
     """
 
     node: int
@@ -92,6 +96,7 @@ class Localization:
     metric: bool
     mode: str
     times: dict = field(default_factory=dict)
+    method: str = "node"
 
 
 class HierarchicalLocalizer:
@@ -117,6 +122,11 @@ class HierarchicalLocalizer:
     mode : {"hierarchical", "coarse", "fine"}, default "hierarchical"
         Coarse: histogram only, answer the nearest node's pose. Fine: SIFT against every node.
         Hierarchical: SIFT against the coarse stage's ``top_k``.
+    min_crossing : float, default 0.26
+        Radians (15 deg): the narrowest spread of directions of travel from two nodes whose
+        crossing is trusted as a position, when the floor gives none.
+    max_range : float, default 4.0
+        Metres: farthest a crossing may lie from a node (farther, the views share too little).
 
     Raises
     ------
@@ -147,7 +157,7 @@ class HierarchicalLocalizer:
 
     def __init__(self, map: TopologicalMap, camera: OmniCamera, *, top_k: int = 5, ratio: float = 0.7,
                  min_matches: int = 25, ambiguity: float = 0.8, n_features: int = 500,
-                 mode: str = "hierarchical") -> None:
+                 mode: str = "hierarchical", min_crossing: float = 0.26, max_range: float = 4.0) -> None:
         if not isinstance(map, TopologicalMap):
             raise TypeError(f"map: expected a robokit.mapping.TopologicalMap, got {describe(map)}")
         if len(map) == 0:
@@ -163,6 +173,10 @@ class HierarchicalLocalizer:
         self.ambiguity = check_positive(ambiguity, "ambiguity")
         self.n_features = check_int(n_features, "n_features", minimum=0)
         self.mode = check_choice(mode, "mode", MODES)
+        self.min_crossing = check_positive(min_crossing, "min_crossing")
+        if self.min_crossing > np.pi / 2:
+            raise ValueError(f"min_crossing: expected an angle in (0, pi/2], got {self.min_crossing}")
+        self.max_range = check_positive(max_range, "max_range")
         self.bins = map.histograms.shape[1]
 
     def __repr__(self) -> str:
@@ -247,7 +261,7 @@ class HierarchicalLocalizer:
             times["total"] = sum(times.values())
             pose = self.map.poses[node].copy()
             return Localization(node, pose, pose.copy(), None, order, distances, np.zeros(len(order), int), True,
-                                False, False, False, self.mode, times)
+                                False, False, False, self.mode, times, "node")
         if self.mode == "hierarchical":
             order, distances = order[:self.top_k], distances[:self.top_k]
         counts, matches = self.fine(view.features, order)
@@ -256,26 +270,35 @@ class HierarchicalLocalizer:
         best = int(ranked[0])
         recognised = bool(counts[best] >= self.min_matches)
         ambiguous = bool(recognised and len(ranked) > 1 and counts[ranked[1]] >= self.ambiguity * counts[best])
-        relative = None
+        relative, method, pose = None, "node", None
         if recognised:
-            relative, best = self._verify(view, order, counts, matches, ranked, ambiguous)
+            relative, best, tried = self._verify(view, order, counts, matches, ranked, ambiguous)
+            if relative.metric:
+                method = "floor"
+            elif relative.epipolar:
+                crossing = self._crossing(view, order, counts, matches, ranked, tried)
+                if crossing is not None:
+                    heading = self.map.poses[int(order[best]), 2] + relative.heading_epipolar
+                    pose, method = np.array([crossing[0], crossing[1], wrap_angle(heading)]), "bearings"
         times["matching"] = t2 - t1
         times["verification"] = time.perf_counter() - t2
         times["total"] = sum(v for k, v in times.items() if k != "total")
         node = int(order[best])
         node_pose = self.map.poses[node].copy()
-        pose = se2_compose(node_pose, relative.pose) if relative is not None else node_pose.copy()
+        if pose is None:
+            pose = se2_compose(node_pose, relative.pose) if relative is not None else node_pose.copy()
         return Localization(node, pose, node_pose, relative, order, distances, counts, recognised, ambiguous,
-                            bool(relative is not None and relative.verified),
-                            bool(relative is not None and relative.metric), self.mode, times)
+                            bool(relative is not None and relative.verified) or method == "bearings",
+                            method != "node", self.mode, times, method)
 
     def _verify(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list, ranked: np.ndarray,
-                ambiguous: bool) -> tuple[RelativePose, int]:
+                ambiguous: bool) -> tuple[RelativePose, int, list]:
         """Relative pose to the best candidate, or to a runner-up when that one verifies and the best does not.
 
         The contenders are the best candidate and, when the answer is ambiguous or the best one
         gives no verified metric pose, the next ones (up to three in all) with at least
         ``min_matches``; a verified metric pose beats a verified one beats none, then more matches.
+        Returns the winner, its candidate index and every ``(relative pose, candidate)`` tried.
         """
         tried = []
         for rank, c in enumerate(ranked[:3]):
@@ -286,4 +309,36 @@ class HierarchicalLocalizer:
             rel = relative_pose(view, self.map.node_view(int(order[c])), matches[c], self.camera)
             tried.append((rel, c))
         rel, c = max(tried, key=lambda rc: (rc[0].verified and rc[0].metric, rc[0].verified, counts[rc[1]]))
-        return rel, c
+        return rel, c, tried
+
+    def _crossing(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list, ranked: np.ndarray,
+                  tried: list) -> np.ndarray | None:
+        """Where the directions of travel from two or more candidate nodes cross (world x, y), or None.
+
+        Each candidate whose essential matrix holds puts the query on a ray from the node's pose;
+        the rays of up to three candidates (with ``min_matches``) are intersected
+        (:func:`robokit.geometry.intersect_lines`). The crossing counts when the rays spread by at
+        least ``min_crossing`` and it lies ahead on each, within ``max_range``.
+        """
+        done = {c for _, c in tried}
+        rays = [(rel, c) for rel, c in tried if rel.epipolar]
+        for c in ranked[:3]:
+            c = int(c)
+            if c not in done and counts[c] >= self.min_matches:
+                rel = relative_pose(view, self.map.node_view(int(order[c])), matches[c], self.camera)
+                if rel.epipolar:
+                    rays.append((rel, c))
+        if len(rays) < 2:
+            return None
+        poses = self.map.poses[[int(order[c]) for _, c in rays]]
+        cos, sin = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+        d = np.array([rel.direction for rel, _ in rays])
+        world = np.column_stack([cos * d[:, 0] - sin * d[:, 1], sin * d[:, 0] + cos * d[:, 1]])
+        cross = world[:, None, 0] * world[None, :, 1] - world[:, None, 1] * world[None, :, 0]
+        spread = np.abs(cross).max()                                                    # sin of the widest angle
+        if spread < np.sin(self.min_crossing):
+            return None
+        point, along = intersect_lines(poses[:, :2], world)
+        if np.any(along <= 0) or np.any(along > self.max_range):
+            return None
+        return point

@@ -191,10 +191,13 @@ class RelativePose:
     n_matches, n_epipolar, n_floor : int
         Tentative matches, essential-matrix inliers, floor points supporting the translation.
     heading_epipolar : float
-        ``dtheta`` from the essential matrix (NaN-free: 0 when not ``epipolar``).
+        ``dtheta`` from the essential matrix (0 when not ``epipolar``).
     rms : float
         Root-mean-square disagreement of the supporting floor points (metres; ``inf`` when not
         ``metric``).
+    direction : numpy.ndarray, shape (2,)
+        Unit direction from the node to the query in the node's frame, from the essential matrix
+        (zeros when not ``epipolar``): the query lies on this ray whatever the distance.
     """
 
     pose: np.ndarray
@@ -206,6 +209,7 @@ class RelativePose:
     n_floor: int
     heading_epipolar: float
     rms: float
+    direction: np.ndarray
 
 
 def relative_pose(query: OmniView, node: OmniView, matches: Matches, camera: OmniCamera, *,
@@ -317,8 +321,9 @@ def relative_pose(query: OmniView, node: OmniView, matches: Matches, camera: Omn
     if not metric:
         pose, rms = np.array([0.0, 0.0, heading_e]), np.inf
     verified = bool(metric and epipolar)
+    direction = np.zeros(2) if direction_e is None else direction_e[:2] / max(np.linalg.norm(direction_e[:2]), 1e-12)
     return RelativePose(pose, bool(metric), bool(epipolar), verified, int(len(qi)), int(n_e), int(n_floor),
-                        heading_e, float(rms))
+                        heading_e, float(rms), direction)
 
 
 def _floor_given_heading(pq: np.ndarray, pn: np.ndarray, heading: float, direction: np.ndarray, threshold: float,

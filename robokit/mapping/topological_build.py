@@ -9,7 +9,9 @@ images and odometry "at a constant rate"; the sequence is then cut into local ma
 2. and the change is not just "someone ... blocking the camera view": we also ask the SIFT match
    count with the key image to fall, and the change to persist for ``occlusion_frames``
    consecutive frames (the *occlusion guard*, :func:`select_key_frames`); a transient change that
-   reverts sooner starts no node;
+   reverts sooner starts no node. SIFT runs only on frames whose histogram has changed: the
+   cheap global feature first, the costly local ones when it asks for them, as in the
+   localizer;
 3. or the local map's number of features reaches a maximum, or its uncertainty a limit
    (:func:`local_map_full`; the uncertainty is the odometry covariance accumulated since the key
    image, :func:`robokit.sim.odometry_covariance`).
@@ -59,21 +61,22 @@ class Comparison:
     ----------
     distance : float
         Hue-histogram distance, Eq. (5).
-    matches : int
-        SIFT matches with the key image.
-    n_features : int
-        Features the local map would hold: the key image's plus the frame's unmatched ones.
+    matches : int or None
+        SIFT matches with the key image (``None``: not computed, the histogram being similar).
+    n_features : int or None
+        Features the local map would hold: the key image's plus the frame's unmatched ones
+        (``None`` with ``matches``).
     variance : float
         Mean position variance (m^2) of the odometry since the key image.
     """
 
     distance: float
-    matches: int
-    n_features: int
+    matches: int | None
+    n_features: int | None
     variance: float
 
 
-def appearance_changed(distance: Any, matches: Any, *, similarity: float = 0.05, min_matches: int = 50) -> Any:
+def appearance_changed(distance: Any, matches: Any, *, similarity: float = 0.1, min_matches: int = 80) -> Any:
     """Whether a frame no longer looks like the key image: histogram far AND few SIFT matches.
 
     Parameters
@@ -82,13 +85,14 @@ def appearance_changed(distance: Any, matches: Any, *, similarity: float = 0.05,
         Hue-histogram distance to the key image (Eq. (5)).
     matches : int or array_like
         SIFT matches with the key image.
-    similarity : float, default 0.05
-        Distance above which the images are not "similar enough". In office_floor() images less
-        than 0.5 m apart are at median 0.02, images 1-2 m apart at 0.13 (5 % of them below 0.05):
-        colour alone separates places weakly there, the match count does the rest.
-    min_matches : int, default 50
-        Match count below which the place has changed (ratio 0.7, 500 features: views 1-2 m
-        apart share about 46, unrelated views about 9).
+    similarity : float, default 0.1
+        Distance above which the images are not "similar enough". On the office tour images less
+        than 0.5 m apart are at median 0.03 (95 % below 0.12), images 1-2 m apart at 0.24 (5 %
+        below 0.09).
+    min_matches : int, default 80
+        Match count below which the place has changed (ratio 0.7, 500 features: office views less
+        than 1 m apart share about 120, 1-2 m apart 46, unrelated ones 9): nodes about 1-2 m
+        apart, close enough for the floor to give a metric pose between them.
 
     Returns
     -------
@@ -163,8 +167,8 @@ def local_map_full(n_features: Any, variance: Any, *, max_features: int = 930, m
     return bool(out) if out.ndim == 0 else out
 
 
-def select_key_frames(n_frames: int, compare: Callable[[int, int], Comparison], *, similarity: float = 0.05,
-                      min_matches: int = 50, occlusion_frames: int = 3, max_features: int = 930,
+def select_key_frames(n_frames: int, compare: Callable[[int, int], Comparison], *, similarity: float = 0.1,
+                      min_matches: int = 80, occlusion_frames: int = 3, max_features: int = 930,
                       max_variance: float = 0.1) -> tuple[list[int], list[str]]:
     """Cut a sequence of frames into local maps: the key frames and why each was started.
 
@@ -212,12 +216,13 @@ def select_key_frames(n_frames: int, compare: Callable[[int, int], Comparison], 
         c = compare(key, k)
         if not isinstance(c, Comparison):
             raise TypeError(f"compare: expected a callable returning a Comparison, got {describe(c)}")
-        reason = None
-        if local_map_full(c.n_features, c.variance, max_features=max_features, max_variance=max_variance):
-            reason = "features" if c.n_features >= max_features else "variance"
+        reason, n_local = None, 0 if c.n_features is None else c.n_features
+        if local_map_full(n_local, c.variance, max_features=max_features, max_variance=max_variance):
+            reason = "features" if n_local >= max_features else "variance"
         else:
-            run = run + 1 if appearance_changed(c.distance, c.matches, similarity=similarity,
-                                                min_matches=min_matches) else 0
+            changed = c.matches is not None and appearance_changed(c.distance, c.matches, similarity=similarity,
+                                                                   min_matches=min_matches)
+            run = run + 1 if changed else 0
             if run >= occlusion_frames:
                 reason = "appearance"
         if reason is not None:
@@ -231,8 +236,8 @@ def _position_variance(cov: np.ndarray) -> float:
     return float(0.5 * (cov[0, 0] + cov[1, 1]))       # as robokit.mapping.edge_variances
 
 
-def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, similarity: float = 0.05,
-                          min_matches: int = 50, occlusion_frames: int = 3, max_features: int = 930,
+def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, similarity: float = 0.1,
+                          min_matches: int = 80, occlusion_frames: int = 3, max_features: int = 930,
                           max_variance: float = 0.1, odometry_alphas: Any = (0.01, 0.001, 0.01, 0.001),
                           bins: int = 32, n_features: int = 500, ratio: float = 0.7, loop_closure: bool = True,
                           loop_top_k: int = 5, loop_min_matches: int = 25, loop_exclude: int = 5,
@@ -320,12 +325,14 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     log = check_callable(log, "log")
     ratio = check_positive(ratio, "ratio")
     cache: dict[int, Any] = {}            # frame -> OmniView: the key frames and the latest frame only
+    has_sift: dict[int, bool] = {}
     key_frames: set[int] = set()
     current: dict[str, Any] = {"key": None, "index": None}
 
-    def view(k):
-        if k not in cache:
-            cache[k] = omni_view(raw[k], camera, bins=bins, n_features=n_features)
+    def view(k, features=True):
+        if k not in cache or (features and not has_sift[k]):
+            cache[k] = omni_view(raw[k], camera, bins=bins, n_features=n_features, features=features)
+            has_sift[k] = features
         return cache[k]
 
     def compare(key, k):
@@ -335,14 +342,16 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
             current["key"] = key
             current["index"] = DescriptorIndex(features.descriptors) if len(features) >= 2 else None
         for f in [f for f in cache if f not in key_frames and f != k]:
-            del cache[f]
-        v = view(k)
-        m = len(current["index"].match(v.features.descriptors, ratio=ratio)) if current["index"] and len(v) else 0
-        var = _position_variance(odometry_covariance(odo[key:k + 1], alphas)[-1])
+            del cache[f], has_sift[f]
         if progress is not None:
             progress(k + 1, n)
-        return Comparison(float(histogram_distance(v.histogram, view(key).histogram)), m,   # Eq. (5)
-                          len(view(key)) + len(v) - m, var)
+        var = _position_variance(odometry_covariance(odo[key:k + 1], alphas)[-1])
+        d = float(histogram_distance(view(k, features=False).histogram, view(key).histogram))   # Eq. (5)
+        if d <= similarity:           # similar enough: the global feature answers, SIFT is not needed
+            return Comparison(d, None, None, var)
+        v = view(k)
+        m = len(current["index"].match(v.features.descriptors, ratio=ratio)) if current["index"] and len(v) else 0
+        return Comparison(d, m, len(view(key)) + len(v) - m, var)
 
     keys, reasons = select_key_frames(n, compare, similarity=similarity, min_matches=min_matches,
                                       occlusion_frames=occlusion_frames, max_features=max_features,

@@ -5,8 +5,10 @@ Modules: :mod:`.features` (containers), :mod:`.plot_detector` (Lin et al. Sec. 2
 (Lin et al. Sec. 3), :mod:`.evaluation` (recall vs 1-precision), :mod:`.stereo` (Lin et al. Sec. 3,
 Se et al. Sec. 2.2 and 3.1), :mod:`.colour` (HSI hue histograms, lesson 02's paper, Sec. "Global
 image features"), :mod:`.omni_features` (SIFT in an omni image's annulus, Sec. "Local image
-features"; its KD-tree per map node is :class:`.matching.DescriptorIndex`). Vision depends only on :mod:`robokit.validation` (never on ``viz`` or
-``sim``).
+features"; its KD-tree per map node is :class:`.matching.DescriptorIndex`), :mod:`.ransac` (the
+sample count and a planar RANSAC), :mod:`.spherical` (the essential matrix of omni bearings, floor
+points below the horizon). Vision depends only on :mod:`robokit.validation` and
+:mod:`robokit.geometry` (never on ``viz`` or ``sim``).
 """
 from .colour import (histogram_distance, histogram_intersection, hue_histogram, hue_histogram_opencv, hue_mask,
                      rgb_to_hsi)
@@ -16,6 +18,9 @@ from .evaluation import apply_homography, recall_precision, similarity_homograph
 from .features import Features, Keypoints, as_gray_image
 from .matching import DescriptorIndex, Matches, k_nearest, ratio_match, ratio_test, two_nearest
 from .omni_features import ImageSizeError, annulus_mask, omni_sift, radial_orientation
+from .ransac import PlanarFit, ransac_sample_count, ransac_se2
+from .spherical import (EssentialFit, as_bearings, decompose_essential, epipolar_error, essential_from_bearings,
+                        floor_points, ransac_essential)
 from .plot_detector import (PlotParams, ScaleSpace, detect_plot, detect_plot_levels, edge_strength, junction_strength,
                    orientation_tensor, plot_scales, polynomial_expansion, tensor_eigenvalues)
 from .stereo import (NotRectifiedError, StereoMatches, StereoObservations, StereoCalibration, disparity_to_point,
@@ -30,4 +35,5 @@ __all__ = ["assign_orientations", "detect_and_describe", "gradient_histogram_des
            "match_stereo", "triangulate_svd", "StereoObservations", "observe_stereo",
            "rgb_to_hsi", "hue_mask", "hue_histogram", "hue_histogram_opencv", "histogram_distance",
            "histogram_intersection", "DescriptorIndex", "ratio_test", "ImageSizeError", "annulus_mask", "omni_sift",
-           "radial_orientation"]
+           "radial_orientation", "PlanarFit", "ransac_sample_count", "ransac_se2", "EssentialFit", "as_bearings",
+           "decompose_essential", "epipolar_error", "essential_from_bearings", "floor_points", "ransac_essential"]
