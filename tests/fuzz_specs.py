@@ -583,7 +583,7 @@ SPECS: dict[str, Call] = {
         "max_features": Int(930), "max_variance": Real(0.1),
         "odometry_alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"), "bins": Int(32), "n_features": Int(100),
         "ratio": Real(0.7), "loop_closure": Flag(True), "loop_top_k": Int(5), "loop_min_matches": Int(25),
-        "loop_exclude": Int(5), "sigma_visual": Array(np.array([0.05, 0.05, 0.02]), "3"),
+        "loop_exclude": Int(5), "sigma_visual": Array(np.array([0.05, 0.05, 0.02]), "3"), "index": Choice("opencv"),
         "progress": Func(None, optional=True), "log": Func(None, optional=True)}, cheap=False),
     "robokit.mapping.omni_views.omni_view": Call({"image": Array(lambda: office_views()[0][0], "120,160,3"),
                                                   "camera": Obj(small_omni), "bins": Int(32), "n_features": Int(100),
@@ -600,7 +600,7 @@ SPECS: dict[str, Call] = {
         for name, shape, rows in [("poses", "N,3", 1), ("variances", "N", 1), ("histograms", "N,N", 1), ("frames", "N", 1),
                                   ("keypoints", "N,4", 0), ("bearings", "N,3", 0), ("descriptors", "N,N", 0),
                                   ("offsets", "N", 1), ("edges", "N,2", 0), ("measurements", "N,3", 0),
-                                  ("covariances", "N,3,3", 0), ("kinds", "N", 0)]}),
+                                  ("covariances", "N,3,3", 0), ("kinds", "N", 0)]} | {"index": Choice("opencv")}),
     "robokit.localization.hierarchical.HierarchicalLocalizer": Call({
         "map": Obj(office_map), "camera": Obj(small_omni), "top_k": Int(2), "ratio": Real(0.7), "min_matches": Int(25),
         "ambiguity": Real(0.8), "n_features": Int(100), "mode": Choice("hierarchical"), "min_crossing": Real(0.26),

@@ -88,6 +88,7 @@ def test_save_and_load_give_back_the_same_arrays(tmp_path):
     for name, value in m.to_arrays().items():
         assert np.array_equal(value, getattr(back, name)), name
     assert back.descriptors.dtype == np.float32
+    assert back.index == "opencv" and TopologicalMap.load(small_map(index="kdtree").save(tmp_path / "k.npz")).index == "kdtree"
     np.savez(tmp_path / "other.npz", poses=np.zeros((1, 3)))
     with pytest.raises(ValueError, match="path"):
         TopologicalMap.load(tmp_path / "other.npz")
@@ -138,6 +139,7 @@ def test_match_counts_equal_ratio_matching_against_each_node():
     (dict(covariances=np.tile(-np.eye(3), (3, 1, 1))), ValueError, "covariances"),
     (dict(kinds=[0, 1, 7]), ValueError, "kinds"),
     (dict(histograms=np.ones((2, 8))), ValueError, "histograms"),
+    (dict(index="octree"), ValueError, "index"),
 ])
 def test_bad_maps_are_refused_by_name(change, error, match):
     with pytest.raises(error, match=match):

@@ -40,9 +40,9 @@ import numpy as np
 from ..geometry import se2_between, wrap_angle
 from ..sim.motion import odometry_covariance
 from ..sim.omni import OmniCamera
-from ..validation import as_array, check_callable, check_int, check_positive, describe
+from ..validation import as_array, check_callable, check_choice, check_int, check_positive, describe
 from ..vision.colour import histogram_distance
-from ..vision.matching import DescriptorIndex
+from ..vision.matching import METHODS, DescriptorIndex
 from .omni_views import check_omni_image, omni_view, relative_pose
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
 
@@ -241,8 +241,8 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
                           max_variance: float = 0.1, odometry_alphas: Any = (0.01, 0.001, 0.01, 0.001),
                           bins: int = 32, n_features: int = 500, ratio: float = 0.7, loop_closure: bool = True,
                           loop_top_k: int = 5, loop_min_matches: int = 25, loop_exclude: int = 5,
-                          sigma_visual: Any = (0.05, 0.05, 0.02), progress: Callable | None = None,
-                          log: Callable | None = None) -> TopologicalMap:
+                          sigma_visual: Any = (0.05, 0.05, 0.02), index: str = "opencv",
+                          progress: Callable | None = None, log: Callable | None = None) -> TopologicalMap:
     """Build a topological map from recorded omni images and odometry (key images, edges, loops).
 
     Parameters
@@ -273,6 +273,8 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
         The last this many nodes before a key image are its neighbours, not loop candidates.
     sigma_visual : array_like, shape (3,)
         Standard deviations assumed for a visual relative pose (m, m, rad).
+    index : {"opencv", "kdtree", "bruteforce", "flann"}, default "opencv"
+        The nodes' descriptor search (see :class:`~robokit.mapping.TopologicalMap`).
     progress : callable ``(done, total)``, optional
     log : callable ``(line)``, optional
         Told about every node and loop closure.
@@ -321,6 +323,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     if np.any(sigma <= 0):
         raise ValueError(f"sigma_visual: expected three positive standard deviations, got {sigma.tolist()}")
     alphas = as_array(odometry_alphas, "odometry_alphas", shape=(4,))
+    index = check_choice(index, "index", METHODS)
     progress = check_callable(progress, "progress")
     log = check_callable(log, "log")
     ratio = check_positive(ratio, "ratio")
@@ -370,7 +373,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
         offsets=np.concatenate([[0], np.cumsum(counts)]),
         edges=np.array([[i, i + 1] for i in range(len(keys) - 1)]).reshape(-1, 2),
         measurements=se2_between(odo[keys[:-1]], odo[keys[1:]]).reshape(-1, 3),
-        covariances=np.array(edge_cov).reshape(-1, 3, 3), kinds=np.full(len(keys) - 1, ODOMETRY_EDGE))
+        covariances=np.array(edge_cov).reshape(-1, 3, 3), kinds=np.full(len(keys) - 1, ODOMETRY_EDGE), index=index)
     if log is not None:
         for i, (k, r) in enumerate(zip(keys, reasons)):
             log(f"node {i}: frame {k} ({r}), {counts[i]} features")
