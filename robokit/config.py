@@ -11,7 +11,7 @@ import json
 import os
 from pathlib import Path
 
-__all__ = ["fast_mode", "FAST", "cache_dir", "cache_key"]
+__all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -53,6 +53,47 @@ def fast_mode(environ: "os._Environ[str] | dict[str, str] | None" = None) -> boo
 
 #: Fast mode as read once at import time (``robokit.FAST``).
 FAST: bool = fast_mode()
+
+
+def headless(environ: "os._Environ[str] | dict[str, str] | None" = None) -> bool:
+    """Return whether notebooks run without a person watching (``ROBOKIT_HEADLESS``).
+
+    The course build and the test-suite execute notebooks with ``ROBOKIT_HEADLESS=1``: widgets
+    that need a live kernel (sliders) are then replaced by their pre-computed static equivalent,
+    which is what the course site shows.
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        Environment to read; defaults to :data:`os.environ`.
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    ValueError
+        If the variable holds anything but the values :func:`fast_mode` accepts.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Visualisation"); not from a paper.
+
+    Examples
+    --------
+    >>> headless({"ROBOKIT_HEADLESS": "1"}), headless({})
+    (True, False)
+    """
+    env = os.environ if environ is None else environ
+    raw = str(env.get("ROBOKIT_HEADLESS", "")).strip().lower()
+    if raw in _TRUE:
+        return True
+    if raw in _FALSE:
+        return False
+    raise ValueError(
+        f"ROBOKIT_HEADLESS: expected one of 1/0/true/false/yes/no/on/off, got {env.get('ROBOKIT_HEADLESS')!r}"
+    )
 
 
 def cache_dir(*parts: str, create: bool = True) -> Path:
