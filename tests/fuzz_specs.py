@@ -450,22 +450,22 @@ SPECS: dict[str, Call] = {
                                                "repetitions": Int(1)}),
     "robokit.viz.scene3d.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3")}),
     # --- lesson 02: controllers.path_following(_loop), localization.pose_ekf, navigation.visual_path --------
-    "robokit.controllers.path_following.VisualPath": Call({
+    "robokit.controllers.path_geometry.VisualPath": Call({
         "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), "N,3"),
         "s": Array(np.array([0.0, 1.0, 2.0]), "N"), "curvature": Array(np.zeros(3), "N"),
         "key_poses": Array(np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), "N,3", optional=True)}),
-    "robokit.controllers.path_following.path_from_poses": Call({"poses": Array(KEY_POSES, "N,3"), "spacing": Real(0.1)}),
-    "robokit.controllers.path_following.reference_point": Call({
+    "robokit.controllers.path_geometry.path_from_poses": Call({"poses": Array(KEY_POSES, "N,3"), "spacing": Real(0.1)}),
+    "robokit.controllers.path_geometry.reference_point": Call({
         "path": Obj(visual_path), "pose": Array(np.array([1.0, 0.2, 0.1]), "3"), "previous": Int(5, optional=True),
-        "window": Real(1.0, optional=True)}),
+        "window": Real(1.0, optional=True), "check": Flag(True)}),
     "robokit.controllers.path_following.path_following_gains": Call({"alpha": Real(2.0), "xi": Real(0.7)}),
     "robokit.controllers.path_following.path_following_command": Call({
         "d": Array(np.array([0.1, -0.2]), "*"), "theta_tilde": Array(np.array([0.1, 0.0]), "*"),
         "curvature": Array(np.array([0.0, 0.5]), "*"), "v": Array(np.array([0.3, 0.3]), "*"), "k2": Real(4.0),
-        "k3": Real(2.8)}),
+        "k3": Real(2.8), "check": Flag(True)}),
     "robokit.controllers.path_following.saturate_command": Call({
         "v": Array(np.array([0.3, 0.3]), "*"), "omega": Array(np.array([2.0, 0.1]), "*"), "v_max": Real(0.3),
-        "w_max": Real(0.5)}),
+        "w_max": Real(0.5), "check": Flag(True)}),
     "robokit.controllers.path_following.PathFollower": Call({
         "path": Obj(visual_path), "alpha": Real(2.0), "v_max": Real(0.3), "w_max": Real(1.0), "xi": Real(0.7),
         "goal_tolerance": Real(0.1), "window": Real(1.0, optional=True)}),
@@ -504,7 +504,7 @@ SPECS: dict[str, Call] = {
         "dt": Real(0.1), "fix_period": Real(0.5), "alpha": Real(2.0), "v_max": Real(0.3), "w_max": Real(1.0),
         "xi": Real(0.7), "goal_tolerance": Real(0.1), "odometry_noise": Array(np.array([0.01, 0.02]), "2"),
         "sigma_fix": Array(np.array([0.1, 0.15, 0.05]), "3"), "sigma_odometry": Array(np.array([0.01, 0.02]), "2", optional=True),
-        "gate": Real(16.0, optional=True), "max_time": Real(3.0, optional=True), "rng": Rng(0)}),
+        "gate": Real(16.0, optional=True), "relocalize_after": Int(3), "max_time": Real(3.0, optional=True), "rng": Rng(0)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -518,9 +518,9 @@ NOT_FUZZED: dict[str, str] = {
 EXTRA: tuple[str, ...] = (
     "robokit.sim.vehicle.unicycle_step",
     # lesson 02 (path following, pose EKF, navigation), fuzzed before the lesson exists
+    *(f"robokit.controllers.path_geometry.{n}" for n in ("VisualPath", "path_from_poses", "reference_point")),
     *(f"robokit.controllers.path_following.{n}" for n in (
-        "VisualPath", "path_from_poses", "reference_point", "path_following_gains", "path_following_command",
-        "saturate_command", "PathFollower")),
+        "path_following_gains", "path_following_command", "saturate_command", "PathFollower")),
     *(f"robokit.controllers.path_following_loop.{n}" for n in (
         "path_following_linearisation", "path_following_poles", "path_following_damping", "lateral_step_response",
         "simulate_path_following")),

@@ -37,8 +37,8 @@ import numpy as np
 from ..sim import unicycle_step
 from ..validation import (as_array, check_finite_result, check_finite_scalar, check_positive, check_sample_count,
                           describe)
-from .path_following import (XI, VisualPath, path_following_command, path_following_gains, reference_point,
-                             saturate_command)
+from .path_following import XI, path_following_command, path_following_gains, saturate_command
+from .path_geometry import VisualPath, reference_point
 
 __all__ = ["path_following_linearisation", "path_following_poles", "path_following_damping",
            "lateral_step_response", "FollowTrace", "simulate_path_following"]
@@ -254,14 +254,16 @@ def simulate_path_following(path: VisualPath, start_pose: Any, *, alpha: float, 
     t, poses, d, th, vs, ws = [], [], [], [], [], []
     ref = None
     for k in range(n + 1):
-        ref = reference_point(path, pose, previous=None if ref is None else ref.index, window=1.0 + 2 * speed * h)
+        ref = reference_point(path, pose, previous=None if ref is None else ref.index, window=1.0 + 2 * speed * h,
+                              check=False)
         t.append(k * h), poses.append(pose), d.append(ref.d), th.append(ref.theta_tilde)
         if k == n or ref.s >= path.length:
             vs.append(0.0), ws.append(0.0)
             break
-        vc, wc = speed, path_following_command(ref.d, ref.theta_tilde, ref.curvature, speed, k2, k3)
+        vc, wc = speed, path_following_command(ref.d, ref.theta_tilde, ref.curvature, speed, k2, k3, check=False)
         if wm is not None:
-            vc, wc = saturate_command(vc, wc, speed, wm)
+            vc, wc = saturate_command(vc, wc, speed, wm, check=False)
+        check_finite_result("start_pose, alpha, v, dt, xi", vc, wc)
         vs.append(vc), ws.append(wc)
         pose = unicycle_step(pose, vc, wc, h, check=False)
     return FollowTrace(np.array(t), np.array(poses), np.array(d), np.array(th), np.array(vs), np.array(ws))

@@ -33,7 +33,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..controllers.path_following import XI, PathFollower, VisualPath, reference_point
+from ..controllers.path_following import XI, PathFollower
+from ..controllers.path_geometry import VisualPath, reference_point
 from ..geometry import wrap_angle
 from ..localization.pose_ekf import UnicycleEKF
 from ..sim import unicycle_step
@@ -187,8 +188,8 @@ def perturbed_starts(path: VisualPath, n: int, *, offset: float = 0.3, heading: 
 def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: float = 0.1, fix_period: float = 0.5,
                 alpha: float = 2.0, v_max: float = 0.3, w_max: float = 1.0, xi: float = XI,
                 goal_tolerance: float = 0.1, odometry_noise: Any = (0.01, 0.02), sigma_fix: Any = (0.10, 0.15, 0.05),
-                sigma_odometry: Any = None, gate: float | None = None, max_time: float | None = None,
-                rng: Any = None) -> FollowResult:
+                sigma_odometry: Any = None, gate: float | None = None, relocalize_after: int = 3,
+                max_time: float | None = None, rng: Any = None) -> FollowResult:
     """Drive along ``path`` from ``start_pose``: visual fixes and odometry in the EKF, Eq. (8) on the estimate.
 
     Parameters
@@ -213,7 +214,11 @@ def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: fl
         Standard deviations the EKF assumes for odometry; default ``odometry_noise`` (at least
         1e-3 each, so the covariance is positive definite).
     gate : float, optional
-        Normalised-innovation gate for fixes (:meth:`UnicycleEKF.update_pose`); ``None`` uses all.
+        Normalised-innovation gate for fixes (:meth:`UnicycleEKF.update_pose`), e.g.
+        ``scipy.stats.chi2.ppf(0.999, 3)``; ``None`` uses every fix.
+    relocalize_after : int, default 3
+        With a gate: after this many fixes rejected in a row the estimate, not the fixes, is taken
+        to be wrong (a false first fix, say) and the filter restarts from the newest fix.
     max_time : float, optional
         Time limit (s); default ``3 * path.length / v_max + 30``.
     rng : numpy.random.Generator or int, optional
@@ -263,6 +268,7 @@ def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: fl
     R_fix, R_odo = np.diag(fix_sd ** 2), np.diag(odo_sigma ** 2)
     check_finite_result("sigma_fix, sigma_odometry", R_fix, R_odo)
     g = None if gate is None else check_positive(gate, "gate")
+    restart = check_int(relocalize_after, "relocalize_after", minimum=1)
     limit = 3 * path.length / follower.v_max + 30 if max_time is None else check_positive(max_time, "max_time")
     check_sample_count(limit / h, "max_time, dt")
     rng = as_rng(rng)
@@ -284,10 +290,10 @@ def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: fl
     if fix is not None:
         P0 = np.diag(np.concatenate([fix_sd ** 2, odo_sigma ** 2]))
         ekf = UnicycleEKF(np.concatenate([fix, [0.0, 0.0]]), P0)
-        step, ref = 0, None
+        step, ref, rejected = 0, None, 0
         while True:
             v, w = follower.command(ekf.pose)
-            ref = reference_point(path, pose, previous=None if ref is None else ref.index, window=1.0)
+            ref = reference_point(path, pose, previous=None if ref is None else ref.index, window=1.0, check=False)
             times.append(t), truth.append(pose.copy()), est.append(ekf.pose), cross.append(ref.d)
             covs.append(ekf.covariance[:3, :3])
             if follower.done or t + h > limit + 1e-9:
@@ -301,7 +307,10 @@ def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: fl
             step += 1
             t = step * h + fixes[0][0]
             if step % every == 0 and (fix := ask(t)) is not None:
-                ekf.update_pose(fix, R_fix, gate=g)
+                rejected = 0 if ekf.update_pose(fix, R_fix, gate=g) else rejected + 1
+                if rejected >= restart:                           # the estimate is what is wrong
+                    ekf = UnicycleEKF(np.concatenate([fix, ekf.state[3:]]), P0)
+                    rejected = 0
     final = float(math.hypot(*(pose[:2] - path.poses[-1, :2])))
     return FollowResult(np.array(times), np.array(truth).reshape(-1, 3), np.array(est).reshape(-1, 3),
                         np.array(covs).reshape(-1, 3, 3), np.array(cmds).reshape(-1, 2), np.array(cross),
