@@ -475,7 +475,7 @@ SPECS: dict[str, Call] = {
     "robokit.controllers.path_following_loop.path_following_damping": Call({"alpha": Real(2.0), "v": Real(0.3),
                                                                             "xi": Real(0.7)}),
     "robokit.controllers.path_following_loop.lateral_step_response": Call({
-        "alpha": Real(2.0), "v": Real(0.3), "t": Array(np.linspace(0.0, 5.0, 11), "N"), "xi": Real(0.7),
+        "alpha": Real(2.0), "v": Real(0.3), "t": Array(np.linspace(0.0, 5.0, 11), "N", optional=True), "xi": Real(0.7),
         "offset": Real(0.1)}),
     "robokit.controllers.path_following_loop.simulate_path_following": Call({
         "path": Obj(visual_path), "start_pose": Array(np.array([0.0, 0.1, 0.0]), "3"), "alpha": Real(2.0),

@@ -202,7 +202,7 @@ def test_small_offsets_decay_as_the_linearised_poles_say(path, start, alpha):
     v = 0.3
     run = simulate_path_following(path, start, alpha=alpha, v=v, duration=15.0, dt=0.01)
     d0 = run.d[0]
-    _, d_lin = lateral_step_response(alpha, v, run.t, offset=d0)
+    _, d_lin = lateral_step_response(alpha, v, t=run.t, offset=d0)
     assert np.abs(run.d - d_lin).max() < 0.02 * abs(d0)
     lin = control.initial_response(path_following_linearisation(alpha, v), run.t, initial_state=[d0, 0.0],
                                    return_states=True)
@@ -256,7 +256,7 @@ def test_the_linearisation_is_the_jacobian_of_the_nonlinear_error_dynamics():
 def test_the_step_response_is_the_damped_oscillation():
     alpha, v, d0 = 2.0, 0.3, 0.1
     t = np.linspace(0.0, 30.0, 601)
-    _, d = lateral_step_response(alpha, v, t, offset=d0)
+    _, d = lateral_step_response(alpha, v, t=t, offset=d0)
     wn, wd = alpha * v, alpha * v * math.sqrt(1 - XI ** 2)
     closed = d0 * np.exp(-XI * wn * t) * (np.cos(wd * t) + XI / math.sqrt(1 - XI ** 2) * np.sin(wd * t))
     assert np.abs(d - closed).max() < 1e-6

@@ -53,7 +53,7 @@ import numpy as np
 from ..validation import as_array, check_finite_result, check_positive, describe
 from .path_geometry import ReferencePoint, VisualPath, path_from_poses, reference_point
 
-# the path's names are re-exported here, where the lesson's first sketch of the API put them
+# the path's names are re-exported: the lesson's API reaches them through this module too
 __all__ = ["path_following_gains", "PathSingularityError", "path_following_command", "saturate_command",
            "PathFollower", "VisualPath", "path_from_poses", "ReferencePoint", "reference_point"]
 

@@ -139,7 +139,7 @@ def path_following_damping(alpha: float, v: float, xi: float = XI) -> dict:
             "time_constant": float(-1.0 / p.real.max()), "poles": p}
 
 
-def lateral_step_response(alpha: float, v: float, t: Any, xi: float = XI, *, offset: float = 1.0
+def lateral_step_response(alpha: float, v: float, xi: float = XI, t: Any = None, *, offset: float = 1.0
                           ) -> tuple[np.ndarray, np.ndarray]:
     """Lateral error ``d(t)`` of a robot that starts ``offset`` metres beside the path, parallel to it.
 
@@ -147,8 +147,9 @@ def lateral_step_response(alpha: float, v: float, t: Any, xi: float = XI, *, off
     ----------
     alpha, v, xi : float
         As in :func:`path_following_linearisation`.
-    t : array_like, shape (N,)
-        Equally spaced increasing times (s) from 0 (python-control asks for equal steps).
+    t : array_like, shape (N,), optional
+        Equally spaced increasing times (s) from 0 (python-control asks for equal steps); default
+        501 times over ten time constants of the envelope (:func:`path_following_damping`).
     offset : float, default 1
         Initial distance to the path (m; positive to its left).
 
@@ -169,10 +170,15 @@ def lateral_step_response(alpha: float, v: float, t: Any, xi: float = XI, *, off
 
     Examples
     --------
-    >>> t, d = lateral_step_response(2.0, 0.3, np.linspace(0.0, 20.0, 201), offset=0.1)
+    >>> t, d = lateral_step_response(2.0, 0.3, t=np.linspace(0.0, 20.0, 201), offset=0.1)
     >>> round(float(d[0]), 4), round(float(d.min()), 4), round(float(abs(d[-1])), 4)   # 4.3 % overshoot
     (0.1, -0.0043, 0.0)
+    >>> t, d = lateral_step_response(1.0, 0.3)        # ten time constants: 10 / (xi alpha v) = 47 s
+    >>> len(t), round(float(t[-1]), 2)
+    (501, 47.14)
     """
+    if t is None:
+        t = np.linspace(0.0, 10 * path_following_damping(alpha, v, xi)["time_constant"], 501)
     tt = as_array(t, "t", ndim=1, min_size=2)
     step = np.diff(tt)
     if tt[0] != 0 or not step[0] > 0 or not np.allclose(step, step[0], rtol=1e-9, atol=0.0):
