@@ -123,6 +123,22 @@ def landmark_map():      # map_consistency takes anything with positions, covari
                                  covariances=np.stack([1e-4 * np.eye(3)] * 2), observations=np.array([3, 1]))
 
 
+# lesson 02's path following, pose EKF and navigation
+KEY_POSES = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 1.0, 0.0]])
+EKF_X = np.array([0.0, 0.0, 0.3, 0.5, 0.2])
+
+
+@functools.cache
+def visual_path():
+    from robokit.controllers import path_from_poses
+    return path_from_poses(KEY_POSES)
+
+
+def localizer():
+    from robokit.navigation import gaussian_localizer
+    return gaussian_localizer()
+
+
 @functools.cache
 def run_results():
     from robokit.outdoor import simulate
@@ -433,6 +449,62 @@ SPECS: dict[str, Call] = {
                                                "transforms": Array(lambda: lap().poses[:5], "N,3|N,4,4"), "fps": Real(10.0),
                                                "repetitions": Int(1)}),
     "robokit.viz.scene3d.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3")}),
+    # --- lesson 02: controllers.path_following(_loop), localization.pose_ekf, navigation.visual_path --------
+    "robokit.controllers.path_geometry.VisualPath": Call({
+        "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), "N,3"),
+        "s": Array(np.array([0.0, 1.0, 2.0]), "N"), "curvature": Array(np.zeros(3), "N"),
+        "key_poses": Array(np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), "N,3", optional=True)}),
+    "robokit.controllers.path_geometry.path_from_poses": Call({"poses": Array(KEY_POSES, "N,3"), "spacing": Real(0.1)}),
+    "robokit.controllers.path_geometry.reference_point": Call({
+        "path": Obj(visual_path), "pose": Array(np.array([1.0, 0.2, 0.1]), "3"), "previous": Int(5, optional=True),
+        "window": Real(1.0, optional=True), "check": Flag(True)}),
+    "robokit.controllers.path_following.path_following_gains": Call({"alpha": Real(2.0), "xi": Real(0.7)}),
+    "robokit.controllers.path_following.path_following_command": Call({
+        "d": Array(np.array([0.1, -0.2]), "*"), "theta_tilde": Array(np.array([0.1, 0.0]), "*"),
+        "curvature": Array(np.array([0.0, 0.5]), "*"), "v": Array(np.array([0.3, 0.3]), "*"), "k2": Real(4.0),
+        "k3": Real(2.8), "check": Flag(True)}),
+    "robokit.controllers.path_following.saturate_command": Call({
+        "v": Array(np.array([0.3, 0.3]), "*"), "omega": Array(np.array([2.0, 0.1]), "*"), "v_max": Real(0.3),
+        "w_max": Real(0.5), "check": Flag(True)}),
+    "robokit.controllers.path_following.PathFollower": Call({
+        "path": Obj(visual_path), "alpha": Real(2.0), "v_max": Real(0.3), "w_max": Real(1.0), "xi": Real(0.7),
+        "goal_tolerance": Real(0.1), "window": Real(1.0, optional=True)}),
+    "robokit.controllers.path_following_loop.path_following_linearisation": Call({"alpha": Real(2.0), "v": Real(0.3),
+                                                                                  "xi": Real(0.7)}),
+    "robokit.controllers.path_following_loop.path_following_poles": Call({"alpha": Real(2.0), "v": Real(0.3), "xi": Real(0.7)}),
+    "robokit.controllers.path_following_loop.path_following_damping": Call({"alpha": Real(2.0), "v": Real(0.3),
+                                                                            "xi": Real(0.7)}),
+    "robokit.controllers.path_following_loop.lateral_step_response": Call({
+        "alpha": Real(2.0), "v": Real(0.3), "t": Array(np.linspace(0.0, 5.0, 11), "N", optional=True), "xi": Real(0.7),
+        "offset": Real(0.1)}),
+    "robokit.controllers.path_following_loop.simulate_path_following": Call({
+        "path": Obj(visual_path), "start_pose": Array(np.array([0.0, 0.1, 0.0]), "3"), "alpha": Real(2.0),
+        "v": Real(0.3), "duration": Real(2.0), "dt": Real(0.1), "w_max": Real(1.0, optional=True), "xi": Real(0.7)}),
+    "robokit.localization.pose_ekf.unicycle_jacobian": Call({"x": Array(EKF_X, "5"), "dt": Real(0.1), "check": Flag(True)}),
+    "robokit.localization.pose_ekf.unicycle_process_noise": Call({
+        "x": Array(EKF_X, "5"), "dt": Real(0.1), "sigma_accel": Real(0.5), "sigma_alpha": Real(1.0), "check": Flag(True)}),
+    "robokit.localization.pose_ekf.ekf_predict": Call({
+        "x": Array(EKF_X, "5"), "P": Array(np.eye(5) * 0.01, "5,5"), "dt": Real(0.1),
+        "Q": Array(np.eye(5) * 1e-4, "5,5"), "check": Flag(True)}),
+    "robokit.localization.pose_ekf.ekf_update": Call({
+        "x": Array(EKF_X, "N"), "P": Array(np.eye(5) * 0.01, "N,N"), "z": Array(np.array([0.1, 0.2, 3.1]), "N"),
+        "H": Array(np.eye(3, 5), "N,N"), "R": Array(np.eye(3) * 0.01, "N,N"), "angles": Obj((2,)), "check": Flag(True)}),
+    "robokit.localization.pose_ekf.nees": Call({"error": Array(np.array([0.1, -0.2]), "N|N,N"),
+                                                "P": Array(np.diag([0.01, 0.04]), "N,N|N,N,N")}),
+    "robokit.localization.pose_ekf.nees_bounds": Call({"dof": Int(5), "runs": Int(50), "confidence": Real(0.95)}),
+    "robokit.localization.pose_ekf.UnicycleEKF": Call({
+        "x0": Array(EKF_X, "5"), "P0": Array(np.eye(5) * 0.01, "5,5"), "sigma_accel": Real(0.5), "sigma_alpha": Real(1.0)}),
+    "robokit.navigation.visual_path.gaussian_localizer": Call({
+        "noise": Array(np.array([0.1, 0.15, 0.05]), "3"), "dropout": Real(0.1), "outlier_rate": Real(0.1),
+        "outlier_offset": Real(2.0)}),
+    "robokit.navigation.visual_path.perturbed_starts": Call({
+        "path": Obj(visual_path), "n": Int(3), "offset": Real(0.3), "heading": Real(0.3), "rng": Rng(0)}),
+    "robokit.navigation.visual_path.follow_path": Call({
+        "path": Obj(visual_path), "start_pose": Array(np.array([0.0, 0.1, 0.0]), "3"), "localize": Func(localizer),
+        "dt": Real(0.1), "fix_period": Real(0.5), "alpha": Real(2.0), "v_max": Real(0.3), "w_max": Real(1.0),
+        "xi": Real(0.7), "goal_tolerance": Real(0.1), "odometry_noise": Array(np.array([0.01, 0.02]), "2"),
+        "sigma_fix": Array(np.array([0.1, 0.15, 0.05]), "3"), "sigma_odometry": Array(np.array([0.01, 0.02]), "2", optional=True),
+        "gate": Real(16.0, optional=True), "relocalize_after": Int(3), "max_time": Real(3.0, optional=True), "rng": Rng(0)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -443,7 +515,19 @@ NOT_FUZZED: dict[str, str] = {
 
 #: Besides the lessons' API: the exercises' references (students reproduce their contracts) and
 #: the functions the issue's fuzz named.
-EXTRA: tuple[str, ...] = ("robokit.sim.vehicle.unicycle_step",)
+EXTRA: tuple[str, ...] = (
+    "robokit.sim.vehicle.unicycle_step",
+    # lesson 02 (path following, pose EKF, navigation), fuzzed before the lesson exists
+    *(f"robokit.controllers.path_geometry.{n}" for n in ("VisualPath", "path_from_poses", "reference_point")),
+    *(f"robokit.controllers.path_following.{n}" for n in (
+        "path_following_gains", "path_following_command", "saturate_command", "PathFollower")),
+    *(f"robokit.controllers.path_following_loop.{n}" for n in (
+        "path_following_linearisation", "path_following_poles", "path_following_damping", "lateral_step_response",
+        "simulate_path_following")),
+    *(f"robokit.localization.pose_ekf.{n}" for n in (
+        "unicycle_jacobian", "unicycle_process_noise", "ekf_predict", "ekf_update", "nees", "nees_bounds", "UnicycleEKF")),
+    *(f"robokit.navigation.visual_path.{n}" for n in ("gaussian_localizer", "perturbed_starts", "follow_path")),
+)
 
 
 def resolve(dotted: str) -> Callable[..., Any]:

@@ -3,7 +3,10 @@
 Modules: :mod:`.egomotion` (Lin et al. Sec. 4-7), :mod:`.hough` (Se et al. Sec. 5) and
 :mod:`.visual_slam` (the whole pipeline over a stereo sequence). They depend on :mod:`robokit.vision`
 and :mod:`robokit.mapping`, never on ``viz`` or ``sim``; only :mod:`.lab_experiment` (Se et al.
-Sec. 6 re-run in the simulated lab, imported on demand) uses :mod:`robokit.sim` to render views.
+Sec. 6 re-run in the simulated lab, imported on demand) uses :mod:`robokit.sim` to render views,
+and :mod:`.pose_ekf` (lesson 02's EKF over ``(x, y, theta, v, omega)``, also imported on demand:
+``from robokit.localization.pose_ekf import UnicycleEKF``) takes the one unicycle model,
+:func:`robokit.sim.unicycle_step`, for its prediction.
 """
 from .egomotion import (DegenerateCorrespondenceError, EgomotionResult, InsufficientMatchesError,
                         continuation_matches, fit_pose, pose_from_two, ransac_pose, ransac_sample_count, track)
