@@ -72,6 +72,22 @@ def image():
     return photo("grace_hopper")[200:320, 180:340].copy()
 
 
+def image_mask():
+    return np.ones(image().shape[:2], bool)
+
+
+@functools.cache
+def small_omni():
+    from robokit.sim import OmniCamera
+    return OmniCamera(width=160, height=120, face_size=60)
+
+
+@functools.cache
+def office():
+    from robokit.sim import office_floor
+    return office_floor()
+
+
 @functools.cache
 def features():
     from robokit.vision import detect_sift_features
@@ -390,7 +406,10 @@ SPECS: dict[str, Call] = {
                                                              "params": Obj(None, optional=True), "descriptor": Choice("sift128"),
                                                              "overrides": Options({})}),
     "robokit.vision.descriptors.detect_sift_features": Call({"image": Array(image, "N,N|N,N,3|N,N,4"), "n_features": Int(0),
-                                                             "descriptor": Choice("sift128")}),
+                                                             "descriptor": Choice("sift128"),
+                                                             "mask": Array(image_mask, "N,N", optional=True,
+                                                                           accepts=("booleans",)),
+                                                             "orientation": Func(None, optional=True)}),
     "robokit.vision.evaluation.recall_precision": Call({
         "features_a": Obj(features), "features_b": Obj(features), "homography": Array(np.eye(3), "3,3"),
         "image_shape_b": Array(np.array([120, 160]), "2|3"), "thresholds": Array(np.array([0.5, 0.6]), "N", optional=True),
@@ -505,6 +524,52 @@ SPECS: dict[str, Call] = {
         "xi": Real(0.7), "goal_tolerance": Real(0.1), "odometry_noise": Array(np.array([0.01, 0.02]), "2"),
         "sigma_fix": Array(np.array([0.1, 0.15, 0.05]), "3"), "sigma_odometry": Array(np.array([0.01, 0.02]), "2", optional=True),
         "gate": Real(16.0, optional=True), "relocalize_after": Int(3), "max_time": Real(3.0, optional=True), "rng": Rng(0)}),
+    # --- robokit.vision.colour (lesson 02: HSI hue histograms) --------------------------------
+    "robokit.vision.colour.rgb_to_hsi": Call({"image": Array(image, "...,3|...,4")}),
+    "robokit.vision.colour.hue_mask": Call({"image": Array(image, "N,N,3|N,N,4"), "min_saturation": Real(0.15),
+                                            "min_intensity": Real(0.04), "max_intensity": Real(0.98)}),
+    "robokit.vision.colour.hue_histogram": Call({"image": Array(image, "N,N,3|N,N,4"), "bins": Int(32),
+                                                 "min_saturation": Real(0.15), "min_intensity": Real(0.04),
+                                                 "max_intensity": Real(0.98),
+                                                 "mask": Array(image_mask, "N,N", optional=True, accepts=("booleans",))}),
+    "robokit.vision.colour.hue_histogram_opencv": Call({"image": Array(image, "N,N,3|N,N,4"), "bins": Int(32),
+                                                        "min_saturation": Real(0.15), "min_intensity": Real(0.04),
+                                                        "max_intensity": Real(0.98),
+                                                        "mask": Array(image_mask, "N,N", optional=True,
+                                                                      accepts=("booleans",))}),
+    "robokit.vision.colour.histogram_distance": Call({"h": Array(np.full(8, 0.125), "N"),
+                                                      "H": Array(np.eye(8)[:3], "N|N,N")}),
+    "robokit.vision.colour.histogram_intersection": Call({"h": Array(np.full(8, 0.125), "N"),
+                                                          "H": Array(np.eye(8)[:3], "N|N,N")}),
+    # --- robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02) ---
+    "robokit.vision.omni_features.omni_sift": Call({"image": Array(image, "N,N|N,N,3|N,N,4"),
+                                                    "centre": Array(np.array([80.0, 60.0]), "2"),
+                                                    "radii": Array(np.array([10.0, 55.0]), "2"), "orientation": Choice("radial"),
+                                                    "n_features": Int(0), "mask": Array(image_mask, "N,N", optional=True,
+                                                                                        accepts=("booleans",))}),
+    "robokit.vision.omni_features.annulus_mask": Call({"shape": Array(np.array([120, 160]), "2"),
+                                                       "centre": Array(np.array([80.0, 60.0]), "2"),
+                                                       "radii": Array(np.array([10.0, 55.0]), "2")}),
+    "robokit.vision.omni_features.radial_orientation": Call({"xy": Array(np.array([[90.0, 60.0], [80.0, 20.0]]), "N,2|2",
+                                                                         min_rows=0),
+                                                             "centre": Array(np.array([80.0, 60.0]), "2")}),
+    "robokit.vision.matching.DescriptorIndex": Call({"descriptors": Array(lambda: features().descriptors[:40], "N,N",
+                                                                          min_rows=0),
+                                                     "method": Choice("flann"), "checks": Int(32), "trees": Int(2),
+                                                     "seed": Int(0)}),
+    "robokit.vision.matching.ratio_test": Call({"dist": Array(np.array([[0.1, 1.0], [0.5, np.inf]]), "N,2", inf_ok=True,
+                                                              min_rows=0),
+                                                "index": Array(np.array([[3, 1], [0, 2]]), "N,2", min_rows=0),
+                                                "ratio": Real(0.8), "max_distance": Real(0.8, optional=True, inf_ok=True)}),
+    "robokit.sim.feature_check.omni_ground_truth_inliers": Call({
+        "camera": Obj(small_omni), "ranges": Array(lambda: np.full((120, 160), 2.0), "120,160", inf_ok=True),
+        "T1": T_(lambda: small_omni().transform_at([2.0, 6.0, 0.0])), "T2": T_(lambda: small_omni().transform_at([2.2, 6.0, 0.3])),
+        "uv1": Array(np.array([[120.0, 60.0], [40.0, 70.0]]), "N,2", min_rows=0),
+        "uv2": Array(np.array([[118.0, 61.0], [45.0, 66.0]]), "N,2", min_rows=0), "tol": Real(3.0)}),
+    "robokit.sim.feature_check.omni_view_pair": Call({
+        "world": Obj(office), "camera": Obj(small_omni), "pose1": Array(np.array([12.0, 3.5, 0.0]), "3"),
+        "pose2": Array(np.array([12.2, 3.5, 0.5]), "3"), "orientation": Choice("radial"), "ratio": Real(0.8),
+        "tol": Real(3.0), "method": Choice("kdtree")}, cheap=False),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -527,6 +592,16 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.localization.pose_ekf.{n}" for n in (
         "unicycle_jacobian", "unicycle_process_noise", "ekf_predict", "ekf_update", "nees", "nees_bounds", "UnicycleEKF")),
     *(f"robokit.navigation.visual_path.{n}" for n in ("gaussian_localizer", "perturbed_starts", "follow_path")),
+    # robokit.vision.colour (lesson 02)
+    "robokit.vision.colour.rgb_to_hsi", "robokit.vision.colour.hue_mask",
+    "robokit.vision.colour.hue_histogram", "robokit.vision.colour.hue_histogram_opencv",
+    "robokit.vision.colour.histogram_distance", "robokit.vision.colour.histogram_intersection",
+    # robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02)
+    "robokit.vision.omni_features.omni_sift", "robokit.vision.omni_features.annulus_mask",
+    "robokit.vision.omni_features.radial_orientation", "robokit.vision.matching.DescriptorIndex",
+    "robokit.vision.matching.ratio_test", "robokit.vision.descriptors.detect_sift_features",
+    "robokit.sim.feature_check.omni_ground_truth_inliers",
+    "robokit.sim.feature_check.omni_view_pair",
 )
 
 

@@ -49,7 +49,9 @@ Recorded runs
 
 Checks
     ``sift_view_pair(world, camera, robot_pose)``: OpenCV SIFT between two views, matches judged
-    against the rendered depth (``ground_truth_inliers``).
+    against the rendered depth (``ground_truth_inliers``); ``omni_view_pair(world, omni, pose1,
+    pose2)`` the same for omni views (``omni_ground_truth_inliers``, lesson 02's "matched accurate
+    rate").
 
 Example
 -------
@@ -61,7 +63,7 @@ Example
 ((480, 640, 3), dtype('float32'))
 """
 from .camera import Frame, PinholeCamera, StereoRig, camera_mount
-from .feature_check import ViewPairCheck, ground_truth_inliers, sift_view_pair
+from .feature_check import ViewPairCheck, ground_truth_inliers, omni_ground_truth_inliers, omni_view_pair, sift_view_pair
 from .layout import Layout, box_corners, obstacle_array
 from .lidar import Lidar, scan_points
 from .motion import (Path, corridor_path, lab_lap, noisy_odometry, odometry_increment, sample_motion_model_odometry,
@@ -82,5 +84,6 @@ __all__ = [
     "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
     "odometry_increment",
     "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap",
-    "Run", "record", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair",
+    "Run", "record", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair", "omni_ground_truth_inliers",
+    "omni_view_pair",
 ]

@@ -21,11 +21,12 @@ References
 from __future__ import annotations
 
 from functools import lru_cache
+from typing import Callable
 
 import cv2
 import numpy as np
 
-from ..validation import check_choice, check_int, check_positive
+from ..validation import as_array, check_callable, check_choice, check_int, check_positive
 from .features import Features, Keypoints, as_gray_image
 from .plot_detector import PlotParams, ScaleSpace, detect_plot_levels
 
@@ -327,7 +328,8 @@ def detect_plot_features(image, params: PlotParams | None = None, *, descriptor:
     return Features(kp, _histograms(_gradients(space, kp.scale, cache), kp, cells, bins, 0.2))
 
 
-def detect_sift_features(image, *, n_features: int = 0, descriptor: str = "sift128") -> Features:
+def detect_sift_features(image, *, n_features: int = 0, descriptor: str = "sift128", mask=None,
+                         orientation: Callable[[np.ndarray], np.ndarray] | None = None) -> Features:
     """OpenCV's SIFT (``cv2.SIFT_create``) returned in robokit's containers.
 
     Parameters
@@ -338,6 +340,15 @@ def detect_sift_features(image, *, n_features: int = 0, descriptor: str = "sift1
     descriptor : {"sift128", "reduced16"}
         OpenCV's own 128-element descriptor, or Se et al.'s 16-element vector computed here at
         OpenCV's keypoints.
+    mask : array_like of bool, shape (H, W), optional
+        Where keypoints may be detected (OpenCV's detection mask); descriptors still see the
+        whole image.
+    orientation : callable, optional
+        ``orientation(xy) -> angles``: replaces SIFT's gradient orientation (Lowe 2004, Sec. 5)
+        by a given angle per keypoint, e.g. the polar angle about an omni image's centre
+        (:func:`robokit.vision.omni_sift`). ``xy`` is ``(N, 2)`` pixel positions; ``angles`` must
+        be ``(N,)`` finite radians in the convention of :class:`Keypoints`. The keypoints OpenCV
+        repeats for a second orientation peak are then kept once.
 
     Returns
     -------
@@ -346,10 +357,18 @@ def detect_sift_features(image, *, n_features: int = 0, descriptor: str = "sift1
         radians (OpenCV measures it as ``360 - atan2(-dy, dx)``, which is ``atan2(dy, dx)`` in our
         y-down image axes; the tests check that it agrees with :func:`assign_orientations`).
 
+    Raises
+    ------
+    TypeError, ValueError
+        For a malformed image, mask of another shape, a non-callable ``orientation`` or one that
+        returns angles of the wrong shape or NaN.
+
     Notes
     -----
     Lowe 2004 (the detector used by Se, Lowe & Little, Sec. 2.1); the library reference beside
-    :func:`detect_plot_features`.
+    :func:`detect_plot_features`. With ``orientation`` the keypoints are detected
+    (``SIFT.detect``), given their angles and described (``SIFT.compute``, which keeps each
+    keypoint's octave): two passes over the pyramid instead of one.
 
     Examples
     --------
@@ -360,12 +379,24 @@ def detect_sift_features(image, *, n_features: int = 0, descriptor: str = "sift1
     >>> f = detect_sift_features(image)
     >>> f.descriptors.shape[1], len(f) > 20, bool(np.allclose(np.linalg.norm(f.descriptors, axis=1), 1))
     (128, True, True)
+    >>> up = detect_sift_features(image, orientation=lambda xy: np.zeros(len(xy)))   # "upright" SIFT
+    >>> bool(np.all(up.keypoints.orientation == 0)), len(up) < len(f)
+    (True, True)
     """
     descriptor = check_choice(descriptor, "descriptor", ("sift128", "reduced16"))
     n_features = check_int(n_features, "n_features", minimum=0)
+    orientation = check_callable(orientation, "orientation")
     img = as_gray_image(image)
+    where = None
+    if mask is not None:
+        where = as_array(mask, "mask", shape=img.shape, dtype=bool).astype(np.uint8) * 255
     u8 = np.clip(img * 255 + 0.5, 0, 255).astype(np.uint8)
-    kps, desc = cv2.SIFT_create(nfeatures=n_features).detectAndCompute(u8, None)
+    sift = cv2.SIFT_create(nfeatures=n_features)
+    if orientation is None:
+        kps, desc = sift.detectAndCompute(u8, where)
+    else:
+        kps = _given_orientations(sift.detect(u8, where), orientation)
+        kps, desc = sift.compute(u8, kps) if kps else ((), None)
     if not kps:
         dim = 128 if descriptor == "sift128" else 16
         return Features(Keypoints.empty(), np.zeros((0, dim), np.float32))
@@ -379,6 +410,20 @@ def detect_sift_features(image, *, n_features: int = 0, descriptor: str = "sift1
     desc = desc.astype(np.float32)
     norm = np.linalg.norm(desc, axis=1, keepdims=True)
     return Features(kp, np.divide(desc, norm, out=np.zeros_like(desc), where=norm > 0))
+
+
+def _given_orientations(kps, orientation) -> list:
+    """OpenCV keypoints, one per (position, size, octave), with ``orientation(xy)`` as their angle."""
+    if not kps:
+        return []
+    key = np.array([[k.pt[0], k.pt[1], k.size, k.octave] for k in kps])
+    _, first = np.unique(key, axis=0, return_index=True)      # SIFT repeats a keypoint per orientation peak
+    kps = [kps[i] for i in np.sort(first)]
+    xy = np.array([k.pt for k in kps], float)
+    angles = as_array(orientation(xy), "orientation(xy)", shape=(len(kps),))
+    for k, a in zip(kps, np.rad2deg(np.mod(angles, 2 * np.pi))):
+        k.angle = float(a) % 360.0
+    return kps
 
 
 def detect_and_describe(image, method: str = "plot", *, descriptor: str = "sift128", **kwargs) -> Features:
