@@ -10,8 +10,8 @@ and the cost is ``chi2 = sum_ij e_ij^T Omega_ij e_ij`` (Kummerle et al. 2011, Eq
 ``[x, y, theta]``; the two agree to second order in the error, so their optima differ slightly.
 
 Both solvers minimise ``chi2`` over every pose but the fixed one (the gauge), with the analytic
-sparse Jacobian :func:`pose_graph_jacobian`. Each error is whitened first: with ``Omega = L L^T`` (Cholesky), ``e^T Omega e = |L^T e|^2``, so the
-problem is an ordinary sum of squares.
+sparse Jacobian :func:`pose_graph_jacobian`. Each error is whitened first: with ``Omega = L L^T``
+(Cholesky), ``e^T Omega e = |L^T e|^2``, so the problem is an ordinary sum of squares.
 
 * ``method="gauss-newton"``: the readable reference of the lesson. Each iteration solves the
   sparse normal equations ``(J^T J) dx = -J^T r`` (Kummerle et al. 2011, Sec. III) with SuperLU;
@@ -53,8 +53,10 @@ from .pose_graph import PoseGraph, as_pose_graph, check_connected
 
 __all__ = ["pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph"]
 
-#: SuperLU options for a symmetric positive-definite matrix: a symmetric fill-reducing ordering
-#: (minimum degree on A^T + A) and no row pivoting, about 20 times faster than the defaults here.
+#: SuperLU options for a symmetric positive-definite matrix, used with a symmetric fill-reducing
+#: ordering (minimum degree on A^T + A) and no row pivoting: one factorisation of the 3500-pose
+#: benchmark's normal equations takes 0.16 s, against 0.33 s with SuperLU's defaults and 3.8 s with
+#: that ordering but row pivoting.
 SYMMETRIC = {"SymmetricMode": True}
 
 #: Largest Levenberg-Marquardt damping tried before a step is given up (the cost is at a minimum).

@@ -304,7 +304,8 @@ def relax(graph: PoseGraph, *, max_iterations: int = 1000, tolerance: float = 1e
         weight = 1.0 / (var[source] + omega_edge)                          # 1 / (omega'_i)_j, Eq. (1)
         total = np.bincount(target, weight, minlength=n)
         new = poses.copy()
-        # Eq. (3): (1 / n_i) sum_j x' omega_i / omega'_j with Eq. (2)'s omega_i = sum x' / omega' / sum 1 / omega'
+        # Eq. (3), (1 / n_i) sum_j x'_j omega_i / omega'_j, is sum_j (x'_j / omega'_j) / sum_j (1 / omega'_j)
+        # once Eq. (2)'s omega_i = n_i / sum_j (1 / omega'_j) is put in
         new[free, 0] = np.bincount(target, weight * guess[:, 0], minlength=n)[free] / total[free]   # Eq. (3)
         new[free, 1] = np.bincount(target, weight * guess[:, 1], minlength=n)[free] / total[free]   # Eq. (3)
         new[free, 2] = np.arctan2(np.bincount(target, weight * np.sin(guess[:, 2]), minlength=n),   # Eq. (3)
