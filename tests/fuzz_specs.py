@@ -216,6 +216,12 @@ def _truck():
     return PAPER_TRUCK
 
 
+@functools.cache
+def pose_graph():          # a small generated pose graph (30 poses, loop closures) for robokit.mapping
+    from robokit.mapping import manhattan_world_graph
+    return manhattan_world_graph(30, seed=1, closure_probability=1.0)[0]
+
+
 SPECS: dict[str, Call] = {
     # --- about, geometry --------------------------------------------------------------------
     "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
@@ -570,6 +576,42 @@ SPECS: dict[str, Call] = {
         "world": Obj(office), "camera": Obj(small_omni), "pose1": Array(np.array([12.0, 3.5, 0.0]), "3"),
         "pose2": Array(np.array([12.2, 3.5, 0.5]), "3"), "orientation": Choice("radial"), "ratio": Real(0.8),
         "tol": Real(3.0), "method": Choice("kdtree")}, cheap=False),
+    # --- mapping: pose graphs (pose_graph, pose_graph_optimize, relaxation, g2o, manhattan) ------
+    "robokit.mapping.pose_graph.PoseGraph": Call({
+        "poses": Array(lambda: pose_graph().poses, "N,3"), "edges": Array(lambda: pose_graph().edges, "N,2", min_rows=0),
+        "measurements": Array(lambda: pose_graph().measurements, "N,3"),
+        "information": Array(lambda: pose_graph().information, "N,3,3", optional=True),
+        "ids": Array(lambda: pose_graph().ids, "N", optional=True), "fixed": Int(0)}),
+    "robokit.mapping.pose_graph.edge_variances": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.pose_graph.unreachable_nodes": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.pose_graph.is_connected": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.pose_graph.check_connected": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.pose_graph.pose_graph_from_odometry": Call({
+        "odometry_poses": Array(lambda: pose_graph().poses[:6], "N,3"),
+        "loop_edges": Array(np.array([[5, 0]]), "N,2", optional=True, min_rows=0),
+        "loop_measurements": Array(np.array([[0.1, 0.0, 0.2]]), "N,3", optional=True),
+        "sigma_odometry": Array(np.array([0.1, 0.1, 0.05]), "|3|N,3"), "sigma_loop": Array(np.array([0.2, 0.2, 0.1]), "|3|N,3")}),
+    "robokit.mapping.pose_graph_optimize.pose_graph_residuals": Call({"graph": Obj(pose_graph),
+                                                             "poses": Array(lambda: pose_graph().poses, "N,3", optional=True)}),
+    "robokit.mapping.pose_graph_optimize.pose_graph_cost": Call({"graph": Obj(pose_graph),
+                                                        "poses": Array(lambda: pose_graph().poses, "N,3", optional=True)}),
+    "robokit.mapping.pose_graph_optimize.pose_graph_jacobian": Call({"graph": Obj(pose_graph),
+                                                            "poses": Array(lambda: pose_graph().poses, "N,3", optional=True)}),
+    "robokit.mapping.pose_graph_optimize.optimize_pose_graph": Call({
+        "graph": Obj(pose_graph), "method": Choice("gauss-newton"), "max_iterations": Int(20), "tolerance": Real(1e-9)}),
+    "robokit.mapping.relaxation.relax": Call({"graph": Obj(pose_graph), "max_iterations": Int(50), "tolerance": Real(1e-6),
+                                              "variances": Array(lambda: np.full(30, 0.01), "N", optional=True)}),
+    "robokit.mapping.relaxation.relax_sweep": Call({
+        "poses": Array(lambda: pose_graph().poses, "N,3"), "variances": Array(lambda: np.full(30, 0.01), "N"),
+        "edges": Array(lambda: pose_graph().edges, "N,2"), "measurements": Array(lambda: pose_graph().measurements, "N,3"),
+        "edge_variances": Array(lambda: np.full(pose_graph().n_edges, 0.02), "N"), "fixed": Int(0)}),
+    "robokit.mapping.relaxation.initial_variances": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.g2o.read_g2o": Call({"source": Text("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n"
+                                                         "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n")}),
+    "robokit.mapping.g2o.write_g2o": Call({"graph": Obj(pose_graph), "path": Text(None, optional=True)}),
+    "robokit.mapping.manhattan.manhattan_world_graph": Call({
+        "n_poses": Int(40), "seed": Int(0), "noise": Array(np.array([0.05, 0.05, 0.01]), "|3"), "extent": Int(5),
+        "closure_probability": Real(0.6), "min_gap": Int(10)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -602,6 +644,16 @@ EXTRA: tuple[str, ...] = (
     "robokit.vision.matching.ratio_test", "robokit.vision.descriptors.detect_sift_features",
     "robokit.sim.feature_check.omni_ground_truth_inliers",
     "robokit.sim.feature_check.omni_view_pair",
+    # robokit.mapping's pose graphs (lesson 02), fuzzed before the lesson exists
+    "robokit.mapping.pose_graph.PoseGraph", "robokit.mapping.pose_graph.edge_variances",
+    "robokit.mapping.pose_graph.unreachable_nodes", "robokit.mapping.pose_graph.is_connected",
+    "robokit.mapping.pose_graph.check_connected", "robokit.mapping.pose_graph.pose_graph_from_odometry",
+    "robokit.mapping.pose_graph_optimize.pose_graph_residuals", "robokit.mapping.pose_graph_optimize.pose_graph_cost",
+    "robokit.mapping.pose_graph_optimize.pose_graph_jacobian",
+    "robokit.mapping.pose_graph_optimize.optimize_pose_graph", "robokit.mapping.relaxation.relax",
+    "robokit.mapping.relaxation.relax_sweep", "robokit.mapping.relaxation.initial_variances",
+    "robokit.mapping.g2o.read_g2o", "robokit.mapping.g2o.write_g2o",
+    "robokit.mapping.manhattan.manhattan_world_graph",
 )
 
 
