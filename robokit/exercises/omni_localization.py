@@ -157,7 +157,7 @@ def _fine_cases(rng: np.random.Generator) -> list[Case]:
         Case((r(query), [r(n) for n in nodes], [4, 2]), label="two candidates, in the coarse stage's order"),
         Case((r(query), [r(n) for n in nodes], [1, 3]), {"ratio": 0.6}, label="the right node not among them"),
         Case((r(query), [r(n) for n in nodes], [7]), raises="ValueError", label="a candidate that does not exist"),
-        Case((r(query)[:3], [r(n)[:, :8] for n in nodes], [0]), raises="ValueError",
+        Case((r(query[:3]), [r(n[:, :8]) for n in nodes], [0]), raises="ValueError",
              label="descriptors of different lengths"),
     ]
 
@@ -171,11 +171,11 @@ def _recognise_cases(rng: np.random.Generator) -> list[Case]:
         nodes = _clustered_nodes(rng, n, 30, 16)
         true = int(rng.integers(n))
         decoy = (true + 1 + int(rng.integers(n - 1))) % n
-        q_hist = hist[true] + rng.normal(0, 0.004, bins)
-        if k % 2 == 0:  # a look-alike: the decoy's histogram is closer to the query than the true node's
-            hist[decoy] = q_hist + rng.normal(0, 0.001, bins)
-        q_hist = np.clip(q_hist, 0, None)
+        q_hist = np.clip(hist[true] + rng.normal(0, 0.004, bins), 0, None)
         q_hist /= q_hist.sum()
+        if k % 2 == 0:  # a look-alike: the decoy's histogram is closer to the query than the true node's
+            look_alike = np.clip(q_hist + rng.normal(0, 0.001, bins), 0, None)
+            hist[decoy] = look_alike / look_alike.sum()
         query = _query_from(rng, nodes[true], 16, 12, 0.05)
         label = "a look-alike node has the closer histogram" if k % 2 == 0 else "an unambiguous place"
         cases.append(Case((np.round(q_hist, 6).tolist(), np.round(query, 4).tolist(), np.round(hist, 6).tolist(),
