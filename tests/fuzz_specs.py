@@ -89,6 +89,48 @@ def office():
 
 
 @functools.cache
+def office_views():      # three small omni images of office_floor() 0.3 m apart (lesson 02's map tests)
+    poses = np.array([[12.0, 3.5, 0.0], [12.3, 3.5, 0.2], [12.6, 3.5, 0.0]])
+    return np.stack([small_omni().observe(office(), p).image for p in poses]), poses
+
+
+@functools.cache
+def office_map():
+    from robokit.mapping import build_topological_map
+    images, poses = office_views()
+    return build_topological_map(images, poses, small_omni(), similarity=0.001, min_matches=10 ** 6,
+                                 occlusion_frames=1, n_features=100, loop_closure=False)
+
+
+@functools.cache
+def omni_views():
+    from robokit.mapping import omni_view
+    images, _ = office_views()
+    return [omni_view(im, small_omni(), n_features=100) for im in images]
+
+
+@functools.cache
+def omni_matches():
+    from robokit.vision import DescriptorIndex
+    a, b = omni_views()[:2]
+    return DescriptorIndex(a.features.descriptors).match(b.features.descriptors, ratio=0.8)
+
+
+def bearings(n=12, seed=0):
+    return points(n, seed) / np.linalg.norm(points(n, seed), axis=1, keepdims=True)
+
+
+def moved_bearings(n=12, seed=0):
+    moved = points(n, seed) + [0.3, 0.1, 0.0]
+    return moved / np.linalg.norm(moved, axis=1, keepdims=True)
+
+
+def essential():
+    from robokit.vision.spherical import essential_from_bearings
+    return essential_from_bearings(bearings(), moved_bearings())
+
+
+@functools.cache
 def features():
     from robokit.vision import detect_sift_features
     return detect_sift_features(image())
@@ -294,8 +336,6 @@ SPECS: dict[str, Call] = {
         "threshold": Real(0.1), "confidence": Real(0.99), "min_matches": Int(5), "max_iterations": Int(100),
         "odometry": Array(np.zeros(3), "3", optional=True), "odometry_covariance": Array(np.eye(3) * 0.01, "3,3", optional=True),
         "rng": Rng(0)}),
-    "robokit.localization.egomotion.ransac_sample_count": Call({"contamination": Real(0.3), "sample_size": Int(2),
-                                                                "confidence": Real(0.99)}),
     "robokit.localization.egomotion.pose_from_two": Call({"robot_points": Array(lambda: points(2, 2), "2,3"),
                                                           "world_points": Array(lambda: points(2, 3), "2,3")}),
     "robokit.localization.lab_experiment.calibrated_rig": Call({"render_rig": Obj(stereo_rig)}),
@@ -612,6 +652,72 @@ SPECS: dict[str, Call] = {
     "robokit.mapping.manhattan.manhattan_world_graph": Call({
         "n_poses": Int(40), "seed": Int(0), "noise": Array(np.array([0.05, 0.05, 0.01]), "|3"), "extent": Int(5),
         "closure_probability": Real(0.6), "min_gap": Int(10)}),
+    # --- lesson 02's topological map and hierarchical localization (helper D) -----------------
+    "robokit.geometry.planar.fit_se2": Call({"source": Array(lambda: points(6)[:, :2], "N,2|N,N,2"),
+                                             "target": Array(lambda: points(6)[:, :2] + 1.0, "N,2|N,N,2"),
+                                             "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
+    "robokit.vision.ransac.ransac_sample_count": Call({"contamination": Real(0.3), "sample_size": Int(2),
+                                                       "confidence": Real(0.99)}),
+    "robokit.vision.ransac.ransac_se2": Call({"source": Array(lambda: points(8)[:, :2], "N,2", min_rows=0),
+                                              "target": Array(lambda: points(8)[:, :2] + 1.0, "N,2", min_rows=0),
+                                              "threshold": Real(0.1), "confidence": Real(0.99), "min_inliers": Int(4),
+                                              "max_iterations": Int(50), "rng": Rng(0)}),
+    "robokit.vision.spherical.essential_from_bearings": Call({"b1": Array(bearings, "N,3"),
+                                                              "b2": Array(moved_bearings, "N,3")}),
+    "robokit.vision.spherical.epipolar_error": Call({"E": Array(essential, "3,3|N,3,3"), "b1": Array(bearings, "N,3"),
+                                                     "b2": Array(moved_bearings, "N,3"), "check": Flag(True)}),
+    "robokit.vision.spherical.ransac_essential": Call({"b1": Array(bearings, "N,3"), "b2": Array(moved_bearings, "N,3"),
+                                                       "threshold": Real(0.01), "confidence": Real(0.99),
+                                                       "min_inliers": Int(8), "max_iterations": Int(64), "rng": Rng(0)}),
+    "robokit.vision.spherical.decompose_essential": Call({"E": Array(essential, "3,3"), "b1": Array(bearings, "N,3"),
+                                                          "b2": Array(moved_bearings, "N,3")}),
+    "robokit.vision.spherical.floor_points": Call({"bearings": Array(lambda: bearings() * [1, 1, -1] + [0, 0, 0.5], "N,3"),
+                                                   "T_body_camera": T_(lambda: small_omni().mount),
+                                                   "min_depression": Real(0.35)}),
+    "robokit.sim.motion.office_tour": Call({"world": Obj(office), "speed": Real(0.3), "rate": Real(2.0)}),
+    "robokit.sim.motion.increment_variances": Call({"delta": Array(np.array([[0.1, 1.0, -0.1]]), "3|N,3"),
+                                                    "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"),
+                                                    "check": Flag(True)}),
+    "robokit.sim.motion.odometry_covariance": Call({"odometry": Array(lambda: lap().poses[:20], "N,3"),
+                                                    "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4")}),
+    "robokit.mapping.topological_build.appearance_changed": Call({"distance": Array(np.array([0.01, 0.3]), "|N"),
+                                                                  "matches": Array(np.array([90, 10]), "|N"),
+                                                                  "similarity": Real(0.05), "min_matches": Int(50)}),
+    "robokit.mapping.topological_build.local_map_full": Call({"n_features": Array(np.array([100, 990]), "|N"),
+                                                              "variance": Array(np.array([0.01, 0.2]), "|N"),
+                                                              "max_features": Int(930), "max_variance": Real(0.1)}),
+    "robokit.mapping.topological_build.select_key_frames": Call({
+        "n_frames": Int(5), "compare": Func(lambda: (lambda key, k: __import__("robokit").mapping.Comparison(
+            0.01, 100, 500, 0.0))),
+        "similarity": Real(0.05), "min_matches": Int(50), "occlusion_frames": Int(3), "max_features": Int(930),
+        "max_variance": Real(0.1)}),
+    "robokit.mapping.topological_build.build_topological_map": Call({
+        "images": Array(lambda: office_views()[0], "N,120,160,3"), "odometry": Array(lambda: office_views()[1], "N,3"),
+        "camera": Obj(small_omni), "similarity": Real(0.05), "min_matches": Int(50), "occlusion_frames": Int(3),
+        "max_features": Int(930), "max_variance": Real(0.1),
+        "odometry_alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"), "bins": Int(32), "n_features": Int(100),
+        "ratio": Real(0.7), "loop_closure": Flag(True), "loop_top_k": Int(5), "loop_min_matches": Int(25),
+        "loop_exclude": Int(5), "sigma_visual": Array(np.array([0.05, 0.05, 0.02]), "3"),
+        "progress": Func(None, optional=True), "log": Func(None, optional=True)}, cheap=False),
+    "robokit.mapping.omni_views.omni_view": Call({"image": Array(lambda: office_views()[0][0], "120,160,3"),
+                                                  "camera": Obj(small_omni), "bins": Int(32), "n_features": Int(100),
+                                                  "features": Flag(True), "times": Mapping(None, optional=True)}),
+    "robokit.mapping.omni_views.check_omni_image": Call({"image": Array(lambda: office_views()[0][0], "120,160,3"),
+                                                         "camera": Obj(small_omni), "name": Text("image")}),
+    "robokit.mapping.omni_views.relative_pose": Call({
+        "query": Obj(lambda: omni_views()[1]), "node": Obj(lambda: omni_views()[0]), "matches": Obj(omni_matches),
+        "camera": Obj(small_omni), "threshold_epipolar": Real(0.01), "threshold_floor": Real(0.08),
+        "min_epipolar": Int(12), "min_floor": Int(3), "min_depression": Real(0.35), "direction_tolerance": Real(0.35),
+        "min_baseline": Real(0.1), "rng": Rng(0)}),
+    "robokit.mapping.topological.TopologicalMap": Call({
+        name: Array(lambda name=name: getattr(office_map(), name), shape, min_rows=rows)
+        for name, shape, rows in [("poses", "N,3", 1), ("variances", "N", 1), ("histograms", "N,N", 1), ("frames", "N", 1),
+                                  ("keypoints", "N,4", 0), ("bearings", "N,3", 0), ("descriptors", "N,N", 0),
+                                  ("offsets", "N", 1), ("edges", "N,2", 0), ("measurements", "N,3", 0),
+                                  ("covariances", "N,3,3", 0), ("kinds", "N", 0)]}),
+    "robokit.localization.hierarchical.HierarchicalLocalizer": Call({
+        "map": Obj(office_map), "camera": Obj(small_omni), "top_k": Int(2), "ratio": Real(0.7), "min_matches": Int(25),
+        "ambiguity": Real(0.8), "n_features": Int(100), "mode": Choice("hierarchical")}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -654,6 +760,30 @@ EXTRA: tuple[str, ...] = (
     "robokit.mapping.relaxation.relax_sweep", "robokit.mapping.relaxation.initial_variances",
     "robokit.mapping.g2o.read_g2o", "robokit.mapping.g2o.write_g2o",
     "robokit.mapping.manhattan.manhattan_world_graph",
+    # robokit.vision.colour (lesson 02)
+    "robokit.vision.colour.rgb_to_hsi", "robokit.vision.colour.hue_mask",
+    "robokit.vision.colour.hue_histogram", "robokit.vision.colour.hue_histogram_opencv",
+    "robokit.vision.colour.histogram_distance", "robokit.vision.colour.histogram_intersection",
+    # robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02)
+    "robokit.vision.omni_features.omni_sift", "robokit.vision.omni_features.annulus_mask",
+    "robokit.vision.omni_features.radial_orientation", "robokit.vision.matching.DescriptorIndex",
+    "robokit.vision.matching.ratio_test", "robokit.vision.descriptors.detect_sift_features",
+    "robokit.sim.feature_check.omni_ground_truth_inliers",
+    "robokit.sim.feature_check.omni_view_pair",
+    # lesson 02's topological map and hierarchical localization (helper D)
+    "robokit.geometry.planar.fit_se2", "robokit.vision.ransac.ransac_sample_count",
+    "robokit.vision.ransac.ransac_se2", "robokit.vision.spherical.essential_from_bearings",
+    "robokit.vision.spherical.epipolar_error", "robokit.vision.spherical.ransac_essential",
+    "robokit.vision.spherical.decompose_essential", "robokit.vision.spherical.floor_points",
+    "robokit.sim.motion.office_tour", "robokit.sim.motion.increment_variances",
+    "robokit.sim.motion.odometry_covariance",
+    "robokit.mapping.topological_build.appearance_changed",
+    "robokit.mapping.topological_build.local_map_full",
+    "robokit.mapping.topological_build.select_key_frames",
+    "robokit.mapping.topological_build.build_topological_map",
+    "robokit.mapping.omni_views.omni_view", "robokit.mapping.omni_views.check_omni_image",
+    "robokit.mapping.omni_views.relative_pose", "robokit.mapping.topological.TopologicalMap",
+    "robokit.localization.hierarchical.HierarchicalLocalizer",
 )
 
 

@@ -6,7 +6,7 @@ from robokit.geometry import wrap_angle
 from robokit.sim import motion as mo
 from robokit.sim.layout import Layout
 from robokit.sim.lidar import Lidar, scan_points
-from robokit.sim.worlds import box_room, lab_room, long_corridor
+from robokit.sim.worlds import box_room, lab_room, long_corridor, office_floor
 
 
 def analytic_box_ranges(x, y, angles, w, d):
@@ -97,7 +97,8 @@ def test_noisy_odometry_drifts_and_zero_noise_is_exact():
     assert np.array_equal(noisy, mo.noisy_odometry(path.poses, [0.01, 0.001, 0.01, 0.001], rng=3))
 
 
-@pytest.mark.parametrize("make, world", [(mo.lab_lap, lab_room), (mo.corridor_path, long_corridor)])
+@pytest.mark.parametrize("make, world", [(mo.lab_lap, lab_room), (mo.corridor_path, long_corridor),
+                                         (mo.office_tour, office_floor)])
 def test_paths_stay_in_free_space(make, world):
     w = world()
     path = make(w)
@@ -113,7 +114,44 @@ def test_paths_stay_in_free_space(make, world):
     (lambda: Lidar().scan(box_room(), [9.0, 1, 0]), "robot_pose"),
     (lambda: mo.sample_motion_model_odometry([0, 0, 0], [1, 0, 0], [0, 0, 0], [-1, 0, 0, 0]), "alphas"),
     (lambda: mo.waypoint_path([[0, 0]]), "waypoints"),
+    (lambda: mo.office_tour(lab_room()), "world"),
+    (lambda: mo.office_tour(office_floor(), speed=0.0), "speed"),
 ])
 def test_bad_input_is_named(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
         call()
+
+
+def test_office_tour_visits_every_room_and_closes_loops():
+    w = office_floor()
+    tour = mo.office_tour(w, rate=2.0)
+    xy = tour.poses[:, :2]
+    for name, (x0, y0, x1, y1) in w.info["rooms"].items():
+        inside = (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
+        assert inside.sum() > 20, name                                   # > 10 s in every room
+    corridor = (xy[:, 1] > 5.0) & (xy[:, 1] < 7.0)
+    assert corridor.sum() > 40
+    # the start is revisited twice: after the R1 lap and at the end of the floor loop
+    near_start = np.linalg.norm(xy - xy[0], axis=1) < 0.3
+    visits = np.flatnonzero(np.diff(near_start.astype(int)) == 1)
+    assert len(visits) >= 2
+    length = np.linalg.norm(np.diff(xy, axis=0), axis=1).sum()
+    assert 90.0 < length < 110.0
+    tests = np.array(mo.OFFICE_TEST_POSES)
+    assert len(tests) == 11 and np.all(w.is_free(tests[:, :2], clearance=0.3))
+    off_path = np.linalg.norm(tests[:, None, :2] - xy[None], axis=2).min(axis=1)
+    assert np.all((off_path > 0.15) & (off_path < 0.35)), off_path
+
+
+def test_odometry_covariance_matches_monte_carlo_of_the_noise_model():
+    from robokit.geometry import se2_between, wrap_angle
+    truth = mo.waypoint_path([[0, 0], [2, 0], [2, 1.5]], speed=0.5, rate=2).poses
+    alphas = [0.02, 0.002, 0.02, 0.002]
+    cov = mo.odometry_covariance(truth, alphas)
+    assert cov.shape == (len(truth), 3, 3) and np.all(cov[0] == 0)
+    rng = np.random.default_rng(0)
+    ends = np.array([se2_between(o[0], o[-1]) for o in (mo.noisy_odometry(truth, alphas, rng) for _ in range(3000))])
+    ends[:, 2] = wrap_angle(ends[:, 2] - np.mean(ends[:, 2]))
+    empirical = np.cov(ends.T)
+    assert np.allclose(empirical, cov[-1], rtol=0.15, atol=2e-4), (empirical, cov[-1])
+    assert np.allclose(mo.increment_variances(np.zeros(3), alphas), 0.0)

@@ -16,7 +16,8 @@ Submodules: :mod:`~robokit.geometry.planar` (SE(2)), :mod:`~robokit.geometry.rot
 from .paper_frames import (R_BODY_OPTICAL, as_pqt, optical_to_y_up, paper_world_to_robokit,
                            pqt_robot_to_world, pqt_rotate_xz, pqt_to_se2, pqt_to_se3, pqt_transform_xz,
                            pqt_world_to_robot, se2_to_pqt)
-from .planar import as_planar, matrix_to_se2, se2_between, se2_compose, se2_inverse, se2_to_matrix, wrap_angle
+from .planar import (as_planar, fit_se2, matrix_to_se2, se2_between, se2_compose, se2_inverse, se2_to_matrix,
+                     wrap_angle)
 from .rotations import (ROTATION_TOL, as_rotation, check_rotation_block, euler_matrix, rot_x, rot_y, rot_z, skew,
                         so3_exp, so3_log, zyz_angles)
 from .spatial import (as_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, se3_inverse, se3_to_se2,
@@ -24,6 +25,7 @@ from .spatial import (as_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, 
 
 __all__ = [
     "as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
+    "fit_se2",
     "ROTATION_TOL", "as_rotation", "check_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y",
     "rot_z", "euler_matrix", "zyz_angles",
     "as_se3", "se3_from_rt", "se3_inverse", "se3_compose", "transform_points", "se2_to_se3", "se3_to_se2",

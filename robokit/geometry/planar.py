@@ -13,6 +13,8 @@ References
 .. [3] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
 .. [4] F. Lu and E. Milios, "Globally consistent range scan alignment for environment mapping",
    *Autonomous Robots* 4(4), 333-349, 1997.
+.. [5] S. Umeyama, "Least-squares estimation of transformation parameters between two point
+   patterns", IEEE Trans. Pattern Analysis and Machine Intelligence 13(4), 376-380, 1991.
 """
 from __future__ import annotations
 
@@ -23,7 +25,8 @@ import numpy as np
 from ..validation import as_array
 from .rotations import as_rotation
 
-__all__ = ["as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2"]
+__all__ = ["as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
+           "fit_se2"]
 
 
 def as_planar(value: Any, name: str) -> np.ndarray:
@@ -266,3 +269,69 @@ def matrix_to_se2(matrix: Any) -> np.ndarray:
     as_rotation(T[:2, :2], "matrix", dim=2)
     return np.array([T[0, 2], T[1, 2], float(np.arctan2(T[1, 0], T[0, 0]))])
 
+
+
+def fit_se2(source: Any, target: Any, weights: Any = None, *, check: bool = True) -> np.ndarray:
+    """Least-squares planar pose taking ``source`` points onto ``target`` points (2-D Procrustes).
+
+    Parameters
+    ----------
+    source, target : array_like, shape (..., N, 2)
+        Corresponding points, N >= 2; leading axes are a batch of independent problems.
+    weights : array_like, shape (..., N), optional
+        Non-negative weight per correspondence (default: all 1).
+    check : bool, default True
+        Validate the inputs and refuse a degenerate set; ``False`` (float arrays of matching shapes
+        only) is the fast path that RANSAC loops take: a degenerate set then gives ``theta = 0``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        ``[x, y, theta]`` minimising ``sum_i w_i ||R(theta) s_i + (x, y) - t_i||^2``, i.e. the pose of
+        the source frame in the target frame.
+
+    Raises
+    ------
+    ValueError
+        For shapes that do not agree, fewer than two points, NaN/inf, negative or all-zero weights,
+        or (with ``check``) points that all coincide, which leave the heading undetermined.
+
+    Notes
+    -----
+    The closed-form minimiser (Umeyama 1991, without scale): the weighted centroids align and
+    ``theta = atan2(sum w (s' x t'), sum w (s' . t'))`` for the centred points ``s', t'``. With two
+    points it is the two-point pose of Lin et al. (Sec. 5): the heading from the direction between
+    them and the translation from their midpoints.
+
+    Examples
+    --------
+    >>> src = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 2.0]])
+    >>> tgt = se2_compose([1.0, 2.0, 0.5], np.column_stack([src, np.zeros(3)]))[:, :2]
+    >>> print(np.round(fit_se2(src, tgt), 6))
+    [1.  2.  0.5]
+    """
+    if check:
+        s = as_array(source, "source")
+        if s.ndim < 2 or s.shape[-1] != 2 or s.shape[-2] < 2:
+            raise ValueError(f"source: expected shape (..., N, 2) with N >= 2, got shape {s.shape}")
+        t = as_array(target, "target", shape=s.shape)
+        w = np.ones(s.shape[:-1]) if weights is None else as_array(weights, "weights", shape=s.shape[:-1])
+        if np.any(w < 0) or np.any(w.sum(-1) <= 0):
+            raise ValueError("weights: expected non-negative weights with a positive sum per problem")
+    else:
+        s, t = source, target
+        w = np.ones(s.shape[:-1]) if weights is None else weights
+    total = w.sum(-1, keepdims=True)
+    sc = (w[..., None] * s).sum(-2) / total
+    tc = (w[..., None] * t).sum(-2) / total
+    a, b = s - sc[..., None, :], t - tc[..., None, :]
+    cross = (w * (a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0])).sum(-1)
+    dot = (w * (a * b).sum(-1)).sum(-1)
+    if check and np.any(np.hypot(cross, dot) < 1e-12):
+        raise ValueError("source, target: expected points spread on the plane, got (nearly) coincident ones "
+                         "(the heading is undetermined)")
+    theta = np.arctan2(cross, dot)
+    c, si = np.cos(theta), np.sin(theta)
+    x = tc[..., 0] - (c * sc[..., 0] - si * sc[..., 1])
+    y = tc[..., 1] - (si * sc[..., 0] + c * sc[..., 1])
+    return np.stack([x, y, wrap_angle(theta)], axis=-1)

@@ -3,7 +3,8 @@
 Lin et al. Sec. 4-7: two tentative matches between features (robot frame) and landmarks (world
 frame) fix a pose hypothesis; a match supports it when the transformed feature lies within
 ``d_threshold`` of its landmark; the hypothesis with most support is refined by least squares. The
-number of samples follows ``P = 1 - (1 - (1 - eps)^p)^m``. With fewer than 15 supporting matches the
+number of samples follows ``P = 1 - (1 - (1 - eps)^p)^m`` (:func:`robokit.vision.ransac.ransac_sample_count`,
+re-exported here for lesson 01). With fewer than 15 supporting matches the
 odometry is used. Matches come from the continuation constraint (landmarks predicted by odometry,
 searched within a window; Lin et al. Sec. 3, Se et al. Sec. 3.2) or, when that finds too few (the
 robot seems kidnapped), from the whole database.
@@ -34,6 +35,7 @@ from ..geometry import (as_pqt, pqt_robot_to_world, pqt_rotate_xz,
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from ..vision.matching import gated_ratio_match, ratio_match
+from ..vision.ransac import ransac_sample_count
 
 __all__ = ["DegenerateCorrespondenceError", "InsufficientMatchesError", "EgomotionResult",
            "ransac_sample_count", "pose_from_two", "fit_pose", "ransac_pose", "continuation_matches",
@@ -82,59 +84,6 @@ class EgomotionResult:
     def n_inliers(self) -> int:
         """Number of supporting matches."""
         return int(np.count_nonzero(self.inliers))
-
-
-def ransac_sample_count(contamination: float, sample_size: int = 2, confidence: float = 0.99) -> int:
-    """Number of RANSAC samples ``m`` so that a clean sample is drawn with probability ``P``.
-
-    Parameters
-    ----------
-    contamination : float
-        Ratio ``eps`` of false matches, in [0, 1).
-    sample_size : int, default 2
-        Matches per hypothesis ``p`` (two for the 3-DoF pose).
-    confidence : float, default 0.99
-        Required probability ``P`` in (0, 1).
-
-    Returns
-    -------
-    int
-        ``ceil(log(1 - P) / log(1 - (1 - eps)^p))``, at least 1.
-
-    Raises
-    ------
-    ValueError
-        For ``eps`` outside [0, 1) (``eps = 1`` would need infinitely many samples) or ``P``
-        outside (0, 1).
-
-    Notes
-    -----
-    Lin et al. Sec. 7, ``P = 1 - (1 - (1 - eps)^p)^m`` solved for ``m`` (Fischler & Bolles 1981).
-
-    Examples
-    --------
-    >>> from robokit.localization import ransac_sample_count
-    >>> ransac_sample_count(0.5)                 # half the matches wrong, two-match samples, P = 0.99
-    17
-    >>> ransac_sample_count(0.5, confidence=0.999), ransac_sample_count(0.8)
-    (25, 113)
-    """
-    eps = check_positive(contamination, "contamination", allow_zero=True)
-    if eps >= 1:
-        raise ValueError(f"contamination: expected a ratio in [0, 1), got {eps}")
-    p = check_int(sample_size, "sample_size", minimum=1)
-    conf = check_positive(confidence, "confidence")
-    if conf >= 1:
-        raise ValueError(f"confidence: expected a probability in (0, 1), got {conf}")
-    good = (1 - eps) ** p
-    if good >= 1:
-        return 1
-    with np.errstate(divide="ignore"):
-        samples = np.log(1 - conf) / np.log(1 - good)
-    if not samples < 2.0 ** 63:   # a clean sample is so unlikely that no count is enough
-        raise ValueError(f"sample_size: expected a sample that can be clean, got {p} matches at contamination {eps} "
-                         f"(probability {good:.3g} per sample)")
-    return max(1, int(np.ceil(samples)))
 
 
 def _poses_from_pairs(r1, r2, w1, w2):

@@ -3,12 +3,19 @@
 :mod:`.landmarks` holds the backward transformation with first-order covariance
 (:func:`transform_covariance`) and the database (:class:`LandmarkMap`). The papers' pose
 ``[p, q, theta]`` acting on points (``pqt_robot_to_world``, ``pqt_transform_xz`` ...) is in
-:mod:`robokit.geometry`. Never imports ``viz`` or ``sim``.
+:mod:`robokit.geometry`. Never imports ``viz``; only the topological map uses ``sim`` (below).
 
 Pose graphs (lesson 02's loop-closure alignment): :mod:`.pose_graph` (the graph, its connectivity,
 a builder from odometry), :mod:`.pose_graph_optimize` (g2o's error, cost and Jacobian; least squares),
 :mod:`.relaxation` (the paper's relaxation, after Duckett et al.), :mod:`.g2o` (the g2o file format)
 and :mod:`.manhattan` (generated graphs with ground truth).
+
+Topological maps (lesson 02's environment map): :mod:`.omni_views` (an image's hue histogram, SIFT
+features and bearings; the relative pose of two views), :mod:`.topological` (the map: nodes, edges,
+KD-trees, the coarse and fine searches) and :mod:`.topological_build` (key images, local-map
+partitioning, loop closure, from a recorded run). Unlike the rest of mapping they use
+:mod:`robokit.sim`'s omni camera model (its rays and mount) and odometry noise model, never its
+renderer.
 """
 from .g2o import G2OFormatError, read_g2o, write_g2o
 from .landmarks import LandmarkMap, kalman_fuse, transform_covariance
@@ -17,11 +24,18 @@ from .pose_graph import (DisconnectedGraphError, PoseGraph, as_pose_graph, check
                          pose_graph_from_odometry, positive_definite, unreachable_nodes)
 from .pose_graph_optimize import (PoseGraphResult, optimize_pose_graph, pose_graph_cost, pose_graph_jacobian,
                                   pose_graph_residuals)
+from .omni_views import OmniView, RelativePose, check_omni_image, omni_view, relative_pose
 from .relaxation import RelaxationResult, initial_variances, relax, relax_sweep
+from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
+from .topological_build import (Comparison, appearance_changed, build_topological_map, local_map_full,
+                                select_key_frames)
 
 __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
            "PoseGraph", "DisconnectedGraphError", "as_pose_graph", "positive_definite", "edge_variances", "unreachable_nodes",
            "is_connected", "check_connected", "pose_graph_from_odometry",
            "pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph",
            "RelaxationResult", "relax", "relax_sweep", "initial_variances",
-           "G2OFormatError", "read_g2o", "write_g2o", "manhattan_world_graph"]
+           "G2OFormatError", "read_g2o", "write_g2o", "manhattan_world_graph",
+           "OmniView", "RelativePose", "check_omni_image", "omni_view", "relative_pose",
+           "LOOP_EDGE", "ODOMETRY_EDGE", "EmptyMapError", "TopologicalMap", "Comparison", "appearance_changed",
+           "build_topological_map", "local_map_full", "select_key_frames"]

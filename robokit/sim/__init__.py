@@ -39,8 +39,8 @@ LiDAR, vehicles and motion
     ``diff_drive_velocities``, ``skid_steer_velocities`` (ICR expansion ``icr_factor``, Mandow et
     al. 2007, and our slip ratio) and its saturating inverse ``skid_steer_wheel_speeds``; odometry noise
     (:mod:`robokit.sim.motion`, Thrun et al. 2005, Tables 5.5-5.6): ``odometry_increment``,
-    ``sample_motion_model_odometry``, ``noisy_odometry``; paths ``waypoint_path``,
-    ``corridor_path``, ``lab_lap``.
+    ``sample_motion_model_odometry``, ``noisy_odometry``, ``odometry_covariance``; paths
+    ``waypoint_path``, ``corridor_path``, ``lab_lap``, ``office_tour`` (and ``OFFICE_TEST_POSES``).
 
 Recorded runs
     ``record(world, path, sensors={"cam": cam, "laser": lidar}, rate=5)`` -> :class:`Run`
@@ -66,8 +66,8 @@ from .camera import Frame, PinholeCamera, StereoRig, camera_mount
 from .feature_check import ViewPairCheck, ground_truth_inliers, omni_ground_truth_inliers, omni_view_pair, sift_view_pair
 from .layout import Layout, box_corners, obstacle_array
 from .lidar import Lidar, scan_points
-from .motion import (Path, corridor_path, lab_lap, noisy_odometry, odometry_increment, sample_motion_model_odometry,
-                     waypoint_path)
+from .motion import (OFFICE_TEST_POSES, Path, corridor_path, increment_variances, lab_lap, noisy_odometry,
+                     odometry_covariance, odometry_increment, office_tour, sample_motion_model_odometry, waypoint_path)
 from .omni import OmniCamera, omni_mount
 from .runs import Run, record
 from .textures import illuminate, photo
@@ -83,7 +83,8 @@ __all__ = [
     "Layout", "box_corners", "obstacle_array", "Lidar", "scan_points",
     "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
     "odometry_increment",
-    "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap",
+    "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap", "office_tour",
+    "OFFICE_TEST_POSES", "increment_variances", "odometry_covariance",
     "Run", "record", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair", "omni_ground_truth_inliers",
     "omni_view_pair",
 ]

@@ -17,6 +17,8 @@ References
 .. [3] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
    environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
    doi:10.1631/FITEE.2200208.
+.. [4] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
+   navigation" (course source 001; README.md, "References").
 """
 from __future__ import annotations
 
@@ -25,11 +27,13 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, as_points, as_rng, check_positive, check_sample_count, describe
+from ..validation import (as_array, as_points, as_rng, check_finite_result, check_positive, check_sample_count,
+                          describe)
 from .world import World
 
-__all__ = ["odometry_increment", "sample_motion_model_odometry", "noisy_odometry", "Path", "waypoint_path",
-           "corridor_path", "lab_lap"]
+__all__ = ["odometry_increment", "increment_variances", "odometry_covariance", "sample_motion_model_odometry",
+           "noisy_odometry", "Path", "waypoint_path",
+           "corridor_path", "lab_lap", "office_tour", "OFFICE_TOUR", "OFFICE_TEST_POSES"]
 
 
 def odometry_increment(previous: Any, current: Any) -> np.ndarray:
@@ -70,13 +74,109 @@ def _alphas(alphas: Any) -> np.ndarray:
     return a
 
 
+def increment_variances(delta: Any, alphas: Any, *, check: bool = True) -> np.ndarray:
+    """Variances of the noise on odometry increments ``[delta_rot1, delta_trans, delta_rot2]``.
+
+    Parameters
+    ----------
+    delta : array_like, shape (3,) or (N, 3)
+        Increments from :func:`odometry_increment`.
+    alphas : array_like, shape (4,)
+        Noise parameters ``a1..a4`` (non-negative).
+    check : bool, default True
+        Validate; ``False`` is the fast path (float arrays).
+
+    Returns
+    -------
+    numpy.ndarray, same shape as ``delta``
+        ``[a1 rot1^2 + a2 trans^2, a3 trans^2 + a4 (rot1^2 + rot2^2), a1 rot2^2 + a2 trans^2]``.
+
+    Notes
+    -----
+    Thrun et al. (2005), Table 5.6, lines 5-7 (the arguments of ``sample``).
+
+    Examples
+    --------
+    >>> increment_variances([0.0, 1.0, 0.5], [0.01, 0.001, 0.01, 0.001]).tolist()
+    [0.001, 0.01025, 0.0035]
+    """
+    d = as_array(delta, "delta") if check else delta
+    a = _alphas(alphas) if check else alphas
+    if check and (d.shape[-1:] != (3,) or d.ndim > 2):
+        raise ValueError(f"delta: expected shape (3,) or (N, 3), got shape {d.shape}")
+    r1, t, r2 = d[..., 0], d[..., 1], d[..., 2]
+    out = np.stack([a[0] * r1 ** 2 + a[1] * t ** 2,                     # Table 5.6, line 5
+                    a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2),          # line 6
+                    a[0] * r2 ** 2 + a[1] * t ** 2], axis=-1)            # line 7
+    if check:
+        check_finite_result("delta, alphas", out)
+    return out
+
+
 def _perturb(delta: np.ndarray, a: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    r1, t, r2 = delta[..., 0], delta[..., 1], delta[..., 2]
-    sd1 = np.sqrt(a[0] * r1 ** 2 + a[1] * t ** 2)                     # Table 5.6, line 5
-    sdt = np.sqrt(a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2))        # line 6
-    sd2 = np.sqrt(a[0] * r2 ** 2 + a[1] * t ** 2)                     # line 7
+    sd = np.sqrt(increment_variances(delta, a, check=False))
     noise = rng.standard_normal(delta.shape)
-    return np.stack([r1 - sd1 * noise[..., 0], t - sdt * noise[..., 1], r2 - sd2 * noise[..., 2]], axis=-1)
+    return np.stack([delta[..., 0] - sd[..., 0] * noise[..., 0], delta[..., 1] - sd[..., 1] * noise[..., 1],
+                     delta[..., 2] - sd[..., 2] * noise[..., 2]], axis=-1)
+
+
+def odometry_covariance(odometry: Any, alphas: Any) -> np.ndarray:
+    """Covariance of each odometry pose relative to the first, propagated to first order.
+
+    Parameters
+    ----------
+    odometry : array_like, shape (N, 3)
+        Consecutive odometry poses ``[x, y, theta]`` (N >= 1).
+    alphas : array_like, shape (4,)
+        The noise parameters an estimator assumes for them (Table 5.6).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 3, 3)
+        ``Sigma_k``: covariance of ``se2_between(odometry[0], odometry[k])``; ``Sigma_0 = 0``.
+
+    Raises
+    ------
+    ValueError
+        For bad shapes, NaN/inf or negative alphas.
+
+    Notes
+    -----
+    Each step's increment ``u = (trans cos rot1, trans sin rot1, rot1 + rot2)`` (Thrun et al. 2005,
+    Table 5.5) has the covariance ``J diag(var) J^T`` of the variances of Table 5.6; composing
+    ``r_{k+1} = r_k (+) u`` (Smith, Self & Cheeseman's compounding) propagates
+    ``Sigma_{k+1} = A Sigma_k A^T + B Q_u B^T`` with ``A, B`` its Jacobians.
+
+    Examples
+    --------
+    Two metres straight ahead in two steps: the heading's uncertainty spreads sideways (y):
+
+    >>> odo = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
+    >>> print(np.round(odometry_covariance(odo, [0.01, 0.001, 0.01, 0.001])[-1], 4))
+    [[0.02  0.    0.   ]
+     [0.    0.006 0.004]
+     [0.    0.004 0.004]]
+    """
+    P = as_points(odometry, "odometry", 3, min_count=1)
+    a = _alphas(alphas)
+    delta = odometry_increment(P[:-1], P[1:])
+    var = increment_variances(delta, a, check=False)
+    r1, t = delta[:, 0], delta[:, 1]
+    c1, s1 = np.cos(r1), np.sin(r1)
+    zeros, ones = np.zeros_like(t), np.ones_like(t)
+    J = np.stack([np.stack([-t * s1, c1, zeros], -1), np.stack([t * c1, s1, zeros], -1),
+                  np.stack([ones, zeros, ones], -1)], 1)                 # d u / d (rot1, trans, rot2)
+    Q = J @ (var[:, :, None] * np.swapaxes(J, 1, 2))
+    u = np.stack([t * c1, t * s1, wrap_angle(r1 + delta[:, 2])], -1)
+    out = np.zeros((len(P), 3, 3))
+    r = np.zeros(3)
+    for k in range(len(delta)):   # sequential by nature: each step composes onto the last
+        c, s = np.cos(r[2]), np.sin(r[2])
+        A = np.array([[1.0, 0.0, -s * u[k, 0] - c * u[k, 1]], [0.0, 1.0, c * u[k, 0] - s * u[k, 1]], [0.0, 0.0, 1.0]])
+        B = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        out[k + 1] = A @ out[k] @ A.T + B @ Q[k] @ B.T
+        r = np.array([r[0] + c * u[k, 0] - s * u[k, 1], r[1] + s * u[k, 0] + c * u[k, 1], r[2] + u[k, 2]])
+    return 0.5 * (out + np.swapaxes(out, 1, 2))
 
 
 def _apply(pose: np.ndarray, d: np.ndarray) -> np.ndarray:
@@ -259,3 +359,74 @@ def lab_lap(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
         raise TypeError(f"world: expected the lab World (lab_room()), got {describe(world)}")
     lap = [[3.0, 2.0], [7.5, 2.0], [7.8, 5.0], [7.5, 8.0], [3.0, 8.0], [2.6, 5.0], [3.0, 2.0]]
     return waypoint_path(lap, speed, rate=rate)
+
+
+#: Waypoints of :func:`office_tour` in :func:`robokit.sim.office_floor`: a lap of R1, then R2, R3
+#: and R4 each walked round their table through the doorways at x = 4 and x = 12, and back to R1.
+OFFICE_TOUR = ((14.5, 4.0), (10.0, 4.0), (10.0, 1.0), (14.8, 0.8), (14.8, 4.0), (12.0, 4.0),   # R1, a loop
+               (12.0, 6.0), (4.0, 6.0),                                                       # corridor west
+               (4.0, 4.2), (6.2, 4.2), (6.2, 1.0), (1.6, 1.0), (1.6, 4.2), (4.0, 4.2), (4.0, 6.0),  # R2
+               (4.0, 8.0), (5.8, 8.0), (5.8, 11.0), (1.6, 11.0), (1.6, 8.0), (4.0, 8.0), (4.0, 6.0),  # R3
+               (12.0, 6.0),                                                                   # corridor east
+               (12.0, 8.0), (14.6, 8.0), (14.6, 11.2), (10.0, 11.2), (10.0, 8.0), (12.0, 8.0),  # R4
+               (12.0, 6.0), (12.0, 4.0), (14.5, 4.0))                                         # back into R1
+
+
+#: Eleven test poses ``[x, y, theta]`` in :func:`robokit.sim.office_floor`, spread like the test
+#: locations of lesson 02's paper (Sec. "Experimental results", Fig. 8): three in R1, two in the
+#: corridor (the paper's cases 4 and 5), two in each of R2, R3 and R4; each 0.2-0.3 m off
+#: :func:`office_tour`'s path, at a heading the tour never drove, and 0.3 m clear of everything.
+OFFICE_TEST_POSES = ((13.0, 3.7, 2.0), (10.3, 2.2, -1.2), (14.5, 1.1, 0.8), (9.0, 6.3, 3.0), (6.5, 5.8, 0.2),
+                     (3.0, 1.3, 0.5), (6.0, 3.0, 2.0), (2.2, 10.75, -0.4), (1.9, 9.0, 1.4), (12.5, 8.3, 0.8),
+                     (14.3, 10.0, -2.5))
+
+
+def office_tour(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
+    """The exploration drive of :func:`robokit.sim.office_floor`: every room and the corridor, with loops.
+
+    Parameters
+    ----------
+    world : World
+        ``office_floor()``. The walls are the same for every seed, the tables are not: the tour
+        keeps 0.3 m from everything for the default seed (1), and from walls only for others
+        (:func:`robokit.sim.record` refuses a pose closer than 0.05 m).
+    speed : float, default 0.3
+        Forward speed (m/s).
+    rate : float, default 10
+        Sampling rate of the returned poses (Hz).
+
+    Returns
+    -------
+    Path
+        Starts in R1 (lower right) at ``(14.5, 4.0)`` facing west, laps R1, crosses the corridor
+        to R2, R3 and R4, each walked round its table, and returns to R1: it closes the R1 lap and
+        the whole-floor loop (work for loop closure), about 98 m in all.
+
+    Raises
+    ------
+    TypeError
+        If ``world`` is not the office floor.
+    ValueError
+        For a non-positive speed or rate.
+
+    Notes
+    -----
+    Lesson 02's paper, Sec. "Experimental results": "We firstly drive the robot to move along the
+    path as shown in Fig. 6a" through "four rooms R1, R2, R3, R4 and a horizontal corridor",
+    recording images "at a constant rate" (Sec. "System overview"). The waypoints are ours (the
+    paper's figure is not reproduced in our copy); every pose keeps at least 0.3 m from walls,
+    tables and cabinets of the default office (tests/test_sim_lidar_motion.py checks it with
+    ``World.is_free``). The robot
+    turns on the spot at each waypoint (:func:`waypoint_path`), as a robot "lead through all parts
+    of the environment by hand" would.
+
+    Examples
+    --------
+    >>> from robokit.sim import office_floor
+    >>> tour = office_tour(office_floor())
+    >>> len(tour.t), round(float(tour.t[-1]), 1), tour.poses[0].round(3).tolist()
+    (4000, 399.9, [14.5, 4.0, -3.142])
+    """
+    if not isinstance(world, World) or world.name != "office_floor":
+        raise TypeError(f"world: expected the office floor World (office_floor()), got {describe(world)}")
+    return waypoint_path(OFFICE_TOUR, speed, rate=rate)

@@ -1,0 +1,289 @@
+"""Hierarchical localization in a topological map: colour histograms first, SIFT matches second.
+
+Lesson 02's paper, Sec. "Hierarchical localization" (Fig. 5): a *coarse* stage compares the query
+image's hue histogram with every node's (Eq. (5)) and keeps the nearest few as candidates; a
+*fine* stage matches the query's SIFT features against each candidate's (KD-tree, distance ratio)
+and "the correct position is the one getting the largest number of matches"; "if the localization
+result is still ambiguous, epipolar geometry constraints ... are employed to verify the result".
+The recognised node's pose is then refined to a metric pose of the robot with the relative pose
+of :func:`robokit.mapping.relative_pose` (floor points below the horizon, checked against the
+essential matrix). Each stage is timed (the paper's Fig. 11 compares coarse-only, fine-only and
+hierarchical localization by error and by time): :class:`HierarchicalLocalizer` runs all three.
+
+The paper also names Monte-Carlo localization for the ambiguous case; a single image with a
+verified relative pose resolves it here, and a particle filter over a sequence of images is the
+navigation loop's business (:mod:`robokit.navigation`).
+
+References
+----------
+.. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
+   navigation" (course source 001; README.md, "References").
+.. [2] D. G. Lowe, "Distinctive image features from scale-invariant keypoints", International Journal
+   of Computer Vision 60(2), 91-110, 2004.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..geometry import se2_compose
+from ..mapping.omni_views import OmniView, RelativePose, omni_view, relative_pose
+from ..mapping.topological import EmptyMapError, TopologicalMap
+from ..sim.omni import OmniCamera
+from ..validation import check_choice, check_int, check_positive, describe
+
+__all__ = ["MODES", "Localization", "HierarchicalLocalizer"]
+
+#: The three ways of localizing that the paper's Fig. 11 compares.
+MODES = ("coarse", "fine", "hierarchical")
+
+
+@dataclass(frozen=True)
+class Localization:
+    """The answer of :meth:`HierarchicalLocalizer.localize`.
+
+    Attributes
+    ----------
+    node : int
+        The recognised node (the best candidate even when not ``recognised``).
+    pose : numpy.ndarray, shape (3,)
+        Estimated robot pose ``[x, y, theta]`` in the map's frame: the node's pose composed with the
+        relative pose (when ``metric``; otherwise the node's own pose, heading corrected when the
+        essential matrix gave one).
+    node_pose : numpy.ndarray, shape (3,)
+        The recognised node's pose.
+    relative : RelativePose or None
+        Query relative to the node (``None`` in coarse mode or when not recognised).
+    candidates : numpy.ndarray of int
+        Nodes the fine stage looked at (coarse mode: every node), nearest histogram first.
+    distances : numpy.ndarray
+        Their hue-histogram distances (Eq. (5)).
+    match_counts : numpy.ndarray of int
+        SIFT matches per candidate (zeros in coarse mode).
+    recognised : bool
+        Coarse mode: always; otherwise the best candidate has at least ``min_matches`` matches.
+    ambiguous : bool
+        The runner-up has at least ``ambiguity`` times the best count, so epipolar verification
+        decided between them.
+    verified : bool
+        The relative pose passed the epipolar check (:attr:`RelativePose.verified`).
+    metric : bool
+        The relative pose is metric (the floor fit held).
+    mode : str
+    times : dict of str to float
+        Seconds per stage: ``"histogram"`` and ``"sift"`` (the query's own features),
+        ``"coarse"`` (ranking every node, Eq. (5)), ``"matching"`` (SIFT against the candidates),
+        ``"verification"`` (epipolar and floor) and ``"total"``.
+    """
+
+    node: int
+    pose: np.ndarray
+    node_pose: np.ndarray
+    relative: RelativePose | None
+    candidates: np.ndarray
+    distances: np.ndarray
+    match_counts: np.ndarray
+    recognised: bool
+    ambiguous: bool
+    verified: bool
+    metric: bool
+    mode: str
+    times: dict = field(default_factory=dict)
+
+
+class HierarchicalLocalizer:
+    """Localize an omni image in a :class:`~robokit.mapping.TopologicalMap`, coarse to fine.
+
+    Parameters
+    ----------
+    map : TopologicalMap
+        With at least one node.
+    camera : OmniCamera
+        The camera of the map's images and of the queries (same size).
+    top_k : int, default 5
+        Candidates the coarse stage passes on.
+    ratio : float, default 0.7
+        SIFT distance-ratio bound of the fine stage (as the map's builder).
+    min_matches : int, default 25
+        Fewest matches for a recognition (unrelated office views share about 9 at ratio 0.7).
+    ambiguity : float, default 0.8
+        Runner-up / best match count from which the answer is ambiguous and the top candidates
+        are verified epipolarly (the best verified one wins).
+    n_features : int, default 500
+        SIFT features per query (use the map's own setting).
+    mode : {"hierarchical", "coarse", "fine"}, default "hierarchical"
+        Coarse: histogram only, answer the nearest node's pose. Fine: SIFT against every node.
+        Hierarchical: SIFT against the coarse stage's ``top_k``.
+
+    Raises
+    ------
+    EmptyMapError
+        For a map without nodes.
+    TypeError, ValueError
+        For other bad arguments.
+
+    Notes
+    -----
+    Sec. "Hierarchical localization" and Fig. 5 of lesson 02's paper; Fig. 11 (the three modes).
+
+    Examples
+    --------
+    A two-node map of rendered views; a query 0.2 m from node 1 is recognised as node 1:
+
+    >>> from robokit.sim import OmniCamera, office_floor
+    >>> from robokit.mapping import build_topological_map
+    >>> cam = OmniCamera(width=320, height=240)
+    >>> nodes = np.array([[14.0, 4.0, np.pi], [13.0, 1.0, 0.0]])
+    >>> tmap = build_topological_map(np.stack([cam.observe(office_floor(), p).image for p in nodes]), nodes, cam,
+    ...                              similarity=0.01, min_matches=10**6, occlusion_frames=1, n_features=300)
+    >>> loc = HierarchicalLocalizer(tmap, cam, top_k=2, n_features=300)
+    >>> result = loc.localize(cam.observe(office_floor(), [13.2, 1.0, 0.3]).image)
+    >>> result.node, result.recognised, sorted(result.times)
+    (1, True, ['coarse', 'histogram', 'matching', 'sift', 'total', 'verification'])
+    """
+
+    def __init__(self, map: TopologicalMap, camera: OmniCamera, *, top_k: int = 5, ratio: float = 0.7,
+                 min_matches: int = 25, ambiguity: float = 0.8, n_features: int = 500,
+                 mode: str = "hierarchical") -> None:
+        if not isinstance(map, TopologicalMap):
+            raise TypeError(f"map: expected a robokit.mapping.TopologicalMap, got {describe(map)}")
+        if len(map) == 0:
+            raise EmptyMapError("map: expected a map with at least one node, got none")
+        if not isinstance(camera, OmniCamera):
+            raise TypeError(f"camera: expected a robokit.sim.OmniCamera, got {describe(camera)}")
+        self.map, self.camera = map, camera
+        self.top_k = check_int(top_k, "top_k", minimum=1)
+        self.ratio = check_positive(ratio, "ratio")
+        if self.ratio > 1:
+            raise ValueError(f"ratio: expected a value in (0, 1], got {self.ratio}")
+        self.min_matches = check_int(min_matches, "min_matches", minimum=1)
+        self.ambiguity = check_positive(ambiguity, "ambiguity")
+        self.n_features = check_int(n_features, "n_features", minimum=0)
+        self.mode = check_choice(mode, "mode", MODES)
+        self.bins = map.histograms.shape[1]
+
+    def __repr__(self) -> str:
+        return f"HierarchicalLocalizer({self.map!r}, mode={self.mode!r}, top_k={self.top_k})"
+
+    def view(self, image: Any) -> tuple[OmniView, dict]:
+        """The query's :class:`~robokit.mapping.OmniView` and the seconds its two parts took.
+
+        Raises
+        ------
+        ImageSizeError
+            For an image of another size than the camera's.
+        """
+        times: dict = {}
+        view = omni_view(image, self.camera, bins=self.bins, n_features=self.n_features,
+                         features=self.mode != "coarse", times=times)
+        return view, times
+
+    def coarse(self, histogram: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Every node ranked by the distance of its hue histogram to the query's (Eq. (5)).
+
+        Returns
+        -------
+        order, distances : numpy.ndarray
+            Node indices nearest first, and their distances.
+
+        Notes
+        -----
+        Sec. "Hierarchical localization", the coarse stage (Sec. "Global image features", Eq. (5)).
+        """
+        return self.map.rank_by_histogram(histogram)
+
+    def fine(self, features: Any, candidates: Any) -> tuple[np.ndarray, list]:
+        """SIFT match counts of the query's features against each candidate node.
+
+        Returns
+        -------
+        counts : numpy.ndarray of int
+        matches : list of robokit.vision.Matches
+
+        Notes
+        -----
+        Sec. "Hierarchical localization", the fine stage: "the correct position is the one getting
+        the largest number of matches".
+        """
+        return self.map.match_counts(features.descriptors, candidates, ratio=self.ratio)
+
+    def localize(self, image: Any) -> Localization:
+        """Localize one omni image (see the class docstring for the stages).
+
+        Raises
+        ------
+        ImageSizeError
+            For an image of another size than the camera's.
+        """
+        view, times = self.view(image)
+        return self.localize_view(view, times)
+
+    def localize_view(self, view: OmniView, times: dict | None = None) -> Localization:
+        """Localize a query already described (histogram and features): every stage after SIFT.
+
+        Parameters
+        ----------
+        view : OmniView
+            E.g. from :meth:`view` or :func:`robokit.mapping.omni_view` with this camera.
+        times : dict, optional
+            Stage times so far (``"histogram"``, ``"sift"``), added to the result's.
+        """
+        if not isinstance(view, OmniView):
+            raise TypeError(f"view: expected an OmniView, got {describe(view)}")
+        times = {"histogram": 0.0, "sift": 0.0, **(times or {})}
+        t0 = time.perf_counter()
+        if self.mode == "fine":
+            order, distances = np.arange(len(self.map)), np.zeros(len(self.map))
+        else:
+            order, distances = self.coarse(view.histogram)
+        t1 = time.perf_counter()
+        times["coarse"] = t1 - t0
+        if self.mode == "coarse":
+            node = int(order[0])
+            times.update(matching=0.0, verification=0.0)
+            times["total"] = sum(times.values())
+            pose = self.map.poses[node].copy()
+            return Localization(node, pose, pose.copy(), None, order, distances, np.zeros(len(order), int), True,
+                                False, False, False, self.mode, times)
+        if self.mode == "hierarchical":
+            order, distances = order[:self.top_k], distances[:self.top_k]
+        counts, matches = self.fine(view.features, order)
+        t2 = time.perf_counter()
+        ranked = np.argsort(-counts, kind="stable")
+        best = int(ranked[0])
+        recognised = bool(counts[best] >= self.min_matches)
+        ambiguous = bool(recognised and len(ranked) > 1 and counts[ranked[1]] >= self.ambiguity * counts[best])
+        relative = None
+        if recognised:
+            relative, best = self._verify(view, order, counts, matches, ranked, ambiguous)
+        times["matching"] = t2 - t1
+        times["verification"] = time.perf_counter() - t2
+        times["total"] = sum(v for k, v in times.items() if k != "total")
+        node = int(order[best])
+        node_pose = self.map.poses[node].copy()
+        pose = se2_compose(node_pose, relative.pose) if relative is not None else node_pose.copy()
+        return Localization(node, pose, node_pose, relative, order, distances, counts, recognised, ambiguous,
+                            bool(relative is not None and relative.verified),
+                            bool(relative is not None and relative.metric), self.mode, times)
+
+    def _verify(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list, ranked: np.ndarray,
+                ambiguous: bool) -> tuple[RelativePose, int]:
+        """Relative pose to the best candidate, or to a runner-up when that one verifies and the best does not.
+
+        The contenders are the best candidate and, when the answer is ambiguous or the best one
+        gives no verified metric pose, the next ones (up to three in all) with at least
+        ``min_matches``; a verified metric pose beats a verified one beats none, then more matches.
+        """
+        tried = []
+        for rank, c in enumerate(ranked[:3]):
+            c = int(c)
+            if rank and not (counts[c] >= self.min_matches and (ambiguous or not (tried[0][0].verified
+                                                                                    and tried[0][0].metric))):
+                break
+            rel = relative_pose(view, self.map.node_view(int(order[c])), matches[c], self.camera)
+            tried.append((rel, c))
+        rel, c = max(tried, key=lambda rc: (rc[0].verified and rc[0].metric, rc[0].verified, counts[rc[1]]))
+        return rel, c

@@ -1,0 +1,200 @@
+"""The topological map (robokit.mapping.topological, topological_build, omni_views).
+
+Independent references: hand-worked criterion values, synthetic frame sequences with a known
+blocker, brute-force sorting and matching, ground-truth poses of a recorded run in office_floor().
+"""
+import numpy as np
+import pytest
+
+from robokit.geometry import se2_between, wrap_angle
+from robokit.mapping import (LOOP_EDGE, ODOMETRY_EDGE, Comparison, EmptyMapError, PoseGraph, TopologicalMap,
+                             appearance_changed, build_topological_map, edge_variances, local_map_full,
+                             optimize_pose_graph, relax, select_key_frames)
+from robokit.sim import odometry_covariance
+from robokit.vision import ImageSizeError, histogram_distance, ratio_match
+from tests.office_runs import camera, room_of, short_map, short_map_and_log, short_run
+
+
+# --- the criteria, one by one --------------------------------------------------------------------
+
+def test_appearance_needs_both_a_far_histogram_and_few_matches():
+    d = np.array([0.01, 0.2, 0.2, 0.01])
+    m = np.array([10, 10, 200, 200])
+    assert appearance_changed(d, m, similarity=0.1, min_matches=50).tolist() == [False, True, False, False]
+    assert appearance_changed(0.1, 10, similarity=0.1, min_matches=50) is False          # strictly above
+    assert appearance_changed(0.1001, 49, similarity=0.1, min_matches=50) is True
+
+
+def test_local_map_limits_act_on_either_count_or_variance():
+    out = local_map_full([10, 999, 1000, 10], [0.0, 0.0, 0.0, 0.2], max_features=1000, max_variance=0.2)
+    assert out.tolist() == [False, False, True, True]
+
+
+def sequence(far_frames, n=20, variance_step=0.0, features=300):
+    """compare(key, k) for frames whose place is 'far' (another place) in ``far_frames``."""
+    far = set(far_frames)
+
+    def compare(key, k):
+        changed = (k in far) != (key in far)
+        return Comparison(0.5 if changed else 0.01, 5 if changed else 120, features, variance_step * (k - key))
+    return compare
+
+
+@pytest.mark.parametrize("blocked", [[5], [5, 6], [3, 4, 9, 10, 14]])
+def test_a_transient_blocker_starts_no_node(blocked):
+    keys, reasons = select_key_frames(20, sequence(blocked), occlusion_frames=3)
+    assert keys == [0] and reasons == ["start"]
+
+
+def test_a_lasting_change_starts_a_node_once_confirmed():
+    keys, reasons = select_key_frames(20, sequence(range(8, 20)), occlusion_frames=3)
+    assert keys == [0, 10] and reasons == ["start", "appearance"]             # 8, 9, 10: confirmed at 10
+    # without the guard the blocker itself starts nodes (and the place after it another)
+    keys, _ = select_key_frames(20, sequence([5]), occlusion_frames=1)
+    assert keys == [0, 5, 6]
+
+
+def test_limits_start_nodes_at_once_and_say_why():
+    keys, reasons = select_key_frames(10, sequence([], variance_step=0.03), max_variance=0.1)
+    assert keys == [0, 4, 8] and set(reasons[1:]) == {"variance"}
+    keys, reasons = select_key_frames(5, sequence([], features=2000), max_features=1000)
+    assert keys == [0, 1, 2, 3, 4] and set(reasons[1:]) == {"features"}
+
+
+def test_select_key_frames_refuses_a_compare_that_returns_something_else():
+    with pytest.raises(TypeError, match="compare"):
+        select_key_frames(3, lambda key, k: (0.1, 5))
+    with pytest.raises(ValueError, match="occlusion_frames"):
+        select_key_frames(3, sequence([]), occlusion_frames=0)
+
+
+# --- the map as data ------------------------------------------------------------------------------
+
+def small_map(**change):
+    rng = np.random.default_rng(0)
+    arrays = dict(poses=[[0, 0, 0], [1, 0, 0], [2, 0, 0.5]], variances=[0.0, 0.01, 0.02],
+                  histograms=rng.dirichlet(np.ones(8), 3), frames=[0, 4, 9], keypoints=rng.uniform(0, 100, (9, 4)),
+                  bearings=rng.normal(size=(9, 3)), descriptors=rng.normal(size=(9, 128)).astype(np.float32),
+                  offsets=[0, 3, 6, 9], edges=[[0, 1], [1, 2], [0, 2]],
+                  measurements=[[1, 0, 0], [1, 0, 0.5], [2, 0, 0.5]], covariances=np.tile(np.eye(3) * 0.01, (3, 1, 1)),
+                  kinds=[ODOMETRY_EDGE, ODOMETRY_EDGE, LOOP_EDGE])
+    arrays.update(change)
+    return TopologicalMap(**arrays)
+
+
+def test_save_and_load_give_back_the_same_arrays(tmp_path):
+    m = small_map()
+    back = TopologicalMap.load(m.save(tmp_path / "map.npz"))
+    for name, value in m.to_arrays().items():
+        assert np.array_equal(value, getattr(back, name)), name
+    assert back.descriptors.dtype == np.float32
+    np.savez(tmp_path / "other.npz", poses=np.zeros((1, 3)))
+    with pytest.raises(ValueError, match="path"):
+        TopologicalMap.load(tmp_path / "other.npz")
+
+
+def test_graph_and_with_poses():
+    m = small_map()
+    g = m.graph()
+    assert isinstance(g, PoseGraph) and g.fixed == 0
+    assert np.allclose(g.information, np.linalg.inv(m.covariances))
+    assert np.allclose(edge_variances(g), 0.01)
+    moved = m.with_poses(m.poses + [0.1, 0.0, 0.0])
+    assert np.allclose(moved.poses[:, 0], [0.1, 1.1, 2.1]) and np.allclose(m.poses[:, 0], [0, 1, 2])
+    assert moved.descriptors is m.descriptors
+    with pytest.raises(ValueError, match="poses"):
+        m.with_poses([[np.nan, 0, 0]] * 3)
+    extra = m.with_edges(m.edges[:2], m.measurements[:2], m.covariances[:2], m.kinds[:2])
+    assert extra.n_edges == 2 and m.n_edges == 3
+
+
+def test_rank_by_histogram_is_a_sort_of_eq5_distances():
+    m = small_map()
+    h = np.random.default_rng(1).dirichlet(np.ones(8))
+    order, d = m.rank_by_histogram(h)
+    brute = sorted(range(3), key=lambda i: np.sqrt(((m.histograms[i] - h) ** 2).sum()))
+    assert order.tolist() == brute and np.allclose(d, histogram_distance(h, m.histograms)[brute])
+    order, _ = m.rank_by_histogram(h, exclude=[brute[0]])
+    assert order.tolist() == brute[1:]
+
+
+def test_match_counts_equal_ratio_matching_against_each_node():
+    m = small_map()
+    q = m.descriptors[[0, 4, 7, 8]] + 0.01
+    counts, matches = m.match_counts(q, [0, 1, 2], ratio=0.7)
+    for node, (c, mt) in enumerate(zip(counts, matches)):
+        ref = ratio_match(q, m.descriptors[m.offsets[node]:m.offsets[node + 1]], ratio=0.7)
+        assert c == len(ref) and mt.train.tolist() == ref.train.tolist()
+    assert counts.tolist() == [1, 1, 2]
+
+
+@pytest.mark.parametrize("change, error, match", [
+    (dict(poses=np.zeros((0, 3))), EmptyMapError, "poses"),
+    (dict(poses=[[0, 0, 0], [np.nan, 0, 0], [2, 0, 0]]), ValueError, "poses"),
+    (dict(variances=[0.0, -1.0, 0.0]), ValueError, "variances"),
+    (dict(offsets=[0, 3, 2, 9]), ValueError, "offsets"),
+    (dict(edges=[[0, 1], [1, 1], [0, 2]]), ValueError, "edges"),
+    (dict(edges=[[0, 1], [1, 3], [0, 2]]), ValueError, "edges"),
+    (dict(covariances=np.tile(-np.eye(3), (3, 1, 1))), ValueError, "covariances"),
+    (dict(kinds=[0, 1, 7]), ValueError, "kinds"),
+    (dict(histograms=np.ones((2, 8))), ValueError, "histograms"),
+])
+def test_bad_maps_are_refused_by_name(change, error, match):
+    with pytest.raises(error, match=match):
+        small_map(**change)
+
+
+# --- built from a recorded run ----------------------------------------------------------------------
+
+def test_map_of_a_short_run_has_nodes_in_every_visited_room_and_closes_its_loop():
+    run = short_run()
+    tmap, log = short_map_and_log()
+    visited = set(room_of(run.poses[:, :2]))
+    assert {"R1", "R4"} <= visited
+    assert set(room_of(run.poses[tmap.frames, :2])) >= visited - {"corridor"}     # 2 m of corridor
+    assert tmap.frames[0] == 0 and np.all(np.diff(tmap.frames) > 0)
+    assert np.allclose(tmap.poses, run.odometry[tmap.frames])
+    odo = tmap.kinds == ODOMETRY_EDGE
+    assert tmap.edges[odo].tolist() == [[i, i + 1] for i in range(len(tmap) - 1)]
+    assert np.allclose(tmap.measurements[odo], se2_between(tmap.poses[:-1], tmap.poses[1:]))
+    # edge covariances are the propagated odometry noise; node variances accumulate Eq. (1)
+    a, b = tmap.frames[0], tmap.frames[1]
+    assert np.allclose(tmap.covariances[0], odometry_covariance(run.odometry[a:b + 1], (0.01, 0.001, 0.01, 0.001))[-1],
+                       atol=2e-6)
+    assert np.all(np.diff(tmap.variances) > 0)
+    # the lap of R1 brings the robot back to the start: a loop edge, measured by vision
+    loops = np.flatnonzero(tmap.kinds == LOOP_EDGE)
+    assert len(loops) >= 1 and any("loop closure" in line for line in log)
+    for k in loops:
+        j, i = tmap.edges[k]
+        truth = se2_between(run.poses[tmap.frames[j]], run.poses[tmap.frames[i]])
+        err = tmap.measurements[k] - truth
+        assert np.hypot(err[0], err[1]) < 0.05 and abs(wrap_angle(err[2])) < 0.01, (j, i, err)
+
+
+def test_relaxing_the_short_map_pulls_the_loop_together():
+    run = short_run()
+    tmap = short_map()
+    k = int(np.flatnonzero(tmap.kinds == LOOP_EDGE)[0])
+    j, i = tmap.edges[k]
+    for result in (relax(tmap.graph()), optimize_pose_graph(tmap.graph())):
+        aligned = tmap.with_poses(result.poses)
+        before = np.hypot(*(se2_between(tmap.poses[j], tmap.poses[i]) - tmap.measurements[k])[:2])
+        after = np.hypot(*(se2_between(aligned.poses[j], aligned.poses[i]) - tmap.measurements[k])[:2])
+        assert after < before
+        assert np.all(np.isfinite(aligned.poses))
+        assert np.abs(aligned.poses[:, :2] - run.poses[tmap.frames, :2]).max() < 0.5
+
+
+def test_build_refuses_empty_runs_wrong_sizes_and_bad_odometry():
+    run = short_run()
+    with pytest.raises(EmptyMapError, match="images"):
+        build_topological_map(np.zeros((0, 480, 640, 3), np.uint8), np.zeros((0, 3)), camera())
+    with pytest.raises(ImageSizeError, match="images"):
+        build_topological_map(run.images["omni"][:2, :240], run.odometry[:2], camera())
+    with pytest.raises(ValueError, match="odometry"):
+        build_topological_map(run.images["omni"][:2], run.odometry[:3], camera())
+    with pytest.raises(ValueError, match="odometry"):
+        build_topological_map(run.images["omni"][:2], [[0, 0, 0], [np.nan, 0, 0]], camera())
+    with pytest.raises(TypeError, match="camera"):
+        build_topological_map(run.images["omni"][:2], run.odometry[:2], "omni")
