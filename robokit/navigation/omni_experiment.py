@@ -6,7 +6,7 @@ The paper's experiments (Sec. "Experimental results") re-run on :func:`robokit.s
    odometry, builds the topological map from the recording, and aligns it twice: by relaxation
    (Eqs. (1)-(3)) and by least squares. The recording and the map are cached (keyed by their
    parameters and the code that makes them).
-2. :func:`localization_trials` localizes omni images taken at test places (Fig. 8, 9 and 11) with
+2. :func:`localization_trials` localizes omni images taken at test places (Figs. 8, 9 and 11) with
    the coarse stage only, the fine stage only and the hierarchy, timing each stage.
 3. :func:`route_recognition` asks which node the robot is at, at key nodes along the route (Fig. 12).
 4. :func:`navigation_trials` follows a visual path from perturbed starts with the omni camera in the
@@ -36,7 +36,7 @@ import numpy as np
 
 from ..config import cache_dir, cache_key, fast_mode, source_digest
 from ..controllers.path_geometry import VisualPath, path_from_poses
-from ..geometry import wrap_angle
+from ..geometry import se2_between, se2_compose
 from ..localization.hierarchical import HierarchicalLocalizer, Localization
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
                        optimize_pose_graph, relax)
@@ -45,7 +45,7 @@ from ..sim.world import World
 from ..validation import as_array, as_points, as_rng, check_callable, check_choice, check_int, check_positive
 from .visual_path import follow_path, perturbed_starts
 
-__all__ = ["OfficeSetup", "office_setup", "trial_places", "localization_trials", "LocalizationTrials",
+__all__ = ["OfficeSetup", "office_setup", "localization_trials", "LocalizationTrials",
            "route_recognition", "omni_localizer", "navigation_trials"]
 
 MODES = ("coarse", "fine", "hierarchical")
@@ -156,61 +156,6 @@ def _check_setup(setup: Any) -> OfficeSetup:
     return setup
 
 
-def trial_places(setup: OfficeSetup, n: int = 11, *, offset: float = 0.25, rng: Any = 0) -> np.ndarray:
-    """``n`` test poses spread along the tour like the paper's Fig. 8, two of them in the corridor.
-
-    Each is a tour pose moved ``offset`` metres sideways and turned at random, so no test image is
-    one of the map's images.
-
-    Parameters
-    ----------
-    setup : OfficeSetup
-    n : int, default 11
-        Number of places (>= 3; the paper has 11).
-    offset : float, default 0.25
-        Sideways displacement from the tour (m).
-    rng : Generator or int, default 0
-
-    Returns
-    -------
-    numpy.ndarray, shape (n, 3)
-        True poses ``[x, y, theta]``; rows 3 and 4 (the paper's cases 4 and 5) lie in the corridor.
-
-    Raises
-    ------
-    TypeError, ValueError
-        For a bad setup, ``n < 3`` or a negative offset.
-
-    Notes
-    -----
-    Sec. "Experimental results": 11 test locations, cases 4 and 5 in the corridor (Fig. 8, 9).
-    """
-    setup = _check_setup(setup)
-    n = check_int(n, "n", minimum=3, maximum=200)
-    offset = check_positive(offset, "offset", allow_zero=True)
-    rng = as_rng(rng)
-    poses = setup.run.poses
-    y0, y1 = setup.world.info["corridor"]
-    in_corridor = (poses[:, 1] > y0 + 0.3) & (poses[:, 1] < y1 - 0.3)
-    rooms = np.flatnonzero(~in_corridor)
-    corridor = np.flatnonzero(in_corridor)
-    picks = list(rooms[np.linspace(0, len(rooms) - 1, n - 2).round().astype(int)])
-    picks[3:3] = list(corridor[np.linspace(0.25, 0.75, 2) * (len(corridor) - 1)].round().astype(int)) \
-        if len(corridor) else []
-    out = []
-    for k in picks[:n]:
-        x, y, theta = poses[k]
-        for _ in range(20):
-            side = rng.choice([-1.0, 1.0]) * offset
-            cand = np.array([x - side * np.sin(theta), y + side * np.cos(theta), wrap_angle(rng.uniform(-np.pi, np.pi))])
-            if setup.world.is_free(cand[None, :2], clearance=0.3)[0]:
-                break
-        else:
-            cand = np.array([x, y, wrap_angle(theta + rng.uniform(-np.pi, np.pi))])
-        out.append(cand)
-    return np.array(out)
-
-
 @dataclasses.dataclass
 class LocalizationTrials:
     """Results of :func:`localization_trials`, one row per test place.
@@ -222,7 +167,11 @@ class LocalizationTrials:
     estimates : dict of str to numpy.ndarray (n, 3)
         Per mode, the estimated poses (map frame).
     errors : dict of str to numpy.ndarray (n, 2)
-        Per mode, ``|x error|`` and ``|y error|`` (m).
+        Per mode, ``|x error|`` and ``|y error|`` (m) against the truth: the map's error plus the
+        localizer's.
+    local_errors : dict of str to numpy.ndarray (n, 2)
+        Per mode, the same for the recognised node's *true* pose composed with the estimated
+        relative pose: the localizer's own error, without the map's.
     times : dict of str to dict of str to numpy.ndarray (n,)
         Per mode, seconds per stage (``histogram``, ``sift``, ``coarse``, ``matching``,
         ``verification``, ``total``).
@@ -232,6 +181,7 @@ class LocalizationTrials:
     places: np.ndarray
     estimates: dict
     errors: dict
+    local_errors: dict
     times: dict
     results: dict
 
@@ -248,7 +198,7 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
     ----------
     setup : OfficeSetup
     places : array_like, shape (n, 3)
-        True poses (e.g. :func:`trial_places`).
+        True poses (e.g. :data:`robokit.sim.OFFICE_TEST_POSES`, the paper's 11 cases of Fig. 8).
     modes : tuple of str, default ("coarse", "fine", "hierarchical")
     map : {"relaxed", "optimized", "raw"}, default "relaxed"
         Which alignment of the map to localize in.
@@ -280,7 +230,7 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
     rng = as_rng(rng)
     images = [_render(setup, p, rng) for p in P]
     n_features = 300 if setup.camera.width < 640 else 500
-    estimates, errors, times, results = {}, {}, {}, {}
+    estimates, errors, local_errors, times, results = {}, {}, {}, {}, {}
     for m, mode in enumerate(modes):
         loc = HierarchicalLocalizer(tmap, setup.camera, mode=mode, n_features=n_features)
         out = []
@@ -291,8 +241,10 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
         results[mode] = out
         estimates[mode] = np.array([r.pose for r in out])
         errors[mode] = np.abs(estimates[mode][:, :2] - P[:, :2])
+        local = np.array([se2_compose(setup.truth[r.node], se2_between(r.node_pose, r.pose)) for r in out])
+        local_errors[mode] = np.abs(local[:, :2] - P[:, :2])
         times[mode] = {stage: np.array([r.times[stage] for r in out]) for stage in out[0].times}
-    return LocalizationTrials(P, estimates, errors, times, results)
+    return LocalizationTrials(P, estimates, errors, local_errors, times, results)
 
 
 def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 0.15, same_place: float = 0.5,
