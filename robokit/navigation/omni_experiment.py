@@ -43,7 +43,7 @@ from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_
 from ..sim import OmniCamera, Run, office_floor, office_tour, record
 from ..sim.world import World
 from ..validation import as_array, as_points, as_rng, check_callable, check_choice, check_int, check_positive
-from .visual_path import follow_path, perturbed_starts
+from .visual_path import FollowResult, follow_path, perturbed_starts
 
 __all__ = ["OfficeSetup", "office_setup", "localization_trials", "LocalizationTrials",
            "route_recognition", "omni_localizer", "navigation_trials"]
@@ -71,7 +71,9 @@ class OfficeSetup:
     truth : numpy.ndarray, shape (N, 3)
         True poses of the nodes (the run's pose at each node's frame).
     build_seconds : float
-        Time to build the map (0 when it came from the cache; the cache stores the first time).
+        Time it took to build the map (stored with the cached map).
+    key : str
+        Identifies the recording, the map and the code that made them (keys later caches).
     """
 
     world: World
@@ -84,17 +86,19 @@ class OfficeSetup:
     least_squares: PoseGraphResult
     truth: np.ndarray
     build_seconds: float
+    key: str
 
 
-def _map_cached(run: Run, params: dict, build: Callable[[], TopologicalMap]) -> tuple[TopologicalMap, float]:
+def _map_cached(run: Run, params: dict, build: Callable[[], TopologicalMap]) -> tuple[TopologicalMap, float, str]:
     meta = {"run": cache_key(**run.meta), "params": params, "code": source_digest("sim", "geometry", "vision", "mapping")}
-    target = cache_dir("maps") / f"office-{cache_key(**meta)}.npz"
+    key = cache_key(**meta)
+    target = cache_dir("maps") / f"office-{key}.npz"
     if target.exists():
         try:
             tmap = TopologicalMap.load(target)
             stored = json.loads(target.with_suffix(".json").read_text())
             if stored.get("meta") == json.loads(json.dumps(meta)):
-                return tmap, float(stored["seconds"])
+                return tmap, float(stored["seconds"]), key
         except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
             pass  # a corrupt or foreign cache file is rebuilt
     t0 = time.perf_counter()
@@ -104,7 +108,7 @@ def _map_cached(run: Run, params: dict, build: Callable[[], TopologicalMap]) -> 
     tmap.save(tmp)
     tmp.replace(target)
     target.with_suffix(".json").write_text(json.dumps({"meta": meta, "seconds": seconds}))
-    return tmap, seconds
+    return tmap, seconds, key
 
 
 def office_setup(*, fast: bool | None = None, progress: Callable | None = None) -> OfficeSetup:
@@ -131,6 +135,15 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     Sec. "Experimental results" (Fig. 6a: the tour; Fig. 8: the map) and Sec. "Environment map"
     (key images, local-map partitioning, loop closure, Eqs. (1)-(3)). The paper records 640 x 480
     colour images; fast mode uses 320 x 240.
+
+    Examples
+    --------
+    The fast setup (320 x 240 images; the first call records and builds for about half a minute,
+    later calls load the cache):
+
+    >>> setup = office_setup(fast=True)
+    >>> len(setup.raw) > 20, setup.truth.shape == setup.raw.poses.shape
+    (True, True)
     """
     fast = fast_mode() if fast is None else bool(fast)
     progress = check_callable(progress, "progress")
@@ -139,7 +152,7 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     rate = 0.7 if fast else 2.0
     run = record(world, office_tour(world), {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
     params = {"n_features": 300 if fast else 500, "alphas": list(TOUR_ALPHAS)}
-    raw, seconds = _map_cached(run, params, lambda: build_topological_map(
+    raw, seconds, key = _map_cached(run, params, lambda: build_topological_map(
         run.images["omni"], run.odometry, camera, n_features=params["n_features"], odometry_alphas=TOUR_ALPHAS,
         progress=progress))
     graph = raw.graph()
@@ -147,7 +160,7 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     least_squares = optimize_pose_graph(graph)
     truth = run.poses[raw.frames]
     return OfficeSetup(world, camera, run, raw, raw.with_poses(relaxation.poses, relaxation.variances),
-                       raw.with_poses(least_squares.poses), relaxation, least_squares, truth, seconds)
+                       raw.with_poses(least_squares.poses), relaxation, least_squares, truth, seconds, key)
 
 
 def _check_setup(setup: Any) -> OfficeSetup:
@@ -219,6 +232,13 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
     -----
     Sec. "Hierarchical localization" (Fig. 5) and "Experimental results" (Fig. 9: errors in x and
     y; Fig. 11: the modes compared in error and time).
+
+    Examples
+    --------
+    >>> from robokit.sim import OFFICE_TEST_POSES
+    >>> trials = localization_trials(office_setup(fast=True), OFFICE_TEST_POSES[:2], modes=("coarse",))
+    >>> trials.errors["coarse"].shape, sorted(trials.times["coarse"])[:2]
+    ((2, 2), ['coarse', 'histogram'])
     """
     setup = _check_setup(setup)
     P = as_points(places, "places", 3, min_count=1)
@@ -279,6 +299,12 @@ def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 
     -----
     Sec. "Experimental results", Fig. 12: 17 key nodes; failures "mostly" at nodes with very few
     features or very ambiguous ones.
+
+    Examples
+    --------
+    >>> route = route_recognition(office_setup(fast=True), 3)
+    >>> len(route["nodes"]), 0.0 <= route["rate"] <= 1.0
+    (3, True)
     """
     setup = _check_setup(setup)
     n_nodes = check_int(n_nodes, "n_nodes", minimum=1, maximum=len(setup.raw))
@@ -334,6 +360,14 @@ def omni_localizer(setup: OfficeSetup, *, noise: float = 1.0, map: str = "relaxe
     -----
     Sec. "Visual-servoing for navigation": the robot recognises the most likely node and is
     steered along the visual path; the fixes feed the EKF.
+
+    Examples
+    --------
+    >>> setup = office_setup(fast=True)
+    >>> localize = omni_localizer(setup)
+    >>> fix = localize(setup.truth[3], np.random.default_rng(0))
+    >>> bool(fix is None or np.hypot(*(fix[:2] - setup.truth[3, :2])) < 3.0), localize.calls
+    (True, 1)
     """
     setup = _check_setup(setup)
     noise = check_positive(noise, "noise", allow_zero=True)
@@ -342,7 +376,11 @@ def omni_localizer(setup: OfficeSetup, *, noise: float = 1.0, map: str = "relaxe
 
     def localize(true_pose: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
         localize.calls += 1
-        image = setup.camera.observe(setup.world, np.asarray(true_pose, float), rng=rng).image
+        try:
+            image = setup.camera.observe(setup.world, np.asarray(true_pose, float), rng=rng).image
+        except ValueError:       # the (non-colliding) simulated robot drove into furniture: no view
+            localize.failures += 1
+            return None
         r: Localization = loc.localize(image)
         if not r.recognised:
             localize.failures += 1
@@ -353,18 +391,38 @@ def omni_localizer(setup: OfficeSetup, *, noise: float = 1.0, map: str = "relaxe
     return localize
 
 
-def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int = 0, n_path_nodes: int = 6,
-                      fix_period: float = 1.0, alpha: float = 2.0, offset: float = 0.3, heading: float = 0.3,
-                      max_time: float = 60.0, localize: Callable | None = None, rng: Any = 3,
-                      progress: Callable | None = None) -> tuple[VisualPath, list]:
+def _open_stretch(setup: OfficeSetup, count: int, clearance: float) -> int:
+    """First node of ``count`` consecutive nodes whose smooth path keeps ``clearance`` from everything."""
+    for first in range(len(setup.relaxed) - count + 1):
+        poses = setup.relaxed.poses[first:first + count]
+        if np.hypot(*(poses[-1, :2] - poses[0, :2])) < 1.0:
+            continue
+        try:   # the path in the map, and where it lies in truth (the map's error moves it)
+            paths = [path_from_poses(poses), path_from_poses(setup.truth[first:first + count])]
+        except ValueError:
+            continue
+        if all(setup.world.is_free(p.poses[:, :2], clearance=clearance).all() for p in paths):
+            return first
+    raise ValueError(f"n_path_nodes: no {count} consecutive nodes keep {clearance:.2f} m from walls and furniture")
+
+
+def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | None = None, n_path_nodes: int = 5,
+                      clearance: float = 0.3, fix_period: float = 1.0, alpha: float = 2.0, offset: float = 0.3, heading: float = 0.3,
+                      max_time: float = 60.0, localize: Callable | None = None, seed: int = 3,
+                      cache: bool = True, progress: Callable | None = None) -> tuple[VisualPath, list]:
     """Follow the visual path through consecutive map nodes from ``n_starts`` perturbed starts (Fig. 13).
 
     Parameters
     ----------
     setup : OfficeSetup
     n_starts : int
-    first_node, n_path_nodes : int
-        The path runs through the relaxed map's nodes ``first_node .. first_node + n_path_nodes - 1``.
+    first_node : int, optional
+        The path runs through the relaxed map's nodes ``first_node .. first_node + n_path_nodes - 1``;
+        default: the first such stretch at least 1 m long whose path keeps ``clearance + offset``
+        from walls and furniture (the simulated robot does not collide, it would drive through).
+    n_path_nodes : int, default 5
+    clearance : float, default 0.3
+        Metres, see ``first_node``.
     fix_period : float, default 1.0
         Seconds between omni fixes (the EKF integrates odometry in between).
     alpha : float, default 2.0
@@ -374,7 +432,12 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int = 0,
     max_time : float, default 60
     localize : callable, optional
         Default :func:`omni_localizer` (the omni camera in the loop).
-    rng : Generator or int, default 3
+    seed : int, default 3
+        Seeds the starts, the odometry noise and the rendering noise.
+    cache : bool, default True
+        With the default localizer, load the runs from / save them to
+        ``robokit.cache_dir("navigation")``, keyed by every parameter, the map and the code (each
+        run renders and localizes an omni image per fix: minutes at full size the first time).
     progress : callable ``(done, total)``, optional
 
     Returns
@@ -390,21 +453,73 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int = 0,
     Notes
     -----
     Sec. "Visual-servoing for navigation" (Eqs. (6)-(8), the EKF) and Fig. 13.
+
+    Examples
+    --------
+    With Gaussian fixes instead of the camera (fast):
+
+    >>> from robokit.navigation import gaussian_localizer
+    >>> path, runs = navigation_trials(office_setup(fast=True), 1, localize=gaussian_localizer(), cache=False)
+    >>> len(runs), runs[0].true_poses.shape[1]
+    (1, 3)
     """
     setup = _check_setup(setup)
     n_starts = check_int(n_starts, "n_starts", minimum=1, maximum=1000)
-    first = check_int(first_node, "first_node", minimum=0, maximum=len(setup.relaxed) - 2)
-    count = check_int(n_path_nodes, "n_path_nodes", minimum=2, maximum=len(setup.relaxed) - first)
+    clearance = check_positive(clearance, "clearance", allow_zero=True)
+    offset = check_positive(offset, "offset", allow_zero=True)
+    count = check_int(n_path_nodes, "n_path_nodes", minimum=2, maximum=len(setup.relaxed))
+    if first_node is None:
+        first = _open_stretch(setup, count, clearance + offset)
+    else:
+        first = check_int(first_node, "first_node", minimum=0, maximum=len(setup.relaxed) - count)
     progress = check_callable(progress, "progress")
-    localize = omni_localizer(setup) if localize is None else check_callable(localize, "localize", optional=False)
-    rng = as_rng(rng)
+    default_localizer = localize is None
+    localize = omni_localizer(setup) if default_localizer else check_callable(localize, "localize", optional=False)
+    seed = check_int(seed, "seed", minimum=0)
+    rng = as_rng(seed)
     path = path_from_poses(as_array(setup.relaxed.poses[first:first + count], "poses"))
     starts = perturbed_starts(path, n_starts, offset=offset, heading=heading, rng=rng)
+    target = None
+    if cache and default_localizer:
+        meta = {"setup": setup.key, "first": first, "count": count, "fix_period": fix_period, "alpha": alpha,
+                "offset": offset, "heading": heading, "max_time": max_time, "rng": seed, "n": n_starts,
+                "code": source_digest("sim", "geometry", "vision", "mapping", "localization", "controllers",
+                                      "navigation")}
+        target = cache_dir("navigation") / f"office-{cache_key(**meta)}.npz"
+        cached = _load_runs(target, n_starts)
+        if cached is not None:
+            return path, cached
     results = []
     for k, start in enumerate(starts):
         results.append(follow_path(path, start, localize=localize, fix_period=fix_period, alpha=alpha,
                                    max_time=max_time, rng=rng))
         if progress is not None:
             progress(k + 1, n_starts)
+    if target is not None:
+        _save_runs(target, results)
     return path, results
+
+
+_FIELDS = [f.name for f in dataclasses.fields(FollowResult)]
+
+
+def _save_runs(target, results: list) -> None:
+    arrays = {f"{k}/{name}": np.asarray(getattr(r, name)) for k, r in enumerate(results) for name in _FIELDS}
+    tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp.npz")
+    np.savez_compressed(tmp, **arrays)
+    tmp.replace(target)
+
+
+def _load_runs(target, n: int) -> list | None:
+    """The cached runs, or ``None`` for a missing, corrupt or incomplete file (then they are re-run)."""
+    try:
+        with np.load(target, allow_pickle=False) as data:
+            out = []
+            for k in range(n):
+                values = {name: data[f"{k}/{name}"] for name in _FIELDS}
+                values["reached"], values["final_error"] = bool(values["reached"]), float(values["final_error"])
+                out.append(FollowResult(**values))
+            return out
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+        return None
 
