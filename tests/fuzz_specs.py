@@ -77,6 +77,26 @@ def image_mask():
 
 
 @functools.cache
+def office_experiment():   # lesson 02's fast office setup (cached on disk after the first build)
+    from robokit.navigation.omni_experiment import office_setup
+    return office_setup(fast=True)
+
+
+def draw_figure(value):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(2, 1))
+    ax.plot([0, 1], [0, float(value)])
+    return fig
+
+
+def rec_nodes():
+    rng = np.random.default_rng(0)
+    return [rng.normal(size=(12, 8)) for _ in range(3)]
+
+
+@functools.cache
 def small_omni():
     from robokit.sim import OmniCamera
     return OmniCamera(width=160, height=120, face_size=60)
@@ -514,6 +534,41 @@ SPECS: dict[str, Call] = {
                                                "transforms": Array(lambda: lap().poses[:5], "N,3|N,4,4"), "fps": Real(10.0),
                                                "repetitions": Int(1)}),
     "robokit.viz.scene3d.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3")}),
+    # --- lesson 02: the assignment's plain-data references, the experiments, graphs and sliders ---
+    "robokit.exercises.omni_localization.fine_stage_counts": Call({
+        "query": Array(lambda: rec_nodes()[1][:4] + 0.01, "N,N", min_rows=0), "node_descriptors": Obj(rec_nodes),
+        "candidates": Array(np.array([0, 1, 2]), "N", min_rows=0), "ratio": Real(0.8)}),
+    "robokit.exercises.omni_localization.recognise_node": Call({
+        "query_histogram": Array(np.array([0.1, 0.9, 0.0]), "N"),
+        "query_descriptors": Array(lambda: rec_nodes()[1][:4] + 0.01, "N,N", min_rows=0),
+        "node_histograms": Array(np.eye(3), "N,N"), "node_descriptors": Obj(rec_nodes), "top_k": Int(2),
+        "ratio": Real(0.8)}),
+    "robokit.navigation.omni_experiment.office_setup": Call({"fast": Flag(True), "progress": Func(None, optional=True)},
+                                                            cheap=False),
+    "robokit.navigation.omni_experiment.localization_trials": Call({
+        "setup": Obj(office_experiment), "places": Array(np.array([[13.0, 3.7, 2.0]]), "N,3"),
+        "modes": Given(("coarse",)), "map": Choice("relaxed"), "rng": Rng(0), "progress": Func(None, optional=True)},
+        cheap=False),
+    "robokit.navigation.omni_experiment.route_recognition": Call({
+        "setup": Obj(office_experiment), "n_nodes": Int(2), "offset": Real(0.15), "same_place": Real(0.5),
+        "rng": Rng(1)}, cheap=False),
+    "robokit.navigation.omni_experiment.navigation_trials": Call({
+        "setup": Obj(office_experiment), "n_starts": Int(1), "first_node": Int(0, optional=True),
+        "n_path_nodes": Int(3), "clearance": Real(0.3), "fix_period": Real(1.0), "alpha": Real(2.0),
+        "offset": Real(0.3), "heading": Real(0.3), "max_time": Real(3.0, optional=True), "localize": Func(localizer, optional=True),
+        "seed": Int(3), "cache": Flag(False), "progress": Func(None, optional=True)}, cheap=False),
+    "robokit.viz.maps.plot_graph": Call({
+        "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]), "N,3"),
+        "edges": Array(np.array([[0, 1], [1, 2]]), "N,2", min_rows=0), "ax": Given(axes),
+        "label": Text("map", optional=True),
+        "highlight": Array(np.array([False, True]), "N", optional=True, accepts=("booleans",)), "kwargs": Given({})}),
+    "robokit.viz.scene3d.add_graph": Call({
+        "scene": Obj(scene), "path": Text("map"),
+        "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]), "N,3"),
+        "edges": Array(np.array([[0, 1], [1, 2]]), "N,2", min_rows=0), "z": Real(0.05), "node_color": Given(0x2255CC),
+        "edge_color": Given(0x2255CC), "size": Real(0.12)}),
+    "robokit.viz.widgets.slider": Call({"draw": Func(lambda: draw_figure), "values": Given([1.0, 2.0]), "label": Text("k"),
+                                        "fmt": Text("{}"), "start": Int(0)}, cheap=False),
     # --- lesson 02: controllers.path_following(_loop), localization.pose_ekf, navigation.visual_path --------
     "robokit.controllers.path_geometry.VisualPath": Call({
         "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), "N,3"),

@@ -8,6 +8,7 @@ from ..localization.pose_ekf import ekf_update
 from ..mapping.relaxation import relax_sweep
 from ..vision.colour import histogram_distance, hue_histogram, rgb_to_hsi
 from ..vision.matching import DescriptorIndex
+from ..validation import as_array, check_int, check_positive
 from .compare import close, exact
 from .spec import Case, Exercise
 
@@ -20,6 +21,32 @@ HELPERS = ()
 RATIO = 0.8       # Lowe's ratio; the paper gives none
 
 
+def _node_list(node_descriptors, dim: int | None) -> list[np.ndarray]:
+    if isinstance(node_descriptors, np.ndarray) and node_descriptors.ndim == 3:
+        node_descriptors = list(node_descriptors)
+    if not isinstance(node_descriptors, (list, tuple)):
+        raise TypeError(f"node_descriptors: expected a list of (M_k, D) descriptor arrays, got "
+                        f"{type(node_descriptors).__name__}")
+    nodes = []
+    for k, d in enumerate(node_descriptors):
+        arr = as_array(d, f"node_descriptors[{k}]", ndim=2)
+        if dim is not None and arr.shape[1] != dim:
+            raise ValueError(f"node_descriptors[{k}]: expected descriptors of length {dim} like the query's, "
+                             f"got {arr.shape[1]}")
+        if len(arr) < 2:
+            raise ValueError(f"node_descriptors[{k}]: expected at least 2 descriptors (the ratio test needs a "
+                             f"second neighbour), got {len(arr)}")
+        nodes.append(arr)
+    return nodes
+
+
+def _ratio(ratio) -> float:
+    r = check_positive(ratio, "ratio")
+    if r > 1:
+        raise ValueError(f"ratio: expected a value in (0, 1], got {r}")
+    return r
+
+
 def fine_stage_counts(query, node_descriptors, candidates, ratio: float = RATIO) -> np.ndarray:
     """Ratio-test match counts of ``query`` against each candidate node (the fine stage).
 
@@ -30,29 +57,43 @@ def fine_stage_counts(query, node_descriptors, candidates, ratio: float = RATIO)
     Parameters
     ----------
     query : array_like, shape (N, D)
-    node_descriptors : list of array_like, each (M_k, D)
-    candidates : list of int
+    node_descriptors : list of array_like, each (M_k, D) with M_k >= 2
+    candidates : array_like of int, shape (K,)
         Indices into ``node_descriptors``.
     ratio : float, default 0.8
+        In (0, 1].
 
     Returns
     -------
-    numpy.ndarray of int, shape (len(candidates),)
+    numpy.ndarray of int, shape (K,)
 
     Raises
     ------
     ValueError, TypeError
-        For a candidate index out of range, descriptors of different lengths or a bad ratio.
+        For a candidate index out of range, descriptors of different lengths, a node with fewer than
+        two descriptors, NaN/inf, or a ratio outside (0, 1].
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> nodes = [rng.normal(size=(20, 8)) for _ in range(3)]
+    >>> fine_stage_counts(nodes[1][:6] + 0.01, nodes, [0, 1, 2]).tolist()   # node 1, and chance matches
+    [1, 6, 2]
     """
-    if isinstance(candidates, (str, bytes)) or np.ndim(candidates) != 1:
-        raise ValueError(f"candidates: expected a list of node indices, got {candidates!r}")
-    nodes = list(node_descriptors)
-    counts = []
-    for c in candidates:
-        if isinstance(c, (bool, np.bool_)) or not float(c).is_integer() or not 0 <= int(c) < len(nodes):
-            raise ValueError(f"candidates: expected indices in [0, {len(nodes)}), got {c!r}")
-        counts.append(DescriptorIndex(nodes[int(c)]).count_matches(query, ratio=ratio))
-    return np.array(counts, int)
+    q = as_array(query, "query", ndim=2)
+    nodes = _node_list(node_descriptors, q.shape[1])
+    cand = as_array(candidates, "candidates", ndim=1)
+    if cand.size and (np.any(cand != np.round(cand)) or cand.min() < 0 or cand.max() >= len(nodes)):
+        raise ValueError(f"candidates: expected node indices in [0, {len(nodes)}), got {cand.tolist()}")
+    return _counts(q, nodes, cand, _ratio(ratio), "query")
+
+
+def _counts(q: np.ndarray, nodes: list, cand: np.ndarray, ratio: float, qname: str) -> np.ndarray:
+    biggest = max([np.abs(q).max(initial=0.0)] + [np.abs(n).max() for n in nodes])
+    if biggest > 1e150:   # squared distances would overflow
+        raise ValueError(f"{qname}, node_descriptors: expected descriptor values below 1e150, got {biggest:.3g}")
+    return np.array([DescriptorIndex(nodes[int(c)]).count_matches(q, ratio=ratio) if len(q) else 0 for c in cand],
+                    int)
 
 
 def recognise_node(query_histogram, query_descriptors, node_histograms, node_descriptors, top_k: int = 3,
@@ -61,20 +102,53 @@ def recognise_node(query_histogram, query_descriptors, node_histograms, node_des
 
     The reference answer of the open exercise (any method that finds the right node passes).
 
+    Parameters
+    ----------
+    query_histogram : array_like, shape (m,)
+    query_descriptors : array_like, shape (N, D)
+    node_histograms : array_like, shape (n, m), n >= 1
+    node_descriptors : list of n array_like, each (M_k, D)
+    top_k : int, default 3
+        Candidates the coarse stage keeps.
+    ratio : float, default 0.8
+
+    Returns
+    -------
+    int
+
     Raises
     ------
-    ValueError
-        For an empty map, histograms of different lengths or ``top_k < 1``.
+    ValueError, TypeError
+        For an empty map, histograms of different lengths or negative bins, one descriptor array per
+        node missing, ``top_k < 1`` or bad descriptors.
+
+    Notes
+    -----
+    The paper's Sec. "Hierarchical localization" (Fig. 5) with Eq. (5) for the coarse stage.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> nodes = [rng.normal(size=(20, 8)) for _ in range(3)]
+    >>> hists = np.eye(3)
+    >>> recognise_node([0.1, 0.9, 0.0], nodes[1][:6] + 0.01, hists, nodes)
+    1
     """
-    H = np.asarray(node_histograms, float)
-    if H.ndim != 2 or len(H) == 0:
-        raise ValueError(f"node_histograms: expected a non-empty (n, m) array, got shape {H.shape}")
-    if len(node_descriptors) != len(H):
-        raise ValueError(f"node_descriptors: expected one array per node ({len(H)}), got {len(node_descriptors)}")
-    if not 1 <= int(top_k):
-        raise ValueError(f"top_k: expected >= 1, got {top_k}")
-    coarse = np.argsort(histogram_distance(query_histogram, H), kind="stable")[:int(top_k)]
-    counts = fine_stage_counts(query_descriptors, node_descriptors, coarse.tolist(), ratio)
+    h = as_array(query_histogram, "query_histogram", ndim=1, min_size=1)
+    q = as_array(query_descriptors, "query_descriptors", ndim=2)
+    H = as_array(node_histograms, "node_histograms", ndim=2)
+    if len(H) == 0:
+        raise ValueError("node_histograms: expected a map with at least one node, got none")
+    if H.shape[1] != h.size:
+        raise ValueError(f"node_histograms: expected {h.size} bins like query_histogram, got {H.shape[1]}")
+    if h.min() < 0 or H.min() < 0:
+        raise ValueError("query_histogram, node_histograms: expected non-negative bins")
+    nodes = _node_list(node_descriptors, q.shape[1])
+    if len(nodes) != len(H):
+        raise ValueError(f"node_descriptors: expected one array per node ({len(H)}), got {len(nodes)}")
+    k = check_int(top_k, "top_k", minimum=1)
+    coarse = np.argsort(histogram_distance(h, H), kind="stable")[:k]
+    counts = _counts(q, nodes, coarse, _ratio(ratio), "query_descriptors")
     return int(coarse[int(np.argmax(counts))])
 
 
@@ -248,7 +322,7 @@ EXERCISES = [
         signature="rgb_to_hsi(pixels: (N, 3) floats in [0, 1]) -> numpy.ndarray (N, 3)  # [H, S, I]",
         points=1, cases=_rgb_cases, reference=rgb_to_hsi, compare=close(rtol=1e-5, atol=1e-5),
         references=("robokit.vision.colour.rgb_to_hsi", "robokit.vision.colour.hue_histogram",
-                    "robokit.vision.colour.hue_mask"),
+                    "robokit.vision.colour.hue_mask", "robokit.vision.colour._rgb01"),
         description="The paper's Eq. (4): H in [0, 2 pi) (2 pi - theta when B > G), S = max - min, I = mean; "
                     "H = 0 where R = G = B; ValueError for a wrong shape, NaN or values outside [0, 1]."),
     Exercise(
@@ -257,14 +331,16 @@ EXERCISES = [
                   "max_intensity=0.98) -> numpy.ndarray (bins,)",
         points=2, cases=_histogram_cases, reference=hue_histogram, compare=close(rtol=1e-9, atol=1e-12),
         references=("robokit.vision.colour.hue_histogram", "robokit.vision.colour.hue_histogram_opencv",
-                    "robokit.vision.colour.hue_mask"),
+                    "robokit.vision.colour.hue_mask", "robokit.vision.colour.rgb_to_hsi",
+                    "robokit.vision.colour._image_mask", "robokit.vision.colour._mask_from_hsi",
+                    "robokit.vision.colour._rgb01", "robokit.vision.colour._thresholds"),
         description="Normalised histogram of the hue of pixels with S >= min_saturation and min_intensity <= I "
                     "<= max_intensity; all zeros when none qualifies; ValueError for bins < 1 or a bad image."),
     Exercise(
         id="02.histogram_distance", function="histogram_distance",
         signature="histogram_distance(h: (m,), H: (m,) or (n, m)) -> float or numpy.ndarray (n,)",
         points=1, cases=_distance_cases, reference=histogram_distance, compare=close(rtol=1e-9, atol=1e-12),
-        references=("robokit.vision.colour.histogram_distance",),
+        references=("robokit.vision.colour.histogram_distance", "robokit.vision.colour._histograms"),
         description="The paper's Eq. (5), the Euclidean distance, against one histogram or each row of a stack; "
                     "ValueError for different bin counts."),
     Exercise(
@@ -285,7 +361,8 @@ EXERCISES = [
         signature="relax_sweep(poses: (N, 3), variances: (N,), edges: (M, 2), measurements: (M, 3), "
                   "edge_variances: (M,), fixed=0) -> (poses (N, 3), variances (N,))",
         points=3, cases=_relax_cases, reference=relax_sweep, compare=close(rtol=1e-7, atol=1e-9),
-        references=("robokit.mapping.relaxation.relax_sweep", "robokit.mapping.relaxation.relax"),
+        references=("robokit.mapping.relaxation.relax_sweep", "robokit.mapping.relaxation.relax",
+                    "robokit.mapping.relaxation._arrays"),
         description="One sweep of the paper's Eqs. (1)-(3) (Jacobi: every node from the input values), the "
                     "fixed node unchanged; ValueError for a negative variance or an edge to a missing node."),
     Exercise(
@@ -299,7 +376,8 @@ EXERCISES = [
         id="02.ekf_update", function="ekf_update",
         signature="ekf_update(x: (n,), P: (n, n), z: (m,), H: (m, n), R: (m, m), angles=()) -> (x, P)",
         points=2, cases=_ekf_cases, reference=ekf_update, compare=close(rtol=1e-7, atol=1e-10),
-        references=("robokit.localization.pose_ekf.ekf_update", "robokit.localization.pose_ekf.UnicycleEKF"),
+        references=("robokit.localization.pose_ekf.ekf_update", "robokit.localization.pose_ekf.UnicycleEKF",
+                    "robokit.localization.pose_ekf._innovation"),
         description="Kalman update with the innovation's angle components wrapped and the Joseph-form "
                     "covariance; ValueError for a covariance that is not positive definite or shapes that "
                     "disagree."),

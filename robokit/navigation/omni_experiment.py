@@ -429,7 +429,8 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
         Natural frequency of the path-following law (1/m), Eq. (8).
     offset, heading : float
         Start perturbation: up to ``offset`` metres and ``heading`` radians from the path's start.
-    max_time : float, default 60
+    max_time : float or None, default 60
+        Seconds per run (``None``: :func:`follow_path`'s default, three times the path's length over the top speed plus 30 s).
     localize : callable, optional
         Default :func:`omni_localizer` (the omni camera in the loop).
     seed : int, default 3

@@ -160,7 +160,8 @@ def _graph(poses: Any, edges: Any) -> tuple[np.ndarray, np.ndarray]:
     P = as_points(poses, "poses", 3, min_count=1)
     E = as_array(edges, "edges", shape=(None, 2), dtype=np.int64)
     if E.size and (E.min() < 0 or E.max() >= len(P)):
-        raise ValueError(f"edges: expected node indices in [0, {len(P)}), got {E.min()}..{E.max()}")
+        raise ValueError(f"poses, edges: expected edges between the {len(P)} poses (indices in [0, {len(P)})), "
+                         f"got indices {E.min()}..{E.max()}")
     return P, E
 
 

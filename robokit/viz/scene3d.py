@@ -242,7 +242,8 @@ def add_graph(scene: Scene, path: str, poses: Any, edges: Any, z: float = 0.05, 
     P = as_points(poses, "poses", 3, min_count=1)
     E = as_array(edges, "edges", shape=(None, 2), dtype=np.int64)
     if E.size and (E.min() < 0 or E.max() >= len(P)):
-        raise ValueError(f"edges: expected node indices in [0, {len(P)}), got {E.min()}..{E.max()}")
+        raise ValueError(f"poses, edges: expected edges between the {len(P)} poses (indices in [0, {len(P)})), "
+                         f"got indices {E.min()}..{E.max()}")
     z = check_finite_scalar(z, "z")
     lifted = np.column_stack([P[:, :2], np.full(len(P), z)])
     scene.add_points(f"{path}/nodes", lifted, size=check_positive(size, "size"), color=node_color)
