@@ -6,12 +6,13 @@ for students. Generated datasets are deterministic and are cached under :func:`c
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
 from pathlib import Path
 
-__all__ = ["fast_mode", "FAST", "cache_dir", "cache_key"]
+__all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -53,6 +54,47 @@ def fast_mode(environ: "os._Environ[str] | dict[str, str] | None" = None) -> boo
 
 #: Fast mode as read once at import time (``robokit.FAST``).
 FAST: bool = fast_mode()
+
+
+def headless(environ: "os._Environ[str] | dict[str, str] | None" = None) -> bool:
+    """Return whether notebooks run without a person watching (``ROBOKIT_HEADLESS``).
+
+    The course build and the test-suite execute notebooks with ``ROBOKIT_HEADLESS=1``: widgets
+    that need a live kernel (sliders) are then replaced by their pre-computed static equivalent,
+    which is what the course site shows.
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        Environment to read; defaults to :data:`os.environ`.
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    ValueError
+        If the variable holds anything but the values :func:`fast_mode` accepts.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Visualisation"); not from a paper.
+
+    Examples
+    --------
+    >>> headless({"ROBOKIT_HEADLESS": "1"}), headless({})
+    (True, False)
+    """
+    env = os.environ if environ is None else environ
+    raw = str(env.get("ROBOKIT_HEADLESS", "")).strip().lower()
+    if raw in _TRUE:
+        return True
+    if raw in _FALSE:
+        return False
+    raise ValueError(
+        f"ROBOKIT_HEADLESS: expected one of 1/0/true/false/yes/no/on/off, got {env.get('ROBOKIT_HEADLESS')!r}"
+    )
 
 
 def cache_dir(*parts: str, create: bool = True) -> Path:
@@ -125,3 +167,47 @@ def cache_key(**params: object) -> str:
     except TypeError as exc:
         raise TypeError(f"params: expected JSON-serialisable values ({exc})") from None
     return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+@functools.lru_cache(maxsize=None)
+def source_digest(*packages: str) -> str:
+    """A short hash of the source of robokit's ``packages`` (e.g. ``"sim", "geometry"``).
+
+    A cached dataset is keyed by it as well as by its parameters, so a change to the code that
+    makes the dataset never serves an old one (DESIGN.md, "Caching").
+
+    Parameters
+    ----------
+    *packages : str
+        Sub-package names of robokit (at least one).
+
+    Returns
+    -------
+    str
+        16 hexadecimal digits.
+
+    Raises
+    ------
+    ValueError
+        For no package or a name that is not a robokit sub-package.
+
+    Notes
+    -----
+    Course convention; not from a paper.
+
+    Examples
+    --------
+    >>> len(source_digest("geometry")), source_digest("geometry") == source_digest("geometry", "sim")
+    (16, False)
+    """
+    root = Path(__file__).resolve().parent
+    if not packages:
+        raise ValueError("packages: expected at least one robokit sub-package name, got none")
+    digest = hashlib.sha256()
+    for package in packages:
+        if not isinstance(package, str) or not package.isidentifier() or not (root / package).is_dir():
+            raise ValueError(f"packages: expected robokit sub-package names, got {package!r}")
+        for source in sorted((root / package).glob("*.py")):
+            digest.update(package.encode() + b"/" + source.name.encode() + b"\0" + source.read_bytes())
+    return digest.hexdigest()[:16]
+

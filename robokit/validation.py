@@ -42,6 +42,7 @@ __all__ = [
     "MAX_SAMPLES",
     "as_rng",
     "describe",
+    "check_covariance",
 ]
 
 
@@ -466,3 +467,48 @@ def as_rng(rng: Any = None, name: str = "rng") -> np.random.Generator:
     if isinstance(rng, (numbers.Integral, np.integer)) and not isinstance(rng, bool) and int(rng) >= 0:
         return np.random.default_rng(int(rng))
     raise TypeError(f"{name}: expected a numpy Generator or a non-negative integer seed, got {describe(rng)}")
+
+
+def check_covariance(value: Any, name: str, n: int, *, semidefinite: bool = False) -> np.ndarray:
+    """Return ``value`` as a finite, symmetric, positive-definite ``(n, n)`` covariance matrix.
+
+    Parameters
+    ----------
+    value : array_like, shape (n, n)
+    name : str
+        Argument name used in error messages.
+    n : int
+        Dimension.
+    semidefinite : bool, default False
+        Accept a positive-semidefinite matrix (a process noise with zero rows, say).
+
+    Returns
+    -------
+    numpy.ndarray
+        The matrix, made exactly symmetric (the mean of it and its transpose).
+
+    Raises
+    ------
+    ValueError
+        For a wrong shape, NaN or infinity, an asymmetry beyond rounding (1e-9 relative), or a
+        negative (or, unless ``semidefinite``, zero) eigenvalue beyond rounding.
+
+    Examples
+    --------
+    >>> check_covariance([[1.0, 0.1], [0.1, 2.0]], "R", 2).tolist()
+    [[1.0, 0.1], [0.1, 2.0]]
+    >>> check_covariance([[1.0, 2.0], [2.0, 1.0]], "R", 2)
+    Traceback (most recent call last):
+    ...
+    ValueError: R: expected a positive-definite covariance, got an eigenvalue -1
+    """
+    M = as_array(value, name, shape=(n, n))
+    scale = float(np.abs(M).max(initial=0.0))
+    if not np.allclose(M, M.T, rtol=0.0, atol=1e-9 * scale):
+        raise ValueError(f"{name}: expected a symmetric covariance, got M[i, j] != M[j, i]")
+    M = 0.5 * (M + M.T)
+    low = float(np.linalg.eigvalsh(M)[0]) if n else 0.0
+    if low < -1e-12 * scale or (not semidefinite and low <= 1e-14 * scale):
+        kind = "positive-semidefinite" if semidefinite else "positive-definite"
+        raise ValueError(f"{name}: expected a {kind} covariance, got an eigenvalue {low:.3g}")
+    return M

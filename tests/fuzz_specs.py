@@ -77,6 +77,26 @@ def image_mask():
 
 
 @functools.cache
+def office_experiment():   # lesson 02's fast office setup (cached on disk after the first build)
+    from robokit.navigation.omni_experiment import office_setup
+    return office_setup(fast=True)
+
+
+def draw_figure(value):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(2, 1))
+    ax.plot([0, 1], [0, float(value)])
+    return fig
+
+
+def rec_nodes():
+    rng = np.random.default_rng(0)
+    return [rng.normal(size=(12, 8)) for _ in range(3)]
+
+
+@functools.cache
 def small_omni():
     from robokit.sim import OmniCamera
     return OmniCamera(width=160, height=120, face_size=60)
@@ -181,6 +201,22 @@ def landmark_map():      # map_consistency takes anything with positions, covari
                                  covariances=np.stack([1e-4 * np.eye(3)] * 2), observations=np.array([3, 1]))
 
 
+# lesson 02's path following, pose EKF and navigation
+KEY_POSES = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 1.0, 0.0]])
+EKF_X = np.array([0.0, 0.0, 0.3, 0.5, 0.2])
+
+
+@functools.cache
+def visual_path():
+    from robokit.controllers import path_from_poses
+    return path_from_poses(KEY_POSES)
+
+
+def localizer():
+    from robokit.navigation import gaussian_localizer
+    return gaussian_localizer()
+
+
 @functools.cache
 def run_results():
     from robokit.outdoor import simulate
@@ -240,6 +276,12 @@ def _sonar():
 def _truck():
     from robokit.outdoor import PAPER_TRUCK
     return PAPER_TRUCK
+
+
+@functools.cache
+def pose_graph():          # a small generated pose graph (30 poses, loop closures) for robokit.mapping
+    from robokit.mapping import manhattan_world_graph
+    return manhattan_world_graph(30, seed=1, closure_probability=1.0)[0]
 
 
 SPECS: dict[str, Call] = {
@@ -492,6 +534,97 @@ SPECS: dict[str, Call] = {
                                                "transforms": Array(lambda: lap().poses[:5], "N,3|N,4,4"), "fps": Real(10.0),
                                                "repetitions": Int(1)}),
     "robokit.viz.scene3d.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3")}),
+    # --- lesson 02: the assignment's plain-data references, the experiments, graphs and sliders ---
+    "robokit.exercises.omni_localization.fine_stage_counts": Call({
+        "query": Array(lambda: rec_nodes()[1][:4] + 0.01, "N,N", min_rows=0), "node_descriptors": Obj(rec_nodes),
+        "candidates": Array(np.array([0, 1, 2]), "N", min_rows=0), "ratio": Real(0.8)}),
+    "robokit.exercises.omni_localization.recognise_node": Call({
+        "query_histogram": Array(np.array([0.1, 0.9, 0.0]), "N"),
+        "query_descriptors": Array(lambda: rec_nodes()[1][:4] + 0.01, "N,N", min_rows=0),
+        "node_histograms": Array(np.eye(3), "N,N"), "node_descriptors": Obj(rec_nodes), "top_k": Int(2),
+        "ratio": Real(0.8)}),
+    "robokit.navigation.omni_experiment.office_setup": Call({"fast": Flag(True), "progress": Func(None, optional=True)},
+                                                            cheap=False),
+    "robokit.navigation.omni_experiment.localization_trials": Call({
+        "setup": Obj(office_experiment), "places": Array(np.array([[13.0, 3.7, 2.0]]), "N,3"),
+        "modes": Given(("coarse",)), "map": Choice("relaxed"), "rng": Rng(0), "progress": Func(None, optional=True)},
+        cheap=False),
+    "robokit.navigation.omni_experiment.route_recognition": Call({
+        "setup": Obj(office_experiment), "n_nodes": Int(2), "offset": Real(0.15), "same_place": Real(0.5),
+        "rng": Rng(1)}, cheap=False),
+    "robokit.navigation.omni_experiment.navigation_trials": Call({
+        "setup": Obj(office_experiment), "n_starts": Int(1), "first_node": Int(0, optional=True),
+        "n_path_nodes": Int(3), "clearance": Real(0.3), "fix_period": Real(1.0), "alpha": Real(2.0),
+        "offset": Real(0.3), "heading": Real(0.3), "max_time": Real(3.0, optional=True), "localize": Func(localizer, optional=True),
+        "seed": Int(3), "cache": Flag(False), "progress": Func(None, optional=True)}, cheap=False),
+    "robokit.viz.maps.plot_graph": Call({
+        "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]), "N,3"),
+        "edges": Array(np.array([[0, 1], [1, 2]]), "N,2", min_rows=0), "ax": Given(axes),
+        "label": Text("map", optional=True),
+        "highlight": Array(np.array([False, True]), "N", optional=True, accepts=("booleans",)), "kwargs": Given({})}),
+    "robokit.viz.scene3d.add_graph": Call({
+        "scene": Obj(scene), "path": Text("map"),
+        "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]), "N,3"),
+        "edges": Array(np.array([[0, 1], [1, 2]]), "N,2", min_rows=0), "z": Real(0.05), "node_color": Given(0x2255CC),
+        "edge_color": Given(0x2255CC), "size": Real(0.12)}),
+    "robokit.viz.widgets.slider": Call({"draw": Func(lambda: draw_figure), "values": Given([1.0, 2.0]), "label": Text("k"),
+                                        "fmt": Text("{}"), "start": Int(0)}, cheap=False),
+    # --- lesson 02: controllers.path_following(_loop), localization.pose_ekf, navigation.visual_path --------
+    "robokit.controllers.path_geometry.VisualPath": Call({
+        "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), "N,3"),
+        "s": Array(np.array([0.0, 1.0, 2.0]), "N"), "curvature": Array(np.zeros(3), "N"),
+        "key_poses": Array(np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), "N,3", optional=True)}),
+    "robokit.controllers.path_geometry.path_from_poses": Call({"poses": Array(KEY_POSES, "N,3"), "spacing": Real(0.1)}),
+    "robokit.controllers.path_geometry.reference_point": Call({
+        "path": Obj(visual_path), "pose": Array(np.array([1.0, 0.2, 0.1]), "3"), "previous": Int(5, optional=True),
+        "window": Real(1.0, optional=True), "check": Flag(True)}),
+    "robokit.controllers.path_following.path_following_gains": Call({"alpha": Real(2.0), "xi": Real(0.7)}),
+    "robokit.controllers.path_following.path_following_command": Call({
+        "d": Array(np.array([0.1, -0.2]), "*"), "theta_tilde": Array(np.array([0.1, 0.0]), "*"),
+        "curvature": Array(np.array([0.0, 0.5]), "*"), "v": Array(np.array([0.3, 0.3]), "*"), "k2": Real(4.0),
+        "k3": Real(2.8), "check": Flag(True)}),
+    "robokit.controllers.path_following.saturate_command": Call({
+        "v": Array(np.array([0.3, 0.3]), "*"), "omega": Array(np.array([2.0, 0.1]), "*"), "v_max": Real(0.3),
+        "w_max": Real(0.5), "check": Flag(True)}),
+    "robokit.controllers.path_following.PathFollower": Call({
+        "path": Obj(visual_path), "alpha": Real(2.0), "v_max": Real(0.3), "w_max": Real(1.0), "xi": Real(0.7),
+        "goal_tolerance": Real(0.1), "window": Real(1.0, optional=True)}),
+    "robokit.controllers.path_following_loop.path_following_linearisation": Call({"alpha": Real(2.0), "v": Real(0.3),
+                                                                                  "xi": Real(0.7)}),
+    "robokit.controllers.path_following_loop.path_following_poles": Call({"alpha": Real(2.0), "v": Real(0.3), "xi": Real(0.7)}),
+    "robokit.controllers.path_following_loop.path_following_damping": Call({"alpha": Real(2.0), "v": Real(0.3),
+                                                                            "xi": Real(0.7)}),
+    "robokit.controllers.path_following_loop.lateral_step_response": Call({
+        "alpha": Real(2.0), "v": Real(0.3), "t": Array(np.linspace(0.0, 5.0, 11), "N", optional=True), "xi": Real(0.7),
+        "offset": Real(0.1)}),
+    "robokit.controllers.path_following_loop.simulate_path_following": Call({
+        "path": Obj(visual_path), "start_pose": Array(np.array([0.0, 0.1, 0.0]), "3"), "alpha": Real(2.0),
+        "v": Real(0.3), "duration": Real(2.0), "dt": Real(0.1), "w_max": Real(1.0, optional=True), "xi": Real(0.7)}),
+    "robokit.localization.pose_ekf.unicycle_jacobian": Call({"x": Array(EKF_X, "5"), "dt": Real(0.1), "check": Flag(True)}),
+    "robokit.localization.pose_ekf.unicycle_process_noise": Call({
+        "x": Array(EKF_X, "5"), "dt": Real(0.1), "sigma_accel": Real(0.5), "sigma_alpha": Real(1.0), "check": Flag(True)}),
+    "robokit.localization.pose_ekf.ekf_predict": Call({
+        "x": Array(EKF_X, "5"), "P": Array(np.eye(5) * 0.01, "5,5"), "dt": Real(0.1),
+        "Q": Array(np.eye(5) * 1e-4, "5,5"), "check": Flag(True)}),
+    "robokit.localization.pose_ekf.ekf_update": Call({
+        "x": Array(EKF_X, "N"), "P": Array(np.eye(5) * 0.01, "N,N"), "z": Array(np.array([0.1, 0.2, 3.1]), "N"),
+        "H": Array(np.eye(3, 5), "N,N"), "R": Array(np.eye(3) * 0.01, "N,N"), "angles": Obj((2,)), "check": Flag(True)}),
+    "robokit.localization.pose_ekf.nees": Call({"error": Array(np.array([0.1, -0.2]), "N|N,N"),
+                                                "P": Array(np.diag([0.01, 0.04]), "N,N|N,N,N")}),
+    "robokit.localization.pose_ekf.nees_bounds": Call({"dof": Int(5), "runs": Int(50), "confidence": Real(0.95)}),
+    "robokit.localization.pose_ekf.UnicycleEKF": Call({
+        "x0": Array(EKF_X, "5"), "P0": Array(np.eye(5) * 0.01, "5,5"), "sigma_accel": Real(0.5), "sigma_alpha": Real(1.0)}),
+    "robokit.navigation.visual_path.gaussian_localizer": Call({
+        "noise": Array(np.array([0.1, 0.15, 0.05]), "3"), "dropout": Real(0.1), "outlier_rate": Real(0.1),
+        "outlier_offset": Real(2.0)}),
+    "robokit.navigation.visual_path.perturbed_starts": Call({
+        "path": Obj(visual_path), "n": Int(3), "offset": Real(0.3), "heading": Real(0.3), "rng": Rng(0)}),
+    "robokit.navigation.visual_path.follow_path": Call({
+        "path": Obj(visual_path), "start_pose": Array(np.array([0.0, 0.1, 0.0]), "3"), "localize": Func(localizer),
+        "dt": Real(0.1), "fix_period": Real(0.5), "alpha": Real(2.0), "v_max": Real(0.3), "w_max": Real(1.0),
+        "xi": Real(0.7), "goal_tolerance": Real(0.1), "odometry_noise": Array(np.array([0.01, 0.02]), "2"),
+        "sigma_fix": Array(np.array([0.1, 0.15, 0.05]), "3"), "sigma_odometry": Array(np.array([0.01, 0.02]), "2", optional=True),
+        "gate": Real(16.0, optional=True), "relocalize_after": Int(3), "max_time": Real(3.0, optional=True), "rng": Rng(0)}),
     # --- robokit.vision.colour (lesson 02: HSI hue histograms) --------------------------------
     "robokit.vision.colour.rgb_to_hsi": Call({"image": Array(image, "...,3|...,4")}),
     "robokit.vision.colour.hue_mask": Call({"image": Array(image, "N,N,3|N,N,4"), "min_saturation": Real(0.15),
@@ -538,6 +671,42 @@ SPECS: dict[str, Call] = {
         "world": Obj(office), "camera": Obj(small_omni), "pose1": Array(np.array([12.0, 3.5, 0.0]), "3"),
         "pose2": Array(np.array([12.2, 3.5, 0.5]), "3"), "orientation": Choice("radial"), "ratio": Real(0.8),
         "tol": Real(3.0), "method": Choice("kdtree")}, cheap=False),
+    # --- mapping: pose graphs (pose_graph, pose_graph_optimize, relaxation, g2o, manhattan) ------
+    "robokit.mapping.pose_graph.PoseGraph": Call({
+        "poses": Array(lambda: pose_graph().poses, "N,3"), "edges": Array(lambda: pose_graph().edges, "N,2", min_rows=0),
+        "measurements": Array(lambda: pose_graph().measurements, "N,3"),
+        "information": Array(lambda: pose_graph().information, "N,3,3", optional=True),
+        "ids": Array(lambda: pose_graph().ids, "N", optional=True), "fixed": Int(0)}),
+    "robokit.mapping.pose_graph.edge_variances": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.pose_graph.unreachable_nodes": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.pose_graph.is_connected": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.pose_graph.check_connected": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.pose_graph.pose_graph_from_odometry": Call({
+        "odometry_poses": Array(lambda: pose_graph().poses[:6], "N,3"),
+        "loop_edges": Array(np.array([[5, 0]]), "N,2", optional=True, min_rows=0),
+        "loop_measurements": Array(np.array([[0.1, 0.0, 0.2]]), "N,3", optional=True),
+        "sigma_odometry": Array(np.array([0.1, 0.1, 0.05]), "|3|N,3"), "sigma_loop": Array(np.array([0.2, 0.2, 0.1]), "|3|N,3")}),
+    "robokit.mapping.pose_graph_optimize.pose_graph_residuals": Call({"graph": Obj(pose_graph),
+                                                             "poses": Array(lambda: pose_graph().poses, "N,3", optional=True)}),
+    "robokit.mapping.pose_graph_optimize.pose_graph_cost": Call({"graph": Obj(pose_graph),
+                                                        "poses": Array(lambda: pose_graph().poses, "N,3", optional=True)}),
+    "robokit.mapping.pose_graph_optimize.pose_graph_jacobian": Call({"graph": Obj(pose_graph),
+                                                            "poses": Array(lambda: pose_graph().poses, "N,3", optional=True)}),
+    "robokit.mapping.pose_graph_optimize.optimize_pose_graph": Call({
+        "graph": Obj(pose_graph), "method": Choice("gauss-newton"), "max_iterations": Int(20), "tolerance": Real(1e-9)}),
+    "robokit.mapping.relaxation.relax": Call({"graph": Obj(pose_graph), "max_iterations": Int(50), "tolerance": Real(1e-6),
+                                              "variances": Array(lambda: np.full(30, 0.01), "N", optional=True)}),
+    "robokit.mapping.relaxation.relax_sweep": Call({
+        "poses": Array(lambda: pose_graph().poses, "N,3"), "variances": Array(lambda: np.full(30, 0.01), "N"),
+        "edges": Array(lambda: pose_graph().edges, "N,2"), "measurements": Array(lambda: pose_graph().measurements, "N,3"),
+        "edge_variances": Array(lambda: np.full(pose_graph().n_edges, 0.02), "N"), "fixed": Int(0)}),
+    "robokit.mapping.relaxation.initial_variances": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.g2o.read_g2o": Call({"source": Text("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n"
+                                                         "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n")}),
+    "robokit.mapping.g2o.write_g2o": Call({"graph": Obj(pose_graph), "path": Text(None, optional=True)}),
+    "robokit.mapping.manhattan.manhattan_world_graph": Call({
+        "n_poses": Int(40), "seed": Int(0), "noise": Array(np.array([0.05, 0.05, 0.01]), "|3"), "extent": Int(5),
+        "closure_probability": Real(0.6), "min_gap": Int(10)}),
     # --- lesson 02's topological map and hierarchical localization (helper D) -----------------
     "robokit.geometry.planar.fit_se2": Call({"source": Array(lambda: points(6)[:, :2], "N,2|N,N,2"),
                                              "target": Array(lambda: points(6)[:, :2] + 1.0, "N,2|N,N,2"),
@@ -617,32 +786,64 @@ NOT_FUZZED: dict[str, str] = {
 
 #: Besides the lessons' API: the exercises' references (students reproduce their contracts) and
 #: the functions the issue's fuzz named.
-EXTRA: tuple[str, ...] = ("robokit.sim.vehicle.unicycle_step",
-                          # robokit.vision.colour (lesson 02)
-                          "robokit.vision.colour.rgb_to_hsi", "robokit.vision.colour.hue_mask",
-                          "robokit.vision.colour.hue_histogram", "robokit.vision.colour.hue_histogram_opencv",
-                          "robokit.vision.colour.histogram_distance", "robokit.vision.colour.histogram_intersection",
-                          # robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02)
-                          "robokit.vision.omni_features.omni_sift", "robokit.vision.omni_features.annulus_mask",
-                          "robokit.vision.omni_features.radial_orientation", "robokit.vision.matching.DescriptorIndex",
-                          "robokit.vision.matching.ratio_test", "robokit.vision.descriptors.detect_sift_features",
-                          "robokit.sim.feature_check.omni_ground_truth_inliers",
-                          "robokit.sim.feature_check.omni_view_pair",
-                          # lesson 02's topological map and hierarchical localization (helper D)
-                          "robokit.geometry.planar.fit_se2", "robokit.geometry.planar.intersect_lines",
-                          "robokit.vision.ransac.ransac_sample_count",
-                          "robokit.vision.ransac.ransac_se2", "robokit.vision.spherical.essential_from_bearings",
-                          "robokit.vision.spherical.epipolar_error", "robokit.vision.spherical.ransac_essential",
-                          "robokit.vision.spherical.decompose_essential", "robokit.vision.spherical.floor_points",
-                          "robokit.sim.motion.office_tour", "robokit.sim.motion.increment_variances",
-                          "robokit.sim.motion.odometry_covariance",
-                          "robokit.mapping.topological_build.appearance_changed",
-                          "robokit.mapping.topological_build.local_map_full",
-                          "robokit.mapping.topological_build.select_key_frames",
-                          "robokit.mapping.topological_build.build_topological_map",
-                          "robokit.mapping.omni_views.omni_view", "robokit.mapping.omni_views.check_omni_image",
-                          "robokit.mapping.omni_views.relative_pose", "robokit.mapping.topological.TopologicalMap",
-                          "robokit.localization.hierarchical.HierarchicalLocalizer")
+EXTRA: tuple[str, ...] = (
+    "robokit.sim.vehicle.unicycle_step",
+    # lesson 02 (path following, pose EKF, navigation), fuzzed before the lesson exists
+    *(f"robokit.controllers.path_geometry.{n}" for n in ("VisualPath", "path_from_poses", "reference_point")),
+    *(f"robokit.controllers.path_following.{n}" for n in (
+        "path_following_gains", "path_following_command", "saturate_command", "PathFollower")),
+    *(f"robokit.controllers.path_following_loop.{n}" for n in (
+        "path_following_linearisation", "path_following_poles", "path_following_damping", "lateral_step_response",
+        "simulate_path_following")),
+    *(f"robokit.localization.pose_ekf.{n}" for n in (
+        "unicycle_jacobian", "unicycle_process_noise", "ekf_predict", "ekf_update", "nees", "nees_bounds", "UnicycleEKF")),
+    *(f"robokit.navigation.visual_path.{n}" for n in ("gaussian_localizer", "perturbed_starts", "follow_path")),
+    # robokit.vision.colour (lesson 02)
+    "robokit.vision.colour.rgb_to_hsi", "robokit.vision.colour.hue_mask",
+    "robokit.vision.colour.hue_histogram", "robokit.vision.colour.hue_histogram_opencv",
+    "robokit.vision.colour.histogram_distance", "robokit.vision.colour.histogram_intersection",
+    # robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02)
+    "robokit.vision.omni_features.omni_sift", "robokit.vision.omni_features.annulus_mask",
+    "robokit.vision.omni_features.radial_orientation", "robokit.vision.matching.DescriptorIndex",
+    "robokit.vision.matching.ratio_test", "robokit.vision.descriptors.detect_sift_features",
+    "robokit.sim.feature_check.omni_ground_truth_inliers",
+    "robokit.sim.feature_check.omni_view_pair",
+    # robokit.mapping's pose graphs (lesson 02), fuzzed before the lesson exists
+    "robokit.mapping.pose_graph.PoseGraph", "robokit.mapping.pose_graph.edge_variances",
+    "robokit.mapping.pose_graph.unreachable_nodes", "robokit.mapping.pose_graph.is_connected",
+    "robokit.mapping.pose_graph.check_connected", "robokit.mapping.pose_graph.pose_graph_from_odometry",
+    "robokit.mapping.pose_graph_optimize.pose_graph_residuals", "robokit.mapping.pose_graph_optimize.pose_graph_cost",
+    "robokit.mapping.pose_graph_optimize.pose_graph_jacobian",
+    "robokit.mapping.pose_graph_optimize.optimize_pose_graph", "robokit.mapping.relaxation.relax",
+    "robokit.mapping.relaxation.relax_sweep", "robokit.mapping.relaxation.initial_variances",
+    "robokit.mapping.g2o.read_g2o", "robokit.mapping.g2o.write_g2o",
+    "robokit.mapping.manhattan.manhattan_world_graph",
+    # robokit.vision.colour (lesson 02)
+    "robokit.vision.colour.rgb_to_hsi", "robokit.vision.colour.hue_mask",
+    "robokit.vision.colour.hue_histogram", "robokit.vision.colour.hue_histogram_opencv",
+    "robokit.vision.colour.histogram_distance", "robokit.vision.colour.histogram_intersection",
+    # robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02)
+    "robokit.vision.omni_features.omni_sift", "robokit.vision.omni_features.annulus_mask",
+    "robokit.vision.omni_features.radial_orientation", "robokit.vision.matching.DescriptorIndex",
+    "robokit.vision.matching.ratio_test", "robokit.vision.descriptors.detect_sift_features",
+    "robokit.sim.feature_check.omni_ground_truth_inliers",
+    "robokit.sim.feature_check.omni_view_pair",
+    # lesson 02's topological map and hierarchical localization (helper D)
+    "robokit.geometry.planar.fit_se2", "robokit.geometry.planar.intersect_lines",
+    "robokit.vision.ransac.ransac_sample_count",
+    "robokit.vision.ransac.ransac_se2", "robokit.vision.spherical.essential_from_bearings",
+    "robokit.vision.spherical.epipolar_error", "robokit.vision.spherical.ransac_essential",
+    "robokit.vision.spherical.decompose_essential", "robokit.vision.spherical.floor_points",
+    "robokit.sim.motion.office_tour", "robokit.sim.motion.increment_variances",
+    "robokit.sim.motion.odometry_covariance",
+    "robokit.mapping.topological_build.appearance_changed",
+    "robokit.mapping.topological_build.local_map_full",
+    "robokit.mapping.topological_build.select_key_frames",
+    "robokit.mapping.topological_build.build_topological_map",
+    "robokit.mapping.omni_views.omni_view", "robokit.mapping.omni_views.check_omni_image",
+    "robokit.mapping.omni_views.relative_pose", "robokit.mapping.topological.TopologicalMap",
+    "robokit.localization.hierarchical.HierarchicalLocalizer",
+)
 
 
 def resolve(dotted: str) -> Callable[..., Any]:

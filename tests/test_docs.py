@@ -18,7 +18,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-TOPICS = ("geometry", "sim", "vision", "mapping", "localization", "controllers", "legged", "outdoor", "arm")
+TOPICS = ("geometry", "sim", "vision", "mapping", "localization", "controllers", "legged", "outdoor", "arm",
+          "navigation")
 _CITATION = re.compile(r"et al\.|\b(19|20)\d\d\b")
 
 

@@ -1,17 +1,31 @@
 """Control loops designed and checked with python-control (named so it never shadows ``control``).
 
-Layer: below the system lessons (``outdoor``, ``legged``); imports only ``geometry``,
-``validation`` and python-control.
+Layer: below the system lessons (``outdoor``, ``legged``) and ``navigation``; imports ``geometry``,
+``validation``, ``sim`` (the one unicycle model) and python-control.
 
-heading       the heading servo of a skid-steer vehicle: pole-placement gains for an overshoot and
-              settling time, and the discrete controller (lesson 05; re-exported by
-              :mod:`robokit.outdoor`)
-heading_loop  that loop as transfer functions: plant, closed loop, loop gain, step and frequency
-              response, margins (no exercise reference: graded notebooks may import it)
+heading              the heading servo of a skid-steer vehicle: pole-placement gains for an overshoot
+                     and settling time, and the discrete controller (lesson 05; re-exported by
+                     :mod:`robokit.outdoor`)
+heading_loop         that loop as transfer functions: plant, closed loop, loop gain, step and
+                     frequency response, margins (no exercise reference: graded notebooks may import it)
+path_geometry        lesson 02's path: a smooth curve through recorded key poses with continuous
+                     curvature, its nearest point (Eq. (7)) and the errors d, theta_tilde
+path_following       the law of Eq. (8), its gains, saturation keeping the curvature, the follower
+path_following_loop  Eq. (8) linearised about the path: poles, damping, step response (python-control),
+                     and the nonlinear simulation beside it
 """
 from .heading import HeadingController, design_heading_gains
 from .heading_loop import (heading_closed_loop, heading_frequency_response, heading_loop_gain, heading_plant,
                            heading_step_response, loop_metrics)
+from .path_following import (PathFollower, PathSingularityError, path_following_command, path_following_gains,
+                             saturate_command)
+from .path_geometry import ReferencePoint, VisualPath, path_from_poses, reference_point
+from .path_following_loop import (FollowTrace, lateral_step_response, path_following_damping,
+                                  path_following_linearisation, path_following_poles, simulate_path_following)
 
 __all__ = ["HeadingController", "design_heading_gains", "heading_closed_loop", "heading_frequency_response",
-           "heading_loop_gain", "heading_plant", "heading_step_response", "loop_metrics"]
+           "heading_loop_gain", "heading_plant", "heading_step_response", "loop_metrics",
+           "PathFollower", "PathSingularityError", "ReferencePoint", "VisualPath", "path_following_command",
+           "path_following_gains", "path_from_poses", "reference_point", "saturate_command",
+           "FollowTrace", "lateral_step_response", "path_following_damping", "path_following_linearisation",
+           "path_following_poles", "simulate_path_following"]

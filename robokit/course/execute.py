@@ -6,7 +6,7 @@ kernel with nbclient; the parent enforces a wall-clock limit on the whole notebo
 worker's process group (kernel included) when it is exceeded, so a hanging notebook is reported as
 ``timeout`` and never blocks the others. Every kernel runs with:
 
-* ``ROBOKIT_FAST`` set as requested (``1`` under tests),
+* ``ROBOKIT_FAST`` set as requested (``1`` under tests), ``ROBOKIT_HEADLESS=1``,
 * its working directory a fresh temporary directory,
 * a private ``IPYTHONDIR`` whose startup file installs :mod:`robokit.course.netguard`,
 * ``PYTHONHASHSEED=0`` for reproducible ordering.
@@ -76,6 +76,7 @@ def _kernel_env(workdir: Path, fast: bool) -> dict[str, str]:
     env = dict(os.environ)
     env.update(
         ROBOKIT_FAST="1" if fast else "0",
+        ROBOKIT_HEADLESS="1",  # sliders show their pre-computed static form (robokit.viz.slider)
         IPYTHONDIR=str(ipydir),
         PYTHONHASHSEED="0",
         JUPYTER_PLATFORM_DIRS="1",

@@ -5,8 +5,8 @@
 ``[p, q, theta]`` acting on points (``pqt_robot_to_world``, ``pqt_transform_xz`` ...) is in
 :mod:`robokit.geometry`. Never imports ``viz``; only the topological map uses ``sim`` (below).
 
-Pose graphs (lesson 02's loop-closure alignment): :mod:`.pose_graph` (the graph, its residuals,
-cost and Jacobian, a builder from odometry), :mod:`.pose_graph_optimize` (least squares),
+Pose graphs (lesson 02's loop-closure alignment): :mod:`.pose_graph` (the graph, its connectivity,
+a builder from odometry), :mod:`.pose_graph_optimize` (g2o's error, cost and Jacobian; least squares),
 :mod:`.relaxation` (the paper's relaxation, after Duckett et al.), :mod:`.g2o` (the g2o file format)
 and :mod:`.manhattan` (generated graphs with ground truth).
 
@@ -20,21 +20,22 @@ renderer.
 from .g2o import G2OFormatError, read_g2o, write_g2o
 from .landmarks import LandmarkMap, kalman_fuse, transform_covariance
 from .manhattan import manhattan_world_graph
+from .pose_graph import (DisconnectedGraphError, PoseGraph, as_pose_graph, check_connected, edge_variances, is_connected,
+                         pose_graph_from_odometry, positive_definite, unreachable_nodes)
+from .pose_graph_optimize import (PoseGraphResult, optimize_pose_graph, pose_graph_cost, pose_graph_jacobian,
+                                  pose_graph_residuals)
 from .omni_views import OmniView, RelativePose, check_omni_image, omni_view, relative_pose
-from .pose_graph import (DisconnectedGraphError, PoseGraph, check_connected, edge_variances, is_connected,
-                         pose_graph_cost, pose_graph_from_odometry, pose_graph_jacobian, pose_graph_residuals,
-                         unreachable_nodes)
-from .pose_graph_optimize import PoseGraphResult, optimize_pose_graph
 from .relaxation import RelaxationResult, initial_variances, relax, relax_sweep
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
 from .topological_build import (Comparison, appearance_changed, build_topological_map, local_map_full,
                                 select_key_frames)
 
 __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
-           "PoseGraph", "DisconnectedGraphError", "edge_variances", "unreachable_nodes", "is_connected",
-           "check_connected", "pose_graph_from_odometry", "pose_graph_residuals", "pose_graph_cost",
-           "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph", "RelaxationResult", "relax", "relax_sweep", "initial_variances", "G2OFormatError",
-           "read_g2o", "write_g2o", "manhattan_world_graph",
+           "PoseGraph", "DisconnectedGraphError", "as_pose_graph", "positive_definite", "edge_variances", "unreachable_nodes",
+           "is_connected", "check_connected", "pose_graph_from_odometry",
+           "pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph",
+           "RelaxationResult", "relax", "relax_sweep", "initial_variances",
+           "G2OFormatError", "read_g2o", "write_g2o", "manhattan_world_graph",
            "OmniView", "RelativePose", "check_omni_image", "omni_view", "relative_pose",
            "LOOP_EDGE", "ODOMETRY_EDGE", "EmptyMapError", "TopologicalMap", "Comparison", "appearance_changed",
            "build_topological_map", "local_map_full", "select_key_frames"]

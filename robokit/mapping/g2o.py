@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..validation import check_text, describe
-from .pose_graph import PoseGraph
+from .pose_graph import PoseGraph, as_pose_graph, positive_definite
 
 __all__ = ["G2OFormatError", "read_g2o", "write_g2o"]
 
@@ -194,11 +194,10 @@ def read_g2o(source: Any) -> PoseGraph:
     information = np.zeros((len(upper), 3, 3))
     information[:, _UPPER[0], _UPPER[1]] = np.array(upper).reshape(-1, 6)
     information[:, _UPPER[1], _UPPER[0]] = np.array(upper).reshape(-1, 6)
-    low = np.linalg.eigvalsh(information)[:, 0] if len(upper) else np.zeros(0)
-    bad = np.flatnonzero(~(low > 0))
+    bad = np.flatnonzero(~positive_definite(information))
     if bad.size:
-        raise G2OFormatError(where, edge_lines[bad[0]], f"EDGE_SE2: information matrix is not positive definite "
-                                                        f"(smallest eigenvalue {low[bad[0]]:.3g})")
+        raise G2OFormatError(where, edge_lines[bad[0]], "EDGE_SE2: information matrix is not positive definite "
+                                                        f"(eigenvalues {np.linalg.eigvalsh(information[bad[0]])})")
     if fixed is not None and fixed[0] not in index:
         raise G2OFormatError(where, fixed[1], f"FIX: vertex {fixed[0]} has no VERTEX_SE2 line")
     return PoseGraph(np.array(poses), edges, np.array(measurements).reshape(-1, 3), information,
@@ -239,8 +238,7 @@ def write_g2o(graph: PoseGraph, path: Any = None) -> str:
     EDGE_SE2 0 1 1.0 0.0 0.1 4.0 0.0 0.0 4.0 0.0 9.0
     FIX 0
     """
-    if not isinstance(graph, PoseGraph):
-        raise TypeError(f"graph: expected a PoseGraph, got {type(graph).__name__}")
+    as_pose_graph(graph)
     if path is not None and not isinstance(path, os.PathLike):
         check_text(path, "path", empty=False)
 

@@ -1,4 +1,4 @@
-"""Planar pose graphs: the graph, its residuals, cost and sparse Jacobian, and a builder from odometry.
+"""Planar pose graphs: the validated graph, its connectivity, and a builder from odometry.
 
 A pose graph (Lu & Milios 1997) has one node per robot pose ``[x, y, theta]`` and one edge per
 measured relative pose: the pose of node ``j`` in the frame of node ``i``, ``[dx, dy, dtheta]``,
@@ -8,18 +8,10 @@ its nodes are the base references ``B_i`` of the local maps and its edges the re
 writes planar poses ``(x, z, theta)``; robokit writes them ``[x, y, theta]`` (x, y in metres, theta
 in radians counter-clockwise from +x).
 
-The error of an edge is the one of g2o (Kummerle et al. 2011; Grisetti et al. 2010), the pose of
-``j`` relative to ``i`` compared with the measurement in the measurement's frame::
-
-    e_ij = t2v(Z_ij^-1 X_i^-1 X_j) = se2_between(z_ij, se2_between(pose_i, pose_j))   (angle wrapped)
-
-and the cost is ``chi2 = sum_ij e_ij^T Omega_ij e_ij`` (Kummerle et al. 2011, Eq. (1)). gtsam's
-``BetweenFactorPose2`` uses the SE(2) logarithm of the same ``Z^-1 X_i^-1 X_j`` instead of its
-``[x, y, theta]``; the two agree to second order in the error, so their optima differ slightly.
-
-The solvers are :func:`robokit.mapping.optimize_pose_graph` (least squares) and
-:func:`robokit.mapping.relax` (the paper's relaxation); files in the g2o format are read and
-written by :mod:`robokit.mapping.g2o`.
+The least-squares error, cost and Jacobian and their solvers are in
+:mod:`robokit.mapping.pose_graph_optimize`, the paper's relaxation in
+:mod:`robokit.mapping.relaxation`, files in the g2o format in :mod:`robokit.mapping.g2o`, and
+generated graphs with ground truth in :mod:`robokit.mapping.manhattan`.
 
 References
 ----------
@@ -27,10 +19,6 @@ References
    navigation" (the lesson's source paper; our copy gives no authors, venue or year).
 .. [2] F. Lu and E. Milios, "Globally consistent range scan alignment for environment mapping",
    *Autonomous Robots* 4(4), 333-349, 1997.
-.. [3] R. Kummerle, G. Grisetti, H. Strasdat, K. Konolige and W. Burgard, "g2o: A general framework
-   for graph optimization", Proc. IEEE Int. Conf. on Robotics and Automation (ICRA), 3607-3613, 2011.
-.. [4] G. Grisetti, R. Kummerle, C. Stachniss and W. Burgard, "A tutorial on graph-based SLAM",
-   *IEEE Intelligent Transportation Systems Magazine* 2(4), 31-43, 2010.
 """
 from __future__ import annotations
 
@@ -42,11 +30,10 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..geometry import se2_between
-from ..validation import as_array, check_finite_result, check_int
+from ..validation import as_array, check_int
 
-__all__ = ["PoseGraph", "DisconnectedGraphError", "edge_variances", "unreachable_nodes", "is_connected",
-           "check_connected", "pose_graph_from_odometry", "pose_graph_residuals", "pose_graph_cost",
-           "pose_graph_jacobian"]
+__all__ = ["PoseGraph", "DisconnectedGraphError", "as_pose_graph", "positive_definite", "edge_variances", "unreachable_nodes",
+           "is_connected", "check_connected", "pose_graph_from_odometry"]
 
 
 class DisconnectedGraphError(ValueError):
@@ -175,32 +162,65 @@ class PoseGraph:
         return len(self.edges)
 
 
+def positive_definite(information: np.ndarray) -> np.ndarray:
+    """Which of a stack of symmetric 3 x 3 matrices are positive definite (all eigenvalues > 0).
+
+    Parameters
+    ----------
+    information : numpy.ndarray, shape (M, 3, 3)
+        Symmetric, finite (unchecked: the callers validated it).
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (M,)
+
+    Notes
+    -----
+    The condition for a Gaussian measurement's information matrix (e.g. Kummerle et al. 2011).
+
+    Examples
+    --------
+    >>> positive_definite(np.stack([np.eye(3), np.diag([1.0, 1.0, 0.0])])).tolist()
+    [True, False]
+    """
+    if len(information) == 0:
+        return np.zeros(0, bool)
+    return np.linalg.eigvalsh(information)[:, 0] > 0
+
+
 def _symmetric_positive_definite(info: np.ndarray) -> np.ndarray:
-    scale = np.maximum(np.abs(info).max(axis=(1, 2)), 1.0)
+    scale = np.maximum(np.abs(info).max(axis=(1, 2)), 1.0) if len(info) else np.zeros(0)
     asym = np.abs(info - np.swapaxes(info, 1, 2)).max(axis=(1, 2)) if len(info) else np.zeros(0)
     bad = np.flatnonzero(asym > 1e-9 * scale)
     if bad.size:
         raise ValueError(f"information: expected symmetric matrices, row {bad[0]} differs from its transpose by "
                          f"{asym[bad[0]]:.3g}")
     info = 0.5 * (info + np.swapaxes(info, 1, 2))
-    low = np.linalg.eigvalsh(info)[:, 0] if len(info) else np.zeros(0)
-    bad = np.flatnonzero(~(low > 0))
+    bad = np.flatnonzero(~positive_definite(info))
     if bad.size:
         raise ValueError(f"information: expected positive-definite matrices, row {bad[0]} has smallest eigenvalue "
-                         f"{low[bad[0]]:.3g} (a variance that is zero, negative or infinite)")
+                         f"{np.linalg.eigvalsh(info[bad[0]])[0]:.3g} (a variance that is zero, negative or infinite)")
     return info
 
 
-def _graph(graph: Any, name: str = "graph") -> PoseGraph:
+def as_pose_graph(graph: Any) -> PoseGraph:
+    """Return ``graph`` if it is a :class:`PoseGraph` (the argument check of every solver).
+
+    Raises
+    ------
+    TypeError
+        Naming the argument ``graph`` and what came instead.
+
+    Examples
+    --------
+    >>> as_pose_graph("map.g2o")
+    Traceback (most recent call last):
+    ...
+    TypeError: graph: expected a PoseGraph (read a g2o file with read_g2o), got str
+    """
     if not isinstance(graph, PoseGraph):
-        raise TypeError(f"{name}: expected a PoseGraph, got {type(graph).__name__}")
+        raise TypeError(f"graph: expected a PoseGraph (read a g2o file with read_g2o), got {type(graph).__name__}")
     return graph
-
-
-def _poses(poses: Any, graph: PoseGraph) -> np.ndarray:
-    if poses is None:
-        return graph.poses
-    return as_array(poses, "poses", shape=(graph.n_poses, 3))
 
 
 def edge_variances(graph: PoseGraph) -> np.ndarray:
@@ -230,7 +250,7 @@ def edge_variances(graph: PoseGraph) -> np.ndarray:
     >>> print(np.round(edge_variances(g), 6))           # (0.01 + 0.04) / 2
     [0.025]
     """
-    g = _graph(graph)
+    g = as_pose_graph(graph)
     cov = np.linalg.inv(g.information) if g.n_edges else np.zeros((0, 3, 3))
     return 0.5 * (cov[:, 0, 0] + cov[:, 1, 1])
 
@@ -259,7 +279,7 @@ def unreachable_nodes(graph: PoseGraph) -> np.ndarray:
     >>> unreachable_nodes(g).tolist()
     [2, 3]
     """
-    g = _graph(graph)
+    g = as_pose_graph(graph)
     n = g.n_poses
     adjacency = sp.coo_matrix((np.ones(g.n_edges), (g.edges[:, 0], g.edges[:, 1])), shape=(n, n))
     _, labels = connected_components(adjacency, directed=False)
@@ -290,9 +310,10 @@ def check_connected(graph: PoseGraph) -> None:
     >>> check_connected(PoseGraph(np.zeros((3, 3)), [[0, 1]], [[1.0, 0.0, 0.0]], ids=[10, 11, 12]))
     Traceback (most recent call last):
     ...
-    robokit.mapping.pose_graph.DisconnectedGraphError: graph: expected a connected pose graph, but 1 node (vertex ids 12) cannot be reached from the fixed node (vertex id 10)
+    robokit.mapping.pose_graph.DisconnectedGraphError: graph: expected a connected pose graph, but 1 node (vertex
+    ids 12) cannot be reached from the fixed node (vertex id 10)
     """
-    g = _graph(graph)
+    g = as_pose_graph(graph)
     bad = unreachable_nodes(g)
     if bad.size:
         shown = ", ".join(str(i) for i in g.ids[bad[:10]]) + (", ..." if bad.size > 10 else "")
@@ -349,9 +370,9 @@ def pose_graph_from_odometry(odometry_poses: Any, loop_edges: Any = None, loop_m
 
     Notes
     -----
-    The paper's map building: a node's pose is "initialized to the robot odometry position when
+    The paper's map building (Sec. 'Loop closure alignment', unnumbered): a node's pose is "initialized to the robot odometry position when
     the node is created" and a node "added or recognized" creates an edge holding the relative
-    position from odometry (Sec. 'Loop closure alignment', unnumbered). A constant sigma per edge
+    position from odometry. A constant sigma per edge
     is the simplest model; pass one row per edge to make it grow with the distance driven.
 
     Examples
@@ -384,118 +405,3 @@ def pose_graph_from_odometry(odometry_poses: Any, loop_edges: Any = None, loop_m
     info[:, [0, 1, 2], [0, 1, 2]] = diagonal
     z = se2_between(odo[:-1], odo[1:]) if n > 1 else np.zeros((0, 3))
     return PoseGraph(odo, np.concatenate([chain, loops]), np.concatenate([z, loop_z]), info)
-
-
-def pose_graph_residuals(graph: PoseGraph, poses: Any = None) -> np.ndarray:
-    """The error ``e_ij`` of every edge at ``poses``.
-
-    Parameters
-    ----------
-    graph : PoseGraph
-    poses : array_like, shape (N, 3), optional
-        Where to evaluate; default ``graph.poses``.
-
-    Returns
-    -------
-    numpy.ndarray, shape (M, 3)
-        ``e_ij = se2_between(z_ij, se2_between(pose_i, pose_j))``, the angle wrapped to [-pi, pi).
-
-    Notes
-    -----
-    g2o's 2-D error ``t2v(Z_ij^-1 X_i^-1 X_j)`` (Kummerle et al. 2011; Grisetti et al. 2010).
-
-    Examples
-    --------
-    >>> g = PoseGraph([[0, 0, 0], [1, 0, 0]], [[0, 1]], [[1, 0, 0.1]])
-    >>> print(np.round(pose_graph_residuals(g), 6) + 0.0)
-    [[ 0.   0.  -0.1]]
-    """
-    g = _graph(graph)
-    p = _poses(poses, g)
-    return se2_between(g.measurements, se2_between(p[g.edges[:, 0]], p[g.edges[:, 1]]))
-
-
-def pose_graph_cost(graph: PoseGraph, poses: Any = None) -> float:
-    """The chi-square cost ``sum_ij e_ij^T Omega_ij e_ij`` at ``poses``.
-
-    Parameters
-    ----------
-    graph : PoseGraph
-    poses : array_like, shape (N, 3), optional
-        Default ``graph.poses``.
-
-    Returns
-    -------
-    float
-
-    Raises
-    ------
-    ValueError
-        If poses are so large that the cost overflows.
-
-    Notes
-    -----
-    Kummerle et al. (2011), Eq. (1); twice gtsam's ``NonlinearFactorGraph.error`` (which halves it)
-    up to the difference of errors described in this module's docstring.
-
-    Examples
-    --------
-    >>> g = PoseGraph([[0, 0, 0], [1, 0, 0]], [[0, 1]], [[1, 0, 0.1]], information=[np.eye(3) * 100.0])
-    >>> print(round(pose_graph_cost(g), 6))          # 100 * 0.1^2
-    1.0
-    """
-    g = _graph(graph)
-    e = pose_graph_residuals(g, poses)
-    cost = float(np.einsum("ka,kab,kb->", e, g.information, e))
-    check_finite_result("poses", cost)
-    return cost
-
-
-def pose_graph_jacobian(graph: PoseGraph, poses: Any = None) -> sp.csr_matrix:
-    """The sparse Jacobian of the stacked errors with respect to every pose.
-
-    Parameters
-    ----------
-    graph : PoseGraph
-    poses : array_like, shape (N, 3), optional
-        Default ``graph.poses``.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (3 M, 3 N)
-        Row ``3 k + a`` is component ``a`` of edge ``k``'s error, column ``3 n + b`` component
-        ``b`` of node ``n``'s pose; 18 stored entries per edge (the fixed node included).
-
-    Notes
-    -----
-    With ``A = R(theta_i + dtheta_ij)^T`` and ``t`` the positions, ``e_xy = A (t_j - t_i) -
-    R(dtheta_ij)^T t_ij``, so ``de_xy/dt_i = -A``, ``de_xy/dtheta_i = (dA/dtheta) (t_j - t_i)``,
-    ``de_xy/dt_j = A``, ``de_theta/dtheta_i = -1`` and ``de_theta/dtheta_j = 1``: the linearisation
-    of Kummerle et al. (2011), Sec. III, for g2o's 2-D error.
-
-    Examples
-    --------
-    >>> g = PoseGraph([[0, 0, 0], [1, 0, 0]], [[0, 1]], [[1, 0, 0]])
-    >>> print(pose_graph_jacobian(g).toarray() + 0.0)
-    [[-1.  0.  0.  1.  0.  0.]
-     [ 0. -1. -1.  0.  1.  0.]
-     [ 0.  0. -1.  0.  0.  1.]]
-    """
-    g = _graph(graph)
-    p = _poses(poses, g)
-    i, j = g.edges[:, 0], g.edges[:, 1]
-    m = g.n_edges
-    phi = p[i, 2] + g.measurements[:, 2]
-    c, s = np.cos(phi), np.sin(phi)
-    d = p[j, :2] - p[i, :2]
-    blocks = np.zeros((m, 3, 6))
-    blocks[:, 0, 0], blocks[:, 0, 1], blocks[:, 1, 0], blocks[:, 1, 1] = -c, -s, s, -c          # -A
-    blocks[:, 0, 2] = -s * d[:, 0] + c * d[:, 1]                                                 # dA/dtheta (t_j - t_i)
-    blocks[:, 1, 2] = -c * d[:, 0] - s * d[:, 1]
-    blocks[:, 2, 2] = -1.0
-    blocks[:, :2, 3:5] = -blocks[:, :2, 0:2]                                                     # A
-    blocks[:, 2, 5] = 1.0
-    rows = np.broadcast_to(3 * np.arange(m)[:, None, None] + np.arange(3)[None, :, None], (m, 3, 6))
-    cols = np.concatenate([3 * i[:, None] + np.arange(3), 3 * j[:, None] + np.arange(3)], axis=1)[:, None, :]
-    cols = np.broadcast_to(cols, (m, 3, 6))
-    return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(3 * m, 3 * g.n_poses))

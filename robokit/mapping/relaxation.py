@@ -54,7 +54,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from ..geometry import se2_compose, se2_inverse, wrap_angle
 from ..validation import as_array, check_finite_result, check_int, check_positive
-from .pose_graph import PoseGraph, check_connected, edge_variances
+from .pose_graph import PoseGraph, as_pose_graph, check_connected, edge_variances
 
 __all__ = ["RelaxationResult", "relax", "relax_sweep", "initial_variances"]
 
@@ -211,8 +211,7 @@ def initial_variances(graph: PoseGraph) -> np.ndarray:
     >>> print(np.round(initial_variances(g), 4))
     [0.   0.01 0.02]
     """
-    if not isinstance(graph, PoseGraph):
-        raise TypeError(f"graph: expected a PoseGraph, got {type(graph).__name__}")
+    as_pose_graph(graph)
     n = graph.n_poses
     a, b = np.sort(graph.edges, axis=1).T
     pairs, inverse = np.unique(a * n + b, return_inverse=True)        # parallel edges: keep the smallest
@@ -276,8 +275,7 @@ def relax(graph: PoseGraph, *, max_iterations: int = 1000, tolerance: float = 1e
      [ 0.95  0.95]
      [-0.01  0.98]]
     """
-    if not isinstance(graph, PoseGraph):
-        raise TypeError(f"graph: expected a PoseGraph, got {type(graph).__name__}")
+    as_pose_graph(graph)
     max_iterations = check_int(max_iterations, "max_iterations", minimum=0)
     tolerance = check_positive(tolerance, "tolerance")
     check_connected(graph)
@@ -292,7 +290,8 @@ def relax(graph: PoseGraph, *, max_iterations: int = 1000, tolerance: float = 1e
     # Each edge gives two directed predictions: b from a (the measurement) and a from b (its inverse).
     a, b = graph.edges[:, 0], graph.edges[:, 1]
     target, source = np.concatenate([b, a]), np.concatenate([a, b])
-    relative = np.concatenate([graph.measurements, se2_inverse(graph.measurements)]) if graph.n_edges else np.zeros((0, 3))
+    relative = np.concatenate([graph.measurements, se2_inverse(graph.measurements)]) if graph.n_edges \
+        else np.zeros((0, 3))
     omega_edge = np.tile(edge_variances(graph), 2)
     count = np.bincount(target, minlength=n)
     free = np.arange(n) != graph.fixed
@@ -305,7 +304,8 @@ def relax(graph: PoseGraph, *, max_iterations: int = 1000, tolerance: float = 1e
         weight = 1.0 / (var[source] + omega_edge)                          # 1 / (omega'_i)_j, Eq. (1)
         total = np.bincount(target, weight, minlength=n)
         new = poses.copy()
-        # Eq. (3): (1 / n_i) sum_j x' omega_i / omega'_j with Eq. (2)'s omega_i = sum x' / omega' / sum 1 / omega'
+        # Eq. (3), (1 / n_i) sum_j x'_j omega_i / omega'_j, is sum_j (x'_j / omega'_j) / sum_j (1 / omega'_j)
+        # once Eq. (2)'s omega_i = n_i / sum_j (1 / omega'_j) is put in
         new[free, 0] = np.bincount(target, weight * guess[:, 0], minlength=n)[free] / total[free]   # Eq. (3)
         new[free, 1] = np.bincount(target, weight * guess[:, 1], minlength=n)[free] / total[free]   # Eq. (3)
         new[free, 2] = np.arctan2(np.bincount(target, weight * np.sin(guess[:, 2]), minlength=n),   # Eq. (3)

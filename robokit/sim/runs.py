@@ -29,7 +29,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..config import cache_dir, cache_key
+from ..config import cache_dir, cache_key, source_digest
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .motion import Path, noisy_odometry
 from .world import World
@@ -126,12 +126,7 @@ def _code_version() -> dict:
     ``robokit.sim`` and ``robokit.geometry`` (renderer, textures, sensors, noise, poses) and the
     numpy and OpenCV versions (their numerics changed results before). A run cached by other code
     is never reused."""
-    root = FsPath(__file__).resolve().parent.parent
-    digest = hashlib.sha256()
-    for package in ("sim", "geometry"):
-        for source in sorted((root / package).glob("*.py")):
-            digest.update(source.name.encode() + b"\0" + source.read_bytes())
-    return {"robokit": digest.hexdigest()[:16], "numpy": np.__version__, "opencv": cv2.__version__}
+    return {"robokit": source_digest("sim", "geometry"), "numpy": np.__version__, "opencv": cv2.__version__}
 
 
 def _cached(target: FsPath, meta: dict) -> Run | None:

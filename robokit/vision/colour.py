@@ -54,21 +54,19 @@ MAX_INTENSITY = 0.98
 
 
 def _rgb01(image, name: str = "image", *, ndim: int | None = None) -> np.ndarray:
-    """``image`` as float32 RGB in [0, 1]: integers divided by their dtype's maximum, floats kept
-    (and refused outside [0, 1]); a 4th (alpha) channel is dropped."""
+    """``image`` as float32 RGB in [0, 1]: uint8/uint16 divided by their dtype's maximum, other
+    numbers kept (and refused outside [0, 1]); a 4th (alpha) channel is dropped."""
     raw = as_array(image, name, dtype=None)
     if raw.ndim < 1 or raw.shape[-1] not in (3, 4) or (ndim is not None and raw.ndim != ndim):
         want = "(..., 3)" if ndim is None else "(H, W, 3) or (H, W, 4)"
         raise ValueError(f"{name}: expected an RGB array of shape {want}, got shape {raw.shape}")
     if raw.size == 0:
         raise ValueError(f"{name}: expected a non-empty image, got shape {raw.shape}")
-    if np.issubdtype(raw.dtype, np.integer):
-        if raw.min() < 0:
-            raise ValueError(f"{name}: expected non-negative integer intensities, got {raw.min()}")
+    if raw.dtype in (np.uint8, np.uint16):  # an image file's intensities: scaled by the dtype's maximum
         return raw[..., :3].astype(np.float32) / np.float32(np.iinfo(raw.dtype).max)
-    rgb = raw[..., :3].astype(np.float32)
+    rgb = raw[..., :3].astype(np.float32)   # floats, and other integers (Python's [1, 0, 0] is red)
     if rgb.min() < 0 or rgb.max() > 1:
-        raise ValueError(f"{name}: expected float intensities in [0, 1] (or an integer image), "
+        raise ValueError(f"{name}: expected intensities in [0, 1] (or a uint8/uint16 image), "
                          f"got values in [{rgb.min():.3g}, {rgb.max():.3g}]")
     return rgb
 
@@ -97,8 +95,8 @@ def rgb_to_hsi(image) -> np.ndarray:
     Parameters
     ----------
     image : array_like, shape (..., 3) or (..., 4)
-        RGB(A) values: integers (``uint8``: 0..255) are divided by their dtype's maximum, floats
-        must lie in [0, 1]. Any leading shape: one pixel ``(3,)``, a list ``(N, 3)``, an image.
+        RGB(A) values: ``uint8`` (0..255) and ``uint16`` images are divided by their dtype's
+        maximum; any other numbers (floats, Python integers) must lie in [0, 1]. Any leading shape: one pixel ``(3,)``, a list ``(N, 3)``, an image.
 
     Returns
     -------

@@ -13,7 +13,7 @@ from ..sim.lidar import scan_points
 from ..sim.world import World
 from ..validation import as_array, as_points, check_int, check_positive, check_text
 
-__all__ = ["map_axes", "plot_footprint", "plot_scan", "plot_trajectory", "plot_occupancy", "plot_covariance"]
+__all__ = ["map_axes", "plot_footprint", "plot_scan", "plot_trajectory", "plot_graph", "plot_occupancy", "plot_covariance"]
 
 
 def map_axes(ax: Any = None, title: str | None = None, figsize: tuple = (7, 5)):
@@ -153,6 +153,69 @@ def plot_trajectory(poses: Any, ax: Any = None, label: str | None = None, every:
         sel = P[::every]
         ax.quiver(sel[:, 0], sel[:, 1], np.cos(sel[:, 2]), np.sin(sel[:, 2]), color=line.get_color(),
                   angles="xy", scale_units="xy", scale=4, width=0.004)
+    return ax
+
+
+def _graph(poses: Any, edges: Any) -> tuple[np.ndarray, np.ndarray]:
+    P = as_points(poses, "poses", 3, min_count=1)
+    E = as_array(edges, "edges", shape=(None, 2), dtype=np.int64)
+    if E.size and (E.min() < 0 or E.max() >= len(P)):
+        raise ValueError(f"poses, edges: expected edges between the {len(P)} poses (indices in [0, {len(P)})), "
+                         f"got indices {E.min()}..{E.max()}")
+    return P, E
+
+
+def plot_graph(poses: Any, edges: Any, ax: Any = None, label: str | None = None, highlight: Any = None,
+               **kwargs: Any):
+    """Draw a pose graph: nodes as dots, edges as lines; ``highlight`` edges (bool mask) drawn dashed.
+
+    Parameters
+    ----------
+    poses : array_like (N, 3)
+        Node poses ``[x, y, theta]``.
+    edges : array_like of int (M, 2)
+        Node index pairs.
+    ax : matplotlib.axes.Axes, optional
+    label : str, optional
+    highlight : array_like of bool (M,), optional
+        Edges to draw dashed (e.g. loop closures).
+    **kwargs
+        Passed to ``Axes.plot`` for the nodes and edges (colour, ...).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ValueError, TypeError
+        For malformed poses, edges to missing nodes or a mask of another length.
+
+    Notes
+    -----
+    The topological map as a graph of places and relations (lesson 02's paper, Sec. "Environment
+    map", Fig. 1 and Fig. 8).
+
+    Examples
+    --------
+    >>> from robokit.viz import plot_graph
+    >>> ax = plot_graph([[0, 0, 0], [1, 0, 0], [1, 1, 0]], [[0, 1], [1, 2], [2, 0]], label="map",
+    ...                 highlight=[False, False, True])
+    >>> len(ax.lines), ax.lines[0].get_label()
+    (3, 'map')
+    """
+    P, E = _graph(poses, edges)
+    mask = np.zeros(len(E), bool) if highlight is None else as_array(highlight, "highlight", shape=(len(E),),
+                                                                     dtype=bool)
+    label = None if label is None else check_text(label, "label")
+    ax = map_axes(ax)
+    nodes, = ax.plot(P[:, 0], P[:, 1], "o", ms=3, label=label, **kwargs)
+    for dashed in (False, True):
+        sel = E[mask == dashed]
+        if len(sel):
+            xy = np.full((3 * len(sel), 2), np.nan)
+            xy[0::3], xy[1::3] = P[sel[:, 0], :2], P[sel[:, 1], :2]
+            ax.plot(xy[:, 0], xy[:, 1], "--" if dashed else "-", lw=0.8, color=nodes.get_color())
     return ax
 
 

@@ -17,7 +17,7 @@ from ..sim.world import World
 from ..validation import as_array, as_points, check_finite_scalar, check_int, check_positive
 from .scene import Scene, as_color, check_scene
 
-__all__ = ["add_world", "add_camera", "add_trajectory", "add_particles", "add_landmarks", "animate_poses",
+__all__ = ["add_world", "add_camera", "add_trajectory", "add_graph", "add_particles", "add_landmarks", "animate_poses",
            "look_from"]
 
 
@@ -198,6 +198,57 @@ def add_trajectory(scene: Scene, path: str, poses: Any, z: float = 0.02, color: 
     if step:
         for k in range(0, len(P), step):
             scene.add_triad(f"{path}/pose{k}", se2_to_se3(P[k], z), scale=0.2)
+    return scene
+
+
+def add_graph(scene: Scene, path: str, poses: Any, edges: Any, z: float = 0.05, node_color: Any = 0x2255CC,
+              edge_color: Any = 0x2255CC, size: float = 0.12) -> Scene:
+    """Draw a pose graph at height ``z``: nodes as points, edges as line segments.
+
+    Parameters
+    ----------
+    scene : Scene
+    path : str
+    poses : array_like (N, 3)
+        Node poses ``[x, y, theta]``.
+    edges : array_like of int (M, 2)
+        Node index pairs.
+    z : float, default 0.05
+        Drawing height (metres).
+    node_color, edge_color : int or RGB
+    size : float, default 0.12
+        Node point size (metres).
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    ValueError, TypeError
+        For malformed poses or edges to missing nodes.
+
+    Notes
+    -----
+    The topological map of lesson 02's paper (Sec. "Environment map", Fig. 1 and 8).
+
+    Examples
+    --------
+    >>> from robokit.viz import Scene, add_graph
+    >>> add_graph(Scene(), "map", [[0, 0, 0], [1, 0, 0], [1, 1, 0]], [[0, 1], [1, 2], [2, 0]])
+    Scene(title='robokit scene', commands=2)
+    """
+    check_scene(scene, path)
+    P = as_points(poses, "poses", 3, min_count=1)
+    E = as_array(edges, "edges", shape=(None, 2), dtype=np.int64)
+    if E.size and (E.min() < 0 or E.max() >= len(P)):
+        raise ValueError(f"poses, edges: expected edges between the {len(P)} poses (indices in [0, {len(P)})), "
+                         f"got indices {E.min()}..{E.max()}")
+    z = check_finite_scalar(z, "z")
+    lifted = np.column_stack([P[:, :2], np.full(len(P), z)])
+    scene.add_points(f"{path}/nodes", lifted, size=check_positive(size, "size"), color=node_color)
+    if len(E):
+        _segments(scene, f"{path}/edges", lifted[E.reshape(-1)], edge_color)
     return scene
 
 

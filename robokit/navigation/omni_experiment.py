@@ -1,0 +1,526 @@
+"""Lesson 02's experiments in the simulated office: the map, localization, node recognition, navigation.
+
+The paper's experiments (Sec. "Experimental results") re-run on :func:`robokit.sim.office_floor`:
+
+1. :func:`office_setup` drives the exploration tour (Fig. 6a) with an omni camera and noisy
+   odometry, builds the topological map from the recording, and aligns it twice: by relaxation
+   (Eqs. (1)-(3)) and by least squares. The recording and the map are cached (keyed by their
+   parameters and the code that makes them).
+2. :func:`localization_trials` localizes omni images taken at test places (Figs. 8, 9 and 11) with
+   the coarse stage only, the fine stage only and the hierarchy, timing each stage.
+3. :func:`route_recognition` asks which node the robot is at, at key nodes along the route (Fig. 12).
+4. :func:`navigation_trials` follows a visual path from perturbed starts with the omni camera in the
+   loop (Fig. 13).
+
+Poses are robokit's ``[x, y, theta]`` in the office's world frame (the paper's ``(x, z, theta)``);
+the map's frame is the odometry's, which starts at the tour's first true pose, so map poses and
+ground truth compare directly.
+
+References
+----------
+.. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
+   navigation" (the lesson's source paper; our copy gives no authors, venue or year).
+.. [2] T. Duckett, S. Marsland and J. Shapiro, "Learning globally consistent maps by relaxation",
+   Proc. IEEE Int. Conf. on Robotics and Automation (ICRA), 3841-3846, 2000.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import time
+import zipfile
+from typing import Any, Callable
+
+import numpy as np
+
+from ..config import cache_dir, cache_key, fast_mode, source_digest
+from ..controllers.path_geometry import VisualPath, path_from_poses
+from ..geometry import se2_between, se2_compose
+from ..localization.hierarchical import HierarchicalLocalizer, Localization
+from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
+                       optimize_pose_graph, relax)
+from ..sim import OmniCamera, Run, office_floor, office_tour, record
+from ..sim.world import World
+from ..validation import as_array, as_points, as_rng, check_callable, check_choice, check_int, check_positive
+from .visual_path import FollowResult, follow_path, perturbed_starts
+
+__all__ = ["OfficeSetup", "office_setup", "localization_trials", "LocalizationTrials",
+           "route_recognition", "omni_localizer", "navigation_trials"]
+
+MODES = ("coarse", "fine", "hierarchical")
+#: Odometry noise of the tour (Thrun et al. 2005, Table 5.6 alphas), the builder assumes the same.
+TOUR_ALPHAS = (0.02, 0.002, 0.02, 0.002)
+
+
+@dataclasses.dataclass
+class OfficeSetup:
+    """The recorded tour, its topological map and the two alignments of it.
+
+    Attributes
+    ----------
+    world, camera : World, OmniCamera
+    run : robokit.sim.Run
+        The exploration drive (true poses, odometry, omni images).
+    raw : TopologicalMap
+        The map as built: nodes at their odometry poses.
+    relaxed, optimized : TopologicalMap
+        The same map after relaxation (the paper's Eqs. (1)-(3)) and after least squares.
+    relaxation : RelaxationResult
+    least_squares : PoseGraphResult
+    truth : numpy.ndarray, shape (N, 3)
+        True poses of the nodes (the run's pose at each node's frame).
+    build_seconds : float
+        Time it took to build the map (stored with the cached map).
+    key : str
+        Identifies the recording, the map and the code that made them (keys later caches).
+    """
+
+    world: World
+    camera: OmniCamera
+    run: Run
+    raw: TopologicalMap
+    relaxed: TopologicalMap
+    optimized: TopologicalMap
+    relaxation: RelaxationResult
+    least_squares: PoseGraphResult
+    truth: np.ndarray
+    build_seconds: float
+    key: str
+
+
+def _map_cached(run: Run, params: dict, build: Callable[[], TopologicalMap]) -> tuple[TopologicalMap, float, str]:
+    meta = {"run": cache_key(**run.meta), "params": params, "code": source_digest("sim", "geometry", "vision", "mapping")}
+    key = cache_key(**meta)
+    target = cache_dir("maps") / f"office-{key}.npz"
+    if target.exists():
+        try:
+            tmap = TopologicalMap.load(target)
+            stored = json.loads(target.with_suffix(".json").read_text())
+            if stored.get("meta") == json.loads(json.dumps(meta)):
+                return tmap, float(stored["seconds"]), key
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+            pass  # a corrupt or foreign cache file is rebuilt
+    t0 = time.perf_counter()
+    tmap = build()
+    seconds = time.perf_counter() - t0
+    tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp.npz")
+    tmap.save(tmp)
+    tmp.replace(target)
+    target.with_suffix(".json").write_text(json.dumps({"meta": meta, "seconds": seconds}))
+    return tmap, seconds, key
+
+
+def office_setup(*, fast: bool | None = None, progress: Callable | None = None) -> OfficeSetup:
+    """Record the office tour with an omni camera, build its topological map and align it.
+
+    Parameters
+    ----------
+    fast : bool, optional
+        Smaller images and a sparser recording (default: :func:`robokit.config.fast_mode`).
+    progress : callable ``(done, total)``, optional
+        Told about the map building (only when it is not cached).
+
+    Returns
+    -------
+    OfficeSetup
+
+    Raises
+    ------
+    TypeError
+        For a non-callable ``progress``.
+
+    Notes
+    -----
+    Sec. "Experimental results" (Fig. 6a: the tour; Fig. 8: the map) and Sec. "Environment map"
+    (key images, local-map partitioning, loop closure, Eqs. (1)-(3)). The paper records 640 x 480
+    colour images; fast mode uses 320 x 240.
+
+    Examples
+    --------
+    The fast setup (320 x 240 images; the first call records and builds for about half a minute,
+    later calls load the cache):
+
+    >>> setup = office_setup(fast=True)
+    >>> len(setup.raw) > 20, setup.truth.shape == setup.raw.poses.shape
+    (True, True)
+    """
+    fast = fast_mode() if fast is None else bool(fast)
+    progress = check_callable(progress, "progress")
+    world = office_floor()
+    camera = OmniCamera(width=320, height=240, face_size=200) if fast else OmniCamera()
+    rate = 0.7 if fast else 2.0
+    run = record(world, office_tour(world), {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
+    params = {"n_features": 300 if fast else 500, "alphas": list(TOUR_ALPHAS)}
+    raw, seconds, key = _map_cached(run, params, lambda: build_topological_map(
+        run.images["omni"], run.odometry, camera, n_features=params["n_features"], odometry_alphas=TOUR_ALPHAS,
+        progress=progress))
+    graph = raw.graph()
+    relaxation = relax(graph)
+    least_squares = optimize_pose_graph(graph)
+    truth = run.poses[raw.frames]
+    return OfficeSetup(world, camera, run, raw, raw.with_poses(relaxation.poses, relaxation.variances),
+                       raw.with_poses(least_squares.poses), relaxation, least_squares, truth, seconds, key)
+
+
+def _check_setup(setup: Any) -> OfficeSetup:
+    if not isinstance(setup, OfficeSetup):
+        raise TypeError(f"setup: expected an OfficeSetup from office_setup(), got {type(setup).__name__}")
+    return setup
+
+
+@dataclasses.dataclass
+class LocalizationTrials:
+    """Results of :func:`localization_trials`, one row per test place.
+
+    Attributes
+    ----------
+    places : numpy.ndarray (n, 3)
+        True poses.
+    estimates : dict of str to numpy.ndarray (n, 3)
+        Per mode, the estimated poses (map frame).
+    errors : dict of str to numpy.ndarray (n, 2)
+        Per mode, ``|x error|`` and ``|y error|`` (m) against the truth: the map's error plus the
+        localizer's.
+    local_errors : dict of str to numpy.ndarray (n, 2)
+        Per mode, the same for the recognised node's *true* pose composed with the estimated
+        relative pose: the localizer's own error, without the map's.
+    times : dict of str to dict of str to numpy.ndarray (n,)
+        Per mode, seconds per stage (``histogram``, ``sift``, ``coarse``, ``matching``,
+        ``verification``, ``total``).
+    results : dict of str to list of Localization
+    """
+
+    places: np.ndarray
+    estimates: dict
+    errors: dict
+    local_errors: dict
+    times: dict
+    results: dict
+
+
+def _render(setup: OfficeSetup, pose: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    return setup.camera.observe(setup.world, pose, rng=rng).image
+
+
+def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES, map: str = "relaxed",
+                        rng: Any = 0, progress: Callable | None = None) -> LocalizationTrials:
+    """Localize an omni image rendered at each place, with each mode of the localizer.
+
+    Parameters
+    ----------
+    setup : OfficeSetup
+    places : array_like, shape (n, 3)
+        True poses (e.g. :data:`robokit.sim.OFFICE_TEST_POSES`, the paper's 11 cases of Fig. 8).
+    modes : tuple of str, default ("coarse", "fine", "hierarchical")
+    map : {"relaxed", "optimized", "raw"}, default "relaxed"
+        Which alignment of the map to localize in.
+    rng : Generator or int, default 0
+        Seeds the rendering noise (the same image for every mode).
+    progress : callable ``(done, total)``, optional
+
+    Returns
+    -------
+    LocalizationTrials
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a bad setup, places, mode or map name.
+
+    Notes
+    -----
+    Sec. "Hierarchical localization" (Fig. 5) and "Experimental results" (Fig. 9: errors in x and
+    y; Fig. 11: the modes compared in error and time).
+
+    Examples
+    --------
+    >>> from robokit.sim import OFFICE_TEST_POSES
+    >>> trials = localization_trials(office_setup(fast=True), OFFICE_TEST_POSES[:2], modes=("coarse",))
+    >>> trials.errors["coarse"].shape, sorted(trials.times["coarse"])[:2]
+    ((2, 2), ['coarse', 'histogram'])
+    """
+    setup = _check_setup(setup)
+    P = as_points(places, "places", 3, min_count=1)
+    if not isinstance(modes, tuple) or not modes:
+        raise TypeError(f"modes: expected a non-empty tuple of {MODES}, got {modes!r}")
+    modes = tuple(check_choice(m, "modes", MODES) for m in modes)
+    tmap = getattr(setup, check_choice(map, "map", ("relaxed", "optimized", "raw")))
+    progress = check_callable(progress, "progress")
+    rng = as_rng(rng)
+    images = [_render(setup, p, rng) for p in P]
+    n_features = 300 if setup.camera.width < 640 else 500
+    estimates, errors, local_errors, times, results = {}, {}, {}, {}, {}
+    for m, mode in enumerate(modes):
+        loc = HierarchicalLocalizer(tmap, setup.camera, mode=mode, n_features=n_features)
+        out = []
+        for k, img in enumerate(images):
+            out.append(loc.localize(img))
+            if progress is not None:
+                progress(m * len(images) + k + 1, len(modes) * len(images))
+        results[mode] = out
+        estimates[mode] = np.array([r.pose for r in out])
+        errors[mode] = np.abs(estimates[mode][:, :2] - P[:, :2])
+        local = np.array([se2_compose(setup.truth[r.node], se2_between(r.node_pose, r.pose)) for r in out])
+        local_errors[mode] = np.abs(local[:, :2] - P[:, :2])
+        times[mode] = {stage: np.array([r.times[stage] for r in out]) for stage in out[0].times}
+    return LocalizationTrials(P, estimates, errors, local_errors, times, results)
+
+
+def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 0.15, same_place: float = 0.5,
+                      rng: Any = 1) -> dict:
+    """Which node is the robot at? Asked at ``n_nodes`` key nodes spread along the route (Fig. 12).
+
+    A query is rendered ``offset`` metres from each chosen node's true position, at a random
+    heading; it counts as recognised when the localizer's node is the chosen node or another node
+    whose true position is within ``same_place`` metres (the tour passes some places twice).
+
+    Parameters
+    ----------
+    setup : OfficeSetup
+    n_nodes : int, default 17
+    offset, same_place : float
+        Metres.
+    rng : Generator or int, default 1
+
+    Returns
+    -------
+    dict
+        ``nodes`` (chosen node indices), ``answers`` (recognised node per query), ``correct`` (bool
+        per query), ``match_counts`` (best count per query), ``features`` (query SIFT features),
+        ``rate`` (fraction correct).
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a bad setup or parameters.
+
+    Notes
+    -----
+    Sec. "Experimental results", Fig. 12: 17 key nodes; failures "mostly" at nodes with very few
+    features or very ambiguous ones.
+
+    Examples
+    --------
+    >>> route = route_recognition(office_setup(fast=True), 3)
+    >>> len(route["nodes"]), 0.0 <= route["rate"] <= 1.0
+    (3, True)
+    """
+    setup = _check_setup(setup)
+    n_nodes = check_int(n_nodes, "n_nodes", minimum=1, maximum=len(setup.raw))
+    offset = check_positive(offset, "offset", allow_zero=True)
+    same_place = check_positive(same_place, "same_place")
+    rng = as_rng(rng)
+    nodes = np.linspace(0, len(setup.raw) - 1, n_nodes).round().astype(int)
+    loc = HierarchicalLocalizer(setup.relaxed, setup.camera, n_features=300 if setup.camera.width < 640 else 500)
+    answers, correct, counts, features = [], [], [], []
+    for i in nodes:
+        x, y, _ = setup.truth[i]
+        a = rng.uniform(-np.pi, np.pi)
+        pose = np.array([x + offset * np.cos(a), y + offset * np.sin(a), rng.uniform(-np.pi, np.pi)])
+        if not setup.world.is_free(pose[None, :2], clearance=0.2)[0]:
+            pose[:2] = [x, y]
+        r = loc.localize(_render(setup, pose, rng))
+        answers.append(r.node)
+        near = np.hypot(*(setup.truth[r.node, :2] - setup.truth[i, :2])) <= same_place
+        correct.append(bool(r.recognised and (r.node == i or near)))
+        counts.append(int(r.match_counts.max()) if len(r.match_counts) else 0)
+        features.append(int(len(setup.relaxed.node_features(i))))
+    correct = np.array(correct)
+    return {"nodes": nodes, "answers": np.array(answers), "correct": correct, "match_counts": np.array(counts),
+            "features": np.array(features), "rate": float(correct.mean())}
+
+
+def omni_localizer(setup: OfficeSetup, *, noise: float = 1.0, map: str = "relaxed") -> Callable:
+    """A ``localize(true_pose, rng)`` for :func:`robokit.navigation.follow_path`: the omni camera in the loop.
+
+    It renders the omni image at the true pose (with ``noise`` grey levels of pixel noise),
+    localizes it hierarchically, and returns the metric pose, or ``None`` when the image is not
+    recognised.
+
+    Parameters
+    ----------
+    setup : OfficeSetup
+    noise : float, default 1.0
+        Pixel noise of the rendered images (grey levels).
+    map : {"relaxed", "optimized", "raw"}, default "relaxed"
+
+    Returns
+    -------
+    callable
+        ``localize(true_pose, rng) -> numpy.ndarray (3,) or None``; its ``calls`` and ``failures``
+        attributes count the queries.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a bad setup, noise or map name.
+
+    Notes
+    -----
+    Sec. "Visual-servoing for navigation": the robot recognises the most likely node and is
+    steered along the visual path; the fixes feed the EKF.
+
+    Examples
+    --------
+    >>> setup = office_setup(fast=True)
+    >>> localize = omni_localizer(setup)
+    >>> fix = localize(setup.truth[3], np.random.default_rng(0))
+    >>> bool(fix is None or np.hypot(*(fix[:2] - setup.truth[3, :2])) < 3.0), localize.calls
+    (True, 1)
+    """
+    setup = _check_setup(setup)
+    noise = check_positive(noise, "noise", allow_zero=True)
+    tmap = getattr(setup, check_choice(map, "map", ("relaxed", "optimized", "raw")))
+    loc = HierarchicalLocalizer(tmap, setup.camera, n_features=300 if setup.camera.width < 640 else 500)
+
+    def localize(true_pose: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
+        localize.calls += 1
+        try:
+            image = setup.camera.observe(setup.world, np.asarray(true_pose, float), rng=rng).image
+        except ValueError:       # the (non-colliding) simulated robot drove into furniture: no view
+            localize.failures += 1
+            return None
+        r: Localization = loc.localize(image)
+        if not r.recognised:
+            localize.failures += 1
+            return None
+        return r.pose
+
+    localize.calls, localize.failures = 0, 0
+    return localize
+
+
+def _open_stretch(setup: OfficeSetup, count: int, clearance: float) -> int:
+    """First node of ``count`` consecutive nodes whose smooth path keeps ``clearance`` from everything."""
+    for first in range(len(setup.relaxed) - count + 1):
+        poses = setup.relaxed.poses[first:first + count]
+        if np.hypot(*(poses[-1, :2] - poses[0, :2])) < 1.0:
+            continue
+        try:   # the path in the map, and where it lies in truth (the map's error moves it)
+            paths = [path_from_poses(poses), path_from_poses(setup.truth[first:first + count])]
+        except ValueError:
+            continue
+        if all(setup.world.is_free(p.poses[:, :2], clearance=clearance).all() for p in paths):
+            return first
+    raise ValueError(f"n_path_nodes: no {count} consecutive nodes keep {clearance:.2f} m from walls and furniture")
+
+
+def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | None = None, n_path_nodes: int = 5,
+                      clearance: float = 0.3, fix_period: float = 1.0, alpha: float = 2.0, offset: float = 0.3, heading: float = 0.3,
+                      max_time: float = 60.0, localize: Callable | None = None, seed: int = 3,
+                      cache: bool = True, progress: Callable | None = None) -> tuple[VisualPath, list]:
+    """Follow the visual path through consecutive map nodes from ``n_starts`` perturbed starts (Fig. 13).
+
+    Parameters
+    ----------
+    setup : OfficeSetup
+    n_starts : int
+    first_node : int, optional
+        The path runs through the relaxed map's nodes ``first_node .. first_node + n_path_nodes - 1``;
+        default: the first such stretch at least 1 m long whose path keeps ``clearance + offset``
+        from walls and furniture (the simulated robot does not collide, it would drive through).
+    n_path_nodes : int, default 5
+    clearance : float, default 0.3
+        Metres, see ``first_node``.
+    fix_period : float, default 1.0
+        Seconds between omni fixes (the EKF integrates odometry in between).
+    alpha : float, default 2.0
+        Natural frequency of the path-following law (1/m), Eq. (8).
+    offset, heading : float
+        Start perturbation: up to ``offset`` metres and ``heading`` radians from the path's start.
+    max_time : float or None, default 60
+        Seconds per run (``None``: :func:`follow_path`'s default, three times the path's length over the top speed plus 30 s).
+    localize : callable, optional
+        Default :func:`omni_localizer` (the omni camera in the loop).
+    seed : int, default 3
+        Seeds the starts, the odometry noise and the rendering noise.
+    cache : bool, default True
+        With the default localizer, load the runs from / save them to
+        ``robokit.cache_dir("navigation")``, keyed by every parameter, the map and the code (each
+        run renders and localizes an omni image per fix: minutes at full size the first time).
+    progress : callable ``(done, total)``, optional
+
+    Returns
+    -------
+    path : VisualPath
+    results : list of FollowResult
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a bad setup or parameters, or a node range outside the map.
+
+    Notes
+    -----
+    Sec. "Visual-servoing for navigation" (Eqs. (6)-(8), the EKF) and Fig. 13.
+
+    Examples
+    --------
+    With Gaussian fixes instead of the camera (fast):
+
+    >>> from robokit.navigation import gaussian_localizer
+    >>> path, runs = navigation_trials(office_setup(fast=True), 1, localize=gaussian_localizer(), cache=False)
+    >>> len(runs), runs[0].true_poses.shape[1]
+    (1, 3)
+    """
+    setup = _check_setup(setup)
+    n_starts = check_int(n_starts, "n_starts", minimum=1, maximum=1000)
+    clearance = check_positive(clearance, "clearance", allow_zero=True)
+    offset = check_positive(offset, "offset", allow_zero=True)
+    count = check_int(n_path_nodes, "n_path_nodes", minimum=2, maximum=len(setup.relaxed))
+    if first_node is None:
+        first = _open_stretch(setup, count, clearance + offset)
+    else:
+        first = check_int(first_node, "first_node", minimum=0, maximum=len(setup.relaxed) - count)
+    progress = check_callable(progress, "progress")
+    default_localizer = localize is None
+    localize = omni_localizer(setup) if default_localizer else check_callable(localize, "localize", optional=False)
+    seed = check_int(seed, "seed", minimum=0)
+    rng = as_rng(seed)
+    path = path_from_poses(as_array(setup.relaxed.poses[first:first + count], "poses"))
+    starts = perturbed_starts(path, n_starts, offset=offset, heading=heading, rng=rng)
+    target = None
+    if cache and default_localizer:
+        meta = {"setup": setup.key, "first": first, "count": count, "fix_period": fix_period, "alpha": alpha,
+                "offset": offset, "heading": heading, "max_time": max_time, "rng": seed, "n": n_starts,
+                "code": source_digest("sim", "geometry", "vision", "mapping", "localization", "controllers",
+                                      "navigation")}
+        target = cache_dir("navigation") / f"office-{cache_key(**meta)}.npz"
+        cached = _load_runs(target, n_starts)
+        if cached is not None:
+            return path, cached
+    results = []
+    for k, start in enumerate(starts):
+        results.append(follow_path(path, start, localize=localize, fix_period=fix_period, alpha=alpha,
+                                   max_time=max_time, rng=rng))
+        if progress is not None:
+            progress(k + 1, n_starts)
+    if target is not None:
+        _save_runs(target, results)
+    return path, results
+
+
+_FIELDS = [f.name for f in dataclasses.fields(FollowResult)]
+
+
+def _save_runs(target, results: list) -> None:
+    arrays = {f"{k}/{name}": np.asarray(getattr(r, name)) for k, r in enumerate(results) for name in _FIELDS}
+    tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp.npz")
+    np.savez_compressed(tmp, **arrays)
+    tmp.replace(target)
+
+
+def _load_runs(target, n: int) -> list | None:
+    """The cached runs, or ``None`` for a missing, corrupt or incomplete file (then they are re-run)."""
+    try:
+        with np.load(target, allow_pickle=False) as data:
+            out = []
+            for k in range(n):
+                values = {name: data[f"{k}/{name}"] for name in _FIELDS}
+                values["reached"], values["final_error"] = bool(values["reached"]), float(values["final_error"])
+                out.append(FollowResult(**values))
+            return out
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+        return None
+
