@@ -135,3 +135,11 @@ def test_bad_input_is_named():
     with pytest.raises(TypeError, match="view"):
         loc.localize_view(np.zeros(3))
     assert short_run().images["omni"].shape[1:] == (480, 640, 3)
+
+
+def test_the_pose_is_always_the_node_pose_composed_with_the_relative_pose():
+    tmap = true_node_map()
+    loc = HierarchicalLocalizer(tmap, camera())
+    for pose in ([11.6, 2.0, 2.5], [14.1, 1.0, 2.0]):                     # a crossing and a floor fix
+        r = loc.localize(camera().observe(office(), pose).image)
+        assert np.allclose(se2_compose(r.node_pose, r.relative.pose), r.pose)

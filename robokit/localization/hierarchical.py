@@ -23,13 +23,14 @@ References
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..geometry import intersect_lines, se2_compose, wrap_angle
+from ..geometry import intersect_lines, se2_between, se2_compose, wrap_angle
 from ..mapping.omni_views import OmniView, RelativePose, omni_view, relative_pose
 from ..mapping.topological import EmptyMapError, TopologicalMap
 from ..sim.omni import OmniCamera
@@ -54,7 +55,10 @@ class Localization:
     node_pose : numpy.ndarray, shape (3,)
         The recognised node's pose.
     relative : RelativePose or None
-        Query relative to the node (``None`` in coarse mode or when not recognised).
+        Query relative to the node (``None`` in coarse mode or when not recognised); always
+        ``pose = se2_compose(node_pose, relative.pose)``. With ``method="bearings"`` its pose is
+        the crossing seen from the node (``metric`` and ``verified`` set; ``n_floor`` as the floor
+        left it).
     candidates : numpy.ndarray of int
         Nodes the fine stage looked at (coarse mode: every node), nearest histogram first.
     distances : numpy.ndarray
@@ -287,9 +291,11 @@ class HierarchicalLocalizer:
         node_pose = self.map.poses[node].copy()
         if pose is None:
             pose = se2_compose(node_pose, relative.pose) if relative is not None else node_pose.copy()
+        else:                         # the crossing, as a relative pose: pose = node_pose (+) relative.pose holds
+            relative = dataclasses.replace(relative, pose=se2_between(node_pose, pose), metric=True, verified=True)
         return Localization(node, pose, node_pose, relative, order, distances, counts, recognised, ambiguous,
-                            bool(relative is not None and relative.verified) or method == "bearings",
-                            method != "node", self.mode, times, method)
+                            bool(relative is not None and relative.verified), method != "node", self.mode, times,
+                            method)
 
     def _verify(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list, ranked: np.ndarray,
                 ambiguous: bool) -> tuple[RelativePose, int, list]:
