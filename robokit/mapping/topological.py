@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_choice, check_int, check_positive, describe
+from ..validation import as_array, check_choice, check_int, check_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
 from ..vision.matching import METHODS, DescriptorIndex, Matches
@@ -353,10 +353,3 @@ class TopologicalMap:
         except KeyError as exc:
             raise ValueError(f"path: expected a saved TopologicalMap, {exc.args[0]!r} is missing") from None
         return cls(**arrays)
-
-    @staticmethod
-    def check(value: Any, name: str = "map") -> "TopologicalMap":
-        """Return ``value`` if it is a :class:`TopologicalMap`, else raise ``TypeError`` naming ``name``."""
-        if not isinstance(value, TopologicalMap):
-            raise TypeError(f"{name}: expected a TopologicalMap, got {describe(value)}")
-        return value
