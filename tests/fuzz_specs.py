@@ -818,16 +818,6 @@ EXTRA: tuple[str, ...] = (
     "robokit.mapping.relaxation.relax_sweep", "robokit.mapping.relaxation.initial_variances",
     "robokit.mapping.g2o.read_g2o", "robokit.mapping.g2o.write_g2o",
     "robokit.mapping.manhattan.manhattan_world_graph",
-    # robokit.vision.colour (lesson 02)
-    "robokit.vision.colour.rgb_to_hsi", "robokit.vision.colour.hue_mask",
-    "robokit.vision.colour.hue_histogram", "robokit.vision.colour.hue_histogram_opencv",
-    "robokit.vision.colour.histogram_distance", "robokit.vision.colour.histogram_intersection",
-    # robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02)
-    "robokit.vision.omni_features.omni_sift", "robokit.vision.omni_features.annulus_mask",
-    "robokit.vision.omni_features.radial_orientation", "robokit.vision.matching.DescriptorIndex",
-    "robokit.vision.matching.ratio_test", "robokit.vision.descriptors.detect_sift_features",
-    "robokit.sim.feature_check.omni_ground_truth_inliers",
-    "robokit.sim.feature_check.omni_view_pair",
     # lesson 02's topological map and hierarchical localization (helper D)
     "robokit.geometry.planar.fit_se2", "robokit.geometry.planar.intersect_lines",
     "robokit.vision.ransac.ransac_sample_count",

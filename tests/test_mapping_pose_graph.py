@@ -330,3 +330,22 @@ def test_relaxation_options():
         relax(g, variances=[0.0, -1.0, 0.0, 0.0])
     with pytest.raises(ValueError, match="tolerance"):
         relax(g, tolerance=0.0)
+
+
+def test_information_from_covariance_matches_the_spread_of_g2o_errors():
+    """Measurements drawn with covariance C in i's frame: the g2o error z^-1 (+) z_true spreads as
+    J C J^T (the information's inverse), not as C, once the edge turns."""
+    from robokit.geometry import se2_between
+    from robokit.mapping import information_from_covariance
+
+    rng = np.random.default_rng(4)
+    z_true = np.array([1.0, 0.5, np.pi / 2])
+    C = np.array([[0.04, 0.01, 0.0], [0.01, 0.005, 0.0], [0.0, 0.0, 1e-4]])
+    z = z_true + rng.multivariate_normal(np.zeros(3), C, 20000)
+    errors = se2_between(z, np.broadcast_to(z_true, z.shape))
+    spread = np.cov(errors.T)
+    predicted = np.linalg.inv(information_from_covariance([z_true], [C])[0])
+    assert np.allclose(spread, predicted, atol=2e-3, rtol=0.05), (spread, predicted)
+    assert not np.allclose(spread, C, atol=2e-3, rtol=0.05)
+    with pytest.raises(ValueError, match="covariances"):
+        information_from_covariance([z_true], [-C])

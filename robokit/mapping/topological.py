@@ -39,7 +39,7 @@ from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
 from ..vision.matching import METHODS, DescriptorIndex, Matches
 from .omni_views import OmniView
-from .pose_graph import PoseGraph
+from .pose_graph import PoseGraph, information_from_covariance
 
 __all__ = ["EmptyMapError", "ODOMETRY_EDGE", "LOOP_EDGE", "TopologicalMap"]
 
@@ -282,10 +282,11 @@ class TopologicalMap:
         Notes
         -----
         Sec. "Loop closure alignment": "The first node of the map is considered as the reference
-        frame"; information matrices are the edges' inverse covariances.
+        frame"; the edges' covariances (in each edge's start frame) become information matrices for
+        g2o's error by :func:`robokit.mapping.information_from_covariance`.
         """
         return PoseGraph(self.poses, self.edges, self.measurements,
-                         np.linalg.inv(self.covariances) if self.n_edges else np.zeros((0, 3, 3)), fixed=0)
+                         information_from_covariance(self.measurements, self.covariances), fixed=0)
 
     def with_poses(self, poses: Any, variances: Any = None) -> "TopologicalMap":
         """A copy with new node poses (e.g. after relaxation), features and edges shared.

@@ -50,7 +50,7 @@ __all__ = ["OfficeSetup", "office_setup", "localization_trials", "LocalizationTr
 
 MODES = ("coarse", "fine", "hierarchical")
 #: Odometry noise of the tour (Thrun et al. 2005, Table 5.6 alphas), the builder assumes the same.
-TOUR_ALPHAS = (0.02, 0.002, 0.02, 0.002)
+TOUR_ALPHAS = (0.005, 0.0005, 0.005, 0.0005)
 
 
 @dataclasses.dataclass
@@ -149,7 +149,7 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     progress = check_callable(progress, "progress")
     world = office_floor()
     camera = OmniCamera(width=320, height=240, face_size=200) if fast else OmniCamera()
-    rate = 0.7 if fast else 2.0
+    rate = 0.7 if fast else 1.0
     run = record(world, office_tour(world), {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
     params = {"n_features": 300 if fast else 500, "alphas": list(TOUR_ALPHAS)}
     raw, seconds, key = _map_cached(run, params, lambda: build_topological_map(
@@ -430,7 +430,8 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
     offset, heading : float
         Start perturbation: up to ``offset`` metres and ``heading`` radians from the path's start.
     max_time : float or None, default 60
-        Seconds per run (``None``: :func:`follow_path`'s default, three times the path's length over the top speed plus 30 s).
+        Seconds per run (``None``: :func:`follow_path`'s default, three times the path's length over
+        the top speed plus 30 s).
     localize : callable, optional
         Default :func:`omni_localizer` (the omni camera in the loop).
     seed : int, default 3
