@@ -40,7 +40,7 @@ from ..geometry import se2_between, se2_compose
 from ..localization.hierarchical import HierarchicalLocalizer, Localization
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
                        optimize_pose_graph, relax)
-from ..sim import OmniCamera, Run, office_floor, office_tour, record
+from ..sim import OmniCamera, office_floor, office_tour, record
 from ..sim.world import World
 from ..validation import as_array, as_points, as_rng, check_callable, check_choice, check_int, check_positive
 from .visual_path import FollowResult, follow_path, perturbed_starts
@@ -55,13 +55,13 @@ TOUR_ALPHAS = (0.005, 0.0005, 0.005, 0.0005)
 
 @dataclasses.dataclass
 class OfficeSetup:
-    """The recorded tour, its topological map and the two alignments of it.
+    """The recorded tour's topological map and the two alignments of it.
 
     Attributes
     ----------
     world, camera : World, OmniCamera
-    run : robokit.sim.Run
-        The exploration drive (true poses, odometry, omni images).
+    n_frames : int
+        Omni frames recorded along the tour.
     raw : TopologicalMap
         The map as built: nodes at their odometry poses.
     relaxed, optimized : TopologicalMap
@@ -69,16 +69,16 @@ class OfficeSetup:
     relaxation : RelaxationResult
     least_squares : PoseGraphResult
     truth : numpy.ndarray, shape (N, 3)
-        True poses of the nodes (the run's pose at each node's frame).
+        True poses of the nodes (the tour's pose at each node's frame).
     build_seconds : float
-        Time it took to build the map (stored with the cached map).
+        Time it took to record the tour and build the map (stored with the cached map).
     key : str
         Identifies the recording, the map and the code that made them (keys later caches).
     """
 
     world: World
     camera: OmniCamera
-    run: Run
+    n_frames: int
     raw: TopologicalMap
     relaxed: TopologicalMap
     optimized: TopologicalMap
@@ -89,26 +89,36 @@ class OfficeSetup:
     key: str
 
 
-def _map_cached(run: Run, params: dict, build: Callable[[], TopologicalMap]) -> tuple[TopologicalMap, float, str]:
-    meta = {"run": cache_key(**run.meta), "params": params, "code": source_digest("sim", "geometry", "vision", "mapping")}
+def _camera_description(camera: OmniCamera) -> dict:
+    return {f.name: np.asarray(getattr(camera, f.name)).round(12).tolist() for f in dataclasses.fields(camera)}
+
+
+def _map_cached(meta: dict, build: Callable[[], tuple[TopologicalMap, np.ndarray, int]]
+                ) -> tuple[TopologicalMap, np.ndarray, int, float, str]:
+    """The map (with its nodes' true poses and the frame count) cached under ``meta``, or built.
+
+    The recording itself is not needed once the map exists, so a cached map never loads the
+    tour's images (hundreds of megabytes at full size)."""
     key = cache_key(**meta)
     target = cache_dir("maps") / f"office-{key}.npz"
-    if target.exists():
+    sidecar = target.with_suffix(".json")
+    if target.exists() and sidecar.exists():
         try:
-            tmap = TopologicalMap.load(target)
-            stored = json.loads(target.with_suffix(".json").read_text())
+            stored = json.loads(sidecar.read_text())
             if stored.get("meta") == json.loads(json.dumps(meta)):
-                return tmap, float(stored["seconds"]), key
-        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+                tmap = TopologicalMap.load(target)
+                truth = np.array(stored["truth"], float).reshape(len(tmap), 3)
+                return tmap, truth, int(stored["frames"]), float(stored["seconds"]), key
+        except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile):
             pass  # a corrupt or foreign cache file is rebuilt
     t0 = time.perf_counter()
-    tmap = build()
+    tmap, truth, frames = build()
     seconds = time.perf_counter() - t0
     tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp.npz")
     tmap.save(tmp)
     tmp.replace(target)
-    target.with_suffix(".json").write_text(json.dumps({"meta": meta, "seconds": seconds}))
-    return tmap, seconds, key
+    sidecar.write_text(json.dumps({"meta": meta, "seconds": seconds, "frames": frames, "truth": truth.tolist()}))
+    return tmap, truth, frames, seconds, key
 
 
 def office_setup(*, fast: bool | None = None, progress: Callable | None = None) -> OfficeSetup:
@@ -150,16 +160,23 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     world = office_floor()
     camera = OmniCamera(width=320, height=240, face_size=200) if fast else OmniCamera()
     rate = 0.7 if fast else 1.0
-    run = record(world, office_tour(world), {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
+    tour = office_tour(world)
     params = {"n_features": 300 if fast else 500, "alphas": list(TOUR_ALPHAS)}
-    raw, seconds, key = _map_cached(run, params, lambda: build_topological_map(
-        run.images["omni"], run.odometry, camera, n_features=params["n_features"], odometry_alphas=TOUR_ALPHAS,
-        progress=progress))
+    meta = {"world": world.name, "world_seed": world.info["seed"], "camera": _camera_description(camera),
+            "tour": cache_key(poses=tour.poses.round(9).tolist()), "rate": rate, "record_seed": 2, "params": params,
+            "code": source_digest("sim", "geometry", "vision", "mapping")}
+
+    def build():
+        run = record(world, tour, {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
+        tmap = build_topological_map(run.images["omni"], run.odometry, camera, n_features=params["n_features"],
+                                     odometry_alphas=TOUR_ALPHAS, progress=progress)
+        return tmap, run.poses[tmap.frames], len(run)
+
+    raw, truth, frames, seconds, key = _map_cached(meta, build)
     graph = raw.graph()
     relaxation = relax(graph)
     least_squares = optimize_pose_graph(graph)
-    truth = run.poses[raw.frames]
-    return OfficeSetup(world, camera, run, raw, raw.with_poses(relaxation.poses, relaxation.variances),
+    return OfficeSetup(world, camera, frames, raw, raw.with_poses(relaxation.poses, relaxation.variances),
                        raw.with_poses(least_squares.poses), relaxation, least_squares, truth, seconds, key)
 
 
