@@ -18,6 +18,17 @@ _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
 
 
+def _flag(environ, name: str) -> bool:
+    """An on/off environment variable; a typo is an error, never silently off."""
+    env = os.environ if environ is None else environ
+    raw = str(env.get(name, "")).strip().lower()
+    if raw in _TRUE:
+        return True
+    if raw in _FALSE:
+        return False
+    raise ValueError(f"{name}: expected one of 1/0/true/false/yes/no/on/off, got {env.get(name)!r}")
+
+
 def fast_mode(environ: "os._Environ[str] | dict[str, str] | None" = None) -> bool:
     """Return whether fast mode is requested by the ``ROBOKIT_FAST`` environment variable.
 
@@ -41,15 +52,7 @@ def fast_mode(environ: "os._Environ[str] | dict[str, str] | None" = None) -> boo
     -----
     Course convention (DESIGN.md, "Fast mode"); not from a paper.
     """
-    env = os.environ if environ is None else environ
-    raw = str(env.get("ROBOKIT_FAST", "")).strip().lower()
-    if raw in _TRUE:
-        return True
-    if raw in _FALSE:
-        return False
-    raise ValueError(
-        f"ROBOKIT_FAST: expected one of 1/0/true/false/yes/no/on/off, got {env.get('ROBOKIT_FAST')!r}"
-    )
+    return _flag(environ, "ROBOKIT_FAST")
 
 
 #: Fast mode as read once at import time (``robokit.FAST``).
@@ -86,15 +89,7 @@ def headless(environ: "os._Environ[str] | dict[str, str] | None" = None) -> bool
     >>> headless({"ROBOKIT_HEADLESS": "1"}), headless({})
     (True, False)
     """
-    env = os.environ if environ is None else environ
-    raw = str(env.get("ROBOKIT_HEADLESS", "")).strip().lower()
-    if raw in _TRUE:
-        return True
-    if raw in _FALSE:
-        return False
-    raise ValueError(
-        f"ROBOKIT_HEADLESS: expected one of 1/0/true/false/yes/no/on/off, got {env.get('ROBOKIT_HEADLESS')!r}"
-    )
+    return _flag(environ, "ROBOKIT_HEADLESS")
 
 
 def cache_dir(*parts: str, create: bool = True) -> Path:

@@ -552,10 +552,11 @@ SPECS: dict[str, Call] = {
     "robokit.navigation.omni_experiment.route_recognition": Call({
         "setup": Obj(office_experiment), "n_nodes": Int(2), "offset": Real(0.15), "same_place": Real(0.5),
         "rng": Rng(1)}, cheap=False),
-    "robokit.navigation.omni_experiment.navigation_trials": Call({
+    "robokit.navigation.omni_navigation.navigation_trials": Call({
         "setup": Obj(office_experiment), "n_starts": Int(1), "first_node": Int(0, optional=True),
         "n_path_nodes": Int(3), "clearance": Real(0.3), "fix_period": Real(1.0), "alpha": Real(2.0),
-        "offset": Real(0.3), "heading": Real(0.3), "max_time": Real(3.0, optional=True), "localize": Func(localizer, optional=True),
+        "offset": Real(0.3), "heading": Real(0.3), "max_time": Real(3.0, optional=True), "success_radius": Real(0.3),
+        "localize": Func(localizer, optional=True),
         "seed": Int(3), "cache": Flag(False), "progress": Func(None, optional=True)}, cheap=False),
     "robokit.viz.maps.plot_graph": Call({
         "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]), "N,3"),
@@ -567,6 +568,9 @@ SPECS: dict[str, Call] = {
         "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]), "N,3"),
         "edges": Array(np.array([[0, 1], [1, 2]]), "N,2", min_rows=0), "z": Real(0.05), "node_color": Given(0x2255CC),
         "edge_color": Given(0x2255CC), "size": Real(0.12)}),
+    "robokit.viz.scene3d.add_image": Call({"scene": Obj(scene), "path": Text("view"),
+                                           "image": Given(np.zeros((4, 6, 3), np.uint8)),
+                                           "centre": Array(np.array([1.0, 2.0, 3.0]), "3"), "width": Real(1.5)}),
     "robokit.viz.widgets.slider": Call({"draw": Func(lambda: draw_figure), "values": Given([1.0, 2.0]), "label": Text("k"),
                                         "fmt": Text("{}"), "start": Int(0)}, cheap=False),
     # --- lesson 02: controllers.path_following(_loop), localization.pose_ekf, navigation.visual_path --------

@@ -89,8 +89,9 @@ def _bounded():
         signal.signal(signal.SIGALRM, old_handler)
 
 
-def _call(name: str, override: dict[str, Any]) -> Any:
-    """Call ``name`` with its valid arguments, ``override`` replacing some of them."""
+def _arguments(name: str, override: dict[str, Any]) -> tuple[list, dict]:
+    """The positional and keyword arguments of a call (valid values built here, outside any budget:
+    a fixture such as a cached map may take a while the first time; the budget is the function's)."""
     spec = SPECS[name]
     fn = POPULATION[name]
     args, kwargs = [], {}
@@ -106,7 +107,7 @@ def _call(name: str, override: dict[str, Any]) -> Any:
             args.append(value)
         else:
             kwargs[pname] = value
-    return fn(*args, **kwargs)
+    return args, kwargs
 
 
 def _parameters(fn: Any) -> dict[str, inspect.Parameter]:
@@ -135,8 +136,9 @@ _BASELINE: dict[str, bool] = {}
 
 def _baseline_nonfinite(name: str) -> bool:
     if name not in _BASELINE:
+        args, kwargs = _arguments(name, {})
         with _bounded():
-            _BASELINE[name] = _nonfinite(_call(name, {}))
+            _BASELINE[name] = _nonfinite(POPULATION[name](*args, **kwargs))
     return _BASELINE[name]
 
 
@@ -151,9 +153,10 @@ def _names(name: str, pname: str, value: Any) -> list[str]:
 def fuzz_one(name: str, pname: str, label: str, value: Any, *, huge: bool = False) -> str | None:
     """Call with one invalid argument; ``None`` when the error is clear, else what went wrong."""
     what = f"{name}({pname}={label})"
+    args, kwargs = _arguments(name, {pname: value})
     try:
         with _bounded():
-            result = _call(name, {pname: value})
+            result = POPULATION[name](*args, **kwargs)
     except Hang:
         return f"{what}: hang (more than {BUDGET} s)"
     except (ValueError, TypeError) as exc:

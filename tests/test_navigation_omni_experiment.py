@@ -7,6 +7,7 @@ import pytest
 from robokit.config import cache_dir
 from robokit.geometry import se2_compose
 from robokit.navigation import omni_experiment as experiment
+from robokit.navigation import omni_navigation as navigation
 from robokit.sim import OFFICE_TEST_POSES
 
 
@@ -31,20 +32,23 @@ def test_coarse_answers_are_node_poses_and_local_errors_exclude_the_map(setup):
         local = se2_compose(setup.truth[r.node], relative)
         assert np.allclose(trials.local_errors["fine"][k], np.abs(local[:2] - OFFICE_TEST_POSES[k][:2]))
 
-def test_navigation_runs_are_cached_and_a_corrupt_cache_is_rerun(setup):
+def test_navigation_runs_are_cached_judged_on_the_truth_and_a_corrupt_cache_is_rerun(setup):
     kwargs = dict(n_path_nodes=3, max_time=8.0, seed=5)
     before = set(cache_dir("navigation").glob("*.npz"))
-    path, first = experiment.navigation_trials(setup, 1, **kwargs)
+    first = navigation.navigation_trials(setup, 1, **kwargs)
     new = set(cache_dir("navigation").glob("*.npz")) - before
-    path2, again = experiment.navigation_trials(setup, 1, **kwargs)
-    assert np.array_equal(path.poses, path2.poses)
-    for a, b in zip(first, again):
+    again = navigation.navigation_trials(setup, 1, **kwargs)
+    assert np.array_equal(first.path.poses, again.path.poses) and np.array_equal(first.nodes, again.nodes)
+    for a, b in zip(first.runs, again.runs):
         assert np.array_equal(a.true_poses, b.true_poses) and np.array_equal(a.fixes, b.fixes)
         assert a.reached == b.reached and a.final_error == b.final_error
+    goal = setup.truth[first.nodes[-1], :2]                   # the target node's true position, not the map's
+    assert np.allclose(first.goal_errors, [np.hypot(*(r.true_poses[-1, :2] - goal)) for r in first.runs])
+    assert np.array_equal(first.success, first.goal_errors <= first.success_radius)
     for target in new:
         target.write_bytes(b"not a zip")
-    _, rerun = experiment.navigation_trials(setup, 1, **kwargs)
-    assert np.array_equal(rerun[0].true_poses, first[0].true_poses)
+    rerun = navigation.navigation_trials(setup, 1, **kwargs)
+    assert np.array_equal(rerun.runs[0].true_poses, first.runs[0].true_poses)
 
 
 def test_bad_arguments_name_themselves(setup):
@@ -53,4 +57,4 @@ def test_bad_arguments_name_themselves(setup):
     with pytest.raises(ValueError, match="modes"):
         experiment.localization_trials(setup, OFFICE_TEST_POSES, modes=("guess",))
     with pytest.raises(ValueError, match="n_path_nodes"):
-        experiment.navigation_trials(setup, 1, n_path_nodes=len(setup.relaxed), clearance=2.0)
+        navigation.navigation_trials(setup, 1, n_path_nodes=len(setup.relaxed), clearance=2.0)

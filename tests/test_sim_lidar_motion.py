@@ -155,3 +155,13 @@ def test_odometry_covariance_matches_monte_carlo_of_the_noise_model():
     empirical = np.cov(ends.T)
     assert np.allclose(empirical, cov[-1], rtol=0.15, atol=2e-4), (empirical, cov[-1])
     assert np.allclose(mo.increment_variances(np.zeros(3), alphas), 0.0)
+
+
+def test_odometry_covariance_of_a_turn_on_the_spot_with_a_slip_is_a_small_rotations():
+    """Noisy odometry of a turn moves millimetres in a random direction; that is no half turn."""
+    from robokit.sim import odometry_covariance
+    alphas = [0.005, 0.0005, 0.005, 0.0005]
+    clean = odometry_covariance([[0.0, 0.0, 0.0], [0.0, 0.0, 0.3]], alphas)[-1]
+    for slip in ([-0.003, 0.0], [0.003, 0.0], [0.0, -0.003]):
+        slipped = odometry_covariance([[0.0, 0.0, 0.0], [*slip, 0.3]], alphas)[-1]
+        assert slipped[2, 2] < 2 * clean[2, 2], (slip, slipped[2, 2], clean[2, 2])

@@ -7,8 +7,8 @@ from ..controllers.path_following import path_following_command
 from ..localization.pose_ekf import ekf_update
 from ..mapping.relaxation import relax_sweep
 from ..vision.colour import histogram_distance, hue_histogram, rgb_to_hsi
-from ..vision.matching import DescriptorIndex
-from ..validation import as_array, check_int, check_positive
+from ..vision.matching import DescriptorIndex, check_ratio
+from ..validation import as_array, check_int
 from .compare import close, exact
 from .spec import Case, Exercise
 
@@ -38,13 +38,6 @@ def _node_list(node_descriptors, dim: int | None) -> list[np.ndarray]:
                              f"second neighbour), got {len(arr)}")
         nodes.append(arr)
     return nodes
-
-
-def _ratio(ratio) -> float:
-    r = check_positive(ratio, "ratio")
-    if r > 1:
-        raise ValueError(f"ratio: expected a value in (0, 1], got {r}")
-    return r
 
 
 def fine_stage_counts(query, node_descriptors, candidates, ratio: float = RATIO) -> np.ndarray:
@@ -85,7 +78,7 @@ def fine_stage_counts(query, node_descriptors, candidates, ratio: float = RATIO)
     cand = as_array(candidates, "candidates", ndim=1)
     if cand.size and (np.any(cand != np.round(cand)) or cand.min() < 0 or cand.max() >= len(nodes)):
         raise ValueError(f"candidates: expected node indices in [0, {len(nodes)}), got {cand.tolist()}")
-    return _counts(q, nodes, cand, _ratio(ratio), "query")
+    return _counts(q, nodes, cand, check_ratio(ratio), "query")
 
 
 def _counts(q: np.ndarray, nodes: list, cand: np.ndarray, ratio: float, qname: str) -> np.ndarray:
@@ -148,7 +141,7 @@ def recognise_node(query_histogram, query_descriptors, node_histograms, node_des
         raise ValueError(f"node_descriptors: expected one array per node ({len(H)}), got {len(nodes)}")
     k = check_int(top_k, "top_k", minimum=1)
     coarse = np.argsort(histogram_distance(h, H), kind="stable")[:k]
-    counts = _counts(q, nodes, coarse, _ratio(ratio), "query_descriptors")
+    counts = _counts(q, nodes, coarse, check_ratio(ratio), "query_descriptors")
     return int(coarse[int(np.argmax(counts))])
 
 
@@ -190,7 +183,13 @@ def _histogram_cases(rng: np.random.Generator) -> list[Case]:
     img32 = _safe_image(rng, (6, 8, 3), 32)
     pale = _safe_image(rng, (4, 5, 3), 16, low=0.35, high=0.65, min_saturation=0.1)
     grey = np.full((3, 4, 3), 0.5)
+    # saturated enough for a loose mask, but too dark (I < 0.04) or too bright (I > 0.98) to count
+    extremes = _safe_image(rng, (3, 4, 3), 8, min_saturation=0.02)
+    extremes[0, :2] = [[0.09, 0.0, 0.01], [0.0, 0.08, 0.02]]
+    extremes[1, :2] = [[1.0, 0.97, 0.99], [0.99, 1.0, 0.97]]
     return [
+        Case((extremes.tolist(),), {"bins": 8, "min_saturation": 0.02},
+             label="dark and bright pixels: outside [min_intensity, max_intensity]"),
         Case((img.tolist(),), {"bins": 8}, label="8 bins of 45 degrees"),
         Case((img32.tolist(),), {"bins": 32}, label="32 bins"),
         Case((pale.tolist(),), {"bins": 16, "min_saturation": 0.1}, label="pale colours, a looser mask"),
@@ -231,6 +230,8 @@ def _fine_cases(rng: np.random.Generator) -> list[Case]:
         Case((r(query), [r(n) for n in nodes], [4, 2]), label="two candidates, in the coarse stage's order"),
         Case((r(query), [r(n) for n in nodes], [1, 3]), {"ratio": 0.6}, label="the right node not among them"),
         Case((r(query), [r(n) for n in nodes], [7]), raises="ValueError", label="a candidate that does not exist"),
+        Case((r(query), [r(n) for n in nodes[:2]] + [r(nodes[2][:1])], [2]), raises="ValueError",
+             label="a node with one descriptor (no second neighbour)"),
         Case((r(query[:3]), [r(n[:, :8]) for n in nodes], [0]), raises="ValueError",
              label="descriptors of different lengths"),
     ]
@@ -350,6 +351,7 @@ EXERCISES = [
         points=2, cases=_fine_cases, reference=fine_stage_counts, compare=exact(),
         references=("robokit.exercises.omni_localization.fine_stage_counts",
                     "robokit.exercises.omni_localization.recognise_node",
+                    "robokit.exercises.omni_localization._counts", "robokit.exercises.omni_localization._node_list",
                     "robokit.vision.matching.DescriptorIndex", "robokit.vision.matching.ratio_match",
                     "robokit.vision.matching.ratio_test", "robokit.vision.matching.k_nearest",
                     "robokit.vision.matching.two_nearest"),
@@ -387,6 +389,7 @@ EXERCISES = [
         points=3, cases=_recognise_cases, reference=recognise_node, compare=exact(),
         references=("robokit.exercises.omni_localization.recognise_node",
                     "robokit.exercises.omni_localization.fine_stage_counts",
+                    "robokit.exercises.omni_localization._counts", "robokit.exercises.omni_localization._node_list",
                     "robokit.vision.matching.DescriptorIndex", "robokit.vision.matching.ratio_match"),
         description="Open: the index of the node the query was taken at, by any method; ValueError for a map "
                     "with no nodes."),

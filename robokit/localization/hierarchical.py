@@ -17,7 +17,7 @@ navigation loop's business (:mod:`robokit.navigation`).
 References
 ----------
 .. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (course source 001; README.md, "References").
+   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
 .. [2] D. G. Lowe, "Distinctive image features from scale-invariant keypoints", International Journal
    of Computer Vision 60(2), 91-110, 2004.
 """

@@ -21,7 +21,7 @@ features of two views into the pose of one robot in the other's frame:
 References
 ----------
 .. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (course source 001; README.md, "References").
+   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
 .. [2] R. Hartley and A. Zisserman, *Multiple View Geometry in Computer Vision*, 2nd ed., Cambridge
    University Press, 2004 (Sec. 9.6).
 .. [3] M. A. Fischler and R. C. Bolles, "Random sample consensus: a paradigm for model fitting with

@@ -23,7 +23,7 @@ Building a map from a recorded run is :func:`robokit.mapping.build_topological_m
 References
 ----------
 .. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (course source 001; README.md, "References").
+   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
 """
 from __future__ import annotations
 

@@ -27,7 +27,7 @@ odometric one); a recognition that passes adds a loop edge measured by the visua
 References
 ----------
 .. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (course source 001; README.md, "References").
+   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
 .. [2] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
 """
 from __future__ import annotations
@@ -141,8 +141,9 @@ def local_map_full(n_features: Any, variance: Any, *, max_features: int = 930, m
         Its accumulated odometry position variance (m^2).
     max_features : int, default 930
         With 500 features per image (about 470 found) this binds only when the current image
-        shares almost nothing with the key image: a backstop for places whose colours hardly
-        change, which the appearance test would miss.
+        shares few matches with the key image while its colours have hardly changed: a backstop
+        the appearance test (which needs both to change) would miss. The builder counts only frames
+        whose SIFT features it computed (frames with an unchanged histogram skip SIFT).
     max_variance : float, default 0.1
         m^2 (about 0.3 m standard deviation along each axis).
 
@@ -182,7 +183,8 @@ def select_key_frames(n_frames: int, compare: Callable[[int, int], Comparison], 
     occlusion_frames : int, default 3
         A change of appearance must hold for this many consecutive frames to start a node (1: at
         once); a shorter one (someone walking past the camera) is ignored.
-    max_features, max_variance : see :func:`local_map_full` (they act at once).
+    max_features, max_variance : see :func:`local_map_full` (they act at once; a frame whose
+        appearance has changed adds no features, so a transient blocker cannot fill the local map).
 
     Returns
     -------
@@ -216,15 +218,16 @@ def select_key_frames(n_frames: int, compare: Callable[[int, int], Comparison], 
         c = compare(key, k)
         if not isinstance(c, Comparison):
             raise TypeError(f"compare: expected a callable returning a Comparison, got {describe(c)}")
-        reason, n_local = None, 0 if c.n_features is None else c.n_features
+        changed = c.matches is not None and appearance_changed(c.distance, c.matches, similarity=similarity,
+                                                               min_matches=min_matches)
+        run = run + 1 if changed else 0
+        # a frame that no longer looks like the local map (perhaps someone blocking the camera) adds
+        # none of its features to it: the occlusion guard, not the feature count, decides on it
+        reason, n_local = None, 0 if c.n_features is None or changed else c.n_features
         if local_map_full(n_local, c.variance, max_features=max_features, max_variance=max_variance):
             reason = "features" if n_local >= max_features else "variance"
-        else:
-            changed = c.matches is not None and appearance_changed(c.distance, c.matches, similarity=similarity,
-                                                                   min_matches=min_matches)
-            run = run + 1 if changed else 0
-            if run >= occlusion_frames:
-                reason = "appearance"
+        elif run >= occlusion_frames:
+            reason = "appearance"
         if reason is not None:
             keys.append(k)
             reasons.append(reason)

@@ -9,8 +9,8 @@ The paper's experiments (Sec. "Experimental results") re-run on :func:`robokit.s
 2. :func:`localization_trials` localizes omni images taken at test places (Figs. 8, 9 and 11) with
    the coarse stage only, the fine stage only and the hierarchy, timing each stage.
 3. :func:`route_recognition` asks which node the robot is at, at key nodes along the route (Fig. 12).
-4. :func:`navigation_trials` follows a visual path from perturbed starts with the omni camera in the
-   loop (Fig. 13).
+4. :func:`robokit.navigation.omni_navigation.navigation_trials` follows a visual path from perturbed
+   starts with the omni camera in the loop (Fig. 13).
 
 Poses are robokit's ``[x, y, theta]`` in the office's world frame (the paper's ``(x, z, theta)``);
 the map's frame is the odometry's, which starts at the tour's first true pose, so map poses and
@@ -35,18 +35,16 @@ from typing import Any, Callable
 import numpy as np
 
 from ..config import cache_dir, cache_key, fast_mode, source_digest
-from ..controllers.path_geometry import VisualPath, path_from_poses
 from ..geometry import se2_between, se2_compose
-from ..localization.hierarchical import HierarchicalLocalizer, Localization
+from ..localization.hierarchical import HierarchicalLocalizer
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
                        optimize_pose_graph, relax)
 from ..sim import OmniCamera, office_floor, office_tour, record
 from ..sim.world import World
-from ..validation import as_array, as_points, as_rng, check_callable, check_choice, check_int, check_positive
-from .visual_path import FollowResult, follow_path, perturbed_starts
+from ..validation import as_points, as_rng, check_callable, check_choice, check_int, check_positive
 
-__all__ = ["OfficeSetup", "office_setup", "localization_trials", "LocalizationTrials",
-           "route_recognition", "omni_localizer", "navigation_trials"]
+__all__ = ["OfficeSetup", "office_setup", "check_setup", "query_features", "localization_trials",
+           "LocalizationTrials", "route_recognition"]
 
 MODES = ("coarse", "fine", "hierarchical")
 #: Odometry noise of the tour (Thrun et al. 2005, Table 5.6 alphas), the builder assumes the same.
@@ -180,7 +178,8 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
                        raw.with_poses(least_squares.poses), relaxation, least_squares, truth, seconds, key)
 
 
-def _check_setup(setup: Any) -> OfficeSetup:
+def check_setup(setup: Any) -> OfficeSetup:
+    """``setup`` if it is an :class:`OfficeSetup`, else a TypeError naming it."""
     if not isinstance(setup, OfficeSetup):
         raise TypeError(f"setup: expected an OfficeSetup from office_setup(), got {type(setup).__name__}")
     return setup
@@ -214,6 +213,11 @@ class LocalizationTrials:
     local_errors: dict
     times: dict
     results: dict
+
+
+def query_features(setup: OfficeSetup) -> int:
+    """SIFT features per query image: the same number the map's images were built with."""
+    return 300 if setup.camera.width < 640 else 500
 
 
 def _render(setup: OfficeSetup, pose: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -257,7 +261,7 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
     >>> trials.errors["coarse"].shape, sorted(trials.times["coarse"])[:2]
     ((2, 2), ['coarse', 'histogram'])
     """
-    setup = _check_setup(setup)
+    setup = check_setup(setup)
     P = as_points(places, "places", 3, min_count=1)
     if not isinstance(modes, tuple) or not modes:
         raise TypeError(f"modes: expected a non-empty tuple of {MODES}, got {modes!r}")
@@ -266,7 +270,7 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
     progress = check_callable(progress, "progress")
     rng = as_rng(rng)
     images = [_render(setup, p, rng) for p in P]
-    n_features = 300 if setup.camera.width < 640 else 500
+    n_features = query_features(setup)
     estimates, errors, local_errors, times, results = {}, {}, {}, {}, {}
     for m, mode in enumerate(modes):
         loc = HierarchicalLocalizer(tmap, setup.camera, mode=mode, n_features=n_features)
@@ -323,13 +327,13 @@ def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 
     >>> len(route["nodes"]), 0.0 <= route["rate"] <= 1.0
     (3, True)
     """
-    setup = _check_setup(setup)
+    setup = check_setup(setup)
     n_nodes = check_int(n_nodes, "n_nodes", minimum=1, maximum=len(setup.raw))
     offset = check_positive(offset, "offset", allow_zero=True)
     same_place = check_positive(same_place, "same_place")
     rng = as_rng(rng)
     nodes = np.linspace(0, len(setup.raw) - 1, n_nodes).round().astype(int)
-    loc = HierarchicalLocalizer(setup.relaxed, setup.camera, n_features=300 if setup.camera.width < 640 else 500)
+    loc = HierarchicalLocalizer(setup.relaxed, setup.camera, n_features=query_features(setup))
     answers, correct, counts, features = [], [], [], []
     for i in nodes:
         x, y, _ = setup.truth[i]
@@ -346,199 +350,3 @@ def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 
     correct = np.array(correct)
     return {"nodes": nodes, "answers": np.array(answers), "correct": correct, "match_counts": np.array(counts),
             "features": np.array(features), "rate": float(correct.mean())}
-
-
-def omni_localizer(setup: OfficeSetup, *, noise: float = 1.0, map: str = "relaxed") -> Callable:
-    """A ``localize(true_pose, rng)`` for :func:`robokit.navigation.follow_path`: the omni camera in the loop.
-
-    It renders the omni image at the true pose (with ``noise`` grey levels of pixel noise),
-    localizes it hierarchically, and returns the metric pose, or ``None`` when the image is not
-    recognised.
-
-    Parameters
-    ----------
-    setup : OfficeSetup
-    noise : float, default 1.0
-        Pixel noise of the rendered images (grey levels).
-    map : {"relaxed", "optimized", "raw"}, default "relaxed"
-
-    Returns
-    -------
-    callable
-        ``localize(true_pose, rng) -> numpy.ndarray (3,) or None``; its ``calls`` and ``failures``
-        attributes count the queries.
-
-    Raises
-    ------
-    TypeError, ValueError
-        For a bad setup, noise or map name.
-
-    Notes
-    -----
-    Sec. "Visual-servoing for navigation": the robot recognises the most likely node and is
-    steered along the visual path; the fixes feed the EKF.
-
-    Examples
-    --------
-    >>> setup = office_setup(fast=True)
-    >>> localize = omni_localizer(setup)
-    >>> fix = localize(setup.truth[3], np.random.default_rng(0))
-    >>> bool(fix is None or np.hypot(*(fix[:2] - setup.truth[3, :2])) < 3.0), localize.calls
-    (True, 1)
-    """
-    setup = _check_setup(setup)
-    noise = check_positive(noise, "noise", allow_zero=True)
-    tmap = getattr(setup, check_choice(map, "map", ("relaxed", "optimized", "raw")))
-    loc = HierarchicalLocalizer(tmap, setup.camera, n_features=300 if setup.camera.width < 640 else 500)
-
-    def localize(true_pose: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
-        localize.calls += 1
-        try:
-            image = setup.camera.observe(setup.world, np.asarray(true_pose, float), rng=rng).image
-        except ValueError:       # the (non-colliding) simulated robot drove into furniture: no view
-            localize.failures += 1
-            return None
-        r: Localization = loc.localize(image)
-        if not r.recognised:
-            localize.failures += 1
-            return None
-        return r.pose
-
-    localize.calls, localize.failures = 0, 0
-    return localize
-
-
-def _open_stretch(setup: OfficeSetup, count: int, clearance: float) -> int:
-    """First node of ``count`` consecutive nodes whose smooth path keeps ``clearance`` from everything."""
-    for first in range(len(setup.relaxed) - count + 1):
-        poses = setup.relaxed.poses[first:first + count]
-        if np.hypot(*(poses[-1, :2] - poses[0, :2])) < 1.0:
-            continue
-        try:   # the path in the map, and where it lies in truth (the map's error moves it)
-            paths = [path_from_poses(poses), path_from_poses(setup.truth[first:first + count])]
-        except ValueError:
-            continue
-        if all(setup.world.is_free(p.poses[:, :2], clearance=clearance).all() for p in paths):
-            return first
-    raise ValueError(f"n_path_nodes: no {count} consecutive nodes keep {clearance:.2f} m from walls and furniture")
-
-
-def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | None = None, n_path_nodes: int = 5,
-                      clearance: float = 0.3, fix_period: float = 1.0, alpha: float = 2.0, offset: float = 0.3, heading: float = 0.3,
-                      max_time: float = 60.0, localize: Callable | None = None, seed: int = 3,
-                      cache: bool = True, progress: Callable | None = None) -> tuple[VisualPath, list]:
-    """Follow the visual path through consecutive map nodes from ``n_starts`` perturbed starts (Fig. 13).
-
-    Parameters
-    ----------
-    setup : OfficeSetup
-    n_starts : int
-    first_node : int, optional
-        The path runs through the relaxed map's nodes ``first_node .. first_node + n_path_nodes - 1``;
-        default: the first such stretch at least 1 m long whose path keeps ``clearance + offset``
-        from walls and furniture (the simulated robot does not collide, it would drive through).
-    n_path_nodes : int, default 5
-    clearance : float, default 0.3
-        Metres, see ``first_node``.
-    fix_period : float, default 1.0
-        Seconds between omni fixes (the EKF integrates odometry in between).
-    alpha : float, default 2.0
-        Natural frequency of the path-following law (1/m), Eq. (8).
-    offset, heading : float
-        Start perturbation: up to ``offset`` metres and ``heading`` radians from the path's start.
-    max_time : float or None, default 60
-        Seconds per run (``None``: :func:`follow_path`'s default, three times the path's length over
-        the top speed plus 30 s).
-    localize : callable, optional
-        Default :func:`omni_localizer` (the omni camera in the loop).
-    seed : int, default 3
-        Seeds the starts, the odometry noise and the rendering noise.
-    cache : bool, default True
-        With the default localizer, load the runs from / save them to
-        ``robokit.cache_dir("navigation")``, keyed by every parameter, the map and the code (each
-        run renders and localizes an omni image per fix: minutes at full size the first time).
-    progress : callable ``(done, total)``, optional
-
-    Returns
-    -------
-    path : VisualPath
-    results : list of FollowResult
-
-    Raises
-    ------
-    TypeError, ValueError
-        For a bad setup or parameters, or a node range outside the map.
-
-    Notes
-    -----
-    Sec. "Visual-servoing for navigation" (Eqs. (6)-(8), the EKF) and Fig. 13.
-
-    Examples
-    --------
-    With Gaussian fixes instead of the camera (fast):
-
-    >>> from robokit.navigation import gaussian_localizer
-    >>> path, runs = navigation_trials(office_setup(fast=True), 1, localize=gaussian_localizer(), cache=False)
-    >>> len(runs), runs[0].true_poses.shape[1]
-    (1, 3)
-    """
-    setup = _check_setup(setup)
-    n_starts = check_int(n_starts, "n_starts", minimum=1, maximum=1000)
-    clearance = check_positive(clearance, "clearance", allow_zero=True)
-    offset = check_positive(offset, "offset", allow_zero=True)
-    count = check_int(n_path_nodes, "n_path_nodes", minimum=2, maximum=len(setup.relaxed))
-    if first_node is None:
-        first = _open_stretch(setup, count, clearance + offset)
-    else:
-        first = check_int(first_node, "first_node", minimum=0, maximum=len(setup.relaxed) - count)
-    progress = check_callable(progress, "progress")
-    default_localizer = localize is None
-    localize = omni_localizer(setup) if default_localizer else check_callable(localize, "localize", optional=False)
-    seed = check_int(seed, "seed", minimum=0)
-    rng = as_rng(seed)
-    path = path_from_poses(as_array(setup.relaxed.poses[first:first + count], "poses"))
-    starts = perturbed_starts(path, n_starts, offset=offset, heading=heading, rng=rng)
-    target = None
-    if cache and default_localizer:
-        meta = {"setup": setup.key, "first": first, "count": count, "fix_period": fix_period, "alpha": alpha,
-                "offset": offset, "heading": heading, "max_time": max_time, "rng": seed, "n": n_starts,
-                "code": source_digest("sim", "geometry", "vision", "mapping", "localization", "controllers",
-                                      "navigation")}
-        target = cache_dir("navigation") / f"office-{cache_key(**meta)}.npz"
-        cached = _load_runs(target, n_starts)
-        if cached is not None:
-            return path, cached
-    results = []
-    for k, start in enumerate(starts):
-        results.append(follow_path(path, start, localize=localize, fix_period=fix_period, alpha=alpha,
-                                   max_time=max_time, rng=rng))
-        if progress is not None:
-            progress(k + 1, n_starts)
-    if target is not None:
-        _save_runs(target, results)
-    return path, results
-
-
-_FIELDS = [f.name for f in dataclasses.fields(FollowResult)]
-
-
-def _save_runs(target, results: list) -> None:
-    arrays = {f"{k}/{name}": np.asarray(getattr(r, name)) for k, r in enumerate(results) for name in _FIELDS}
-    tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp.npz")
-    np.savez_compressed(tmp, **arrays)
-    tmp.replace(target)
-
-
-def _load_runs(target, n: int) -> list | None:
-    """The cached runs, or ``None`` for a missing, corrupt or incomplete file (then they are re-run)."""
-    try:
-        with np.load(target, allow_pickle=False) as data:
-            out = []
-            for k in range(n):
-                values = {name: data[f"{k}/{name}"] for name in _FIELDS}
-                values["reached"], values["final_error"] = bool(values["reached"]), float(values["final_error"])
-                out.append(FollowResult(**values))
-            return out
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
-        return None
-

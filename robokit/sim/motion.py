@@ -18,7 +18,7 @@ References
    environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
    doi:10.1631/FITEE.2200208.
 .. [4] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (course source 001; README.md, "References").
+   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
 """
 from __future__ import annotations
 
@@ -34,6 +34,10 @@ from .world import World
 __all__ = ["odometry_increment", "increment_variances", "odometry_covariance", "sample_motion_model_odometry",
            "noisy_odometry", "Path", "waypoint_path",
            "corridor_path", "lab_lap", "office_tour", "OFFICE_TOUR", "OFFICE_TEST_POSES"]
+
+
+#: Odometry steps shorter than this (m) are turns on the spot to :func:`odometry_covariance`.
+SPOT_TURN = 0.01
 
 
 def odometry_increment(previous: Any, current: Any) -> np.ndarray:
@@ -160,6 +164,19 @@ def odometry_covariance(odometry: Any, alphas: Any) -> np.ndarray:
     P = as_points(odometry, "odometry", 3, min_count=1)
     a = _alphas(alphas)
     delta = odometry_increment(P[:-1], P[1:])
+    # Noisy odometry of a turn on the spot moves a few millimetres in a random direction, which
+    # Table 5.5 decomposes with a rot1 of up to +-pi and would charge alpha1 rot1^2 of heading
+    # variance for a direction that is only noise. Steps under SPOT_TURN metres are taken as turns on
+    # the spot (rot1 = 0), and a backward step as a forward one with the translation signed (rot1
+    # folded into (-pi/2, pi/2]); the increment (t cos rot1, t sin rot1, rot1 + rot2) is unchanged
+    # by the fold and moves by under SPOT_TURN by the first rule.
+    spot = delta[:, 1] < SPOT_TURN
+    delta[spot, 2] = wrap_angle(delta[spot, 0] + delta[spot, 2])
+    delta[spot, 0] = 0.0
+    back = np.abs(delta[:, 0]) > np.pi / 2
+    delta[back, 0] = wrap_angle(delta[back, 0] + np.pi)
+    delta[back, 1] = -delta[back, 1]
+    delta[back, 2] = wrap_angle(delta[back, 2] - np.pi)
     var = increment_variances(delta, a, check=False)
     r1, t = delta[:, 0], delta[:, 1]
     c1, s1 = np.cos(r1), np.sin(r1)

@@ -18,7 +18,7 @@ References
    environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
    doi:10.1631/FITEE.2200208.
 .. [3] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (course source 001; README.md, "References").
+   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
 """
 from __future__ import annotations
 

@@ -37,7 +37,7 @@ from scipy.spatial import cKDTree
 
 from ..validation import as_array, check_choice, check_int, check_positive
 
-__all__ = ["Matches", "LIN_RATIO", "LOWE_RATIO", "FLANN_TREES", "FLANN_CHECKS", "METHODS", "DescriptorIndex",
+__all__ = ["Matches", "LIN_RATIO", "LOWE_RATIO", "FLANN_TREES", "FLANN_CHECKS", "METHODS", "DescriptorIndex", "check_ratio",
            "k_nearest", "two_nearest", "distance_ratio", "ratio_test", "ratio_match", "gated_ratio_match"]
 
 #: Lin et al.'s nearest-neighbour ratio threshold ``t`` (PLOT paper, Sec. 3: "t is set equal to 0.65").
@@ -264,7 +264,7 @@ class DescriptorIndex:
         -----
         :func:`ratio_test` on :meth:`query` (Lowe 2004, Sec. 7.1).
         """
-        ratio = _check_ratio(ratio)
+        ratio = check_ratio(ratio)
         q = _descriptors(query_descriptors, "query")
         if q.shape[0] == 0 or len(self) < 2:
             return Matches.empty()
@@ -390,7 +390,8 @@ def _distance_bound(max_distance) -> float:
     return bound
 
 
-def _check_ratio(ratio) -> float:
+def check_ratio(ratio) -> float:
+    """A distance-ratio bound in (0, 1], or a ValueError/TypeError naming ``ratio``."""
     ratio = check_positive(ratio, "ratio")
     if ratio > 1:
         raise ValueError(f"ratio: expected a value in (0, 1], got {ratio}")
@@ -432,7 +433,7 @@ def ratio_test(dist, index, *, ratio: float = LIN_RATIO, max_distance: float | N
     >>> m.query.tolist(), m.train.tolist(), m.ratio.tolist()
     ([0], [4], [0.1])
     """
-    ratio = _check_ratio(ratio)
+    ratio = check_ratio(ratio)
     d = as_array(dist, "dist", shape=(None, 2), finite=False)
     idx = as_array(index, "index", shape=(d.shape[0], 2), dtype=int)
     if not (np.all(np.isfinite(d[:, 0])) and np.all(d[:, 0] >= 0) and np.all(d[:, 1] >= d[:, 0])):
@@ -485,7 +486,7 @@ def ratio_match(query, train, *, ratio: float = LIN_RATIO, method: str = "kdtree
     >>> len(ratio_match(np.vstack([train[:1], train[:1]]), np.vstack([train[:1], train[:1]])))  # ambiguous
     0
     """
-    ratio = _check_ratio(ratio)
+    ratio = check_ratio(ratio)
     q, t = _descriptors(query, "query"), _descriptors(train, "train")
     if q.shape[0] == 0 or t.shape[0] < 2:
         return Matches.empty()
@@ -531,7 +532,7 @@ def gated_ratio_match(query, train, query_index, train_index, *, ratio: float = 
     orientation, scale and continuation constraints; Se, Lowe & Little (2002), Sec. 3.2 (search
     only the landmarks predicted near each feature).
     """
-    ratio = _check_ratio(ratio)
+    ratio = check_ratio(ratio)
     q, t = _descriptors(query, "query"), _descriptors(train, "train")
     qi = as_array(query_index, "query_index", ndim=1, dtype=int)
     ti = as_array(train_index, "train_index", shape=(qi.size,), dtype=int)

@@ -27,7 +27,7 @@ References
    applications to image analysis and automated cartography", Communications of the ACM 24(6),
    381-395, 1981.
 .. [5] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (course source 001; README.md, "References").
+   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
 """
 from __future__ import annotations
 
@@ -414,8 +414,9 @@ def floor_points(bearings: Any, T_body_camera: Any, *, min_depression: float = 0
     A ray ``c + l d`` from the viewpoint ``c`` (height ``h = c_z``) meets the floor at
     ``l = h / (-d_z)``. Features that are not on the floor (a wall's foot, a table's leg) lift to
     wrong points; a robust fit between two views rejects them (:func:`robokit.vision.ransac.ransac_se2`).
-    Lesson 02's camera looks down at a mirror from 1.0 m (Sec. "Implementation for omnidirectional
-    vision"); the floor lifting is this course's choice for a metric pose relative to a node.
+    In the paper (Sec. "Implementation for omnidirectional vision") a CCD camera looks *up* at a
+    spherical mirror and no height is given; the 1.0 m viewpoint height of our simulated robot and
+    the floor lifting are this course's choices, for a metric pose relative to a node.
 
     Examples
     --------

@@ -13,7 +13,8 @@ from ..sim.lidar import scan_points
 from ..sim.world import World
 from ..validation import as_array, as_points, check_int, check_positive, check_text
 
-__all__ = ["map_axes", "plot_footprint", "plot_scan", "plot_trajectory", "plot_graph", "plot_occupancy", "plot_covariance"]
+__all__ = ["map_axes", "plot_footprint", "plot_scan", "plot_trajectory", "plot_graph", "check_graph", "plot_occupancy",
+           "plot_covariance"]
 
 
 def map_axes(ax: Any = None, title: str | None = None, figsize: tuple = (7, 5)):
@@ -156,9 +157,11 @@ def plot_trajectory(poses: Any, ax: Any = None, label: str | None = None, every:
     return ax
 
 
-def _graph(poses: Any, edges: Any) -> tuple[np.ndarray, np.ndarray]:
+def check_graph(poses: Any, edges: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``poses`` (N, 3) and ``edges`` (M, 2) node indices, checked (errors name both)."""
     P = as_points(poses, "poses", 3, min_count=1)
-    E = as_array(edges, "edges", shape=(None, 2), dtype=np.int64)
+    E = as_array(edges, "edges", dtype=np.int64)
+    E = E.reshape(0, 2) if E.size == 0 else as_array(E, "edges", shape=(None, 2), dtype=np.int64)
     if E.size and (E.min() < 0 or E.max() >= len(P)):
         raise ValueError(f"poses, edges: expected edges between the {len(P)} poses (indices in [0, {len(P)})), "
                          f"got indices {E.min()}..{E.max()}")
@@ -204,7 +207,7 @@ def plot_graph(poses: Any, edges: Any, ax: Any = None, label: str | None = None,
     >>> len(ax.lines), ax.lines[0].get_label()
     (3, 'map')
     """
-    P, E = _graph(poses, edges)
+    P, E = check_graph(poses, edges)
     mask = np.zeros(len(E), bool) if highlight is None else as_array(highlight, "highlight", shape=(len(E),),
                                                                      dtype=bool)
     label = None if label is None else check_text(label, "label")

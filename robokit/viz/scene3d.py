@@ -15,10 +15,11 @@ from ..geometry import as_se3, se2_to_se3
 from ..sim.camera import PinholeCamera
 from ..sim.world import World
 from ..validation import as_array, as_points, check_finite_scalar, check_int, check_positive
+from .maps import check_graph
 from .scene import Scene, as_color, check_scene
 
-__all__ = ["add_world", "add_camera", "add_trajectory", "add_graph", "add_particles", "add_landmarks", "animate_poses",
-           "look_from"]
+__all__ = ["add_world", "add_camera", "add_trajectory", "add_graph", "add_image", "add_particles", "add_landmarks",
+           "animate_poses", "look_from"]
 
 
 def _textured_mesh(vertices: np.ndarray, faces: np.ndarray, uvs: np.ndarray):
@@ -239,17 +240,62 @@ def add_graph(scene: Scene, path: str, poses: Any, edges: Any, z: float = 0.05, 
     Scene(title='robokit scene', commands=2)
     """
     check_scene(scene, path)
-    P = as_points(poses, "poses", 3, min_count=1)
-    E = as_array(edges, "edges", shape=(None, 2), dtype=np.int64)
-    if E.size and (E.min() < 0 or E.max() >= len(P)):
-        raise ValueError(f"poses, edges: expected edges between the {len(P)} poses (indices in [0, {len(P)})), "
-                         f"got indices {E.min()}..{E.max()}")
+    P, E = check_graph(poses, edges)
     z = check_finite_scalar(z, "z")
     lifted = np.column_stack([P[:, :2], np.full(len(P), z)])
     scene.add_points(f"{path}/nodes", lifted, size=check_positive(size, "size"), color=node_color)
     if len(E):
         _segments(scene, f"{path}/edges", lifted[E.reshape(-1)], edge_color)
     return scene
+
+
+def add_image(scene: Scene, path: str, image: Any, centre: Any, width: float = 1.5) -> Scene:
+    """Lay an RGB image flat (facing up) at ``centre``, e.g. a robot's omni view above its node.
+
+    Parameters
+    ----------
+    scene : Scene
+    path : str
+    image : array_like (H, W, 3) uint8
+        RGB image; drawn with its top row towards +y.
+    centre : array_like, shape (3,)
+        World position of the image's centre (metres).
+    width : float, default 1.5
+        Width in metres (the height follows the aspect ratio).
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    ValueError, TypeError
+        For an image that is not (H, W, 3) uint8, a bad centre or a non-positive width.
+
+    Notes
+    -----
+    A textured quad (meshcat mesh with an image texture), as :func:`add_world` draws surfaces.
+
+    Examples
+    --------
+    >>> from robokit.viz import Scene, add_image
+    >>> add_image(Scene(), "view", np.zeros((4, 6, 3), np.uint8), [1.0, 2.0, 3.0])
+    Scene(title='robokit scene', commands=1)
+    """
+    check_scene(scene, path)
+    from meshcat.geometry import ImageTexture, Mesh, MeshBasicMaterial, PngImage
+
+    img = np.asarray(image)
+    if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8 or min(img.shape[:2]) < 1:
+        raise ValueError(f"image: expected an (H, W, 3) uint8 RGB image, got {img.dtype} of shape {img.shape}")
+    c = as_array(centre, "centre", shape=(3,))
+    w = check_positive(width, "width")
+    h = w * img.shape[0] / img.shape[1]
+    verts = c + np.array([[-w / 2, -h / 2, 0], [w / 2, -h / 2, 0], [w / 2, h / 2, 0], [-w / 2, h / 2, 0]])
+    uvs = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    ok, png = cv2.imencode(".png", cv2.cvtColor(img, cv2.COLOR_RGB2BGR))
+    return scene.set_object(path, Mesh(_textured_mesh(verts, np.array([[0, 1, 2], [0, 2, 3]]), uvs),
+                                       MeshBasicMaterial(map=ImageTexture(PngImage(png.tobytes())), side=2)))
 
 
 def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, z: float = 0.03,

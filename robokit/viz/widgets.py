@@ -12,6 +12,7 @@ import base64
 import html as _html
 import io
 import itertools
+import json
 from typing import Any, Callable, Sequence
 
 from ..config import headless
@@ -101,7 +102,7 @@ def static_slider_html(draw: Callable[[Any], Any], values: Sequence[Any], *, lab
         f'<img src="data:image/png;base64,{png}" alt="{_html.escape(label)} = {_html.escape(t)}" '
         f'style="display:{"block" if k == start else "none"};max-width:100%">'
         for k, (png, t) in enumerate(zip(pngs, texts)))
-    names = _html.escape(repr(texts).replace('"', "'"), quote=True)
+    names = _html.escape(json.dumps(texts), quote=True)
     handler = ("var k=+this.value,box=this.parentNode.parentNode;"
                "box.querySelectorAll('img').forEach(function(im,i){im.style.display=i==k?'block':'none'});"
                f"this.nextSibling.textContent=' '+{names}[k];")
