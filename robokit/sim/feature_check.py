@@ -73,7 +73,17 @@ def ground_truth_inliers(camera: PinholeCamera, depth: Any, T1: Any, T2: Any, uv
     """
     if not isinstance(camera, PinholeCamera):
         raise TypeError(f"camera: expected robokit.sim.PinholeCamera, got {type(camera).__name__}")
-    depth = as_array(depth, "depth", shape=(camera.height, camera.width), finite=False)
+    return _reprojects(camera, depth, "depth", T1, T2, uv1, uv2, tol)
+
+
+def _reprojects(camera: Any, depth: Any, depth_name: str, T1: Any, T2: Any, uv1: Any, uv2: Any,
+                tol: float) -> np.ndarray:
+    """Lift ``uv1`` with the depth (or range) read at its nearest pixel, project into view 2, compare
+    with ``uv2``: the one check behind both cameras (each camera's own ``backproject``/``project``)."""
+    depth = as_array(depth, depth_name, shape=(camera.height, camera.width), finite=False)
+    if np.isnan(depth).any():
+        raise ValueError(f"{depth_name}: expected {depth_name} or inf (no surface), got NaN")
+    T1, T2 = as_se3(T1, "T1"), as_se3(T2, "T2")
     tol = check_positive(tol, "tol")
     uv1 = as_points(uv1, "uv1", 2)
     uv2 = as_points(uv2, "uv2", 2)
@@ -87,7 +97,8 @@ def ground_truth_inliers(camera: PinholeCamera, depth: Any, T1: Any, T2: Any, uv
     ok = np.zeros(len(uv1), bool)
     if known.any():
         predicted, _ = camera.project(camera.backproject(uv1[known], z[known], T1), T2)
-        ok[known] = np.linalg.norm(predicted - uv2[known], axis=1) < tol
+        with np.errstate(invalid="ignore"):    # NaN: the point left view 2 (an omni annulus), not correct
+            ok[known] = np.linalg.norm(predicted - uv2[known], axis=1) < tol
     return ok
 
 
@@ -207,26 +218,7 @@ def omni_ground_truth_inliers(camera: OmniCamera, ranges: Any, T1: Any, T2: Any,
     """
     if not isinstance(camera, OmniCamera):
         raise TypeError(f"camera: expected robokit.sim.OmniCamera, got {type(camera).__name__}")
-    ranges = as_array(ranges, "ranges", shape=(camera.height, camera.width), finite=False)
-    if np.isnan(ranges).any():
-        raise ValueError("ranges: expected ranges or inf (no surface), got NaN")
-    T1, T2 = as_se3(T1, "T1"), as_se3(T2, "T2")
-    tol = check_positive(tol, "tol")
-    uv1 = as_points(uv1, "uv1", 2)
-    uv2 = as_points(uv2, "uv2", 2)
-    if len(uv1) != len(uv2):
-        raise ValueError(f"uv2: expected {len(uv1)} pixels like uv1, got {len(uv2)}")
-    col, row = np.round(uv1[:, 0]).astype(int), np.round(uv1[:, 1]).astype(int)
-    if np.any((col < 0) | (col >= camera.width) | (row < 0) | (row >= camera.height)):
-        raise ValueError(f"uv1: expected pixels inside the {camera.width}x{camera.height} image")
-    r = ranges[row, col]
-    known = np.isfinite(r) & (r > 0)
-    ok = np.zeros(len(uv1), bool)
-    if known.any():
-        predicted, _ = camera.project(camera.backproject(uv1[known], r[known], T1), T2)
-        with np.errstate(invalid="ignore"):                 # NaN: left view 2's annulus, not correct
-            ok[known] = np.linalg.norm(predicted - uv2[known], axis=1) < tol
-    return ok
+    return _reprojects(camera, ranges, "ranges", T1, T2, uv1, uv2, tol)
 
 
 def omni_view_pair(world: World, camera: OmniCamera, pose1: Any, pose2: Any, *, orientation: str = "radial",

@@ -33,6 +33,13 @@ def _values(values: Any) -> list:
     return out
 
 
+def _checked(draw: Any, values: Any, label: Any, fmt: Any, start: Any) -> tuple:
+    draw = check_callable(draw, "draw", optional=False)
+    vals = _values(values)
+    return (draw, vals, check_text(label, "label"), check_text(fmt, "fmt", empty=False),
+            check_int(start, "start", minimum=0, maximum=len(vals) - 1))
+
+
 def _figure_png(draw: Callable[[Any], Any], value: Any) -> str:
     import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
@@ -90,11 +97,7 @@ def static_slider_html(draw: Callable[[Any], Any], values: Sequence[Any], *, lab
     >>> page.count("<img"), 'max="2"' in page
     (3, True)
     """
-    draw = check_callable(draw, "draw", optional=False)
-    vals = _values(values)
-    label = check_text(label, "label")
-    fmt = check_text(fmt, "fmt", empty=False)
-    start = check_int(start, "start", minimum=0, maximum=len(vals) - 1)
+    draw, vals, label, fmt, start = _checked(draw, values, label, fmt, start)
     texts = [fmt.format(v) for v in vals]
     pngs = [_figure_png(draw, v) for v in vals]
     uid = f"robokit-slider-{next(_ids)}"
@@ -150,11 +153,7 @@ def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "v
     ...     return fig
     >>> slider(draw, [1, 2], label="slope")  # doctest: +SKIP
     """
-    draw = check_callable(draw, "draw", optional=False)
-    vals = _values(values)
-    label = check_text(label, "label")
-    fmt = check_text(fmt, "fmt", empty=False)
-    start = check_int(start, "start", minimum=0, maximum=len(vals) - 1)
+    draw, vals, label, fmt, start = _checked(draw, values, label, fmt, start)
     from IPython.display import display
 
     widgets = None
