@@ -224,3 +224,15 @@ def test_frames_similar_in_colour_skip_sift_and_the_feature_count():
     assert keys == [0, 5, 6, 7] and reasons[1:] == ["features"] * 3
     keys, reasons = select_key_frames(8, same_colours, occlusion_frames=2, max_features=10 ** 6)
     assert keys == [0] and reasons == ["start"]
+
+
+def test_rank_by_histogram_refuses_nodes_that_do_not_exist_and_wrong_bin_counts():
+    tmap = short_map()
+    h = tmap.histograms[0]
+    order, _ = tmap.rank_by_histogram(h, exclude=[0])
+    assert 0 not in order and len(order) == len(tmap) - 1
+    for bad in ([-1], [len(tmap)], np.ones(len(tmap) + 1, bool)):
+        with pytest.raises(ValueError, match="exclude"):
+            tmap.rank_by_histogram(h, exclude=bad)
+    with pytest.raises(ValueError, match="histogram"):
+        tmap.rank_by_histogram(h[:5])

@@ -235,11 +235,21 @@ class TopologicalMap:
         The coarse stage of Sec. "Hierarchical localization": Eq. (5) against every node in one
         vectorised step (:func:`robokit.vision.histogram_distance`).
         """
+        if len(self.histograms) and np.size(histogram) != self.histograms.shape[1]:
+            raise ValueError(f"histogram: expected {self.histograms.shape[1]} bins like the map's, got "
+                             f"{np.size(histogram)}")
         d = histogram_distance(histogram, self.histograms)                      # Eq. (5)
         keep = np.ones(len(self), bool)
         if exclude is not None:
             ex = np.asarray(exclude)
-            keep[ex if ex.dtype != bool else np.flatnonzero(ex)] = False
+            if ex.dtype == bool:
+                if ex.shape != (len(self),):
+                    raise ValueError(f"exclude: expected a mask of {len(self)} nodes, got shape {ex.shape}")
+                ex = np.flatnonzero(ex)
+            ex = as_array(ex, "exclude", ndim=1).astype(np.int64) if ex.size else np.zeros(0, np.int64)
+            if ex.size and (ex.min() < 0 or ex.max() >= len(self)):
+                raise ValueError(f"exclude: expected node indices in [0, {len(self)}), got {ex.min()}..{ex.max()}")
+            keep[ex] = False
         order = np.flatnonzero(keep)[np.argsort(d[keep], kind="stable")]
         return order, d[order]
 
