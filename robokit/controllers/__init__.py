@@ -18,7 +18,7 @@ from .heading import HeadingController, design_heading_gains
 from .heading_loop import (heading_closed_loop, heading_frequency_response, heading_loop_gain, heading_plant,
                            heading_step_response, loop_metrics)
 from .path_following import (PathFollower, PathSingularityError, path_following_command, path_following_gains,
-                             saturate_command)
+                             reference_command, saturate_command)
 from .path_geometry import ReferencePoint, VisualPath, path_from_poses, reference_point
 from .path_following_loop import (FollowTrace, lateral_step_response, path_following_damping,
                                   path_following_linearisation, path_following_poles, simulate_path_following)
@@ -26,6 +26,6 @@ from .path_following_loop import (FollowTrace, lateral_step_response, path_follo
 __all__ = ["HeadingController", "design_heading_gains", "heading_closed_loop", "heading_frequency_response",
            "heading_loop_gain", "heading_plant", "heading_step_response", "loop_metrics",
            "PathFollower", "PathSingularityError", "ReferencePoint", "VisualPath", "path_following_command",
-           "path_following_gains", "path_from_poses", "reference_point", "saturate_command",
+           "path_following_gains", "path_from_poses", "reference_point", "reference_command", "saturate_command",
            "FollowTrace", "lateral_step_response", "path_following_damping", "path_following_linearisation",
            "path_following_poles", "simulate_path_following"]

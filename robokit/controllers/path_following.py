@@ -54,7 +54,7 @@ from ..validation import as_array, check_finite_result, check_positive, describe
 from .path_geometry import ReferencePoint, VisualPath, path_from_poses, reference_point
 
 # the path's names are re-exported: the lesson's API reaches them through this module too
-__all__ = ["path_following_gains", "PathSingularityError", "path_following_command", "saturate_command",
+__all__ = ["reference_command", "path_following_gains", "PathSingularityError", "path_following_command", "saturate_command",
            "PathFollower", "VisualPath", "path_from_poses", "ReferencePoint", "reference_point"]
 
 XI = 1 / math.sqrt(2)   # the paper's damping: "a small overshoot" (4.3 %)
@@ -311,6 +311,47 @@ class PathFollower:
         self.done = self.reached or ref.s >= self.path.length
         if self.done:
             return 0.0, 0.0
-        c = ref.curvature if 1 - ref.curvature * ref.d >= 0.1 else 0.0
-        omega = path_following_command(ref.d, ref.theta_tilde, c, self.v_max, self.k2, self.k3, check=False)
-        return saturate_command(self.v_max, omega, self.v_max, self.w_max, check=False)
+        return reference_command(ref, self.v_max, self.k2, self.k3, self.w_max)
+
+
+def reference_command(ref: ReferencePoint, v: float, k2: float, k3: float, w_max: float | None = None
+                      ) -> tuple[float, float]:
+    """``(v, omega)`` at a reference point: Eq. (8), then the paper's saturation.
+
+    The one step every follower takes (:class:`PathFollower`, the nonlinear simulation beside the
+    linearised loop). Near the path's centre of curvature (``1 - c d < 0.1``, where Eq. (8)'s third
+    term blows up) the curvature term is dropped rather than the robot stopped.
+
+    Parameters
+    ----------
+    ref : ReferencePoint
+        From :func:`reference_point` (its ``d``, ``theta_tilde`` and ``curvature``).
+    v : float
+        Forward speed (m/s), also the saturation's ``V_max``.
+    k2, k3 : float
+        Gains of Eq. (8).
+    w_max : float, optional
+        Turn-rate bound ``W_max`` (rad/s); ``None``: no saturation.
+
+    Returns
+    -------
+    (v, omega) : float, float
+
+    Notes
+    -----
+    Eq. (8) and Sec. "Visual-servoing for navigation" (saturation keeping the curvature); inputs
+    are trusted (the callers validated them).
+
+    Examples
+    --------
+    >>> from robokit.controllers import path_from_poses, reference_point
+    >>> line = path_from_poses([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    >>> v, omega = reference_command(reference_point(line, [0.5, 0.2, 0.0]), 0.3, 4.0, 2.83, w_max=0.2)
+    >>> round(v, 3), round(omega, 3)                 # omega -0.24 saturated to -0.2, v scaled with it
+    (0.25, -0.2)
+    """
+    c = ref.curvature if 1 - ref.curvature * ref.d >= 0.1 else 0.0
+    omega = path_following_command(ref.d, ref.theta_tilde, c, v, k2, k3, check=False)
+    if w_max is None:
+        return float(v), float(omega)
+    return saturate_command(v, omega, v, w_max, check=False)

@@ -37,7 +37,7 @@ import numpy as np
 from ..sim import unicycle_step
 from ..validation import (as_array, check_finite_result, check_finite_scalar, check_positive, check_sample_count,
                           describe)
-from .path_following import XI, path_following_command, path_following_gains, saturate_command
+from .path_following import XI, path_following_gains, reference_command
 from .path_geometry import VisualPath, reference_point
 
 __all__ = ["path_following_linearisation", "path_following_poles", "path_following_damping",
@@ -266,9 +266,7 @@ def simulate_path_following(path: VisualPath, start_pose: Any, *, alpha: float, 
         if k == n or ref.s >= path.length:
             vs.append(0.0), ws.append(0.0)
             break
-        vc, wc = speed, path_following_command(ref.d, ref.theta_tilde, ref.curvature, speed, k2, k3, check=False)
-        if wm is not None:
-            vc, wc = saturate_command(vc, wc, speed, wm, check=False)
+        vc, wc = reference_command(ref, speed, k2, k3, wm)
         check_finite_result("start_pose, alpha, v, dt, xi", vc, wc)
         vs.append(vc), ws.append(wc)
         pose = unicycle_step(pose, vc, wc, h, check=False)
