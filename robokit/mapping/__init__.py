@@ -22,7 +22,7 @@ from .landmarks import LandmarkMap, kalman_fuse, transform_covariance
 from .manhattan import manhattan_world_graph
 from .pose_graph import (DisconnectedGraphError, PoseGraph, as_pose_graph, check_connected, edge_variances, is_connected,
                          pose_graph_from_odometry, positive_definite, unreachable_nodes,
-                         information_from_covariance)
+                         information_from_covariance, position_variance)
 from .pose_graph_optimize import (PoseGraphResult, optimize_pose_graph, pose_graph_cost, pose_graph_jacobian,
                                   pose_graph_residuals)
 from .omni_views import OmniView, RelativePose, check_omni_image, omni_view, relative_pose
@@ -33,7 +33,7 @@ from .topological_build import (Comparison, appearance_changed, build_topologica
 
 __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
            "PoseGraph", "DisconnectedGraphError", "as_pose_graph", "positive_definite", "edge_variances", "unreachable_nodes",
-           "is_connected", "check_connected", "pose_graph_from_odometry", "information_from_covariance",
+           "is_connected", "check_connected", "pose_graph_from_odometry", "information_from_covariance", "position_variance",
            "pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph",
            "RelaxationResult", "relax", "relax_sweep", "initial_variances",
            "G2OFormatError", "read_g2o", "write_g2o", "manhattan_world_graph",

@@ -33,7 +33,8 @@ from ..geometry import se2_between
 from ..validation import as_array, check_int
 
 __all__ = ["PoseGraph", "DisconnectedGraphError", "as_pose_graph", "positive_definite", "edge_variances", "unreachable_nodes",
-           "is_connected", "check_connected", "pose_graph_from_odometry", "information_from_covariance"]
+           "is_connected", "check_connected", "pose_graph_from_odometry", "information_from_covariance",
+           "position_variance"]
 
 
 class DisconnectedGraphError(ValueError):
@@ -302,8 +303,33 @@ def edge_variances(graph: PoseGraph) -> np.ndarray:
     [0.025]
     """
     g = as_pose_graph(graph)
-    cov = np.linalg.inv(g.information) if g.n_edges else np.zeros((0, 3, 3))
-    return 0.5 * (cov[:, 0, 0] + cov[:, 1, 1])
+    return position_variance(np.linalg.inv(g.information) if g.n_edges else np.zeros((0, 3, 3)))
+
+
+def position_variance(covariances: np.ndarray) -> np.ndarray:
+    """The paper's scalar variance of a pose covariance: the mean of its x and y variances.
+
+    Parameters
+    ----------
+    covariances : numpy.ndarray, shape (..., 3, 3)
+        Covariances of ``[x, y, theta]`` (unchecked: the callers made them).
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        ``(C_xx + C_yy) / 2`` [m^2]; it does not change when the frame turns.
+
+    Notes
+    -----
+    One variance per edge and per node, as Sec. 'Loop closure alignment' keeps them (Eqs. (1)-(2));
+    :func:`edge_variances` applies it to a pose graph's edges.
+
+    Examples
+    --------
+    >>> print(position_variance(np.diag([0.01, 0.04, 0.0025])))
+    0.025
+    """
+    return 0.5 * (covariances[..., 0, 0] + covariances[..., 1, 1])
 
 
 def unreachable_nodes(graph: PoseGraph) -> np.ndarray:

@@ -44,6 +44,7 @@ from ..validation import as_array, check_callable, check_choice, check_int, chec
 from ..vision.colour import histogram_distance
 from ..vision.matching import METHODS, DescriptorIndex
 from .omni_views import check_omni_image, omni_view, relative_pose
+from .pose_graph import position_variance
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
 
 __all__ = ["Comparison", "appearance_changed", "local_map_full", "select_key_frames", "build_topological_map"]
@@ -235,10 +236,6 @@ def select_key_frames(n_frames: int, compare: Callable[[int, int], Comparison], 
     return keys, reasons
 
 
-def _position_variance(cov: np.ndarray) -> float:
-    return float(0.5 * (cov[0, 0] + cov[1, 1]))       # as robokit.mapping.edge_variances
-
-
 def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, similarity: float = 0.1,
                           min_matches: int = 80, occlusion_frames: int = 3, max_features: int = 930,
                           max_variance: float = 0.1, odometry_alphas: Any = (0.01, 0.001, 0.01, 0.001),
@@ -351,7 +348,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
             del cache[f], has_sift[f]
         if progress is not None:
             progress(k + 1, n)
-        var = _position_variance(odometry_covariance(odo[key:k + 1], alphas)[-1])
+        var = float(position_variance(odometry_covariance(odo[key:k + 1], alphas)[-1]))
         d = float(histogram_distance(view(k, features=False).histogram, view(key).histogram))   # Eq. (5)
         if d <= similarity:           # similar enough: the global feature answers, SIFT is not needed
             return Comparison(d, None, None, var)
@@ -364,7 +361,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
                                       max_variance=max_variance)
     key_views = [view(k) for k in keys]
     edge_cov = [odometry_covariance(odo[a:b + 1], alphas)[-1] + _COVARIANCE_FLOOR for a, b in zip(keys[:-1], keys[1:])]
-    variances = np.concatenate([[0.0], np.cumsum([_position_variance(c) for c in edge_cov])])
+    variances = np.concatenate([[0.0], np.cumsum(position_variance(np.reshape(edge_cov, (-1, 3, 3))))])
     counts = np.array([len(v) for v in key_views])
     tmap = TopologicalMap(
         poses=odo[keys], variances=variances, histograms=np.stack([v.histogram for v in key_views]),
