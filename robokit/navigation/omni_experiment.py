@@ -43,7 +43,7 @@ from ..sim import OmniCamera, office_floor, office_tour, record
 from ..sim.world import World
 from ..validation import as_points, as_rng, check_callable, check_choice, check_int, check_positive
 
-__all__ = ["OfficeSetup", "office_setup", "check_setup", "query_features", "localization_trials",
+__all__ = ["OfficeSetup", "office_setup", "check_setup", "localization_trials",
            "LocalizationTrials", "route_recognition"]
 
 MODES = ("coarse", "fine", "hierarchical")
@@ -60,6 +60,8 @@ class OfficeSetup:
     world, camera : World, OmniCamera
     n_frames : int
         Omni frames recorded along the tour.
+    n_features : int
+        SIFT features per image the map was built with (queries use the same).
     raw : TopologicalMap
         The map as built: nodes at their odometry poses.
     relaxed, optimized : TopologicalMap
@@ -77,6 +79,7 @@ class OfficeSetup:
     world: World
     camera: OmniCamera
     n_frames: int
+    n_features: int
     raw: TopologicalMap
     relaxed: TopologicalMap
     optimized: TopologicalMap
@@ -174,8 +177,9 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     graph = raw.graph()
     relaxation = relax(graph)
     least_squares = optimize_pose_graph(graph)
-    return OfficeSetup(world, camera, frames, raw, raw.with_poses(relaxation.poses, relaxation.variances),
-                       raw.with_poses(least_squares.poses), relaxation, least_squares, truth, seconds, key)
+    return OfficeSetup(world, camera, frames, params["n_features"], raw,
+                       raw.with_poses(relaxation.poses, relaxation.variances), raw.with_poses(least_squares.poses),
+                       relaxation, least_squares, truth, seconds, key)
 
 
 def check_setup(setup: Any) -> OfficeSetup:
@@ -213,11 +217,6 @@ class LocalizationTrials:
     local_errors: dict
     times: dict
     results: dict
-
-
-def query_features(setup: OfficeSetup) -> int:
-    """SIFT features per query image: the same number the map's images were built with."""
-    return 300 if setup.camera.width < 640 else 500
 
 
 def _render(setup: OfficeSetup, pose: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -270,10 +269,9 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
     progress = check_callable(progress, "progress")
     rng = as_rng(rng)
     images = [_render(setup, p, rng) for p in P]
-    n_features = query_features(setup)
     estimates, errors, local_errors, times, results = {}, {}, {}, {}, {}
     for m, mode in enumerate(modes):
-        loc = HierarchicalLocalizer(tmap, setup.camera, mode=mode, n_features=n_features)
+        loc = HierarchicalLocalizer(tmap, setup.camera, mode=mode, n_features=setup.n_features)
         out = []
         for k, img in enumerate(images):
             out.append(loc.localize(img))
@@ -333,7 +331,7 @@ def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 
     same_place = check_positive(same_place, "same_place")
     rng = as_rng(rng)
     nodes = np.linspace(0, len(setup.raw) - 1, n_nodes).round().astype(int)
-    loc = HierarchicalLocalizer(setup.relaxed, setup.camera, n_features=query_features(setup))
+    loc = HierarchicalLocalizer(setup.relaxed, setup.camera, n_features=setup.n_features)
     answers, correct, counts, features = [], [], [], []
     for i in nodes:
         x, y, _ = setup.truth[i]

@@ -27,7 +27,7 @@ from ..config import cache_dir, cache_key, source_digest
 from ..controllers.path_geometry import VisualPath, path_from_poses
 from ..localization.hierarchical import HierarchicalLocalizer, Localization
 from ..validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive
-from .omni_experiment import OfficeSetup, check_setup, query_features
+from .omni_experiment import OfficeSetup, check_setup
 from .visual_path import FollowResult, follow_path, perturbed_starts
 
 __all__ = ["omni_localizer", "navigation_trials", "NavigationTrials"]
@@ -75,7 +75,7 @@ def omni_localizer(setup: OfficeSetup, *, noise: float = 1.0, map: str = "relaxe
     setup = check_setup(setup)
     noise = check_positive(noise, "noise", allow_zero=True)
     tmap = getattr(setup, check_choice(map, "map", ("relaxed", "optimized", "raw")))
-    loc = HierarchicalLocalizer(tmap, setup.camera, n_features=query_features(setup))
+    loc = HierarchicalLocalizer(tmap, setup.camera, n_features=setup.n_features)
 
     def localize(true_pose: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
         localize.calls += 1
