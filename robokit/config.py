@@ -11,8 +11,9 @@ import hashlib
 import json
 import os
 from pathlib import Path
+from typing import Any, Callable
 
-__all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest"]
+__all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest", "write_atomically"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -205,4 +206,53 @@ def source_digest(*packages: str) -> str:
         for source in sorted((root / package).glob("*.py")):
             digest.update(package.encode() + b"/" + source.name.encode() + b"\0" + source.read_bytes())
     return digest.hexdigest()[:16]
+
+
+def write_atomically(target: str | Path, write: Callable[[Path], Any]) -> Path:
+    """Write a cache file so that no reader ever sees it half written.
+
+    ``write(tmp)`` writes a temporary sibling of ``target`` (same suffix, named after this process);
+    it is then renamed over ``target`` in one step. Notebooks run in parallel (the course build, the
+    tests) and share the cache: each either finds the old file, the complete new one, or none.
+
+    Parameters
+    ----------
+    target : str or Path
+    write : callable ``(path) -> Any``
+        Writes the file at the path it is given.
+
+    Returns
+    -------
+    Path
+        ``target``.
+
+    Raises
+    ------
+    TypeError
+        For a non-callable ``write``. Whatever ``write`` raises propagates; its temporary file is
+        removed.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Caching"); a rename within one directory is atomic on POSIX.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> write_atomically(folder / "a.json", lambda p: p.write_text("{}")).read_text()
+    '{}'
+    >>> sorted(f.name for f in folder.iterdir())
+    ['a.json']
+    """
+    if not callable(write):
+        raise TypeError(f"write: expected a callable that writes a path, got {type(write).__name__}")
+    target = Path(target)
+    tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp{target.suffix}")
+    try:
+        write(tmp)
+        tmp.replace(target)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return target
 

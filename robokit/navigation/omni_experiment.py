@@ -27,14 +27,13 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 import time
 import zipfile
 from typing import Any, Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, fast_mode, source_digest
+from ..config import cache_dir, cache_key, fast_mode, source_digest, write_atomically
 from ..geometry import se2_between, se2_compose
 from ..localization.hierarchical import HierarchicalLocalizer
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
@@ -115,10 +114,9 @@ def _map_cached(meta: dict, build: Callable[[], tuple[TopologicalMap, np.ndarray
     t0 = time.perf_counter()
     tmap, truth, frames = build()
     seconds = time.perf_counter() - t0
-    tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp.npz")
-    tmap.save(tmp)
-    tmp.replace(target)
-    sidecar.write_text(json.dumps({"meta": meta, "seconds": seconds, "frames": frames, "truth": truth.tolist()}))
+    write_atomically(target, tmap.save)
+    write_atomically(sidecar, lambda path: path.write_text(
+        json.dumps({"meta": meta, "seconds": seconds, "frames": frames, "truth": truth.tolist()})))
     return tmap, truth, frames, seconds, key
 
 

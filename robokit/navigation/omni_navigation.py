@@ -17,13 +17,12 @@ References
 from __future__ import annotations
 
 import dataclasses
-import os
 import zipfile
 from typing import Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, source_digest
+from ..config import cache_dir, cache_key, source_digest, write_atomically
 from ..controllers.path_geometry import VisualPath, path_from_poses
 from ..localization.hierarchical import HierarchicalLocalizer, Localization
 from ..validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive
@@ -252,9 +251,7 @@ _FIELDS = [f.name for f in dataclasses.fields(FollowResult)]
 
 def _save_runs(target, results: list) -> None:
     arrays = {f"{k}/{name}": np.asarray(getattr(r, name)) for k, r in enumerate(results) for name in _FIELDS}
-    tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp.npz")
-    np.savez_compressed(tmp, **arrays)
-    tmp.replace(target)
+    write_atomically(target, lambda path: np.savez_compressed(path, **arrays))
 
 
 def _load_runs(target, n: int) -> list | None:

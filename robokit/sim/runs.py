@@ -21,7 +21,6 @@ import dataclasses
 import functools
 import hashlib
 import json
-import os
 import zipfile
 from pathlib import Path as FsPath
 from typing import Any
@@ -29,7 +28,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..config import cache_dir, cache_key, source_digest
+from ..config import cache_dir, cache_key, source_digest, write_atomically
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .motion import Path, noisy_odometry
 from .world import World
@@ -273,7 +272,5 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     stacked = {group: {k: np.stack(v) for k, v in arrays.items()} for group, arrays in logs.items()}
     run = Run(t, poses, odometry, stacked["images"], stacked["depths"], stacked["scans"], meta)
     if target is not None:
-        tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp")
-        run.save(tmp)
-        tmp.replace(target)  # atomic: notebooks running in parallel never read a half-written file
+        write_atomically(target, run.save)   # notebooks running in parallel never read a half-written file
     return run
