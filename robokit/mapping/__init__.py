@@ -16,6 +16,9 @@ KD-trees, the coarse and fine searches) and :mod:`.topological_build` (key image
 partitioning, loop closure, from a recorded run). Unlike the rest of mapping they use
 :mod:`robokit.sim`'s omni camera model (its rays and mount) and odometry noise model, never its
 renderer.
+
+Occupancy grids (lesson 03's corridor map): :mod:`.occupancy_grid` (log odds per cell, the
+free/occupied/unknown reading with map_server's thresholds, the likelihood field of a range finder).
 """
 from .g2o import G2OFormatError, read_g2o, write_g2o
 from .landmarks import LandmarkMap, kalman_fuse, transform_covariance
@@ -25,6 +28,8 @@ from .pose_graph import (DisconnectedGraphError, PoseGraph, as_pose_graph, check
                          information_from_covariance, position_variance)
 from .pose_graph_optimize import (PoseGraphResult, optimize_pose_graph, pose_graph_cost, pose_graph_jacobian,
                                   pose_graph_residuals)
+from .occupancy_grid import (FREE_THRESHOLD, LOG_ODDS_MAX, LOG_ODDS_MIN, OCCUPIED_THRESHOLD, LikelihoodField,
+                             OccupancyGrid, likelihood_field, log_odds, probability)
 from .omni_views import OmniView, RelativePose, check_omni_image, omni_view, relative_pose
 from .relaxation import RelaxationResult, initial_variances, relax, relax_sweep
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
@@ -39,4 +44,6 @@ __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
            "G2OFormatError", "read_g2o", "write_g2o", "manhattan_world_graph",
            "OmniView", "RelativePose", "check_omni_image", "omni_view", "relative_pose",
            "LOOP_EDGE", "ODOMETRY_EDGE", "EmptyMapError", "TopologicalMap", "Comparison", "appearance_changed",
-           "build_topological_map", "local_map_full", "select_key_frames"]
+           "build_topological_map", "local_map_full", "select_key_frames",
+           "FREE_THRESHOLD", "OCCUPIED_THRESHOLD", "LOG_ODDS_MIN", "LOG_ODDS_MAX", "log_odds", "probability",
+           "OccupancyGrid", "LikelihoodField", "likelihood_field"]
