@@ -194,3 +194,96 @@ def test_mapping_refuses_bad_scans():
         update_log_odds(OccupancyGrid.empty((0, 0, 1, 1), 0.1), [0, 0, 0], [], [0.0], r_max=1.0)
     with pytest.raises(ValueError, match="clamp"):
         occupancy_grid_mapping(np.zeros((1, 3)), [[1.0] * 4], a, clamp=(1.0, -1.0), **kw)
+
+
+# ---- ROS map_server files ----
+
+from robokit.mapping import MapFileError, load_map, save_map  # noqa: E402
+
+
+def masks(grid):
+    return grid.free_mask(), grid.occupied_mask(), grid.unknown_mask()
+
+
+@pytest.mark.parametrize("negate", [0, 1])
+@pytest.mark.parametrize("mode", ["trinary", "scale"])
+def test_map_server_round_trip(tmp_path, negate, mode):
+    rng = np.random.default_rng(5)
+    grid = OccupancyGrid(rng.uniform(-3, 4, (9, 14)), 0.05, origin=(-0.2, -1.4))
+    pgm, yaml = save_map(grid, tmp_path / "run", negate=negate, mode=mode)
+    assert (pgm.name, yaml.name) == ("run.pgm", "run.yaml")
+    back = load_map(yaml)
+    assert back.shape == grid.shape and back.resolution == 0.05 and back.origin.tolist() == [-0.2, -1.4]
+    for a, b in zip(masks(back), masks(grid)):
+        np.testing.assert_array_equal(a, b)
+    if mode == "scale":
+        unknown = grid.unknown_mask()
+        np.testing.assert_allclose(back.probability[unknown], grid.probability[unknown], atol=1 / 255)
+
+
+def test_pgm_rows_are_flipped_and_trinary(tmp_path):
+    P = np.array([[1.0, 0.0], [np.nan, 0.0], [0.0, 0.0]])             # row 0 = lowest y
+    pgm, _ = save_map(OccupancyGrid.from_probability(P, 0.1), tmp_path / "m")
+    data = pgm.read_bytes()
+    assert data.startswith(b"P5\n2 3\n255\n")
+    assert list(data[-6:]) == [254, 254, 205, 254, 0, 254]              # the top row (highest y) first
+
+
+def test_load_map_reads_a_hand_written_ros_map(tmp_path):
+    (tmp_path / "maps").mkdir()
+    (tmp_path / "maps" / "office.pgm").write_bytes(b"P5\n# CREATOR: map_saver.cpp\n3 2\n255\n" + bytes([0, 254, 205, 100, 230, 20]))
+    (tmp_path / "maps" / "office.yaml").write_text(
+        "# a ROS map\nimage: office.pgm\nresolution: 0.025000\norigin: [-12.5, -7.25, 0.000000]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    grid = load_map(str(tmp_path / "maps" / "office.yaml"))
+    assert grid.resolution == 0.025 and grid.origin.tolist() == [-12.5, -7.25]
+    # bottom image row [100, 230, 20]: p = 0.608 (unknown), 0.098 (free), 0.922 (occupied)
+    assert grid.occupied_mask().astype(int).tolist() == [[0, 0, 1], [1, 0, 0]]
+    assert grid.free_mask().astype(int).tolist() == [[0, 1, 0], [0, 1, 0]]
+
+
+@pytest.mark.parametrize("yaml_text, pgm, message", [
+    ("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\n", None,
+     r"missing key\(s\) \['free_thresh'\]"),
+    ("image: m.pgm\nresolution: fast\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.2\n",
+     None, "resolution: expected a positive number"),
+    ("image: m.pgm\nresolution: 0.05\norigin: [0, zero, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.2\n",
+     None, "line 3: 'zero' is not a number"),
+    ("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0.5]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.2\n",
+     None, "yaw = 0.5.*not supported"),
+    ("image: m.pgm\nresolution: 0.05\nresolution: 0.1\n", None, "line 3: key 'resolution' appears twice"),
+    ("image: m.pgm\n  - just a list item\n", None, "line 2: expected 'key: value'"),
+    ("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.1\nfree_thresh: 0.2\n",
+     None, "free_thresh: expected below occupied_thresh"),
+    ("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 2\noccupied_thresh: 0.65\nfree_thresh: 0.2\n",
+     None, "negate: expected 0 or 1"),
+    ("image: m.pgm\nmode: raw\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.2\n",
+     None, "'raw' is not supported"),
+    ("image: gone.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.2\n",
+     None, "gone.pgm: the map image named by the YAML does not exist"),
+    (None, b"P5\n3 2\n255\n" + bytes(5), r"m.pgm: expected 3 x 2 = 6 pixel bytes, got 5"),
+    (None, b"P5\n3 2\n255\n" + bytes(7), "got 7"),
+    (None, b"P2\n3 2\n255\n0 0 0 0 0 0", "expected a binary PGM"),
+    (None, b"P5\n3 2\n65535\n" + bytes(12), "maxval 65535"),
+    (None, b"P5\n3", "truncated PGM header"),
+    (None, b"P5\n3 x\n255\n" + bytes(6), "must be integers"),
+    (None, b"P5\n0 2\n255\n", "positive width and height"),
+])
+def test_corrupt_map_files_raise_map_file_error(tmp_path, yaml_text, pgm, message):
+    good = "image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.2\n"
+    (tmp_path / "m.yaml").write_text(yaml_text or good)
+    (tmp_path / "m.pgm").write_bytes(pgm or b"P5\n3 2\n255\n" + bytes(6))
+    with pytest.raises(MapFileError, match=message):
+        load_map(tmp_path / "m.yaml")
+
+
+def test_missing_yaml_and_bad_save_arguments(tmp_path):
+    with pytest.raises(MapFileError, match="no such map file"):
+        load_map(tmp_path / "nothing.yaml")
+    grid = OccupancyGrid(np.zeros((2, 2)), 0.1)
+    with pytest.raises(ValueError, match="negate"):
+        save_map(grid, tmp_path / "m", negate=3)
+    with pytest.raises(ValueError, match="mode"):
+        save_map(grid, tmp_path / "m", mode="raw")
+    with pytest.raises(TypeError, match="grid"):
+        save_map(np.zeros((2, 2)), tmp_path / "m")
