@@ -45,7 +45,7 @@ def test_empty_covers_bounds_exactly():
 
 
 def test_masks_use_map_server_thresholds():
-    P = np.array([[0.1, 0.195, 0.197, 0.5, 0.65, 0.651, np.nan]])
+    P = np.array([[0.1, 0.195, 0.197, 0.5, 0.65, 0.651, 0.3]])
     g = OccupancyGrid.from_probability(P, 1.0)
     assert g.free_mask().tolist() == [[True, True, False, False, False, False, False]]
     assert g.occupied_mask().tolist() == [[False, False, False, False, False, True, False]]
@@ -55,10 +55,10 @@ def test_masks_use_map_server_thresholds():
 
 
 def test_free_cells_and_empty_map_error():
-    g = OccupancyGrid.from_probability([[0.0, 1.0], [np.nan, 0.0]], 0.5, origin=(10.0, 0.0))
+    g = OccupancyGrid.from_probability([[0.0, 1.0], [0.5, 0.0]], 0.5, origin=(10.0, 0.0))
     np.testing.assert_allclose(g.free_cells(), [[10.25, 0.25], [10.75, 0.75]])
     with pytest.raises(EmptyMapError, match="no free cell"):
-        OccupancyGrid.from_probability([[1.0, np.nan]], 0.5).free_cells()
+        OccupancyGrid.from_probability([[1.0, 0.5]], 0.5).free_cells()
 
 
 def test_likelihood_field_matches_brute_force():
@@ -222,7 +222,7 @@ def test_map_server_round_trip(tmp_path, negate, mode):
 
 
 def test_pgm_rows_are_flipped_and_trinary(tmp_path):
-    P = np.array([[1.0, 0.0], [np.nan, 0.0], [0.0, 0.0]])             # row 0 = lowest y
+    P = np.array([[1.0, 0.0], [0.5, 0.0], [0.0, 0.0]])             # row 0 = lowest y
     pgm, _ = save_map(OccupancyGrid.from_probability(P, 0.1), tmp_path / "m")
     data = pgm.read_bytes()
     assert data.startswith(b"P5\n2 3\n255\n")
@@ -287,3 +287,11 @@ def test_missing_yaml_and_bad_save_arguments(tmp_path):
         save_map(grid, tmp_path / "m", mode="raw")
     with pytest.raises(TypeError, match="grid"):
         save_map(np.zeros((2, 2)), tmp_path / "m")
+
+
+def test_from_probability_refuses_nan_and_out_of_range():
+    for bad in ([[0.5, np.nan]], [[0.5, 1.5]], [[-0.1]], [[np.inf]]):
+        with pytest.raises(ValueError, match="P:"):
+            OccupancyGrid.from_probability(bad, 0.1)
+    with pytest.raises(ValueError, match="log_odds"):
+        OccupancyGrid(np.zeros((0, 3)), 0.1)

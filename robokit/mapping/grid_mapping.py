@@ -197,7 +197,9 @@ def update_log_odds(grid: OccupancyGrid, pose: Any, ranges: Any, angles: Any, *,
         Left unchanged; the updated grid is returned.
     pose : array_like, shape (3,)
         The sensor's pose ``[x, y, theta]``.
-    ranges, angles, r_max, l_occ, l_free, l0, thickness, beam_width
+    ranges : array_like, shape (B,)
+        Metres; ``inf`` (or any value ``>= r_max``) is a max-range reading: free up to ``r_max``.
+    angles, r_max, l_occ, l_free, l0, thickness, beam_width
         As :func:`inverse_range_sensor_model`.
     clamp : (float, float), default (LOG_ODDS_MIN, LOG_ODDS_MAX)
         Bounds of a cell's log odds after the update (P = 0.12 and 0.97).
@@ -322,7 +324,8 @@ def occupancy_grid_mapping_reference(poses: Any, scans: Any, angles: Any, bounds
                                      clamp: Any = (LOG_ODDS_MIN, LOG_ODDS_MAX)) -> OccupancyGrid:
     """Tables 9.1 and 9.2 of Thrun et al. (2005) as written: one cell and one beam at a time (slow; the reference).
 
-    Parameters and result as :func:`occupancy_grid_mapping`, which it is tested equal to. Plain
+    Parameters and result as :func:`occupancy_grid_mapping` (``inf`` in ``scans`` is a max-range
+    reading), which it is tested equal to. Plain
     Python loops: about a second per 360-beam scan of the corridor; for teaching and testing only.
 
     Examples

@@ -110,7 +110,7 @@ def save_map(grid: OccupancyGrid, stem: Any, *, occupied_thresh: float = OCCUPIE
     Examples
     --------
     >>> import tempfile, os
-    >>> grid = OccupancyGrid.from_probability([[0.0, 1.0, np.nan]], 0.05, origin=(-1.0, 2.0))
+    >>> grid = OccupancyGrid.from_probability([[0.0, 1.0, 0.5]], 0.05, origin=(-1.0, 2.0))
     >>> folder = tempfile.mkdtemp()
     >>> pgm, yaml = save_map(grid, os.path.join(folder, "tiny"))
     >>> pgm.read_bytes()
@@ -269,7 +269,7 @@ def load_map(yaml_path: Any) -> OccupancyGrid:
     --------
     >>> import tempfile, os
     >>> folder = tempfile.mkdtemp()
-    >>> grid = OccupancyGrid.from_probability([[0.0, 1.0], [np.nan, 0.0]], 0.1, origin=(3.0, 4.0))
+    >>> grid = OccupancyGrid.from_probability([[0.0, 1.0], [0.5, 0.0]], 0.1, origin=(3.0, 4.0))
     >>> back = load_map(save_map(grid, os.path.join(folder, "m"))[1])
     >>> back.origin.tolist(), back.resolution, back.occupied_mask().tolist(), back.unknown_mask().tolist()
     ([3.0, 4.0], 0.1, [[False, True], [False, False]], [[False, False], [True, False]])
@@ -303,5 +303,5 @@ def load_map(yaml_path: Any) -> OccupancyGrid:
     img = _read_pgm(image if image.is_absolute() else path.parent / image)
     v = img[::-1].astype(float)                                 # row 0 = lowest y
     p = v / 255.0 if keys["negate"] else (255.0 - v) / 255.0
-    P = np.where(p > occ_t, 1.0, np.where(p < free_t, 0.0, np.nan if mode == "trinary" else p))
+    P = np.where(p > occ_t, 1.0, np.where(p < free_t, 0.0, 0.5 if mode == "trinary" else p))
     return OccupancyGrid.from_probability(P, float(res), origin[:2])
