@@ -74,7 +74,7 @@ def _model_options(r_max: Any, l_occ: Any, l_free: Any, l0: Any, thickness: Any,
 
 
 def _nearest_beam(phi: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Index of the beam whose angle is nearest each bearing ``phi`` (the argmin of Table 9.2, line 4),
+    """Index of the beam whose angle is nearest each bearing ``phi`` (the argmin over beams of Table 9.2),
     by a binary search over the beams sorted around the circle."""
     wrapped = wrap_angle(angles)
     order = np.argsort(wrapped, kind="stable")
@@ -124,10 +124,10 @@ def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, 
 
     Notes
     -----
-    Table 9.2, line by line: ``r`` and ``phi`` (lines 2-3) are the cell's range and bearing in the
-    sensor frame, ``k`` (line 4) the nearest beam; ``l0`` if ``r > min(z_max, z_k + alpha / 2)`` or
-    ``|phi - theta_k| > beta / 2`` (line 5), ``l_occ`` if ``z_k < z_max`` and
-    ``|r - z_k| < alpha / 2`` (line 7), ``l_free`` if ``r <= z_k`` (line 9).
+    Table 9.2, step by step: ``r`` and ``phi`` are the cell's range and bearing in the sensor
+    frame, ``k`` the nearest beam; ``l0`` if ``r > min(z_max, z_k + alpha / 2)`` or
+    ``|phi - theta_k| > beta / 2``, else ``l_occ`` if ``z_k < z_max`` and ``|r - z_k| < alpha / 2``,
+    else ``l_free`` if ``r <= z_k``.
 
     Examples
     --------
@@ -150,14 +150,14 @@ def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, 
         z_max, lo, lf, prior, alpha = r_max, l_occ, l_free, l0, thickness
         beta = 2 * np.pi / a.size if beam_width is None else beam_width
     d = pts - p[:2]
-    r = np.hypot(d[:, 0], d[:, 1])                                         # Table 9.2, line 2
-    phi = wrap_angle(np.arctan2(d[:, 1], d[:, 0]) - p[2])                  # line 3
-    k = _nearest_beam(phi, a)                                              # line 4
+    r = np.hypot(d[:, 0], d[:, 1])                                         # Table 9.2: range
+    phi = wrap_angle(np.arctan2(d[:, 1], d[:, 0]) - p[2])                  # bearing
+    k = _nearest_beam(phi, a)                                              # nearest beam
     zk = np.minimum(z[k], z_max)                                           # max-range readings are z_max
-    outside = (r > np.minimum(z_max, zk + alpha / 2)) | (np.abs(wrap_angle(phi - a[k])) > beta / 2)   # line 5
-    hit = (zk < z_max) & (np.abs(r - zk) < alpha / 2)                      # line 7
-    out = np.where(hit, lo, np.where(r <= zk, lf, prior))                  # lines 7-10
-    out[outside] = prior                                                   # line 6
+    outside = (r > np.minimum(z_max, zk + alpha / 2)) | (np.abs(wrap_angle(phi - a[k])) > beta / 2)   # no information
+    hit = (zk < z_max) & (np.abs(r - zk) < alpha / 2)                      # a hit
+    out = np.where(hit, lo, np.where(r <= zk, lf, prior))                  # Table 9.2: l_occ, l_free
+    out[outside] = prior                                                   # Table 9.2: l0
     return out
 
 
@@ -348,19 +348,19 @@ def occupancy_grid_mapping_reference(poses: Any, scans: Any, angles: Any, bounds
             for j in range(W):
                 xi = grid.origin[0] + (j + 0.5) * grid.resolution
                 yi = grid.origin[1] + (i + 0.5) * grid.resolution
-                r = math.hypot(xi - x, yi - y)                             # Table 9.2, line 2
+                r = math.hypot(xi - x, yi - y)                             # Table 9.2: range
                 if r > z_max + alpha / 2:                                  # not in the perceptual field (9.1, line 3)
                     continue
-                phi = math.atan2(yi - y, xi - x) - theta                   # line 3
-                # line 4; |remainder(d, 2 pi)| is |wrap_angle(d)|, in plain Python for speed
+                phi = math.atan2(yi - y, xi - x) - theta                   # bearing
+                # nearest beam; |remainder(d, 2 pi)| is |wrap_angle(d)|, in plain Python for speed
                 k = min(range(len(beams)), key=lambda b: abs(math.remainder(phi - beams[b], math.tau)))
                 zk = min(scan[k], z_max)
-                if r > min(z_max, zk + alpha / 2) or abs(math.remainder(phi - beams[k], math.tau)) > beta / 2:  # line 5
-                    ism = prior                                            # line 6
-                elif zk < z_max and abs(r - zk) < alpha / 2:               # line 7
-                    ism = lo                                               # line 8
-                elif r <= zk:                                              # line 9
-                    ism = lf                                               # line 10
+                if r > min(z_max, zk + alpha / 2) or abs(math.remainder(phi - beams[k], math.tau)) > beta / 2:
+                    ism = prior                                            # no information
+                elif zk < z_max and abs(r - zk) < alpha / 2:               # a hit
+                    ism = lo
+                elif r <= zk:                                              # passed through
+                    ism = lf
                 else:
                     ism = prior
                 L[i][j] = min(high, max(low, L[i][j] + ism - prior))       # Table 9.1, line 4, clamped

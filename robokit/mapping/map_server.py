@@ -188,7 +188,7 @@ def _parse_yaml(path: Path) -> dict:
         raise MapFileError(path, f"cannot read the map description: {exc}") from None
     out: dict = {}
     for n, raw in enumerate(text.splitlines(), 1):
-        line = raw.split(" #")[0].strip() if not raw.lstrip().startswith("#") else ""
+        line = "" if raw.lstrip().startswith("#") else re.split(r"\s#", raw)[0].strip()
 
         def fail(message: str, n: int = n) -> None:
             raise MapFileError(path, f"line {n}: {message}")

@@ -433,7 +433,7 @@ def likelihood_field(grid: OccupancyGrid, *, occupied_threshold: float = OCCUPIE
     -----
     The exact Euclidean distance transform between cell centres,
     ``scipy.ndimage.distance_transform_edt`` with ``sampling=resolution``; ``dist`` of
-    Table 6.3, line 7 (Ge et al. 2023 localize with AMCL, Sec. 3.4, whose laser model is this one).
+    Table 6.3 (Ge et al. 2023 localize with AMCL, Sec. 3.4, whose laser model is this one).
 
     Examples
     --------
@@ -446,7 +446,7 @@ def likelihood_field(grid: OccupancyGrid, *, occupied_threshold: float = OCCUPIE
     occupied = grid.occupied_mask(occupied_threshold)
     d_max = check_positive(max_distance, "max_distance")
     if occupied.any():
-        dist = ndimage.distance_transform_edt(~occupied, sampling=grid.resolution)  # dist, Table 6.3 line 7
+        dist = ndimage.distance_transform_edt(~occupied, sampling=grid.resolution)  # dist of Table 6.3
         dist = np.minimum(dist, d_max)
     else:
         dist = np.full(grid.shape, d_max)
