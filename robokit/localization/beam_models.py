@@ -220,7 +220,8 @@ def likelihood_field_log_weights(particles: Any, ranges: Any, angles: Any, field
     g = np.exp(-(d * d) / (2.0 * s * s))
     if rule == "product":
         p = zh * g / math.sqrt(2.0 * math.pi * s * s) + zr / float(r_max)   # line 8
-        return np.log(p).sum(axis=1)
+        with np.errstate(divide="ignore"):           # a zero likelihood is log 0 = -inf, on purpose
+            return np.log(p).sum(axis=1)
     p = zh * g + zr / float(r_max)                                  # ROS: unnormalised Gaussian
     return np.log1p((p * p * p).sum(axis=1))                        # ROS: p = 1 + sum pz^3
 
@@ -267,7 +268,8 @@ def likelihood_field_log_weight_reference(pose: Any, ranges: Any, angles: Any, f
         dist = float(field.lookup(np.array([[ex, ey]]))[0])          # line 7
         if rule == "product":
             prob = math.exp(-dist ** 2 / (2 * s ** 2)) / math.sqrt(2 * math.pi * s ** 2)
-            log_q += math.log(zh * prob + zr / r_max)                # line 8, in logs
+            q = zh * prob + zr / r_max
+            log_q += math.log(q) if q > 0 else -math.inf             # line 8, in logs
         else:
             pz = zh * math.exp(-dist ** 2 / (2 * s ** 2)) + zr / r_max
             ros_sum += pz ** 3

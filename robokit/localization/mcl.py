@@ -320,7 +320,7 @@ class MonteCarloLocalizer:
     def _reset(self, particles: np.ndarray, weights: np.ndarray | None = None) -> None:
         self.particles = particles
         self.weights = np.full(len(particles), 1.0 / len(particles)) if weights is None else weights
-        self._log_w_slow = self._log_w_fast = -np.inf      # ROS: w_slow = w_fast = 0 on every init
+        self._log_w_slow = self._log_w_fast = -np.inf      # w_slow = w_fast = 0 (unset) on every init
         self._since_resample = 0
 
     def _random_poses(self, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -434,10 +434,12 @@ class MonteCarloLocalizer:
         Thrun et al. (2005), Table 8.3: motion and weights (lines 4-5), ``w_avg`` (line 6, the
         weighted mean of the likelihoods ``log_mean``, which is the table's plain mean right after
         a resampling), ``w_slow += alpha_slow (w_avg - w_slow)`` and ``w_fast`` likewise (line 9,
-        kept as logs; seeded by the first ``w_avg`` as ROS does), and at a resampling each new
-        particle is a uniform random pose with probability ``max(0, 1 - w_fast / w_slow)`` (line
-        13), after which ROS resets both averages. All-zero weights recover as uniform
-        (:attr:`degenerate` set).
+        kept as logs), and at a resampling each new particle is a uniform random pose with
+        probability ``max(0, 1 - w_fast / w_slow)`` (line 13). The averages start at the first
+        ``w_avg`` (ROS; Table 8.3 starts them at 0, which holds off any recovery for about
+        ``1 / alpha_slow`` updates) and are never reset (Table 8.3; ROS resets both after every
+        injection and so re-seeds them at the next, possibly already low, ``w_avg``); an
+        initialization resets them. All-zero weights recover as uniform (:attr:`degenerate` set).
 
         Examples
         --------
@@ -500,8 +502,7 @@ class MonteCarloLocalizer:
         self.n_injected = int(round(p_inj * len(new))) if p_inj > 0 else 0
         log_slow, log_fast = self._log_w_slow, self._log_w_fast
         self._reset(new)
-        if p_inj == 0:                                   # ROS resets the averages only after an injection
-            self._log_w_slow, self._log_w_fast = log_slow, log_fast
+        self._log_w_slow, self._log_w_fast = log_slow, log_fast    # Table 8.3 never resets them
 
     # --- results -------------------------------------------------------------------------------
     def estimate(self) -> np.ndarray:
