@@ -284,6 +284,40 @@ def pose_graph():          # a small generated pose graph (30 poses, loop closur
     return manhattan_world_graph(30, seed=1, closure_probability=1.0)[0]
 
 
+# --- lesson 03's occupancy grid (robokit.mapping.occupancy_grid, grid_mapping, map_server) ---
+
+def small_grid():
+    from robokit.mapping import OccupancyGrid
+    return OccupancyGrid.from_probability([[0.0, 1.0, 0.0], [0.5, 0.0, 1.0]], 0.5, origin=(-0.5, -0.5))
+
+
+def grid_model_kinds() -> dict:
+    return {"r_max": Real(2.0), "l_occ": Real(0.85), "l_free": Real(-0.4), "l0": Real(0.0), "thickness": Real(0.1),
+            "beam_width": Real(1.6, optional=True)}
+
+
+def grid_mapping_kinds() -> dict:
+    beams = np.array([[1.0, np.inf, 0.8, 0.5], [1.2, 1.5, np.inf, 0.4]])
+    return {"poses": Array(np.array([[0.0, 0.0, 0.0], [0.2, 0.1, 0.5]]), "N,3"),
+            "scans": Array(beams, "N,4", inf_ok=True), "angles": Array(np.arange(4) * np.pi / 2, "N"),
+            "bounds": Array(np.array([-1.0, -1.0, 1.0, 1.0]), "4"), "resolution": Real(0.1),
+            "sensor_offset": Array(np.array([0.05, 0.0, 0.1]), "3"),
+            "clamp": Array(np.array([-2.0, 3.5]), "2"), **grid_model_kinds()}
+
+
+@functools.cache
+def map_folder():
+    import tempfile
+    from pathlib import Path
+    return Path(tempfile.mkdtemp(prefix="robokit-fuzz-map-"))
+
+
+@functools.cache
+def saved_map():
+    from robokit.mapping import save_map
+    return str(save_map(small_grid(), map_folder() / "saved")[1])
+
+
 SPECS: dict[str, Call] = {
     # --- about, geometry --------------------------------------------------------------------
     "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
@@ -780,6 +814,33 @@ SPECS: dict[str, Call] = {
         "max_range": Real(4.0)}),
     "robokit.geometry.planar.intersect_lines": Call({"origins": Array(np.array([[0.0, 0.0], [4.0, 0.0]]), "N,2"),
                                                      "directions": Array(np.array([[1.0, 1.0], [-1.0, 1.0]]), "N,2")}),
+    # --- robokit.mapping.occupancy_grid, grid_mapping, map_server (lesson 03's occupancy grid) --
+    "robokit.mapping.occupancy_grid.log_odds": Call({"p": Array(np.array([0.3, 0.7]), "...")}),
+    "robokit.mapping.occupancy_grid.probability": Call({"l": Array(np.array([-1.0, 2.0]), "...")}),
+    "robokit.mapping.occupancy_grid.OccupancyGrid": Call({"log_odds": Array(np.zeros((3, 4)), "N,N"),
+                                                          "resolution": Real(0.1), "origin": Array(np.zeros(2), "2")}),
+    "robokit.mapping.occupancy_grid.OccupancyGrid.empty": Call({"bounds": Array(np.array([0.0, -1.0, 2.0, 1.0]), "4"),
+                                                                "resolution": Real(0.1)}),
+    "robokit.mapping.occupancy_grid.OccupancyGrid.from_probability": Call({
+        "P": Array(np.array([[0.0, 1.0], [0.5, 0.2]]), "N,N"),
+        "resolution": Real(0.1), "origin": Array(np.zeros(2), "2")}),
+    "robokit.mapping.occupancy_grid.likelihood_field": Call({"grid": Obj(small_grid), "occupied_threshold": Real(0.65),
+                                                             "max_distance": Real(2.0)}),
+    "robokit.mapping.grid_mapping.inverse_range_sensor_model": Call({
+        "xy": Array(np.array([[0.5, 0.0], [0.0, 0.7]]), "N,2", min_rows=0), "pose": Array(np.zeros(3), "3"),
+        "ranges": Array(np.array([1.0, np.inf, 3.0, 0.5]), "N", inf_ok=True),
+        "angles": Array(np.arange(4) * np.pi / 2, "N"), **grid_model_kinds(), "check": Flag(True)}),
+    "robokit.mapping.grid_mapping.update_log_odds": Call({
+        "grid": Obj(small_grid), "pose": Array(np.array([0.1, 0.0, 0.3]), "3"),
+        "ranges": Array(np.array([1.0, np.inf, 3.0, 0.5]), "N", inf_ok=True),
+        "angles": Array(np.arange(4) * np.pi / 2, "N"), **grid_model_kinds(),
+        "clamp": Array(np.array([-2.0, 3.5]), "2")}),
+    "robokit.mapping.grid_mapping.occupancy_grid_mapping": Call(grid_mapping_kinds()),
+    "robokit.mapping.grid_mapping.occupancy_grid_mapping_reference": Call(grid_mapping_kinds()),
+    "robokit.mapping.map_server.save_map": Call({"grid": Obj(small_grid), "stem": Text(lambda: str(map_folder() / "m")),
+                                                 "occupied_thresh": Real(0.65), "free_thresh": Real(0.196),
+                                                 "negate": Int(0), "mode": Choice("trinary")}),
+    "robokit.mapping.map_server.load_map": Call({"yaml_path": Text(saved_map)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -837,6 +898,13 @@ EXTRA: tuple[str, ...] = (
     "robokit.mapping.omni_views.omni_view", "robokit.mapping.omni_views.check_omni_image",
     "robokit.mapping.omni_views.relative_pose", "robokit.mapping.topological.TopologicalMap",
     "robokit.localization.hierarchical.HierarchicalLocalizer",
+    # lesson 03's occupancy grid (robokit.mapping.occupancy_grid, grid_mapping, map_server)
+    *(f"robokit.mapping.occupancy_grid.{n}" for n in (
+        "log_odds", "probability", "OccupancyGrid", "OccupancyGrid.empty", "OccupancyGrid.from_probability",
+        "likelihood_field")),
+    *(f"robokit.mapping.grid_mapping.{n}" for n in (
+        "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping", "occupancy_grid_mapping_reference")),
+    "robokit.mapping.map_server.save_map", "robokit.mapping.map_server.load_map",
 )
 
 

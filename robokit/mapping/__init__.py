@@ -21,7 +21,10 @@ Occupancy grids (lesson 03's corridor map): :mod:`.occupancy_grid` (log odds per
 free/occupied/unknown reading with map_server's thresholds, the likelihood field of a range finder).
 """
 from .g2o import G2OFormatError, read_g2o, write_g2o
+from .grid_mapping import (L_FREE, L_OCC, inverse_range_sensor_model, occupancy_grid_mapping,
+                           occupancy_grid_mapping_reference, update_log_odds)
 from .landmarks import LandmarkMap, kalman_fuse, transform_covariance
+from .map_server import FREE_VALUE, OCCUPIED_VALUE, UNKNOWN_VALUE, MapFileError, load_map, save_map
 from .manhattan import manhattan_world_graph
 from .pose_graph import (DisconnectedGraphError, PoseGraph, as_pose_graph, check_connected, edge_variances, is_connected,
                          pose_graph_from_odometry, positive_definite, unreachable_nodes,
@@ -46,4 +49,7 @@ __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
            "LOOP_EDGE", "ODOMETRY_EDGE", "EmptyMapError", "TopologicalMap", "Comparison", "appearance_changed",
            "build_topological_map", "local_map_full", "select_key_frames",
            "FREE_THRESHOLD", "OCCUPIED_THRESHOLD", "LOG_ODDS_MIN", "LOG_ODDS_MAX", "log_odds", "probability",
-           "OccupancyGrid", "LikelihoodField", "likelihood_field"]
+           "OccupancyGrid", "LikelihoodField", "likelihood_field",
+           "L_OCC", "L_FREE", "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping",
+           "occupancy_grid_mapping_reference", "MapFileError", "save_map", "load_map", "OCCUPIED_VALUE", "FREE_VALUE",
+           "UNKNOWN_VALUE"]

@@ -208,7 +208,7 @@ class OccupancyGrid:
 
     @classmethod
     def from_probability(cls, P: Any, resolution: float, origin: Any = (0.0, 0.0)) -> "OccupancyGrid":
-        """A grid from P(occupied) per cell; NaN means unknown (0.5), like :func:`robokit.viz.plot_occupancy`.
+        """A grid from P(occupied) per cell (0.5 for unknown).
 
         Probabilities 0 and 1 (infinite log odds) are clamped to ``[LOG_ODDS_MIN, LOG_ODDS_MAX]``
         (P = 0.12 and 0.97), so they stay free and occupied under the default thresholds.
@@ -216,19 +216,17 @@ class OccupancyGrid:
         Raises
         ------
         ValueError
-            If ``P`` is not 2-D, is empty, or holds a value outside [0, 1] or an infinity.
+            If ``P`` is not 2-D, is empty, or holds NaN, an infinity or a value outside [0, 1].
 
         Examples
         --------
-        >>> grid = OccupancyGrid.from_probability([[0.0, 0.5], [1.0, np.nan]], 0.1)
+        >>> grid = OccupancyGrid.from_probability([[0.0, 0.5], [1.0, 0.3]], 0.1)
         >>> grid.free_mask().astype(int).tolist(), grid.occupied_mask().astype(int).tolist()
         ([[1, 0], [0, 0]], [[0, 0], [1, 0]])
         """
-        arr = as_array(P, "P", ndim=2, finite=False)
-        if np.any(np.isinf(arr)) or np.any((arr < 0) | (arr > 1)):
-            raise ValueError(f"P: expected probabilities in [0, 1] (NaN for unknown), got {describe(P)} "
-                             f"with values in [{np.nanmin(arr) if arr.size else 0}, {np.nanmax(arr) if arr.size else 0}]")
-        p = np.where(np.isnan(arr), 0.5, arr)
+        p = as_array(P, "P", ndim=2)
+        if np.any((p < 0) | (p > 1)):
+            raise ValueError(f"P: expected probabilities in [0, 1], got {p[(p < 0) | (p > 1)].flat[0]}")
         with np.errstate(divide="ignore"):
             lo = np.log(p) - np.log1p(-p)                 # log odds, Sec. 9.2 (+-inf at 1 and 0)
         return cls(np.clip(lo, LOG_ODDS_MIN, LOG_ODDS_MAX), resolution, origin)
