@@ -25,7 +25,7 @@ def lab_grid(world, res: float = 0.1) -> OccupancyGrid:
     centres = np.column_stack([X.ravel(), Y.ravel()])
     occupied = (lay.clearance(centres) < 0.75 * res) | lay.contains(centres)
     free = world.is_free(centres, clearance=0.0) & ~occupied
-    P = np.full(len(centres), np.nan)
+    P = np.full(len(centres), 0.5)                                # unknown outside the room
     P[free], P[occupied] = 0.0, 1.0
     return OccupancyGrid.from_probability(P.reshape(X.shape), res, (-0.2, -0.2))
 

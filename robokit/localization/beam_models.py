@@ -214,16 +214,22 @@ def likelihood_field_log_weights(particles: Any, ranges: Any, angles: Any, field
     sensor = se2_compose(P, offset, check=False)
     c, sn = np.cos(sensor[:, 2:3]), np.sin(sensor[:, 2:3])
     bx, by = r * np.cos(a), r * np.sin(a)                           # the end point in the sensor frame
-    ex = sensor[:, 0:1] + c * bx - sn * by                          # Table 6.3, line 5
-    ey = sensor[:, 1:2] + sn * bx + c * by                          # line 6
-    d = field.lookup(np.column_stack([ex.ravel(), ey.ravel()]), check=False).reshape(ex.shape)  # line 7
-    g = np.exp(-(d * d) / (2.0 * s * s))
+    ends = np.empty((len(P), r.size, 2))                            # written in place: one pass each
+    ex, ey, tmp = ends[..., 0], ends[..., 1], np.empty((len(P), r.size))
+    np.add(np.multiply(c, bx, out=ex), sensor[:, 0:1], out=ex)
+    ex -= np.multiply(sn, by, out=tmp)                              # Table 6.3, line 5
+    np.add(np.multiply(sn, bx, out=ey), sensor[:, 1:2], out=ey)
+    ey += np.multiply(c, by, out=tmp)                               # line 6
+    d = field.lookup(ends, check=False)                             # line 7
+    g = np.exp(np.multiply(d, d, out=d) * (-0.5 / (s * s)), out=d)
     if rule == "product":
-        p = zh * g / math.sqrt(2.0 * math.pi * s * s) + zr / float(r_max)   # line 8
+        g *= zh / math.sqrt(2.0 * math.pi * s * s)
+        g += zr / float(r_max)                                      # line 8
         with np.errstate(divide="ignore"):           # a zero likelihood is log 0 = -inf, on purpose
-            return np.log(p).sum(axis=1)
-    p = zh * g + zr / float(r_max)                                  # ROS: unnormalised Gaussian
-    return np.log1p((p * p * p).sum(axis=1))                        # ROS: p = 1 + sum pz^3
+            return np.log(g, out=g).sum(axis=1)
+    g *= zh                                                         # ROS: an unnormalised Gaussian
+    g += zr / float(r_max)
+    return np.log1p(np.einsum("ij,ij,ij->i", g, g, g))              # ROS: p = 1 + sum pz^3
 
 
 def likelihood_field_log_weight_reference(pose: Any, ranges: Any, angles: Any, field: Any, *,
