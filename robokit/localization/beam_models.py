@@ -225,11 +225,19 @@ def likelihood_field_log_weights(particles: Any, ranges: Any, angles: Any, field
     if rule == "product":
         g *= zh / math.sqrt(2.0 * math.pi * s * s)
         g += zr / float(r_max)                                      # line 8
-        with np.errstate(divide="ignore"):           # a zero likelihood is log 0 = -inf, on purpose
-            return np.log(g, out=g).sum(axis=1)
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):   # log 0 = -inf is a zero weight
+            return _finite_or_zero_weight(np.log(g, out=g).sum(axis=1))
     g *= zh                                                         # ROS: an unnormalised Gaussian
     g += zr / float(r_max)
-    return np.log1p(np.einsum("ij,ij,ij->i", g, g, g))              # ROS: p = 1 + sum pz^3
+    return _finite_or_zero_weight(np.log1p(np.einsum("ij,ij,ij->i", g, g, g)))   # ROS: p = 1 + sum pz^3
+
+
+def _finite_or_zero_weight(log_w: Any) -> Any:
+    """Refuse NaN and +inf log-weights (model parameters so large that the sum overflows); -inf is a zero weight."""
+    if np.any(np.isnan(log_w)) or np.any(np.asarray(log_w) == np.inf):
+        raise ValueError("sigma_hit, z_hit, z_rand, r_max: expected model parameters whose likelihood is finite, "
+                         "got an overflow (values too large?)")
+    return log_w
 
 
 def likelihood_field_log_weight_reference(pose: Any, ranges: Any, angles: Any, field: Any, *,
@@ -242,7 +250,9 @@ def likelihood_field_log_weight_reference(pose: Any, ranges: Any, angles: Any, f
     ----------
     pose : array_like, shape (3,)
         One robot pose.
-    ranges, angles, field, sensor_offset, sigma_hit, z_hit, z_rand, r_max, max_beams, combine
+    ranges : array_like, shape (B,)
+        Ranges; ``inf`` (a max-range return) is skipped, NaN raises.
+    angles, field, sensor_offset, sigma_hit, z_hit, z_rand, r_max, max_beams, combine
         As :func:`likelihood_field_log_weights`.
 
     Returns
@@ -268,15 +278,17 @@ def likelihood_field_log_weight_reference(pose: Any, ranges: Any, angles: Any, f
     (xs, ys, ts), s, zh, zr, rule = _model_args(sensor_offset, sigma_hit, z_hit, z_rand, combine)
     r, a = valid_beams(ranges, angles, r_max, max_beams)
     log_q, ros_sum = 0.0, 0.0
+    s2 = np.float64(s) ** 2                                          # numpy floats: an overflow is inf, not a crash
     for z, theta_sens in zip(r, a):                                  # Table 6.3, line 3: for all k
         ex = x + xs * math.cos(theta) - ys * math.sin(theta) + z * math.cos(theta + ts + theta_sens)  # line 5
         ey = y + xs * math.sin(theta) + ys * math.cos(theta) + z * math.sin(theta + ts + theta_sens)  # line 6
         dist = float(field.lookup(np.array([[ex, ey]]))[0])          # line 7
-        if rule == "product":
-            prob = math.exp(-dist ** 2 / (2 * s ** 2)) / math.sqrt(2 * math.pi * s ** 2)
-            q = zh * prob + zr / r_max
-            log_q += math.log(q) if q > 0 else -math.inf             # line 8, in logs
-        else:
-            pz = zh * math.exp(-dist ** 2 / (2 * s ** 2)) + zr / r_max
-            ros_sum += pz ** 3
-    return log_q if rule == "product" else math.log(1.0 + ros_sum)
+        with np.errstate(all="ignore"):
+            if rule == "product":
+                prob = np.exp(-dist ** 2 / (2 * s2)) / np.sqrt(2 * np.pi * s2)
+                log_q += np.log(zh * prob + zr / r_max)              # line 8, in logs (log 0 = -inf)
+            else:
+                pz = zh * np.exp(-dist ** 2 / (2 * s2)) + zr / r_max
+                ros_sum += pz ** 3
+    with np.errstate(all="ignore"):
+        return float(_finite_or_zero_weight(log_q if rule == "product" else np.log1p(ros_sum)))

@@ -168,8 +168,9 @@ def mcl_step(particles: Any, weights: Any, odom_prev: Any, odom_now: Any, ranges
     w = as_array(weights, "weights", shape=(len(P),))
     if np.any(w < 0) or not w.sum() > 0:
         raise ValueError(f"weights: expected non-negative weights with a positive sum, got {describe(weights)}")
+    u = (as_array(odom_prev, "odom_prev", shape=(3,)), as_array(odom_now, "odom_now", shape=(3,)))
     g = as_rng(rng)
-    moved = sample_motion_model_odometry(odom_prev, odom_now, P, alphas, g)          # Table 8.2, line 4
+    moved = sample_motion_model_odometry(*u, P, alphas, g)                            # Table 8.2, line 4
     log_lik = likelihood_field_log_weights(moved, ranges, angles, field, **model)    # line 5
     with np.errstate(divide="ignore"):
         out = normalise_log_weights(np.log(w / w.sum()) + log_lik)
@@ -208,7 +209,7 @@ def uniform_free_poses(free_cells: Any, resolution: float, n: int, rng: Any = No
     >>> uniform_free_poses([[0.5, 0.5]], 1.0, 3, rng=0)[:, :2].round(2).tolist()
     [[0.64, 0.27], [0.04, 0.02], [0.81, 0.91]]
     """
-    cells = as_points(free_cells, "free_cells", 2, min_count=1)
+    cells = as_array(free_cells, "free_cells", shape=(None, 2), min_size=2)
     res = check_positive(resolution, "resolution")
     count = check_int(n, "n", minimum=0)
     g = as_rng(rng)

@@ -41,7 +41,8 @@ from scipy.special import logsumexp
 from scipy.stats import norm
 
 from ..geometry import wrap_angle
-from ..validation import as_array, as_points, as_rng, check_int, check_positive, check_sample_count
+from ..validation import (as_array, as_points, as_rng, check_callable, check_finite_result, check_int, check_positive,
+                          check_sample_count, describe)
 
 __all__ = ["NormalisedWeights", "normalise_log_weights", "low_variance_resample", "kld_sample_count",
            "kld_resample", "pose_bins", "weighted_pose_mean", "sample_ellipse_poses", "ellipse_weights",
@@ -49,6 +50,9 @@ __all__ = ["NormalisedWeights", "normalise_log_weights", "low_variance_resample"
 
 #: Upper 0.99 quantile of the standard normal, ``z_{1-delta}`` for ``delta = 0.01`` (Fox 2003).
 KLD_Z_99 = float(norm.ppf(0.99))
+
+#: Most histogram bins :func:`kld_sample_count` accepts (far beyond any particle count).
+MAX_BINS = 10 ** 9
 
 #: ROS amcl's KLD histogram bins (``pf_kdtree.c``): 0.5 m in x and y, 10 degrees in heading.
 ROS_KLD_BIN_SIZE = (0.5, 0.5, float(np.deg2rad(10.0)))
@@ -179,7 +183,7 @@ def kld_sample_count(k: Any, *, epsilon: float = 0.01, z: float = KLD_Z_99) -> A
     Parameters
     ----------
     k : int or array_like of int
-        Number of non-empty histogram bins (``k >= 1``).
+        Number of non-empty histogram bins (``1 <= k <= MAX_BINS``).
     epsilon : float, default 0.01
         Bound on the Kullback-Leibler divergence between the sample-based and the true posterior
         (ROS amcl's ``kld_err``).
@@ -198,7 +202,8 @@ def kld_sample_count(k: Any, *, epsilon: float = 0.01, z: float = KLD_Z_99) -> A
     Raises
     ------
     ValueError
-        For ``k < 1``, a non-positive ``epsilon`` or a non-finite ``z``.
+        For ``k`` out of range or fractional, a non-positive ``epsilon``, a non-finite ``z``, or a
+        count beyond int64.
 
     Notes
     -----
@@ -212,16 +217,20 @@ def kld_sample_count(k: Any, *, epsilon: float = 0.01, z: float = KLD_Z_99) -> A
     >>> int(kld_sample_count(2)), int(kld_sample_count(100)), int(kld_sample_count(100, z=0.99))
     (330, 6733, 5644)
     """
-    kk = as_array(k, "k", dtype=None)
-    if kk.dtype.kind not in "iu" and not np.all(kk == np.round(kk)):
-        raise ValueError(f"k: expected whole bin counts, got {kk}")
-    if np.any(kk < 1):
-        raise ValueError(f"k: expected bin counts >= 1, got a minimum of {kk.min()}")
+    kk = as_array(k, "k")
+    if kk.ndim > 1:
+        raise ValueError(f"k: expected a bin count or a 1-D array of them, got shape {kk.shape}")
+    if not np.all(kk == np.round(kk)):
+        raise ValueError(f"k: expected whole bin counts, got {describe(k)}")
+    if np.any(kk < 1) or np.any(kk > MAX_BINS):
+        raise ValueError(f"k: expected bin counts in [1, {MAX_BINS}], got values in [{kk.min()}, {kk.max()}]")
     eps = check_positive(epsilon, "epsilon")
     zz = float(as_array(z, "z", shape=()))
     km1 = np.maximum(kk.astype(float) - 1.0, 1.0)
     a = 2.0 / (9.0 * km1)
     n = np.ceil(km1 / (2.0 * eps) * (1.0 - a + np.sqrt(a) * zz) ** 3)   # Table 8.4, line 15
+    if not np.all(n < 2.0 ** 62):
+        raise ValueError(f"epsilon, z: expected values whose sample count fits an int64, got epsilon = {eps}, z = {zz}")
     out = np.where(kk > 1, n, 0.0).astype(np.int64)
     return int(out) if out.ndim == 0 else out
 
@@ -309,6 +318,7 @@ def kld_resample(particles: Any, weights: Any, rng: Any = None, *, min_count: in
     p_inj = check_positive(inject_probability, "inject_probability", allow_zero=True)
     if p_inj > 1:
         raise ValueError(f"inject_probability: expected a probability in [0, 1], got {p_inj}")
+    check_callable(random_pose, "random_pose")
     if p_inj > 0 and random_pose is None:
         raise ValueError("random_pose: expected a callable random_pose(n, rng) when inject_probability > 0")
     g = as_rng(rng)
@@ -453,7 +463,10 @@ def ellipse_weights(particles: Any, pose: Any, sigma_x: float, sigma_y: float, *
     dx, dy = P[:, 0] - c[0], P[:, 1] - c[1]
     ct, st = np.cos(c[2]), np.sin(c[2])
     along, across = ct * dx + st * dy, -st * dx + ct * dy
-    log_w = -(along ** 2 / (2 * sx ** 2) + across ** 2 / (2 * sy ** 2)) - np.log(2 * np.pi * sx * sy)  # Eq. (19)
+    sx, sy = np.float64(sx), np.float64(sy)                  # an overflow is inf, not an OverflowError
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        log_w = -(along ** 2 / (2 * sx ** 2) + across ** 2 / (2 * sy ** 2)) - np.log(2 * np.pi * sx * sy)  # Eq. (19)
+    check_finite_result("particles, pose, sigma_x, sigma_y", log_w)
     if not normalise:
         return np.exp(log_w)
     return normalise_log_weights(log_w).weights
