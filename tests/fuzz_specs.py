@@ -870,12 +870,12 @@ SPECS: dict[str, Call] = {
     "robokit.localization.beam_models.likelihood_field_log_weight_reference": Call({
         "pose": Array(np.array([0.2, 0.1, 0.5]), "3"), "ranges": Array(SCAN, "N", inf_ok=True),
         "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field), **beam_model_kinds()}),
-    "robokit.localization.mcl.mcl_step": Call({
+    "robokit.localization.mcl_step.mcl_step": Call({
         "particles": Array(np.array([[0.0, 0.0, 0.0], [0.2, 0.1, 0.5]]), "N,3"), "weights": Array(np.array([0.5, 0.5]), "N"),
         "odom_prev": Array(np.zeros(3), "3"), "odom_now": Array(np.array([0.3, 0.0, 0.1]), "3"),
         "ranges": Array(SCAN, "N", inf_ok=True), "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field),
         "alphas": Array(np.full(4, 0.05), "4"), "resample": Flag(True), "rng": Rng(0), "model": Given({})}),
-    "robokit.localization.mcl.uniform_free_poses": Call({
+    "robokit.localization.mcl_step.uniform_free_poses": Call({
         "free_cells": Array(np.array([[0.5, 0.5], [1.5, 0.5]]), "N,2"), "resolution": Real(1.0), "n": Int(3),
         "rng": Rng(0)}),
     "robokit.localization.mcl.MonteCarloLocalizer": Call({
@@ -982,7 +982,8 @@ EXTRA: tuple[str, ...] = (
         "weighted_pose_mean", "sample_ellipse_poses", "ellipse_weights")),
     *(f"robokit.localization.beam_models.{n}" for n in (
         "subsample_beams", "valid_beams", "likelihood_field_log_weights", "likelihood_field_log_weight_reference")),
-    *(f"robokit.localization.mcl.{n}" for n in ("mcl_step", "uniform_free_poses", "MonteCarloLocalizer")),
+    "robokit.localization.mcl_step.mcl_step", "robokit.localization.mcl_step.uniform_free_poses",
+    "robokit.localization.mcl.MonteCarloLocalizer",
 )
 
 

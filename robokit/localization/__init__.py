@@ -13,8 +13,8 @@ in the simulated lab, imported on demand) uses :mod:`robokit.sim` to render view
 Monte-Carlo localization (lesson 03, Ge et al. 2023 and Thrun et al. 2005): :mod:`.particle_filter`
 (weights, low-variance and KLD resampling, the paper's ellipse start of Eq. (19)),
 :mod:`.beam_models` (the likelihood-field laser model, Table 6.3 and ROS amcl's variant) and
-:mod:`.mcl` (one MCL step on arrays, and :class:`MonteCarloLocalizer`: ROS amcl's adaptive MCL with
-the paper's Algorithm 1). They use :mod:`robokit.mapping`'s occupancy grid and likelihood field and
+:mod:`.mcl_step` (one MCL step on arrays) and :mod:`.mcl` (:class:`MonteCarloLocalizer`: ROS amcl's
+adaptive MCL with the paper's Algorithm 1). They use :mod:`robokit.mapping`'s occupancy grid and likelihood field and
 :mod:`robokit.sim`'s odometry motion model.
 """
 from .egomotion import (DegenerateCorrespondenceError, EgomotionResult, InsufficientMatchesError,
@@ -24,7 +24,8 @@ from .hough import Hypothesis, candidate_matches, global_localize, hough_accumul
 from .visual_slam import FrameReport, VisualSLAM
 from .beam_models import (COMBINE_RULES, likelihood_field_log_weight_reference, likelihood_field_log_weights,
                           subsample_beams, valid_beams)
-from .mcl import AMCL_DEFAULTS, KLDConfig, MCLStep, MonteCarloLocalizer, mcl_step, uniform_free_poses
+from .mcl import AMCL_DEFAULTS, KLDConfig, MonteCarloLocalizer
+from .mcl_step import MCLStep, mcl_step, uniform_free_poses
 from .particle_filter import (KLD_Z_99, ROS_KLD_BIN_SIZE, NormalisedWeights, ellipse_weights, kld_resample,
                               kld_sample_count, low_variance_resample, normalise_log_weights, pose_bins,
                               sample_ellipse_poses, weighted_pose_mean)
