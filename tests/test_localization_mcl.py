@@ -228,6 +228,9 @@ def test_update_schedule_follows_ros(lab):
     assert mcl.update([2.15, 2.25, 0.5], scan) and mcl.n_updates == 1
     assert mcl.update([2.15, 2.25, 1.1], scan) and mcl.n_updates == 2   # a turn alone
     assert mcl.update([2.15, 2.25, 1.1], scan, force=True)
+    with pytest.raises(ValueError, match="ranges"):
+        mcl.update([3.0, 3.0, 0.0], np.full(360, np.nan))
+    assert mcl.n_updates == 3
 
 
 def test_resample_interval_and_kld_shrink(lab):

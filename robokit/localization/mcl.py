@@ -336,6 +336,8 @@ class MonteCarloLocalizer:
         """
         odom = as_array(odometry_pose, "odometry_pose", shape=(3,))
         r = as_array(ranges, "ranges", ndim=1, finite=False, min_size=1)
+        if np.any(np.isnan(r)):
+            raise ValueError("ranges: expected ranges or inf (a max-range return), got NaN")
         a = 2 * np.pi * np.arange(r.size) / r.size if angles is None else angles
         if self._odom is None:
             self._odom = odom
