@@ -318,6 +318,29 @@ def saved_map():
     return str(save_map(small_grid(), map_folder() / "saved")[1])
 
 
+# --- lesson 03's Monte-Carlo localization (robokit.localization.particle_filter, beam_models, mcl) ---
+
+def small_field():
+    from robokit.mapping import likelihood_field
+    return likelihood_field(small_grid())
+
+
+def room_grid():       # a 2 m x 1.5 m box room at 0.1 m
+    from robokit.mapping import OccupancyGrid
+    P = np.ones((15, 20))
+    P[1:-1, 1:-1] = 0.0
+    return OccupancyGrid.from_probability(P, 0.1)
+
+
+def beam_model_kinds() -> dict:
+    return {"sensor_offset": Array(np.array([0.05, 0.0, 0.1]), "3"), "sigma_hit": Real(0.2), "z_hit": Real(0.95),
+            "z_rand": Real(0.05), "r_max": Real(8.0), "max_beams": Int(30, optional=True), "combine": Choice("ros")}
+
+
+SCAN = np.array([1.0, np.inf, 0.8, 0.5])
+SCAN_ANGLES = np.arange(4) * np.pi / 2
+
+
 SPECS: dict[str, Call] = {
     # --- about, geometry --------------------------------------------------------------------
     "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
@@ -814,6 +837,54 @@ SPECS: dict[str, Call] = {
         "max_range": Real(4.0)}),
     "robokit.geometry.planar.intersect_lines": Call({"origins": Array(np.array([[0.0, 0.0], [4.0, 0.0]]), "N,2"),
                                                      "directions": Array(np.array([[1.0, 1.0], [-1.0, 1.0]]), "N,2")}),
+    # --- robokit.localization.particle_filter, beam_models, mcl (lesson 03's Monte-Carlo localization) --
+    "robokit.localization.particle_filter.normalise_log_weights": Call({
+        "log_w": Array(np.array([0.0, -1.0, -np.inf]), "N", inf_ok=True)}),
+    "robokit.localization.particle_filter.low_variance_resample": Call({
+        "weights": Array(np.array([0.2, 0.5, 0.3]), "N"), "rng": Rng(0), "count": Int(4, optional=True)}),
+    "robokit.localization.particle_filter.kld_sample_count": Call({"k": Array(np.array([1, 5]), "|N"), "epsilon": Real(0.01), "z": Real(2.33)}),
+    "robokit.localization.particle_filter.pose_bins": Call({
+        "particles": Array(np.array([[0.2, 0.7, 0.0], [1.3, 0.6, 0.1]]), "N,3"),
+        "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3")}),
+    "robokit.localization.particle_filter.kld_resample": Call({
+        "particles": Array(np.array([[0.2, 0.7, 0.0], [1.3, 0.6, 0.1]]), "N,3"), "weights": Array(np.array([1.0, 2.0]), "N"),
+        "rng": Rng(0), "min_count": Int(5), "max_count": Int(50), "epsilon": Real(0.05), "z": Real(0.99),
+        "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3"), "random_pose": Func(None, optional=True),
+        "inject_probability": Real(0.0)}),
+    "robokit.localization.particle_filter.weighted_pose_mean": Call({
+        "particles": Array(np.array([[0.0, 0.0, 3.0], [2.0, 0.0, -3.0]]), "N,3"),
+        "weights": Array(np.array([1.0, 3.0]), "N", optional=True)}),
+    "robokit.localization.particle_filter.sample_ellipse_poses": Call({
+        "pose": Array(np.array([5.0, 0.0, 0.3]), "3"), "sigma_x": Real(0.5), "sigma_y": Real(0.1), "n": Int(10),
+        "nsigma": Real(2.0), "sigma_theta": Real(0.05), "rng": Rng(0)}),
+    "robokit.localization.particle_filter.ellipse_weights": Call({
+        "particles": Array(np.array([[5.0, 0.1, 0.0], [4.5, 0.0, 0.0]]), "N,3"), "pose": Array(np.array([5.0, 0.0, 0.3]), "3"),
+        "sigma_x": Real(0.5), "sigma_y": Real(0.1), "normalise": Flag(True)}),
+    "robokit.localization.beam_models.subsample_beams": Call({"count": Int(360), "max_beams": Int(30, optional=True)}),
+    "robokit.localization.beam_models.valid_beams": Call({
+        "ranges": Array(SCAN, "N", inf_ok=True), "angles": Array(SCAN_ANGLES, "N"), "r_max": Real(8.0),
+        "max_beams": Int(3, optional=True)}),
+    "robokit.localization.beam_models.likelihood_field_log_weights": Call({
+        "particles": Array(np.array([[0.0, 0.0, 0.0], [0.2, 0.1, 0.5]]), "N,3"), "ranges": Array(SCAN, "N", inf_ok=True),
+        "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field), **beam_model_kinds()}),
+    "robokit.localization.beam_models.likelihood_field_log_weight_reference": Call({
+        "pose": Array(np.array([0.2, 0.1, 0.5]), "3"), "ranges": Array(SCAN, "N", inf_ok=True),
+        "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field), **beam_model_kinds()}),
+    "robokit.localization.mcl_step.mcl_step": Call({
+        "particles": Array(np.array([[0.0, 0.0, 0.0], [0.2, 0.1, 0.5]]), "N,3"), "weights": Array(np.array([0.5, 0.5]), "N"),
+        "odom_prev": Array(np.zeros(3), "3"), "odom_now": Array(np.array([0.3, 0.0, 0.1]), "3"),
+        "ranges": Array(SCAN, "N", inf_ok=True), "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field),
+        "alphas": Array(np.full(4, 0.05), "4"), "resample": Flag(True), "rng": Rng(0), "model": Given({})}),
+    "robokit.localization.mcl_step.uniform_free_poses": Call({
+        "free_cells": Array(np.array([[0.5, 0.5], [1.5, 0.5]]), "N,2"), "resolution": Real(1.0), "n": Int(3),
+        "rng": Rng(0)}),
+    "robokit.localization.mcl.MonteCarloLocalizer": Call({
+        "grid": Obj(room_grid), "field": Obj(None, optional=True), "n_particles": Int(50),
+        "alphas": Array(np.full(4, 0.2), "4"), "sigma_hit": Real(0.2), "z_hit": Real(0.95), "z_rand": Real(0.05),
+        "r_max": Real(8.0), "max_beams": Int(30, optional=True), "combine": Choice("ros"),
+        "sensor_offset": Array(np.zeros(3), "3"), "update_min_d": Real(0.2), "update_min_a": Real(0.5),
+        "resample_interval": Int(2), "kld": Obj(None, optional=True), "alpha_slow": Real(0.0), "alpha_fast": Real(0.0),
+        "rng": Rng(0)}),
     # --- robokit.mapping.occupancy_grid, grid_mapping, map_server (lesson 03's occupancy grid) --
     "robokit.mapping.occupancy_grid.log_odds": Call({"p": Array(np.array([0.3, 0.7]), "...")}),
     "robokit.mapping.occupancy_grid.probability": Call({"l": Array(np.array([-1.0, 2.0]), "...")}),
@@ -905,6 +976,14 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.mapping.grid_mapping.{n}" for n in (
         "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping", "occupancy_grid_mapping_reference")),
     "robokit.mapping.map_server.save_map", "robokit.mapping.map_server.load_map",
+    # lesson 03's Monte-Carlo localization (robokit.localization.particle_filter, beam_models, mcl)
+    *(f"robokit.localization.particle_filter.{n}" for n in (
+        "normalise_log_weights", "low_variance_resample", "kld_sample_count", "pose_bins", "kld_resample",
+        "weighted_pose_mean", "sample_ellipse_poses", "ellipse_weights")),
+    *(f"robokit.localization.beam_models.{n}" for n in (
+        "subsample_beams", "valid_beams", "likelihood_field_log_weights", "likelihood_field_log_weight_reference")),
+    "robokit.localization.mcl_step.mcl_step", "robokit.localization.mcl_step.uniform_free_poses",
+    "robokit.localization.mcl.MonteCarloLocalizer",
 )
 
 
