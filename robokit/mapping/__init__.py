@@ -16,7 +16,16 @@ KD-trees, the coarse and fine searches) and :mod:`.topological_build` (key image
 partitioning, loop closure, from a recorded run). Unlike the rest of mapping they use
 :mod:`robokit.sim`'s omni camera model (its rays and mount) and odometry noise model, never its
 renderer.
+
+Lesson 03's corridor (Ge et al. 2023): :mod:`.corridor_areas` (a scan's invalid areas, Eq. (9), and
+the bounds of Eqs. (6)-(8)), :mod:`.corridor_scan` (wall distances, the corridor axis, the width and
+middle-line conditions, Eqs. (1)-(4), and one scan's :class:`CorridorState`) and :mod:`.hybrid_map`
+(keyframes geo-tagged with the grid-map pose by time, Eq. (18)).
 """
+from .corridor_areas import EmptyScanError, as_scan, invalid_areas, theta_limits, theta_limits_geometric
+from .corridor_scan import (CorridorState, NoWallError, corridor_axis, corridor_state, door_sides,
+                            middle_line_condition, wall_distances, width_condition)
+from .hybrid_map import GeoIndex, geo_index, geo_tag
 from .g2o import G2OFormatError, read_g2o, write_g2o
 from .landmarks import LandmarkMap, kalman_fuse, transform_covariance
 from .manhattan import manhattan_world_graph
@@ -39,4 +48,7 @@ __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
            "G2OFormatError", "read_g2o", "write_g2o", "manhattan_world_graph",
            "OmniView", "RelativePose", "check_omni_image", "omni_view", "relative_pose",
            "LOOP_EDGE", "ODOMETRY_EDGE", "EmptyMapError", "TopologicalMap", "Comparison", "appearance_changed",
-           "build_topological_map", "local_map_full", "select_key_frames"]
+           "build_topological_map", "local_map_full", "select_key_frames",
+           "EmptyScanError", "as_scan", "invalid_areas", "theta_limits", "theta_limits_geometric",
+           "CorridorState", "NoWallError", "corridor_axis", "corridor_state", "door_sides", "middle_line_condition",
+           "wall_distances", "width_condition", "GeoIndex", "geo_index", "geo_tag"]
