@@ -24,9 +24,6 @@ def two_walls(d_l, d_r, axis=0.0, r_max=RMAX, angles=ANGLES):
     return r
 
 
-def median_bias(d, step_deg=1.0):
-    """The 5-beam median at the nearest beam is the range one beam off the perpendicular."""
-    return d * (1 / math.cos(math.radians(step_deg)) - 1) + 1e-12
 
 
 # --- wall distances and the axis ----------------------------------------------------------------
@@ -34,8 +31,7 @@ def median_bias(d, step_deg=1.0):
 @pytest.mark.parametrize("d_l, d_r", [(1.085, 1.085), (0.8, 1.37), (0.3, 1.87), (1.155, 1.085)])
 def test_wall_distances_of_two_parallel_walls(d_l, d_r):
     got = wall_distances(two_walls(d_l, d_r), ANGLES, heading=0.0)
-    assert got[0] == pytest.approx(d_l, abs=median_bias(d_l))
-    assert got[1] == pytest.approx(d_r, abs=median_bias(d_r))
+    assert got == pytest.approx((d_l, d_r), abs=1e-12)     # r cos(phi - normal) is d on every beam
 
 
 @pytest.mark.parametrize("axis_deg", [-60.0, -33.5, -5.0, 0.0, 12.25, 45.0, 60.0])
@@ -44,30 +40,30 @@ def test_the_axis_and_the_distances_do_not_depend_on_the_heading(axis_deg):
     r = two_walls(0.5, 1.67, axis)
     assert math.degrees(corridor_axis(r, ANGLES)) == pytest.approx(axis_deg, abs=0.05)
     d_l, d_r = wall_distances(r, ANGLES)
-    # the nearest beam to the wall normal is at most 0.5 deg off it
-    assert d_l == pytest.approx(0.5, abs=median_bias(0.5, 1.5))
-    assert d_r == pytest.approx(1.67, abs=median_bias(1.67, 1.5))
+    # with the axis 0.05 deg off, the coordinate along the normal is off by d (1 - cos) ~ 1e-7 at most ~ 0.001 d
+    assert (d_l, d_r) == pytest.approx((0.5, 1.67), rel=2e-3)
 
 
 def test_the_robots_own_halves_mislabel_a_wall_when_it_is_turned():
-    """Why the sides follow the axis: turned 60 deg near the left wall, the beam 135 deg right of
-    the robot's forward axis reaches the left wall (0.3 / sin 15 deg = 1.16 m) before any beam of the
-    robot's right sector reaches the right wall (1.87 m away)."""
+    """Why the sides follow the axis: turned 60 deg, the robot's own left and right (+-90 deg) meet the
+    walls 60 deg off their normals, at 0.3 / sin 30 deg and 1.87 / sin 30 deg: ranges, not distances."""
     r = two_walls(0.3, 1.87, math.radians(60))
-    assert wall_distances(r, ANGLES, heading=math.radians(60))[1] == pytest.approx(1.87, abs=median_bias(1.87))
-    assert 0.3 / math.sin(math.radians(15)) <= wall_distances(r, ANGLES, heading=0.0)[1] < 1.3
+    assert wall_distances(r, ANGLES, heading=math.radians(60)) == pytest.approx((0.3, 1.87), abs=1e-12)
+    assert wall_distances(r, ANGLES, heading=0.0) == pytest.approx((0.6, 3.74),
+                                                                   rel=1e-3)
 
 
 def test_one_noisy_beam_does_not_set_the_shortest_distance():
     r = two_walls(1.0, 1.17)
     r[90] = 0.6                                       # a spurious short return on the left normal
-    assert wall_distances(r, ANGLES, heading=0.0)[0] == pytest.approx(1.0, abs=median_bias(1.0, 2.0))
+    r[92] = np.inf                                    # and a lost one beside it
+    assert wall_distances(r, ANGLES, heading=0.0)[0] == pytest.approx(1.0, abs=1e-12)
 
 
 def test_a_missing_wall_is_a_named_error():
     r = two_walls(1.0, 1.17)
     r[np.sin(ANGLES) < 0] = np.inf                   # nothing on the right within r_max
-    with pytest.raises(NoWallError, match="right wall"):
+    with pytest.raises(NoWallError, match="right wall's normal, got 0"):
         wall_distances(r, ANGLES, heading=0.0)
 
 

@@ -34,7 +34,6 @@ import dataclasses
 from typing import Any
 
 import numpy as np
-from scipy.ndimage import median_filter
 
 from ..geometry import wrap_angle
 from ..validation import check_choice, check_finite_scalar, check_positive
@@ -45,7 +44,7 @@ __all__ = ["NoWallError", "CorridorState", "corridor_axis", "wall_distances", "d
            "theta_limits_geometric"]
 
 WIDTH_CASES = ("corridor", "facing doors", "staggered doors")
-_SECTOR = np.pi / 4       # beams within 45 deg of a wall's normal measure its shortest distance
+_FOOT = 7                 # beams nearest a wall's normal that measure its distance
 _BIN = 0.02               # Hough bin (m) of the lateral coordinate
 _BAND = 0.05              # half-width (m) of a wall's inlier band for the line fit
 
@@ -146,36 +145,39 @@ def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[fl
     Raises
     ------
     NoWallError
-        If a side has no valid return within 45 deg of its wall normal.
+        If fewer than 4 of the 7 beams nearest a wall's normal have a return.
 
     Notes
     -----
     Ge et al. (2023), Eq. (1): "the shortest distance between the left wall and the center of the
-    laser sensor". Ours, for robustness: the ranges are first median-filtered over 5 neighbouring
-    beams (circularly), so one noisy or spurious beam cannot set the minimum; the minimum is then
-    taken over the beams within 45 deg of the wall's normal (``axis +- pi/2``), so that neither the
-    far wall seen at a slant nor an end wall more than ~0.8 m away is taken for the side wall. The
-    minimum range is the perpendicular distance whatever the robot's heading (the nearest point of
-    a line), and beside a door it is the recessed distance, as Eqs. (2)-(3) expect.
+    laser sensor". Ours: the distance to a wall is its perpendicular distance, measured at the foot
+    of the perpendicular: the median, over the 7 beams nearest the wall's normal (``axis +- pi/2``),
+    of each return's coordinate along that normal, ``r cos(phi - normal)``. On a plain wall every
+    one of them equals the perpendicular distance (the nearest point of a line, whatever the
+    heading); beside a door it is the recessed distance, as Eqs. (2)-(3) expect; the median keeps
+    one spurious or noisy beam from setting it; and neither the far wall seen at a slant, nor an
+    end wall, nor a door frame's corner near the foot (which the minimum range would pick, neither
+    wall nor recess) enters it.
 
     Examples
     --------
     >>> ang = 2 * np.pi * np.arange(360) / 360
     >>> r = np.where(np.sin(ang) > 0, 0.8 / np.abs(np.sin(ang) + 1e-300), 1.37 / np.abs(np.sin(ang) + 1e-300))
     >>> r[r > 8] = np.inf
-    >>> tuple(round(d, 3) for d in wall_distances(r, ang))
+    >>> tuple(round(d, 9) for d in wall_distances(r, ang))
     (0.8, 1.37)
     """
     r, a = as_scan(ranges, angles)
     axis = corridor_axis(r, a) if heading is None else check_finite_scalar(heading, "heading")
-    rf = median_filter(r, size=min(5, len(r)), mode="wrap")
     out = []
     for name, normal in (("left", axis + np.pi / 2), ("right", axis - np.pi / 2)):
-        near = np.abs(wrap_angle(a - normal)) <= _SECTOR
-        d = rf[near].min() if near.any() else np.inf
-        if not np.isfinite(d):
-            raise NoWallError(f"ranges: expected a valid return within 45 deg of the {name} wall's normal, got none")
-        out.append(float(d))
+        off = wrap_angle(a - normal)
+        foot = np.argsort(np.abs(off), kind="stable")[:_FOOT]
+        along = r[foot] * np.cos(off[foot])
+        if np.count_nonzero(np.isfinite(along)) < (len(foot) + 2) // 2:
+            raise NoWallError(f"ranges: expected returns on most of the {len(foot)} beams nearest the {name} "
+                              f"wall's normal, got {np.count_nonzero(np.isfinite(along))}")
+        out.append(float(np.median(along)))
     return out[0], out[1]
 
 
@@ -220,12 +222,11 @@ def door_sides(ranges: Any, angles: Any, *, heading: Any = None, recess: float =
     axis = corridor_axis(r, a) if heading is None else check_finite_scalar(heading, "heading")
     dda = check_positive(recess, "recess", allow_zero=True)
     d = wall_distances(r, a, heading=axis)
-    rf = median_filter(r, size=min(5, len(r)), mode="wrap")
     out = []
     for dist, normal in zip(d, (axis + np.pi / 2, axis - np.pi / 2)):
         off = wrap_angle(a - normal)
-        near = (np.abs(off) <= np.pi / 3) & np.isfinite(rf)
-        level = np.percentile(rf[near] * np.cos(off[near]), 10)
+        near = (np.abs(off) <= np.pi / 3) & np.isfinite(r)
+        level = np.percentile(r[near] * np.cos(off[near]), 10)
         out.append(bool(dist - level > dda / 2))
     return out[0], out[1]
 
