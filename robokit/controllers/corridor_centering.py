@@ -173,7 +173,7 @@ def move_to_middle_line(world: World, pose: Any, lidar: Lidar, *, rng: Any = 0, 
     >>> res.reached, bool(abs(res.poses[-1, 1]) < 0.02), bool(abs(np.rad2deg(res.poses[-1, 2])) < 2.0)
     (True, True, True)
     >>> round(res.distance_moved, 2)
-    0.78
+    0.77
     """
     if not isinstance(world, World):
         raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
