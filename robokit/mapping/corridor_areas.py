@@ -34,7 +34,10 @@ import numpy as np
 
 from ..validation import as_array, check_positive
 
-__all__ = ["EmptyScanError", "as_scan", "invalid_areas", "theta_limits", "theta_limits_geometric"]
+__all__ = ["EmptyScanError", "as_scan", "invalid_areas", "theta_limits", "theta_limits_geometric", "MAX_RANGE"]
+
+#: Largest finite range a scan may hold (m): beyond it a number is a fault, not a distance.
+MAX_RANGE = 1e6
 
 
 class EmptyScanError(ValueError):
@@ -47,6 +50,8 @@ def as_scan(ranges: Any, angles: Any) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     ranges, angles : array_like, shape (B,)
+        Ranges in metres, ``inf`` where a beam has no return within the sensor's range (below
+        ``MAX_RANGE`` = 1e6 m otherwise), and beam angles in radians.
 
     Returns
     -------
@@ -57,7 +62,7 @@ def as_scan(ranges: Any, angles: Any) -> tuple[np.ndarray, np.ndarray]:
     EmptyScanError
         For ``B = 0``.
     ValueError
-        For NaN, negative or ``-inf`` ranges, non-finite or non-increasing angles, a span of 2 pi or
+        For NaN, negative, ``-inf`` or absurd (``>= MAX_RANGE``, finite) ranges, non-finite or non-increasing angles, a span of 2 pi or
         more, or lengths that differ.
 
     Notes
@@ -76,9 +81,9 @@ def as_scan(ranges: Any, angles: Any) -> tuple[np.ndarray, np.ndarray]:
         raise EmptyScanError("ranges: expected a scan with at least one beam, got an empty array")
     if len(a) != len(r):
         raise ValueError(f"angles: expected {len(r)} angles to match ranges, got {len(a)}")
-    bad = np.isnan(r) | (r < 0)
+    bad = np.isnan(r) | (r < 0) | (np.isfinite(r) & (r >= MAX_RANGE))
     if bad.any():
-        raise ValueError(f"ranges: expected non-negative ranges or inf (no return), got {r[bad][0]}")
+        raise ValueError(f"ranges: expected non-negative ranges below {MAX_RANGE:g} m or inf (no return), got {r[bad][0]}")
     if np.any(np.diff(a) <= 0) or a[-1] - a[0] >= 2 * np.pi:
         raise ValueError(f"angles: expected strictly increasing angles spanning less than 2 pi, "
                          f"got {a[0]} ... {a[-1]} (B = {len(a)})")
@@ -91,7 +96,7 @@ def invalid_areas(ranges: Any, angles: Any) -> np.ndarray:
     Parameters
     ----------
     ranges, angles : array_like, shape (B,)
-        See :func:`as_scan`; ``inf`` is an invalid return.
+        Ranges (m; ``inf`` = an invalid return) and beam angles (rad); see :func:`as_scan`.
 
     Returns
     -------

@@ -59,7 +59,7 @@ def corridor_axis(ranges: Any, angles: Any) -> float:
     Parameters
     ----------
     ranges, angles : array_like, shape (B,)
-        See :func:`as_scan`.
+        Ranges (m; ``inf`` = no return) and beam angles (rad); see :func:`as_scan`.
 
     Returns
     -------
@@ -131,7 +131,7 @@ def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[fl
     Parameters
     ----------
     ranges, angles : array_like, shape (B,)
-        See :func:`as_scan`.
+        Ranges (m; ``inf`` = no return) and beam angles (rad); see :func:`as_scan`.
     heading : float, optional
         Corridor axis in the robot frame (radians, see :func:`corridor_axis`); ``None`` estimates
         it from the scan. ``0.0`` takes the robot's own left and right, as the paper does for a
@@ -187,7 +187,7 @@ def door_sides(ranges: Any, angles: Any, *, heading: Any = None, recess: float =
     Parameters
     ----------
     ranges, angles : array_like, shape (B,)
-        See :func:`as_scan`.
+        Ranges (m; ``inf`` = no return) and beam angles (rad); see :func:`as_scan`.
     heading : float, optional
         Corridor axis in the robot frame (see :func:`wall_distances`); ``None`` estimates it.
     recess : float, default 0.07
@@ -226,7 +226,7 @@ def door_sides(ranges: Any, angles: Any, *, heading: Any = None, recess: float =
     for dist, normal in zip(d, (axis + np.pi / 2, axis - np.pi / 2)):
         off = wrap_angle(a - normal)
         near = (np.abs(off) <= np.pi / 3) & np.isfinite(r)
-        level = np.percentile(r[near] * np.cos(off[near]), 10)
+        level = np.percentile(r[near] * np.cos(off[near]), 10) if near.any() else dist
         out.append(bool(dist - level > dda / 2))
     return out[0], out[1]
 
@@ -313,9 +313,10 @@ def middle_line_condition(d_l: float, d_r: float, *, tol: float = 0.04, width: A
     dl, dr = check_positive(d_l, "d_l"), check_positive(d_r, "d_r")
     e4 = check_positive(tol, "tol", allow_zero=True)
     dda = check_positive(recess, "recess", allow_zero=True)
+    e_w = check_positive(width_tol, "width_tol", allow_zero=True)
     doors = "none"
     if width is not None:
-        case = width_condition(dl, dr, width, recess=dda, tol=width_tol)
+        case = width_condition(dl, dr, width, recess=dda, tol=e_w)
         if case == "facing doors":
             doors = "both"
         elif case == "staggered doors":
@@ -377,7 +378,7 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
     Parameters
     ----------
     ranges, angles : array_like, shape (B,)
-        See :func:`as_scan`.
+        Ranges (m; ``inf`` = no return) and beam angles (rad); see :func:`as_scan`.
     width, r_max : float
         Corridor width and LiDAR range (m).
     bounds : {"paper", "geometric"}, default "paper"
@@ -408,6 +409,9 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
     """
     r, a = as_scan(ranges, angles)
     check_choice(bounds, "bounds", ["paper", "geometric"])
+    recess = check_positive(recess, "recess", allow_zero=True)
+    tol = check_positive(tol, "tol", allow_zero=True)
+    width_tol = check_positive(width_tol, "width_tol", allow_zero=True)
     lo, hi = theta_limits(width, r_max) if bounds == "paper" else theta_limits_geometric(width, r_max, recess)
     if bounds == "geometric" and len(a) > 1:
         lo -= 2 * float(np.min(np.diff(a)))
