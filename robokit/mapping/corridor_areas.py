@@ -16,8 +16,9 @@ Eq. (9)'s first-to-last beam angle (which is ``(n - 1)`` beam steps for ``n`` in
 a resolution allowance. Door recesses also widen the cone: a 7 cm recess where a beam crosses
 ``r_max`` gives up to 16.76 deg, above Eq. (6). In ``robokit.sim.long_corridor()`` with the 360-beam
 ``robokit.sim.Lidar`` Eq. (9) measures 14 or 15 deg on the middle line (inside the printed bounds),
-but 16 deg for one area at ``[15, -0.7, -60 deg]`` (0.385 m from a wall): the printed Eq. (8) fails
-there and the end rule would call it an end. :func:`theta_limits` gives the printed bounds,
+but 16 deg for one area at ``[15, -0.7, -60 deg]`` (0.385 m from a wall) and at ``[14.5, 0.935,
+0]`` (0.15 m from a wall): the printed Eq. (8) fails there and the end rule calls it an end.
+Closer than ``r_min`` (0.15 m) the near wall itself becomes a wide invalid area. :func:`theta_limits` gives the printed bounds,
 :func:`theta_limits_geometric` the cone's with recesses.
 
 References
