@@ -339,6 +339,26 @@ def beam_model_kinds() -> dict:
 
 SCAN = np.array([1.0, np.inf, 0.8, 0.5])
 SCAN_ANGLES = np.arange(4) * np.pi / 2
+@functools.cache
+def corridor_world():
+    from robokit.sim import long_corridor
+    return long_corridor()
+
+
+@functools.cache
+def corridor_lidar():
+    from robokit.sim import Lidar
+    return Lidar(noise=0.01)
+
+
+@functools.cache
+def corridor_angles():
+    return corridor_lidar().angles
+
+
+@functools.cache
+def corridor_ranges():   # lesson 03: a scan 0.3 m left of the middle line, turned 0.2 rad
+    return corridor_lidar().scan(corridor_world(), [14.5, 0.3, 0.2], rng=0)
 
 
 SPECS: dict[str, Call] = {
@@ -912,6 +932,41 @@ SPECS: dict[str, Call] = {
                                                  "occupied_thresh": Real(0.65), "free_thresh": Real(0.196),
                                                  "negate": Int(0), "mode": Choice("trinary")}),
     "robokit.mapping.map_server.load_map": Call({"yaml_path": Text(saved_map)}),
+    # robokit.mapping.corridor_scan / corridor_areas, controllers.corridor_centering, mapping.hybrid_map (lesson 03)
+    **{f"robokit.mapping.corridor_scan.{n}": Call({"ranges": Array(corridor_ranges, "N", inf_ok=True),
+                                                    "angles": Array(corridor_angles, "N")} | extra)
+       for n, extra in [("corridor_axis", {}), ("wall_distances", {"heading": Real(0.0, optional=True)}),
+                        ("door_sides", {"heading": Real(0.0, optional=True), "recess": Real(0.07)}),
+                        ("corridor_state", {"width": Real(2.17), "r_max": Real(8.0), "bounds": Choice("paper"),
+                                            "recess": Real(0.07), "tol": Real(0.04), "width_tol": Real(0.03)})]},
+    **{f"robokit.mapping.corridor_areas.{n}": Call({"ranges": Array(corridor_ranges, "N", inf_ok=True),
+                                                     "angles": Array(corridor_angles, "N")})
+       for n in ("as_scan", "invalid_areas")},
+    "robokit.mapping.corridor_areas.theta_limits": Call({"width": Real(2.17), "r_max": Real(8.0)}),
+    "robokit.mapping.corridor_areas.theta_limits_geometric": Call({"width": Real(2.17), "r_max": Real(8.0),
+                                                                   "recess": Real(0.07)}),
+    "robokit.mapping.corridor_scan.width_condition": Call({"d_l": Real(1.085), "d_r": Real(1.155), "width": Real(2.17),
+                                                           "recess": Real(0.07), "tol": Real(0.03)}),
+    "robokit.mapping.corridor_scan.middle_line_condition": Call({
+        "d_l": Real(1.085), "d_r": Real(1.155), "tol": Real(0.04), "width": Real(2.17, optional=True),
+        "recess": Real(0.07), "width_tol": Real(0.03), "door": Choice("right", optional=True)}),
+    "robokit.controllers.corridor_centering.centering_command": Call({
+        "lateral_offset": Real(0.3), "heading_error": Real(0.2), "lookahead": Real(0.15), "k_omega": Real(1.5),
+        "k_v": Real(0.5), "v_min": Real(0.02), "v_max": Real(0.15), "w_max": Real(0.6), "deadband": Real(0.01)}),
+    "robokit.controllers.corridor_centering.move_to_middle_line": Call({
+        "world": Obj(corridor_world), "pose": Array(np.array([14.5, 0.05, 0.1]), "3"), "lidar": Obj(corridor_lidar),
+        "rng": Rng(0), "tol": Real(0.04), "heading_tol": Real(0.035), "max_steps": Int(40), "dt": Real(0.1),
+        "direction": Choice("nearest", optional=True), "width": Real(2.17, optional=True),
+        "recess": Real(0.07, optional=True), "settle": Int(3)}, cheap=False),
+    "robokit.mapping.hybrid_map.geo_tag": Call({"keyframe_times": Array(np.array([0.5, 1.5]), "N"),
+                                                "pose_times": Array(np.array([0.0, 1.0, 2.0]), "N"),
+                                                "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 3.0],
+                                                                         [2.0, 0.0, -3.0]]), "N,3")}),
+    "robokit.mapping.hybrid_map.geo_index": Call({"keyframe_ids": Array(np.array([3, 8]), "N"),
+                                                  "keyframe_times": Array(np.array([0.5, 1.5]), "N"),
+                                                  "pose_times": Array(np.array([0.0, 1.0, 2.0]), "N"),
+                                                  "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 3.0],
+                                                                           [2.0, 0.0, -3.0]]), "N,3")}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -984,6 +1039,13 @@ EXTRA: tuple[str, ...] = (
         "subsample_beams", "valid_beams", "likelihood_field_log_weights", "likelihood_field_log_weight_reference")),
     "robokit.localization.mcl_step.mcl_step", "robokit.localization.mcl_step.uniform_free_poses",
     "robokit.localization.mcl.MonteCarloLocalizer",
+    # lesson 03's corridor scan, moving strategy and geo-tags, fuzzed before the lesson exists
+    *(f"robokit.mapping.corridor_scan.{n}" for n in (
+        "corridor_axis", "wall_distances", "door_sides", "corridor_state", "width_condition", "middle_line_condition")),
+    *(f"robokit.mapping.corridor_areas.{n}" for n in ("as_scan", "invalid_areas", "theta_limits", "theta_limits_geometric")),
+    "robokit.controllers.corridor_centering.centering_command",
+    "robokit.controllers.corridor_centering.move_to_middle_line",
+    "robokit.mapping.hybrid_map.geo_tag", "robokit.mapping.hybrid_map.geo_index",
 )
 
 

@@ -1,7 +1,7 @@
 """Control loops designed and checked with python-control (named so it never shadows ``control``).
 
 Layer: below the system lessons (``outdoor``, ``legged``) and ``navigation``; imports ``geometry``,
-``validation``, ``sim`` (the one unicycle model) and python-control.
+``validation``, ``sim`` (the one unicycle model), ``mapping`` (the corridor scan analysis) and python-control.
 
 heading              the heading servo of a skid-steer vehicle: pole-placement gains for an overshoot
                      and settling time, and the discrete controller (lesson 05; re-exported by
@@ -13,7 +13,11 @@ path_geometry        lesson 02's path: a smooth curve through recorded key poses
 path_following       the law of Eq. (8), its gains, saturation keeping the curvature, the follower
 path_following_loop  Eq. (8) linearised about the path: poles, damping, step response (python-control),
                      and the nonlinear simulation beside it
+corridor_centering   lesson 03's moving strategy (Ge et al. 2023, Sec. 3.1): a law that brings the robot
+                     onto the corridor's middle line facing along it, and the closed loop on LiDAR scans
+                     (reads them with robokit.mapping.corridor_scan)
 """
+from .corridor_centering import CenteringResult, centering_command, move_to_middle_line
 from .heading import HeadingController, design_heading_gains
 from .heading_loop import (heading_closed_loop, heading_frequency_response, heading_loop_gain, heading_plant,
                            heading_step_response, loop_metrics)
@@ -28,4 +32,5 @@ __all__ = ["HeadingController", "design_heading_gains", "heading_closed_loop", "
            "PathFollower", "PathSingularityError", "ReferencePoint", "VisualPath", "path_following_command",
            "path_following_gains", "path_from_poses", "reference_point", "reference_command", "saturate_command",
            "FollowTrace", "lateral_step_response", "path_following_damping", "path_following_linearisation",
-           "path_following_poles", "simulate_path_following"]
+           "path_following_poles", "simulate_path_following", "CenteringResult", "centering_command",
+           "move_to_middle_line"]

@@ -19,7 +19,16 @@ renderer.
 
 Occupancy grids (lesson 03's corridor map): :mod:`.occupancy_grid` (log odds per cell, the
 free/occupied/unknown reading with map_server's thresholds, the likelihood field of a range finder).
+
+Lesson 03's corridor (Ge et al. 2023): :mod:`.corridor_areas` (a scan's invalid areas, Eq. (9), and
+the bounds of Eqs. (6)-(8)), :mod:`.corridor_scan` (wall distances, the corridor axis, the width and
+middle-line conditions, Eqs. (1)-(4), and one scan's :class:`CorridorState`) and :mod:`.hybrid_map`
+(keyframes geo-tagged with the grid-map pose by time, Eq. (18)).
 """
+from .corridor_areas import EmptyScanError, as_scan, invalid_areas, theta_limits, theta_limits_geometric
+from .corridor_scan import (CorridorState, NoWallError, corridor_axis, corridor_state, door_sides,
+                            middle_line_condition, wall_distances, width_condition)
+from .hybrid_map import GeoIndex, geo_index, geo_tag
 from .g2o import G2OFormatError, read_g2o, write_g2o
 from .grid_mapping import (L_FREE, L_OCC, inverse_range_sensor_model, occupancy_grid_mapping,
                            occupancy_grid_mapping_reference, update_log_odds)
@@ -52,4 +61,7 @@ __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
            "OccupancyGrid", "LikelihoodField", "likelihood_field",
            "L_OCC", "L_FREE", "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping",
            "occupancy_grid_mapping_reference", "MapFileError", "save_map", "load_map", "OCCUPIED_VALUE", "FREE_VALUE",
-           "UNKNOWN_VALUE"]
+           "UNKNOWN_VALUE",
+           "EmptyScanError", "as_scan", "invalid_areas", "theta_limits", "theta_limits_geometric",
+           "CorridorState", "NoWallError", "corridor_axis", "corridor_state", "door_sides", "middle_line_condition",
+           "wall_distances", "width_condition", "GeoIndex", "geo_index", "geo_tag"]
