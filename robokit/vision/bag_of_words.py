@@ -146,7 +146,7 @@ def tf_idf(word_ids, idf) -> BowVector:
     idf = as_array(idf, "idf", ndim=1)
     if np.any(idf < 0):
         raise ValueError(f"idf: expected non-negative values, got {idf.min()}")
-    ids = as_array(word_ids, "word_ids", dtype=np.int64).reshape(-1)
+    ids = as_array(word_ids, "word_ids", dtype=np.int64, ndim=1)
     if ids.size and (ids.min() < 0 or ids.max() >= idf.size):
         raise ValueError(f"word_ids: expected ids in [0, {idf.size}), got values in [{ids.min()}, {ids.max()}]")
     if ids.size == 0:

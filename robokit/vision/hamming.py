@@ -30,7 +30,7 @@ import numpy as np
 from ..validation import as_array, describe
 from .matching import Matches, check_ratio, ratio_test
 
-__all__ = ["ORB_BYTES", "ORB_MATCH_DISTANCE", "ORB_RATIO", "as_binary_descriptors", "hamming_distance",
+__all__ = ["ORB_BYTES", "ORB_MATCH_DISTANCE", "ORB_RATIO", "as_binary_descriptors", "same_width", "hamming_distance",
            "hamming_distances", "hamming_match"]
 
 #: Bytes of one ORB descriptor (256 bits).
@@ -93,6 +93,21 @@ def as_binary_descriptors(value, name: str = "descriptors", *, n_bytes: int | No
     return np.ascontiguousarray(arr)
 
 
+def same_width(a: np.ndarray, b: np.ndarray, name_a: str, name_b: str) -> None:
+    """Raise a ValueError naming both arguments unless their descriptors have one length (or one set is empty)."""
+    if a.size and b.size and a.shape[-1] != b.shape[-1]:
+        raise ValueError(f"{name_a}, {name_b}: expected descriptors of one length, got {a.shape[-1]} and "
+                         f"{b.shape[-1]} bytes")
+
+
+def _leading_rows(x, name: str) -> np.ndarray:
+    """Byte rows with any leading axes, (..., B), as uint8."""
+    arr = x if isinstance(x, np.ndarray) and x.dtype == np.uint8 else as_array(x, name, dtype=np.int64)
+    if arr.ndim == 0 or arr.shape[-1] == 0:
+        raise ValueError(f"{name}: expected rows of bytes, shape (..., B), got shape {arr.shape}")
+    return as_binary_descriptors(arr.reshape(-1, arr.shape[-1]), name).reshape(arr.shape)
+
+
 def _words64(d: np.ndarray) -> np.ndarray:
     """Rows of bytes as 64-bit words (zero-padded to a multiple of 8 bytes; zeros XOR to zero)."""
     pad = -d.shape[-1] % 8
@@ -133,12 +148,8 @@ def hamming_distance(a, b, *, check: bool = True) -> np.ndarray:
     [10]
     """
     if check:
-        a = np.asarray(a)
-        b = np.asarray(b)
-        a = as_binary_descriptors(a.reshape(-1, a.shape[-1]) if a.ndim else a, "a").reshape(a.shape)
-        b = as_binary_descriptors(b.reshape(-1, b.shape[-1]) if b.ndim else b, "b").reshape(b.shape)
-        if a.shape[-1] != b.shape[-1]:
-            raise ValueError(f"b: expected {a.shape[-1]} bytes per descriptor like a, got {b.shape[-1]}")
+        a, b = _leading_rows(a, "a"), _leading_rows(b, "b")
+        same_width(a, b, "a", "b")
         try:
             np.broadcast_shapes(a.shape[:-1], b.shape[:-1])
         except ValueError:
@@ -177,8 +188,8 @@ def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
     [[1, 1, 8], [1, 1, 6]]
     """
     if check:
-        a = as_binary_descriptors(a, "a")
-        b = as_binary_descriptors(b, "b", n_bytes=a.shape[1])
+        a, b = as_binary_descriptors(a, "a"), as_binary_descriptors(b, "b")
+        same_width(a, b, "a", "b")
     out = np.empty((a.shape[0], b.shape[0]), np.int64)
     words = max(1, -(-a.shape[1] // 8))
     step = max(1, _BLOCK // max(1, b.shape[0] * words))
@@ -201,7 +212,7 @@ def hamming_match(query, train, *, ratio: float = ORB_RATIO, max_distance: float
         Distance-ratio bound in (0, 1] (:func:`robokit.vision.matching.ratio_test`); ``1`` keeps
         every nearest neighbour except exact ties. With one train row the ratio is 0 (no second).
     max_distance : float or None, default 50
-        Largest accepted distance in bits (ORB-SLAM's ``TH_LOW``); ``None`` means no bound.
+        Largest accepted distance in bits (ORB-SLAM's ``TH_LOW``); ``None`` or ``inf`` mean no bound.
     cross_check : bool, default False
         Keep only mutual nearest neighbours (the query row is also the train row's nearest).
 
@@ -230,9 +241,8 @@ def hamming_match(query, train, *, ratio: float = ORB_RATIO, max_distance: float
     """
     ratio = check_ratio(ratio)
     q = as_binary_descriptors(query, "query")
-    t = as_binary_descriptors(train, "train", n_bytes=q.shape[1] if len(q) else None)
-    if len(q) and len(t) and q.shape[1] != t.shape[1]:
-        raise ValueError(f"train: expected {q.shape[1]} bytes per descriptor like query, got {t.shape[1]}")
+    t = as_binary_descriptors(train, "train")
+    same_width(q, t, "query", "train")
     if len(q) == 0 or len(t) == 0:       # validates ratio and max_distance all the same
         ratio_test(np.zeros((0, 2)), np.zeros((0, 2), int), ratio=ratio, max_distance=max_distance)
         return Matches.empty()

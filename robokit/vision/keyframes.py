@@ -40,7 +40,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..validation import as_array, check_finite_scalar, check_int, describe
-from .hamming import ORB_MATCH_DISTANCE, as_binary_descriptors, hamming_match
+from .hamming import ORB_MATCH_DISTANCE, as_binary_descriptors, hamming_match, same_width
 
 __all__ = ["KeyframeConditions", "KeyframeSelector", "feature_threshold", "shared_fraction", "select_keyframes",
            "select_keyframes_orbslam"]
@@ -109,10 +109,9 @@ def shared_fraction(desc_current, desc_keyframe, *, max_distance: float = ORB_MA
     max_distance = check_finite_scalar(max_distance, "max_distance")
     if max_distance <= 0:
         raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
+    same_width(cur, key, "desc_current", "desc_keyframe")
     if len(key) == 0 or len(cur) == 0:
         return 0.0
-    if cur.shape[1] != key.shape[1]:
-        raise ValueError(f"desc_keyframe: expected {cur.shape[1]} bytes per descriptor, got {key.shape[1]}")
     return _match_count(cur, key, max_distance) / len(key)    # denominator: the keyframe's features
 
 
