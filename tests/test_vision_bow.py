@@ -172,6 +172,12 @@ def test_vocabulary_save_load_and_a_foreign_file(tmp_path, clustered_images):
     np.savez(tmp_path / "other.npz", x=np.zeros(3))
     with pytest.raises(VocabularyFileError):
         Vocabulary.load(tmp_path / "other.npz")
+    broken = voc.arrays()
+    broken["children"] = broken["children"].copy()
+    broken["children"][0, 0] = broken["children"][0, 1]       # a node with two parents
+    np.savez(tmp_path / "broken.npz", **broken)
+    with pytest.raises(VocabularyFileError, match="children"):
+        Vocabulary.load(tmp_path / "broken.npz")
 
 
 # --- the database ---------------------------------------------------------------------------------

@@ -283,10 +283,22 @@ class Vocabulary:
         self.levels = check_int(levels, "levels", minimum=1, maximum=16)
         if self.centres.shape[0] != n_nodes or n_nodes < 2:
             raise ValueError(f"centres: expected one row per node ({n_nodes} >= 2), got {self.centres.shape[0]}")
-        kids = self.children[self.children >= 0]
-        if kids.size and (kids.max() >= n_nodes or kids.min() < 1 or np.unique(kids).size != kids.size
-                          or kids.size != n_nodes - 1):
-            raise ValueError("children: expected every node but the root to be the child of exactly one node")
+        rows, cols = np.nonzero(self.children >= 0)
+        kids = self.children[rows, cols]
+        packed = np.all(np.diff((self.children >= 0).astype(np.int8), axis=1) <= 0)     # children first, then -1
+        if (kids.size != n_nodes - 1 or np.unique(kids).size != kids.size or np.any(kids <= rows)
+                or np.any(kids >= n_nodes) or not packed):
+            raise ValueError("children: expected a tree in node order (each node but the root the child of exactly "
+                             "one earlier node; child ids first in each row, then -1)")
+        depth = np.zeros(n_nodes, np.int64)
+        for _ in range(n_nodes):                   # children come after parents: one sweep per level
+            new = depth.copy()
+            new[kids] = depth[rows] + 1
+            if np.array_equal(new, depth) or new.max() > self.levels:
+                break
+            depth = new
+        if depth.max() > self.levels or not np.array_equal(depth[kids], depth[rows] + 1):
+            raise ValueError(f"children: expected a tree at most levels={self.levels} deep")
         leaf = self.children[:, 0] < 0
         self.word_of_node = np.where(leaf, np.cumsum(leaf) - 1, -1)
         self.n_words = int(leaf.sum())
