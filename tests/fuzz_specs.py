@@ -359,6 +359,14 @@ def corridor_angles():
 @functools.cache
 def corridor_ranges():   # lesson 03: a scan 0.3 m left of the middle line, turned 0.2 rad
     return corridor_lidar().scan(corridor_world(), [14.5, 0.3, 0.2], rng=0)
+def orb_descriptors(n=40, seed=0):  # random 256-bit descriptors (robokit.vision lesson 03)
+    return np.random.default_rng(seed).integers(0, 256, (n, 32), dtype=np.uint8)
+
+
+@functools.cache
+def bow_vocabulary():
+    from robokit.vision import Vocabulary
+    return Vocabulary.train([orb_descriptors(40, i) for i in range(4)], branching=3, levels=2, rng=0)
 
 
 SPECS: dict[str, Call] = {
@@ -967,6 +975,47 @@ SPECS: dict[str, Call] = {
                                                   "pose_times": Array(np.array([0.0, 1.0, 2.0]), "N"),
                                                   "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 3.0],
                                                                            [2.0, 0.0, -3.0]]), "N,3")}),
+    # --- robokit.vision.orb, hamming, keyframes, bag_of_words, bow_database (lesson 03) ------------
+    "robokit.vision.orb.detect_orb_features": Call({"image": Array(image, "N,N|N,N,3|N,N,4"), "n_features": Int(100),
+                                                    "scale_factor": Real(1.2), "n_levels": Int(4),
+                                                    "fast_threshold": Int(20),
+                                                    "mask": Array(image_mask, "N,N", optional=True,
+                                                                  accepts=("booleans",))}),
+    "robokit.vision.hamming.hamming_distance": Call({"a": Array(orb_descriptors, "...,32"),
+                                                     "b": Array(lambda: orb_descriptors(40, 1), "...,32"),
+                                                     "check": Flag(True)}),
+    "robokit.vision.hamming.hamming_distances": Call({"a": Array(orb_descriptors, "N,32", min_rows=0),
+                                                      "b": Array(lambda: orb_descriptors(30, 1), "N,32", min_rows=0),
+                                                      "check": Flag(True)}),
+    "robokit.vision.hamming.hamming_match": Call({"query": Array(orb_descriptors, "N,32", min_rows=0),
+                                                  "train": Array(lambda: orb_descriptors(30, 1), "N,32", min_rows=0),
+                                                  "ratio": Real(0.75), "max_distance": Real(50.0, optional=True, inf_ok=True),
+                                                  "cross_check": Flag(False)}),
+    "robokit.vision.keyframes.feature_threshold": Call({"counts": Array(np.array([400.0, 380.0, 100.0]), "N")}),
+    "robokit.vision.keyframes.shared_fraction": Call({"desc_current": Array(orb_descriptors, "N,32", min_rows=0),
+                                                      "desc_keyframe": Array(lambda: orb_descriptors(30), "N,32",
+                                                                             min_rows=0),
+                                                      "max_distance": Real(50.0)}),
+    "robokit.vision.keyframes.KeyframeSelector": Call({"f_min": Real(100.0), "min_frame_gap": Int(10),
+                                                       "shared_range": Array(np.array([0.7, 0.9]), "2"),
+                                                       "min_distance": Real(0.02), "max_distance": Real(50.0)}),
+    "robokit.vision.keyframes.select_keyframes": Call({
+        "descriptor_list": Obj(lambda: [orb_descriptors(40, 0)] * 3), "positions": Array(np.zeros((3, 2)), "N,2|N,3"),
+        "f_min": Real(10.0), "kw": Options({"min_frame_gap": 1})}),
+    "robokit.vision.keyframes.select_keyframes_orbslam": Call({
+        "descriptor_list": Obj(lambda: [orb_descriptors(40, 0)] * 3),
+        "positions": Array(np.zeros((3, 2)), "N,2|N,3", optional=True), "min_frame_gap": Int(1),
+        "min_tracked": Int(10), "max_tracked_fraction": Real(0.9), "max_distance": Real(50.0)}),
+    "robokit.vision.bag_of_words.tf_idf": Call({"word_ids": Array(np.array([0, 0, 1, 2]), "N", min_rows=0),
+                                                "idf": Array(np.log2([3.0, 3.0, 1.5, 1.0]), "N")}),
+    "robokit.vision.bag_of_words.l1_score": Call({"v_a": Obj(([0, 2], [0.5, 0.5])), "v_b": Obj(([0, 3], [0.2, 0.8]))}),
+    "robokit.vision.bag_of_words.Vocabulary": Call({
+        "children": Array(lambda: bow_vocabulary().children, "N,N"), "centres": Array(lambda: bow_vocabulary().centres, "N,N"),
+        "idf": Array(lambda: bow_vocabulary().idf, "N"), "levels": Int(2)}),
+    "robokit.vision.bag_of_words.Vocabulary.train": Call({
+        "descriptors": Obj(lambda: [orb_descriptors(30, 0), orb_descriptors(30, 1)]), "branching": Int(3),
+        "levels": Int(2), "iterations": Int(5), "rng": Rng(0)}),
+    "robokit.vision.bow_database.BowDatabase": Call({"vocabulary": Obj(bow_vocabulary)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -1046,6 +1095,14 @@ EXTRA: tuple[str, ...] = (
     "robokit.controllers.corridor_centering.centering_command",
     "robokit.controllers.corridor_centering.move_to_middle_line",
     "robokit.mapping.hybrid_map.geo_tag", "robokit.mapping.hybrid_map.geo_index",
+    # robokit.vision lesson 03: ORB, Hamming matching, keyframes, bag of words (fuzzed before the lesson exists)
+    *(f"robokit.vision.{n}" for n in (
+        "orb.detect_orb_features", "hamming.hamming_distance",
+        "hamming.hamming_distances", "hamming.hamming_match", "keyframes.feature_threshold",
+        "keyframes.shared_fraction", "keyframes.KeyframeSelector", "keyframes.select_keyframes",
+        "keyframes.select_keyframes_orbslam", "bag_of_words.tf_idf", "bag_of_words.l1_score",
+        "bag_of_words.Vocabulary", "bag_of_words.Vocabulary.train",
+        "bow_database.BowDatabase")),
 )
 
 

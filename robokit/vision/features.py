@@ -125,8 +125,10 @@ class Features:
     Attributes
     ----------
     keypoints : Keypoints
-    descriptors : numpy.ndarray, shape (N, D), float32
-        D = 128 for the SIFT-style descriptor, 16 for Se et al.'s reduced vector (Sec. 4).
+    descriptors : numpy.ndarray, shape (N, D), float32 or uint8
+        D = 128 for the SIFT-style descriptor, 16 for Se et al.'s reduced vector (Sec. 4). Binary
+        descriptors (ORB's 256 bits packed in D = 32 bytes, :mod:`.orb`) stay uint8: their
+        distance is the Hamming distance (:mod:`.hamming`), and a float copy would hide that.
     """
 
     keypoints: Keypoints
@@ -135,7 +137,8 @@ class Features:
     def __post_init__(self):
         if not isinstance(self.keypoints, Keypoints):
             raise TypeError(f"keypoints: expected Keypoints, got {describe(self.keypoints)}")
-        d = np.asarray(self.descriptors, dtype=np.float32)
+        d = np.asarray(self.descriptors)
+        d = d if d.dtype == np.uint8 else d.astype(np.float32)   # binary descriptors stay bytes
         if d.ndim != 2 or d.shape[0] != len(self.keypoints):
             raise ValueError(f"descriptors: expected shape ({len(self.keypoints)}, D), got shape {d.shape}")
         object.__setattr__(self, "descriptors", d)

@@ -1,0 +1,341 @@
+"""Keyframe selection from ORB features: Ge et al. (2023)'s four conditions and an ORB-SLAM-like rule.
+
+Ge et al. (2023), Sec. 3.2: the first image is a keyframe; a later one is a keyframe when
+
+1. its ORB feature count exceeds ``F_min`` (Eq. (15), from a calibration run: :func:`feature_threshold`);
+2. more than 10 frames have passed since the last keyframe;
+3. it shares fewer than 90 % but more than 70 % matched points with the last keyframe;
+4. the robot has moved (about) 0.02 m since the last keyframe.
+
+Condition (3)'s "shared matched points" is :func:`shared_fraction`: the fraction of the last
+keyframe's features that find a match in the current frame (mutual nearest neighbours by Hamming
+distance within ORB-SLAM's 50 bits, :func:`.hamming.hamming_match`). The denominator is the
+keyframe's feature count, as in ORB-SLAM's "tracks less than 90 % points than K_ref": it asks how
+much of the stored keyframe is still seen, and does not change while the current frame's own count
+varies. Taken literally, condition (3) also means that a frame sharing 70 % or less is never a
+keyframe: if the robot jumps too far between frames, selection stops until it sees the last
+keyframe's scene again (:class:`KeyframeSelector` records it in ``conditions``).
+
+The ORB-SLAM rule beside it (Mur-Artal, Montiel & Tardos 2015, Sec. V-E, conditions 2-4; the
+relocalisation and local-mapping-idle parts do not apply here): more than 20 frames since the last
+keyframe insertion, the current frame tracks at least 50 points, and it tracks fewer than 90 % of
+the reference keyframe's points. "Tracked points" are approximated by Hamming matches with the
+reference keyframe (ORB-SLAM tracks map points; we have no map).
+
+Positions are planar robot positions ``(N, 2)`` or poses ``[x, y, theta]`` ``(N, 3)`` in metres;
+condition (4) uses the Euclidean distance between positions (the heading is ignored).
+
+References
+----------
+.. [1] F. Ge, Y. Zhang, L. Wang, W. Hu, W. Wang and W. Jiang (Ge et al.), "Visual-feature-assisted
+   mobile robot localization in a long corridor environment", Frontiers of Information Technology
+   & Electronic Engineering 24(6), 2023, doi:10.1631/FITEE.2200208.
+.. [2] R. Mur-Artal, J. M. M. Montiel and J. D. Tardos, "ORB-SLAM: a versatile and accurate monocular
+   SLAM system", IEEE Transactions on Robotics 31(5), 1147-1163, 2015.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..validation import as_array, check_finite_scalar, check_int, describe
+from .hamming import ORB_MATCH_DISTANCE, as_binary_descriptors, hamming_match, same_width
+
+__all__ = ["KeyframeConditions", "KeyframeSelector", "feature_threshold", "shared_fraction", "select_keyframes",
+           "select_keyframes_orbslam"]
+
+
+def feature_threshold(counts) -> float:
+    """``F_min`` of Ge et al. (2023), Eq. (15): ``max(0.5 * mean count, smallest count)``.
+
+    Parameters
+    ----------
+    counts : array_like, shape (N,)
+        ORB feature count of every image of a calibration run (the paper records 10 m of
+        corridor), non-negative, N >= 1.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        For an empty, negative or non-finite ``counts``.
+
+    Examples
+    --------
+    >>> feature_threshold([400, 420, 380, 100])       # half the mean, 162.5, beats the smallest
+    162.5
+    >>> feature_threshold([300, 310])
+    300.0
+    """
+    c = as_array(counts, "counts", ndim=1, min_size=1)
+    if np.any(c < 0):
+        raise ValueError(f"counts: expected non-negative feature counts, got {c.min()}")
+    return float(max(0.5 * c.mean(), c.min()))                  # Eq. (15)
+
+
+def _match_count(current: np.ndarray, keyframe: np.ndarray, max_distance: float) -> int:
+    m = hamming_match(current, keyframe, ratio=1.0, max_distance=max_distance, cross_check=True)
+    return len(m)
+
+
+def shared_fraction(desc_current, desc_keyframe, *, max_distance: float = ORB_MATCH_DISTANCE) -> float:
+    """Fraction of a keyframe's features matched in the current frame (Ge et al. (2023), Sec. 3.2, condition (3)).
+
+    Parameters
+    ----------
+    desc_current, desc_keyframe : array_like of uint8, shape (N, 32) and (M, 32)
+        ORB descriptors of the current frame and of the last keyframe.
+    max_distance : float, default 50
+        Largest Hamming distance of a match (ORB-SLAM's ``TH_LOW``).
+
+    Returns
+    -------
+    float
+        ``(mutual nearest neighbours within max_distance) / M``, in [0, 1]; 0 when either frame
+        has no features.
+
+    Examples
+    --------
+    >>> kf = np.array([[0] * 32, [255] * 32, [15] * 32, [240] * 32], np.uint8)
+    >>> shared_fraction(kf[:3], kf)                      # 3 of the keyframe's 4 features seen
+    0.75
+    """
+    cur = as_binary_descriptors(desc_current, "desc_current")
+    key = as_binary_descriptors(desc_keyframe, "desc_keyframe")
+    max_distance = check_finite_scalar(max_distance, "max_distance")
+    if max_distance <= 0:
+        raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
+    same_width(cur, key, "desc_current", "desc_keyframe")
+    if len(key) == 0 or len(cur) == 0:
+        return 0.0
+    return _match_count(cur, key, max_distance) / len(key)    # denominator: the keyframe's features
+
+
+class KeyframeConditions(NamedTuple):
+    """Ge et al. (2023)'s conditions (1)-(4) for one frame, and the measured quantities."""
+
+    features: bool        #: (1) feature count > F_min
+    frames: bool          #: (2) more than min_frame_gap frames since the last keyframe
+    shared: bool          #: (3) shared fraction inside (low, high)
+    moved: bool           #: (4) moved >= min_distance since the last keyframe
+    n_features: int
+    frame_gap: int
+    fraction: float
+    distance: float
+
+    @property
+    def all(self) -> bool:
+        """Whether every condition holds."""
+        return self.features and self.frames and self.shared and self.moved
+
+
+def _position(position, name="position") -> np.ndarray:
+    p = as_array(position, name, ndim=1)
+    if p.size not in (2, 3):
+        raise ValueError(f"{name}: expected [x, y] or a pose [x, y, theta], got shape {p.shape}")
+    return p[:2]
+
+
+class KeyframeSelector:
+    """Online keyframe selection with Ge et al. (2023)'s conditions (1)-(4) (Sec. 3.2).
+
+    Parameters
+    ----------
+    f_min : float
+        Condition (1): a keyframe has more than ``f_min`` features (:func:`feature_threshold`).
+    min_frame_gap : int, default 10
+        Condition (2): more than this many frames since the last keyframe.
+    shared_range : (float, float), default (0.70, 0.90)
+        Condition (3): ``low < shared_fraction < high``.
+    min_distance : float, default 0.02
+        Condition (4): metres moved since the last keyframe, at least.
+    max_distance : float, default 50
+        Hamming bound of a match in :func:`shared_fraction`.
+
+    Attributes
+    ----------
+    indices : list of int
+        Frame numbers (0-based, in offer order) of the keyframes so far.
+    conditions : KeyframeConditions or None
+        The last offered frame's conditions (None for the first frame, always a keyframe).
+
+    Examples
+    --------
+    >>> kf = np.random.default_rng(0).integers(0, 256, (10, 32), dtype=np.uint8)
+    >>> sel = KeyframeSelector(5, min_frame_gap=1)
+    >>> sel.offer(kf, [0.0, 0.0]), sel.offer(kf, [0.1, 0.0]), sel.offer(kf[:8], [0.2, 0.0])
+    (True, False, True)
+    >>> sel.conditions.fraction, sel.indices
+    (0.8, [0, 2])
+    """
+
+    def __init__(self, f_min: float, *, min_frame_gap: int = 10, shared_range=(0.70, 0.90), min_distance: float = 0.02,
+                 max_distance: float = ORB_MATCH_DISTANCE) -> None:
+        self.f_min = check_finite_scalar(f_min, "f_min")
+        self.min_frame_gap = check_int(min_frame_gap, "min_frame_gap", minimum=0)
+        rng = as_array(shared_range, "shared_range", shape=(2,))
+        if not 0 <= rng[0] < rng[1] <= 1:
+            raise ValueError(f"shared_range: expected 0 <= low < high <= 1, got {rng.tolist()}")
+        self.shared_range = (float(rng[0]), float(rng[1]))
+        self.min_distance = check_finite_scalar(min_distance, "min_distance")
+        if self.min_distance < 0:
+            raise ValueError(f"min_distance: expected a non-negative distance, got {self.min_distance}")
+        self.max_distance = check_finite_scalar(max_distance, "max_distance")
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every frame: the next one offered is a keyframe again."""
+        self.indices: list[int] = []
+        self.conditions: KeyframeConditions | None = None
+        self._n = 0
+        self._key_desc = None
+        self._key_pos = None
+
+    def check(self, descriptors, position) -> KeyframeConditions:
+        """Evaluate conditions (1)-(4) for a frame against the last keyframe, without recording it."""
+        if self._key_desc is None:
+            raise ValueError("check: no keyframe yet (offer the first frame, which is always one)")
+        d = as_binary_descriptors(descriptors, "descriptors")
+        p = _position(position)
+        fraction = shared_fraction(d, self._key_desc, max_distance=self.max_distance)
+        gap = self._n - self.indices[-1]
+        moved = float(np.hypot(*(p - self._key_pos)))
+        low, high = self.shared_range
+        return KeyframeConditions(len(d) > self.f_min, gap > self.min_frame_gap,       # (1), (2)
+                                  low < fraction < high, moved >= self.min_distance,   # (3), (4)
+                                  len(d), gap, fraction, moved)
+
+    def offer(self, descriptors, position) -> bool:
+        """Offer the next frame; returns whether it becomes a keyframe (the first always does).
+
+        Parameters
+        ----------
+        descriptors : array_like of uint8, shape (N, 32)
+            The frame's ORB descriptors (N may be 0).
+        position : array_like, shape (2,) or (3,)
+            The robot's position ``[x, y]`` or pose ``[x, y, theta]`` in metres.
+        """
+        if self._key_desc is None:
+            d = as_binary_descriptors(descriptors, "descriptors")
+            self._accept(d, _position(position))
+            return True
+        self.conditions = self.check(descriptors, position)
+        if self.conditions.all:
+            self._accept(as_binary_descriptors(descriptors, "descriptors"), _position(position))
+            return True
+        self._n += 1
+        return False
+
+    def _accept(self, d, p) -> None:
+        self.indices.append(self._n)
+        self._key_desc, self._key_pos = d, p
+        self._n += 1
+
+
+def _stream(descriptor_list, positions):
+    if not isinstance(descriptor_list, (list, tuple)):
+        raise TypeError(f"descriptor_list: expected a list of per-frame descriptor arrays, got {describe(descriptor_list)}")
+    frames = [as_binary_descriptors(d, f"descriptor_list[{i}]") for i, d in enumerate(descriptor_list)]
+    if positions is None:
+        return frames, None
+    p = as_array(positions, "positions", ndim=2)
+    if p.shape != (len(frames), p.shape[1]) or p.shape[1] not in (2, 3):
+        raise ValueError(f"positions: expected shape ({len(frames)}, 2) or ({len(frames)}, 3), got {p.shape}")
+    return frames, p
+
+
+def select_keyframes(descriptor_list, positions, f_min: float, **kw) -> np.ndarray:
+    """Indices of the keyframes Ge et al. (2023)'s conditions (1)-(4) pick from a run (Sec. 3.2).
+
+    Parameters
+    ----------
+    descriptor_list : list of array_like of uint8, shape (N_i, 32) each
+        Every frame's ORB descriptors, in time order.
+    positions : array_like, shape (n_frames, 2) or (n_frames, 3)
+        The robot's position (or pose) at each frame, metres.
+    f_min : float
+        Condition (1)'s threshold (:func:`feature_threshold`).
+    **kw
+        ``min_frame_gap``, ``shared_range``, ``min_distance``, ``max_distance`` of
+        :class:`KeyframeSelector`.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Frame indices, starting with 0 (the first frame is always a keyframe); empty for no frames.
+
+    Examples
+    --------
+    >>> kf = np.random.default_rng(0).integers(0, 256, (10, 32), dtype=np.uint8)
+    >>> frames = [kf, kf, kf[:8], kf[:8], kf[:7]]
+    >>> select_keyframes(frames, np.c_[np.arange(5) * 0.1, np.zeros(5)], 5, min_frame_gap=1).tolist()
+    [0, 2, 4]
+    """
+    frames, p = _stream(descriptor_list, positions)
+    if p is None:
+        raise TypeError("positions: expected an array of shape (n_frames, 2) or (n_frames, 3), got None")
+    selector = KeyframeSelector(f_min, **kw)
+    for d, x in zip(frames, p):
+        selector.offer(d, x)
+    return np.array(selector.indices, dtype=np.int64)
+
+
+def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: int = 20, min_tracked: int = 50,
+                             max_tracked_fraction: float = 0.90,
+                             max_distance: float = ORB_MATCH_DISTANCE) -> np.ndarray:
+    """Indices of the keyframes an ORB-SLAM-like rule picks (Mur-Artal et al. 2015, Sec. V-E).
+
+    Parameters
+    ----------
+    descriptor_list : list of array_like of uint8, shape (N_i, 32) each
+        Every frame's ORB descriptors, in time order.
+    positions : array_like, shape (n_frames, 2|3), optional
+        Accepted (and checked) so both rules take the same arguments; ORB-SLAM's rule does not
+        use the distance moved.
+    min_frame_gap : int, default 20
+        More than this many frames since the last keyframe insertion.
+    min_tracked : int, default 50
+        The frame tracks at least this many points (Hamming matches with the reference keyframe).
+    max_tracked_fraction : float, default 0.90
+        ... and fewer than this fraction of the reference keyframe's features.
+    max_distance : float, default 50
+        Hamming bound of a match.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Frame indices; frame 0 is the first keyframe (ORB-SLAM's map initialisation, which makes
+        its first keyframes from two views, is not modelled).
+
+    Examples
+    --------
+    >>> kf = np.random.default_rng(0).integers(0, 256, (100, 32), dtype=np.uint8)
+    >>> frames = [kf] * 3 + [kf[:80]] * 3
+    >>> select_keyframes_orbslam(frames, min_frame_gap=2).tolist()
+    [0, 3]
+    """
+    frames, _ = _stream(descriptor_list, positions)
+    min_frame_gap = check_int(min_frame_gap, "min_frame_gap", minimum=0)
+    min_tracked = check_int(min_tracked, "min_tracked", minimum=0)
+    top = check_finite_scalar(max_tracked_fraction, "max_tracked_fraction")
+    if not 0 < top <= 1:
+        raise ValueError(f"max_tracked_fraction: expected a value in (0, 1], got {top}")
+    max_distance = check_finite_scalar(max_distance, "max_distance")
+    if max_distance <= 0:
+        raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
+    keys: list[int] = []
+    for i, d in enumerate(frames):
+        if not keys:
+            keys.append(i)
+            continue
+        ref = frames[keys[-1]]
+        if i - keys[-1] <= min_frame_gap:
+            continue
+        tracked = _match_count(d, ref, max_distance) if len(d) and len(ref) else 0
+        if tracked >= min_tracked and tracked < top * len(ref):
+            keys.append(i)
+    return np.array(keys, dtype=np.int64)
