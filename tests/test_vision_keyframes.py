@@ -53,8 +53,9 @@ def test_each_condition_in_isolation():
     good = frame(80, 20)                                 # 100 features, 80 % shared
     # all four hold at frame 3 (gap 3 > 2): a keyframe
     assert run(KeyframeSelector(50, **base), [POOL[:100], good, good, good], far) == [True, False, False, True]
-    # (1) too few features: the same frames against f_min = 100 (a frame has 100, not more)
-    sel = KeyframeSelector(100, **base)
+    # (1) too few features: the same frames against f_min = 101 (a frame has 100); 100 is enough
+    assert run(KeyframeSelector(100, **base), [POOL[:100], good, good, good], far)[-1]
+    sel = KeyframeSelector(101, **base)
     assert run(sel, [POOL[:100], good, good, good], far) == [True, False, False, False]
     assert sel.conditions == sel.conditions._replace(features=False, frames=True, shared=True, moved=True)
     # (2) not enough frames since the last keyframe
@@ -116,3 +117,14 @@ def test_keyframes_on_a_rendered_corridor():
     assert select_keyframes(desc, np.c_[xs, 0 * xs], f_min, min_frame_gap=2).tolist() == [0]
     wide = select_keyframes(desc, np.c_[xs, 0 * xs], f_min, min_frame_gap=2, shared_range=(0.2, 0.9))
     assert wide.tolist() == [0, 3, 6, 9]
+
+
+def test_below_band_take_never_stalls_where_skip_does():
+    """A stream whose overlap with the last keyframe falls straight below the band's floor: the printed
+    condition (3) takes no keyframe after the first; below_band="take" keeps taking them."""
+    rng = np.random.default_rng(4)
+    frames = [rng.integers(0, 256, (60, 32), dtype=np.uint8) for _ in range(12)]   # unrelated frames: 0 shared
+    positions = np.c_[np.arange(12) * 0.1, np.zeros(12)]
+    assert select_keyframes(frames, positions, 10, min_frame_gap=1).tolist() == [0]
+    taken = select_keyframes(frames, positions, 10, min_frame_gap=1, below_band="take")
+    assert taken.tolist() == [0, 2, 4, 6, 8, 10]

@@ -39,7 +39,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..validation import as_array, check_finite_scalar, check_int, describe
+from ..validation import as_array, check_choice, check_finite_scalar, check_int, describe
 from .hamming import ORB_MATCH_DISTANCE, as_binary_descriptors, hamming_match, same_width
 
 __all__ = ["KeyframeConditions", "KeyframeSelector", "feature_threshold", "shared_fraction", "select_keyframes",
@@ -118,7 +118,7 @@ def shared_fraction(desc_current, desc_keyframe, *, max_distance: float = ORB_MA
 class KeyframeConditions(NamedTuple):
     """Ge et al. (2023)'s conditions (1)-(4) for one frame, and the measured quantities."""
 
-    features: bool        #: (1) feature count > F_min
+    features: bool        #: (1) feature count >= F_min
     frames: bool          #: (2) more than min_frame_gap frames since the last keyframe
     shared: bool          #: (3) shared fraction inside (low, high)
     moved: bool           #: (4) moved >= min_distance since the last keyframe
@@ -146,7 +146,9 @@ class KeyframeSelector:
     Parameters
     ----------
     f_min : float
-        Condition (1): a keyframe has more than ``f_min`` features (:func:`feature_threshold`).
+        Condition (1): a keyframe has at least ``f_min`` features (:func:`feature_threshold`). The
+        paper says the count must "exceed" the threshold; when every calibration frame reaches ORB's
+        feature cap, Eq. (15) gives the cap itself and a strict ``>`` would refuse every frame.
     min_frame_gap : int, default 10
         Condition (2): more than this many frames since the last keyframe.
     shared_range : (float, float), default (0.70, 0.90)
@@ -155,6 +157,11 @@ class KeyframeSelector:
         Condition (4): metres moved since the last keyframe, at least.
     max_distance : float, default 50
         Hamming bound of a match in :func:`shared_fraction`.
+    below_band : {"skip", "take"}, default "skip"
+        A frame sharing ``low`` or less: ``"skip"`` it, as condition (3) is printed (once no frame
+        shares more than ``low``, selection stalls for good), or ``"take"`` it when (1), (2) and (4)
+        hold (ours: the band's floor is where the frame rate should catch the overlap; a camera too
+        slow for that still gets keyframes, like ORB-SLAM inserting one when tracking weakens).
 
     Attributes
     ----------
@@ -171,10 +178,15 @@ class KeyframeSelector:
     (True, False, True)
     >>> sel.conditions.fraction, sel.indices
     (0.8, [0, 2])
+    >>> for rule in ("skip", "take"):                  # a frame sharing 60 %, below the band
+    ...     sel = KeyframeSelector(5, min_frame_gap=0, below_band=rule)
+    ...     print(rule, sel.offer(kf, [0.0, 0.0]), sel.offer(kf[:6], [0.1, 0.0]))
+    skip True False
+    take True True
     """
 
     def __init__(self, f_min: float, *, min_frame_gap: int = 10, shared_range=(0.70, 0.90), min_distance: float = 0.02,
-                 max_distance: float = ORB_MATCH_DISTANCE) -> None:
+                 max_distance: float = ORB_MATCH_DISTANCE, below_band: str = "skip") -> None:
         self.f_min = check_finite_scalar(f_min, "f_min")
         self.min_frame_gap = check_int(min_frame_gap, "min_frame_gap", minimum=0)
         rng = as_array(shared_range, "shared_range", shape=(2,))
@@ -185,6 +197,7 @@ class KeyframeSelector:
         if self.min_distance < 0:
             raise ValueError(f"min_distance: expected a non-negative distance, got {self.min_distance}")
         self.max_distance = check_finite_scalar(max_distance, "max_distance")
+        self.below_band = check_choice(below_band, "below_band", ("skip", "take"))
         self.reset()
 
     def reset(self) -> None:
@@ -205,7 +218,8 @@ class KeyframeSelector:
         gap = self._n - self.indices[-1]
         moved = float(np.hypot(*(p - self._key_pos)))
         low, high = self.shared_range
-        return KeyframeConditions(len(d) > self.f_min, gap > self.min_frame_gap,       # (1), (2)
+        low = -1.0 if self.below_band == "take" else low
+        return KeyframeConditions(len(d) >= self.f_min, gap > self.min_frame_gap,      # (1), (2)
                                   low < fraction < high, moved >= self.min_distance,   # (3), (4)
                                   len(d), gap, fraction, moved)
 
@@ -260,7 +274,7 @@ def select_keyframes(descriptor_list, positions, f_min: float, **kw) -> np.ndarr
     f_min : float
         Condition (1)'s threshold (:func:`feature_threshold`).
     **kw
-        ``min_frame_gap``, ``shared_range``, ``min_distance``, ``max_distance`` of
+        ``min_frame_gap``, ``shared_range``, ``min_distance``, ``max_distance``, ``below_band`` of
         :class:`KeyframeSelector`.
 
     Returns
