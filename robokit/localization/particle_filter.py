@@ -41,8 +41,8 @@ from scipy.special import logsumexp
 from scipy.stats import norm
 
 from ..geometry import wrap_angle
-from ..validation import (as_array, as_points, as_rng, check_callable, check_finite_result, check_int, check_positive,
-                          check_sample_count, describe)
+from ..validation import (as_array, as_points, as_rng, check_callable, check_finite_result, check_finite_scalar,
+                          check_int, check_positive, check_sample_count, describe)
 
 __all__ = ["NormalisedWeights", "normalise_log_weights", "low_variance_resample", "kld_sample_count",
            "kld_resample", "pose_bins", "weighted_pose_mean", "sample_ellipse_poses", "ellipse_weights",
@@ -133,7 +133,8 @@ def _weights(weights: Any, name: str = "weights") -> np.ndarray:
     return w / total
 
 
-def low_variance_resample(weights: Any, rng: Any = None, count: int | None = None) -> np.ndarray:
+def low_variance_resample(weights: Any, rng: Any = None, count: int | None = None, *, start: float | None = None
+                          ) -> np.ndarray:
     """Indices of the particles drawn by the low-variance (systematic) sampler.
 
     Parameters
@@ -143,6 +144,9 @@ def low_variance_resample(weights: Any, rng: Any = None, count: int | None = Non
     rng : Generator or int, optional
     count : int, optional
         Number of draws ``M`` (default ``N``).
+    start : float, optional
+        The one random number ``r`` of Table 4.4, in ``[0, 1/M)``; default drawn from ``rng`` (give
+        it to replay a draw, as the lesson's exercise does).
 
     Returns
     -------
@@ -165,11 +169,18 @@ def low_variance_resample(weights: Any, rng: Any = None, count: int | None = Non
     --------
     >>> low_variance_resample([0.5, 0.25, 0.25], rng=0, count=4).tolist()
     [0, 0, 1, 2]
+    >>> low_variance_resample([0.5, 0.25, 0.25], start=0.3).tolist()
+    [0, 1, 2]
     """
     w = _weights(weights)
     m = w.size if count is None else check_int(count, "count", minimum=1)
     check_sample_count(m, "count")
-    r = as_rng(rng).uniform(0.0, 1.0 / m)                          # Table 4.4, line 3
+    if start is None:
+        r = as_rng(rng).uniform(0.0, 1.0 / m)                      # Table 4.4, line 3
+    else:
+        r = check_finite_scalar(start, "start")
+        if not 0.0 <= r < 1.0 / m:
+            raise ValueError(f"start: expected r in [0, 1/M) = [0, {1.0 / m:.6g}), got {r}")
     pointers = r + np.arange(m) / m                                 # line 6
     cumulative = np.cumsum(w)
     cumulative /= cumulative[-1]
