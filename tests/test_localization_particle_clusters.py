@@ -1,0 +1,67 @@
+"""Clusters of a particle cloud (ROS amcl's pf_cluster_stats), against a brute-force labelling."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robokit.localization import ROS_KLD_BIN_SIZE, largest_cluster_share, pose_clusters
+
+
+def brute_force_clusters(particles, size):
+    """Particles are joined when their cells differ by at most one in x, y and (cyclically) heading."""
+    cells = np.floor(np.asarray(particles) / size).astype(int)
+    n_heading = int(np.ceil(2 * np.pi / size[2]))
+    cells[:, 2] %= n_heading
+    parent = list(range(len(cells)))
+
+    def find(i):
+        while parent[i] != i:
+            i = parent[i]
+        return i
+
+    for i in range(len(cells)):
+        for j in range(i):
+            dh = abs(cells[i, 2] - cells[j, 2])
+            if abs(cells[i, 0] - cells[j, 0]) <= 1 and abs(cells[i, 1] - cells[j, 1]) <= 1 and \
+                    min(dh, n_heading - dh) <= 1:
+                parent[find(i)] = find(j)
+    roots = [find(i) for i in range(len(cells))]
+    first = {}
+    return np.array([first.setdefault(r, len(first)) for r in roots])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_labels_equal_a_brute_force_union_of_touching_cells(seed):
+    rng = np.random.default_rng(seed)
+    centres = rng.uniform([0, -1, -np.pi], [20, 1, np.pi], (4, 3))
+    cloud = np.vstack([c + rng.normal(0, [0.4, 0.2, 0.15], (40, 3)) for c in centres])
+    cloud[:, 2] = np.angle(np.exp(1j * cloud[:, 2]))
+    got = pose_clusters(cloud)
+    assert got.tolist() == brute_force_clusters(cloud, np.array(ROS_KLD_BIN_SIZE)).tolist()
+
+
+def test_share_counts_particles_or_weights_and_one_cluster_is_one():
+    line = np.column_stack([np.arange(0, 3, 0.3), np.zeros(10), np.zeros(10)])     # touching cells
+    assert largest_cluster_share(line) == 1.0
+    cloud = np.vstack([line, [[10.0, 0.0, 0.0]]])
+    assert largest_cluster_share(cloud) == pytest.approx(10 / 11)
+    weights = np.r_[np.full(10, 0.01), 0.9]
+    assert largest_cluster_share(cloud, weights) == pytest.approx(0.9)
+
+
+def test_a_gap_of_one_empty_cell_splits_and_heading_wraps():
+    assert pose_clusters([[0.1, 0.1, 0.0], [1.1, 0.1, 0.0]]).tolist() == [0, 1]          # cells 0 and 2
+    assert pose_clusters([[0.1, 0.1, np.pi - 0.01], [0.1, 0.1, -np.pi + 0.01]]).tolist() == [0, 0]
+
+
+@pytest.mark.parametrize("bad", [np.zeros((0, 3)), [[0.0, np.nan, 0.0]], [[0.0, 0.0]]])
+def test_bad_particles_raise(bad):
+    with pytest.raises(ValueError, match="particles"):
+        pose_clusters(bad)
+
+
+def test_bad_weights_raise():
+    with pytest.raises(ValueError, match="weights"):
+        largest_cluster_share([[0.0, 0.0, 0.0]], [0.0])
+    with pytest.raises(ValueError, match="weights"):
+        largest_cluster_share([[0.0, 0.0, 0.0], [1.0, 0, 0]], [1.0])
