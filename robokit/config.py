@@ -167,7 +167,7 @@ def cache_key(**params: object) -> str:
 
 @functools.lru_cache(maxsize=None)
 def source_digest(*packages: str) -> str:
-    """A short hash of the source of robokit's ``packages`` (e.g. ``"sim", "geometry"``).
+    """A short hash of the source of robokit's ``packages`` (e.g. ``"sim", "geometry"``) or single modules.
 
     A cached dataset is keyed by it as well as by its parameters, so a change to the code that
     makes the dataset never serves an old one (DESIGN.md, "Caching").
@@ -175,7 +175,8 @@ def source_digest(*packages: str) -> str:
     Parameters
     ----------
     *packages : str
-        Sub-package names of robokit (at least one).
+        Sub-package names of robokit (at least one), or ``"package.module"`` for one module (an
+        experiment keys its cache by its own module, not by every module beside it).
 
     Returns
     -------
@@ -195,16 +196,25 @@ def source_digest(*packages: str) -> str:
     --------
     >>> len(source_digest("geometry")), source_digest("geometry") == source_digest("geometry", "sim")
     (16, False)
+    >>> source_digest("geometry.planar") == source_digest("geometry")
+    False
     """
     root = Path(__file__).resolve().parent
     if not packages:
         raise ValueError("packages: expected at least one robokit sub-package name, got none")
     digest = hashlib.sha256()
     for package in packages:
-        if not isinstance(package, str) or not package.isidentifier() or not (root / package).is_dir():
-            raise ValueError(f"packages: expected robokit sub-package names, got {package!r}")
-        for source in sorted((root / package).glob("*.py")):
-            digest.update(package.encode() + b"/" + source.name.encode() + b"\0" + source.read_bytes())
+        parts = package.split(".") if isinstance(package, str) else [None]
+        if not 1 <= len(parts) <= 2 or not all(isinstance(p, str) and p.isidentifier() for p in parts):
+            raise ValueError(f"packages: expected robokit sub-package or module names, got {package!r}")
+        if len(parts) == 2 and (root / parts[0] / f"{parts[1]}.py").is_file():
+            sources = [root / parts[0] / f"{parts[1]}.py"]
+        elif len(parts) == 1 and (root / package).is_dir():
+            sources = sorted((root / package).glob("*.py"))
+        else:
+            raise ValueError(f"packages: expected robokit sub-package or module names, got {package!r}")
+        for source in sources:
+            digest.update(parts[0].encode() + b"/" + source.name.encode() + b"\0" + source.read_bytes())
     return digest.hexdigest()[:16]
 
 
