@@ -369,6 +369,27 @@ def bow_vocabulary():
     return Vocabulary.train([orb_descriptors(40, i) for i in range(4)], branching=3, levels=2, rng=0)
 
 
+@functools.cache
+def corridor_setup():   # lesson 03's fast corridor map (cached on disk after the first build)
+    from robokit.navigation.corridor_experiment import corridor_map
+    return corridor_map(fast=True)
+
+
+@functools.cache
+def corridor_calibration():
+    from robokit.navigation.corridor_experiment import calibration_run
+    return calibration_run(fast=True)
+
+
+def snapshot_scene():
+    from robokit.viz import Scene
+    return Scene().add_box("a", size=(1, 1, 1)).add_box("b", size=(1, 1, 1)).add_box("robot", size=(1, 1, 1))
+
+
+def distance_grid():   # lesson 03's exercise: distance to a wall at x = 1.55 m on a 20 x 20 grid of 0.1 m
+    return np.abs(np.arange(20)[None, :] * 0.1 + 0.05 - 1.55) * np.ones((20, 1))
+
+
 SPECS: dict[str, Call] = {
     # --- about, geometry --------------------------------------------------------------------
     "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
@@ -615,9 +636,9 @@ SPECS: dict[str, Call] = {
                                                 "color": Given(0x22AA22), "every": Int(0)}),
     "robokit.viz.scene3d.add_world": Call({"scene": Obj(scene), "world": Obj(lab), "path": Text("world"), "cell": Int(8),
                                            "ceiling": Flag(False)}, cheap=False),
-    "robokit.viz.scene3d.animate_poses": Call({"scene": Obj(scene), "path": Text("truck"),
-                                               "transforms": Array(lambda: lap().poses[:5], "N,3|N,4,4"), "fps": Real(10.0),
-                                               "repetitions": Int(1)}),
+    "robokit.viz.animation.animate_poses": Call({"scene": Obj(scene), "path": Text("truck"),
+                                                 "transforms": Array(lambda: lap().poses[:5], "N,3|N,4,4"),
+                                                 "fps": Real(10.0), "repetitions": Int(1)}),
     "robokit.viz.scene3d.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3")}),
     # --- lesson 02: the assignment's plain-data references, the experiments, graphs and sliders ---
     "robokit.exercises.omni_localization.fine_stage_counts": Call({
@@ -1016,6 +1037,69 @@ SPECS: dict[str, Call] = {
         "descriptors": Obj(lambda: [orb_descriptors(30, 0), orb_descriptors(30, 1)]), "branching": Int(3),
         "levels": Int(2), "iterations": Int(5), "rng": Rng(0)}),
     "robokit.vision.bow_database.BowDatabase": Call({"vocabulary": Obj(bow_vocabulary)}),
+    # --- lesson 03: the assignment's plain-data references, the experiments, clusters, animation ---
+    "robokit.exercises.corridor_localization.cell_log_odds": Call({
+        "probabilities": Array(np.array([0.7, 0.7, 0.4]), "N", min_rows=0), "prior": Real(0.5)}),
+    "robokit.exercises.corridor_localization.bow_similarity": Call({
+        "words_a": Array(np.array([0, 1, 1]), "N", min_rows=0), "words_b": Array(np.array([1, 2]), "N", min_rows=0),
+        "idf": Array(np.array([1.0, 1.0, 1.0]), "N")}),
+    "robokit.exercises.corridor_localization.likelihood_field_weight": Call({
+        "pose": Array(np.array([0.55, 1.0, 0.0]), "3"), "ranges": Array(np.array([1.0, 0.8]), "N", inf_ok=True),
+        "angles": Array(np.array([0.0, 1.5]), "N"), "distance": Array(distance_grid, "N,N"), "resolution": Real(0.1),
+        "origin": Array(np.array([0.0, 0.0]), "2"), "sigma_hit": Real(0.2), "z_hit": Real(0.95), "z_rand": Real(0.05),
+        "r_max": Real(8.0), "max_distance": Real(2.0)}),
+    "robokit.exercises.corridor_localization.resample_indices": Call({
+        "weights": Array(np.array([0.1, 0.6, 0.3]), "N"), "r": Real(0.2)}),
+    "robokit.exercises.corridor_localization.ellipse_start_weights": Call({
+        "points": Array(np.array([[0.0, 0.0], [1.0, 0.0]]), "N,2"), "centre": Array(np.array([0.0, 0.0]), "2"),
+        "sigma_x": Real(1.0), "sigma_y": Real(1.0)}),
+    "robokit.exercises.corridor_localization.recognise_keyframe": Call({
+        "query": Array(lambda: orb_descriptors(40, 2)[:10], "N,32"),
+        "keyframes": Obj(lambda: [orb_descriptors(40, 1), orb_descriptors(40, 2)])}),
+    "robokit.localization.particle_clusters.pose_clusters": Call({
+        "particles": Array(np.array([[0.1, 0.1, 0.0], [0.6, 0.1, 0.0], [5.0, 0.0, 0.0]]), "N,3"),
+        "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3")}),
+    "robokit.localization.particle_clusters.largest_cluster_share": Call({
+        "particles": Array(np.array([[0.1, 0.1, 0.0], [0.6, 0.1, 0.0], [5.0, 0.0, 0.0]]), "N,3"),
+        "weights": Array(np.array([0.1, 0.1, 0.8]), "N", optional=True),
+        "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3")}),
+    "robokit.navigation.corridor_aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),
+    "robokit.navigation.corridor_experiment.corridor_lidar": Call({}),
+    "robokit.navigation.corridor_experiment.corridor_camera": Call({"fast": Flag(True, optional=True)}),
+    "robokit.navigation.corridor_experiment.calibration_run": Call({
+        "fast": Flag(True, optional=True), "start": Real(12.0), "length": Real(10.0), "speed": Real(0.2),
+        "frame_rate": Real(30.0), "progress": Func(None, optional=True)}, cheap=False),
+    "robokit.navigation.corridor_experiment.keyframe_comparison": Call({
+        "run": Obj(corridor_calibration), "min_frame_gap": Int(10), "shared_range": Array(np.array([0.7, 0.9]), "2"),
+        "below_band": Choice("take")}, cheap=False),
+    "robokit.navigation.corridor_experiment.corridor_map": Call({
+        "fast": Flag(True, optional=True), "resolution": Real(0.05), "progress": Func(None, optional=True)},
+        cheap=False),
+    "robokit.navigation.corridor_trials.retrieve_pose": Call({
+        "setup": Obj(corridor_setup), "pose": Array(np.array([10.0, 0.0, 0.0]), "3"), "rng": Rng(0)}, cheap=False),
+    "robokit.navigation.corridor_trials.localization_trial": Call({
+        "setup": Obj(corridor_setup), "start": Array(np.array([12.0, 0.3, 0.4]), "3"), "method": Choice("ours"),
+        "rng": Rng(1), "max_distance": Real(3.0), "share": Real(0.95), "sigma_x": Real(0.3), "sigma_y": Real(0.1),
+        "settle": Int(1), "keep_particles": Flag(False)}, cheap=False),
+    "robokit.navigation.corridor_trials.localization_trials": Call({
+        "setup": Obj(corridor_setup), "method": Choice("ours"), "trials": Int(1, optional=True),
+        "positions": Given([0]), "seed": Int(0), "max_distance": Real(3.0), "cache": Flag(False),
+        "progress": Func(None, optional=True)}, cheap=False),
+    "robokit.navigation.corridor_trials.kidnapping": Call({
+        "setup": Obj(corridor_setup), "origin": Int(0), "destination": Int(2), "period": Real(5.0), "after": Real(3.0),
+        "kidnap_distance": Real(1.0), "seed": Int(0)}, cheap=False),
+    "robokit.viz.animation.animate_snapshots": Call({
+        "scene": Obj(snapshot_scene), "paths": Given(["a", "b"]), "fps": Real(4.0), "repetitions": Int(1),
+        "moving": Text("robot", optional=True),
+        "transforms": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]), "N,3|N,4,4", optional=True)}),
+    "robokit.viz.maps.plot_occupancy": Call({
+        "grid": Array(np.array([[0.0, 1.0], [0.5, 0.2]]), "N,N"), "origin": Array(np.array([0.0, 0.0]), "2"),
+        "resolution": Real(0.5), "ax": Given(axes), "cmap": Text("gray_r"), "colorbar": Flag(False)}),
+    "robokit.viz.scene3d.add_particles": Call({
+        "scene": Obj(scene), "path": Text("cloud"),
+        "particles": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.5]]), "N,3"),
+        "weights": Array(np.array([0.5, 0.5]), "N", optional=True), "z": Real(0.03), "arrow": Real(0.15),
+        "color": Given(0xAA2288)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.

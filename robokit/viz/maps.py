@@ -229,7 +229,8 @@ def plot_occupancy(grid: Any, origin: Any, resolution: float, ax: Any = None, cm
     Parameters
     ----------
     grid : array_like (rows, cols)
-        Probabilities in [0, 1] (NaN = unknown, drawn light blue) or booleans.
+        Probabilities in [0, 1] (e.g. :attr:`robokit.mapping.OccupancyGrid.probability`, where an
+        unknown cell is 0.5).
     origin : array_like (2,)
         World (x, y) of the lower-left corner of cell (0, 0).
     resolution : float
@@ -243,20 +244,27 @@ def plot_occupancy(grid: Any, origin: Any, resolution: float, ax: Any = None, cm
     -----
     Occupancy grid maps: Thrun, Burgard & Fox (2005), Ch. 9; row 0 is drawn at the bottom
     (``origin="lower"``) so the map is not upside down.
+
+    Examples
+    --------
+    >>> from robokit.viz import plot_occupancy
+    >>> ax = plot_occupancy([[0.0, 1.0, 0.5], [0.2, 0.9, 0.5]], (-1.0, 0.0), 0.5, colorbar=False)
+    >>> [float(e) for e in ax.images[0].get_extent()]      # x from -1 m, 3 cells of 0.5 m; y 2 rows
+    [-1.0, 0.5, 0.0, 1.0]
     """
     import matplotlib as mpl
 
-    G = np.asarray(grid, float)
-    if G.ndim != 2:
-        raise ValueError(f"grid: expected a 2-D array, got shape {G.shape}")
-    if np.any((G[np.isfinite(G)] < 0) | (G[np.isfinite(G)] > 1)):
-        raise ValueError("grid: expected probabilities in [0, 1]")
+    G = as_array(grid, "grid", ndim=2, min_size=1)
+    if np.any((G < 0) | (G > 1)):
+        raise ValueError(f"grid: expected probabilities in [0, 1], got values in [{G.min():.3g}, {G.max():.3g}]")
     o = as_array(origin, "origin", shape=(2,))
     r = check_positive(resolution, "resolution")
     ax = map_axes(ax)
-    cm = mpl.colormaps[cmap].with_extremes(bad="#cfe3f5")
+    if not isinstance(cmap, str) or cmap not in mpl.colormaps:
+        raise ValueError(f"cmap: expected a matplotlib colormap name, got {cmap!r}")
+    cm = mpl.colormaps[cmap]
     extent = (o[0], o[0] + G.shape[1] * r, o[1], o[1] + G.shape[0] * r)
-    im = ax.imshow(np.ma.masked_invalid(G), origin="lower", extent=extent, cmap=cm, vmin=0, vmax=1,
+    im = ax.imshow(G, origin="lower", extent=extent, cmap=cm, vmin=0, vmax=1,
                    interpolation="nearest")
     if colorbar:
         ax.figure.colorbar(im, ax=ax, label="P(occupied)")

@@ -19,7 +19,7 @@ from .maps import check_graph
 from .scene import Scene, as_color, check_scene
 
 __all__ = ["add_world", "add_camera", "add_trajectory", "add_graph", "add_image", "add_particles", "add_landmarks",
-           "animate_poses", "look_from"]
+           "look_from"]
 
 
 def _textured_mesh(vertices: np.ndarray, faces: np.ndarray, uvs: np.ndarray):
@@ -307,6 +307,12 @@ def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, 
     Notes
     -----
     The usual display of Monte Carlo localization (Thrun et al. 2005, Sec. 8.3, Fig. 8.11).
+
+    Examples
+    --------
+    >>> from robokit.viz import Scene, add_particles
+    >>> add_particles(Scene(), "cloud", [[0.0, 0.0, 0.0], [1.0, 0.5, 1.5]], weights=[0.2, 0.8])
+    Scene(title='robokit scene', commands=2)
     """
     check_scene(scene, path)
     P = as_points(particles, "particles", 3, min_count=1)
@@ -318,7 +324,7 @@ def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, 
             raise ValueError("weights: expected non-negative weights with a positive sum")
         w = w / w.max()
     L = check_positive(arrow, "arrow") * (0.3 + 0.7 * w)
-    base = np.column_stack([P[:, :2], np.full(len(P), z)])
+    base = np.column_stack([P[:, :2], np.full(len(P), check_finite_scalar(z, "z"))])
     tip = base + np.column_stack([L * np.cos(P[:, 2]), L * np.sin(P[:, 2]), np.zeros(len(P))])
     scene.add_points(f"{path}/points", base, size=0.04, color=color)
     return _segments(scene, f"{path}/headings", np.stack([base, tip], axis=1).reshape(-1, 3), color)
@@ -385,51 +391,6 @@ def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None,
         scene.set_object(f"{path}/ellipsoid{k}", Ellipsoid(radii.tolist()),
                          MeshLambertMaterial(color=0xFFAA00, opacity=0.35, transparent=True))
         scene.set_transform(f"{path}/ellipsoid{k}", T)
-    return scene
-
-
-def animate_poses(scene: Scene, path: str, transforms: Any, fps: float = 10.0, repetitions: int = 1) -> Scene:
-    """Animate the object at ``path`` through a sequence of 4x4 poses (meshcat animation).
-
-    Parameters
-    ----------
-    transforms : array_like (N, 4, 4) or (N, 3)
-        Poses per frame; planar ``[x, y, theta]`` rows are lifted with :func:`robokit.geometry.se2_to_se3`.
-    fps : float, default 10
-        Frames per second of playback.
-    repetitions : int, default 1
-
-    Notes
-    -----
-    meshcat's ``set_animation`` command (three.js AnimationClip keyframe tracks).
-
-    Examples
-    --------
-    >>> from robokit.viz import Scene, animate_poses
-    >>> scene = Scene().add_box("robot", size=(0.5, 0.25, 0.15))
-    >>> animate_poses(scene, "robot", [[0.0, 0.0, 0.0], [1.0, 0.0, 0.5], [2.0, 1.0, 1.0]], fps=2)
-    Scene(title='robokit scene', commands=3)
-    """
-    check_scene(scene, path)
-    from meshcat.animation import AnimationClip, js_position, js_quaternion
-    from meshcat.commands import SetAnimation
-
-    T = as_array(transforms, "transforms")
-    if T.ndim == 2 and T.shape[1] == 3:
-        T = np.stack([se2_to_se3(p) for p in T])
-    T = as_array(T, "transforms", shape=(None, 4, 4))
-    if len(T) < 2:
-        raise ValueError(f"transforms: expected at least 2 poses, got {len(T)}")
-    clip = AnimationClip(fps=check_positive(fps, "fps"))
-    for k, M in enumerate(T):
-        clip.set_property(k, "position", "vector3", js_position(M))
-        clip.set_property(k, "quaternion", "quaternion", js_quaternion(M))
-
-    class _Animation:  # meshcat's Animation keyed by our own path object
-        def lower(self):
-            return [{"path": Scene.meshcat_path(path).lower(), "clip": clip.lower()}]
-
-    scene.send(SetAnimation(_Animation(), play=True, repetitions=check_int(repetitions, "repetitions", minimum=1)))
     return scene
 
 
