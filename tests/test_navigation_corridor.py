@@ -1,0 +1,65 @@
+"""Lesson 03's experiments on the fast corridor map: the hybrid map, a run of each method, a kidnapping."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robokit.navigation import corridor_experiment as experiment, corridor_trials as trials
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return experiment.corridor_map(fast=True)
+
+
+def test_the_hybrid_map_geo_tags_every_keyframe_where_it_was_taken(setup):
+    assert setup.n_keyframes == len(setup.database) > 20
+    assert np.abs(setup.keyframe_poses - setup.keyframe_truth).max() < 1e-9     # constant speed: exact
+    assert np.all(np.diff(setup.keyframe_poses[:, 0]) > 0)
+    walls = setup.grid.occupied_mask()
+    _, inside = setup.grid.cell_of([[10.0, 0.0]])
+    assert inside.all() and walls.any() and setup.grid.free_mask().sum() > walls.sum()
+
+
+def test_retrieval_finds_the_place_facing_the_way_the_map_was_recorded(setup):
+    found = [trials.retrieve_pose(setup, [x, 0.0, 0.0], rng=2)[0] for x in (4.0, 9.0, 14.0, 19.0)]
+    assert all(p is not None and abs(p[0] - x) < 0.5 for p, x in zip(found, (4.0, 9.0, 14.0, 19.0)))
+
+
+def test_ours_starts_near_the_truth_and_converges_at_once(setup):
+    run = trials.localization_trial(setup, trials.START_POSES[2], "ours", rng=3)
+    assert run.converged and run.iterations <= 3
+    assert run.retrieval_error < 0.5 and run.error[0] < 0.5 and run.error[1] < np.deg2rad(5)
+    assert run.distance < 2.0               # the moving strategy and a few updates
+
+
+def test_amcl_spreads_over_the_whole_map_and_moves_much_further(setup):
+    run = trials.localization_trial(setup, trials.START_POSES[2], "amcl", rng=3, keep_particles=True)
+    start = run.particles[0]
+    assert len(start) == trials.PARTICLES["amcl"] and np.ptp(start[:, 0]) > 30.0
+    assert not run.converged or run.distance > 2.0
+
+
+def test_trial_sets_judge_on_the_paper_criterion(setup):
+    runs = trials.localization_trials(setup, "ours", trials=1, positions=[0, 1], cache=False)
+    assert runs.positions.tolist() == [0, 1] and runs.error.shape == (2, 2)
+    loose = runs.success((10.0, np.pi))
+    assert loose.tolist() == runs.converged.tolist()
+    assert (runs.success() <= loose).all()
+
+
+def test_kidnapping_ours_recovers_amcl_does_not(setup):
+    kid = trials.kidnapping(setup, origin=0, destination=2, after=8.0)
+    assert kid.jump == pytest.approx(trials.START_POSES[2][0] - trials.START_POSES[0][0])
+    late = kid.times > 6.0
+    assert np.abs(kid.errors["amcl"][late]).min() > kid.jump - 1.0
+    assert np.abs(kid.errors["ours"][late]).max() < 0.5
+    assert any(t >= 0 for t in kid.reinitialised)
+
+
+@pytest.mark.parametrize("bad, match", [(dict(method="both"), "method"), (dict(share=1.5), "share"),
+                                        (dict(start=[50.0, 0.0, 0.0]), "start")])
+def test_bad_trial_input_is_named(setup, bad, match):
+    kw = dict(start=trials.START_POSES[0], method="ours") | bad
+    with pytest.raises((ValueError, TypeError), match=match):
+        trials.localization_trial(setup, kw.pop("start"), kw.pop("method"), **kw)
