@@ -395,13 +395,29 @@ class LikelihoodField:
                 raise ValueError(f"xy: expected shape (..., 2), got shape {pts.shape}")
         else:
             pts = np.asarray(xy, dtype=float)
-        h, w = self.distance.shape
-        fx = np.floor((pts[..., 0] - self.origin[0]) / self.resolution)
-        fy = np.floor((pts[..., 1] - self.origin[1]) / self.resolution)
-        inside = (fx >= 0) & (fx < w) & (fy >= 0) & (fy < h)      # NaN compares False: off the map
-        out = np.full(pts.shape[:-1], self.max_distance)
-        out[inside] = self.distance[fy[inside].astype(np.intp), fx[inside].astype(np.intp)]
-        return out
+        # The table framed by one ring of max_distance cells: index 0 and W + 1 (H + 1) are "off the map",
+        # so every point needs one clip instead of four comparisons and a masked copy. Cell j of the
+        # table is column j + 1; truncating u + 1 (u = the point's column coordinate) is floor(u) + 1
+        # for u >= -1, and anything further out (negative, NaN or inf casts) clips to the frame.
+        framed = self._framed()
+        h, w = framed.shape
+        inv = 1.0 / self.resolution
+        with np.errstate(invalid="ignore"):
+            ix = ((pts[..., 0] - self.origin[0]) * inv + 1.0).astype(np.intp)
+            iy = ((pts[..., 1] - self.origin[1]) * inv + 1.0).astype(np.intp)
+        np.clip(ix, 0, w - 1, out=ix)
+        np.clip(iy, 0, h - 1, out=iy)
+        iy *= w
+        iy += ix
+        return framed.ravel().take(iy)
+
+    def _framed(self) -> np.ndarray:
+        cached = self.__dict__.get("_framed_table")
+        if cached is None or cached[0] is not self.distance:
+            table = np.pad(np.asarray(self.distance, float), 1, constant_values=self.max_distance)
+            cached = (self.distance, table)
+            self.__dict__["_framed_table"] = cached
+        return cached[1]
 
 
 def likelihood_field(grid: OccupancyGrid, *, occupied_threshold: float = OCCUPIED_THRESHOLD,
