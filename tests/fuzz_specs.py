@@ -1063,6 +1063,12 @@ SPECS: dict[str, Call] = {
         "particles": Array(np.array([[0.1, 0.1, 0.0], [0.6, 0.1, 0.0], [5.0, 0.0, 0.0]]), "N,3"),
         "weights": Array(np.array([0.1, 0.1, 0.8]), "N", optional=True),
         "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3")}),
+    "robokit.localization.particle_clusters.largest_cluster_mean": Call({
+        "particles": Array(np.array([[10.0, 0.0, 0.0], [10.2, 0.0, 0.0], [30.0, 0.0, 0.0]]), "N,3"),
+        "weights": Array(np.array([0.4, 0.4, 0.2]), "N", optional=True),
+        "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3")}),
+    "robokit.navigation.corridor_trials.corridor_localizer": Call({
+        "setup": Obj(corridor_setup), "method": Choice("ours"), "rng": Rng(0)}, cheap=False),
     "robokit.navigation.corridor_aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),
     "robokit.navigation.corridor_experiment.corridor_lidar": Call({}),
     "robokit.navigation.corridor_experiment.corridor_camera": Call({"fast": Flag(True, optional=True)}),
@@ -1085,7 +1091,7 @@ SPECS: dict[str, Call] = {
         "setup": Obj(corridor_setup), "method": Choice("ours"), "trials": Int(1, optional=True),
         "positions": Given([0]), "seed": Int(0), "max_distance": Real(3.0), "cache": Flag(False),
         "progress": Func(None, optional=True)}, cheap=False),
-    "robokit.navigation.corridor_trials.kidnapping": Call({
+    "robokit.navigation.corridor_kidnapping.kidnapping": Call({
         "setup": Obj(corridor_setup), "origin": Int(0), "destination": Int(2), "period": Real(5.0), "after": Real(3.0),
         "kidnap_distance": Real(1.0), "seed": Int(0)}, cheap=False),
     "robokit.viz.animation.animate_snapshots": Call({

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robokit.localization import ROS_KLD_BIN_SIZE, largest_cluster_share, pose_clusters
+from robokit.localization import ROS_KLD_BIN_SIZE, largest_cluster_mean, largest_cluster_share, pose_clusters
 
 
 def brute_force_clusters(particles, size):
@@ -65,3 +65,15 @@ def test_bad_weights_raise():
         largest_cluster_share([[0.0, 0.0, 0.0]], [0.0])
     with pytest.raises(ValueError, match="weights"):
         largest_cluster_share([[0.0, 0.0, 0.0], [1.0, 0, 0]], [1.0])
+
+
+def test_largest_cluster_mean_ignores_strays_and_follows_the_weight():
+    rng = np.random.default_rng(5)
+    main = np.column_stack([rng.normal(10.0, 0.1, 95), rng.normal(0.0, 0.05, 95), rng.normal(0.0, 0.02, 95)])
+    strays = np.column_stack([rng.uniform(25, 30, 5), np.zeros(5), np.zeros(5)])
+    cloud = np.vstack([main, strays])
+    mean = largest_cluster_mean(cloud)
+    assert np.allclose(mean[:2], main[:, :2].mean(axis=0), atol=1e-12)
+    assert abs(cloud[:, 0].mean() - 10.0) > 0.5                 # the plain mean is pulled away
+    heavy = np.r_[np.full(95, 1e-3), np.full(5, 1.0)]           # the strays carry the weight: pick them
+    assert largest_cluster_mean(cloud, heavy)[0] > 20.0

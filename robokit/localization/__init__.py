@@ -26,7 +26,7 @@ from .beam_models import (COMBINE_RULES, likelihood_field_log_weight_reference, 
                           subsample_beams, valid_beams)
 from .mcl import AMCL_DEFAULTS, KLDConfig, MonteCarloLocalizer
 from .mcl_step import MCLStep, mcl_step, uniform_free_poses
-from .particle_clusters import largest_cluster_share, pose_clusters
+from .particle_clusters import largest_cluster_mean, largest_cluster_share, pose_clusters
 from .particle_filter import (KLD_Z_99, ROS_KLD_BIN_SIZE, NormalisedWeights, ellipse_weights, kld_resample,
                               kld_sample_count, low_variance_resample, normalise_log_weights, pose_bins,
                               sample_ellipse_poses, weighted_pose_mean)
@@ -39,4 +39,4 @@ __all__ = ["DegenerateCorrespondenceError", "EgomotionResult", "InsufficientMatc
            "valid_beams", "AMCL_DEFAULTS", "KLDConfig", "MCLStep", "MonteCarloLocalizer", "mcl_step",
            "uniform_free_poses", "KLD_Z_99", "ROS_KLD_BIN_SIZE", "NormalisedWeights", "ellipse_weights",
            "kld_resample", "kld_sample_count", "low_variance_resample", "normalise_log_weights", "pose_bins",
-           "sample_ellipse_poses", "weighted_pose_mean", "pose_clusters", "largest_cluster_share"]
+           "sample_ellipse_poses", "weighted_pose_mean", "pose_clusters", "largest_cluster_share", "largest_cluster_mean"]

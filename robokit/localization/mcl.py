@@ -313,15 +313,16 @@ class MonteCarloLocalizer:
         Returns
         -------
         bool
-            Whether an update ran. The first call only stores the odometry (as ROS's first scan).
+            Whether an update ran. The first call only stores the odometry (amcl runs a sensor update
+            on its first scan; ours waits for motion, or ``force``).
 
         Notes
         -----
-        Thrun et al. (2005), Table 8.3: motion and weights (lines 4-5), ``w_avg`` (line 6, the
+        Thrun et al. (2005), Table 8.3: motion and weights, ``w_avg`` (the
         weighted mean of the likelihoods ``log_mean``, which is the table's plain mean right after
-        a resampling), ``w_slow += alpha_slow (w_avg - w_slow)`` and ``w_fast`` likewise (line 9,
-        kept as logs), and at a resampling each new particle is a uniform random pose with
-        probability ``max(0, 1 - w_fast / w_slow)`` (line 13). The averages start at the first
+        a resampling), ``w_slow += alpha_slow (w_avg - w_slow)`` and ``w_fast`` likewise (kept
+        as logs), and at a resampling each new particle is a uniform random pose with
+        probability ``max(0, 1 - w_fast / w_slow)``. The averages start at the first
         ``w_avg`` (ROS; Table 8.3 starts them at 0, which holds off any recovery for about
         ``1 / alpha_slow`` updates) and are never reset (Table 8.3; ROS resets both after every
         injection and so re-seeds them at the next, possibly already low, ``w_avg``); an
@@ -349,11 +350,11 @@ class MonteCarloLocalizer:
             return False
         step = mcl_step(self.particles, self.weights, self._odom, odom, r, a, self.field, alphas=self.alphas,
                         resample=False, rng=self.rng, **self.model)
-        self.particles, self.weights, self.degenerate, log_avg = step                 # Table 8.3, lines 4-6
+        self.particles, self.weights, self.degenerate, log_avg = step                 # Table 8.3: motion, weights, w_avg
         self._odom = odom
         self.n_updates += 1
         if not self.degenerate and self.alpha_slow > 0 and self.alpha_fast > 0:
-            self._log_w_slow = self._average(self._log_w_slow, log_avg, self.alpha_slow)   # Table 8.3, line 9
+            self._log_w_slow = self._average(self._log_w_slow, log_avg, self.alpha_slow)   # Table 8.3: w_slow, w_fast
             self._log_w_fast = self._average(self._log_w_fast, log_avg, self.alpha_fast)
         self._since_resample += 1
         if self._since_resample >= self.resample_interval:
@@ -368,7 +369,7 @@ class MonteCarloLocalizer:
 
     @property
     def inject_probability(self) -> float:
-        """``max(0, 1 - w_fast / w_slow)``: the chance a resampled particle is random (Table 8.3, line 13)."""
+        """``max(0, 1 - w_fast / w_slow)``: the chance a resampled particle is random (Table 8.3)."""
         if not np.isfinite(self._log_w_slow) or not np.isfinite(self._log_w_fast):
             return 0.0
         return max(0.0, 1.0 - math.exp(min(self._log_w_fast - self._log_w_slow, 50.0)))
@@ -382,7 +383,7 @@ class MonteCarloLocalizer:
                                random_pose=self._random_poses, inject_probability=p_inj)
         else:
             n = len(self.particles)
-            injected = self.rng.random(n) < p_inj                           # Table 8.3, line 13
+            injected = self.rng.random(n) < p_inj                           # Table 8.3: max(0, 1 - w_fast / w_slow)
             new = np.empty((n, 3))
             new[injected] = self._random_poses(int(injected.sum()), self.rng)
             if (~injected).any():

@@ -4,7 +4,8 @@ ROS amcl groups its particles by the occupied cells of the same (x, y, theta) hi
 KLD-sampling counts (0.5 m, 0.5 m, 10 degrees): two occupied cells that touch, faces, edges or
 corners, belong to one cluster (``pf_cluster_stats``). Ge et al. (2023, Sec. 4.1) count the
 iterations until "the particles had converged to a single cluster"; :func:`pose_clusters` gives the
-clusters and :func:`largest_cluster_share` how much of the cloud the biggest one holds.
+clusters, :func:`largest_cluster_share` how much of the cloud the biggest one holds, and
+:func:`largest_cluster_mean` its mean pose, the estimate amcl publishes.
 
 References
 ----------
@@ -23,10 +24,10 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from ..validation import as_array, as_points
-from .particle_filter import ROS_KLD_BIN_SIZE, pose_bins
+from ..validation import as_array
+from .particle_filter import ROS_KLD_BIN_SIZE, pose_bins, weighted_pose_mean
 
-__all__ = ["pose_clusters", "largest_cluster_share"]
+__all__ = ["pose_clusters", "largest_cluster_share", "largest_cluster_mean"]
 
 _OFFSETS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if any(d)], np.int64)
 
@@ -64,7 +65,9 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     >>> pose_clusters(cloud).tolist()        # two touching cells; a far one; a pair across +-pi
     [0, 0, 1, 2, 2]
     """
-    P = as_points(particles, "particles", 3, min_count=1)
+    P = as_array(particles, "particles", ndim=2, min_size=1)
+    if P.shape[1] != 3:
+        raise ValueError(f"particles: expected poses of shape (N, 3), got shape {P.shape}")
     size = as_array(bin_size, "bin_size", shape=(3,))
     cells = pose_bins(P, size)
     n_heading = int(np.ceil(2 * np.pi / size[2]))
@@ -134,8 +137,56 @@ def largest_cluster_share(particles: Any, weights: Any = None, bin_size: Any = R
     if weights is None:
         w = np.ones(len(labels))
     else:
-        w = as_array(weights, "weights", shape=(len(labels),))
+        w = as_array(weights, "weights", ndim=1)
+        if len(w) != len(labels):
+            raise ValueError(f"weights: expected one weight per row of particles ({len(labels)}), got {len(w)}")
         if np.any(w < 0) or not w.sum() > 0:
             raise ValueError(f"weights: expected non-negative weights with a positive sum, got sum {w.sum()}")
     totals = np.bincount(labels, weights=w)
     return float(totals.max() / totals.sum())
+
+
+def largest_cluster_mean(particles: Any, weights: Any = None, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarray:
+    """The weighted mean pose of the heaviest cluster: the estimate ROS amcl publishes.
+
+    Parameters
+    ----------
+    particles : array_like, shape (N, 3)
+    weights : array_like, shape (N,), optional
+        Non-negative; default equal weights.
+    bin_size : array_like, shape (3,), default (0.5 m, 0.5 m, 10 degrees)
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``[x, y, theta]``, theta the circular mean.
+
+    Raises
+    ------
+    ValueError
+        For bad particles or weights (see :func:`largest_cluster_share`).
+
+    Notes
+    -----
+    ROS amcl's ``pf_cluster_stats`` and its pose hypothesis: the cluster with the largest total weight
+    and its mean. The mean of *all* particles is pulled away by a few strays in another cluster.
+
+    Examples
+    --------
+    >>> cloud = [[10.0, 0.0, 0.0], [10.2, 0.0, 0.0], [10.1, 0.0, 0.0], [30.0, 0.0, 0.0]]
+    >>> largest_cluster_mean(cloud).round(3).tolist()       # the stray at x = 30 m does not count
+    [10.1, 0.0, 0.0]
+    """
+    labels = pose_clusters(particles, bin_size)
+    P = np.asarray(particles, float)
+    if weights is None:
+        w = np.ones(len(labels))
+    else:
+        w = as_array(weights, "weights", ndim=1)
+        if len(w) != len(labels):
+            raise ValueError(f"weights: expected one weight per row of particles ({len(labels)}), got {len(w)}")
+        if np.any(w < 0) or not w.sum() > 0:
+            raise ValueError(f"weights: expected non-negative weights with a positive sum, got sum {w.sum()}")
+    heaviest = int(np.argmax(np.bincount(labels, weights=w)))
+    keep = labels == heaviest
+    return weighted_pose_mean(P[keep], w[keep] if w[keep].sum() > 0 else None)

@@ -101,7 +101,7 @@ def normalise_log_weights(log_w: Any) -> NormalisedWeights:
     Notes
     -----
     Thrun et al. (2005), Table 4.3 line 8 (the weights are normalised by the resampling) and
-    Table 8.3 line 8 (``w_avg``).
+    Table 8.3 (its ``w_avg``).
 
     Examples
     --------
@@ -181,10 +181,10 @@ def low_variance_resample(weights: Any, rng: Any = None, count: int | None = Non
         r = check_finite_scalar(start, "start")
         if not 0.0 <= r < 1.0 / m:
             raise ValueError(f"start: expected r in [0, 1/M) = [0, {1.0 / m:.6g}), got {r}")
-    pointers = r + np.arange(m) / m                                 # line 6
+    pointers = r + np.arange(m) / m                                 # line 7
     cumulative = np.cumsum(w)
     cumulative /= cumulative[-1]
-    idx = np.searchsorted(cumulative, pointers, side="left")        # lines 7-10: first c_i >= U
+    idx = np.searchsorted(cumulative, pointers, side="left")        # lines 8-11: first c_i >= U
     return np.minimum(idx, w.size - 1)
 
 
@@ -337,7 +337,7 @@ def kld_resample(particles: Any, weights: Any, rng: Any = None, *, min_count: in
     cumulative /= cumulative[-1]
     idx = np.minimum(np.searchsorted(cumulative, g.random(hi), side="right"), w.size - 1)
     cand = P[idx]
-    injected = g.random(hi) < p_inj                                  # Table 8.3, line 13
+    injected = g.random(hi) < p_inj                                  # Table 8.3, max(0, 1 - w_fast / w_slow)
     if injected.any():
         cand[injected] = as_points(random_pose(int(injected.sum()), g), "random_pose(n, rng)", 3)
     keys = pose_bins(cand, bin_size)

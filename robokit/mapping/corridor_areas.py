@@ -104,7 +104,8 @@ def invalid_areas(ranges: Any, angles: Any) -> np.ndarray:
     numpy.ndarray, shape (K, 3)
         One row per run: ``(start_angle, end_angle, theta_null)``, the first and last invalid beam
         angles and ``theta_null = |phi_i - phi_j|`` counted counter-clockwise from start to end.
-        A run crossing the end of the scan (beam ``B - 1`` to beam 0) is one area.
+        A run crossing the end of a full-turn scan (beam ``B - 1`` to beam 0) is one area; a scan
+        short of a full turn never joins its last and first beams.
 
     Notes
     -----
@@ -125,11 +126,15 @@ def invalid_areas(ranges: Any, angles: Any) -> np.ndarray:
         return np.array([[a[0], a[-1], a[-1] - a[0]]])
     if not bad.any():
         return np.zeros((0, 3))
-    shift = int(np.argmin(bad))                     # walk from a valid beam: no run wraps in that order
+    step = np.median(np.diff(a)) if len(a) > 1 else 2 * np.pi
+    full_turn = abs(a[0] + 2 * np.pi - a[-1] - step) < 0.5 * step     # the last beam's neighbour is the first
+    # walk from a valid beam, so no run wraps in that order; a scan short of a full turn has a blind
+    # sector between its last and first beams, so a run never continues across it
+    shift = int(np.argmin(bad)) if full_turn else 0
     b = np.roll(bad, -shift).astype(np.int8)
-    edges = np.diff(np.append(b, 0))
-    starts = (np.flatnonzero(edges == 1) + 1 + shift) % len(r)
-    ends = (np.flatnonzero(edges == -1) + shift) % len(r)
+    edges = np.diff(np.concatenate([[0], b, [0]]))
+    starts = (np.flatnonzero(edges == 1) + shift) % len(r)
+    ends = (np.flatnonzero(edges == -1) - 1 + shift) % len(r)
     order = np.argsort(starts)
     starts, ends = starts[order], ends[order]
     theta = np.mod(a[ends] - a[starts], 2 * np.pi)  # Eq. (9)

@@ -256,8 +256,10 @@ def load_map(yaml_path: Any) -> OccupancyGrid:
     -------
     OccupancyGrid
         Occupied cells have P = 1 and free cells P = 0 (clamped to 0.97 and 0.12 in log odds),
-        unknown ones 0.5 (``mode: scale``: their own probability), so the grid's default masks
-        reproduce the file's three classes for any thresholds written in it.
+        unknown ones 0.5, so in ``mode: trinary`` the grid's default masks reproduce the file's three
+        classes for any thresholds written in it. In ``mode: scale`` unknown cells keep their own
+        probability, which the default masks read with the default thresholds (0.65, 0.196), not the
+        file's.
 
     Raises
     ------

@@ -397,14 +397,20 @@ class LikelihoodField:
             pts = np.asarray(xy, dtype=float)
         # The table framed by one ring of max_distance cells: index 0 and W + 1 (H + 1) are "off the map",
         # so every point needs one clip instead of four comparisons and a masked copy. Cell j of the
-        # table is column j + 1; truncating u + 1 (u = the point's column coordinate) is floor(u) + 1
-        # for u >= -1, and anything further out (negative, NaN or inf casts) clips to the frame.
+        # table is column j + 1 of the frame, j = floor((x - x0) / resolution) as in OccupancyGrid.cell_of;
+        # anything outside (and NaN or inf, whatever integer they cast to) clips to the frame.
         framed = self._framed()
         h, w = framed.shape
-        inv = 1.0 / self.resolution
-        with np.errstate(invalid="ignore"):
-            ix = ((pts[..., 0] - self.origin[0]) * inv + 1.0).astype(np.intp)
-            iy = ((pts[..., 1] - self.origin[1]) * inv + 1.0).astype(np.intp)
+        index = []
+        for axis in (0, 1):
+            u = np.subtract(pts[..., axis], self.origin[axis])
+            u /= self.resolution
+            np.floor(u, out=u)
+            with np.errstate(invalid="ignore"):
+                k = u.astype(np.intp)
+            k += 1
+            index.append(k)
+        ix, iy = index
         np.clip(ix, 0, w - 1, out=ix)
         np.clip(iy, 0, h - 1, out=iy)
         iy *= w
@@ -412,10 +418,12 @@ class LikelihoodField:
         return framed.ravel().take(iy)
 
     def _framed(self) -> np.ndarray:
+        """The framed table, rebuilt whenever ``distance`` or ``max_distance`` changed (also in place)."""
+        d = np.asarray(self.distance, float)
+        key = (id(self.distance), float(self.max_distance), d.shape, hash(d.tobytes()))
         cached = self.__dict__.get("_framed_table")
-        if cached is None or cached[0] is not self.distance:
-            table = np.pad(np.asarray(self.distance, float), 1, constant_values=self.max_distance)
-            cached = (self.distance, table)
+        if cached is None or cached[0] != key:
+            cached = (key, np.pad(d, 1, constant_values=self.max_distance))
             self.__dict__["_framed_table"] = cached
         return cached[1]
 

@@ -495,9 +495,12 @@ def _build_map(world: World, lidar: Lidar, camera: PinholeCamera, path, f_min: f
                                   sensor_offset=lidar.offset)
     # camera frames half a period after each scan: their poses are what Eq. (18) must recover
     frame_times = (times[:-1] + 0.5 * np.diff(times))[::every]
-    frame_truth = np.column_stack([np.interp(frame_times, times, poses[:, i]) for i in range(3)])
+    # the true pose at each frame (the path is piecewise linear in time) is also its geo-tag: the
+    # grid's pose log is the truth here, so Eq. (18) is exact; with a SLAM pose log it would carry
+    # the log's error
+    frame_truth = geo_tag(frame_times, times, poses)
     descriptors = _orb_frames(world, camera, frame_truth, rng, progress)
-    positions = geo_tag(frame_times, times, poses)[:, :2]
+    positions = frame_truth[:, :2]
     index = np.asarray(select_keyframes(descriptors, positions, f_min, min_frame_gap=gap,
                                        shared_range=SHARED_RANGE, below_band="take"), int)
     flat, counts = _descriptor_stack([descriptors[i] for i in index])

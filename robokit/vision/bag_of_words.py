@@ -16,7 +16,7 @@ Hamming-distance array per level (:func:`.hamming.hamming_distance`).
 
 References
 ----------
-.. [1] F. Ge, Y. Zhang, L. Wang, W. Hu, W. Wang and W. Jiang (Ge et al.), "Visual-feature-assisted
+.. [1] G. Ge, Y. Zhang, W. Wang, L. Hu, Y. Wang and Q. Jiang (Ge et al.), "Visual-feature-assisted
    mobile robot localization in a long corridor environment", Frontiers of Information Technology
    & Electronic Engineering 24(6), 2023, doi:10.1631/FITEE.2200208.
 .. [2] D. Galvez-Lopez and J. D. Tardos, "Bags of binary words for fast place recognition in image

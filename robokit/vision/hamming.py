@@ -19,7 +19,7 @@ References
    SURF", Proc. IEEE Int. Conf. on Computer Vision (ICCV), 2564-2571, 2011.
 .. [2] R. Mur-Artal, J. M. M. Montiel and J. D. Tardos, "ORB-SLAM: a versatile and accurate monocular
    SLAM system", IEEE Transactions on Robotics 31(5), 1147-1163, 2015.
-.. [3] F. Ge, Y. Zhang, L. Wang, W. Hu, W. Wang and W. Jiang (Ge et al.), "Visual-feature-assisted
+.. [3] G. Ge, Y. Zhang, W. Wang, L. Hu, Y. Wang and Q. Jiang (Ge et al.), "Visual-feature-assisted
    mobile robot localization in a long corridor environment", Frontiers of Information Technology
    & Electronic Engineering 24(6), 2023, doi:10.1631/FITEE.2200208.
 """

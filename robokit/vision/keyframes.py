@@ -2,7 +2,8 @@
 
 Ge et al. (2023), Sec. 3.2: the first image is a keyframe; a later one is a keyframe when
 
-1. its ORB feature count exceeds ``F_min`` (Eq. (15), from a calibration run: :func:`feature_threshold`);
+1. its ORB feature count exceeds ``F_min`` (Eq. (15), from a calibration run: :func:`feature_threshold`;
+   we test "at least", see :class:`KeyframeSelector`);
 2. more than 10 frames have passed since the last keyframe;
 3. it shares fewer than 90 % but more than 70 % matched points with the last keyframe;
 4. the robot has moved (about) 0.02 m since the last keyframe.
@@ -14,7 +15,8 @@ keyframe's feature count, as in ORB-SLAM's "tracks less than 90 % points than K_
 much of the stored keyframe is still seen, and does not change while the current frame's own count
 varies. Taken literally, condition (3) also means that a frame sharing 70 % or less is never a
 keyframe: if the robot jumps too far between frames, selection stops until it sees the last
-keyframe's scene again (:class:`KeyframeSelector` records it in ``conditions``).
+keyframe's scene again (``below_band="skip"``); ``below_band="take"`` takes such a frame when the
+other conditions hold (:class:`KeyframeSelector` records each frame's conditions).
 
 The ORB-SLAM rule beside it (Mur-Artal, Montiel & Tardos 2015, Sec. V-E, conditions 2-4; the
 relocalisation and local-mapping-idle parts do not apply here): more than 20 frames since the last
@@ -27,7 +29,7 @@ condition (4) uses the Euclidean distance between positions (the heading is igno
 
 References
 ----------
-.. [1] F. Ge, Y. Zhang, L. Wang, W. Hu, W. Wang and W. Jiang (Ge et al.), "Visual-feature-assisted
+.. [1] G. Ge, Y. Zhang, W. Wang, L. Hu, Y. Wang and Q. Jiang (Ge et al.), "Visual-feature-assisted
    mobile robot localization in a long corridor environment", Frontiers of Information Technology
    & Electronic Engineering 24(6), 2023, doi:10.1631/FITEE.2200208.
 .. [2] R. Mur-Artal, J. M. M. Montiel and J. D. Tardos, "ORB-SLAM: a versatile and accurate monocular

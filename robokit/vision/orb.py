@@ -10,7 +10,7 @@ References
 ----------
 .. [1] E. Rublee, V. Rabaud, K. Konolige and G. Bradski, "ORB: an efficient alternative to SIFT or
    SURF", Proc. IEEE Int. Conf. on Computer Vision (ICCV), 2564-2571, 2011.
-.. [2] F. Ge, Y. Zhang, L. Wang, W. Hu, W. Wang and W. Jiang (Ge et al.), "Visual-feature-assisted
+.. [2] G. Ge, Y. Zhang, W. Wang, L. Hu, Y. Wang and Q. Jiang (Ge et al.), "Visual-feature-assisted
    mobile robot localization in a long corridor environment", Frontiers of Information Technology
    & Electronic Engineering 24(6), 2023, doi:10.1631/FITEE.2200208.
 """
