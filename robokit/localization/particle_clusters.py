@@ -101,6 +101,17 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     return renumber[labels]
 
 
+def _cloud_weights(weights: Any, n: int) -> np.ndarray:
+    if weights is None:
+        return np.ones(n)
+    w = as_array(weights, "weights", ndim=1)
+    if len(w) != n:
+        raise ValueError(f"weights: expected one weight per row of particles ({n}), got {len(w)}")
+    if np.any(w < 0) or not w.sum() > 0:
+        raise ValueError(f"weights: expected non-negative weights with a positive sum, got sum {w.sum()}")
+    return w
+
+
 def largest_cluster_share(particles: Any, weights: Any = None, bin_size: Any = ROS_KLD_BIN_SIZE) -> float:
     """The share of the cloud (by weight, or by count) in its largest cluster.
 
@@ -134,14 +145,7 @@ def largest_cluster_share(particles: Any, weights: Any = None, bin_size: Any = R
     0.8
     """
     labels = pose_clusters(particles, bin_size)
-    if weights is None:
-        w = np.ones(len(labels))
-    else:
-        w = as_array(weights, "weights", ndim=1)
-        if len(w) != len(labels):
-            raise ValueError(f"weights: expected one weight per row of particles ({len(labels)}), got {len(w)}")
-        if np.any(w < 0) or not w.sum() > 0:
-            raise ValueError(f"weights: expected non-negative weights with a positive sum, got sum {w.sum()}")
+    w = _cloud_weights(weights, len(labels))
     totals = np.bincount(labels, weights=w)
     return float(totals.max() / totals.sum())
 
@@ -179,14 +183,7 @@ def largest_cluster_mean(particles: Any, weights: Any = None, bin_size: Any = RO
     """
     labels = pose_clusters(particles, bin_size)
     P = np.asarray(particles, float)
-    if weights is None:
-        w = np.ones(len(labels))
-    else:
-        w = as_array(weights, "weights", ndim=1)
-        if len(w) != len(labels):
-            raise ValueError(f"weights: expected one weight per row of particles ({len(labels)}), got {len(w)}")
-        if np.any(w < 0) or not w.sum() > 0:
-            raise ValueError(f"weights: expected non-negative weights with a positive sum, got sum {w.sum()}")
+    w = _cloud_weights(weights, len(labels))
     heaviest = int(np.argmax(np.bincount(labels, weights=w)))
     keep = labels == heaviest
     return weighted_pose_mean(P[keep], w[keep] if w[keep].sum() > 0 else None)
