@@ -890,7 +890,8 @@ SPECS: dict[str, Call] = {
     "robokit.localization.particle_filter.normalise_log_weights": Call({
         "log_w": Array(np.array([0.0, -1.0, -np.inf]), "N", inf_ok=True)}),
     "robokit.localization.particle_filter.low_variance_resample": Call({
-        "weights": Array(np.array([0.2, 0.5, 0.3]), "N"), "rng": Rng(0), "count": Int(4, optional=True)}),
+        "weights": Array(np.array([0.2, 0.5, 0.3]), "N"), "rng": Rng(0), "count": Int(4, optional=True),
+        "start": Real(0.1, optional=True)}),
     "robokit.localization.particle_filter.kld_sample_count": Call({"k": Array(np.array([1, 5]), "|N"), "epsilon": Real(0.01), "z": Real(2.33)}),
     "robokit.localization.particle_filter.pose_bins": Call({
         "particles": Array(np.array([[0.2, 0.7, 0.0], [1.3, 0.6, 0.1]]), "N,3"),
@@ -1019,7 +1020,8 @@ SPECS: dict[str, Call] = {
                                                       "max_distance": Real(50.0)}),
     "robokit.vision.keyframes.KeyframeSelector": Call({"f_min": Real(100.0), "min_frame_gap": Int(10),
                                                        "shared_range": Array(np.array([0.7, 0.9]), "2"),
-                                                       "min_distance": Real(0.02), "max_distance": Real(50.0)}),
+                                                       "min_distance": Real(0.02), "max_distance": Real(50.0),
+                                                       "below_band": Choice("skip")}),
     "robokit.vision.keyframes.select_keyframes": Call({
         "descriptor_list": Obj(lambda: [orb_descriptors(40, 0)] * 3), "positions": Array(np.zeros((3, 2)), "N,2|N,3"),
         "f_min": Real(10.0), "kw": Options({"min_frame_gap": 1})}),

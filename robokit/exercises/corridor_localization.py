@@ -348,7 +348,8 @@ EXERCISES = [
         id="03.invalid_areas", function="invalid_areas",
         signature="invalid_areas(ranges: (B,), angles: (B,) increasing in [0, 2 pi)) -> numpy.ndarray (K, 3)",
         points=2, cases=_invalid_cases, reference=invalid_areas, compare=close(rtol=1e-9, atol=1e-9),
-        references=("robokit.mapping.corridor_areas.invalid_areas", "robokit.mapping.corridor_scan.corridor_state"),
+        references=("robokit.mapping.corridor_areas.invalid_areas", "robokit.mapping.corridor_areas.as_scan",
+                    "robokit.mapping.corridor_scan.corridor_state"),
         description="Eq. (9): (first angle, last angle, theta_null) of each run of invalid (inf) returns, a run "
                     "wrapping past the last beam counted once, rows ordered by first angle; ValueError for NaN."),
     Exercise(

@@ -175,8 +175,9 @@ def low_variance_resample(weights: Any, rng: Any = None, count: int | None = Non
     w = _weights(weights)
     m = w.size if count is None else check_int(count, "count", minimum=1)
     check_sample_count(m, "count")
+    g = as_rng(rng)                                                 # checked even when start is given
     if start is None:
-        r = as_rng(rng).uniform(0.0, 1.0 / m)                      # Table 4.4, line 3
+        r = g.uniform(0.0, 1.0 / m)                                 # Table 4.4, line 3
     else:
         r = check_finite_scalar(start, "start")
         if not 0.0 <= r < 1.0 / m:
