@@ -1107,7 +1107,7 @@ SPECS: dict[str, Call] = {
         "scene": Obj(scene), "path": Text("cloud"),
         "particles": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.5]]), "N,3"),
         "weights": Array(np.array([0.5, 0.5]), "N", optional=True), "z": Real(0.03), "arrow": Real(0.15),
-        "color": Given(0xAA2288)}),
+        "color": Given(0xAA2288), "size": Real(0.04)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.

@@ -299,10 +299,11 @@ def add_image(scene: Scene, path: str, image: Any, centre: Any, width: float = 1
 
 
 def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, z: float = 0.03,
-                  arrow: float = 0.15, color: Any = 0xAA2288) -> Scene:
+                  arrow: float = 0.15, color: Any = 0xAA2288, size: float = 0.04) -> Scene:
     """Draw a particle cloud ``(N, 3)`` of planar poses: points plus short heading strokes.
 
-    Weights (optional, ``(N,)`` non-negative) scale the stroke length, so likely particles stand out.
+    Weights (optional, ``(N,)`` non-negative) scale the stroke length, so likely particles stand out;
+    ``size`` is the points' size in metres (larger for a view from far away).
 
     Notes
     -----
@@ -326,7 +327,7 @@ def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, 
     L = check_positive(arrow, "arrow") * (0.3 + 0.7 * w)
     base = np.column_stack([P[:, :2], np.full(len(P), check_finite_scalar(z, "z"))])
     tip = base + np.column_stack([L * np.cos(P[:, 2]), L * np.sin(P[:, 2]), np.zeros(len(P))])
-    scene.add_points(f"{path}/points", base, size=0.04, color=color)
+    scene.add_points(f"{path}/points", base, size=check_positive(size, "size"), color=color)
     return _segments(scene, f"{path}/headings", np.stack([base, tip], axis=1).reshape(-1, 3), color)
 
 
