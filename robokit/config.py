@@ -11,9 +11,10 @@ import hashlib
 import json
 import os
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
-__all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest", "write_atomically"]
+__all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest", "write_atomically",
+           "read_arrays"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -266,3 +267,45 @@ def write_atomically(target: str | Path, write: Callable[[Path], Any]) -> Path:
         tmp.unlink(missing_ok=True)
     return target
 
+
+
+def read_arrays(target: str | Path, names: Sequence[str]) -> dict | None:
+    """The named arrays of a cache file written with ``numpy.savez``, or ``None`` to rebuild it.
+
+    Parameters
+    ----------
+    target : str or Path
+    names : sequence of str
+        The arrays the cache must hold.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray, or None
+        ``None`` for a missing, truncated, corrupt or foreign file, or one without every name: the
+        caller rebuilds it, so a cache is never needed for correctness.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Caching"), the reading twin of :func:`write_atomically`; never
+    unpickles.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> import numpy as np
+    >>> target = Path(tempfile.mkdtemp()) / "c.npz"
+    >>> read_arrays(target, ["a"]) is None
+    True
+    >>> _ = write_atomically(target, lambda p: np.savez(p, a=np.arange(3)))
+    >>> read_arrays(target, ["a"])["a"].tolist(), read_arrays(target, ["a", "b"])
+    ([0, 1, 2], None)
+    """
+    import zipfile
+
+    import numpy as np
+
+    try:
+        with np.load(target, allow_pickle=False) as data:
+            return {name: data[name] for name in names}
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+        return None

@@ -37,9 +37,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, fast_mode, source_digest, write_atomically
+from ..config import cache_dir, cache_key, fast_mode, read_arrays, source_digest, write_atomically
 from ..mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
-from ..sim import Lidar, PinholeCamera, camera_mount, corridor_path, long_corridor, waypoint_path
+from ..sim import Lidar, PinholeCamera, camera_mount, corridor_path, describe_sensor, long_corridor, waypoint_path
 from ..sim.world import World
 from ..validation import check_callable, check_int, check_positive
 from ..vision import BowDatabase, Vocabulary, detect_orb_features, feature_threshold, select_keyframes, \
@@ -110,21 +110,8 @@ def corridor_camera(fast: bool | None = None) -> PinholeCamera:
     return PinholeCamera.from_fov(np.deg2rad(65.0), w, h, mount=camera_mount(0.35))
 
 
-def _camera_description(camera: PinholeCamera) -> dict:
-    return {f.name: np.asarray(getattr(camera, f.name)).round(12).tolist() for f in dataclasses.fields(camera)}
-
-
 def _code() -> str:
     return source_digest("sim", "geometry", "vision", "mapping", "navigation.corridor_experiment")
-
-
-def _load_npz(target, names: tuple) -> dict | None:
-    """The arrays of a cache file, or ``None`` for a missing, corrupt or foreign one (then it is rebuilt)."""
-    try:
-        with np.load(target, allow_pickle=False) as data:
-            return {name: data[name] for name in names}
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
-        return None
 
 
 def _descriptor_stack(descriptors: list) -> tuple[np.ndarray, np.ndarray]:
@@ -230,10 +217,10 @@ def calibration_run(*, fast: bool | None = None, start: float = 12.0, length: fl
         raise ValueError(f"length, speed, frame_rate: expected at most 20000 frames, got {length / speed * frame_rate:.3g}")
     camera = corridor_camera(fast)
     path = waypoint_path([[start, 0.0], [start + length, 0.0]], speed, rate=frame_rate)
-    meta = {"camera": _camera_description(camera), "start": start, "length": length, "speed": speed,
+    meta = {"camera": describe_sensor(camera), "start": start, "length": length, "speed": speed,
             "rate": frame_rate, "features": N_FEATURES, "code": _code()}
     target = cache_dir("corridor") / f"calibration-{cache_key(**meta)}.npz"
-    data = _load_npz(target, ("flat", "counts", "positions"))
+    data = read_arrays(target, ("flat", "counts", "positions"))
     if data is None:
         flat, counts = _descriptor_stack(_orb_frames(world, camera, path.poses, np.random.default_rng(5), progress))
         data = {"flat": flat, "counts": counts, "positions": path.poses[:, :2]}
@@ -334,7 +321,7 @@ def training_vocabulary(*, fast: bool | None = None, branching: int = 10, levels
     xs = np.arange(1.0, world.info["length"] - 1.0, step)
     poses = np.vstack([np.column_stack([xs, np.zeros_like(xs), np.zeros_like(xs)]),
                        np.column_stack([xs[::-1], np.zeros_like(xs), np.full_like(xs, np.pi)])])
-    meta = {"camera": _camera_description(camera), "step": step, "branching": branching, "levels": levels,
+    meta = {"camera": describe_sensor(camera), "step": step, "branching": branching, "levels": levels,
             "features": N_FEATURES, "code": _code()}
     target = cache_dir("corridor") / f"vocabulary-{cache_key(**meta)}.npz"
     if target.exists():
@@ -465,13 +452,13 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress
     vocabulary = training_vocabulary(fast=fast)
     path = corridor_path(world, speed=0.3, rate=10.0)
     every, gap = (4, 0) if fast else (1, MAPPING_FRAME_GAP)
-    meta = {"camera": _camera_description(camera), "lidar": dataclasses.asdict(lidar) | {"offset": list(lidar.offset)},
+    meta = {"camera": describe_sensor(camera), "lidar": describe_sensor(lidar),
             "resolution": resolution, "f_min": f_min, "gap": gap, "every": every, "band": list(SHARED_RANGE),
             "features": N_FEATURES,
             "path": cache_key(poses=path.poses.round(9).tolist()), "code": _code()}
     key = cache_key(**meta)
     target = cache_dir("corridor") / f"map-{key}.npz"
-    data = _load_npz(target, _MAP_ARRAYS)
+    data = read_arrays(target, _MAP_ARRAYS)
     if data is None:
         data = _build_map(world, lidar, camera, path, f_min, resolution, every, gap, progress)
         write_atomically(target, lambda p: np.savez_compressed(p, **data))

@@ -30,12 +30,11 @@ References
 from __future__ import annotations
 
 import dataclasses
-import zipfile
 from typing import Any, Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, fast_mode, source_digest, write_atomically
+from ..config import cache_dir, cache_key, fast_mode, read_arrays, source_digest, write_atomically
 from ..controllers import move_to_middle_line
 from ..geometry import wrap_angle
 from ..localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share
@@ -454,11 +453,9 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
                                                                     "controllers", "navigation.corridor_experiment",
                                                                     "navigation.corridor_trials")}
         target = cache_dir("corridor") / f"trials-{cache_key(**meta)}.npz"
-        try:
-            with np.load(target, allow_pickle=False) as data:
-                return TrialSet(method, **{name: data[name] for name in _SET_FIELDS})
-        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
-            pass  # a missing, corrupt or foreign cache file: run again
+        data = read_arrays(target, _SET_FIELDS)
+        if data is not None:          # else a missing, corrupt or foreign cache file: run again
+            return TrialSet(method, **data)
     runs = []
     for i in starts:
         for j in range(trials):

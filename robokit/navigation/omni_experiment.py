@@ -38,7 +38,7 @@ from ..geometry import se2_between, se2_compose
 from ..localization.hierarchical import HierarchicalLocalizer
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
                        optimize_pose_graph, relax)
-from ..sim import OmniCamera, office_floor, office_tour, record
+from ..sim import OmniCamera, describe_sensor, office_floor, office_tour, record
 from ..sim.world import World
 from ..validation import as_points, as_rng, check_callable, check_choice, check_int, check_positive
 
@@ -87,10 +87,6 @@ class OfficeSetup:
     truth: np.ndarray
     build_seconds: float
     key: str
-
-
-def _camera_description(camera: OmniCamera) -> dict:
-    return {f.name: np.asarray(getattr(camera, f.name)).round(12).tolist() for f in dataclasses.fields(camera)}
 
 
 def _map_cached(meta: dict, build: Callable[[], tuple[TopologicalMap, np.ndarray, int]]
@@ -161,7 +157,7 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     rate = 0.7 if fast else 1.0
     tour = office_tour(world)
     params = {"n_features": 300 if fast else 500, "alphas": list(TOUR_ALPHAS)}
-    meta = {"world": world.name, "world_seed": world.info["seed"], "camera": _camera_description(camera),
+    meta = {"world": world.name, "world_seed": world.info["seed"], "camera": describe_sensor(camera),
             "tour": cache_key(poses=tour.poses.round(9).tolist()), "rate": rate, "record_seed": 2, "params": params,
             "code": source_digest("sim", "geometry", "vision", "mapping")}
 

@@ -33,7 +33,7 @@ from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .motion import Path, noisy_odometry
 from .world import World
 
-__all__ = ["Run", "record"]
+__all__ = ["Run", "record", "describe_sensor"]
 
 _FORMAT = 1
 
@@ -141,13 +141,43 @@ def _cached(target: FsPath, meta: dict) -> Run | None:
     return run if stored == json.loads(json.dumps(meta)) else None
 
 
-def _describe(sensor: Any) -> dict:
-    """JSON description of a sensor's parameters (for the cache key)."""
+def describe_sensor(sensor: Any) -> dict:
+    """JSON description of a sensor's parameters, for the key of a cache of what it recorded.
+
+    Parameters
+    ----------
+    sensor : dataclass instance
+        A camera, stereo rig, omni camera or LiDAR (any dataclass of numbers, arrays, tuples and
+        nested dataclasses).
+
+    Returns
+    -------
+    dict
+        ``{"type": class name, field: value, ...}`` with arrays rounded to 12 decimals and listed.
+
+    Raises
+    ------
+    TypeError
+        If ``sensor`` is not a dataclass instance.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Caching"): equal sensors give equal descriptions across runs.
+
+    Examples
+    --------
+    >>> from robokit.sim import Lidar
+    >>> d = describe_sensor(Lidar(beams=8))
+    >>> d["type"], d["beams"], d["offset"]
+    ('Lidar', 8, [0.0, 0.0, 0.0])
+    """
+    if not dataclasses.is_dataclass(sensor) or isinstance(sensor, type):
+        raise TypeError(f"sensor: expected a sensor dataclass (camera, rig or LiDAR), got {type(sensor).__name__}")
     out = {"type": type(sensor).__name__}
     for field in dataclasses.fields(sensor):
         value = getattr(sensor, field.name)
         if dataclasses.is_dataclass(value):          # e.g. the camera of a stereo rig
-            value = _describe(value)
+            value = describe_sensor(value)
         elif isinstance(value, np.ndarray):
             value = np.round(value, 12).tolist()
         elif isinstance(value, tuple):
@@ -257,7 +287,7 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     digest = hashlib.sha256(np.ascontiguousarray(poses).tobytes() + t.tobytes()).hexdigest()[:16]
     geometry = hashlib.sha256(np.round(world.corner_array, 9).tobytes()).hexdigest()[:16]
     meta = {"world": world.name, "world_info": json.loads(json.dumps(world.info, default=str)), "geometry": geometry,
-            "rate": rate, "path": digest, "sensors": {k: _describe(s) for k, s in sensors.items()},
+            "rate": rate, "path": digest, "sensors": {k: describe_sensor(s) for k, s in sensors.items()},
             "odometry_alphas": alphas.tolist(), "seed": int(seed), "code": _code_version()}
     target = cache_dir("runs") / f"{world.name}-{cache_key(**meta)}.npz" if cache else None
     if target is not None and (cached := _cached(target, meta)) is not None:
