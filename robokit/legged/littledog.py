@@ -1,0 +1,249 @@
+"""The LittleDog quadruped: its published facts and a MuJoCo model written from them by code.
+
+One source of truth: the constants below give the kinematics (:mod:`robokit.legged.leg_kinematics`
+computes with them) and :func:`littledog_mjcf` writes the same numbers into MJCF for the physics,
+so the two can never disagree.
+
+What comes from where:
+
+* The *LittleDog User Guide* (Question 2 of the course's assignment; Sec. 3 "Platform
+  Specification"): body 340 x 180 x 143 mm, ground clearance 120 mm, leg length 180 mm, total mass
+  3 kg, twelve actuated joints (hip roll, hip pitch, knee), a single-axis force sensor in each lower
+  leg, a MEMS IMU, a 2.1 Ah / 14.8 V battery; Sec. 2: joint servos at 500 Hz, host loop at 100 Hz.
+  :data:`GUIDE` holds them.
+* The guide's Sec. 4 figures (body, hip and leg frames) did not survive the text extraction, and
+  the guide gives no hip positions, segment lengths, masses of parts or joint limits. Those come
+  from the MIT LittleDog model (converted from the CSAIL LittleDog simulator; Drake's
+  ``examples/LittleDog/LittleDog.urdf``): hips at x = +-0.101 m, y = +-0.03625 m; the hip-pitch axis
+  0.0236 m further out; upper leg 0.0751 m; lower leg 0.102 m to the foot centre (we make the lower
+  leg straight: that model bends it by 0.26 rad, which only shifts the knee angle's zero); the
+  parts' masses and the joint limits.
+* Our reading of the guide's body size: the trunk is 0.24 x 0.09 x 0.023 m and, standing, its
+  bottom is 0.120 m above the ground (the guide's clearance) and its top 0.143 m (the guide's
+  height); the trunk mass makes the total 3 kg (the MIT model's parts sum to 2.75 kg).
+
+Frames: the body frame has its origin at the trunk's centre, x forward, y left, z up; the world
+frame has z up. Legs are ordered ``FL, FR, HL, HR`` and each has joints ``hip_roll`` (about x),
+``hip_pitch`` (about y) and ``knee`` (about y); a 12-vector ``q`` is leg-major. Positive pitch and
+knee angles swing the foot backwards.
+
+References
+----------
+.. [1] Boston Dynamics, *LittleDog User Guide*, version 1.0.2, 2006 (Secs. 2-4).
+.. [2] R. Tedrake et al., the LittleDog model of the Drake toolbox (``examples/LittleDog``),
+   converted from the CSAIL LittleDog simulator, MIT, 2014.
+.. [3] E. Todorov, T. Erez and Y. Tassa, "MuJoCo: a physics engine for model-based control",
+   *IROS* 2012; MuJoCo documentation, "XML reference" (MJCF).
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from ..validation import check_finite_scalar, check_positive
+
+__all__ = ["LEGS", "JOINTS", "JOINT_NAMES", "GUIDE", "HIP_POSITIONS", "HIP_OFFSET", "UPPER_LEG",
+           "LOWER_LEG", "FOOT_RADIUS", "TRUNK_SIZE", "TRUNK_MASS", "LEG_MASSES", "TOTAL_MASS",
+           "STANDING_HEIGHT", "STANCE_FEET", "MARKERS", "JOINT_LIMITS", "TIMESTEP", "littledog_mjcf",
+           "littledog_model"]
+
+LEGS = ("FL", "FR", "HL", "HR")
+"""Leg order: front-left, front-right, hind-left, hind-right."""
+JOINTS = ("hip_roll", "hip_pitch", "knee")
+"""Joint order within a leg."""
+JOINT_NAMES = tuple(f"{leg}_{joint}" for leg in LEGS for joint in JOINTS)
+"""The twelve actuated joints, leg-major (the order of every 12-vector ``q``)."""
+
+GUIDE = {
+    "body_size": (0.340, 0.180, 0.143),   # m, Sec. 3.i
+    "ground_clearance": 0.120,            # m, Sec. 3.i
+    "leg_length": 0.180,                  # m, Sec. 3.i
+    "total_mass": 3.0,                    # kg, Sec. 3.i
+    "servo_rate": 500.0,                  # Hz, Sec. 2
+    "host_rate": 100.0,                   # Hz, Sec. 2 ("every 10ms")
+    "battery_capacity": 2.1,              # Ah, Sec. 3.ii
+    "battery_voltage": 14.8,              # V, Sec. 3.ii (4 LiPo cells in series)
+    "runtime": 30 * 60.0,                 # s, Sec. 1 ("approximately 30 minutes")
+}
+"""The LittleDog User Guide's numbers (SI units), with the section that states each."""
+
+HIP_POSITIONS = np.array([[0.101, 0.03625, 0.0], [0.101, -0.03625, 0.0],
+                          [-0.101, 0.03625, 0.0], [-0.101, -0.03625, 0.0]])
+"""Hip-roll joint of each leg in the body frame (m); MIT model."""
+HIP_OFFSET = 0.0236
+"""Lateral distance from the hip-roll joint to the hip-pitch axis (m, outwards); MIT model."""
+UPPER_LEG = 0.0751
+"""Hip pitch to knee (m); MIT model."""
+LOWER_LEG = 0.1020
+"""Knee to foot centre (m); MIT model (0.0265 m x 0.0985 m bent shank, made straight)."""
+FOOT_RADIUS = 0.01
+"""Radius of the foot sphere (m); ours."""
+TRUNK_SIZE = (0.24, 0.09, 0.023)
+"""Trunk box, full lengths (m); ours, read from the guide's height and clearance."""
+LEG_MASSES = (0.0623, 0.1279, 0.0464)
+"""Hip, upper-leg and lower-leg masses (kg); MIT model."""
+TOTAL_MASS = GUIDE["total_mass"]
+TRUNK_MASS = TOTAL_MASS - 4 * sum(LEG_MASSES)
+"""The trunk takes what the legs leave of the guide's 3 kg (2.0536 kg)."""
+STANDING_HEIGHT = GUIDE["ground_clearance"] + TRUNK_SIZE[2] / 2
+"""Height of the trunk's centre when standing (m): 0.1315."""
+STANCE_FEET = np.array([[0.16, 0.08, 0.0], [0.16, -0.08, 0.0],
+                        [-0.16, 0.08, 0.0], [-0.16, -0.08, 0.0]]) + [0.0, 0.0, FOOT_RADIUS - STANDING_HEIGHT]
+"""Nominal stance: foot centres in the body frame (m) when standing on flat ground."""
+MARKERS = np.array([[0.10, 0.03, 0.0115], [0.10, -0.04, 0.0115],
+                    [-0.11, 0.035, 0.0115], [-0.05, -0.02, 0.04]])
+"""MoCap markers in the body frame (m): three on the trunk's top, one on a post (not coplanar)."""
+JOINT_LIMITS = np.array([
+    [-0.6, 0.6], [-3.5, 2.4], [-3.1, 1.0],     # FL
+    [-0.6, 0.6], [-3.5, 2.4], [-3.1, 1.0],     # FR
+    [-0.6, 0.6], [-2.4, 3.5], [-1.0, 3.1],     # HL
+    [-0.6, 0.6], [-2.4, 3.5], [-1.0, 3.1],     # HR
+])
+"""Joint limits (rad), rows in :data:`JOINT_NAMES` order; MIT model."""
+TIMESTEP = 0.001
+"""MuJoCo's physics step (s): two steps per 500 Hz servo tick."""
+
+
+def _f(x: float) -> str:
+    return f"{x:.6g}"
+
+
+def _vec(v) -> str:
+    return " ".join(_f(float(x)) for x in v)
+
+
+def _leg_xml(i: int, armature: float, damping: float) -> str:
+    leg = LEGS[i]
+    side = 1.0 if leg.endswith("L") else -1.0
+    lim = JOINT_LIMITS[3 * i:3 * i + 3]
+    m_hip, m_upper, m_lower = LEG_MASSES
+    m_foot = 0.005
+    joint = f'armature="{_f(armature)}" damping="{_f(damping)}"'
+    return f"""
+      <body name="{leg}_hip" pos="{_vec(HIP_POSITIONS[i])}">
+        <joint name="{leg}_hip_roll" axis="1 0 0" range="{_vec(lim[0])}" {joint}/>
+        <geom class="link" type="cylinder" size="0.012 0.012" fromto="0 0 0 0 {_f(side * HIP_OFFSET)} 0" mass="{_f(m_hip)}"/>
+        <body name="{leg}_upper" pos="0 {_f(side * HIP_OFFSET)} 0">
+          <joint name="{leg}_hip_pitch" axis="0 1 0" range="{_vec(lim[1])}" {joint}/>
+          <geom class="link" type="capsule" size="0.011" fromto="0 0 0 0 0 {_f(-UPPER_LEG)}" mass="{_f(m_upper)}"/>
+          <body name="{leg}_lower" pos="0 0 {_f(-UPPER_LEG)}">
+            <joint name="{leg}_knee" axis="0 1 0" range="{_vec(lim[2])}" {joint}/>
+            <site name="{leg}_force" pos="0 0 0"/>
+            <geom class="link" type="capsule" size="0.008" fromto="0 0 0 0 0 {_f(-LOWER_LEG + FOOT_RADIUS)}" mass="{_f(m_lower - m_foot)}"/>
+            <geom name="{leg}_foot" class="foot" pos="0 0 {_f(-LOWER_LEG)}" mass="{_f(m_foot)}"/>
+            <site name="{leg}_foot" pos="0 0 {_f(-LOWER_LEG)}"/>
+          </body>
+        </body>
+      </body>"""
+
+
+def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: float = 1.0,
+                   timestep: float = TIMESTEP) -> str:
+    """Write the LittleDog model as MJCF (MuJoCo's XML), from this module's constants.
+
+    Parameters
+    ----------
+    armature : float, default 0
+        Inertia added to every joint (kg m^2): a geared motor's rotor inertia reflected through its
+        gearbox, ``J_m N^2`` (:func:`robokit.controllers.reflected_inertia`).
+    damping : float, default 0
+        Viscous friction at every joint (N m s/rad). Back-EMF damping is not here: the motor model
+        that turns voltage into torque holds it.
+    friction : float, default 1
+        Coulomb friction coefficient between the feet and the ground.
+    timestep : float, default :data:`TIMESTEP`
+        Physics step (s).
+
+    Returns
+    -------
+    str
+        MJCF with a free-floating trunk (``trunk``), twelve hinge joints named as
+        :data:`JOINT_NAMES`, one torque motor per joint (``ctrl`` is the joint torque, N m), sites
+        ``imu`` (gyro ``imu_gyro`` and accelerometer ``imu_acc``), ``marker0``..``marker3`` and per
+        leg ``<leg>_force`` (a 3-axis ``force`` sensor at the knee, in the lower leg's frame whose z
+        axis runs along the shank: the guide's single-axis lower-leg force sensor is its z
+        component) and ``<leg>_foot``.
+
+    Notes
+    -----
+    Only the feet and the trunk collide, and only with the ground; the legs' capsules carry mass
+    and inertia (from their shapes) and are drawn, but pass through each other.
+
+    Examples
+    --------
+    >>> import mujoco
+    >>> model = mujoco.MjModel.from_xml_string(littledog_mjcf())
+    >>> model.nu, model.nq, round(float(sum(model.body_mass)), 4)
+    (12, 19, 3.0)
+    """
+    armature = check_positive(armature, "armature", allow_zero=True)
+    damping = check_positive(damping, "damping", allow_zero=True)
+    friction = check_positive(friction, "friction")
+    timestep = check_positive(timestep, "timestep")
+    if timestep > 0.01:
+        raise ValueError(f"timestep: expected at most 0.01 s (the host period), got {timestep}")
+    legs = "".join(_leg_xml(i, armature, damping) for i in range(4))
+    markers = "".join(f'\n      <site name="marker{k}" pos="{_vec(m)}" size="0.006" rgba="0.9 0.9 0.9 1"/>'
+                      for k, m in enumerate(MARKERS))
+    motors = "".join(f'\n    <motor name="{n}" joint="{n}"/>' for n in JOINT_NAMES)
+    forces = "".join(f'\n    <force name="{leg}_force" site="{leg}_force"/>' for leg in LEGS)
+    lx, ly, lz = (s / 2 for s in TRUNK_SIZE)
+    return f"""<mujoco model="littledog">
+  <compiler angle="radian" inertiafromgeom="true" autolimits="true"/>
+  <option timestep="{_f(timestep)}" gravity="0 0 -9.81" integrator="implicitfast"/>
+  <default>
+    <geom contype="0" conaffinity="0" friction="{_f(friction)} 0.005 0.0001"/>
+    <default class="link"><geom rgba="0.25 0.25 0.28 1"/></default>
+    <default class="foot"><geom type="sphere" size="{_f(FOOT_RADIUS)}" contype="1" rgba="0.1 0.1 0.1 1"/></default>
+  </default>
+  <worldbody>
+    <geom name="ground" type="plane" size="5 5 0.1" contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>
+    <body name="trunk" pos="0 0 {_f(STANDING_HEIGHT)}">
+      <freejoint name="trunk"/>
+      <geom name="trunk" type="box" size="{_f(lx)} {_f(ly)} {_f(lz)}" contype="1" mass="{_f(TRUNK_MASS)}" rgba="0.15 0.15 0.6 1"/>
+      <site name="imu" pos="0 0 0"/>{markers}{legs}
+    </body>
+  </worldbody>
+  <actuator>{motors}
+  </actuator>
+  <sensor>
+    <gyro name="imu_gyro" site="imu"/>
+    <accelerometer name="imu_acc" site="imu"/>{forces}
+  </sensor>
+</mujoco>
+"""
+
+
+@functools.lru_cache(maxsize=8)
+def _compiled(armature: float, damping: float, friction: float, timestep: float):
+    import mujoco
+    return mujoco.MjModel.from_xml_string(littledog_mjcf(armature=armature, damping=damping,
+                                                         friction=friction, timestep=timestep))
+
+
+def littledog_model(*, armature: float = 0.0, damping: float = 0.0, friction: float = 1.0,
+                    timestep: float = TIMESTEP):
+    """The compiled MuJoCo model of :func:`littledog_mjcf` (compiled once per set of arguments).
+
+    Parameters
+    ----------
+    armature, damping, friction, timestep : float
+        As in :func:`littledog_mjcf`.
+
+    Returns
+    -------
+    mujoco.MjModel
+        A fresh copy: change it freely (``mujoco.MjModel`` is mutable).
+
+    Examples
+    --------
+    >>> model = littledog_model()
+    >>> model.opt.timestep, model.nsensordata      # gyro 3 + accelerometer 3 + 4 forces x 3
+    (0.001, 18)
+    """
+    import copy
+    args = [check_finite_scalar(v, n) for v, n in ((armature, "armature"), (damping, "damping"),
+                                                   (friction, "friction"), (timestep, "timestep"))]
+    littledog_mjcf(armature=args[0], damping=args[1], friction=args[2], timestep=args[3])  # validates
+    return copy.deepcopy(_compiled(*args))
