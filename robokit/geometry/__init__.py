@@ -10,17 +10,19 @@ robokit's with :func:`paper_world_to_robokit`. Functions accept one element or a
 axes where their docstrings say so; those that solvers call in loops take ``check=False``.
 
 Submodules: :mod:`~robokit.geometry.planar` (SE(2)), :mod:`~robokit.geometry.rotations` (SO(3)),
-:mod:`~robokit.geometry.spatial` (SE(3)), :mod:`~robokit.geometry.paper_frames` (the papers'
-``[p, q, theta]`` and camera frame).
+:mod:`~robokit.geometry.spatial` (SE(3)), :mod:`~robokit.geometry.procrustes` (the one weighted
+rigid fit of point sets, behind ``fit_se2`` and ``fit_se3``), :mod:`~robokit.geometry.paper_frames`
+(the papers' ``[p, q, theta]`` and camera frame).
 """
 from .paper_frames import (R_BODY_OPTICAL, as_pqt, optical_to_y_up, paper_world_to_robokit,
                            pqt_robot_to_world, pqt_rotate_xz, pqt_to_se2, pqt_to_se3, pqt_transform_xz,
                            pqt_world_to_robot, se2_to_pqt)
 from .planar import (as_planar, fit_se2, intersect_lines, matrix_to_se2, se2_between, se2_compose, se2_inverse, se2_to_matrix,
                      wrap_angle)
+from .procrustes import FIT_TOL, DegenerateFitError, RigidFit, fit_rigid
 from .rotations import (ROTATION_TOL, as_rotation, check_rotation_block, euler_matrix, rot_x, rot_y, rot_z, skew,
                         so3_exp, so3_log, zyz_angles)
-from .spatial import (as_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, se3_inverse, se3_to_se2,
+from .spatial import (as_se3, fit_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, se3_inverse, se3_to_se2,
                       transform_points)
 
 __all__ = [
@@ -29,7 +31,8 @@ __all__ = [
     "ROTATION_TOL", "as_rotation", "check_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y",
     "rot_z", "euler_matrix", "zyz_angles",
     "as_se3", "se3_from_rt", "se3_inverse", "se3_compose", "transform_points", "se2_to_se3", "se3_to_se2",
-    "pose_error",
+    "pose_error", "fit_se3",
+    "FIT_TOL", "DegenerateFitError", "RigidFit", "fit_rigid",
     "R_BODY_OPTICAL", "as_pqt", "se2_to_pqt", "pqt_to_se2", "pqt_to_se3", "pqt_rotate_xz", "pqt_transform_xz",
     "pqt_robot_to_world", "pqt_world_to_robot", "paper_world_to_robokit", "optical_to_y_up",
 ]

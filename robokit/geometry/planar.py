@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array
+from .procrustes import fit_rigid
 from .rotations import as_rotation
 
 __all__ = ["as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
@@ -292,16 +293,20 @@ def fit_se2(source: Any, target: Any, weights: Any = None, *, check: bool = True
 
     Raises
     ------
+    DegenerateFitError
+        (A ``ValueError``, with ``check``) for fewer than two points, or points that all coincide,
+        which leave the heading undetermined.
     ValueError
-        For shapes that do not agree, fewer than two points, NaN/inf, negative or all-zero weights,
-        or (with ``check``) points that all coincide, which leave the heading undetermined.
+        For shapes that do not agree, NaN/inf, or negative or all-zero weights.
 
     Notes
     -----
-    The closed-form minimiser (Umeyama 1991, without scale): the weighted centroids align and
-    ``theta = atan2(sum w (s' x t'), sum w (s' . t'))`` for the centred points ``s', t'``. With two
-    points it is the two-point pose of Lin et al. (Sec. 5): the heading from the direction between
-    them and the translation from their midpoints.
+    The closed-form minimiser of Umeyama (1991), Eqs. (34)-(41) without scale, computed by the one
+    rigid-fit kernel :func:`~robokit.geometry.procrustes.fit_rigid` (shared with
+    :func:`~robokit.geometry.fit_se3`); the heading is ``atan2(R[1, 0], R[0, 0])``. In the plane it
+    equals ``theta = atan2(sum w (s' x t'), sum w (s' . t'))`` for the centred points ``s', t'``.
+    With two points it is the two-point pose of Lin et al. (Sec. 5): the heading from the
+    direction between them and the translation from their midpoints.
 
     Examples
     --------
@@ -312,29 +317,11 @@ def fit_se2(source: Any, target: Any, weights: Any = None, *, check: bool = True
     """
     if check:
         s = as_array(source, "source")
-        if s.ndim < 2 or s.shape[-1] != 2 or s.shape[-2] < 2:
+        if s.ndim < 2 or s.shape[-1] != 2:
             raise ValueError(f"source: expected shape (..., N, 2) with N >= 2, got shape {s.shape}")
-        t = as_array(target, "target", shape=s.shape)
-        w = np.ones(s.shape[:-1]) if weights is None else as_array(weights, "weights", shape=s.shape[:-1])
-        if np.any(w < 0) or np.any(w.sum(-1) <= 0):
-            raise ValueError("weights: expected non-negative weights with a positive sum per problem")
-    else:
-        s, t = source, target
-        w = np.ones(s.shape[:-1]) if weights is None else weights
-    total = w.sum(-1, keepdims=True)
-    sc = (w[..., None] * s).sum(-2) / total
-    tc = (w[..., None] * t).sum(-2) / total
-    a, b = s - sc[..., None, :], t - tc[..., None, :]
-    cross = (w * (a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0])).sum(-1)
-    dot = (w * (a * b).sum(-1)).sum(-1)
-    if check and np.any(np.hypot(cross, dot) < 1e-12):
-        raise ValueError("source, target: expected points spread on the plane, got (nearly) coincident ones "
-                         "(the heading is undetermined)")
-    theta = np.arctan2(cross, dot)
-    c, si = np.cos(theta), np.sin(theta)
-    x = tc[..., 0] - (c * sc[..., 0] - si * sc[..., 1])
-    y = tc[..., 1] - (si * sc[..., 0] + c * sc[..., 1])
-    return np.stack([x, y, wrap_angle(theta)], axis=-1)
+        source = s
+    R, t, _ = fit_rigid(source, target, weights, check=check)
+    return np.stack([t[..., 0], t[..., 1], wrap_angle(np.arctan2(R[..., 1, 0], R[..., 0, 0]))], axis=-1)
 
 
 def intersect_lines(origins: Any, directions: Any) -> tuple[np.ndarray, np.ndarray]:
