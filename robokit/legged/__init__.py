@@ -2,7 +2,18 @@
 from .littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, JOINT_NAMES, JOINTS,
                         LEG_MASSES, LEGS, LOWER_LEG, MARKERS, STANCE_FEET, STANDING_HEIGHT, TIMESTEP,
                         TOTAL_MASS, TRUNK_MASS, TRUNK_SIZE, UPPER_LEG, littledog_mjcf, littledog_model)
+# sensing and estimation (MoCap, IMU, fusion, touchdowns)
+from .imu import GRAVITY, ImuReadings, integrate_gyro, simulate_imu, specific_force
+from .mocap import (MocapFrames, MocapPoses, TooFewMarkersError, fit_marker_pose, mocap_body_poses,
+                    simulate_mocap)
+from .state_estimation import BodyState, fuse_body_state, orientation_errors, position_errors
+from .touchdown import EventScore, contact_events, detect_contacts, event_precision_recall
 
 __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS", "JOINT_NAMES", "JOINTS",
            "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS", "STANCE_FEET", "STANDING_HEIGHT", "TIMESTEP",
-           "TOTAL_MASS", "TRUNK_MASS", "TRUNK_SIZE", "UPPER_LEG", "littledog_mjcf", "littledog_model"]
+           "TOTAL_MASS", "TRUNK_MASS", "TRUNK_SIZE", "UPPER_LEG", "littledog_mjcf", "littledog_model",
+           # sensing and estimation
+           "GRAVITY", "ImuReadings", "simulate_imu", "integrate_gyro", "specific_force",
+           "MocapFrames", "MocapPoses", "TooFewMarkersError", "simulate_mocap", "fit_marker_pose", "mocap_body_poses",
+           "BodyState", "fuse_body_state", "orientation_errors", "position_errors",
+           "EventScore", "detect_contacts", "contact_events", "event_precision_recall"]
