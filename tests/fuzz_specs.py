@@ -390,6 +390,30 @@ def distance_grid():   # lesson 03's exercise: distance to a wall at x = 1.55 m 
     return np.abs(np.arange(20)[None, :] * 0.1 + 0.05 - 1.55) * np.ones((20, 1))
 
 
+# --- lesson 04's sensing (robokit.legged.mocap, imu, state_estimation, touchdown) --------------
+
+def sensing_T(n=5):         # a short walk of body poses
+    from robokit.geometry import rot_z, se3_from_rt
+    k = np.arange(n)
+    return se3_from_rt(rot_z(0.05 * k), np.column_stack([0.01 * k, np.zeros(n), np.full(n, 0.13)]))
+
+
+@functools.cache
+def sensing_frames():
+    from robokit.legged import MARKERS
+    from robokit.legged.mocap import simulate_mocap
+    return simulate_mocap(sensing_T(), MARKERS, 0.001, 0.0, 0)
+
+
+def sensing_markers():
+    from robokit.legged import MARKERS
+    return MARKERS.copy()
+
+
+def walk_contacts():
+    return np.array([False, True, True, False, True, True, True, False, False, True, True, False])
+
+
 SPECS: dict[str, Call] = {
     # --- about, geometry --------------------------------------------------------------------
     "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
@@ -1108,6 +1132,55 @@ SPECS: dict[str, Call] = {
         "particles": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.5]]), "N,3"),
         "weights": Array(np.array([0.5, 0.5]), "N", optional=True), "z": Real(0.03), "arrow": Real(0.15),
         "color": Given(0xAA2288), "size": Real(0.04)}),
+    # --- robokit.geometry.procrustes / spatial.fit_se3, robokit.legged sensing (lesson 04) -----------
+    "robokit.geometry.procrustes.fit_rigid": Call({
+        "source": Array(lambda: points(6), "N,2|N,3|N,N,2|N,N,3"),
+        "target": Array(lambda: points(6) @ np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]]).T + 1.0,
+                        "N,2|N,3|N,N,2|N,N,3"),
+        "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
+    "robokit.geometry.spatial.fit_se3": Call({
+        "source": Array(lambda: points(6), "N,3|N,N,3"), "target": Array(lambda: points(6) + 1.0, "N,3|N,N,3"),
+        "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
+    "robokit.legged.mocap.simulate_mocap": Call({
+        "T_world_body": Array(sensing_T, "N,4,4|4,4"), "markers_body": Array(sensing_markers, "N,3|3"),
+        "noise": Real(0.001), "dropout": Real(0.1), "rng": Rng(0), "bursts": Real(0.1), "burst_length": Int(2)}),
+    "robokit.legged.mocap.fit_marker_pose": Call({
+        "markers_body": Array(sensing_markers, "N,3|3"), "observed": Array(lambda: sensing_frames().positions[0], "N,3"),
+        "visible": Array(np.ones(4, bool), "N", optional=True, accepts=("booleans",))}),
+    "robokit.legged.mocap.mocap_body_poses": Call({
+        "markers_body": Array(sensing_markers, "N,3|3"), "observed": Array(lambda: sensing_frames().positions, "N,N,3"),
+        "visible": Array(lambda: sensing_frames().visible, "N,N", accepts=("booleans",))}),
+    "robokit.legged.imu.simulate_imu": Call({
+        "omega_body": Array(np.tile([0.0, 0.1, 0.3], (5, 1)), "N,3"),
+        "specific_force_body": Array(np.tile([0.0, 0.0, 9.81], (5, 1)), "N,3"), "rng": Rng(0),
+        "gyro_noise": Real(0.005), "acc_noise": Real(0.05), "gyro_bias": Array(np.array([0.02, 0.0, 0.0]), "3"),
+        "acc_bias": Array(np.array([0.1, 0.0, 0.0]), "3")}),
+    "robokit.legged.imu.integrate_gyro": Call({
+        "R0": Array(np.eye(3), "3,3"), "gyro": Array(np.tile([0.0, 0.1, 0.3], (5, 1)), "N,3"), "dt": Real(0.01)}),
+    "robokit.legged.imu.specific_force": Call({
+        "acc_world": Array(np.array([[0.1, 0.0, 0.0], [0.0, 0.2, 0.0]]), "N,3"),
+        "R_world_body": Array(lambda: sensing_T(2)[:, :3, :3], "N,3,3"), "g": Real(9.81)}),
+    "robokit.legged.state_estimation.fuse_body_state": Call({
+        "gyro": Array(np.tile([0.0, 0.0, 0.05], (5, 1)), "N,3"), "acc": Array(np.tile([0.0, 0.0, 9.81], (5, 1)), "N,3"),
+        "dt": Real(0.01), "T_mocap": Array(sensing_T, "N,4,4"),
+        "mocap_ok": Array(np.array([True, False, True, True, True]), "N", accepts=("booleans",)),
+        "k_p": Real(2.0), "k_i": Real(0.5), "sigma_acc": Real(0.5), "sigma_mocap": Real(0.001),
+        "R0": Array(np.eye(3), "3,3", optional=True), "p0": Array(np.array([0.0, 0.0, 0.13]), "3", optional=True),
+        "g": Real(9.81)}),
+    "robokit.legged.state_estimation.orientation_errors": Call({
+        "R_est": Array(lambda: sensing_T(3)[:, :3, :3], "N,3,3|3,3"),
+        "R_true": Array(lambda: sensing_T(3)[::-1, :3, :3], "N,3,3|3,3")}),
+    "robokit.legged.state_estimation.position_errors": Call({
+        "p_est": Array(np.array([[0.0, 0.0, 0.13], [0.1, 0.0, 0.13]]), "N,3"),
+        "p_true": Array(np.array([[0.0, 0.01, 0.13], [0.1, 0.0, 0.12]]), "N,3")}),
+    "robokit.legged.touchdown.detect_contacts": Call({
+        "force": Array(np.array([0.0, 4.0, 6.0, 1.0, 6.0, 0.5]), "N|N,N", min_rows=0), "threshold_on": Real(3.0),
+        "threshold_off": Real(1.0), "debounce": Int(2)}),
+    "robokit.legged.touchdown.contact_events": Call({
+        "contact": Array(walk_contacts, "N|N,N", min_rows=0, accepts=("booleans",))}),
+    "robokit.legged.touchdown.event_precision_recall": Call({
+        "detected": Array(lambda: np.roll(walk_contacts(), 1), "N|N,N", accepts=("booleans",)),
+        "truth": Array(walk_contacts, "N|N,N", accepts=("booleans",)), "tolerance": Int(2)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -1195,6 +1268,12 @@ EXTRA: tuple[str, ...] = (
         "keyframes.select_keyframes_orbslam", "bag_of_words.tf_idf", "bag_of_words.l1_score",
         "bag_of_words.Vocabulary", "bag_of_words.Vocabulary.train",
         "bow_database.BowDatabase")),
+    # lesson 04's sensing: the one rigid fit, MoCap, IMU, fusion, touchdowns
+    "robokit.geometry.procrustes.fit_rigid", "robokit.geometry.spatial.fit_se3",
+    *(f"robokit.legged.mocap.{n}" for n in ("simulate_mocap", "fit_marker_pose", "mocap_body_poses")),
+    *(f"robokit.legged.imu.{n}" for n in ("simulate_imu", "integrate_gyro", "specific_force")),
+    *(f"robokit.legged.state_estimation.{n}" for n in ("fuse_body_state", "orientation_errors", "position_errors")),
+    *(f"robokit.legged.touchdown.{n}" for n in ("detect_contacts", "contact_events", "event_precision_recall")),
 )
 
 

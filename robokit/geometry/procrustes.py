@@ -143,6 +143,7 @@ def fit_rigid(source: Any, target: Any, weights: Any = None, *, check: bool = Tr
                   | ((sign < 0) & (sv[..., d - 2] - sv[..., d - 1] <= gap)))
     if check and np.any(degenerate):
         i = int(np.argmax(degenerate.reshape(-1)))
-        raise DegenerateFitError("source, target: expected points that fix the rotation (not all coincident; "
+        names = "source, target" if weights is None else "source, target, weights"
+        raise DegenerateFitError(f"{names}: expected points that fix the rotation (not all coincident; "
                                  f"in 3-D not all on one line), got a degenerate set (problem {i})")
     return RigidFit(R, trans, degenerate)

@@ -192,7 +192,11 @@ def fit_marker_pose(markers_body: Any, observed: Any, visible: Any = None) -> np
         raise TooFewMarkersError(f"visible: expected at least 3 visible markers for a body pose, got {int(vis.sum())}")
     if not np.all(np.isfinite(obs[vis])):
         raise ValueError("observed: expected finite positions of the visible markers, got NaN or infinity")
-    return fit_se3(m[vis], obs[vis])
+    try:
+        return fit_se3(m[vis], obs[vis])
+    except DegenerateFitError:
+        raise DegenerateFitError("markers_body, observed: expected visible markers that are not all on one line "
+                                 "(relative to their spread), got a degenerate set") from None
 
 
 def mocap_body_poses(markers_body: Any, observed: Any, visible: Any) -> MocapPoses:
@@ -220,7 +224,7 @@ def mocap_body_poses(markers_body: Any, observed: Any, visible: Any) -> MocapPos
     TooFewMarkersError
         (A ``ValueError``) if no frame of the trial has a pose (naming ``visible``).
     ValueError
-        For shapes that do not agree or NaN/inf in a visible marker.
+        For shapes that do not agree, no frames, or NaN/inf in a visible marker.
 
     Notes
     -----
@@ -242,6 +246,8 @@ def mocap_body_poses(markers_body: Any, observed: Any, visible: Any) -> MocapPos
     """
     m = _markers(markers_body)
     obs = as_array(observed, "observed", shape=(None, len(m), 3), finite=False)
+    if len(obs) == 0:
+        raise ValueError("observed: expected at least one frame, shape (N, M, 3), got none")
     vis = _visible(visible, obs.shape[:2])
     if not np.all(np.isfinite(obs[vis])):
         raise ValueError("observed: expected finite positions of the visible markers, got NaN or infinity")
@@ -254,8 +260,8 @@ def mocap_body_poses(markers_body: Any, observed: Any, visible: Any) -> MocapPos
         T[ok, :3, :3], T[ok, :3, 3], T[:, 3, 3] = fit.R, fit.t, 1.0
         ok[ok] = ~fit.degenerate
     if not ok.any():
-        raise TooFewMarkersError(f"visible: expected a frame with at least 3 visible markers (not on one line), "
-                                 f"got none in {n} frames")
+        raise TooFewMarkersError(f"visible, markers_body, observed: expected a frame with at least 3 visible markers "
+                                 f"not all on one line, got none in {n} frames")
     last = np.maximum.accumulate(np.where(ok, np.arange(n), -1))
     last[last < 0] = int(np.argmax(ok))
     return MocapPoses(T[last], ok)

@@ -134,15 +134,15 @@ def fuse_body_state(gyro: Any, acc: Any, dt: float, T_mocap: Any, mocap_ok: Any,
     w = as_vector_series(gyro, "gyro")
     f = as_vector_series(acc, "acc", len(w))
     n = len(w)
-    step = check_positive(dt, "dt")
+    step = np.float64(check_positive(dt, "dt"))
     T = as_se3(T_mocap, "T_mocap", batch=True)
     if len(T) != n:
         raise ValueError(f"T_mocap: expected {n} poses (one per IMU sample), got {len(T)}")
     ok = as_array(mocap_ok, "mocap_ok", shape=(n,), dtype=bool)
     kp = check_positive(k_p, "k_p", allow_zero=True)
     ki = check_positive(k_i, "k_i", allow_zero=True)
-    s_acc = check_positive(sigma_acc, "sigma_acc")
-    s_mocap = check_positive(sigma_mocap, "sigma_mocap")
+    var_acc = np.float64(check_positive(sigma_acc, "sigma_acc")) ** 2      # numpy: overflow gives inf, not an error
+    var_mocap = np.float64(check_positive(sigma_mocap, "sigma_mocap")) ** 2
     gz = check_positive(g, "g", allow_zero=True)
     R_hat = T[0, :3, :3].copy() if R0 is None else as_rotation(R0, "R0")
     p_start = T[0, :3, 3] if p0 is None else as_array(p0, "p0", shape=(3,))
@@ -150,10 +150,10 @@ def fuse_body_state(gyro: Any, acc: Any, dt: float, T_mocap: Any, mocap_ok: Any,
     R_out, p_out, v_out, b_out = np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     b_hat = np.zeros(3)
     x = np.column_stack([p_start, np.zeros(3)])          # per axis [p, v]
-    P = np.diag([s_mocap ** 2, 1.0])                     # shared by the three axes
+    P = np.diag([var_mocap, 1.0])                     # shared by the three axes
     A = np.array([[1.0, step], [0.0, 1.0]])
     B = np.array([0.5 * step ** 2, step])
-    Q_acc = s_acc ** 2 * np.outer(B, B)                  # white acceleration held over a step
+    Q_acc = var_acc * np.outer(B, B)                  # white acceleration held over a step
     gravity = np.array([0.0, 0.0, gz])
     R_out[0], p_out[0], v_out[0], b_out[0] = R_hat, x[:, 0], x[:, 1], b_hat
     for k in range(1, n):
@@ -169,11 +169,11 @@ def fuse_body_state(gyro: Any, acc: Any, dt: float, T_mocap: Any, mocap_ok: Any,
         x = x @ A.T + np.outer(a_world, B)                                     # line 2
         P = A @ P @ A.T + Q_acc                                                # line 3
         if ok[k]:
-            K = P[:, 0] / (P[0, 0] + s_mocap ** 2)                             # line 4
+            K = P[:, 0] / (P[0, 0] + var_mocap)                             # line 4
             x = x + np.outer(T[k, :3, 3] - x[:, 0], K)                         # line 5
             P = P - np.outer(K, P[0])                                          # line 6
         R_out[k], p_out[k], v_out[k], b_out[k] = R_hat, x[:, 0], x[:, 1], b_hat
-    check_finite_result("gyro, acc, k_p, k_i, sigma_acc, sigma_mocap", p_out, v_out, b_out)
+    check_finite_result("gyro, acc, dt, k_p, k_i, sigma_acc, sigma_mocap, p0, g", p_out, v_out, b_out, R_out)
     return BodyState(R_out, p_out, v_out, b_out)
 
 
