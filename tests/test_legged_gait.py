@@ -239,5 +239,7 @@ def test_walking_plan_bad_input():
     with pytest.raises(ValueError, match="nominal_feet"):
         walking_plan(crawl_gait(), 1.0, nominal_feet=[[0.1, 0.0, -0.1], [0.0, 0.0, -0.1], [-0.1, 0.0, -0.1],
                                                       [-0.2, 0.0, -0.1]])
-    with pytest.raises(ValueError, match="distance, dt"):
+    with pytest.raises(ValueError, match="distance, schedule: expected at most 100000 steps"):
         walking_plan(crawl_gait(), 1e9)
+    with pytest.raises(ValueError, match="distance, dt, settle, schedule: expected at most"):
+        walking_plan(crawl_gait(), 1.0, dt=1e-6)

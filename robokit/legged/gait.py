@@ -40,12 +40,14 @@ import numpy as np
 from ..validation import array_ndim, as_array, broadcast_to, check_positive, check_sample_count
 from .gait_schedule import (CRAWL_SEQUENCE, LEGS, NOMINAL_FEET, TROT_PAIRS, GaitSchedule, as_gait_schedule, crawl_gait,
                             stance_pattern, trot_gait)
-from .support import stability_margins, support_polygon
+from .support import SupportPolygonError, stability_margins, support_polygon
 
 __all__ = ["GaitSchedule", "crawl_gait", "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan",
            "walking_plan", "CRAWL_SEQUENCE", "TROT_PAIRS"]
 
 _EPS = 1e-9      # s and m: below this, two instants or two footholds are the same
+#: Most steps (``distance / step_length``) a plan may take: a bound no walk comes near.
+MAX_STEPS = 100_000
 
 
 def _smoothstep(u: np.ndarray) -> np.ndarray:
@@ -139,6 +141,12 @@ class WalkPlan(NamedTuple):
     margin : numpy.ndarray, shape (N,)
         Static stability margin (m) of the trunk centre over the stance feet
         (:func:`robokit.legged.support.stability_margins`); ``-inf`` with fewer than three feet down.
+
+    Examples
+    --------
+    >>> plan = walking_plan(trot_gait(), 0.1)
+    >>> plan.feet_world.shape == (len(plan.t), 4, 3), bool(np.isneginf(plan.margin).any())
+    (True, True)
     """
 
     t: np.ndarray
@@ -257,7 +265,7 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     ValueError, TypeError
         For invalid arguments; a crawl schedule without a four-foot phase (``duty_factor`` 0.75:
         no time to shift the body); a ``margin`` that no point of some support triangle has (the
-        triangle's inradius is smaller); too many samples.
+        triangle's inradius is smaller); more than ``MAX_STEPS`` steps or too many samples.
 
     Notes
     -----
@@ -306,6 +314,9 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     settle = check_positive(settle, "settle", allow_zero=True)
     margin = check_positive(margin, "margin")
     T, beta = schedule.period, schedule.duty_factor
+    if not distance / schedule.step_length <= MAX_STEPS:
+        raise ValueError(f"distance, schedule: expected at most {MAX_STEPS} steps of step_length, got "
+                         f"{distance / schedule.step_length:.3g}")
     check_sample_count((2 * settle + (distance / schedule.step_length + 4) * T) / dt, "distance, dt, settle, schedule")
 
     static = schedule.max_swinging == 1
@@ -325,7 +336,11 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
         knots_t, knots_p, now = [tau0], [np.zeros(2)], footholds.copy()
         for sw in swings:
             others = [i for i in range(4) if i != sw.leg]
-            triangle = support_polygon(now[others, :2])
+            try:
+                triangle = support_polygon(now[others, :2])
+            except SupportPolygonError:
+                raise ValueError(f"nominal_feet: the three feet that stay down when {LEGS[sw.leg]} lifts are "
+                                 "collinear: no support triangle") from None
             goal = np.array([progress(sw.lift + schedule.swing_duration / 2), 0.0])
             target = _nearest_point_inside(triangle, margin + _EPS, goal, LEGS[sw.leg])
             knots_t += [sw.lift, sw.touchdown]

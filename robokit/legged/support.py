@@ -187,7 +187,7 @@ def stability_margins(feet_xy: Any, stance: Any, com_xy: Any) -> np.ndarray:
     each hull. An ordered pair of stance feet ``(i, j)`` is an edge of the counter-clockwise hull
     when every other stance foot lies on its left or on its line; the centre of mass is inside when
     it is left of every such edge, and the margin is its distance to the nearest one. All K (K - 1)
-    ordered pairs are tested for all N instants at once (arrays of N x K x K x K values, no loop
+    ordered pairs are tested for all N instants at once (arrays of N x K (K - 1) x K values, no loop
     over time). Where a foot lies on an edge, the edge's parts count as edges too, which changes no
     distance. Collinear stance feet are detected as in :func:`support_polygon`.
 
@@ -216,20 +216,21 @@ def stability_margins(feet_xy: Any, stance: Any, com_xy: Any) -> np.ndarray:
     half_trace, root = (sxx + syy) / 2, np.hypot((sxx - syy) / 2, sxy)
     flat = ~(half_trace - root > FLATNESS ** 2 * (half_trace + root))
 
-    # every ordered pair (i, j) as a candidate edge, its vector e and the other feet seen from i
+    # every ordered pair (i, j) as a candidate edge: its vector e, and every foot seen from foot i
+    x, y = feet[..., 0], feet[..., 1]                              # (N, K) each
     i, j = np.nonzero(~np.eye(k, dtype=bool))                      # the K (K - 1) ordered pairs
-    a, e = feet[:, i], feet[:, j] - feet[:, i]                     # (N, P, 2)
-    to_feet = feet[:, None, :, :] - a[:, :, None, :]               # (N, P, K, 2): foot k from a
-    cross = e[..., None, 0] * to_feet[..., 1] - e[..., None, 1] * to_feet[..., 0]
-    scale = np.linalg.norm(e, axis=-1)[..., None] * np.linalg.norm(to_feet, axis=-1)
-    left = (cross >= -FLATNESS * scale) | ~mask[:, None, :]        # each other foot: left, on the line, or up
-    length2 = np.sum(e * e, axis=-1)
-    is_edge = mask[:, i] & mask[:, j] & (length2 > 0) & left.all(axis=-1)
+    ex, ey = x[:, j] - x[:, i], y[:, j] - y[:, i]                  # (N, P)
+    dx, dy = x[:, None, :] - x[:, i, None], y[:, None, :] - y[:, i, None]      # (N, P, K)
+    cross = ex[..., None] * dy - ey[..., None] * dx
+    length2 = ex * ex + ey * ey
+    # each foot left of the edge, on its line (|sin| <= FLATNESS), or in the air
+    left = (cross >= 0) | (cross * cross <= FLATNESS ** 2 * length2[..., None] * (dx * dx + dy * dy))
+    is_edge = mask[:, i] & mask[:, j] & (length2 > 0) & (left | ~mask[:, None, :]).all(axis=-1)
 
-    rel = com[:, None, :] - a                                      # (N, P, 2)
-    inside = (e[..., 0] * rel[..., 1] - e[..., 1] * rel[..., 0] >= 0) | ~is_edge
-    t = np.clip(np.sum(rel * e, axis=-1) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
-    distance = np.linalg.norm(rel - t[..., None] * e, axis=-1)
+    rx, ry = com[:, 0, None] - x[:, i], com[:, 1, None] - y[:, i]  # (N, P): the centre of mass seen from i
+    inside = (ex * ry - ey * rx >= 0) | ~is_edge
+    t = np.clip((rx * ex + ry * ey) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
+    distance = np.hypot(rx - t * ex, ry - t * ey)                  # to the nearest point of the segment
     nearest = np.where(is_edge, distance, np.inf).min(axis=1)
     margin = np.where(inside.all(axis=1), nearest, -nearest)
     return np.where((count < 3) | flat, -np.inf, margin)
