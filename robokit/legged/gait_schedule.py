@@ -58,7 +58,8 @@ class GaitSchedule:
         ``(1 - beta) T``.
     phase_offsets : numpy.ndarray, shape (4,)
         For each leg (order ``FL, FR, HL, HR``), the fraction of the cycle, in [0, 1), at which it
-        lifts off. (McGhee & Frank count phase from touchdown; the two differ by ``1 - beta``.)
+        lifts off. (McGhee & Frank measure a leg's phase at its touchdown, relative to a reference
+        leg; touchdown follows lift-off by ``(1 - beta) T`` for every leg, so relative phases agree.)
     step_length : float
         How far (m) a foot moves forward in a steady-state swing, which is also how far the body
         advances per cycle (mean speed ``step_length / period``).
@@ -157,7 +158,7 @@ def crawl_gait(period: float = 4.0, step_length: float = 0.08, step_height: floa
     McGhee & Frank (1968) prove that of the six leg sequences of a regular creeping gait with
     ``beta >= 3/4``, the one in which each hind leg is followed by the front leg on its own side
     (left hind, left front, right hind, right front) has the largest longitudinal stability
-    margin (their main theorem, unnumbered).
+    margin (unnumbered).
 
     Examples
     --------
