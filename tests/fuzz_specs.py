@@ -412,6 +412,14 @@ def sensing_markers():
 
 def walk_contacts():
     return np.array([False, True, True, False, True, True, True, False, False, True, True, False])
+def unit_square():
+    return np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+
+
+@functools.cache
+def gait(name):
+    from robokit.legged import crawl_gait, trot_gait
+    return {"crawl": crawl_gait, "trot": trot_gait}[name]()
 
 
 SPECS: dict[str, Call] = {
@@ -1181,11 +1189,40 @@ SPECS: dict[str, Call] = {
     "robokit.legged.touchdown.event_precision_recall": Call({
         "detected": Array(lambda: np.roll(walk_contacts(), 1), "N|N,N", accepts=("booleans",)),
         "truth": Array(walk_contacts, "N|N,N", accepts=("booleans",)), "tolerance": Int(2)}),
+    # --- robokit.legged.support, gait_schedule, gait (lesson 04's gaits) ----------------------------
+    "robokit.legged.support.support_polygon": Call({"feet_xy": Array(lambda: unit_square(), "N,2")}),
+    "robokit.legged.support.stability_margin": Call({"feet_xy": Array(lambda: unit_square(), "N,2"),
+                                                     "com_xy": Array(np.array([0.5, 0.4]), "2")}),
+    "robokit.legged.support.stability_margins": Call({
+        "feet_xy": Array(lambda: np.stack([unit_square()] * 3), "N,N,2"),
+        "stance": Array(np.array([[1, 1, 1, 1], [1, 1, 1, 0], [1, 0, 1, 0]], bool), "N,N", accepts=("booleans",)),
+        "com_xy": Array(np.array([[0.5, 0.5], [0.6, 0.5], [0.5, 0.5]]), "N,2")}),
+    "robokit.legged.gait_schedule.GaitSchedule": Call({
+        "name": Text("crawl"), "period": Real(4.0), "duty_factor": Real(0.9),
+        "phase_offsets": Array(np.array([0.25, 0.75, 0.0, 0.5]), "4"), "step_length": Real(0.08),
+        "step_height": Real(0.03)}),
+    "robokit.legged.gait_schedule.crawl_gait": Call({"period": Real(4.0), "step_length": Real(0.08),
+                                                     "step_height": Real(0.03), "duty_factor": Real(0.9)}),
+    "robokit.legged.gait_schedule.trot_gait": Call({"period": Real(0.5), "step_length": Real(0.06),
+                                                    "step_height": Real(0.03), "duty_factor": Real(0.5)}),
+    "robokit.legged.gait_schedule.as_gait_schedule": Call({"schedule": Obj(lambda: gait("crawl"))}),
+    "robokit.legged.gait_schedule.stance_pattern": Call({"schedule": Obj(lambda: gait("trot")),
+                                                         "t": Array(np.array([0.0, 0.3, 7.1]), "N|", min_rows=0)}),
+    "robokit.legged.gait.swing_trajectory": Call({
+        "p_start": Array(np.array([0.0, 0.08, 0.01]), "3|N,3"), "p_end": Array(np.array([0.08, 0.08, 0.01]), "3|N,3"),
+        "phase": Array(np.array([0.0, 0.5, 1.0]), "N|", min_rows=0), "height": Real(0.03)}),
+    "robokit.legged.gait.walking_plan": Call({
+        "schedule": Obj(lambda: gait("crawl")), "distance": Real(0.1),
+        "nominal_feet": Array(lambda: np.array([[0.16, 0.08, -0.1215], [0.16, -0.08, -0.1215],
+                                                [-0.16, 0.08, -0.1215], [-0.16, -0.08, -0.1215]]), "4,3",
+                              optional=True),
+        "body_height": Real(0.1315), "dt": Real(0.01), "settle": Real(0.5), "margin": Real(0.02)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
 NOT_FUZZED: dict[str, str] = {
     "robokit.sim.motion.Path": "a plain record (NamedTuple) of t and poses; the functions that take one validate it",
+    "robokit.legged.gait.WalkPlan": "a plain record (NamedTuple) of a plan's arrays; walking_plan makes it",
     "robokit.grading.check.check": "the notebook's checker of a student's function (grading's own tests cover it)",
 }
 
@@ -1274,6 +1311,11 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.legged.imu.{n}" for n in ("simulate_imu", "integrate_gyro", "specific_force")),
     *(f"robokit.legged.state_estimation.{n}" for n in ("fuse_body_state", "orientation_errors", "position_errors")),
     *(f"robokit.legged.touchdown.{n}" for n in ("detect_contacts", "contact_events", "event_precision_recall")),
+    # robokit.legged's gaits (lesson 04), fuzzed before the lesson exists
+    *(f"robokit.legged.support.{n}" for n in ("support_polygon", "stability_margin", "stability_margins")),
+    *(f"robokit.legged.gait_schedule.{n}" for n in (
+        "GaitSchedule", "crawl_gait", "trot_gait", "as_gait_schedule", "stance_pattern")),
+    "robokit.legged.gait.swing_trajectory", "robokit.legged.gait.walking_plan",
 )
 
 

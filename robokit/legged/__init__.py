@@ -8,6 +8,10 @@ from .mocap import (MocapFrames, MocapPoses, TooFewMarkersError, fit_marker_pose
                     simulate_mocap)
 from .state_estimation import BodyState, fuse_body_state, orientation_errors, position_errors
 from .touchdown import EventScore, contact_events, detect_contacts, event_precision_recall
+# gaits: support polygon and stability margin, gait schedules, crawl and trot plans
+from .gait import WalkPlan, swing_trajectory, walking_plan
+from .gait_schedule import CRAWL_SEQUENCE, TROT_PAIRS, GaitSchedule, crawl_gait, stance_pattern, trot_gait
+from .support import SupportPolygonError, stability_margin, stability_margins, support_polygon
 
 __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS", "JOINT_NAMES", "JOINTS",
            "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS", "STANCE_FEET", "STANDING_HEIGHT", "TIMESTEP",
@@ -16,4 +20,8 @@ __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS"
            "GRAVITY", "ImuReadings", "simulate_imu", "integrate_gyro", "specific_force",
            "MocapFrames", "MocapPoses", "TooFewMarkersError", "simulate_mocap", "fit_marker_pose", "mocap_body_poses",
            "BodyState", "fuse_body_state", "orientation_errors", "position_errors",
-           "EventScore", "detect_contacts", "contact_events", "event_precision_recall"]
+           "EventScore", "detect_contacts", "contact_events", "event_precision_recall",
+           # gaits
+           "SupportPolygonError", "support_polygon", "stability_margin", "stability_margins", "GaitSchedule", "crawl_gait",
+           "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan", "walking_plan", "CRAWL_SEQUENCE", "TROT_PAIRS",
+]
