@@ -453,7 +453,7 @@ SPECS: dict[str, Call] = {
         "kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3), "omega": Array(np.array([0.1, 1.0, 10.0]), "N|"), "gain": Real(1.0)}),
     "robokit.controllers.heading_loop.heading_step_response": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
                                                                "gain": Real(1.0), "duration": Real(2.0), "n": Int(50)}),
-    "robokit.controllers.heading_loop.loop_metrics": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+    "robokit.controllers.servo_loop.loop_metrics": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
                                                       "gain": Real(1.0), "delay": Real(0.0)}),
     # --- localization, mapping -------------------------------------------------------------
     "robokit.localization.egomotion.ransac_pose": Call({

@@ -6,8 +6,16 @@ Layer: below the system lessons (``outdoor``, ``legged``) and ``navigation``; im
 heading              the heading servo of a skid-steer vehicle: pole-placement gains for an overshoot
                      and settling time, and the discrete controller (lesson 05; re-exported by
                      :mod:`robokit.outdoor`)
-heading_loop         that loop as transfer functions: plant, closed loop, loop gain, step and
-                     frequency response, margins (no exercise reference: graded notebooks may import it)
+heading_loop         that loop as transfer functions, in lesson 05's names (servo_loop's functions)
+servo_loop           an integrator plus a first-order lag under PD with rate feedback, continuous and
+                     sampled: plant, closed loop, loop gain, step and frequency response, margins,
+                     the ZOH loop's poles and bandwidth (no exercise reference: graded notebooks may
+                     import it)
+dc_motor             a geared DC motor per joint (lesson 04): torque from voltage and speed, current,
+                     copper and mechanical power, reflected inertia; LittleDog's assumed motor
+joint_servo          lesson 04's 500 Hz joint servo: the joint plant, gains by pole placement, the
+                     sampled loop analysed with python-control, the PD step the robot runs each tick
+host_link            lesson 04's 100 Hz host link: set-points over a lossy, late, jittery channel
 path_geometry        lesson 02's path: a smooth curve through recorded key poses with continuous
                      curvature, its nearest point (Eq. (7)) and the errors d, theta_tilde
 path_following       the law of Eq. (8), its gains, saturation keeping the curvature, the follower
