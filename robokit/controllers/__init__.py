@@ -26,14 +26,21 @@ corridor_centering   lesson 03's moving strategy (Ge et al. 2023, Sec. 3.1): a l
                      (reads them with robokit.mapping.corridor_scan)
 """
 from .corridor_centering import CenteringResult, centering_command, move_to_middle_line
+from .dc_motor import (LITTLEDOG_MOTOR, DCMotor, MotorPower, electrical_power, joint_torque, motor_current,
+                       reflected_inertia, voltage_for_torque)
 from .heading import HeadingController, design_heading_gains
 from .heading_loop import (heading_closed_loop, heading_frequency_response, heading_loop_gain, heading_plant,
                            heading_step_response, loop_metrics)
+from .host_link import SetpointChannel
+from .joint_servo import (NOMINAL_LINK_INERTIA, JointLag, ServoResponse, design_servo_gains, discrete_servo_response,
+                          joint_lag, joint_plant, pd_servo_step, servo_analysis)
 from .path_following import (PathFollower, PathSingularityError, path_following_command, path_following_gains,
                              reference_command, saturate_command)
 from .path_geometry import ReferencePoint, VisualPath, path_from_poses, reference_point
 from .path_following_loop import (FollowTrace, lateral_step_response, path_following_damping,
                                   path_following_linearisation, path_following_poles, simulate_path_following)
+from .servo_loop import (DiscreteServoLoop, ServoAnalysis, discrete_servo_analysis, discrete_servo_loop,
+                         servo_closed_loop, servo_frequency_response, servo_loop_gain, servo_plant, servo_step_response)
 
 __all__ = ["HeadingController", "design_heading_gains", "heading_closed_loop", "heading_frequency_response",
            "heading_loop_gain", "heading_plant", "heading_step_response", "loop_metrics",
@@ -41,4 +48,10 @@ __all__ = ["HeadingController", "design_heading_gains", "heading_closed_loop", "
            "path_following_gains", "path_from_poses", "reference_point", "reference_command", "saturate_command",
            "FollowTrace", "lateral_step_response", "path_following_damping", "path_following_linearisation",
            "path_following_poles", "simulate_path_following", "CenteringResult", "centering_command",
-           "move_to_middle_line"]
+           "move_to_middle_line",
+           "DiscreteServoLoop", "ServoAnalysis", "discrete_servo_analysis", "discrete_servo_loop", "servo_closed_loop",
+           "servo_frequency_response", "servo_loop_gain", "servo_plant", "servo_step_response",
+           "LITTLEDOG_MOTOR", "DCMotor", "MotorPower", "electrical_power", "joint_torque", "motor_current",
+           "reflected_inertia", "voltage_for_torque",
+           "NOMINAL_LINK_INERTIA", "JointLag", "ServoResponse", "design_servo_gains", "discrete_servo_response",
+           "joint_lag", "joint_plant", "pd_servo_step", "servo_analysis", "SetpointChannel"]
