@@ -39,7 +39,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..validation import as_array, check_positive
+from ..validation import as_array, check_finite_result, check_positive
 
 __all__ = ["DCMotor", "LITTLEDOG_MOTOR", "MotorPower", "joint_torque", "motor_current", "voltage_for_torque",
            "electrical_power", "reflected_inertia"]
@@ -307,10 +307,14 @@ def electrical_power(voltage: Any, joint_velocity: Any, motor: DCMotor, check: b
     v, w = _inputs(voltage, joint_velocity, motor, check)
     i = np.asarray(motor_current(v, w, motor, check=False))
     v = np.clip(v, -motor.voltage_max, motor.voltage_max)
-    copper = motor.resistance * i ** 2                                          # Joule loss R i^2
-    mechanical = motor.back_emf_constant * motor.gear_ratio * np.asarray(w) * i     # k_e omega_m i
-    total = np.broadcast_to(np.asarray(v) * i, np.shape(copper))               # V i = R i^2 + k_e omega_m i
-    return MotorPower(_out(copper), _out(np.broadcast_to(mechanical, np.shape(copper))), _out(total))
+    shape = np.shape(i)
+    with np.errstate(over="ignore", invalid="ignore"):
+        copper = motor.resistance * i ** 2                                          # Joule loss R i^2
+        mechanical = motor.back_emf_constant * motor.gear_ratio * np.asarray(w) * i     # k_e omega_m i
+        total = np.asarray(v) * i                                                   # V i = R i^2 + k_e omega_m i
+    if check:
+        check_finite_result("voltage, joint_velocity", copper, mechanical)
+    return MotorPower(_out(copper), _out(np.broadcast_to(mechanical, shape)), _out(np.broadcast_to(total, shape)))
 
 
 def reflected_inertia(motor: DCMotor) -> float:

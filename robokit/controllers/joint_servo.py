@@ -31,7 +31,7 @@ import numpy as np
 
 from ..validation import as_array, check_int, check_positive, check_sample_count
 from .dc_motor import DCMotor, reflected_inertia
-from .servo_loop import ServoAnalysis, discrete_servo_analysis, servo_plant
+from .servo_loop import MIN_DT_OVER_TAU, ServoAnalysis, discrete_servo_analysis, servo_plant
 
 __all__ = ["NOMINAL_LINK_INERTIA", "JointLag", "joint_lag", "joint_plant", "design_servo_gains", "servo_analysis",
            "pd_servo_step", "ServoResponse", "discrete_servo_response"]
@@ -156,13 +156,17 @@ def design_servo_gains(motor: DCMotor, inertia: float, bandwidth_hz: float, damp
     tau, gain = joint_lag(motor, inertia)
     fb = check_positive(bandwidth_hz, "bandwidth_hz")
     zeta = check_positive(damping, "damping")
-    shape = math.sqrt(1 - 2 * zeta ** 2 + math.sqrt(4 * zeta ** 4 - 4 * zeta ** 2 + 2))    # Nise Sec. 10.8
-    wn = 2 * math.pi * fb / shape
+    # omega_BW / omega_n = sqrt(a + sqrt(a^2 + 1)), a = 1 - 2 zeta^2 (Nise Sec. 10.8), without cancellation
+    a = 1 - 2 * zeta * zeta
+    ratio2 = a + math.hypot(a, 1.0) if a >= 0 else 1.0 / (math.hypot(a, 1.0) - a)
+    if not ratio2 > 0:
+        raise ValueError(f"damping: expected a damping ratio whose bandwidth is representable, got {zeta}")
+    wn = 2 * math.pi * fb / math.sqrt(ratio2)
     J, K, B = float(inertia), motor.torque_per_volt, motor.damping
-    kp = J * wn ** 2 / K                        # J omega_n^2 = K kp
+    kp = J * wn * wn / K                        # J omega_n^2 = K kp
     kd = (2 * zeta * wn * J - B) / K            # 2 zeta omega_n J = B + K kd
     if not (math.isfinite(kp) and math.isfinite(kd)):
-        raise ValueError(f"bandwidth_hz: expected a bandwidth whose gains are finite, got {fb}")
+        raise ValueError(f"bandwidth_hz, damping: expected values whose gains are finite, got {fb} and {zeta}")
     if kd < 0:
         raise ValueError(f"bandwidth_hz: expected a bandwidth the motor's back-EMF damping does not exceed "
                          f"(kd >= 0), got {fb} Hz which needs kd={kd:.3g}; ask for more bandwidth or damping")
@@ -208,7 +212,11 @@ def servo_analysis(kp: float, kd: float, motor: DCMotor, inertia: float, rate_hz
     False
     """
     tau, gain = joint_lag(motor, inertia)
-    return discrete_servo_analysis(kp, kd, tau, rate_hz, gain, duration)
+    rate = check_positive(rate_hz, "rate_hz")
+    if not 1.0 / (rate * tau) > MIN_DT_OVER_TAU:       # the lag must be visible at the sample rate
+        raise ValueError(f"inertia, rate_hz: expected a joint whose time constant J / B = {tau:.3g} s the servo "
+                         f"period {1 / rate:.3g} s can resolve")
+    return discrete_servo_analysis(kp, kd, tau, rate, gain, duration)
 
 
 def pd_servo_step(q_ref: Any, q: Any, q_prev: Any, kp: Any, kd: Any, dt: float, voltage_max: float,

@@ -41,7 +41,7 @@ from scipy.optimize import brentq
 
 from ..validation import as_array, check_int, check_positive, check_sample_count
 
-__all__ = ["servo_plant", "servo_closed_loop", "servo_loop_gain", "servo_step_response", "servo_frequency_response",
+__all__ = ["MIN_DT_OVER_TAU", "servo_plant", "servo_closed_loop", "servo_loop_gain", "servo_step_response", "servo_frequency_response",
            "loop_metrics", "DiscreteServoLoop", "discrete_servo_loop", "ServoAnalysis", "discrete_servo_analysis"]
 
 
@@ -214,6 +214,10 @@ def loop_metrics(kp: float, kd: float, tau: float, gain: float = 1.0, delay: flo
 
 # --- the sampled loop ------------------------------------------------------------------------
 
+#: Smallest ``dt / tau`` the ZOH discretisation resolves (below it ``exp(-dt / tau)`` rounds towards 1).
+MIN_DT_OVER_TAU = 1e-9
+
+
 class DiscreteServoLoop(NamedTuple):
     """The sampled loop's transfer functions in ``z`` (python-control, ``dt`` = the sample period)."""
 
@@ -258,15 +262,22 @@ def discrete_servo_loop(kp: float, kd: float, tau: float, rate_hz: float, gain: 
     p = check_positive(kp, "kp")
     d = check_positive(kd, "kd", allow_zero=True)
     rate = check_positive(rate_hz, "rate_hz")
+    t = check_positive(tau, "tau")
     dt = 1.0 / rate
-    if not dt > 0:
-        raise ValueError(f"rate_hz: expected a rate whose period is a positive number, got {rate}")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        plant = control.c2d(servo_plant(tau, gain), dt, "zoh")
+    if not dt / t > MIN_DT_OVER_TAU:
+        raise ValueError(f"tau, rate_hz: expected a sample period the lag can see (dt / tau > {MIN_DT_OVER_TAU:g}), "
+                         f"got dt = {dt:.3g} s for tau = {t:.3g} s")
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore")
+        plant = control.c2d(servo_plant(t, gain), dt, "zoh")
         controller = control.tf([p + d / dt, -d / dt], [1.0, 0.0], dt)
         closed = control.feedback(p * plant, controller / p)
-    return DiscreteServoLoop(plant, controller, closed, controller * plant)
+        loop = controller * plant
+    coefficients = [np.asarray(c[0][0], dtype=float) for tf in (closed, loop) for c in (tf.num, tf.den)]
+    if not all(np.all(np.isfinite(c)) for c in coefficients):
+        raise ValueError("kp, kd, tau, gain, rate_hz: expected values whose sampled loop has finite coefficients, "
+                         "got NaN or inf (values too large?)")
+    return DiscreteServoLoop(plant, controller, closed, loop)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -289,8 +300,8 @@ class ServoAnalysis:
     crossover : float
         Gain-crossover frequency (rad/s; NaN if ``|L|`` never crosses 1).
     bandwidth_hz : float
-        Closed-loop -3 dB bandwidth (Hz); NaN when the loop is unstable or ``|T|`` stays above
-        -3 dB up to the Nyquist frequency.
+        Closed-loop -3 dB bandwidth (Hz): the first frequency where ``|T|`` falls to its DC value over
+        ``sqrt(2)``; NaN when the loop is unstable or ``|T|`` stays above that up to the Nyquist frequency.
     overshoot : float
         Step overshoot (fraction); NaN when unstable.
     rise_time, settling_time : float
@@ -368,7 +379,11 @@ def discrete_servo_analysis(kp: float, kd: float, tau: float, rate_hz: float, ga
     stable = bool(np.all(np.abs(poles) < 1.0))
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
-        gm, pm, _, _, wc = control.stability_margins(loop.loop_gain)[:5]
+        try:
+            gm, pm, _, _, wc = control.stability_margins(loop.loop_gain)[:5]
+        except np.linalg.LinAlgError:       # python-control squares the coefficients: an overflow
+            raise ValueError("kp, kd, tau, gain, rate_hz: expected values whose loop gain python-control can "
+                             "analyse, got coefficients that overflow (values too large?)") from None
         t = np.arange(int(round(span / dt)) + 1) * dt
         y = np.asarray(control.forced_response(loop.closed_loop, t, np.ones_like(t)).outputs).ravel()
     finite = np.isfinite(y)

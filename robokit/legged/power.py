@@ -100,7 +100,7 @@ def trial_power(voltage: Any, joint_velocity: Any, motor: DCMotor, regenerative:
     w = as_array(joint_velocity, "joint_velocity", ndim=2)
     if w.shape != v.shape:
         raise ValueError(f"joint_velocity: expected the shape of voltage {v.shape}, got {w.shape}")
-    p = electrical_power(v, w, motor, check=False).total        # V i per joint
+    p = electrical_power(v, w, motor).total                     # V i per joint
     if not regenerative:
         p = np.maximum(p, 0.0)                                  # a braking joint's power is lost
     return p.sum(axis=1)
