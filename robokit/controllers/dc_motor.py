@@ -144,7 +144,13 @@ LITTLEDOG_MOTOR = DCMotor(resistance=3.0, torque_constant=0.0125, back_emf_const
 
 
 class MotorPower(NamedTuple):
-    """Electrical power drawn by each motor (W), split where it goes."""
+    """Electrical power drawn by each motor (W), split where it goes.
+
+    Examples
+    --------
+    >>> MotorPower(1.0, 2.0, 3.0).total
+    3.0
+    """
 
     copper: float | np.ndarray      #: ``R i^2``, heat in the winding (>= 0)
     mechanical: float | np.ndarray  #: ``k_e omega_m i``, to the shaft (negative when the joint drives the motor)

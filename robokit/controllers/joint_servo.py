@@ -42,7 +42,13 @@ NOMINAL_LINK_INERTIA = 2.0e-4
 
 
 class JointLag(NamedTuple):
-    """The joint plant as ``g / (s (tau s + 1))``."""
+    """The joint plant as ``g / (s (tau s + 1))``.
+
+    Examples
+    --------
+    >>> JointLag(0.01, 1.0).tau
+    0.01
+    """
 
     tau: float     #: ``J / B`` (s)
     gain: float    #: ``K / B`` (rad/s per V)
@@ -300,7 +306,13 @@ def _per_joint(value: Any, name: str, shape: tuple[int, ...], nonnegative: bool 
 
 
 class ServoResponse(NamedTuple):
-    """A simulated servo step: samples at the servo ticks."""
+    """A simulated servo step: samples at the servo ticks.
+
+    Examples
+    --------
+    >>> ServoResponse(np.zeros(2), np.zeros(2), np.zeros(2)).q.shape
+    (2,)
+    """
 
     t: np.ndarray          #: tick times (s), ``k dt``
     q: np.ndarray          #: joint angle at each tick (rad)
