@@ -318,7 +318,7 @@ class ServoAnalysis:
     Examples
     --------
     >>> a = discrete_servo_analysis(4.479, 0.6, 0.3, rate_hz=50.0, duration=4.0)
-    >>> len(a.t) == len(a.y) == 201, a.y[0]
+    >>> len(a.t) == len(a.y) == 201, float(a.y[0])
     (True, 0.0)
     """
 
