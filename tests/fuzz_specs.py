@@ -30,6 +30,11 @@ class Call:
 
 # --- shared valid values (built once) ---------------------------------------------------------
 
+def littledog_motor():
+    from robokit.controllers.dc_motor import LITTLEDOG_MOTOR
+    return LITTLEDOG_MOTOR
+
+
 @functools.cache
 def iiwa():
     from robokit.arm import iiwa14
@@ -485,7 +490,7 @@ SPECS: dict[str, Call] = {
         "kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3), "omega": Array(np.array([0.1, 1.0, 10.0]), "N|"), "gain": Real(1.0)}),
     "robokit.controllers.heading_loop.heading_step_response": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
                                                                "gain": Real(1.0), "duration": Real(2.0), "n": Int(50)}),
-    "robokit.controllers.heading_loop.loop_metrics": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+    "robokit.controllers.servo_loop.loop_metrics": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
                                                       "gain": Real(1.0), "delay": Real(0.0)}),
     # --- localization, mapping -------------------------------------------------------------
     "robokit.localization.egomotion.ransac_pose": Call({
@@ -1217,6 +1222,56 @@ SPECS: dict[str, Call] = {
                                                 [-0.16, 0.08, -0.1215], [-0.16, -0.08, -0.1215]]), "4,3",
                               optional=True),
         "body_height": Real(0.1315), "dt": Real(0.01), "settle": Real(0.5), "margin": Real(0.02)}),
+    # --- lesson 04's loops: controllers.servo_loop, dc_motor, joint_servo, host_link; legged.power ---
+    "robokit.controllers.servo_loop.servo_plant": Call({"tau": Real(0.3), "gain": Real(1.0)}),
+    "robokit.controllers.servo_loop.servo_closed_loop": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+                                                              "gain": Real(1.0)}),
+    "robokit.controllers.servo_loop.servo_loop_gain": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+                                                            "gain": Real(1.0)}),
+    "robokit.controllers.servo_loop.servo_step_response": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+                                                                "gain": Real(1.0), "duration": Real(2.0), "n": Int(50)}),
+    "robokit.controllers.servo_loop.servo_frequency_response": Call({
+        "kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3), "omega": Array(np.array([0.1, 1.0, 10.0]), "N|"),
+        "gain": Real(1.0)}),
+    "robokit.controllers.servo_loop.discrete_servo_loop": Call({"kp": Real(96.0), "kd": Real(0.42), "tau": Real(0.011),
+                                                                "rate_hz": Real(500.0), "gain": Real(0.98)}),
+    "robokit.controllers.servo_loop.discrete_servo_analysis": Call({
+        "kp": Real(96.0), "kd": Real(0.42), "tau": Real(0.011), "rate_hz": Real(500.0), "gain": Real(0.98),
+        "duration": Real(0.1)}),
+    "robokit.controllers.dc_motor.DCMotor": Call({
+        "resistance": Real(3.0), "torque_constant": Real(0.0125), "back_emf_constant": Real(0.0125),
+        "gear_ratio": Real(80.0), "efficiency": Real(0.75), "rotor_inertia": Real(4e-7), "viscous_friction": Real(0.005),
+        "voltage_max": Real(14.8), "continuous_current": Real(1.2, inf_ok=True)}),
+    **{f"robokit.controllers.dc_motor.{n}": Call({
+        first: Array(np.array([1.0, -2.0, 20.0]), "*"), "joint_velocity": Array(np.array([0.5, 0.0, -3.0]), "*"),
+        "motor": Obj(littledog_motor), "check": Flag(True)})
+       for n, first in (("joint_torque", "voltage"), ("motor_current", "voltage"), ("electrical_power", "voltage"),
+                        ("voltage_for_torque", "torque"))},
+    "robokit.controllers.dc_motor.reflected_inertia": Call({"motor": Obj(littledog_motor)}),
+    "robokit.controllers.joint_servo.joint_lag": Call({"motor": Obj(littledog_motor), "inertia": Real(2.76e-3)}),
+    "robokit.controllers.joint_servo.joint_plant": Call({"motor": Obj(littledog_motor), "inertia": Real(2.76e-3)}),
+    "robokit.controllers.joint_servo.design_servo_gains": Call({
+        "motor": Obj(littledog_motor), "inertia": Real(2.76e-3), "bandwidth_hz": Real(15.0), "damping": Real(0.7)}),
+    "robokit.controllers.joint_servo.servo_analysis": Call({
+        "kp": Real(96.0), "kd": Real(0.42), "motor": Obj(littledog_motor), "inertia": Real(2.76e-3),
+        "rate_hz": Real(500.0), "duration": Real(0.1)}),
+    "robokit.controllers.joint_servo.pd_servo_step": Call({
+        "q_ref": Array(np.array([0.1, 0.2, -0.3]), "|3"), "q": Array(np.array([0.0, 0.25, -0.3]), "3"),
+        "q_prev": Array(np.array([0.0, 0.24, -0.31]), "3"), "kp": Array(np.array([96.0, 90.0, 80.0]), "|3"),
+        "kd": Array(np.array(0.42), "|3"), "dt": Real(0.002), "voltage_max": Real(14.8), "check": Flag(True)}),
+    "robokit.controllers.joint_servo.discrete_servo_response": Call({
+        "kp": Real(96.0), "kd": Real(0.42), "motor": Obj(littledog_motor), "inertia": Real(2.76e-3),
+        "rate_hz": Real(500.0), "steps": Int(50), "q_ref": Real(0.1), "saturate": Flag(True)}),
+    "robokit.controllers.host_link.SetpointChannel": Call({
+        "period": Real(0.01), "latency": Real(0.004), "jitter": Real(0.002), "loss": Real(0.1), "rng": Rng(0)}),
+    "robokit.legged.power.battery_energy": Call({"capacity_ah": Real(2.1), "voltage": Real(14.8)}),
+    "robokit.legged.power.trial_power": Call({
+        "voltage": Array(np.array([[1.6, 10.0, 2.0], [0.0, -3.0, 14.8]]), "N,N"),
+        "joint_velocity": Array(np.array([[0.0, 5.0, 5.0], [1.0, -2.0, 0.0]]), "N,N"),
+        "motor": Obj(littledog_motor), "regenerative": Flag(False)}),
+    "robokit.legged.power.endurance": Call({"energy_j": Real(111888.0), "mean_power_w": Real(62.0)}),
+    "robokit.legged.power.cost_of_transport": Call({"energy_j": Real(620.0), "mass": Real(3.0), "distance": Real(1.0),
+                                                     "g": Real(9.81)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -1316,6 +1371,16 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.legged.gait_schedule.{n}" for n in (
         "GaitSchedule", "crawl_gait", "trot_gait", "as_gait_schedule", "stance_pattern")),
     "robokit.legged.gait.swing_trajectory", "robokit.legged.gait.walking_plan",
+    # lesson 04's loops (controllers.servo_loop, dc_motor, joint_servo, host_link; legged.power), before the lesson
+    *(f"robokit.controllers.servo_loop.{n}" for n in (
+        "servo_plant", "servo_closed_loop", "servo_loop_gain", "servo_step_response", "servo_frequency_response",
+        "loop_metrics", "discrete_servo_loop", "discrete_servo_analysis")),
+    *(f"robokit.controllers.dc_motor.{n}" for n in (
+        "DCMotor", "joint_torque", "motor_current", "voltage_for_torque", "electrical_power", "reflected_inertia")),
+    *(f"robokit.controllers.joint_servo.{n}" for n in (
+        "joint_lag", "joint_plant", "design_servo_gains", "servo_analysis", "pd_servo_step", "discrete_servo_response")),
+    "robokit.controllers.host_link.SetpointChannel",
+    *(f"robokit.legged.power.{n}" for n in ("battery_energy", "trial_power", "endurance", "cost_of_transport")),
 )
 
 

@@ -10,7 +10,7 @@ so ``kp`` and ``kd`` place its poles for a chosen overshoot ``M`` and settling t
 the standard relations ``zeta = -ln M / sqrt(pi^2 + ln^2 M)`` and ``omega_n = 4 / (zeta Ts)``, the
 settling time to within 2 % of the final value (Nise 2015, Sec. 4.6; Franklin, Powell &
 Emami-Naeini 2015, Sec. 3.4, use the 1 % criterion ``4.6 / (zeta omega_n)`` instead). The 2 %
-criterion is also python-control's default in :func:`~robokit.controllers.heading_loop.loop_metrics`.
+criterion is also python-control's default in :func:`~robokit.controllers.servo_loop.loop_metrics`.
 Hamid et al. (2009) steer by the compass bearing but do not give their control law; this design is
 ours. (:func:`design_heading_gains` is the reference of exercise 05.heading_gains, so the loop's
 model and metrics, which graded notebooks may import, live in their own module.)

@@ -54,7 +54,7 @@ class Manifest:
         Packages present only as an empty ``__init__``.
     helpers : dict of str to str
         A helper as the notebook names it (``"robokit.outdoor.loop_metrics"``) -> the module that
-        defines it (``"robokit.controllers.heading_loop"``, one of ``modules``).
+        defines it (``"robokit.controllers.servo_loop"``, one of ``modules``).
     forbidden : tuple of str
         Modules that define or bind one of the assignment's references (importing one is flagged).
     references : tuple of str

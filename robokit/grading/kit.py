@@ -183,7 +183,7 @@ def build_kit(assignment: Assignment, dest: str | Path) -> Kit:
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     kit = build_kit(get_assignment("05_gps_sonar_truck"), tmp)
     >>> kit.manifest.helpers
-    {'robokit.outdoor.loop_metrics': 'robokit.controllers.heading_loop'}
+    {'robokit.outdoor.loop_metrics': 'robokit.controllers.servo_loop'}
     >>> "robokit.outdoor.navigator" in kit.manifest.modules, "robokit.outdoor" in kit.manifest.forbidden
     (False, True)
     """

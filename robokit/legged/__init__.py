@@ -12,6 +12,8 @@ from .touchdown import EventScore, contact_events, detect_contacts, event_precis
 from .gait import WalkPlan, swing_trajectory, walking_plan
 from .gait_schedule import CRAWL_SEQUENCE, TROT_PAIRS, GaitSchedule, crawl_gait, stance_pattern, trot_gait
 from .support import SupportPolygonError, stability_margin, stability_margins, support_polygon
+# power and endurance
+from .power import battery_energy, cost_of_transport, endurance, trial_power
 
 __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS", "JOINT_NAMES", "JOINTS",
            "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS", "STANCE_FEET", "STANDING_HEIGHT", "TIMESTEP",
@@ -24,4 +26,6 @@ __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS"
            # gaits
            "SupportPolygonError", "support_polygon", "stability_margin", "stability_margins", "GaitSchedule", "crawl_gait",
            "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan", "walking_plan", "CRAWL_SEQUENCE", "TROT_PAIRS",
+           # power
+           "battery_energy", "cost_of_transport", "endurance", "trial_power",
 ]
