@@ -14,6 +14,9 @@ from .gait_schedule import CRAWL_SEQUENCE, TROT_PAIRS, GaitSchedule, crawl_gait,
 from .support import SupportPolygonError, stability_margin, stability_margins, support_polygon
 # power and endurance
 from .power import battery_energy, cost_of_transport, endurance, trial_power
+# the trial log
+from .trial_log import (LOG_FORMAT, LOG_LAYOUT, LOG_VERSION, META_KEYS, TrialLog, TrialLogError, describe_layout,
+                        empty_streams, load_trial, save_trial, trial_meta)
 
 __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS", "JOINT_NAMES", "JOINTS",
            "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS", "STANCE_FEET", "STANDING_HEIGHT", "TIMESTEP",
@@ -28,4 +31,6 @@ __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS"
            "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan", "walking_plan", "CRAWL_SEQUENCE", "TROT_PAIRS",
            # power
            "battery_energy", "cost_of_transport", "endurance", "trial_power",
-]
+           # the trial log
+           "LOG_FORMAT", "LOG_LAYOUT", "LOG_VERSION", "META_KEYS", "TrialLog", "TrialLogError", "describe_layout",
+           "empty_streams", "load_trial", "save_trial", "trial_meta"]
