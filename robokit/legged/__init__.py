@@ -12,6 +12,9 @@ from .touchdown import EventScore, contact_events, detect_contacts, event_precis
 from .gait import WalkPlan, swing_trajectory, walking_plan
 from .gait_schedule import CRAWL_SEQUENCE, TROT_PAIRS, GaitSchedule, crawl_gait, stance_pattern, trot_gait
 from .support import SupportPolygonError, stability_margin, stability_margins, support_polygon
+# the servo on the model, and walking in MuJoCo with both loops
+from .servo_design import SERVO_BANDWIDTH, link_inertias, littledog_servo_gains, servo_inertia
+from .simulation import FALL_HEIGHT, LoopSettings, SensorSettings, TrialOutcome, simulate_walk
 # power and endurance
 from .power import battery_energy, cost_of_transport, endurance, trial_power
 # the trial log
@@ -29,6 +32,9 @@ __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS"
            # gaits
            "SupportPolygonError", "support_polygon", "stability_margin", "stability_margins", "GaitSchedule", "crawl_gait",
            "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan", "walking_plan", "CRAWL_SEQUENCE", "TROT_PAIRS",
+           # servo design and simulation
+           "SERVO_BANDWIDTH", "link_inertias", "littledog_servo_gains", "servo_inertia",
+           "FALL_HEIGHT", "LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk",
            # power
            "battery_energy", "cost_of_transport", "endurance", "trial_power",
            # the trial log

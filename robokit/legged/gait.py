@@ -142,6 +142,8 @@ class WalkPlan(NamedTuple):
     margin : numpy.ndarray, shape (N,)
         Static stability margin (m) of the trunk centre over the stance feet
         (:func:`robokit.legged.support.stability_margins`); ``-inf`` with fewer than three feet down.
+    gait : str
+        The schedule's name (``"crawl"``, ``"trot"``), carried into trial logs.
 
     Examples
     --------
@@ -155,6 +157,7 @@ class WalkPlan(NamedTuple):
     feet_world: np.ndarray
     stance: np.ndarray
     margin: np.ndarray
+    gait: str = ""
 
 
 class _Swing(NamedTuple):
@@ -373,4 +376,4 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     T_world_body = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
     T_world_body[:, :2, 3], T_world_body[:, 2, 3] = body_xy, height
     margins = stability_margins(feet[..., :2], stance, body_xy)
-    return WalkPlan(t, T_world_body, feet, stance, margins)
+    return WalkPlan(t, T_world_body, feet, stance, margins, schedule.name)

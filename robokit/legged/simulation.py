@@ -1,0 +1,273 @@
+"""LittleDog walking in MuJoCo with the guide's two loops: joint servos on the robot, a host over a link.
+
+The guide (LittleDog User Guide, Sec. 2) splits control in two: the robot runs a servo on every
+joint at 500 Hz, and a host computer sends new joint set-points every 10 ms (100 Hz) over a
+wireless link, reading back a snapshot of the state and logging everything. :func:`simulate_walk`
+runs exactly that loop around MuJoCo:
+
+* every physics step (1 ms): each joint's torque comes from its DC motor, given the voltage the
+  servo holds and the joint's speed (back-EMF) - :func:`robokit.controllers.joint_torque`;
+* every servo tick (2 ms at 500 Hz): the robot takes the newest set-point that has arrived over
+  the link and sets a new voltage by a discrete PD law - :func:`robokit.controllers.pd_servo_step`;
+* every host cycle (10 ms): the host logs the state and the sensors, and sends the set-point that
+  the walking plan asks for next (leg IK of the planned feet seen from the planned body) over the
+  link, which may delay, jitter or drop it - :class:`robokit.controllers.SetpointChannel`.
+
+The sensors are recorded true and then corrupted the way the real ones are (MoCap marker noise and
+dropouts, IMU noise and bias), so the trial log holds what the host would have seen.
+
+References
+----------
+.. [1] Boston Dynamics, *LittleDog User Guide*, version 1.0.2, 2006, Secs. 2-3.
+.. [2] E. Todorov, T. Erez and Y. Tassa, "MuJoCo: a physics engine for model-based control",
+   *IROS* 2012.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import mujoco
+import numpy as np
+
+from ..controllers import (LITTLEDOG_MOTOR, DCMotor, SetpointChannel, motor_current, pd_servo_step,
+                           reflected_inertia, torque_from_current)
+from ..geometry import quat_to_matrix, se3_from_rt
+from ..validation import as_rng, check_positive
+from .gait import WalkPlan
+from .imu import simulate_imu
+from .leg_kinematics import body_ik
+from .littledog import LEGS, MARKERS, TIMESTEP, littledog_model
+from .mocap import simulate_mocap
+from .servo_design import littledog_servo_gains
+from .trial_log import TrialLog, empty_streams, trial_meta
+
+__all__ = ["LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "FALL_HEIGHT"]
+
+FALL_HEIGHT = 0.06
+"""The robot has fallen when its trunk's centre is lower than this (m) or it tips past 45 deg."""
+
+
+@dataclass(frozen=True)
+class LoopSettings:
+    """The two control loops and the link between them.
+
+    Parameters
+    ----------
+    servo_rate : float, default 500
+        Joint servo rate on the robot (Hz; the guide's 500). Must divide the 1 kHz physics rate.
+    latency, jitter : float, default 0
+        One-way link delay and its spread (s) for every set-point packet.
+    loss : float, default 0
+        Probability that a packet is lost.
+    gains : (float, float), optional
+        Servo ``(kp, kd)`` in V/rad and V s/rad; default :func:`littledog_servo_gains` for the motor
+        the trial uses.
+    """
+
+    servo_rate: float = 500.0
+    latency: float = 0.0
+    jitter: float = 0.0
+    loss: float = 0.0
+    gains: tuple | None = None
+
+    def __post_init__(self):
+        rate = check_positive(self.servo_rate, "servo_rate")
+        steps = 1.0 / (rate * TIMESTEP)
+        if abs(steps - round(steps)) > 1e-9 or round(steps) < 1:
+            raise ValueError(f"servo_rate: expected a rate that divides the {1 / TIMESTEP:.0f} Hz physics "
+                             f"rate (e.g. 500, 250, 100), got {self.servo_rate}")
+        check_positive(self.latency, "latency", allow_zero=True)
+        check_positive(self.jitter, "jitter", allow_zero=True)
+        loss = check_positive(self.loss, "loss", allow_zero=True)
+        if loss >= 1:
+            raise ValueError(f"loss: expected a probability in [0, 1), got {loss}")
+        if self.gains is not None:
+            if not isinstance(self.gains, (tuple, list)) or len(self.gains) != 2:
+                raise ValueError(f"gains: expected (kp, kd) or None, got {self.gains!r}")
+            check_positive(self.gains[0], "gains[0] (kp)")
+            check_positive(self.gains[1], "gains[1] (kd)", allow_zero=True)
+
+
+@dataclass(frozen=True)
+class SensorSettings:
+    """How the simulated sensors err (standard deviations per sample; biases constant).
+
+    The defaults are ours (the guide gives none): Vicon-class marker noise of 0.5 mm with 5 % of
+    markers occluded, a MEMS gyro with 0.02 rad/s bias, an accelerometer with 0.1 m/s^2 bias.
+    """
+
+    mocap_noise: float = 0.0005
+    mocap_dropout: float = 0.05
+    gyro_noise: float = 0.005
+    acc_noise: float = 0.05
+    gyro_bias: tuple = (0.02, -0.015, 0.01)
+    acc_bias: tuple = (0.1, -0.05, 0.08)
+    force_noise: float = 0.1
+
+
+class TrialOutcome(NamedTuple):
+    """What one walking trial produced.
+
+    Attributes
+    ----------
+    log : TrialLog
+        Every host-cycle sample (:mod:`robokit.legged.trial_log`).
+    fell : bool
+        The trunk dropped below :data:`FALL_HEIGHT` or tipped past 45 deg (the trial stops there).
+    distance : float
+        Forward progress of the trunk along the plan's direction (m).
+    energy : float
+        Electrical energy the twelve motors drew (J), integrated every physics step, without
+        regeneration (a joint's negative power is lost).
+    tracking_rms : float
+        RMS over joints and host cycles of the set-point the host sent minus the angle the joint had
+        reached one host period later, when the next set-point went out (rad).
+    link : dict
+        The link's packet counters.
+    """
+
+    log: TrialLog
+    fell: bool
+    distance: float
+    energy: float
+    tracking_rms: float
+    link: dict
+
+
+def _tipped(quat: np.ndarray) -> bool:
+    # the body z axis' world z component is 1 - 2(x^2 + y^2); below cos 45 deg the robot has tipped
+    return 1 - 2 * (quat[1] ** 2 + quat[2] ** 2) < np.cos(np.pi / 4)
+
+
+def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors: SensorSettings = SensorSettings(),
+                  *, motor: DCMotor = LITTLEDOG_MOTOR, rng: Any = 0) -> TrialOutcome:
+    """Walk LittleDog through a plan in MuJoCo with the servo and host loops of the guide.
+
+    Parameters
+    ----------
+    plan : WalkPlan
+        Body poses and foot positions at the host rate (:func:`robokit.legged.walking_plan`).
+    loops : LoopSettings
+        Servo rate, link latency/jitter/loss and servo gains.
+    sensors : SensorSettings
+        Sensor noise and biases.
+    motor : DCMotor
+        The joint motors (all twelve alike).
+    rng : numpy.random.Generator or int, default 0
+        Seeds the link and the sensor noise.
+
+    Returns
+    -------
+    TrialOutcome
+
+    Examples
+    --------
+    >>> from robokit.legged import crawl_gait, walking_plan
+    >>> out = simulate_walk(walking_plan(crawl_gait(), 0.05))
+    >>> out.fell, len(out.log) == len(walking_plan(crawl_gait(), 0.05).t)
+    (False, True)
+    """
+    if not isinstance(plan, WalkPlan):
+        raise TypeError(f"plan: expected a WalkPlan (robokit.legged.walking_plan), got {type(plan).__name__}")
+    if not isinstance(loops, LoopSettings):
+        raise TypeError(f"loops: expected LoopSettings, got {type(loops).__name__}")
+    if not isinstance(sensors, SensorSettings):
+        raise TypeError(f"sensors: expected SensorSettings, got {type(sensors).__name__}")
+    if not isinstance(motor, DCMotor):
+        raise TypeError(f"motor: expected a DCMotor, got {type(motor).__name__}")
+    seed = rng if isinstance(rng, int) and not isinstance(rng, bool) else None
+    gen = as_rng(rng)
+    host_dt = float(plan.t[1] - plan.t[0])
+    host_steps = int(round(host_dt / TIMESTEP))
+    servo_steps = int(round(1.0 / (loops.servo_rate * TIMESTEP)))
+    servo_dt = servo_steps * TIMESTEP
+    q_cmd, ok = body_ik(plan.feet_world, plan.T_world_body, check=False)
+    if not ok.all():
+        raise ValueError(f"plan: {int((~ok).sum())} host cycles ask for feet out of reach (first at "
+                         f"t = {plan.t[~ok][0]:.2f} s)")
+    model = littledog_model(armature=reflected_inertia(motor))
+    data = mujoco.MjData(model)
+    T0 = plan.T_world_body[0]
+    data.qpos[:3] = T0[:3, 3]
+    mujoco.mju_mat2Quat(data.qpos[3:7], T0[:3, :3].ravel())
+    data.qpos[7:] = q_cmd[0]
+    mujoco.mj_forward(model, data)
+    channel = SetpointChannel(period=host_dt, latency=loops.latency, jitter=loops.jitter, loss=loops.loss, rng=gen)
+    kp, kd = loops.gains if loops.gains is not None else littledog_servo_gains(motor=motor)
+    n = len(plan.t)
+    rec = empty_streams(n, 1.0 / host_dt)
+    rec["t"][:] = plan.t
+    rec["q_cmd"][:] = q_cmd
+    gyro_true, acc_true = np.zeros((n, 3)), np.zeros((n, 3))
+    foot_geoms = [model.geom(f"{leg}_foot").id for leg in LEGS]
+    foot_sites = [model.site(f"{leg}_foot").id for leg in LEGS]
+    force_adr = [model.sensor_adr[model.sensor(f"{leg}_force").id] + 2 for leg in LEGS]
+    gyro_adr = model.sensor_adr[model.sensor("imu_gyro").id]
+    acc_adr = model.sensor_adr[model.sensor("imu_acc").id]
+    trunk = model.body("trunk").id
+    q_ref = q_cmd[0].copy()
+    q_prev = data.qpos[7:].copy()
+    voltage = np.zeros(12)
+    energy = 0.0
+    fell = False
+    rows = n
+    for k in range(n):
+        t = k * host_dt
+        # host cycle: snapshot of the state and sensors, then the next set-point goes out
+        rec["q"][k] = data.qpos[7:]
+        rec["qd"][k] = data.qvel[6:]
+        rec["q_ref"][k] = q_ref
+        rec["voltage"][k] = voltage
+        rec["tau"][k] = data.ctrl
+        rec["current"][k] = motor_current(voltage, data.qvel[6:], motor, check=False)
+        rec["body_pos"][k] = data.qpos[:3]
+        rec["body_quat"][k] = data.qpos[3:7]
+        rec["body_vel"][k, :3] = data.qvel[:3]
+        rec["body_vel"][k, 3:] = data.qvel[3:6]
+        rec["com"][k] = data.subtree_com[trunk]
+        rec["feet"][k] = data.site_xpos[foot_sites]
+        rec["foot_force"][k] = -data.sensordata[force_adr]      # compression along the shank
+        gyro_true[k] = data.sensordata[gyro_adr:gyro_adr + 3]
+        acc_true[k] = data.sensordata[acc_adr:acc_adr + 3]
+        for c in range(data.ncon):
+            pair = (data.contact.geom1[c], data.contact.geom2[c])
+            for i, g in enumerate(foot_geoms):
+                if g in pair:
+                    rec["contact"][k, i] = True
+        if data.qpos[2] < FALL_HEIGHT or _tipped(data.qpos[3:7]):
+            fell, rows = True, k + 1
+            break
+        channel.send(t, q_cmd[k])
+        for s in range(host_steps):
+            if s % servo_steps == 0:
+                arrived = channel.receive(t + s * TIMESTEP)
+                if arrived is not None:
+                    q_ref = arrived
+                q_now = data.qpos[7:].copy()
+                voltage = pd_servo_step(q_ref, q_now, q_prev, kp, kd, servo_dt, motor.voltage_max, check=False)
+                q_prev = q_now
+            qd = data.qvel[6:]
+            current = motor_current(voltage, qd, motor, check=False)
+            data.ctrl[:] = torque_from_current(current, qd, motor, check=False)
+            energy += float(np.maximum(voltage * current, 0.0).sum()) * TIMESTEP     # no regeneration
+            mujoco.mj_step(model, data)
+    streams = {key: value[:rows] for key, value in rec.items()}
+    streams["foot_force"] = streams["foot_force"] + gen.normal(0.0, sensors.force_noise, (rows, 4))
+    streams["imu_gyro"], streams["imu_acc"] = simulate_imu(
+        gyro_true[:rows], acc_true[:rows], gen, gyro_noise=sensors.gyro_noise, acc_noise=sensors.acc_noise,
+        gyro_bias=np.asarray(sensors.gyro_bias), acc_bias=np.asarray(sensors.acc_bias))
+    T_true = se3_from_rt(quat_to_matrix(streams["body_quat"]), streams["body_pos"])
+    streams["mocap"], streams["mocap_visible"] = simulate_mocap(T_true, MARKERS, sensors.mocap_noise,
+                                                                sensors.mocap_dropout, gen)
+    meta = trial_meta(gait=plan.gait, host_rate=1.0 / host_dt, servo_rate=loops.servo_rate,
+                      link_latency=loops.latency, link_jitter=loops.jitter, link_loss=loops.loss, seed=seed,
+                      notes="simulated in MuJoCo by robokit.legged.simulate_walk", kp=kp, kd=kd)
+    log = TrialLog(streams, meta)
+    heading = plan.T_world_body[-1, :3, 3] - plan.T_world_body[0, :3, 3]
+    heading = heading / max(np.linalg.norm(heading), 1e-12)
+    distance = float((streams["body_pos"][-1] - streams["body_pos"][0]) @ heading)
+    tracking = float(np.sqrt(np.mean((streams["q_cmd"][:-1] - streams["q"][1:]) ** 2)))
+    counters = {name: getattr(channel, name) for name in ("sent", "delivered", "lost", "stale", "rejected")}
+    return TrialOutcome(log, fell, distance, energy, tracking, counters)
+

@@ -1,0 +1,80 @@
+"""LittleDog walking in MuJoCo with the servo and host loops (robokit.legged.simulation)."""
+import numpy as np
+import pytest
+
+from robokit.controllers import LITTLEDOG_MOTOR, motor_current
+from robokit.legged import crawl_gait, load_trial, save_trial, stability_margins, trot_gait, walking_plan
+from robokit.legged.simulation import LoopSettings, simulate_walk
+
+
+@pytest.fixture(scope="module")
+def crawl():
+    plan = walking_plan(crawl_gait(period=2.0, step_height=0.04), 0.3)
+    return plan, simulate_walk(plan, rng=1)
+
+
+def test_crawl_keeps_a_positive_margin_over_the_true_contacts(crawl):
+    plan, out = crawl
+    log = out.log
+    assert not out.fell and len(log) == len(plan.t)
+    assert out.distance == pytest.approx(0.3, abs=0.03)
+    margin = stability_margins(log.feet[:, :, :2], log.contact, log.com[:, :2])   # MuJoCo's truth, not the plan
+    assert margin.min() > 0.005
+    assert (plan.stance == log.contact).mean() > 0.9          # the feet touch down about when planned
+
+
+def test_log_holds_what_the_host_saw_and_survives_a_file(crawl, tmp_path):
+    _, out = crawl
+    log = out.log
+    assert log.meta["gait"] == "crawl" and log.meta["servo_rate"] == 500.0
+    # the servo's set-point is what the host sent one cycle before (no latency)
+    np.testing.assert_allclose(log.q_ref[2:], log.q_cmd[1:-1])
+    # standing still, the IMU reads gravity (plus its bias); the feet carry the robot
+    assert log.imu_acc[25:50, 2].mean() == pytest.approx(9.81 + 0.08, abs=0.05)
+    assert log.foot_force[25:50].sum(axis=1).mean() > 10
+    assert 0.9 < log.mocap_visible.mean() < 0.99
+    back = load_trial(save_trial(tmp_path / "crawl.npz", log))
+    for name in ("q", "mocap", "contact", "t"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(log, name))
+
+
+def test_energy_standing_still_is_the_copper_loss_of_the_holding_currents():
+    """Standing, each joint holds a constant voltage at zero speed: the motors draw sum V^2 / R."""
+    stand = walking_plan(crawl_gait(), 0.3)._replace(gait="stand")
+    n = 201
+    plan = stand._replace(t=stand.t[:n], T_world_body=np.repeat(stand.T_world_body[:1], n, 0),
+                          feet_world=np.repeat(stand.feet_world[:1], n, 0), stance=stand.stance[:n],
+                          margin=stand.margin[:n])
+    out = simulate_walk(plan)
+    v = out.log.voltage[-1]
+    assert np.abs(out.log.qd[-1]).max() < 1e-3
+    steady = float((v ** 2).sum() / LITTLEDOG_MOTOR.resistance)
+    assert steady > 1.0                                        # a few watts just to stand
+    # the first 0.5 s include settling onto the feet; after that the draw is steady
+    late = simulate_walk(plan._replace(t=plan.t[:101], T_world_body=plan.T_world_body[:101],
+                                       feet_world=plan.feet_world[:101], stance=plan.stance[:101],
+                                       margin=plan.margin[:101]))
+    assert (out.energy - late.energy) == pytest.approx(steady * 1.0, rel=0.02)
+    assert np.allclose(motor_current(v, 0.0, LITTLEDOG_MOTOR), v / LITTLEDOG_MOTOR.resistance)
+
+
+def test_latency_and_a_slow_servo_hurt_tracking():
+    plan = walking_plan(trot_gait(step_height=0.04), 0.15)
+    base = simulate_walk(plan)
+    late = simulate_walk(plan, LoopSettings(latency=0.03))
+    assert late.tracking_rms > 1.5 * base.tracking_rms
+    lossy = simulate_walk(plan, LoopSettings(loss=0.3), rng=4)
+    assert 0.2 < lossy.link["lost"] / lossy.link["sent"] < 0.4
+
+
+def test_bad_settings_are_named():
+    with pytest.raises(ValueError, match="servo_rate"):
+        LoopSettings(servo_rate=300)
+    with pytest.raises(ValueError, match="loss"):
+        LoopSettings(loss=1.0)
+    with pytest.raises(ValueError, match="gains"):
+        LoopSettings(gains=(1.0,))
+    with pytest.raises(TypeError, match="plan"):
+        simulate_walk("crawl")
+    with pytest.raises(TypeError, match="sensors"):
+        simulate_walk(walking_plan(trot_gait(), 0.05), sensors={})
