@@ -14,7 +14,10 @@ runs exactly that loop around MuJoCo:
   link, which may delay, jitter or drop it - :class:`robokit.controllers.SetpointChannel`.
 
 The sensors are recorded true and then corrupted the way the real ones are (MoCap marker noise and
-dropouts, IMU noise and bias), so the trial log holds what the host would have seen.
+dropouts, IMU noise and bias), so the trial log holds what the host would have seen. The IMU
+reports the average of its readings over each host period, as an IMU's anti-aliasing filter does:
+sampled once per 10 ms instead, the impacts of touchdowns (a few milliseconds long) would alias
+into its 100 Hz data.
 
 References
 ----------
@@ -42,10 +45,14 @@ from .mocap import simulate_mocap
 from .servo_design import littledog_servo_gains
 from .trial_log import TrialLog, empty_streams, trial_meta
 
-__all__ = ["LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "FALL_HEIGHT"]
+__all__ = ["LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "FALL_HEIGHT", "CONTACT_FORCE"]
 
 FALL_HEIGHT = 0.06
 """The robot has fallen when its trunk's centre is lower than this (m) or it tips past 45 deg."""
+
+CONTACT_FORCE = 0.2
+"""A foot is truly in contact (the log's ``contact``) when the ground pushes it with more than this
+normal force (N): MuJoCo also reports touching contacts that carry nothing."""
 
 
 @dataclass(frozen=True)
@@ -94,11 +101,15 @@ class SensorSettings:
     """How the simulated sensors err (standard deviations per sample; biases constant).
 
     The defaults are ours (the guide gives none): Vicon-class marker noise of 0.5 mm with 5 % of
-    markers occluded, a MEMS gyro with 0.02 rad/s bias, an accelerometer with 0.1 m/s^2 bias.
+    markers occluded, and now and then (probability 0.005 per frame) the whole trunk hidden for
+    0.2 s; a MEMS gyro with 0.02 rad/s bias, an accelerometer with 0.1 m/s^2 bias; 0.1 N of force
+    sensor noise.
     """
 
     mocap_noise: float = 0.0005
     mocap_dropout: float = 0.05
+    mocap_bursts: float = 0.005
+    mocap_burst_length: int = 20
     gyro_noise: float = 0.005
     acc_noise: float = 0.05
     gyro_bias: tuple = (0.02, -0.015, 0.01)
@@ -206,6 +217,11 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     gyro_adr = model.sensor_adr[model.sensor("imu_gyro").id]
     acc_adr = model.sensor_adr[model.sensor("imu_acc").id]
     trunk = model.body("trunk").id
+    if acc_adr != gyro_adr + 3:
+        raise RuntimeError("the model's IMU sensors are not gyro then accelerometer")
+    imu_span = slice(gyro_adr, gyro_adr + 6)
+    imu_sum = np.zeros(6)
+    wrench = np.zeros(6)
     q_ref = q_cmd[0].copy()
     q_prev = data.qpos[7:].copy()
     voltage = np.zeros(12)
@@ -228,13 +244,16 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         rec["com"][k] = data.subtree_com[trunk]
         rec["feet"][k] = data.site_xpos[foot_sites]
         rec["foot_force"][k] = -data.sensordata[force_adr]      # compression along the shank
-        gyro_true[k] = data.sensordata[gyro_adr:gyro_adr + 3]
-        acc_true[k] = data.sensordata[acc_adr:acc_adr + 3]
+        if k == 0:
+            imu_sum[:] = data.sensordata[imu_span] * host_steps
+        gyro_true[k], acc_true[k] = np.split(imu_sum / host_steps, 2)       # the IMU's average
+        imu_sum[:] = 0.0
         for c in range(data.ncon):
             pair = (data.contact.geom1[c], data.contact.geom2[c])
             for i, g in enumerate(foot_geoms):
                 if g in pair:
-                    rec["contact"][k, i] = True
+                    mujoco.mj_contactForce(model, data, c, wrench)
+                    rec["contact"][k, i] |= wrench[0] > CONTACT_FORCE      # normal force, contact frame
         if data.qpos[2] < FALL_HEIGHT or _tipped(data.qpos[3:7]):
             fell, rows = True, k + 1
             break
@@ -252,14 +271,16 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
             data.ctrl[:] = torque_from_current(current, qd, motor, check=False)
             energy += float(np.maximum(voltage * current, 0.0).sum()) * TIMESTEP     # no regeneration
             mujoco.mj_step(model, data)
+            imu_sum += data.sensordata[imu_span]
     streams = {key: value[:rows] for key, value in rec.items()}
     streams["foot_force"] = streams["foot_force"] + gen.normal(0.0, sensors.force_noise, (rows, 4))
     streams["imu_gyro"], streams["imu_acc"] = simulate_imu(
         gyro_true[:rows], acc_true[:rows], gen, gyro_noise=sensors.gyro_noise, acc_noise=sensors.acc_noise,
         gyro_bias=np.asarray(sensors.gyro_bias), acc_bias=np.asarray(sensors.acc_bias))
     T_true = se3_from_rt(quat_to_matrix(streams["body_quat"]), streams["body_pos"])
-    streams["mocap"], streams["mocap_visible"] = simulate_mocap(T_true, MARKERS, sensors.mocap_noise,
-                                                                sensors.mocap_dropout, gen)
+    streams["mocap"], streams["mocap_visible"] = simulate_mocap(
+        T_true, MARKERS, sensors.mocap_noise, sensors.mocap_dropout, gen, bursts=sensors.mocap_bursts,
+        burst_length=sensors.mocap_burst_length)
     meta = trial_meta(gait=plan.gait, host_rate=1.0 / host_dt, servo_rate=loops.servo_rate,
                       link_latency=loops.latency, link_jitter=loops.jitter, link_loss=loops.loss, seed=seed,
                       notes="simulated in MuJoCo by robokit.legged.simulate_walk", kp=kp, kd=kd)
