@@ -133,3 +133,23 @@ def test_zyz_angles_agree_with_scipy_and_are_batched():
 def test_bad_input_is_named(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_quat_to_matrix_agrees_with_scipy_and_with_the_axis_angle():
+    rng = np.random.default_rng(7)
+    q = rng.normal(size=(300, 4))                          # any non-zero quaternion, normalised inside
+    R = g.quat_to_matrix(q)
+    np.testing.assert_allclose(R, Rotation.from_quat(q, scalar_first=True).as_matrix(), atol=1e-14)
+    np.testing.assert_allclose(g.quat_to_matrix(-q), R, atol=1e-15)             # q and -q: one rotation
+    np.testing.assert_allclose(g.quat_to_matrix(q.reshape(3, 100, 4)), R.reshape(3, 100, 3, 3), atol=0)
+    v = _rotvecs(rng, 50)                                    # [cos(t/2), sin(t/2) u] is so3_exp(t u)
+    t = np.linalg.norm(v, axis=1, keepdims=True)
+    np.testing.assert_allclose(g.quat_to_matrix(np.hstack([np.cos(t / 2), np.sin(t / 2) * v / t])), g.so3_exp(v),
+                               atol=1e-14)
+
+
+@pytest.mark.parametrize("bad, word", [([1.0, 0.0, 0.0], "shape"), ([0.0, 0.0, 0.0, 0.0], "non-zero"),
+                                       ([1.0, np.nan, 0.0, 0.0], "finite")])
+def test_quat_to_matrix_refuses_what_is_no_rotation(bad, word):
+    with pytest.raises(ValueError, match=f"quat: .*{word}"):
+        g.quat_to_matrix(bad)

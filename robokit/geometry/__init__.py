@@ -18,8 +18,8 @@ from .paper_frames import (R_BODY_OPTICAL, as_pqt, optical_to_y_up, paper_world_
                            pqt_world_to_robot, se2_to_pqt)
 from .planar import (as_planar, fit_se2, intersect_lines, matrix_to_se2, se2_between, se2_compose, se2_inverse, se2_to_matrix,
                      wrap_angle)
-from .rotations import (ROTATION_TOL, as_rotation, check_rotation_block, euler_matrix, rot_x, rot_y, rot_z, skew,
-                        so3_exp, so3_log, zyz_angles)
+from .rotations import (ROTATION_TOL, as_rotation, check_rotation_block, euler_matrix, quat_to_matrix, rot_x, rot_y,
+                        rot_z, skew, so3_exp, so3_log, zyz_angles)
 from .spatial import (as_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, se3_inverse, se3_to_se2,
                       transform_points)
 
@@ -27,7 +27,7 @@ __all__ = [
     "as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
     "fit_se2", "intersect_lines",
     "ROTATION_TOL", "as_rotation", "check_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y",
-    "rot_z", "euler_matrix", "zyz_angles",
+    "rot_z", "euler_matrix", "zyz_angles", "quat_to_matrix",
     "as_se3", "se3_from_rt", "se3_inverse", "se3_compose", "transform_points", "se2_to_se3", "se3_to_se2",
     "pose_error",
     "R_BODY_OPTICAL", "as_pqt", "se2_to_pqt", "pqt_to_se2", "pqt_to_se3", "pqt_rotate_xz", "pqt_transform_xz",

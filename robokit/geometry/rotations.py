@@ -21,7 +21,7 @@ from scipy.spatial.transform import Rotation
 from ..validation import array_ndim, as_array
 
 __all__ = ["ROTATION_TOL", "as_rotation", "check_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y", "rot_z",
-           "euler_matrix", "zyz_angles"]
+           "euler_matrix", "zyz_angles", "quat_to_matrix"]
 
 #: Default tolerance on ``|R^T R - I|`` and ``|det R - 1|`` when a rotation is checked.
 ROTATION_TOL = 1e-6
@@ -417,3 +417,55 @@ def zyz_angles(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.n
         out[0] = np.where(sing, 0.0, out[0])
         out[2] = np.where(sing, np.arctan2(R[..., 1, 0], R[..., 1, 1]), out[2])
     return out.transpose(*range(1, out.ndim), 0)
+
+
+def quat_to_matrix(quat: Any, *, check: bool = True) -> np.ndarray:
+    """Rotation matrices of quaternions ``[w, x, y, z]`` (scalar first, MuJoCo's order).
+
+    Parameters
+    ----------
+    quat : array_like, shape (..., 4)
+        Quaternions; each is normalised first, so one a little off unit length (rounding in a
+        simulator's integration) still gives a proper rotation. ``q`` and ``-q`` give the same
+        matrix.
+    check : bool, default True
+        Validate the input (shape, finite values, a norm above 1e-12); ``False`` skips it.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+
+    Raises
+    ------
+    ValueError
+        If the last axis does not have length 4, a value is not finite, or a quaternion is zero.
+
+    Notes
+    -----
+    The rotation of the unit quaternion ``(w, x, y, z)`` (Lynch & Park 2017, Appendix B.3)::
+
+        [[1 - 2(y^2 + z^2), 2(xy - wz),       2(xz + wy)],
+         [2(xy + wz),       1 - 2(x^2 + z^2), 2(yz - wx)],
+         [2(xz - wy),       2(yz + wx),       1 - 2(x^2 + y^2)]]
+
+    ``[cos(t/2), sin(t/2) u]`` is the rotation by ``t`` about the unit axis ``u``.
+
+    Examples
+    --------
+    >>> c = np.cos(np.pi / 4)
+    >>> print(np.round(quat_to_matrix([c, 0.0, 0.0, c]) @ [1.0, 0.0, 0.0], 6))   # 90 deg about z
+    [0. 1. 0.]
+    >>> quat_to_matrix(np.tile([1.0, 0.0, 0.0, 0.0], (5, 1))).shape
+    (5, 3, 3)
+    """
+    q = as_array(quat, "quat") if check else np.asarray(quat, dtype=float)
+    if check and (q.ndim == 0 or q.shape[-1] != 4):
+        raise ValueError(f"quat: expected quaternions [w, x, y, z], shape (..., 4), got shape {q.shape}")
+    norm = np.linalg.norm(q, axis=-1, keepdims=True)
+    if check and np.any(norm < 1e-12):
+        raise ValueError("quat: expected non-zero quaternions (a zero one is no rotation), got a norm below 1e-12")
+    w, x, y, z = np.moveaxis(q / norm, -1, 0)
+    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+                     np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+                     np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)],
+                    -2)  # Lynch & Park 2017, App. B.3
