@@ -48,3 +48,20 @@ def test_textured_world_is_drawn(tmp_path):
     changed = (np.abs(img.astype(int) - empty.astype(int)).sum(axis=2) > 30).mean()
     assert changed > 0.2
     assert len(np.unique(img.reshape(-1, 3) // 8, axis=0)) > 200  # textured, not flat colour
+
+
+def test_camera_target_frames_an_object_away_from_the_origin(tmp_path):
+    """look_from(..., target=) makes the viewer look at the target, not at the origin."""
+    def scene(target):
+        s = Scene()
+        s.add_box("box", (0.2, 0.2, 0.2), np.array([[1, 0, 0, 6.0], [0, 1, 0, 4.0], [0, 0, 1, 0.1], [0, 0, 0, 1]]),
+                  color=0xFF00FF)
+        from robokit.viz import look_from
+        return look_from(s, [6.5, 3.4, 0.5], target=target)
+
+    magenta = lambda im: (im[..., 0] > 120) & (im[..., 2] > 120) & (im[..., 1] < 60)
+    framed = magenta(screenshot(scene([6.0, 4.0, 0.1]), tmp_path, "framed"))
+    h, w = framed.shape
+    assert framed[h // 3:2 * h // 3, w // 3:2 * w // 3].mean() > 0.2          # the box fills the middle
+    at_origin = magenta(screenshot(scene(None), tmp_path, "origin"))
+    assert at_origin[h // 3:2 * h // 3, w // 3:2 * w // 3].mean() < 0.01      # looking at the origin misses it
