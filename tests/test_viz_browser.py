@@ -65,3 +65,22 @@ def test_camera_target_frames_an_object_away_from_the_origin(tmp_path):
     assert framed[h // 3:2 * h // 3, w // 3:2 * w // 3].mean() > 0.2          # the box fills the middle
     at_origin = magenta(screenshot(scene(None), tmp_path, "origin"))
     assert at_origin[h // 3:2 * h // 3, w // 3:2 * w // 3].mean() < 0.01      # looking at the origin misses it
+
+
+def test_the_camera_follows_a_walking_littledog(tmp_path):
+    """animate_trial's camera keeps the robot in the middle of the view while it walks away."""
+    from robokit.viz import animate_trial, look_from
+    from tests.legged_logs import synthetic_log
+
+    log = synthetic_log(300)                     # 0.9 m forward in 3 s (played in full before the shot)
+    yellow = lambda im: (im[..., 0] > 180) & (im[..., 1] > 120) & (im[..., 2] < 80)    # the centre-of-mass disc
+
+    followed = yellow(screenshot(animate_trial(Scene(), log), tmp_path, "followed"))
+    rows, cols = np.nonzero(followed)
+    assert len(cols) > 20
+    h, w = followed.shape
+    assert abs(cols.mean() - w / 2) < 0.2 * w and abs(rows.mean() - h / 2) < 0.3 * h
+    still = animate_trial(Scene(), log, frame=False)
+    look_from(still, [0.33, -0.51, 0.39], target=[0.0, 0.0, 0.08])   # the same view, not following
+    rows, cols = np.nonzero(yellow(screenshot(still, tmp_path, "still")))
+    assert len(cols) == 0 or abs(cols.mean() - w / 2) > 0.25 * w

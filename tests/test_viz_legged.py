@@ -161,17 +161,19 @@ def test_support_polygon_triangles_cover_the_stance_feet():
     assert n_checked == 40
 
 
-def test_the_camera_looks_at_the_walked_path():
+def test_the_camera_looks_at_the_robot_and_follows_it():
     log = synthetic_log(40)
     scene = animate_trial(Scene(), log)
     target = [c for c in scene.commands if c["type"] == "set_target"][-1]["value"]
-    sampled = log.body_pos[::2]                                                # every=2 by default
-    middle = (sampled.min(axis=0) + sampled.max(axis=0)) / 2
-    np.testing.assert_allclose([target[0], -target[2]], middle[:2])            # y-up (x, z, -y) back to x, y
+    np.testing.assert_allclose([target[0], -target[2], target[1]], [*log.body_pos[0, :2], 0.6 * 0.1315])  # y-up back
+    position = [c for c in scene.commands if c.get("property") == "position"][-1]["value"]
+    assert np.linalg.norm(np.subtract(position, target)) == pytest.approx(0.6)           # close to a 0.3 m robot
+    assert [c["path"] for c in scene.commands if c["type"] == "robokit_follow"] == ["/meshcat/littledog"]
     page = scene.html()
     assert re.search(r"viewer\.controls\.target\.set\([-\d.e]+, [-\d.e]+, [-\d.e]+\); viewer\.controls\.update\(\)", page)
-    position = [c for c in scene.commands if c.get("property") == "position"][-1]["value"]
-    assert 0.5 <= np.linalg.norm(np.subtract(position, target)) < 2.0         # close to a 0.3 m robot
+    assert 'viewer.scene_tree.find(["meshcat", "littledog"])' in page
+    still = animate_trial(Scene(), log, frame=False)
+    assert not [c for c in still.commands if c["type"] in ("set_target", "robokit_follow")]
 
 
 def test_look_from_keeps_its_old_callers():

@@ -24,6 +24,8 @@ References
    *Mathematical Biosciences* 3, 331-351, 1968 (support polygon; centre-of-mass projection).
 .. [2] Boston Dynamics, *LittleDog User Guide*, version 1.0.2, 2006, Sec. 3 (the single-axis force
    sensor in each lower leg).
+.. [3] B. Siciliano and O. Khatib (eds.), *Springer Handbook of Robotics*, 2nd ed., Springer, 2016,
+   Ch. 2 "Kinematics" (elementary rotations composed along a chain).
 """
 from __future__ import annotations
 
@@ -51,6 +53,7 @@ _COLORS = {"trunk": 0x2B2B8C, "link": 0x404048, "foot": 0x151515, "marker": 0xEE
 _RADII = (0.012, 0.011, 0.008)                    # hip stub, upper and lower leg, as in the MJCF
 _SIDE = np.array([1.0 if leg.endswith("L") else -1.0 for leg in LEGS])
 _HALF_TURN = rot_x(np.pi / 2)                     # a cylinder's y axis onto z
+_VIEW = 0.6 * np.array([0.55, -1.0, 0.6]) / np.linalg.norm([0.55, -1.0, 0.6])   # camera from the target: front right, above
 
 
 def joint_path(path: str, leg: Any, joint: str) -> str:
@@ -294,7 +297,8 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
     force_scale : float, default 0.004
         m of arrow per N (7.4 N, a quarter of the weight, is 3 cm).
     frame : bool, default True
-        Point the viewer's camera at the walked path (:func:`robokit.viz.look_from` with a target).
+        Look at the robot from its front right, 0.6 m away (:func:`robokit.viz.look_from` with a
+        target), and follow it as it walks (:meth:`Scene.set_camera_follow`, offline pages).
 
     Returns
     -------
@@ -361,14 +365,7 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
             tracks[f"{overlay}/mocap/{k}"] = {"position": log.mocap[rows, k],
                                               "scale": np.where(seen[:, None], 1.0, HIDDEN_SCALE) * np.ones(3)}
     if frame:
-        _frame_path(scene, log.body_pos[rows])
+        target = np.array([*log.body_pos[0, :2], 0.6 * STANDING_HEIGHT])
+        look_from(scene, target + _VIEW, target=target)
+        scene.set_camera_follow(root)
     return animate_tracks(scene, tracks, fps, check=False)
-
-
-def _frame_path(scene: Scene, body_pos: np.ndarray) -> None:
-    """Look at the middle of the walked path from the robot's front right, far enough to see it all."""
-    lo, hi = body_pos.min(axis=0), body_pos.max(axis=0)
-    target = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, 0.6 * STANDING_HEIGHT])
-    extent = float(np.hypot(hi[0] - lo[0], hi[1] - lo[1])) + TRUNK_SIZE[0]
-    direction = np.array([0.55, -1.0, 0.6]) / np.linalg.norm([0.55, -1.0, 0.6])
-    look_from(scene, target + max(0.5, 0.7 * extent) * direction, target=target)

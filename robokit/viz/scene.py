@@ -12,6 +12,7 @@ from __future__ import annotations
 import base64
 import functools
 import html as _html
+import json
 from importlib import resources
 from pathlib import Path
 from typing import Any, Sequence
@@ -222,6 +223,21 @@ class Scene:
 
         return self.send(_SetTarget())
 
+    def set_camera_follow(self, path: str) -> "Scene":
+        """Make the viewer's camera follow the object at ``path``: as it moves (an animation), the
+        camera and the point it looks at move with it, keeping the view the user chose.
+
+        A ``robokit_follow`` command that :meth:`html` implements in the offline page (a meshcat
+        server ignores it: there the camera stays put).
+        """
+        path = self.meshcat_path(path).lower()
+
+        class _Follow:
+            def lower(self):
+                return {"type": "robokit_follow", "path": path}
+
+        return self.send(_Follow())
+
     def add_triad(self, path: str, transform: Any = None, scale: float = 0.3) -> "Scene":
         """Add a coordinate frame: x red, y green, z blue, each ``scale`` metres long."""
         from meshcat.geometry import LineBasicMaterial, LineSegments, PointsGeometry
@@ -270,6 +286,16 @@ class Scene:
         targets = [c["value"] for c in commands if c.get("type") == "set_target"]
         target = ("viewer.controls.target.set(%r, %r, %r); viewer.controls.update();\n" % tuple(targets[-1])
                   if targets else "")
+        follows = [c["path"] for c in commands if c.get("type") == "robokit_follow"]
+        if follows:     # after each frame, shift camera and target by what the followed node moved
+            target += (
+                "(function () { const node = viewer.scene_tree.find(%s).object;"
+                " const last = node.position.clone(); node.getWorldPosition(last);"
+                " function follow() { requestAnimationFrame(follow); const now = last.clone();"
+                " node.getWorldPosition(now); const d = now.clone().sub(last);"
+                " if (d.lengthSq() > 0) { viewer.controls.target.add(d); viewer.camera.position.add(d);"
+                " last.copy(now); viewer.set_dirty(); } }"
+                " follow(); })();\n" % json.dumps([p for p in follows[-1].split("/") if p]))
         return (
             "<!DOCTYPE html><html><head><meta charset='utf-8'>"
             f"<title>{_html.escape(self.title)}</title><style>body{{margin:0}}"
