@@ -425,6 +425,39 @@ def unit_square():
 def gait(name):
     from robokit.legged import crawl_gait, trot_gait
     return {"crawl": crawl_gait, "trot": trot_gait}[name]()
+# --- lesson 04's trial log and LittleDog scenes (robokit.legged.trial_log, viz.legged, viz.legged_plots) ---
+
+@functools.cache
+def trial_log():      # 10 rows of a synthetic crawl, self-consistent (tests/legged_logs.py)
+    from tests.legged_logs import synthetic_log
+    return synthetic_log(10)
+
+
+def trial_streams():
+    return {k: np.array(v) for k, v in trial_log().streams.items()}
+
+
+def trial_meta_dict():
+    return dict(trial_log().meta)
+
+
+@functools.cache
+def trial_folder():
+    import tempfile
+    from pathlib import Path
+    return Path(tempfile.mkdtemp(prefix="robokit-fuzz-trial-"))
+
+
+@functools.cache
+def saved_trial():
+    from robokit.legged.trial_log import save_trial
+    return str(save_trial(trial_folder() / "saved.npz", trial_log()))
+
+
+def stance_q():
+    from robokit.legged.leg_kinematics import body_ik
+    from robokit.legged.littledog import STANCE_FEET
+    return body_ik(STANCE_FEET).q[0]
 
 
 SPECS: dict[str, Call] = {
@@ -676,7 +709,8 @@ SPECS: dict[str, Call] = {
     "robokit.viz.animation.animate_poses": Call({"scene": Obj(scene), "path": Text("truck"),
                                                  "transforms": Array(lambda: lap().poses[:5], "N,3|N,4,4"),
                                                  "fps": Real(10.0), "repetitions": Int(1)}),
-    "robokit.viz.scene3d.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3")}),
+    "robokit.viz.scene3d.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3"),
+                                           "target": Array(np.array([0.0, 0.0, 0.1]), "3", optional=True)}),
     # --- lesson 02: the assignment's plain-data references, the experiments, graphs and sliders ---
     "robokit.exercises.omni_localization.fine_stage_counts": Call({
         "query": Array(lambda: rec_nodes()[1][:4] + 0.01, "N,N", min_rows=0), "node_descriptors": Obj(rec_nodes),
@@ -1272,6 +1306,47 @@ SPECS: dict[str, Call] = {
     "robokit.legged.power.endurance": Call({"energy_j": Real(111888.0), "mean_power_w": Real(62.0)}),
     "robokit.legged.power.cost_of_transport": Call({"energy_j": Real(620.0), "mass": Real(3.0), "distance": Real(1.0),
                                                      "g": Real(9.81)}),
+    # --- lesson 04: robokit.legged.trial_log, viz.legged, viz.legged_plots, viz.animation.animate_tracks ---
+    "robokit.geometry.rotations.quat_to_matrix": Call({"quat": Array(np.array([0.9, 0.1, -0.2, 0.3]), "...,4"),
+                                                       "check": Flag(True)}),
+    "robokit.legged.trial_log.TrialLog": Call({"streams": Mapping(trial_streams), "meta": Mapping(trial_meta_dict)}),
+    "robokit.legged.trial_log.trial_meta": Call({
+        "gait": Text("crawl"), "host_rate": Real(100.0), "servo_rate": Real(500.0), "physics_timestep": Real(0.001),
+        "link_latency": Real(0.01), "link_jitter": Real(0.002), "link_loss": Real(0.01), "seed": Int(0, optional=True),
+        "notes": Text(""), "extra": Given({})}),
+    "robokit.legged.trial_log.empty_streams": Call({"n": Int(4), "host_rate": Real(100.0)}),
+    "robokit.legged.trial_log.save_trial": Call({"path": Text(lambda: str(trial_folder() / "t.npz")),
+                                                 "log": Obj(trial_log)}),
+    "robokit.legged.trial_log.load_trial": Call({"path": Text(saved_trial)}),
+    "robokit.legged.trial_log.describe_layout": Call({}),
+    "robokit.viz.animation.animate_tracks": Call({
+        "scene": Obj(scene), "tracks": Mapping(lambda: {"a": {"position": np.zeros((3, 3)), "scale": np.ones((3, 3))}}),
+        "fps": Real(10.0), "repetitions": Int(1), "check": Flag(True)}),
+    "robokit.viz.legged.joint_path": Call({"path": Text("littledog"), "leg": Choice("HL"), "joint": Choice("knee")}),
+    "robokit.viz.legged.add_littledog": Call({"scene": Obj(scene), "path": Text("littledog"),
+                                              "T_world_body": T_(lambda: np.eye(4), optional=True),
+                                              "q": Array(stance_q, "12", optional=True)}),
+    "robokit.viz.legged.pose_littledog": Call({"scene": Obj(scene), "path": Text("littledog"),
+                                               "T_world_body": T_(lambda: np.eye(4)), "q": Array(stance_q, "12")}),
+    "robokit.viz.legged.animate_trial": Call({
+        "scene": Obj(scene), "log": Obj(trial_log), "path": Text("littledog"), "every": Int(2),
+        "fps": Real(50.0, optional=True), "support": Flag(True), "com": Flag(True), "forces": Flag(True),
+        "mocap": Flag(False), "force_scale": Real(0.004), "frame": Flag(True)}),
+    "robokit.viz.legged_plots.support_outline": Call({
+        "feet_xy": Array(np.array([[0.16, 0.08], [0.16, -0.08], [-0.16, 0.08], [-0.16, -0.08]]), "N,2", min_rows=0)}),
+    "robokit.viz.legged_plots.plot_gait_diagram": Call({
+        "t": Array(np.arange(4) * 0.01, "N"), "stance": Array(np.eye(4, dtype=bool) == 0, "N,4", accepts=("booleans",)),
+        "ax": Given(axes), "legs": Given(("FL", "FR", "HL", "HR"))}),
+    "robokit.viz.legged_plots.plot_joint_tracking": Call({"log": Obj(trial_log), "joints": Given(["FL_knee", 3]),
+                                                          "ax": Given(axes)}),
+    "robokit.viz.legged_plots.plot_foot_forces": Call({
+        "log": Obj(trial_log), "ax": Given(axes),
+        "detected": Array(lambda: trial_log().foot_force > 3.0, "N,4", optional=True, accepts=("booleans",)),
+        "legs": Given(["HR"])}),
+    "robokit.viz.legged_plots.plot_support": Call({
+        "feet_xy": Array(np.array([[0.16, 0.08], [0.16, -0.08], [-0.16, 0.08], [-0.16, -0.08]]), "N,2|N,3"),
+        "stance": Array(np.array([True, True, True, False]), "N", accepts=("booleans",)),
+        "com_xy": Array(np.array([0.01, 0.0]), "2|3"), "ax": Given(axes), "legs": Given(("FL", "FR", "HL", "HR"))}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -1381,6 +1456,14 @@ EXTRA: tuple[str, ...] = (
         "joint_lag", "joint_plant", "design_servo_gains", "servo_analysis", "pd_servo_step", "discrete_servo_response")),
     "robokit.controllers.host_link.SetpointChannel",
     *(f"robokit.legged.power.{n}" for n in ("battery_energy", "trial_power", "endurance", "cost_of_transport")),
+    # lesson 04's trial log, LittleDog scenes and figures (fuzzed before the lesson exists)
+    "robokit.geometry.rotations.quat_to_matrix",
+    *(f"robokit.legged.trial_log.{n}" for n in (
+        "TrialLog", "trial_meta", "empty_streams", "save_trial", "load_trial", "describe_layout")),
+    "robokit.viz.animation.animate_tracks",
+    *(f"robokit.viz.legged.{n}" for n in ("joint_path", "add_littledog", "pose_littledog", "animate_trial")),
+    *(f"robokit.viz.legged_plots.{n}" for n in (
+        "support_outline", "plot_gait_diagram", "plot_joint_tracking", "plot_foot_forces", "plot_support")),
 )
 
 

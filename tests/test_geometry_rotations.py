@@ -146,6 +146,8 @@ def test_quat_to_matrix_agrees_with_scipy_and_with_the_axis_angle():
     t = np.linalg.norm(v, axis=1, keepdims=True)
     np.testing.assert_allclose(g.quat_to_matrix(np.hstack([np.cos(t / 2), np.sin(t / 2) * v / t])), g.so3_exp(v),
                                atol=1e-14)
+    for s in (1e-200, 1e300):                               # scaled far from 1: still the same rotation
+        np.testing.assert_allclose(g.quat_to_matrix(q[:5] * s), R[:5], atol=1e-14)
 
 
 @pytest.mark.parametrize("bad, word", [([1.0, 0.0, 0.0], "shape"), ([0.0, 0.0, 0.0, 0.0], "non-zero"),

@@ -48,3 +48,39 @@ def test_textured_world_is_drawn(tmp_path):
     changed = (np.abs(img.astype(int) - empty.astype(int)).sum(axis=2) > 30).mean()
     assert changed > 0.2
     assert len(np.unique(img.reshape(-1, 3) // 8, axis=0)) > 200  # textured, not flat colour
+
+
+def test_camera_target_frames_an_object_away_from_the_origin(tmp_path):
+    """look_from(..., target=) makes the viewer look at the target, not at the origin."""
+    def scene(target):
+        s = Scene()
+        s.add_box("box", (0.2, 0.2, 0.2), np.array([[1, 0, 0, 6.0], [0, 1, 0, 4.0], [0, 0, 1, 0.1], [0, 0, 0, 1]]),
+                  color=0xFF00FF)
+        from robokit.viz import look_from
+        return look_from(s, [6.5, 3.4, 0.5], target=target)
+
+    magenta = lambda im: (im[..., 0] > 120) & (im[..., 2] > 120) & (im[..., 1] < 60)
+    framed = magenta(screenshot(scene([6.0, 4.0, 0.1]), tmp_path, "framed"))
+    h, w = framed.shape
+    assert framed[h // 3:2 * h // 3, w // 3:2 * w // 3].mean() > 0.2          # the box fills the middle
+    at_origin = magenta(screenshot(scene(None), tmp_path, "origin"))
+    assert at_origin[h // 3:2 * h // 3, w // 3:2 * w // 3].mean() < 0.01      # looking at the origin misses it
+
+
+def test_the_camera_follows_a_walking_littledog(tmp_path):
+    """animate_trial's camera keeps the robot in the middle of the view while it walks away."""
+    from robokit.viz import animate_trial, look_from
+    from tests.legged_logs import synthetic_log
+
+    log = synthetic_log(300)                     # 0.9 m forward in 3 s (played in full before the shot)
+    yellow = lambda im: (im[..., 0] > 180) & (im[..., 1] > 120) & (im[..., 2] < 80)    # the centre-of-mass disc
+
+    followed = yellow(screenshot(animate_trial(Scene(), log), tmp_path, "followed"))
+    rows, cols = np.nonzero(followed)
+    assert len(cols) > 20
+    h, w = followed.shape
+    assert abs(cols.mean() - w / 2) < 0.2 * w and abs(rows.mean() - h / 2) < 0.3 * h
+    still = animate_trial(Scene(), log, frame=False)
+    look_from(still, [0.33, -0.51, 0.39], target=[0.0, 0.0, 0.08])   # the same view, not following
+    rows, cols = np.nonzero(yellow(screenshot(still, tmp_path, "still")))
+    assert len(cols) == 0 or abs(cols.mean() - w / 2) > 0.25 * w

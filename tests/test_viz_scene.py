@@ -45,7 +45,22 @@ def test_notebook_repr_is_an_offline_iframe(tmp_path):
     (lambda s: s.add_points("p", np.zeros((3, 2))), "points"),
     (lambda s: s.add_box("b", (1, 1, 1), color=(2, 0, 0)), "color"),
     (lambda s: s.add_line("l", [[0, 0, 0]]), "points"),
+    (lambda s: s.add_cylinder("c", -1.0, 0.1), "length"),
+    (lambda s: s.add_cylinder("c", 1.0, 0.1, radius_top=-0.1), "radius_top"),
+    (lambda s: s.add_mesh("m", [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 3]]), "faces"),
+    (lambda s: s.add_mesh("m", [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0.0, 1.5, 2.0]]), "faces"),
+    (lambda s: s.set_camera_target([1.0, np.nan, 0.0]), "target"),
+    (lambda s: s.set_camera_follow(""), "path"),
 ])
 def test_bad_input_is_named(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
         call(Scene())
+
+
+def test_cylinder_mesh_and_camera_commands():
+    scene = Scene().add_cylinder("c", 0.2, 0.01, radius_top=0.0).add_mesh("m", [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    cyl = scene.commands[0]["object"]["geometries"][0]
+    assert (cyl["type"], cyl["height"], cyl["radiusTop"], cyl["radiusBottom"]) == ("CylinderGeometry", 0.2, 0.0, 0.01)
+    scene.set_camera_target([1.0, 2.0, 3.0])
+    assert scene.commands[-1] == {"type": "set_target", "path": "", "value": [1.0, 3.0, -2.0]}   # three.js y-up
+    assert "viewer.controls.target.set(1.0, 3.0, -2.0)" in scene.html()

@@ -425,11 +425,12 @@ def quat_to_matrix(quat: Any, *, check: bool = True) -> np.ndarray:
     Parameters
     ----------
     quat : array_like, shape (..., 4)
-        Quaternions; each is normalised first, so one a little off unit length (rounding in a
+        Quaternions; each is normalised first (scaled by its largest entry, then by its norm, so
+        huge and tiny ones do not overflow), so one a little off unit length (rounding in a
         simulator's integration) still gives a proper rotation. ``q`` and ``-q`` give the same
         matrix.
     check : bool, default True
-        Validate the input (shape, finite values, a norm above 1e-12); ``False`` skips it.
+        Validate the input (shape, finite values, not zero); ``False`` skips it.
 
     Returns
     -------
@@ -461,10 +462,11 @@ def quat_to_matrix(quat: Any, *, check: bool = True) -> np.ndarray:
     q = as_array(quat, "quat") if check else np.asarray(quat, dtype=float)
     if check and (q.ndim == 0 or q.shape[-1] != 4):
         raise ValueError(f"quat: expected quaternions [w, x, y, z], shape (..., 4), got shape {q.shape}")
-    norm = np.linalg.norm(q, axis=-1, keepdims=True)
-    if check and np.any(norm < 1e-12):
-        raise ValueError("quat: expected non-zero quaternions (a zero one is no rotation), got a norm below 1e-12")
-    w, x, y, z = np.moveaxis(q / norm, -1, 0)
+    big = np.max(np.abs(q), axis=-1, keepdims=True)
+    if check and np.any(big == 0):
+        raise ValueError("quat: expected non-zero quaternions (a zero one is no rotation), got [0, 0, 0, 0]")
+    q = q / big
+    w, x, y, z = np.moveaxis(q / np.linalg.norm(q, axis=-1, keepdims=True), -1, 0)
     return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
                      np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
                      np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)],

@@ -6,22 +6,19 @@ log holds the same, plus the simulator's ground truth, one row per 10 ms host cy
 100 Hz host loop): ``N`` rows of every stream of :data:`LOG_LAYOUT`, and a metadata dict saying how
 the trial was run (rates, gait, the wireless link's latency, jitter and loss, the seed).
 
-* :class:`TrialLog` - the streams (read-only arrays, ``log.q``, ``len(log)``) and the metadata;
-  checked when built, so a log in hand is always complete and consistent.
-* :func:`empty_streams` and :func:`trial_meta` - zero-filled streams of ``N`` rows to fill in a
-  simulation loop, and the metadata dict with its defaults.
-* :func:`save_trial` / :func:`load_trial` - one compressed ``.npz`` per trial, written atomically.
-* :func:`describe_layout` - the layout as a text table, for the lesson to print.
+:class:`TrialLog` holds both (read-only arrays, ``log.q``), checked when built so a log in hand is
+complete and consistent; :func:`empty_streams` and :func:`trial_meta` give a simulation loop arrays
+to fill and the metadata; :func:`save_trial` / :func:`load_trial` write and read one compressed
+``.npz``; :func:`describe_layout` prints the layout.
 
 The file is a numpy ``.npz`` (a zip of ``.npy`` arrays, readable without robokit): one array per
 stream, named as in :data:`LOG_LAYOUT`, plus two JSON strings, ``__meta__`` (the metadata, with
 ``format`` = :data:`LOG_FORMAT` and ``version`` = :data:`LOG_VERSION`) and ``__layout__`` (the
 layout: shape, dtype, unit, description of every stream). It loads with ``allow_pickle=False``, so
 a log file can never run code. A file that is truncated or corrupt, of another format or version,
-or that lacks a stream or holds one of the wrong shape raises :class:`TrialLogError`.
-
-A MoCap marker that the cameras did not see has ``mocap_visible`` False; its ``mocap`` row holds
-no measurement (zeros by convention, never NaN: the mask says what is missing).
+or that lacks a stream or holds one of the wrong shape raises :class:`TrialLogError`. A MoCap
+marker the cameras did not see has ``mocap_visible`` False and no measurement in ``mocap`` (zeros
+by convention, never NaN: the mask says what is missing).
 
 References
 ----------
@@ -153,8 +150,7 @@ def _checked_streams(streams: Any) -> dict:
     if unknown or missing:
         raise TrialLogError(f"streams: expected exactly the streams of LOG_LAYOUT version {LOG_VERSION}; "
                             f"missing {missing}, unknown {unknown}")
-    out = {}
-    n = None
+    out, n = {}, None
     for name, spec in LOG_LAYOUT.items():
         label = f"streams['{name}']"
         arr = as_array(streams[name], label, dtype=spec.dtype)
@@ -197,8 +193,7 @@ class TrialLog:
     Attributes
     ----------
     streams, meta : read-only mappings
-    <stream> : numpy.ndarray
-        Every stream is an attribute too: ``log.q``, ``log.feet``.
+        Every stream is an attribute too: ``log.q``, ``log.feet``; ``len(log)`` is ``N``.
 
     Raises
     ------
@@ -231,17 +226,8 @@ class TrialLog:
         object.__setattr__(self, "meta", MappingProxyType(_checked_meta(self.meta)))
 
     def validate(self) -> "TrialLog":
-        """Check the log again (its arrays may have been changed through other references).
-
-        Returns
-        -------
-        TrialLog
-            ``self``.
-
-        Raises
-        ------
-        TrialLogError, ValueError, TypeError
-            As the constructor.
+        """Check the log again (its arrays may have changed through other references); returns
+        ``self``, or raises as the constructor does.
 
         Examples
         --------
@@ -269,15 +255,8 @@ class TrialLog:
                 f"version={self.meta['version']})")
 
     def T_world_body(self) -> np.ndarray:
-        """The trunk's true pose at every row, from ``body_pos`` and ``body_quat``.
-
-        Returns
-        -------
-        numpy.ndarray, shape (N, 4, 4)
-
-        Notes
-        -----
-        :func:`robokit.geometry.quat_to_matrix` and :func:`robokit.geometry.se3_from_rt`.
+        """The trunk's true pose at every row, (N, 4, 4), from ``body_pos`` and ``body_quat``
+        (:func:`robokit.geometry.quat_to_matrix`, :func:`robokit.geometry.se3_from_rt`).
 
         Examples
         --------
@@ -289,22 +268,8 @@ class TrialLog:
         return se3_from_rt(quat_to_matrix(self.streams["body_quat"], check=False), self.streams["body_pos"])
 
     def slice(self, start: int, stop: int) -> "TrialLog":
-        """Rows ``start`` to ``stop`` (excluded) as a log of their own, same metadata.
-
-        Parameters
-        ----------
-        start, stop : int
-            Row indices, as in Python slicing (negative from the end; clipped to the log).
-
-        Returns
-        -------
-        TrialLog
-            Read-only views of the rows (no copy).
-
-        Raises
-        ------
-        ValueError
-            If the range holds no row.
+        """Rows ``start`` to ``stop`` (excluded; Python's slicing rules) as a log of their own, with
+        the same metadata and views of the rows (no copy); a ValueError if the range holds no row.
 
         Examples
         --------
@@ -330,29 +295,19 @@ def trial_meta(*, gait: str = "", host_rate: float = GUIDE["host_rate"], servo_r
 
     Parameters
     ----------
-    gait : str, default ""
-    host_rate, servo_rate : float
-        Hz; default 100 and 500 (LittleDog User Guide, Sec. 2).
-    physics_timestep : float
-        s; default :data:`~robokit.legged.littledog.TIMESTEP`.
-    link_latency, link_jitter : float, default 0
-        s, the wireless link's mean delay and its standard deviation.
-    link_loss : float, default 0
-        Fraction of host commands lost, in [0, 1].
+    gait, notes : str, default ""
+    host_rate, servo_rate, physics_timestep : float
+        Hz, Hz, s; default 100 and 500 (LittleDog User Guide, Sec. 2) and 1 ms.
+    link_latency, link_jitter, link_loss : float, default 0
+        The wireless link's mean delay (s), its standard deviation (s), the fraction of commands lost.
     seed : int or None
-    notes : str
     **extra
         More JSON-able entries.
 
     Returns
     -------
     dict
-        All of :data:`META_KEYS`.
-
-    Raises
-    ------
-    ValueError, TypeError
-        For a bad value (naming its key).
+        All of :data:`META_KEYS`; a ValueError or TypeError names a bad key.
 
     Examples
     --------
@@ -374,12 +329,7 @@ def empty_streams(n: int, host_rate: float = GUIDE["host_rate"]) -> dict:
     n : int
         Rows (host cycles), at least 1.
     host_rate : float, default 100
-        Hz; ``t`` is filled with ``k / host_rate``.
-
-    Returns
-    -------
-    dict of str to numpy.ndarray
-        Every stream of :data:`LOG_LAYOUT`: zeros (False), except ``t`` and ``body_quat`` = [1, 0, 0, 0].
+        Hz; ``t = k / host_rate``. Every other stream is zeros (False), ``body_quat`` [1, 0, 0, 0].
 
     Examples
     --------
@@ -423,10 +373,9 @@ def save_trial(path: Any, log: TrialLog) -> Path:
 
     Raises
     ------
-    TypeError
-        If ``log`` is not a TrialLog or ``path`` not a path.
-    TrialLogError
-        If the log's arrays were changed into an invalid state since it was built.
+    TypeError, TrialLogError
+        If ``log`` is not a TrialLog or ``path`` not a path; if the log's arrays were changed into
+        an invalid state since it was built.
 
     Notes
     -----
@@ -474,10 +423,8 @@ def load_trial(path: Any) -> TrialLog:
         For a truncated or corrupt file, a file of another format or of another version (the
         message says which version it is and which this code reads), a missing or unexpected
         stream, or one of the wrong shape, dtype or length.
-    FileNotFoundError
-        If there is no such file.
-    TypeError
-        If ``path`` is not a path.
+    FileNotFoundError, TypeError
+        If there is no such file; if ``path`` is not a path.
 
     Notes
     -----
@@ -532,11 +479,7 @@ def load_trial(path: Any) -> TrialLog:
 
 def describe_layout() -> str:
     """The log's layout as a text table: each stream's name, shape, dtype, unit and description,
-    then the metadata keys.
-
-    Returns
-    -------
-    str
+    then the metadata keys (a str).
 
     Examples
     --------

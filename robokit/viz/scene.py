@@ -12,6 +12,7 @@ from __future__ import annotations
 import base64
 import functools
 import html as _html
+import json
 from importlib import resources
 from pathlib import Path
 from typing import Any, Sequence
@@ -178,6 +179,65 @@ class Scene:
         self.set_object(path, Sphere(check_positive(radius, "radius")), self._material(color, opacity))
         return self.set_transform(path, transform)
 
+    def add_cylinder(self, path: str, length: float, radius: float, transform: Any = None, color: Any = 0x8899AA,
+                     opacity: float = 1.0, radius_top: float | None = None) -> "Scene":
+        """Add a cylinder of ``length`` and ``radius`` metres centred at ``transform``, its axis along
+        the local **y** axis (three.js's convention); ``radius_top`` (at +y) other than ``radius``
+        makes a cone or a frustum (0: a cone with its tip at +y)."""
+        from meshcat.geometry import Cylinder
+
+        length, radius = check_positive(length, "length"), check_positive(radius, "radius")
+        top = radius if radius_top is None else check_positive(radius_top, "radius_top", allow_zero=True)
+        geometry = Cylinder(length, radiusTop=top, radiusBottom=radius)
+        self.set_object(path, geometry, self._material(color, opacity))
+        return self.set_transform(path, transform)
+
+    def add_mesh(self, path: str, vertices: Any, faces: Any, transform: Any = None, color: Any = 0x8899AA,
+                 opacity: float = 1.0) -> "Scene":
+        """Add a triangle mesh (seen from both sides): ``vertices`` (N, 3) metres and ``faces`` (M, 3)
+        vertex indices."""
+        from meshcat.geometry import TriangularMeshGeometry
+
+        v = as_points(vertices, "vertices", 3, min_count=3)
+        f = as_array(faces, "faces", dtype=None)
+        if f.ndim != 2 or f.shape[1] != 3 or len(f) < 1 or f.dtype.kind not in "iu":
+            raise ValueError(f"faces: expected (M, 3) integer vertex indices, M >= 1, got {describe(faces)}")
+        if f.min() < 0 or f.max() >= len(v):
+            raise ValueError(f"faces: expected indices in [0, {len(v) - 1}] (rows of vertices), got {f.min()}..{f.max()}")
+        self.set_object(path, TriangularMeshGeometry(v, f), self._material(color, opacity))
+        return self.set_transform(path, transform)
+
+    def set_camera_target(self, target: Any) -> "Scene":
+        """Make the viewer's camera look at, and orbit about, world point ``target`` (metres, z up).
+
+        meshcat's ``set_target`` command (meshcat-python's ``SetCamTarget``; its position in three.js's
+        y-up frame, ``(x, z, -y)``). The viewer bundled with meshcat 0.3.2 does not know the command,
+        so :meth:`html` also sets the orbit controls' target itself; a live server of that version
+        ignores it (its camera keeps orbiting the origin).
+        """
+        p = as_array(target, "target", shape=(3,))
+
+        class _SetTarget:
+            def lower(self):
+                return {"type": "set_target", "path": "", "value": [float(p[0]), float(p[2]), float(-p[1])]}
+
+        return self.send(_SetTarget())
+
+    def set_camera_follow(self, path: str) -> "Scene":
+        """Make the viewer's camera follow the object at ``path``: as it moves (an animation), the
+        camera and the point it looks at move with it, keeping the view the user chose.
+
+        A ``robokit_follow`` command that :meth:`html` implements in the offline page (a meshcat
+        server ignores it: there the camera stays put).
+        """
+        path = self.meshcat_path(path).lower()
+
+        class _Follow:
+            def lower(self):
+                return {"type": "robokit_follow", "path": path}
+
+        return self.send(_Follow())
+
     def add_triad(self, path: str, transform: Any = None, scale: float = 0.3) -> "Scene":
         """Add a coordinate frame: x red, y green, z blue, each ``scale`` metres long."""
         from meshcat.geometry import LineBasicMaterial, LineSegments, PointsGeometry
@@ -219,9 +279,23 @@ class Scene:
         """Return the scene as one self-contained HTML page (works offline, no server)."""
         import umsgpack
 
+        commands = self.commands
         payload = ",\n".join(
-            '"' + base64.b64encode(umsgpack.packb(c)).decode("ascii") + '"' for c in self.commands
+            '"' + base64.b64encode(umsgpack.packb(c)).decode("ascii") + '"' for c in commands
         )
+        targets = [c["value"] for c in commands if c.get("type") == "set_target"]
+        target = ("viewer.controls.target.set(%r, %r, %r); viewer.controls.update();\n" % tuple(targets[-1])
+                  if targets else "")
+        follows = [c["path"] for c in commands if c.get("type") == "robokit_follow"]
+        if follows:     # after each frame, shift camera and target by what the followed node moved
+            target += (
+                "(function () { const node = viewer.scene_tree.find(%s).object;"
+                " const last = node.position.clone(); node.getWorldPosition(last);"
+                " function follow() { requestAnimationFrame(follow); const now = last.clone();"
+                " node.getWorldPosition(now); const d = now.clone().sub(last);"
+                " if (d.lengthSq() > 0) { viewer.controls.target.add(d); viewer.camera.position.add(d);"
+                " last.copy(now); viewer.set_dirty(); } }"
+                " follow(); })();\n" % json.dumps([p for p in follows[-1].split("/") if p]))
         return (
             "<!DOCTYPE html><html><head><meta charset='utf-8'>"
             f"<title>{_html.escape(self.title)}</title><style>body{{margin:0}}"
@@ -232,7 +306,7 @@ class Scene:
             f"var robokitCommands = [{payload}];\n"
             "for (const c of robokitCommands) {"
             " viewer.handle_command_bytearray(Uint8Array.from(atob(c), ch => ch.charCodeAt(0))); }\n"
-            "</script></body></html>"
+            f"{target}</script></body></html>"
         )
 
     def save_html(self, path: str | Path) -> Path:
