@@ -23,9 +23,9 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
 
 from ..legged.littledog import JOINT_NAMES, LEGS
+from ..legged.support import SupportPolygonError, stability_margin, support_polygon
 from ..legged.trial_log import TrialLog
 from ..validation import as_array, describe
 from .maps import map_axes
@@ -60,7 +60,7 @@ def support_outline(feet_xy: Any) -> np.ndarray:
     Notes
     -----
     The support pattern of McGhee & Frank (1968), unnumbered: the convex hull of the supporting
-    feet (``scipy.spatial.ConvexHull``, counter-clockwise in 2-D). Unlike a stability computation it
+    feet (:func:`robokit.legged.support.support_polygon`). Unlike a stability computation it
     never refuses fewer than three feet: a two-foot support is drawn as its segment.
 
     Examples
@@ -75,10 +75,10 @@ def support_outline(feet_xy: Any) -> np.ndarray:
         raise ValueError(f"feet_xy: expected shape (k, 2), got {describe(feet_xy)}")
     if len(xy) >= 3:
         try:
-            v = ConvexHull(xy).vertices
-            start = np.lexsort((xy[v, 1], xy[v, 0]))[0]          # lowest x (then y) first: a fixed order
-            return xy[np.roll(v, -start)]
-        except QhullError:          # on one line: the segment below
+            v = support_polygon(xy)
+            start = np.lexsort((v[:, 1], v[:, 0]))[0]            # lowest x (then y) first: a fixed order
+            return np.roll(v, -start, axis=0)
+        except SupportPolygonError:          # on one line: the segment below
             pass
     if len(xy) >= 2:
         d = np.linalg.norm(xy[:, None] - xy[None], axis=-1)
@@ -282,17 +282,13 @@ def plot_foot_forces(log: TrialLog, ax: Any = None, detected: Any = None, legs: 
     return axes
 
 
-def _nearest_on_outline(v: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, float]:
-    """Nearest point of a closed convex polygon's boundary (CCW vertices) to ``p`` and the signed
-    distance to it: positive inside."""
+def _nearest_on_outline(v: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Nearest point of a closed polygon's boundary to ``p`` (where the margin's dashed line ends)."""
     a, b = v, np.roll(v, -1, axis=0)
-    e, rel = b - a, p - a
-    s = np.clip(np.sum(rel * e, axis=1) / np.sum(e * e, axis=1), 0.0, 1.0)
+    e = b - a
+    s = np.clip(np.sum((p - a) * e, axis=1) / np.sum(e * e, axis=1), 0.0, 1.0)
     near = a + s[:, None] * e
-    d = np.linalg.norm(p - near, axis=1)
-    k = int(np.argmin(d))
-    inside = np.all(e[:, 0] * rel[:, 1] - e[:, 1] * rel[:, 0] >= 0)
-    return near[k], float(d[k] if inside else -d[k])
+    return near[int(np.argmin(np.linalg.norm(p - near, axis=1)))]
 
 
 def plot_support(feet_xy: Any, stance: Any, com_xy: Any, ax: Any = None, legs: Sequence[str] = LEGS):
@@ -347,7 +343,7 @@ def plot_support(feet_xy: Any, stance: Any, com_xy: Any, ax: Any = None, legs: S
         closed = np.vstack([v, v[:1]])
         ax.fill(v[:, 0], v[:, 1], color="tab:green", alpha=0.25, label="support polygon")
         ax.plot(closed[:, 0], closed[:, 1], color="tab:green", lw=1.5)
-        near, margin = _nearest_on_outline(v, p)
+        near, margin = _nearest_on_outline(v, p), stability_margin(v, p)
         color = "tab:green" if margin >= 0 else "tab:red"
         ax.plot([p[0], near[0]], [p[1], near[1]], "--", color=color, lw=1.5, label=f"margin {1000 * margin:.0f} mm")
         title = f"support: stability margin {1000 * margin:.0f} mm"
