@@ -93,8 +93,8 @@ META_KEYS: Mapping[str, str] = MappingProxyType({
     "servo_rate": "Hz, joint servo loop on the robot",
     "physics_timestep": "s, the simulator's step",
     "gait": "str, the gait's name ('' if none)",
-    "link_latency": "s, mean delay of the wireless link",
-    "link_jitter": "s, standard deviation of that delay",
+    "link_latency": "s, the wireless link's fixed delay",
+    "link_jitter": "s, spread of the extra delay (controllers.SetpointChannel: uniform in [0, jitter])",
     "link_loss": "fraction of host commands lost, in [0, 1]",
     "seed": "int or None, the seed of the trial's randomness",
     "notes": "str, free text",
@@ -299,7 +299,8 @@ def trial_meta(*, gait: str = "", host_rate: float = GUIDE["host_rate"], servo_r
     host_rate, servo_rate, physics_timestep : float
         Hz, Hz, s; default 100 and 500 (LittleDog User Guide, Sec. 2) and 1 ms.
     link_latency, link_jitter, link_loss : float, default 0
-        The wireless link's mean delay (s), its standard deviation (s), the fraction of commands lost.
+        The wireless link's fixed delay (s), the spread of its extra delay (s; uniform in
+        [0, jitter], :class:`robokit.controllers.SetpointChannel`), the fraction of commands lost.
     seed : int or None
     **extra
         More JSON-able entries.

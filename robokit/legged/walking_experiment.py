@@ -43,7 +43,8 @@ from .support import stability_margins
 from .touchdown import contact_events, detect_contacts, event_precision_recall
 from .trial_log import TrialLog
 
-__all__ = ["LESSON_CRAWL", "LESSON_TROT", "LESSON_DISTANCE", "LATENCIES", "lesson_plans", "loop_table",
+__all__ = ["LESSON_CRAWL", "LESSON_TROT", "LESSON_DISTANCE", "LATENCIES", "TOUCHDOWN_DETECTORS", "lesson_plans",
+           "loop_table",
            "estimation_table", "touchdown_table", "endurance_table", "true_margins"]
 
 LESSON_CRAWL = {"period": 2.0, "step_length": 0.08, "step_height": 0.04, "duty_factor": 0.9}
@@ -54,6 +55,10 @@ LESSON_DISTANCE = 0.3 if config.FAST else 1.0
 """How far the lesson walks (m): 1 m, the issue's distance (0.3 m in fast mode)."""
 LATENCIES = (0.0, 0.01, 0.03, 0.05)
 """Link latencies of the loop table (s)."""
+TOUCHDOWN_DETECTORS = (("threshold 2 N", 2.0, 2.0 - 1e-9, 1), ("hysteresis 3 / 1 N", 3.0, 1.0, 1),
+                       ("hysteresis + debounce 2", 3.0, 1.0, 2))
+"""The touchdown detectors the lesson compares: ``(label, threshold_on, threshold_off, debounce)``
+(N, N, host samples); the plain threshold's off level is a nanonewton below its on level."""
 
 
 def lesson_plans(distance: float = LESSON_DISTANCE) -> dict:
@@ -193,9 +198,8 @@ def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5)
     ----------
     log : TrialLog
     detectors : sequence of (str, float, float, int), optional
-        ``(label, threshold_on, threshold_off, debounce)`` (N, N, samples); default: a plain 2 N
-        threshold (off a nanonewton below on), hysteresis 3 / 1 N, and hysteresis with a 2-sample
-        debounce.
+        ``(label, threshold_on, threshold_off, debounce)`` (N, N, samples); default
+        :data:`TOUCHDOWN_DETECTORS`.
     tolerance : int, default 5
         Host samples (50 ms) within which a detection counts for a true touchdown.
 
@@ -214,8 +218,7 @@ def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5)
     if not isinstance(log, TrialLog):
         raise TypeError(f"log: expected a TrialLog, got {type(log).__name__}")
     if detectors is None:
-        detectors = (("threshold 2 N", 2.0, 2.0 - 1e-9, 1), ("hysteresis 3 / 1 N", 3.0, 1.0, 1),
-                     ("hysteresis + debounce 2", 3.0, 1.0, 2))
+        detectors = TOUCHDOWN_DETECTORS
     dt_ms = 1000.0 * float(log.t[1] - log.t[0])
     truth = np.asarray(log.contact)
     rows = []
