@@ -406,7 +406,7 @@ def sensing_T(n=5):         # a short walk of body poses
 @functools.cache
 def sensing_frames():
     from robokit.legged import MARKERS
-    from robokit.legged.mocap import simulate_mocap
+    from robokit.legged.mocap_sensor import simulate_mocap
     return simulate_mocap(sensing_T(), MARKERS, 0.001, 0.0, 0)
 
 
@@ -1188,7 +1188,7 @@ SPECS: dict[str, Call] = {
     "robokit.geometry.spatial.fit_se3": Call({
         "source": Array(lambda: points(6), "N,3|N,N,3"), "target": Array(lambda: points(6) + 1.0, "N,3|N,N,3"),
         "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
-    "robokit.legged.mocap.simulate_mocap": Call({
+    "robokit.legged.mocap_sensor.simulate_mocap": Call({
         "T_world_body": Array(sensing_T, "N,4,4|4,4"), "markers_body": Array(sensing_markers, "N,3|3"),
         "noise": Real(0.001), "dropout": Real(0.1), "rng": Rng(0), "bursts": Real(0.1), "burst_length": Int(2)}),
     "robokit.legged.mocap.fit_marker_pose": Call({
@@ -1223,9 +1223,9 @@ SPECS: dict[str, Call] = {
     "robokit.legged.touchdown.detect_contacts": Call({
         "force": Array(np.array([0.0, 4.0, 6.0, 1.0, 6.0, 0.5]), "N|N,N", min_rows=0), "threshold_on": Real(3.0),
         "threshold_off": Real(1.0), "debounce": Int(2)}),
-    "robokit.legged.touchdown.contact_events": Call({
+    "robokit.legged.event_scoring.contact_events": Call({
         "contact": Array(walk_contacts, "N|N,N", min_rows=0, accepts=("booleans",))}),
-    "robokit.legged.touchdown.event_precision_recall": Call({
+    "robokit.legged.event_scoring.event_precision_recall": Call({
         "detected": Array(lambda: np.roll(walk_contacts(), 1), "N|N,N", accepts=("booleans",)),
         "truth": Array(walk_contacts, "N|N,N", accepts=("booleans",)), "tolerance": Int(2)}),
     # --- robokit.legged.support, gait_schedule, gait (lesson 04's gaits) ----------------------------
@@ -1437,10 +1437,12 @@ EXTRA: tuple[str, ...] = (
         "bow_database.BowDatabase")),
     # lesson 04's sensing: the one rigid fit, MoCap, IMU, fusion, touchdowns
     "robokit.geometry.procrustes.fit_rigid", "robokit.geometry.spatial.fit_se3",
-    *(f"robokit.legged.mocap.{n}" for n in ("simulate_mocap", "fit_marker_pose", "mocap_body_poses")),
+    "robokit.legged.mocap_sensor.simulate_mocap",
+    *(f"robokit.legged.mocap.{n}" for n in ("fit_marker_pose", "mocap_body_poses")),
     *(f"robokit.legged.imu.{n}" for n in ("simulate_imu", "integrate_gyro", "specific_force")),
     *(f"robokit.legged.state_estimation.{n}" for n in ("fuse_body_state", "orientation_errors", "position_errors")),
-    *(f"robokit.legged.touchdown.{n}" for n in ("detect_contacts", "contact_events", "event_precision_recall")),
+    "robokit.legged.touchdown.detect_contacts",
+    *(f"robokit.legged.event_scoring.{n}" for n in ("contact_events", "event_precision_recall")),
     # robokit.legged's gaits (lesson 04), fuzzed before the lesson exists
     *(f"robokit.legged.support.{n}" for n in ("support_polygon", "stability_margin", "stability_margins")),
     *(f"robokit.legged.gait_schedule.{n}" for n in (

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from robokit.legged.touchdown import contact_events, detect_contacts, event_precision_recall
+from robokit.legged.event_scoring import contact_events, event_precision_recall, score_events
+from robokit.legged.touchdown import detect_contacts
 
 
 def reference_detector(force, on, off, debounce):
@@ -116,6 +117,30 @@ def test_matching_has_maximum_size():
         m = brute_force_matches(det, tru, tol)
         assert score.precision == (m / len(det) if len(det) else 1.0)
         assert score.recall == (m / len(tru) if len(tru) else 1.0)
+
+
+def test_score_events_on_indices_is_the_same_maximum_matching():
+    # indices in any order, repeats allowed (a detector that reports a touchdown twice): the score
+    # of the sorted indices, against the Hungarian algorithm's maximum matching
+    rng = np.random.default_rng(4)
+    for _ in range(300):
+        tru = rng.choice(200, rng.integers(0, 15), replace=False)
+        det = rng.integers(0, 200, rng.integers(0, 15))
+        tol = int(rng.integers(0, 12))
+        score = score_events(det.tolist(), tru, tol)
+        m = brute_force_matches(np.sort(det), np.sort(tru), tol)
+        assert score.precision == (m / len(det) if len(det) else 1.0)
+        assert score.recall == (m / len(tru) if len(tru) else 1.0)
+    # the states' score is the indices' score of their rising edges
+    truth = np.zeros(20, bool); truth[2:6] = True; truth[10:15] = True
+    found = np.zeros(20, bool); found[4:6] = True; found[7:8] = True; found[11:15] = True
+    assert score_events(contact_events(found), contact_events(truth), 2) == event_precision_recall(found, truth, 2)
+    assert score_events([9, 3.0], [2], 2) == (0.5, 1.0, 1.0)               # whole floats are indices
+    for bad, match in (([1.5], "detected"), ([-1], "detected"), ([[1, 2]], "detected"), ([float("nan")], "detected")):
+        with pytest.raises(ValueError, match=match):
+            score_events(bad, [2], 2)
+    with pytest.raises(ValueError, match="tolerance"):
+        score_events([1], [2], -1)
 
 
 def test_hand_worked_score_and_empty_conventions():
