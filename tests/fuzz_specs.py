@@ -1347,6 +1347,26 @@ SPECS: dict[str, Call] = {
         "feet_xy": Array(np.array([[0.16, 0.08], [0.16, -0.08], [-0.16, 0.08], [-0.16, -0.08]]), "N,2|N,3"),
         "stance": Array(np.array([True, True, True, False]), "N", accepts=("booleans",)),
         "com_xy": Array(np.array([0.01, 0.0]), "2|3"), "ax": Given(axes), "legs": Given(("FL", "FR", "HL", "HR"))}),
+    # --- assignment 04: robokit.exercises.littledog, its helpers (legged.exercise_data, event_scoring) and
+    #     the leg kinematics its exercises reference ----------------------------------------------------
+    "robokit.legged.leg_kinematics.foot_position": Call({
+        "q_leg": Array(np.array([0.1, 0.6, -1.2]), "...,3"), "leg": Choice("FL")}),
+    "robokit.legged.leg_kinematics.leg_ik": Call({
+        "p_foot": Array(np.array([0.12, 0.07, -0.11]), "3"), "leg": Choice("FL"),
+        "branch": Int(-1, optional=True, accepts=("a list",))}),
+    "robokit.legged.event_scoring.score_events": Call({
+        "detected": Array(np.array([3, 5, 8]), "N", min_rows=0), "truth": Array(np.array([2, 8]), "N", min_rows=0),
+        "tolerance": Int(2)}),
+    "robokit.legged.exercise_data.model_facts": Call({}),
+    "robokit.legged.exercise_data.touchdown_trace": Call({
+        "rng": Rng(0), "duration": Real(3.0), "noise": Real(0.2), "bounce": Real(0.5), "drift": Real(0.5)}),
+    "robokit.legged.exercise_data.touchdown_traces": Call({"seed": Int(0)}),
+    "robokit.legged.exercise_data.mocap_frames": Call({"seed": Int(0), "n": Int(5), "noise": Real(0.001)}),
+    "robokit.exercises.littledog.battery_endurance": Call({
+        "capacity_ah": Real(2.1), "voltage": Real(14.8), "mean_power_w": Real(62.0)}),
+    "robokit.exercises.littledog.detect_touchdowns": Call({
+        "force": Array(np.array([0.0, 0.2, 9.0, 0.5, 11.0, 10.0, 10.0, 10.0, 4.0, 1.0, 0.0]), "N", min_rows=0),
+        "dt": Real(0.01)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
@@ -1442,7 +1462,7 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.legged.imu.{n}" for n in ("simulate_imu", "integrate_gyro", "specific_force")),
     *(f"robokit.legged.state_estimation.{n}" for n in ("fuse_body_state", "orientation_errors", "position_errors")),
     "robokit.legged.touchdown.detect_contacts",
-    *(f"robokit.legged.event_scoring.{n}" for n in ("contact_events", "event_precision_recall")),
+    *(f"robokit.legged.event_scoring.{n}" for n in ("contact_events", "event_precision_recall", "score_events")),
     # robokit.legged's gaits (lesson 04), fuzzed before the lesson exists
     *(f"robokit.legged.support.{n}" for n in ("support_polygon", "stability_margin", "stability_margins")),
     *(f"robokit.legged.gait_schedule.{n}" for n in (
@@ -1466,6 +1486,11 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.viz.legged.{n}" for n in ("joint_path", "add_littledog", "pose_littledog", "animate_trial")),
     *(f"robokit.viz.legged_plots.{n}" for n in (
         "support_outline", "plot_gait_diagram", "plot_joint_tracking", "plot_foot_forces", "plot_support")),
+    # assignment 04's exercises and helpers
+    "robokit.legged.leg_kinematics.foot_position", "robokit.legged.leg_kinematics.leg_ik",
+    *(f"robokit.legged.exercise_data.{n}" for n in ("model_facts", "touchdown_trace", "touchdown_traces",
+                                                     "mocap_frames")),
+    "robokit.exercises.littledog.battery_endurance", "robokit.exercises.littledog.detect_touchdowns",
 )
 
 
