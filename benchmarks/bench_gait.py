@@ -11,22 +11,13 @@ then the time of :func:`robokit.legged.walking_plan` for the 1 m crawl and trot.
 from __future__ import annotations
 
 import argparse
-import statistics
-import time
 
 import numpy as np
 
+from timing import median_time
+
 from robokit.legged import crawl_gait, stability_margin, stability_margins, trot_gait, walking_plan
 
-
-def median_time(fn, repeats: int) -> float:
-    fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def main() -> None:

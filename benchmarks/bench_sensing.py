@@ -13,25 +13,16 @@ against ``integrate_gyro`` over the same samples (the fusion's loop against the 
 from __future__ import annotations
 
 import argparse
-import statistics
-import time
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from timing import median_time
 
 from robokit.geometry import fit_se2, rot_z, se3_from_rt
 from robokit.legged import (MARKERS, detect_contacts, fit_marker_pose, fuse_body_state, integrate_gyro,
                             mocap_body_poses, simulate_mocap)
 
-
-def median_time(fn, repeats: int) -> float:
-    fn()
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def loop_detector(force, on, off, debounce):

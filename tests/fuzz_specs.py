@@ -889,7 +889,7 @@ SPECS: dict[str, Call] = {
         "n_poses": Int(40), "seed": Int(0), "noise": Array(np.array([0.05, 0.05, 0.01]), "|3"), "extent": Int(5),
         "closure_probability": Real(0.6), "min_gap": Int(10)}),
     # --- lesson 02's topological map and hierarchical localization (helper D) -----------------
-    "robokit.geometry.planar.fit_se2": Call({"source": Array(lambda: points(6)[:, :2], "N,2|N,N,2"),
+    "robokit.geometry.procrustes.fit_se2": Call({"source": Array(lambda: points(6)[:, :2], "N,2|N,N,2"),
                                              "target": Array(lambda: points(6)[:, :2] + 1.0, "N,2|N,N,2"),
                                              "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
     "robokit.vision.ransac.ransac_sample_count": Call({"contamination": Real(0.3), "sample_size": Int(2),
@@ -1185,7 +1185,7 @@ SPECS: dict[str, Call] = {
         "target": Array(lambda: points(6) @ np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]]).T + 1.0,
                         "N,2|N,3|N,N,2|N,N,3"),
         "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
-    "robokit.geometry.spatial.fit_se3": Call({
+    "robokit.geometry.procrustes.fit_se3": Call({
         "source": Array(lambda: points(6), "N,3|N,N,3"), "target": Array(lambda: points(6) + 1.0, "N,3|N,N,3"),
         "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
     "robokit.legged.mocap_sensor.simulate_mocap": Call({
@@ -1411,7 +1411,7 @@ EXTRA: tuple[str, ...] = (
     "robokit.mapping.g2o.read_g2o", "robokit.mapping.g2o.write_g2o",
     "robokit.mapping.manhattan.manhattan_world_graph",
     # lesson 02's topological map and hierarchical localization (helper D)
-    "robokit.geometry.planar.fit_se2", "robokit.geometry.planar.intersect_lines",
+    "robokit.geometry.procrustes.fit_se2", "robokit.geometry.planar.intersect_lines",
     "robokit.vision.ransac.ransac_sample_count",
     "robokit.vision.ransac.ransac_se2", "robokit.vision.spherical.essential_from_bearings",
     "robokit.vision.spherical.epipolar_error", "robokit.vision.spherical.ransac_essential",
@@ -1456,7 +1456,7 @@ EXTRA: tuple[str, ...] = (
         "bag_of_words.Vocabulary", "bag_of_words.Vocabulary.train",
         "bow_database.BowDatabase")),
     # lesson 04's sensing: the one rigid fit, MoCap, IMU, fusion, touchdowns
-    "robokit.geometry.procrustes.fit_rigid", "robokit.geometry.spatial.fit_se3",
+    "robokit.geometry.procrustes.fit_rigid", "robokit.geometry.procrustes.fit_se3",
     "robokit.legged.mocap_sensor.simulate_mocap",
     *(f"robokit.legged.mocap.{n}" for n in ("fit_marker_pose", "mocap_body_poses")),
     *(f"robokit.legged.imu.{n}" for n in ("simulate_imu", "integrate_gyro", "specific_force")),

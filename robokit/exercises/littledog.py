@@ -313,7 +313,7 @@ EXERCISES = [
         points=2, cases=_fit_cases, reference=fit_marker_pose, compare=_same_rigid_fit,
         references=("robokit.legged.mocap.fit_marker_pose", "robokit.legged.mocap.mocap_body_poses",
                     "robokit.legged.mocap._markers", "robokit.legged.mocap._visible",
-                    "robokit.geometry.spatial.fit_se3", "robokit.geometry.procrustes.fit_rigid"),
+                    "robokit.geometry.procrustes.fit_se3", "robokit.geometry.procrustes.fit_rigid"),
         description="Open: T_world_body minimising the squared distances of the visible markers, by any method "
                     "(SVD, quaternions, least squares); ValueError for fewer than three visible markers."),
     Exercise(

@@ -17,12 +17,12 @@ rigid fit of point sets, behind ``fit_se2`` and ``fit_se3``), :mod:`~robokit.geo
 from .paper_frames import (R_BODY_OPTICAL, as_pqt, optical_to_y_up, paper_world_to_robokit,
                            pqt_robot_to_world, pqt_rotate_xz, pqt_to_se2, pqt_to_se3, pqt_transform_xz,
                            pqt_world_to_robot, se2_to_pqt)
-from .planar import (as_planar, fit_se2, intersect_lines, matrix_to_se2, se2_between, se2_compose, se2_inverse, se2_to_matrix,
+from .planar import (as_planar, intersect_lines, matrix_to_se2, se2_between, se2_compose, se2_inverse, se2_to_matrix,
                      wrap_angle)
-from .procrustes import FIT_TOL, DegenerateFitError, RigidFit, fit_rigid
+from .procrustes import FIT_TOL, DegenerateFitError, RigidFit, fit_rigid, fit_se2, fit_se3
 from .rotations import (ROTATION_TOL, as_rotation, check_rotation_block, euler_matrix, quat_to_matrix, rot_x, rot_y,
                         rot_z, skew, so3_exp, so3_log, zyz_angles)
-from .spatial import (as_se3, fit_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, se3_inverse, se3_to_se2,
+from .spatial import (as_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, se3_inverse, se3_to_se2,
                       transform_points)
 
 __all__ = [

@@ -23,11 +23,10 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array
-from .procrustes import fit_rigid
 from .rotations import as_rotation
 
 __all__ = ["as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
-           "fit_se2", "intersect_lines"]
+           "intersect_lines"]
 
 
 def as_planar(value: Any, name: str) -> np.ndarray:
@@ -270,58 +269,6 @@ def matrix_to_se2(matrix: Any) -> np.ndarray:
     as_rotation(T[:2, :2], "matrix", dim=2)
     return np.array([T[0, 2], T[1, 2], float(np.arctan2(T[1, 0], T[0, 0]))])
 
-
-
-def fit_se2(source: Any, target: Any, weights: Any = None, *, check: bool = True) -> np.ndarray:
-    """Least-squares planar pose taking ``source`` points onto ``target`` points (2-D Procrustes).
-
-    Parameters
-    ----------
-    source, target : array_like, shape (..., N, 2)
-        Corresponding points, N >= 2; leading axes are a batch of independent problems.
-    weights : array_like, shape (..., N), optional
-        Non-negative weight per correspondence (default: all 1).
-    check : bool, default True
-        Validate the inputs and refuse a degenerate set; ``False`` (float arrays of matching shapes
-        only) is the fast path that RANSAC loops take: a degenerate set then gives ``theta = 0``.
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., 3)
-        ``[x, y, theta]`` minimising ``sum_i w_i ||R(theta) s_i + (x, y) - t_i||^2``, i.e. the pose of
-        the source frame in the target frame.
-
-    Raises
-    ------
-    DegenerateFitError
-        (A ``ValueError``, with ``check``) for fewer than two points, or points that all coincide,
-        which leave the heading undetermined.
-    ValueError
-        For shapes that do not agree, NaN/inf, or negative or all-zero weights.
-
-    Notes
-    -----
-    The closed-form minimiser of Umeyama (1991), Eqs. (34)-(41) without scale, computed by the one
-    rigid-fit kernel :func:`~robokit.geometry.procrustes.fit_rigid` (shared with
-    :func:`~robokit.geometry.fit_se3`); the heading is ``atan2(R[1, 0], R[0, 0])``. In the plane it
-    equals ``theta = atan2(sum w (s' x t'), sum w (s' . t'))`` for the centred points ``s', t'``.
-    With two points it is the two-point pose of Lin et al. (Sec. 5): the heading from the
-    direction between them and the translation from their midpoints.
-
-    Examples
-    --------
-    >>> src = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 2.0]])
-    >>> tgt = se2_compose([1.0, 2.0, 0.5], np.column_stack([src, np.zeros(3)]))[:, :2]
-    >>> print(np.round(fit_se2(src, tgt), 6))
-    [1.  2.  0.5]
-    """
-    if check:
-        s = as_array(source, "source")
-        if s.ndim < 2 or s.shape[-1] != 2:
-            raise ValueError(f"source: expected shape (..., N, 2) with N >= 2, got shape {s.shape}")
-        source = s
-    R, t, _ = fit_rigid(source, target, weights, check=check)
-    return np.stack([t[..., 0], t[..., 1], wrap_angle(np.arctan2(R[..., 1, 0], R[..., 0, 0]))], axis=-1)
 
 
 def intersect_lines(origins: Any, directions: Any) -> tuple[np.ndarray, np.ndarray]:

@@ -25,11 +25,10 @@ import numpy as np
 
 from ..validation import array_ndim, as_array, as_points, check_finite_scalar
 from .planar import as_planar
-from .procrustes import fit_rigid
 from .rotations import ROTATION_TOL, as_rotation, check_rotation_block, rot_z, so3_log
 
 __all__ = ["as_se3", "se3_from_rt", "se3_inverse", "se3_compose", "transform_points", "se2_to_se3",
-           "se3_to_se2", "pose_error", "fit_se3"]
+           "se3_to_se2", "pose_error"]
 
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -346,63 +345,3 @@ def pose_error(T_target: Any, T: Any, *, check: bool = True) -> np.ndarray:
     np.subtract(T_target[..., :3, 3], T[..., :3, 3], out=out[..., :3])
     out[..., 3:] = dw
     return out
-
-
-def fit_se3(source: Any, target: Any, weights: Any = None, *, check: bool = True) -> np.ndarray:
-    """Least-squares rigid transform taking ``source`` points onto ``target`` points (3-D Procrustes).
-
-    Parameters
-    ----------
-    source, target : array_like, shape (..., N, 3)
-        Corresponding points, N >= 3 and not all on one line; leading axes are a batch of
-        independent problems (one per MoCap frame, say).
-    weights : array_like, shape (..., N), optional
-        Non-negative weight per correspondence (default: all 1); zero drops a point.
-    check : bool, default True
-        Validate the inputs and refuse a degenerate set; ``False`` (float arrays of matching shapes,
-        positive weight sums) is the fast path: a degenerate set then gives one of its minimisers.
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., 4, 4)
-        ``T`` with ``target ~ T @ source`` (homogeneous points): it minimises
-        ``sum_i w_i |R s_i + t - t_i|^2`` with ``det R = +1``. With ``source`` the markers in the
-        body frame and ``target`` where the cameras saw them, ``T`` is ``T_world_body``.
-
-    Raises
-    ------
-    DegenerateFitError
-        (A ``ValueError``, with ``check``) for fewer than three points, or points that coincide or
-        lie on one line (a rotation about that line is then free).
-    ValueError
-        For shapes that do not agree, NaN/inf, or negative or all-zero weights.
-
-    Notes
-    -----
-    Arun et al. (1987): centring on the centroids separates the translation from the rotation,
-    which comes from the SVD of the correlation matrix; Umeyama (1991), Eqs. (34)-(41) and (43)
-    without scale, adds the sign matrix ``S`` that makes the answer a rotation, never a reflection.
-    The kernel is :func:`~robokit.geometry.procrustes.fit_rigid`, the one that
-    :func:`~robokit.geometry.fit_se2` uses too.
-
-    Examples
-    --------
-    >>> markers = np.array([[0.10, 0.03, 0.0115], [0.10, -0.04, 0.0115], [-0.11, 0.035, 0.0115],
-    ...                     [-0.05, -0.02, 0.04]])
-    >>> T_world_body = se3_from_rt(rot_z(0.3), [1.0, 0.5, 0.13])
-    >>> seen = transform_points(T_world_body, markers)
-    >>> print(np.round(fit_se3(markers, seen), 6) + 0.0)
-    [[ 0.955336 -0.29552   0.        1.      ]
-     [ 0.29552   0.955336  0.        0.5     ]
-     [ 0.        0.        1.        0.13    ]
-     [ 0.        0.        0.        1.      ]]
-    """
-    if check:
-        s = as_array(source, "source")
-        if s.ndim < 2 or s.shape[-1] != 3:
-            raise ValueError(f"source: expected shape (..., N, 3) with N >= 3, got shape {s.shape}")
-        source = s
-    R, t, _ = fit_rigid(source, target, weights, check=check)
-    T = np.zeros(R.shape[:-2] + (4, 4))
-    T[..., :3, :3], T[..., :3, 3], T[..., 3, 3] = R, t, 1.0
-    return T

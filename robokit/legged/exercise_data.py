@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry.rotations import rot_x, rot_y, rot_z
+from ..geometry.spatial import se3_from_rt
 from ..validation import as_rng, check_int, check_positive
 from .littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, JOINTS, LEGS, LOWER_LEG,
                         MARKERS, STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG)
@@ -228,10 +229,8 @@ def mocap_frames(seed: int = 0, n: int = 200, noise: float = 0.001) -> dict:
     sigma = check_positive(noise, "noise", allow_zero=True)
     roll, pitch = g.uniform(-0.1, 0.1, (2, count))
     yaw = g.uniform(-np.pi, np.pi, count)
-    T = np.zeros((count, 4, 4))
-    T[:, :3, :3] = rot_z(yaw) @ rot_y(pitch) @ rot_x(roll)
-    T[:, :3, 3] = np.column_stack([g.uniform(-1.0, 1.0, (count, 2)), STANDING_HEIGHT + g.uniform(-0.01, 0.01, count)])
-    T[:, 3, 3] = 1.0
+    T = se3_from_rt(rot_z(yaw) @ rot_y(pitch) @ rot_x(roll),
+                    np.column_stack([g.uniform(-1.0, 1.0, (count, 2)), STANDING_HEIGHT + g.uniform(-0.01, 0.01, count)]))
     frames = simulate_mocap(T, MARKERS, sigma, 0.0, g)
     return {"markers_body": MARKERS.tolist(), "T_world_body": T.tolist(), "observed": frames.positions.tolist(),
             "noise": sigma}

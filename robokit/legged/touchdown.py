@@ -24,10 +24,8 @@ from typing import Any
 import numpy as np
 
 from ..validation import as_array, check_finite_scalar, check_int
-# moved to event_scoring; still importable from here for robokit.legged.walking_experiment
-from .event_scoring import EventScore, contact_events, event_precision_recall
 
-__all__ = ["detect_contacts", "EventScore", "contact_events", "event_precision_recall"]
+__all__ = ["detect_contacts"]
 
 
 def _forward_fill(defined: np.ndarray, values: np.ndarray, first: np.ndarray) -> np.ndarray:

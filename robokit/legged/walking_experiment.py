@@ -40,7 +40,8 @@ from .servo_design import SERVO_BANDWIDTH, littledog_servo_gains, servo_inertia
 from .simulation import LoopSettings, TrialOutcome, simulate_walk
 from .state_estimation import fuse_body_state, orientation_errors, position_errors
 from .support import stability_margins
-from .touchdown import contact_events, detect_contacts, event_precision_recall
+from .event_scoring import contact_events, event_precision_recall
+from .touchdown import detect_contacts
 from .trial_log import TrialLog
 
 __all__ = ["LESSON_CRAWL", "LESSON_TROT", "LESSON_DISTANCE", "LATENCIES", "TOUCHDOWN_DETECTORS", "lesson_plans",
