@@ -176,3 +176,30 @@ def test_hysteresis_and_debounce_fix_the_chatter_of_a_plain_threshold_on_a_gait(
     assert 2.0 < tuned.mean_delay_samples < 6.0
     # a tolerance below the delay turns correct detections into misses and false alarms
     assert event_precision_recall(detect_contacts(force, 3.0, 1.0, 3), truth, 5).recall < 0.5
+
+
+def test_gate_touchdowns_keeps_the_first_detection_near_each_planned_one():
+    from robokit.legged.touchdown import gate_touchdowns
+    assert gate_touchdowns([3, 40, 52, 95], [50, 100], 10).tolist() == [40, 95]
+    assert gate_touchdowns([45, 48, 52], [50], 5).tolist() == [45]          # one per planned touchdown
+    assert gate_touchdowns([45, 48], [50, 52], 5).tolist() == [45, 48]      # a detection is used once
+    assert gate_touchdowns([], [10, 20], 3).tolist() == []
+    assert gate_touchdowns([10, 20], [], 3).tolist() == []
+    # brute force on random cases: the same as scanning the detections in order
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        det = np.sort(rng.choice(300, rng.integers(0, 20), replace=False))
+        exp = np.sort(rng.choice(300, rng.integers(0, 10), replace=False))
+        w = int(rng.integers(0, 15))
+        want, used = [], set()
+        for p in exp:
+            for d in det:
+                if abs(d - p) <= w and d not in used and (not want or d > want[-1]):
+                    want.append(int(d))
+                    used.add(d)
+                    break
+        assert gate_touchdowns(det, exp, w).tolist() == want
+    with pytest.raises(ValueError, match="detected"):
+        gate_touchdowns([5, 3], [4], 2)
+    with pytest.raises(ValueError, match="window"):
+        gate_touchdowns([5], [4], -1)

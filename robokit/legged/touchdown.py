@@ -23,9 +23,9 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_finite_scalar, check_int
+from ..validation import as_array, check_finite_scalar, check_int, describe
 
-__all__ = ["detect_contacts"]
+__all__ = ["detect_contacts", "gate_touchdowns"]
 
 
 def _forward_fill(defined: np.ndarray, values: np.ndarray, first: np.ndarray) -> np.ndarray:
@@ -104,3 +104,48 @@ def detect_contacts(force: Any, threshold_on: float, threshold_off: float, debou
     settled = np.arange(n).reshape(start.shape[:1] + (1,) * (h.ndim - 1)) - start + 1 >= count
     settled[0] = True                                                          # the first sample sets the state
     return _forward_fill(settled, h, h[0])
+
+
+def gate_touchdowns(detected: Any, expected: Any, window: int) -> np.ndarray:
+    """Keep the detected touchdowns the gait plan expects: the first one near each planned touchdown.
+
+    A host that planned the swing knows when each foot should land. A detection far from any
+    planned touchdown (a loaded foot that reads almost nothing mid-stance, then recovers) is then
+    not believed, and one planned touchdown accepts only one detection.
+
+    Parameters
+    ----------
+    detected : array_like of int, shape (K,)
+        Sample indices of the detected touchdowns of one foot, increasing.
+    expected : array_like of int, shape (M,)
+        Sample indices of its planned touchdowns, increasing.
+    window : int
+        Samples (>= 0) a detection may lie before or after a planned touchdown.
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (<= M,)
+        For each planned touchdown, the first detection within ``window`` of it (none if there is
+        none); each detection is used once.
+
+    Examples
+    --------
+    >>> gate_touchdowns([3, 40, 52, 95], [50, 100], 10).tolist()
+    [40, 95]
+    """
+    k = check_int(window, "window", minimum=0)
+    out = []
+    arrays = []
+    for name, value in (("detected", detected), ("expected", expected)):
+        a = as_array(value, name, ndim=1, min_size=0)
+        if np.any(a != np.round(a)) or np.any(a < 0) or np.any(np.diff(a) < 0):
+            raise ValueError(f"{name}: expected increasing sample indices >= 0, got {describe(value)}")
+        arrays.append(a.astype(np.int64))
+    det, exp = arrays
+    used = -1
+    for p in exp:
+        j = int(np.searchsorted(det, max(p - k, used + 1)))
+        if j < len(det) and det[j] <= p + k:
+            out.append(int(det[j]))
+            used = int(det[j])
+    return np.asarray(out, dtype=np.int64)

@@ -40,8 +40,8 @@ from .servo_design import SERVO_BANDWIDTH, littledog_servo_gains, servo_inertia
 from .simulation import LoopSettings, TrialOutcome, simulate_walk
 from .state_estimation import fuse_body_state, orientation_errors, position_errors
 from .support import stability_margins
-from .event_scoring import contact_events, event_precision_recall
-from .touchdown import detect_contacts
+from .event_scoring import contact_events, event_precision_recall, score_events
+from .touchdown import detect_contacts, gate_touchdowns
 from .trial_log import TrialLog
 
 __all__ = ["LESSON_CRAWL", "LESSON_TROT", "LESSON_DISTANCE", "LATENCIES", "TOUCHDOWN_DETECTORS", "lesson_plans",
@@ -192,7 +192,8 @@ def estimation_table(log: TrialLog) -> dict:
     return table
 
 
-def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5) -> list:
+def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5, plan: Any = None,
+                    gate: int = 10) -> list:
     """Touchdowns detected on the lower-leg force sensors against MuJoCo's true contacts.
 
     Parameters
@@ -203,6 +204,12 @@ def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5)
         :data:`TOUCHDOWN_DETECTORS`.
     tolerance : int, default 5
         Host samples (50 ms) within which a detection counts for a true touchdown.
+    plan : WalkPlan, optional
+        The plan the trial walked: adds a row for the last detector gated by the plan
+        (:func:`~robokit.legged.touchdown.gate_touchdowns`, ``gate`` samples either side of each
+        planned touchdown).
+    gate : int, default 10
+        Host samples (100 ms) of the gate.
 
     Returns
     -------
@@ -230,6 +237,18 @@ def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5)
                      "delay_ms": score.mean_delay_samples * dt_ms,
                      "true_touchdowns": int(sum(len(e) for e in contact_events(truth))),
                      "detected": int(sum(len(e) for e in contact_events(detected)))})
+    if plan is not None:
+        if not isinstance(plan, WalkPlan) or len(plan.t) < len(log):
+            raise ValueError("plan: expected the WalkPlan the trial walked (at least as many rows as the log)")
+        true_events, planned = contact_events(truth), contact_events(plan.stance[:len(log)])
+        gated = [gate_touchdowns(d, p, gate) for d, p in zip(contact_events(detected), planned)]
+        scores = [score_events(g, t, tolerance) for g, t in zip(gated, true_events)]
+        n_det, n_true = sum(len(g) for g in gated), sum(len(t) for t in true_events)
+        hits = sum(round(sc.recall * len(t)) for sc, t in zip(scores, true_events))
+        delay = sum(sc.mean_delay_samples * round(sc.recall * len(t)) for sc, t in zip(scores, true_events))
+        rows.append({"label": f"{label}, gated by the plan", "precision": hits / n_det if n_det else 1.0,
+                     "recall": hits / n_true if n_true else 1.0, "delay_ms": dt_ms * delay / hits if hits else 0.0,
+                     "true_touchdowns": n_true, "detected": n_det})
     return rows
 
 
