@@ -80,3 +80,15 @@ def test_bad_settings_are_named():
         simulate_walk("crawl")
     with pytest.raises(TypeError, match="sensors"):
         simulate_walk(walking_plan(trot_gait(), 0.05), sensors={})
+
+
+def test_a_plan_with_nan_or_uneven_steps_is_refused_by_name():
+    plan = walking_plan(trot_gait(), 0.05)
+    feet = plan.feet_world.copy()
+    feet[3, 1, 2] = np.nan
+    with pytest.raises(ValueError, match="plan.feet_world"):
+        simulate_walk(plan._replace(feet_world=feet))
+    t = plan.t.copy()
+    t[5:] += 0.003
+    with pytest.raises(ValueError, match="plan.t"):
+        simulate_walk(plan._replace(t=t))

@@ -35,8 +35,8 @@ import numpy as np
 
 from ..controllers import (LITTLEDOG_MOTOR, DCMotor, SetpointChannel, motor_current, pd_servo_step,
                            reflected_inertia, torque_from_current)
-from ..geometry import quat_to_matrix, se3_from_rt
-from ..validation import as_rng, check_positive
+from ..geometry import as_se3, quat_to_matrix, se3_from_rt
+from ..validation import as_array, as_rng, check_positive
 from .gait import WalkPlan
 from .imu import simulate_imu
 from .leg_kinematics import body_ik
@@ -189,8 +189,16 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         raise TypeError(f"motor: expected a DCMotor, got {type(motor).__name__}")
     seed = rng if isinstance(rng, int) and not isinstance(rng, bool) else None
     gen = as_rng(rng)
-    host_dt = float(plan.t[1] - plan.t[0])
+    t = as_array(plan.t, "plan.t", ndim=1, min_size=2)
+    as_array(plan.feet_world, "plan.feet_world", shape=(len(t), 4, 3))
+    as_se3(plan.T_world_body, "plan.T_world_body", batch=True)
+    host_dt = float(t[1] - t[0])
     host_steps = int(round(host_dt / TIMESTEP))
+    if host_steps < 1 or abs(host_steps * TIMESTEP - host_dt) > 1e-9 or np.any(np.abs(np.diff(t) - host_dt) > 1e-9):
+        raise ValueError(f"plan.t: expected even steps of a whole number of {1000 * TIMESTEP:.0f} ms physics steps "
+                         f"(the host period), got a first step of {host_dt} s")
+    if len(plan.T_world_body) != len(t):
+        raise ValueError(f"plan.T_world_body: expected {len(t)} poses (one per plan.t), got {len(plan.T_world_body)}")
     servo_steps = int(round(1.0 / (loops.servo_rate * TIMESTEP)))
     servo_dt = servo_steps * TIMESTEP
     q_cmd, ok = body_ik(plan.feet_world, plan.T_world_body, check=False)
@@ -229,7 +237,7 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     fell = False
     rows = n
     for k in range(n):
-        t = k * host_dt
+        now = k * host_dt
         # host cycle: snapshot of the state and sensors, then the next set-point goes out
         rec["q"][k] = data.qpos[7:]
         rec["qd"][k] = data.qvel[6:]
@@ -257,10 +265,10 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         if data.qpos[2] < FALL_HEIGHT or _tipped(data.qpos[3:7]):
             fell, rows = True, k + 1
             break
-        channel.send(t, q_cmd[k])
+        channel.send(now, q_cmd[k])
         for s in range(host_steps):
             if s % servo_steps == 0:
-                arrived = channel.receive(t + s * TIMESTEP)
+                arrived = channel.receive(now + s * TIMESTEP)
                 if arrived is not None:
                     q_ref = arrived
                 q_now = data.qpos[7:].copy()
