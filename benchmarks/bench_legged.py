@@ -20,18 +20,17 @@ import mujoco
 import numpy as np
 from timing import median_time
 
-from robokit.controllers import LITTLEDOG_MOTOR, reflected_inertia
+from robokit.controllers import LITTLEDOG_MOTOR
+from robokit.legged import STANCE_FEET, littledog_model, simulate_walk
 from robokit.legged import leg_kinematics as lk
-from robokit.legged import littledog_model, simulate_walk
 from robokit.legged.walking_experiment import lesson_plans
 
 
 def bare_physics(seconds: float) -> float:
     """Wall time of MuJoCo alone stepping the model for ``seconds`` of simulated time."""
-    model = littledog_model(armature=reflected_inertia(LITTLEDOG_MOTOR))
+    model = littledog_model(motor=LITTLEDOG_MOTOR)
     data = mujoco.MjData(model)
-    data.qpos[7:] = lk.body_ik(np.array([[0.16, 0.08, -0.1215], [0.16, -0.08, -0.1215],
-                                         [-0.16, 0.08, -0.1215], [-0.16, -0.08, -0.1215]])).q[0]
+    data.qpos[7:] = lk.body_ik(STANCE_FEET).q[0]
     steps = int(round(seconds / model.opt.timestep))
     t = time.perf_counter()
     for _ in range(steps):

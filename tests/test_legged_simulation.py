@@ -92,3 +92,22 @@ def test_a_plan_with_nan_or_uneven_steps_is_refused_by_name():
     t[5:] += 0.003
     with pytest.raises(ValueError, match="plan.t"):
         simulate_walk(plan._replace(t=t))
+
+
+def test_mujoco_actuators_apply_the_dc_motor_model():
+    """With a motor, the MJCF's affine actuators give exactly controllers.joint_torque (clipped voltage too)."""
+    import mujoco
+
+    from robokit.controllers import joint_torque
+    from robokit.legged import littledog_model
+
+    model = littledog_model(motor=LITTLEDOG_MOTOR)
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        data.qvel[6:] = rng.uniform(-10, 10, 12)
+        data.ctrl[:] = rng.uniform(-20, 20, 12)          # beyond +-14.8 V: the driver saturates
+        mujoco.mj_forward(model, data)
+        np.testing.assert_allclose(data.actuator_force, joint_torque(data.ctrl, data.qvel[6:], LITTLEDOG_MOTOR),
+                                   rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(model.dof_armature[6:], LITTLEDOG_MOTOR.rotor_inertia * LITTLEDOG_MOTOR.gear_ratio ** 2)

@@ -27,7 +27,7 @@ corridor_centering   lesson 03's moving strategy (Ge et al. 2023, Sec. 3.1): a l
 """
 from .corridor_centering import CenteringResult, centering_command, move_to_middle_line
 from .dc_motor import (LITTLEDOG_MOTOR, DCMotor, MotorPower, electrical_power, joint_torque, motor_current,
-                       reflected_inertia, torque_from_current, voltage_for_torque)
+                       reflected_inertia, voltage_for_torque)
 from .heading import HeadingController, design_heading_gains
 from .heading_loop import (heading_closed_loop, heading_frequency_response, heading_loop_gain, heading_plant,
                            heading_step_response, loop_metrics)
@@ -51,7 +51,7 @@ __all__ = ["HeadingController", "design_heading_gains", "heading_closed_loop", "
            "move_to_middle_line",
            "DiscreteServoLoop", "ServoAnalysis", "discrete_servo_analysis", "discrete_servo_loop", "servo_closed_loop",
            "servo_frequency_response", "servo_loop_gain", "servo_plant", "servo_step_response",
-           "LITTLEDOG_MOTOR", "DCMotor", "MotorPower", "electrical_power", "joint_torque", "torque_from_current", "motor_current",
+           "LITTLEDOG_MOTOR", "DCMotor", "MotorPower", "electrical_power", "joint_torque", "motor_current",
            "reflected_inertia", "voltage_for_torque",
            "NOMINAL_LINK_INERTIA", "JointLag", "ServoResponse", "design_servo_gains", "discrete_servo_response",
            "joint_lag", "joint_plant", "pd_servo_step", "servo_analysis", "SetpointChannel"]

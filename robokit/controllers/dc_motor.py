@@ -41,8 +41,7 @@ import numpy as np
 
 from ..validation import as_array, check_finite_result, check_positive
 
-__all__ = ["DCMotor", "LITTLEDOG_MOTOR", "MotorPower", "joint_torque", "torque_from_current", "motor_current",
-           "voltage_for_torque",
+__all__ = ["DCMotor", "LITTLEDOG_MOTOR", "MotorPower", "joint_torque", "motor_current", "voltage_for_torque",
            "electrical_power", "reflected_inertia"]
 
 
@@ -241,33 +240,7 @@ def joint_torque(voltage: Any, joint_velocity: Any, motor: DCMotor, check: bool 
     [0.245, -0.5]
     """
     v, w = _inputs(voltage, joint_velocity, motor, check)
-    return torque_from_current(motor_current(v, w, motor, check=False), w, motor, check=False)
-
-
-def torque_from_current(current: Any, joint_velocity: Any, motor: DCMotor, check: bool = True) -> float | np.ndarray:
-    """Torque at the joint (N m) for a winding current: ``eta N k_t i - b dq/dt``.
-
-    The second half of :func:`joint_torque`, for a loop that already has the current (the
-    simulation needs both the torque and the current every step).
-
-    Parameters
-    ----------
-    current : float or array_like
-        Winding current per joint (A), e.g. from :func:`motor_current`.
-    joint_velocity, motor, check
-        As in :func:`motor_current`.
-
-    Returns
-    -------
-    float or numpy.ndarray
-
-    Examples
-    --------
-    >>> v, w = 2.0, 1.0
-    >>> torque_from_current(motor_current(v, w, LITTLEDOG_MOTOR), w, LITTLEDOG_MOTOR) == joint_torque(v, w, LITTLEDOG_MOTOR)
-    True
-    """
-    i, w = _inputs(current, joint_velocity, motor, check)
+    i = motor_current(v, w, motor, check=False)
     tau = motor.efficiency * motor.gear_ratio * motor.torque_constant * np.asarray(i)    # Sec. 2.3: tau_m = k_t i
     return _out(tau - motor.viscous_friction * w)
 

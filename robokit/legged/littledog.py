@@ -41,6 +41,7 @@ import functools
 
 import numpy as np
 
+from ..controllers import DCMotor, reflected_inertia
 from ..validation import check_finite_scalar, check_positive
 
 __all__ = ["LEGS", "JOINTS", "JOINT_NAMES", "GUIDE", "HIP_POSITIONS", "HIP_OFFSET", "UPPER_LEG",
@@ -139,27 +140,34 @@ def _leg_xml(i: int, armature: float, damping: float) -> str:
 
 
 def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: float = 1.0,
-                   timestep: float = TIMESTEP) -> str:
+                   timestep: float = TIMESTEP, motor: DCMotor | None = None) -> str:
     """Write the LittleDog model as MJCF (MuJoCo's XML), from this module's constants.
 
     Parameters
     ----------
     armature : float, default 0
         Inertia added to every joint (kg m^2): a geared motor's rotor inertia reflected through its
-        gearbox, ``J_m N^2`` (:func:`robokit.controllers.reflected_inertia`).
+        gearbox, ``J_m N^2`` (:func:`robokit.controllers.reflected_inertia`). With ``motor`` it is
+        the motor's unless given.
     damping : float, default 0
-        Viscous friction at every joint (N m s/rad). Back-EMF damping is not here: the motor model
-        that turns voltage into torque holds it.
+        Viscous friction at every joint (N m s/rad); must stay 0 with ``motor``, whose damping
+        already holds it.
     friction : float, default 1
         Coulomb friction coefficient between the feet and the ground.
     timestep : float, default :data:`TIMESTEP`
         Physics step (s).
+    motor : DCMotor, optional
+        Drive every joint with this geared DC motor: ``ctrl`` is then the motor voltage (clipped to
+        ``+-motor.voltage_max``) and MuJoCo applies the joint torque ``K V - B dq/dt`` of
+        :func:`robokit.controllers.joint_torque` itself, every physics step, as an affine actuator
+        (gain ``K`` = ``motor.torque_per_volt``, bias ``-B dq/dt`` with ``B`` = ``motor.damping``).
+        Without it ``ctrl`` is the joint torque (N m).
 
     Returns
     -------
     str
         MJCF with a free-floating trunk (``trunk``), twelve hinge joints named as
-        :data:`JOINT_NAMES`, one torque motor per joint (``ctrl`` is the joint torque, N m), sites
+        :data:`JOINT_NAMES`, one actuator per joint (named like its joint), sites
         ``imu`` (gyro ``imu_gyro`` and accelerometer ``imu_acc``), ``marker0``..``marker3`` and per
         leg ``<leg>_force`` (a 3-axis ``force`` sensor at the knee, in the lower leg's frame whose z
         axis runs along the shank: the guide's single-axis lower-leg force sensor is its z
@@ -179,6 +187,12 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
     """
     armature = check_positive(armature, "armature", allow_zero=True)
     damping = check_positive(damping, "damping", allow_zero=True)
+    if motor is not None:
+        if not isinstance(motor, DCMotor):
+            raise TypeError(f"motor: expected a DCMotor or None, got {type(motor).__name__}")
+        if damping:
+            raise ValueError(f"damping: expected 0 with a motor (its damping holds the joint's friction), got {damping}")
+        armature = armature or reflected_inertia(motor)
     friction = check_positive(friction, "friction")
     timestep = check_positive(timestep, "timestep")
     if timestep > 0.01:
@@ -186,7 +200,12 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
     legs = "".join(_leg_xml(i, armature, damping) for i in range(4))
     markers = "".join(f'\n      <site name="marker{k}" pos="{_vec(m)}" size="0.006" rgba="0.9 0.9 0.9 1"/>'
                       for k, m in enumerate(MARKERS))
-    motors = "".join(f'\n    <motor name="{n}" joint="{n}"/>' for n in JOINT_NAMES)
+    if motor is None:
+        motors = "".join(f'\n    <motor name="{n}" joint="{n}"/>' for n in JOINT_NAMES)
+    else:   # joint_torque's K V - B dq/dt, as MuJoCo's affine actuator
+        vmax, gain, bias = _f(motor.voltage_max), _f(motor.torque_per_volt), _f(-motor.damping)
+        motors = "".join(f'\n    <general name="{n}" joint="{n}" ctrlrange="-{vmax} {vmax}" gainprm="{gain}" '
+                         f'biastype="affine" biasprm="0 0 {bias}"/>' for n in JOINT_NAMES)
     forces = "".join(f'\n    <force name="{leg}_force" site="{leg}_force"/>' for leg in LEGS)
     lx, ly, lz = (s / 2 for s in TRUNK_SIZE)
     return f"""<mujoco model="littledog">
@@ -216,20 +235,22 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
 
 
 @functools.lru_cache(maxsize=8)
-def _compiled(armature: float, damping: float, friction: float, timestep: float):
+def _compiled(armature: float, damping: float, friction: float, timestep: float, motor: DCMotor | None):
     import mujoco
     return mujoco.MjModel.from_xml_string(littledog_mjcf(armature=armature, damping=damping,
-                                                         friction=friction, timestep=timestep))
+                                                         friction=friction, timestep=timestep, motor=motor))
 
 
 def littledog_model(*, armature: float = 0.0, damping: float = 0.0, friction: float = 1.0,
-                    timestep: float = TIMESTEP):
+                    timestep: float = TIMESTEP, motor: DCMotor | None = None):
     """The compiled MuJoCo model of :func:`littledog_mjcf` (compiled once per set of arguments).
 
     Parameters
     ----------
     armature, damping, friction, timestep : float
         As in :func:`littledog_mjcf`.
+    motor : DCMotor, optional
+        As in :func:`littledog_mjcf`: voltage-driven joints.
 
     Returns
     -------
@@ -245,5 +266,5 @@ def littledog_model(*, armature: float = 0.0, damping: float = 0.0, friction: fl
     import copy
     args = [check_finite_scalar(v, n) for v, n in ((armature, "armature"), (damping, "damping"),
                                                    (friction, "friction"), (timestep, "timestep"))]
-    littledog_mjcf(armature=args[0], damping=args[1], friction=args[2], timestep=args[3])  # validates
-    return copy.deepcopy(_compiled(*args))
+    littledog_mjcf(armature=args[0], damping=args[1], friction=args[2], timestep=args[3], motor=motor)  # validates
+    return copy.deepcopy(_compiled(*args, motor))

@@ -6,7 +6,8 @@ wireless link, reading back a snapshot of the state and logging everything. :fun
 runs exactly that loop around MuJoCo:
 
 * every physics step (1 ms): each joint's torque comes from its DC motor, given the voltage the
-  servo holds and the joint's speed (back-EMF) - :func:`robokit.controllers.joint_torque`;
+  servo holds and the joint's speed (back-EMF) - :func:`robokit.controllers.joint_torque`, which
+  MuJoCo's affine actuators apply (:func:`~robokit.legged.littledog.littledog_mjcf` with a motor);
 * every servo tick (2 ms at 500 Hz): the robot takes the newest set-point that has arrived over
   the link and sets a new voltage by a discrete PD law - :func:`robokit.controllers.pd_servo_step`;
 * every host cycle (10 ms): the host logs the state and the sensors, and sends the set-point that
@@ -33,8 +34,7 @@ from typing import Any, NamedTuple
 import mujoco
 import numpy as np
 
-from ..controllers import (LITTLEDOG_MOTOR, DCMotor, SetpointChannel, motor_current, pd_servo_step,
-                           reflected_inertia, torque_from_current)
+from ..controllers import LITTLEDOG_MOTOR, DCMotor, SetpointChannel, motor_current, pd_servo_step
 from ..geometry import as_se3, quat_to_matrix, se3_from_rt
 from ..validation import as_array, as_rng, check_positive
 from .gait import WalkPlan
@@ -129,8 +129,9 @@ class TrialOutcome(NamedTuple):
     distance : float
         Forward progress of the trunk along the plan's direction (m).
     energy : float
-        Electrical energy the twelve motors drew (J), integrated every physics step, without
-        regeneration (a joint's negative power is lost).
+        Electrical energy the twelve motors drew (J), integrated over every servo tick from the
+        joints' mean speed over it (exact for a constant voltage), without regeneration (a joint's
+        negative power is lost).
     tracking_rms : float
         RMS over joints and host cycles of the set-point the host sent minus the angle the joint had
         reached one host period later, when the next set-point went out (rad).
@@ -144,6 +145,17 @@ class TrialOutcome(NamedTuple):
     energy: float
     tracking_rms: float
     link: dict
+
+
+def _tick_energy(voltage: np.ndarray, mean_qd: np.ndarray, dt: float, motor: DCMotor) -> float:
+    """Electrical energy (J) the motors drew over one servo tick, without regeneration.
+
+    The voltage is constant over a tick and the current is linear in the joint speed, so each
+    joint's ``V i`` integrates exactly from its mean speed; a joint whose power is negative (braking)
+    gives nothing back (exact while a joint's power keeps its sign within the tick).
+    """
+    power = voltage * motor_current(voltage, mean_qd, motor, check=False)
+    return float(np.maximum(power, 0.0).sum()) * dt
 
 
 def _tipped(quat: np.ndarray) -> bool:
@@ -205,7 +217,7 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     if not ok.all():
         raise ValueError(f"plan: {int((~ok).sum())} host cycles ask for feet out of reach (first at "
                          f"t = {plan.t[~ok][0]:.2f} s)")
-    model = littledog_model(armature=reflected_inertia(motor))
+    model = littledog_model(motor=motor)
     data = mujoco.MjData(model)
     T0 = plan.T_world_body[0]
     data.qpos[:3] = T0[:3, 3]
@@ -233,6 +245,7 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     q_ref = q_cmd[0].copy()
     q_prev = data.qpos[7:].copy()
     voltage = np.zeros(12)
+    qd_sum = np.zeros(12)
     energy = 0.0
     fell = False
     rows = n
@@ -243,7 +256,7 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         rec["qd"][k] = data.qvel[6:]
         rec["q_ref"][k] = q_ref
         rec["voltage"][k] = voltage
-        rec["tau"][k] = data.ctrl
+        rec["tau"][k] = data.actuator_force
         rec["current"][k] = motor_current(voltage, data.qvel[6:], motor, check=False)
         rec["body_pos"][k] = data.qpos[:3]
         rec["body_quat"][k] = data.qpos[3:7]
@@ -268,18 +281,19 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         channel.send(now, q_cmd[k])
         for s in range(host_steps):
             if s % servo_steps == 0:
+                energy += _tick_energy(voltage, qd_sum / servo_steps, servo_dt, motor)
+                qd_sum[:] = 0.0
                 arrived = channel.receive(now + s * TIMESTEP)
                 if arrived is not None:
                     q_ref = arrived
                 q_now = data.qpos[7:].copy()
                 voltage = pd_servo_step(q_ref, q_now, q_prev, kp, kd, servo_dt, motor.voltage_max, check=False)
+                data.ctrl[:] = voltage          # MuJoCo's actuators apply joint_torque(voltage, dq/dt)
                 q_prev = q_now
-            qd = data.qvel[6:]
-            current = motor_current(voltage, qd, motor, check=False)
-            data.ctrl[:] = torque_from_current(current, qd, motor, check=False)
-            energy += float(np.maximum(voltage * current, 0.0).sum()) * TIMESTEP     # no regeneration
+            qd_sum += data.qvel[6:]
             mujoco.mj_step(model, data)
             imu_sum += data.sensordata[imu_span]
+    energy += _tick_energy(voltage, qd_sum / servo_steps, servo_dt, motor)     # the last tick
     streams = {key: value[:rows] for key, value in rec.items()}
     streams["foot_force"] = streams["foot_force"] + gen.normal(0.0, sensors.force_noise, (rows, 4))
     streams["imu_gyro"], streams["imu_acc"] = simulate_imu(
