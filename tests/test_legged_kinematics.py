@@ -114,6 +114,26 @@ def test_bad_input_is_named():
         littledog_mjcf(timestep=0.02)
 
 
+def test_statics_name_the_argument_whose_batch_does_not_fit_and_refuse_an_overflow():
+    # found by the fuzz: numpy's "operands could not be broadcast" named no argument, and torques near
+    # the largest float gave a silent inf/NaN force
+    q2 = np.tile([0.0, 0.6, -1.2], (2, 1))
+    with pytest.raises(ValueError, match=r"^force: .*broadcast"):
+        lk.torques_from_foot_force(q2, np.ones((5, 3)), "FL")
+    with pytest.raises(ValueError, match=r"^tau: .*broadcast"):
+        lk.foot_force_from_torques(q2, np.ones((5, 3)), "FL")
+    with pytest.raises(ValueError, match=r"^gravity_torque: .*broadcast"):
+        lk.foot_force_from_torques(q2[0], np.ones((2, 3)), "FL", np.ones((5, 3)))
+    with pytest.raises(ValueError, match="tau, gravity_torque"):
+        lk.foot_force_from_torques(q2[0], np.full(3, 1e308), "FL", np.full(3, -1e308))
+    # batches that do broadcast still give each row's own answer
+    f = np.array([[0.0, 0.0, -7.4], [1.0, 0.5, -3.0]])
+    tau = lk.torques_from_foot_force(q2[0], f, "FL")
+    assert np.allclose(tau[1], lk.foot_jacobian(q2[0], "FL").T @ f[1])
+    back = lk.foot_force_from_torques(q2, tau[:, None, :], "FL")      # (2, 1, 3) against q's (2,)
+    assert back.shape == (2, 2, 3) and np.allclose(back[:, 0], -f)
+
+
 def _stand(armature=0.01, seconds=2.0):
     """Hold the nominal stance with a stiff joint PD in MuJoCo until it settles."""
     m = littledog_model(armature=armature)

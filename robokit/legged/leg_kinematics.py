@@ -36,7 +36,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import as_se3
-from ..validation import as_array, as_rng, check_int, describe
+from ..validation import as_array, as_rng, check_finite_result, check_int, describe
 from .littledog import HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, LEGS, LOWER_LEG, UPPER_LEG
 
 __all__ = ["KNEE_BRANCH", "UnreachableFootError", "leg_index", "foot_position", "leg_points",
@@ -348,6 +348,19 @@ def reachable_workspace(leg: Any, n: int = 20000, *, rng: Any = 0, branch: Any =
     return _chain(q, i)[2]
 
 
+def _vectors(value: Any, name: str, batch: tuple, against: str = "q_leg's") -> np.ndarray:
+    """``value`` as 3-vectors (..., 3) whose leading axes broadcast with ``batch`` (the joint angles')."""
+    v = as_array(value, name)
+    if v.shape[-1:] != (3,):
+        raise ValueError(f"{name}: expected shape (..., 3), got {describe(value)}")
+    try:
+        np.broadcast_shapes(v.shape[:-1], batch)
+    except ValueError:
+        raise ValueError(f"{name}: expected leading axes that broadcast with {against} {batch}, "
+                         f"got shape {v.shape}") from None
+    return v
+
+
 def torques_from_foot_force(q_leg: Any, force: Any, leg: Any) -> np.ndarray:
     """Joint torques that balance a force applied at the foot: ``tau = J^T f``.
 
@@ -369,10 +382,11 @@ def torques_from_foot_force(q_leg: Any, force: Any, leg: Any) -> np.ndarray:
     [-0.175, 0.112, 0.426]
     """
     J = foot_jacobian(q_leg, leg)
-    f = as_array(force, "force")
-    if f.shape[-1:] != (3,):
-        raise ValueError(f"force: expected shape (..., 3), got {describe(force)}")
-    return np.einsum("...ji,...j->...i", J, f)  # Eq. (2.98)
+    f = _vectors(force, "force", J.shape[:-2])
+    with np.errstate(over="ignore", invalid="ignore"):
+        tau = np.einsum("...ji,...j->...i", J, f)  # Eq. (2.98)
+    check_finite_result("force", tau)
+    return tau
 
 
 def foot_force_from_torques(q_leg: Any, tau: Any, leg: Any, gravity_torque: Any = None) -> np.ndarray:
@@ -396,7 +410,9 @@ def foot_force_from_torques(q_leg: Any, tau: Any, leg: Any, gravity_torque: Any 
     Raises
     ------
     ValueError
-        If the leg is singular (fully stretched or folded: ``J`` cannot be inverted).
+        If the leg is singular (fully stretched or folded: ``J`` cannot be inverted), if ``tau`` or
+        ``gravity_torque`` has leading axes that do not broadcast with ``q_leg``'s, or if the force
+        overflows (torques near the largest float).
 
     Examples
     --------
@@ -405,18 +421,19 @@ def foot_force_from_torques(q_leg: Any, tau: Any, leg: Any, gravity_torque: Any 
     [0.0, -0.0, 7.4]
     """
     J = foot_jacobian(q_leg, leg)
-    t = as_array(tau, "tau")
-    if t.shape[-1:] != (3,):
-        raise ValueError(f"tau: expected shape (..., 3), got {describe(tau)}")
+    t = _vectors(tau, "tau", J.shape[:-2])
     if gravity_torque is not None:
-        g = as_array(gravity_torque, "gravity_torque")
-        if g.shape[-1:] != (3,):
-            raise ValueError(f"gravity_torque: expected shape (..., 3), got {describe(gravity_torque)}")
-        t = t - g
+        g = _vectors(gravity_torque, "gravity_torque", np.broadcast_shapes(J.shape[:-2], t.shape[:-1]),
+                     "those of q_leg and tau,")
+        with np.errstate(over="ignore"):
+            t = t - g
     if np.any(np.abs(np.linalg.det(J)) < 1e-9):
         raise ValueError("q_leg: the leg is singular there (stretched or folded); J^T cannot be inverted")
     JT = np.swapaxes(J, -1, -2)
-    return -np.linalg.solve(JT, t[..., None])[..., 0]
+    with np.errstate(over="ignore", invalid="ignore"):
+        f = -np.linalg.solve(JT, t[..., None])[..., 0]
+    check_finite_result("tau, gravity_torque", f)
+    return f
 
 
 def body_fk(q: Any) -> np.ndarray:
