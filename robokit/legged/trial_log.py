@@ -104,7 +104,21 @@ META_KEYS: Mapping[str, str] = MappingProxyType({
 
 class TrialLogError(ValueError):
     """A trial log that cannot be used: a truncated or corrupt file, another format or version, a
-    missing stream, one of the wrong shape, dtype or length, or bad metadata."""
+    missing stream, one of the wrong shape, dtype or length, or bad metadata.
+
+    A ``ValueError``, so code that refuses bad input in general catches it too; the message names
+    the stream or key at fault.
+
+    Examples
+    --------
+    >>> streams = empty_streams(3)
+    >>> del streams["contact"]
+    >>> try:
+    ...     TrialLog(streams, trial_meta())
+    ... except TrialLogError as err:
+    ...     print(isinstance(err, ValueError), err)
+    True streams: expected exactly the streams of LOG_LAYOUT version 1; missing ['contact'], unknown []
+    """
 
 
 def _json_default(value: Any) -> Any:
