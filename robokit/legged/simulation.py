@@ -70,6 +70,15 @@ class LoopSettings:
     gains : (float, float), optional
         Servo ``(kp, kd)`` in V/rad and V s/rad; default :func:`littledog_servo_gains` for the motor
         the trial uses.
+
+    Examples
+    --------
+    >>> LoopSettings(servo_rate=100.0, latency=0.03).servo_rate
+    100.0
+    >>> LoopSettings(servo_rate=300.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: servo_rate: expected a rate that divides the 1000 Hz physics rate (e.g. 500, 250, 100), got 300.0
     """
 
     servo_rate: float = 500.0
@@ -104,6 +113,13 @@ class SensorSettings:
     markers occluded, and now and then (probability 0.005 per frame) the whole trunk hidden for
     0.2 s; a MEMS gyro with 0.02 rad/s bias, an accelerometer with 0.1 m/s^2 bias; 0.1 N of force
     sensor noise.
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> perfect = dataclasses.replace(SensorSettings(), gyro_bias=(0.0, 0.0, 0.0), force_noise=0.0)
+    >>> perfect.gyro_bias, perfect.force_noise, SensorSettings().gyro_bias
+    ((0.0, 0.0, 0.0), 0.0, (0.02, -0.015, 0.01))
     """
 
     mocap_noise: float = 0.0005
