@@ -460,6 +460,32 @@ def stance_q():
     return body_ik(STANCE_FEET).q[0]
 
 
+@functools.cache
+def tiny_walk_plan():   # 0.02 m of trot: a few dozen host cycles, ~0.1 s of MuJoCo per valid call
+    from robokit.legged import trot_gait, walking_plan
+    return walking_plan(trot_gait(), 0.02)
+
+
+def loop_settings():
+    from robokit.legged.simulation import LoopSettings
+    return LoopSettings()
+
+
+def sensor_settings():
+    from robokit.legged.simulation import SensorSettings
+    return SensorSettings()
+
+
+def trial_outcomes():     # a TrialOutcome around the synthetic log: no MuJoCo needed
+    from robokit.legged.simulation import TrialOutcome
+    return {"trot": TrialOutcome(trial_log(), False, 0.03, 2.0, 0.01, {})}
+
+
+def touchdown_detectors():
+    from robokit.legged.walking_experiment import TOUCHDOWN_DETECTORS
+    return list(TOUCHDOWN_DETECTORS)
+
+
 SPECS: dict[str, Call] = {
     # --- about, geometry --------------------------------------------------------------------
     "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
@@ -1367,12 +1393,74 @@ SPECS: dict[str, Call] = {
     "robokit.exercises.littledog.detect_touchdowns": Call({
         "force": Array(np.array([0.0, 0.2, 9.0, 0.5, 11.0, 10.0, 10.0, 10.0, 4.0, 1.0, 0.0]), "N", min_rows=0),
         "dt": Real(0.01)}),
+    # --- lesson 04: leg kinematics and statics, the MuJoCo model, the servo design (robokit.legged.leg_kinematics,
+    #     littledog, servo_design) -------------------------------------------------------------------
+    "robokit.legged.leg_kinematics.leg_points": Call({
+        "q_leg": Array(np.array([0.1, 0.6, -1.2]), "...,3"), "leg": Choice("HR")}),
+    "robokit.legged.leg_kinematics.foot_jacobian": Call({
+        "q_leg": Array(np.array([0.1, 0.6, -1.2]), "...,3"), "leg": Choice("FL")}),
+    "robokit.legged.leg_kinematics.leg_ik_batch": Call({
+        "p_foot": Array(np.array([[0.12, 0.07, -0.11], [0.10, 0.06, -0.12]]), "N,3|3"), "leg": Choice("FL"),
+        "branch": Int(-1, optional=True)}),
+    "robokit.legged.leg_kinematics.within_limits": Call({
+        "q": Array(np.array([0.0, 0.5, -1.5]), "...,3"), "leg": Choice("FL", optional=True)}),
+    "robokit.legged.leg_kinematics.reachable_workspace": Call({
+        "leg": Choice("FL"), "n": Int(200), "rng": Rng(0), "branch": Int(-1, optional=True, accepts=("a list",))}),
+    "robokit.legged.leg_kinematics.torques_from_foot_force": Call({
+        "q_leg": Array(np.array([0.0, 0.6, -1.2]), "...,3"), "force": Array(np.array([0.0, 0.0, -7.4]), "...,3"),
+        "leg": Choice("FL")}),
+    "robokit.legged.leg_kinematics.foot_force_from_torques": Call({
+        "q_leg": Array(np.array([0.0, 0.6, -1.2]), "...,3"), "tau": Array(np.array([-0.175, 0.112, 0.426]), "...,3"),
+        "leg": Choice("FL"), "gravity_torque": Array(np.array([0.0, 0.01, 0.02]), "...,3", optional=True)}),
+    "robokit.legged.leg_kinematics.body_fk": Call({"q": Array(stance_q, "...,12")}),
+    "robokit.legged.leg_kinematics.body_ik": Call({
+        "feet": Array(lambda: np.array([[0.16, 0.08, -0.1215], [0.16, -0.08, -0.1215],
+                                        [-0.16, 0.08, -0.1215], [-0.16, -0.08, -0.1215]]), "N,4,3|4,3"),
+        "T_world_body": T_(lambda: np.eye(4), optional=True), "check": Flag(True)}),
+    "robokit.legged.littledog.littledog_mjcf": Call({
+        "armature": Real(0.0), "damping": Real(0.0), "friction": Real(1.0), "timestep": Real(0.001),
+        "motor": Obj(littledog_motor, optional=True)}),
+    "robokit.legged.littledog.littledog_model": Call({
+        "armature": Real(0.0), "damping": Real(0.0), "friction": Real(1.0), "timestep": Real(0.001),
+        "motor": Obj(littledog_motor, optional=True)}),
+    "robokit.legged.servo_design.link_inertias": Call({}),
+    "robokit.legged.servo_design.servo_inertia": Call({"motor": Obj(littledog_motor)}),
+    "robokit.legged.servo_design.littledog_servo_gains": Call({"bandwidth_hz": Real(15.0),
+                                                               "motor": Obj(littledog_motor)}),
+    # --- lesson 04: the walk in MuJoCo and its tables (robokit.legged.simulation, walking_experiment); every
+    #     invalid input is refused before MuJoCo runs, so only the cheap flag keeps huge values out ---------
+    "robokit.legged.simulation.LoopSettings": Call({
+        "servo_rate": Real(500.0), "latency": Real(0.01), "jitter": Real(0.002), "loss": Real(0.1),
+        "gains": Obj((96.0, 0.42), optional=True)}),
+    "robokit.legged.simulation.SensorSettings": Call({
+        "mocap_noise": Real(0.0005), "mocap_dropout": Real(0.05), "mocap_bursts": Real(0.005),
+        "mocap_burst_length": Int(20), "gyro_noise": Real(0.005), "acc_noise": Real(0.05),
+        "gyro_bias": Array(np.array([0.02, -0.015, 0.01]), "3"), "acc_bias": Array(np.array([0.1, -0.05, 0.08]), "3"),
+        "force_noise": Real(0.1)}),
+    "robokit.legged.simulation.simulate_walk": Call({
+        "plan": Obj(tiny_walk_plan), "loops": Obj(loop_settings), "sensors": Obj(sensor_settings),
+        "motor": Obj(littledog_motor), "rng": Rng(0)}, cheap=False),
+    "robokit.legged.walking_experiment.lesson_plans": Call({"distance": Real(0.05)}),
+    "robokit.legged.walking_experiment.loop_table": Call({
+        "plan": Obj(tiny_walk_plan), "servo_rates": Array(np.array([500.0]), "N"),
+        "latencies": Array(np.array([0.0]), "N"), "bandwidths": Array(np.array([15.0]), "N"), "rng": Rng(0),
+        "progress": Func(None, optional=True)}, cheap=False),
+    "robokit.legged.walking_experiment.estimation_table": Call({"log": Obj(trial_log)}),
+    "robokit.legged.walking_experiment.touchdown_table": Call({
+        "log": Obj(trial_log), "detectors": Obj(touchdown_detectors, optional=True), "tolerance": Int(5),
+        "plan": Obj(tiny_walk_plan, optional=True), "gate": Int(10)}),
+    "robokit.legged.walking_experiment.endurance_table": Call({"outcomes": Mapping(trial_outcomes)}),
+    "robokit.legged.walking_experiment.true_margins": Call({"log": Obj(trial_log)}),
+    "robokit.legged.touchdown.gate_touchdowns": Call({
+        "detected": Array(np.array([3, 40, 52, 95]), "N", min_rows=0), "expected": Array(np.array([50, 100]), "N", min_rows=0),
+        "window": Int(10)}),
 }
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
 NOT_FUZZED: dict[str, str] = {
     "robokit.sim.motion.Path": "a plain record (NamedTuple) of t and poses; the functions that take one validate it",
     "robokit.legged.gait.WalkPlan": "a plain record (NamedTuple) of a plan's arrays; walking_plan makes it",
+    "robokit.legged.trial_log.TrialLogError": "an exception class (a ValueError) the lesson catches, not calls",
     "robokit.grading.check.check": "the notebook's checker of a student's function (grading's own tests cover it)",
 }
 
@@ -1461,7 +1549,7 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.legged.mocap.{n}" for n in ("fit_marker_pose", "mocap_body_poses")),
     *(f"robokit.legged.imu.{n}" for n in ("simulate_imu", "integrate_gyro", "specific_force")),
     *(f"robokit.legged.state_estimation.{n}" for n in ("fuse_body_state", "orientation_errors", "position_errors")),
-    "robokit.legged.touchdown.detect_contacts",
+    "robokit.legged.touchdown.detect_contacts", "robokit.legged.touchdown.gate_touchdowns",
     *(f"robokit.legged.event_scoring.{n}" for n in ("contact_events", "event_precision_recall", "score_events")),
     # robokit.legged's gaits (lesson 04), fuzzed before the lesson exists
     *(f"robokit.legged.support.{n}" for n in ("support_polygon", "stability_margin", "stability_margins")),
