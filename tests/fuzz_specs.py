@@ -1550,6 +1550,7 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.legged.imu.{n}" for n in ("simulate_imu", "integrate_gyro", "specific_force")),
     *(f"robokit.legged.state_estimation.{n}" for n in ("fuse_body_state", "orientation_errors", "position_errors")),
     "robokit.legged.touchdown.detect_contacts", "robokit.legged.touchdown.gate_touchdowns",
+    "robokit.legged.simulation.SensorSettings",
     *(f"robokit.legged.event_scoring.{n}" for n in ("contact_events", "event_precision_recall", "score_events")),
     # robokit.legged's gaits (lesson 04), fuzzed before the lesson exists
     *(f"robokit.legged.support.{n}" for n in ("support_polygon", "stability_margin", "stability_margins")),

@@ -4,7 +4,7 @@ import pytest
 
 from robokit.controllers import LITTLEDOG_MOTOR, motor_current
 from robokit.legged import crawl_gait, load_trial, save_trial, stability_margins, trot_gait, walking_plan
-from robokit.legged.simulation import LoopSettings, simulate_walk
+from robokit.legged.simulation import LoopSettings, SensorSettings, simulate_walk
 
 
 @pytest.fixture(scope="module")
@@ -80,6 +80,16 @@ def test_bad_settings_are_named():
         simulate_walk("crawl")
     with pytest.raises(TypeError, match="sensors"):
         simulate_walk(walking_plan(trot_gait(), 0.05), sensors={})
+
+
+@pytest.mark.parametrize("field, value, error", [
+    ("force_noise", np.nan, ValueError), ("gyro_noise", -0.1, ValueError), ("mocap_dropout", 1.5, ValueError),
+    ("mocap_burst_length", 2.5, TypeError), ("gyro_bias", (0.0, 0.0), ValueError), ("acc_bias", "abc", TypeError)])
+def test_bad_sensor_settings_are_named_before_any_walk(field, value, error):
+    # found by the fuzz: SensorSettings took anything, and a NaN noise or a 2-vector bias surfaced (if at all)
+    # only after the whole MuJoCo walk had run, named by the sensor model's argument, not the setting
+    with pytest.raises(error, match=rf"^{field}: "):
+        SensorSettings(**{field: value})
 
 
 def test_a_plan_with_nan_or_uneven_steps_is_refused_by_name():

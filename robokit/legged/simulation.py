@@ -36,7 +36,7 @@ import numpy as np
 
 from ..controllers import LITTLEDOG_MOTOR, DCMotor, SetpointChannel, motor_current, pd_servo_step
 from ..geometry import as_se3, quat_to_matrix, se3_from_rt
-from ..validation import as_array, as_rng, check_positive
+from ..validation import as_array, as_rng, check_int, check_positive
 from .gait import WalkPlan
 from .imu import simulate_imu
 from .leg_kinematics import body_ik
@@ -131,6 +131,17 @@ class SensorSettings:
     gyro_bias: tuple = (0.02, -0.015, 0.01)
     acc_bias: tuple = (0.1, -0.05, 0.08)
     force_noise: float = 0.1
+
+    def __post_init__(self):
+        # refused here, by name, rather than after the whole walk has run (the sensors are corrupted last)
+        for name in ("mocap_noise", "gyro_noise", "acc_noise", "force_noise"):
+            check_positive(getattr(self, name), name, allow_zero=True)
+        for name in ("mocap_dropout", "mocap_bursts"):
+            if check_positive(getattr(self, name), name, allow_zero=True) > 1:
+                raise ValueError(f"{name}: expected a probability in [0, 1], got {getattr(self, name)}")
+        check_int(self.mocap_burst_length, "mocap_burst_length", minimum=1)
+        for name in ("gyro_bias", "acc_bias"):
+            as_array(getattr(self, name), name, shape=(3,))
 
 
 class TrialOutcome(NamedTuple):

@@ -30,7 +30,7 @@ import numpy as np
 
 from .. import config
 from ..controllers import LITTLEDOG_MOTOR, servo_analysis
-from ..validation import as_array, check_positive
+from ..validation import as_array, check_callable, check_int, check_positive, describe
 from .gait import WalkPlan, walking_plan
 from .gait_schedule import crawl_gait, trot_gait
 from .littledog import GUIDE, MARKERS, TOTAL_MASS
@@ -123,6 +123,16 @@ def loop_table(plan: WalkPlan, *, servo_rates: Any = (500.0, 100.0), latencies: 
     rates = as_array(servo_rates, "servo_rates", ndim=1, min_size=1)
     lats = as_array(latencies, "latencies", ndim=1, min_size=1)
     bws = as_array(bandwidths, "bandwidths", ndim=1, min_size=1)
+    progress = check_callable(progress, "progress")
+    for rate in rates:              # every setting is refused by name before the first trial runs
+        try:
+            LoopSettings(servo_rate=float(rate))
+        except ValueError as exc:
+            raise ValueError(f"servo_rates: {exc}") from None
+    if np.any(lats < 0):
+        raise ValueError(f"latencies: expected non-negative delays (s), got {lats.tolist()}")
+    if np.any(bws <= 0):
+        raise ValueError(f"bandwidths: expected positive frequencies (Hz), got {bws.tolist()}")
     combos = [(float(b), float(r), float(lat)) for b in bws for r in rates for lat in lats]
     rows = []
     for k, (bw, rate, lat) in enumerate(combos):
@@ -192,6 +202,27 @@ def estimation_table(log: TrialLog) -> dict:
     return table
 
 
+def _detectors(detectors: Any, log: TrialLog) -> list:
+    """The detectors as ``(label, on, off, debounce)`` rows, each tried on the log's first sample."""
+    if detectors is None:
+        return list(TOUCHDOWN_DETECTORS)
+    want = "a sequence of (label, threshold_on, threshold_off, debounce)"
+    if isinstance(detectors, (str, bytes)):
+        raise TypeError(f"detectors: expected {want}, got {describe(detectors)}")
+    try:
+        rows = [tuple(d) for d in detectors]
+    except TypeError:
+        raise TypeError(f"detectors: expected {want}, got {describe(detectors)}") from None
+    if not rows or any(len(r) != 4 or not isinstance(r[0], str) for r in rows):
+        raise ValueError(f"detectors: expected {want}, got {describe(detectors)}")
+    for k, (_, on, off, debounce) in enumerate(rows):
+        try:
+            detect_contacts(log.foot_force[:1], on, off, debounce)
+        except (TypeError, ValueError) as exc:
+            raise type(exc)(f"detectors[{k}]: {exc}") from None
+    return rows
+
+
 def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5, plan: Any = None,
                     gate: int = 10) -> list:
     """Touchdowns detected on the lower-leg force sensors against MuJoCo's true contacts.
@@ -225,8 +256,9 @@ def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5,
     """
     if not isinstance(log, TrialLog):
         raise TypeError(f"log: expected a TrialLog, got {type(log).__name__}")
-    if detectors is None:
-        detectors = TOUCHDOWN_DETECTORS
+    detectors = _detectors(detectors, log)
+    tolerance = check_int(tolerance, "tolerance", minimum=0)
+    gate = check_int(gate, "gate", minimum=0)
     dt_ms = 1000.0 * float(log.t[1] - log.t[0])
     truth = np.asarray(log.contact)
     rows = []
