@@ -125,7 +125,7 @@ def test_kalman_filter_equals_batch_least_squares():
             r = np.zeros((2, 2 * n))
             r[:, 2 * k:2 * k + 2] = Lq
             r[:, 2 * k - 2:2 * k] = -Lq @ A
-            rows.append(r); rhs.append(Lq @ (B * acc_world[k - 1, axis]))
+            rows.append(r); rhs.append(Lq @ (B * acc_world[k, axis]))     # sample k covers (t_{k-1}, t_k]
             if ok[k]:
                 r = np.zeros((1, 2 * n)); r[0, 2 * k] = 1 / s_m; rows.append(r); rhs.append([z[k, axis] / s_m])
         x = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]

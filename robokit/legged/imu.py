@@ -136,21 +136,22 @@ def simulate_imu(omega_body: Any, specific_force_body: Any, rng: Any = None, *, 
 
 
 def integrate_gyro(R0: Any, gyro: Any, dt: float) -> np.ndarray:
-    """Orientations from integrating body rates alone: ``R[k] = R[k-1] exp([gyro[k-1] dt])``.
+    """Orientations from integrating body rates alone: ``R[k] = R[k-1] exp([gyro[k] dt])``.
 
     Parameters
     ----------
     R0 : array_like, shape (3, 3)
         Orientation ``R_world_body`` at the first sample.
     gyro : array_like, shape (N, 3)
-        Body-frame rates (rad/s), sample ``k`` held over ``[t_k, t_k + dt)``.
+        Body-frame rates (rad/s); sample ``k`` is what the IMU reports at ``t_k``: its rate over
+        the period that ends there, ``(t_k - dt, t_k]`` (as the trial log stores it).
     dt : float
         Sample period (s, > 0).
 
     Returns
     -------
     numpy.ndarray, shape (N, 3, 3)
-        ``R[0] = R0``; the last rate is not used (it would give sample ``N``).
+        ``R[0] = R0``; the first rate is not used (it covers the period before ``t_0``).
 
     Raises
     ------
@@ -174,12 +175,12 @@ def integrate_gyro(R0: Any, gyro: Any, dt: float) -> np.ndarray:
     R = as_rotation(R0, "R0")
     w = as_vector_series(gyro, "gyro")
     step = check_positive(dt, "dt")
-    incr = so3_exp(w[:-1] * step, check=False)
+    incr = so3_exp(w[1:] * step, check=False)
     check_finite_result("gyro, dt", incr)
     out = np.empty((len(w), 3, 3))
     out[0] = R
     for k in range(1, len(w)):
-        out[k] = out[k - 1] @ incr[k - 1]
+        out[k] = out[k - 1] @ incr[k - 1]                # the rate reported at t_k covers (t_k - dt, t_k]
     return out
 
 

@@ -68,7 +68,9 @@ def fuse_body_state(gyro: Any, acc: Any, dt: float, T_mocap: Any, mocap_ok: Any,
     Parameters
     ----------
     gyro, acc : array_like, shape (N, 3)
-        IMU readings: body rates (rad/s) and specific forces (m/s^2), one per host sample.
+        IMU readings: body rates (rad/s) and specific forces (m/s^2), one per host sample; sample
+        ``k`` covers the period ``(t_k - dt, t_k]`` (the IMU's average, as the trial log stores it),
+        so it carries the estimate from ``k - 1`` to ``k`` and sample 0 is not used.
     dt : float
         Sample period (s, > 0; 0.01 on the LittleDog's host).
     T_mocap : array_like, shape (N, 4, 4)
@@ -158,8 +160,9 @@ def fuse_body_state(gyro: Any, acc: Any, dt: float, T_mocap: Any, mocap_ok: Any,
     R_out[0], p_out[0], v_out[0], b_out[0] = R_hat, x[:, 0], x[:, 1], b_hat
     for k in range(1, n):
         # --- orientation: predict with the gyro, correct with the MoCap (Mahony et al., Eq. (32))
-        a_world = R_hat @ f[k - 1] - gravity
-        R_hat = R_hat @ so3_exp((w[k - 1] - b_hat) * step, check=False)       # Eq. (32a), gyro part
+        # the IMU's sample k covers (t_{k-1}, t_k]: it carries the state from k - 1 to k
+        a_world = R_hat @ f[k] - gravity
+        R_hat = R_hat @ so3_exp((w[k] - b_hat) * step, check=False)           # Eq. (32a), gyro part
         if ok[k]:
             R_y = T[k, :3, :3]
             omega_mes = 0.5 * np.cross(R_y, R_hat).sum(0)                     # Eq. (32c), v_i = R_y^T e_i

@@ -78,8 +78,8 @@ LOG_LAYOUT: Mapping[str, StreamSpec] = MappingProxyType({
     "feet": StreamSpec((4, 3), _F, "m", "true foot centres (world)"),
     "contact": StreamSpec((4,), _B, "-", "true foot contacts"),
     "foot_force": StreamSpec((4,), _F, "N", "axial lower-leg force sensors, compression positive"),
-    "imu_gyro": StreamSpec((3,), _F, "rad/s", "IMU angular rate (body axes)"),
-    "imu_acc": StreamSpec((3,), _F, "m/s^2", "IMU specific force (body axes; +9.81 on z at rest, level)"),
+    "imu_gyro": StreamSpec((3,), _F, "rad/s", "IMU angular rate (body axes), its average over the host period ending at t"),
+    "imu_acc": StreamSpec((3,), _F, "m/s^2", "IMU specific force (body axes; +9.81 on z at rest, level), averaged likewise"),
     "mocap": StreamSpec((4, 3), _F, "m", "MoCap marker positions (world); no measurement where not visible"),
     "mocap_visible": StreamSpec((4,), _B, "-", "whether the MoCap system saw each marker"),
 })
