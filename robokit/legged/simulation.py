@@ -42,6 +42,7 @@ from .imu import simulate_imu
 from .leg_kinematics import body_ik
 from .littledog import LEGS, MARKERS, TIMESTEP, littledog_model
 from .mocap_sensor import simulate_mocap
+from .power import trial_power
 from .servo_design import littledog_servo_gains
 from .trial_log import TrialLog, empty_streams, trial_meta
 
@@ -156,9 +157,10 @@ class TrialOutcome(NamedTuple):
     distance : float
         Forward progress of the trunk along the plan's direction (m).
     energy : float
-        Electrical energy the twelve motors drew (J), integrated over every servo tick from the
-        joints' mean speed over it (exact for a constant voltage), without regeneration (a joint's
-        negative power is lost).
+        Electrical energy the twelve motors drew (J): over every servo tick, the held voltage times
+        the current at the joint's mean speed over the tick (its angle change over the tick; the
+        current is linear in the speed, so this is the tick's mean current), without regeneration
+        (a joint's negative power is lost: :func:`robokit.legged.trial_power`).
     tracking_rms : float
         RMS over joints and host cycles of the set-point the host sent minus the angle the joint had
         reached one host period later, when the next set-point went out (rad).
@@ -172,17 +174,6 @@ class TrialOutcome(NamedTuple):
     energy: float
     tracking_rms: float
     link: dict
-
-
-def _tick_energy(voltage: np.ndarray, mean_qd: np.ndarray, dt: float, motor: DCMotor) -> float:
-    """Electrical energy (J) the motors drew over one servo tick, without regeneration.
-
-    The voltage is constant over a tick and the current is linear in the joint speed, so each
-    joint's ``V i`` integrates exactly from its mean speed; a joint whose power is negative (braking)
-    gives nothing back (exact while a joint's power keeps its sign within the tick).
-    """
-    power = voltage * motor_current(voltage, mean_qd, motor, check=False)
-    return float(np.maximum(power, 0.0).sum()) * dt
 
 
 def _tipped(quat: np.ndarray) -> bool:
@@ -272,8 +263,8 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     q_ref = q_cmd[0].copy()
     q_prev = data.qpos[7:].copy()
     voltage = np.zeros(12)
-    qd_sum = np.zeros(12)
-    energy = 0.0
+    n_ticks = n * host_steps // servo_steps + 1
+    tick_voltage, tick_speed, ticks = np.zeros((n_ticks + 1, 12)), np.zeros((n_ticks + 1, 12)), 0
     fell = False
     rows = n
     for k in range(n):
@@ -308,19 +299,22 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         channel.send(now, q_cmd[k])
         for s in range(host_steps):
             if s % servo_steps == 0:
-                energy += _tick_energy(voltage, qd_sum / servo_steps, servo_dt, motor)
-                qd_sum[:] = 0.0
                 arrived = channel.receive(now + s * TIMESTEP)
                 if arrived is not None:
                     q_ref = arrived
                 q_now = data.qpos[7:].copy()
+                tick_speed[ticks] = (q_now - q_prev) / servo_dt       # the tick that just ended
                 voltage = pd_servo_step(q_ref, q_now, q_prev, kp, kd, servo_dt, motor.voltage_max, check=False)
                 data.ctrl[:] = voltage          # MuJoCo's actuators apply joint_torque(voltage, dq/dt)
+                ticks += 1
+                tick_voltage[ticks] = voltage
                 q_prev = q_now
-            qd_sum += data.qvel[6:]
             mujoco.mj_step(model, data)
             imu_sum += data.sensordata[imu_span]
-    energy += _tick_energy(voltage, qd_sum / servo_steps, servo_dt, motor)     # the last tick
+    tick_speed[ticks] = (data.qpos[7:] - q_prev) / servo_dt
+    # the voltage is held over a tick and the current is linear in the speed, so each tick's V i is the
+    # one at its mean speed; no regeneration (trial_power clips a braking joint's power)
+    energy = float(trial_power(tick_voltage[1:ticks + 1], tick_speed[1:ticks + 1], motor).sum()) * servo_dt
     streams = {key: value[:rows] for key, value in rec.items()}
     streams["foot_force"] = streams["foot_force"] + gen.normal(0.0, sensors.force_noise, (rows, 4))
     streams["imu_gyro"], streams["imu_acc"] = simulate_imu(
