@@ -1451,6 +1451,12 @@ SPECS: dict[str, Call] = {
         "plan": Obj(tiny_walk_plan, optional=True), "gate": Int(10)}),
     "robokit.legged.walking_experiment.endurance_table": Call({"outcomes": Mapping(trial_outcomes)}),
     "robokit.legged.walking_experiment.true_margins": Call({"log": Obj(trial_log)}),
+    "robokit.legged.event_scoring.match_events": Call({
+        "detected": Array(np.array([3, 5, 8]), "N", min_rows=0), "truth": Array(np.array([2, 8]), "N", min_rows=0),
+        "tolerance": Int(2)}),
+    "robokit.legged.support.nearest_boundary_point": Call({
+        "polygon": Array(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]), "N,2"),
+        "point": Array(np.array([0.5, 0.2]), "2"), "check": Flag(True)}),
     "robokit.legged.touchdown.gate_touchdowns": Call({
         "detected": Array(np.array([3, 40, 52, 95]), "N", min_rows=0), "expected": Array(np.array([50, 100]), "N", min_rows=0),
         "window": Int(10)}),
@@ -1550,8 +1556,10 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.legged.imu.{n}" for n in ("simulate_imu", "integrate_gyro", "specific_force")),
     *(f"robokit.legged.state_estimation.{n}" for n in ("fuse_body_state", "orientation_errors", "position_errors")),
     "robokit.legged.touchdown.detect_contacts", "robokit.legged.touchdown.gate_touchdowns",
+    "robokit.legged.support.nearest_boundary_point",
     "robokit.legged.simulation.SensorSettings",
-    *(f"robokit.legged.event_scoring.{n}" for n in ("contact_events", "event_precision_recall", "score_events")),
+    *(f"robokit.legged.event_scoring.{n}" for n in ("contact_events", "event_precision_recall", "score_events",
+                                                     "match_events")),
     # robokit.legged's gaits (lesson 04), fuzzed before the lesson exists
     *(f"robokit.legged.support.{n}" for n in ("support_polygon", "stability_margin", "stability_margins")),
     *(f"robokit.legged.gait_schedule.{n}" for n in (

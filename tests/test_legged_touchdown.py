@@ -199,7 +199,8 @@ def test_gate_touchdowns_keeps_the_first_detection_near_each_planned_one():
                     used.add(d)
                     break
         assert gate_touchdowns(det, exp, w).tolist() == want
+    assert gate_touchdowns([5, 3], [4], 2).tolist() == [3]                   # any order: sorted first
     with pytest.raises(ValueError, match="detected"):
-        gate_touchdowns([5, 3], [4], 2)
+        gate_touchdowns([-5, 3], [4], 2)
     with pytest.raises(ValueError, match="window"):
         gate_touchdowns([5], [4], -1)

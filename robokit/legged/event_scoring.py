@@ -22,9 +22,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..validation import as_array, check_int
+from ..validation import as_array, check_int, describe
 
-__all__ = ["EventScore", "contact_events", "score_events", "event_precision_recall"]
+__all__ = ["EventScore", "contact_events", "match_events", "score_events", "score_leg_events", "event_precision_recall"]
 
 
 class EventScore(NamedTuple):
@@ -84,17 +84,52 @@ def contact_events(contact: Any) -> np.ndarray | list[np.ndarray]:
     return [np.flatnonzero(rising[:, j]) for j in range(c.shape[1])]
 
 
-def _match(detected: np.ndarray, truth: np.ndarray, tol: int) -> np.ndarray:
-    """Delays (detected - true) of a maximum matching: each true event takes the earliest detection still
-    free within ``[t - tol, t + tol]``. Both index arrays are sorted."""
-    delays, j = [], 0
+def _pairs(detected: np.ndarray, truth: np.ndarray, tol: int) -> np.ndarray:
+    """Unchecked :func:`match_events` on sorted index arrays."""
+    pairs, j = [], 0
     for t in truth:
         while j < len(detected) and detected[j] < t - tol:
             j += 1                                   # too early for this and every later true event
         if j < len(detected) and detected[j] <= t + tol:
-            delays.append(int(detected[j] - t))
+            pairs.append((int(detected[j]), int(t)))
             j += 1
-    return np.array(delays, dtype=float)
+    return np.array(pairs, dtype=np.int64).reshape(-1, 2)
+
+
+def _match(detected: np.ndarray, truth: np.ndarray, tol: int) -> np.ndarray:
+    """Delays (detected - true) of the matching of :func:`match_events`."""
+    p = _pairs(detected, truth, tol)
+    return (p[:, 0] - p[:, 1]).astype(float)
+
+
+def match_events(detected: Any, truth: Any, tolerance: int) -> np.ndarray:
+    """Pair detected events with true (or expected) ones: each takes the earliest free detection near it.
+
+    Parameters
+    ----------
+    detected, truth : array_like of int, shape (K,)
+        Sample indices (whole numbers >= 0, any order: sorted here).
+    tolerance : int
+        Largest ``|detected - true|`` (samples, >= 0) for a pair.
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (P, 2)
+        ``(detected, true)`` index pairs in time order; each index is used at most once.
+
+    Notes
+    -----
+    Taking, in time order, for each true event the earliest free detection in its window gives a
+    matching of maximum size, because all windows have the same width (the greedy argument of
+    interval scheduling); ours, not from a paper.
+
+    Examples
+    --------
+    >>> match_events([3, 5, 8], [2, 8], tolerance=2).tolist()
+    [[3, 2], [8, 8]]
+    """
+    d, t = _indices(detected, "detected"), _indices(truth, "truth")
+    return _pairs(d, t, check_int(tolerance, "tolerance", minimum=0))
 
 
 def _score(delays: np.ndarray, n_detected: int, n_true: int) -> EventScore:
@@ -156,6 +191,37 @@ def score_events(detected: Any, truth: Any, tolerance: int) -> EventScore:
     return _score(_match(d, t, tol), len(d), len(t))
 
 
+def score_leg_events(detected: Any, truth: Any, tolerance: int) -> EventScore:
+    """:func:`score_events` counted over several legs: one list of touchdown indices per leg.
+
+    Parameters
+    ----------
+    detected, truth : sequence of array_like of int
+        One entry per leg (the same number of legs in both), each as in :func:`score_events`.
+    tolerance : int
+
+    Returns
+    -------
+    EventScore
+        Matches, detections and true touchdowns summed over the legs (a detection can only match a
+        touchdown of its own leg).
+
+    Examples
+    --------
+    >>> score_leg_events([[3, 5, 8], [10]], [[2, 8], [30]], tolerance=2)
+    EventScore(precision=0.5, recall=0.6666666666666666, mean_delay_samples=0.5)
+    """
+    tol = check_int(tolerance, "tolerance", minimum=0)
+    if isinstance(detected, (str, bytes, np.ndarray)) or isinstance(truth, (str, bytes, np.ndarray)) or \
+            not hasattr(detected, "__len__") or not hasattr(truth, "__len__") or len(detected) != len(truth):
+        raise ValueError("detected, truth: expected two lists with one array of indices per leg, as many legs in "
+                         f"each, got {describe(detected)} and {describe(truth)}")
+    d = [_indices(a, f"detected[{i}]") for i, a in enumerate(detected)]
+    t = [_indices(b, f"truth[{i}]") for i, b in enumerate(truth)]
+    delays = np.concatenate([_match(a, b, tol) for a, b in zip(d, t)] + [np.zeros(0)])
+    return _score(delays, sum(len(a) for a in d), sum(len(b) for b in t))
+
+
 def event_precision_recall(detected: Any, truth: Any, tolerance: int) -> EventScore:
     """Precision, recall and mean delay of detected touchdowns against the true ones, from contact states.
 
@@ -198,9 +264,7 @@ def event_precision_recall(detected: Any, truth: Any, tolerance: int) -> EventSc
     t = _bool_contacts(truth, "truth")
     if t.shape != d.shape:
         raise ValueError(f"truth: expected shape {d.shape} (that of detected), got shape {t.shape}")
-    tol = check_int(tolerance, "tolerance", minimum=0)
     ev_d, ev_t = contact_events(d), contact_events(t)
     if d.ndim == 1:
         ev_d, ev_t = [ev_d], [ev_t]
-    delays = np.concatenate([_match(a, b, tol) for a, b in zip(ev_d, ev_t)])
-    return _score(delays, sum(len(a) for a in ev_d), sum(len(b) for b in ev_t))
+    return score_leg_events(ev_d, ev_t, tolerance)

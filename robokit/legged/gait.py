@@ -41,7 +41,7 @@ from ..validation import array_ndim, as_array, broadcast_to, check_positive, che
 from .gait_schedule import (CRAWL_SEQUENCE, TROT_PAIRS, GaitSchedule, as_gait_schedule, crawl_gait,
                             stance_pattern, trot_gait)
 from .littledog import LEGS, STANCE_FEET, STANDING_HEIGHT
-from .support import SupportPolygonError, stability_margins, support_polygon
+from .support import SupportPolygonError, nearest_boundary_point, stability_margins, support_polygon
 
 __all__ = ["GaitSchedule", "crawl_gait", "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan",
            "walking_plan", "CRAWL_SEQUENCE", "TROT_PAIRS"]
@@ -216,12 +216,8 @@ def _nearest_point_inside(triangle: np.ndarray, inset: float, point: np.ndarray,
                          f"lifts, got {inset:.4f} (shorter steps or a wider stance make room)")
     incentre = side @ triangle / side.sum()
     inner = incentre + (r - inset) / r * (triangle - incentre)        # shrinking about the incentre keeps edges parallel
-    e, rel = np.roll(inner, -1, axis=0) - inner, point - inner
-    if np.all(e[:, 0] * rel[:, 1] - e[:, 1] * rel[:, 0] >= 0):
-        return point
-    s = np.clip(np.sum(rel * e, axis=1) / np.sum(e * e, axis=1), 0.0, 1.0)
-    candidates = inner + s[:, None] * e
-    return candidates[np.argmin(np.linalg.norm(candidates - point, axis=1))]
+    near, inside = nearest_boundary_point(inner, point, check=False)
+    return point if inside >= 0 else near
 
 
 def _rest_to_rest(knot_t: np.ndarray, knot_p: np.ndarray, t: np.ndarray) -> np.ndarray:

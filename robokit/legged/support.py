@@ -29,7 +29,8 @@ from scipy.spatial import ConvexHull, QhullError
 
 from ..validation import as_array
 
-__all__ = ["SupportPolygonError", "MAX_COORDINATE", "support_polygon", "stability_margin", "stability_margins"]
+__all__ = ["SupportPolygonError", "MAX_COORDINATE", "support_polygon", "stability_margin", "stability_margins",
+           "nearest_boundary_point"]
 
 #: Largest coordinate (m) a foot or centre of mass may have: beyond it a number is a fault (a unit
 #: error), not a place a robot stands, and squares of it stay far from overflow.
@@ -147,13 +148,46 @@ def stability_margin(feet_xy: Any, com_xy: Any) -> float:
     (-1.0, 0.0)
     """
     polygon = support_polygon(feet_xy)
-    p = _as_xy(com_xy, "com_xy", (2,))
+    return nearest_boundary_point(polygon, _as_xy(com_xy, "com_xy", (2,)), check=False)[1]
+
+
+def nearest_boundary_point(polygon: Any, point: Any, *, check: bool = True) -> tuple[np.ndarray, float]:
+    """The point of a convex polygon's boundary nearest to ``point``, and the signed distance to it.
+
+    Parameters
+    ----------
+    polygon : array_like, shape (k, 2)
+        Vertices of a convex polygon, counter-clockwise (as :func:`support_polygon` gives), k >= 3.
+    point : array_like, shape (2,)
+    check : bool, default True
+        Validate the inputs; ``False`` is the fast path for callers that built the polygon.
+
+    Returns
+    -------
+    nearest : numpy.ndarray, shape (2,)
+    distance : float
+        Positive inside the polygon, negative outside, 0 on an edge: McGhee & Frank's margin when
+        ``point`` is the centre of mass's projection.
+
+    Examples
+    --------
+    >>> near, d = nearest_boundary_point([[0, 0], [1, 0], [1, 1], [0, 1]], [0.5, 0.2])
+    >>> near.tolist(), d
+    ([0.5, 0.0], 0.2)
+    """
+    if check:
+        polygon = _as_xy(polygon, "polygon", (None, 2))
+        if len(polygon) < 3:
+            raise SupportPolygonError(f"polygon: expected at least 3 vertices, got {len(polygon)}")
+        point = _as_xy(point, "point", (2,))
     a, b = polygon, np.roll(polygon, -1, axis=0)           # edge i runs from a[i] to b[i]
-    edge, rel = b - a, p - a
-    cross = edge[:, 0] * rel[:, 1] - edge[:, 1] * rel[:, 0]   # > 0: p left of the edge, the inside
+    edge, rel = b - a, point - a
+    cross = edge[:, 0] * rel[:, 1] - edge[:, 1] * rel[:, 0]   # > 0: point left of the edge, the inside
     t = np.clip(np.sum(rel * edge, axis=1) / np.sum(edge * edge, axis=1), 0.0, 1.0)
-    distance = np.linalg.norm(rel - t[:, None] * edge, axis=1).min()   # to the nearest edge
-    return float(distance if np.all(cross >= 0) else -distance)
+    foot = a + t[:, None] * edge                               # nearest point of each edge
+    dist = np.linalg.norm(point - foot, axis=1)
+    k = int(np.argmin(dist))
+    return foot[k], float(dist[k] if np.all(cross >= 0) else -dist[k])
 
 
 def stability_margins(feet_xy: Any, stance: Any, com_xy: Any) -> np.ndarray:

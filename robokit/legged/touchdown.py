@@ -23,7 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_finite_scalar, check_int, describe
+from ..validation import as_array, check_finite_scalar, check_int
+from .event_scoring import match_events
 
 __all__ = ["detect_contacts", "gate_touchdowns"]
 
@@ -116,36 +117,22 @@ def gate_touchdowns(detected: Any, expected: Any, window: int) -> np.ndarray:
     Parameters
     ----------
     detected : array_like of int, shape (K,)
-        Sample indices of the detected touchdowns of one foot, increasing.
+        Sample indices of the detected touchdowns of one foot (whole numbers >= 0).
     expected : array_like of int, shape (M,)
-        Sample indices of its planned touchdowns, increasing.
+        Sample indices of its planned touchdowns.
     window : int
         Samples (>= 0) a detection may lie before or after a planned touchdown.
 
     Returns
     -------
     numpy.ndarray of int, shape (<= M,)
-        For each planned touchdown, the first detection within ``window`` of it (none if there is
-        none); each detection is used once.
+        For each planned touchdown, the first free detection within ``window`` of it (none if
+        there is none); each detection is used once: the detected side of
+        :func:`robokit.legged.event_scoring.match_events`.
 
     Examples
     --------
     >>> gate_touchdowns([3, 40, 52, 95], [50, 100], 10).tolist()
     [40, 95]
     """
-    k = check_int(window, "window", minimum=0)
-    out = []
-    arrays = []
-    for name, value in (("detected", detected), ("expected", expected)):
-        a = as_array(value, name, ndim=1, min_size=0)
-        if np.any(a != np.round(a)) or np.any(a < 0) or np.any(np.diff(a) < 0):
-            raise ValueError(f"{name}: expected increasing sample indices >= 0, got {describe(value)}")
-        arrays.append(a.astype(np.int64))
-    det, exp = arrays
-    used = -1
-    for p in exp:
-        j = int(np.searchsorted(det, max(p - k, used + 1)))
-        if j < len(det) and det[j] <= p + k:
-            out.append(int(det[j]))
-            used = int(det[j])
-    return np.asarray(out, dtype=np.int64)
+    return match_events(detected, expected, check_int(window, "window", minimum=0))[:, 0]

@@ -19,8 +19,9 @@ No cache: every trial runs in about a second (the simulation runs at more than 2
 References
 ----------
 .. [1] Boston Dynamics, *LittleDog User Guide*, version 1.0.2, 2006, Secs. 1-3.
-.. [2] V. A. Tucker, "The energetic cost of moving about", *American Scientist* 63(4), 1975
-   (cost of transport, unnumbered).
+.. [2] G. Gabrielli and T. von Karman, "What price speed?", *Mechanical Engineering* 72(10), 1950,
+   and V. A. Tucker, "The energetic cost of moving about", *American Scientist* 63(4), 1975 (cost of
+   transport, unnumbered).
 """
 from __future__ import annotations
 
@@ -40,7 +41,7 @@ from .servo_design import SERVO_BANDWIDTH, littledog_servo_gains, servo_inertia
 from .simulation import LoopSettings, TrialOutcome, simulate_walk
 from .state_estimation import fuse_body_state, orientation_errors, position_errors
 from .support import stability_margins
-from .event_scoring import contact_events, event_precision_recall, score_events
+from .event_scoring import contact_events, event_precision_recall, score_leg_events
 from .touchdown import detect_contacts, gate_touchdowns
 from .trial_log import TrialLog
 
@@ -142,10 +143,15 @@ def loop_table(plan: WalkPlan, *, servo_rates: Any = (500.0, 100.0), latencies: 
         rows.append({"servo_rate": rate, "latency": lat, "bandwidth": bw, "stable": bool(analysis.stable),
                      "gain_margin": float(analysis.gain_margin), "fell": out.fell, "distance": out.distance,
                      "tracking_deg": float(np.degrees(out.tracking_rms)),
-                     "power": out.energy / float(out.log.t[-1])})
+                     "power": out.energy / _duration(out.log)})
         if progress is not None:
             progress(k + 1, len(combos))
     return rows
+
+
+def _duration(log: TrialLog) -> float:
+    """Seconds a trial ran: one host period per logged cycle (the energy covers every one)."""
+    return len(log) * float(log.t[1] - log.t[0])
 
 
 def _rms(x: np.ndarray) -> float:
@@ -274,13 +280,10 @@ def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5,
             raise ValueError("plan: expected the WalkPlan the trial walked (at least as many rows as the log)")
         true_events, planned = contact_events(truth), contact_events(plan.stance[:len(log)])
         gated = [gate_touchdowns(d, p, gate) for d, p in zip(contact_events(detected), planned)]
-        scores = [score_events(g, t, tolerance) for g, t in zip(gated, true_events)]
-        n_det, n_true = sum(len(g) for g in gated), sum(len(t) for t in true_events)
-        hits = sum(round(sc.recall * len(t)) for sc, t in zip(scores, true_events))
-        delay = sum(sc.mean_delay_samples * round(sc.recall * len(t)) for sc, t in zip(scores, true_events))
-        rows.append({"label": f"{label}, gated by the plan", "precision": hits / n_det if n_det else 1.0,
-                     "recall": hits / n_true if n_true else 1.0, "delay_ms": dt_ms * delay / hits if hits else 0.0,
-                     "true_touchdowns": n_true, "detected": n_det})
+        score = score_leg_events(gated, true_events, tolerance)
+        rows.append({"label": f"{label}, gated by the plan", "precision": score.precision, "recall": score.recall,
+                     "delay_ms": score.mean_delay_samples * dt_ms, "true_touchdowns": sum(len(t) for t in true_events),
+                     "detected": sum(len(g) for g in gated)})
     return rows
 
 
@@ -315,7 +318,7 @@ def endurance_table(outcomes: dict) -> list:
     for name, out in outcomes.items():
         if not isinstance(out, TrialOutcome):
             raise TypeError(f"outcomes[{name!r}]: expected a TrialOutcome, got {type(out).__name__}")
-        duration = float(out.log.t[-1])
+        duration = _duration(out.log)
         power = out.energy / duration
         rows.append({"name": str(name), "power": power, "speed": out.distance / duration,
                      "endurance_min": endurance(energy, power) / 60.0, "guide_power": guide_power,

@@ -25,7 +25,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..legged.littledog import JOINT_NAMES, LEGS
-from ..legged.support import SupportPolygonError, stability_margin, support_polygon
+from ..legged.support import SupportPolygonError, nearest_boundary_point, stability_margin, support_polygon
 from ..legged.trial_log import TrialLog
 from ..validation import as_array, describe
 from .maps import map_axes
@@ -282,15 +282,6 @@ def plot_foot_forces(log: TrialLog, ax: Any = None, detected: Any = None, legs: 
     return axes
 
 
-def _nearest_on_outline(v: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Nearest point of a closed polygon's boundary to ``p`` (where the margin's dashed line ends)."""
-    a, b = v, np.roll(v, -1, axis=0)
-    e = b - a
-    s = np.clip(np.sum((p - a) * e, axis=1) / np.sum(e * e, axis=1), 0.0, 1.0)
-    near = a + s[:, None] * e
-    return near[int(np.argmin(np.linalg.norm(p - near, axis=1)))]
-
-
 def plot_support(feet_xy: Any, stance: Any, com_xy: Any, ax: Any = None, legs: Sequence[str] = LEGS):
     """Top view of one instant: feet (filled in stance), support polygon, centre of mass, margin.
 
@@ -343,7 +334,8 @@ def plot_support(feet_xy: Any, stance: Any, com_xy: Any, ax: Any = None, legs: S
         closed = np.vstack([v, v[:1]])
         ax.fill(v[:, 0], v[:, 1], color="tab:green", alpha=0.25, label="support polygon")
         ax.plot(closed[:, 0], closed[:, 1], color="tab:green", lw=1.5)
-        near, margin = _nearest_on_outline(v, p), stability_margin(v, p)
+        margin = stability_margin(v, p)                    # validates com_xy by name
+        near = nearest_boundary_point(v, p, check=False)[0]
         color = "tab:green" if margin >= 0 else "tab:red"
         ax.plot([p[0], near[0]], [p[1], near[1]], "--", color=color, lw=1.5, label=f"margin {1000 * margin:.0f} mm")
         title = f"support: stability margin {1000 * margin:.0f} mm"
