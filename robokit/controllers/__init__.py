@@ -32,7 +32,7 @@ from .heading import HeadingController, design_heading_gains
 from .heading_loop import (heading_closed_loop, heading_frequency_response, heading_loop_gain, heading_plant,
                            heading_step_response, loop_metrics)
 from .host_link import SetpointChannel
-from .joint_servo import (NOMINAL_LINK_INERTIA, JointLag, ServoResponse, design_servo_gains, discrete_servo_response,
+from .joint_servo import (JointLag, ServoResponse, design_servo_gains, discrete_servo_response,
                           joint_lag, joint_plant, pd_servo_step, servo_analysis)
 from .path_following import (PathFollower, PathSingularityError, path_following_command, path_following_gains,
                              reference_command, saturate_command)
@@ -53,5 +53,5 @@ __all__ = ["HeadingController", "design_heading_gains", "heading_closed_loop", "
            "servo_frequency_response", "servo_loop_gain", "servo_plant", "servo_step_response",
            "LITTLEDOG_MOTOR", "DCMotor", "MotorPower", "electrical_power", "joint_torque", "motor_current",
            "reflected_inertia", "voltage_for_torque",
-           "NOMINAL_LINK_INERTIA", "JointLag", "ServoResponse", "design_servo_gains", "discrete_servo_response",
+           "JointLag", "ServoResponse", "design_servo_gains", "discrete_servo_response",
            "joint_lag", "joint_plant", "pd_servo_step", "servo_analysis", "SetpointChannel"]

@@ -66,7 +66,7 @@ class DCMotor:
     viscous_friction : float
         ``b`` (N m s / rad, >= 0), at the joint.
     voltage_max : float, default 14.8
-        The driver's saturation (V, > 0): the battery voltage (LittleDog User Guide, Sec. 2).
+        The driver's saturation (V, > 0): the battery voltage (LittleDog User Guide, Sec. 3.ii).
     continuous_current : float, default inf
         The motor's rated continuous current (A, > 0; ``inf`` when unknown), for thermal checks.
 

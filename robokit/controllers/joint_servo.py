@@ -11,7 +11,7 @@ Sec. 2: joint servos on the robot at 500 Hz) is ``V_k = kp (q_ref - q_k) - kd (q
 saturated at the battery voltage (:func:`pd_servo_step`); the gains come from continuous pole
 placement for a closed-loop bandwidth (:func:`design_servo_gains`), and :func:`servo_analysis` checks
 the sampled loop with python-control. Sampling the same gains at 100 Hz (the host loop's rate) costs
-most of the phase margin: Franklin et al. (2015), Sec. 8.5, advise a sample rate of 20 or more times
+about half the phase margin and most of the gain margin: Franklin et al. (2015), Sec. 8.5, advise a sample rate of 20 or more times
 the closed-loop bandwidth, and 100 Hz is under 7 times a 15 Hz servo's.
 
 References
@@ -33,13 +33,8 @@ from ..validation import as_array, check_int, check_positive, check_sample_count
 from .dc_motor import DCMotor, reflected_inertia
 from .servo_loop import MIN_DT_OVER_TAU, ServoAnalysis, discrete_servo_analysis, servo_plant
 
-__all__ = ["NOMINAL_LINK_INERTIA", "JointLag", "joint_lag", "joint_plant", "design_servo_gains", "servo_analysis",
+__all__ = ["JointLag", "joint_lag", "joint_plant", "design_servo_gains", "servo_analysis",
            "pd_servo_step", "ServoResponse", "discrete_servo_response"]
-
-#: ASSUMED inertia (kg m^2) of the leg below a hip-pitch or knee joint about its axis (links of
-#: 0.13 and 0.05 kg over 75 and 102 mm): the order of the Drake model's legs, for the design.
-NOMINAL_LINK_INERTIA = 2.0e-4
-
 
 class JointLag(NamedTuple):
     """The joint plant as ``g / (s (tau s + 1))``.

@@ -50,7 +50,8 @@ FIT_TOLERANCE = 5e-5
 _CUBE = np.array([[x, y, z, 1.0] for x in (-0.2, 0.2) for y in (-0.2, 0.2) for z in (-0.2, 0.2)])
 
 SERVO = {"kp": 96.12, "kd": 0.4222, "dt": 0.002, "voltage_max": 14.8}
-"""The joint servo of the lesson: gains (V/rad, V s/rad) from the model, 500 Hz, the battery's 14.8 V."""
+"""Example servo settings for the cases: gains (V/rad, V s/rad) of the order of the lesson's (a 15 Hz
+design on a lighter joint), 500 Hz, the battery's 14.8 V."""
 
 
 def battery_endurance(capacity_ah: float, voltage: float, mean_power_w: float) -> float:
@@ -218,7 +219,7 @@ def _servo_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
-def _pose(rng: np.random.Generator, big: bool = False) -> np.ndarray:
+def _T_world_body(rng: np.random.Generator, big: bool = False) -> np.ndarray:
     rotvec = rng.normal(0, 1.5 if big else 0.1, 3) + [0.0, 0.0, rng.uniform(-np.pi, np.pi)]
     return se3_from_rt(so3_exp(rotvec), [*rng.uniform(-1.0, 1.0, 2), STANDING_HEIGHT])
 
@@ -233,7 +234,7 @@ def _fit_cases(rng: np.random.Generator) -> list[Case]:
     m = MARKERS
     rig = rng.uniform(-0.15, 0.15, (6, 3))
     all4, no_post, no_fl = [True] * 4, [True, True, True, False], [False, True, True, True]
-    T = [_pose(rng) for _ in range(4)] + [_pose(rng, big=True) for _ in range(2)]
+    T = [_T_world_body(rng) for _ in range(4)] + [_T_world_body(rng, big=True) for _ in range(2)]
     return [
         Case((m.tolist(), _seen(rng, T[0], m, 0.0, all4), all4), label="four markers, no noise: exact"),
         Case((m.tolist(), _seen(rng, T[1], m, 0.001, all4), all4), label="four markers, 1 mm noise"),

@@ -12,10 +12,6 @@ References
    University Press, 2017.
 .. [2] B. Siciliano, L. Sciavicco, L. Villani and G. Oriolo, *Robotics: Modelling, Planning and
    Control*, Springer, 2009.
-.. [3] K. S. Arun, T. S. Huang and S. D. Blostein, "Least-squares fitting of two 3-D point sets",
-   IEEE Trans. Pattern Analysis and Machine Intelligence 9(5), 698-700, 1987.
-.. [4] S. Umeyama, "Least-squares estimation of transformation parameters between two point
-   patterns", IEEE Trans. Pattern Analysis and Machine Intelligence 13(4), 376-380, 1991.
 """
 from __future__ import annotations
 

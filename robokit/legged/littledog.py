@@ -8,8 +8,9 @@ What comes from where:
 
 * The *LittleDog User Guide* (Question 2 of the course's assignment; Sec. 3 "Platform
   Specification"): body 340 x 180 x 143 mm, ground clearance 120 mm, leg length 180 mm, total mass
-  3 kg, twelve actuated joints (hip roll, hip pitch, knee), a single-axis force sensor in each lower
-  leg, a MEMS IMU, a 2.1 Ah / 14.8 V battery; Sec. 2: joint servos at 500 Hz, host loop at 100 Hz.
+  3 kg, twelve actuated degrees of freedom (three motors per leg), a single-axis force sensor in
+  each lower leg, a MEMS IMU, a 2.1 Ah / 14.8 V battery; Sec. 2: joint servos at 500 Hz, host loop
+  at 100 Hz. The joints' names (hip roll, hip pitch, knee) are the MIT model's.
   :data:`GUIDE` holds them.
 * The guide's Sec. 4 figures (body, hip and leg frames) did not survive the text extraction, and
   the guide gives no hip positions, segment lengths, masses of parts or joint limits. Those come
@@ -41,7 +42,7 @@ import functools
 
 import numpy as np
 
-from ..controllers import DCMotor, reflected_inertia
+from ..controllers.dc_motor import DCMotor, reflected_inertia
 from ..validation import check_finite_scalar, check_positive
 
 __all__ = ["LEGS", "JOINTS", "JOINT_NAMES", "GUIDE", "HIP_POSITIONS", "HIP_OFFSET", "UPPER_LEG",

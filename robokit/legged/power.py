@@ -1,7 +1,7 @@
 """Power and endurance of a walking robot: the motors' electrical power, the battery, the cost of transport.
 
-LittleDog carries a 2.1 Ah lithium-polymer battery at 14.8 V, "about 30 minutes" of operation
-(LittleDog User Guide, Sec. 2): 31.08 Wh, so about 62 W on average. The twelve joint motors draw
+LittleDog carries a 2.1 Ah lithium-polymer battery at 14.8 V (LittleDog User Guide, Sec. 3.ii),
+"approximately 30 minutes" of operation (Sec. 1): 31.08 Wh, so about 62 W on average. The twelve joint motors draw
 ``V i`` each (:func:`robokit.controllers.dc_motor.electrical_power`: copper loss plus mechanical
 power); a joint that brakes a load (negative power) returns energy to the supply only if the drivers
 regenerate, and a simple H-bridge driver does not, so by default a joint's negative power is lost
@@ -23,18 +23,19 @@ from typing import Any
 import numpy as np
 
 from ..controllers.dc_motor import DCMotor, electrical_power
+from .littledog import GUIDE
 from ..validation import as_array, check_finite_result, check_positive
 
 __all__ = ["battery_energy", "trial_power", "endurance", "cost_of_transport"]
 
 
-def battery_energy(capacity_ah: float = 2.1, voltage: float = 14.8) -> float:
+def battery_energy(capacity_ah: float = GUIDE["battery_capacity"], voltage: float = GUIDE["battery_voltage"]) -> float:
     """Energy stored in a battery (J): ``capacity (A h) x 3600 s/h x voltage``.
 
     Parameters
     ----------
     capacity_ah : float, default 2.1
-        Capacity (A h, > 0): LittleDog's pack (LittleDog User Guide, Sec. 2).
+        Capacity (A h, > 0): LittleDog's pack (LittleDog User Guide, Sec. 3.ii).
     voltage : float, default 14.8
         Nominal voltage (V, > 0): four lithium-polymer cells.
 

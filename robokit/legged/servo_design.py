@@ -8,7 +8,7 @@ at LittleDog's scale is the larger part (:func:`robokit.controllers.reflected_in
 References
 ----------
 .. [1] G. F. Franklin, J. D. Powell and A. Emami-Naeini, *Feedback Control of Dynamic Systems*,
-   7th ed., Pearson, 2015, Sec. 3.3 (pole placement for a second-order response).
+   7th ed., Pearson, 2015, Secs. 3.3 (second-order response) and 4.3 (PD control).
 .. [2] Boston Dynamics, *LittleDog User Guide*, version 1.0.2, 2006, Sec. 2 (servos at 500 Hz).
 """
 from __future__ import annotations
