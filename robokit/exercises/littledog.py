@@ -297,7 +297,7 @@ EXERCISES = [
         signature="stability_margin(feet_xy: (k, 2), com_xy: (2,)) -> float",
         points=1, cases=_margin_cases, reference=stability_margin, compare=close(rtol=1e-9, atol=1e-12),
         references=tuple(f"robokit.legged.support.{n}" for n in (
-            "stability_margin", "stability_margins", "support_polygon", "_as_xy")),
+            "stability_margin", "stability_margins", "support_polygon", "nearest_boundary_point", "_as_xy")),
         description="McGhee & Frank's margin, signed: distance to the support polygon's boundary, negative "
                     "outside; ValueError for fewer than three feet."),
     Exercise(
