@@ -142,3 +142,34 @@ def test_fit_se3_gives_T_world_body_from_markers():
     markers = np.array([[0.10, 0.03, 0.0115], [0.10, -0.04, 0.0115], [-0.11, 0.035, 0.0115], [-0.05, -0.02, 0.04]])
     T = se3_from_rt(so3_exp([0.1, -0.2, 2.0]), [1.0, 2.0, 0.13])
     assert np.abs(fit_se3(markers, transform_points(T, markers)) - T).max() < 1e-12
+
+
+def _umeyama_svd_2d(source, target):
+    """Umeyama's Eqs. (34)-(43) without scale, by numpy's SVD (the 3-D path's algorithm, in 2-D)."""
+    a, b = source - source.mean(0), target - target.mean(0)
+    U, sv, Vt = np.linalg.svd(b.T @ a / len(a))
+    S = np.diag([1.0, np.sign(np.linalg.det(U) * np.linalg.det(Vt)) or 1.0])
+    return U @ S @ Vt, sv
+
+
+def test_the_planar_closed_form_equals_the_svd_rotation():
+    """fit_rigid's d = 2 branch (atan2 of the correlation matrix) gives Umeyama's SVD rotation."""
+    rng = np.random.default_rng(5)
+    for k in range(300):
+        n = int(rng.integers(2, 9))
+        src = rng.normal(size=(n, 2)) * rng.uniform(0.01, 100)
+        if k % 3 == 0:
+            tgt = src * [1.0, -1.0] + rng.normal(scale=0.5, size=(n, 2))     # a mirror: a reflection fits best
+        else:
+            th = rng.uniform(-np.pi, np.pi)
+            tgt = src @ np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]]).T + rng.normal(scale=0.3, size=(n, 2))
+        want, sv = _umeyama_svd_2d(src, tgt)
+        if sv[0] - sv[1] < 1e-6 * sv[0]:
+            continue                                  # no unique rotation: nothing to compare
+        fit = fit_rigid(src, tgt, check=False)
+        np.testing.assert_allclose(fit.R, want, atol=1e-9)
+        assert np.isclose(np.linalg.det(fit.R), 1.0)
+    # a set whose best reflection and best rotation tie has no unique rotation: flagged
+    sq = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
+    assert fit_rigid(sq, sq * [1.0, -1.0], check=False).degenerate
+    assert not fit_rigid(sq, sq, check=False).degenerate

@@ -52,6 +52,28 @@ class RigidFit(NamedTuple):
     degenerate: np.ndarray
 
 
+def _rotation_2d(cov: np.ndarray, gap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eqs. (39)-(40) in closed form for d = 2 (the same rotation and degeneracy as the SVD, faster).
+
+    Write ``Sigma = [[p + r, u - q], [u + q, p - r]]``. Its singular values are
+    ``rho +- sqrt(r^2 + u^2)`` with ``rho = sqrt(p^2 + q^2)``, and the rotation ``U S V^T`` is the
+    one by ``atan2(q, p)``: it maximises ``trace(R^T Sigma) = 2 (p cos + q sin)``. It is unique
+    unless ``rho = 0``; with ``det Sigma < 0`` the SVD rule's ``sigma_1 - sigma_2`` is ``2 rho``, and
+    with ``det Sigma >= 0`` the largest singular value is at most ``2 rho``, so the rule reads
+    ``sigma_1 <= gap or 2 rho <= gap``.
+    """
+    p = 0.5 * (cov[..., 0, 0] + cov[..., 1, 1])
+    q = 0.5 * (cov[..., 1, 0] - cov[..., 0, 1])
+    r = 0.5 * (cov[..., 0, 0] - cov[..., 1, 1])
+    u = 0.5 * (cov[..., 1, 0] + cov[..., 0, 1])
+    rho = np.hypot(p, q)
+    theta = np.arctan2(q, p)                                                       # Eq. (40) in 2-D
+    c, s = np.cos(theta), np.sin(theta)
+    R = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+    degenerate = (gap <= 0) | (rho + np.hypot(r, u) <= gap) | (2 * rho <= gap)
+    return R, degenerate
+
+
 def fit_rigid(source: Any, target: Any, weights: Any = None, *, check: bool = True) -> RigidFit:
     """Weighted least-squares rotation and translation taking ``source`` onto ``target``.
 
@@ -134,15 +156,18 @@ def fit_rigid(source: Any, target: Any, weights: Any = None, *, check: bool = Tr
     var_s = np.einsum("...n,...ni,...ni->...", w, a, a) / total                   # Eq. (36)
     var_t = np.einsum("...n,...ni,...ni->...", w, b, b) / total                   # Eq. (37)
     cov = np.einsum("...n,...ni,...nj->...ij", w, b, a) / total[..., None, None]  # Eq. (38)
-    U, sv, Vt = np.linalg.svd(cov)
-    sign = np.where(np.linalg.det(U) * np.linalg.det(Vt) < 0, -1.0, 1.0)         # Eqs. (39), (43)
-    S = np.ones(sv.shape)
-    S[..., -1] = sign
-    R = (U * S[..., None, :]) @ Vt                                                 # Eq. (40)
-    trans = mu_t - np.einsum("...ij,...j->...i", R, mu_s)                         # Eq. (41), c = 1
     gap = FIT_TOL * np.sqrt(var_s * var_t)
-    degenerate = ((gap <= 0) | (sv[..., d - 2] <= gap)
-                  | ((sign < 0) & (sv[..., d - 2] - sv[..., d - 1] <= gap)))
+    if d == 2:
+        R, degenerate = _rotation_2d(cov, gap)
+    else:
+        U, sv, Vt = np.linalg.svd(cov)
+        sign = np.where(np.linalg.det(U) * np.linalg.det(Vt) < 0, -1.0, 1.0)     # Eqs. (39), (43)
+        S = np.ones(sv.shape)
+        S[..., -1] = sign
+        R = (U * S[..., None, :]) @ Vt                                             # Eq. (40)
+        degenerate = ((gap <= 0) | (sv[..., d - 2] <= gap)
+                      | ((sign < 0) & (sv[..., d - 2] - sv[..., d - 1] <= gap)))
+    trans = mu_t - np.einsum("...ij,...j->...i", R, mu_s)                         # Eq. (41), c = 1
     if check and np.any(degenerate):
         i = int(np.argmax(degenerate.reshape(-1)))
         names = "source, target" if weights is None else "source, target, weights"
