@@ -203,11 +203,9 @@ def _branch(branch: Any, i: int, n: int) -> np.ndarray:
     b = as_array(branch, "branch")
     if b.ndim > 1 or not np.all(np.isin(b, (-1.0, 1.0))):
         raise ValueError(f"branch: expected -1 (knee back), +1 (knee forward) or None, got {describe(branch)}")
-    return np.broadcast_to(b, (n,)).astype(float) if b.ndim == 0 or b.size == n else _bad_branch(b, n)
-
-
-def _bad_branch(b: np.ndarray, n: int):
-    raise ValueError(f"branch: expected a scalar or {n} values (one per target), got {b.size}")
+    if b.ndim == 1 and b.size != n:
+        raise ValueError(f"branch: expected one value, or one per target ({n}), got {b.size}")
+    return np.broadcast_to(b, (n,)).astype(float)
 
 
 def leg_ik_batch(p_foot: Any, leg: Any, branch: Any = None) -> LegIK:

@@ -134,18 +134,20 @@ def loop_table(plan: WalkPlan, *, servo_rates: Any = (500.0, 100.0), latencies: 
         raise ValueError(f"latencies: expected non-negative delays (s), got {lats.tolist()}")
     if np.any(bws <= 0):
         raise ValueError(f"bandwidths: expected positive frequencies (Hz), got {bws.tolist()}")
-    combos = [(float(b), float(r), float(lat)) for b in bws for r in rates for lat in lats]
+    total = len(bws) * len(rates) * len(lats)
     rows = []
-    for k, (bw, rate, lat) in enumerate(combos):
+    for bw in map(float, bws):
         gains = littledog_servo_gains(bw)
-        analysis = servo_analysis(gains[0], gains[1], LITTLEDOG_MOTOR, servo_inertia(), rate)
-        out = simulate_walk(plan, LoopSettings(servo_rate=rate, latency=lat, gains=gains), rng=rng)
-        rows.append({"servo_rate": rate, "latency": lat, "bandwidth": bw, "stable": bool(analysis.stable),
-                     "gain_margin": float(analysis.gain_margin), "fell": out.fell, "distance": out.distance,
-                     "tracking_deg": float(np.degrees(out.tracking_rms)),
-                     "power": out.energy / _duration(out.log)})
-        if progress is not None:
-            progress(k + 1, len(combos))
+        for rate in map(float, rates):
+            analysis = servo_analysis(gains[0], gains[1], LITTLEDOG_MOTOR, servo_inertia(), rate)   # one per loop
+            for lat in map(float, lats):
+                out = simulate_walk(plan, LoopSettings(servo_rate=rate, latency=lat, gains=gains), rng=rng)
+                rows.append({"servo_rate": rate, "latency": lat, "bandwidth": bw, "stable": bool(analysis.stable),
+                             "gain_margin": float(analysis.gain_margin), "fell": out.fell,
+                             "distance": out.distance, "tracking_deg": float(np.degrees(out.tracking_rms)),
+                             "power": out.energy / _duration(out.log)})
+                if progress is not None:
+                    progress(len(rows), total)
     return rows
 
 
