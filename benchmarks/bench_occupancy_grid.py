@@ -14,23 +14,15 @@ Then the likelihood field of the map (``distance_transform_edt``) and a lookup o
 from __future__ import annotations
 
 import argparse
-import statistics
 import time
 
 import numpy as np
 
+from timing import median_time
+
 from robokit.mapping import likelihood_field, occupancy_grid_mapping, occupancy_grid_mapping_reference
 from robokit.sim import Lidar, corridor_path, long_corridor
 
-
-def median_time(fn, repeats: int) -> float:
-    fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def main() -> None:

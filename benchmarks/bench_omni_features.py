@@ -12,23 +12,15 @@ random ``office_floor()`` view pairs 0.1-0.5 m apart with any turn.
 """
 from __future__ import annotations
 
-import time
 
 import numpy as np
+
+from timing import median_time
 
 from robokit.sim import OmniCamera, office_floor, omni_ground_truth_inliers
 from robokit.vision import DescriptorIndex, detect_sift_features, omni_sift
 from robokit.vision.colour import histogram_distance, histogram_intersection, hue_histogram, hue_histogram_opencv
 
-
-def _median_time(fn, repeats: int = 7) -> float:
-    fn()                                                       # warm-up
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
 
 
 def bench_coarse_ranking(n_nodes: int = 1000, bins: int = 32) -> None:
@@ -40,17 +32,17 @@ def bench_coarse_ranking(n_nodes: int = 1000, bins: int = 32) -> None:
         return np.array([np.sqrt(((h - node) ** 2).sum()) for node in nodes])
 
     assert np.allclose(loop(), histogram_distance(h, nodes))
-    t_vec = _median_time(lambda: np.argsort(histogram_distance(h, nodes)))
-    t_int = _median_time(lambda: np.argsort(-histogram_intersection(h, nodes)))
-    t_loop = _median_time(lambda: np.argsort(loop()))
+    t_vec = median_time(lambda: np.argsort(histogram_distance(h, nodes)), 7)
+    t_int = median_time(lambda: np.argsort(-histogram_intersection(h, nodes)), 7)
+    t_loop = median_time(lambda: np.argsort(loop()), 7)
     print(f"coarse stage, 1 query vs {n_nodes} node histograms ({bins} bins): Eq. (5) vectorised {t_vec * 1e3:.3f} ms, "
           f"intersection {t_int * 1e3:.3f} ms, per-node Python loop {t_loop * 1e3:.2f} ms; "
           f"loop/vectorised = {t_loop / t_vec:.0f}x")
 
 
 def bench_histograms(image: np.ndarray) -> None:
-    t_ours = _median_time(lambda: hue_histogram(image))
-    t_cv = _median_time(lambda: hue_histogram_opencv(image))
+    t_ours = median_time(lambda: hue_histogram(image), 7)
+    t_cv = median_time(lambda: hue_histogram_opencv(image), 7)
     print(f"hue histogram of a 640x480 omni image: HSI (Eq. (4)) {t_ours * 1e3:.1f} ms, OpenCV HSV reference "
           f"{t_cv * 1e3:.1f} ms (its mask is ours, so it pays for rgb_to_hsi too); ratio ours/OpenCV = {t_ours / t_cv:.2f}")
 
@@ -59,9 +51,9 @@ def bench_matching(node, query) -> None:
     exact = DescriptorIndex(node.descriptors, "bruteforce").match(query.descriptors)
     rows = []
     for method in ("kdtree", "flann", "bruteforce", "opencv"):
-        build = _median_time(lambda: DescriptorIndex(node.descriptors, method))
+        build = median_time(lambda: DescriptorIndex(node.descriptors, method), 7)
         index = DescriptorIndex(node.descriptors, method)
-        match = _median_time(lambda: index.match(query.descriptors))
+        match = median_time(lambda: index.match(query.descriptors), 7)
         m = index.match(query.descriptors)
         same = len(set(zip(m.query, m.train)) & set(zip(exact.query, exact.train)))
         rows.append((method, build, match, len(m), same))
@@ -74,11 +66,11 @@ def bench_matching(node, query) -> None:
 
 def bench_extraction(image: np.ndarray, cam: OmniCamera) -> None:
     centre = (cam.cx, cam.cy)
-    t_plain = _median_time(lambda: detect_sift_features(image), repeats=5)
+    t_plain = median_time(lambda: detect_sift_features(image), 5)
     print(f"SIFT on a 640x480 omni image: plain detect_sift_features {t_plain * 1e3:.0f} ms "
           f"({len(detect_sift_features(image))} features)")
     for orientation in ("gradient", "radial", "upright"):
-        t = _median_time(lambda: omni_sift(image, centre, cam.radii, orientation=orientation), repeats=5)
+        t = median_time(lambda: omni_sift(image, centre, cam.radii, orientation=orientation), 5)
         n = len(omni_sift(image, centre, cam.radii, orientation=orientation))
         print(f"  omni_sift {orientation:8s} {t * 1e3:.0f} ms ({n} features in the annulus); ratio to plain = {t / t_plain:.2f}")
 

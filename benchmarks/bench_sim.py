@@ -13,24 +13,15 @@ the ground-truth geometry (back-projection with the rendered depth, 3 px).
 from __future__ import annotations
 
 import argparse
-import statistics
-import time
 
 import cv2
 import numpy as np
 
+from timing import median_time
+
 from robokit.sim import (Lidar, OmniCamera, PinholeCamera, box_room, lab_room, long_corridor, office_floor, open_field,
                          sift_view_pair)
 
-
-def median_time(fn, repeats: int) -> float:
-    fn()  # warm-up (caches, mip-maps)
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def main() -> None:
