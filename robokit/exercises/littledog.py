@@ -289,7 +289,7 @@ EXERCISES = [
         signature="leg_ik(p_foot: [x, y, z], leg: str, branch: -1|+1) -> [q1, q2, q3]",
         points=2, cases=_ik_cases, reference=leg_ik, compare=close(rtol=0, atol=1e-7),
         references=tuple(f"robokit.legged.leg_kinematics.{n}" for n in (
-            "leg_ik", "leg_ik_batch", "body_ik", "_solve", "_branch", "_bad_branch", "leg_index", "_side")),
+            "leg_ik", "leg_ik_batch", "body_ik", "_solve", "_branch", "leg_index", "_side")),
         description="Closed-form IK: the roll root with the foot below the hip, the knee on the given branch, "
                     "angles in (-pi, pi]; ValueError for an unreachable target or a bad branch."),
     Exercise(
