@@ -82,3 +82,32 @@ def test_bad_arguments():
 def test_cli_without_lessons_is_a_clear_error(tmp_path, capsys):
     assert main(["course", "build", "--root", str(tmp_path)]) == 2
     assert "no lessons/ directory" in capsys.readouterr().err
+
+
+def test_check_in_a_notebook_shows_its_message_not_a_traceback(tmp_path):
+    """A passing check() leaves no Out[...]; a failing one ends the cell in an error whose only text
+    is the message (no frames through robokit); a stub's NotImplementedYet is allowed in assignments."""
+    import nbformat as nbf
+
+    good = ("import numpy as np\nfrom robokit.grading import check\n"
+            "def wrap_angle(angle):\n    a = np.asarray(angle, float)\n"
+            "    if np.isnan(a).any():\n        raise ValueError('angle: NaN')\n"
+            "    r = np.mod(a + np.pi, 2 * np.pi) - np.pi\n    return float(r) if r.ndim == 0 else r\n")
+    folder = tmp_path / "assignments"
+    folder.mkdir()
+    nb = _notebook(folder / "a.ipynb", good, 'check("00.wrap_angle", wrap_angle)',
+                   "def stub(angle):\n    raise NotImplementedError", 'check("00.wrap_angle", stub)',
+                   'check("00.wrap_angle", lambda angle: angle)')
+    run = run_notebook(nb, timeout=120, output=tmp_path / "out.ipynb")
+    assert run.status == "failed"                       # the wrong answer is not a stub: not allowed
+    cells = nbf.read(tmp_path / "out.ipynb", as_version=4).cells
+    passed, stubbed = cells[1], cells[3]
+    assert not [o for o in passed.outputs if o.output_type == "execute_result"]
+    assert "6/6 public cases passed" in "".join(o.get("text", "") for o in passed.outputs)
+    stub_error = [o for o in stubbed.outputs if o.output_type == "error"]
+    assert stub_error and stub_error[0].ename == "NotImplementedYet"
+    assert stub_error[0].traceback == ["NotImplementedYet: 00.wrap_angle is not implemented yet"]
+    wrong = [o for o in cells[4].outputs if o.output_type == "error"]
+    assert wrong and wrong[0].ename == "CheckFailed"
+    assert len(wrong[0].traceback) == 1 and "robokit" not in wrong[0].traceback[0]
+    assert "4 of 6 public cases failed" in wrong[0].traceback[0]

@@ -6,6 +6,7 @@ import pytest
 
 from robokit.exercises import corridor_localization as module
 from robokit.grading import check, exercises_for
+from tests.conftest import assert_check_passes
 from robokit.vision import hamming_distances
 
 EXERCISES = {ex.id: ex for ex in module.EXERCISES}
@@ -119,7 +120,7 @@ def test_check_fails_a_wrong_implementation(exercise_id, capsys):
 
 @pytest.mark.parametrize("exercise_id", list(EXERCISES))
 def test_check_passes_the_reference(exercise_id, capsys):
-    assert check(exercise_id, EXERCISES[exercise_id].reference) == len(EXERCISES[exercise_id].make_cases(2024))
+    assert_check_passes(exercise_id, EXERCISES[exercise_id].reference, len(EXERCISES[exercise_id].make_cases(2024)))
 
 
 @pytest.mark.parametrize("seed", range(12))

@@ -9,6 +9,7 @@ from scipy.spatial.transform import Rotation
 from robokit.exercises import littledog as module
 from robokit.geometry import so3_log
 from robokit.grading import check, exercises_for
+from tests.conftest import assert_check_passes
 from robokit.legged import littledog
 from robokit.legged.event_scoring import contact_events, score_events
 from robokit.legged.exercise_data import model_facts, mocap_frames, touchdown_traces
@@ -93,7 +94,7 @@ def test_check_fails_a_wrong_implementation(exercise_id, capsys):
 
 @pytest.mark.parametrize("exercise_id", list(EXERCISES))
 def test_check_passes_the_reference(exercise_id, capsys):
-    assert check(exercise_id, EXERCISES[exercise_id].reference) == len(EXERCISES[exercise_id].make_cases(2024))
+    assert_check_passes(exercise_id, EXERCISES[exercise_id].reference, len(EXERCISES[exercise_id].make_cases(2024)))
 
 
 def test_the_fk_cases_match_a_chain_of_homogeneous_transforms():
@@ -218,7 +219,7 @@ def test_the_open_marker_fit_accepts_other_correct_methods(method, capsys):
                     method(*case.args)
                 continue
             assert exercise.compare(exercise.reference(*case.args).tolist(), method(*case.args)) is None, case.label
-    assert check("04.marker_fit", method) == 7
+    assert_check_passes("04.marker_fit", method, 7)
 
 
 def test_the_marker_fit_compare_rejects_near_misses():

@@ -61,17 +61,21 @@ def test_check_reports_and_raises(capsys):
         r = np.mod(a + np.pi, 2 * np.pi) - np.pi
         return float(r) if r.ndim == 0 else r
 
-    assert check("00.wrap_angle", good) == 6
-    assert "feedback only" in capsys.readouterr().out
-    with pytest.raises(AssertionError, match="public cases failed"):
+    assert check("00.wrap_angle", good) is None          # nothing for the notebook to show as Out[...]
+    assert "6/6 public cases passed" in capsys.readouterr().out
+    with pytest.raises(AssertionError, match="public cases failed") as failed:
         check("00.wrap_angle", lambda a: a)
     assert "FAIL" in capsys.readouterr().out
+    # the message itself names the failed cases, and IPython shows only that message
+    assert str(failed.value).count("FAIL  case") == 4
+    assert failed.value._render_traceback_() == [f"CheckFailed: {failed.value}"]
 
     def stub(angle):
         raise NotImplementedError
 
-    with pytest.raises(NotImplementedError):
+    with pytest.raises(NotImplementedError) as stubbed:
         check("00.wrap_angle", stub)
+    assert stubbed.value._render_traceback_() == ["NotImplementedYet: 00.wrap_angle is not implemented yet"]
     assert "not implemented yet" in capsys.readouterr().out
     with pytest.raises(UnknownExerciseError):
         check("99.nothing", good)

@@ -26,8 +26,9 @@ from pathlib import Path
 
 __all__ = ["NotebookRun", "run_notebook", "execute_in_process"]
 
-#: Exception names an assignment notebook may raise: the stubs students have not filled in yet.
-STUB_ERRORS = ("NotImplementedError",)
+#: Exception names an assignment notebook may raise: the stubs students have not filled in yet
+#: (``NotImplementedYet`` is the ``NotImplementedError`` that ``check()`` raises on a stub).
+STUB_ERRORS = ("NotImplementedError", "NotImplementedYet")
 
 _STARTUP = "from robokit.course import netguard as _rk_netguard\n_rk_netguard.install()\ndel _rk_netguard\n"
 

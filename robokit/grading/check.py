@@ -10,13 +10,33 @@ from typing import Any, Callable
 from ..exercises.discovery import get_exercise
 from .judge import call_student, expected_output, judge
 
-__all__ = ["check", "PUBLIC_SEED"]
+__all__ = ["check", "PUBLIC_SEED", "CheckFailed", "NotImplementedYet"]
 
 #: Seed of the public cases used by :func:`check`; official grading uses the instructor's seed.
 PUBLIC_SEED = 2024
 
 
-def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> int:
+class _MessageOnly:
+    """Mixin: IPython shows only ``Name: message`` for these errors, not a traceback through robokit.
+
+    IPython asks an exception for ``_render_traceback_()`` before formatting a traceback; the cell
+    still ends in an error (red, and a failed grade cell for nbgrader), but the student reads only
+    what concerns their code.
+    """
+
+    def _render_traceback_(self) -> list[str]:
+        return [f"{type(self).__name__}: {self}"]
+
+
+class CheckFailed(_MessageOnly, AssertionError):
+    """Some public cases of :func:`check` failed (an ``AssertionError``); the message lists them."""
+
+
+class NotImplementedYet(_MessageOnly, NotImplementedError):
+    """The function given to :func:`check` is still the assignment's stub (a ``NotImplementedError``)."""
+
+
+def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> None:
     """Run the public cases of an exercise on ``fn`` and print a short report.
 
     This is feedback only: it runs in your own notebook on public cases, and your grade comes
@@ -33,17 +53,19 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
 
     Returns
     -------
-    int
-        Number of cases passed (all of them, since failures raise).
+    None
+        On success it prints the report and returns nothing, so the cell shows no ``Out[...]``.
 
     Raises
     ------
-    NotImplementedError
-        If ``fn`` is still the stub: the report says "not implemented yet". (It raises, rather than
-        returning quietly, so that nbgrader's in-kernel autograde scores an untouched stub zero;
-        robokit's harness lets the rest of an assignment notebook run on.)
-    AssertionError
-        If any case fails, so the cell shows red.
+    NotImplementedYet
+        (a ``NotImplementedError``) If ``fn`` is still the stub: the report says "not implemented
+        yet". It raises, rather than returning quietly, so that nbgrader's in-kernel autograde
+        scores an untouched stub zero; robokit's harness lets the rest of an assignment notebook
+        run on.
+    CheckFailed
+        (an ``AssertionError``) If any case fails, so the cell shows red. Its message lists the
+        failed cases; in a notebook only that message is shown, not a traceback through robokit.
     TypeError
         If ``fn`` is not callable.
     robokit.exercises.UnknownExerciseError
@@ -64,14 +86,14 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
     ...     return float(wrapped) if wrapped.ndim == 0 else wrapped
     >>> check("00.wrap_angle", wrap_angle, verbose=False)
     check 00.wrap_angle: 6/6 public cases passed (feedback only; your grade comes from hidden cases)
-    6
 
-    A wrong answer fails the cell, and the report says which cases and why:
+    A wrong answer fails the cell, and the message says which cases and why:
 
     >>> check("00.wrap_angle", lambda angle: angle, verbose=False)
     Traceback (most recent call last):
     ...
-    AssertionError: 00.wrap_angle: 4 of 6 public cases failed (see above)
+    robokit.grading.check.CheckFailed: 00.wrap_angle: 4 of 6 public cases failed:
+    ...
     """
     exercise = get_exercise(exercise_id)
     if not callable(fn):
@@ -83,7 +105,7 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
         if result.error is not None and result.error.type == "NotImplementedError":
             print(f"{exercise.id}: not implemented yet — replace `raise NotImplementedError` in "
                   f"{exercise.function} with your code, then run this cell again.")
-            raise NotImplementedError(f"{exercise.id} is not implemented yet")
+            raise NotImplementedYet(f"{exercise.id} is not implemented yet")
         outcome = judge(exercise, case, expected_output(exercise, case), result)
         mark = "pass" if outcome.passed else "FAIL"
         where = f" [{result.error.line}]" if not outcome.passed and result.error and result.error.line else ""
@@ -95,8 +117,8 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
             lines.append(text)
     print(f"check {exercise.id}: {len(cases) - failed}/{len(cases)} public cases passed "
           "(feedback only; your grade comes from hidden cases)")
-    if lines:
+    if verbose and lines:
         print("\n".join(lines))
     if failed:
-        raise AssertionError(f"{exercise.id}: {failed} of {len(cases)} public cases failed (see above)")
-    return len(cases)
+        failures = "\n".join(line for line in lines if line.lstrip().startswith("FAIL"))
+        raise CheckFailed(f"{exercise.id}: {failed} of {len(cases)} public cases failed:\n{failures}")
