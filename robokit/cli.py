@@ -18,6 +18,16 @@ def _cmd_course_build(args: argparse.Namespace) -> int:
         print(f"robokit course build: no lessons/ directory under {root.resolve()} "
               "(run it from the course repository or pass --root)", file=sys.stderr)
         return 2
+    if not (root / "book" / "conf.py").is_file():
+        print(f"robokit course build: no book/conf.py under {root.resolve()} (the site's sources; "
+              "copy book/ from the robokit course repository)", file=sys.stderr)
+        return 2
+    import importlib.util
+
+    if importlib.util.find_spec("myst_nb") is None:   # the site needs the lab extra
+        print("robokit course build: the course site needs Sphinx and myst-nb: pip install -e '.[lab]'",
+              file=sys.stderr)
+        return 2
     from .grading.selfcheck import course_grading_step
 
     steps = [] if args.no_grading else [course_grading_step]
@@ -147,10 +157,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     course = sub.add_parser("course", help="build the course site, strip and check notebooks")
     csub = course.add_subparsers(dest="course_command", metavar="ACTION")
-    build = csub.add_parser("build", help="execute lessons/ and solutions/ and write build/course/")
+    build = csub.add_parser("build", help="execute lessons/ and solutions/, write the student site "
+                                          "build/course/ and the instructor site build/instructor/")
     build.add_argument("notebooks", nargs="*", help="only these notebooks (default: all)")
     build.add_argument("--root", default=".", help="course repository root (default: .)")
-    build.add_argument("--out", default="build/course", help="site directory (default: build/course)")
+    build.add_argument("--out", default="build/course", help="student site directory; the instructor site and the executed "
+                       "notebooks go beside it (default: build/course)")
     build.add_argument("--jobs", type=int, default=None, help="notebooks run at once (default: cores)")
     build.add_argument("--timeout", type=float, default=900, help="per-notebook limit in s (default: 900)")
     build.add_argument("--fast", action="store_true", help="run with ROBOKIT_FAST=1 (shrunk experiments)")

@@ -54,3 +54,20 @@ def assert_check_passes(exercise_id: str, fn, n_cases: int) -> None:
     with contextlib.redirect_stdout(out):
         assert check(exercise_id, fn) is None
     assert f": {n_cases}/{n_cases} public cases passed" in out.getvalue(), out.getvalue()
+
+
+@pytest.fixture(scope="session")
+def fast_course(tmp_path_factory):
+    """The repository's lessons and solutions executed once in fast mode (2 at a time) and rendered
+    into both course sites: shared by the notebook tests and the site tests, so nothing runs twice."""
+    from types import SimpleNamespace
+
+    from robokit.course.build import build_report_page, discover, run_notebooks, write_sites
+
+    out = tmp_path_factory.mktemp("course-build") / "course"
+    quiet = lambda *_: None  # noqa: E731
+    runs = run_notebooks(discover(ROOT), out.parent / "executed", root=ROOT, jobs=2, timeout=300, fast=True,
+                         log=quiet)
+    sites = write_sites(ROOT, runs, out, [build_report_page(runs, ROOT, fast=True)], log=quiet)
+    return SimpleNamespace(runs={r.path: r for r in runs}, sites=sites, student=out,
+                           instructor=out.parent / "instructor")

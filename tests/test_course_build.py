@@ -1,9 +1,13 @@
 """`robokit course build` keeps going past broken notebooks and reports them (issue: Bad input)."""
+import re
+import shutil
+
 import nbformat
 import pytest
 
 from robokit.cli import main
 from robokit.course.execute import run_notebook
+from tests.conftest import ROOT
 
 
 def _notebook(path, *sources):
@@ -19,10 +23,14 @@ def course(tmp_path_factory):
     root = tmp_path_factory.mktemp("course")
     (root / "lessons").mkdir()
     (root / "solutions").mkdir()
-    _notebook(root / "lessons" / "00_good.ipynb", "import os\nprint('fast', os.environ['ROBOKIT_FAST'])",
+    (root / "assignments").mkdir()
+    shutil.copytree(ROOT / "book", root / "book")
+    _notebook(root / "lessons" / "00_good.ipynb", "import os\nimport math",
+              "print('fast', os.environ['ROBOKIT_FAST'])",
               "import matplotlib.pyplot as plt\nplt.plot([0, 1], [1, 0]); plt.xlabel('x [m]'); plt.show()")
     _notebook(root / "lessons" / "01_raises.ipynb", "x = 1", "raise ValueError('boom in lesson one')")
     _notebook(root / "solutions" / "02_hangs.ipynb", "import time\ntime.sleep(600)")
+    _notebook(root / "assignments" / "02_hangs.ipynb", "def f():\n    raise NotImplementedError")
     code = main(["course", "build", "--root", str(root), "--timeout", "25", "--fast", "--no-grading"])
     return root, code
 
@@ -30,25 +38,45 @@ def course(tmp_path_factory):
 def test_build_exits_nonzero_but_builds_everything(course):
     root, code = course
     assert code == 1
-    site = root / "build" / "course"
-    assert (site / "index.html").exists()
-    for page in ("lessons-00_good.html", "lessons-01_raises.html", "solutions-02_hangs.html"):
-        assert (site / page).exists(), page
+    student, instructor = root / "build" / "course", root / "build" / "instructor"
+    for site in (student, instructor):
+        assert (site / "index.html").exists()
+        for page in ("lessons/00_good.html", "lessons/01_raises.html", "assignments/02_hangs.html",
+                     "api/index.html", "references.html", "search.html"):
+            assert (site / page).exists(), page
+    assert (instructor / "solutions" / "02_hangs.html").exists()
+    assert not (student / "solutions").exists()
 
 
-def test_index_reports_status_and_error_tail(course):
+def test_instructor_build_report_has_status_and_error_tail(course):
+    root, _ = course
+    report = (root / "build" / "instructor" / "instructor" / "build.html").read_text()
+    assert "1 of 3 notebooks ran without error" in report
+    assert "boom in lesson one" in report
+    assert "timeout" in report and "time limit of 25 s" in report
+    assert "instructor/build" not in (root / "build" / "course" / "index.html").read_text()
+
+
+def test_pages_have_outputs_figures_titles_and_folded_imports(course):
+    root, _ = course
+    page = (root / "build" / "course" / "lessons" / "00_good.html").read_text()
+    assert "fast 1" in page
+    assert re.search(r'<img[^>]+src="\.\./_images/[^"]+\.png"', page)
+    assert re.search(r'class="[^"]*tag_hide-input', page)           # the import-only cell is folded
+    assert "<title>" in page and "Notebook</title>" not in page
+    broken = (root / "build" / "course" / "lessons" / "01_raises.html").read_text()
+    assert "did not run to the end" in broken and "boom in lesson one" in broken
+    solution = (root / "build" / "instructor" / "solutions" / "02_hangs.html").read_text()
+    assert "did not run to the end when the site was built (timeout)" in solution
+
+
+def test_sites_are_linked_in_lesson_order_with_previous_next(course):
     root, _ = course
     index = (root / "build" / "course" / "index.html").read_text()
-    assert "1 of 3 notebooks ran without error" in index
-    assert "boom in lesson one" in index
-    assert "class='timeout'" in index and "time limit of 25 s" in index
-    assert "class='ok'" in index
-
-
-def test_good_page_has_output_and_figure(course):
-    root, _ = course
-    page = (root / "build" / "course" / "lessons-00_good.html").read_text()
-    assert "fast 1" in page and "data:image/png;base64" in page
+    assert index.index("lessons/00_good.html") < index.index("lessons/01_raises.html") \
+        < index.index("assignments/02_hangs.html")
+    lesson = (root / "build" / "course" / "lessons" / "00_good.html").read_text()
+    assert 'class="right-next"' in lesson and "01_raises.html" in lesson
 
 
 def test_run_notebook_cwd_is_a_fresh_temp_dir(tmp_path):

@@ -202,7 +202,7 @@ def saturate_command(v: Any, omega: Any, v_max: float, w_max: float, *, check: b
     Notes
     -----
     Sec. 'Visual-servoing for navigation', unnumbered: "when this value is achieved, we saturate
-    omega and reduce v to Vmax Wmax / |omega|, in order to avoid large lags in narrow turns". With
+    omega and reduce v to Vmax Wmax / abs(omega), in order to avoid large lags in narrow turns". With
     ``v = v_max`` the common factor gives exactly that ``v``; it is the same rule for any ``v``.
 
     Examples

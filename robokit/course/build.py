@@ -1,20 +1,33 @@
-"""``robokit course build``: run every lesson and solution notebook and write the course site."""
+"""``robokit course build``: run every lesson and solution notebook, then write the two course sites.
+
+Layout of one build (``out`` is the student site, by default ``build/course``)::
+
+    build/executed/     the executed notebooks (lessons-NN.ipynb, solutions-NN.ipynb); not published
+    build/course/       the student site: lessons, blank assignments, library reference, references
+    build/instructor/   the instructor site: all of that plus solutions, grading self-check, build report
+    build/.site-src/    the Sphinx sources of both (generated), with Sphinx's warnings
+"""
 from __future__ import annotations
 
+import html
 import os
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Callable, Sequence
 
+from .book import SITES, BookPage, SiteBuild, prepare_notebook, sphinx_build, write_sources
 from .execute import NotebookRun, run_notebook
-from .site import install_mathjax, notebook_page, write_index
 
-__all__ = ["discover", "build_course", "format_summary"]
+__all__ = ["discover", "build_course", "run_notebooks", "write_sites", "format_summary", "build_report_page"]
 
 #: Directories whose notebooks the course build executes, in site order.
 BUILD_DIRS = ("lessons", "solutions")
 #: Directories whose notebooks the test-suite executes.
 ALL_DIRS = ("lessons", "solutions", "assignments")
+
+#: An extra step of the build: ``step(root, workdir) -> (ok, page)``; the page joins the
+#: instructor site (``robokit.grading.selfcheck.course_grading_step`` is the one the CLI adds).
+ExtraStep = Callable[[Path, Path], "tuple[bool, BookPage]"]
 
 
 def discover(root: str | Path, dirs: Sequence[str] = BUILD_DIRS) -> list[Path]:
@@ -29,9 +42,13 @@ def discover(root: str | Path, dirs: Sequence[str] = BUILD_DIRS) -> list[Path]:
     return found
 
 
+def _name(run: NotebookRun, root: Path) -> str:
+    return str(run.path.relative_to(root)) if run.path.is_relative_to(root) else str(run.path)
+
+
 def format_summary(runs: Sequence[NotebookRun], root: Path) -> str:
     """Return a plain-text table of notebook, status and run time."""
-    names = [str(r.path.relative_to(root)) if r.path.is_relative_to(root) else str(r.path) for r in runs]
+    names = [_name(r, root) for r in runs]
     width = max([len(n) for n in names] + [8])
     lines = [f"{'notebook':<{width}}  {'status':<8}  {'time':>8}", "-" * (width + 20)]
     for name, run in zip(names, runs):
@@ -40,18 +57,38 @@ def format_summary(runs: Sequence[NotebookRun], root: Path) -> str:
     return "\n".join(lines)
 
 
+def build_report_page(runs: Sequence[NotebookRun], root: Path, *, fast: bool) -> BookPage:
+    """The instructor site's build report: status and run time of every notebook, full error tails."""
+    rows = "".join(f"| `{_name(r, root)}` | {'ok' if r.ok else '**' + r.status + '**'} | {r.seconds:.1f} s |\n"
+                   for r in runs)
+    errors = "".join(f"\n## `{_name(r, root)}`: {r.status}\n\n<pre>{html.escape(r.error)}</pre>\n"
+                     for r in runs if not r.ok)
+    total = sum(r.seconds for r in runs)
+    text = (f"# Build report\n\n{sum(r.ok for r in runs)} of {len(runs)} notebooks ran without error "
+            f"({'fast mode' if fast else 'full size'}; {total:.0f} s of notebook time in all).\n\n"
+            "| notebook | status | run time |\n|---|---|---|\n" + rows + errors)
+    return BookPage("instructor/build", text)
+
+
+def _failure_note(run: NotebookRun) -> str:
+    if run.ok:
+        return ""
+    return (f"This notebook did not run to the end when the site was built ({run.status}); the "
+            "outputs below stop where it stopped.")
+
+
 def build_course(root: str | Path = ".", out: str | Path = "build/course", *, jobs: int | None = None,
                  timeout: float = 900, fast: bool = False, notebooks: Sequence[Path] | None = None,
-                 log: Callable[[str], None] = print,
-                 extra_steps: Sequence[Callable[[Path, Path], tuple[bool, str]]] = ()) -> int:
-    """Execute the course notebooks in parallel, write the HTML site and return an exit code.
+                 log: Callable[[str], None] = print, extra_steps: Sequence[ExtraStep] = ()) -> int:
+    """Execute the course notebooks in parallel, build the student and instructor sites, return an exit code.
 
     Parameters
     ----------
     root : path, default "."
-        Repository root (holds ``lessons/`` and ``solutions/``).
+        Repository root (holds ``lessons/``, ``solutions/``, ``assignments/`` and ``book/``).
     out : path, default "build/course"
-        Site directory; created if needed.
+        The student site; the instructor site goes to the sibling ``instructor/`` and the executed
+        notebooks to the sibling ``executed/``.
     jobs : int, optional
         Notebooks run at once; defaults to the number of available cores.
     timeout : float, default 900
@@ -63,50 +100,88 @@ def build_course(root: str | Path = ".", out: str | Path = "build/course", *, jo
     log : callable, default print
         Receives progress lines and the summary table.
     extra_steps : sequence of callables, optional
-        Called as ``step(root, out)`` after the notebooks; each returns ``(ok, html_fragment)``
-        appended to the index (used by the grader to add ``grades.csv``).
+        Called as ``step(root, workdir)`` after the notebooks; each returns ``(ok, page)`` and the
+        page joins the instructor site (the grading self-check).
 
     Returns
     -------
     int
-        0 if every notebook (and every extra step) succeeded, 1 otherwise.
+        0 if every notebook, every extra step and both sites succeeded, 1 otherwise.
 
     Notes
     -----
-    Course tooling (issue "Course platform"); not from a paper.
+    Course tooling (DESIGN.md, "Course build"); not from a paper.
     """
     root = Path(root).resolve()
     out = Path(out)
     out = (out if out.is_absolute() else root / out).resolve()
-    (out / "executed").mkdir(parents=True, exist_ok=True)
+    build = out.parent
+    executed = build / "executed"
+    executed.mkdir(parents=True, exist_ok=True)
     paths = [Path(p).resolve() for p in notebooks] if notebooks else discover(root)
     if not paths:
         log(f"no notebooks found under {root} in {', '.join(BUILD_DIRS)}")
         return 1
+    runs = run_notebooks(paths, executed, root=root, jobs=jobs, timeout=timeout, fast=fast, log=log)
+    ok = all(r.ok for r in runs)
+    pages = [build_report_page(runs, root, fast=fast)]
+    for step in extra_steps:
+        step_ok, page = step(root, build / "reports")
+        ok = ok and step_ok
+        pages.append(page)
+    sites = write_sites(root, runs, out, pages, log=log)
+    ok = ok and all(s.ok for s in sites.values())
+    log("")
+    log(format_summary(runs, root))
+    for name, site in sites.items():
+        n_warn = len(site.warnings.splitlines())
+        log(f"{name} site: {site.index} ({'ok' if site.ok else 'FAILED'}, {site.seconds:.1f} s, "
+            f"{n_warn} Sphinx warning lines{'' if not n_warn else ' in build/.site-src/sphinx-warnings-' + name + '.txt'})")
+        if not site.ok:
+            log(site.warnings[-3000:])
+    return 0 if ok else 1
+
+
+def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: int | None = None,
+                  timeout: float = 900, fast: bool = False, log: Callable[[str], None] = print) -> list[NotebookRun]:
+    """Execute ``paths`` (``jobs`` at a time, each in a fresh kernel) into ``executed/<folder>-<name>``."""
     if not jobs:
         jobs = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    executed.mkdir(parents=True, exist_ok=True)
 
     def one(path: Path) -> NotebookRun:
-        run = run_notebook(path, timeout=timeout, fast=fast,
-                           output=out / "executed" / f"{path.parent.name}-{path.name}")
+        run = run_notebook(path, timeout=timeout, fast=fast, output=executed / f"{path.parent.name}-{path.name}")
         log(f"  {run.status:<8} {run.seconds:6.1f}s  {path.relative_to(root) if path.is_relative_to(root) else path}")
         return run
 
-    log(f"building the course site from {len(paths)} notebooks with {jobs} parallel jobs "
-        f"({'fast' if fast else 'full'} mode) ...")
+    log(f"running {len(paths)} notebooks with {jobs} parallel jobs ({'fast' if fast else 'full'} mode) ...")
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        runs = list(pool.map(one, paths))
-    local_mathjax = install_mathjax(out)
-    for run in runs:
-        notebook_page(run, out, local_mathjax=local_mathjax)
-    ok = all(r.ok for r in runs)
-    fragments = []
-    for step in extra_steps:
-        step_ok, fragment = step(root, out)
-        ok = ok and step_ok
-        fragments.append(fragment)
-    index = write_index(runs, out, root, "".join(fragments))
-    log("")
-    log(format_summary(runs, root))
-    log(f"site: {index}")
-    return 0 if ok else 1
+        return list(pool.map(one, paths))
+
+
+def write_sites(root: Path, runs: Sequence[NotebookRun], out: Path, pages: Sequence[BookPage] = (), *,
+                log: Callable[[str], None] = print) -> dict[str, SiteBuild]:
+    """Write the Sphinx sources of the student site ``out`` and the instructor site beside it
+    (``out/../instructor``) from the executed ``runs``, and render both side by side (one Sphinx
+    process each). ``pages`` join the instructor site only."""
+    book = root / "book"
+    lessons = [r for r in runs if r.path.parent.name == "lessons"]
+    solutions = [r for r in runs if r.path.parent.name == "solutions"]
+    assignments = discover(root, ("assignments",))
+    src_root = out.parent / ".site-src"
+    outs = {"course": out, "instructor": out.parent / "instructor"}
+    staged = src_root / "notebooks"
+    for run in runs:   # an executed copy if there is one, else the source notebook, with a warning
+        source = run.executed if run.executed is not None and run.executed.exists() else run.path
+        prepare_notebook(source, staged / run.path.parent.name / run.path.name, note=_failure_note(run))
+    staged_lessons = [staged / "lessons" / r.path.name for r in lessons]
+    staged_solutions = [staged / "solutions" / r.path.name for r in solutions]
+    for name, instructor in SITES.items():
+        write_sources(src_root / name, book, lessons=staged_lessons, assignments=assignments,
+                      solutions=staged_solutions if instructor else (), pages=pages if instructor else (),
+                      instructor=instructor)
+    log("rendering the student and instructor sites with Sphinx ...")
+    with ThreadPoolExecutor(max_workers=len(SITES)) as pool:
+        futures = {name: pool.submit(sphinx_build, src_root / name, outs[name], instructor=instructor)
+                   for name, instructor in SITES.items()}
+        return {name: f.result() for name, f in futures.items()}

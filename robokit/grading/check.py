@@ -77,14 +77,10 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
 
     Examples
     --------
-    >>> import numpy as np
-    >>> def wrap_angle(angle):
-    ...     a = np.asarray(angle, dtype=float)
-    ...     if np.isnan(a).any():
-    ...         raise ValueError("angle: expected finite angles, got NaN")
-    ...     wrapped = np.mod(a + np.pi, 2 * np.pi) - np.pi
-    ...     return float(wrapped) if wrapped.ndim == 0 else wrapped
-    >>> check("00.wrap_angle", wrap_angle, verbose=False)
+    A right answer (here the exercise's own reference, so that this page shows no solution):
+
+    >>> from robokit.exercises import get_exercise
+    >>> check("00.wrap_angle", get_exercise("00.wrap_angle").reference, verbose=False)
     check 00.wrap_angle: 6/6 public cases passed (feedback only; your grade comes from hidden cases)
 
     A wrong answer fails the cell, and the message says which cases and why:

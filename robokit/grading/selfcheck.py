@@ -7,6 +7,7 @@ import csv
 import html
 from pathlib import Path
 
+from ..course.book import BookPage
 from ..exercises.discovery import assignments
 from .grader import grade_batch
 from .sandbox import Limits
@@ -22,7 +23,9 @@ def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int 
     -------
     list of dict
         One row per notebook: ``assignment``, ``kind`` (solution/assignment), ``total``, ``max``,
-        ``expected`` and ``ok`` (solution at full marks, assignment at zero, no crash).
+        ``expected``, ``ok`` (solution at full marks, assignment at zero, no crash), ``note`` (the
+        first message of each exercise that went wrong, whole) and ``log`` (the worker's full log
+        with the submission's flags, reason and cell errors).
     """
     root = Path(root)
     rows = []
@@ -30,34 +33,49 @@ def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int 
         for kind, folder in (("solution", "solutions"), ("assignment", "assignments")):
             path = root / folder / f"{slug}.ipynb"
             if not path.exists():
-                rows.append({"assignment": slug, "kind": kind, "total": 0, "max": 0,
-                             "expected": "present", "ok": False, "note": f"{folder}/{slug}.ipynb missing"})
+                rows.append({"assignment": slug, "kind": kind, "total": 0, "max": 0, "expected": "present",
+                             "ok": False, "note": f"{folder}/{slug}.ipynb missing", "log": ""})
                 continue
             result = grade_batch([path], slug, seed, jobs=1, limits=limits, log=lambda *_: None)[0]
             want = result.max_total if kind == "solution" else 0.0
             ok = result.total == want and not result.reason and "worker-ended-early" not in result.flags \
                 and "timeout" not in result.flags
-            note = "; ".join(m for s in result.scores for m in s.messages[:1]) if not ok else ""
+            note = "; ".join([result.reason] * bool(result.reason)
+                             + [m for s in result.scores for m in s.messages[:1]]) if not ok else ""
+            log = "\n".join([f"flags: {', '.join(result.flags) or 'none'}"]
+                            + [f"reason: {result.reason}"] * bool(result.reason)
+                            + [f"cell error: {e}" for e in result.cell_errors]
+                            + ["--- worker log ---", result.worker_log.rstrip()])
             rows.append({"assignment": slug, "kind": kind, "total": result.total, "max": result.max_total,
-                         "expected": want, "ok": ok, "note": note[:300]})
+                         "expected": want, "ok": ok, "note": note, "log": log})
     return rows
 
 
-def course_grading_step(root: Path, out: Path) -> tuple[bool, str]:
-    """Extra step for ``robokit course build``: write ``grades.csv`` and an HTML summary."""
+def course_grading_step(root: Path, workdir: Path) -> tuple[bool, BookPage]:
+    """Extra step for ``robokit course build``: grade the course, write ``grades.csv`` into
+    ``workdir`` and return the instructor site's self-check page (verdicts, full worker logs)."""
     rows = grade_course(root)
-    with open(out / "grades.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["assignment", "kind", "total", "max", "expected", "ok", "note"])
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    table = workdir / "grades.csv"
+    fields = ["assignment", "kind", "total", "max", "expected", "ok", "note"]
+    with open(table, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
-    body = "".join(
-        f"<tr><td>{html.escape(r['assignment'])}</td><td>{r['kind']}</td><td>{r['total']:g} / {r['max']:g}</td>"
-        f"<td class='{'ok' if r['ok'] else 'failed'}'>{'ok' if r['ok'] else 'WRONG: ' + html.escape(r['note'])}</td></tr>"
-        for r in rows)
-    fragment = ("<h2>Autograder self-check</h2><p>Every solution must score full marks and every blank "
-                "assignment zero (<a href='grades.csv'>grades.csv</a>).</p><table><tr><th>assignment</th>"
-                f"<th>notebook</th><th>score</th><th>verdict</th></tr>{body}</table>")
+    lines = ["# Grading self-check", "",
+             "Every solution must score full marks and every blank assignment zero, graded by the same "
+             "sandboxed grader that grades submissions (table: {download}`grades.csv <grades.csv>`).", "",
+             "| assignment | notebook | score | verdict |", "|---|---|---|---|"]
+    for r in rows:
+        verdict = "ok" if r["ok"] else "**wrong**: " + html.escape(r["note"]).replace("|", "\\|").replace("\n", " ")
+        lines.append(f"| `{r['assignment']}` | {r['kind']} | {r['total']:g} / {r['max']:g} | {verdict} |")
+    lines += ["", "## Worker logs", ""]
+    for r in rows:
+        lines += [f"<details><summary>{html.escape(r['assignment'])}, {r['kind']}: "
+                  f"{'ok' if r['ok'] else 'WRONG'}</summary>", "",
+                  f"<pre>{html.escape(r['log'] or r['note'])}</pre>", "", "</details>", ""]
     for r in rows:
         print(f"  grading self-check: {r['assignment']:<28} {r['kind']:<10} {r['total']:g}/{r['max']:g} "
               f"{'ok' if r['ok'] else 'WRONG ' + r['note']}")
-    return all(r["ok"] for r in rows), fragment
+    return all(r["ok"] for r in rows), BookPage("instructor/selfcheck", "\n".join(lines) + "\n", files=(table,))

@@ -84,7 +84,7 @@ class Keypoints:
     scale : numpy.ndarray, shape (N,)
         Gaussian scale sigma in pixels.
     response : numpy.ndarray, shape (N,)
-        Detector strength (PLOT: junction strength lambda_2; SIFT: |DoG|).
+        Detector strength (PLOT: junction strength lambda_2; SIFT: the absolute difference-of-Gaussians response).
     orientation : numpy.ndarray, shape (N,)
         Dominant gradient orientation in radians, ``[0, 2 pi)``; zeros before assignment.
     """

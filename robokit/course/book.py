@@ -1,0 +1,227 @@
+"""The course site: the executed notebooks rendered as a book with Sphinx, myst-nb and
+sphinx-book-theme, twice from one build.
+
+* ``build/course/``, the **student site**: a home page, the lessons (executed), the blank
+  assignments, a reference of the robokit library generated from its numpydoc docstrings, and the
+  papers behind each lesson. It never contains solution code (``tests/test_course_site.py``).
+* ``build/instructor/``, the **instructor site**: the same, plus every solution (executed), the
+  grading self-check with each worker's full log, and the build report (status and time of every
+  notebook). It must stay private.
+
+The committed sources of both live in ``book/`` (``conf.py``, the two home pages, the references,
+the style sheet); :func:`write_sources` copies them next to the notebooks and generates the tables of
+contents and the library reference, and :func:`sphinx_build` renders the result. Nothing is
+executed here: myst-nb runs with ``nb_execution_mode = "off"``.
+"""
+from __future__ import annotations
+
+import ast
+import dataclasses
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Sequence
+
+__all__ = ["SITES", "API_MODULES", "BookPage", "is_import_cell", "prepare_notebook", "write_sources",
+           "sphinx_build", "SiteBuild"]
+
+#: The two sites of one build: name -> whether it is the instructor's.
+SITES = {"course": False, "instructor": True}
+
+#: Modules whose public functions the library reference documents, in the order of the house
+#: (DESIGN.md); ``robokit.grading.check`` is there for ``check()``, the one grading call students make.
+API_MODULES = ("robokit.geometry", "robokit.vision", "robokit.sim", "robokit.mapping",
+               "robokit.localization", "robokit.controllers", "robokit.legged", "robokit.outdoor",
+               "robokit.arm", "robokit.navigation", "robokit.viz", "robokit.grading.check")
+
+#: myst-nb's cell tag that folds a cell's code behind a "show code" button.
+HIDE_INPUT = "hide-input"
+
+
+@dataclasses.dataclass
+class BookPage:
+    """A generated Markdown page: ``name`` (path under the site without suffix), its ``text``, and
+    ``files`` copied next to it (the page links them with MyST's ``{download}`` role)."""
+
+    name: str
+    text: str
+    files: tuple[Path, ...] = ()
+
+
+@dataclasses.dataclass
+class SiteBuild:
+    """Outcome of one :func:`sphinx_build`: ``ok``, ``seconds``, the ``warnings`` Sphinx printed
+    and the site's ``index`` page."""
+
+    ok: bool
+    seconds: float
+    warnings: str
+    index: Path
+
+
+def is_import_cell(source: str) -> bool:
+    """Return whether a code cell only imports (every statement an ``import``; comments allowed).
+
+    Such cells are folded on the site (they open every lesson and say little); they stay one
+    click away.
+
+    Examples
+    --------
+    >>> is_import_cell("import numpy as np\\n# the library\\nfrom robokit import sim")
+    True
+    >>> is_import_cell("import numpy as np\\nprint(np.pi)")
+    False
+    >>> is_import_cell("%matplotlib inline")
+    False
+    """
+    if not isinstance(source, str):
+        raise TypeError(f"source: expected a cell's source text, got {type(source).__name__}")
+    try:
+        body = ast.parse(source).body
+    except SyntaxError:
+        return False
+    return bool(body) and all(isinstance(node, (ast.Import, ast.ImportFrom)) for node in body)
+
+
+def prepare_notebook(src: Path, dst: Path, *, title: tuple[str, str] | None = None,
+                     note: str = "") -> Path:
+    """Copy the notebook ``src`` to ``dst`` for the site, folding the cells that only import.
+
+    Parameters
+    ----------
+    src, dst : Path
+        The notebook (executed or not) and where its site copy goes.
+    title : (str, str), optional
+        Replace the first occurrence of ``title[0]`` in the first heading by ``title[1]`` (the
+        instructor site calls a solution notebook "Solution 01", not "Assignment 01").
+    note : str, optional
+        A warning shown under the title (used when the notebook failed to run in this build).
+
+    Returns
+    -------
+    Path
+        ``dst``.
+    """
+    src, dst = Path(src), Path(dst)
+    if not src.is_file():
+        raise FileNotFoundError(f"src: expected a notebook file, got {str(src)!r}")
+    nb = json.loads(src.read_text(encoding="utf-8"))
+    renamed = title is None
+    if note:
+        cells = nb.setdefault("cells", [])
+        first = next((i for i, c in enumerate(cells) if c.get("cell_type") == "markdown"), -1)
+        cells.insert(first + 1, {"cell_type": "markdown", "metadata": {},
+                                 "source": f"```{{warning}}\n{note}\n```\n"})
+    for cell in nb.get("cells", []):
+        text = "".join(cell.get("source", ""))
+        if cell.get("cell_type") == "code" and is_import_cell(text):
+            tags = cell.setdefault("metadata", {}).setdefault("tags", [])
+            if HIDE_INPUT not in tags:
+                tags.append(HIDE_INPUT)
+        if not renamed and cell.get("cell_type") == "markdown" and text.lstrip().startswith("# "):
+            cell["source"] = text.replace(title[0], title[1], 1)
+            renamed = True
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    dst.write_text(json.dumps(nb, ensure_ascii=False), encoding="utf-8")
+    return dst
+
+
+def _toctree(caption: str, entries: Sequence[str]) -> str:
+    lines = "\n".join(entries)
+    return f"\n```{{toctree}}\n:caption: {caption}\n:maxdepth: 1\n\n{lines}\n```\n"
+
+
+def _api_pages() -> list[BookPage]:
+    pages = []
+    for module in API_MODULES:
+        options = ":members:\n:imported-members:\n" if not module.endswith(".check") else ":members: check\n"
+        pages.append(BookPage(f"api/{module.removeprefix('robokit.')}",
+                              f"# `{module}`\n\n```{{eval-rst}}\n.. automodule:: {module}\n"
+                              + "".join(f"   {line}\n" for line in options.splitlines()) + "```\n"))
+    entries = [p.name.removeprefix("api/") for p in pages]
+    index = ("# Library reference\n\nThe public functions of `robokit` that the lessons use, grouped by "
+             "subpackage in the order they build on each other. Each docstring names the paper and "
+             "equation it implements.\n" + _toctree("Subpackages", entries))
+    return [BookPage("api/index", index)] + pages
+
+
+def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments: Sequence[Path],
+                  solutions: Sequence[Path] = (), pages: Sequence[BookPage] = (),
+                  instructor: bool = False) -> Path:
+    """Write a Sphinx source tree for one site into ``src`` and return its ``index.md``.
+
+    Parameters
+    ----------
+    src : Path
+        Source directory (emptied first).
+    book : Path
+        The committed ``book/`` folder: ``conf.py``, ``home.md``, ``instructor_home.md``,
+        ``references.md``, ``_static/``.
+    lessons, assignments, solutions : sequences of Path
+        Notebooks in site order (lessons and solutions as executed, assignments blank). The student
+        site must get no solutions.
+    pages : sequence of BookPage
+        Extra pages of the instructor site (grading self-check, build report).
+    instructor : bool, default False
+        Build the instructor site (its home page, solutions and extra pages).
+    """
+    src, book = Path(src), Path(book)
+    if not (book / "conf.py").is_file():
+        raise FileNotFoundError(f"book: expected the site sources (conf.py) in {str(book)!r}")
+    if not instructor and (solutions or pages):
+        raise ValueError("solutions: the student site must not contain solutions or instructor pages")
+    if src.exists():
+        shutil.rmtree(src)
+    shutil.copytree(book, src, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    home = (book / ("instructor_home.md" if instructor else "home.md")).read_text(encoding="utf-8")
+    parts = []
+    for caption, folder, notebooks, title in (("Lessons", "lessons", lessons, None),
+                                              ("Assignments", "assignments", assignments, None),
+                                              ("Solutions", "solutions", solutions, ("Assignment", "Solution"))):
+        for path in notebooks:
+            prepare_notebook(path, src / folder / Path(path).name, title=title)
+        if notebooks:
+            parts.append(_toctree(caption, [f"{folder}/{Path(p).stem}" for p in notebooks]))
+    for page in list(pages) + _api_pages():
+        target = src / f"{page.name}.md"
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(page.text, encoding="utf-8")
+        for file in page.files:
+            shutil.copy(file, target.parent / Path(file).name)
+    if pages:
+        parts.append(_toctree("Instructor", [p.name for p in pages]))
+    parts.append(_toctree("Reference", ["api/index", "references"]))
+    index = src / "index.md"
+    index.write_text(home.rstrip() + "\n" + "".join(parts), encoding="utf-8")
+    return index
+
+
+def sphinx_build(src: Path, out: Path, *, instructor: bool = False, timeout: float = 600) -> SiteBuild:
+    """Render the source tree ``src`` (from :func:`write_sources`) into the HTML site ``out``.
+
+    Sphinx runs in its own process (``python -m sphinx``), from scratch each time (``-E``), so a
+    site never keeps a page that the build no longer writes. Its warnings are returned, not fatal:
+    a docstring Sphinx cannot format must not hide the course.
+    """
+    src, out = Path(src), Path(out)
+    if out.exists():
+        shutil.rmtree(out)
+    doctrees = src.parent / f".doctrees-{src.name}"
+    warnings = src.parent / f"sphinx-warnings-{src.name}.txt"
+    env = dict(os.environ, ROBOKIT_SITE="instructor" if instructor else "student", PYTHONHASHSEED="0")
+    cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-E", "-q", "-d", str(doctrees),
+           "-w", str(warnings), str(src), str(out)]
+    start = time.perf_counter()
+    try:
+        proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
+        ok, log = proc.returncode == 0, proc.stderr
+    except subprocess.TimeoutExpired:
+        ok, log = False, f"sphinx-build stopped after the time limit of {timeout:.0f} s"
+    text = warnings.read_text(encoding="utf-8") if warnings.exists() else ""
+    if not ok:
+        text = (text + "\n" + log).strip()
+    return SiteBuild(ok and (out / "index.html").exists(), time.perf_counter() - start, text, out / "index.html")
