@@ -226,3 +226,11 @@ def test_a_hidden_scene_is_reported(browser, tmp_path):
     report = browser.inspect(page(tmp_path, "hidden", "<p>text</p>" + hidden))
     assert len(report.scenes) == 1 and report.scenes[0].png == b""
     assert report.problems() == ["scene 0 is not visible (size 0 x 0)"]
+
+
+@_slow
+def test_every_page_is_a_first_visit(browser, tmp_path):
+    """Nothing a page stores is seen by the next one (a student's first visit is what is checked)."""
+    visit = page(tmp_path, "storage", "<script>if (localStorage.getItem('seen')) console.error('stored');"
+                                      "localStorage.setItem('seen', '1')</script>")
+    assert browser.inspect(visit).ok and browser.inspect(visit).ok
