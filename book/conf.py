@@ -48,6 +48,8 @@ html_css_files = ["robokit.css"]
 html_copy_source = True          # the download button offers the .ipynb
 html_show_sourcelink = False
 html_last_updated_fmt = None
+# pydata-sphinx-theme logs "invalid theme mode" on a first visit unless a default mode is set
+html_context = {"default_mode": "light"}
 html_theme_options = {
     "show_toc_level": 2,
     "use_download_button": True,
