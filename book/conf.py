@@ -35,11 +35,12 @@ suppress_warnings = ["mystnb.unknown_mime_type", "myst.header"]
 
 # Library reference from numpydoc docstrings.
 autodoc_member_order = "bysource"
-autodoc_typehints = "description"
+autodoc_typehints = "none"          # the numpydoc sections already give every type
 autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": False}
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 napoleon_use_rtype = False
+napoleon_use_param = False         # types as plain text: no cross-reference search per type word (halves the build)
 napoleon_use_ivar = True          # dataclass fields: documented once, not twice
 
 html_theme = "sphinx_book_theme"
@@ -61,9 +62,11 @@ html_theme_options = {
 
 
 def _module_docstring_as_text(app, what, name, obj, options, lines):
-    """A subpackage's docstring is a plain-text table of its modules (aligned columns): show it
-    as preformatted text rather than let reStructuredText reflow it."""
-    if what == "module" and lines:
+    """Most subpackage docstrings are a plain-text table of their modules (a name, then aligned
+    columns): show those as preformatted text rather than let reStructuredText reflow them."""
+    import re
+
+    if what == "module" and any(re.match(r"^[a-z_0-9]+ {2,}\S", line) for line in lines):
         lines[:] = ["::", ""] + ["    " + line for line in lines] + [""]
 
 

@@ -32,7 +32,8 @@ def _cmd_course_build(args: argparse.Namespace) -> int:
 
     steps = [] if args.no_grading else [course_grading_step]
     return build_course(root, args.out, jobs=args.jobs, timeout=args.timeout, fast=args.fast,
-                        notebooks=[Path(p) for p in args.notebooks] or None, extra_steps=steps)
+                        notebooks=[Path(p) for p in args.notebooks] or None, extra_steps=steps,
+                        api_reference=not args.no_api_reference)
 
 
 def _cmd_course_strip(args: argparse.Namespace) -> int:
@@ -166,6 +167,8 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument("--jobs", type=int, default=None, help="notebooks run at once (default: cores)")
     build.add_argument("--timeout", type=float, default=900, help="per-notebook limit in s (default: 900)")
     build.add_argument("--fast", action="store_true", help="run with ROBOKIT_FAST=1 (shrunk experiments)")
+    build.add_argument("--no-api-reference", action="store_true",
+                       help="leave the library reference out of the sites (a quicker preview build)")
     build.add_argument("--no-grading", action="store_true",
                        help="skip grading solutions (full marks) and blank assignments (zero)")
     build.set_defaults(func=_cmd_course_build)

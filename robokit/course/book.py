@@ -111,8 +111,11 @@ def prepare_notebook(src: Path, dst: Path, *, title: tuple[str, str] | None = No
         raise FileNotFoundError(f"src: expected a notebook file, got {str(src)!r}")
     nb = json.loads(src.read_text(encoding="utf-8"))
     renamed = title is None
+    cells = nb.setdefault("cells", [])
+    if not any(c.get("cell_type") == "markdown" and "".join(c.get("source", "")).lstrip().startswith("# ")
+               for c in cells):       # every page needs a title for the sidebar and the browser tab
+        cells.insert(0, {"cell_type": "markdown", "metadata": {}, "source": f"# {src.stem}"})
     if note:
-        cells = nb.setdefault("cells", [])
         first = next((i for i, c in enumerate(cells) if c.get("cell_type") == "markdown"), -1)
         cells.insert(first + 1, {"cell_type": "markdown", "metadata": {},
                                  "source": f"```{{warning}}\n{note}\n```\n"})
@@ -135,9 +138,11 @@ def _toctree(caption: str, entries: Sequence[str]) -> str:
     return f"\n```{{toctree}}\n:caption: {caption}\n:maxdepth: 1\n\n{lines}\n```\n"
 
 
-def _api_pages() -> list[BookPage]:
+def _api_pages(modules: Sequence[str]) -> list[BookPage]:
+    if not modules:
+        return []
     pages = []
-    for module in API_MODULES:
+    for module in modules:
         options = ":members:\n:imported-members:\n" if not module.endswith(".check") else ":members: check\n"
         pages.append(BookPage(f"api/{module.removeprefix('robokit.')}",
                               f"# `{module}`\n\n```{{eval-rst}}\n.. automodule:: {module}\n"
@@ -151,7 +156,7 @@ def _api_pages() -> list[BookPage]:
 
 def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments: Sequence[Path],
                   solutions: Sequence[Path] = (), pages: Sequence[BookPage] = (),
-                  instructor: bool = False) -> Path:
+                  instructor: bool = False, api_modules: Sequence[str] = API_MODULES) -> Path:
     """Write a Sphinx source tree for one site into ``src`` and return its ``index.md``.
 
     Parameters
@@ -168,6 +173,8 @@ def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments
         Extra pages of the instructor site (grading self-check, build report).
     instructor : bool, default False
         Build the instructor site (its home page, solutions and extra pages).
+    api_modules : sequence of str, default API_MODULES
+        Modules of the library reference; empty for a quicker site without it.
     """
     src, book = Path(src), Path(book)
     if not (book / "conf.py").is_file():
@@ -186,7 +193,8 @@ def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments
             prepare_notebook(path, src / folder / Path(path).name, title=title)
         if notebooks:
             parts.append(_toctree(caption, [f"{folder}/{Path(p).stem}" for p in notebooks]))
-    for page in list(pages) + _api_pages():
+    api = _api_pages(api_modules)
+    for page in list(pages) + api:
         target = src / f"{page.name}.md"
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(page.text, encoding="utf-8")
@@ -194,7 +202,7 @@ def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments
             shutil.copy(file, target.parent / Path(file).name)
     if pages:
         parts.append(_toctree("Instructor", [p.name for p in pages]))
-    parts.append(_toctree("Reference", ["api/index", "references"]))
+    parts.append(_toctree("Reference", ["api/index"] * bool(api) + ["references"]))
     index = src / "index.md"
     index.write_text(home.rstrip() + "\n" + "".join(parts), encoding="utf-8")
     return index

@@ -15,7 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Callable, Sequence
 
-from .book import SITES, BookPage, SiteBuild, prepare_notebook, sphinx_build, write_sources
+from .book import API_MODULES, SITES, BookPage, SiteBuild, prepare_notebook, sphinx_build, write_sources
 from .execute import NotebookRun, run_notebook
 
 __all__ = ["discover", "build_course", "run_notebooks", "write_sites", "format_summary", "build_report_page"]
@@ -79,7 +79,8 @@ def _failure_note(run: NotebookRun) -> str:
 
 def build_course(root: str | Path = ".", out: str | Path = "build/course", *, jobs: int | None = None,
                  timeout: float = 900, fast: bool = False, notebooks: Sequence[Path] | None = None,
-                 log: Callable[[str], None] = print, extra_steps: Sequence[ExtraStep] = ()) -> int:
+                 log: Callable[[str], None] = print, extra_steps: Sequence[ExtraStep] = (),
+                 api_reference: bool = True) -> int:
     """Execute the course notebooks in parallel, build the student and instructor sites, return an exit code.
 
     Parameters
@@ -102,6 +103,9 @@ def build_course(root: str | Path = ".", out: str | Path = "build/course", *, jo
     extra_steps : sequence of callables, optional
         Called as ``step(root, workdir)`` after the notebooks; each returns ``(ok, page)`` and the
         page joins the instructor site (the grading self-check).
+    api_reference : bool, default True
+        Include the library reference (generated from robokit's docstrings; about half of the
+        site's build time).
 
     Returns
     -------
@@ -129,7 +133,7 @@ def build_course(root: str | Path = ".", out: str | Path = "build/course", *, jo
         step_ok, page = step(root, build / "reports")
         ok = ok and step_ok
         pages.append(page)
-    sites = write_sites(root, runs, out, pages, log=log)
+    sites = write_sites(root, runs, out, pages, log=log, api_modules=API_MODULES if api_reference else ())
     ok = ok and all(s.ok for s in sites.values())
     log("")
     log(format_summary(runs, root))
@@ -160,7 +164,7 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
 
 
 def write_sites(root: Path, runs: Sequence[NotebookRun], out: Path, pages: Sequence[BookPage] = (), *,
-                log: Callable[[str], None] = print) -> dict[str, SiteBuild]:
+                log: Callable[[str], None] = print, api_modules: Sequence[str] = API_MODULES) -> dict[str, SiteBuild]:
     """Write the Sphinx sources of the student site ``out`` and the instructor site beside it
     (``out/../instructor``) from the executed ``runs``, and render both side by side (one Sphinx
     process each). ``pages`` join the instructor site only."""
@@ -179,7 +183,7 @@ def write_sites(root: Path, runs: Sequence[NotebookRun], out: Path, pages: Seque
     for name, instructor in SITES.items():
         write_sources(src_root / name, book, lessons=staged_lessons, assignments=assignments,
                       solutions=staged_solutions if instructor else (), pages=pages if instructor else (),
-                      instructor=instructor)
+                      instructor=instructor, api_modules=api_modules)
     log("rendering the student and instructor sites with Sphinx ...")
     with ThreadPoolExecutor(max_workers=len(SITES)) as pool:
         futures = {name: pool.submit(sphinx_build, src_root / name, outs[name], instructor=instructor)
