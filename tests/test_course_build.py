@@ -140,3 +140,15 @@ def test_check_in_a_notebook_shows_its_message_not_a_traceback(tmp_path):
     assert wrong and wrong[0].ename == "CheckFailed"
     assert len(wrong[0].traceback) == 1 and "robokit" not in wrong[0].traceback[0]
     assert "4 of 6 public cases failed" in wrong[0].traceback[0]
+
+
+def test_the_student_site_sources_refuse_solutions(tmp_path):
+    from robokit.course.book import BookPage, write_sources
+
+    solution = _notebook(tmp_path / "01.ipynb", "x = 1")
+    with pytest.raises(ValueError, match="solutions"):
+        write_sources(tmp_path / "src", ROOT / "book", lessons=[], assignments=[], solutions=[solution])
+    with pytest.raises(ValueError, match="solutions"):
+        write_sources(tmp_path / "src", ROOT / "book", lessons=[], assignments=[], pages=[BookPage("x", "# x")])
+    with pytest.raises(FileNotFoundError, match="book"):
+        write_sources(tmp_path / "src", tmp_path, lessons=[], assignments=[])
