@@ -42,7 +42,7 @@ from ..validation import as_array, check_choice, check_int, check_positive, chec
 from .animation import HIDDEN_SCALE, animate_tracks
 from .legged_plots import support_outline
 from .scene import Scene, check_scene
-from .scene3d import look_from
+from .framing import look_from
 
 __all__ = ["joint_path", "add_littledog", "pose_littledog", "animate_trial", "GROUND_Z"]
 
