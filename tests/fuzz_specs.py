@@ -1483,6 +1483,7 @@ NOT_FUZZED: dict[str, str] = {
 #: the functions the issue's fuzz named.
 EXTRA: tuple[str, ...] = (
     "robokit.sim.vehicle.unicycle_step",
+    "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.frame
     # lesson 02 (path following, pose EKF, navigation), fuzzed before the lesson exists
     *(f"robokit.controllers.path_geometry.{n}" for n in ("VisualPath", "path_from_poses", "reference_point")),
     *(f"robokit.controllers.path_following.{n}" for n in (
