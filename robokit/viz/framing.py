@@ -114,9 +114,9 @@ def frame(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[st
     scene : Scene
     direction : array_like, shape (3,), default (0.5, -1.0, 0.9)
         From the box towards the camera: the camera looks along ``-direction`` (any length; world
-        frame, z up). The default looks
-        from the south (-y), a little east, 39 degrees above the horizon; ``(0, 0, 1)`` looks straight
-        down with +y up in the image; ``(-1, 0, 0.3)`` looks along +x from behind, slightly above.
+        frame, z up). The default looks from the south (-y), a little east, 39 degrees above the
+        horizon; ``(0, 0, 1)`` looks straight down with +y up in the image; ``(-1, 0, 0.3)`` looks
+        along +x from behind, slightly above.
     paths : str or sequence of str, optional
         Frame only the objects at or under these scene paths (:meth:`Scene.bounds`), e.g. the robot
         rather than the whole world.
