@@ -54,7 +54,7 @@ _RADII = (0.012, 0.011, 0.008)                    # hip stub, upper and lower le
 _SIDE = np.array([1.0 if leg.endswith("L") else -1.0 for leg in LEGS])
 _HALF_TURN = rot_x(np.pi / 2)                     # a cylinder's y axis onto z
 _VIEW = np.array([0.55, -1.0, 0.6])             # towards the camera: front right, above
-_ROOM = 0.4                                      # framing margin: the legs swing out of the standing box
+_ROOM = 0.6                                      # framing margin: the legs swing out of the standing box
 
 
 def joint_path(path: str, leg: Any, joint: str) -> str:
