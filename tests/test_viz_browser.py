@@ -17,7 +17,7 @@ pytestmark = [pytest.mark.slow,
                                                           ".ci/run installs it)")]
 
 
-def screenshot(scene: Scene, tmp_path: Path, name: str) -> np.ndarray:
+def screenshot(scene: Scene, tmp_path: Path, name: str, size: tuple[int, int] = (640, 480)) -> np.ndarray:
     import matplotlib.image as mimage
 
     page = scene.save_html(tmp_path / f"{name}.html")
@@ -25,7 +25,7 @@ def screenshot(scene: Scene, tmp_path: Path, name: str) -> np.ndarray:
     with tempfile.TemporaryDirectory() as profile:
         cmd = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                "--disable-background-networking", "--disable-component-update", "--disable-sync",
-               f"--user-data-dir={profile}", "--window-size=640,480", "--virtual-time-budget=8000",
+               f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}", "--virtual-time-budget=8000",
                f"--screenshot={shot}", page.resolve().as_uri()]
         subprocess.run(cmd, capture_output=True, timeout=120, check=False)
     assert shot.exists(), "Chromium wrote no screenshot"
@@ -84,3 +84,25 @@ def test_the_camera_follows_a_walking_littledog(tmp_path):
     look_from(still, [0.33, -0.51, 0.39], target=[0.0, 0.0, 0.08])   # the same view, not following
     rows, cols = np.nonzero(yellow(screenshot(still, tmp_path, "still")))
     assert len(cols) == 0 or abs(cols.mean() - w / 2) > 0.25 * w
+
+
+def test_frame_shows_a_whole_football_field(tmp_path):
+    """frame() shows a 100 m x 60 m field with a small box at each end; meshcat's own camera does not."""
+    from robokit.geometry import se3_from_rt
+    from robokit.viz import frame
+
+    def field():
+        s = Scene(height=420)
+        s.add_box("ground", (100.0, 60.0, 0.02), se3_from_rt(np.eye(3), [50.0, 30.0, -0.01]), color=0x6AA84F)
+        s.add_box("near", (3.0, 3.0, 3.0), se3_from_rt(np.eye(3), [2.0, 2.0, 1.5]), color=0xFF00FF)
+        s.add_box("far", (3.0, 3.0, 3.0), se3_from_rt(np.eye(3), [98.0, 58.0, 1.5]), color=0x00FFFF)
+        return s
+
+    magenta = lambda im: ((im[..., 0] > 120) & (im[..., 2] > 120) & (im[..., 1] < 60)).mean()
+    cyan = lambda im: ((im[..., 0] < 60) & (im[..., 1] > 120) & (im[..., 2] > 120)).mean()
+    grass = lambda im: ((im[..., 1] > im[..., 0] + 20) & (im[..., 1] > im[..., 2] + 20)).mean()
+    framed = screenshot(frame(field(), (0.0, -1.0, 1.0)), tmp_path, "field_framed", (1270, 420)).astype(int)
+    assert magenta(framed) > 1e-4 and cyan(framed) > 1e-4       # both ends of the field in view
+    assert grass(framed) > 0.2                                    # and the grass fills a good part of it
+    default = screenshot(field(), tmp_path, "field_default", (1270, 420)).astype(int)
+    assert cyan(default) < 1e-4 and grass(default) < 0.1          # meshcat's camera: the far end cut off

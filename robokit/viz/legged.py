@@ -42,7 +42,7 @@ from ..validation import as_array, check_choice, check_int, check_positive, chec
 from .animation import HIDDEN_SCALE, animate_tracks
 from .legged_plots import support_outline
 from .scene import Scene, check_scene
-from .scene3d import look_from
+from . import framing
 
 __all__ = ["joint_path", "add_littledog", "pose_littledog", "animate_trial", "GROUND_Z"]
 
@@ -53,7 +53,8 @@ _COLORS = {"trunk": 0x2B2B8C, "link": 0x404048, "foot": 0x151515, "marker": 0xEE
 _RADII = (0.012, 0.011, 0.008)                    # hip stub, upper and lower leg, as in the MJCF
 _SIDE = np.array([1.0 if leg.endswith("L") else -1.0 for leg in LEGS])
 _HALF_TURN = rot_x(np.pi / 2)                     # a cylinder's y axis onto z
-_VIEW = 0.6 * np.array([0.55, -1.0, 0.6]) / np.linalg.norm([0.55, -1.0, 0.6])   # camera from the target: front right, above
+_VIEW = np.array([0.55, -1.0, 0.6])             # towards the camera: front right, above
+_ROOM = 0.6                                      # framing margin: the legs swing out of the standing box
 
 
 def joint_path(path: str, leg: Any, joint: str) -> str:
@@ -131,10 +132,10 @@ def add_littledog(scene: Scene, path: str = "littledog", T_world_body: Any = Non
 
     Examples
     --------
-    >>> from robokit.viz import Scene, look_from
+    >>> from robokit.viz import Scene, frame
     >>> scene = add_littledog(Scene())                   # standing at the origin
-    >>> look_from(scene, [0.45, -0.55, 0.35], target=[0.0, 0.0, 0.08])
-    Scene(title='robokit scene', commands=57)
+    >>> frame(scene, direction=(0.55, -1.0, 0.6))        # seen from its front right, filling the view
+    Scene(title='robokit scene', commands=59)
     """
     check_scene(scene, path)
     T, q = _pose_args(T_world_body, q)
@@ -297,8 +298,9 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
     force_scale : float, default 0.004
         m of arrow per N (7.4 N, a quarter of the weight, is 3 cm).
     frame : bool, default True
-        Look at the robot from its front right, 0.6 m away (:func:`robokit.viz.look_from` with a
-        target), and follow it as it walks (:meth:`Scene.set_camera_follow`, offline pages).
+        Look at the robot from its front right, close enough for it to fill most of the view
+        (:func:`robokit.viz.frame` on the robot as it starts), and follow it as it walks
+        (:meth:`Scene.set_camera_follow`, offline pages).
 
     Returns
     -------
@@ -341,6 +343,9 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
     force_scale = check_positive(force_scale, "force_scale")
     root, overlay = path.strip("/"), path.strip("/") + "_overlay"
     add_littledog(scene, root, log.T_world_body()[0], log.q[0])
+    if frame:                     # on the robot alone: its unit force arrows are scaled by the animation
+        framing.frame(scene, _VIEW, paths=root, margin=_ROOM)
+        scene.set_camera_follow(root)
     _add_overlays(scene, root, overlay, bool(support), bool(com), bool(forces), bool(mocap))
 
     tracks: dict = {root: {"position": log.body_pos[rows], "quaternion": log.body_quat[rows]}}
@@ -364,8 +369,4 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
             seen = log.mocap_visible[rows, k]
             tracks[f"{overlay}/mocap/{k}"] = {"position": log.mocap[rows, k],
                                               "scale": np.where(seen[:, None], 1.0, HIDDEN_SCALE) * np.ones(3)}
-    if frame:
-        target = np.array([*log.body_pos[0, :2], 0.6 * STANDING_HEIGHT])
-        look_from(scene, target + _VIEW, target=target)
-        scene.set_camera_follow(root)
     return animate_tracks(scene, tracks, fps, check=False)

@@ -72,6 +72,33 @@ def _transform(value: Any, name: str = "transform") -> np.ndarray:
     return T
 
 
+def _object_corners(obj: Any) -> np.ndarray | None:
+    """The 8 corners of the box around a meshcat object's geometry, in its node's frame (None: not known)."""
+    from meshcat import geometry as g
+
+    geometry = getattr(obj, "geometry", None)
+    if isinstance(geometry, g.Box):
+        half = np.abs(np.asarray(geometry.lengths, float)) / 2
+        lo, hi = -half, half
+    elif isinstance(geometry, g.Sphere):                  # an Ellipsoid too: a unit sphere, scaled below
+        r = float(geometry.radius)
+        lo, hi = np.full(3, -r), np.full(3, r)
+    elif isinstance(geometry, g.Cylinder):                # three.js: the axis along y
+        r, h = max(float(geometry.radiusTop), float(geometry.radiusBottom)), float(geometry.height) / 2
+        lo, hi = np.array([-r, -h, -r]), np.array([r, h, r])
+    elif isinstance(geometry, (g.TriangularMeshGeometry, g.PointsGeometry)):
+        v = geometry.vertices if isinstance(geometry, g.TriangularMeshGeometry) else np.asarray(geometry.position).T
+        v = np.asarray(v, float).reshape(-1, 3)
+        if not len(v):
+            return None
+        lo, hi = v.min(axis=0), v.max(axis=0)
+    else:
+        return None
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    M = np.asarray(geometry.intrinsic_transform(), float)
+    return corners @ M[:3, :3].T + M[:3, 3]
+
+
 class Scene:
     """A 3D scene built from meshcat commands, shown without a server.
 
@@ -99,6 +126,8 @@ class Scene:
         self.title = check_text(title, "title")
         self.height = check_int(height, "height", minimum=1)
         self._commands: list[Any] = []
+        self._extents: dict[tuple, np.ndarray] = {}      # object node -> (8, 3) corners in its node's frame
+        self._poses: dict[tuple, np.ndarray] = {}        # node -> 4x4 transform relative to its parent
         self._live = None
         if live:
             import meshcat
@@ -128,9 +157,88 @@ class Scene:
         kept for the offline page and, with ``live=True``, sent to the meshcat server too.
         """
         self._commands.append(command)
+        self._track(command)
         if self._live is not None:
             self._live.window.send(command)
         return self
+
+    def _track(self, command: Any) -> None:
+        from meshcat.commands import SetObject, SetTransform
+
+        if isinstance(command, SetObject):
+            key = tuple(command.path.entries)
+            corners = _object_corners(command.object)
+            if corners is None:
+                self._extents.pop(key, None)
+            else:
+                self._extents[key] = corners
+        elif isinstance(command, SetTransform):
+            self._poses[tuple(command.path.entries)] = np.asarray(command.matrix, float)
+
+    def bounds(self, paths: Sequence[str] | str | None = None) -> tuple[np.ndarray, np.ndarray] | None:
+        """The axis-aligned box (world frame, metres) around what the scene draws, as it stands.
+
+        Parameters
+        ----------
+        paths : str or sequence of str, optional
+            Only objects at or under these scene paths (``"robot"`` takes ``"robot/body"``, not
+            ``"robot2"``); every object if omitted.
+
+        Returns
+        -------
+        (lo, hi) : tuple of ndarray, shape (3,), or None
+            The least and greatest corner; None when no object matches.
+
+        Raises
+        ------
+        ValueError, TypeError
+            For a path that is not a non-empty string.
+
+        Notes
+        -----
+        Every object recorded through :meth:`set_object` (so every ``add_*`` helper, and
+        :meth:`send` with a ``SetObject``) counts with the box of its geometry (box, sphere,
+        ellipsoid, cylinder, triangle mesh, points, lines), moved by the transforms last set
+        (:meth:`set_transform`) on its path and on every group above it: a later
+        ``set_transform`` moves the box, with its children. Not tracked: animations (the box is
+        the one before an animation plays; a robot driving across a field counts where it starts),
+        ``set_property`` commands, and meshes loaded from files (meshcat's ``MeshGeometry``); nor
+        meshcat's own grid and axes.
+
+        Examples
+        --------
+        >>> scene = Scene().add_box("robot/body", size=(2.0, 1.0, 0.5))
+        >>> scene.set_transform("robot", [[1, 0, 0, 5.0], [0, 1, 0, 0], [0, 0, 1, 0.25], [0, 0, 0, 1]])
+        Scene(title='robokit scene', commands=3)
+        >>> lo, hi = scene.bounds()
+        >>> lo.tolist(), hi.tolist()
+        ([4.0, -0.5, 0.0], [6.0, 0.5, 0.5])
+        >>> scene.bounds("elsewhere") is None
+        True
+        """
+        if paths is None:
+            prefixes = None
+        else:
+            names = [paths] if isinstance(paths, str) else paths
+            if not isinstance(names, (list, tuple)) or not names:
+                raise TypeError(f"paths: expected a scene path or a non-empty list of them, got {describe(paths)}")
+            prefixes = []
+            for name in names:
+                if not check_text(name, "paths").strip("/"):
+                    raise ValueError(f"paths: expected scene paths like 'robot', got {name!r}")
+                prefixes.append(tuple(self.meshcat_path(name).entries))
+        corners = []
+        for key, local in self._extents.items():
+            if prefixes is not None and not any(key[:len(p)] == p for p in prefixes):
+                continue
+            T = np.eye(4)
+            for depth in range(1, len(key) + 1):
+                T = T @ self._poses.get(key[:depth], np.eye(4))
+            corners.append(local @ T[:3, :3].T + T[:3, 3])
+        if not corners:
+            return None
+        allc = np.concatenate(corners)
+        return allc.min(axis=0), allc.max(axis=0)
 
     @property
     def commands(self) -> list[dict]:
@@ -317,7 +425,7 @@ class Scene:
 
     def _repr_html_(self) -> str:
         return (f"<iframe srcdoc=\"{_html.escape(self.html(), quote=True)}\" "
-                f"style=\"width:100%;height:{self.height}px;border:1px solid #ccc\" "
+                f"style=\"width:100%;height:{self.height}px;border:1px solid #ccc;box-sizing:border-box\" "
                 "title=\"robokit meshcat scene\"></iframe>")
 
     def show(self) -> None:

@@ -18,8 +18,7 @@ from ..validation import as_array, as_points, check_finite_scalar, check_int, ch
 from .maps import check_graph
 from .scene import Scene, as_color, check_scene
 
-__all__ = ["add_world", "add_camera", "add_trajectory", "add_graph", "add_image", "add_particles", "add_landmarks",
-           "look_from"]
+__all__ = ["add_world", "add_camera", "add_trajectory", "add_graph", "add_image", "add_particles", "add_landmarks"]
 
 
 def _textured_mesh(vertices: np.ndarray, faces: np.ndarray, uvs: np.ndarray):
@@ -392,55 +391,4 @@ def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None,
         scene.set_object(f"{path}/ellipsoid{k}", Ellipsoid(radii.tolist()),
                          MeshLambertMaterial(color=0xFFAA00, opacity=0.35, transparent=True))
         scene.set_transform(f"{path}/ellipsoid{k}", T)
-    return scene
-
-
-def look_from(scene: Scene, position: Any, target: Any = None) -> Scene:
-    """Place the viewer's camera at world ``position`` (metres, z up), looking at ``target``.
-
-    Parameters
-    ----------
-    scene : Scene
-    position : array_like, shape (3,)
-    target : array_like, shape (3,), optional
-        The point looked at and orbited about (:meth:`Scene.set_camera_target`); the origin if
-        omitted. Frame what the text talks about: a 0.3 m robot seen from 0.7 m, not the origin of
-        a 20 m grid.
-
-    Returns
-    -------
-    Scene
-
-    Raises
-    ------
-    ValueError
-        If ``position`` is the target (no direction to look in).
-
-    Notes
-    -----
-    meshcat's default camera lives under ``/Cameras/default/rotated``, a node that turns
-    three.js's y-up convention into robokit's z-up one, so the position is given to it as
-    ``(x, z, -y)``; the orbit controls then look at the target.
-
-    Examples
-    --------
-    >>> from robokit.viz import Scene, look_from
-    >>> look_from(Scene(), [5.0, -5.0, 8.0])          # above and south-east of the origin
-    Scene(title='robokit scene', commands=1)
-    >>> look_from(Scene(), [0.6, -0.7, 0.45], target=[0.1, 0.0, 0.1])   # a small robot, close up
-    Scene(title='robokit scene', commands=2)
-    """
-    check_scene(scene)
-    from meshcat.commands import SetProperty
-    from meshcat.path import Path as MeshcatPath
-
-    p = as_array(position, "position", shape=(3,))
-    t = np.zeros(3) if target is None else as_array(target, "target", shape=(3,))
-    if np.linalg.norm(p - t) == 0:
-        where = "origin" if target is None else "target"
-        raise ValueError(f"position: expected a point away from the {where}, got {p.tolist()}")
-    scene.send(SetProperty("position", [float(p[0]), float(p[2]), float(-p[1])],
-                            MeshcatPath(("Cameras", "default", "rotated", "<object>"))))
-    if target is not None:
-        scene.set_camera_target(t)
     return scene
