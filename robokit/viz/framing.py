@@ -16,7 +16,7 @@ import numpy as np
 from ..validation import as_array, check_finite_result, check_int, check_positive
 from .scene import Scene, check_scene
 
-__all__ = ["look_from", "frame", "FOV", "NEAR", "FAR"]
+__all__ = ["look_from", "frame", "FOV", "NEAR", "FAR", "VIEW_WIDTH"]
 
 FOV = 75.0
 """Vertical field of view (degrees) of meshcat's default camera."""
@@ -24,6 +24,11 @@ NEAR, FAR = 0.01, 100.0
 """meshcat's default clipping distances (metres): :func:`frame` only ever widens them."""
 _CAMERA = ("Cameras", "default", "rotated", "<object>")
 _SMALLEST = 0.1          # a box smaller than this (metres) is framed as one this size
+
+
+#: Width (px) the framing assumes by default: the course site's content column, where a scene's
+#: iframe is about 674 px wide; JupyterLab's notebook is wider, so there it shows a little more.
+VIEW_WIDTH = 680
 
 
 def _camera_property(scene: Scene, name: str, value: Any) -> None:
@@ -105,7 +110,7 @@ def _centred(offsets: np.ndarray, depths: np.ndarray) -> float:
 
 
 def frame(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[str] | str | None = None,
-          bounds: Any = None, margin: float = 0.08, width: int = 1000) -> Scene:
+          bounds: Any = None, margin: float = 0.08, width: int = VIEW_WIDTH) -> Scene:
     """Point the viewer's camera at the box around the scene's objects, from ``direction``, close
     enough for the box to fill the view.
 
@@ -124,9 +129,11 @@ def frame(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[st
         The box to frame, rows ``lo`` and ``hi`` (metres), instead of the objects' box.
     margin : float, default 0.08
         Free room around the box, as a fraction of the view's half-size.
-    width : int, default 1000
+    width : int, default VIEW_WIDTH (680)
         Width in pixels the view is assumed to have (with ``scene.height``, its aspect ratio); a
-        narrower view cuts off the box's sides.
+        narrower view cuts off the box's sides, a wider one leaves room beside them. The default
+        is the course site's content column, the narrowest place a scene is shown (JupyterLab's
+        notebook is usually wider).
 
     Returns
     -------
@@ -163,7 +170,7 @@ def frame(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[st
     >>> frame(scene, direction=(0.0, 0.0, 1.0))      # from above: a 100 m x 60 m field fills the view
     Scene(title='robokit scene', commands=6)
     >>> [round(c["value"], 1) for c in scene.commands if c.get("property") == "far"]   # not cut at 100 m
-    [169.1]
+    [174.2]
     """
     check_scene(scene)
     d = as_array(direction, "direction", shape=(3,))
