@@ -18,21 +18,11 @@ def _cmd_course_build(args: argparse.Namespace) -> int:
         print(f"robokit course build: no lessons/ directory under {root.resolve()} "
               "(run it from the course repository or pass --root)", file=sys.stderr)
         return 2
-    if not (root / "book" / "conf.py").is_file():
-        print(f"robokit course build: no book/conf.py under {root.resolve()} (the site's sources; "
-              "copy book/ from the robokit course repository)", file=sys.stderr)
-        return 2
-    import importlib.util
-
-    if importlib.util.find_spec("myst_nb") is None:   # the site needs the lab extra
-        print("robokit course build: the course site needs Sphinx and myst-nb: pip install -e '.[lab]'",
-              file=sys.stderr)
-        return 2
     from .grading.selfcheck import course_grading_step
 
     steps = [] if args.no_grading else [course_grading_step]
-    return build_course(root, args.out, jobs=args.jobs, timeout=args.timeout, fast=args.fast,
-                        notebooks=[Path(p) for p in args.notebooks] or None, extra_steps=steps,
+    return build_course(root, args.out, instructor_out=args.instructor_out, jobs=args.jobs, timeout=args.timeout,
+                        fast=args.fast, notebooks=[Path(p) for p in args.notebooks] or None, extra_steps=steps,
                         api_reference=not args.no_api_reference)
 
 
@@ -162,8 +152,10 @@ def build_parser() -> argparse.ArgumentParser:
                                           "build/course/ and the instructor site build/instructor/")
     build.add_argument("notebooks", nargs="*", help="only these notebooks (default: all)")
     build.add_argument("--root", default=".", help="course repository root (default: .)")
-    build.add_argument("--out", default="build/course", help="student site directory; the instructor site and the executed "
-                       "notebooks go beside it (default: build/course)")
+    build.add_argument("--out", default="build/course",
+                       help="student site folder, to publish (default: build/course under --root)")
+    build.add_argument("--instructor-out", default="build/instructor",
+                       help="instructor site folder, with the solutions: keep it private (default: build/instructor)")
     build.add_argument("--jobs", type=int, default=None, help="notebooks run at once (default: cores)")
     build.add_argument("--timeout", type=float, default=900, help="per-notebook limit in s (default: 900)")
     build.add_argument("--fast", action="store_true", help="run with ROBOKIT_FAST=1 (shrunk experiments)")

@@ -64,10 +64,10 @@ def fast_course(tmp_path_factory):
 
     from robokit.course.build import build_report_page, discover, run_notebooks, write_sites
 
-    out = tmp_path_factory.mktemp("course-build") / "course"
+    build = tmp_path_factory.mktemp("course-build")
     quiet = lambda *_: None  # noqa: E731
-    runs = run_notebooks(discover(ROOT), out.parent / "executed", root=ROOT, jobs=2, timeout=300, fast=True,
-                         log=quiet)
-    sites = write_sites(ROOT, runs, out, [build_report_page(runs, ROOT, fast=True)], log=quiet)
-    return SimpleNamespace(runs={r.path: r for r in runs}, sites=sites, student=out,
-                           instructor=out.parent / "instructor")
+    runs = run_notebooks(discover(ROOT), build / "executed", root=ROOT, jobs=2, timeout=300, fast=True, log=quiet)
+    outs = {"course": build / "course", "instructor": build / "instructor"}
+    sites = write_sites(ROOT, runs, outs, [build_report_page(runs, ROOT, fast=True)], log=quiet, work=build / ".site")
+    return SimpleNamespace(runs={r.path: r for r in runs}, sites=sites, student=outs["course"],
+                           instructor=outs["instructor"])

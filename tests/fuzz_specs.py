@@ -740,7 +740,7 @@ SPECS: dict[str, Call] = {
     "robokit.viz.animation.animate_poses": Call({"scene": Obj(scene), "path": Text("truck"),
                                                  "transforms": Array(lambda: lap().poses[:5], "N,3|N,4,4"),
                                                  "fps": Real(10.0), "repetitions": Int(1)}),
-    "robokit.viz.framing.frame": Call({"scene": Obj(framed_scene), "direction": Array(np.array([0.5, -1.0, 0.9]), "3"),
+    "robokit.viz.framing.fit_view": Call({"scene": Obj(framed_scene), "direction": Array(np.array([0.5, -1.0, 0.9]), "3"),
                                        "paths": Text(None, optional=True),
                                        "bounds": Array(np.array([[0.0, 0.0, 0.0], [2.0, 1.0, 0.5]]), "2,3", optional=True),
                                        "margin": Real(0.08), "width": Int(1000)}),
@@ -1483,7 +1483,7 @@ NOT_FUZZED: dict[str, str] = {
 #: the functions the issue's fuzz named.
 EXTRA: tuple[str, ...] = (
     "robokit.sim.vehicle.unicycle_step",
-    "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.frame
+    "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view
     # lesson 02 (path following, pose EKF, navigation), fuzzed before the lesson exists
     *(f"robokit.controllers.path_geometry.{n}" for n in ("VisualPath", "path_from_poses", "reference_point")),
     *(f"robokit.controllers.path_following.{n}" for n in (

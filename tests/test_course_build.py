@@ -152,3 +152,31 @@ def test_the_student_site_sources_refuse_solutions(tmp_path):
         write_sources(tmp_path / "src", ROOT / "book", lessons=[], assignments=[], pages=[BookPage("x", "# x")])
     with pytest.raises(FileNotFoundError, match="book"):
         write_sources(tmp_path / "src", tmp_path, lessons=[], assignments=[])
+
+
+def test_build_refuses_output_folders_it_would_have_to_wipe(tmp_path, capsys):
+    """--out pointing at a folder with other files (the repository, docs/) is refused before any
+    notebook runs, and nothing is deleted; so is an instructor site inside the student site."""
+    root = tmp_path / "course"
+    (root / "lessons").mkdir(parents=True)
+    shutil.copytree(ROOT / "book", root / "book")
+    _notebook(root / "lessons" / "00.ipynb", "x = 1")
+    docs = root / "docs"
+    docs.mkdir()
+    (docs / "keep.txt").write_text("mine")
+    assert main(["course", "build", "--root", str(root), "--out", str(docs), "--no-grading"]) == 2
+    assert (docs / "keep.txt").read_text() == "mine" and not (root / "build" / "executed").exists()
+    assert "holds other files" in capsys.readouterr().out
+    assert main(["course", "build", "--root", str(root), "--out", str(root), "--no-grading"]) == 2
+    assert (root / "lessons" / "00.ipynb").exists()
+    assert main(["course", "build", "--root", str(root), "--out", "site",
+                 "--instructor-out", "site/private", "--no-grading"]) == 2
+    assert "instructor_out" in capsys.readouterr().out
+
+
+def test_build_needs_the_site_sources(tmp_path, capsys):
+    root = tmp_path / "course"
+    (root / "lessons").mkdir(parents=True)
+    _notebook(root / "lessons" / "00.ipynb", "x = 1")
+    assert main(["course", "build", "--root", str(root), "--no-grading"]) == 2
+    assert "book/" in capsys.readouterr().out and not (root / "build" / "executed").exists()

@@ -87,9 +87,9 @@ def test_the_camera_follows_a_walking_littledog(tmp_path):
 
 
 def test_frame_shows_a_whole_football_field(tmp_path):
-    """frame() shows a 100 m x 60 m field with a small box at each end; meshcat's own camera does not."""
+    """fit_view() shows a 100 m x 60 m field with a small box at each end; meshcat's own camera does not."""
     from robokit.geometry import se3_from_rt
-    from robokit.viz import frame
+    from robokit.viz import fit_view
 
     def field():
         s = Scene(height=420)
@@ -101,7 +101,7 @@ def test_frame_shows_a_whole_football_field(tmp_path):
     magenta = lambda im: ((im[..., 0] > 120) & (im[..., 2] > 120) & (im[..., 1] < 60)).mean()
     cyan = lambda im: ((im[..., 0] < 60) & (im[..., 1] > 120) & (im[..., 2] > 120)).mean()
     grass = lambda im: ((im[..., 1] > im[..., 0] + 20) & (im[..., 1] > im[..., 2] + 20)).mean()
-    framed = screenshot(frame(field(), (0.0, -1.0, 1.0), width=1270), tmp_path, "field_framed", (1270, 420)).astype(int)
+    framed = screenshot(fit_view(field(), (0.0, -1.0, 1.0), width=1270), tmp_path, "field_framed", (1270, 420)).astype(int)
     assert magenta(framed) > 1e-4 and cyan(framed) > 1e-4       # both ends of the field in view
     assert grass(framed) > 0.2                                    # and the grass fills a good part of it
     default = screenshot(field(), tmp_path, "field_default", (1270, 420)).astype(int)

@@ -1,11 +1,11 @@
-"""Scene.bounds knows where the drawn objects are; frame() puts the camera where they fill the view."""
+"""Scene.bounding_box knows where the drawn objects are; fit_view() puts the camera where they fill the view."""
 import numpy as np
 import pytest
 from meshcat.geometry import MeshGeometry
 
 from robokit.geometry import rot_x, rot_z, se3_from_rt
 from robokit.sim import box_room
-from robokit.viz import Scene, add_landmarks, add_littledog, add_world, frame, viewer_javascript
+from robokit.viz import Scene, add_landmarks, add_littledog, add_world, fit_view, viewer_javascript
 from robokit.viz.framing import FAR, FOV, NEAR
 
 
@@ -14,15 +14,15 @@ def moved(x=0.0, y=0.0, z=0.0, R=np.eye(3)):
 
 
 def box_of(scene, paths=None):
-    lo, hi = scene.bounds(paths)
+    lo, hi = scene.bounding_box(paths)
     return np.round(np.concatenate([lo, hi]), 6).tolist()
 
 
 # --- bounds -------------------------------------------------------------------------------------
 
 def test_an_empty_scene_has_no_bounds():
-    assert Scene().bounds() is None
-    assert Scene().add_box("a", (1, 1, 1)).bounds("b") is None
+    assert Scene().bounding_box() is None
+    assert Scene().add_box("a", (1, 1, 1)).bounding_box("b") is None
 
 
 def test_a_box_turned_45_degrees_about_z():
@@ -70,17 +70,17 @@ def test_paths_are_prefixes_of_whole_names_and_a_replaced_object_counts_once():
     s.add_sphere("robot2", 0.1, moved(10.0))                       # replaces the box at that path
     assert box_of(s, "robot2") == [9.9, -0.1, -0.1, 10.1, 0.1, 0.1]
     s.set_object("robot2", MeshGeometry("v 0 0 0\n", "obj"))           # a mesh file: not measured, not counted
-    assert s.bounds("robot2") is None
+    assert s.bounding_box("robot2") is None
 
 
 def test_a_world_and_a_robot_are_bounded_where_they_are():
     world = box_room()
-    lo, hi = add_world(Scene(), world).bounds()
+    lo, hi = add_world(Scene(), world).bounding_box()
     corners = np.concatenate([s.corners for s in world.surfaces])
     floor_and_walls = corners.min(axis=0), corners.max(axis=0)
     assert np.allclose(lo, floor_and_walls[0]) and hi[2] <= floor_and_walls[1][2] + 1e-9
     dog = add_littledog(Scene())
-    lo, hi = dog.bounds()
+    lo, hi = dog.bounding_box()
     assert lo[2] == pytest.approx(0.0, abs=0.01)                   # standing on the ground: feet at z = 0
     assert 0.15 < hi[2] < 0.3 and 0.3 < hi[0] - lo[0] < 0.5       # trunk 0.2 m up, 0.3 m long + feet
 
@@ -88,7 +88,7 @@ def test_a_world_and_a_robot_are_bounded_where_they_are():
 @pytest.mark.parametrize("paths, match", [(42, "paths"), ([], "paths"), (["a", 3], "paths"), ("/", "paths")])
 def test_bounds_refuses_bad_paths(paths, match):
     with pytest.raises((TypeError, ValueError), match=match):
-        Scene().bounds(paths)
+        Scene().bounding_box(paths)
 
 
 # --- frame --------------------------------------------------------------------------------------
@@ -131,7 +131,7 @@ def test_the_constants_are_those_of_the_bundled_viewer():
 def test_every_corner_is_in_view_and_the_box_fills_it(size, centre, direction, height, width):
     scene = Scene(height=height).add_box("thing", size, moved(*centre))
     margin = 0.1
-    frame(scene, direction, margin=margin, width=width)
+    fit_view(scene, direction, margin=margin, width=width)
     position, target, near, far = camera_of(scene)
     lo, hi = np.array(centre) - np.array(size) / 2, np.array(centre) + np.array(size) / 2
     uv, depth = project(corners(lo, hi), position, target, width / height)
@@ -154,26 +154,26 @@ def test_every_corner_is_in_view_and_the_box_fills_it(size, centre, direction, h
 
 def test_frame_looks_at_the_paths_or_bounds_given():
     scene = Scene().add_box("field", (100.0, 60.0, 0.02)).add_box("robot/body", (0.4, 0.3, 0.2), moved(20.0, 10.0, 0.1))
-    frame(scene, (0, -1, 1), paths="robot")
+    fit_view(scene, (0, -1, 1), paths="robot")
     position, target, near, far = camera_of(scene)
     assert np.linalg.norm(target - [20.0, 10.0, 0.1]) < 0.1 and np.linalg.norm(position - target) < 2.0
     assert (near, far) == (NEAR, FAR)                                     # a small box keeps meshcat's planes
-    frame(scene, (0, 0, 1), bounds=[[-50, -30, 0], [50, 30, 0]])
+    fit_view(scene, (0, 0, 1), bounds=[[-50, -30, 0], [50, 30, 0]])
     position, target, near, far = camera_of(scene)
     assert np.allclose(target, 0, atol=0.05) and far > 4 * position[2] * 0.999
 
 
 @pytest.mark.parametrize("call, match", [
-    (lambda: frame(Scene()), "scene"),
-    (lambda: frame(Scene().add_box("a", (1, 1, 1)), paths="b"), "scene"),
-    (lambda: frame(Scene().add_box("a", (1, 1, 1)), (0, 0, 0)), "direction"),
-    (lambda: frame(Scene().add_box("a", (1, 1, 1)), (1, 0)), "direction"),
-    (lambda: frame(Scene().add_box("a", (1, 1, 1)), paths="a", bounds=[[0, 0, 0], [1, 1, 1]]), "paths, bounds"),
-    (lambda: frame(Scene(), bounds=[[1, 0, 0], [0, 1, 1]]), "bounds"),
-    (lambda: frame(Scene(), bounds=[[0, 0, 0], [1e300, 1e300, 1e300]]), "bounds"),
-    (lambda: frame(Scene().add_box("a", (1, 1, 1)), margin=-0.1), "margin"),
-    (lambda: frame(Scene().add_box("a", (1, 1, 1)), width=0), "width"),
-    (lambda: frame("scene"), "scene"),
+    (lambda: fit_view(Scene()), "scene"),
+    (lambda: fit_view(Scene().add_box("a", (1, 1, 1)), paths="b"), "scene"),
+    (lambda: fit_view(Scene().add_box("a", (1, 1, 1)), (0, 0, 0)), "direction"),
+    (lambda: fit_view(Scene().add_box("a", (1, 1, 1)), (1, 0)), "direction"),
+    (lambda: fit_view(Scene().add_box("a", (1, 1, 1)), paths="a", bounds=[[0, 0, 0], [1, 1, 1]]), "paths, bounds"),
+    (lambda: fit_view(Scene(), bounds=[[1, 0, 0], [0, 1, 1]]), "bounds"),
+    (lambda: fit_view(Scene(), bounds=[[0, 0, 0], [1e300, 1e300, 1e300]]), "bounds"),
+    (lambda: fit_view(Scene().add_box("a", (1, 1, 1)), margin=-0.1), "margin"),
+    (lambda: fit_view(Scene().add_box("a", (1, 1, 1)), width=0), "width"),
+    (lambda: fit_view("scene"), "scene"),
 ])
 def test_frame_refuses_bad_input(call, match):
     with pytest.raises((ValueError, TypeError), match=match):

@@ -166,7 +166,7 @@ def test_the_camera_looks_at_the_robot_and_follows_it():
     scene = animate_trial(Scene(), log)
     target = [c for c in scene.commands if c["type"] == "set_target"][-1]["value"]
     target = np.array([target[0], -target[2], target[1]])                                 # y-up back to z-up
-    lo, hi = add_littledog(Scene(), "littledog", log.T_world_body()[0], log.q[0]).bounds()  # the robot as it starts
+    lo, hi = add_littledog(Scene(), "littledog", log.T_world_body()[0], log.q[0]).bounding_box()  # the robot as it starts
     assert np.all(target > lo - 0.03) and np.all(target < hi + 0.03)                     # looked at: at its box
     position = np.array([c for c in scene.commands if c.get("property") == "position"][-1]["value"])
     assert 0.2 < np.linalg.norm(position[[0, 2, 1]] * [1, -1, 1] - (lo + hi) / 2) < 1.0    # close to a 0.3 m robot

@@ -26,8 +26,9 @@ import time
 from pathlib import Path
 from typing import Sequence
 
-__all__ = ["SITES", "API_MODULES", "BookPage", "is_import_cell", "prepare_notebook", "write_sources",
-           "sphinx_build", "SiteBuild"]
+__all__ = ["SITES", "API_MODULES", "SITE_TOOLS", "BookPage", "is_import_cell", "prepare_notebook",
+           "write_sources", "sphinx_build", "SiteBuild", "site_tool_problems", "site_out_problem",
+           "replace_site"]
 
 #: The two sites of one build: name -> whether it is the instructor's.
 SITES = {"course": False, "instructor": True}
@@ -208,28 +209,106 @@ def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments
     return index
 
 
-def sphinx_build(src: Path, out: Path, *, instructor: bool = False, timeout: float = 600) -> SiteBuild:
-    """Render the source tree ``src`` (from :func:`write_sources`) into the HTML site ``out``.
+#: Python modules the site build needs (the ``lab`` extra), by import name.
+SITE_TOOLS = ("sphinx", "myst_nb", "sphinx_book_theme", "sphinx-mathjax-offline")
 
-    Sphinx runs in its own process (``python -m sphinx``), from scratch each time (``-E``), so a
-    site never keeps a page that the build no longer writes. Its warnings are returned, not fatal:
-    a docstring Sphinx cannot format must not hide the course.
+
+def site_tool_problems(book: Path) -> list[str]:
+    """Return what is missing to build the sites (empty when all is there): a site tool that is not
+    installed, or ``book/conf.py``. Checked before any notebook runs, so a build never fails after
+    minutes of work for want of a package."""
+    import importlib.util
+
+    problems = [f"the course site needs {name!r}: pip install -e '.[lab]'"
+                for name in SITE_TOOLS if importlib.util.find_spec(name) is None]
+    if not (Path(book) / "conf.py").is_file():
+        problems.append(f"book: expected the site's sources (conf.py) in {str(book)!r}; copy book/ from the "
+                        "robokit course repository")
+    return problems
+
+
+def site_out_problem(out: Path, work: Path) -> str:
+    """Why ``out`` cannot receive a site (empty string if it can): it must lie outside the build's
+    private ``work`` folder, and be missing, an empty folder, or an earlier Sphinx site (it holds
+    Sphinx's ``.buildinfo``), so that replacing it never deletes anything else."""
+    out, work = Path(out).resolve(), Path(work).resolve()
+    if work.is_relative_to(out) or out.is_relative_to(work):
+        return f"out: expected a folder apart from the build's work folder {str(work)!r}, got {str(out)!r}"
+    if out.exists() and (not out.is_dir() or (any(out.iterdir()) and not (out / ".buildinfo").is_file())):
+        return (f"out: expected a new or empty folder or an earlier site (with .buildinfo); {str(out)!r} "
+                "holds other files, so it is left alone")
+    return ""
+
+
+def replace_site(built: Path, out: Path) -> Path:
+    """Move the freshly built site ``built`` to ``out``, replacing the site that was there.
+
+    ``out`` is deleted only if it is empty or is itself a Sphinx site (it holds Sphinx's
+    ``.buildinfo``): a mistyped ``--out`` (the repository, ``docs/``) raises instead of being wiped.
+
+    Raises
+    ------
+    ValueError
+        If :func:`site_out_problem` finds one (``out`` holds other files, or overlaps ``built``).
     """
-    src, out = Path(src), Path(out)
+    built, out = Path(built).resolve(), Path(out).resolve()
+    problem = site_out_problem(out, built)
+    if problem:
+        raise ValueError(problem)
     if out.exists():
         shutil.rmtree(out)
-    doctrees = src.parent / f".doctrees-{src.name}"
-    warnings = src.parent / f"sphinx-warnings-{src.name}.txt"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    shutil.move(str(built), str(out))
+    return out
+
+
+def sphinx_build(src: Path, out: Path, *, instructor: bool = False, timeout: float = 600) -> SiteBuild:
+    """Render the source tree ``src`` (from :func:`write_sources`) and publish the HTML site at ``out``.
+
+    Sphinx runs in its own process (``python -m sphinx``), from scratch (``-E``), into a private
+    folder beside ``src`` (``html/``; myst-nb's ``jupyter_execute/`` and the doctrees go there too),
+    and only a finished site replaces ``out`` (:func:`replace_site`), so a site never keeps a page
+    the build no longer writes and a failed build leaves the previous site in place. Warnings are
+    returned, not fatal: a docstring Sphinx cannot format must not hide the course.
+
+    Parameters
+    ----------
+    src : Path
+        The site's sources; its parent is the site's private work folder.
+    out : Path
+        Where the site goes.
+    instructor : bool, default False
+        Passed to ``conf.py`` (``ROBOKIT_SITE``) for the site's title.
+    timeout : float, default 600
+        Wall-clock limit in seconds for Sphinx.
+
+    Returns
+    -------
+    SiteBuild
+        ``ok`` is false if Sphinx failed, timed out or wrote no ``index.html``; ``warnings`` then
+        ends with Sphinx's error output.
+    """
+    src, out = Path(src), Path(out)
+    if not isinstance(timeout, (int, float)) or not timeout > 0:
+        raise ValueError(f"timeout: expected a positive number of seconds, got {timeout!r}")
+    work = src.parent
+    html_dir, doctrees, warnings = work / "html", work / "doctrees", work / "sphinx-warnings.txt"
+    for stale in (html_dir, doctrees, work / "jupyter_execute"):
+        if stale.exists():
+            shutil.rmtree(stale)
+    warnings.unlink(missing_ok=True)
     env = dict(os.environ, ROBOKIT_SITE="instructor" if instructor else "student", PYTHONHASHSEED="0")
     cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-E", "-q", "-d", str(doctrees),
-           "-w", str(warnings), str(src), str(out)]
+           "-w", str(warnings), str(src), str(html_dir)]
     start = time.perf_counter()
     try:
         proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
-        ok, log = proc.returncode == 0, proc.stderr
+        ok, log = proc.returncode == 0 and (html_dir / "index.html").is_file(), proc.stderr
     except subprocess.TimeoutExpired:
         ok, log = False, f"sphinx-build stopped after the time limit of {timeout:.0f} s"
     text = warnings.read_text(encoding="utf-8") if warnings.exists() else ""
-    if not ok:
+    if ok:
+        replace_site(html_dir, out)
+    else:
         text = (text + "\n" + log).strip()
-    return SiteBuild(ok and (out / "index.html").exists(), time.perf_counter() - start, text, out / "index.html")
+    return SiteBuild(ok, time.perf_counter() - start, text, out / "index.html")

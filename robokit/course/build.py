@@ -1,21 +1,26 @@
 """``robokit course build``: run every lesson and solution notebook, then write the two course sites.
 
-Layout of one build (``out`` is the student site, by default ``build/course``)::
+Layout of one build. The two sites go where asked (by default under ``build/``); everything else
+stays in the repository's private ``build/`` whatever the sites' folders are::
 
-    build/executed/     the executed notebooks (lessons-NN.ipynb, solutions-NN.ipynb); not published
-    build/course/       the student site: lessons, blank assignments, library reference, references
-    build/instructor/   the instructor site: all of that plus solutions, grading self-check, build report
-    build/.site-src/    the Sphinx sources of both (generated), with Sphinx's warnings
+    build/course/           the student site: lessons, blank assignments, library reference, references
+    build/instructor/       the instructor site: that plus solutions, grading self-check, build report
+    build/executed/         the executed notebooks (lessons-NN.ipynb, solutions-NN.ipynb)
+    build/reports/          grades.csv of the grading self-check
+    build/.site/<site>/     Sphinx's sources (src/), output before it is moved (html/), doctrees,
+                            myst-nb's jupyter_execute/ and sphinx-warnings.txt, per site
 """
 from __future__ import annotations
 
 import html
 import os
+import shutil
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Callable, Sequence
 
-from .book import API_MODULES, SITES, BookPage, SiteBuild, prepare_notebook, sphinx_build, write_sources
+from .book import (API_MODULES, SITES, BookPage, SiteBuild, prepare_notebook, site_out_problem, site_tool_problems,
+                   sphinx_build, write_sources)
 from .execute import NotebookRun, run_notebook
 
 __all__ = ["discover", "build_course", "run_notebooks", "write_sites", "format_summary", "build_report_page"]
@@ -77,7 +82,8 @@ def _failure_note(run: NotebookRun) -> str:
             "outputs below stop where it stopped.")
 
 
-def build_course(root: str | Path = ".", out: str | Path = "build/course", *, jobs: int | None = None,
+def build_course(root: str | Path = ".", out: str | Path = "build/course", *,
+                 instructor_out: str | Path = "build/instructor", jobs: int | None = None,
                  timeout: float = 900, fast: bool = False, notebooks: Sequence[Path] | None = None,
                  log: Callable[[str], None] = print, extra_steps: Sequence[ExtraStep] = (),
                  api_reference: bool = True) -> int:
@@ -88,8 +94,10 @@ def build_course(root: str | Path = ".", out: str | Path = "build/course", *, jo
     root : path, default "."
         Repository root (holds ``lessons/``, ``solutions/``, ``assignments/`` and ``book/``).
     out : path, default "build/course"
-        The student site; the instructor site goes to the sibling ``instructor/`` and the executed
-        notebooks to the sibling ``executed/``.
+        The student site (relative paths are from ``root``). It may be published.
+    instructor_out : path, default "build/instructor"
+        The instructor site, with the solutions: keep it private. The executed notebooks, the
+        grading report and Sphinx's work stay in ``root/build/`` whatever these two are.
     jobs : int, optional
         Notebooks run at once; defaults to the number of available cores.
     timeout : float, default 900
@@ -110,18 +118,27 @@ def build_course(root: str | Path = ".", out: str | Path = "build/course", *, jo
     Returns
     -------
     int
-        0 if every notebook, every extra step and both sites succeeded, 1 otherwise.
+        0 if every notebook, every extra step and both sites succeeded, 1 otherwise, 2 if nothing was
+        run (a site tool or ``book/`` missing, an output folder that cannot be replaced).
 
     Notes
     -----
     Course tooling (DESIGN.md, "Course build"); not from a paper.
     """
     root = Path(root).resolve()
-    out = Path(out)
-    out = (out if out.is_absolute() else root / out).resolve()
-    build = out.parent
-    executed = build / "executed"
-    executed.mkdir(parents=True, exist_ok=True)
+    work = root / "build"
+    outs = {name: (p if p.is_absolute() else root / p).resolve()
+            for name, p in (("course", Path(out)), ("instructor", Path(instructor_out)))}
+    problems = site_tool_problems(root / "book")
+    problems += [p for site in outs.values() for p in [site_out_problem(site, work / ".site")] if p]
+    if outs["course"].is_relative_to(outs["instructor"]) or outs["instructor"].is_relative_to(outs["course"]):
+        problems.append(f"instructor_out: expected a folder apart from the student site {str(outs['course'])!r}, "
+                        f"got {str(outs['instructor'])!r}")
+    if problems:
+        for problem in problems:
+            log(f"robokit course build: {problem}")
+        return 2
+    executed = work / "executed"
     paths = [Path(p).resolve() for p in notebooks] if notebooks else discover(root)
     if not paths:
         log(f"no notebooks found under {root} in {', '.join(BUILD_DIRS)}")
@@ -130,17 +147,18 @@ def build_course(root: str | Path = ".", out: str | Path = "build/course", *, jo
     ok = all(r.ok for r in runs)
     pages = [build_report_page(runs, root, fast=fast)]
     for step in extra_steps:
-        step_ok, page = step(root, build / "reports")
+        step_ok, page = step(root, work / "reports")
         ok = ok and step_ok
         pages.append(page)
-    sites = write_sites(root, runs, out, pages, log=log, api_modules=API_MODULES if api_reference else ())
+    sites = write_sites(root, runs, outs, pages, log=log, api_modules=API_MODULES if api_reference else (),
+                        work=work / ".site")
     ok = ok and all(s.ok for s in sites.values())
     log("")
     log(format_summary(runs, root))
     for name, site in sites.items():
         n_warn = len(site.warnings.splitlines())
         log(f"{name} site: {site.index} ({'ok' if site.ok else 'FAILED'}, {site.seconds:.1f} s, "
-            f"{n_warn} Sphinx warning lines{'' if not n_warn else ' in build/.site-src/sphinx-warnings-' + name + '.txt'})")
+            f"{n_warn} Sphinx warning lines{'' if not n_warn else ' in build/.site/' + name + '/sphinx-warnings.txt'})")
         if not site.ok:
             log(site.warnings[-3000:])
     return 0 if ok else 1
@@ -163,29 +181,53 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
         return list(pool.map(one, paths))
 
 
-def write_sites(root: Path, runs: Sequence[NotebookRun], out: Path, pages: Sequence[BookPage] = (), *,
-                log: Callable[[str], None] = print, api_modules: Sequence[str] = API_MODULES) -> dict[str, SiteBuild]:
-    """Write the Sphinx sources of the student site ``out`` and the instructor site beside it
-    (``out/../instructor``) from the executed ``runs``, and render both side by side (one Sphinx
-    process each). ``pages`` join the instructor site only."""
-    book = root / "book"
+def write_sites(root: Path, runs: Sequence[NotebookRun], outs: dict[str, Path], pages: Sequence[BookPage] = (),
+                *, log: Callable[[str], None] = print, api_modules: Sequence[str] = API_MODULES,
+                work: Path | None = None) -> dict[str, SiteBuild]:
+    """Write the Sphinx sources of both sites from the executed ``runs`` and render them side by side.
+
+    Parameters
+    ----------
+    root : Path
+        Repository root (``book/``, ``assignments/``; the work folder is ``root/build/.site``).
+    runs : sequence of NotebookRun
+        The executed lessons and solutions (a failed run's page shows what ran, with a warning).
+    outs : dict
+        Where each site of :data:`~robokit.course.book.SITES` goes (``"course"``, ``"instructor"``).
+    pages : sequence of BookPage
+        Pages of the instructor site only (build report, grading self-check).
+    log : callable, default print
+    api_modules : sequence of str
+        Modules of the library reference (empty: none).
+    work : Path, optional
+        The private work folder (sources, Sphinx output before it moves); ``root/build/.site``.
+
+    Returns
+    -------
+    dict
+        Site name -> :class:`~robokit.course.book.SiteBuild`.
+    """
+    missing = set(SITES) - set(outs)
+    if missing:
+        raise ValueError(f"outs: expected a folder for every site {sorted(SITES)}, missing {sorted(missing)}")
     lessons = [r for r in runs if r.path.parent.name == "lessons"]
     solutions = [r for r in runs if r.path.parent.name == "solutions"]
     assignments = discover(root, ("assignments",))
-    src_root = out.parent / ".site-src"
-    outs = {"course": out, "instructor": out.parent / "instructor"}
-    staged = src_root / "notebooks"
+    work = Path(work) if work is not None else root / "build" / ".site"
+    staged = work / "notebooks"
+    if staged.exists():
+        shutil.rmtree(staged)
     for run in runs:   # an executed copy if there is one, else the source notebook, with a warning
         source = run.executed if run.executed is not None and run.executed.exists() else run.path
         prepare_notebook(source, staged / run.path.parent.name / run.path.name, note=_failure_note(run))
     staged_lessons = [staged / "lessons" / r.path.name for r in lessons]
     staged_solutions = [staged / "solutions" / r.path.name for r in solutions]
     for name, instructor in SITES.items():
-        write_sources(src_root / name, book, lessons=staged_lessons, assignments=assignments,
+        write_sources(work / name / "src", root / "book", lessons=staged_lessons, assignments=assignments,
                       solutions=staged_solutions if instructor else (), pages=pages if instructor else (),
                       instructor=instructor, api_modules=api_modules)
     log("rendering the student and instructor sites with Sphinx ...")
     with ThreadPoolExecutor(max_workers=len(SITES)) as pool:
-        futures = {name: pool.submit(sphinx_build, src_root / name, outs[name], instructor=instructor)
+        futures = {name: pool.submit(sphinx_build, work / name / "src", outs[name], instructor=instructor)
                    for name, instructor in SITES.items()}
         return {name: f.result() for name, f in futures.items()}

@@ -186,6 +186,7 @@ def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
     cwd.mkdir()
     dst = Path(output).resolve() if output else workdir / path.name
     dst.parent.mkdir(parents=True, exist_ok=True)
+    dst.unlink(missing_ok=True)    # a worker killed at the time limit writes nothing: never show an old run
     result_file = workdir / "result.json"
     cmd = [sys.executable, "-m", "robokit.course.execute", str(path), str(dst), str(result_file),
            "--cwd", str(cwd), "--runtime-dir", str(workdir), "--cell-timeout", str(int(max(1, timeout)))]

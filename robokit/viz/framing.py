@@ -4,7 +4,7 @@ meshcat's viewer has one perspective camera (three.js ``PerspectiveCamera(75, 1,
 viewer bundled with the ``meshcat`` package: a 75 degree vertical field of view, and nothing nearer
 than 1 cm or farther than 100 m is drawn), orbiting a target point. A lesson's scene shows what its
 text talks about when the camera looks at that and stands just far enough away for it to fill the
-view: :func:`frame` works that distance out from the box around the objects (:meth:`Scene.bounds`)
+view: :func:`frame` works that distance out from the box around the objects (:meth:`Scene.bounding_box`)
 and moves the clipping planes past the box, so a 100 m field is not cut off at 100 m.
 """
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 from ..validation import as_array, check_finite_result, check_int, check_positive
 from .scene import Scene, check_scene
 
-__all__ = ["look_from", "frame", "FOV", "NEAR", "FAR", "VIEW_WIDTH"]
+__all__ = ["look_from", "fit_view", "FOV", "NEAR", "FAR", "VIEW_WIDTH"]
 
 FOV = 75.0
 """Vertical field of view (degrees) of meshcat's default camera."""
@@ -109,7 +109,7 @@ def _centred(offsets: np.ndarray, depths: np.ndarray) -> float:
     return (lo + hi) / 2
 
 
-def frame(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[str] | str | None = None,
+def fit_view(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[str] | str | None = None,
           bounds: Any = None, margin: float = 0.08, width: int = VIEW_WIDTH) -> Scene:
     """Point the viewer's camera at the box around the scene's objects, from ``direction``, close
     enough for the box to fill the view.
@@ -123,7 +123,7 @@ def frame(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[st
         horizon; ``(0, 0, 1)`` looks straight down with +y up in the image; ``(-1, 0, 0.3)`` looks
         along +x from behind, slightly above.
     paths : str or sequence of str, optional
-        Frame only the objects at or under these scene paths (:meth:`Scene.bounds`), e.g. the robot
+        Frame only the objects at or under these scene paths (:meth:`Scene.bounding_box`), e.g. the robot
         rather than the whole world.
     bounds : array_like, shape (2, 3), optional
         The box to frame, rows ``lo`` and ``hi`` (metres), instead of the objects' box.
@@ -161,13 +161,13 @@ def frame(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[st
 
     The near clipping plane is set before the nearest corner (at most meshcat's 1 cm) and the far
     one at four times the farthest corner (at least meshcat's 100 m), so the box can be orbited and
-    zoomed out of without being cut. Animations are not in the box (:meth:`Scene.bounds`).
+    zoomed out of without being cut. Animations are not in the box (:meth:`Scene.bounding_box`).
 
     Examples
     --------
-    >>> from robokit.viz import Scene, frame
+    >>> from robokit.viz import Scene, fit_view
     >>> scene = Scene(height=420).add_box("field", size=(100.0, 60.0, 0.02))
-    >>> frame(scene, direction=(0.0, 0.0, 1.0))      # from above: a 100 m x 60 m field fills the view
+    >>> fit_view(scene, direction=(0.0, 0.0, 1.0))      # from above: a 100 m x 60 m field fills the view
     Scene(title='robokit scene', commands=6)
     >>> [round(c["value"], 1) for c in scene.commands if c.get("property") == "far"]   # not cut at 100 m
     [174.2]
@@ -182,7 +182,7 @@ def frame(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[st
     margin = check_positive(margin, "margin", allow_zero=True)
     aspect = check_int(width, "width", minimum=1) / scene.height
     if bounds is None:
-        found = scene.bounds(paths)
+        found = scene.bounding_box(paths)
         if found is None:
             where = "" if paths is None else f" under {paths!r}"
             raise ValueError(f"scene: expected objects{where} to frame, got none")

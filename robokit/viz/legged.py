@@ -132,9 +132,9 @@ def add_littledog(scene: Scene, path: str = "littledog", T_world_body: Any = Non
 
     Examples
     --------
-    >>> from robokit.viz import Scene, frame
+    >>> from robokit.viz import Scene, fit_view
     >>> scene = add_littledog(Scene())                   # standing at the origin
-    >>> frame(scene, direction=(0.55, -1.0, 0.6))        # seen from its front right, filling the view
+    >>> fit_view(scene, direction=(0.55, -1.0, 0.6))        # seen from its front right, filling the view
     Scene(title='robokit scene', commands=59)
     """
     check_scene(scene, path)
@@ -344,7 +344,7 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
     root, overlay = path.strip("/"), path.strip("/") + "_overlay"
     add_littledog(scene, root, log.T_world_body()[0], log.q[0])
     if frame:                     # on the robot alone: its unit force arrows are scaled by the animation
-        framing.frame(scene, _VIEW, paths=root, margin=_ROOM)
+        framing.fit_view(scene, _VIEW, paths=root, margin=_ROOM)
         scene.set_camera_follow(root)
     _add_overlays(scene, root, overlay, bool(support), bool(com), bool(forces), bool(mocap))
 

@@ -175,7 +175,7 @@ class Scene:
         elif isinstance(command, SetTransform):
             self._poses[tuple(command.path.entries)] = np.asarray(command.matrix, float)
 
-    def bounds(self, paths: Sequence[str] | str | None = None) -> tuple[np.ndarray, np.ndarray] | None:
+    def bounding_box(self, paths: Sequence[str] | str | None = None) -> tuple[np.ndarray, np.ndarray] | None:
         """The axis-aligned box (world frame, metres) around what the scene draws, as it stands.
 
         Parameters
@@ -210,10 +210,10 @@ class Scene:
         >>> scene = Scene().add_box("robot/body", size=(2.0, 1.0, 0.5))
         >>> scene.set_transform("robot", [[1, 0, 0, 5.0], [0, 1, 0, 0], [0, 0, 1, 0.25], [0, 0, 0, 1]])
         Scene(title='robokit scene', commands=3)
-        >>> lo, hi = scene.bounds()
+        >>> lo, hi = scene.bounding_box()
         >>> lo.tolist(), hi.tolist()
         ([4.0, -0.5, 0.0], [6.0, 0.5, 0.5])
-        >>> scene.bounds("elsewhere") is None
+        >>> scene.bounding_box("elsewhere") is None
         True
         """
         if paths is None:
