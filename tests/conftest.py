@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import contextlib
+import os
 import shutil
 import tempfile
 from pathlib import Path
@@ -10,6 +11,13 @@ from typing import Iterator
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+
+#: Headless Chromium for the browser tests (Debian's ``chromium``; ``.ci/run`` installs it).
+CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
+#: Browser tests skip without Chromium, unless ROBOKIT_REQUIRE_BROWSER=1 (CI sets it): then they fail.
+needs_chromium = pytest.mark.skipif(
+    CHROMIUM is None and os.environ.get("ROBOKIT_REQUIRE_BROWSER") != "1",
+    reason="no Chromium on PATH (Debian package 'chromium'; .ci/run installs it)")
 
 
 @pytest.fixture(scope="session")

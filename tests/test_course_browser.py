@@ -5,7 +5,6 @@ remote image, a console error, a broken formula, MathJax's fonts out of reach, a
 finishes loading) next to a clean control, so every check is seen both failing and passing.
 """
 import importlib.util
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -13,16 +12,13 @@ import pytest
 
 from robokit.course.browser import Browser, BrowserError, changed_fraction, content_fraction
 from robokit.course.cdp import find_chromium
+from tests.conftest import CHROMIUM, needs_chromium
 
-CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)),
-                None)
 
 
 def _slow(test):
     """Marks a test that drives Chromium: slow, and skipped where there is none."""
-    skip = pytest.mark.skipif(CHROMIUM is None, reason="no Chromium on PATH (Debian package 'chromium'; "
-                                                       ".ci/run installs it)")
-    return pytest.mark.slow(skip(test))
+    return pytest.mark.slow(needs_chromium(test))
 
 
 def _mathjax() -> Path | None:
@@ -211,7 +207,7 @@ def test_a_scene_is_screenshot_and_differs_from_an_empty_one(browser, tmp_path):
     assert len(report.scenes) == 2
     drawn, empty = (s.pixels() for s in report.scenes)
     assert all(s.canvas and s.settled for s in report.scenes)
-    assert drawn.shape == empty.shape and drawn.shape[0] == box.height
+    assert drawn.shape == empty.shape and drawn.shape[0] == box.height - 2   # inside the 1 px border (border-box)
     magenta = (drawn[..., 0] > 120) & (drawn[..., 2] > 120) & (drawn[..., 1] < 60)
     assert magenta.mean() > 0.02
     assert changed_fraction(drawn, empty) > 0.02

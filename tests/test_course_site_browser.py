@@ -2,18 +2,16 @@
 would: no failed request, no console error, every formula rendered with MathJax's own fonts, every
 3D scene drawn and covering a reasonable part of its view. The site is the one the ``fast_course``
 fixture built from the repository's notebooks."""
+import base64
 import html
-import shutil
+import re
 
 import pytest
 
 from robokit.course.browser import SCENE_TITLE, Browser, changed_fraction
+from tests.conftest import CHROMIUM, needs_chromium
 
-CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
-
-pytestmark = [pytest.mark.slow, pytest.mark.notebook,
-              pytest.mark.skipif(CHROMIUM is None, reason="no Chromium on PATH (Debian package 'chromium'; "
-                                                          ".ci/run installs it)")]
+pytestmark = [pytest.mark.slow, pytest.mark.notebook, needs_chromium]
 
 #: Share of a scene's pixels that must differ from an empty scene of the same size: the robot,
 #: world or arm the text talks about fills a reasonable part of the view, not a speck on the grid.
@@ -28,25 +26,33 @@ def reports(fast_course):
         return {str(p.relative_to(fast_course.student)): browser.inspect(p, timeout=90) for p in pages}
 
 
-@pytest.fixture(scope="module")
-def empty_scene(tmp_path_factory):
-    """Screenshots of an empty scene, per iframe size, to tell a drawn scene from the bare grid."""
-    from robokit.viz import Scene
+SCENE_IFRAME = re.compile(r'<iframe srcdoc="([^"]*)"[^>]*title="' + re.escape(SCENE_TITLE) + '"')
+COMMANDS = re.compile(r"var robokitCommands = \[(.*?)\];", re.S)
 
-    cache, folder = {}, tmp_path_factory.mktemp("empty-scenes")
 
-    def shot(width: float, height: float):
-        key = (round(width), round(height))
-        if key not in cache:
-            page = folder / f"empty-{key[0]}x{key[1]}.html"
-            page.write_text(f'<html><body style="margin:0"><iframe title="{SCENE_TITLE}" '
-                            f'style="width:{key[0]}px;height:{key[1]}px;border:0" '
-                            f'srcdoc="{html.escape(Scene().html(), quote=True)}"></iframe></body></html>')
-            with Browser(CHROMIUM) as browser:
-                cache[key] = browser.inspect(page).scenes[0].pixels()
-        return cache[key]
+def camera_only(page_html: str) -> str:
+    """The scene page with every command dropped but the camera's (position, target, clipping
+    planes): the same view of meshcat's empty grid, the reference a drawn scene is compared with."""
+    import umsgpack
 
-    return shot
+    def keep(encoded: str) -> bool:
+        command = umsgpack.unpackb(base64.b64decode(encoded.strip().strip('"')))
+        return command.get("type") == "set_target" or str(command.get("path", "")).startswith("/Cameras")
+
+    match = COMMANDS.search(page_html)
+    kept = [c for c in match.group(1).split(",") if c.strip() and keep(c)]
+    return page_html[:match.start(1)] + ",".join(kept) + page_html[match.end(1):]
+
+
+def scene_coverage(browser: Browser, scene, scene_html: str, folder) -> float:
+    """Share of the scene's pixels that differ from the same camera's view of an empty scene."""
+    width, height = round(scene.rect[2]), round(scene.rect[3])
+    page = folder / f"empty-{abs(hash(scene_html))}.html"
+    page.write_text(f'<html><body style="margin:0"><iframe title="{SCENE_TITLE}" style="width:{width}px;'
+                    f'height:{height}px;border:0" srcdoc="{html.escape(camera_only(scene_html), quote=True)}">'
+                    "</iframe></body></html>")
+    empty = browser.inspect(page).scenes[0].pixels()
+    return changed_fraction(scene.pixels(), empty)
 
 
 def test_every_page_was_inspected(reports):
@@ -69,17 +75,42 @@ def test_maths_renders_with_its_own_fonts(reports):
         assert math.fonts_loaded, (page, math.fonts)
 
 
-def test_every_scene_is_drawn_and_fills_its_view(reports, empty_scene):
-    scenes = [(page, s) for page, r in reports.items() for s in r.scenes]
-    assert len(scenes) >= 8, "every lesson shows at least one 3D scene"
-    thin = []
-    for page, scene in scenes:
-        assert scene.png, f"{page}: scene {scene.index} not visible"
-        image = scene.pixels()
-        covered = changed_fraction(image, empty_scene(scene.rect[2], scene.rect[3]))
-        if covered < MIN_SCENE_CONTENT:
-            thin.append(f"{page} scene {scene.index}: {covered:.3f} of the view differs from an empty scene")
+def test_every_scene_is_drawn_and_fills_its_view(reports, fast_course, tmp_path):
+    thin, n_scenes = [], 0
+    with Browser(CHROMIUM) as browser:
+        for page, report in reports.items():
+            if not report.scenes:
+                continue
+            sources = [html.unescape(m.group(1)) for m in
+                       SCENE_IFRAME.finditer((fast_course.student / page).read_text(encoding="utf-8"))]
+            assert len(sources) == len(report.scenes), page
+            for scene, source in zip(report.scenes, sources):
+                n_scenes += 1
+                assert scene.png, f"{page}: scene {scene.index} not visible"
+                covered = scene_coverage(browser, scene, source, tmp_path)
+                if covered < MIN_SCENE_CONTENT:
+                    thin.append(f"{page} scene {scene.index}: {covered:.3f} of the view differs from the empty grid")
+    assert n_scenes >= 8, "every lesson shows at least one 3D scene"
     assert not thin, "\n".join(thin)
+
+
+def test_the_coverage_measure_catches_a_speck_on_the_grid(tmp_path):
+    """A 10 cm box in a view framed on 30 m (the grid seen from the same camera) scores far below the
+    threshold, and the same box framed on itself far above: the scene check can fail."""
+    from robokit.viz import Scene, fit_view
+
+    def coverage(scene):
+        page = tmp_path / f"scene-{len(list(tmp_path.iterdir()))}.html"
+        page.write_text(f"<html><body style='margin:0'>{scene._repr_html_()}</body></html>")
+        with Browser(CHROMIUM) as browser:
+            shot = browser.inspect(page).scenes[0]
+            return scene_coverage(browser, shot, scene.html(), tmp_path)
+
+    speck = fit_view(Scene(height=420).add_box("speck", (0.1, 0.1, 0.1), color=0xFF00FF),
+                     (0.5, -1.0, 0.9), bounds=[[-15, -15, 0], [15, 15, 1]])
+    filled = fit_view(Scene(height=420).add_box("speck", (0.1, 0.1, 0.1), color=0xFF00FF), (0.5, -1.0, 0.9))
+    assert coverage(speck) < 0.01 < MIN_SCENE_CONTENT
+    assert coverage(filled) > 0.2
 
 
 def test_page_titles_are_the_pages_own(reports):

@@ -108,6 +108,11 @@ def prepare_notebook(src: Path, dst: Path, *, title: tuple[str, str] | None = No
         ``dst``.
     """
     src, dst = Path(src), Path(dst)
+    if title is not None and (not isinstance(title, tuple) or len(title) != 2
+                              or not all(isinstance(t, str) and t for t in title)):
+        raise TypeError(f"title: expected a pair of non-empty strings (old, new), got {title!r}")
+    if not isinstance(note, str):
+        raise TypeError(f"note: expected a string, got {type(note).__name__}")
     if not src.is_file():
         raise FileNotFoundError(f"src: expected a notebook file, got {str(src)!r}")
     nb = json.loads(src.read_text(encoding="utf-8"))
@@ -176,8 +181,24 @@ def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments
         Build the instructor site (its home page, solutions and extra pages).
     api_modules : sequence of str, default API_MODULES
         Modules of the library reference; empty for a quicker site without it.
+
+    Returns
+    -------
+    Path
+        The site's ``index.md`` (home page plus the generated tables of contents).
+
+    Raises
+    ------
+    ValueError
+        If the student site is given solutions or instructor pages.
+    FileNotFoundError
+        If ``book`` has no ``conf.py``, or a notebook is missing.
+    TypeError
+        If ``api_modules`` is not a sequence of ``robokit.*`` names.
     """
     src, book = Path(src), Path(book)
+    if isinstance(api_modules, str) or not all(isinstance(m, str) and m.startswith("robokit.") for m in api_modules):
+        raise TypeError(f"api_modules: expected a sequence of robokit module names, got {api_modules!r}")
     if not (book / "conf.py").is_file():
         raise FileNotFoundError(f"book: expected the site sources (conf.py) in {str(book)!r}")
     if not instructor and (solutions or pages):

@@ -63,7 +63,21 @@ def format_summary(runs: Sequence[NotebookRun], root: Path) -> str:
 
 
 def build_report_page(runs: Sequence[NotebookRun], root: Path, *, fast: bool) -> BookPage:
-    """The instructor site's build report: status and run time of every notebook, full error tails."""
+    """The instructor site's build report: status and run time of every notebook, full error tails.
+
+    Parameters
+    ----------
+    runs : sequence of NotebookRun
+    root : Path
+        Repository root (notebook names are shown relative to it).
+    fast : bool
+        Whether the notebooks ran in fast mode (said on the page).
+
+    Returns
+    -------
+    BookPage
+        ``instructor/build``.
+    """
     rows = "".join(f"| `{_name(r, root)}` | {'ok' if r.ok else '**' + r.status + '**'} | {r.seconds:.1f} s |\n"
                    for r in runs)
     errors = "".join(f"\n## `{_name(r, root)}`: {r.status}\n\n<pre>{html.escape(r.error)}</pre>\n"
@@ -166,7 +180,32 @@ def build_course(root: str | Path = ".", out: str | Path = "build/course", *,
 
 def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: int | None = None,
                   timeout: float = 900, fast: bool = False, log: Callable[[str], None] = print) -> list[NotebookRun]:
-    """Execute ``paths`` (``jobs`` at a time, each in a fresh kernel) into ``executed/<folder>-<name>``."""
+    """Execute ``paths``, ``jobs`` at a time, each in a fresh kernel (:func:`run_notebook`).
+
+    Parameters
+    ----------
+    paths : sequence of Path
+        The notebooks.
+    executed : Path
+        Folder of the executed copies, named ``<folder>-<name>`` (``lessons-01_visual_slam.ipynb``).
+    root : Path
+        Repository root (progress lines name notebooks relative to it).
+    jobs : int, optional
+        Notebooks at once; the number of available cores by default.
+    timeout : float, default 900
+        Per-notebook wall-clock limit in seconds.
+    fast : bool, default False
+        Run with ``ROBOKIT_FAST=1``.
+    log : callable, default print
+        Receives one progress line per notebook.
+
+    Returns
+    -------
+    list of NotebookRun
+        In the order of ``paths``.
+    """
+    if jobs is not None and (not isinstance(jobs, int) or jobs < 1):
+        raise ValueError(f"jobs: expected a positive number of notebooks at once, got {jobs!r}")
     if not jobs:
         jobs = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     executed.mkdir(parents=True, exist_ok=True)

@@ -77,13 +77,8 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
 
     Examples
     --------
-    A right answer (here the exercise's own reference, so that this page shows no solution):
-
-    >>> from robokit.exercises import get_exercise
-    >>> check("00.wrap_angle", get_exercise("00.wrap_angle").reference, verbose=False)
-    check 00.wrap_angle: 6/6 public cases passed (feedback only; your grade comes from hidden cases)
-
-    A wrong answer fails the cell, and the message says which cases and why:
+    A right answer prints ``check 00.wrap_angle: 6/6 public cases passed (...)`` and returns
+    nothing. A wrong answer fails the cell, and the message says which cases and why:
 
     >>> check("00.wrap_angle", lambda angle: angle, verbose=False)
     Traceback (most recent call last):
@@ -113,8 +108,9 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
             lines.append(text)
     print(f"check {exercise.id}: {len(cases) - failed}/{len(cases)} public cases passed "
           "(feedback only; your grade comes from hidden cases)")
-    if verbose and lines:
-        print("\n".join(lines))
+    passes = [line for line in lines if not line.lstrip().startswith("FAIL")]
+    if verbose and passes:          # the failed cases are in the error's message, shown once
+        print("\n".join(passes))
     if failed:
         failures = "\n".join(line for line in lines if line.lstrip().startswith("FAIL"))
         raise CheckFailed(f"{exercise.id}: {failed} of {len(cases)} public cases failed:\n{failures}")

@@ -51,6 +51,14 @@ def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int 
     return rows
 
 
+def _markdown_text(text: str) -> str:
+    """``text`` as literal Markdown table-cell text: one line, with every character MyST would read
+    as markup (``$`` maths, ``*`` emphasis, ``|`` cells, ``<`` HTML ...) backslash-escaped."""
+    import re
+
+    return re.sub(r"([\\`*_$|\[\]{}<>#])", r"\\\1", text.replace("\n", " "))
+
+
 def course_grading_step(root: Path, workdir: Path) -> tuple[bool, BookPage]:
     """Extra step for ``robokit course build``: grade the course, write ``grades.csv`` into
     ``workdir`` and return the instructor site's self-check page (verdicts, full worker logs)."""
@@ -68,7 +76,7 @@ def course_grading_step(root: Path, workdir: Path) -> tuple[bool, BookPage]:
              "sandboxed grader that grades submissions (table: {download}`grades.csv <grades.csv>`).", "",
              "| assignment | notebook | score | verdict |", "|---|---|---|---|"]
     for r in rows:
-        verdict = "ok" if r["ok"] else "**wrong**: " + html.escape(r["note"]).replace("|", "\\|").replace("\n", " ")
+        verdict = "ok" if r["ok"] else "**wrong**: " + _markdown_text(r["note"])
         lines.append(f"| `{r['assignment']}` | {r['kind']} | {r['total']:g} / {r['max']:g} | {verdict} |")
     lines += ["", "## Worker logs", ""]
     for r in rows:
