@@ -8,14 +8,18 @@ import re
 
 import pytest
 
-from robokit.course.browser import SCENE_TITLE, Browser, changed_fraction
+from robokit.course.browser import SCENE_TITLE, Browser
+from robokit.course.screenshots import changed_span, changed_fraction
 from tests.conftest import CHROMIUM, needs_chromium
 
 pytestmark = [pytest.mark.slow, pytest.mark.notebook, needs_chromium]
 
-#: Share of a scene's pixels that must differ from an empty scene of the same size: the robot,
-#: world or arm the text talks about fills a reasonable part of the view, not a speck on the grid.
-MIN_SCENE_CONTENT = 0.05
+#: A scene is drawn if this share of its pixels differs from its camera's view of the empty grid ...
+MIN_SCENE_PIXELS = 0.002
+#: ... and framed on its content if what differs spans this share of the view's height or width (a
+#: robot arm or a path drawn with lines changes few pixels however well it is framed, a long corridor
+#: is a strip; a speck on the grid spans little either way).
+MIN_SCENE_SPAN = 0.6
 
 
 @pytest.fixture(scope="module")
@@ -44,15 +48,16 @@ def camera_only(page_html: str) -> str:
     return page_html[:match.start(1)] + ",".join(kept) + page_html[match.end(1):]
 
 
-def scene_coverage(browser: Browser, scene, scene_html: str, folder) -> float:
-    """Share of the scene's pixels that differ from the same camera's view of an empty scene."""
+def scene_coverage(browser: Browser, scene, scene_html: str, folder) -> tuple[float, float]:
+    """(share of pixels, larger share of the view's height or width spanned) that differ from the
+    same camera's view of an empty scene."""
     width, height = round(scene.rect[2]), round(scene.rect[3])
     page = folder / f"empty-{abs(hash(scene_html))}.html"
     page.write_text(f'<html><body style="margin:0"><iframe title="{SCENE_TITLE}" style="width:{width}px;'
                     f'height:{height}px;border:0" srcdoc="{html.escape(camera_only(scene_html), quote=True)}">'
                     "</iframe></body></html>")
     empty = browser.inspect(page).scenes[0].pixels()
-    return changed_fraction(scene.pixels(), empty)
+    return changed_fraction(scene.pixels(), empty), changed_span(scene.pixels(), empty)
 
 
 def test_every_page_was_inspected(reports):
@@ -87,9 +92,10 @@ def test_every_scene_is_drawn_and_fills_its_view(reports, fast_course, tmp_path)
             for scene, source in zip(report.scenes, sources):
                 n_scenes += 1
                 assert scene.png, f"{page}: scene {scene.index} not visible"
-                covered = scene_coverage(browser, scene, source, tmp_path)
-                if covered < MIN_SCENE_CONTENT:
-                    thin.append(f"{page} scene {scene.index}: {covered:.3f} of the view differs from the empty grid")
+                pixels, span = scene_coverage(browser, scene, source, tmp_path)
+                if pixels < MIN_SCENE_PIXELS or span < MIN_SCENE_SPAN:
+                    thin.append(f"{page} scene {scene.index}: {pixels:.3f} of its pixels differ from its camera's "
+                                f"view of the empty grid, spanning {span:.2f} of the view")
     assert n_scenes >= 8, "every lesson shows at least one 3D scene"
     assert not thin, "\n".join(thin)
 
@@ -102,15 +108,17 @@ def test_the_coverage_measure_catches_a_speck_on_the_grid(tmp_path):
     def coverage(scene):
         page = tmp_path / f"scene-{len(list(tmp_path.iterdir()))}.html"
         page.write_text(f"<html><body style='margin:0'>{scene._repr_html_()}</body></html>")
-        with Browser(CHROMIUM) as browser:
+        with Browser(CHROMIUM, width=700) as browser:       # about the site's content column
             shot = browser.inspect(page).scenes[0]
             return scene_coverage(browser, shot, scene.html(), tmp_path)
 
     speck = fit_view(Scene(height=420).add_box("speck", (0.1, 0.1, 0.1), color=0xFF00FF),
                      (0.5, -1.0, 0.9), bounds=[[-15, -15, 0], [15, 15, 1]])
     filled = fit_view(Scene(height=420).add_box("speck", (0.1, 0.1, 0.1), color=0xFF00FF), (0.5, -1.0, 0.9))
-    assert coverage(speck) < 0.01 < MIN_SCENE_CONTENT
-    assert coverage(filled) > 0.2
+    pixels, span = coverage(speck)
+    assert pixels < 0.01 and span < 0.2 < MIN_SCENE_SPAN
+    pixels, span = coverage(filled)
+    assert pixels > 0.2 > MIN_SCENE_PIXELS and span > 0.8 > MIN_SCENE_SPAN
 
 
 def test_page_titles_are_the_pages_own(reports):

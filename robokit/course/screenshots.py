@@ -11,7 +11,7 @@ import numbers
 
 import numpy as np
 
-__all__ = ["decode_png", "changed_fraction", "content_fraction"]
+__all__ = ["decode_png", "changed_fraction", "changed_span", "content_fraction"]
 
 
 def decode_png(png: bytes) -> np.ndarray:
@@ -131,3 +131,48 @@ def content_fraction(image: np.ndarray, *, tolerance: float = 30.0) -> float:
         background = np.array([(mode >> 16) & 255, (mode >> 8) & 255, mode & 255], dtype=float)
         changed += int((np.abs(row - background).sum(axis=1) > tolerance).sum())
     return changed / (img.shape[0] * img.shape[1])
+
+
+def changed_span(image: np.ndarray, reference: np.ndarray, *, tolerance: float = 30.0,
+                 trim: float = 0.01) -> float:
+    """How much of the view what differs from ``reference`` spans: the larger of the height and
+    width fractions of the box around the changed pixels (between the ``trim`` and ``1 - trim``
+    quantiles of their rows and columns, so a few stray pixels do not count).
+
+    A drawing made of lines (a robot arm, a path) changes few pixels however well it is framed, and
+    a long corridor framed whole is a strip; a view framed on what it shows is spanned by it in
+    at least one direction, a speck on the grid in neither.
+
+    Parameters
+    ----------
+    image, reference : array_like
+        ``(H, W, 3)`` or ``(H, W, 4)`` images of the same height and width, values in [0, 255].
+    tolerance : float
+        Summed difference below which two pixels count as equal (as in :func:`changed_fraction`).
+    trim : float
+        Share of changed pixels ignored at each end, in [0, 0.5).
+
+    Returns
+    -------
+    float
+        In [0, 1]; 0 if nothing changed.
+
+    Examples
+    --------
+    >>> empty = np.full((10, 20, 3), 200, dtype=np.uint8)
+    >>> shot = empty.copy(); shot[2, 1:17] = 0; shot[4:7, 9] = 0      # a long thin line and a tick
+    >>> round(changed_fraction(shot, empty), 3), changed_span(shot, empty, trim=0.0)
+    (0.095, 0.8)
+    """
+    img, ref = _as_image(image, "image"), _as_image(reference, "reference")
+    if img.shape != ref.shape:
+        raise ValueError(f"reference: expected the image's shape {img.shape[:2] + (3,)}, got {ref.shape}")
+    tolerance = _tolerance(tolerance)
+    if isinstance(trim, bool) or not isinstance(trim, numbers.Real) or not 0 <= trim < 0.5:
+        raise ValueError(f"trim: expected a number in [0, 0.5), got {trim!r:.60}")
+    rows, cols = np.nonzero(np.abs(img - ref).sum(axis=2) > tolerance)
+    if rows.size == 0:
+        return 0.0
+    r0, r1 = np.quantile(rows, [trim, 1 - trim])
+    c0, c1 = np.quantile(cols, [trim, 1 - trim])
+    return float(max((r1 - r0 + 1) / img.shape[0], (c1 - c0 + 1) / img.shape[1]))
