@@ -18,7 +18,6 @@ import numbers
 import os
 import select
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -26,6 +25,8 @@ import time
 import weakref
 from pathlib import Path
 from typing import Any, Callable, Sequence
+
+from .execute import kill_process_group
 
 __all__ = ["find_chromium", "DevToolsPipe", "BrowserError", "CHROMIUM_NAMES", "check_seconds"]
 
@@ -126,14 +127,7 @@ def find_chromium(names: Sequence[str] = CHROMIUM_NAMES) -> str:
 
 def _kill(proc: subprocess.Popen, profile: str, fds: tuple[int, ...]) -> None:
     """Kill Chromium's process group (it leads its own session), close our pipe ends, remove its profile."""
-    try:
-        os.killpg(proc.pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        pass
-    try:
-        proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:
-        pass
+    kill_process_group(proc)
     for fd in fds:
         try:
             os.close(fd)

@@ -24,7 +24,7 @@ import tempfile
 import time
 from pathlib import Path
 
-__all__ = ["NotebookRun", "run_notebook", "execute_in_process"]
+__all__ = ["NotebookRun", "run_notebook", "execute_in_process", "kill_process_group"]
 
 #: Exception names an assignment notebook may raise: the stubs students have not filled in yet
 #: (``NotImplementedYet`` is the ``NotImplementedError`` that ``check()`` raises on a stub).
@@ -198,11 +198,11 @@ def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
     try:
         log, _ = proc.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
-        _kill_group(proc)
+        kill_process_group(proc)
         log = ""
         status, error = "timeout", f"stopped after the notebook time limit of {timeout:g} s"
     else:
-        _kill_group(proc)  # the kernel may outlive a crashed worker
+        kill_process_group(proc)  # the kernel may outlive a crashed worker
         try:
             result = json.loads(result_file.read_text())
             status, error = result["status"], result["error"]
@@ -212,7 +212,9 @@ def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
     return NotebookRun(path, status, seconds, error, dst if dst.exists() else None)
 
 
-def _kill_group(proc: subprocess.Popen) -> None:
+def kill_process_group(proc: subprocess.Popen) -> None:
+    """Kill the process group that ``proc`` leads (started with ``start_new_session=True``: a
+    notebook worker and its kernel, or Chromium and its helpers) and reap ``proc``."""
     try:
         os.killpg(proc.pid, signal.SIGKILL)
     except (ProcessLookupError, PermissionError):

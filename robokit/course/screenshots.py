@@ -61,6 +61,13 @@ def _tolerance(value: object) -> float:
     return float(value)
 
 
+def _image_pair(image: object, reference: object, tolerance: object) -> tuple[np.ndarray, np.ndarray, float]:
+    img, ref = _as_image(image, "image"), _as_image(reference, "reference")
+    if img.shape != ref.shape:
+        raise ValueError(f"reference: expected the image's shape {img.shape[:2] + (3,)}, got {ref.shape}")
+    return img, ref, _tolerance(tolerance)
+
+
 def changed_fraction(image: np.ndarray, reference: np.ndarray, *, tolerance: float = 30.0) -> float:
     """Fraction of pixels of ``image`` that differ from ``reference`` (e.g. an empty scene's shot).
 
@@ -86,10 +93,7 @@ def changed_fraction(image: np.ndarray, reference: np.ndarray, *, tolerance: flo
     >>> changed_fraction(shot, empty)
     0.25
     """
-    img, ref = _as_image(image, "image"), _as_image(reference, "reference")
-    if img.shape != ref.shape:
-        raise ValueError(f"reference: expected the image's shape {img.shape[:2] + (3,)}, got {ref.shape}")
-    tolerance = _tolerance(tolerance)
+    img, ref, tolerance = _image_pair(image, reference, tolerance)
     return float((np.abs(img - ref).sum(axis=2) > tolerance).mean())
 
 
@@ -164,10 +168,7 @@ def changed_span(image: np.ndarray, reference: np.ndarray, *, tolerance: float =
     >>> round(changed_fraction(shot, empty), 3), changed_span(shot, empty, trim=0.0)
     (0.095, 0.8)
     """
-    img, ref = _as_image(image, "image"), _as_image(reference, "reference")
-    if img.shape != ref.shape:
-        raise ValueError(f"reference: expected the image's shape {img.shape[:2] + (3,)}, got {ref.shape}")
-    tolerance = _tolerance(tolerance)
+    img, ref, tolerance = _image_pair(image, reference, tolerance)
     if isinstance(trim, bool) or not isinstance(trim, numbers.Real) or not 0 <= trim < 0.5:
         raise ValueError(f"trim: expected a number in [0, 0.5), got {trim!r:.60}")
     rows, cols = np.nonzero(np.abs(img - ref).sum(axis=2) > tolerance)

@@ -48,7 +48,7 @@ def look_from(scene: Scene, position: Any, target: Any = None) -> Scene:
     target : array_like, shape (3,), optional
         The point looked at and orbited about (:meth:`Scene.set_camera_target`); the origin if
         omitted. Frame what the text talks about: a 0.3 m robot seen from 0.7 m, not the origin of
-        a 20 m grid (:func:`frame` works the position out from the objects).
+        a 20 m grid (:func:`fit_view` works the position out from the objects).
 
     Returns
     -------
