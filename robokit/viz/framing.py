@@ -111,12 +111,8 @@ def _centred(offsets: np.ndarray, depths: np.ndarray) -> float:
 
 def fit_view(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence[str] | str | None = None,
           bounds: Any = None, margin: float = 0.08, width: int = VIEW_WIDTH) -> Scene:
-    """Point the viewer's camera at the scene's objects, from ``direction``, close enough for them
-    to fill the view.
-
-    Without ``bounds`` the view is fitted to :meth:`Scene.outline_points` (each object's own box
-    corners, each line's and mesh's vertices), so a fan of lines fills the view rather than the
-    empty corners of the box around it; with ``bounds``, to that box's 8 corners.
+    """Point the viewer's camera at the box around the scene's objects, from ``direction``, close
+    enough for the box to fill the view.
 
     Parameters
     ----------
@@ -155,9 +151,8 @@ def fit_view(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence
     axes ``r``, ``u``, ``f`` and the camera at ``p`` (relative to the box's centre), a corner ``q``
     is in view when ``|(q - p).r| <= t_x (q - p).f`` and ``|(q - p).u| <= t_y (q - p).f``, where
     ``t_y = tan(fov / 2) / (1 + margin)`` and ``t_x = aspect t_y``. Both are linear in the three
-    coordinates of ``p``, so the closest camera that sees every point (the outline, or the box's 8
-    corners), and the sideways shift that centres their image, are closed form (per image axis, two
-    maxima over the points) - exact,
+    coordinates of ``p``, so the closest camera that sees all 8 corners, and the sideways shift that
+    centres the box's image, are closed form (per image axis, two maxima over the corners) - exact,
     not a bounding-sphere guess; only, the camera stays in front of the box's nearest corner by 5 %
     of the box's half-diagonal (a flat box seen at a grazing angle would let it come closer). The
     orbit target is the point looked at level with the box's centre:
@@ -186,13 +181,12 @@ def fit_view(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence
         d = np.array([0.0, -1e-3 * abs(d[2]), d[2]])
     margin = check_positive(margin, "margin", allow_zero=True)
     aspect = check_int(width, "width", minimum=1) / scene.height
-    points = None
     if bounds is None:
-        points = scene.outline_points(paths)
-        if points is None:
+        found = scene.bounding_box(paths)
+        if found is None:
             where = "" if paths is None else f" under {paths!r}"
             raise ValueError(f"scene: expected objects{where} to frame, got none")
-        lo, hi = points.min(axis=0), points.max(axis=0)
+        lo, hi = found
     else:
         box = as_array(bounds, "bounds", shape=(2, 3))
         if paths is not None:
@@ -202,10 +196,7 @@ def fit_view(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence
         lo, hi = box
     centre = (lo + hi) / 2
     half = (hi - lo) / 2 if np.max(hi - lo) >= _SMALLEST else np.full(3, _SMALLEST / 2)
-    if points is None or np.max(hi - lo) < _SMALLEST:       # the box's 8 corners
-        q = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
-    else:                                                   # the outline of what is drawn
-        q = points - centre
+    q = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
     back, right, up = _view_axes(d)
     t_y = np.tan(np.radians(FOV) / 2) / (1 + margin)
     t_x = t_y * aspect

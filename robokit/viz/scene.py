@@ -72,14 +72,8 @@ def _transform(value: Any, name: str = "transform") -> np.ndarray:
     return T
 
 
-#: At most this many vertices of a mesh, point cloud or line are kept to outline it (evenly spaced).
-_OUTLINE_POINTS = 512
-
-
-def _object_outline(obj: Any) -> np.ndarray | None:
-    """Points outlining a meshcat object's geometry in its node's frame (None: not known): the 8
-    corners of a box, sphere or cylinder's box; the vertices of a mesh, point cloud or line (at
-    most ``_OUTLINE_POINTS``, always with the extreme ones)."""
+def _object_corners(obj: Any) -> np.ndarray | None:
+    """The 8 corners of the box around a meshcat object's geometry, in its node's frame (None: not known)."""
     from meshcat import geometry as g
 
     geometry = getattr(obj, "geometry", None)
@@ -97,16 +91,12 @@ def _object_outline(obj: Any) -> np.ndarray | None:
         v = np.asarray(v, float).reshape(-1, 3)
         if not len(v):
             return None
-        if len(v) > _OUTLINE_POINTS:
-            extremes = np.concatenate([v.argmin(axis=0), v.argmax(axis=0)])
-            v = v[np.union1d(np.linspace(0, len(v) - 1, _OUTLINE_POINTS).astype(int), extremes)]
-        lo = hi = None
+        lo, hi = v.min(axis=0), v.max(axis=0)
     else:
         return None
-    if lo is not None:
-        v = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     M = np.asarray(geometry.intrinsic_transform(), float)
-    return v @ M[:3, :3].T + M[:3, 3]
+    return corners @ M[:3, :3].T + M[:3, 3]
 
 
 class Scene:
@@ -136,7 +126,7 @@ class Scene:
         self.title = check_text(title, "title")
         self.height = check_int(height, "height", minimum=1)
         self._commands: list[Any] = []
-        self._outlines: dict[tuple, np.ndarray] = {}     # object node -> (n, 3) outline points in its frame
+        self._extents: dict[tuple, np.ndarray] = {}      # object node -> (8, 3) corners in its node's frame
         self._poses: dict[tuple, np.ndarray] = {}        # node -> 4x4 transform relative to its parent
         self._live = None
         if live:
@@ -177,11 +167,11 @@ class Scene:
 
         if isinstance(command, SetObject):
             key = tuple(command.path.entries)
-            outline = _object_outline(command.object)
-            if outline is None:
-                self._outlines.pop(key, None)
+            corners = _object_corners(command.object)
+            if corners is None:
+                self._extents.pop(key, None)
             else:
-                self._outlines[key] = outline
+                self._extents[key] = corners
         elif isinstance(command, SetTransform):
             self._poses[tuple(command.path.entries)] = np.asarray(command.matrix, float)
 
@@ -226,29 +216,6 @@ class Scene:
         >>> scene.bounding_box("elsewhere") is None
         True
         """
-        points = self.outline_points(paths)
-        return None if points is None else (points.min(axis=0), points.max(axis=0))
-
-    def outline_points(self, paths: Sequence[str] | str | None = None) -> np.ndarray | None:
-        """World points (metres) outlining what the scene draws, as it stands: the corners of each
-        box, sphere and cylinder's own box, the vertices of each mesh, point cloud and line.
-
-        :func:`robokit.viz.fit_view` fits the view to these rather than to :meth:`bounding_box`'s
-        corners, so a fan of sonar beams or an arm drawn with lines fills the view instead of the
-        empty corners of the box around it. ``paths`` and what is tracked are as in
-        :meth:`bounding_box`.
-
-        Returns
-        -------
-        ndarray, shape (n, 3), or None
-            None when no object matches.
-
-        Examples
-        --------
-        >>> scene = Scene().add_line("path", [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 3.0, 0.0]])
-        >>> scene.outline_points().tolist()
-        [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 3.0, 0.0]]
-        """
         if paths is None:
             prefixes = None
         else:
@@ -260,15 +227,18 @@ class Scene:
                 if not check_text(name, "paths").strip("/"):
                     raise ValueError(f"paths: expected scene paths like 'robot', got {name!r}")
                 prefixes.append(tuple(self.meshcat_path(name).entries))
-        points = []
-        for key, local in self._outlines.items():
+        corners = []
+        for key, local in self._extents.items():
             if prefixes is not None and not any(key[:len(p)] == p for p in prefixes):
                 continue
             T = np.eye(4)
             for depth in range(1, len(key) + 1):
                 T = T @ self._poses.get(key[:depth], np.eye(4))
-            points.append(local @ T[:3, :3].T + T[:3, 3])
-        return np.concatenate(points) if points else None
+            corners.append(local @ T[:3, :3].T + T[:3, 3])
+        if not corners:
+            return None
+        allc = np.concatenate(corners)
+        return allc.min(axis=0), allc.max(axis=0)
 
     @property
     def commands(self) -> list[dict]:
