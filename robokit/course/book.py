@@ -24,7 +24,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Sequence
+from typing import Mapping, Sequence
 
 __all__ = ["SITES", "API_MODULES", "SITE_TOOLS", "BookPage", "is_import_cell", "prepare_notebook",
            "write_sources", "sphinx_build", "SiteBuild", "site_tool_problems", "site_out_problem",
@@ -88,6 +88,11 @@ def is_import_cell(source: str) -> bool:
     return bool(body) and all(isinstance(node, (ast.Import, ast.ImportFrom)) for node in body)
 
 
+def _is_title(cell: dict) -> bool:
+    """Whether a notebook cell is Markdown opening with a level-1 heading (the page's title)."""
+    return cell.get("cell_type") == "markdown" and "".join(cell.get("source", "")).lstrip().startswith("# ")
+
+
 def prepare_notebook(src: Path, dst: Path, *, title: tuple[str, str] | None = None,
                      note: str = "") -> Path:
     """Copy the notebook ``src`` to ``dst`` for the site, folding the cells that only import.
@@ -118,20 +123,19 @@ def prepare_notebook(src: Path, dst: Path, *, title: tuple[str, str] | None = No
     nb = json.loads(src.read_text(encoding="utf-8"))
     renamed = title is None
     cells = nb.setdefault("cells", [])
-    if not any(c.get("cell_type") == "markdown" and "".join(c.get("source", "")).lstrip().startswith("# ")
-               for c in cells):       # every page needs a title for the sidebar and the browser tab
+    if not any(_is_title(c) for c in cells):    # every page needs a title for the sidebar and the browser tab
         cells.insert(0, {"cell_type": "markdown", "metadata": {}, "source": f"# {src.stem}"})
     if note:
         first = next((i for i, c in enumerate(cells) if c.get("cell_type") == "markdown"), -1)
         cells.insert(first + 1, {"cell_type": "markdown", "metadata": {},
                                  "source": f"```{{warning}}\n{note}\n```\n"})
-    for cell in nb.get("cells", []):
+    for cell in cells:
         text = "".join(cell.get("source", ""))
         if cell.get("cell_type") == "code" and is_import_cell(text):
             tags = cell.setdefault("metadata", {}).setdefault("tags", [])
             if HIDE_INPUT not in tags:
                 tags.append(HIDE_INPUT)
-        if not renamed and cell.get("cell_type") == "markdown" and text.lstrip().startswith("# "):
+        if not renamed and _is_title(cell):
             cell["source"] = text.replace(title[0], title[1], 1)
             renamed = True
     dst.parent.mkdir(parents=True, exist_ok=True)
@@ -162,7 +166,8 @@ def _api_pages(modules: Sequence[str]) -> list[BookPage]:
 
 def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments: Sequence[Path],
                   solutions: Sequence[Path] = (), pages: Sequence[BookPage] = (),
-                  instructor: bool = False, api_modules: Sequence[str] = API_MODULES) -> Path:
+                  instructor: bool = False, api_modules: Sequence[str] = API_MODULES,
+                  notes: Mapping[Path, str] | None = None) -> Path:
     """Write a Sphinx source tree for one site into ``src`` and return its ``index.md``.
 
     Parameters
@@ -181,6 +186,8 @@ def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments
         Build the instructor site (its home page, solutions and extra pages).
     api_modules : sequence of str, default API_MODULES
         Modules of the library reference; empty for a quicker site without it.
+    notes : mapping, optional
+        Notebook path -> a warning shown under its title (:func:`prepare_notebook`'s ``note``).
 
     Returns
     -------
@@ -212,7 +219,7 @@ def write_sources(src: Path, book: Path, *, lessons: Sequence[Path], assignments
                                               ("Assignments", "assignments", assignments, None),
                                               ("Solutions", "solutions", solutions, ("Assignment", "Solution"))):
         for path in notebooks:
-            prepare_notebook(path, src / folder / Path(path).name, title=title)
+            prepare_notebook(path, src / folder / Path(path).name, title=title, note=(notes or {}).get(path, ""))
         if notebooks:
             parts.append(_toctree(caption, [f"{folder}/{Path(p).stem}" for p in notebooks]))
     api = _api_pages(api_modules)

@@ -5,7 +5,7 @@ stays in the repository's private ``build/`` whatever the sites' folders are::
 
     build/course/           the student site: lessons, blank assignments, library reference, references
     build/instructor/       the instructor site: that plus solutions, grading self-check, build report
-    build/executed/         the executed notebooks (lessons-NN.ipynb, solutions-NN.ipynb)
+    build/executed/         the executed notebooks (lessons/NN_slug.ipynb, solutions/NN_slug.ipynb)
     build/reports/          grades.csv of the grading self-check
     build/.site/<site>/     Sphinx's sources (src/), output before it is moved (html/), doctrees,
                             myst-nb's jupyter_execute/ and sphinx-warnings.txt, per site
@@ -14,13 +14,12 @@ from __future__ import annotations
 
 import html
 import os
-import shutil
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Callable, Sequence
 
-from .book import (API_MODULES, SITES, BookPage, SiteBuild, prepare_notebook, site_out_problem, site_tool_problems,
-                   sphinx_build, write_sources)
+from .book import (API_MODULES, SITES, BookPage, SiteBuild, site_out_problem, site_tool_problems, sphinx_build,
+                   write_sources)
 from .execute import NotebookRun, run_notebook
 
 __all__ = ["discover", "build_course", "run_notebooks", "write_sites", "format_summary", "build_report_page"]
@@ -187,7 +186,8 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     paths : sequence of Path
         The notebooks.
     executed : Path
-        Folder of the executed copies, named ``<folder>-<name>`` (``lessons-01_visual_slam.ipynb``).
+        Folder of the executed copies, under their own folder and name (``lessons/01_visual_slam.ipynb``),
+        so a page keeps its notebook's name.
     root : Path
         Repository root (progress lines name notebooks relative to it).
     jobs : int, optional
@@ -211,7 +211,7 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     executed.mkdir(parents=True, exist_ok=True)
 
     def one(path: Path) -> NotebookRun:
-        run = run_notebook(path, timeout=timeout, fast=fast, output=executed / f"{path.parent.name}-{path.name}")
+        run = run_notebook(path, timeout=timeout, fast=fast, output=executed / path.parent.name / path.name)
         log(f"  {run.status:<8} {run.seconds:6.1f}s  {path.relative_to(root) if path.is_relative_to(root) else path}")
         return run
 
@@ -253,18 +253,15 @@ def write_sites(root: Path, runs: Sequence[NotebookRun], outs: dict[str, Path], 
     solutions = [r for r in runs if r.path.parent.name == "solutions"]
     assignments = discover(root, ("assignments",))
     work = Path(work) if work is not None else root / "build" / ".site"
-    staged = work / "notebooks"
-    if staged.exists():
-        shutil.rmtree(staged)
-    for run in runs:   # an executed copy if there is one, else the source notebook, with a warning
-        source = run.executed if run.executed is not None and run.executed.exists() else run.path
-        prepare_notebook(source, staged / run.path.parent.name / run.path.name, note=_failure_note(run))
-    staged_lessons = [staged / "lessons" / r.path.name for r in lessons]
-    staged_solutions = [staged / "solutions" / r.path.name for r in solutions]
+    # an executed copy if there is one, else the source notebook; a failed run's page gets a warning
+    shown = {run.path: run.executed if run.executed is not None and run.executed.exists() else run.path
+             for run in runs}
+    notes = {shown[run.path]: _failure_note(run) for run in runs if not run.ok}
     for name, instructor in SITES.items():
-        write_sources(work / name / "src", root / "book", lessons=staged_lessons, assignments=assignments,
-                      solutions=staged_solutions if instructor else (), pages=pages if instructor else (),
-                      instructor=instructor, api_modules=api_modules)
+        write_sources(work / name / "src", root / "book", lessons=[shown[r.path] for r in lessons],
+                      assignments=assignments, solutions=[shown[r.path] for r in solutions] if instructor else (),
+                      pages=pages if instructor else (), instructor=instructor, api_modules=api_modules,
+                      notes=notes)
     log("rendering the student and instructor sites with Sphinx ...")
     with ThreadPoolExecutor(max_workers=len(SITES)) as pool:
         futures = {name: pool.submit(sphinx_build, work / name / "src", outs[name], instructor=instructor)
