@@ -90,7 +90,7 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
     if not callable(fn):
         raise TypeError(f"fn: expected your function {exercise.function}, got {type(fn).__name__}")
     cases = exercise.make_cases(PUBLIC_SEED)
-    lines, failed = [], 0
+    passes, failures = [], []
     for i, case in enumerate(cases, 1):
         result = call_student(fn, case)
         if result.error is not None and result.error.type == "NotImplementedError":
@@ -98,19 +98,16 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
                   f"{exercise.function} with your code, then run this cell again.")
             raise NotImplementedYet(f"{exercise.id} is not implemented yet")
         outcome = judge(exercise, case, expected_output(exercise, case), result)
-        mark = "pass" if outcome.passed else "FAIL"
-        where = f" [{result.error.line}]" if not outcome.passed and result.error and result.error.line else ""
-        text = f"  {mark}  case {i}" + (f" ({case.label})" if case.label else "")
-        if not outcome.passed:
-            failed += 1
-            text += f": {outcome.message}{where}"
-        if verbose or not outcome.passed:
-            lines.append(text)
-    print(f"check {exercise.id}: {len(cases) - failed}/{len(cases)} public cases passed "
+        text = f"case {i}" + (f" ({case.label})" if case.label else "")
+        if outcome.passed:
+            passes.append(f"  pass  {text}")
+        else:
+            where = f" [{result.error.line}]" if result.error and result.error.line else ""
+            failures.append(f"  FAIL  {text}: {outcome.message}{where}")
+    print(f"check {exercise.id}: {len(passes)}/{len(cases)} public cases passed "
           "(feedback only; your grade comes from hidden cases)")
-    passes = [line for line in lines if not line.lstrip().startswith("FAIL")]
     if verbose and passes:          # the failed cases are in the error's message, shown once
         print("\n".join(passes))
-    if failed:
-        failures = "\n".join(line for line in lines if line.lstrip().startswith("FAIL"))
-        raise CheckFailed(f"{exercise.id}: {failed} of {len(cases)} public cases failed:\n{failures}")
+    if failures:
+        raise CheckFailed(f"{exercise.id}: {len(failures)} of {len(cases)} public cases failed:\n"
+                          + "\n".join(failures))
