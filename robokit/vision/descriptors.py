@@ -142,15 +142,16 @@ def _histograms(grads, keypoints: Keypoints, cells: int, bins: int, clip: float)
         rx, ry = _sample(gx, gy, keypoints.xy[idx] / step, keypoints.scale[idx] / step, keypoints.orientation[idx],
                          2 * _CELL)
         mag, ang = cv2.cartToPolar(np.ascontiguousarray(rx), np.ascontiguousarray(ry))  # angle in [0, 2 pi)
-        mag, ang = mag.T.ravel(), ang.T.ravel()  # sample-major, so the spatial binning is one matrix product
-        pos = ang * np.float32(bins / (2 * np.pi))
-        lo = np.floor(pos).astype(np.intp)
-        frac = pos - lo
-        # orientation soft-binning per sample ...
-        per_sample = np.zeros(mag.size * bins, np.float32)
-        base = np.arange(mag.size) * bins
-        per_sample[base + lo % bins] = mag * (1 - frac)
-        per_sample[base + (lo + 1) % bins] += mag * frac
+        # sample-major (samples, keypoints), so the spatial binning is one matrix product
+        mag, pos = mag.T, ang.T * np.float32(bins / (2 * np.pi))
+        # orientation soft-binning per sample: weight max(0, 1 - circular distance to the bin) ...
+        per_sample = np.empty((weights.shape[1], idx.size, bins), np.float32)
+        for b in range(bins):  # a loop over the 8 bins, each a whole-array float32 operation
+            d = np.abs(pos - np.float32(b))
+            np.minimum(d, np.float32(bins) - d, out=d)
+            np.subtract(np.float32(1), d, out=d)
+            np.maximum(d, 0, out=d)
+            np.multiply(d, mag, out=per_sample[:, :, b])
         # ... then (cells^2, samples) @ (samples, k * bins) sums the samples into the spatial cells
         hist = weights @ per_sample.reshape(weights.shape[1], idx.size * bins)
         out[idx] = hist.reshape(cells * cells, idx.size, bins).transpose(1, 0, 2).reshape(idx.size, dim)
