@@ -5,6 +5,8 @@ Lin et al. Sec. 2.iii compare PLOT and SIFT with the protocol of Mikolajczyk & S
 ``1 - precision = #false matches / (#correct matches + #false matches)``, sweeping the matching
 threshold (0.15 .. 0.7 for the nearest-neighbour ratio). Image pairs are related by a known
 homography, so a match is correct when the warped keypoint lands within a tolerance of its partner.
+:func:`matching_score` rates detector and descriptor together in one number per pair
+(Mikolajczyk et al. 2005): correct matches over the keypoints the two images can share.
 
 References
 ----------
@@ -12,7 +14,10 @@ References
    Pattern Analysis and Machine Intelligence 27(10), 1615-1630, 2005.
 .. [2] R. Lin, Z. Wang, R. Sun and L. Sun, "Vision-based mobile robot localization and mapping using
    the PLOT features" (Question 1 of the course's assignment; our copy gives no venue or year).
-.. [3] R. Hartley and A. Zisserman, *Multiple View Geometry in Computer Vision*, 2nd ed., Cambridge
+.. [3] K. Mikolajczyk, T. Tuytelaars, C. Schmid, A. Zisserman, J. Matas, F. Schaffalitzky, T. Kadir
+   and L. Van Gool, "A comparison of affine region detectors", International Journal of Computer
+   Vision 65(1-2), 43-72, 2005.
+.. [4] R. Hartley and A. Zisserman, *Multiple View Geometry in Computer Vision*, 2nd ed., Cambridge
    University Press, 2004.
 """
 from __future__ import annotations
@@ -285,7 +290,7 @@ def matching_score(features_a: Features, features_b: Features, homography, image
 
     Notes
     -----
-    The matching score of Mikolajczyk et al. (2005, Sec. 3.2, "A comparison of affine region
+    The matching score of Mikolajczyk et al. (2005, "A comparison of affine region
     detectors"), with a position tolerance instead of their region-overlap criterion (as in
     :func:`recall_precision`). It rates detector and descriptor together, so it is the number to
     compare PLOT with SIFT on under a known transformation.

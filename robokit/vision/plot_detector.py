@@ -496,16 +496,9 @@ def _scale_space(img: np.ndarray, p: PlotParams) -> ScaleSpace:
 
 
 def _lookup(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Bilinear samples of ``img`` at grid positions ``(x, y)``, clamped to the grid."""
-    x = np.clip(x, 0, img.shape[1] - 1)
-    y = np.clip(y, 0, img.shape[0] - 1)
-    x0 = np.minimum(x.astype(int), img.shape[1] - 2 if img.shape[1] > 1 else 0)
-    y0 = np.minimum(y.astype(int), img.shape[0] - 2 if img.shape[0] > 1 else 0)
-    x1, y1 = np.minimum(x0 + 1, img.shape[1] - 1), np.minimum(y0 + 1, img.shape[0] - 1)
-    fx, fy = x - x0, y - y0
-    top = img[y0, x0] * (1 - fx) + img[y0, x1] * fx
-    bottom = img[y1, x0] * (1 - fx) + img[y1, x1] * fx
-    return top * (1 - fy) + bottom * fy
+    """Bilinear samples of ``img`` at grid positions ``(x, y)`` (clamped to the grid)."""
+    return cv2.remap(img, x.astype(np.float32)[:, None], y.astype(np.float32)[:, None], cv2.INTER_LINEAR,
+                     borderMode=cv2.BORDER_REPLICATE).ravel() if x.size else np.zeros(0, img.dtype)
 
 
 def _level_maxima(n: int, responses: list, dilated: list, steps: np.ndarray, thr: float, border: int):
