@@ -14,8 +14,8 @@ value of ``k`` and does not say how a keypoint's scale is chosen (our copy's equ
 unnumbered, so we cite the section). Within that series we use three levels per octave
 (``k = 2^(1/3)``) over nine levels (``sigma`` from 1.6 to 10.2 px, about three octaves), and keep a
 point when its junction strength is an 8-neighbour maximum at its level *and* no weaker than the
-same place on both adjacent levels: an extremum in scale of the scale-normalised response, as
-Lindeberg's scale selection and SIFT's difference-of-Gaussian extrema. Only inner levels can hold
+same place on both adjacent levels: an extremum in scale of the scale-normalised response, as in
+Lindeberg's scale selection [3] and SIFT's difference-of-Gaussian extrema [4]. Only inner levels can hold
 one, so the outermost levels 1.6 and 10.2 px only bracket the search. The scale is refined by a
 parabola through the three levels (``log sigma`` axis); positions by parabolas in x and y. With four
 levels at ``k = sqrt(2)`` and one-sided comparisons at the ends, most keypoints sat on the finest
@@ -38,6 +38,10 @@ References
    the PLOT features" (Question 1 of the course's assignment; our copy gives no venue or year).
 .. [2] G. Farnebäck, *Polynomial Expansion for Orientation and Motion Estimation*, PhD thesis,
    Linköping University, 2002.
+.. [3] T. Lindeberg, "Feature detection with automatic scale selection", International Journal of
+   Computer Vision 30(2), 79-116, 1998.
+.. [4] D. G. Lowe, "Distinctive image features from scale-invariant keypoints", International Journal
+   of Computer Vision 60(2), 91-110, 2004.
 """
 from __future__ import annotations
 
