@@ -1,8 +1,9 @@
 """Vision: PLOT and SIFT features, descriptor matching, evaluation, rectified stereo, colour.
 
-Modules: :mod:`.features` (containers), :mod:`.plot_detector` (Lin et al. Sec. 2.i),
+Modules: :mod:`.features` (containers), :mod:`.plot_detector` (Lin et al. Sec. 2.i; its plain
+reference :mod:`.plot_reference`),
 :mod:`.descriptors` (Lin et al. Sec. 2.ii, Se et al. Sec. 4, OpenCV SIFT), :mod:`.matching`
-(Lin et al. Sec. 3), :mod:`.evaluation` (recall vs 1-precision), :mod:`.stereo` (Lin et al. Sec. 3,
+(Lin et al. Sec. 3), :mod:`.evaluation` (recall vs 1-precision, matching score), :mod:`.stereo` (Lin et al. Sec. 3,
 Se et al. Sec. 2.2 and 3.1), :mod:`.colour` (HSI hue histograms, lesson 02's paper, Sec. "Global
 image features"), :mod:`.omni_features` (SIFT in an omni image's annulus, Sec. "Local image
 features"; its KD-tree per map node is :class:`.matching.DescriptorIndex`), :mod:`.ransac` (the

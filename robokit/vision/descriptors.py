@@ -139,7 +139,7 @@ def _orientations(grads, keypoints: Keypoints, ratio: float) -> Keypoints:
 
 def _histograms(grads, keypoints: Keypoints, cells: int, bins: int, clip: float) -> np.ndarray:
     n, dim = len(keypoints), cells * cells * bins
-    out = np.zeros((n, dim))
+    out = np.zeros((n, dim), np.float32)
     weights = _cell_weights(cells)
     for idx, gx, gy, step in grads:
         rx, ry = _sample(gx, gy, keypoints.xy[idx] / step, keypoints.scale[idx] / step, keypoints.orientation[idx],
