@@ -6,7 +6,8 @@ from matplotlib import cbook
 from PIL import Image
 
 from robokit.vision.descriptors import detect_plot_features, detect_sift_features
-from robokit.vision.evaluation import apply_homography, recall_precision, similarity_homography
+from robokit.vision.evaluation import apply_homography, matching_score, recall_precision, similarity_homography
+from robokit.vision.features import Features, Keypoints
 from robokit.vision.matching import distance_ratio, gated_ratio_match, k_nearest, ratio_match, two_nearest
 
 
@@ -151,3 +152,28 @@ def test_recall_precision_detects_wrong_ground_truth(photo):
         recall_precision(fa, fb.descriptors, h, photo.shape)
     empty = recall_precision(fa.subset(slice(0, 0)), fb, h, photo.shape)
     assert empty["n_correspondences"] == 0 and not np.any(np.isnan(empty["recall"]))
+
+
+def test_matching_score_counts_correct_matches_over_the_shared_keypoints():
+    def feats(xy, desc):
+        n = len(xy)
+        return Features(Keypoints(np.array(xy, float), np.ones(n), np.ones(n), np.zeros(n)), np.array(desc, np.float32))
+
+    e = np.eye(4)
+    h = np.array([[1.0, 0, 10], [0, 1, 0], [0, 0, 1]])              # B is A shifted 10 px right
+    a = feats([[5, 50], [20, 50], [40, 50], [95, 50]], e)          # the last one leaves B
+    b = feats([[15, 50], [30, 50], [50.5, 50], [8, 50]], [e[0], e[2], e[1], e[3]])   # the last one is not in A
+    m = matching_score(a, b, h, (100, 100), (100, 100))
+    # A0 -> B0 right; A1 -> B2 and A2 -> B1 land 20 px from where they should; A3 is outside B
+    assert (m["n_correct"], m["n_matches"], m["n_overlap"]) == (1, 3, 3)
+    assert m["score"] == pytest.approx(1 / 3)
+    assert matching_score(a, b, h, (100, 100), (100, 100), tolerance=25)["n_correct"] == 3
+    assert matching_score(a, b, np.eye(3), (100, 100), (100, 100))["n_correct"] == 0
+    empty = matching_score(a.subset(slice(0, 0)), b, h, (100, 100), (100, 100))
+    assert empty == {"score": 0.0, "n_correct": 0, "n_matches": 0, "n_overlap": 0}
+    with pytest.raises(ValueError, match="ratio: expected a threshold in"):
+        matching_score(a, b, h, (100, 100), (100, 100), ratio=1.5)
+    with pytest.raises(ValueError, match="image_shape_a: expected"):
+        matching_score(a, b, h, 100, (100, 100))
+    with pytest.raises(TypeError, match="features_a: expected Features"):
+        matching_score(a.descriptors, b, h, (100, 100), (100, 100))

@@ -102,8 +102,10 @@ def test_keypoints_sorted_capped_and_scaled(photo):
     kp = detect_plot(photo, PlotParams(max_keypoints=300))
     assert len(kp) == 300
     assert np.all(np.diff(kp.response) <= 0)
-    sig = plot_scales()
-    assert np.all((kp.scale >= sig[0] / 2 ** 0.25 - 1e-9) & (kp.scale <= sig[-1] + 1e-9))
+    sig, k = plot_scales(), PlotParams().k
+    # keypoints sit on the inner levels, refined by at most half a level
+    assert np.all((kp.scale >= sig[1] / k ** 0.5 - 1e-9) & (kp.scale <= sig[-2] * k ** 0.5 + 1e-9))
+    assert np.ptp(np.log2(kp.scale)) > 1.5          # and they spread over the octaves
     assert np.all((kp.xy >= 4.5) & (kp.xy <= [640 - 5.5, 480 - 5.5]))
 
 
@@ -122,9 +124,43 @@ def test_scale_space_levels_are_subsampled_consistently(photo):
     from robokit.vision.plot_detector import detect_plot_levels
     kp, space = detect_plot_levels(photo)
     assert np.allclose(space.sigmas, plot_scales())
-    assert space.steps.tolist() == [1, 1, 2, 2]
-    assert space.images[0].shape == (480, 640) and space.images[2].shape == (240, 320)
-    # a coarse level sampled every 2 pixels equals the full-resolution smoothing at those pixels
-    ref = cv2.GaussianBlur(photo.astype(np.float32) / 255, (0, 0), plot_scales()[2])
-    assert np.abs(space.images[2][20:-20, 20:-20] - ref[40:-40:2, 40:-40:2]).max() < 0.01
+    assert space.steps.tolist() == [1, 1, 1, 2, 2, 2, 4, 4, 4]
+    assert space.images[0].shape == (480, 640) and space.images[3].shape == (240, 320)
+    assert space.images[6].shape == (120, 160)
+    # a coarse level sampled every 2 (4) pixels equals the full-resolution smoothing at those pixels
+    for n, step in ((3, 2), (6, 4)):
+        ref = cv2.GaussianBlur(photo.astype(np.float32) / 255, (0, 0), plot_scales()[n])
+        assert np.abs(space.images[n][20:-20, 20:-20] - ref[20 * step:-20 * step:step, 20 * step:-20 * step:step]).max() < 0.01
     assert np.array_equal(kp.xy, detect_plot(photo).xy)
+
+
+def test_fast_detector_agrees_with_the_plain_reference(photo):
+    from robokit.vision.plot_reference import reference_detect_plot
+    small = photo[::2, ::2]
+    ref, fast = reference_detect_plot(small), detect_plot(small)
+    assert 0.8 < len(fast) / len(ref) < 1.25
+    d, i = cKDTree(ref.xy).query(fast.xy)
+    near = d < 1.5
+    # the subsampled coarse levels move a few maxima; most keypoints are the reference's
+    assert near.mean() > 0.75
+    assert np.median(np.abs(np.log2(fast.scale[near] / ref.scale[i[near]]))) < 0.1
+    # a stricter parameter set changes both alike
+    strict = PlotParams(threshold=0.05)
+    assert abs(len(detect_plot(small, strict)) - len(reference_detect_plot(small, strict))) <= 0.25 * len(
+        reference_detect_plot(small, strict))
+
+
+@pytest.mark.parametrize("zoom", [0.7, 1.4])
+def test_selected_scale_follows_a_zoom(photo, zoom):
+    # the scale of a repeated keypoint grows with the zoom (a detector that keeps its keypoints on
+    # the finest level, as the four-level PLOT did, fails this: median ratio near 1)
+    h = similarity_homography(photo.shape, zoom)
+    warped = cv2.warpPerspective(photo, h, (640, 480))
+    a, b = detect_plot(photo), detect_plot(warped)
+    pa = apply_homography(h, a.xy)
+    inside = np.all((pa > 15) & (pa < [625, 465]), axis=1)
+    d, i = cKDTree(b.xy).query(pa[inside])
+    ok = d < 2.5
+    assert ok.sum() > 50
+    ratio = np.log2(b.scale[i[ok]] / a.scale[inside][ok])
+    assert abs(np.median(ratio) - np.log2(zoom)) < 0.15

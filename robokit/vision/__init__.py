@@ -1,8 +1,9 @@
 """Vision: PLOT and SIFT features, descriptor matching, evaluation, rectified stereo, colour.
 
-Modules: :mod:`.features` (containers), :mod:`.plot_detector` (Lin et al. Sec. 2.i),
+Modules: :mod:`.features` (containers), :mod:`.plot_detector` (Lin et al. Sec. 2.i; its plain
+reference :mod:`.plot_reference`),
 :mod:`.descriptors` (Lin et al. Sec. 2.ii, Se et al. Sec. 4, OpenCV SIFT), :mod:`.matching`
-(Lin et al. Sec. 3), :mod:`.evaluation` (recall vs 1-precision), :mod:`.stereo` (Lin et al. Sec. 3,
+(Lin et al. Sec. 3), :mod:`.evaluation` (recall vs 1-precision, matching score), :mod:`.stereo` (Lin et al. Sec. 3,
 Se et al. Sec. 2.2 and 3.1), :mod:`.colour` (HSI hue histograms, lesson 02's paper, Sec. "Global
 image features"), :mod:`.omni_features` (SIFT in an omni image's annulus, Sec. "Local image
 features"; its KD-tree per map node is :class:`.matching.DescriptorIndex`), :mod:`.ransac` (the
@@ -21,7 +22,7 @@ from .colour import (histogram_distance, histogram_intersection, hue_histogram, 
                      rgb_to_hsi)
 from .descriptors import (assign_orientations, detect_and_describe, gradient_histogram_descriptor,
                           detect_plot_features, reduced_descriptor, sift_descriptor, detect_sift_features)
-from .evaluation import apply_homography, recall_precision, similarity_homography, warp_image
+from .evaluation import apply_homography, matching_score, recall_precision, similarity_homography, warp_image
 from .features import Features, Keypoints, as_gray_image
 from .hamming import as_binary_descriptors, hamming_distance, hamming_distances, hamming_match
 from .keyframes import (KeyframeConditions, KeyframeSelector, feature_threshold, select_keyframes,
@@ -38,7 +39,7 @@ from .stereo import (NotRectifiedError, StereoMatches, StereoObservations, Stere
                      match_stereo, observe_stereo, triangulate_svd)
 
 __all__ = ["assign_orientations", "detect_and_describe", "gradient_histogram_descriptor", "detect_plot_features",
-           "reduced_descriptor", "sift_descriptor", "detect_sift_features", "apply_homography", "recall_precision", "warp_image",
+           "reduced_descriptor", "sift_descriptor", "detect_sift_features", "apply_homography", "matching_score", "recall_precision", "warp_image",
            "similarity_homography", "Features", "Keypoints", "as_gray_image", "Matches", "ratio_match",
            "two_nearest", "k_nearest", "PlotParams", "ScaleSpace", "detect_plot", "detect_plot_levels", "edge_strength",
            "junction_strength", "orientation_tensor", "plot_scales", "polynomial_expansion",

@@ -70,11 +70,14 @@ def _sample(gx, gy, xy, scale, angle, half_width):
     Grid sample ``s`` sits at ``(u, v) = _grid()[s]`` in [-1, 1]^2 of the keypoint frame.
     """
     u, v = _grid()
-    r = (half_width * scale)[:, None]
-    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-    mx = (xy[:, :1] + r * (c * u - s * v)).astype(np.float32)
-    my = (xy[:, 1:] + r * (s * u + c * v)).astype(np.float32)
-    c, s = c.astype(np.float32), s.astype(np.float32)  # keep the per-sample arithmetic in float32
+    f32 = np.float32
+    # rotated, scaled grid offsets (r cos, r sin per keypoint), all per-sample arithmetic in float32
+    rc = (half_width * scale * np.cos(angle)).astype(f32)[:, None]
+    rs = (half_width * scale * np.sin(angle)).astype(f32)[:, None]
+    u32, v32 = u.astype(f32), v.astype(f32)
+    mx = xy[:, :1].astype(f32) + (rc * u32 - rs * v32)
+    my = xy[:, 1:].astype(f32) + (rs * u32 + rc * v32)
+    c, s = np.cos(angle).astype(f32)[:, None], np.sin(angle).astype(f32)[:, None]
     sx = cv2.remap(gx, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
     sy = cv2.remap(gy, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
     return c * sx + s * sy, -s * sx + c * sy
@@ -136,24 +139,25 @@ def _orientations(grads, keypoints: Keypoints, ratio: float) -> Keypoints:
 
 def _histograms(grads, keypoints: Keypoints, cells: int, bins: int, clip: float) -> np.ndarray:
     n, dim = len(keypoints), cells * cells * bins
-    out = np.zeros((n, dim))
+    out = np.zeros((n, dim), np.float32)
     weights = _cell_weights(cells)
     for idx, gx, gy, step in grads:
         rx, ry = _sample(gx, gy, keypoints.xy[idx] / step, keypoints.scale[idx] / step, keypoints.orientation[idx],
                          2 * _CELL)
         mag, ang = cv2.cartToPolar(np.ascontiguousarray(rx), np.ascontiguousarray(ry))  # angle in [0, 2 pi)
-        mag, ang = mag.T.ravel(), ang.T.ravel()  # sample-major, so the spatial binning is one matrix product
         pos = ang * np.float32(bins / (2 * np.pi))
-        lo = np.floor(pos).astype(np.intp)
-        frac = pos - lo
-        # orientation soft-binning per sample ...
-        per_sample = np.zeros(mag.size * bins, np.float32)
-        base = np.arange(mag.size) * bins
-        per_sample[base + lo % bins] = mag * (1 - frac)
-        per_sample[base + (lo + 1) % bins] += mag * frac
-        # ... then (cells^2, samples) @ (samples, k * bins) sums the samples into the spatial cells
-        hist = weights @ per_sample.reshape(weights.shape[1], idx.size * bins)
-        out[idx] = hist.reshape(cells * cells, idx.size, bins).transpose(1, 0, 2).reshape(idx.size, dim)
+        # orientation soft-binning per sample: weight max(0, 1 - circular distance to the bin) ...
+        per_bin = np.empty((bins, idx.size, weights.shape[1]), np.float32)
+        for b in range(bins):  # a loop over the 8 bins, each a whole-array float32 operation
+            d = np.abs(pos - np.float32(b))
+            np.minimum(d, np.float32(bins) - d, out=d)
+            np.subtract(np.float32(1), d, out=d)
+            np.maximum(d, 0, out=d)
+            np.multiply(d, mag, out=per_bin[b])
+        # ... then (bins * k, samples) @ (samples, cells^2) sums the samples into the spatial cells
+        # (OpenCV's single-threaded product: OpenBLAS threads spin against a loaded 2-core machine)
+        hist = cv2.gemm(per_bin.reshape(bins * idx.size, -1), weights, 1.0, None, 0.0, flags=cv2.GEMM_2_T)
+        out[idx] = hist.reshape(bins, idx.size, cells * cells).transpose(1, 2, 0).reshape(idx.size, dim)
     for _ in range(2):  # normalise, clip large gradients, renormalise (Lowe 2004, Sec. 6.1)
         norm = np.linalg.norm(out, axis=1, keepdims=True)
         out = np.divide(out, norm, out=np.zeros_like(out), where=norm > 1e-12)
