@@ -58,8 +58,8 @@ def _roots(alpha: float, beta: float, gamma: float) -> list[float]:
 
 
 def _stationary(coeffs, e: int) -> np.ndarray:
-    """Arm angles where a tangent-type joint (q1, q3, q5, q7) of elbow sign ``e`` is stationary, and the
-    middle of each such pair (where a joint near Shimizu's singular case turns fastest).
+    """Arm angles where a joint of elbow sign ``e`` is stationary, and the middle of each pair of a
+    tangent-type joint (q1, q3, q5, q7; where a joint near Shimizu's singular case turns fastest).
 
     ``d/dpsi atan2(n, d)`` has the numerator ``(cn bd - bn cd) sin psi + (an cd - cn ad) cos psi +
     (an bd - bn ad)`` (Shimizu et al. 2008, Sec. IV-B), the same for both branches."""
@@ -75,6 +75,9 @@ def _stationary(coeffs, e: int) -> np.ndarray:
                 d = (r[1] - r[0] + np.pi) % (2 * np.pi) - np.pi
                 r.append((r[0] + 0.5 * d + np.pi) % (2 * np.pi) - np.pi)
             out += r
+        if np.hypot(A[eg, 8], B[eg, 8]) > 1e-14:       # cosine type: stationary at atan2(a, b) and opposite
+            r0 = float(np.arctan2(A[eg, 8], B[eg, 8]))
+            out += [r0, r0 - np.pi if r0 >= 0 else r0 + np.pi]
     return np.sort(out)
 
 
@@ -209,7 +212,7 @@ def ik_srs_reference(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 32) -
         Start posture; the middle of the joint ranges by default.
     n_psi : int, default 32
         Each feasible interval is sampled at its ends, at the arm angles ``-pi + 2 pi k / n_psi``
-        at the stationary points of the tangent-type joints and at ``q0``'s arm angle inside it;
+        at the stationary points of the joints and at ``q0``'s arm angle inside it;
         every local minimum of
         the samples is refined by bounded minimisation between its neighbours (see
         :func:`~robokit.arm.ik_srs_batch`).

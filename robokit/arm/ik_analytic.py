@@ -395,11 +395,12 @@ def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_p
     the tangent-type joints q1, q3, q5, q7 and the cosine-type joints q2, q6;
     :func:`~robokit.arm.arm_angle_intervals.feasible_arm_angles`). Inside each interval the
     distance is sampled at the interval's ends, at the arm angles ``-pi + 2 pi k / n_psi``, at
-    the stationary points of the tangent-type joints (and the middle of each pair, where a joint
-    near Shimizu's singular case turns fastest) and at the arm angle of ``q0`` inside it. Every
+    the stationary points of the joints (and the middle of each pair of a tangent-type joint, where
+    a joint near Shimizu's singular case turns fastest) and at the arm angle of ``q0`` inside it. Every
     local minimum of the samples is refined between its neighbouring samples by Brent's bounded
     minimisation (Brent 1973, Ch. 5), to its tolerance of about ``1.5e-8 |psi|`` rad (an interval
-    end only if the distance falls into the interval). So the answer is the global optimum (a
+    end only if the distance falls into the interval; skipped when the joints' ranges between the
+    samples, where each joint is monotonic, prove it cannot beat the best so far). So the answer is the global optimum (a
     boundary optimum exactly, in closed form; an interior one to that tolerance) unless two local
     minima of the distance lie between the same two samples. A joint within the tolerance of a
     limit is put exactly on it. Each target

@@ -321,8 +321,9 @@ END_STEP = 1e-7
 
 @njit
 def group_stationary(G, e, g, out):
-    """Arm angles where a tangent-type joint of group ``g`` (elbow ``e``) is stationary, and the middle
-    of each such pair (where a near-singular joint turns fastest); returns their number (<= 6).
+    """Arm angles where a joint of group ``g`` (elbow ``e``) is stationary, and the middle of each pair
+    of a tangent-type joint (where a near-singular joint turns fastest); returns their number (<= 8).
+    Between these points every joint of the group is monotonic in ``psi``.
 
     For ``theta = atan2(n, d)`` with ``n = an sin + bn cos + cn`` (and ``d`` alike), ``dtheta/dpsi``
     has the numerator ``(cn bd - bn cd) sin psi + (an cd - cn ad) cos psi + (an bd - bn ad)``
@@ -338,6 +339,12 @@ def group_stationary(G, e, g, out):
             out[m] = (out[n] + 0.5 * d + _PI) % (2.0 * _PI) - _PI
             m += 1
         n = m
+    a, b = G[e, g, 0, 8], G[e, g, 1, 8]            # cosine type: a sin + b cos + c is stationary at atan2(a, b) (+ pi)
+    if math.hypot(a, b) > 1e-14:
+        r = math.atan2(a, b)
+        out[n] = r
+        out[n + 1] = r - _PI if r >= 0 else r + _PI
+        n += 2
     return n
 
 
@@ -351,8 +358,8 @@ def _combine(base, e, s, w, q4e, lo, hi, q0, work, q):
     q[3] = q4e
     f = 0.0
     for j in range(7):
-        x = min(hi[j], max(lo[j], q[j]))
-        f += (x - q0[j]) ** 2
+        q[j] = min(hi[j], max(lo[j], q[j]))
+        f += (q[j] - q0[j]) ** 2
     return f
 
 
@@ -362,10 +369,12 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
     in ``q``; branch -1 when no arm angle is feasible.
 
     Each feasible interval of each branch is sampled at its two ends, at the arm angles
-    ``-pi + 2 pi k / n_psi``, at the stationary points of its tangent-type joints
-    (:func:`group_stationary`) and at ``psi0`` (the arm angle of ``q0``) inside it. Every local minimum of the samples, lowest first, is refined
-    by :func:`minimise` between its neighbours (an interval end only if the distance falls into
-    the interval from it).
+    ``-pi + 2 pi k / n_psi``, at the stationary points of its joints (:func:`group_stationary`) and
+    at ``psi0`` (the arm angle of ``q0``) inside it. Every local minimum of the samples, lowest
+    first, is refined by :func:`minimise` between its neighbours (an interval end only if the
+    distance falls into the interval from it), unless a lower bound says the bracket cannot beat
+    the best so far: no joint has a stationary point between samples, so each joint's range over
+    the bracket is spanned by its three samples, which bounds the distance from below.
     """
     ivl = np.empty((8, MAX_SPLITS, 2))
     counts = np.zeros(8, np.int64)
@@ -376,7 +385,7 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
         for e in range(2):
             for g in range(2):
                 group_angles(G, e, g, -_PI + h * k, base[k, e, g])
-    st = np.empty((2, 13))                       # per elbow: stationary points of both groups and psi0, sorted
+    st = np.empty((2, 17))                       # per elbow: stationary points of both groups and psi0, sorted
     nst = np.zeros(2, np.int64)
     for e in range(2):
         nst[e] = group_stationary(G, e, 0, st[e])
@@ -384,9 +393,9 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
         st[e, nst[e]] = psi0
         nst[e] += 1
         st[e, :nst[e]].sort()
-    ps, fs = np.empty(n_psi + 16), np.empty(n_psi + 16)
+    ps, fs, qs = np.empty(n_psi + 20), np.empty(n_psi + 20), np.empty((n_psi + 20, 7))
     ncand = 0
-    cand = np.empty((8 * (n_psi + 2 * MAX_SPLITS + 13), 5))   # value, branch, left, centre, right
+    cand = np.empty((8 * (n_psi + 2 * MAX_SPLITS + 17), 6))   # value, branch, left, centre, right, bound
     work, qt = np.empty(3), np.empty(7)
     evals = 4 * n_psi // 2
     for b in range(8):
@@ -394,7 +403,7 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
         for k in range(counts[b]):
             a, c = ivl[b, k, 0], ivl[b, k, 1]
             n = 0
-            ps[n], fs[n] = a, cost(G, q4, b, a, lo, hi, q0, work, qt)
+            ps[n], fs[n] = a, cost(G, q4, b, a, lo, hi, q0, work, qs[n])
             n += 1
             j = int(math.floor((a + _PI) / h)) + 1
             t = 0
@@ -406,24 +415,32 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
                 if min(xg, xs) >= c:
                     break
                 if xg <= xs:
-                    ps[n], fs[n] = xg, _combine(base[j], e, s, w, q4[e], lo, hi, q0, work, qt)
+                    ps[n], fs[n] = xg, _combine(base[j], e, s, w, q4[e], lo, hi, q0, work, qs[n])
                     j += 1
                     if xs == xg:
                         t += 1
                 else:
-                    ps[n], fs[n] = xs, cost(G, q4, b, xs, lo, hi, q0, work, qt)
+                    ps[n], fs[n] = xs, cost(G, q4, b, xs, lo, hi, q0, work, qs[n])
                     t += 1
                     evals += 1
                 n += 1
             if c > a:
-                ps[n], fs[n] = c, cost(G, q4, b, c, lo, hi, q0, work, qt)
+                ps[n], fs[n] = c, cost(G, q4, b, c, lo, hi, q0, work, qs[n])
                 n += 1
             evals += 2
             for i in range(n):
                 if (i > 0 and fs[i] > fs[i - 1]) or (i < n - 1 and fs[i] > fs[i + 1]):
                     continue
+                left, right = max(i - 1, 0), min(i + 1, n - 1)
                 cand[ncand, 0], cand[ncand, 1], cand[ncand, 3] = fs[i], b, ps[i]
-                cand[ncand, 2], cand[ncand, 4] = ps[max(i - 1, 0)], ps[min(i + 1, n - 1)]
+                cand[ncand, 2], cand[ncand, 4] = ps[left], ps[right]
+                bound = 0.0                      # every joint is monotonic between samples: its range
+                for jj in range(7):              # over the bracket is spanned by the three samples
+                    x_lo = min(qs[left, jj], qs[i, jj], qs[right, jj])
+                    x_hi = max(qs[left, jj], qs[i, jj], qs[right, jj])
+                    d = x_lo - q0[jj] if q0[jj] < x_lo else (q0[jj] - x_hi if q0[jj] > x_hi else 0.0)
+                    bound += d * d
+                cand[ncand, 5] = bound
                 ncand += 1
     if ncand == 0:
         return -1, 0.0, np.inf, evals
@@ -432,7 +449,7 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
     for r in range(ncand):
         f0, b, left, x0, right = cand[order[r], 0], int(cand[order[r], 1]), cand[order[r], 2], cand[order[r], 3], \
             cand[order[r], 4]
-        if right - left <= 1e-12:
+        if right - left <= 1e-12 or cand[order[r], 5] >= best:   # cannot beat the best: skip
             continue
         if x0 == left or x0 == right:            # an interval end: refine only if the distance falls inwards
             inward = x0 + END_STEP if x0 == left else x0 - END_STEP
