@@ -37,7 +37,7 @@ from scipy.optimize import minimize_scalar
 
 from ..geometry import as_se3
 from ..validation import check_int
-from .chain import LIMIT_TOL, Chain
+from .chain import Chain
 from .ik_analytic import BRANCHES, SRSArm
 
 __all__ = ["feasible_arm_angles", "ik_srs_reference", "split_points"]

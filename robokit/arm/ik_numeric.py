@@ -26,7 +26,7 @@ import numpy as np
 
 from ..geometry import ROTATION_TOL, as_se3, pose_error
 from ..validation import array_ndim, as_rng, check_choice, check_int, check_positive
-from .chain import LIMIT_TOL, Chain
+from .chain import Chain
 from .ik_steps import PROJECTION_EPS, METHODS, NULL_SPACE_FADE, STEP_RULES
 from .jacobian import jacobian_from_frames
 from .result import IKBatchResult, IKResult, verify
@@ -258,26 +258,30 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
         return ik_numeric_batch(chain, T, q0, **opts)[0]
     if not isinstance(chain, Chain):
         raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
-    method, tol, max_iter, restarts, damping, gain, clamp, max_step, patience, P = _settings(
-        *(opts[k] for k in ("method", "tol", "max_iter", "restarts", "damping", "gain", "clamp", "max_step",
-                            "patience", "parallel")))
+    if options.keys() <= {"rng"}:
+        settings = _DEFAULT_SETTINGS
+    else:
+        settings = _settings(*(opts[k] for k in _SETTINGS))
+    method, tol, max_iter, restarts, damping, gain, clamp, max_step, patience, P = settings
     K = _kernels()
     if not (type(T) is np.ndarray and T.dtype == np.float64 and T.shape == (4, 4) and T.flags.c_contiguous
             and K.check_se3(T, ROTATION_TOL) == 0):
         T = np.ascontiguousarray(as_se3(T, "T"))
     q = 0.5 * (chain.qmin + chain.qmax) if q0 is None else np.ascontiguousarray(chain.check_q(q0, "q0"))
-    if math.dist(T[:3, 3], chain.base[:3, 3]) > chain.reach():        # the batch says why
+    args, reach, base_p, lo, hi = _chain_data(chain)
+    if math.dist(T[:3, 3], base_p) > reach:                          # the batch says why
         return ik_numeric_batch(chain, T, q, **opts)[0]
-    gen = as_rng(opts["rng"])
-    pool = gen.uniform(chain.qmin, chain.qmax, size=(P - 1 + restarts, chain.n))
-    args = _chain_args(chain)
+    seed = opts["rng"]
+    if seed is None or (type(seed) is int and seed >= 0):             # the same draws every call: kept
+        pool = _pool(chain, seed, P - 1 + restarts)
+    else:
+        pool = as_rng(seed).uniform(chain.qmin, chain.qmax, size=(P - 1 + restarts, chain.n))
     q_out, info = np.empty(chain.n), np.zeros(4)
-    K.search(T, q, pool, *args, chain.qmin, chain.qmax, _METHOD_CODE[method], tol, max_iter, restarts,
-             damping**2, gain, clamp, max_step, patience, P, NULL_SPACE_FADE, PROJECTION_EPS, q_out, info)
+    winner = K.search(T, q, pool, *args, lo, hi, _METHOD_CODE[method], tol, max_iter, restarts, damping**2, gain,
+                      clamp, max_step, patience, P, NULL_SPACE_FADE, PROJECTION_EPS, q_out, info)
     pos, rot = float(info[0]), float(info[1])
-    inside = bool(np.all((q_out >= chain.qmin - LIMIT_TOL) & (q_out <= chain.qmax + LIMIT_TOL)))
     iterations, used = int(info[2]), int(info[3])
-    if pos < tol and rot < tol and inside:
+    if winner >= 0 and pos < tol and rot < tol:          # converged strictly inside the limits
         return IKResult(q=q_out, success=True, reason="converged", residual=math.hypot(pos, rot),
                         iterations=iterations, position_error=pos, orientation_error=rot, restarts=used)
     out = verify(chain, T[None], q_out[None], tol, check=False)[0]
@@ -291,11 +295,23 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
 _METHOD_CODE = {"dls": 0, "gradient_projection": 1, "wln": 2}
 
 
+_SETTINGS = ("method", "tol", "max_iter", "restarts", "damping", "gain", "clamp", "max_step", "patience", "parallel")
+_DEFAULT_SETTINGS = _settings(*(DEFAULTS[k] for k in _SETTINGS))
+
+
 @functools.lru_cache(maxsize=16)
-def _chain_args(chain: Chain) -> tuple:
-    """The chain's arrays as the compiled kernels take them (built once per chain object)."""
+def _chain_data(chain: Chain) -> tuple:
+    """The chain's arrays as the compiled kernels take them, its reach bound and base position, and
+    its limits (built once per chain object)."""
     from .chain_kernels import chain_arrays
-    return chain_arrays(chain)
+    return chain_arrays(chain), chain.reach(), chain.base[:3, 3].copy(), chain.qmin.copy(), chain.qmax.copy()
+
+
+@functools.lru_cache(maxsize=64)
+def _pool(chain: Chain, seed, rows: int) -> np.ndarray:
+    """The random configurations a seed (or None) gives, drawn as the batch search draws them (shared
+    between calls: the kernel never writes to it)."""
+    return as_rng(seed).uniform(chain.qmin, chain.qmax, size=(rows, chain.n))
 
 
 def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln", tol: float = 1e-6,

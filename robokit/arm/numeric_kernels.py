@@ -28,8 +28,10 @@ import math
 
 import numpy as np
 
-from .chain_kernels import check_se3, frames, jacobian, pose_error  # noqa: F401 - check_se3 for ik_numeric
+from .chain_kernels import check_se3, frames, jacobian, pose_error
 from .jit import njit
+
+__all__ = ["search", "step", "solve6", "check_se3", "DLS", "GRADIENT_PROJECTION", "WLN"]
 
 #: Method codes of the kernel.
 DLS, GRADIENT_PROJECTION, WLN = 0, 1, 2
