@@ -151,3 +151,19 @@ def test_import_compiles_nothing_and_an_unwritable_cache_only_disables_caching(t
     assert r.returncode == 0 and r.stdout.split() == ["False", "3.0"], r.stderr
     r = _run(code, ROBOKIT_CACHE=str(tmp_path / "cache"), NUMBA_CACHE_DIR="")
     assert r.returncode == 0 and r.stdout.split() == ["True", "3.0"], r.stderr
+
+
+def test_compiled_code_is_cached_in_robokits_cache_not_in_the_package():
+    from pathlib import Path
+
+    from numba.core import config as numba_config
+
+    import robokit
+    from robokit.arm import jit
+    from robokit.config import cache_dir
+
+    ik_srs(IIWA, IIWA.fk(np.zeros(7)))                       # compiled or loaded by now
+    if not os.environ.get("NUMBA_CACHE_DIR") and jit.CACHING:
+        assert numba_config.CACHE_DIR == str(cache_dir("numba"))
+        assert any(cache_dir("numba").rglob("*.nbi"))
+    assert not list(Path(robokit.__file__).parent.rglob("*.nbi"))   # nothing written next to the source
