@@ -144,3 +144,33 @@ def test_fast_solver_follows_the_readable_reference_iterate_by_iterate(method, c
         np.testing.assert_array_equal(fast.history[k:, i], np.broadcast_to(fast.history[k - 1, i], fast.history[k:, i].shape))
         assert ref.success == fast.success[i] and ref.iterations == fast.iterations[i]
         np.testing.assert_allclose(ref.q, fast.q[i], rtol=0, atol=1e-10)
+
+
+@pytest.mark.parametrize("method", ["dls", "gradient_projection", "wln"])
+@pytest.mark.parametrize("parallel", [1, 4])
+def test_compiled_single_solve_runs_the_batch_search_exactly(method, parallel):
+    """ik_numeric's compiled search takes the batch search's attempts, steps and restarts: same answer
+    (to rounding; measured <= 3e-13 rad), iterations, restarts and verdict, including targets that
+    need restarts (hard starts: q0 far away, few iterations per attempt) and a target out of reach."""
+    q, T, q0 = _targets(PANDA, 10, seed=31)
+    far = np.eye(4)
+    far[:3, 3] = [2.0, 0.0, 0.5]
+    for Ti, si, kw in [(Ti, si, {}) for Ti, si in zip(T, q0)] + [(T[0], q0[0], {"max_iter": 8}), (far, q0[0], {})]:
+        fast = ik_numeric(PANDA, Ti, si, method=method, parallel=parallel, rng=7, **kw)
+        slow = ik_numeric_batch(PANDA, Ti, si, method=method, parallel=parallel, rng=7, **kw)[0]
+        np.testing.assert_allclose(fast.q, slow.q, rtol=0, atol=1e-10)
+        assert (fast.success, fast.iterations, fast.restarts) == (slow.success, slow.iterations, slow.restarts)
+        assert fast.reason == slow.reason
+        assert abs(fast.position_error - slow.position_error) < 1e-12
+
+
+def test_single_solve_options_are_checked():
+    T = PANDA.fk(PANDA.random_q(rng=0))
+    with pytest.raises(TypeError, match="options"):
+        ik_numeric(PANDA, T, n_psi=3)
+    with pytest.raises(ValueError, match="parallel"):
+        ik_numeric(PANDA, T, parallel=0)
+    with pytest.raises(ValueError, match=r"T\[:3, :3\]"):
+        ik_numeric(PANDA, T @ np.diag([1.0, 1.0, -1.0, 1.0]))
+    r = ik_numeric(PANDA, T, rng=1, history=True)           # the vectorised search, with its iterates
+    assert r.success

@@ -9,7 +9,8 @@ transforms, rotations and the pose error come from :mod:`robokit.geometry`.
 * :func:`wrist_centre`, :func:`elbow_angle`, :func:`shoulder_angles` - the S-R-S decomposition
   step by step; :func:`dh_fk`, :func:`dh_jacobian` - the same for a plain DH table.
 * :func:`ik_srs`, :func:`ik_srs_batch`, :func:`ik_srs_branches`, :func:`arm_angle` - the analytic
-  arm-angle IK of S-R-S arms (KUKA LBR iiwa).
+  arm-angle IK of S-R-S arms (KUKA LBR iiwa); :func:`feasible_arm_angles`, :func:`split_points` -
+  Shimizu's exact feasible arm-angle intervals; :func:`ik_srs_reference` - the same search step by step.
 * :func:`ik_numeric`, :func:`ik_numeric_batch` - damped least squares with null-space gradient
   projection (Dubey) or weighted least norm (Chan), random restarts; any chain.
   :func:`ik_numeric_reference` is the same for one target as a plain loop.
@@ -17,6 +18,7 @@ transforms, rotations and the pose error come from :mod:`robokit.geometry`.
 """
 from ..geometry import pose_error
 from .chain import LIMIT_TOL, Chain, chain_from_table, dh_fk
+from .arm_angle_intervals import feasible_arm_angles, ik_srs_reference, split_points
 from .dh import dh_transform, mdh_transform
 from .ik_analytic import SRSArm, arm_angle, ik_srs, ik_srs_batch, ik_srs_branches
 from .ik_numeric import ik_numeric, ik_numeric_batch
@@ -33,4 +35,5 @@ __all__ = ["Chain", "dh_transform", "mdh_transform", "iiwa14", "panda", "geometr
            "ik_srs_branches", "IKResult", "IKBatchResult", "verify", "pose_error", "METHODS", "dls_step",
            "null_space_step", "ik_numeric", "ik_numeric_batch", "ik_numeric_reference",
            "limit_distance_gradient", "wln_weights", "chain_from_table", "dh_fk", "dh_jacobian", "elbow_angle",
-           "shoulder_angles", "wrist_centre", "LIMIT_TOL"]
+           "shoulder_angles", "wrist_centre", "LIMIT_TOL", "feasible_arm_angles", "split_points",
+           "ik_srs_reference"]

@@ -106,6 +106,12 @@ class Chain:
         """True for the modified (Craig) DH convention."""
         return self.convention == "modified"
 
+    @property
+    def link_terms(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(K, U, V)``, each (n, 4, 4) and read-only: link ``i`` is ``K_i + cos(theta_i) U_i + sin(theta_i) V_i``
+        (what :meth:`frames` and the compiled kernels multiply)."""
+        return self._K, self._U, self._V
+
     def __repr__(self) -> str:
         return f"Chain({self.name!r}, n={self.n}, convention={self.convention!r})"
 

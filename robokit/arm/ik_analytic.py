@@ -8,10 +8,13 @@ The method is the separation of position and posture of Huang & Jiang (2013):
    remaining freedom is the rotation of that triangle about the shoulder-wrist line, the *arm
    angle* ``psi`` of Shimizu et al. (2008), Sec. III;
 3. joints 5-7 produce the orientation in closed form (a ZYZ Euler decomposition);
-4. an iteration over the redundancy parameter ``psi`` finds values that keep every joint inside
-   its limits and picks the solution closest to a preferred configuration ``q0``.
+4. the exact feasible arm-angle intervals of Shimizu et al. (2008), Sec. IV
+   (:mod:`robokit.arm.arm_angle_intervals`) bound a one-dimensional minimisation over ``psi``
+   that picks the valid solution closest to a preferred configuration ``q0``.
 
-Every function here is vectorised over many targets at once.
+The solvers run as one compiled call per target (:mod:`robokit.arm.srs_kernels`, numba, compiled
+on the first solve and cached on disk); :func:`robokit.arm.arm_angle_intervals.ik_srs_reference`
+is the same search step by step.
 
 References
 ----------
@@ -24,6 +27,7 @@ References
 from __future__ import annotations
 
 import functools
+import math
 from typing import Any
 
 import numpy as np
@@ -34,7 +38,9 @@ from .chain import LIMIT_TOL, Chain
 from .result import IKBatchResult, IKResult, verify
 from .srs_geometry import ARRAY, SCALAR, arm_angle_terms, coefficient_terms, mirror_angle
 
-__all__ = ["SRSArm", "arm_angle", "ik_srs_branches", "ik_srs", "ik_srs_batch"]
+_KERNELS = None
+
+__all__ = ["SRSArm", "arm_angle", "ik_srs_branches", "ik_srs", "ik_srs_batch", "BRANCHES"]
 
 _ALPHA = np.array([-1, 1, 1, -1, -1, 1, 0]) * np.pi / 2
 #: Branch order of the 8 solutions for one arm angle: (elbow, shoulder, wrist) sign flags.
@@ -78,12 +84,11 @@ class SRSArm:
         self._tool_inv = np.linalg.inv(chain.tool)
         self._base_inv = np.linalg.inv(chain.base)
         self._plain = np.array_equal(chain.tool, np.eye(4)) and np.array_equal(chain.base, np.eye(4))
-        # limits of the spherical joints as (branch, joint-in-group, 1, 1, group): the layout of
-        # the angle arrays in _best_on_grid
-        grp = np.array([[0, 4], [1, 5], [2, 6]])
-        self._lo = chain.qmin[grp][None, :, None, None, None, :] - LIMIT_TOL
-        self._hi = chain.qmax[grp][None, :, None, None, None, :] + LIMIT_TOL
-        self._grp = grp
+        # what the compiled kernels take (robokit.arm.srs_kernels), as plain writable float arrays
+        self.kernel_args = (self._base_inv.copy(), self._tool_inv.copy(), self._plain,
+                            np.array([self.d_bs, self.d_se, self.d_ew, self.d_wf]), chain.qmin.copy(), chain.qmax.copy())
+        self.chain_args = tuple(np.array(x, dtype=float) for x in (*chain.link_terms, chain.offset, chain.base,
+                                                                     chain.tool))
         self.mid = 0.5 * (chain.qmin + chain.qmax)
 
     # --- the decomposition, step by step ---------------------------------------------------------
@@ -151,45 +156,6 @@ class SRSArm:
         if q.ndim == 1:
             return arm_angle_terms(*q[:4].tolist(), self.d_se, self.d_ew, SCALAR)
         return arm_angle_terms(*q[:, :4].T, self.d_se, self.d_ew, ARRAY)
-
-
-_CHUNK = 256
-_LOCAL = np.linspace(-1.0, 1.0, 9)
-#: Up to this many targets, one dense pass replaces the coarse pass + local refinement.
-_SMALL = 16
-
-
-def _best_on_grid(arm: SRSArm, coeffs, psi: np.ndarray, q0: np.ndarray):
-    """Unchecked: over arm angles ``psi`` (m, K) and all 8 branches, the feasible solution nearest
-    ``q0`` (m, 7). Returns ``(cost, q, psi)``; cost is ``inf`` where nothing is feasible.
-
-    The squared distance to ``q0`` separates into shoulder, elbow and wrist terms, so the best
-    shoulder and wrist branch are chosen independently for each elbow sign and arm angle.
-    """
-    chain = arm.chain
-    G, q4 = coeffs[0], coeffs[1]
-    m, K = psi.shape
-    a, b, c = arm.angles(G, psi)                                     # (m, K, 2e, 2g)
-    X = np.empty((2, 3, m, K, 2, 2))                                  # branch, joint in group, ...
-    X[0, 0], X[0, 1], X[0, 2] = a, b, c
-    X[1, 0], X[1, 1], X[1, 2] = mirror_angle(a), -b, mirror_angle(c)
-    ok = ((X >= arm._lo) & (X <= arm._hi)).all(1)                    # (2b, m, K, 2e, 2g)
-    D = X - q0[:, arm._grp].transpose(1, 0, 2)[None, :, :, None, None, :]
-    cost = np.where(ok, np.einsum("bjmkeg,bjmkeg->bmkeg", D, D), np.inf)
-    br = cost[1] < cost[0]                                           # (m, K, 2e, 2g)
-    cmin = np.minimum(cost[0], cost[1])
-    c4 = (q4 - q0[:, 3:4]) ** 2
-    c4[(q4 < chain.qmin[3] - LIMIT_TOL) | (q4 > chain.qmax[3] + LIMIT_TOL)] = np.inf
-    total = cmin.sum(-1) + c4[:, None, :]                            # (m, K, 2e)
-    flat = total.reshape(m, -1).argmin(1)
-    k, e = np.divmod(flat, 2)
-    i = np.arange(m)
-    q = np.empty((m, 7))
-    q[:, :3] = X[br[i, k, e, 0].astype(np.intp), :, i, k, e, 0]
-    q[:, 4:] = X[br[i, k, e, 1].astype(np.intp), :, i, k, e, 1]
-    q[:, 3] = q4[i, e]
-    np.clip(q, chain.qmin, chain.qmax, out=q)   # a joint within LIMIT_TOL of a limit lands on it
-    return total[i, k, e], q, psi[i, k]
 
 
 def _srs(chain: Chain) -> SRSArm:
@@ -293,53 +259,46 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
     return q
 
 
-def _options(n_psi: Any, n_fine: Any, tol: Any):
-    n_psi = check_int(n_psi, "n_psi", minimum=4)
-    return n_psi, check_int(n_fine, "n_fine", minimum=n_psi), check_positive(tol, "tol")
+def _kernels():
+    """The compiled kernels, imported (and numba loaded) on the first solve, never by ``import robokit``."""
+    global _KERNELS
+    if _KERNELS is None:
+        from . import srs_kernels
+        _KERNELS = srs_kernels
+    return _KERNELS
 
 
-def _search(arm: SRSArm, coeffs, psi0: np.ndarray, q0: np.ndarray, n: int, dense: bool):
-    """Unchecked: one pass of the arm-angle iteration with ``n`` coarse arm angles per target.
-
-    ``dense``: a single grid of ``4 n`` arm angles (few targets, where numpy's per-call overhead
-    dominates); otherwise ``n`` angles, then a local grid of 9 spanning one step either side of
-    the best. Returns ``(cost, q, branch evaluations per target)``.
-    """
-    if dense:
-        m = 4 * n
-        cost, q, _ = _best_on_grid(arm, coeffs, psi0[:, None] + np.arange(m) * (2 * np.pi / m), q0)
-        return cost, q, 8 * m
-    cost, q, psi = _best_on_grid(arm, coeffs, psi0[:, None] + np.arange(n) * (2 * np.pi / n), q0)
-    c2, q2, _ = _best_on_grid(arm, coeffs, psi[:, None] + (2 * np.pi / n) * _LOCAL, q0)
-    better = c2 < cost
-    return np.where(better, c2, cost), np.where(better[:, None], q2, q), 8 * (n + len(_LOCAL))
+#: Tolerance of the SE(3) check on targets (:data:`robokit.geometry.ROTATION_TOL`).
+_SE3_TOL = 1e-6
+#: Arm-angle tolerance of the bounded minimisation [rad].
+_XATOL = 1e-10
 
 
-def _finish(arm: SRSArm, T: np.ndarray, c4: np.ndarray, q: np.ndarray, found: np.ndarray, evals,
-            n_psi: int, n_fine: int, tol: float) -> IKBatchResult:
-    """Unchecked: FK-verify ``q`` (N, 7) against targets ``T`` (N, 4, 4) and say why not."""
-    out = verify(arm.chain, T, q, tol, check=False)
-    reasons = out.reason
-    reach = np.abs(c4) <= 1.0 + 1e-12
-    for i in np.flatnonzero(~reach):
-        L = np.sqrt(max(0.0, c4[i] * 2 * arm.d_se * arm.d_ew + arm.d_se**2 + arm.d_ew**2))
-        reasons[i] = (f"out of reach: shoulder-wrist distance {L:.4f} m outside "
-                      f"[{abs(arm.d_se - arm.d_ew):.4f}, {arm.d_se + arm.d_ew:.4f}] m")
-    for i in np.flatnonzero(reach & ~found):
-        reasons[i] = f"no arm angle keeps all joints within limits ({n_psi} + {n_fine} arm angles tried)"
-    out.success &= found
-    out.iterations = np.broadcast_to(evals, (len(q),)).astype(int)
-    return out
+def _options(n_psi: Any, tol: Any):
+    if type(n_psi) is int and type(tol) is float and n_psi == 32 and tol == 1e-6:   # the defaults
+        return 32, 1e-6
+    return check_int(n_psi, "n_psi", minimum=4), check_positive(tol, "tol")
 
 
-def ik_srs(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: float = 1e-6,
-           n_fine: int = 720) -> IKResult:
+def _reason(arm: SRSArm, status: int, ok: bool, pos: float, rot: float, c4: float) -> str:
+    """Why a solve failed (or ``"converged"``)."""
+    if status == 2:
+        L = math.sqrt(max(0.0, c4 * 2 * arm.d_se * arm.d_ew + arm.d_se**2 + arm.d_ew**2))
+        return (f"out of reach: shoulder-wrist distance {L:.4f} m outside "
+                f"[{abs(arm.d_se - arm.d_ew):.4f}, {arm.d_se + arm.d_ew:.4f}] m")
+    if status == 3:
+        return "no arm angle keeps all joints within limits (the exact feasible arm-angle set is empty)"
+    if not ok:
+        return f"pose error above tolerance (position {pos:.2e} m, orientation {rot:.2e} rad)"
+    return "converged"
+
+
+def ik_srs(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_psi: int = 32) -> IKResult:
     """Analytic IK of an S-R-S arm for one target: the valid solution closest to ``q0``.
 
     Parameters and result as :func:`ik_srs_batch`, for one transform ``T`` (4, 4) and one preferred
-    configuration ``q0`` (7,). The per-target geometry runs on Python floats and the arm-angle
-    search is one dense pass over ``4 n_psi`` arm angles (then ``4 n_fine`` if nothing is
-    feasible), the form of :func:`ik_srs_batch` for few targets.
+    configuration ``q0`` (7,). One compiled call does the whole solve, the check of ``T`` included
+    (a target that fails it is handed to :func:`robokit.geometry.as_se3`, which names the error).
 
     Raises
     ------
@@ -348,7 +307,8 @@ def ik_srs(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: float 
 
     Notes
     -----
-    Huang & Jiang (2013) with the arm angle of Shimizu et al. (2008), Sec. III.
+    Huang & Jiang (2013) with the arm angle and the exact feasible intervals of Shimizu et al.
+    (2008), Secs. III-IV.
 
     Examples
     --------
@@ -359,29 +319,44 @@ def ik_srs(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: float 
     >>> r.success, r.reason, r.position_error < 1e-9
     (True, 'converged', True)
     """
-    if array_ndim(T, "T") != 2:
-        raise ValueError(f"T: expected one transform of shape (4, 4), got shape {np.shape(T)}")
-    if q0 is not None and array_ndim(q0, "q0") != 1:
-        raise ValueError(f"q0: expected one joint vector of shape (7,), got shape {np.shape(q0)}")
     arm = _srs(chain)
-    Tt = as_se3(T, "T")
-    n_psi, n_fine, tol = _options(n_psi, n_fine, tol)
-    near = arm.mid if q0 is None else chain.check_q(q0, "q0")
-    coeffs = arm.coefficients(arm.to_link7(Tt))
-    near, psi0 = near[None], np.array([arm.arm_angle(near)])
-    q, found, evals = near, np.zeros(1, bool), 0
-    if abs(coeffs[2][0]) <= 1.0 + 1e-12:
-        for n in (n_psi, n_fine):
-            cost, q_n, ev = _search(arm, coeffs, psi0, near, n, dense=True)
-            evals += ev
-            if cost[0] < np.inf:
-                q, found[0] = q_n, True
-                break
-    return _finish(arm, Tt[None], coeffs[2], q, found, evals, n_psi, n_fine, tol)[0]
+    if not (type(T) is np.ndarray and T.dtype == np.float64 and T.shape == (4, 4)):
+        if array_ndim(T, "T") != 2:
+            raise ValueError(f"T: expected one transform of shape (4, 4), got shape {np.shape(T)}")
+        T = as_se3(T, "T")
+    if not T.flags.c_contiguous:
+        T = np.ascontiguousarray(T)
+    if q0 is None:
+        near = arm.mid
+    elif type(q0) is np.ndarray and q0.dtype == np.float64 and q0.shape == (7,) and q0.flags.c_contiguous:
+        near = q0
+    else:
+        if array_ndim(q0, "q0") != 1:
+            raise ValueError(f"q0: expected one joint vector of shape (7,), got shape {np.shape(q0)}")
+        near = chain.check_q(q0, "q0")
+    n_psi, tol = _options(n_psi, tol)
+    K = _kernels()
+    q, info = np.empty(7), np.zeros(5)
+    args = (arm.kernel_args + (LIMIT_TOL,), (_XATOL,) + arm.chain_args)
+    psi0 = arm.arm_angle(near) if math.isfinite(near.sum()) else 0.0
+    status = K.solve(T, near, psi0, *args[0], _SE3_TOL, n_psi, *args[1], q, info)
+    if status == 1:
+        T = as_se3(T, "T")                      # raises the named error (or passes within rounding)
+        status = K.solve(T, near, psi0, *args[0], -1.0, n_psi, *args[1], q, info)
+    if status == 4:
+        chain.check_q(q0, "q0")                 # raises: NaN or infinity in q0
+    if status == 0:
+        pos, rot = float(info[0]), float(info[1])
+        e = math.hypot(pos, rot)
+    else:
+        v = verify(chain, T[None], q[None], tol, check=False)
+        pos, rot, e = float(v.position_error[0]), float(v.orientation_error[0]), float(v.residual[0])
+    ok = status == 0 and pos < tol and rot < tol
+    return IKResult(q=q, success=ok, reason=_reason(arm, status, ok, pos, rot, float(info[3])), residual=e,
+                    iterations=int(info[2]), position_error=pos, orientation_error=rot)
 
 
-def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: float = 1e-6,
-                 n_fine: int = 720) -> IKBatchResult:
+def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_psi: int = 32) -> IKBatchResult:
     """Analytic IK of an S-R-S arm for many targets, with joint limits and a preferred solution.
 
     Parameters
@@ -393,18 +368,18 @@ def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: 
     q0 : array_like, shape (N, 7) or (7,), optional
         Preferred configurations (the solution nearest each is kept); the middle of the joint
         ranges by default.
-    n_psi : int, default 12
-        Arm angles tried in the first pass (evenly spaced, starting at each ``q0``'s own arm angle).
     tol : float, default 1e-6
         Tolerance on the FK-verified position error [m] and orientation error [rad].
-    n_fine : int, default 720
-        Arm angles tried for targets whose first pass found no branch inside the limits.
+    n_psi : int, default 32
+        Bracketing resolution of the minimisation: each feasible arm-angle interval is sampled at
+        its ends and at most ``2 pi / n_psi`` apart before the bounded minimisation.
 
     Returns
     -------
     IKBatchResult
         ``success[i]`` is true only when the FK of ``q[i]`` is within ``tol`` of the target and
-        every joint is within its limits; ``reason[i]`` says why not otherwise.
+        every joint is within its limits; ``reason[i]`` says why not otherwise. ``iterations[i]``
+        counts the branch evaluations.
 
     Raises
     ------
@@ -413,15 +388,23 @@ def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: 
 
     Notes
     -----
-    The iteration over the redundancy parameter (Huang & Jiang 2013, "algebraic iteration") runs
-    over the arm angle of Shimizu et al. (2008): (1) evaluate the 8 closed-form branches at
-    ``n_psi`` arm angles; keep those inside the limits and take the one nearest ``q0``; (2)
-    refine ``psi`` on a local grid of 9 arm angles spanning one grid step either side, accepting
-    only feasible improvements; (3) targets with no feasible branch are retried on a finer grid.
-    For 16 targets or fewer, steps (1)-(2) are one pass over ``4 n_psi`` arm angles (the same
-    spacing as the local grid), which is cheaper when numpy's call overhead dominates. Shimizu et al.
-    compute the feasible arm-angle intervals exactly (Sec. IV); the sampled search here is simpler
-    and is what the lesson's experiment measures.
+    *Optimal* here means: over the 8 branches and every arm angle ``psi`` at which all joints are
+    within their limits (:data:`~robokit.arm.LIMIT_TOL`), the solution with the smallest squared
+    joint distance ``sum((q - q0)^2)`` to the preferred configuration. The feasible arm angles are
+    the exact intervals of Shimizu et al. (2008), Sec. IV (interval boundaries in closed form for
+    the tangent-type joints q1, q3, q5, q7 and the cosine-type joints q2, q6;
+    :func:`~robokit.arm.arm_angle_intervals.feasible_arm_angles`). Inside each interval the
+    distance is sampled at the interval's ends, at the arm angles ``-pi + 2 pi k / n_psi``, at
+    the stationary points of the joints (and the middle of each pair of a tangent-type joint, where
+    a joint near Shimizu's singular case turns fastest) and at the arm angle of ``q0`` inside it. Every
+    local minimum of the samples is refined between its neighbouring samples by Brent's bounded
+    minimisation (Brent 1973, Ch. 5), to its tolerance of about ``1.5e-8 |psi|`` rad (an interval
+    end only if the distance falls into the interval; skipped when the joints' ranges between the
+    samples, where each joint is monotonic, prove it cannot beat the best so far). So the answer is the global optimum (a
+    boundary optimum exactly, in closed form; an interior one to that tolerance) unless two local
+    minima of the distance lie between the same two samples. A joint within the tolerance of a
+    limit is put exactly on it. Each target
+    is one compiled call (:mod:`robokit.arm.srs_kernels`); the answers equal :func:`ik_srs`'s.
 
     Examples
     --------
@@ -433,33 +416,26 @@ def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 12, tol: 
     (1.0, True)
     """
     arm = _srs(chain)
-    Tt = as_se3(T, "T", batch=True)
+    Tt = np.ascontiguousarray(as_se3(T, "T", batch=True))
     N = Tt.shape[0]
-    n_psi, n_fine, tol = _options(n_psi, n_fine, tol)
+    n_psi, tol = _options(n_psi, tol)
     if q0 is None:
         near = np.broadcast_to(arm.mid, (N, 7)).copy()
     else:
         near = chain.check_q(q0, "q0", batch=True)
         if near.shape[0] == 1 and N > 1:
-            near = np.broadcast_to(near, (N, 7)).copy()
+            near = np.broadcast_to(near, (N, 7))
         elif near.shape[0] != N:
             raise ValueError(f"q0: expected one joint vector or {N} (one per target), got {near.shape[0]}")
-
-    G, q4, c4 = arm.coefficients(arm.to_link7(Tt))
-    psi0 = arm.arm_angle(near)
-    q_best = near.copy()
-    found = np.zeros(N, bool)
-    evals = np.zeros(N, int)
-    reachable = np.flatnonzero(np.abs(c4) <= 1.0 + 1e-12)
-    for start in range(0, len(reachable), _CHUNK):
-        rows = reachable[start:start + _CHUNK]
-        for n in (n_psi, n_fine):
-            if not rows.size:
-                break
-            cost, q, ev = _search(arm, (G[rows], q4[rows]), psi0[rows], near[rows], n, len(rows) <= _SMALL)
-            evals[rows] += ev
-            has = cost < np.inf
-            q_best[rows[has]] = q[has]
-            found[rows[has]] = True
-            rows = rows[~has]
-    return _finish(arm, Tt, c4, q_best, found, evals, n_psi, n_fine, tol)
+        near = np.ascontiguousarray(near, dtype=float)
+    q, status, info = np.empty((N, 7)), np.empty(N, np.int64), np.zeros((N, 5))
+    _kernels().solve_batch(Tt, near, np.ascontiguousarray(arm.arm_angle(near)), *arm.kernel_args, LIMIT_TOL, n_psi, _XATOL, *arm.chain_args,
+                           q, status, info)
+    out = verify(chain, Tt, q, tol, check=False)
+    found = status == 0
+    out.success &= found
+    for i in np.flatnonzero(~out.success):
+        out.reason[i] = _reason(arm, int(status[i]), False, out.position_error[i], out.orientation_error[i],
+                                float(info[i, 3]))
+    out.iterations = info[:, 2].astype(int)
+    return out

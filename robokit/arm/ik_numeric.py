@@ -18,14 +18,16 @@ References
 """
 from __future__ import annotations
 
+import functools
+import math
 from typing import Any
 
 import numpy as np
 
-from ..geometry import as_se3, pose_error
+from ..geometry import ROTATION_TOL, as_se3, pose_error
 from ..validation import array_ndim, as_rng, check_choice, check_int, check_positive
 from .chain import Chain
-from .ik_steps import METHODS, STEP_RULES
+from .ik_steps import PROJECTION_EPS, METHODS, NULL_SPACE_FADE, STEP_RULES
 from .jacobian import jacobian_from_frames
 from .result import IKBatchResult, IKResult, verify
 
@@ -189,17 +191,47 @@ def _search(chain: Chain, T: np.ndarray, q0: np.ndarray, skip: np.ndarray, step,
 
 
 # --- the solvers ----------------------------------------------------------------------------------
+_KERNELS = None
+#: Defaults of the solvers' options (:func:`ik_numeric_batch`); :func:`ik_numeric` runs one attempt
+#: at a time (``parallel=1``) since its compiled search pays for every attempt it runs.
+DEFAULTS = {"method": "wln", "tol": 1e-6, "max_iter": 60, "restarts": 40, "damping": 1e-3, "gain": 0.5,
+            "clamp": True, "max_step": 0.5, "patience": 15, "parallel": 1, "rng": None, "history": False}
+
+
+def _kernels():
+    """The compiled search, imported (and numba loaded) on the first solve, never by ``import robokit``."""
+    global _KERNELS
+    if _KERNELS is None:
+        from . import numeric_kernels
+        _KERNELS = numeric_kernels
+    return _KERNELS
+
+
+def _settings(method, tol, max_iter, restarts, damping, gain, clamp, max_step, patience, parallel):
+    """The checked options of the solvers."""
+    return (check_choice(method, "method", METHODS), check_positive(tol, "tol"),
+            check_int(max_iter, "max_iter", minimum=1), check_int(restarts, "restarts", minimum=0),
+            check_positive(damping, "damping", allow_zero=True), check_positive(gain, "gain", allow_zero=True),
+            bool(clamp), check_positive(max_step, "max_step"), check_int(patience, "patience", minimum=1),
+            check_int(parallel, "parallel", minimum=1))
+
+
 def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult:
     """Numerical IK of one target; see :func:`ik_numeric_batch` for the parameters.
 
-    Runs ``parallel=16`` attempts side by side unless told otherwise (one from ``q0``): vectorised,
-    they cost little more than one and make the time to a solution far more predictable.
+    The same search as :func:`ik_numeric_batch` (same attempts, steps, restarts and answer), run
+    as one compiled call (:mod:`robokit.arm.numeric_kernels`, numba, compiled on the first solve
+    and cached on disk); ``history=True`` runs the vectorised search instead. One attempt at a time
+    (``parallel=1``) unless told otherwise: compiled, every attempt side by side costs as much as
+    one in turn. The restart configurations are drawn from ``rng`` before the search, all at once.
 
     Raises
     ------
     ValueError
         As :func:`ik_numeric_batch`, or if ``T`` is not one (4, 4) transform or ``q0`` not one
         joint vector.
+    TypeError
+        On an unknown option.
 
     Notes
     -----
@@ -218,8 +250,68 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
         raise ValueError(f"T: expected one pose of shape (4, 4), got shape {np.shape(T)}")
     if q0 is not None and array_ndim(q0, "q0") != 1:
         raise ValueError(f"q0: expected one joint vector, got shape {np.shape(q0)}")
-    options.setdefault("parallel", 16)
-    return ik_numeric_batch(chain, T, q0, **options)[0]
+    unknown = sorted(set(options) - set(DEFAULTS))
+    if unknown:
+        raise TypeError(f"options: expected some of {sorted(DEFAULTS)}, got unknown {unknown}")
+    opts = {**DEFAULTS, **options}
+    if opts["history"]:
+        return ik_numeric_batch(chain, T, q0, **opts)[0]
+    if not isinstance(chain, Chain):
+        raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
+    if options.keys() <= {"rng"}:
+        settings = _DEFAULT_SETTINGS
+    else:
+        settings = _settings(*(opts[k] for k in _SETTINGS))
+    method, tol, max_iter, restarts, damping, gain, clamp, max_step, patience, P = settings
+    K = _kernels()
+    if not (type(T) is np.ndarray and T.dtype == np.float64 and T.shape == (4, 4) and T.flags.c_contiguous
+            and K.check_se3(T, ROTATION_TOL) == 0):
+        T = np.ascontiguousarray(as_se3(T, "T"))
+    q = 0.5 * (chain.qmin + chain.qmax) if q0 is None else np.ascontiguousarray(chain.check_q(q0, "q0"))
+    args, reach, base_p, lo, hi = _chain_data(chain)
+    if math.dist(T[:3, 3], base_p) > reach:                          # the batch says why
+        return ik_numeric_batch(chain, T, q, **opts)[0]
+    seed = opts["rng"]
+    if seed is None or (type(seed) is int and seed >= 0):             # the same draws every call: kept
+        pool = _pool(chain, seed, P - 1 + restarts)
+    else:
+        pool = as_rng(seed).uniform(chain.qmin, chain.qmax, size=(P - 1 + restarts, chain.n))
+    q_out, info = np.empty(chain.n), np.zeros(4)
+    winner = K.search(T, q, pool, *args, lo, hi, _METHOD_CODE[method], tol, max_iter, restarts, damping**2, gain,
+                      clamp, max_step, patience, P, NULL_SPACE_FADE, PROJECTION_EPS, q_out, info)
+    pos, rot = float(info[0]), float(info[1])
+    iterations, used = int(info[2]), int(info[3])
+    if winner >= 0 and pos < tol and rot < tol:          # converged strictly inside the limits
+        return IKResult(q=q_out, success=True, reason="converged", residual=math.hypot(pos, rot),
+                        iterations=iterations, position_error=pos, orientation_error=rot, restarts=used)
+    out = verify(chain, T[None], q_out[None], tol, check=False)[0]
+    out.reason += f" after {used + P} attempts of up to {max_iter} iterations"
+    if out.reason.startswith("pose error"):
+        out.reason += " (target may be unreachable)"
+    out.iterations, out.restarts = iterations, used
+    return out
+
+
+_METHOD_CODE = {"dls": 0, "gradient_projection": 1, "wln": 2}
+
+
+_SETTINGS = ("method", "tol", "max_iter", "restarts", "damping", "gain", "clamp", "max_step", "patience", "parallel")
+_DEFAULT_SETTINGS = _settings(*(DEFAULTS[k] for k in _SETTINGS))
+
+
+@functools.lru_cache(maxsize=16)
+def _chain_data(chain: Chain) -> tuple:
+    """The chain's arrays as the compiled kernels take them, its reach bound and base position, and
+    its limits (built once per chain object)."""
+    from .chain_kernels import chain_arrays
+    return chain_arrays(chain), chain.reach(), chain.base[:3, 3].copy(), chain.qmin.copy(), chain.qmax.copy()
+
+
+@functools.lru_cache(maxsize=64)
+def _pool(chain: Chain, seed, rows: int) -> np.ndarray:
+    """The random configurations a seed (or None) gives, drawn as the batch search draws them (shared
+    between calls: the kernel never writes to it)."""
+    return as_rng(seed).uniform(chain.qmin, chain.qmax, size=(rows, chain.n))
 
 
 def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln", tol: float = 1e-6,
@@ -294,15 +386,8 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
         raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
     Tt = as_se3(T, "T", batch=True)
     N = Tt.shape[0]
-    method = check_choice(method, "method", METHODS)
-    tol = check_positive(tol, "tol")
-    max_iter = check_int(max_iter, "max_iter", minimum=1)
-    restarts = check_int(restarts, "restarts", minimum=0)
-    damping = check_positive(damping, "damping", allow_zero=True)
-    gain = check_positive(gain, "gain", allow_zero=True)
-    max_step = check_positive(max_step, "max_step")
-    patience = check_int(patience, "patience", minimum=1)
-    parallel = check_int(parallel, "parallel", minimum=1)
+    method, tol, max_iter, restarts, damping, gain, clamp, max_step, patience, parallel = _settings(
+        method, tol, max_iter, restarts, damping, gain, clamp, max_step, patience, parallel)
     gen = as_rng(rng)
     if q0 is None:
         q = np.tile(0.5 * (chain.qmin + chain.qmax), (N, 1))

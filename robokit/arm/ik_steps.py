@@ -42,14 +42,14 @@ from ..validation import as_array, check_finite_result, check_positive
 from .chain import Chain
 from .limits import limit_distance_gradient, wln_weights
 
-__all__ = ["METHODS", "NULL_SPACE_FADE", "dls_step", "null_space_step", "DampedLeastSquares",
+__all__ = ["METHODS", "NULL_SPACE_FADE", "PROJECTION_EPS", "dls_step", "null_space_step", "DampedLeastSquares",
            "GradientProjection", "WeightedLeastNorm", "STEP_RULES"]
 
 _EYE6 = np.eye(6)
 #: Regularisation of the null-space projector: ``J^T (J J^T + eps I)^-1 J`` has eigenvalues
 #: ``s^2 / (s^2 + eps)`` in [0, 1], so the projector stays bounded at singularities while leaking
 #: almost nothing of the secondary motion into the hand elsewhere.
-_PROJ_EPS = 1e-9
+PROJECTION_EPS = 1e-9
 #: Pose-error norm [m, rad] below which the null-space gain fades linearly to zero (the projected
 #: motion is exact only to first order).
 NULL_SPACE_FADE = 1e-2
@@ -179,7 +179,7 @@ def _gp(J, e, g, lam2, k):
     JJt = J @ Jt
     primary = (Jt @ np.linalg.solve(JJt + lam2[..., None, None] * _EYE6, e[..., None]))[..., 0]   # J# e
     Jg = (J @ g[..., None])
-    leak = (Jt @ np.linalg.solve(JJt + _PROJ_EPS * _EYE6, Jg))[..., 0]                           # J# J g
+    leak = (Jt @ np.linalg.solve(JJt + PROJECTION_EPS * _EYE6, Jg))[..., 0]                           # J# J g
     return primary + k[..., None] * (g - leak) if np.ndim(k) else primary + k * (g - leak)   # Liégeois Eq. (9)
 
 
