@@ -101,7 +101,12 @@ def _entry(G, e, g, ij, s, c):
 def group_angles(G, e, g, psi, out):
     """ZYZ angles ``(a, b >= 0, c)`` of group ``g``, elbow ``e`` at arm angle ``psi`` into ``out`` (3,)
     (as :func:`robokit.geometry.zyz_angles`; the mirror branch is ``(a -+ pi, -b, c -+ pi)``)."""
-    s, c = math.sin(psi), math.cos(psi)
+    group_angles_sc(G, e, g, math.sin(psi), math.cos(psi), out)
+
+
+@njit
+def group_angles_sc(G, e, g, s, c, out):
+    """:func:`group_angles` from ``s, c = sin psi, cos psi`` (both groups share them)."""
     m02, m12, m22 = _entry(G, e, g, 2, s, c), _entry(G, e, g, 5, s, c), _entry(G, e, g, 8, s, c)
     sb = math.hypot(m02, m12)
     out[1] = math.atan2(sb, m22)
@@ -230,8 +235,9 @@ def feasible_intervals(G, q4, lo, hi, tol, out, counts):
 def branch_q(G, q4, b, psi, lo, hi, work, q):
     """Joints (7,) of branch ``b`` at arm angle ``psi``, clipped onto the limits (within the tolerance)."""
     e, s, w = b // 4, (b // 2) % 2, b % 2
+    sp, cp = math.sin(psi), math.cos(psi)
     for g in range(2):
-        group_angles(G, e, g, psi, work)
+        group_angles_sc(G, e, g, sp, cp, work)
         branch_angles(work, (s if g == 0 else w) == 1, q[4 * g:4 * g + 3])
     q[3] = q4[e]
     for j in range(7):
@@ -364,6 +370,14 @@ def _combine(base, e, s, w, q4e, lo, hi, q0, work, q):
 
 
 @njit
+def _fill(G, e, psi, out):
+    """Base angles (2, 3) of both groups of elbow ``e`` at ``psi``."""
+    sp, cp = math.sin(psi), math.cos(psi)
+    group_angles_sc(G, e, 0, sp, cp, out[0])
+    group_angles_sc(G, e, 1, sp, cp, out[1])
+
+
+@njit
 def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
     """The feasible arm angle and branch nearest ``q0``: ``(branch, psi, cost, evaluations)``, the joints
     in ``q``; branch -1 when no arm angle is feasible.
@@ -380,11 +394,8 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
     counts = np.zeros(8, np.int64)
     feasible_intervals(G, q4, lo, hi, tol, ivl, counts)
     h = 2.0 * _PI / n_psi
-    base = np.empty((n_psi, 2, 2, 3))            # arm angle, elbow, group, ZYZ angles
-    for k in range(n_psi):
-        for e in range(2):
-            for g in range(2):
-                group_angles(G, e, g, -_PI + h * k, base[k, e, g])
+    base = np.empty((n_psi, 2, 2, 3))            # arm angle, elbow, group, ZYZ angles; filled when first used
+    have = np.zeros((n_psi, 2), np.bool_)
     st = np.empty((2, 17))                       # per elbow: stationary points of both groups and psi0, sorted
     nst = np.zeros(2, np.int64)
     for e in range(2):
@@ -393,11 +404,13 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
         st[e, nst[e]] = psi0
         nst[e] += 1
         st[e, :nst[e]].sort()
+    sbase = np.empty((17, 2, 2, 3))              # the same at the stationary points (shared by 4 branches)
+    shave = np.zeros((17, 2), np.bool_)
     ps, fs, qs = np.empty(n_psi + 20), np.empty(n_psi + 20), np.empty((n_psi + 20, 7))
     ncand = 0
     cand = np.empty((8 * (n_psi + 2 * MAX_SPLITS + 17), 6))   # value, branch, left, centre, right, bound
     work, qt = np.empty(3), np.empty(7)
-    evals = 4 * n_psi // 2
+    evals = 0                                    # each fill of both groups' angles and each cost counts one
     for b in range(8):
         e, s, w = b // 4, (b // 2) % 2, b % 2
         for k in range(counts[b]):
@@ -415,14 +428,21 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
                 if min(xg, xs) >= c:
                     break
                 if xg <= xs:
+                    if not have[j, e]:
+                        _fill(G, e, -_PI + h * j, base[j, e])
+                        have[j, e] = True
+                        evals += 1
                     ps[n], fs[n] = xg, _combine(base[j], e, s, w, q4[e], lo, hi, q0, work, qs[n])
                     j += 1
                     if xs == xg:
                         t += 1
                 else:
-                    ps[n], fs[n] = xs, cost(G, q4, b, xs, lo, hi, q0, work, qs[n])
+                    if not shave[t, e]:
+                        _fill(G, e, xs, sbase[t, e])
+                        shave[t, e] = True
+                        evals += 1
+                    ps[n], fs[n] = xs, _combine(sbase[t], e, s, w, q4[e], lo, hi, q0, work, qs[n])
                     t += 1
-                    evals += 1
                 n += 1
             if c > a:
                 ps[n], fs[n] = c, cost(G, q4, b, c, lo, hi, q0, work, qs[n])
