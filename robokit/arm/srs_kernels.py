@@ -93,11 +93,6 @@ def coefficients(T7, d_bs, d_se, d_ew, d_wf, G, q4):
 
 
 @njit
-def _entry(G, e, g, ij, s, c):
-    return G[e, g, 0, ij] * s + G[e, g, 1, ij] * c + G[e, g, 2, ij]
-
-
-@njit
 def group_angles(G, e, g, psi, out):
     """ZYZ angles ``(a, b >= 0, c)`` of group ``g``, elbow ``e`` at arm angle ``psi`` into ``out`` (3,)
     (as :func:`robokit.geometry.zyz_angles`; the mirror branch is ``(a -+ pi, -b, c -+ pi)``)."""
@@ -107,15 +102,16 @@ def group_angles(G, e, g, psi, out):
 @njit
 def group_angles_sc(G, e, g, s, c, out):
     """:func:`group_angles` from ``s, c = sin psi, cos psi`` (both groups share them)."""
-    m02, m12, m22 = _entry(G, e, g, 2, s, c), _entry(G, e, g, 5, s, c), _entry(G, e, g, 8, s, c)
+    A, B, C = G[e, g, 0], G[e, g, 1], G[e, g, 2]     # entry ij of the rotation: A[ij] s + B[ij] c + C[ij]
+    m02, m12, m22 = A[2] * s + B[2] * c + C[2], A[5] * s + B[5] * c + C[5], A[8] * s + B[8] * c + C[8]
     sb = math.hypot(m02, m12)
     out[1] = math.atan2(sb, m22)
     if sb < 1e-12:
         out[0] = 0.0
-        out[2] = math.atan2(_entry(G, e, g, 3, s, c), _entry(G, e, g, 4, s, c))
+        out[2] = math.atan2(A[3] * s + B[3] * c + C[3], A[4] * s + B[4] * c + C[4])
     else:
         out[0] = math.atan2(m12, m02)
-        out[2] = math.atan2(_entry(G, e, g, 7, s, c), -_entry(G, e, g, 6, s, c))
+        out[2] = math.atan2(A[7] * s + B[7] * c + C[7], -(A[6] * s + B[6] * c + C[6]))
 
 
 @njit
@@ -127,6 +123,19 @@ def branch_angles(ang, mirror, out):
         out[2] = ang[2] - _PI if ang[2] > 0 else ang[2] + _PI
     else:
         out[0], out[1], out[2] = ang[0], ang[1], ang[2]
+
+
+@njit
+def sort_prefix(a, n):
+    """Sort ``a[:n]`` in place (insertion sort: a few dozen numbers, and it compiles in a fraction of
+    the time of ``ndarray.sort``)."""
+    for i in range(1, n):
+        x = a[i]
+        j = i - 1
+        while j >= 0 and a[j] > x:
+            a[j + 1] = a[j]
+            j -= 1
+        a[j + 1] = x
 
 
 @njit
@@ -159,7 +168,7 @@ def group_splits(G, e, g, lo, hi, out):
                        G[e, g, 2, num] * cl - sd * G[e, g, 2, den] * sl, out, n)
     for lim in (lo[1], hi[1]):
         n = _roots(G[e, g, 0, 8], G[e, g, 1, 8], G[e, g, 2, 8] - math.cos(lim), out, n)
-    out[:n].sort()
+    sort_prefix(out, n)
     return n
 
 
@@ -373,8 +382,8 @@ def _combine(base, e, s, w, q4e, lo, hi, q0, work, q):
 def _fill(G, e, psi, out):
     """Base angles (2, 3) of both groups of elbow ``e`` at ``psi``."""
     sp, cp = math.sin(psi), math.cos(psi)
-    group_angles_sc(G, e, 0, sp, cp, out[0])
-    group_angles_sc(G, e, 1, sp, cp, out[1])
+    for g in range(2):                           # a loop: a constant argument would compile a second copy
+        group_angles_sc(G, e, g, sp, cp, out[g])
 
 
 @njit
@@ -399,11 +408,12 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
     st = np.empty((2, 17))                       # per elbow: stationary points of both groups and psi0, sorted
     nst = np.zeros(2, np.int64)
     for e in range(2):
-        nst[e] = group_stationary(G, e, 0, st[e])
-        nst[e] += group_stationary(G, e, 1, st[e, nst[e]:])
+        nst[e] = 0
+        for g in range(2):
+            nst[e] += group_stationary(G, e, g, st[e, nst[e]:])
         st[e, nst[e]] = psi0
         nst[e] += 1
-        st[e, :nst[e]].sort()
+        sort_prefix(st[e], nst[e])
     sbase = np.empty((17, 2, 2, 3))              # the same at the stationary points (shared by 4 branches)
     shave = np.zeros((17, 2), np.bool_)
     ps, fs, qs = np.empty(n_psi + 20), np.empty(n_psi + 20), np.empty((n_psi + 20, 7))
@@ -464,7 +474,13 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
                 ncand += 1
     if ncand == 0:
         return -1, 0.0, np.inf, evals
-    order = np.argsort(cand[:ncand, 0], kind="mergesort")
+    order = np.empty(ncand, np.int64)           # candidates by value, ties in sampling order (a stable
+    for i in range(ncand):                       # insertion sort, as np.argsort(kind="mergesort"))
+        x, j = cand[i, 0], i - 1
+        while j >= 0 and cand[order[j], 0] > x:
+            order[j + 1] = order[j]
+            j -= 1
+        order[j + 1] = i
     best, best_b, best_psi = cand[order[0], 0], int(cand[order[0], 1]), cand[order[0], 3]
     for r in range(ncand):
         f0, b, left, x0, right = cand[order[r], 0], int(cand[order[r], 1]), cand[order[r], 2], cand[order[r], 3], \
