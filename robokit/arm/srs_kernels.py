@@ -386,6 +386,24 @@ def _fill(G, e, psi, out):
         group_angles_sc(G, e, g, sp, cp, out[g])
 
 
+#: Most distinct interval ends of one elbow: the split points of its two groups and ``pi``.
+_MAX_ENDS = 2 * MAX_SPLITS + 1
+
+
+@njit
+def _end_cost(G, e, s, w, psi, q4e, lo, hi, q0, epsi, ebase, ne, work, q):
+    """:func:`cost` of branch ``(e, s, w)`` at interval end ``psi``, from the angles of both groups at
+    ``psi`` computed once per elbow (an end is a split point of one group, so other branches share it)."""
+    k = 0
+    while k < ne[e] and epsi[e, k] != psi:
+        k += 1
+    if k == ne[e]:
+        epsi[e, k] = psi
+        _fill(G, e, psi, ebase[k, e])
+        ne[e] = k + 1
+    return _combine(ebase[k], e, s, w, q4e, lo, hi, q0, work, q)
+
+
 @njit
 def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
     """The feasible arm angle and branch nearest ``q0``: ``(branch, psi, cost, evaluations)``, the joints
@@ -416,6 +434,9 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
         sort_prefix(st[e], nst[e])
     sbase = np.empty((17, 2, 2, 3))              # the same at the stationary points (shared by 4 branches)
     shave = np.zeros((17, 2), np.bool_)
+    epsi = np.empty((2, _MAX_ENDS))              # and at the interval ends met so far (split points of
+    ebase = np.empty((_MAX_ENDS, 2, 2, 3))       # either group, shared by the branches of an elbow)
+    ne = np.zeros(2, np.int64)
     ps, fs, qs = np.empty(n_psi + 20), np.empty(n_psi + 20), np.empty((n_psi + 20, 7))
     ncand = 0
     cand = np.empty((8 * (n_psi + 2 * MAX_SPLITS + 17), 6))   # value, branch, left, centre, right, bound
@@ -426,7 +447,7 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
         for k in range(counts[b]):
             a, c = ivl[b, k, 0], ivl[b, k, 1]
             n = 0
-            ps[n], fs[n] = a, cost(G, q4, b, a, lo, hi, q0, work, qs[n])
+            ps[n], fs[n] = a, _end_cost(G, e, s, w, a, q4[e], lo, hi, q0, epsi, ebase, ne, work, qs[n])
             n += 1
             j = int(math.floor((a + _PI) / h)) + 1
             t = 0
@@ -455,9 +476,8 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
                     t += 1
                 n += 1
             if c > a:
-                ps[n], fs[n] = c, cost(G, q4, b, c, lo, hi, q0, work, qs[n])
+                ps[n], fs[n] = c, _end_cost(G, e, s, w, c, q4[e], lo, hi, q0, epsi, ebase, ne, work, qs[n])
                 n += 1
-            evals += 2
             for i in range(n):
                 if (i > 0 and fs[i] > fs[i - 1]) or (i < n - 1 and fs[i] > fs[i + 1]):
                     continue
@@ -472,6 +492,7 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
                     bound += d * d
                 cand[ncand, 5] = bound
                 ncand += 1
+    evals += ne[0] + ne[1]
     if ncand == 0:
         return -1, 0.0, np.inf, evals
     order = np.empty(ncand, np.int64)           # candidates by value, ties in sampling order (a stable
