@@ -167,3 +167,22 @@ def test_compiled_code_is_cached_in_robokits_cache_not_in_the_package():
         assert numba_config.CACHE_DIR == str(cache_dir("numba"))
         assert any(cache_dir("numba").rglob("*.nbi"))
     assert not list(Path(robokit.__file__).parent.rglob("*.nbi"))   # nothing written next to the source
+
+
+def test_the_first_compiling_call_says_so_once_and_a_cache_hit_stays_quiet(tmp_path, monkeypatch, capsys):
+    from numba.core import config as numba_config
+
+    from robokit.arm import jit
+
+    monkeypatch.setattr(numba_config, "CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(jit, "CACHING", True)
+    record = jit.compile_notice("srs_solve", "the analytic IK solver")
+    err = capsys.readouterr().err
+    assert record is not None and record.parent == tmp_path
+    assert err.count("\n") == 1 and "compiling the analytic IK solver" in err and "once" in err
+    jit.compiled(record)
+    assert jit.compile_notice("srs_solve", "the analytic IK solver") is None      # recorded: quiet
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(jit, "CACHING", False)                  # no cache: every process compiles, and says so
+    assert jit.compile_notice("srs_solve", "the analytic IK solver") is None
+    assert "every new process" in capsys.readouterr().err

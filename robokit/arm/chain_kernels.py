@@ -53,7 +53,9 @@ def check_se3(T, tol):
 def frames(q, K, U, V, offset, base, tool, F):
     """Frames 0..n into ``F`` (n + 1, 4, 4); returns the flange transform (frame n times the tool)."""
     n = q.shape[0]
-    F[0] = base
+    for r in range(4):                          # element loops, not array assignment: numba compiles
+        for k in range(4):                      # the latter with its shape-mismatch message (seconds)
+            F[0, r, k] = base[r, k]
     A = np.empty((4, 4))
     for i in range(n):
         th = q[i] + offset[i]

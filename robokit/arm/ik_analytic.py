@@ -268,6 +268,22 @@ def _kernels():
     return _KERNELS
 
 
+#: Compiled entry points not yet called in this process: their first call may compile (and says so).
+_FIRST = {"solve", "solve_batch"}
+
+
+def _first_call(name: str):
+    """The one-line compile notice before kernel ``name``'s first call (:func:`robokit.arm.jit.compile_notice`)."""
+    _FIRST.discard(name)
+    from .jit import compile_notice
+    return compile_notice(f"srs_{name}", "the analytic IK solver" if name == "solve" else "the batched analytic IK solver")
+
+
+def _compiled(record) -> None:
+    from .jit import compiled
+    compiled(record)
+
+
 #: Tolerance of the SE(3) check on targets (:data:`robokit.geometry.ROTATION_TOL`).
 _SE3_TOL = 1e-6
 #: Arm-angle tolerance of the bounded minimisation [rad].
@@ -339,7 +355,10 @@ def ik_srs(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_psi: in
     q, info = np.empty(7), np.zeros(5)
     args = (arm.kernel_args + (LIMIT_TOL,), (_XATOL,) + arm.chain_args)
     psi0 = arm.arm_angle(near) if math.isfinite(near.sum()) else 0.0
+    record = _first_call("solve") if "solve" in _FIRST else None
     status = K.solve(T, near, psi0, *args[0], _SE3_TOL, n_psi, *args[1], q, info)
+    if record is not None:
+        _compiled(record)
     if status == 1:
         T = as_se3(T, "T")                      # raises the named error (or passes within rounding)
         status = K.solve(T, near, psi0, *args[0], -1.0, n_psi, *args[1], q, info)
@@ -429,8 +448,12 @@ def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_p
             raise ValueError(f"q0: expected one joint vector or {N} (one per target), got {near.shape[0]}")
         near = np.ascontiguousarray(near, dtype=float)
     q, status, info = np.empty((N, 7)), np.empty(N, np.int64), np.zeros((N, 5))
-    _kernels().solve_batch(Tt, near, np.ascontiguousarray(arm.arm_angle(near)), *arm.kernel_args, LIMIT_TOL, n_psi, _XATOL, *arm.chain_args,
-                           q, status, info)
+    K = _kernels()
+    record = _first_call("solve_batch") if "solve_batch" in _FIRST else None
+    K.solve_batch(Tt, near, np.ascontiguousarray(arm.arm_angle(near)), *arm.kernel_args, LIMIT_TOL, n_psi, _XATOL, *arm.chain_args,
+                  q, status, info)
+    if record is not None:
+        _compiled(record)
     out = verify(chain, Tt, q, tol, check=False)
     found = status == 0
     out.success &= found

@@ -198,6 +198,10 @@ DEFAULTS = {"method": "wln", "tol": 1e-6, "max_iter": 60, "restarts": 40, "dampi
             "clamp": True, "max_step": 0.5, "patience": 15, "parallel": 1, "rng": None, "history": False}
 
 
+#: True until the first single solve of this process (its first call may compile, and says so).
+_FIRST = [True]
+
+
 def _kernels():
     """The compiled search, imported (and numba loaded) on the first solve, never by ``import robokit``."""
     global _KERNELS
@@ -264,6 +268,11 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
         settings = _settings(*(opts[k] for k in _SETTINGS))
     method, tol, max_iter, restarts, damping, gain, clamp, max_step, patience, P = settings
     K = _kernels()
+    record = None
+    if _FIRST:
+        _FIRST.clear()
+        from .jit import compile_notice
+        record = compile_notice("numeric_search", "the numerical IK solver")
     if not (type(T) is np.ndarray and T.dtype == np.float64 and T.shape == (4, 4) and T.flags.c_contiguous
             and K.check_se3(T, ROTATION_TOL) == 0):
         T = np.ascontiguousarray(as_se3(T, "T"))
@@ -279,6 +288,9 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
     q_out, info = np.empty(chain.n), np.zeros(4)
     winner = K.search(T, q, pool, *args, lo, hi, _METHOD_CODE[method], tol, max_iter, restarts, damping**2, gain,
                       clamp, max_step, patience, P, NULL_SPACE_FADE, PROJECTION_EPS, q_out, info)
+    if record is not None:
+        from .jit import compiled
+        compiled(record)
     pos, rot = float(info[0]), float(info[1])
     iterations, used = int(info[2]), int(info[3])
     if winner >= 0 and pos < tol and rot < tol:          # converged strictly inside the limits

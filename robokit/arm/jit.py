@@ -9,15 +9,18 @@ process then pays the compile time again).
 """
 from __future__ import annotations
 
+import hashlib
 import os
+import sys
 import warnings
+from pathlib import Path
 
 import numba
 from numba.core import config as _numba_config
 
 from ..config import cache_dir
 
-__all__ = ["njit", "CACHING"]
+__all__ = ["njit", "CACHING", "compile_notice", "compiled"]
 
 
 def _use_robokit_cache() -> bool:
@@ -67,3 +70,75 @@ def njit(fn):
         except (RuntimeError, OSError):          # numba found no writable cache location
             pass
     return numba.njit(fn)
+
+
+#: The kernel modules whose source decides whether the cached machine code is current.
+_SOURCES = ("jit.py", "chain_kernels.py", "srs_kernels.py", "numeric_kernels.py")
+
+
+def _record(kernel: str) -> Path:
+    """Where this machine records that ``kernel`` was compiled from the current source and numba."""
+    h = hashlib.sha1(f"{numba.__version__} {sys.version_info[:2]}".encode())
+    here = Path(__file__).parent
+    for name in _SOURCES:
+        h.update((here / name).read_bytes())
+    return Path(_numba_config.CACHE_DIR or here) / f"robokit-{kernel}-{h.hexdigest()[:12]}.compiled"
+
+
+def compile_notice(kernel: str, what: str) -> Path | None:
+    """Say, before the first call of compiled ``kernel`` in this process, that it compiles now.
+
+    One line on standard error, only when this machine's cache has no record that ``kernel`` was
+    compiled from the current source (a cache hit stays quiet). Call :func:`compiled` with the
+    returned record after the call.
+
+    Parameters
+    ----------
+    kernel : str
+        A name for the compiled entry point, e.g. ``"srs_solve"``.
+    what : str
+        What the student is waiting for, e.g. ``"the analytic IK solver"``.
+
+    Returns
+    -------
+    pathlib.Path or None
+        The record to write once the call has compiled; None when nothing is to be written.
+
+    Examples
+    --------
+    >>> isinstance(compile_notice("doctest-never-recorded", "nothing") , Path) or not CACHING
+    True
+    """
+    if not CACHING:
+        print(f"robokit: compiling {what} for this machine (no writable cache folder, so every new "
+              "process compiles it again)", file=sys.stderr)
+        return None
+    try:
+        record = _record(kernel)
+        if record.exists():
+            return None
+    except OSError:
+        return None
+    print(f"robokit: compiling {what} for this machine; this happens once, later runs load it from the "
+          f"cache ({record.parent})", file=sys.stderr)
+    return record
+
+
+def compiled(record: Path | None) -> None:
+    """Record that the kernel of :func:`compile_notice` is compiled and cached (nothing if ``None``).
+
+    Parameters
+    ----------
+    record : pathlib.Path or None
+        What :func:`compile_notice` returned.
+
+    Examples
+    --------
+    >>> compiled(None)
+    """
+    if record is not None:
+        try:
+            record.parent.mkdir(parents=True, exist_ok=True)
+            record.touch()
+        except OSError:
+            pass

@@ -128,10 +128,12 @@ def search(Tt, q0, pool, K, U, V, offset, base, tool, first, lo, hi, method, tol
     orientation error, iterations, restarts) of the answer.
     """
     n = q0.shape[0]
-    q = np.empty((P, n))
-    q[0] = q0
+    q = np.empty((P, n))                                        # element copies, not array assignment
+    for j in range(n):                                          # (see chain_kernels.frames)
+        q[0, j] = q0[j]
     for r in range(1, P):
-        q[r] = pool[r - 1]
+        for j in range(n):
+            q[r, j] = pool[r - 1, j]
     drawn = P - 1
     steps, stall = np.zeros(P, np.int64), np.zeros(P, np.int64)
     best = np.full(P, np.inf)
@@ -151,7 +153,10 @@ def search(Tt, q0, pool, K, U, V, offset, base, tool, first, lo, hi, method, tol
             if not alive[r]:
                 continue
             n_active += 1
-            flange[r] = frames(q[r], K, U, V, offset, base, tool, F[r])
+            out = frames(q[r], K, U, V, offset, base, tool, F[r])
+            for i in range(4):
+                for k in range(4):
+                    flange[r, i, k] = out[i, k]
             pos2, rot2 = pose_error(Tt, flange[r], e[r])
             err2[r] = pos2 + rot2
             conv[r] = max(pos2, rot2) < tol * tol
@@ -184,7 +189,8 @@ def search(Tt, q0, pool, K, U, V, offset, base, tool, first, lo, hi, method, tol
         for r in range(P):
             if alive[r] and ended[r]:
                 if used < restarts:
-                    q[r] = pool[drawn]
+                    for j in range(n):
+                        q[r, j] = pool[drawn, j]
                     drawn += 1
                     used += 1
                     steps[r], best[r], stall[r] = 0, np.inf, 0
@@ -198,7 +204,10 @@ def search(Tt, q0, pool, K, U, V, offset, base, tool, first, lo, hi, method, tol
                 continue
             jacobian(F[r], flange[r], first, J)
             step(method, J, e[r], err2[r], q[r], previous[r], lo, hi, lam2_0, gain, fade_at, proj_eps, dq)
-            big = math.sqrt(np.sum(dq * dq))
+            big = 0.0
+            for j in range(n):
+                big += dq[j] * dq[j]
+            big = math.sqrt(big)
             if big > max_step:
                 dq *= max_step / big
             for j in range(n):
@@ -213,7 +222,8 @@ def search(Tt, q0, pool, K, U, V, offset, base, tool, first, lo, hi, method, tol
                 winner_row = r
     else:
         winner_row = winner
-    q_out[:] = q[winner_row]
+    for j in range(n):
+        q_out[j] = q[winner_row, j]
     fl = frames(q_out, K, U, V, offset, base, tool, F[0])
     pos2, rot2 = pose_error(Tt, fl, e[0])
     info[0], info[1], info[2], info[3] = math.sqrt(pos2), math.sqrt(rot2), iterations, used

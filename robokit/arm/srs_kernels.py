@@ -93,24 +93,25 @@ def coefficients(T7, d_bs, d_se, d_ew, d_wf, G, q4):
 
 
 @njit
-def _entry(G, e, g, ij, s, c):
-    return G[e, g, 0, ij] * s + G[e, g, 1, ij] * c + G[e, g, 2, ij]
-
-
-@njit
 def group_angles(G, e, g, psi, out):
     """ZYZ angles ``(a, b >= 0, c)`` of group ``g``, elbow ``e`` at arm angle ``psi`` into ``out`` (3,)
     (as :func:`robokit.geometry.zyz_angles`; the mirror branch is ``(a -+ pi, -b, c -+ pi)``)."""
-    s, c = math.sin(psi), math.cos(psi)
-    m02, m12, m22 = _entry(G, e, g, 2, s, c), _entry(G, e, g, 5, s, c), _entry(G, e, g, 8, s, c)
+    group_angles_sc(G, e, g, math.sin(psi), math.cos(psi), out)
+
+
+@njit
+def group_angles_sc(G, e, g, s, c, out):
+    """:func:`group_angles` from ``s, c = sin psi, cos psi`` (both groups share them)."""
+    A, B, C = G[e, g, 0], G[e, g, 1], G[e, g, 2]     # entry ij of the rotation: A[ij] s + B[ij] c + C[ij]
+    m02, m12, m22 = A[2] * s + B[2] * c + C[2], A[5] * s + B[5] * c + C[5], A[8] * s + B[8] * c + C[8]
     sb = math.hypot(m02, m12)
     out[1] = math.atan2(sb, m22)
     if sb < 1e-12:
         out[0] = 0.0
-        out[2] = math.atan2(_entry(G, e, g, 3, s, c), _entry(G, e, g, 4, s, c))
+        out[2] = math.atan2(A[3] * s + B[3] * c + C[3], A[4] * s + B[4] * c + C[4])
     else:
         out[0] = math.atan2(m12, m02)
-        out[2] = math.atan2(_entry(G, e, g, 7, s, c), -_entry(G, e, g, 6, s, c))
+        out[2] = math.atan2(A[7] * s + B[7] * c + C[7], -(A[6] * s + B[6] * c + C[6]))
 
 
 @njit
@@ -122,6 +123,19 @@ def branch_angles(ang, mirror, out):
         out[2] = ang[2] - _PI if ang[2] > 0 else ang[2] + _PI
     else:
         out[0], out[1], out[2] = ang[0], ang[1], ang[2]
+
+
+@njit
+def sort_prefix(a, n):
+    """Sort ``a[:n]`` in place (insertion sort: a few dozen numbers, and it compiles in a fraction of
+    the time of ``ndarray.sort``)."""
+    for i in range(1, n):
+        x = a[i]
+        j = i - 1
+        while j >= 0 and a[j] > x:
+            a[j + 1] = a[j]
+            j -= 1
+        a[j + 1] = x
 
 
 @njit
@@ -154,7 +168,7 @@ def group_splits(G, e, g, lo, hi, out):
                        G[e, g, 2, num] * cl - sd * G[e, g, 2, den] * sl, out, n)
     for lim in (lo[1], hi[1]):
         n = _roots(G[e, g, 0, 8], G[e, g, 1, 8], G[e, g, 2, 8] - math.cos(lim), out, n)
-    out[:n].sort()
+    sort_prefix(out, n)
     return n
 
 
@@ -230,8 +244,9 @@ def feasible_intervals(G, q4, lo, hi, tol, out, counts):
 def branch_q(G, q4, b, psi, lo, hi, work, q):
     """Joints (7,) of branch ``b`` at arm angle ``psi``, clipped onto the limits (within the tolerance)."""
     e, s, w = b // 4, (b // 2) % 2, b % 2
+    sp, cp = math.sin(psi), math.cos(psi)
     for g in range(2):
-        group_angles(G, e, g, psi, work)
+        group_angles_sc(G, e, g, sp, cp, work)
         branch_angles(work, (s if g == 0 else w) == 1, q[4 * g:4 * g + 3])
     q[3] = q4[e]
     for j in range(7):
@@ -364,6 +379,32 @@ def _combine(base, e, s, w, q4e, lo, hi, q0, work, q):
 
 
 @njit
+def _fill(G, e, psi, out):
+    """Base angles (2, 3) of both groups of elbow ``e`` at ``psi``."""
+    sp, cp = math.sin(psi), math.cos(psi)
+    for g in range(2):                           # a loop: a constant argument would compile a second copy
+        group_angles_sc(G, e, g, sp, cp, out[g])
+
+
+#: Most distinct interval ends of one elbow: the split points of its two groups and ``pi``.
+_MAX_ENDS = 2 * MAX_SPLITS + 1
+
+
+@njit
+def _end_cost(G, e, s, w, psi, q4e, lo, hi, q0, epsi, ebase, ne, work, q):
+    """:func:`cost` of branch ``(e, s, w)`` at interval end ``psi``, from the angles of both groups at
+    ``psi`` computed once per elbow (an end is a split point of one group, so other branches share it)."""
+    k = 0
+    while k < ne[e] and epsi[e, k] != psi:
+        k += 1
+    if k == ne[e]:
+        epsi[e, k] = psi
+        _fill(G, e, psi, ebase[k, e])
+        ne[e] = k + 1
+    return _combine(ebase[k], e, s, w, q4e, lo, hi, q0, work, q)
+
+
+@njit
 def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
     """The feasible arm angle and branch nearest ``q0``: ``(branch, psi, cost, evaluations)``, the joints
     in ``q``; branch -1 when no arm angle is feasible.
@@ -380,30 +421,33 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
     counts = np.zeros(8, np.int64)
     feasible_intervals(G, q4, lo, hi, tol, ivl, counts)
     h = 2.0 * _PI / n_psi
-    base = np.empty((n_psi, 2, 2, 3))            # arm angle, elbow, group, ZYZ angles
-    for k in range(n_psi):
-        for e in range(2):
-            for g in range(2):
-                group_angles(G, e, g, -_PI + h * k, base[k, e, g])
+    base = np.empty((n_psi, 2, 2, 3))            # arm angle, elbow, group, ZYZ angles; filled when first used
+    have = np.zeros((n_psi, 2), np.bool_)
     st = np.empty((2, 17))                       # per elbow: stationary points of both groups and psi0, sorted
     nst = np.zeros(2, np.int64)
     for e in range(2):
-        nst[e] = group_stationary(G, e, 0, st[e])
-        nst[e] += group_stationary(G, e, 1, st[e, nst[e]:])
+        nst[e] = 0
+        for g in range(2):
+            nst[e] += group_stationary(G, e, g, st[e, nst[e]:])
         st[e, nst[e]] = psi0
         nst[e] += 1
-        st[e, :nst[e]].sort()
+        sort_prefix(st[e], nst[e])
+    sbase = np.empty((17, 2, 2, 3))              # the same at the stationary points (shared by 4 branches)
+    shave = np.zeros((17, 2), np.bool_)
+    epsi = np.empty((2, _MAX_ENDS))              # and at the interval ends met so far (split points of
+    ebase = np.empty((_MAX_ENDS, 2, 2, 3))       # either group, shared by the branches of an elbow)
+    ne = np.zeros(2, np.int64)
     ps, fs, qs = np.empty(n_psi + 20), np.empty(n_psi + 20), np.empty((n_psi + 20, 7))
     ncand = 0
     cand = np.empty((8 * (n_psi + 2 * MAX_SPLITS + 17), 6))   # value, branch, left, centre, right, bound
     work, qt = np.empty(3), np.empty(7)
-    evals = 4 * n_psi // 2
+    evals = 0                                    # each fill of both groups' angles and each cost counts one
     for b in range(8):
         e, s, w = b // 4, (b // 2) % 2, b % 2
         for k in range(counts[b]):
             a, c = ivl[b, k, 0], ivl[b, k, 1]
             n = 0
-            ps[n], fs[n] = a, cost(G, q4, b, a, lo, hi, q0, work, qs[n])
+            ps[n], fs[n] = a, _end_cost(G, e, s, w, a, q4[e], lo, hi, q0, epsi, ebase, ne, work, qs[n])
             n += 1
             j = int(math.floor((a + _PI) / h)) + 1
             t = 0
@@ -415,19 +459,25 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
                 if min(xg, xs) >= c:
                     break
                 if xg <= xs:
+                    if not have[j, e]:
+                        _fill(G, e, -_PI + h * j, base[j, e])
+                        have[j, e] = True
+                        evals += 1
                     ps[n], fs[n] = xg, _combine(base[j], e, s, w, q4[e], lo, hi, q0, work, qs[n])
                     j += 1
                     if xs == xg:
                         t += 1
                 else:
-                    ps[n], fs[n] = xs, cost(G, q4, b, xs, lo, hi, q0, work, qs[n])
+                    if not shave[t, e]:
+                        _fill(G, e, xs, sbase[t, e])
+                        shave[t, e] = True
+                        evals += 1
+                    ps[n], fs[n] = xs, _combine(sbase[t], e, s, w, q4[e], lo, hi, q0, work, qs[n])
                     t += 1
-                    evals += 1
                 n += 1
             if c > a:
-                ps[n], fs[n] = c, cost(G, q4, b, c, lo, hi, q0, work, qs[n])
+                ps[n], fs[n] = c, _end_cost(G, e, s, w, c, q4[e], lo, hi, q0, epsi, ebase, ne, work, qs[n])
                 n += 1
-            evals += 2
             for i in range(n):
                 if (i > 0 and fs[i] > fs[i - 1]) or (i < n - 1 and fs[i] > fs[i + 1]):
                     continue
@@ -442,9 +492,16 @@ def best_arm_angle(G, q4, lo, hi, tol, q0, psi0, n_psi, xatol, q):
                     bound += d * d
                 cand[ncand, 5] = bound
                 ncand += 1
+    evals += ne[0] + ne[1]
     if ncand == 0:
         return -1, 0.0, np.inf, evals
-    order = np.argsort(cand[:ncand, 0], kind="mergesort")
+    order = np.empty(ncand, np.int64)           # candidates by value, ties in sampling order (a stable
+    for i in range(ncand):                       # insertion sort, as np.argsort(kind="mergesort"))
+        x, j = cand[i, 0], i - 1
+        while j >= 0 and cand[order[j], 0] > x:
+            order[j + 1] = order[j]
+            j -= 1
+        order[j + 1] = i
     best, best_b, best_psi = cand[order[0], 0], int(cand[order[0], 1]), cand[order[0], 3]
     for r in range(ncand):
         f0, b, left, x0, right = cand[order[r], 0], int(cand[order[r], 1]), cand[order[r], 2], cand[order[r], 3], \
