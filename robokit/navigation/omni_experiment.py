@@ -33,7 +33,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, fast_mode, source_digest, write_atomically
+from ..config import cache_dir, cache_key, code_version, fast_mode, progress_bar, write_atomically
 from ..geometry import se2_between, se2_compose
 from ..localization.hierarchical import HierarchicalLocalizer
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
@@ -159,7 +159,7 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     params = {"n_features": 300 if fast else 500, "alphas": list(TOUR_ALPHAS)}
     meta = {"world": world.name, "world_seed": world.info["seed"], "camera": describe_sensor(camera),
             "tour": cache_key(poses=tour.poses.round(9).tolist()), "rate": rate, "record_seed": 2, "params": params,
-            "code": source_digest("sim", "geometry", "vision", "mapping")}
+            "code": code_version("sim", "geometry", "vision", "mapping")}
 
     def build():
         run = record(world, tour, {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
@@ -264,19 +264,20 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
     rng = as_rng(rng)
     images = [_render(setup, p, rng) for p in P]
     estimates, errors, local_errors, times, results = {}, {}, {}, {}, {}
-    for m, mode in enumerate(modes):
+    bar = progress_bar(len(modes) * len(images), "localizing", unit="view", callback=progress)
+    for mode in modes:
         loc = HierarchicalLocalizer(tmap, setup.camera, mode=mode, n_features=setup.n_features)
         out = []
-        for k, img in enumerate(images):
+        for img in images:
             out.append(loc.localize(img))
-            if progress is not None:
-                progress(m * len(images) + k + 1, len(modes) * len(images))
+            bar.update()
         results[mode] = out
         estimates[mode] = np.array([r.pose for r in out])
         errors[mode] = np.abs(estimates[mode][:, :2] - P[:, :2])
         local = np.array([se2_compose(setup.truth[r.node], se2_between(r.node_pose, r.pose)) for r in out])
         local_errors[mode] = np.abs(local[:, :2] - P[:, :2])
         times[mode] = {stage: np.array([r.times[stage] for r in out]) for stage in out[0].times}
+    bar.close()
     return LocalizationTrials(P, estimates, errors, local_errors, times, results)
 
 
