@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from ..config import progress_bar
 from ..validation import check_callable, check_choice, check_int, check_mapping, check_positive, describe
 from .field import Course, random_course
 from .geodesy import LocalTangentPlane
@@ -308,11 +309,11 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     course_options = check_mapping(course_options, "course_options")
     progress = check_callable(progress, "progress")
     out = []
-    for i, s in enumerate(seeds):
-        course = random_course(s, **(course_options or {}))
-        out.append(simulate(course, seed=10_000 + s, firing=firing, **options))
-        if progress is not None:
-            progress(i + 1, len(seeds))
+    with progress_bar(len(seeds), f"courses ({firing})", unit="course", callback=progress) as bar:
+        for s in seeds:
+            course = random_course(s, **(course_options or {}))
+            out.append(simulate(course, seed=10_000 + s, firing=firing, **options))
+            bar.update()
     return out
 
 
