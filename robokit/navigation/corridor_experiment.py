@@ -32,6 +32,7 @@ References
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import zipfile
 from typing import Any, Callable
 
@@ -250,7 +251,8 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     -------
     dict
         ``{"ours": indices, "orbslam": indices, "images": N}``; the extraction rate is
-        ``len(indices) / N``.
+        ``len(indices) / N``. Cached under ``robokit.cache_dir("corridor")``, keyed by the run's
+        descriptors and positions, the parameters and the code (a stale file is rebuilt).
 
     Raises
     ------
@@ -272,10 +274,24 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     if not isinstance(run, CalibrationRun):
         raise TypeError(f"run: expected a CalibrationRun (calibration_run()), got {type(run).__name__}")
     gap = check_int(min_frame_gap, "min_frame_gap", minimum=0)
-    ours = select_keyframes(run.descriptors, run.positions, run.f_min, min_frame_gap=gap, shared_range=shared_range,
-                            below_band=below_band)
-    orbslam = select_keyframes_orbslam(run.descriptors, run.positions)
-    return {"ours": np.asarray(ours, int), "orbslam": np.asarray(orbslam, int), "images": len(run.descriptors)}
+    flat, counts = _descriptor_stack(run.descriptors)
+    content = hashlib.sha256(flat.tobytes() + counts.tobytes() + np.asarray(run.positions, float).tobytes())
+    try:
+        band = np.asarray(shared_range, float).tolist()
+    except (TypeError, ValueError):
+        band = None                  # select_keyframes names the error
+    meta = {"run": content.hexdigest()[:16], "f_min": float(run.f_min), "gap": gap, "shared_range": band,
+            "below_band": str(below_band), "code": _code()}
+    target = cache_dir("corridor") / f"keyframes-{cache_key(**meta)}.npz"
+    data = read_arrays(target, ("ours", "orbslam"), meta) if band is not None else None
+    if data is None:
+        ours = select_keyframes(run.descriptors, run.positions, run.f_min, min_frame_gap=gap,
+                                shared_range=shared_range, below_band=below_band)
+        orbslam = select_keyframes_orbslam(run.descriptors, run.positions)
+        data = {"ours": np.asarray(ours, int), "orbslam": np.asarray(orbslam, int)}
+        if band is not None:
+            write_arrays(target, data, meta)
+    return {"ours": data["ours"], "orbslam": data["orbslam"], "images": len(run.descriptors)}
 
 
 # --- the vocabulary -----------------------------------------------------------------------------
