@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, code_version, write_atomically
+from ..config import cache_dir, cache_key, code_version, progress_bar, write_atomically
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .motion import Path, noisy_odometry
 from .world import World
@@ -285,10 +285,12 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     rng = as_rng(int(seed))
     odometry = noisy_odometry(poses, alphas, rng)
     logs: dict[str, dict[str, list]] = {"images": {}, "depths": {}, "scans": {}}
-    for pose in poses:
-        for name, sensor in sensors.items():
-            for group, key, array in _readings(name, sensor.observe(world, pose, rng=rng)):
-                logs[group].setdefault(key, []).append(array)
+    with progress_bar(len(poses), f"recording in {world.name}", unit="frame") as bar:
+        for pose in poses:
+            for name, sensor in sensors.items():
+                for group, key, array in _readings(name, sensor.observe(world, pose, rng=rng)):
+                    logs[group].setdefault(key, []).append(array)
+            bar.update()
     stacked = {group: {k: np.stack(v) for k, v in arrays.items()} for group, arrays in logs.items()}
     run = Run(t, poses, odometry, stacked["images"], stacked["depths"], stacked["scans"], meta)
     if target is not None:
