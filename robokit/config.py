@@ -10,11 +10,12 @@ import functools
 import hashlib
 import json
 import os
+import time
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-__all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest", "write_atomically",
-           "read_arrays"]
+__all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest", "code_version",
+           "write_atomically", "write_arrays", "read_arrays", "progress_bar"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -269,7 +270,105 @@ def write_atomically(target: str | Path, write: Callable[[Path], Any]) -> Path:
 
 
 
-def read_arrays(target: str | Path, names: Sequence[str]) -> dict | None:
+@functools.lru_cache(maxsize=None)
+def code_version(*packages: str) -> dict:
+    """What decides a cached dataset besides its parameters: the code that makes it.
+
+    A hash of the source of robokit's ``packages`` (:func:`source_digest`) and the numpy and
+    OpenCV versions (their numerics changed results before). It enters every cache key and is
+    stored in the cache file, so a dataset made by other code is never served.
+
+    Parameters
+    ----------
+    *packages : str
+        As for :func:`source_digest`.
+
+    Returns
+    -------
+    dict
+        ``{"robokit": digest, "numpy": version, "opencv": version}``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`source_digest`.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Caching"); not from a paper.
+
+    Examples
+    --------
+    >>> v = code_version("geometry")
+    >>> sorted(v), v["robokit"] == source_digest("geometry")
+    (['numpy', 'opencv', 'robokit'], True)
+    """
+    import cv2
+    import numpy as np
+
+    return {"robokit": source_digest(*packages), "numpy": np.__version__, "opencv": cv2.__version__}
+
+
+#: The entry of a cache file (:func:`write_arrays`) that holds the parameters it was made with.
+_META = "cache_meta"
+
+
+def _meta_text(meta: dict) -> str:
+    try:
+        return json.dumps(meta, sort_keys=True, separators=(",", ":"))
+    except TypeError as exc:
+        raise TypeError(f"meta: expected a JSON-serialisable dict of parameters ({exc})") from None
+
+
+def write_arrays(target: str | Path, arrays: dict, meta: dict | None = None) -> Path:
+    """Write named arrays as a compressed ``.npz`` cache file, with the parameters that made them.
+
+    Parameters
+    ----------
+    target : str or Path
+    arrays : dict of str to array_like
+    meta : dict, optional
+        The parameters and code version (:func:`code_version`) the arrays were made with; stored
+        in the file, and :func:`read_arrays` serves the file only to a caller asking with equal ones.
+
+    Returns
+    -------
+    Path
+        ``target``, written through :func:`write_atomically`.
+
+    Raises
+    ------
+    TypeError
+        For a ``meta`` that is not JSON-serialisable or ``arrays`` that is not a dict of names.
+    ValueError
+        If ``arrays`` uses the reserved name ``"cache_meta"``.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Caching"); not from a paper.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> import numpy as np
+    >>> target = Path(tempfile.mkdtemp()) / "c.npz"
+    >>> _ = write_arrays(target, {"a": np.arange(3)}, {"n": 3})
+    >>> read_arrays(target, ["a"], {"n": 3})["a"].tolist(), read_arrays(target, ["a"], {"n": 4})
+    ([0, 1, 2], None)
+    """
+    import numpy as np
+
+    if not isinstance(arrays, dict) or not all(isinstance(k, str) and k for k in arrays):
+        raise TypeError(f"arrays: expected a dict of array names to arrays, got {type(arrays).__name__}")
+    if _META in arrays:
+        raise ValueError(f"arrays: expected names other than the reserved {_META!r}, got {sorted(arrays)}")
+    stored = dict(arrays)
+    if meta is not None:
+        stored[_META] = np.array(_meta_text(meta))
+    return write_atomically(target, lambda path: np.savez_compressed(path, **stored))
+
+
+def read_arrays(target: str | Path, names: Sequence[str], meta: dict | None = None) -> dict | None:
     """The named arrays of a cache file written with ``numpy.savez``, or ``None`` to rebuild it.
 
     Parameters
@@ -277,17 +376,22 @@ def read_arrays(target: str | Path, names: Sequence[str]) -> dict | None:
     target : str or Path
     names : sequence of str
         The arrays the cache must hold.
+    meta : dict, optional
+        The parameters the caller needs (as given to :func:`write_arrays`): a file made with any
+        others, or that does not say what it was made with, is not served.
 
     Returns
     -------
     dict of str to numpy.ndarray, or None
-        ``None`` for a missing, truncated, corrupt or foreign file, or one without every name: the
-        caller rebuilds it, so a cache is never needed for correctness.
+        ``None`` for a missing, truncated, corrupt or foreign file, one without every name, or one
+        made with other parameters or code: the caller rebuilds it, so a cache is never needed for
+        correctness and never serves a stale dataset.
 
     Notes
     -----
-    Course convention (DESIGN.md, "Caching"), the reading twin of :func:`write_atomically`; never
-    unpickles.
+    Course convention (DESIGN.md, "Caching"), the reading twin of :func:`write_atomically` and
+    :func:`write_arrays`; never unpickles. Every array is read here, so a damaged member is found
+    now rather than by the caller.
 
     Examples
     --------
@@ -299,13 +403,142 @@ def read_arrays(target: str | Path, names: Sequence[str]) -> dict | None:
     >>> _ = write_atomically(target, lambda p: np.savez(p, a=np.arange(3)))
     >>> read_arrays(target, ["a"])["a"].tolist(), read_arrays(target, ["a", "b"])
     ([0, 1, 2], None)
+    >>> read_arrays(target, ["a"], {"n": 3}) is None     # says nothing of what made it
+    True
     """
     import zipfile
+    import zlib
 
     import numpy as np
 
     try:
         with np.load(target, allow_pickle=False) as data:
+            if meta is not None and (_META not in data.files or str(data[_META]) != _meta_text(meta)):
+                return None
             return {name: data[name] for name in names}
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile, zlib.error):
         return None
+
+
+class ProgressBar:
+    """A progress bar for a step a student waits for; see :func:`progress_bar`.
+
+    Call it as ``bar(done, total)`` (the ``progress`` callback protocol of robokit's long steps) or
+    ``bar.update(n)``; close it (or use it as a context manager) when the step ends.
+    """
+
+    def __init__(self, total: int, desc: str, unit: str, mode: str, callback: Callable | None):
+        self.total, self.desc, self.unit, self.mode, self.callback = total, desc, unit, mode, callback
+        self.done = 0
+        self._bar = None
+        self._closed = False
+        if mode == "live":
+            from tqdm.auto import tqdm
+
+            self._bar = tqdm(total=total, desc=desc, unit=unit, leave=True)
+        self._start = time.perf_counter()
+
+    def __call__(self, done: int, total: int | None = None) -> None:
+        if total is not None and total != self.total:
+            self.total = int(total)
+            if self._bar is not None:
+                self._bar.total = self.total
+        step = int(done) - self.done
+        self.done = int(done)
+        if self._bar is not None and step:
+            self._bar.update(step)
+        if self.callback is not None:
+            self.callback(self.done, self.total)
+
+    def update(self, n: int = 1) -> None:
+        """Advance the bar by ``n`` steps."""
+        self(self.done + int(n))
+
+    def line(self) -> str:
+        """The bar's current state as one line of text (what a saved notebook shows)."""
+        from tqdm import tqdm
+
+        elapsed = time.perf_counter() - self._start
+        return tqdm.format_meter(self.done, self.total, elapsed, prefix=self.desc, unit=self.unit, ncols=80)
+
+    def close(self) -> None:
+        """End the bar: a live one stays as it is; a headless one prints its one final line."""
+        if self._closed:
+            return
+        self._closed = True
+        if self._bar is not None:
+            self._bar.close()
+        elif self.mode == "line":
+            print(self.line(), flush=True)
+
+    def __enter__(self) -> "ProgressBar":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def progress_bar(total: int, desc: str, *, unit: str = "step", callback: Callable | None = None,
+                 environ: "os._Environ[str] | dict[str, str] | None" = None) -> ProgressBar:
+    """A tqdm progress bar for a step that takes more than a few seconds, in one place for robokit.
+
+    Live (a student's notebook or terminal) it is tqdm's own bar (``tqdm.auto``: a widget in
+    Jupyter, text in a terminal). Headless (``ROBOKIT_HEADLESS=1``: the course build, the tests) it
+    prints one line when the step ends, the bar's final state with its time, so an executed
+    notebook and the course site show one clean line instead of hundreds of updates (and no
+    widget, whose JavaScript the site does not run). In fast mode (``ROBOKIT_FAST=1``) it is quiet.
+
+    Parameters
+    ----------
+    total : int
+        Steps in all (at least 0).
+    desc : str
+        What is being done, e.g. ``"mapping the lab"``.
+    unit : str, default "step"
+        What one step is (``"frame"``, ``"trial"``).
+    callback : callable, optional
+        A caller's own ``progress(done, total)``, called on every step too.
+    environ : mapping, optional
+        Environment to read (default :data:`os.environ`).
+
+    Returns
+    -------
+    ProgressBar
+        Call it as ``bar(done, total)`` or ``bar.update()``; use it as a context manager.
+
+    Raises
+    ------
+    ValueError
+        For a negative ``total`` or an empty ``desc`` or ``unit``.
+    TypeError
+        For a ``callback`` that is not callable.
+
+    Notes
+    -----
+    Course convention (issue 17: progress bars on every step a student waits for); not from a paper.
+
+    Examples
+    --------
+    >>> with progress_bar(3, "counting", unit="number", environ={"ROBOKIT_HEADLESS": "1"}) as bar:
+    ...     for k in range(3):
+    ...         bar.update()                                # doctest: +ELLIPSIS
+    counting: 100%|...| 3/3 [...]
+    >>> with progress_bar(3, "counting", environ={"ROBOKIT_FAST": "1"}) as bar:
+    ...     bar(3, 3)
+    >>> bar.done
+    3
+    """
+    if isinstance(total, bool) or not isinstance(total, int) or total < 0:
+        raise ValueError(f"total: expected a non-negative whole number of steps, got {total!r}")
+    for name, value in (("desc", desc), ("unit", unit)):
+        if not isinstance(value, str) or not value.strip():
+            raise ValueError(f"{name}: expected a non-empty string, got {value!r}")
+    if callback is not None and not callable(callback):
+        raise TypeError(f"callback: expected a callable progress(done, total) or None, got {type(callback).__name__}")
+    if fast_mode(environ):
+        mode = "quiet"
+    elif headless(environ):
+        mode = "line"
+    else:
+        mode = "live"
+    return ProgressBar(total, desc, unit, mode, callback)

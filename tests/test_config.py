@@ -51,3 +51,121 @@ def test_cache_key_is_stable_and_order_free():
 def test_cache_key_rejects_unserialisable():
     with pytest.raises(TypeError, match="params"):
         cache_key(a=np.zeros(2))
+
+
+# --- cache files: a corrupt, truncated or stale file is rebuilt, never loaded -------------------
+
+def _cache_file(tmp_path, meta):
+    from robokit.config import write_arrays
+
+    return write_arrays(tmp_path / "c.npz", {"a": np.arange(1000.0), "b": np.eye(3)}, meta)
+
+
+def test_write_arrays_round_trip_needs_equal_parameters(tmp_path):
+    from robokit.config import code_version, read_arrays
+
+    meta = {"n": 3, "x": [0.5, 1.0], "code": code_version("geometry")}
+    target = _cache_file(tmp_path, meta)
+    data = read_arrays(target, ["a", "b"], {"code": code_version("geometry"), "x": [0.5, 1.0], "n": 3})  # key order free
+    assert data is not None and np.array_equal(data["a"], np.arange(1000.0))
+    assert read_arrays(target, ["a"], {**meta, "n": 4}) is None                                 # other parameters
+    assert read_arrays(target, ["a"], {**meta, "code": {**meta["code"], "robokit": "0" * 16}}) is None  # other code
+    assert read_arrays(target, ["a"], {**meta, "code": {**meta["code"], "numpy": "0.0"}}) is None      # other numpy
+    assert read_arrays(target, ["a", "missing"], meta) is None
+    assert sorted(read_arrays(target, ["a"]).keys()) == ["a"]        # a caller without parameters reads it too
+
+
+def test_a_file_without_parameters_is_not_served_to_a_caller_with_them(tmp_path):
+    from robokit.config import read_arrays, write_arrays
+
+    target = write_arrays(tmp_path / "c.npz", {"a": np.arange(3)})
+    assert read_arrays(target, ["a"]) is not None and read_arrays(target, ["a"], {"n": 3}) is None
+
+
+@pytest.mark.parametrize("damage", ["truncated", "zeroed middle", "flipped byte", "empty", "text", "directory"])
+def test_a_damaged_cache_file_reads_as_none(tmp_path, damage):
+    from robokit.config import read_arrays
+
+    meta = {"n": 3}
+    target = _cache_file(tmp_path, meta)
+    raw = bytearray(target.read_bytes())
+    if damage == "truncated":
+        target.write_bytes(raw[: len(raw) // 2])
+    elif damage == "zeroed middle":
+        raw[200:-200] = bytes(len(raw) - 400)
+        target.write_bytes(raw)
+    elif damage == "flipped byte":          # inside the compressed data of an array: the CRC check finds it
+        raw[len(raw) // 3] ^= 0xFF
+        target.write_bytes(raw)
+    elif damage == "empty":
+        target.write_bytes(b"")
+    elif damage == "text":
+        target.write_text("not a cache file")
+    else:
+        target.unlink()
+        target.mkdir()
+    assert read_arrays(target, ["a", "b"], meta) is None
+
+
+def test_write_arrays_refuses_bad_input(tmp_path):
+    from robokit.config import write_arrays
+
+    with pytest.raises(TypeError, match="meta"):
+        write_arrays(tmp_path / "c.npz", {"a": np.zeros(2)}, {"a": np.zeros(2)})
+    with pytest.raises(ValueError, match="arrays"):
+        write_arrays(tmp_path / "c.npz", {"cache_meta": np.zeros(2)}, {"n": 1})
+    with pytest.raises(TypeError, match="arrays"):
+        write_arrays(tmp_path / "c.npz", [np.zeros(2)])
+    assert not list(tmp_path.iterdir())               # nothing half written is left behind
+
+
+def test_code_version_names_the_code_and_the_numerics():
+    from robokit.config import code_version, source_digest
+
+    v = code_version("sim", "geometry")
+    assert v["robokit"] == source_digest("sim", "geometry") and v["numpy"] == np.__version__
+    assert code_version("sim") != v
+    with pytest.raises(ValueError, match="packages"):
+        code_version("no_such_package")
+
+
+# --- progress bars ----------------------------------------------------------------------------
+
+def test_progress_bar_headless_prints_one_final_line(capsys):
+    from robokit.config import progress_bar
+
+    seen = []
+    with progress_bar(50, "mapping", unit="frame", callback=lambda d, t: seen.append((d, t)),
+                      environ={"ROBOKIT_HEADLESS": "1"}) as bar:
+        for k in range(50):
+            bar(k + 1, 50)
+    out = capsys.readouterr()
+    assert out.out.count("\n") == 1 and "\r" not in out.out and out.err == ""
+    assert out.out.startswith("mapping: 100%") and "50/50" in out.out
+    assert seen[-1] == (50, 50) and len(seen) == 50          # the caller's own callback still runs
+
+
+def test_progress_bar_is_quiet_in_fast_mode_and_live_otherwise(capsys):
+    from robokit.config import progress_bar
+
+    with progress_bar(3, "quiet", environ={"ROBOKIT_FAST": "1", "ROBOKIT_HEADLESS": "1"}) as bar:
+        bar.update(3)
+    assert capsys.readouterr() == ("", "")
+    with progress_bar(3, "live", unit="trial", environ={}) as bar:   # a terminal: tqdm's own bar
+        bar.update()
+        bar.update(2)
+    out = capsys.readouterr()
+    assert out.out == "" and "live: 100%" in out.err and "3/3" in out.err
+    assert bar.done == 3
+
+
+@pytest.mark.parametrize("kwargs, match", [({"total": -1}, "total"), ({"total": 2.5}, "total"),
+                                           ({"desc": ""}, "desc"), ({"unit": " "}, "unit")])
+def test_progress_bar_refuses_bad_input(kwargs, match):
+    from robokit.config import progress_bar
+
+    args = {"total": 3, "desc": "x", **kwargs}
+    with pytest.raises(ValueError, match=match):
+        progress_bar(args.pop("total"), args.pop("desc"), **args)
+    with pytest.raises(TypeError, match="callback"):
+        progress_bar(3, "x", callback=3)

@@ -205,3 +205,30 @@ def test_ransac_recovers_the_rendered_motion_with_half_the_matches_wrong():
     truth = se2_to_pqt(poses[1])
     assert len(bad) > 0.4 * len(m) and res.source == "ransac"
     assert np.hypot(*(res.pqt[:2] - truth[:2])) < 0.02 and abs(wrap_angle(res.pqt[2] - truth[2])) < np.deg2rad(0.5)
+
+
+def test_lab_experiment_is_cached_and_a_bad_cache_file_is_rebuilt(tmp_path, monkeypatch):
+    import robokit.localization.lab_experiment as lab
+
+    monkeypatch.setattr(lab, "cache_dir", lambda *parts: tmp_path)
+    first = lab_experiment(frames=2, test_poses=LAB_TEST_POSES[:1])
+    (target,) = tmp_path.glob("experiment-*.npz")
+    again = lab_experiment(frames=2, test_poses=LAB_TEST_POSES[:1])
+    assert not first.from_cache and again.from_cache
+    assert np.array_equal(again.slam.trajectory, first.slam.trajectory)
+    assert np.array_equal(again.slam.map.descriptors, first.slam.map.descriptors)
+    assert np.array_equal(again.slam.map.ids, first.slam.map.ids) and len(again.slam.map) == len(first.slam.map)
+    assert [r.source for r in again.slam.reports] == [r.source for r in first.slam.reports]
+    assert again.rows[0]["matches"] == first.rows[0]["matches"]
+    assert np.array_equal(again.rows[0]["estimated"], first.rows[0]["estimated"])
+    assert again.slam.rng.random() == first.slam.rng.random()    # the generator goes on where it stopped
+    good = target.read_bytes()
+    for bad in (good[: len(good) // 2], good[:100] + b"\0" * (len(good) - 100)):   # cut short, overwritten
+        target.write_bytes(bad)
+        rebuilt = lab_experiment(frames=2, test_poses=LAB_TEST_POSES[:1])
+        assert not rebuilt.from_cache and np.array_equal(rebuilt.slam.trajectory, first.slam.trajectory)
+    # a file made with other parameters (or other code), stored under this name, is not served either
+    lab_experiment(frames=3, test_poses=LAB_TEST_POSES[:1])
+    (other_target,) = set(tmp_path.glob("experiment-*.npz")) - {target}
+    target.write_bytes(other_target.read_bytes())
+    assert not lab_experiment(frames=2, test_poses=LAB_TEST_POSES[:1]).from_cache

@@ -64,3 +64,18 @@ def test_bad_trial_input_is_named(setup, bad, match):
     kw = dict(start=trials.START_POSES[0], method="ours") | bad
     with pytest.raises((ValueError, TypeError), match=match):
         trials.localization_trial(setup, kw.pop("start"), kw.pop("method"), **kw)
+
+
+def test_keyframe_comparison_is_cached_and_a_stale_file_is_rebuilt(tmp_path, monkeypatch):
+    run = experiment.calibration_run(fast=True)
+    monkeypatch.setattr(experiment, "cache_dir", lambda *parts: tmp_path)
+    first = experiment.keyframe_comparison(run, below_band="skip")
+    (target,) = tmp_path.glob("keyframes-*.npz")
+    again = experiment.keyframe_comparison(run, below_band="skip")
+    assert all(np.array_equal(again[k], first[k]) for k in ("ours", "orbslam")) and again["images"] == first["images"]
+    experiment.keyframe_comparison(run, below_band="take")
+    (other,) = set(tmp_path.glob("keyframes-*.npz")) - {target}
+    target.write_bytes(other.read_bytes())              # another parameter's result under this name
+    assert np.array_equal(experiment.keyframe_comparison(run, below_band="skip")["ours"], first["ours"])
+    target.write_bytes(b"broken")
+    assert np.array_equal(experiment.keyframe_comparison(run, below_band="skip")["ours"], first["ours"])

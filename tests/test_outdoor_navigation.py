@@ -105,3 +105,26 @@ def test_simulate_bad_input():
         simulate(random_course(0), seed=np.random.default_rng(0))
     with pytest.raises(ValueError, match="seed"):
         random_course(-1)
+
+
+def test_run_courses_is_cached_and_a_bad_cache_file_is_rebuilt(tmp_path, monkeypatch):
+    import dataclasses
+
+    monkeypatch.setenv("ROBOKIT_CACHE", str(tmp_path))
+    small = {"n_waypoints": 1, "size": (30.0, 20.0), "n_obstacles": 2}
+    fresh = run_courses([0, 1], course_options=small, cache=False)
+    assert not (tmp_path / "outdoor").exists()
+    first = run_courses([0, 1], course_options=small)
+    (target,) = (tmp_path / "outdoor").glob("courses-*.npz")
+    again = run_courses([0, 1], course_options=small)
+    for a, b in zip(again, fresh):
+        for f in dataclasses.fields(a):
+            x, y = getattr(a, f.name), getattr(b, f.name)
+            assert type(x) is type(y) and np.array_equal(np.asarray(x), np.asarray(y)), f.name
+    assert summarize_runs(again) == summarize_runs(first)
+    target.write_bytes(target.read_bytes()[:500])                         # a write cut short
+    assert summarize_runs(run_courses([0, 1], course_options=small)) == summarize_runs(fresh)
+    run_courses([0, 1], course_options=small, firing="free")              # other parameters, other file
+    (other,) = set((tmp_path / "outdoor").glob("courses-*.npz")) - {target}
+    target.write_bytes(other.read_bytes())                                # ... stored under this name
+    assert summarize_runs(run_courses([0, 1], course_options=small)) == summarize_runs(fresh)

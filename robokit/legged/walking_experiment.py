@@ -136,6 +136,7 @@ def loop_table(plan: WalkPlan, *, servo_rates: Any = (500.0, 100.0), latencies: 
         raise ValueError(f"bandwidths: expected positive frequencies (Hz), got {bws.tolist()}")
     total = len(bws) * len(rates) * len(lats)
     rows = []
+    bar = config.progress_bar(total, "walking trials", unit="trial", callback=progress)
     for bw in map(float, bws):
         gains = littledog_servo_gains(bw)
         for rate in map(float, rates):
@@ -146,8 +147,8 @@ def loop_table(plan: WalkPlan, *, servo_rates: Any = (500.0, 100.0), latencies: 
                              "gain_margin": float(analysis.gain_margin), "fell": out.fell,
                              "distance": out.distance, "tracking_deg": float(np.degrees(out.tracking_rms)),
                              "power": out.energy / _duration(out.log)})
-                if progress is not None:
-                    progress(len(rows), total)
+                bar(len(rows), total)
+    bar.close()
     return rows
 
 

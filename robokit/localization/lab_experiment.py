@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..config import FAST
+from ..config import FAST, cache_dir, cache_key, code_version, progress_bar, read_arrays, write_arrays
 from ..geometry import paper_world_to_robokit, se2_to_pqt, wrap_angle
 from ..sim import PinholeCamera, StereoRig, World, lab_lap, lab_room, record
 from ..validation import as_points, check_callable, check_choice, check_int, check_positive, describe
@@ -105,9 +105,17 @@ def mapping_run(rate: float = 1.0, *, baseline: float = 0.12, seed: int = 0):
     Se et al. Sec. 3.6: the robot "traverses around" the 10 m x 10 m lab while building the map.
     """
     world = lab_room()
-    rig = StereoRig(PinholeCamera.from_fov(), baseline=check_positive(baseline, "baseline"))
+    rig = _lab_rig(baseline)
     run = record(world, lab_lap(world), {"stereo": rig}, rate=check_positive(rate, "rate"), seed=seed)
     return run, rig
+
+
+def _lab_rig(baseline: float = 0.12) -> StereoRig:
+    return StereoRig(PinholeCamera.from_fov(), baseline=check_positive(baseline, "baseline"))
+
+
+#: The test-pose results in a cache file of :func:`lab_experiment`.
+_ROW_ARRAYS = ("measured", "estimated", "errors", "matches", "seconds")
 
 
 @dataclass
@@ -124,13 +132,16 @@ class LabExperiment:
         One per test pose: ``measured`` and ``estimated`` ``[p, q, theta]``, ``error_m``,
         ``error_rad``, ``matches`` and ``seconds`` (features, stereo and Hough for that view).
     mapping_seconds : float
-        Wall-clock time of map building.
+        Wall-clock time of map building (when it was built, for a map loaded from the cache).
+    from_cache : bool
+        Whether the map and the test-pose results were loaded from robokit's cache.
     """
 
     slam: VisualSLAM
     truth: np.ndarray
     rows: list
     mapping_seconds: float
+    from_cache: bool = False
 
     @property
     def mean_error_m(self) -> float:
@@ -188,11 +199,15 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     seed : int, default 0
         Seeds odometry, image noise and RANSAC.
     progress : callable, optional
-        ``progress(done, total)`` after every mapping frame (see :meth:`VisualSLAM.process`).
+        ``progress(done, total)`` after every mapping frame (see :meth:`VisualSLAM.process`), besides
+        the progress bar (:func:`robokit.config.progress_bar`).
 
     Returns
     -------
     LabExperiment
+        Cached under ``robokit.cache_dir("lab")`` keyed by every parameter and the code that makes
+        it (:func:`robokit.config.code_version`): a second run loads the map and the test-pose
+        results instead of rebuilding them; a corrupt or stale cache file is rebuilt.
 
     Raises
     ------
@@ -202,7 +217,9 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     Notes
     -----
     Se, Lowe & Little (2002), Sec. 6. The run time per test pose covers feature extraction in both
-    images, stereo matching and the Hough transform with refinement, as in the paper.
+    images, stereo matching and the Hough transform with refinement, as in the paper (for a cached
+    result, the times measured when it was built). Deterministic, hence cacheable (DESIGN.md,
+    "Caching").
 
     Examples
     --------
@@ -227,28 +244,50 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     world = lab_room()
     if not np.all(world.is_free(poses[:, :2], clearance=0.05)):
         raise ValueError("test_poses: expected poses in the lab's free space, got one inside furniture or walls")
-    run, render_rig = mapping_run(rate, seed=seed)
-    k = min(frames or (6 if FAST else len(run)), len(run))
+    render_rig = _lab_rig()
     slam = VisualSLAM(calibrated_rig(render_rig), method=method, descriptor=descriptor, rng=seed)
+    meta = {"method": method, "descriptor": descriptor, "rate": rate, "frames": frames, "fast": bool(FAST),
+            "test_poses": np.round(poses, 12).tolist(), "noise": noise, "seed": seed,
+            "code": code_version("sim", "geometry", "vision", "mapping", "localization")}
+    target = cache_dir("lab") / f"experiment-{cache_key(**meta)}.npz"
+    data = read_arrays(target, (*slam.to_arrays(), *_ROW_ARRAYS, "truth", "mapping_seconds"), meta)
+    if data is not None:
+        slam.load_arrays(data)
+        rows = [{"measured": m, "estimated": e, "error_m": float(err[0]), "error_rad": float(err[1]),
+                 "matches": int(n), "seconds": float(t)}
+                for m, e, err, n, t in zip(data["measured"], data["estimated"], data["errors"], data["matches"],
+                                           data["seconds"])]
+        return LabExperiment(slam, data["truth"], rows, float(data["mapping_seconds"]), from_cache=True)
+    run, _ = mapping_run(rate, seed=seed)
+    k = min(frames or (6 if FAST else len(run)), len(run))
     corners = world.corner_array.reshape(-1, 3)
     lo, hi = corners[:, :2].min(0), corners[:, :2].max(0)
     bounds = (lo[0], hi[0], lo[1], hi[1])  # the robot is somewhere in the lab (p = x, q = y)
     truth = se2_to_pqt(run.poses[:k])
     t0 = time.perf_counter()
-    slam.process(run.images["stereo/left"][:k], run.images["stereo/right"][:k], se2_to_pqt(run.odometry[:k]),
-                 start_pqt=truth[0], progress=progress)
+    with progress_bar(k, "mapping the lab", unit="frame", callback=progress) as bar:
+        slam.process(run.images["stereo/left"][:k], run.images["stereo/right"][:k], se2_to_pqt(run.odometry[:k]),
+                     start_pqt=truth[0], progress=bar)
     mapping_seconds = time.perf_counter() - t0
     rows = []
-    for i, pose in enumerate(poses):
-        views = render_rig.observe(world, pose, noise=noise, rng=seed + 1000 + i)
-        start = time.perf_counter()
-        best, _ = slam.localize(views["left"].image, views["right"].image, bounds=bounds)
-        seconds = time.perf_counter() - start
-        measured = se2_to_pqt(pose)
-        rows.append({"measured": measured, "estimated": best.pqt,
-                     "error_m": float(np.hypot(*(best.pqt[:2] - measured[:2]))),
-                     "error_rad": float(abs(wrap_angle(best.pqt[2] - measured[2]))),
-                     "matches": best.n_matches, "seconds": seconds})
+    with progress_bar(len(poses), "global localization", unit="pose") as bar:
+        for i, pose in enumerate(poses):
+            views = render_rig.observe(world, pose, noise=noise, rng=seed + 1000 + i)
+            start = time.perf_counter()
+            best, _ = slam.localize(views["left"].image, views["right"].image, bounds=bounds)
+            seconds = time.perf_counter() - start
+            measured = se2_to_pqt(pose)
+            rows.append({"measured": measured, "estimated": best.pqt,
+                         "error_m": float(np.hypot(*(best.pqt[:2] - measured[:2]))),
+                         "error_rad": float(abs(wrap_angle(best.pqt[2] - measured[2]))),
+                         "matches": best.n_matches, "seconds": seconds})
+            bar.update()
+    write_arrays(target, {**slam.to_arrays(), "truth": truth, "mapping_seconds": np.array(mapping_seconds),
+                          "measured": np.array([r["measured"] for r in rows]).reshape(-1, 3),
+                          "estimated": np.array([r["estimated"] for r in rows]).reshape(-1, 3),
+                          "errors": np.array([[r["error_m"], r["error_rad"]] for r in rows]).reshape(-1, 2),
+                          "matches": np.array([r["matches"] for r in rows], int),
+                          "seconds": np.array([r["seconds"] for r in rows], float)}, meta)
     return LabExperiment(slam, truth, rows, mapping_seconds)
 
 

@@ -154,6 +154,81 @@ class VisualSLAM:
         """Estimated poses ``[p, q, theta]`` of the frames processed so far, shape (K, 3)."""
         return np.array([r.pqt for r in self.reports]).reshape(-1, 3)
 
+    def to_arrays(self) -> dict:
+        """What the pipeline has built (map, frame reports, odometry, RANSAC generator) as plain arrays.
+
+        For a cache file (:func:`robokit.config.write_arrays`); :meth:`load_arrays` restores it into
+        a pipeline made with the same parameters.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+
+        Examples
+        --------
+        >>> from robokit.vision import StereoCalibration
+        >>> rig = StereoCalibration(focal=500.0, c0=319.5, r0=239.5, baseline=0.12)
+        >>> slam = VisualSLAM(rig, rng=0)
+        >>> again = VisualSLAM(rig)
+        >>> again.load_arrays(slam.to_arrays())
+        >>> len(again.map), again.trajectory.shape, bool(again.rng.random() == slam.rng.random())
+        (0, (0, 3), True)
+        """
+        import json
+
+        reports = self.reports
+        out = self.map.to_arrays("map:")
+        out.update({
+            "report:pqt": np.array([r.pqt for r in reports], float).reshape(-1, 3),
+            "report:covariance": np.array([r.covariance for r in reports], float).reshape(-1, 3, 3),
+            "report:source": np.array([r.source for r in reports], dtype="<U8"),
+            "report:counts": np.array([[r.n_observations, r.n_inliers, r.kidnapped, r.n_landmarks]
+                                       for r in reports], int).reshape(-1, 4),
+            "last_odometry": np.full(3, np.nan) if self._last_odometry is None else self._last_odometry,
+            "rng_state": np.array(json.dumps(self.rng.bit_generator.state)),
+        })
+        return out
+
+    def load_arrays(self, arrays: dict) -> None:
+        """Restore what :meth:`to_arrays` wrote (the map, reports, odometry and RANSAC generator).
+
+        Parameters
+        ----------
+        arrays : mapping of str to numpy.ndarray
+
+        Raises
+        ------
+        ValueError
+            For missing arrays, or a map whose descriptors are not this pipeline's.
+
+        Examples
+        --------
+        >>> from robokit.vision import StereoCalibration
+        >>> VisualSLAM(StereoCalibration(500.0, 319.5, 239.5, 0.12)).load_arrays({})
+        Traceback (most recent call last):
+        ...
+        ValueError: arrays: expected the arrays of VisualSLAM.to_arrays, missing ['report:pqt', ...]
+        """
+        import json
+
+        names = ("report:pqt", "report:covariance", "report:source", "report:counts", "last_odometry", "rng_state")
+        missing = [n for n in names if n not in arrays]
+        if missing:
+            raise ValueError(f"arrays: expected the arrays of VisualSLAM.to_arrays, missing {missing}")
+        landmark_map = LandmarkMap.from_arrays(arrays, "map:")
+        if landmark_map.descriptor_size != self.map.descriptor_size:
+            raise ValueError(f"arrays: expected a map of {self.map.descriptor_size}-element descriptors, got "
+                             f"{landmark_map.descriptor_size}")
+        counts = np.asarray(arrays["report:counts"], int)
+        self.map = landmark_map
+        self.reports = [FrameReport(np.asarray(p, float), np.asarray(c, float), str(src), int(n[0]), int(n[1]),
+                                    bool(n[2]), int(n[3]))
+                        for p, c, src, n in zip(arrays["report:pqt"], arrays["report:covariance"],
+                                                arrays["report:source"], counts)]
+        last = np.asarray(arrays["last_odometry"], float)
+        self._last_odometry = None if np.isnan(last).any() else last.copy()
+        self.rng.bit_generator.state = json.loads(str(arrays["rng_state"]))
+
     def observe(self, left, right) -> StereoObservations:
         """Features of a rectified pair and their 3-D positions with covariance (robot frame).
 

@@ -192,6 +192,73 @@ class LandmarkMap:
     def __len__(self) -> int:
         return self.positions.shape[0]
 
+    #: The arrays of :meth:`to_arrays`, in order.
+    ARRAYS = ("positions", "covariances", "descriptors", "scales", "orientations", "missed", "observations", "ids")
+
+    def to_arrays(self, prefix: str = "") -> dict:
+        """The map as plain arrays (for a cache file), named ``prefix + name``.
+
+        Parameters
+        ----------
+        prefix : str, default ""
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            :attr:`ARRAYS`, plus ``max_missed`` and ``next_id`` (the next identifier to hand out).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> m = LandmarkMap(2)
+        >>> _ = m.add(np.ones((1, 3)), np.eye(3)[None], np.zeros((1, 2)))
+        >>> again = LandmarkMap.from_arrays(m.to_arrays("map:"), "map:")
+        >>> len(again), again.descriptor_size, int(again.add(np.ones((1, 3)), np.eye(3)[None], np.zeros((1, 2)))[0])
+        (1, 2, 1)
+        """
+        out = {prefix + name: getattr(self, name) for name in self.ARRAYS}
+        out[prefix + "max_missed"] = np.array(self.max_missed)
+        out[prefix + "next_id"] = np.array(self._next_id)
+        return out
+
+    @classmethod
+    def from_arrays(cls, arrays: dict, prefix: str = "") -> "LandmarkMap":
+        """The map that :meth:`to_arrays` wrote.
+
+        Parameters
+        ----------
+        arrays : mapping of str to array_like
+        prefix : str, default ""
+
+        Returns
+        -------
+        LandmarkMap
+
+        Raises
+        ------
+        ValueError
+            For missing arrays or arrays of unequal lengths.
+
+        Examples
+        --------
+        >>> LandmarkMap.from_arrays({}) # doctest: +IGNORE_EXCEPTION_DETAIL
+        Traceback (most recent call last):
+        ValueError: arrays: expected the arrays of LandmarkMap.to_arrays ...
+        """
+        names = (*cls.ARRAYS, "max_missed", "next_id")
+        missing = [prefix + n for n in names if prefix + n not in arrays]
+        if missing:
+            raise ValueError(f"arrays: expected the arrays of LandmarkMap.to_arrays, missing {missing}")
+        descriptors = np.asarray(arrays[prefix + "descriptors"], np.float32)
+        out = cls(descriptors.shape[1], max_missed=int(arrays[prefix + "max_missed"]))
+        for name in cls.ARRAYS:
+            setattr(out, name, np.asarray(arrays[prefix + name], getattr(out, name).dtype))
+        if len({len(getattr(out, name)) for name in cls.ARRAYS}) != 1:
+            raise ValueError(f"arrays: expected equal lengths of {list(cls.ARRAYS)}, got "
+                             f"{[len(getattr(out, name)) for name in cls.ARRAYS]}")
+        out._next_id = int(arrays[prefix + "next_id"])
+        return out
+
     def add(self, positions, covariances, descriptors, scales=None, orientations=None) -> np.ndarray:
         """Append new landmarks (world frame); return their ids.
 

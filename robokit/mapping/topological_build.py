@@ -37,6 +37,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..config import progress_bar
 from ..geometry import se2_between, wrap_angle
 from ..sim.motion import odometry_covariance
 from ..sim.omni import OmniCamera
@@ -346,8 +347,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
             current["index"] = DescriptorIndex(features.descriptors) if len(features) >= 2 else None
         for f in [f for f in cache if f not in key_frames and f != k]:
             del cache[f], has_sift[f]
-        if progress is not None:
-            progress(k + 1, n)
+        bar(k + 1, n)
         var = float(position_variance(odometry_covariance(odo[key:k + 1], alphas)[-1]))
         d = float(histogram_distance(view(k, features=False).histogram, view(key).histogram))   # Eq. (5)
         if d <= similarity:           # similar enough: the global feature answers, SIFT is not needed
@@ -356,9 +356,10 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
         m = len(current["index"].match(v.features.descriptors, ratio=ratio)) if current["index"] and len(v) else 0
         return Comparison(d, m, len(view(key)) + len(v) - m, var)
 
-    keys, reasons = select_key_frames(n, compare, similarity=similarity, min_matches=min_matches,
-                                      occlusion_frames=occlusion_frames, max_features=max_features,
-                                      max_variance=max_variance)
+    with progress_bar(n, "building the map", unit="frame", callback=progress) as bar:
+        keys, reasons = select_key_frames(n, compare, similarity=similarity, min_matches=min_matches,
+                                          occlusion_frames=occlusion_frames, max_features=max_features,
+                                          max_variance=max_variance)
     key_views = [view(k) for k in keys]
     edge_cov = [odometry_covariance(odo[a:b + 1], alphas)[-1] + _COVARIANCE_FLOOR for a, b in zip(keys[:-1], keys[1:])]
     variances = np.concatenate([[0.0], np.cumsum(position_variance(np.reshape(edge_cov, (-1, 3, 3))))])

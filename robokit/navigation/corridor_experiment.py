@@ -32,12 +32,14 @@ References
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import zipfile
 from typing import Any, Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, fast_mode, read_arrays, source_digest, write_atomically
+from ..config import (cache_dir, cache_key, code_version, fast_mode, progress_bar, read_arrays, write_arrays,
+                      write_atomically)
 from ..mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
 from ..sim import Lidar, PinholeCamera, camera_mount, corridor_path, describe_sensor, long_corridor, waypoint_path
 from ..sim.world import World
@@ -110,8 +112,8 @@ def corridor_camera(fast: bool | None = None) -> PinholeCamera:
     return PinholeCamera.from_fov(np.deg2rad(65.0), w, h, mount=camera_mount(0.35))
 
 
-def _code() -> str:
-    return source_digest("sim", "geometry", "vision", "mapping", "navigation.corridor_experiment")
+def _code() -> dict:
+    return code_version("sim", "geometry", "vision", "mapping", "navigation.corridor_experiment")
 
 
 def _descriptor_stack(descriptors: list) -> tuple[np.ndarray, np.ndarray]:
@@ -125,13 +127,13 @@ def _descriptor_list(flat: np.ndarray, counts: np.ndarray) -> list:
 
 
 def _orb_frames(world: World, camera: PinholeCamera, poses: np.ndarray, rng: np.random.Generator,
-                progress: Callable | None) -> list:
+                progress: Callable | None, desc: str) -> list:
     out = []
-    for k, pose in enumerate(poses):
-        image = camera.observe(world, pose, rng=rng).image
-        out.append(detect_orb_features(image, N_FEATURES).descriptors)
-        if progress is not None:
-            progress(k + 1, len(poses))
+    with progress_bar(len(poses), desc, unit="frame", callback=progress) as bar:
+        for pose in poses:
+            image = camera.observe(world, pose, rng=rng).image
+            out.append(detect_orb_features(image, N_FEATURES).descriptors)
+            bar.update()
     return out
 
 
@@ -220,11 +222,12 @@ def calibration_run(*, fast: bool | None = None, start: float = 12.0, length: fl
     meta = {"camera": describe_sensor(camera), "start": start, "length": length, "speed": speed,
             "rate": frame_rate, "features": N_FEATURES, "code": _code()}
     target = cache_dir("corridor") / f"calibration-{cache_key(**meta)}.npz"
-    data = read_arrays(target, ("flat", "counts", "positions"))
+    data = read_arrays(target, ("flat", "counts", "positions"), meta)
     if data is None:
-        flat, counts = _descriptor_stack(_orb_frames(world, camera, path.poses, np.random.default_rng(5), progress))
+        flat, counts = _descriptor_stack(_orb_frames(world, camera, path.poses, np.random.default_rng(5), progress,
+                                                        "calibration run"))
         data = {"flat": flat, "counts": counts, "positions": path.poses[:, :2]}
-        write_atomically(target, lambda p: np.savez_compressed(p, **data))
+        write_arrays(target, data, meta)
     descriptors = _descriptor_list(data["flat"], data["counts"])
     return CalibrationRun(descriptors, data["positions"], frame_rate, speed, float(feature_threshold(data["counts"])))
 
@@ -248,7 +251,8 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     -------
     dict
         ``{"ours": indices, "orbslam": indices, "images": N}``; the extraction rate is
-        ``len(indices) / N``.
+        ``len(indices) / N``. Cached under ``robokit.cache_dir("corridor")``, keyed by the run's
+        descriptors and positions, the parameters and the code (a stale file is rebuilt).
 
     Raises
     ------
@@ -270,10 +274,24 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     if not isinstance(run, CalibrationRun):
         raise TypeError(f"run: expected a CalibrationRun (calibration_run()), got {type(run).__name__}")
     gap = check_int(min_frame_gap, "min_frame_gap", minimum=0)
-    ours = select_keyframes(run.descriptors, run.positions, run.f_min, min_frame_gap=gap, shared_range=shared_range,
-                            below_band=below_band)
-    orbslam = select_keyframes_orbslam(run.descriptors, run.positions)
-    return {"ours": np.asarray(ours, int), "orbslam": np.asarray(orbslam, int), "images": len(run.descriptors)}
+    flat, counts = _descriptor_stack(run.descriptors)
+    content = hashlib.sha256(flat.tobytes() + counts.tobytes() + np.asarray(run.positions, float).tobytes())
+    try:
+        band = np.asarray(shared_range, float).tolist()
+    except (TypeError, ValueError):
+        band = None                  # select_keyframes names the error
+    meta = {"run": content.hexdigest()[:16], "f_min": float(run.f_min), "gap": gap, "shared_range": band,
+            "below_band": str(below_band), "code": _code()}
+    target = cache_dir("corridor") / f"keyframes-{cache_key(**meta)}.npz"
+    data = read_arrays(target, ("ours", "orbslam"), meta) if band is not None else None
+    if data is None:
+        ours = select_keyframes(run.descriptors, run.positions, run.f_min, min_frame_gap=gap,
+                                shared_range=shared_range, below_band=below_band)
+        orbslam = select_keyframes_orbslam(run.descriptors, run.positions)
+        data = {"ours": np.asarray(ours, int), "orbslam": np.asarray(orbslam, int)}
+        if band is not None:
+            write_arrays(target, data, meta)
+    return {"ours": data["ours"], "orbslam": data["orbslam"], "images": len(run.descriptors)}
 
 
 # --- the vocabulary -----------------------------------------------------------------------------
@@ -329,7 +347,7 @@ def training_vocabulary(*, fast: bool | None = None, branching: int = 10, levels
             return Vocabulary.load(target)
         except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
             pass  # a corrupt or foreign cache file is rebuilt
-    images = _orb_frames(world, camera, poses, np.random.default_rng(7), progress)
+    images = _orb_frames(world, camera, poses, np.random.default_rng(7), progress, "vocabulary images")
     vocabulary = Vocabulary.train(images, branching=branching, levels=levels, rng=0)
     write_atomically(target, vocabulary.save)
     return vocabulary
@@ -458,10 +476,10 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress
             "path": cache_key(poses=path.poses.round(9).tolist()), "code": _code()}
     key = cache_key(**meta)
     target = cache_dir("corridor") / f"map-{key}.npz"
-    data = read_arrays(target, _MAP_ARRAYS)
+    data = read_arrays(target, _MAP_ARRAYS, meta)
     if data is None:
         data = _build_map(world, lidar, camera, path, f_min, resolution, every, gap, progress)
-        write_atomically(target, lambda p: np.savez_compressed(p, **data))
+        write_arrays(target, data, meta)
     grid = OccupancyGrid(data["log_odds"], float(data["resolution"]), data["origin"])
     database = BowDatabase(vocabulary)
     for d in _descriptor_list(data["kf_flat"], data["kf_counts"]):
@@ -486,7 +504,7 @@ def _build_map(world: World, lidar: Lidar, camera: PinholeCamera, path, f_min: f
     # grid's pose log is the truth here, so Eq. (18) is exact; with a SLAM pose log it would carry
     # the log's error
     frame_truth = geo_tag(frame_times, times, poses)
-    descriptors = _orb_frames(world, camera, frame_truth, rng, progress)
+    descriptors = _orb_frames(world, camera, frame_truth, rng, progress, "camera frames")
     positions = frame_truth[:, :2]
     index = np.asarray(select_keyframes(descriptors, positions, f_min, min_frame_gap=gap,
                                        shared_range=SHARED_RANGE, below_band="take"), int)

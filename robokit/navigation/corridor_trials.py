@@ -34,7 +34,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, fast_mode, read_arrays, source_digest, write_atomically
+from ..config import cache_dir, cache_key, code_version, fast_mode, progress_bar, read_arrays, write_arrays
 from ..controllers import move_to_middle_line
 from ..geometry import wrap_angle
 from ..localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share
@@ -449,25 +449,24 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     target = None
     if cache:
         meta = {"setup": setup.key, "method": method, "trials": trials, "starts": starts, "seed": seed,
-                "max_distance": max_distance, "code": source_digest("sim", "geometry", "vision", "mapping", "localization",
+                "max_distance": max_distance, "code": code_version("sim", "geometry", "vision", "mapping", "localization",
                                                                     "controllers", "navigation.corridor_experiment",
                                                                     "navigation.corridor_trials")}
         target = cache_dir("corridor") / f"trials-{cache_key(**meta)}.npz"
-        data = read_arrays(target, _SET_FIELDS)
+        data = read_arrays(target, _SET_FIELDS, meta)
         if data is not None:          # else a missing, corrupt or foreign cache file: run again
             return TrialSet(method, **data)
     runs = []
-    for i in starts:
-        for j in range(trials):
-            runs.append(localization_trial(setup, START_POSES[i], method, rng=np.random.default_rng([seed, i, j]),
-                                           max_distance=max_distance))
-            if progress is not None:
-                progress(len(runs), len(starts) * trials)
+    with progress_bar(len(starts) * trials, f"localization trials ({method})", unit="trial", callback=progress) as bar:
+        for i in starts:
+            for j in range(trials):
+                runs.append(localization_trial(setup, START_POSES[i], method, rng=np.random.default_rng([seed, i, j]),
+                                               max_distance=max_distance))
+                bar.update()
     out = TrialSet(method, np.repeat(starts, trials).astype(int), np.array([r.converged for r in runs]),
                    np.array([r.iterations for r in runs], int), np.array([r.distance for r in runs]),
                    np.array([r.error for r in runs]).reshape(-1, 2), np.array([r.settled for r in runs]).reshape(-1, 2),
                    np.array([r.retrieval_error for r in runs]))
     if target is not None:
-        arrays = {name: getattr(out, name) for name in _SET_FIELDS}
-        write_atomically(target, lambda path: np.savez_compressed(path, **arrays))
+        write_arrays(target, {name: getattr(out, name) for name in _SET_FIELDS}, meta)
     return out

@@ -33,7 +33,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, fast_mode, source_digest, write_atomically
+from ..config import (cache_dir, cache_key, code_version, fast_mode, progress_bar, read_arrays, write_arrays,
+                      write_atomically)
 from ..geometry import se2_between, se2_compose
 from ..localization.hierarchical import HierarchicalLocalizer
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
@@ -159,7 +160,7 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     params = {"n_features": 300 if fast else 500, "alphas": list(TOUR_ALPHAS)}
     meta = {"world": world.name, "world_seed": world.info["seed"], "camera": describe_sensor(camera),
             "tour": cache_key(poses=tour.poses.round(9).tolist()), "rate": rate, "record_seed": 2, "params": params,
-            "code": source_digest("sim", "geometry", "vision", "mapping")}
+            "code": code_version("sim", "geometry", "vision", "mapping")}
 
     def build():
         run = record(world, tour, {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
@@ -264,19 +265,20 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
     rng = as_rng(rng)
     images = [_render(setup, p, rng) for p in P]
     estimates, errors, local_errors, times, results = {}, {}, {}, {}, {}
-    for m, mode in enumerate(modes):
+    bar = progress_bar(len(modes) * len(images), "localizing", unit="view", callback=progress)
+    for mode in modes:
         loc = HierarchicalLocalizer(tmap, setup.camera, mode=mode, n_features=setup.n_features)
         out = []
-        for k, img in enumerate(images):
+        for img in images:
             out.append(loc.localize(img))
-            if progress is not None:
-                progress(m * len(images) + k + 1, len(modes) * len(images))
+            bar.update()
         results[mode] = out
         estimates[mode] = np.array([r.pose for r in out])
         errors[mode] = np.abs(estimates[mode][:, :2] - P[:, :2])
         local = np.array([se2_compose(setup.truth[r.node], se2_between(r.node_pose, r.pose)) for r in out])
         local_errors[mode] = np.abs(local[:, :2] - P[:, :2])
         times[mode] = {stage: np.array([r.times[stage] for r in out]) for stage in out[0].times}
+    bar.close()
     return LocalizationTrials(P, estimates, errors, local_errors, times, results)
 
 
@@ -323,6 +325,14 @@ def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 
     n_nodes = check_int(n_nodes, "n_nodes", minimum=1, maximum=len(setup.raw))
     offset = check_positive(offset, "offset", allow_zero=True)
     same_place = check_positive(same_place, "same_place")
+    target = meta = None
+    if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):   # a seed: the answer is deterministic
+        meta = {"setup": setup.key, "n_nodes": n_nodes, "offset": offset, "same_place": same_place, "rng": int(rng),
+                "code": code_version("sim", "geometry", "vision", "mapping", "localization", "navigation.omni_experiment")}
+        target = cache_dir("maps") / f"route-{cache_key(**meta)}.npz"
+        data = read_arrays(target, _ROUTE_ARRAYS, meta)
+        if data is not None:
+            return {**data, "rate": float(data["correct"].mean())}
     rng = as_rng(rng)
     nodes = np.linspace(0, len(setup.raw) - 1, n_nodes).round().astype(int)
     loc = HierarchicalLocalizer(setup.relaxed, setup.camera, n_features=setup.n_features)
@@ -339,6 +349,12 @@ def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 
         correct.append(bool(r.recognised and (r.node == i or near)))
         counts.append(int(r.match_counts.max()) if len(r.match_counts) else 0)
         features.append(int(len(setup.relaxed.node_features(i))))
-    correct = np.array(correct)
-    return {"nodes": nodes, "answers": np.array(answers), "correct": correct, "match_counts": np.array(counts),
-            "features": np.array(features), "rate": float(correct.mean())}
+    out = {"nodes": nodes, "answers": np.array(answers, int), "correct": np.array(correct, bool),
+           "match_counts": np.array(counts, int), "features": np.array(features, int)}
+    if target is not None:
+        write_arrays(target, out, meta)
+    return {**out, "rate": float(out["correct"].mean())}
+
+
+#: The arrays of :func:`route_recognition`'s cache file.
+_ROUTE_ARRAYS = ("nodes", "answers", "correct", "match_counts", "features")

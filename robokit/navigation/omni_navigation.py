@@ -17,12 +17,11 @@ References
 from __future__ import annotations
 
 import dataclasses
-import zipfile
 from typing import Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, source_digest, write_atomically
+from ..config import cache_dir, cache_key, code_version, progress_bar, read_arrays, write_arrays
 from ..controllers.path_geometry import VisualPath, path_from_poses
 from ..localization.hierarchical import HierarchicalLocalizer, Localization
 from ..validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive
@@ -222,20 +221,20 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
     if cache and default_localizer:
         meta = {"setup": setup.key, "first": first, "count": count, "fix_period": fix_period, "alpha": alpha,
                 "offset": offset, "heading": heading, "max_time": max_time, "rng": seed, "n": n_starts,
-                "code": source_digest("sim", "geometry", "vision", "mapping", "localization", "controllers",
+                "code": code_version("sim", "geometry", "vision", "mapping", "localization", "controllers",
                                       "navigation")}
         target = cache_dir("navigation") / f"office-{cache_key(**meta)}.npz"
-        results = _load_runs(target, n_starts)
+        results = _load_runs(target, n_starts, meta)
         if results is not None:
             return _judged(setup, path, first, count, results, radius)
     results = []
-    for k, start in enumerate(starts):
-        results.append(follow_path(path, start, localize=localize, fix_period=fix_period, alpha=alpha,
-                                   max_time=max_time, rng=rng))
-        if progress is not None:
-            progress(k + 1, n_starts)
+    with progress_bar(n_starts, "following the path", unit="run", callback=progress) as bar:
+        for start in starts:
+            results.append(follow_path(path, start, localize=localize, fix_period=fix_period, alpha=alpha,
+                                       max_time=max_time, rng=rng))
+            bar.update()
     if target is not None:
-        _save_runs(target, results)
+        _save_runs(target, results, meta)
     return _judged(setup, path, first, count, results, radius)
 
 
@@ -249,21 +248,20 @@ def _judged(setup: OfficeSetup, path: VisualPath, first: int, count: int, runs: 
 _FIELDS = [f.name for f in dataclasses.fields(FollowResult)]
 
 
-def _save_runs(target, results: list) -> None:
-    arrays = {f"{k}/{name}": np.asarray(getattr(r, name)) for k, r in enumerate(results) for name in _FIELDS}
-    write_atomically(target, lambda path: np.savez_compressed(path, **arrays))
+def _save_runs(target, results: list, meta: dict) -> None:
+    write_arrays(target, {f"{k}/{name}": np.asarray(getattr(r, name)) for k, r in enumerate(results) for name in _FIELDS},
+                 meta)
 
 
-def _load_runs(target, n: int) -> list | None:
-    """The cached runs, or ``None`` for a missing, corrupt or incomplete file (then they are re-run)."""
-    try:
-        with np.load(target, allow_pickle=False) as data:
-            out = []
-            for k in range(n):
-                values = {name: data[f"{k}/{name}"] for name in _FIELDS}
-                values["reached"], values["final_error"] = bool(values["reached"]), float(values["final_error"])
-                out.append(FollowResult(**values))
-            return out
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+def _load_runs(target, n: int, meta: dict) -> list | None:
+    """The cached runs, or ``None`` for a missing, corrupt, incomplete or stale file (then they are re-run)."""
+    data = read_arrays(target, [f"{k}/{name}" for k in range(n) for name in _FIELDS], meta)
+    if data is None:
         return None
+    out = []
+    for k in range(n):
+        values = {name: data[f"{k}/{name}"] for name in _FIELDS}
+        values["reached"], values["final_error"] = bool(values["reached"]), float(values["final_error"])
+        out.append(FollowResult(**values))
+    return out
 

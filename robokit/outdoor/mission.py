@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from ..config import cache_dir, cache_key, code_version, progress_bar, read_arrays, write_arrays
 from ..validation import check_callable, check_choice, check_int, check_mapping, check_positive, describe
 from .field import Course, random_course
 from .geodesy import LocalTangentPlane
@@ -264,7 +265,7 @@ class _Mission:
 
 
 def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | None = None,
-                progress: Any = None, **options: Any) -> list[RunResult]:
+                progress: Any = None, cache: bool = True, **options: Any) -> list[RunResult]:
     """Simulate one mission per seed on :func:`~robokit.outdoor.field.random_course` ``(seed)``.
 
     Parameters
@@ -274,7 +275,11 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     course_options : dict, optional
         Keyword arguments of :func:`~robokit.outdoor.field.random_course`.
     progress : callable, optional
-        ``progress(i, n)`` after each run (e.g. to print a progress bar).
+        ``progress(i, n)`` after each run, besides the progress bar (:func:`robokit.config.progress_bar`).
+    cache : bool, default True
+        Load from / save to ``robokit.cache_dir("outdoor")``, keyed by the seeds, every option and
+        the code (:func:`robokit.config.code_version`); a corrupt or stale cache file is rebuilt,
+        never loaded. Options that are not plain data (a custom ``truck``) are not cached.
     **options
         Passed to :func:`simulate`.
 
@@ -290,7 +295,8 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     Notes
     -----
     The seeded repetition of Hamid et al.'s experiment (2009, Sec. 4) used by the lesson; course
-    ``s`` is driven with ``simulate(..., seed=10_000 + s)``.
+    ``s`` is driven with ``simulate(..., seed=10_000 + s)``; deterministic, hence cacheable
+    (DESIGN.md, "Caching").
 
     Examples
     --------
@@ -307,13 +313,35 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     seeds = [check_int(s, f"seeds[{i}]", minimum=0) for i, s in enumerate(items)]
     course_options = check_mapping(course_options, "course_options")
     progress = check_callable(progress, "progress")
+    target = meta = None
+    if cache:
+        meta = {"seeds": seeds, "firing": firing, "course_options": course_options or {}, "options": options,
+                "code": code_version("outdoor", "geometry", "sim", "controllers")}
+        try:
+            target = cache_dir("outdoor") / f"courses-{cache_key(**meta)}.npz"
+        except TypeError:           # an option that is not plain data: run without the cache
+            target = None
+    if target is not None:
+        data = read_arrays(target, [f"{k}/{f.name}" for k in range(len(seeds)) for f in dataclasses.fields(RunResult)],
+                           meta)
+        if data is not None:
+            return [_result_from_arrays(data, f"{k}/") for k in range(len(seeds))]
     out = []
-    for i, s in enumerate(seeds):
-        course = random_course(s, **(course_options or {}))
-        out.append(simulate(course, seed=10_000 + s, firing=firing, **options))
-        if progress is not None:
-            progress(i + 1, len(seeds))
+    with progress_bar(len(seeds), f"courses ({firing})", unit="course", callback=progress) as bar:
+        for s in seeds:
+            course = random_course(s, **(course_options or {}))
+            out.append(simulate(course, seed=10_000 + s, firing=firing, **options))
+            bar.update()
+    if target is not None:
+        write_arrays(target, {f"{k}/{f.name}": np.asarray(getattr(r, f.name), str if f.type == "list" else None)
+                              for k, r in enumerate(out) for f in dataclasses.fields(RunResult)}, meta)
     return out
+
+
+def _result_from_arrays(data: dict, prefix: str) -> RunResult:
+    """The :class:`RunResult` that :func:`run_courses` cached under ``prefix``."""
+    cast = {"int": int, "float": float, "list": lambda a: [str(v) for v in a], "np.ndarray": np.asarray}
+    return RunResult(**{f.name: cast[f.type](data[prefix + f.name]) for f in dataclasses.fields(RunResult)})
 
 
 def summarize_runs(results: list[RunResult]) -> dict:

@@ -18,17 +18,15 @@ References
 from __future__ import annotations
 
 import dataclasses
-import functools
 import hashlib
 import json
 import zipfile
 from pathlib import Path as FsPath
 from typing import Any
 
-import cv2
 import numpy as np
 
-from ..config import cache_dir, cache_key, source_digest, write_atomically
+from ..config import cache_dir, cache_key, code_version, progress_bar, write_atomically
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .motion import Path, noisy_odometry
 from .world import World
@@ -117,15 +115,6 @@ class Run:
                     groups[group][name] = data[key]
             return cls(data["t"], data["poses"], data["odometry"], groups["images"], groups["depths"],
                        groups["scans"], json.loads(str(data["meta"])))
-
-
-@functools.lru_cache(maxsize=1)
-def _code_version() -> dict:
-    """What else decides a recording besides its parameters: a hash of the source of
-    ``robokit.sim`` and ``robokit.geometry`` (renderer, textures, sensors, noise, poses) and the
-    numpy and OpenCV versions (their numerics changed results before). A run cached by other code
-    is never reused."""
-    return {"robokit": source_digest("sim", "geometry"), "numpy": np.__version__, "opencv": cv2.__version__}
 
 
 def _cached(target: FsPath, meta: dict) -> Run | None:
@@ -288,17 +277,20 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     geometry = hashlib.sha256(np.round(world.corner_array, 9).tobytes()).hexdigest()[:16]
     meta = {"world": world.name, "world_info": json.loads(json.dumps(world.info, default=str)), "geometry": geometry,
             "rate": rate, "path": digest, "sensors": {k: describe_sensor(s) for k, s in sensors.items()},
-            "odometry_alphas": alphas.tolist(), "seed": int(seed), "code": _code_version()}
+            "odometry_alphas": alphas.tolist(), "seed": int(seed),
+            "code": code_version("sim", "geometry")}   # renderer, textures, sensors, noise, poses
     target = cache_dir("runs") / f"{world.name}-{cache_key(**meta)}.npz" if cache else None
     if target is not None and (cached := _cached(target, meta)) is not None:
         return cached
     rng = as_rng(int(seed))
     odometry = noisy_odometry(poses, alphas, rng)
     logs: dict[str, dict[str, list]] = {"images": {}, "depths": {}, "scans": {}}
-    for pose in poses:
-        for name, sensor in sensors.items():
-            for group, key, array in _readings(name, sensor.observe(world, pose, rng=rng)):
-                logs[group].setdefault(key, []).append(array)
+    with progress_bar(len(poses), f"recording in {world.name}", unit="frame") as bar:
+        for pose in poses:
+            for name, sensor in sensors.items():
+                for group, key, array in _readings(name, sensor.observe(world, pose, rng=rng)):
+                    logs[group].setdefault(key, []).append(array)
+            bar.update()
     stacked = {group: {k: np.stack(v) for k, v in arrays.items()} for group, arrays in logs.items()}
     run = Run(t, poses, odometry, stacked["images"], stacked["depths"], stacked["scans"], meta)
     if target is not None:
