@@ -132,7 +132,7 @@ def test_code_version_names_the_code_and_the_numerics():
 # --- progress bars ----------------------------------------------------------------------------
 
 def test_progress_bar_headless_prints_one_final_line(capsys):
-    from robokit.config import progress_bar
+    from robokit.progress import progress_bar
 
     seen = []
     with progress_bar(50, "mapping", unit="frame", callback=lambda d, t: seen.append((d, t)),
@@ -146,7 +146,7 @@ def test_progress_bar_headless_prints_one_final_line(capsys):
 
 
 def test_progress_bar_is_quiet_in_fast_mode_and_live_otherwise(capsys):
-    from robokit.config import progress_bar
+    from robokit.progress import progress_bar
 
     with progress_bar(3, "quiet", environ={"ROBOKIT_FAST": "1", "ROBOKIT_HEADLESS": "1"}) as bar:
         bar.update(3)
@@ -162,7 +162,7 @@ def test_progress_bar_is_quiet_in_fast_mode_and_live_otherwise(capsys):
 @pytest.mark.parametrize("kwargs, match", [({"total": -1}, "total"), ({"total": 2.5}, "total"),
                                            ({"desc": ""}, "desc"), ({"unit": " "}, "unit")])
 def test_progress_bar_refuses_bad_input(kwargs, match):
-    from robokit.config import progress_bar
+    from robokit.progress import progress_bar
 
     args = {"total": 3, "desc": "x", **kwargs}
     with pytest.raises(ValueError, match=match):

@@ -23,6 +23,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "robokit"
 #: Bottom to top. A unit may import from units of earlier rows (and from itself).
 LAYERS: list[set[str]] = [
     {"validation", "config", "about", "course"},   # base: input checks, settings, notebook tooling
+    {"progress"},                                   # the one progress bar (reads fast/headless from config)
     {"geometry"},                                   # SE(2)/SE(3)/SO(3), the papers' frames
     {"vision"},                                     # detectors, descriptors, matching
     {"sim"},                                        # worlds, sensors, motion (its feature check uses vision)

@@ -31,6 +31,7 @@ import numpy as np
 
 from .. import config
 from ..controllers import LITTLEDOG_MOTOR, servo_analysis
+from ..progress import progress_bar
 from ..validation import as_array, check_callable, check_int, check_positive, describe
 from .gait import WalkPlan, walking_plan
 from .gait_schedule import crawl_gait, trot_gait
@@ -136,7 +137,7 @@ def loop_table(plan: WalkPlan, *, servo_rates: Any = (500.0, 100.0), latencies: 
         raise ValueError(f"bandwidths: expected positive frequencies (Hz), got {bws.tolist()}")
     total = len(bws) * len(rates) * len(lats)
     rows = []
-    bar = config.progress_bar(total, "walking trials", unit="trial", callback=progress)
+    bar = progress_bar(total, "walking trials", unit="trial", callback=progress)
     for bw in map(float, bws):
         gains = littledog_servo_gains(bw)
         for rate in map(float, rates):

@@ -25,8 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..config import FAST, cache_dir, cache_key, code_version, progress_bar, read_arrays, write_arrays
+from ..config import FAST, cache_dir, cache_key, code_version, read_arrays, write_arrays
 from ..geometry import paper_world_to_robokit, se2_to_pqt, wrap_angle
+from ..progress import progress_bar
 from ..sim import PinholeCamera, StereoRig, World, lab_lap, lab_room, record
 from ..validation import as_points, check_callable, check_choice, check_int, check_positive, describe
 from ..vision.stereo import StereoCalibration
@@ -200,7 +201,7 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
         Seeds odometry, image noise and RANSAC.
     progress : callable, optional
         ``progress(done, total)`` after every mapping frame (see :meth:`VisualSLAM.process`), besides
-        the progress bar (:func:`robokit.config.progress_bar`).
+        the progress bar (:func:`robokit.progress.progress_bar`).
 
     Returns
     -------

@@ -37,8 +37,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import progress_bar
 from ..geometry import se2_between, wrap_angle
+from ..progress import progress_bar
 from ..sim.motion import odometry_covariance
 from ..sim.omni import OmniCamera
 from ..validation import as_array, check_callable, check_choice, check_int, check_positive, describe

@@ -38,9 +38,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import (cache_dir, cache_key, code_version, fast_mode, progress_bar, read_arrays, write_arrays,
+from ..config import (cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays,
                       write_atomically)
 from ..mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
+from ..progress import progress_bar
 from ..sim import Lidar, PinholeCamera, camera_mount, corridor_path, describe_sensor, long_corridor, waypoint_path
 from ..sim.world import World
 from ..validation import check_callable, check_int, check_positive

@@ -34,10 +34,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, code_version, fast_mode, progress_bar, read_arrays, write_arrays
+from ..config import cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays
 from ..controllers import move_to_middle_line
 from ..geometry import wrap_angle
 from ..localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share
+from ..progress import progress_bar
 from ..sim import noisy_odometry, waypoint_path
 from ..vision import detect_orb_features
 from ..validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive

@@ -33,12 +33,13 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import (cache_dir, cache_key, code_version, fast_mode, progress_bar, read_arrays, write_arrays,
+from ..config import (cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays,
                       write_atomically)
 from ..geometry import se2_between, se2_compose
 from ..localization.hierarchical import HierarchicalLocalizer
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
                        optimize_pose_graph, relax)
+from ..progress import progress_bar
 from ..sim import OmniCamera, describe_sensor, office_floor, office_tour, record
 from ..sim.world import World
 from ..validation import as_points, as_rng, check_callable, check_choice, check_int, check_positive

@@ -21,9 +21,10 @@ from typing import Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, code_version, progress_bar, read_arrays, write_arrays
+from ..config import cache_dir, cache_key, code_version, read_arrays, write_arrays
 from ..controllers.path_geometry import VisualPath, path_from_poses
 from ..localization.hierarchical import HierarchicalLocalizer, Localization
+from ..progress import progress_bar
 from ..validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive
 from .omni_experiment import OfficeSetup, check_setup
 from .visual_path import FollowResult, follow_path, perturbed_starts

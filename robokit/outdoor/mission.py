@@ -22,7 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, code_version, progress_bar, read_arrays, write_arrays
+from ..config import cache_dir, cache_key, code_version, read_arrays, write_arrays
+from ..progress import progress_bar
 from ..validation import check_callable, check_choice, check_int, check_mapping, check_positive, describe
 from .field import Course, random_course
 from .geodesy import LocalTangentPlane
@@ -275,7 +276,7 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     course_options : dict, optional
         Keyword arguments of :func:`~robokit.outdoor.field.random_course`.
     progress : callable, optional
-        ``progress(i, n)`` after each run, besides the progress bar (:func:`robokit.config.progress_bar`).
+        ``progress(i, n)`` after each run, besides the progress bar (:func:`robokit.progress.progress_bar`).
     cache : bool, default True
         Load from / save to ``robokit.cache_dir("outdoor")``, keyed by the seeds, every option and
         the code (:func:`robokit.config.code_version`); a corrupt or stale cache file is rebuilt,

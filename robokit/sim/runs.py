@@ -26,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, code_version, progress_bar, write_atomically
+from ..config import cache_dir, cache_key, code_version, write_atomically
+from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .motion import Path, noisy_odometry
 from .world import World
