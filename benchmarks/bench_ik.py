@@ -147,6 +147,7 @@ def main(argv=None):
         if peer is not None:
             def peer_single(Ti, si, peer=peer):
                 return np.asarray(peer.ik_LM(Ti, q0=si, tol=PEER_TOL, joint_limits=True).q)
+            peer_single(T[0], q0s[0])                          # untimed, as our solvers' first calls above
             solvers.append(("roboticstoolbox ik_LM (C++)", None, peer_single))
 
         peer_time = None

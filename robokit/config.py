@@ -10,11 +10,13 @@ import functools
 import hashlib
 import json
 import os
+import zipfile
+import zlib
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
 __all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest", "code_version",
-           "write_atomically", "write_arrays", "read_arrays"]
+           "write_atomically", "write_arrays", "read_arrays", "CACHE_READ_ERRORS"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -273,8 +275,9 @@ def write_atomically(target: str | Path, write: Callable[[Path], Any]) -> Path:
 def code_version(*packages: str) -> dict:
     """What decides a cached dataset besides its parameters: the code that makes it.
 
-    A hash of the source of robokit's ``packages`` (:func:`source_digest`) and the numpy and
-    OpenCV versions (their numerics changed results before). It enters every cache key and is
+    A hash of the source of robokit's ``packages`` (:func:`source_digest`) and the numpy, scipy
+    and OpenCV versions (their numerics changed results before; scipy's KD-trees and least squares
+    sit under matching and mapping). It enters every cache key and is
     stored in the cache file, so a dataset made by other code is never served.
 
     Parameters
@@ -285,7 +288,7 @@ def code_version(*packages: str) -> dict:
     Returns
     -------
     dict
-        ``{"robokit": digest, "numpy": version, "opencv": version}``.
+        ``{"robokit": digest, "numpy": version, "scipy": version, "opencv": version}``.
 
     Raises
     ------
@@ -300,13 +303,19 @@ def code_version(*packages: str) -> dict:
     --------
     >>> v = code_version("geometry")
     >>> sorted(v), v["robokit"] == source_digest("geometry")
-    (['numpy', 'opencv', 'robokit'], True)
+    (['numpy', 'opencv', 'robokit', 'scipy'], True)
     """
     import cv2
     import numpy as np
+    import scipy
 
-    return {"robokit": source_digest(*packages), "numpy": np.__version__, "opencv": cv2.__version__}
+    return {"robokit": source_digest(*packages), "numpy": np.__version__, "scipy": scipy.__version__,
+            "opencv": cv2.__version__}
 
+
+#: What reading a damaged, truncated or foreign cache file can raise; every cache reader catches
+#: exactly these and rebuilds (``zlib.error`` is a damaged compressed member; it is not an OSError).
+CACHE_READ_ERRORS: tuple = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, zlib.error)
 
 #: The entry of a cache file (:func:`write_arrays`) that holds the parameters it was made with.
 _META = "cache_meta"
@@ -405,9 +414,6 @@ def read_arrays(target: str | Path, names: Sequence[str], meta: dict | None = No
     >>> read_arrays(target, ["a"], {"n": 3}) is None     # says nothing of what made it
     True
     """
-    import zipfile
-    import zlib
-
     import numpy as np
 
     try:
@@ -415,5 +421,5 @@ def read_arrays(target: str | Path, names: Sequence[str], meta: dict | None = No
             if meta is not None and (_META not in data.files or str(data[_META]) != _meta_text(meta)):
                 return None
             return {name: data[name] for name in names}
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile, zlib.error):
+    except CACHE_READ_ERRORS:
         return None

@@ -604,7 +604,7 @@ SPECS: dict[str, Call] = {
                                              "white_noise": Real(0.3), "period": Real(1.0), "rng": Rng(2)}),
     "robokit.outdoor.mission.run_courses": Call({"seeds": Array(np.array([0]), "N"), "firing": Choice("chained"),
                                                  "course_options": Mapping({"n_waypoints": 1}, optional=True),
-                                                 "progress": Func(None, optional=True),
+                                                 "progress": Func(None, optional=True), "cache": Flag(False),
                                                  "options": Options({"max_time": 2.0})}, cheap=False),
     "robokit.outdoor.mission.simulate": Call({
         "course": Obj(course), "seed": Int(0), "firing": Choice("chained"), "truck": Obj(_truck, optional=True),

@@ -112,8 +112,13 @@ def test_elbow_on_its_limit_solves_from_any_start():
     rng = np.random.default_rng(5)
     q = IIWA.random_q(300, rng)
     q[:150, 3], q[150:, 3] = IIWA.qmax[3], IIWA.qmin[3]
-    res = ik_srs_batch(IIWA, IIWA.fk(q), IIWA.random_q(300, rng))
+    starts = IIWA.random_q(300, rng)
+    res = ik_srs_batch(IIWA, IIWA.fk(q), starts)
     assert res.success.all() and IIWA.within_limits(res.q, tol=0.0).all()
+    # one target at a time (the path a slider or a real-time loop takes) gives the same answers
+    single = [ik_srs(IIWA, T, s) for T, s in zip(IIWA.fk(q[::5]), starts[::5])]
+    assert all(r.success for r in single)
+    assert np.abs(np.array([r.q for r in single]) - res.q[::5]).max() < 1e-9
 
 
 def test_single_and_batch_agree_and_bad_targets_raise_named_errors():
@@ -164,7 +169,7 @@ def test_compiled_code_is_cached_in_robokits_cache_not_in_the_package():
 
     ik_srs(IIWA, IIWA.fk(np.zeros(7)))                       # compiled or loaded by now
     if not os.environ.get("NUMBA_CACHE_DIR") and jit.CACHING:
-        assert numba_config.CACHE_DIR == str(cache_dir("numba"))
+        assert numba_config.CACHE_DIR == str(cache_dir("numba", jit.SOURCE_DIGEST))
         assert any(cache_dir("numba").rglob("*.nbi"))
     assert not list(Path(robokit.__file__).parent.rglob("*.nbi"))   # nothing written next to the source
 
@@ -186,3 +191,22 @@ def test_the_first_compiling_call_says_so_once_and_a_cache_hit_stays_quiet(tmp_p
     monkeypatch.setattr(jit, "CACHING", False)                  # no cache: every process compiles, and says so
     assert jit.compile_notice("srs_solve", "the analytic IK solver") is None
     assert "every new process" in capsys.readouterr().err
+
+
+def test_the_compiled_cache_folder_changes_with_any_kernel_source(monkeypatch):
+    # numba checks only the file of the function it compiled; our kernels inline functions of the
+    # other kernel modules, so the cache folder must be named by all of their sources together
+    from pathlib import Path
+
+    import robokit.arm
+    from robokit.arm import jit
+
+    arm = Path(robokit.arm.__file__).parent
+    with_kernels = {p.name for p in arm.glob("*.py") if "@njit" in p.read_text()} | {"jit.py"}
+    assert with_kernels <= set(jit._SOURCES)
+    assert jit._source_digest() == jit.SOURCE_DIGEST
+    read = Path.read_bytes
+    for name in jit._SOURCES:
+        monkeypatch.setattr(Path, "read_bytes", lambda self, n=name: read(self) + (b"#" if self.name == n else b""))
+        assert jit._source_digest() != jit.SOURCE_DIGEST, name
+    monkeypatch.setattr(Path, "read_bytes", read)

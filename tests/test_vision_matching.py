@@ -177,3 +177,18 @@ def test_matching_score_counts_correct_matches_over_the_shared_keypoints():
         matching_score(a, b, h, 100, (100, 100))
     with pytest.raises(TypeError, match="features_a: expected Features"):
         matching_score(a.descriptors, b, h, (100, 100), (100, 100))
+
+
+def test_matching_score_counts_each_partner_once_so_repeated_keypoints_cannot_inflate_it(photo):
+    # a detector that reports every keypoint three times (e.g. three orientations at one place)
+    # must not score higher than the same detector reporting it once
+    h = similarity_homography(photo.shape, zoom=1.2)
+    warped = cv2.warpPerspective(photo, h, (640, 480))
+    fa, fb = detect_sift_features(photo), detect_sift_features(warped)
+    once = matching_score(fa, fb, h, photo.shape, warped.shape)
+    kp = fa.keypoints
+    tripled = Features(Keypoints(np.tile(kp.xy, (3, 1)), np.tile(kp.scale, 3), np.tile(kp.response, 3),
+                                 np.tile(kp.orientation, 3)), np.tile(fa.descriptors, (3, 1)))
+    thrice = matching_score(tripled, fb, h, photo.shape, warped.shape)
+    assert 0.2 < once["score"] <= 1 and thrice["n_correct"] == once["n_correct"]
+    assert thrice["score"] <= once["score"]

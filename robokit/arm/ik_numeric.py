@@ -281,7 +281,7 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
     if math.dist(T[:3, 3], base_p) > reach:                          # the batch says why
         return ik_numeric_batch(chain, T, q, **opts)[0]
     seed = opts["rng"]
-    if seed is None or (type(seed) is int and seed >= 0):             # the same draws every call: kept
+    if type(seed) is int and seed >= 0:                               # an integer seed draws the same every call: kept
         pool = _pool(chain, seed, P - 1 + restarts)
     else:
         pool = as_rng(seed).uniform(chain.qmin, chain.qmax, size=(P - 1 + restarts, chain.n))
@@ -321,8 +321,8 @@ def _chain_data(chain: Chain) -> tuple:
 
 @functools.lru_cache(maxsize=64)
 def _pool(chain: Chain, seed, rows: int) -> np.ndarray:
-    """The random configurations a seed (or None) gives, drawn as the batch search draws them (shared
-    between calls: the kernel never writes to it)."""
+    """The random configurations an integer seed gives, drawn as the batch search draws them (shared
+    between calls: the kernel never writes to it). ``rng=None`` draws fresh ones on every call."""
     return as_rng(seed).uniform(chain.qmin, chain.qmax, size=(rows, chain.n))
 
 

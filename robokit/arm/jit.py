@@ -2,10 +2,15 @@
 
 Only the compiled kernel modules of the IK solvers import this module, and they are imported on
 the first solve, never by ``import robokit``: importing robokit compiles nothing and does not load
-numba. Compiled machine code is cached under ``cache_dir("numba")`` (``$ROBOKIT_CACHE/numba``)
-unless ``NUMBA_CACHE_DIR`` says otherwise, so a read-only package directory is never written to. If
-no cache directory can be created, the kernels are still compiled, only not cached (each new
-process then pays the compile time again).
+numba. Compiled machine code is cached under ``cache_dir("numba", <digest>)``
+(``$ROBOKIT_CACHE/numba/<digest>``, or ``$NUMBA_CACHE_DIR/<digest>`` if that is set), so a
+read-only package directory is never written to. ``<digest>`` hashes the source of every kernel
+module with the numba and Python versions: numba checks only the file of the function it compiled,
+and our kernels inline functions of the other kernel modules, so an edit there must start a new
+cache rather than let numba load machine code built from the old source. If no cache directory can
+be created, the kernels are still compiled, only not cached (each new process then pays the
+compile time again). The redirection is process-wide: a student's own ``@njit(cache=True)`` code
+run after a robokit solve is cached in the same folder.
 """
 from __future__ import annotations
 
@@ -23,13 +28,32 @@ from ..config import cache_dir
 __all__ = ["njit", "CACHING", "compile_notice", "compiled"]
 
 
+#: The kernel modules whose source decides whether the cached machine code is current.
+_SOURCES = ("jit.py", "chain_kernels.py", "srs_kernels.py", "numeric_kernels.py")
+
+
+def _source_digest() -> str:
+    """Hash of every kernel module's source with the numba and Python versions."""
+    h = hashlib.sha1(f"{numba.__version__} {sys.version_info[:2]}".encode())
+    here = Path(__file__).parent
+    for name in _SOURCES:
+        h.update((here / name).read_bytes())
+    return h.hexdigest()[:12]
+
+
+#: Names the cache folder of the compiled kernels (see the module docstring).
+SOURCE_DIGEST = _source_digest()
+
+
 def _use_robokit_cache() -> bool:
-    """Point numba's cache at ``cache_dir("numba")`` (unless ``NUMBA_CACHE_DIR`` is set); False if
-    that directory cannot be created."""
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        return True
+    """Point numba's cache at a folder named by :data:`SOURCE_DIGEST`, under ``NUMBA_CACHE_DIR`` if
+    set, else under ``cache_dir("numba")``; False if that folder cannot be created."""
     try:
-        path = cache_dir("numba")
+        if os.environ.get("NUMBA_CACHE_DIR"):
+            path = Path(os.environ["NUMBA_CACHE_DIR"]) / SOURCE_DIGEST
+            path.mkdir(parents=True, exist_ok=True)
+        else:
+            path = cache_dir("numba", SOURCE_DIGEST)
     except OSError:
         return False
     if not os.access(path, os.W_OK):
@@ -72,17 +96,9 @@ def njit(fn):
     return numba.njit(fn)
 
 
-#: The kernel modules whose source decides whether the cached machine code is current.
-_SOURCES = ("jit.py", "chain_kernels.py", "srs_kernels.py", "numeric_kernels.py")
-
-
 def _record(kernel: str) -> Path:
     """Where this machine records that ``kernel`` was compiled from the current source and numba."""
-    h = hashlib.sha1(f"{numba.__version__} {sys.version_info[:2]}".encode())
-    here = Path(__file__).parent
-    for name in _SOURCES:
-        h.update((here / name).read_bytes())
-    return Path(_numba_config.CACHE_DIR or here) / f"robokit-{kernel}-{h.hexdigest()[:12]}.compiled"
+    return Path(_numba_config.CACHE_DIR or Path(__file__).parent) / f"robokit-{kernel}-{SOURCE_DIGEST}.compiled"
 
 
 def compile_notice(kernel: str, what: str) -> Path | None:

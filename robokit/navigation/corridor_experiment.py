@@ -33,12 +33,11 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import zipfile
 from typing import Any, Callable
 
 import numpy as np
 
-from ..config import (cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays,
+from ..config import (CACHE_READ_ERRORS, cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays,
                       write_atomically)
 from ..mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
 from ..progress import progress_bar
@@ -346,7 +345,7 @@ def training_vocabulary(*, fast: bool | None = None, branching: int = 10, levels
     if target.exists():
         try:
             return Vocabulary.load(target)
-        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+        except CACHE_READ_ERRORS:
             pass  # a corrupt or foreign cache file is rebuilt
     images = _orb_frames(world, camera, poses, np.random.default_rng(7), progress, "vocabulary images")
     vocabulary = Vocabulary.train(images, branching=branching, levels=levels, rng=0)

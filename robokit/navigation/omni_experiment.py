@@ -28,12 +28,11 @@ from __future__ import annotations
 import dataclasses
 import json
 import time
-import zipfile
 from typing import Any, Callable
 
 import numpy as np
 
-from ..config import (cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays,
+from ..config import (CACHE_READ_ERRORS, cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays,
                       write_atomically)
 from ..geometry import se2_between, se2_compose
 from ..localization.hierarchical import HierarchicalLocalizer
@@ -107,7 +106,7 @@ def _map_cached(meta: dict, build: Callable[[], tuple[TopologicalMap, np.ndarray
                 tmap = TopologicalMap.load(target)
                 truth = np.array(stored["truth"], float).reshape(len(tmap), 3)
                 return tmap, truth, int(stored["frames"]), float(stored["seconds"]), key
-        except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile):
+        except CACHE_READ_ERRORS:
             pass  # a corrupt or foreign cache file is rebuilt
     t0 = time.perf_counter()
     tmap, truth, frames = build()

@@ -20,13 +20,12 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import zipfile
 from pathlib import Path as FsPath
 from typing import Any
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, code_version, write_atomically
+from ..config import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, write_atomically
 from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .motion import Path, noisy_odometry
@@ -125,7 +124,7 @@ def _cached(target: FsPath, meta: dict) -> Run | None:
         return None
     try:
         run = Run.load(target)
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+    except CACHE_READ_ERRORS:
         return None
     stored = {k: v for k, v in run.meta.items() if k != "format"}
     return run if stored == json.loads(json.dumps(meta)) else None

@@ -278,7 +278,9 @@ def matching_score(features_a: Features, features_b: Features, homography, image
     Returns
     -------
     dict
-        ``score`` (float in [0, 1]), ``n_correct``, ``n_matches`` (ratio-test matches of A's
+        ``score`` (float in [0, 1]), ``n_correct`` (B keypoints that are the correct partner of at
+        least one of A's: each counts once, so repeated keypoints in A cannot inflate the score),
+        ``n_matches`` (ratio-test matches of A's
         keypoints that map into B) and ``n_overlap`` (the smaller of A's keypoints that map into
         B and B's that map back into A). No overlap or fewer than two features in B gives score 0
         (documented empty result, never NaN).
@@ -323,6 +325,6 @@ def matching_score(features_a: Features, features_b: Features, homography, image
     dist, index = two_nearest(features_a.descriptors, features_b.descriptors, method=method)
     matched = inside_a & (distance_ratio(dist[:, 0], dist[:, 1]) < t)
     correct = matched & (np.linalg.norm(warped - features_b.keypoints.xy[index[:, 0]], axis=1) <= tol)
-    n_correct = int(correct.sum())
+    n_correct = int(np.unique(index[correct, 0]).size)        # one-to-one: each B keypoint counts once
     return {"score": n_correct / overlap if overlap else 0.0, "n_correct": n_correct, "n_matches": int(matched.sum()),
             "n_overlap": overlap}
