@@ -43,7 +43,7 @@ from ..mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field,
 from ..progress import progress_bar
 from ..sim import Lidar, PinholeCamera, camera_mount, corridor_path, describe_sensor, long_corridor, waypoint_path
 from ..sim.world import World
-from ..validation import check_callable, check_int, check_positive
+from ..validation import as_array, check_callable, check_int, check_positive
 from ..vision import BowDatabase, Vocabulary, detect_orb_features, feature_threshold, select_keyframes, \
     select_keyframes_orbslam
 
@@ -276,21 +276,17 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     gap = check_int(min_frame_gap, "min_frame_gap", minimum=0)
     flat, counts = _descriptor_stack(run.descriptors)
     content = hashlib.sha256(flat.tobytes() + counts.tobytes() + np.asarray(run.positions, float).tobytes())
-    try:
-        band = np.asarray(shared_range, float).tolist()
-    except (TypeError, ValueError):
-        band = None                  # select_keyframes names the error
+    band = as_array(shared_range, "shared_range", shape=(2,)).tolist()   # checked before any cache lookup
     meta = {"run": content.hexdigest()[:16], "f_min": float(run.f_min), "gap": gap, "shared_range": band,
             "below_band": str(below_band), "code": _code()}
     target = cache_dir("corridor") / f"keyframes-{cache_key(**meta)}.npz"
-    data = read_arrays(target, ("ours", "orbslam"), meta) if band is not None else None
+    data = read_arrays(target, ("ours", "orbslam"), meta)
     if data is None:
         ours = select_keyframes(run.descriptors, run.positions, run.f_min, min_frame_gap=gap,
                                 shared_range=shared_range, below_band=below_band)
         orbslam = select_keyframes_orbslam(run.descriptors, run.positions)
         data = {"ours": np.asarray(ours, int), "orbslam": np.asarray(orbslam, int)}
-        if band is not None:
-            write_arrays(target, data, meta)
+        write_arrays(target, data, meta)
     return {"ours": data["ours"], "orbslam": data["orbslam"], "images": len(run.descriptors)}
 
 
