@@ -11,6 +11,7 @@ import time
 from typing import Callable
 
 from .config import fast_mode, headless
+from .validation import check_int
 
 __all__ = ["ProgressBar", "progress_bar"]
 
@@ -106,7 +107,8 @@ def progress_bar(total: int, desc: str, *, unit: str = "step", callback: Callabl
     ValueError
         For a negative ``total`` or an empty ``desc`` or ``unit``.
     TypeError
-        For a ``callback`` that is not callable.
+        For a ``total`` that is not an integer (numpy integers are) or a ``callback`` that is not
+        callable.
 
     Notes
     -----
@@ -123,8 +125,7 @@ def progress_bar(total: int, desc: str, *, unit: str = "step", callback: Callabl
     >>> bar.done
     3
     """
-    if isinstance(total, bool) or not isinstance(total, int) or total < 0:
-        raise ValueError(f"total: expected a non-negative whole number of steps, got {total!r}")
+    total = check_int(total, "total", minimum=0)
     for name, value in (("desc", desc), ("unit", unit)):
         if not isinstance(value, str) or not value.strip():
             raise ValueError(f"{name}: expected a non-empty string, got {value!r}")

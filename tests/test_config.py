@@ -159,13 +159,15 @@ def test_progress_bar_is_quiet_in_fast_mode_and_live_otherwise(capsys):
     assert bar.done == 3
 
 
-@pytest.mark.parametrize("kwargs, match", [({"total": -1}, "total"), ({"total": 2.5}, "total"),
-                                           ({"desc": ""}, "desc"), ({"unit": " "}, "unit")])
-def test_progress_bar_refuses_bad_input(kwargs, match):
+@pytest.mark.parametrize("kwargs, error, match", [({"total": -1}, ValueError, "total"), ({"total": 2.5}, TypeError, "total"),
+                                                  ({"total": True}, TypeError, "total"),
+                                                  ({"desc": ""}, ValueError, "desc"), ({"unit": " "}, ValueError, "unit")])
+def test_progress_bar_refuses_bad_input(kwargs, error, match):
     from robokit.progress import progress_bar
 
     args = {"total": 3, "desc": "x", **kwargs}
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises(error, match=match):
         progress_bar(args.pop("total"), args.pop("desc"), **args)
     with pytest.raises(TypeError, match="callback"):
         progress_bar(3, "x", callback=3)
+    assert progress_bar(np.int64(3), "x", environ={"ROBOKIT_FAST": "1"}).total == 3     # a numpy count is a count

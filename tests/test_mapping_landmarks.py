@@ -108,3 +108,19 @@ def test_association_uses_pose_uncertainty_and_descriptors():
     assert m.associate(off, cov, desc, pqt)[0] == -1
     assert m.associate(off, np.stack([np.eye(3) * 1e-2] * 40), desc, pqt)[0] == 0
     assert np.all(LandmarkMap(16).associate(obs, cov, desc, pqt) == -1)
+
+
+def test_a_map_round_trips_through_its_arrays_and_bad_arrays_are_named():
+    lm = LandmarkMap(4)
+    rng = np.random.default_rng(0)
+    lm.add(rng.normal(size=(5, 3)), np.tile(np.eye(3) * 0.01, (5, 1, 1)), rng.normal(size=(5, 4)))
+    arrays = lm.to_arrays("m_")
+    back = LandmarkMap.from_arrays(arrays, "m_")
+    assert len(back) == len(lm) and np.array_equal(back.positions, lm.positions)
+    assert np.array_equal(back.add(np.zeros((1, 3)), np.eye(3)[None] * 0.01, np.zeros((1, 4))),
+                          lm.add(np.zeros((1, 3)), np.eye(3)[None] * 0.01, np.zeros((1, 4))))   # ids continue alike
+    flat = {**arrays, "m_descriptors": np.zeros(5)}
+    with pytest.raises(ValueError, match="descriptors of shape"):
+        LandmarkMap.from_arrays(flat, "m_")
+    with pytest.raises(ValueError, match="missing"):
+        LandmarkMap.from_arrays({}, "m_")

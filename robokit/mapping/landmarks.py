@@ -237,7 +237,7 @@ class LandmarkMap:
         Raises
         ------
         ValueError
-            For missing arrays or arrays of unequal lengths.
+            For missing arrays, descriptors that are not a 2-D table, or arrays of unequal lengths.
 
         Examples
         --------
@@ -250,6 +250,8 @@ class LandmarkMap:
         if missing:
             raise ValueError(f"arrays: expected the arrays of LandmarkMap.to_arrays, missing {missing}")
         descriptors = np.asarray(arrays[prefix + "descriptors"], np.float32)
+        if descriptors.ndim != 2:
+            raise ValueError(f"arrays: expected {prefix}descriptors of shape (N, D), got shape {descriptors.shape}")
         out = cls(descriptors.shape[1], max_missed=int(arrays[prefix + "max_missed"]))
         for name in cls.ARRAYS:
             setattr(out, name, np.asarray(arrays[prefix + name], getattr(out, name).dtype))
