@@ -63,15 +63,16 @@ def frames(q, K, U, V, offset, base, tool, F):
         for r in range(4):
             for k in range(4):
                 A[r, k] = K[i, r, k] + c * U[i, r, k] + s * V[i, r, k]
-        P = F[i]
-        for r in range(4):
-            for k in range(4):
-                F[i + 1, r, k] = P[r, 0] * A[0, k] + P[r, 1] * A[1, k] + P[r, 2] * A[2, k] + P[r, 3] * A[3, k]
-    E = F[n]
-    out = np.empty((4, 4))
+        matmul4(F[i], A, F[i + 1])
+    return matmul4(F[n], tool, np.empty((4, 4)))
+
+
+@njit
+def matmul4(A, B, out):
+    """``out = A @ B`` for 4 x 4 matrices (element loops; ``out`` must not be ``A`` or ``B``); returns ``out``."""
     for r in range(4):
         for k in range(4):
-            out[r, k] = E[r, 0] * tool[0, k] + E[r, 1] * tool[1, k] + E[r, 2] * tool[2, k] + E[r, 3] * tool[3, k]
+            out[r, k] = A[r, 0] * B[0, k] + A[r, 1] * B[1, k] + A[r, 2] * B[2, k] + A[r, 3] * B[3, k]
     return out
 
 

@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from .chain_kernels import check_se3, frames, pose_error
+from .chain_kernels import check_se3, frames, matmul4, pose_error
 from .jit import njit
 
 #: Most split points of one group's arm-angle circle (3 joints x 3 equations x 2 roots, and -pi).
@@ -37,6 +37,9 @@ _PI = math.pi
 MERGE = 1e-12
 _SQRT_EPS = math.sqrt(2.220446049250313e-16)
 _GOLDEN = 0.5 * (3.0 - math.sqrt(5.0))
+#: ``(numerator entry, denominator entry, denominator sign)`` of the two tangent-type joints of a ZYZ
+#: group in its rotation ``M`` (row-major entries): ``a = atan2(M12, M02)``, ``c = atan2(M21, -M20)``.
+TANGENT = ((5, 2, 1.0), (7, 6, -1.0))
 
 
 @njit
@@ -160,8 +163,9 @@ def group_splits(G, e, g, lo, hi, out):
     n = 0
     out[n] = -_PI
     n += 1
-    for joint in (0, 2):
-        num, den, sd = (5, 2, 1.0) if joint == 0 else (7, 6, -1.0)
+    for t in range(2):
+        num, den, sd = TANGENT[t]
+        joint = 2 * t                                 # a (t = 0) and c (t = 1) of the group
         for lim in (lo[joint], hi[joint], _PI):
             cl, sl = math.cos(lim), math.sin(lim)
             n = _roots(G[e, g, 0, num] * cl - sd * G[e, g, 0, den] * sl, G[e, g, 1, num] * cl - sd * G[e, g, 1, den] * sl,
@@ -321,15 +325,6 @@ def minimise(G, q4, b, a, c, lo, hi, q0, xatol, work, q):
     return xf, fx, evals
 
 
-@njit
-def _matmul4(A, B):
-    out = np.empty((4, 4))
-    for r in range(4):
-        for k in range(4):
-            out[r, k] = A[r, 0] * B[0, k] + A[r, 1] * B[1, k] + A[r, 2] * B[2, k] + A[r, 3] * B[3, k]
-    return out
-
-
 #: Step [rad] of the one-sided test at an interval end: is the distance falling into the interval?
 END_STEP = 1e-7
 
@@ -344,8 +339,8 @@ def group_stationary(G, e, g, out):
     has the numerator ``(cn bd - bn cd) sin psi + (an cd - cn ad) cos psi + (an bd - bn ad)``
     (Shimizu et al. 2008, Sec. IV-B); the same for both branches."""
     n = 0
-    for joint in range(2):
-        num, den, sd = (5, 2, 1.0) if joint == 0 else (7, 6, -1.0)
+    for t in range(2):
+        num, den, sd = TANGENT[t]
         an, bn, cn = G[e, g, 0, num], G[e, g, 1, num], G[e, g, 2, num]
         ad, bd, cd = sd * G[e, g, 0, den], sd * G[e, g, 1, den], sd * G[e, g, 2, den]
         m = _roots(cn * bd - bn * cd, an * cd - cn * ad, an * bd - bn * ad, out, n)
@@ -534,7 +529,7 @@ def solve(T, q0, psi0, base_inv, tool_inv, plain, dims, lo, hi, tol, se3_tol, n_
         q[j] = q0[j]
     if se3_tol > 0 and check_se3(T, se3_tol):
         return 1
-    T7 = T if plain else _matmul4(_matmul4(base_inv, T), tool_inv)
+    T7 = T if plain else matmul4(matmul4(base_inv, T, np.empty((4, 4))), tool_inv, np.empty((4, 4)))
     G, q4 = np.empty((2, 2, 3, 9)), np.empty(2)
     c4 = coefficients(T7, dims[0], dims[1], dims[2], dims[3], G, q4)
     info[3] = c4
