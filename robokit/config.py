@@ -16,7 +16,8 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 __all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest", "code_version",
-           "write_atomically", "write_arrays", "read_arrays", "CACHE_READ_ERRORS"]
+           "write_atomically", "write_arrays", "read_arrays", "CACHE_READ_ERRORS", "records_to_arrays",
+           "record_names", "records_from_arrays"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -423,3 +424,76 @@ def read_arrays(target: str | Path, names: Sequence[str], meta: dict | None = No
             return {name: data[name] for name in names}
     except CACHE_READ_ERRORS:
         return None
+
+
+#: Field annotations a cached record may have (as strings: ``from __future__ import annotations``).
+_RECORD_FIELD_KINDS = ("int", "float", "bool", "list", "np.ndarray")
+
+
+def _record_fields(cls) -> tuple:
+    import dataclasses
+
+    if not (isinstance(cls, type) and dataclasses.is_dataclass(cls)):
+        raise TypeError(f"cls: expected a dataclass, got {cls!r}")
+    odd = [f"{f.name}: {f.type}" for f in dataclasses.fields(cls) if f.type not in _RECORD_FIELD_KINDS]
+    if odd:
+        raise TypeError(f"cls: expected fields annotated {list(_RECORD_FIELD_KINDS)}, got {odd}")
+    return dataclasses.fields(cls)
+
+
+def records_to_arrays(records: Sequence, cls) -> dict:
+    """Named arrays ``"k/field"`` of dataclass records, for :func:`write_arrays`; read them back
+    with :func:`read_arrays` ``(target,`` :func:`record_names` ``(cls, n))`` and :func:`records_from_arrays`.
+
+    Parameters
+    ----------
+    records : sequence of ``cls``
+    cls : dataclass type
+        Fields annotated ``int``, ``float``, ``bool``, ``list`` (of str) or ``np.ndarray``.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+
+    Raises
+    ------
+    TypeError
+        For a ``cls`` that is not such a dataclass, or a record that is not a ``cls``.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Caching"); not from a paper.
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> @dataclasses.dataclass
+    ... class Run:
+    ...     reached: int
+    ...     states: list
+    >>> arrays = records_to_arrays([Run(2, ["go", "stop"])], Run)
+    >>> record_names(Run, 1), records_from_arrays(arrays, Run, 1)
+    (['0/reached', '0/states'], [Run(reached=2, states=['go', 'stop'])])
+    """
+    import numpy as np
+
+    fields = _record_fields(cls)
+    bad = [k for k, r in enumerate(records) if not isinstance(r, cls)]
+    if bad:
+        raise TypeError(f"records: expected {cls.__name__} records, got another kind at {bad[:5]}")
+    return {f"{k}/{f.name}": np.asarray(getattr(r, f.name), str if f.type == "list" else None)
+            for k, r in enumerate(records) for f in fields}
+
+
+def record_names(cls, n: int) -> list:
+    """The array names of ``n`` records of ``cls`` in :func:`records_to_arrays` (its Examples)."""
+    return [f"{k}/{f.name}" for k in range(n) for f in _record_fields(cls)]
+
+
+def records_from_arrays(data: dict, cls, n: int) -> list:
+    """The ``n`` records of ``cls`` stored by :func:`records_to_arrays` (see its Examples): ``int``,
+    ``float`` and ``bool`` fields as Python scalars, ``list`` fields as lists of str."""
+    import numpy as np
+
+    cast = {"int": int, "float": float, "bool": bool, "list": lambda a: [str(v) for v in a], "np.ndarray": np.asarray}
+    return [cls(**{f.name: cast[f.type](data[f"{k}/{f.name}"]) for f in _record_fields(cls)}) for k in range(n)]

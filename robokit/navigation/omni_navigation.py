@@ -21,7 +21,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, code_version, read_arrays, write_arrays
+from ..config import (cache_dir, cache_key, code_version, read_arrays, record_names, records_from_arrays,
+                      records_to_arrays, write_arrays)
 from ..controllers.path_geometry import VisualPath, path_from_poses
 from ..localization.hierarchical import HierarchicalLocalizer, Localization
 from ..progress import progress_bar
@@ -225,8 +226,9 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
                 "code": code_version("sim", "geometry", "vision", "mapping", "localization", "controllers",
                                       "navigation")}
         target = cache_dir("navigation") / f"office-{cache_key(**meta)}.npz"
-        results = _load_runs(target, n_starts, meta)
-        if results is not None:
+        data = read_arrays(target, record_names(FollowResult, n_starts), meta)
+        if data is not None:
+            results = records_from_arrays(data, FollowResult, n_starts)
             return _judged(setup, path, first, count, results, radius)
     results = []
     with progress_bar(n_starts, "following the path", unit="run", callback=progress) as bar:
@@ -235,7 +237,7 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
                                        max_time=max_time, rng=rng))
             bar.update()
     if target is not None:
-        _save_runs(target, results, meta)
+        write_arrays(target, records_to_arrays(results, FollowResult), meta)
     return _judged(setup, path, first, count, results, radius)
 
 
@@ -244,25 +246,3 @@ def _judged(setup: OfficeSetup, path: VisualPath, first: int, count: int, runs: 
     goal = setup.truth[first + count - 1, :2]
     errors = np.array([np.hypot(*(r.true_poses[-1, :2] - goal)) for r in runs])
     return NavigationTrials(path, np.arange(first, first + count), runs, errors, errors <= radius, radius)
-
-
-_FIELDS = [f.name for f in dataclasses.fields(FollowResult)]
-
-
-def _save_runs(target, results: list, meta: dict) -> None:
-    write_arrays(target, {f"{k}/{name}": np.asarray(getattr(r, name)) for k, r in enumerate(results) for name in _FIELDS},
-                 meta)
-
-
-def _load_runs(target, n: int, meta: dict) -> list | None:
-    """The cached runs, or ``None`` for a missing, corrupt, incomplete or stale file (then they are re-run)."""
-    data = read_arrays(target, [f"{k}/{name}" for k in range(n) for name in _FIELDS], meta)
-    if data is None:
-        return None
-    out = []
-    for k in range(n):
-        values = {name: data[f"{k}/{name}"] for name in _FIELDS}
-        values["reached"], values["final_error"] = bool(values["reached"]), float(values["final_error"])
-        out.append(FollowResult(**values))
-    return out
-

@@ -22,7 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, code_version, read_arrays, write_arrays
+from ..config import (cache_dir, cache_key, code_version, read_arrays, record_names, records_from_arrays,
+                      records_to_arrays, write_arrays)
 from ..progress import progress_bar
 from ..validation import check_callable, check_choice, check_int, check_mapping, check_positive, describe
 from .field import Course, random_course
@@ -323,10 +324,9 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
         except TypeError:           # an option that is not plain data: run without the cache
             target = None
     if target is not None:
-        data = read_arrays(target, [f"{k}/{f.name}" for k in range(len(seeds)) for f in dataclasses.fields(RunResult)],
-                           meta)
+        data = read_arrays(target, record_names(RunResult, len(seeds)), meta)
         if data is not None:
-            return [_result_from_arrays(data, f"{k}/") for k in range(len(seeds))]
+            return records_from_arrays(data, RunResult, len(seeds))
     out = []
     with progress_bar(len(seeds), f"courses ({firing})", unit="course", callback=progress) as bar:
         for s in seeds:
@@ -334,15 +334,8 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
             out.append(simulate(course, seed=10_000 + s, firing=firing, **options))
             bar.update()
     if target is not None:
-        write_arrays(target, {f"{k}/{f.name}": np.asarray(getattr(r, f.name), str if f.type == "list" else None)
-                              for k, r in enumerate(out) for f in dataclasses.fields(RunResult)}, meta)
+        write_arrays(target, records_to_arrays(out, RunResult), meta)
     return out
-
-
-def _result_from_arrays(data: dict, prefix: str) -> RunResult:
-    """The :class:`RunResult` that :func:`run_courses` cached under ``prefix``."""
-    cast = {"int": int, "float": float, "list": lambda a: [str(v) for v in a], "np.ndarray": np.asarray}
-    return RunResult(**{f.name: cast[f.type](data[prefix + f.name]) for f in dataclasses.fields(RunResult)})
 
 
 def summarize_runs(results: list[RunResult]) -> dict:
