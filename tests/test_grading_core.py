@@ -39,6 +39,41 @@ def test_comparisons():
     assert unordered_rows()(rows, rows + 1) is not None
 
 
+def test_array_mismatch_names_the_count_and_the_worst_values():
+    expected = np.zeros((3, 4))
+    got = expected.copy()
+    got[0, 1], got[2, 3], got[1, 0] = 0.5, -2.0, float("nan")
+    msg = close(rtol=0, atol=1e-9)(expected, got)
+    assert msg.startswith("result: 3 of 12 values differ")
+    # worst first: the NaN, then the largest miss (-2 at (2, 3)), then 0.5 at (0, 1)
+    assert msg.index("(1, 0)") < msg.index("(2, 3)") < msg.index("(0, 1)")
+    many = close(rtol=0, atol=1e-9)(np.zeros(50), np.arange(50.0))
+    assert "49 of 50 values differ" in many and many.count("at index") == 3 and "(49,)" in many.split(";")[1]
+    assert close()(2.0, 2.5) == "result: expected 2, got 2.5 (tolerance 1e-09 + 1e-06*|expected|)"
+
+
+def test_a_list_and_an_array_are_the_same_answer_in_every_comparison():
+    idx, vals = np.array([2, 0, 1]), np.array([[0.5, 1.0]])
+    for cmp in (close(), exact()):
+        assert cmp(idx, [2, 0, 1]) is None and cmp([2, 0, 1], idx) is None
+        assert cmp(idx, [2, 1, 0]) is not None and cmp(idx, [[2, 0, 1]]) is not None
+    assert close()(vals, [[0.5, 1.0]]) is None and unordered_rows()(vals, [[0.5, 1.0]]) is None
+    assert exact()(np.array([], dtype=int), []) is None
+    assert "2 of 3 values differ; first at index (1,): expected 0, got 1" in exact()(idx, [2, 1, 0])
+    assert exact()(idx, [2.0, 0.0, 1.0]) is not None          # exact: integers asked, floats refused
+    assert exact()(np.array([True, False]), [True, False]) is None
+    assert exact()(np.array([True, False]), [1, 0]) is not None
+    assert exact()(idx, ["2", "0", "1"]) is not None and exact()(idx, None) is not None
+
+
+def test_case_call_text_shows_the_inputs_within_a_bound():
+    case = Case(("$GPRMC,123519,A,4807.038,N*6A",), {"strict": True})
+    assert case.call_text("parse") == "parse('$GPRMC,123519,A,4807.038,N*6A', strict=True)"
+    big = Case((np.arange(10_000.0), "x" * 1000))
+    text = big.call_text("f")
+    assert len(text) <= 400 and text.startswith("f(array(10000,)") and text.endswith("...)")
+
+
 def test_transport_round_trip_and_limits(tmp_path):
     value = {"a": np.arange(3.0), "b": [1, "x", None, float("nan")], "c": np.array([True, False])}
     write_plain(value, tmp_path / "v")
@@ -69,6 +104,8 @@ def test_check_reports_and_raises(capsys):
     assert "2/6 public cases passed" in report and "FAIL" not in report   # failures: in the message only
     # the message itself names the failed cases, and IPython shows only that message
     assert str(failed.value).count("FAIL  case") == 4
+    # each failed case shows the call that broke it, with its inputs
+    assert str(failed.value).count("input: wrap_angle(") == 4
     assert failed.value._render_traceback_() == [f"CheckFailed: {failed.value}"]
 
     def stub(angle):

@@ -664,6 +664,10 @@ def test_inputs_learnt_from_feedback_do_not_score_the_next_submission(tmp_path):
     drawn = sum(a != b for a, b in zip(map(repr, exercise.make_cases("a")), map(repr, exercise.make_cases("b"))))
     score = {s.id: s for s in second.scores}["00.wrap_angle"]
     assert drawn >= 2 and score.passed == score.total - drawn, (drawn, score)
-    assert all("not in the table" in m for m in score.messages), score.messages
+    verdicts = [m for m in score.messages if m.startswith("case ")]
+    assert verdicts and all("not in the table" in m for m in verdicts), score.messages
+    # each failed case's verdict is followed by the call that failed, with its (fresh) input
+    inputs = [m for m in score.messages if m.startswith("  input: wrap_angle(")]
+    assert len(inputs) == len(verdicts), score.messages
     again = grade_batch([probe], "00_getting_started", seed, limits=LIMITS, log=lambda *_: None)[0]
     assert feedback_text(again, "00_getting_started") == feedback_text(first, "00_getting_started")  # regrades identically

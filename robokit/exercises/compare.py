@@ -4,6 +4,10 @@ A comparison is a callable ``compare(expected, got) -> str | None``: ``None`` me
 accepted, a string says why not. Build them with :func:`close`, :func:`exact` and
 :func:`unordered_rows`; they are plain functions of plain data, so a student's return value can
 never influence them beyond its numbers.
+
+Containers: where an exercise asks for an array, a (nested) list with the same shape and values is
+the same answer, and the other way round, in every comparison; an answer is judged by its numbers,
+and a mismatch names how many values differ and the worst of them.
 """
 from __future__ import annotations
 
@@ -43,7 +47,10 @@ def close(rtol: float = 1e-6, atol: float = 1e-9, *, shape: bool = True) -> Comp
     Examples
     --------
     >>> close(rtol=0, atol=1e-9)([1.0, 2.0], [1.0, 2.1])
-    'result: values differ at index (1,): expected 2, got 2.1 (tolerance 1e-09 + 0*|expected|)'
+    'result: 1 of 2 values differ (tolerance 1e-09 + 0*|expected|); at index (1,): expected 2, got 2.1'
+
+    A list is as good as an array with the same shape and values (and an array as a list): the
+    comparison judges the numbers, not the container.
     """
 
     def compare(expected: Any, got: Any, where: str = "") -> str | None:
@@ -70,11 +77,7 @@ def close(rtol: float = 1e-6, atol: float = 1e-9, *, shape: bool = True) -> Comp
             except ValueError:
                 return f"{where or 'result'}: shapes {e.shape} and {g.shape} do not match"
             if not np.all(ok):
-                bad = np.argwhere(~np.atleast_1d(ok))[0]
-                ge, gg = np.atleast_1d(e)[tuple(bad)], np.atleast_1d(g)[tuple(bad)]
-                at = "" if e.ndim == 0 else f" at index {tuple(int(i) for i in bad)}"
-                return (f"{where or 'result'}: values differ{at}: expected {ge:.6g}, got {gg:.6g} "
-                        f"(tolerance {atol:g} + {rtol:g}*|expected|)")
+                return f"{where or 'result'}: " + _worst_differences(e, g, ok, rtol, atol)
             return None
         if isinstance(expected, list):
             if not isinstance(got, list) or len(got) != len(expected):
@@ -91,6 +94,23 @@ def close(rtol: float = 1e-6, atol: float = 1e-9, *, shape: bool = True) -> Comp
     return lambda expected, got: compare(expected, got)
 
 
+def _worst_differences(e: np.ndarray, g: np.ndarray, ok: np.ndarray, rtol: float, atol: float,
+                       show: int = 3) -> str:
+    """Say how many of the values in ``g`` miss ``e`` and which are the worst (by how far past the
+    tolerance), e.g. ``"3 of 12 values differ (tolerance ...); worst at index (2,): ..."``."""
+    if e.ndim == 0:
+        return f"expected {float(e):.6g}, got {float(g):.6g} (tolerance {atol:g} + {rtol:g}*|expected|)"
+    excess = np.abs(g - e) - (atol + rtol * np.abs(e))
+    excess = np.where(np.isnan(excess), np.inf, excess)          # a NaN is the worst miss of all
+    bad = np.argwhere(~ok)
+    worst = bad[np.argsort(-excess[tuple(bad.T)], kind="stable")[:show]]
+    where = "; ".join(f"at index {tuple(int(i) for i in idx)}: expected {e[tuple(idx)]:.6g}, "
+                      f"got {g[tuple(idx)]:.6g}" for idx in worst)
+    head = "worst " if len(bad) > 1 else ""
+    return (f"{len(bad)} of {e.size} values differ (tolerance {atol:g} + {rtol:g}*|expected|); "
+            f"{head}{where}")
+
+
 def exact() -> Comparison:
     """Accept only an identical value (strings, integers, booleans, lists of them).
 
@@ -98,18 +118,42 @@ def exact() -> Comparison:
     --------
     >>> exact()("2A", "2a")
     "expected '2A', got '2a'"
+
+    An integer array and a list of the same integers are the same answer; floats for integers are not:
+
+    >>> exact()(np.array([2, 0, 1]), [2, 0, 1]) is None, exact()(np.array([2, 0, 1]), [2.0, 0.0, 1.0]) is None
+    (True, False)
     """
 
     def compare(expected: Any, got: Any) -> str | None:
-        if isinstance(expected, np.ndarray):
-            if not isinstance(got, np.ndarray) or got.shape != expected.shape or not np.array_equal(got, expected):
+        if isinstance(expected, np.ndarray) or isinstance(got, np.ndarray):
+            e, g = _as_array(expected), _as_array(got)
+            if e is None or g is None or g.shape != e.shape or (e.size and g.dtype.kind != e.dtype.kind):
                 return f"expected {summarize(expected)}, got {summarize(got)}"
+            if not np.array_equal(g, e):
+                bad = np.argwhere(g != e)
+                idx = tuple(int(i) for i in bad[0])
+                return (f"{len(bad)} of {e.size} values differ; first at index {idx}: expected "
+                        f"{e[idx].item()!r}, got {g[idx].item()!r}")
             return None
         if type(expected) is not type(got) or expected != got:
             return f"expected {summarize(expected)}, got {summarize(got)}"
         return None
 
     return compare
+
+
+def _as_array(x: Any) -> np.ndarray | None:
+    """``x`` as an array if it is one or a (nested) list of numbers/booleans of one kind, else None."""
+    if isinstance(x, np.ndarray):
+        return x
+    if not isinstance(x, list):
+        return None
+    try:
+        arr = np.asarray(x)
+    except (TypeError, ValueError):
+        return None
+    return arr if arr.dtype.kind in "biuf" and arr.dtype != object else None
 
 
 def unordered_rows(rtol: float = 1e-6, atol: float = 1e-9) -> Comparison:

@@ -16,7 +16,8 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .compare import Comparison, close
-from .plain import to_plain
+from ..validation import check_int, check_text
+from .plain import summarize, to_plain
 
 __all__ = ["Case", "Exercise", "EXERCISE_ID"]
 
@@ -47,6 +48,30 @@ class Case:
     def __post_init__(self):
         object.__setattr__(self, "args", tuple(to_plain(list(self.args))))
         object.__setattr__(self, "kwargs", to_plain(dict(self.kwargs)))
+
+    def call_text(self, function: str, limit: int = 400) -> str:
+        """The call this case makes, for feedback: ``function(arg, ..., key=value)``.
+
+        Each argument is shortened by :func:`~robokit.exercises.plain.summarize` (large arrays
+        show their shape and ends) and the whole text is at most ``limit`` characters, so a failing
+        case can always show the student the inputs that broke it.
+
+        Examples
+        --------
+        >>> Case(("$GPRMC,A*00", 2), {"strict": True}).call_text("parse")
+        "parse('$GPRMC,A*00', 2, strict=True)"
+
+        Raises
+        ------
+        TypeError, ValueError
+            If ``function`` is not a non-empty string or ``limit`` is not an integer >= 16.
+        """
+        function = check_text(function, "function", empty=False)
+        limit = check_int(limit, "limit", minimum=16)
+        parts = [summarize(a, 160) for a in self.args]
+        parts += [f"{k}={summarize(v, 160)}" for k, v in self.kwargs.items()]
+        text = f"{function}({', '.join(parts)})"
+        return text if len(text) <= limit else text[: limit - 4] + "...)"
 
 
 @dataclasses.dataclass(frozen=True)

@@ -103,7 +103,8 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
             passes.append(f"  pass  {text}")
         else:
             where = f" [{result.error.line}]" if result.error and result.error.line else ""
-            failures.append(f"  FAIL  {text}: {outcome.message}{where}")
+            failures.append(f"  FAIL  {text}: {outcome.message}{where}\n"
+                            f"        input: {case.call_text(exercise.function)}")
     print(f"check {exercise.id}: {len(passes)}/{len(cases)} public cases passed "
           "(feedback only; your grade comes from hidden cases)")
     if verbose and passes:          # the failed cases are in the error's message, shown once

@@ -214,8 +214,9 @@ def _score_exercise(ex: Exercise, cases: list[Case], expected: list[Any],
             errors_passed += outcome.passed
         else:
             values_passed += outcome.passed
-        if not outcome.passed and len(messages) < 5:
+        if not outcome.passed and len(messages) < 10:     # the first five failures, each with its input
             messages.append(f"case {i}" + (f" ({case.label})" if case.label else "") + f": {outcome.message}")
+            messages.append(f"  input: {case.call_text(ex.function)}")
     passed = values_passed + errors_passed
     if errors_passed and not values_passed and any(not c.raises for c in cases):
         passed = 0
