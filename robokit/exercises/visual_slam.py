@@ -240,6 +240,17 @@ def robust_pose_problems(rng: np.random.Generator) -> list[tuple[np.ndarray, np.
     of the scene (as a wrong descriptor match does). Headings stay within +-2.5 rad so that no
     answer sits on the +-pi seam.
 
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    list of tuple
+        Four scenes, contamination 0, 0.2, 0.4 and 0.6: robot points ``(N, 3)``, world points
+        ``(N, 3)`` (both rounded to micrometres, as the cases hand them out), the true ``[p, q, theta]``
+        and the share of wrong matches.
+
     Examples
     --------
     >>> r, w, truth, eps = robust_pose_problems(np.random.default_rng(0))[2]
