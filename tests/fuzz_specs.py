@@ -721,6 +721,10 @@ SPECS: dict[str, Call] = {
         "c": Array(np.array([320.0, 100.0]), "N"), "r": Array(np.array([240.0, 50.0]), "N"),
         "d": Array(np.array([10.0, 20.0]), "N"), "focal": Real(500.0), "c0": Real(320.0), "r0": Real(240.0),
         "baseline": Real(0.12)}),
+    "robokit.exercises.visual_slam.robust_pose": Call({
+        "robot_points": Array(np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [-1.0, 0.2, 3.0]]), "N,3"),
+        "world_points": Array(np.array([[1.0, 0.0, 2.0], [2.0, 0.0, 3.0], [0.0, 0.2, 4.0]]), "N,3")}),
+    "robokit.exercises.visual_slam.robust_pose_problems": Call({"rng": Rng()}),
     "robokit.exercises.visual_slam.hough_votes": Call({
         "robot_xz": Array(np.array([[0.0, 1.0], [0.5, 2.0]]), "N,2"), "robot_cov_xz": Array(np.tile(np.eye(2) * 1e-3, (2, 1, 1)), "N,2,2"),
         "world_xz": Array(np.array([[0.2, 1.2], [0.7, 2.2]]), "N,2"), "world_cov_xz": Array(np.tile(np.eye(2) * 1e-3, (2, 1, 1)), "N,2,2"),

@@ -11,10 +11,10 @@ EXERCISES = exercises_for("01_visual_slam")
 
 def test_assignment_is_registered():
     assert visual_slam.ASSIGNMENT == "01_visual_slam"
-    assert set(visual_slam.WRITTEN) == {"01.reduced_descriptor"}
+    assert set(visual_slam.WRITTEN) == {"01.reduced_descriptor", "01.depth_uncertainty", "01.overconfident_fusion"}
     assert {e.id for e in EXERCISES} == {"01.junction_strength", "01.match_ratio", "01.triangulate_svd",
                                          "01.stereo_point", "01.ransac_sample_count", "01.pose_from_two",
-                                         "01.kalman_fuse", "01.hough_votes"}
+                                         "01.kalman_fuse", "01.hough_votes", "01.robust_pose"}
 
 
 @pytest.mark.parametrize("exercise", EXERCISES, ids=lambda e: e.id)
@@ -34,10 +34,26 @@ def _wrong(reference):
     return lambda *args, **kwargs: _shift(reference(*args, **kwargs))
 
 
+def _least_squares_pose(robot_points, world_points):
+    """The tempting shortcut for the open exercise: one least-squares fit to every match, wrong ones too."""
+    r, w = np.asarray(robot_points, float)[:, [0, 2]], np.asarray(world_points, float)[:, [0, 2]]
+    if r.shape != w.shape or len(r) < 2:
+        raise ValueError("robot_points, world_points: expected equal (N, 3) arrays with N >= 2")
+    rc, wc = r - r.mean(0), w - w.mean(0)
+    theta = np.arctan2(np.sum(rc[:, 0] * wc[:, 1] - rc[:, 1] * wc[:, 0]), np.sum(rc * wc))
+    c, s = np.cos(theta), np.sin(theta)
+    p, q = w.mean(0) - np.array([[c, -s], [s, c]]) @ r.mean(0)
+    return np.array([p, q, theta])
+
+
+#: Wrong answers that a small shift would not expose (the open exercise accepts 2 cm).
+WRONG = {"01.robust_pose": _least_squares_pose}
+
+
 @pytest.mark.parametrize("exercise", EXERCISES, ids=lambda e: e.id)
 def test_check_fails_a_wrong_implementation(exercise, capsys):
     with pytest.raises(AssertionError):
-        check(exercise.id, _wrong(exercise.reference))
+        check(exercise.id, WRONG.get(exercise.id, _wrong(exercise.reference)))
     assert_check_passes(exercise.id, exercise.reference, len(exercise.make_cases(2024)))
 
 
@@ -76,3 +92,18 @@ def test_wrappers_and_library_functions_are_disabled_while_grading():
         for dotted in names:
             module, _, attr = dotted.rpartition(".")
             assert callable(getattr(importlib.import_module(module), attr)), dotted
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_the_open_exercise_is_fair(seed):
+    """The reference lands within 1 cm and 0.1 degree of the pose that generated every scene, even
+    with 60 % wrong matches; one least-squares fit to all matches is right only without them."""
+    fooled = 0
+    for robot, world, truth, eps in visual_slam.robust_pose_problems(np.random.default_rng(seed)):
+        answer = visual_slam.robust_pose(robot, world)
+        assert np.all(np.abs(answer[:2] - truth[:2]) < 0.01) and abs(answer[2] - truth[2]) < np.deg2rad(0.1)
+        shortcut = np.abs(_least_squares_pose(robot, world) - answer)
+        fooled += bool(np.any(shortcut > 0.02))
+        if eps == 0:
+            assert np.all(shortcut < 0.02)                 # the shortcut is fine on clean matches
+    assert fooled >= 2

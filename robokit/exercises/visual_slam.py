@@ -8,18 +8,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..localization.egomotion import pose_from_two, ransac_sample_count
+from ..geometry import pqt_robot_to_world
+from ..localization.egomotion import pose_from_two, ransac_pose, ransac_sample_count
 from ..localization.hough import hough_accumulator
 from ..mapping.landmarks import kalman_fuse
 from ..vision.matching import ratio_match
 from ..vision.plot_detector import junction_strength
 from ..vision.stereo import StereoCalibration, disparity_to_point, triangulate_svd
+from ..validation import as_array
 from .compare import close, exact, unordered_rows
 from .spec import Case, Exercise
 
 ASSIGNMENT = "01_visual_slam"
 #: Written (manually graded) questions: id -> points.
-WRITTEN = {"01.reduced_descriptor": 2}
+WRITTEN = {"01.reduced_descriptor": 2, "01.depth_uncertainty": 2, "01.overconfident_fusion": 2}
 
 
 def match_ratio(query, train, ratio: float = 0.65) -> np.ndarray:
@@ -64,6 +66,45 @@ def hough_votes(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, bin_size
     """
     return hough_accumulator(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, bin_size=bin_size,
                              angle_bin=angle_bin)[0]
+
+
+def robust_pose(robot_points, world_points) -> np.ndarray:
+    """The robot pose ``[p, q, theta]`` from tentative matches of which many may be wrong (the open exercise).
+
+    The reference answer: :func:`robokit.localization.ransac_pose` (two-point hypotheses, support
+    within 10 cm, least-squares refit on the support; Lin et al. Sec. 5-6) with a fixed seed and
+    no minimum support beyond two matches.
+
+    Parameters
+    ----------
+    robot_points, world_points : array_like, shape (N, 3)
+        Feature ``k`` in the robot frame (X right, Y up, Z forward) and the landmark it was matched
+        to in the world frame; ``N >= 2``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``[p, q, theta]`` with ``(X, Z)_world = R(theta) (X', Z')_robot + (p, q)``.
+
+    Raises
+    ------
+    ValueError
+        For shapes other than two equal ``(N, 3)`` arrays, fewer than two matches or non-finite values.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> robot = rng.uniform([-2.0, -0.5, 1.0], [2.0, 0.5, 5.0], (30, 3))
+    >>> world = pqt_robot_to_world(robot, [1.0, 2.0, 0.3])
+    >>> world[:12] = rng.uniform(0.0, 8.0, (12, 3))          # 12 of the 30 matches are wrong
+    >>> print(np.round(robust_pose(robot, world), 6))
+    [1.  2.  0.3]
+    """
+    r = as_array(robot_points, "robot_points", shape=(None, 3))
+    w = as_array(world_points, "world_points", shape=(r.shape[0], 3))
+    if r.shape[0] < 2:
+        raise ValueError(f"robot_points: expected at least 2 matches, got {r.shape[0]}")
+    return ransac_pose(r, w, min_matches=2, rng=0).pqt
 
 
 def _spd(rng, n, scale):
@@ -191,6 +232,54 @@ def _hough_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
+def robust_pose_problems(rng: np.random.Generator) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, float]]:
+    """The open exercise's scenes: ``(robot_points, world_points, true_pqt, contamination)`` each.
+
+    40 to 80 features 1-6 m ahead of the robot, their landmarks placed by the true pose with 5 mm
+    noise, then a share (0 to 60 %) of the matches made wrong by pointing them at other landmarks
+    of the scene (as a wrong descriptor match does). Headings stay within +-2.5 rad so that no
+    answer sits on the +-pi seam.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    list of tuple
+        Four scenes, contamination 0, 0.2, 0.4 and 0.6: robot points ``(N, 3)``, world points
+        ``(N, 3)`` (both rounded to micrometres, as the cases hand them out), the true ``[p, q, theta]``
+        and the share of wrong matches.
+
+    Examples
+    --------
+    >>> r, w, truth, eps = robust_pose_problems(np.random.default_rng(0))[2]
+    >>> r.shape == w.shape, eps
+    (True, 0.4)
+    """
+    out = []
+    for eps in (0.0, 0.2, 0.4, 0.6):
+        n = int(rng.integers(40, 81))
+        truth = rng.uniform([0.0, 0.0, -2.5], [10.0, 10.0, 2.5])
+        robot = rng.uniform([-3.0, -1.0, 1.0], [3.0, 1.0, 6.0], (n, 3))
+        world = pqt_robot_to_world(robot, truth) + rng.normal(0.0, 0.005, (n, 3))
+        wrong = rng.choice(n, int(round(eps * n)), replace=False)
+        world[wrong] = world[np.roll(wrong, 1)] if len(wrong) > 1 else world[wrong]
+        world[wrong] += rng.normal(0.0, 0.5, (len(wrong), 3))      # another landmark, roughly
+        out.append((robot.round(6), world.round(6), truth, eps))
+    return out
+
+
+def _robust_pose_cases(rng: np.random.Generator) -> list[Case]:
+    cases = [Case((r.tolist(), w.tolist()), label=f"{len(r)} matches, {eps:.0%} of them wrong")
+             for r, w, _, eps in robust_pose_problems(rng)]
+    return cases + [
+        Case(([[0.0, 0.0, 1.0]], [[1.0, 0.0, 2.0]]), raises="ValueError", label="a single match"),
+        Case(([[0.0, 0.0, 1.0], [1.0, 0.0, 2.0]], [[1.0, 0.0, 2.0]]), raises="ValueError",
+             label="two features but one landmark"),
+    ]
+
+
 EXERCISES = [
     Exercise(
         id="01.junction_strength", function="junction_strength",
@@ -254,4 +343,12 @@ EXERCISES = [
         description="For each heading bin centre, each match votes for every (X, Z) bin within +-2.8 sigma of the "
                     "position (X, Z) - R(theta) (X', Z') (Se et al. Sec. 5); see the notebook for the bin layout; "
                     "ValueError for empty bounds."),
+    Exercise(
+        id="01.robust_pose", function="robust_pose",
+        signature="robust_pose(robot_points: (N, 3), world_points: (N, 3)) -> numpy.ndarray [p, q, theta]",
+        points=3, cases=_robust_pose_cases, reference=robust_pose, compare=close(rtol=0, atol=0.02),
+        references=("robokit.exercises.visual_slam.robust_pose", "robokit.localization.egomotion.ransac_pose",
+                    "robokit.localization.egomotion.fit_pose", "robokit.localization.egomotion.track"),
+        description="Open: any method. The pose that explains the true matches, within 2 cm and 0.02 rad, when up to "
+                    "60 % of the matches are wrong; ValueError for fewer than two matches or unequal shapes."),
 ]
