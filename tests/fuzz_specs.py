@@ -552,6 +552,7 @@ SPECS: dict[str, Call] = {
                                      "modified": Flag(False)}),
     "robokit.arm.jacobian.dh_jacobian": Call({"dh": Array(DH, "N,3"), "q": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"),
                                               "modified": Flag(False)}),
+    "robokit.arm.limits.limit_distance_gradient": Call({"chain": Obj(iiwa), "q": Array(q7, "7|N,7"), "check": Flag(True)}),
     "robokit.arm.ik_steps.null_space_step": Call({"J": Array(lambda: np.eye(6, 7) + 0.1, "6,N|N,6,N"),
                                                   "e": Array(np.full(6, 0.01), "6"), "gradient": Array(np.full(7, 0.1), "7"),
                                                   "damping": Real(0.01), "gain": Real(1.0)}),

@@ -116,7 +116,7 @@ def ik_position_posture(chain: Any, T: Any, q0: Any = None, *, tol: float = 1e-6
     for steps in range(max_iter + 1):                   # step 2: Newton on w(q1..q4) = W
         w, J, R04 = _wrist_and_jacobian(arm, q)
         e = target - w
-        if e @ e < (0.1 * tol) ** 2 or steps == max_iter:
+        if np.linalg.norm(e) < 0.1 * tol or steps == max_iter:
             break
         step = J.T @ np.linalg.solve(J @ J.T + 1e-12 * np.eye(3), e)
         if not np.all(np.isfinite(step)):             # cannot happen with eps > 0; keep the last iterate
