@@ -11,6 +11,8 @@ transforms, rotations and the pose error come from :mod:`robokit.geometry`.
 * :func:`ik_srs`, :func:`ik_srs_batch`, :func:`ik_srs_branches`, :func:`arm_angle` - the analytic
   arm-angle IK of S-R-S arms (KUKA LBR iiwa); :func:`feasible_arm_angles`, :func:`split_points` -
   Shimizu's exact feasible arm-angle intervals; :func:`ik_srs_reference` - the same search step by step.
+* :func:`ik_position_posture` - Huang & Jiang's reduction worked through: Newton iteration on joints
+  1-4 for the wrist centre, joints 5-7 in closed form.
 * :func:`ik_numeric`, :func:`ik_numeric_batch` - damped least squares with null-space gradient
   projection (Dubey) or weighted least norm (Chan), random restarts; any chain.
   :func:`ik_numeric_reference` is the same for one target as a plain loop.
@@ -24,6 +26,7 @@ from .ik_analytic import SRSArm, arm_angle, ik_srs, ik_srs_batch, ik_srs_branche
 from .ik_numeric import ik_numeric, ik_numeric_batch
 from .ik_reference import ik_numeric_reference
 from .ik_steps import METHODS, dls_step, null_space_step
+from .position_posture import ik_position_posture
 from .jacobian import dh_jacobian, geometric_jacobian, jacobian_from_frames, manipulability
 from .limits import limit_distance_gradient, wln_weights
 from .result import IKBatchResult, IKResult, verify
@@ -36,4 +39,4 @@ __all__ = ["Chain", "dh_transform", "mdh_transform", "iiwa14", "panda", "geometr
            "null_space_step", "ik_numeric", "ik_numeric_batch", "ik_numeric_reference",
            "limit_distance_gradient", "wln_weights", "chain_from_table", "dh_fk", "dh_jacobian", "elbow_angle",
            "shoulder_angles", "wrist_centre", "LIMIT_TOL", "feasible_arm_angles", "split_points",
-           "ik_srs_reference"]
+           "ik_srs_reference", "ik_position_posture"]

@@ -1,6 +1,8 @@
 """Analytic inverse kinematics of S-R-S 7-DOF arms (e.g. the KUKA LBR iiwa) with the arm angle.
 
-The method is the separation of position and posture of Huang & Jiang (2013):
+The method is Shimizu et al.'s (2008); its first steps are the separation of position and posture
+that Huang & Jiang (2013) also start from (our reading of their own route, a Newton iteration on
+joints 1-4, is :func:`robokit.arm.ik_position_posture`):
 
 1. the wrist centre ``W = p - d_wf z_7`` depends only on the target transform;
 2. joints 1-4 place the wrist centre: a position problem of a 4-DOF arm, redundant by one. The
@@ -323,8 +325,8 @@ def ik_srs(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_psi: in
 
     Notes
     -----
-    Huang & Jiang (2013) with the arm angle and the exact feasible intervals of Shimizu et al.
-    (2008), Secs. III-IV.
+    The arm angle and the exact feasible intervals of Shimizu et al. (2008), Secs. III-IV, after
+    the separation of position and posture (as in Huang & Jiang 2013).
 
     Examples
     --------

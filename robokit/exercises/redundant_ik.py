@@ -1,4 +1,5 @@
-"""Exercises of assignment 06 (redundant 7-DOF arm IK): from one DH transform to a null-space step.
+"""Exercises of assignment 06 (redundant 7-DOF arm IK): from one DH transform to a null-space step,
+and an open exercise, a whole IK solver for the iiwa by any method.
 
 Inputs are generated from the KUKA LBR iiwa 14 R820 and the Franka Panda of :mod:`robokit.arm`
 (random configurations inside the joint limits), plus small hand-checkable chains.
@@ -7,14 +8,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..arm import (dh_fk, dh_jacobian, dh_transform, elbow_angle, geometric_jacobian, iiwa14,
-                   limit_distance_gradient, null_space_step, panda, shoulder_angles, wrist_centre)
+from typing import Any
+
+from ..arm import (LIMIT_TOL, dh_fk, dh_jacobian, dh_transform, elbow_angle, feasible_arm_angles, geometric_jacobian,
+                   iiwa14, ik_srs_reference, limit_distance_gradient, null_space_step, panda, shoulder_angles,
+                   wrist_centre)
+from ..geometry import as_se3, pose_error
 from .compare import close
+from .plain import summarize
 from .spec import Case, Exercise
 
 ASSIGNMENT = "06_redundant_ik"
 #: Written (manually graded) questions: id -> points.
-WRITTEN = {"06.extra_dof": 2}
+WRITTEN = {"06.extra_dof": 2, "06.self_motion": 2, "06.your_solver": 2}
+#: Tolerance on the open exercise's answers: flange position [m] and orientation [rad].
+IK_TOL = 1e-6
 
 _IIWA = iiwa14()
 _IIWA_DH = np.stack([_IIWA.d, _IIWA.a, _IIWA.alpha], 1).tolist()
@@ -28,6 +36,68 @@ def _iiwa_q(rng: np.random.Generator, n: int) -> np.ndarray:
     # keep clear of the shoulder/wrist singularities (sin q2 = 0), where q1 and q3 are not unique
     q[:, 1] = np.sign(q[:, 1]) * np.clip(np.abs(q[:, 1]), 0.2, None)
     return q
+
+
+def solve_ik(T: Any, q_start: Any) -> np.ndarray:
+    """Joints of the KUKA LBR iiwa 14 that reach ``T`` inside the joint limits (the open exercise's reference).
+
+    The arm-angle search of :func:`robokit.arm.ik_srs_reference` (Shimizu et al. 2008): over the
+    eight branches and their exact feasible arm angles, the posture nearest ``q_start``. Any
+    posture that reaches the target inside the limits is a right answer; the compare checks that,
+    not the posture.
+
+    Parameters
+    ----------
+    T : array_like, shape (4, 4)
+        Target flange transform in the iiwa's base frame (metres).
+    q_start : array_like, shape (7,)
+        The arm's current joints [rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (7,)
+
+    Raises
+    ------
+    ValueError
+        If ``T`` is not a rigid transform, ``q_start`` is not 7 finite angles, or no posture inside
+        the limits reaches ``T`` (out of reach, or no feasible arm angle).
+
+    Examples
+    --------
+    >>> q = np.radians([35, 50, -40, -75, 60, 45, 20])
+    >>> bool(np.abs(solve_ik(_IIWA.fk(q), q) - q).max() < 1e-6)
+    True
+    """
+    T = as_se3(T, "T")
+    q0 = _IIWA.check_q(q_start, "q_start")
+    q, _, cost = ik_srs_reference(_IIWA, T, q0)
+    if not np.isfinite(cost):
+        raise ValueError("T: no posture of the iiwa reaches this target inside its joint limits "
+                         "(the wrist centre is out of reach, or no arm angle keeps every joint inside)")
+    return q
+
+
+def _reaches_target(expected: Any, got: Any) -> str | None:
+    """Accept any 7 joint angles inside the iiwa's limits whose flange pose is the reference's (the target)."""
+    try:
+        q = np.array(got, dtype=float)
+    except (TypeError, ValueError):
+        return f"expected 7 joint angles, got {summarize(got)}"
+    if q.shape != (7,) or not np.all(np.isfinite(q)):
+        return f"expected 7 finite joint angles (shape (7,)), got {summarize(got)}"
+    err = pose_error(_IIWA.fk(np.asarray(expected, dtype=float)), _IIWA.fk(q))
+    pos, rot = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
+    outside = np.flatnonzero((q < _IIWA.qmin - LIMIT_TOL) | (q > _IIWA.qmax + LIMIT_TOL))
+    if outside.size:
+        j = int(outside[0])
+        return (f"joint {j + 1} is at {np.degrees(q[j]):.2f} deg, outside its limits [{np.degrees(_IIWA.qmin[j]):.0f}, "
+                f"{np.degrees(_IIWA.qmax[j]):.0f}] deg ({outside.size} joint(s) outside; the flange is "
+                f"{pos * 1e3:.3g} mm and {rot:.3g} rad from the target)")
+    if pos > IK_TOL or rot > IK_TOL:
+        return (f"your joints put the flange {pos * 1e3:.3g} mm and {rot:.3g} rad from the target "
+                f"(tolerance {IK_TOL:g} m and {IK_TOL:g} rad)")
+    return None
 
 
 def _dh_cases(rng: np.random.Generator) -> list[Case]:
@@ -105,6 +175,33 @@ def _null_space_cases(rng: np.random.Generator) -> list[Case]:
         Case((J[2], e[2].tolist(), g[2].tolist(), 0.01, 0.5), label="both terms"),
         Case((J[0][:5], e[0].tolist(), g[0].tolist(), 0.01, 0.5), raises="ValueError",
              label="Jacobian with 5 rows"),
+    ]
+
+
+def _psi_zero_infeasible(rng: np.random.Generator) -> np.ndarray:
+    """A configuration whose pose no branch reaches inside the limits at arm angle 0 (drawn until found)."""
+    for _ in range(1000):
+        q = _IIWA.random_q(rng=rng)
+        if not any(((iv[:, 0] <= 0.0) & (iv[:, 1] >= 0.0)).any() for iv in feasible_arm_angles(_IIWA, _IIWA.fk(q))):
+            return q
+    raise RuntimeError("no configuration with an infeasible arm angle 0 in 1000 draws")  # pragma: no cover
+
+
+def _solve_ik_cases(rng: np.random.Generator) -> list[Case]:
+    q = _IIWA.random_q(3, rng)
+    starts = _IIWA.random_q(3, rng)
+    hard = _psi_zero_infeasible(rng)
+    near = np.clip(hard + rng.normal(0.0, 0.05, 7), _IIWA.qmin, _IIWA.qmax)
+    hard2 = _psi_zero_infeasible(rng)
+    far = np.eye(4)
+    far[:3, 3] = [1.2, 0.3, 0.5]
+    return [
+        *[Case((_IIWA.fk(qi).tolist(), si.tolist()), label="a random reachable target, random start")
+          for qi, si in zip(q, starts)],
+        Case((_IIWA.fk(hard).tolist(), near.tolist()), label="arm angle 0 breaks a limit on every branch; start nearby"),
+        Case((_IIWA.fk(hard2).tolist(), _IIWA.random_q(rng=rng).tolist()),
+             label="arm angle 0 breaks a limit on every branch; random start"),
+        Case((far.tolist(), [0.0] * 7), raises="ValueError", label="target 1.3 m away: out of reach"),
     ]
 
 
@@ -192,5 +289,21 @@ EXERCISES = [
                     "robokit.arm.ik_steps._jacobian_and_error", "robokit.arm.ik_steps.GradientProjection"),
         compare=close(rtol=1e-6, atol=1e-9),
         description="DLS step plus the gradient projected into the null space; ValueError on a bad Jacobian shape.",
+    ),
+    Exercise(
+        id="06.solve_ik",
+        function="solve_ik",
+        signature="solve_ik(T: list[list[float]], q_start: list[float]) -> numpy.ndarray",
+        points=3,
+        cases=_solve_ik_cases,
+        reference=solve_ik,
+        references=("robokit.exercises.redundant_ik.solve_ik", "robokit.arm.arm_angle_intervals.ik_srs_reference",
+                    "robokit.arm.arm_angle_intervals.feasible_arm_angles", "robokit.arm.ik_analytic.ik_srs",
+                    "robokit.arm.ik_analytic.ik_srs_batch", "robokit.arm.ik_analytic.ik_srs_branches",
+                    "robokit.arm.ik_numeric.ik_numeric", "robokit.arm.ik_numeric.ik_numeric_batch",
+                    "robokit.arm.ik_reference.ik_numeric_reference", "robokit.arm.position_posture.ik_position_posture"),
+        compare=_reaches_target,
+        description=("Open: iiwa joints inside the limits reaching T to 1e-6 m and rad, any method; "
+                     "ValueError when no posture reaches it."),
     ),
 ]

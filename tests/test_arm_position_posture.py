@@ -1,0 +1,64 @@
+"""Huang & Jiang's reduction (robokit.arm.position_posture): Newton on joints 1-4 for the wrist centre,
+closed-form joints 5-7; FK-verified answers, honest failures, validated inputs."""
+import numpy as np
+import pytest
+
+from robokit.arm import iiwa14, ik_position_posture, panda, wrist_centre
+
+IIWA = iiwa14()
+
+
+def _targets(n, seed, spread=0.1):
+    rng = np.random.default_rng(seed)
+    q = IIWA.random_q(n, rng)
+    start = np.clip(q + rng.normal(0, spread, q.shape), IIWA.qmin, IIWA.qmax)
+    return q, IIWA.fk(q), start
+
+
+def test_reaches_targets_from_nearby_starts_and_places_the_wrist_centre():
+    q, T, start = _targets(30, 0)
+    results = [ik_position_posture(IIWA, Ti, s) for Ti, s in zip(T, start)]
+    assert np.mean([r.success for r in results]) >= 0.9
+    for r, Ti in zip(results, T):
+        if r.success:
+            W = IIWA.link_frames(r.q)[5, :3, 3]                  # frame 5's origin is the wrist centre
+            assert np.abs(W - wrist_centre(Ti, 0.126)).max() < 1e-6
+            assert r.position_error < 1e-6 and r.orientation_error < 1e-6
+
+
+def test_a_start_on_the_answer_takes_no_step_and_returns_it():
+    q, T, _ = _targets(3, 1)
+    for qi, Ti in zip(q, T):
+        r = ik_position_posture(IIWA, Ti, qi)
+        assert r.iterations == 0
+        assert np.abs(r.q - qi).max() < 1e-9
+
+
+def test_failures_are_reported_not_hidden():
+    far = np.eye(4)
+    far[:3, 3] = [1.4, 0.0, 0.4]                                  # the wrist centre out of reach
+    r = ik_position_posture(IIWA, far)
+    assert not r.success and "pose error" in r.reason
+    q, T, start = _targets(60, 3, spread=2.0)                      # far starts: some land outside the limits
+    reasons = [ik_position_posture(IIWA, Ti, s).reason for Ti, s in zip(T, start)]
+    assert any("outside its limits" in x for x in reasons)
+
+
+@pytest.mark.parametrize("kwargs, word", [
+    (dict(T=np.eye(3)), "T"),
+    (dict(q0=np.zeros(6)), "q0"),
+    (dict(tol=0.0), "tol"),
+    (dict(max_iter=0), "max_iter"),
+])
+def test_bad_input_names_the_argument(kwargs, word):
+    args = dict(chain=IIWA, T=IIWA.fk(np.zeros(7)))
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=word):
+        ik_position_posture(**args)
+
+
+def test_only_s_r_s_arms():
+    with pytest.raises(ValueError, match="S-R-S"):
+        ik_position_posture(panda(), panda().fk(np.zeros(7)))
+    with pytest.raises(TypeError, match="chain"):
+        ik_position_posture("iiwa", np.eye(4))
