@@ -600,6 +600,8 @@ SPECS: dict[str, Call] = {
         "lat1": Array(np.array([LAT, 0.2]), "*"), "lon1": Array(np.array([LON, 0.3]), "*"),
         "lat2": Array(np.array([LAT + 1e-4, 0.25]), "*"), "lon2": Array(np.array([LON, 0.2]), "*"),
         "tol": Real(1e-12), "max_iter": Int(200)}),
+    "robokit.outdoor.gps.Compass": Call({"noise": Real(0.01), "accuracy": Real(0.035), "resolution": Real(0.017),
+                                         "variation": Real(-0.005), "rng": Rng(1)}),
     "robokit.outdoor.gps.GPSReceiver": Call({"plane": Obj(plane), "noise": Real(2.5), "tau": Real(60.0),
                                              "white_noise": Real(0.3), "period": Real(1.0), "rng": Rng(2)}),
     "robokit.outdoor.mission.run_courses": Call({"seeds": Array(np.array([0]), "N"), "firing": Choice("chained"),
@@ -609,7 +611,7 @@ SPECS: dict[str, Call] = {
     "robokit.outdoor.mission.simulate": Call({
         "course": Obj(course), "seed": Int(0), "firing": Choice("chained"), "truck": Obj(_truck, optional=True),
         "max_time": Real(2.0, optional=True), "dt": Real(0.049), "keep_nmea": Int(20), "gps_noise": Real(2.5),
-        "navigator_options": Mapping(None, optional=True)}, cheap=False),
+        "compass_accuracy": Real(0.035), "navigator_options": Mapping(None, optional=True)}, cheap=False),
     "robokit.outdoor.mission.summarize_runs": Call({"results": Obj(run_results)}),
     "robokit.outdoor.navigator.avoidance_decision": Call({
         "ranges": Array(np.array([6.45, 0.5, 0.6, 6.45]), "4", inf_ok=True), "front": Real(1.2), "side": Real(0.8),
