@@ -600,6 +600,7 @@ SPECS: dict[str, Call] = {
         "lat1": Array(np.array([LAT, 0.2]), "*"), "lon1": Array(np.array([LON, 0.3]), "*"),
         "lat2": Array(np.array([LAT + 1e-4, 0.25]), "*"), "lon2": Array(np.array([LON, 0.2]), "*"),
         "tol": Real(1e-12), "max_iter": Int(200)}),
+    "robokit.outdoor.gps.compass_to_heading": Call({"psi_deg": Real(90.0)}),
     "robokit.outdoor.gps.Compass": Call({"noise": Real(0.01), "accuracy": Real(0.035), "resolution": Real(0.017),
                                          "variation": Real(-0.005), "rng": Rng(1)}),
     "robokit.outdoor.gps.GPSReceiver": Call({"plane": Obj(plane), "noise": Real(2.5), "tau": Real(60.0),
@@ -1177,6 +1178,10 @@ SPECS: dict[str, Call] = {
     "robokit.exercises.corridor_localization.recognise_keyframe": Call({
         "query": Array(lambda: orb_descriptors(40, 2)[:10], "N,32"),
         "keyframes": Obj(lambda: [orb_descriptors(40, 1), orb_descriptors(40, 2)])}),
+    # --- lesson 05: the open exercise's reference ---
+    "robokit.exercises.gps_sonar_truck.compass_bias": Call({
+        "fixes": Array(np.array([[0.0, 0.0], [0.7, 0.1], [1.4, 0.0]]), "N,2"),
+        "compass_deg": Array(np.array([91.0, 92.0, 91.0]), "N")}),
     "robokit.localization.particle_clusters.pose_clusters": Call({
         "particles": Array(np.array([[0.1, 0.1, 0.0], [0.6, 0.1, 0.0], [5.0, 0.0, 0.0]]), "N,3"),
         "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3")}),

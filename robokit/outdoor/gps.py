@@ -54,6 +54,11 @@ def compass_to_heading(psi_deg: float) -> float:
     Notes
     -----
     Inverse of :func:`heading_to_compass` (NMEA 0183 Sec. 6.3 heading convention).
+
+    Examples
+    --------
+    >>> round(compass_to_heading(90.0), 6), round(compass_to_heading(0.0), 6)     # east, north
+    (0.0, 1.570796)
     """
     return wrap_angle(math.radians(90.0 - check_finite_scalar(psi_deg, "psi_deg")))
 
