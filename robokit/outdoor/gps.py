@@ -1,6 +1,6 @@
 """A 1 Hz GPS receiver and a magnetic compass that speak NMEA 0183, as on the paper's truck.
 
-Hamid et al. (2009, Sec. 3) read position from a Garmin eTrex Vista ($GPRMC, $GPGGA) and
+Hamid et al. (2009) read position from a Garmin eTrex Vista ($GPRMC, $GPGGA) and
 heading from its compass ($HCHDG), and note that the position may be wrong by up to about 9 m.
 Consumer GPS errors are not independent from second to second: they wander slowly (satellite
 geometry, atmosphere, multipath). We model each horizontal axis as a first-order Gauss-Markov
@@ -203,9 +203,9 @@ class Compass:
 
     Notes
     -----
-    The paper's $HCHDG and its stated compass accuracy and resolution (Hamid et al. 2009, in the
-    description of the GPS module; no section number in the text we follow). The sentence writes
-    0.1 degree; the value in it is a whole number of ``resolution`` steps.
+    The paper's $HCHDG and its stated compass accuracy and resolution (Hamid et al. 2009, in their
+    description of the GPS module). The sentence writes 0.1 degree; the value in it is a whole
+    number of ``resolution`` steps.
 
     Examples
     --------

@@ -5,7 +5,7 @@ Every control step (one sonar slot, 49 ms) the true truck moves, one sonar of th
 ``$GPRMC``, ``$GPGGA`` and ``$GPRMB`` (its own range and bearing to the active waypoint) once a
 second, and the :class:`~robokit.outdoor.navigator.Navigator` -
 which sees only that text and the sonar ranges - answers with a speed and yaw rate. Results follow
-the experiment of Hamid et al. (2009, Sec. 4): waypoints reached, collisions, path length
+the experiment of Hamid et al. (2009): waypoints reached, collisions, path length
 relative to the straight legs, and time. A collision ends the run, as it would end a real trial:
 a truck that touched an obstacle does not go on to "reach" the later waypoints.
 
@@ -263,7 +263,7 @@ class _Mission:
         self.range_log.append(self.ranges.copy())
 
     def result(self) -> RunResult:
-        """The figures of Hamid et al.'s experiment (Sec. 4), path ratio over the legs actually driven."""
+        """The figures of Hamid et al.'s experiment, path ratio over the legs actually driven."""
         legs = np.vstack(self.arrival_points + ([self.state.pose[:2]] if not self.nav.done else []))
         direct = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
         return RunResult(reached=len(self.nav.arrivals), n_waypoints=len(self.course.waypoints),
@@ -305,7 +305,7 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
 
     Notes
     -----
-    The seeded repetition of Hamid et al.'s experiment (2009, Sec. 4) used by the lesson; course
+    The seeded repetition of Hamid et al.'s experiment (2009) used by the lesson; course
     ``s`` is driven with ``simulate(..., seed=10_000 + s)``; deterministic, hence cacheable
     (DESIGN.md, "Caching").
 
@@ -363,7 +363,7 @@ def summarize_runs(results: list[RunResult]) -> dict:
 
     Notes
     -----
-    The figures of the paper's experiment (Hamid et al. 2009, Sec. 4) plus the GPS error.
+    The figures of the paper's experiment (Hamid et al. 2009) plus the GPS error.
 
     Examples
     --------

@@ -1,6 +1,6 @@
 """Waypoint navigation from NMEA text, with the four-sonar obstacle-avoidance state machine.
 
-Hamid et al. (2009, Sec. 4): the truck follows GPS waypoints; when a sonar sees an obstacle
+Hamid et al. (2009): the truck follows GPS waypoints; when a sonar sees an obstacle
 it turns left or right (it has no rear sensor, so it never backs up), and once past the obstacle it
 re-computes the bearing to the waypoint from its current position. :class:`Navigator` does exactly
 that, reading only what the real truck reads - NMEA sentences from the GPS and compass (parsed with
@@ -69,7 +69,7 @@ def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefe
 
     Notes
     -----
-    Hamid et al. (2009, Sec. 4): the outer sensors watch the sides, the middle pair the
+    Hamid et al. (2009): the outer sensors watch the sides, the middle pair the
     front; the robot avoids by moving left or right only.
     """
     r = as_array(ranges, "ranges", shape=(4,), finite=False)
@@ -210,7 +210,7 @@ class Navigator:
 
         Notes
         -----
-        GOTO / AVOID / BYPASS behaviour of Hamid et al. (2009, Sec. 4); see the module docstring.
+        GOTO / AVOID / BYPASS behaviour of Hamid et al. (2009); see the module docstring.
         """
         r = as_array(ranges, "ranges", shape=(4,), finite=False)
         h = check_positive(dt, "dt")
