@@ -605,6 +605,9 @@ SPECS: dict[str, Call] = {
         "lat1": Array(np.array([LAT, 0.2]), "*"), "lon1": Array(np.array([LON, 0.3]), "*"),
         "lat2": Array(np.array([LAT + 1e-4, 0.25]), "*"), "lon2": Array(np.array([LON, 0.2]), "*"),
         "tol": Real(1e-12), "max_iter": Int(200)}),
+    "robokit.outdoor.gps.compass_to_heading": Call({"psi_deg": Real(90.0)}),
+    "robokit.outdoor.gps.Compass": Call({"noise": Real(0.01), "accuracy": Real(0.035), "resolution": Real(0.017),
+                                         "variation": Real(-0.005), "rng": Rng(1)}),
     "robokit.outdoor.gps.GPSReceiver": Call({"plane": Obj(plane), "noise": Real(2.5), "tau": Real(60.0),
                                              "white_noise": Real(0.3), "period": Real(1.0), "rng": Rng(2)}),
     "robokit.outdoor.mission.run_courses": Call({"seeds": Array(np.array([0]), "N"), "firing": Choice("chained"),
@@ -614,7 +617,7 @@ SPECS: dict[str, Call] = {
     "robokit.outdoor.mission.simulate": Call({
         "course": Obj(course), "seed": Int(0), "firing": Choice("chained"), "truck": Obj(_truck, optional=True),
         "max_time": Real(2.0, optional=True), "dt": Real(0.049), "keep_nmea": Int(20), "gps_noise": Real(2.5),
-        "navigator_options": Mapping(None, optional=True)}, cheap=False),
+        "compass_accuracy": Real(0.035), "navigator_options": Mapping(None, optional=True)}, cheap=False),
     "robokit.outdoor.mission.summarize_runs": Call({"results": Obj(run_results)}),
     "robokit.outdoor.navigator.avoidance_decision": Call({
         "ranges": Array(np.array([6.45, 0.5, 0.6, 6.45]), "4", inf_ok=True), "front": Real(1.2), "side": Real(0.8),
@@ -1184,6 +1187,10 @@ SPECS: dict[str, Call] = {
     "robokit.exercises.corridor_localization.recognise_keyframe": Call({
         "query": Array(lambda: orb_descriptors(40, 2)[:10], "N,32"),
         "keyframes": Obj(lambda: [orb_descriptors(40, 1), orb_descriptors(40, 2)])}),
+    # --- lesson 05: the open exercise's reference ---
+    "robokit.exercises.gps_sonar_truck.compass_bias": Call({
+        "fixes": Array(np.array([[0.0, 0.0], [0.7, 0.1], [1.4, 0.0]]), "N,2"),
+        "compass_deg": Array(np.array([91.0, 92.0, 91.0]), "N")}),
     "robokit.localization.particle_clusters.pose_clusters": Call({
         "particles": Array(np.array([[0.1, 0.1, 0.0], [0.6, 0.1, 0.0], [5.0, 0.0, 0.0]]), "N,3"),
         "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3")}),

@@ -8,7 +8,10 @@ from robokit.outdoor.field import UNIMAP_ORIGIN, Course, Field, random_course
 from robokit.outdoor.geodesy import LocalTangentPlane
 from robokit.outdoor.gps import Compass, GPSReceiver
 from robokit.outdoor.mission import run_courses, simulate, summarize_runs
+from robokit.outdoor.geodesy import haversine_distance_bearing
+from robokit.outdoor.gps import heading_to_compass
 from robokit.outdoor.navigator import Navigator, avoidance_decision
+from robokit.outdoor.nmea import fix_position, parse_sentence
 from robokit.outdoor.truck import PAPER_TRUCK
 
 FAR = 6.45
@@ -49,7 +52,7 @@ def test_navigator_needs_nmea_before_moving_and_rejects_bad_text():
     assert len(nav.parse_errors) == 2 and nav.heading is None
     for line in GPSReceiver(plane, noise=0.0, white_noise=0.0).fix(0.0, [0.0, 10.0], 0.0, 0.0):
         nav.feed(line)
-    nav.feed(Compass(noise=0.0).reading(0.0))
+    nav.feed(Compass(noise=0.0, accuracy=0.0).reading(0.0))
     v, omega = nav.update([FAR] * 4, 0.05)
     assert v > 0 and abs(omega) < 0.05      # facing the waypoint (to the 0.2 m resolution of the fix)
     v, _ = nav.update([FAR, 0.5, 0.5, FAR], 0.05)
@@ -74,6 +77,78 @@ def test_obstacle_dead_ahead_is_avoided():
     assert run.reached == 1 and run.collisions == 0 and run.avoidances >= 1
     blind = simulate(course, seed=2, gps_noise=0.5, firing="off")
     assert blind.collisions == 1
+
+
+def test_a_collision_ends_the_run():
+    """The blind truck stops at the obstacle: it does not drive through it and 'reach' the waypoint."""
+    field = Field(circles=[[15.0, 10.0, 0.8]])
+    course = Course(field, np.array([[30.0, 10.0], [40.0, 10.0]]), np.array([2.0, 10.0, 0.0]))
+    blind = simulate(course, seed=2, gps_noise=0.5, firing="off")
+    assert blind.collisions == 1 and blind.reached == 0 and not blind.success
+    assert field.collides(blind.truth[-1], PAPER_TRUCK.length, PAPER_TRUCK.width)       # ended at the contact
+    assert not any(field.collides(p, PAPER_TRUCK.length, PAPER_TRUCK.width) for p in blind.truth[:-1])
+    assert blind.truth[-1][0] < 15.0
+    summary = summarize_runs([blind, simulate(course, seed=2, gps_noise=0.5)])
+    assert summary["waypoints_reached"] == "2/4" and summary["collisions_per_run"] == [1, 0]
+
+
+def test_compass_accuracy_bias_and_resolution():
+    headings = np.linspace(-np.pi, np.pi, 73)
+    biases = []
+    for seed in range(20):
+        c = Compass(noise=0.0, rng=seed)
+        assert abs(c.bias) <= np.radians(2.0)
+        biases.append(c.bias)
+        for h in headings:
+            rec = parse_sentence(c.reading(h))
+            assert rec.heading_deg == round(rec.heading_deg)                         # 1 degree resolution
+            err = (rec.true_heading_deg - heading_to_compass(h) + 180) % 360 - 180
+            assert abs(err - np.degrees(c.bias)) <= 0.5 + 1e-9                       # bias + rounding only
+    assert np.ptp(biases) > np.radians(2.0)                                          # each compass its own bias
+    wide = [Compass(noise=0.0, accuracy=np.radians(5.0), rng=s).bias for s in range(20)]
+    assert max(map(abs, wide)) > np.radians(2.0) and max(map(abs, wide)) <= np.radians(5.0)
+    assert Compass(noise=0.0, accuracy=0.0).bias == 0.0
+    with pytest.raises(ValueError, match="resolution"):
+        Compass(resolution=0.0)
+    with pytest.raises(ValueError, match="accuracy"):
+        Compass(accuracy=-1.0)
+
+
+def test_rmb_is_the_receivers_own_range_and_bearing_from_its_fix():
+    plane = LocalTangentPlane(*UNIMAP_ORIGIN)
+    gps = GPSReceiver(plane, rng=3)
+    wp = np.column_stack(plane.to_geodetic([[70.0, 45.0]]))[0]
+    for k in range(30):
+        rmc, _, rmb = gps.fix(float(k), [10.0 + k, 20.0], 0.7, 0.0, destination=wp, destination_id="004")
+        lat, lon = np.radians(fix_position(rmc))
+        ours = haversine_distance_bearing(lat, lon, wp[0], wp[1])
+        rec = parse_sentence(rmb)
+        assert rec.destination_id == "004"
+        # RMB is written to 0.001 nmi and 0.1 deg; RMC's position to 0.0001 minute (0.2 m)
+        assert abs(rec.range_m - ours[0]) <= 0.5 * 1.852 + 0.3
+        assert abs((rec.bearing_deg - np.degrees(ours[1]) + 180) % 360 - 180) <= 0.05 + 0.5
+    assert len(gps.fix(31.0, [0.0, 0.0], 0.0, 0.0)) == 2                              # no destination, no RMB
+
+
+def test_navigator_steers_by_rmb_when_asked_and_ignores_other_waypoints():
+    plane = LocalTangentPlane(*UNIMAP_ORIGIN)
+    wps = np.column_stack(plane.to_geodetic([[20.0, 10.0], [20.0, 30.0]]))
+    nav = Navigator(wps, PAPER_TRUCK, guidance="rmb")
+    gps = GPSReceiver(plane, noise=0.0, white_noise=0.0)
+    for line in gps.fix(0.0, [0.0, 10.0], 0.0, 0.0, destination=wps[1], destination_id="002"):
+        nav.feed(line)                                   # about the second waypoint: not the active one
+    nav.feed(Compass(noise=0.0, accuracy=0.0).reading(0.0))
+    assert nav.rmb is None and nav.update([FAR] * 4, 0.05) == (0.0, 0.0)            # waits for its RMB
+    for line in gps.fix(1.0, [0.0, 10.0], 0.0, 0.0, destination=wps[0], destination_id="001"):
+        nav.feed(line)
+    assert nav.rmb[0] == pytest.approx(20.0, abs=1.0) and nav.rmb[1] == pytest.approx(0.0, abs=0.01)
+    v, omega = nav.update([FAR] * 4, 0.05)
+    assert v > 0 and abs(omega) < 0.05
+    with pytest.raises(ValueError, match="guidance"):
+        Navigator(wps, PAPER_TRUCK, guidance="radio")
+    course = Course(Field(circles=[[7.0, 10.0, 0.4]]), np.array([[14.0, 10.0]]), np.array([2.0, 10.0, 0.0]))
+    run = simulate(course, seed=2, gps_noise=0.5, navigator_options={"guidance": "rmb"})
+    assert run.reached == 1 and run.collisions == 0
 
 
 @pytest.mark.slow

@@ -114,16 +114,17 @@ def test_compass_convention():
     assert compass_to_heading(270.0) == pytest.approx(-np.pi) or compass_to_heading(270.0) == pytest.approx(np.pi)
     for th in np.linspace(-3, 3, 7):
         assert compass_to_heading(heading_to_compass(th)) == pytest.approx(th)
-    rec = parse_sentence(Compass(noise=0.0, rng=1).reading(0.3))
+    rec = parse_sentence(Compass(noise=0.0, accuracy=0.0, resolution=math.radians(0.1), rng=1).reading(0.3))
     assert isinstance(rec, HDG) and rec.talker == "HC"
     assert compass_to_heading(rec.true_heading_deg) == pytest.approx(0.3, abs=np.radians(0.1))
 
 
 def test_compass_takes_radians_and_writes_degrees():
-    rec = parse_sentence(Compass(noise=0.0, variation=math.radians(2.5)).reading(0.3))
+    fine = {"accuracy": 0.0, "resolution": math.radians(0.1)}       # no bias, NMEA's 0.1 degree steps
+    rec = parse_sentence(Compass(noise=0.0, variation=math.radians(2.5), **fine).reading(0.3))
     assert rec.variation_deg == pytest.approx(2.5)                  # NMEA keeps degrees
     assert compass_to_heading(rec.true_heading_deg) == pytest.approx(0.3, abs=np.radians(0.1))
-    compass = Compass(noise=math.radians(2.0), rng=5)
+    compass = Compass(noise=math.radians(2.0), rng=5, **fine)
     err = [compass_to_heading(parse_sentence(compass.reading(0.3)).true_heading_deg) - 0.3 for _ in range(2000)]
     assert np.std(err) == pytest.approx(math.radians(2.0), rel=0.1)   # a standard deviation in radians
     with pytest.raises(ValueError, match="noise: expected a non-negative number"):

@@ -11,14 +11,89 @@ from ..outdoor.navigator import avoidance_decision
 from ..outdoor.nmea import fix_position, nmea_checksum
 from ..outdoor.nmea_write import format_sentence, gga_sentence, hdg_sentence, random_sentences, rmc_sentence
 from ..outdoor.sonar import pulse_width_to_cm_inches
+from ..validation import as_array, as_points
 from .compare import close, exact
 from .spec import Case, Exercise
 
 ASSIGNMENT = "05_gps_sonar_truck"
 #: Written (manually graded) questions: id -> points.
-WRITTEN = {"05.gps_accuracy": 2}
+WRITTEN = {"05.calibration_drive": 2, "05.bearing_near_waypoint": 2, "05.gps_accuracy": 2}
 #: What the notebook imports from robokit besides check(): the grading worker provides only these.
 HELPERS = ("robokit.outdoor.loop_metrics",)
+
+
+def compass_bias(fixes, compass_deg) -> float:
+    """The compass's constant error (degrees, reported minus true) from a straight drive (the open exercise's reference).
+
+    Parameters
+    ----------
+    fixes : array_like, shape (N, 2)
+        GPS positions (east, north metres) along a straight drive at constant heading.
+    compass_deg : array_like, shape (N,)
+        Compass headings (degrees clockwise from north) read at the same times.
+
+    Returns
+    -------
+    float
+        Bias in degrees in (-180, 180].
+
+    Raises
+    ------
+    ValueError
+        Fewer than two fixes, or not one compass reading per fix.
+
+    Notes
+    -----
+    The direction of travel is the principal axis of the fixes (a total-least-squares line, robust
+    to the GPS's sideways scatter), oriented from the first to the last fix; the bias is the circular
+    mean of the readings minus that course. One way among several: the cases accept any estimate
+    within a degree.
+
+    Examples
+    --------
+    >>> t = np.arange(100.0)
+    >>> fixes = np.column_stack([0.7 * t, np.zeros_like(t)])        # due east: course 90 degrees
+    >>> round(compass_bias(fixes, np.full(100, 93.0)), 6)
+    3.0
+    """
+    p = as_points(fixes, "fixes", 2, min_count=2)
+    c = as_array(compass_deg, "compass_deg", shape=(len(p),))
+    centred = p - p.mean(axis=0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+    if np.dot(axis, p[-1] - p[0]) < 0:
+        axis = -axis
+    course = np.arctan2(axis[0], axis[1])                       # clockwise from north
+    diff = np.radians(c) - course
+    bias = np.degrees(np.arctan2(np.sin(diff).mean(), np.cos(diff).mean()))
+    return float(bias if bias > -180.0 else 180.0)
+
+
+def _calibration_drive(rng: np.random.Generator, length: float = 120.0, *, heading: float | None = None,
+                      bias: float | None = None, gps_sigma: float = 0.8, poor_start: float = 0.0):
+    """A straight drive at 0.7 m/s with 1 Hz fixes and whole-degree compass readings: (fixes, compass, true bias)."""
+    n = max(2, int(round(length / 0.7)))
+    psi = float(rng.uniform(0, 360)) if heading is None else heading
+    b = float(rng.uniform(-5, 5)) if bias is None else bias
+    t = np.arange(n) * 0.7
+    start = rng.uniform(10, 40, 2)
+    truth = start + np.column_stack([t * np.sin(np.radians(psi)), t * np.cos(np.radians(psi))])
+    fixes = truth + rng.normal(0, gps_sigma, (n, 2))
+    side = np.array([np.cos(np.radians(psi)), -np.sin(np.radians(psi))])
+    fixes[:3] += poor_start * side                               # first fixes after power-up
+    compass = np.round(psi + b + rng.normal(0, 0.5, n)) % 360.0
+    return np.round(fixes, 2), compass, b
+
+
+def _bias_cases(rng: np.random.Generator) -> list[Case]:
+    drives = [_calibration_drive(rng) for _ in range(3)]
+    drives.append(_calibration_drive(rng, heading=359.6, bias=0.8))
+    drives.append(_calibration_drive(rng, poor_start=4.0))
+    labels = ["straight drive"] * 3 + ["heading close to north: readings either side of 0/360",
+                                       "poor first fixes after power-up"]
+    cases = [Case((f.tolist(), c.tolist()), label=lab) for (f, c, _), lab in zip(drives, labels)]
+    f, c, _ = drives[0]
+    return cases + [Case(([f[0].tolist()], [c[0]]), raises="ValueError", label="a single fix"),
+                    Case((f.tolist(), c[:-1].tolist()), raises="ValueError", label="one reading missing")]
 
 
 def _checksum_cases(rng: np.random.Generator) -> list[Case]:
@@ -176,5 +251,16 @@ EXERCISES = [
         references=("robokit.controllers.heading.design_heading_gains",),
         compare=close(rtol=1e-6, atol=1e-9),
         description="Rate-feedback gains that place the closed-loop poles for an overshoot/settling spec.",
+    ),
+    Exercise(
+        id="05.compass_bias",
+        function="compass_bias",
+        signature="compass_bias(fixes: (N, 2), compass_deg: (N,)) -> float  # degrees, in (-180, 180]",
+        points=3,
+        cases=_bias_cases,
+        reference=compass_bias,
+        references=("robokit.exercises.gps_sonar_truck.compass_bias",),
+        compare=close(rtol=0, atol=1.0),
+        description="Open: a compass's constant error from a straight GPS drive, by any method, within 1 degree.",
     ),
 ]

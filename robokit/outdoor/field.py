@@ -1,6 +1,6 @@
 """Lesson 05's field: an obstacle layout with a size and a place on the Earth, and seeded courses.
 
-Hamid et al. (2009, Sec. 1) test their truck on a football field with obstacles placed between GPS
+Hamid et al. (2009) test their truck on a football field with obstacles placed between GPS
 waypoints. A :class:`Field` is a :class:`robokit.sim.Layout` of circles (poles, bins, people) and
 rotated boxes (crates, benches), so the sonars cast their rays and the truck checks collisions
 with the course's one ray caster and collision test; it adds the field's size and the geodetic
@@ -60,7 +60,7 @@ class Field(Layout):
 
     Notes
     -----
-    The test ground of Hamid et al. (2009, Sec. 1: "semi-rugged terrain such as a football
+    The test ground of Hamid et al. (2009: "semi-rugged terrain such as a football
     field").
 
     Examples
@@ -104,7 +104,7 @@ class Field(Layout):
 
         Notes
         -----
-        :func:`robokit.sim.field_world`; Hamid et al. (2009, Sec. 1) test on a football field.
+        :func:`robokit.sim.field_world`; Hamid et al. (2009) test on a football field.
 
         Examples
         --------
@@ -154,7 +154,7 @@ def random_course(seed: int = 0, *, n_waypoints: int = 4, n_obstacles: int = 14,
 
     Notes
     -----
-    Modelled on the experiment of Hamid et al. (2009, Sec. 4): drive from the first to the last
+    Modelled on the experiment of Hamid et al. (2009): drive from the first to the last
     waypoint, avoiding the obstacles met on the way. The obstacles come from
     :func:`robokit.sim.scatter_obstacles` (random sequential adsorption, Feder 1980), the generator
     :func:`robokit.sim.open_field` also uses; ``course.field.world()`` is the course as a 3D world.

@@ -1,6 +1,6 @@
 """Distances, bearings and a local east-north plane on the Earth, spherical and WGS84.
 
-Hamid et al. (2009, Sec. 3) steer their truck by the bearing and distance from the GPS fix
+Hamid et al. (2009) steer their truck by the bearing and distance from the GPS fix
 to the next waypoint. Three models, from simplest to exact:
 
 * **sphere** - haversine distance and initial bearing on a sphere of radius ``R`` (Sinnott 1984). With the IUGG mean radius the error against the
@@ -171,7 +171,7 @@ def initial_bearing(lat1: Any, lon1: Any, lat2: Any, lon2: Any) -> Any:
     Notes
     -----
     Spherical trigonometry (e.g. Snyder 1987, Eq. 5-4b); the "bearing" field of $GPRMB in Hamid
-    et al. (2009, Sec. 3).
+    et al. (2009).
     """
     p1, l1, p2, l2 = _two_points(lat1, lon1, lat2, lon2)
     dl = l2 - l1
@@ -194,7 +194,7 @@ def haversine_distance_bearing(lat1: float, lon1: float, lat2: float, lon2: floa
     -------
     numpy.ndarray, shape (2,)
         :func:`haversine_distance` and :func:`initial_bearing` together (what $GPRMB reports as
-        range and bearing to the destination, Hamid et al. 2009, Sec. 3).
+        range and bearing to the destination, Hamid et al. 2009).
 
     Raises
     ------
@@ -318,8 +318,8 @@ def distance_bearing(lat1: Any, lon1: Any, lat2: Any, lon2: Any, model: str = "s
 
     Notes
     -----
-    What a GPS receiver reports in $GPRMB (range, bearing to destination), Hamid et al. (2009,
-    Sec. 3); formulas as in :func:`haversine_distance`, :func:`vincenty_inverse`.
+    What a GPS receiver reports in $GPRMB (range, bearing to destination), Hamid et al.
+    (2009); formulas as in :func:`haversine_distance`, :func:`vincenty_inverse`.
 
     Examples
     --------

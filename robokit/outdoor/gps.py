@@ -1,6 +1,6 @@
 """A 1 Hz GPS receiver and a magnetic compass that speak NMEA 0183, as on the paper's truck.
 
-Hamid et al. (2009, Sec. 3) read position from a Garmin eTrex Vista ($GPRMC, $GPGGA) and
+Hamid et al. (2009) read position from a Garmin eTrex Vista ($GPRMC, $GPGGA) and
 heading from its compass ($HCHDG), and note that the position may be wrong by up to about 9 m.
 Consumer GPS errors are not independent from second to second: they wander slowly (satellite
 geometry, atmosphere, multipath). We model each horizontal axis as a first-order Gauss-Markov
@@ -29,8 +29,8 @@ import numpy as np
 
 from ..geometry import wrap_angle
 from ..validation import as_array, as_rng, check_finite_scalar, check_positive
-from .geodesy import LocalTangentPlane
-from .nmea_write import gga_sentence, hdg_sentence, rmc_sentence
+from .geodesy import LocalTangentPlane, haversine_distance_bearing
+from .nmea_write import gga_sentence, hdg_sentence, rmb_sentence, rmc_sentence
 
 __all__ = ["GPSReceiver", "Compass", "heading_to_compass", "compass_to_heading", "MISSION_START"]
 
@@ -54,12 +54,17 @@ def compass_to_heading(psi_deg: float) -> float:
     Notes
     -----
     Inverse of :func:`heading_to_compass` (NMEA 0183 Sec. 6.3 heading convention).
+
+    Examples
+    --------
+    >>> round(compass_to_heading(90.0), 6), round(compass_to_heading(0.0), 6)     # east, north
+    (0.0, 1.570796)
     """
     return wrap_angle(math.radians(90.0 - check_finite_scalar(psi_deg, "psi_deg")))
 
 
 class GPSReceiver:
-    """Simulated receiver emitting ``$GPRMC`` and ``$GPGGA`` once per ``period`` seconds.
+    """Simulated receiver emitting ``$GPRMC``, ``$GPGGA`` (and ``$GPRMB`` to a waypoint) once per ``period`` s.
 
     Parameters
     ----------
@@ -104,7 +109,8 @@ class GPSReceiver:
         self.bias = self.rng.normal(0.0, self.noise, 2) if self.noise else np.zeros(2)
         self.last_error = np.zeros(2)
 
-    def fix(self, t: float, position: Any, speed: float, heading: float) -> list[str]:
+    def fix(self, t: float, position: Any, speed: float, heading: float, destination: Any = None,
+            destination_id: str = "001") -> list[str]:
         """Advance the error one period and return the NMEA sentences of a fix at time ``t``.
 
         Parameters
@@ -117,18 +123,37 @@ class GPSReceiver:
             True ground speed (m/s).
         heading : float
             True heading (rad CCW from east), reported as RMC course over ground.
+        destination : array_like, shape (2,), optional
+            ``[latitude, longitude]`` (radians) of the active waypoint. When given, the receiver
+            also sends ``$GPRMB``: its own range and bearing from this (noisy) fix to the waypoint,
+            computed on the sphere (:func:`~robokit.outdoor.geodesy.haversine_distance_bearing`)
+            and written, as NMEA does, in nautical miles to 0.001 and degrees to 0.1.
+        destination_id : str, default "001"
+            The waypoint's name in the RMB sentence.
 
         Returns
         -------
         list of str
-            ``[RMC, GGA]``; :attr:`last_error` holds the position error (m) that went into them.
+            ``[RMC, GGA]`` or ``[RMC, GGA, RMB]``; :attr:`last_error` holds the position error (m)
+            that went into them.
 
         Notes
         -----
         Gauss-Markov error (Grewal et al. 2013, Sec. 10.2); sentences per NMEA 0183 v4.11 Sec. 6.3.
+        The paper's truck reads RMB's bearing and range to the waypoint (Hamid et al. 2009).
+
+        Examples
+        --------
+        >>> from robokit.outdoor.field import UNIMAP_ORIGIN
+        >>> plane = LocalTangentPlane(*UNIMAP_ORIGIN)
+        >>> gps = GPSReceiver(plane, noise=0.0, white_noise=0.0)
+        >>> wp = np.column_stack(plane.to_geodetic([[60.0, 30.0]]))[0]
+        >>> gps.fix(0.0, [0.0, 30.0], 0.7, 0.0, destination=wp)[2]      # 60 m due east
+        '$GPRMB,A,0.000,L,000,001,0627.5563,N,10021.0625,E,0.032,90.0,0.0,V,A*57'
         """
         p = as_array(position, "position", shape=(2,))
         ts = check_positive(t, "t", allow_zero=True)
+        goal = None if destination is None else as_array(destination, "destination", shape=(2,))
         phi = math.exp(-self.period / self.tau)
         self.bias = phi * self.bias + math.sqrt(1 - phi * phi) * self.noise * self.rng.normal(size=2)  # Gauss-Markov
         self.last_error = self.bias + self.white_noise * self.rng.normal(size=2)
@@ -137,8 +162,13 @@ class GPSReceiver:
         lat_d, lon_d = math.degrees(lat), math.degrees(lon)
         v = abs(check_finite_scalar(speed, "speed"))
         hdop = 1.0 + float(np.hypot(*self.bias)) / 4
-        return [rmc_sentence(when, lat_d, lon_d, speed_mps=v, course_deg=heading_to_compass(heading)),
-                gga_sentence(when.time(), lat_d, lon_d, quality=1, satellites=8, hdop=hdop, altitude_m=12.0)]
+        out = [rmc_sentence(when, lat_d, lon_d, speed_mps=v, course_deg=heading_to_compass(heading)),
+               gga_sentence(when.time(), lat_d, lon_d, quality=1, satellites=8, hdop=hdop, altitude_m=12.0)]
+        if goal is not None:   # the receiver's own navigation to the active waypoint
+            rng_m, brg = haversine_distance_bearing(float(lat), float(lon), float(goal[0]), float(goal[1]))
+            out.append(rmb_sentence(math.degrees(goal[0]), math.degrees(goal[1]), range_m=float(rng_m),
+                                    bearing_deg=math.degrees(brg), destination_id=destination_id))
+        return out
 
 
 class Compass:
@@ -146,42 +176,67 @@ class Compass:
 
     Parameters
     ----------
-    noise : float, default ``radians(1.0)``
-        Standard deviation of the heading noise (rad).
+    noise : float, default ``radians(0.5)``
+        Standard deviation of the heading noise from reading to reading (rad).
+    accuracy : float, default ``radians(2.0)``
+        Bound of the error left after calibration (rad): each compass gets one constant bias drawn
+        uniformly in ``[-accuracy, accuracy]``. Hamid et al. give +-2 degrees for the eTrex's compass
+        and +-5 degrees at extreme northern and southern latitudes.
+    resolution : float, default ``radians(1.0)``
+        The compass reports whole multiples of this (rad); the paper's compass: 1 degree.
     variation : float, default ``radians(-0.3)``
         Local magnetic variation (rad, east positive) sent in the sentence; the reported heading is
         the magnetic one, so true = heading + variation (NMEA 0183 Sec. 6.3, HDG). The sentence
         carries both in degrees, as NMEA does.
     rng : numpy.random.Generator or int, optional
 
+    Attributes
+    ----------
+    bias : float
+        This compass's constant error (rad, clockwise positive like the compass heading).
+
     Raises
     ------
     ValueError, TypeError
-        For a negative or non-finite ``noise`` or a non-finite ``variation``.
+        For a negative or non-finite ``noise`` or ``accuracy``, a non-positive ``resolution`` or a
+        non-finite ``variation``.
 
     Notes
     -----
-    The paper's $HCHDG (Hamid et al. 2009, Sec. 3); resolution 0.1 degree in the sentence.
+    The paper's $HCHDG and its stated compass accuracy and resolution (Hamid et al. 2009, in their
+    description of the GPS module). The sentence writes 0.1 degree; the value in it is a whole
+    number of ``resolution`` steps.
 
     Examples
     --------
-    >>> Compass(noise=0.0).reading(np.pi / 2)          # facing north; variation 0.3 deg west
-    '$HCHDG,0.3,0.0,E,0.3,W*50'
+    >>> Compass(noise=0.0, accuracy=0.0).reading(np.pi / 2)   # facing north; magnetic 0.3 rounds to 0
+    '$HCHDG,0.0,0.0,E,0.3,W*53'
+    >>> c = Compass(noise=0.0, rng=4)                          # a +-2 degree compass: this one's bias
+    >>> round(float(np.degrees(c.bias)), 2), c.reading(np.pi / 2)
+    (1.77, '$HCHDG,2.0,0.0,E,0.3,W*51')
     """
 
-    def __init__(self, *, noise: float = math.radians(1.0), variation: float = math.radians(-0.3),
+    def __init__(self, *, noise: float = math.radians(0.5), accuracy: float = math.radians(2.0),
+                 resolution: float = math.radians(1.0), variation: float = math.radians(-0.3),
                  rng: Any = None) -> None:
         self.noise = check_positive(noise, "noise", allow_zero=True)
+        self.accuracy = check_positive(accuracy, "accuracy", allow_zero=True)
+        self.resolution = check_positive(resolution, "resolution")
         self.variation = check_finite_scalar(variation, "variation")
         self.rng = as_rng(rng)
+        self.bias = float(self.rng.uniform(-self.accuracy, self.accuracy)) if self.accuracy else 0.0
 
     def reading(self, heading: float) -> str:
         """Return the ``$HCHDG`` sentence for a true field heading (rad CCW from east).
 
         Notes
         -----
-        HDG layout, NMEA 0183 v4.11 Sec. 6.3; the compass sentence of Hamid et al. (2009, Sec. 3).
+        HDG layout, NMEA 0183 v4.11 Sec. 6.3; the compass sentence of Hamid et al. (2009): magnetic
+        heading + bias + noise, rounded to the resolution.
         """
         noise_deg, variation_deg = math.degrees(self.noise), math.degrees(self.variation)   # NMEA's unit
-        true_deg = heading_to_compass(heading) + (self.rng.normal(0.0, noise_deg) if noise_deg else 0.0)
-        return hdg_sentence(true_deg - variation_deg, deviation_deg=0.0, variation_deg=variation_deg)
+        true_deg = heading_to_compass(heading) + math.degrees(self.bias)
+        true_deg += self.rng.normal(0.0, noise_deg) if noise_deg else 0.0
+        step = math.degrees(self.resolution)
+        magnetic = (round((true_deg - variation_deg) / step) * step) % 360.0
+        return hdg_sentence(magnetic, deviation_deg=0.0, variation_deg=variation_deg)

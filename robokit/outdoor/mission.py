@@ -2,10 +2,12 @@
 
 Every control step (one sonar slot, 49 ms) the true truck moves, one sonar of the daisy chain pings
 (or all four free-run with cross-talk), the compass sends ``$HCHDG`` every other step, the GPS sends
-``$GPRMC`` and ``$GPGGA`` once a second, and the :class:`~robokit.outdoor.navigator.Navigator` -
+``$GPRMC``, ``$GPGGA`` and ``$GPRMB`` (its own range and bearing to the active waypoint) once a
+second, and the :class:`~robokit.outdoor.navigator.Navigator` -
 which sees only that text and the sonar ranges - answers with a speed and yaw rate. Results follow
-the experiment of Hamid et al. (2009, Sec. 4): waypoints reached, collisions, path length
-relative to the straight legs, and time.
+the experiment of Hamid et al. (2009): waypoints reached, collisions, path length
+relative to the straight legs, and time. A collision ends the run, as it would end a real trial:
+a truck that touched an obstacle does not go on to "reach" the later waypoints.
 
 References
 ----------
@@ -46,11 +48,11 @@ class RunResult:
         Waypoints the navigator reached (by its own estimate), in order.
     n_waypoints : int
     collisions : int
-        Times the truck's body came into contact with an obstacle.
+        1 if the truck's body touched an obstacle (which ended the run), else 0.
     avoidances : int
         Times the navigator entered its AVOID state.
     time : float
-        Mission time (s) until the last waypoint or the time limit.
+        Mission time (s) until the last waypoint, a collision or the time limit.
     path_length : float
         Distance the truck actually drove (m).
     path_ratio : float
@@ -100,7 +102,8 @@ class RunResult:
 
 def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: SkidSteerTruck | None = None,
              max_time: float | None = None, dt: float = 0.049, keep_nmea: int = 200,
-             gps_noise: float = 2.5, navigator_options: dict | None = None) -> RunResult:
+             gps_noise: float = 2.5, compass_accuracy: float = math.radians(2.0),
+             navigator_options: dict | None = None) -> RunResult:
     """Run one mission on ``course`` and return its :class:`RunResult`.
 
     Parameters
@@ -123,8 +126,12 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: S
         Number of sentences kept in the result (for display).
     gps_noise : float, default 2.5
         Standard deviation (m) of the wandering GPS error per axis.
+    compass_accuracy : float, default ``radians(2.0)``
+        Bound (rad) of the compass's constant calibration error (:class:`~robokit.outdoor.gps.Compass`;
+        the paper: +-2 degrees, +-5 degrees at extreme latitudes; 1 degree resolution).
     navigator_options : dict, optional
-        Extra keyword arguments for :class:`~robokit.outdoor.navigator.Navigator`.
+        Extra keyword arguments for :class:`~robokit.outdoor.navigator.Navigator`, e.g.
+        ``{"guidance": "rmb"}`` to steer by the receiver's own $GPRMB bearing and range.
 
     Returns
     -------
@@ -137,9 +144,9 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: S
 
     Notes
     -----
-    The loop is the system of Hamid et al. (2009, Secs. 3-4) with our sensor models, one phase
-    per method of :class:`_Mission`: set-up, sensors (GPS and compass as NMEA text, sonars),
-    navigator, truck, bookkeeping, result.
+    The loop is the system of Hamid et al. (2009) with our sensor models, one phase per method of
+    :class:`_Mission`: set-up, sensors (GPS and compass as NMEA text, sonars), navigator, truck,
+    bookkeeping, result. The run stops at the first contact with an obstacle.
 
     Examples
     --------
@@ -157,10 +164,11 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: S
         raise TypeError(f"truck: expected a SkidSteerTruck or None, got {describe(truck)}")
     max_time = None if max_time is None else check_positive(max_time, "max_time")
     gps_noise = check_positive(gps_noise, "gps_noise", allow_zero=True)
+    compass_accuracy = check_positive(compass_accuracy, "compass_accuracy", allow_zero=True)
     navigator_options = check_mapping(navigator_options, "navigator_options")
     mission = _Mission(course, rng, firing, truck, check_positive(dt, "dt"), check_int(keep_nmea, "keep_nmea", minimum=0),
-                       gps_noise, navigator_options, max_time)
-    while mission.t < mission.limit and not mission.nav.done:
+                       gps_noise, compass_accuracy, navigator_options, max_time)
+    while mission.t < mission.limit and not mission.nav.done and not mission.collisions:
         mission.send_nmea()
         mission.ping_sonars()
         v, omega = mission.navigate()
@@ -173,7 +181,8 @@ class _Mission:
     """One mission's state, advanced one control step at a time by :func:`simulate`'s phases."""
 
     def __init__(self, course: Course, rng: np.random.Generator, firing: str, truck: SkidSteerTruck | None,
-                 dt: float, keep: int, gps_noise: float, navigator_options: dict | None, max_time: float | None):
+                 dt: float, keep: int, gps_noise: float, compass_accuracy: float, navigator_options: dict | None,
+                 max_time: float | None):
         # set-up; the order of the random draws below is part of every seeded result
         self.course, self.field, self.rng, self.firing, self.dt, self.keep = course, course.field, rng, firing, dt, keep
         self.real = truck if truck is not None else dataclasses.replace(
@@ -181,17 +190,17 @@ class _Mission:
         plane = LocalTangentPlane(*self.field.origin)
         legs = np.vstack([course.start[:2], course.waypoints])
         straight = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
-        self.nav = Navigator(np.column_stack(plane.to_geodetic(course.waypoints)), PAPER_TRUCK,
-                             **dict(navigator_options or {}))
+        self.route = np.column_stack(plane.to_geodetic(course.waypoints))   # what the receiver stores
+        self.nav = Navigator(self.route, PAPER_TRUCK, **dict(navigator_options or {}))
         self.offset = plane.to_local(self.nav.plane.lat0, self.nav.plane.lon0)  # navigator's frame -> field frame
         self.limit = 3 * straight / self.nav.cruise_speed + 120.0 if max_time is None else max_time
         self.gps = GPSReceiver(plane, noise=gps_noise, rng=rng)
-        self.compass = Compass(rng=rng)
+        self.compass = Compass(accuracy=compass_accuracy, rng=rng)
         self.sonar = LVMaxSonarEZ()
         self.state = TruckState(np.array(course.start, dtype=float))
         self.ranges = np.full(4, self.sonar.max_range)
         self.phases = rng.uniform(0, dt, 4)                 # free-running sensors' power-up phases
-        self.t, self.k, self.length, self.collisions, self.contact, self.avoidances = 0.0, 0, 0.0, 0, False, 0
+        self.t, self.k, self.length, self.collisions, self.avoidances = 0.0, 0, 0.0, 0, 0
         self.previous = self.nav.state
         self.truth, self.estimate, self.states, self.range_log = [], [], [], []
         self.fixes, self.gps_errors, self.nmea = [], [], []
@@ -199,10 +208,12 @@ class _Mission:
         self.arrival_points = [np.array(course.start[:2], dtype=float)]
 
     def send_nmea(self) -> None:
-        """Sensors, text: a GPS fix (RMC + GGA) every 20 steps (1 Hz), a compass HDG every other step."""
+        """Sensors, text: a GPS fix (RMC + GGA + RMB) every 20 steps (1 Hz), a compass HDG every other step."""
         lines = []
         if self.k % 20 == 0:
-            lines = self.gps.fix(self.t, self.state.pose[:2], self.state.v, self.state.pose[2])
+            active = min(self.nav.target, len(self.route) - 1)      # the receiver follows the same route
+            lines = self.gps.fix(self.t, self.state.pose[:2], self.state.v, self.state.pose[2],
+                                 destination=self.route[active], destination_id=f"{active + 1:03d}")
             self.fixes.append(self.state.pose[:2] + self.gps.last_error)
             self.gps_errors.append(float(np.hypot(*self.gps.last_error)))
         if self.k % 2 == 0:
@@ -235,13 +246,11 @@ class _Mission:
         return v, omega
 
     def drive(self, v: float, omega: float) -> None:
-        """Truck: the nominal model's wheel commands drive the real truck; count new contacts."""
+        """Truck: the nominal model's wheel commands drive the real truck; a contact ends the run."""
         new = self.real.step(self.state, self.nav.truck.wheel_commands(v, omega, check=False), self.dt, check=False)
         self.length += math.hypot(*(new.pose[:2] - self.state.pose[:2]))
         self.state = new
-        hit = self.field.collides(self.state.pose, self.real.length, self.real.width)
-        self.collisions += hit and not self.contact
-        self.contact = hit
+        self.collisions = int(self.field.collides(self.state.pose, self.real.length, self.real.width))
         self.t += self.dt
         self.k += 1
 
@@ -254,7 +263,7 @@ class _Mission:
         self.range_log.append(self.ranges.copy())
 
     def result(self) -> RunResult:
-        """The figures of Hamid et al.'s experiment (Sec. 4), path ratio over the legs actually driven."""
+        """The figures of Hamid et al.'s experiment, path ratio over the legs actually driven."""
         legs = np.vstack(self.arrival_points + ([self.state.pose[:2]] if not self.nav.done else []))
         direct = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
         return RunResult(reached=len(self.nav.arrivals), n_waypoints=len(self.course.waypoints),
@@ -296,7 +305,7 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
 
     Notes
     -----
-    The seeded repetition of Hamid et al.'s experiment (2009, Sec. 4) used by the lesson; course
+    The seeded repetition of Hamid et al.'s experiment (2009) used by the lesson; course
     ``s`` is driven with ``simulate(..., seed=10_000 + s)``; deterministic, hence cacheable
     (DESIGN.md, "Caching").
 
@@ -354,7 +363,7 @@ def summarize_runs(results: list[RunResult]) -> dict:
 
     Notes
     -----
-    The figures of the paper's experiment (Hamid et al. 2009, Sec. 4) plus the GPS error.
+    The figures of the paper's experiment (Hamid et al. 2009) plus the GPS error.
 
     Examples
     --------

@@ -1,6 +1,6 @@
 """Waypoint navigation from NMEA text, with the four-sonar obstacle-avoidance state machine.
 
-Hamid et al. (2009, Sec. 4): the truck follows GPS waypoints; when a sonar sees an obstacle
+Hamid et al. (2009): the truck follows GPS waypoints; when a sonar sees an obstacle
 it turns left or right (it has no rear sensor, so it never backs up), and once past the obstacle it
 re-computes the bearing to the waypoint from its current position. :class:`Navigator` does exactly
 that, reading only what the real truck reads - NMEA sentences from the GPS and compass (parsed with
@@ -30,13 +30,15 @@ from ..geometry import wrap_angle
 from ..validation import as_array, as_points, check_choice, check_positive
 from .geodesy import LocalTangentPlane
 from .gps import compass_to_heading
-from .nmea import GGA, HDG, RMC, NMEAError, parse_sentence
+from .nmea import GGA, HDG, RMB, RMC, NMEAError, parse_sentence
 from .truck import SkidSteerTruck
 
-__all__ = ["avoidance_decision", "Navigator", "DECISIONS"]
+__all__ = ["avoidance_decision", "Navigator", "DECISIONS", "GUIDANCE"]
 
 #: The three moves of the paper's avoidance behaviour.
 DECISIONS = ("forward", "left", "right")
+#: Where the bearing and distance to the waypoint come from: our own estimate, or the receiver's $GPRMB.
+GUIDANCE = ("estimate", "rmb")
 
 
 def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefer: str = "left") -> str:
@@ -67,7 +69,7 @@ def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefe
 
     Notes
     -----
-    Hamid et al. (2009, Sec. 4): the outer sensors watch the sides, the middle pair the
+    Hamid et al. (2009): the outer sensors watch the sides, the middle pair the
     front; the robot avoids by moving left or right only.
     """
     r = as_array(ranges, "ranges", shape=(4,), finite=False)
@@ -114,6 +116,11 @@ class Navigator:
     gains : array_like, optional
         ``[kp, kd]`` of the heading loop; default :func:`design_heading_gains` for 5 % overshoot
         and 1.5 s settling with the truck's motor lag.
+    guidance : {"estimate", "rmb"}, default "estimate"
+        ``"estimate"``: bearing and distance to the waypoint computed by us, in the local tangent
+        plane, from the position estimate (GPS fixes blended with dead reckoning). ``"rmb"``: the
+        receiver's own bearing and range from its latest ``$GPRMB`` about the active waypoint, as
+        the paper's truck reads them; until such a sentence arrives the truck waits.
 
     Notes
     -----
@@ -124,7 +131,7 @@ class Navigator:
 
     def __init__(self, waypoints: Any, truck: SkidSteerTruck, *, cruise_speed: float = 0.7,
                  arrival_radius: float = 2.0, gps_gain: float = 0.3, front: float = 1.2, side: float = 0.8,
-                 bypass_distance: float = 1.5, gains: Any = None) -> None:
+                 bypass_distance: float = 1.5, gains: Any = None, guidance: str = "estimate") -> None:
         wp = as_points(waypoints, "waypoints", 2, min_count=1)
         if np.any(np.abs(wp[:, 0]) >= np.pi / 2):
             raise ValueError("waypoints: expected [lat, lon] in radians with |lat| < pi/2 (did you pass degrees?)")
@@ -141,6 +148,8 @@ class Navigator:
         self.bypass_distance = check_positive(bypass_distance, "bypass_distance")
         kp, kd = design_heading_gains(truck.motor_tau, 0.05, 1.5) if gains is None else as_array(gains, "gains", shape=(2,))
         self.heading_loop = HeadingController(kp, kd, max_rate=0.8 * truck.max_turn_rate)
+        self.guidance = check_choice(guidance, "guidance", GUIDANCE)
+        self.rmb: tuple[float, float] | None = None     # latest (range m, field bearing rad) about the target
         self.state = "GOTO"
         self.target = 0
         self.position: np.ndarray | None = None
@@ -159,14 +168,19 @@ class Navigator:
 
         Notes
         -----
-        RMC position and HDG heading, as the truck of Hamid et al. reads them (2009, Sec. 3).
+        RMC position, RMB range and bearing to the active waypoint (kept when its destination id
+        is ``f"{target + 1:03d}"``) and HDG heading, as the truck of Hamid et al. reads them (2009).
         """
         try:
             rec = parse_sentence(line)
         except NMEAError as exc:
             self.parse_errors.append(exc)
             return
-        if isinstance(rec, HDG):
+        if isinstance(rec, RMB):
+            if (rec.status == "A" and rec.destination_id == f"{self.target + 1:03d}"
+                    and rec.range_m is not None and rec.bearing_deg is not None):
+                self.rmb = (rec.range_m, compass_to_heading(rec.bearing_deg))
+        elif isinstance(rec, HDG):
             if rec.heading_deg is not None:
                 h = compass_to_heading(rec.true_heading_deg)
                 self.heading_loop.measure(h, max(self._heading_age, 1e-3))
@@ -196,24 +210,23 @@ class Navigator:
 
         Notes
         -----
-        GOTO / AVOID / BYPASS behaviour of Hamid et al. (2009, Sec. 4); see the module docstring.
+        GOTO / AVOID / BYPASS behaviour of Hamid et al. (2009); see the module docstring.
         """
         r = as_array(ranges, "ranges", shape=(4,), finite=False)
         h = check_positive(dt, "dt")
         self._heading_age += h
         if self.position is None or self.heading is None or self.state == "DONE":
             return 0.0, 0.0
-        goal = self.waypoints[self.target]
-        delta = goal - self.position
-        if math.hypot(*delta) < self.arrival_radius:
+        distance, bearing = self._to_target()
+        if distance < self.arrival_radius:
             self.arrivals.append((self.target, self.position.copy()))
-            self.target += 1
+            self.target, self.rmb = self.target + 1, None
             if self.target == len(self.waypoints):
                 self.state = "DONE"
                 return 0.0, 0.0
-            goal = self.waypoints[self.target]
-            delta = goal - self.position
-        bearing = math.atan2(delta[1], delta[0])
+            distance, bearing = self._to_target()
+        if math.isnan(bearing):     # "rmb": no sentence about this waypoint yet
+            return 0.0, 0.0
         side_of_goal = "left" if wrap_angle(bearing - self.heading) > 0 else "right"
         decision = avoidance_decision(r, self.front, self.side, prefer=side_of_goal)
         v, reference = self._behave(decision, bearing, r, h)
@@ -223,6 +236,13 @@ class Navigator:
         if self.heading is not None:  # dead reckoning between GPS fixes
             self.position = self.position + v * h * np.array([math.cos(self.heading), math.sin(self.heading)])
         return v, omega
+
+    def _to_target(self) -> tuple[float, float]:
+        """Distance (m) and field bearing (rad) to the active waypoint, from :attr:`guidance`'s source."""
+        if self.guidance == "rmb":
+            return self.rmb if self.rmb is not None else (math.inf, math.nan)
+        delta = self.waypoints[self.target] - self.position
+        return math.hypot(*delta), math.atan2(delta[1], delta[0])
 
     def _behave(self, decision: str, bearing: float, r: np.ndarray, dt: float) -> tuple[float, float]:
         if self.state == "GOTO":

@@ -2,8 +2,8 @@
 
 A sentence looks like ``$GPRMC,123519,A,4807.038,N,...*6A\\r\\n``: a ``$``, an address (a two-letter
 talker such as ``GP``, ``GN``, ``GL`` or ``HC``, then a three-letter sentence type), comma separated
-fields, ``*`` and a two-hex-digit checksum (NMEA 0183 v4.11, Sec. 5.2-5.3). Hamid et al. (2009,
-Sec. 3) drive their truck from ``$GPRMC``, ``$GPRMB``, ``$GPGGA`` and ``$HCHDG``; those four get
+fields, ``*`` and a two-hex-digit checksum (NMEA 0183 v4.11, Sec. 5.2-5.3). Hamid et al. (2009)
+drive their truck from ``$GPRMC``, ``$GPRMB``, ``$GPGGA`` and ``$HCHDG``; those four get
 typed records (:class:`RMC`, :class:`RMB`, :class:`GGA`, :class:`HDG`) for any talker, and every
 other type is returned as a :class:`Sentence` (never an error).
 
@@ -79,7 +79,7 @@ def nmea_checksum(sentence: str) -> str:
 
     Notes
     -----
-    NMEA 0183 v4.11, Sec. 5.2.1 (checksum field); the example in Hamid et al. (2009, Sec. 3)
+    NMEA 0183 v4.11, Sec. 5.2.1 (checksum field); the example in Hamid et al. (2009)
     reads the receiver's ASCII output in exactly this form.
 
     Examples
@@ -135,7 +135,7 @@ def parse_sentence(sentence: str | bytes, *, require_checksum: bool = True) -> R
     Notes
     -----
     Framing and checksum: NMEA 0183 v4.11, Sec. 5.2-5.3; field layouts: Sec. 6.3 (RMC, RMB, GGA,
-    HDG), the four sentences Hamid et al. (2009, Sec. 3) read.
+    HDG), the four sentences Hamid et al. (2009) read.
 
     Examples
     --------
@@ -221,7 +221,7 @@ def fix_position(sentence: str) -> list[float]:
     Notes
     -----
     ``ddmm.mmmm`` -> ``dd + mm.mmmm / 60`` (NMEA 0183 v4.11, Sec. 6.2); the position the truck of
-    Hamid et al. (2009, Sec. 3) reads from $GPRMC/$GPGGA.
+    Hamid et al. (2009) reads from $GPRMC/$GPGGA.
 
     Examples
     --------

@@ -2,7 +2,7 @@
 
 Immutable named tuples (cheap to build, compare and print). Field names carry NMEA's own units
 (``speed_knots``, ``course_deg``); SI properties convert them (DESIGN.md: SI units in APIs).
-Layouts follow NMEA 0183 v4.11, Sec. 6.3, for the sentences Hamid et al. (2009, Sec. 3) read.
+Layouts follow NMEA 0183 v4.11, Sec. 6.3, for the sentences Hamid et al. (2009) read.
 
 References
 ----------

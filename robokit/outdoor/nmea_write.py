@@ -1,7 +1,7 @@
 """Build NMEA 0183 sentences: what the simulated GPS receiver and compass emit.
 
 The simulation talks to the navigator in the same text a Garmin eTrex sends over its serial port
-(Hamid et al. 2009, Sec. 3), so the whole stack runs through :mod:`robokit.outdoor.nmea`.
+(Hamid et al. 2009), so the whole stack runs through :mod:`robokit.outdoor.nmea`.
 Formats follow NMEA 0183 v4.11, Sec. 5.3 (framing) and 6.3 (RMC, RMB, GGA, HDG).
 
 References
@@ -168,7 +168,7 @@ def rmc_sentence(when: _dt.datetime, latitude: float | None, longitude: float | 
         For a non-datetime ``when`` or out-of-range values.
     Notes
     -----
-    RMC field layout, NMEA 0183 v4.11 Sec. 6.3 (the fix sentence of Hamid et al. 2009, Sec. 3).
+    RMC field layout, NMEA 0183 v4.11 Sec. 6.3 (the fix sentence of Hamid et al. 2009).
 
     Examples
     --------
@@ -254,7 +254,7 @@ def hdg_sentence(heading_deg: float, *, deviation_deg: float | None = None,
     str
     Notes
     -----
-    HDG field layout, NMEA 0183 v4.11 Sec. 6.3 (``$HCHDG``, the compass of Hamid et al. 2009, Sec. 3).
+    HDG field layout, NMEA 0183 v4.11 Sec. 6.3 (``$HCHDG``, the compass of Hamid et al. 2009).
 
     Examples
     --------

@@ -1,6 +1,6 @@
 """LV-MaxSonar-EZ ultrasonic rangers: pulse-width output, beam, timing, and chained versus free firing.
 
-Hamid et al. (2009, Sec. 4) mount four MaxBotix LV-MaxSonar-EZ sensors on the front of the
+Hamid et al. (2009) mount four MaxBotix LV-MaxSonar-EZ sensors on the front of the
 truck, read their pulse-width output and convert it to centimetres or inches (their Eqs. (1), (2)),
 and fire them in a commanded daisy-chain loop so that they never hear each other. Sensor facts from
 the MaxBotix LV-MaxSonar-EZ datasheet: 147 us of pulse width per inch, 6 to 254 inch reported
@@ -132,7 +132,7 @@ def pulse_width_to_range(pulse_width: Any) -> Any:
 
     Notes
     -----
-    Hamid et al. (2009, Sec. 4), Eqs. (1)-(2); scale factor from the LV-MaxSonar-EZ
+    Hamid et al. (2009), Eqs. (1)-(2); scale factor from the LV-MaxSonar-EZ
     datasheet (147 us per inch).
     """
     pw = as_array(pulse_width, "pulse_width")
@@ -171,7 +171,7 @@ def pulse_width_to_cm_inches(pulse_width_us: float) -> dict:
 
     Notes
     -----
-    Hamid et al. (2009, Sec. 4), Eqs. (1)-(2); the datasheet scale is 147 us per inch.
+    Hamid et al. (2009), Eqs. (1)-(2); the datasheet scale is 147 us per inch.
 
     Examples
     --------
@@ -209,7 +209,7 @@ class SonarMount:
 
 #: The paper's layout on the 50 cm truck's front bumper (x = 0.25 m from the centre): the outer pair
 #: 20 cm apart turned 45 degrees outwards, the middle pair 10 cm apart facing forward
-#: (Hamid et al. 2009, Sec. 4). Order: outer left, middle left, middle right, outer right.
+#: (Hamid et al. 2009). Order: outer left, middle left, middle right, outer right.
 PAPER_LAYOUT = (
     SonarMount("outer_left", 0.25, 0.10, np.pi / 4),
     SonarMount("middle_left", 0.25, 0.05, 0.0),
@@ -291,7 +291,7 @@ def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.n
     Notes
     -----
     Planar pose composition (Smith, Self & Cheeseman 1990) of the truck pose and each mount of
-    :data:`PAPER_LAYOUT` (Hamid et al. 2009, Sec. 4).
+    :data:`PAPER_LAYOUT` (Hamid et al. 2009).
 
     Examples
     --------
@@ -349,7 +349,7 @@ def true_ranges(field: Layout, pose: Any, mounts: Sequence[SonarMount] = PAPER_L
     Notes
     -----
     A sonar reports the *first* echo anywhere in its cone, which is why wide beams see obstacles
-    off to the side (datasheet beam pattern; Hamid et al. 2009, Sec. 4, side sensors at 45 degrees).
+    off to the side (datasheet beam pattern; Hamid et al. 2009, side sensors at 45 degrees).
     The rays are cast with :meth:`robokit.sim.Layout.raycast` (its tie rule applies).
 
     Examples
@@ -418,8 +418,8 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
 
     Notes
     -----
-    Cross-talk is the reason for the chained, commanded-loop firing in Hamid et al. (2009,
-    Sec. 4) and in the MaxBotix multi-sensor application note.
+    Cross-talk is the reason for the chained, commanded-loop firing in Hamid et al.
+    (2009) and in the MaxBotix multi-sensor application note.
 
     Examples
     --------

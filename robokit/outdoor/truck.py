@@ -1,6 +1,6 @@
 """The skid-steer RC truck of Hamid et al.: body, four driven wheels, slip, and motor lag.
 
-Hamid et al. (2009, Sec. 2) use a 50 x 25 x 15 cm RC truck whose four wheels are driven
+Hamid et al. (2009) use a 50 x 25 x 15 cm RC truck whose four wheels are driven
 independently, so it steers by driving its left and right sides at different speeds and can turn on
 the spot. Its kinematics are the skid-steer model of :mod:`robokit.sim.vehicle`: the ICR
 kinematics of Mandow et al. (2007, Sec. III), a differential-drive form with an effective track
