@@ -70,8 +70,8 @@ def grass(width: int, height: int, rng: Any = None) -> np.ndarray:
 
     Notes
     -----
-    The ground of Hamid et al.'s test site (2009, Sec. 1: "semi-rugged terrain such as a
-    football field"); procedural, no paper equation.
+    The ground of Hamid et al.'s test site (2009, description of the truck: "semi-rugged terrain
+    such a football field", as printed); procedural, no paper equation.
     """
     rng = as_rng(rng)
     img = noise_texture(width, height, rng, base=(78, 124, 52), amplitude=26.0, scales=(1, 3, 10), tint=0.01)

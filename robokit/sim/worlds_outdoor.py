@@ -1,7 +1,8 @@
 """Hamid et al.'s outdoor field as a textured 3D world, and the obstacle layout it shares with lesson 05.
 
 Hamid et al. (2009) test their GPS + sonar skid-steer truck on "semi-rugged terrain such a
-football field" (Sec. 1) and let it avoid obstacles met between GPS waypoints (Sec. 4).
+football field" (description of the truck) and let it avoid obstacles met between GPS waypoints
+(their obstacle-avoidance tests; the text numbers no sections).
 
 * :func:`scatter_obstacles` draws such a layout in the plane: circles (posts, bins, trunks) and
   rotated boxes (bales, crates), kept ``min_gap`` apart. It is the one obstacle generator of the
@@ -105,7 +106,7 @@ def scatter_obstacles(rng: Any, n_obstacles: int, size: Any = (100.0, 60.0), *, 
     Notes
     -----
     Rejection sampling of non-overlapping discs (random sequential adsorption, Feder 1980) around
-    the experiment of Hamid et al. (2009, Sec. 4): obstacles lie on the way between waypoints so
+    the experiment of Hamid et al. (2009, the obstacle-avoidance tests): obstacles lie on the way between waypoints so
     the truck must avoid them.
 
     Examples
@@ -210,7 +211,7 @@ def field_world(size: Any = (100.0, 60.0), circles: Any = None, boxes: Any = Non
 
     Notes
     -----
-    Test site of Hamid et al. (2009, Sec. 1, a football field); world representation of
+    Test site of Hamid et al. (2009, description of the truck: a football field); world representation of
     the course (DESIGN.md, "Simulation"); skybox after Greene (1986).
 
     Examples
@@ -313,8 +314,8 @@ def open_field(seed: int = 0, *, size: Any = (100.0, 60.0), n_obstacles: int = 1
 
     Notes
     -----
-    Hamid et al. (2009), Sec. 1: the truck runs on "semi-rugged terrain such a football field";
-    obstacles as in their Sec. 4 experiment. Worlds are cached per parameter set.
+    Hamid et al. (2009, description of the truck): it runs on "semi-rugged terrain such a football
+    field"; obstacles as in their obstacle-avoidance tests. Worlds are cached per parameter set.
 
     Examples
     --------
