@@ -60,10 +60,21 @@ def test_a_list_and_an_array_are_the_same_answer_in_every_comparison():
     assert close()(vals, [[0.5, 1.0]]) is None and unordered_rows()(vals, [[0.5, 1.0]]) is None
     assert exact()(np.array([], dtype=int), []) is None
     assert "2 of 3 values differ; first at index (1,): expected 0, got 1" in exact()(idx, [2, 1, 0])
-    assert exact()(idx, [2.0, 0.0, 1.0]) is not None          # exact: integers asked, floats refused
+    # numbers by value everywhere (a count returned by np.ceil is still the count), as close() does
+    assert exact()(idx, [2.0, 0.0, 1.0]) is None and exact()(17, 17.0) is None and exact()(17, 16.5) is not None
+    assert close()(idx, [2.0, 0.0, 1.0]) is None and exact()(idx, [2.5, 0.0, 1.0]) is not None
+    # a boolean is not a number, a string is not either, in close() and exact() alike
     assert exact()(np.array([True, False]), [True, False]) is None
-    assert exact()(np.array([True, False]), [1, 0]) is not None
+    assert exact()(np.array([True, False]), [1, 0]) == "expected booleans, got numbers: array(2,) [1, 0]"
+    assert exact()(17, "17") == "expected the integer 17, got the string '17'"
+    assert exact()(1, True) == "expected the integer 1, got the boolean True"
+    assert close()(2.0, "2.0") is not None and close()([1.5], ["1.5"]) is not None
     assert exact()(idx, ["2", "0", "1"]) is not None and exact()(idx, None) is not None
+    # "nothing" is one answer however it is written
+    for cmp in (close(), exact(), unordered_rows()):
+        assert cmp(np.empty((0, 2)), []) is None and cmp(np.empty((0, 2), int), np.array([])) is None
+    # unordered rows report in sorted order and say so
+    assert unordered_rows()([[0.0, 1.0], [2.0, 3.0]], [[2.0, 3.0], [0.0, 5.0]]).startswith("rows sorted by value")
 
 
 def test_case_call_text_shows_the_inputs_within_a_bound():
@@ -72,6 +83,10 @@ def test_case_call_text_shows_the_inputs_within_a_bound():
     big = Case((np.arange(10_000.0), "x" * 1000))
     text = big.call_text("f")
     assert len(text) <= 400 and text.startswith("f(array(10000,)") and text.endswith("...)")
+    # inputs are stored as plain lists; a list of numbers is shown as the array it stands for
+    rows = Case((np.arange(210.0).reshape(70, 3) / 7,)).call_text("robust_pose")
+    assert rows.startswith("robust_pose(array(70, 3) [[ 0. , 0.1429,") and len(rows) < 200, rows
+    assert Case(([0.5],)).call_text("f") == "f([0.5])"
 
 
 def test_transport_round_trip_and_limits(tmp_path):

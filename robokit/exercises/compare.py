@@ -15,7 +15,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .plain import summarize
+from .plain import numeric_array, summarize
 
 __all__ = ["Comparison", "close", "exact", "unordered_rows"]
 
@@ -23,19 +23,11 @@ Comparison = Callable[[Any, Any], "str | None"]
 
 
 def _numeric(x: Any) -> np.ndarray | None:
-    if isinstance(x, bool):
-        return None
-    if isinstance(x, (int, float)):
+    """A number, or an array/list of numbers (not booleans, not strings), as a float array."""
+    if type(x) in (int, float):
         return np.asarray(float(x))
-    if isinstance(x, np.ndarray) and x.dtype.kind in "iuf":
-        return x.astype(float)
-    if isinstance(x, list):
-        try:
-            arr = np.asarray(x, dtype=float)
-        except (TypeError, ValueError):
-            return None
-        return arr
-    return None
+    arr = numeric_array(x)
+    return None if arr is None or arr.dtype.kind == "b" else arr.astype(float)
 
 
 def close(rtol: float = 1e-6, atol: float = 1e-9, *, shape: bool = True) -> Comparison:
@@ -70,6 +62,8 @@ def close(rtol: float = 1e-6, atol: float = 1e-9, *, shape: bool = True) -> Comp
             g = _numeric(got)
             if g is None:
                 return f"{where or 'result'}: expected a number/array like {summarize(expected)}, got {summarize(got)}"
+            if e.size == 0 and g.size == 0:          # "nothing" as [], an empty array or shape (0, k)
+                return None
             if shape and e.shape != g.shape:
                 return f"{where or 'result'}: expected shape {e.shape}, got shape {g.shape}"
             try:
@@ -112,48 +106,64 @@ def _worst_differences(e: np.ndarray, g: np.ndarray, ok: np.ndarray, rtol: float
 
 
 def exact() -> Comparison:
-    """Accept only an identical value (strings, integers, booleans, lists of them).
+    """Accept only the same value: equal strings and booleans, equal numbers, equal arrays or lists.
+
+    Numbers are judged by value (``17.0`` is ``17``, as in :func:`close`), but a boolean is not a
+    number and a string is not either; an array and a list with the same shape and values are the
+    same answer, and every empty answer is the same.
 
     Examples
     --------
     >>> exact()("2A", "2a")
     "expected '2A', got '2a'"
-
-    An integer array and a list of the same integers are the same answer; floats for integers are not:
-
-    >>> exact()(np.array([2, 0, 1]), [2, 0, 1]) is None, exact()(np.array([2, 0, 1]), [2.0, 0.0, 1.0]) is None
-    (True, False)
+    >>> exact()(np.array([2, 0, 1]), [2, 0, 1]) is None, exact()(17, 17.0) is None
+    (True, True)
+    >>> exact()(17, "17")
+    "expected the integer 17, got the string '17'"
     """
 
     def compare(expected: Any, got: Any) -> str | None:
-        if isinstance(expected, np.ndarray) or isinstance(got, np.ndarray):
-            e, g = _as_array(expected), _as_array(got)
-            if e is None or g is None or g.shape != e.shape or (e.size and g.dtype.kind != e.dtype.kind):
-                return f"expected {summarize(expected)}, got {summarize(got)}"
-            if not np.array_equal(g, e):
-                bad = np.argwhere(g != e)
-                idx = tuple(int(i) for i in bad[0])
-                return (f"{len(bad)} of {e.size} values differ; first at index {idx}: expected "
-                        f"{e[idx].item()!r}, got {g[idx].item()!r}")
-            return None
-        if type(expected) is not type(got) or expected != got:
+        if isinstance(expected, (np.ndarray, list)) or isinstance(got, (np.ndarray, list)):
+            e, g = numeric_array(expected), numeric_array(got)
+            if e is not None and g is not None:
+                return _exact_arrays(e, g)
+        elif _is_number(expected) and _is_number(got):
+            return None if expected == got else f"expected {summarize(expected)}, got {summarize(got)}"
+        if type(expected) is not type(got):
+            return f"expected {_kind(expected)} {summarize(expected)}, got {_kind(got)} {summarize(got)}"
+        if expected != got:
             return f"expected {summarize(expected)}, got {summarize(got)}"
         return None
 
     return compare
 
 
-def _as_array(x: Any) -> np.ndarray | None:
-    """``x`` as an array if it is one or a (nested) list of numbers/booleans of one kind, else None."""
-    if isinstance(x, np.ndarray):
-        return x
-    if not isinstance(x, list):
+def _is_number(x: Any) -> bool:
+    return type(x) in (int, float)
+
+
+def _kind(x: Any) -> str:
+    """``'the integer'``, ``'the string'``, ... for a feedback message."""
+    names = {bool: "the boolean", int: "the integer", float: "the float", str: "the string",
+             list: "the list", dict: "the dict", np.ndarray: "the array"}
+    return names.get(type(x), "the value")
+
+
+def _exact_arrays(e: np.ndarray, g: np.ndarray) -> str | None:
+    """Exact comparison of two numeric/boolean arrays (numbers by value, booleans apart)."""
+    if e.size == 0 and g.size == 0:
         return None
-    try:
-        arr = np.asarray(x)
-    except (TypeError, ValueError):
-        return None
-    return arr if arr.dtype.kind in "biuf" and arr.dtype != object else None
+    if g.shape != e.shape:
+        return f"expected shape {e.shape}, got shape {g.shape}: {summarize(g)}"
+    if (e.dtype.kind == "b") != (g.dtype.kind == "b"):
+        want, have = ("booleans" if a.dtype.kind == "b" else "numbers" for a in (e, g))
+        return f"expected {want}, got {have}: {summarize(g)}"
+    bad = np.argwhere(g != e)
+    if len(bad):
+        idx = tuple(int(i) for i in bad[0])
+        return (f"{len(bad)} of {e.size} values differ; first at index {idx}: expected "
+                f"{e[idx].item()!r}, got {g[idx].item()!r}")
+    return None
 
 
 def unordered_rows(rtol: float = 1e-6, atol: float = 1e-9) -> Comparison:
@@ -169,10 +179,13 @@ def unordered_rows(rtol: float = 1e-6, atol: float = 1e-9) -> Comparison:
 
     def compare(expected: Any, got: Any) -> str | None:
         e, g = _numeric(expected), _numeric(got)
+        if e is not None and g is not None and e.size == 0 and g.size == 0:
+            return None
         if g is None or e is None or e.ndim != 2 or g.shape != e.shape:
             return f"expected an array of shape {None if e is None else e.shape}, got {summarize(got)}"
         order_e = np.lexsort(np.round(e, 6).T[::-1])
         order_g = np.lexsort(np.round(g, 6).T[::-1])
-        return inner(e[order_e], g[order_g])
+        msg = inner(e[order_e], g[order_g])
+        return None if msg is None else "rows sorted by value (their order is free): " + msg.split(": ", 1)[1]
 
     return compare

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["to_plain", "NotPlainData", "summarize"]
+__all__ = ["to_plain", "NotPlainData", "summarize", "numeric_array"]
 
 _MAX_DEPTH = 20
 _MAX_ITEMS = 1_000_000
@@ -98,3 +98,23 @@ def summarize(value: Any, limit: int = 160) -> str:
         text = repr(value)
     text = " ".join(text.split())
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def numeric_array(value: Any) -> np.ndarray | None:
+    """``value`` as an array if it is a numeric/boolean array or a (nested, rectangular) list of
+    numbers or booleans, else ``None``: the one rule by which a list counts as an array.
+
+    Examples
+    --------
+    >>> numeric_array([[1, 2], [3, 4]]).shape, numeric_array(["a"]), numeric_array([1, [2]])
+    ((2, 2), None, None)
+    """
+    if isinstance(value, np.ndarray):
+        return value if value.dtype.kind in "biuf" else None
+    if not isinstance(value, list):
+        return None
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):
+        return None
+    return arr if arr.dtype.kind in "biuf" else None

@@ -17,7 +17,7 @@ import numpy as np
 
 from .compare import Comparison, close
 from ..validation import check_int, check_text
-from .plain import summarize, to_plain
+from .plain import numeric_array, summarize, to_plain
 
 __all__ = ["Case", "Exercise", "EXERCISE_ID"]
 
@@ -68,8 +68,12 @@ class Case:
         """
         function = check_text(function, "function", empty=False)
         limit = check_int(limit, "limit", minimum=16)
-        parts = [summarize(a, 160) for a in self.args]
-        parts += [f"{k}={summarize(v, 160)}" for k, v in self.kwargs.items()]
+        def show(value: Any) -> str:          # a list of numbers reads as the array it stands for
+            arr = numeric_array(value) if isinstance(value, list) else None
+            return summarize(value if arr is None or arr.size < 2 else arr, 160)
+
+        parts = [show(a) for a in self.args]
+        parts += [f"{k}={show(v)}" for k, v in self.kwargs.items()]
         text = f"{function}({', '.join(parts)})"
         return text if len(text) <= limit else text[: limit - 4] + "...)"
 
