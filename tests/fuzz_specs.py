@@ -523,7 +523,7 @@ SPECS: dict[str, Call] = {
                                                              cheap=False),
     "robokit.arm.position_posture.ik_position_posture": Call({"chain": Obj(iiwa), "T": T_(),
                                                               "q0": Array(q7, "7", optional=True), "tol": Real(1e-6),
-                                                              "max_iter": Int(50)}),
+                                                              "max_iter": Int(50), "method": Choice("newton")}),
     "robokit.exercises.redundant_ik.solve_ik": Call({"T": T_(), "q_start": Array(q7, "7")}, cheap=False),
     "robokit.arm.ik_analytic.ik_srs_branches": Call({"chain": Obj(iiwa), "T": T_(), "psi": Real(0.3),
                                                      "within_limits": Flag(True)}),

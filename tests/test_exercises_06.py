@@ -94,21 +94,77 @@ def test_open_ik_compare_accepts_another_valid_posture_and_names_a_limit():
     assert "joint 3" in SOLVE_IK.compare(q.tolist(), outside.tolist())
 
 
-def test_open_ik_tempting_shortcut_fails_some_cases():
-    """Taking arm angle 0 (the reference plane) and the first branch inside the limits, without
-    searching the arm angle, fails the cases where no branch is inside at psi = 0."""
+def _psi_zero_shortcut(T, q_start):
+    """Arm angle 0 (the reference plane), the first branch inside the limits, else the first branch."""
     from robokit.arm import ik_srs_branches, iiwa14
 
     arm = iiwa14()
+    inside = ik_srs_branches(arm, np.asarray(T), 0.0)
+    if len(inside):
+        return inside[0]
+    every = ik_srs_branches(arm, np.asarray(T), 0.0, within_limits=False)
+    if not len(every):
+        raise ValueError("T: out of reach")
+    return every[0]
 
-    def psi_zero(T, q_start):
-        inside = ik_srs_branches(arm, T, 0.0)
+
+def _grid_shortcut(T, q_start, step_deg=30):
+    """Arm angles every ``step_deg`` degrees; the first branch inside the limits at the first that has one."""
+    from robokit.arm import ik_srs_branches, iiwa14
+
+    arm = iiwa14()
+    for psi in np.radians(np.arange(-180, 180, step_deg)):
+        inside = ik_srs_branches(arm, np.asarray(T), psi)
         if len(inside):
             return inside[0]
-        every = ik_srs_branches(arm, T, 0.0, within_limits=False)
-        if not len(every):
-            raise ValueError("T: out of reach")
-        return every[0]
+    raise ValueError("T: no arm angle on the grid keeps the joints inside")
 
-    with pytest.raises(AssertionError, match="arm angle 0 breaks a limit"):
-        check("06.solve_ik", psi_zero)
+
+def _failed_labels(fn, seed):
+    failed = set()
+    for case in _solve_ik_cases(seed):
+        try:
+            out = fn(*case.args)
+        except ValueError:
+            if not case.raises:
+                failed.add(case.label)
+            continue
+        if case.raises or SOLVE_IK.compare(redundant_ik.solve_ik(*case.args), out) is not None:
+            failed.add(case.label)
+    return failed
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2024])
+def test_open_ik_tempting_shortcuts_fail_some_cases(seed):
+    """Arm angle 0 fails where no branch is inside at psi = 0 and where no arm angle is; a 30-degree
+    (or 10-degree) grid of arm angles misses the narrow feasible arcs; the reference passes all."""
+    assert "arm angle 0 breaks a limit on every branch; random start" in _failed_labels(_psi_zero_shortcut, seed)
+    narrow = "feasible arm angles total under 5 deg, none at a multiple of 10 deg"
+    assert _failed_labels(_grid_shortcut, seed) == {narrow}
+    assert narrow in _failed_labels(lambda T, q: _grid_shortcut(T, q, step_deg=10), seed)
+    assert _failed_labels(redundant_ik.solve_ik, seed) == set()
+
+
+def test_open_ik_cases_are_what_their_labels_say():
+    """The narrow case's arcs total under 5 deg and miss every multiple of 10 deg; the blocked case's
+    wrist centre is in reach yet no branch has a feasible arm angle."""
+    from robokit.arm import feasible_arm_angles, iiwa14, wrist_centre
+
+    arm = iiwa14()
+    for seed in (0, 1):
+        for case in _solve_ik_cases(seed):
+            arcs = np.degrees(np.concatenate([iv.reshape(-1, 2) for iv in feasible_arm_angles(arm, np.array(case.args[0]))]))
+            if case.label.startswith("feasible arm angles total"):
+                assert 0 < np.diff(arcs, axis=1).sum() < 5
+                assert not (np.floor(arcs[:, 1] / 10) * 10 >= arcs[:, 0]).any()
+            if case.label.startswith("wrist centre in reach"):
+                L = np.linalg.norm(wrist_centre(np.array(case.args[0]), 0.126) - [0, 0, 0.36])
+                assert 0.02 <= L <= 0.82 and len(arcs) == 0
+
+
+def test_open_ik_feedback_says_how_far_a_joint_is_over():
+    q = np.radians([35, 50, -40, -75, 60, 45, 20])
+    outside = q.copy()
+    outside[2] = np.radians(175)
+    message = SOLVE_IK.compare(q.tolist(), outside.tolist())
+    assert "joint 3" in message and "5 deg beyond" in message

@@ -11,8 +11,9 @@ transforms, rotations and the pose error come from :mod:`robokit.geometry`.
 * :func:`ik_srs`, :func:`ik_srs_batch`, :func:`ik_srs_branches`, :func:`arm_angle` - the analytic
   arm-angle IK of S-R-S arms (KUKA LBR iiwa); :func:`feasible_arm_angles`, :func:`split_points` -
   Shimizu's exact feasible arm-angle intervals; :func:`ik_srs_reference` - the same search step by step.
-* :func:`ik_position_posture` - Huang & Jiang's reduction worked through: Newton iteration on joints
-  1-4 for the wrist centre, joints 5-7 in closed form.
+* :func:`ik_position_posture` - Huang & Jiang's reduction worked through, in two readings: Newton
+  iteration on joints 1-4 for the wrist centre, or ``q3`` as the parameter with ``q1, q2, q4`` in
+  closed form; joints 5-7 in closed form.
 * :func:`ik_numeric`, :func:`ik_numeric_batch` - damped least squares with null-space gradient
   projection (Dubey) or weighted least norm (Chan), random restarts; any chain.
   :func:`ik_numeric_reference` is the same for one target as a plain loop.

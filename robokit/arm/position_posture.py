@@ -17,6 +17,14 @@ no equations, so the steps below are our reading of them, each a plain numpy sta
    ``R_4^7 = Rz(q5) Ry(q6) Rz(q7)`` on the iiwa: joints 5-7 follow in closed form (two branches; we
    keep one inside the joint limits, the nearer to the start posture if both are).
 
+Step 2's Newton step is a (right) pseudo-inverse of ``J_w``: the very matrix whose computation Huang
+& Jiang hold against Chan's weighted least norm ("it is very difficult to solve it"). The quoted
+passage does not say how their "algebraic iterative" method avoids it, so ``method="joint_parameter"``
+offers a second reading without any pseudo-inverse: fix one joint (``q3``) as the redundancy
+parameter, solve ``q1, q2, q4`` for the wrist centre in closed form (law of cosines for ``q4``, one
+trigonometric equation each for ``q2`` and ``q1``), and iterate on the parameter, starting at the
+current ``q3`` and stepping outward over its range until a posture inside every limit appears.
+
 The arm-angle method (:func:`robokit.arm.ik_srs`, Shimizu et al. 2008) solves step 2 in closed
 form for every arm angle instead, and searches the arm angle; this module iterates on the joints.
 
@@ -34,11 +42,14 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3, wrap_angle, zyz_angles
-from ..validation import check_int, check_positive
+from ..validation import check_choice, check_int, check_positive
 from .ik_analytic import SRSArm
 from .result import IKResult, verify
 
 __all__ = ["ik_position_posture"]
+
+#: The two readings of the "algebraic iterative" step (see the module's text).
+METHODS = ("newton", "joint_parameter")
 
 
 def _wrist_and_jacobian(arm: SRSArm, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -55,8 +66,80 @@ def _wrist_and_jacobian(arm: SRSArm, q: np.ndarray) -> tuple[np.ndarray, np.ndar
     return w, np.cross(z, w - p).T, frames[4, :3, :3]
 
 
-def ik_position_posture(chain: Any, T: Any, q0: Any = None, *, tol: float = 1e-6, max_iter: int = 50) -> IKResult:
-    """IK of an S-R-S arm by Huang & Jiang's reduction: Newton on joints 1-4 for the wrist, closed-form 5-7.
+def _shoulder_for_q3(arm: SRSArm, u: np.ndarray, q3: float, q4: float) -> list[np.ndarray]:
+    """Unchecked: ``(q1, q2, q3, q4)`` with ``Rz(q1) Ry(q2) Rz(q3) v(q4) = u`` (up to two), closed form.
+
+    ``u = W - S`` in frame 0 and ``v(q4) = (-d_ew sin q4, 0, d_se + d_ew cos q4)`` the wrist seen
+    from the shoulder (:class:`robokit.arm.ik_analytic.SRSArm`'s Notes). With ``p = Rz(q3) v``, the
+    z row reads ``p_z cos q2 - p_x sin q2 = u_z`` (one equation for ``q2``) and ``q1`` turns the
+    horizontal part of ``Ry(q2) p`` onto that of ``u``. Empty when this ``q3`` cannot reach ``u``.
+    """
+    s4, c4 = np.sin(q4), np.cos(q4)
+    px, py, pz = -arm.d_ew * s4 * np.cos(q3), -arm.d_ew * s4 * np.sin(q3), arm.d_se + arm.d_ew * c4
+    r = np.hypot(pz, px)
+    if r < 1e-12 or abs(u[2]) > r:
+        return []
+    out = []
+    for q2 in np.arctan2(-px, pz) + np.array([1.0, -1.0]) * np.arccos(np.clip(u[2] / r, -1.0, 1.0)):
+        rx = px * np.cos(q2) + pz * np.sin(q2)
+        out.append(np.array([np.arctan2(u[1], u[0]) - np.arctan2(py, rx), q2, q3, q4]))
+    return out
+
+
+def _wrist_joints(arm: SRSArm, q4: np.ndarray, T7: np.ndarray, q0: np.ndarray) -> np.ndarray:
+    """Unchecked: joints 1-7 from joints 1-4 by the ZYZ angles of ``R_4^7``, the branch inside the limits (nearer q0)."""
+    _, _, R04 = _wrist_and_jacobian(arm, q4)
+    a, b, c = zyz_angles(R04.T @ T7[:3, :3], check=False)          # step 3: R_4^7 = Rz(q5) Ry(q6) Rz(q7)
+    wrists = wrap_angle(np.array([[a, b, c], [a + np.pi, -b, c + np.pi]]))
+    inside = ((wrists >= arm.chain.qmin[4:]) & (wrists <= arm.chain.qmax[4:])).all(1)
+    distance = (wrap_angle(wrists - q0[4:]) ** 2).sum(1) + np.where(inside, 0.0, 100.0)   # inside first, then nearer
+    return np.concatenate([q4, wrists[np.argmin(distance)]])
+
+
+def _newton(arm: SRSArm, target: np.ndarray, T7: np.ndarray, q0: np.ndarray, tol: float,
+            max_iter: int) -> tuple[np.ndarray, int]:
+    """Step 2 by Newton's minimum-norm steps on ``w(q1..q4) = W``, then step 3; returns (q, steps)."""
+    q = q0[:4].copy()
+    steps = 0
+    for steps in range(max_iter + 1):
+        w, J, _ = _wrist_and_jacobian(arm, q)
+        e = target - w
+        if np.linalg.norm(e) < 0.1 * tol or steps == max_iter:
+            break
+        step = J.T @ np.linalg.solve(J @ J.T + 1e-12 * np.eye(3), e)
+        if not np.all(np.isfinite(step)):             # cannot happen with eps > 0; keep the last iterate
+            break
+        q = q + step
+    return _wrist_joints(arm, wrap_angle(q), T7, q0), steps
+
+
+def _joint_parameter(arm: SRSArm, target: np.ndarray, T7: np.ndarray, q0: np.ndarray,
+                     max_iter: int) -> tuple[np.ndarray, int]:
+    """Step 2 with ``q3`` as the parameter: the current ``q3``, then ``max_iter`` values outward; returns (q, tries)."""
+    chain = arm.chain
+    u = target - np.array([0.0, 0.0, arm.d_bs])
+    c4 = (u @ u - arm.d_se**2 - arm.d_ew**2) / (2 * arm.d_se * arm.d_ew)
+    q4 = np.arccos(np.clip(c4, -1.0, 1.0))
+    grid = chain.qmin[2] + (chain.qmax[2] - chain.qmin[2]) * (np.arange(max_iter) + 0.5) / max_iter
+    values = np.concatenate([[q0[2]], grid[np.argsort(np.abs(grid - q0[2]), kind="stable")]])
+    best, best_cost, fallback = None, np.inf, None
+    for tries, q3 in enumerate(values, start=1):
+        for s in (q4, -q4):
+            for q14 in _shoulder_for_q3(arm, u, q3, s):
+                q = _wrist_joints(arm, wrap_angle(q14), T7, q0)
+                cost = float((wrap_angle(q - q0) ** 2).sum())
+                if chain.within_limits(q) and cost < best_cost:
+                    best, best_cost = q, cost
+                elif fallback is None:
+                    fallback = q                                  # reaches W, kept if nothing inside the limits
+        if best is not None:
+            return best, tries
+    return (q0.copy() if fallback is None else fallback), len(values)
+
+
+def ik_position_posture(chain: Any, T: Any, q0: Any = None, *, tol: float = 1e-6, max_iter: int = 50,
+                        method: str = "newton") -> IKResult:
+    """IK of an S-R-S arm by Huang & Jiang's reduction: joints 1-4 place the wrist centre, 5-7 in closed form.
 
     Parameters
     ----------
@@ -67,33 +150,43 @@ def ik_position_posture(chain: Any, T: Any, q0: Any = None, *, tol: float = 1e-6
     q0 : array_like, shape (7,), optional
         Start posture (the current joint angles); the middle of the joint ranges by default.
     tol : float, default 1e-6
-        Tolerance on the final position [m] and orientation [rad] errors; the iteration stops once
-        the wrist centre is within ``tol / 10`` of its target.
+        Tolerance on the final position [m] and orientation [rad] errors; Newton stops once the
+        wrist centre is within ``tol / 10`` of its target.
     max_iter : int, default 50
-        Newton steps at most.
+        ``"newton"``: Newton steps at most. ``"joint_parameter"``: values of ``q3`` tried after the
+        current one, evenly spaced over its range and taken nearest first (50: every 6.8 deg on the
+        iiwa, so a feasible stretch of ``q3`` narrower than that can be missed).
+    method : {"newton", "joint_parameter"}, default "newton"
+        Our two readings of the "algebraic iterative" step (see the module's text): Newton on
+        joints 1-4 (a pseudo-inverse of the 3x4 wrist Jacobian at each step), or ``q3`` as the
+        parameter with ``q1, q2, q4`` in closed form (no pseudo-inverse).
 
     Returns
     -------
     IKResult
         FK-verified: ``success`` needs the pose within ``tol`` and every joint within its limits.
-        ``iterations`` counts the Newton steps. Joints are wrapped into ``[-pi, pi)``.
+        ``iterations`` counts the Newton steps, or the ``q3`` values tried. Joints are wrapped into
+        ``[-pi, pi)``. A wrist centre out of reach (shoulder-wrist distance outside
+        ``[|d_se - d_ew|, d_se + d_ew]``) is found before any iteration: ``success`` False,
+        ``q = q0``, ``iterations`` 0 and a reason starting ``"out of reach"``, as :func:`ik_srs` says.
 
     Raises
     ------
     TypeError
-        If ``chain`` is not a :class:`robokit.arm.Chain`.
+        If ``chain`` is not a :class:`robokit.arm.Chain`, or ``max_iter`` is not an integer.
     ValueError
         On a non-SE(3) target, a ``q0`` of the wrong shape, a non-positive ``tol``, a ``max_iter``
-        below 1, or a chain that is not S-R-S.
+        below 1, an unknown ``method``, or a chain that is not S-R-S.
 
     Notes
     -----
     Huang & Jiang (2013): separation of position and posture and an algebraic iteration on the
-    4-DOF position-redundant problem (the quoted passage gives no equation numbers; the steps are
+    4-DOF position-redundant problem (the quoted passage gives no equations; both methods are
     our reading, see the module's text). The minimum-norm Newton step is
     ``dq = J^T (J J^T + eps I)^-1 e`` with ``eps = 1e-12`` (so a stretched elbow does not divide
-    by zero); joints 5-7 are the ZYZ angles of ``R_4^7`` (Craig 2005, Sec. 2.8). No joint limit
-    enters the iteration: the result reports whether they hold.
+    by zero); joints 5-7 are the ZYZ angles of ``R_4^7`` (Craig 2005, Sec. 2.8). Newton lets no
+    joint limit into its iteration (the result reports whether they hold); the joint-parameter
+    method keeps the first ``q3`` with a posture inside every limit, the nearest to ``q0`` there.
 
     Examples
     --------
@@ -103,6 +196,12 @@ def ik_position_posture(chain: Any, T: Any, q0: Any = None, *, tol: float = 1e-6
     >>> r = ik_position_posture(arm, arm.fk(q), q0=q + 0.2)
     >>> r.success, bool(r.position_error < 1e-9), r.iterations <= 10
     (True, True, True)
+    >>> r = ik_position_posture(arm, arm.fk(q), q0=q + 0.2, method="joint_parameter")
+    >>> r.success, bool(r.position_error < 1e-9), r.iterations
+    (True, True, 1)
+    >>> far = np.eye(4); far[:3, 3] = [1.4, 0.0, 0.4]
+    >>> ik_position_posture(arm, far).reason[:12]
+    'out of reach'
     """
     arm = SRSArm(chain)
     T = as_se3(T, "T")
@@ -110,25 +209,19 @@ def ik_position_posture(chain: Any, T: Any, q0: Any = None, *, tol: float = 1e-6
     q0 = arm.mid.copy() if q0 is None else arm.chain.check_q(q0, "q0")
     tol = check_positive(tol, "tol")
     max_iter = check_int(max_iter, "max_iter", minimum=1)
+    method = check_choice(method, "method", METHODS)
     target = arm.wrist_centre(T7)
-    q = q0[:4].copy()
-    steps = 0
-    for steps in range(max_iter + 1):                   # step 2: Newton on w(q1..q4) = W
-        w, J, R04 = _wrist_and_jacobian(arm, q)
-        e = target - w
-        if np.linalg.norm(e) < 0.1 * tol or steps == max_iter:
-            break
-        step = J.T @ np.linalg.solve(J @ J.T + 1e-12 * np.eye(3), e)
-        if not np.all(np.isfinite(step)):             # cannot happen with eps > 0; keep the last iterate
-            break
-        q = q + step
-    q = wrap_angle(q)
-    _, _, R04 = _wrist_and_jacobian(arm, q)
-    a, b, c = zyz_angles(R04.T @ T7[:3, :3], check=False)          # step 3: R_4^7 = Rz(q5) Ry(q6) Rz(q7)
-    wrists = wrap_angle(np.array([[a, b, c], [a + np.pi, -b, c + np.pi]]))
-    inside = ((wrists >= arm.chain.qmin[4:]) & (wrists <= arm.chain.qmax[4:])).all(1)
-    distance = (wrap_angle(wrists - q0[4:]) ** 2).sum(1) + np.where(inside, 0.0, 100.0)   # inside first, then nearer
-    q_all = np.concatenate([q, wrists[np.argmin(distance)]])
+    L = float(np.linalg.norm(target - np.array([0.0, 0.0, arm.d_bs])))
+    if not abs(arm.d_se - arm.d_ew) <= L <= arm.d_se + arm.d_ew:
+        result = verify(arm.chain, T[None], q0[None], tol, check=False)[0]
+        result.success, result.iterations = False, 0
+        result.reason = (f"out of reach: shoulder-wrist distance {L:.4f} m outside "
+                         f"[{abs(arm.d_se - arm.d_ew):.4f}, {arm.d_se + arm.d_ew:.4f}] m")
+        return result
+    if method == "newton":
+        q_all, steps = _newton(arm, target, T7, q0, tol, max_iter)
+    else:
+        q_all, steps = _joint_parameter(arm, target, T7, q0, max_iter)
     result = verify(arm.chain, T[None], q_all[None], tol, check=False)[0]
     result.iterations = steps
     return result

@@ -66,7 +66,7 @@ def wrist_centre(T: Any, d_wf: float) -> np.ndarray:
 
     Notes
     -----
-    Separation of position and posture: Huang & Jiang (2013), abstract (unnumbered); Shimizu et al. (2008), Eq. (3).
+    Separation of position and posture: Huang & Jiang (2013), as quoted in the course's assignment; Shimizu et al. (2008), Eq. (3).
 
     Examples
     --------

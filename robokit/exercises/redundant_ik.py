@@ -91,9 +91,10 @@ def _reaches_target(expected: Any, got: Any) -> str | None:
     outside = np.flatnonzero((q < _IIWA.qmin - LIMIT_TOL) | (q > _IIWA.qmax + LIMIT_TOL))
     if outside.size:
         j = int(outside[0])
-        return (f"joint {j + 1} is at {np.degrees(q[j]):.2f} deg, outside its limits [{np.degrees(_IIWA.qmin[j]):.0f}, "
-                f"{np.degrees(_IIWA.qmax[j]):.0f}] deg ({outside.size} joint(s) outside; the flange is "
-                f"{pos * 1e3:.3g} mm and {rot:.3g} rad from the target)")
+        over = max(_IIWA.qmin[j] - q[j], q[j] - _IIWA.qmax[j])
+        return (f"joint {j + 1} is at {np.degrees(q[j]):.2f} deg, {np.degrees(over):.3g} deg beyond its limits "
+                f"[{np.degrees(_IIWA.qmin[j]):.0f}, {np.degrees(_IIWA.qmax[j]):.0f}] deg ({outside.size} joint(s) "
+                f"outside; the flange is {pos * 1e3:.3g} mm and {rot:.3g} rad from the target)")
     if pos > IK_TOL or rot > IK_TOL:
         return (f"your joints put the flange {pos * 1e3:.3g} mm and {rot:.3g} rad from the target "
                 f"(tolerance {IK_TOL:g} m and {IK_TOL:g} rad)")
@@ -178,29 +179,71 @@ def _null_space_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
+def _arcs(T: np.ndarray) -> np.ndarray:
+    """The exact feasible arm-angle arcs of all eight branches of target ``T``, stacked (k, 2) [rad]."""
+    return np.concatenate([iv.reshape(-1, 2) for iv in feasible_arm_angles(_IIWA, T)])
+
+
 def _psi_zero_infeasible(rng: np.random.Generator) -> np.ndarray:
     """A configuration whose pose no branch reaches inside the limits at arm angle 0 (drawn until found)."""
     for _ in range(1000):
         q = _IIWA.random_q(rng=rng)
-        if not any(((iv[:, 0] <= 0.0) & (iv[:, 1] >= 0.0)).any() for iv in feasible_arm_angles(_IIWA, _IIWA.fk(q))):
+        arcs = _arcs(_IIWA.fk(q))
+        if not ((arcs[:, 0] <= 0.0) & (arcs[:, 1] >= 0.0)).any():
             return q
     raise RuntimeError("no configuration with an infeasible arm angle 0 in 1000 draws")  # pragma: no cover
+
+
+def _no_feasible_arm_angle(rng: np.random.Generator) -> np.ndarray:
+    """Joints (some outside the limits) whose pose has a reachable wrist centre but no feasible arm angle."""
+    for _ in range(1000):
+        q = rng.uniform(-np.pi, np.pi, 7)
+        if not len(_arcs(_IIWA.fk(q))):
+            return q
+    raise RuntimeError("no target without a feasible arm angle in 1000 draws")  # pragma: no cover
+
+
+def _narrow(rng: np.random.Generator) -> np.ndarray:
+    """Joints whose pose has feasible arcs totalling 1.5-5 deg over the eight branches, none of them
+    containing a multiple of 10 deg, one containing a whole degree: between a feasible target and
+    one with no feasible arm angle, bisected on the straight line of joint values between them."""
+    for _ in range(200):
+        q_in, q_out = _IIWA.random_q(rng=rng), _no_feasible_arm_angle(rng)
+        lo, hi = 0.0, 1.0
+        for _ in range(40):
+            t = 0.5 * (lo + hi)
+            q = (1 - t) * q_in + t * q_out
+            arcs = np.degrees(_arcs(_IIWA.fk(q)))
+            total = float(np.diff(arcs, axis=1).sum())
+            if 1.5 < total < 5.0:
+                whole = np.floor(arcs[:, 1]) >= arcs[:, 0]
+                tens = np.floor(arcs[:, 1] / 10) * 10 >= arcs[:, 0]
+                if whole.any() and not tens.any():
+                    return q
+                break
+            lo, hi = (t, hi) if total >= 5.0 else (lo, t)
+    raise RuntimeError("no narrow target in 200 attempts")  # pragma: no cover
 
 
 def _solve_ik_cases(rng: np.random.Generator) -> list[Case]:
     q = _IIWA.random_q(3, rng)
     starts = _IIWA.random_q(3, rng)
-    hard = _psi_zero_infeasible(rng)
-    near = np.clip(hard + rng.normal(0.0, 0.05, 7), _IIWA.qmin, _IIWA.qmax)
-    hard2 = _psi_zero_infeasible(rng)
+    hard = [_psi_zero_infeasible(rng) for _ in range(4)]
+    near = np.clip(hard[0] + rng.normal(0.0, 0.05, 7), _IIWA.qmin, _IIWA.qmax)
+    narrow = [_narrow(rng) for _ in range(2)]
+    blocked = _no_feasible_arm_angle(rng)
     far = np.eye(4)
     far[:3, 3] = [1.2, 0.3, 0.5]
     return [
         *[Case((_IIWA.fk(qi).tolist(), si.tolist()), label="a random reachable target, random start")
           for qi, si in zip(q, starts)],
-        Case((_IIWA.fk(hard).tolist(), near.tolist()), label="arm angle 0 breaks a limit on every branch; start nearby"),
-        Case((_IIWA.fk(hard2).tolist(), _IIWA.random_q(rng=rng).tolist()),
-             label="arm angle 0 breaks a limit on every branch; random start"),
+        Case((_IIWA.fk(hard[0]).tolist(), near.tolist()), label="arm angle 0 breaks a limit on every branch; start nearby"),
+        *[Case((_IIWA.fk(h).tolist(), _IIWA.random_q(rng=rng).tolist()),
+               label="arm angle 0 breaks a limit on every branch; random start") for h in hard[1:]],
+        *[Case((_IIWA.fk(n).tolist(), _IIWA.random_q(rng=rng).tolist()),
+               label="feasible arm angles total under 5 deg, none at a multiple of 10 deg") for n in narrow],
+        Case((_IIWA.fk(blocked).tolist(), [0.0] * 7), raises="ValueError",
+             label="wrist centre in reach, but no arm angle keeps every joint inside its limits"),
         Case((far.tolist(), [0.0] * 7), raises="ValueError", label="target 1.3 m away: out of reach"),
     ]
 
@@ -304,6 +347,6 @@ EXERCISES = [
                     "robokit.arm.ik_reference.ik_numeric_reference", "robokit.arm.position_posture.ik_position_posture"),
         compare=_reaches_target,
         description=("Open: iiwa joints inside the limits reaching T to 1e-6 m and rad, any method; "
-                     "ValueError when no posture reaches it."),
+                     "ValueError when no posture inside the limits reaches it (out of reach, or no arm angle)."),
     ),
 ]
