@@ -33,7 +33,7 @@ from ..validation import as_points, check_callable, check_choice, check_int, che
 from ..vision.stereo import StereoCalibration
 from .visual_slam import DESCRIPTORS, FEATURE_METHODS, VisualSLAM
 
-__all__ = ["LAB_TEST_POSES", "PAPER_RESULT", "LabExperiment", "MapConsistency", "calibrated_rig", "mapping_run",
+__all__ = ["EXPERIMENT_MODULES", "LAB_TEST_POSES", "PAPER_RESULT", "LabExperiment", "MapConsistency", "calibrated_rig", "mapping_run",
            "lab_experiment", "map_consistency"]
 
 #: Eight test poses ``[x, y, theta]`` in the simulator's frame, in free space near the lap, with
@@ -41,6 +41,21 @@ __all__ = ["LAB_TEST_POSES", "PAPER_RESULT", "LabExperiment", "MapConsistency", 
 LAB_TEST_POSES = np.array([
     [4.0, 2.3, 0.2], [6.0, 1.8, -0.15], [7.4, 3.5, 1.4], [7.5, 6.5, 1.85],
     [6.0, 8.2, 3.0], [4.2, 7.7, -2.9], [2.8, 6.5, -1.4], [2.9, 3.5, -1.75]])
+
+#: The robokit modules whose code decides the experiment's result, and so its cache key
+#: (:func:`robokit.config.code_version`): what this module imports, followed to the module that
+#: defines each name, and so on. Listed by module rather than by package so that an edit to, say,
+#: the outdoor worlds does not rebuild the lab's map; ``tests/test_localization_lab_experiment.py``
+#: checks that the list covers every module reached that way.
+EXPERIMENT_MODULES = (
+    "validation", "config", "progress",
+    "geometry.paper_frames", "geometry.planar", "geometry.procrustes", "geometry.rotations", "geometry.spatial",
+    "sim.build", "sim.camera", "sim.layout", "sim.motion", "sim.render", "sim.runs", "sim.textures", "sim.world",
+    "sim.worlds",
+    "vision.descriptors", "vision.features", "vision.matching", "vision.plot_detector", "vision.ransac",
+    "vision.stereo",
+    "mapping.landmarks",
+    "localization.egomotion", "localization.hough", "localization.visual_slam", "localization.lab_experiment")
 
 #: Se, Lowe & Little (2002), Sec. 6: mean errors and run time of their global localization.
 PAPER_RESULT = {"translation_m": 0.06, "rotation_rad": np.deg2rad(1.2), "seconds": 2.5,
@@ -249,7 +264,7 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     slam = VisualSLAM(calibrated_rig(render_rig), method=method, descriptor=descriptor, rng=seed)
     meta = {"method": method, "descriptor": descriptor, "rate": rate, "frames": frames, "fast": bool(FAST),
             "test_poses": np.round(poses, 12).tolist(), "noise": noise, "seed": seed,
-            "code": code_version("sim", "geometry", "vision", "mapping", "localization")}
+            "code": code_version(*EXPERIMENT_MODULES)}
     target = cache_dir("lab") / f"experiment-{cache_key(**meta)}.npz"
     data = read_arrays(target, (*slam.to_arrays(), *_ROW_ARRAYS, "truth", "mapping_seconds"), meta)
     if data is not None:
