@@ -179,8 +179,9 @@ def source_digest(*packages: str) -> str:
     Parameters
     ----------
     *packages : str
-        Sub-package names of robokit (at least one), or ``"package.module"`` for one module (an
-        experiment keys its cache by its own module, not by every module beside it).
+        Sub-package names of robokit (at least one), ``"package.module"`` for one module (an
+        experiment keys its cache by its own module, not by every module beside it), or a
+        top-level module such as ``"validation"``.
 
     Returns
     -------
@@ -200,8 +201,8 @@ def source_digest(*packages: str) -> str:
     --------
     >>> len(source_digest("geometry")), source_digest("geometry") == source_digest("geometry", "sim")
     (16, False)
-    >>> source_digest("geometry.planar") == source_digest("geometry")
-    False
+    >>> source_digest("geometry.planar") == source_digest("geometry"), len(source_digest("validation"))
+    (False, 16)
     """
     root = Path(__file__).resolve().parent
     if not packages:
@@ -215,6 +216,8 @@ def source_digest(*packages: str) -> str:
             sources = [root / parts[0] / f"{parts[1]}.py"]
         elif len(parts) == 1 and (root / package).is_dir():
             sources = sorted((root / package).glob("*.py"))
+        elif len(parts) == 1 and (root / f"{package}.py").is_file():
+            sources = [root / f"{package}.py"]
         else:
             raise ValueError(f"packages: expected robokit sub-package or module names, got {package!r}")
         for source in sources:

@@ -714,6 +714,8 @@ SPECS: dict[str, Call] = {
                                                  "max_distance": Real(0.8, optional=True, inf_ok=True)}),
     "robokit.vision.plot_reference.reference_detect_plot": Call({"image": Array(image, "N,N|N,N,3|N,N,4"),
                                                                 "params": Obj(None, optional=True)}),
+    "robokit.vision.plot_detector.plot_scales": Call({"sigma0": Real(1.6, optional=True), "k": Real(1.26, optional=True),
+                                                      "n_scales": Int(9, optional=True)}),
     "robokit.vision.plot_detector.junction_strength": Call({"tensor": Array(np.tile([[1.0, 0.1], [0.1, 2.0]], (4, 5, 1, 1)),
                                                                             "...,2,2")}),
     "robokit.vision.stereo.observe_stereo": Call({"left": Obj(features), "right": Obj(features), "rig": Obj(calibration),

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..validation import as_array, check_int, check_positive
+from ..validation import as_array, check_finite_result, check_int, check_positive
 from .features import Keypoints, as_gray_image
 
 __all__ = ["PlotParams", "ScaleSpace", "plot_scales", "polynomial_expansion", "orientation_tensor",
@@ -149,12 +149,26 @@ def plot_scales(sigma0: float = 1.6, k: float = 2 ** (1 / 3), n_scales: int = 9)
     -------
     numpy.ndarray, shape (n_scales,)
 
+    Raises
+    ------
+    ValueError
+        For ``sigma0 <= 0``, ``k <= 1``, ``n_scales`` outside 3..16, or levels too large to be finite.
+
     Notes
     -----
     Lin et al. Sec. 2.i, the multi-scale strategy.
+
+    Examples
+    --------
+    >>> levels = plot_scales()                 # the detector's default levels
+    >>> len(levels), round(float(levels[0]), 2), round(float(levels[-1]), 2)
+    (9, 1.6, 10.16)
     """
     p = PlotParams(sigma0=sigma0, k=k, n_scales=n_scales)
-    return p.sigma0 * p.k ** np.arange(p.n_scales)
+    with np.errstate(over="ignore"):
+        levels = p.sigma0 * p.k ** np.arange(p.n_scales)
+    check_finite_result("sigma0, k, n_scales", levels)
+    return levels
 
 
 def _blur(img: np.ndarray, sigma: float) -> np.ndarray:
