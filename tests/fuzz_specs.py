@@ -615,7 +615,8 @@ SPECS: dict[str, Call] = {
                                                  "progress": Func(None, optional=True), "cache": Flag(False),
                                                  "options": Options({"max_time": 2.0})}, cheap=False),
     "robokit.outdoor.mission.simulate": Call({
-        "course": Obj(course), "seed": Int(0), "firing": Choice("chained"), "truck": Obj(_truck, optional=True),
+        "course": Obj(course), "seed": Int(0), "firing": Choice("chained"), "crosstalk": Flag(True),
+        "truck": Obj(_truck, optional=True),
         "max_time": Real(2.0, optional=True), "dt": Real(0.049), "keep_nmea": Int(20), "gps_noise": Real(2.5),
         "compass_accuracy": Real(0.035), "navigator_options": Mapping(None, optional=True)}, cheap=False),
     "robokit.outdoor.mission.summarize_runs": Call({"results": Obj(run_results)}),
