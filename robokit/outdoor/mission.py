@@ -139,7 +139,7 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", crosstal
     gps_noise : float, default 2.5
         Standard deviation (m) of the wandering GPS error per axis.
     compass_accuracy : float, default ``radians(2.0)``
-        Bound (rad) of the compass's constant calibration error (:class:`~robokit.outdoor.gps.Compass`;
+        Bound (rad) of the compass's total error after calibration (:class:`~robokit.outdoor.gps.Compass`;
         the paper: +-2 degrees, +-5 degrees at extreme latitudes; 1 degree resolution).
     navigator_options : dict, optional
         Extra keyword arguments for :class:`~robokit.outdoor.navigator.Navigator`, e.g.
