@@ -620,6 +620,11 @@ SPECS: dict[str, Call] = {
         "max_time": Real(2.0, optional=True), "dt": Real(0.049), "keep_nmea": Int(20), "gps_noise": Real(2.5),
         "compass_accuracy": Real(0.035), "navigator_options": Mapping(None, optional=True)}, cheap=False),
     "robokit.outdoor.mission.summarize_runs": Call({"results": Obj(run_results)}),
+    "robokit.outdoor.navigator.Navigator": Call({
+        "waypoints": Array(np.array([[LAT, LON]]), "N,2"), "truck": Obj(_truck), "cruise_speed": Real(0.7),
+        "arrival_radius": Real(2.0), "gps_gain": Real(0.3), "front": Real(1.2), "side": Real(0.8),
+        "bypass_distance": Real(1.5), "bypass_side": Real(0.35), "gains": Array(np.array([1.0, 0.5]), "2", optional=True),
+        "guidance": Choice("estimate")}),
     "robokit.outdoor.navigator.avoidance_decision": Call({
         "ranges": Array(np.array([6.45, 0.5, 0.6, 6.45]), "4", inf_ok=True), "front": Real(1.2), "side": Real(0.8),
         "prefer": Choice("left")}),

@@ -134,6 +134,15 @@ class Navigator:
     Position estimate: dead reckoning with the compass heading and the commanded speed, pulled
     towards each GPS fix (a complementary filter; e.g. Thrun et al. 2005, Sec. 3.2 in its
     steady-state, fixed-gain form).
+
+    Examples
+    --------
+    >>> from robokit.outdoor.truck import PAPER_TRUCK
+    >>> nav = Navigator(np.radians([[6.4594, 100.3509]]), PAPER_TRUCK)
+    >>> nav.state, nav.arrival_radius, nav.bypass_distance, nav.side, nav.bypass_side
+    ('GOTO', 2.0, 1.5, 0.8, 0.35)
+    >>> nav.update([6.45, 6.45, 6.45, 6.45], 0.049)           # no GPS fix or compass heading yet: wait
+    (0.0, 0.0)
     """
 
     def __init__(self, waypoints: Any, truck: SkidSteerTruck, *, cruise_speed: float = 0.7,
