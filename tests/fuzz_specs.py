@@ -615,10 +615,16 @@ SPECS: dict[str, Call] = {
                                                  "progress": Func(None, optional=True), "cache": Flag(False),
                                                  "options": Options({"max_time": 2.0})}, cheap=False),
     "robokit.outdoor.mission.simulate": Call({
-        "course": Obj(course), "seed": Int(0), "firing": Choice("chained"), "truck": Obj(_truck, optional=True),
+        "course": Obj(course), "seed": Int(0), "firing": Choice("chained"), "crosstalk": Flag(True),
+        "truck": Obj(_truck, optional=True),
         "max_time": Real(2.0, optional=True), "dt": Real(0.049), "keep_nmea": Int(20), "gps_noise": Real(2.5),
         "compass_accuracy": Real(0.035), "navigator_options": Mapping(None, optional=True)}, cheap=False),
     "robokit.outdoor.mission.summarize_runs": Call({"results": Obj(run_results)}),
+    "robokit.outdoor.navigator.Navigator": Call({
+        "waypoints": Array(np.array([[LAT, LON]]), "N,2"), "truck": Obj(_truck), "cruise_speed": Real(0.7),
+        "arrival_radius": Real(2.0), "gps_gain": Real(0.3), "front": Real(1.2), "side": Real(0.8),
+        "bypass_distance": Real(1.5), "bypass_side": Real(0.35), "gains": Array(np.array([1.0, 0.5]), "2", optional=True),
+        "guidance": Choice("estimate")}),
     "robokit.outdoor.navigator.avoidance_decision": Call({
         "ranges": Array(np.array([6.45, 0.5, 0.6, 6.45]), "4", inf_ok=True), "front": Real(1.2), "side": Real(0.8),
         "prefer": Choice("left")}),

@@ -44,10 +44,12 @@ def compass_bias(fixes, compass_deg) -> float:
 
     Notes
     -----
-    The direction of travel is the principal axis of the fixes (a total-least-squares line, robust
-    to the GPS's sideways scatter), oriented from the first to the last fix; the bias is the circular
-    mean of the readings minus that course. One way among several: the cases accept any estimate
-    within a degree.
+    The direction of travel is the principal axis of the fixes (a total-least-squares line), refitted
+    without the fixes more than three robust standard deviations (1.4826 times the median distance)
+    off the previous line until that set stops changing (at most five fits), so that a few poor fixes
+    do not tilt it. The
+    line is oriented from the first to the last fix; the bias is the circular mean of the readings
+    minus that course. One way among several: the cases accept any estimate within a degree.
 
     Examples
     --------
@@ -58,8 +60,15 @@ def compass_bias(fixes, compass_deg) -> float:
     """
     p = as_points(fixes, "fixes", 2, min_count=2)
     c = as_array(compass_deg, "compass_deg", shape=(len(p),))
-    centred = p - p.mean(axis=0)
-    axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+    keep = np.ones(len(p), dtype=bool)
+    for _ in range(5):
+        centre = p[keep].mean(axis=0)
+        axis = np.linalg.svd(p[keep] - centre, full_matrices=False)[2][0]
+        off = np.abs((p - centre) @ np.array([-axis[1], axis[0]]))      # distance from the line
+        spread = 1.4826 * np.median(off[keep])
+        if spread == 0 or len(p) < 5 or np.array_equal(keep, off <= 3 * spread):
+            break
+        keep = off <= 3 * spread
     if np.dot(axis, p[-1] - p[0]) < 0:
         axis = -axis
     course = np.arctan2(axis[0], axis[1])                       # clockwise from north
@@ -69,29 +78,63 @@ def compass_bias(fixes, compass_deg) -> float:
 
 
 def _calibration_drive(rng: np.random.Generator, length: float = 120.0, *, heading: float | None = None,
-                      bias: float | None = None, gps_sigma: float = 0.8, poor_start: float = 0.0):
-    """A straight drive at 0.7 m/s with 1 Hz fixes and whole-degree compass readings: (fixes, compass, true bias)."""
+                       bias: float | None = None, gps_sigma: float = 0.8, poor: int = 0, poor_at: str = "start",
+                       wander: float = 0.0):
+    """A straight drive at 0.7 m/s with 1 Hz fixes and whole-degree compass readings: (fixes, compass, true bias).
+
+    The bias has a random sign and a magnitude in [1.5, 5] degrees unless given; ``poor`` fixes at the
+    ``poor_at`` end ("start": after power-up, "end": under trees, "both") lie 5-10 m to one side; ``wander``
+    (m) adds a slowly varying GPS error (Gauss-Markov, 30 s correlation time) on top of the scatter.
+    """
     n = max(2, int(round(length / 0.7)))
     psi = float(rng.uniform(0, 360)) if heading is None else heading
-    b = float(rng.uniform(-5, 5)) if bias is None else bias
+    b = float(rng.choice([-1.0, 1.0]) * rng.uniform(1.5, 5.0)) if bias is None else bias
     t = np.arange(n) * 0.7
     start = rng.uniform(10, 40, 2)
     truth = start + np.column_stack([t * np.sin(np.radians(psi)), t * np.cos(np.radians(psi))])
     fixes = truth + rng.normal(0, gps_sigma, (n, 2))
+    if wander:
+        phi = np.exp(-1.0 / 30.0)
+        drift = np.zeros((n, 2))
+        drift[0] = rng.normal(0, wander, 2)
+        for k in range(1, n):
+            drift[k] = phi * drift[k - 1] + np.sqrt(1 - phi * phi) * rng.normal(0, wander, 2)
+        fixes += drift
     side = np.array([np.cos(np.radians(psi)), -np.sin(np.radians(psi))])
-    fixes[:3] += poor_start * side                               # first fixes after power-up
+    for end in ("start", "end"):
+        if poor and poor_at in (end, "both"):
+            rows = slice(0, poor) if end == "start" else slice(n - poor, n)
+            fixes[rows] += rng.uniform(5.0, 10.0, (poor, 1)) * side * rng.choice([-1.0, 1.0])
     compass = np.round(psi + b + rng.normal(0, 0.5, n)) % 360.0
     return np.round(fixes, 2), compass, b
 
 
+#: The kinds of calibration drive in the open exercise's cases: (label, keyword arguments of _calibration_drive).
+#: ``poor=True`` means a random number (2-8) of poor fixes.
+BIAS_DRIVES = (
+    ("straight drive", {}),
+    ("heading close to north: readings either side of 0/360, poor first fixes", {"heading": 359.6, "poor": True}),
+    ("poor first fixes after power-up", {"poor": True}),
+    ("poor first fixes after power-up", {"poor": True}),
+    ("poor last fixes (under trees at the end)", {"poor": True, "poor_at": "end"}),
+    ("poor last fixes (under trees at the end)", {"poor": True, "poor_at": "end"}),
+    ("poor first and last fixes", {"poor": True, "poor_at": "both"}),
+    ("poor first and last fixes", {"poor": True, "poor_at": "both"}),
+    ("slowly wandering GPS error, poor first fixes", {"wander": 0.4, "length": 200.0, "poor": True}),
+    ("slowly wandering GPS error, poor last fixes", {"wander": 0.4, "length": 200.0, "poor": True, "poor_at": "end"}),
+)
+
+
 def _bias_cases(rng: np.random.Generator) -> list[Case]:
-    drives = [_calibration_drive(rng) for _ in range(3)]
-    drives.append(_calibration_drive(rng, heading=359.6, bias=0.8))
-    drives.append(_calibration_drive(rng, poor_start=4.0))
-    labels = ["straight drive"] * 3 + ["heading close to north: readings either side of 0/360",
-                                       "poor first fixes after power-up"]
-    cases = [Case((f.tolist(), c.tolist()), label=lab) for (f, c, _), lab in zip(drives, labels)]
-    f, c, _ = drives[0]
+    cases, first = [], None
+    for label, kwargs in BIAS_DRIVES:
+        kw = dict(kwargs)
+        if kw.get("poor") is True:
+            kw["poor"] = int(rng.integers(2, 9))
+        f, c, _ = _calibration_drive(rng, **kw)
+        first = first or (f, c)
+        cases.append(Case((f.tolist(), c.tolist()), label=label))
+    f, c = first
     return cases + [Case(([f[0].tolist()], [c[0]]), raises="ValueError", label="a single fix"),
                     Case((f.tolist(), c[:-1].tolist()), raises="ValueError", label="one reading missing")]
 

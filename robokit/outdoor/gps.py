@@ -110,7 +110,8 @@ class GPSReceiver:
         self.last_error = np.zeros(2)
 
     def fix(self, t: float, position: Any, speed: float, heading: float, destination: Any = None,
-            destination_id: str = "001") -> list[str]:
+            destination_id: str = "001", *, origin: Any = None, origin_id: str = "000",
+            arrival_radius: float = 2.0) -> list[str]:
         """Advance the error one period and return the NMEA sentences of a fix at time ``t``.
 
         Parameters
@@ -127,9 +128,19 @@ class GPSReceiver:
             ``[latitude, longitude]`` (radians) of the active waypoint. When given, the receiver
             also sends ``$GPRMB``: its own range and bearing from this (noisy) fix to the waypoint,
             computed on the sphere (:func:`~robokit.outdoor.geodesy.haversine_distance_bearing`)
-            and written, as NMEA does, in nautical miles to 0.001 and degrees to 0.1.
+            and written, as NMEA does, in nautical miles to 0.001 and degrees to 0.1, with the closing
+            velocity ``speed * cos(course - bearing)`` and the arrival status.
         destination_id : str, default "001"
             The waypoint's name in the RMB sentence.
+        origin : array_like, shape (2,), optional
+            ``[latitude, longitude]`` (radians) where the active leg starts (the previous waypoint
+            or the start). When given, RMB carries the cross-track error: the fix's signed distance
+            (m) from the straight leg origin -> destination in the local plane, with the side to
+            steer back; without it the cross-track field is 0.
+        origin_id : str, default "000"
+            The origin's name in the RMB sentence.
+        arrival_radius : float, default 2.0
+            RMB's arrival status is "A" when the unrounded range from the fix is below this (m).
 
         Returns
         -------
@@ -148,12 +159,17 @@ class GPSReceiver:
         >>> plane = LocalTangentPlane(*UNIMAP_ORIGIN)
         >>> gps = GPSReceiver(plane, noise=0.0, white_noise=0.0)
         >>> wp = np.column_stack(plane.to_geodetic([[60.0, 30.0]]))[0]
-        >>> gps.fix(0.0, [0.0, 30.0], 0.7, 0.0, destination=wp)[2]      # 60 m due east
-        '$GPRMB,A,0.000,L,000,001,0627.5563,N,10021.0625,E,0.032,90.0,0.0,V,A*57'
+        >>> gps.fix(0.0, [0.0, 30.0], 0.7, 0.0, destination=wp)[2]      # 60 m due east, closing at 0.7 m/s
+        '$GPRMB,A,0.000,L,000,001,0627.5563,N,10021.0625,E,0.032,90.0,1.4,V,A*52'
+        >>> start = np.column_stack(plane.to_geodetic([[0.0, 33.0]]))[0]   # leg from 3 m further north
+        >>> gps.fix(1.0, [0.0, 30.0], 0.7, 0.0, destination=wp, origin=start)[2].split(",")[2:4]
+        ['0.002', 'L']
         """
         p = as_array(position, "position", shape=(2,))
         ts = check_positive(t, "t", allow_zero=True)
         goal = None if destination is None else as_array(destination, "destination", shape=(2,))
+        leg_start = None if origin is None else as_array(origin, "origin", shape=(2,))
+        radius = check_positive(arrival_radius, "arrival_radius", allow_zero=True)
         phi = math.exp(-self.period / self.tau)
         self.bias = phi * self.bias + math.sqrt(1 - phi * phi) * self.noise * self.rng.normal(size=2)  # Gauss-Markov
         self.last_error = self.bias + self.white_noise * self.rng.normal(size=2)
@@ -166,8 +182,17 @@ class GPSReceiver:
                gga_sentence(when.time(), lat_d, lon_d, quality=1, satellites=8, hdop=hdop, altitude_m=12.0)]
         if goal is not None:   # the receiver's own navigation to the active waypoint
             rng_m, brg = haversine_distance_bearing(float(lat), float(lon), float(goal[0]), float(goal[1]))
+            closing = v * math.cos(math.radians(heading_to_compass(heading)) - float(brg))
+            xte = 0.0
+            if leg_start is not None:
+                a, b = (self.plane.to_local(*leg_start), self.plane.to_local(*goal))
+                u = (b - a) / max(float(np.hypot(*(b - a))), 1e-9)
+                rel = p + self.last_error - a
+                xte = -float(u[0] * rel[1] - u[1] * rel[0])     # left of the leg: steer right (negative)
             out.append(rmb_sentence(math.degrees(goal[0]), math.degrees(goal[1]), range_m=float(rng_m),
-                                    bearing_deg=math.degrees(brg), destination_id=destination_id))
+                                    bearing_deg=math.degrees(brg), cross_track_m=xte, origin_id=origin_id,
+                                    destination_id=destination_id, closing_velocity_mps=closing,
+                                    arrived=bool(rng_m < radius)))
         return out
 
 
@@ -179,9 +204,11 @@ class Compass:
     noise : float, default ``radians(0.5)``
         Standard deviation of the heading noise from reading to reading (rad).
     accuracy : float, default ``radians(2.0)``
-        Bound of the error left after calibration (rad): each compass gets one constant bias drawn
-        uniformly in ``[-accuracy, accuracy]``. Hamid et al. give +-2 degrees for the eTrex's compass
-        and +-5 degrees at extreme northern and southern latitudes.
+        Bound of the total error after calibration (rad): Hamid et al. give +-2 degrees for the
+        eTrex's compass and +-5 degrees at extreme northern and southern latitudes. Each compass gets
+        one constant bias drawn uniformly within ``accuracy - resolution / 2``; bias plus noise is
+        kept within that bound too, so that after rounding to the resolution every reading is within
+        ``accuracy`` of the truth (within ``resolution / 2`` when ``accuracy`` is smaller).
     resolution : float, default ``radians(1.0)``
         The compass reports whole multiples of this (rad); the paper's compass: 1 degree.
     variation : float, default ``radians(-0.3)``
@@ -194,6 +221,8 @@ class Compass:
     ----------
     bias : float
         This compass's constant error (rad, clockwise positive like the compass heading).
+    bound : float
+        Bound of bias plus noise before rounding (rad), ``max(0, accuracy - resolution / 2)``.
 
     Raises
     ------
@@ -211,9 +240,9 @@ class Compass:
     --------
     >>> Compass(noise=0.0, accuracy=0.0).reading(np.pi / 2)   # facing north; magnetic 0.3 rounds to 0
     '$HCHDG,0.0,0.0,E,0.3,W*53'
-    >>> c = Compass(noise=0.0, rng=4)                          # a +-2 degree compass: this one's bias
+    >>> c = Compass(noise=0.0, rng=4)                          # a +-2 degree compass: bias within +-1.5
     >>> round(float(np.degrees(c.bias)), 2), c.reading(np.pi / 2)
-    (1.77, '$HCHDG,2.0,0.0,E,0.3,W*51')
+    (1.33, '$HCHDG,2.0,0.0,E,0.3,W*51')
     """
 
     def __init__(self, *, noise: float = math.radians(0.5), accuracy: float = math.radians(2.0),
@@ -224,7 +253,8 @@ class Compass:
         self.resolution = check_positive(resolution, "resolution")
         self.variation = check_finite_scalar(variation, "variation")
         self.rng = as_rng(rng)
-        self.bias = float(self.rng.uniform(-self.accuracy, self.accuracy)) if self.accuracy else 0.0
+        self.bound = max(0.0, self.accuracy - self.resolution / 2)     # bias + noise, before rounding
+        self.bias = float(self.rng.uniform(-self.bound, self.bound)) if self.bound else 0.0
 
     def reading(self, heading: float) -> str:
         """Return the ``$HCHDG`` sentence for a true field heading (rad CCW from east).
@@ -232,11 +262,12 @@ class Compass:
         Notes
         -----
         HDG layout, NMEA 0183 v4.11 Sec. 6.3; the compass sentence of Hamid et al. (2009): magnetic
-        heading + bias + noise, rounded to the resolution.
+        heading + bias + noise (together within ``accuracy - resolution / 2``), rounded to the resolution.
         """
         noise_deg, variation_deg = math.degrees(self.noise), math.degrees(self.variation)   # NMEA's unit
-        true_deg = heading_to_compass(heading) + math.degrees(self.bias)
-        true_deg += self.rng.normal(0.0, noise_deg) if noise_deg else 0.0
+        error = math.degrees(self.bias) + (self.rng.normal(0.0, noise_deg) if noise_deg else 0.0)
+        bound = math.degrees(self.bound)
+        true_deg = heading_to_compass(heading) + min(max(error, -bound), bound)
         step = math.degrees(self.resolution)
         magnetic = (round((true_deg - variation_deg) / step) * step) % 360.0
         return hdg_sentence(magnetic, deviation_deg=0.0, variation_deg=variation_deg)

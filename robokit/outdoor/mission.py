@@ -2,8 +2,8 @@
 
 Every control step (one sonar slot, 49 ms) the true truck moves, one sonar of the daisy chain pings
 (or all four free-run with cross-talk), the compass sends ``$HCHDG`` every other step, the GPS sends
-``$GPRMC``, ``$GPGGA`` and ``$GPRMB`` (its own range and bearing to the active waypoint) once a
-second, and the :class:`~robokit.outdoor.navigator.Navigator` -
+``$GPRMC``, ``$GPGGA`` and ``$GPRMB`` (its own range, bearing, cross-track error, closing velocity
+and arrival status for the active leg) once a second, and the :class:`~robokit.outdoor.navigator.Navigator` -
 which sees only that text and the sonar ranges - answers with a speed and yaw rate. Results follow
 the experiment of Hamid et al. (2009): waypoints reached, collisions, path length
 relative to the straight legs, and time. A collision ends the run, as it would end a real trial:
@@ -50,7 +50,11 @@ class RunResult:
     collisions : int
         1 if the truck's body touched an obstacle (which ended the run), else 0.
     avoidances : int
-        Times the navigator entered its AVOID state.
+        Times the navigator entered its AVOID state: ``encounters + reentries``.
+    encounters : int
+        Entries into AVOID from GOTO: a new obstacle met while heading for the waypoint.
+    reentries : int
+        Entries into AVOID from BYPASS: the truck was still getting past an obstacle.
     time : float
         Mission time (s) until the last waypoint, a collision or the time limit.
     path_length : float
@@ -81,6 +85,8 @@ class RunResult:
     n_waypoints: int
     collisions: int
     avoidances: int
+    encounters: int
+    reentries: int
     time: float
     path_length: float
     path_ratio: float
@@ -100,7 +106,8 @@ class RunResult:
         return self.reached == self.n_waypoints and self.collisions == 0
 
 
-def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: SkidSteerTruck | None = None,
+def simulate(course: Course, seed: int = 0, *, firing: str = "chained", crosstalk: bool = True,
+             truck: SkidSteerTruck | None = None,
              max_time: float | None = None, dt: float = 0.049, keep_nmea: int = 200,
              gps_noise: float = 2.5, compass_accuracy: float = math.radians(2.0),
              navigator_options: dict | None = None) -> RunResult:
@@ -114,7 +121,12 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: S
         Non-negative integer that seeds the GPS, compass and sonar noise and the real truck's slip.
     firing : {"chained", "free", "off"}, default "chained"
         Sonar firing: one sensor per 49 ms slot in a loop, all free-running with cross-talk, or
-        no sonar at all (the baseline that shows what the sonars are for).
+        no sonar at all (the baseline that shows what the sonars are for). Free-running sensors
+        keep their own 49 ms cycles: each starts at a random phase and its clock runs up to 0.5 %
+        fast or slow, so the phases drift slowly against each other.
+    crosstalk : bool, default True
+        With ``firing="free"``, whether a sensor hears the others' pings. ``False`` keeps the
+        free-running sensors' four-times-faster update without cross-talk, to tell the two apart.
     truck : SkidSteerTruck, optional
         The real truck; default: the paper's truck with slip drawn in [0.02, 0.12] and track
         expansion in [1.3, 1.8] (the navigator always assumes the nominal 0.05 and 1.5).
@@ -127,7 +139,7 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: S
     gps_noise : float, default 2.5
         Standard deviation (m) of the wandering GPS error per axis.
     compass_accuracy : float, default ``radians(2.0)``
-        Bound (rad) of the compass's constant calibration error (:class:`~robokit.outdoor.gps.Compass`;
+        Bound (rad) of the compass's total error after calibration (:class:`~robokit.outdoor.gps.Compass`;
         the paper: +-2 degrees, +-5 degrees at extreme latitudes; 1 degree resolution).
     navigator_options : dict, optional
         Extra keyword arguments for :class:`~robokit.outdoor.navigator.Navigator`, e.g.
@@ -160,13 +172,15 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: S
         raise TypeError(f"course: expected a Course from random_course(), got {type(course).__name__}")
     rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
     check_choice(firing, "firing", ("chained", "free", "off"))
+    if not isinstance(crosstalk, (bool, np.bool_)):
+        raise TypeError(f"crosstalk: expected True or False, got {describe(crosstalk)}")
     if truck is not None and not isinstance(truck, SkidSteerTruck):
         raise TypeError(f"truck: expected a SkidSteerTruck or None, got {describe(truck)}")
     max_time = None if max_time is None else check_positive(max_time, "max_time")
     gps_noise = check_positive(gps_noise, "gps_noise", allow_zero=True)
     compass_accuracy = check_positive(compass_accuracy, "compass_accuracy", allow_zero=True)
     navigator_options = check_mapping(navigator_options, "navigator_options")
-    mission = _Mission(course, rng, firing, truck, check_positive(dt, "dt"), check_int(keep_nmea, "keep_nmea", minimum=0),
+    mission = _Mission(course, rng, firing, bool(crosstalk), truck, check_positive(dt, "dt"), check_int(keep_nmea, "keep_nmea", minimum=0),
                        gps_noise, compass_accuracy, navigator_options, max_time)
     while mission.t < mission.limit and not mission.nav.done and not mission.collisions:
         mission.send_nmea()
@@ -180,17 +194,20 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", truck: S
 class _Mission:
     """One mission's state, advanced one control step at a time by :func:`simulate`'s phases."""
 
-    def __init__(self, course: Course, rng: np.random.Generator, firing: str, truck: SkidSteerTruck | None,
+    def __init__(self, course: Course, rng: np.random.Generator, firing: str, crosstalk: bool,
+                 truck: SkidSteerTruck | None,
                  dt: float, keep: int, gps_noise: float, compass_accuracy: float, navigator_options: dict | None,
                  max_time: float | None):
         # set-up; the order of the random draws below is part of every seeded result
         self.course, self.field, self.rng, self.firing, self.dt, self.keep = course, course.field, rng, firing, dt, keep
+        self.crosstalk = crosstalk
         self.real = truck if truck is not None else dataclasses.replace(
             PAPER_TRUCK, slip=float(rng.uniform(0.02, 0.12)), icr_factor=float(rng.uniform(1.3, 1.8)))
         plane = LocalTangentPlane(*self.field.origin)
         legs = np.vstack([course.start[:2], course.waypoints])
         straight = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
         self.route = np.column_stack(plane.to_geodetic(course.waypoints))   # what the receiver stores
+        self.route_start = np.column_stack(plane.to_geodetic(course.start[:2].reshape(1, 2)))[0]
         self.nav = Navigator(self.route, PAPER_TRUCK, **dict(navigator_options or {}))
         self.offset = plane.to_local(self.nav.plane.lat0, self.nav.plane.lon0)  # navigator's frame -> field frame
         self.limit = 3 * straight / self.nav.cruise_speed + 120.0 if max_time is None else max_time
@@ -200,7 +217,9 @@ class _Mission:
         self.state = TruckState(np.array(course.start, dtype=float))
         self.ranges = np.full(4, self.sonar.max_range)
         self.phases = rng.uniform(0, dt, 4)                 # free-running sensors' power-up phases
-        self.t, self.k, self.length, self.collisions, self.avoidances = 0.0, 0, 0.0, 0, 0
+        self.clock_errors = rng.uniform(-0.005, 0.005, 4)   # and their clocks' errors: the phases drift
+        self.t, self.k, self.length, self.collisions = 0.0, 0, 0.0, 0
+        self.entries = {"GOTO": 0, "BYPASS": 0}             # entries into AVOID, by the state before
         self.previous = self.nav.state
         self.truth, self.estimate, self.states, self.range_log = [], [], [], []
         self.fixes, self.gps_errors, self.nmea = [], [], []
@@ -212,8 +231,10 @@ class _Mission:
         lines = []
         if self.k % 20 == 0:
             active = min(self.nav.target, len(self.route) - 1)      # the receiver follows the same route
+            origin = self.route[active - 1] if active else self.route_start
             lines = self.gps.fix(self.t, self.state.pose[:2], self.state.v, self.state.pose[2],
-                                 destination=self.route[active], destination_id=f"{active + 1:03d}")
+                                 destination=self.route[active], destination_id=f"{active + 1:03d}",
+                                 origin=origin, origin_id=f"{active:03d}", arrival_radius=self.nav.arrival_radius)
             self.fixes.append(self.state.pose[:2] + self.gps.last_error)
             self.gps_errors.append(float(np.hypot(*self.gps.last_error)))
         if self.k % 2 == 0:
@@ -224,15 +245,15 @@ class _Mission:
                 self.nmea.append(line)
 
     def ping_sonars(self) -> None:
-        """Sensors, sonar: one sensor of the daisy chain per step, or all four free-running."""
+        """Sensors, sonar: one sensor of the daisy chain per step, or all four free-running (own drifting clocks)."""
         if self.firing == "chained":
             i = self.k % 4
             self.ranges[i] = read_sensors(self.field, self.state.pose, [i], [self.t], sensor=self.sonar,
                                           rng=self.rng)[0]
         elif self.firing == "free":
-            times = self.t + self.phases
+            times = self.t + (self.phases + self.t * self.clock_errors) % self.dt
             self.ranges[:] = read_sensors(self.field, self.state.pose, [0, 1, 2, 3], times, sensor=self.sonar,
-                                          others=dict(enumerate(times)), rng=self.rng)
+                                          others=dict(enumerate(times)) if self.crosstalk else None, rng=self.rng)
 
     def navigate(self) -> tuple[float, float]:
         """Navigator: ``(v, omega)`` from the latest text and ranges; note arrivals and avoidances."""
@@ -241,7 +262,8 @@ class _Mission:
         if self.nav.target > before:  # arrival declared: how far is the truck really?
             self.arrival_errors.append(math.hypot(*(self.state.pose[:2] - self.course.waypoints[before])))
             self.arrival_points.append(self.state.pose[:2].copy())
-        self.avoidances += self.nav.state == "AVOID" and self.previous != "AVOID"
+        if self.nav.state == "AVOID" and self.previous != "AVOID":
+            self.entries[self.previous] = self.entries.get(self.previous, 0) + 1
         self.previous = self.nav.state
         return v, omega
 
@@ -267,7 +289,8 @@ class _Mission:
         legs = np.vstack(self.arrival_points + ([self.state.pose[:2]] if not self.nav.done else []))
         direct = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
         return RunResult(reached=len(self.nav.arrivals), n_waypoints=len(self.course.waypoints),
-                         collisions=int(self.collisions), avoidances=int(self.avoidances), time=self.t,
+                         collisions=int(self.collisions), avoidances=int(sum(self.entries.values())),
+                         encounters=int(self.entries["GOTO"]), reentries=int(self.entries["BYPASS"]), time=self.t,
                          path_length=self.length, path_ratio=self.length / direct if direct > 0 else math.nan,
                          arrival_errors=np.array(self.arrival_errors), gps_errors=np.array(self.gps_errors),
                          truth=np.array(self.truth), estimate=np.array(self.estimate),
@@ -354,7 +377,9 @@ def summarize_runs(results: list[RunResult]) -> dict:
     -------
     dict
         ``runs``, ``success_rate``, ``waypoints_reached`` (total / total), ``collisions`` (total and
-        per run), and ``min``/``median``/``max`` of ``path_ratio``, ``time`` and ``arrival_error``.
+        per run), avoidances per run, ``encounters_per_100m`` and ``reentries_per_100m`` (entries
+        into AVOID from GOTO and from BYPASS per 100 m driven, over all runs), and
+        ``min``/``median``/``max`` of ``path_ratio``, ``time`` and ``arrival_error``.
 
     Raises
     ------
@@ -379,6 +404,7 @@ def summarize_runs(results: list[RunResult]) -> dict:
     ratio = np.array([r.path_ratio for r in results])
     time = np.array([r.time for r in results])
     arr = np.concatenate([r.arrival_errors for r in results])
+    total = sum(r.path_length for r in results)     # metres driven, over all runs
 
     def stats(x):
         x = np.asarray(x, dtype=float)
@@ -389,5 +415,7 @@ def summarize_runs(results: list[RunResult]) -> dict:
             "collisions_total": int(sum(r.collisions for r in results)),
             "collisions_per_run": [r.collisions for r in results],
             "avoidances_per_run": [r.avoidances for r in results],
+            "encounters_per_100m": 100 * sum(r.encounters for r in results) / max(total, 1e-9),
+            "reentries_per_100m": 100 * sum(r.reentries for r in results) / max(total, 1e-9),
             "path_ratio": stats(ratio), "time_s": stats(time), "arrival_error_m": stats(arr),
             "gps_error_max_m": float(max(r.gps_errors.max() for r in results if r.gps_errors.size))}

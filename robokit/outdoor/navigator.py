@@ -113,6 +113,11 @@ class Navigator:
         Thresholds of :func:`avoidance_decision`.
     bypass_distance : float, default 1.5
         Straight run (m) after the front clears, before heading for the waypoint again.
+    bypass_side : float, default 0.35
+        During that run a side counts as blocked only below this range (m), less than ``side``: the
+        outer sensor on the obstacle's side sees the obstacle being passed, and without this
+        hysteresis every such reading would send the truck back to AVOID (as AVOID's own exit test
+        asks for more room than its entry test). Must not exceed ``side``.
     gains : array_like, optional
         ``[kp, kd]`` of the heading loop; default :func:`design_heading_gains` for 5 % overshoot
         and 1.5 s settling with the truck's motor lag.
@@ -120,18 +125,30 @@ class Navigator:
         ``"estimate"``: bearing and distance to the waypoint computed by us, in the local tangent
         plane, from the position estimate (GPS fixes blended with dead reckoning). ``"rmb"``: the
         receiver's own bearing and range from its latest ``$GPRMB`` about the active waypoint, as
-        the paper's truck reads them; until such a sentence arrives the truck waits.
+        the paper's truck reads them, and arrival when that sentence's arrival status is "A" (the
+        receiver's own test on the unrounded range; the range field's 0.001 nautical mile steps
+        are 1.852 m); until such a sentence arrives the truck waits.
 
     Notes
     -----
     Position estimate: dead reckoning with the compass heading and the commanded speed, pulled
     towards each GPS fix (a complementary filter; e.g. Thrun et al. 2005, Sec. 3.2 in its
     steady-state, fixed-gain form).
+
+    Examples
+    --------
+    >>> from robokit.outdoor.truck import PAPER_TRUCK
+    >>> nav = Navigator(np.radians([[6.4594, 100.3509]]), PAPER_TRUCK)
+    >>> nav.state, nav.arrival_radius, nav.bypass_distance, nav.side, nav.bypass_side
+    ('GOTO', 2.0, 1.5, 0.8, 0.35)
+    >>> nav.update([6.45, 6.45, 6.45, 6.45], 0.049)           # no GPS fix or compass heading yet: wait
+    (0.0, 0.0)
     """
 
     def __init__(self, waypoints: Any, truck: SkidSteerTruck, *, cruise_speed: float = 0.7,
                  arrival_radius: float = 2.0, gps_gain: float = 0.3, front: float = 1.2, side: float = 0.8,
-                 bypass_distance: float = 1.5, gains: Any = None, guidance: str = "estimate") -> None:
+                 bypass_distance: float = 1.5, bypass_side: float = 0.35, gains: Any = None,
+                 guidance: str = "estimate") -> None:
         wp = as_points(waypoints, "waypoints", 2, min_count=1)
         if np.any(np.abs(wp[:, 0]) >= np.pi / 2):
             raise ValueError("waypoints: expected [lat, lon] in radians with |lat| < pi/2 (did you pass degrees?)")
@@ -146,10 +163,14 @@ class Navigator:
         self.front = check_positive(front, "front")
         self.side = check_positive(side, "side")
         self.bypass_distance = check_positive(bypass_distance, "bypass_distance")
+        self.bypass_side = check_positive(bypass_side, "bypass_side")
+        if self.bypass_side > self.side:
+            raise ValueError(f"bypass_side: expected at most side = {self.side}, got {self.bypass_side}")
         kp, kd = design_heading_gains(truck.motor_tau, 0.05, 1.5) if gains is None else as_array(gains, "gains", shape=(2,))
         self.heading_loop = HeadingController(kp, kd, max_rate=0.8 * truck.max_turn_rate)
         self.guidance = check_choice(guidance, "guidance", GUIDANCE)
         self.rmb: tuple[float, float] | None = None     # latest (range m, field bearing rad) about the target
+        self.rmb_arrived = False                         # and its arrival status
         self.state = "GOTO"
         self.target = 0
         self.position: np.ndarray | None = None
@@ -180,6 +201,7 @@ class Navigator:
             if (rec.status == "A" and rec.destination_id == f"{self.target + 1:03d}"
                     and rec.range_m is not None and rec.bearing_deg is not None):
                 self.rmb = (rec.range_m, compass_to_heading(rec.bearing_deg))
+                self.rmb_arrived = rec.arrival == "A"
         elif isinstance(rec, HDG):
             if rec.heading_deg is not None:
                 h = compass_to_heading(rec.true_heading_deg)
@@ -218,9 +240,9 @@ class Navigator:
         if self.position is None or self.heading is None or self.state == "DONE":
             return 0.0, 0.0
         distance, bearing = self._to_target()
-        if distance < self.arrival_radius:
+        if self.rmb_arrived if self.guidance == "rmb" else distance < self.arrival_radius:
             self.arrivals.append((self.target, self.position.copy()))
-            self.target, self.rmb = self.target + 1, None
+            self.target, self.rmb, self.rmb_arrived = self.target + 1, None, False
             if self.target == len(self.waypoints):
                 self.state = "DONE"
                 return 0.0, 0.0
@@ -257,7 +279,8 @@ class Navigator:
                 self.state, self.bypassed, self.hold = "BYPASS", 0.0, self.heading
             else:
                 return 0.0, self.heading
-        # BYPASS: straight on past the obstacle, unless something new blocks the way
+        # BYPASS: straight on past the obstacle, unless something blocks the way (sides: hysteresis)
+        decision = avoidance_decision(r, self.front, self.bypass_side, prefer=self.turn)
         if decision != "forward":
             self.state = "AVOID"
             if decision != self.turn and min(r[1], r[2]) >= self.front:

@@ -25,11 +25,12 @@ References
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any, Sequence
 
 import numpy as np
 
-from ..geometry import se2_compose, wrap_angle
+from ..geometry import se2_compose
 from ..validation import (as_array, as_rng, check_choice, check_finite_scalar, check_int, check_positive,
                           check_sample_count)
 from ..sim.layout import Layout
@@ -451,10 +452,10 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
         for j, t_j in pending.items():
             if j == i or not np.isfinite(ranges[j]):
                 continue
-            v = hits[j] - sp[i, :2]
-            dist = float(np.hypot(*v))
-            bearing = np.arctan2(v[1], v[0]) - sp[i, 2]
-            if abs(wrap_angle(bearing)) > sensor.half_angle or dist > sensor.max_range:
+            vx, vy = float(hits[j, 0] - sp[i, 0]), float(hits[j, 1] - sp[i, 1])
+            dist = math.hypot(vx, vy)
+            bearing = (math.atan2(vy, vx) - float(sp[i, 2]) + math.pi) % (2 * math.pi) - math.pi   # wrapped
+            if abs(bearing) > sensor.half_angle or dist > sensor.max_range:
                 continue
             a = t_j + (ranges[j] + dist) / SPEED_OF_SOUND
             if t_i < a < arrival:
@@ -462,5 +463,5 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
         heard = SPEED_OF_SOUND * (arrival - t_i) / 2
         if np.isfinite(heard):
             heard += g.normal(0, sigma) if sigma else 0.0
-        out[n] = sensor.quantize(heard if np.isfinite(heard) else np.inf)
-    return out
+        out[n] = heard if np.isfinite(heard) else np.inf
+    return np.asarray(sensor.quantize(out), dtype=float).reshape(len(idx))
