@@ -17,6 +17,7 @@ from ..vision.plot_detector import junction_strength
 from ..vision.stereo import StereoCalibration, disparity_to_point, triangulate_svd
 from ..validation import as_array
 from .compare import close, exact, unordered_rows
+from .plain import numeric_array
 from .spec import Case, Exercise
 
 ASSIGNMENT = "01_visual_slam"
@@ -276,13 +277,11 @@ def robust_pose_problems(rng: np.random.Generator) -> list[tuple[np.ndarray, np.
 
 def _same_pose(expected, got) -> str | None:
     """:func:`close` within 2 cm and 0.02 rad, the heading compared modulo 2 pi (the answer is a heading)."""
-    try:
-        g = np.array(got, dtype=float)
-        e = np.asarray(expected, dtype=float)
-    except (TypeError, ValueError):
-        g = None
+    g, e = numeric_array(got), numeric_array(expected)      # the one rule for what counts as numbers
     note = ""
-    if g is not None and g.shape == (3,) and e.shape == (3,) and np.all(np.isfinite(g)):
+    if g is not None and e is not None and g.dtype.kind in "iuf" and g.shape == (3,) == e.shape \
+            and np.all(np.isfinite(g)):
+        g, e = g.astype(float), e.astype(float)
         turned = e[2] + wrap_angle(g[2] - e[2])
         if turned != g[2]:
             note = f" (your heading {g[2]:.6g} read as {turned:.6g}: headings are compared modulo 2 pi)"
