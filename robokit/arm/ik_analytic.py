@@ -98,6 +98,14 @@ class SRSArm:
         """Unchecked: target flange transforms (N, 4, 4) -> link-7 transforms in frame 0."""
         return T if self._plain else self._base_inv @ T @ self._tool_inv
 
+    def out_of_reach(self, L: float, *, known: bool = False) -> str | None:
+        """Unchecked: why a shoulder-wrist distance ``L`` [m] is out of reach, or ``None`` if it is not
+        (``known=True``: a kernel already found it out of reach; say so whatever ``L`` rounds to)."""
+        if not known and abs(self.d_se - self.d_ew) <= L <= self.d_se + self.d_ew:
+            return None
+        return (f"out of reach: shoulder-wrist distance {L:.4f} m outside "
+                f"[{abs(self.d_se - self.d_ew):.4f}, {self.d_se + self.d_ew:.4f}] m")
+
     def wrist_centre(self, T7: np.ndarray) -> np.ndarray:
         """Unchecked: wrist centre ``p - d_wf z_7`` of link-7 transforms (Huang & Jiang's step 1)."""
         return T7[..., :3, 3] - self.d_wf * T7[..., :3, 2]
@@ -302,8 +310,7 @@ def _reason(arm: SRSArm, status: int, ok: bool, pos: float, rot: float, c4: floa
     """Why a solve failed (or ``"converged"``)."""
     if status == 2:
         L = math.sqrt(max(0.0, c4 * 2 * arm.d_se * arm.d_ew + arm.d_se**2 + arm.d_ew**2))
-        return (f"out of reach: shoulder-wrist distance {L:.4f} m outside "
-                f"[{abs(arm.d_se - arm.d_ew):.4f}, {arm.d_se + arm.d_ew:.4f}] m")
+        return arm.out_of_reach(L, known=True)
     if status == 3:
         return "no arm angle keeps all joints within limits (the exact feasible arm-angle set is empty)"
     if not ok:

@@ -45,6 +45,7 @@ from ..geometry import as_se3, wrap_angle, zyz_angles
 from ..validation import check_choice, check_int, check_positive
 from .ik_analytic import SRSArm
 from .result import IKResult, verify
+from .srs import elbow_angle
 
 __all__ = ["ik_position_posture"]
 
@@ -113,13 +114,12 @@ def _newton(arm: SRSArm, target: np.ndarray, T7: np.ndarray, q0: np.ndarray, tol
     return _wrist_joints(arm, wrap_angle(q), T7, q0), steps
 
 
-def _joint_parameter(arm: SRSArm, target: np.ndarray, T7: np.ndarray, q0: np.ndarray,
+def _joint_parameter(arm: SRSArm, shoulder: np.ndarray, target: np.ndarray, T7: np.ndarray, q0: np.ndarray,
                      max_iter: int) -> tuple[np.ndarray, int]:
     """Step 2 with ``q3`` as the parameter: the current ``q3``, then ``max_iter`` values outward; returns (q, tries)."""
     chain = arm.chain
-    u = target - np.array([0.0, 0.0, arm.d_bs])
-    c4 = (u @ u - arm.d_se**2 - arm.d_ew**2) / (2 * arm.d_se * arm.d_ew)
-    q4 = np.arccos(np.clip(c4, -1.0, 1.0))
+    u = target - shoulder
+    q4 = elbow_angle(shoulder, target, arm.d_se, arm.d_ew)       # the law of cosines (Shimizu et al. Eq. 4)
     grid = chain.qmin[2] + (chain.qmax[2] - chain.qmin[2]) * (np.arange(max_iter) + 0.5) / max_iter
     values = np.concatenate([[q0[2]], grid[np.argsort(np.abs(grid - q0[2]), kind="stable")]])
     best, best_cost, fallback = None, np.inf, None
@@ -211,17 +211,16 @@ def ik_position_posture(chain: Any, T: Any, q0: Any = None, *, tol: float = 1e-6
     max_iter = check_int(max_iter, "max_iter", minimum=1)
     method = check_choice(method, "method", METHODS)
     target = arm.wrist_centre(T7)
-    L = float(np.linalg.norm(target - np.array([0.0, 0.0, arm.d_bs])))
-    if not abs(arm.d_se - arm.d_ew) <= L <= arm.d_se + arm.d_ew:
+    shoulder = np.array([0.0, 0.0, arm.d_bs])
+    unreachable = arm.out_of_reach(float(np.linalg.norm(target - shoulder)))
+    if unreachable:
         result = verify(arm.chain, T[None], q0[None], tol, check=False)[0]
-        result.success, result.iterations = False, 0
-        result.reason = (f"out of reach: shoulder-wrist distance {L:.4f} m outside "
-                         f"[{abs(arm.d_se - arm.d_ew):.4f}, {arm.d_se + arm.d_ew:.4f}] m")
+        result.success, result.iterations, result.reason = False, 0, unreachable
         return result
     if method == "newton":
         q_all, steps = _newton(arm, target, T7, q0, tol, max_iter)
     else:
-        q_all, steps = _joint_parameter(arm, target, T7, q0, max_iter)
+        q_all, steps = _joint_parameter(arm, shoulder, target, T7, q0, max_iter)
     result = verify(arm.chain, T[None], q_all[None], tol, check=False)[0]
     result.iterations = steps
     return result
