@@ -49,8 +49,6 @@ class RunResult:
     n_waypoints : int
     collisions : int
         1 if the truck's body touched an obstacle (which ended the run), else 0.
-    avoidances : int
-        Times the navigator entered its AVOID state: ``encounters + reentries``.
     encounters : int
         Entries into AVOID from GOTO: a new obstacle met while heading for the waypoint.
     reentries : int
@@ -79,12 +77,13 @@ class RunResult:
         Every sentence sent (first ``keep_nmea`` only).
     parse_errors : int
         Sentences the navigator rejected.
+    avoidances : int
+        Times the navigator entered its AVOID state, ``encounters + reentries`` (derived).
     """
 
     reached: int
     n_waypoints: int
     collisions: int
-    avoidances: int
     encounters: int
     reentries: int
     time: float
@@ -99,6 +98,11 @@ class RunResult:
     ranges: np.ndarray
     nmea: list
     parse_errors: int
+
+    @property
+    def avoidances(self) -> int:
+        """Entries into AVOID, new obstacles and re-entries together."""
+        return self.encounters + self.reentries
 
     @property
     def success(self) -> bool:
@@ -289,7 +293,7 @@ class _Mission:
         legs = np.vstack(self.arrival_points + ([self.state.pose[:2]] if not self.nav.done else []))
         direct = float(np.sum(np.hypot(*np.diff(legs, axis=0).T)))
         return RunResult(reached=len(self.nav.arrivals), n_waypoints=len(self.course.waypoints),
-                         collisions=int(self.collisions), avoidances=int(sum(self.entries.values())),
+                         collisions=int(self.collisions),
                          encounters=int(self.entries["GOTO"]), reentries=int(self.entries["BYPASS"]), time=self.t,
                          path_length=self.length, path_ratio=self.length / direct if direct > 0 else math.nan,
                          arrival_errors=np.array(self.arrival_errors), gps_errors=np.array(self.gps_errors),
