@@ -15,7 +15,7 @@ from ..arm import (LIMIT_TOL, dh_fk, dh_jacobian, dh_transform, elbow_angle, fea
                    wrist_centre)
 from ..geometry import as_se3, pose_error
 from .compare import close
-from .plain import summarize
+from .plain import numeric_array, summarize
 from .spec import Case, Exercise
 
 ASSIGNMENT = "06_redundant_ik"
@@ -80,10 +80,10 @@ def solve_ik(T: Any, q_start: Any) -> np.ndarray:
 
 def _reaches_target(expected: Any, got: Any) -> str | None:
     """Accept any 7 joint angles inside the iiwa's limits whose flange pose is the reference's (the target)."""
-    try:
-        q = np.array(got, dtype=float)
-    except (TypeError, ValueError):
+    q = numeric_array(got)                  # the one rule for what counts as numbers
+    if q is None or q.dtype.kind == "b":
         return f"expected 7 joint angles, got {summarize(got)}"
+    q = q.astype(float)
     if q.shape != (7,) or not np.all(np.isfinite(q)):
         return f"expected 7 finite joint angles (shape (7,)), got {summarize(got)}"
     err = pose_error(_IIWA.fk(np.asarray(expected, dtype=float)), _IIWA.fk(q))
