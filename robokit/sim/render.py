@@ -6,7 +6,9 @@ nearest surface per pixel. On a plane ``n . X = d`` (camera frame), inverse dept
 function of the pixel, ``1/Z = n . K^-1 [u, v, 1]^T / d``, so the depth image costs one multiply-add
 per pixel. Surfaces outside the view frustum are culled before any pixel work, polygons are clipped
 against a near plane (so no point behind the camera is ever projected) and far, small-looking
-textures are read from a coarser mip-map level (Williams 1983) to avoid aliasing.
+textures are read from a coarser mip-map level (Williams 1983) to avoid aliasing. What needs no
+pixels (projection, bounding box, plane, mip level, homography) is computed for every surface of
+a frame at once; only the rasterisation and the z-test go surface by surface, in the world's order.
 
 Pixel convention (OpenCV): the centre of pixel ``(col, row)`` is at image coordinates
 ``(u, v) = (col, row)``.
@@ -87,58 +89,83 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     # a surface is culled when all its corners lie outside one side of the view frustum
     outside = [z < near, fx * x + (cx + 0.5) * z < 0, fx * x - (width - 0.5 - cx) * z > 0,
                fy * y + (cy + 0.5) * z < 0, fy * y - (height - 0.5 - cy) * z > 0]
-    keep = ~np.any([o.all(axis=1) for o in outside], axis=0)
+    idx = np.flatnonzero(~np.any([o.all(axis=1) for o in outside], axis=0))
     image = np.zeros((height, width, 3), np.uint8)
     zinv_buf = np.zeros((height, width), np.float32)
-    for idx in np.flatnonzero(keep):
-        s = world.surfaces[idx]
-        poly = _clip(P[idx], np.array([0.0, 0.0, 1.0]), near)
-        if len(poly) < 3:
-            continue
-        uv = np.column_stack([fx * poly[:, 0] / poly[:, 2] + cx, fy * poly[:, 1] / poly[:, 2] + cy])
-        if np.abs(uv).max() > _FAR_PIXELS:
-            # clip to planes through the optical centre 2 px outside the image: what falls inside the
-            # image is unchanged, and projected coordinates stay small
-            for normal in ([fx, 0.0, cx + 2], [-fx, 0.0, width + 1 - cx], [0.0, fy, cy + 2],
-                           [0.0, -fy, height + 1 - cy]):
-                poly = _clip(poly, np.array(normal), 0.0)
-            if len(poly) < 3:
-                continue
-            uv = np.column_stack([fx * poly[:, 0] / poly[:, 2] + cx, fy * poly[:, 1] / poly[:, 2] + cy])
-        x0, y0 = np.maximum(np.floor(uv.min(axis=0)).astype(int), 0)
-        x1 = min(int(np.ceil(uv[:, 0].max())), width - 1)
-        y1 = min(int(np.ceil(uv[:, 1].max())), height - 1)
-        if x1 < x0 or y1 < y0:
-            continue
-        bw, bh = x1 - x0 + 1, y1 - y0 + 1
-        # inverse depth on the bounding box: plane n.X = d in the camera frame
-        n_c = R_cw @ s.normal
-        d = n_c @ P[idx, 0]
-        if abs(d) < 1e-12:  # plane seen edge-on: covers no pixel area
-            continue
-        w = np.linalg.solve(K.T, n_c) / d
-        zi = (w[0] * np.arange(x0, x1 + 1, dtype=np.float32)[None, :]
-              + w[1] * np.arange(y0, y1 + 1, dtype=np.float32)[:, None] + w[2]).astype(np.float32)
-        mask = np.zeros((bh, bw), np.uint8)
-        cv2.fillPoly(mask, [np.round((uv - [x0, y0]) * 16).astype(np.int32)], 1, lineType=cv2.LINE_8, shift=4)
+    # 1. every surface in view at once: its polygon in the image, bounding box, plane and texture map
+    Pk, arrays = P[idx], world.surface_arrays
+    with np.errstate(divide="ignore", invalid="ignore"):
+        polygons = np.stack([fx * Pk[..., 0] / Pk[..., 2] + cx, fy * Pk[..., 1] / Pk[..., 2] + cy], axis=-1)
+        simple = (Pk[..., 2] >= near).all(axis=1) & (np.abs(polygons).max(axis=(1, 2)) <= _FAR_PIXELS)
+    polygons = list(polygons)
+    lo, hi = np.floor(np.min(polygons, axis=1, initial=np.inf)), np.ceil(np.max(polygons, axis=1, initial=-np.inf))
+    zmin, zmax = Pk[..., 2].min(axis=1, initial=np.inf), Pk[..., 2].max(axis=1, initial=-np.inf)
+    seen = simple.copy()
+    for i in np.flatnonzero(~simple):   # a corner behind the near plane, or very far off the image: clip
+        poly = _clip_to_view(Pk[i], fx, fy, cx, cy, width, height, near)
+        if poly is not None:
+            polygons[i] = np.column_stack([fx * poly[:, 0] / poly[:, 2] + cx, fy * poly[:, 1] / poly[:, 2] + cy])
+            lo[i], hi[i] = np.floor(polygons[i].min(axis=0)), np.ceil(polygons[i].max(axis=0))
+            zmin[i], zmax[i] = poly[:, 2].min(), poly[:, 2].max()
+            seen[i] = True
+    box = np.column_stack([np.maximum(lo, 0), np.minimum(hi, [width - 1, height - 1])])  # x0, y0, x1, y1
+    seen &= (box[:, 2] >= box[:, 0]) & (box[:, 3] >= box[:, 1])
+    # inverse depth is affine in the pixel: plane n.X = d in the camera frame, 1/Z = (K^-T n / d) . [u, v, 1]
+    n_c = arrays["normal"][idx] @ R_cw.T
+    d = np.einsum("ij,ij->i", n_c, Pk[:, 0])
+    seen &= np.abs(d) >= 1e-12          # a plane seen edge-on covers no pixel area
+    with np.errstate(divide="ignore", invalid="ignore"):
+        plane = np.linalg.solve(K.T, n_c.T).T / d[:, None]
+        # mip level: texels per pixel at a representative depth of the visible part
+        zref = np.minimum(np.sqrt(zmin * zmax), 3 * zmin)
+        texels_per_pixel = zref / fx * arrays["mip_sizes"][idx, 0, 0] / arrays["u_length"][idx]
+        level = np.floor(np.log2(np.maximum(np.nan_to_num(texels_per_pixel, nan=1.0), 1.0)))
+    level = np.clip(level, 0, arrays["mip_levels"][idx] - 1).astype(int)
+    # homography from the chosen level's texture (pixel centres) to the bounding box
+    size = arrays["mip_sizes"][idx, level]
+    a_col = (arrays["u"][idx] @ R_cw.T) / size[:, :1]
+    b_col = (arrays["v"][idx] @ R_cw.T) / size[:, 1:]
+    M = K @ np.stack([a_col, b_col, Pk[:, 0] + 0.5 * (a_col + b_col)], axis=-1)
+    M[:, 0] -= box[:, :1] * M[:, 2]
+    M[:, 1] -= box[:, 1:2] * M[:, 2]
+    # 2. each surface in turn (in the world's order, which settles ties): rasterise, z-test, texture
+    box = box.astype(int).tolist()
+    cols, rows = np.arange(width, dtype=np.float32)[None, :], np.arange(height, dtype=np.float32)[:, None]
+    for i in np.flatnonzero(seen).tolist():
+        x0, y0, x1, y1 = box[i]
+        w = plane[i]
+        zi = (w[0] * cols[:, x0:x1 + 1] + w[1] * rows[y0:y1 + 1] + w[2]).astype(np.float32)
+        mask = np.zeros((y1 - y0 + 1, x1 - x0 + 1), np.uint8)
+        cv2.fillPoly(mask, [np.round((polygons[i] - [x0, y0]) * 16).astype(np.int32)], 1, lineType=cv2.LINE_8,
+                     shift=4)
         sub_z = zinv_buf[y0:y1 + 1, x0:x1 + 1]
         update = (mask > 0) & (zi > sub_z)
         if not update.any():
             continue
-        # mip level: texels per pixel at a representative depth of the visible part
-        lu = np.linalg.norm(s.u)
-        zmin, zmax = poly[:, 2].min(), poly[:, 2].max()
-        zref = min(np.sqrt(zmin * zmax), 3 * zmin)
-        texels_per_pixel = zref / fx * s.texture.shape[1] / lu
-        level = int(np.clip(np.floor(np.log2(max(texels_per_pixel, 1.0))), 0, len(s.pyramid) - 1))
-        tex = s.pyramid[level]
-        th, tw = tex.shape[:2]
-        a_col, b_col = R_cw @ s.u / tw, R_cw @ s.v / th
-        M = K @ np.column_stack([a_col, b_col, P[idx, 0] + 0.5 * (a_col + b_col)])
-        M = np.array([[1, 0, -x0], [0, 1, -y0], [0, 0, 1]], float) @ M
-        warped = cv2.warpPerspective(tex, M, (bw, bh), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-        np.copyto(image[y0:y1 + 1, x0:x1 + 1], warped, where=update[..., None])
-        np.copyto(sub_z, zi, where=update)
+        tex = world.surfaces[idx[i]].pyramid[level[i]]
+        warped = cv2.warpPerspective(tex, M[i], (x1 - x0 + 1, y1 - y0 + 1), flags=cv2.INTER_LINEAR,
+                                     borderMode=cv2.BORDER_REPLICATE)
+        # OpenCV's masked copy writes into the views (the image and the z-buffer) in place
+        cv2.copyTo(warped, update.view(np.uint8), image[y0:y1 + 1, x0:x1 + 1])
+        cv2.copyTo(zi, update.view(np.uint8), sub_z)
     with np.errstate(divide="ignore"):
         depth = np.where(zinv_buf > 0, 1.0 / zinv_buf, np.inf).astype(np.float32)
     return image, depth
+
+
+def _clip_to_view(corners: np.ndarray, fx: float, fy: float, cx: float, cy: float, width: int, height: int,
+                  near: float) -> np.ndarray | None:
+    """The part of a surface (camera frame) in front of the near plane, also clipped to the view's
+    sides when its image would reach beyond :data:`_FAR_PIXELS`; ``None`` if nothing is left."""
+    poly = _clip(corners, np.array([0.0, 0.0, 1.0]), near)
+    if len(poly) < 3:
+        return None
+    uv = np.column_stack([fx * poly[:, 0] / poly[:, 2] + cx, fy * poly[:, 1] / poly[:, 2] + cy])
+    if np.abs(uv).max() > _FAR_PIXELS:
+        # clip to planes through the optical centre 2 px outside the image: what falls inside the
+        # image is unchanged, and projected coordinates stay small
+        for normal in ([fx, 0.0, cx + 2], [-fx, 0.0, width + 1 - cx], [0.0, fy, cy + 2], [0.0, -fy, height + 1 - cy]):
+            poly = _clip(poly, np.array(normal), 0.0)
+        if len(poly) < 3:
+            return None
+    return poly

@@ -187,6 +187,24 @@ class World:
         """All surface corners, shape ``(N, 4, 3)`` (used by the renderer's culling)."""
         return np.stack([s.corners for s in self.surfaces])
 
+    @functools.cached_property
+    def surface_arrays(self) -> dict[str, np.ndarray]:
+        """The surfaces as arrays, for the renderer to treat every surface of a frame at once.
+
+        Keys: ``u``, ``v``, ``normal`` (N, 3) (as :attr:`Surface.u`, :attr:`Surface.v`,
+        :attr:`Surface.normal`), ``u_length`` (N,) metres, and ``mip_sizes`` (N, L, 2): width and
+        height of each :attr:`Surface.pyramid` level (``mip_levels`` (N,) of them; the last repeats
+        beyond).
+        """
+        pyramids = [s.pyramid for s in self.surfaces]
+        depth = max(len(p) for p in pyramids)
+        sizes = np.array([[lv.shape[1::-1] for lv in p] + [p[-1].shape[1::-1]] * (depth - len(p)) for p in pyramids],
+                         float)
+        return {"u": np.stack([s.u for s in self.surfaces]), "v": np.stack([s.v for s in self.surfaces]),
+                "normal": np.stack([s.normal for s in self.surfaces]),
+                "u_length": np.array([np.linalg.norm(s.u) for s in self.surfaces]),
+                "mip_levels": np.array([len(p) for p in pyramids]), "mip_sizes": sizes}
+
     @functools.lru_cache(maxsize=8)
     def slice(self, z: float) -> np.ndarray:
         """Wall segments ``(M, 2, 2)`` where solid surfaces cross the horizontal plane at height ``z``.
