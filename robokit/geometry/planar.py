@@ -54,13 +54,16 @@ def as_planar(value: Any, name: str) -> np.ndarray:
     return p
 
 
-def wrap_angle(angle: Any) -> Any:
+def wrap_angle(angle: Any, *, check: bool = True) -> Any:
     """Wrap angles to the interval [-pi, pi).
 
     Parameters
     ----------
     angle : float or array_like
         Angles in radians (finite).
+    check : bool, default True
+        Validate ``angle``; ``False`` is the fast path for inner loops whose angles are already
+        finite floats (a non-finite angle then comes back NaN instead of raising).
 
     Returns
     -------
@@ -82,7 +85,7 @@ def wrap_angle(angle: Any) -> Any:
     >>> print(round(wrap_angle(3 * np.pi / 2), 6))
     -1.570796
     """
-    a = as_array(angle, "angle")
+    a = as_array(angle, "angle") if check else np.asarray(angle, float)
     out = np.mod(a + np.pi, 2 * np.pi) - np.pi
     return float(out) if out.ndim == 0 else out
 

@@ -296,6 +296,36 @@ class MonteCarloLocalizer:
         self._reset(P, ellipse_weights(P, pose, sigma_x, sigma_y))       # Eq. (19)
 
     # --- the filter ----------------------------------------------------------------------------
+    def due(self, odometry_pose: Any) -> bool:
+        """Whether :meth:`update` with this odometry pose would run a filter update.
+
+        True when the odometry has moved more than ``update_min_d`` along x or y, or turned more
+        than ``update_min_a``, since the last update (ROS amcl's ``update_min_d`` and
+        ``update_min_a``); false before the first odometry pose is known. A simulation can skip
+        rendering a scan the filter would not use.
+
+        Parameters
+        ----------
+        odometry_pose : array_like, shape (3,)
+
+        Returns
+        -------
+        bool
+
+        Examples
+        --------
+        >>> from robokit.mapping import OccupancyGrid
+        >>> mcl = MonteCarloLocalizer(OccupancyGrid.from_probability(np.zeros((10, 10)), 0.1), n_particles=10)
+        >>> mcl.due([0.5, 0, 0]), mcl.update([0, 0, 0], [1.0]), mcl.due([0.1, 0, 0]), mcl.due([0.3, 0, 0])
+        (False, False, False, True)
+        """
+        odom = as_array(odometry_pose, "odometry_pose", shape=(3,))
+        if self._odom is None:
+            return False
+        d = odom - self._odom
+        return bool(abs(d[0]) > self.update_min_d or abs(d[1]) > self.update_min_d
+                    or abs(wrap_angle(d[2])) > self.update_min_a)
+
     def update(self, odometry_pose: Any, ranges: Any, angles: Any = None, *, force: bool = False) -> bool:
         """Feed one odometry pose and scan; run a filter update if the robot moved enough.
 
@@ -343,10 +373,7 @@ class MonteCarloLocalizer:
         if self._odom is None:
             self._odom = odom
             return False
-        d = odom - self._odom
-        moved = abs(d[0]) > self.update_min_d or abs(d[1]) > self.update_min_d or \
-            abs(wrap_angle(d[2])) > self.update_min_a
-        if not (moved or force):
+        if not (force or self.due(odom)):
             return False
         step = mcl_step(self.particles, self.weights, self._odom, odom, r, a, self.field, alphas=self.alphas,
                         resample=False, rng=self.rng, **self.model)

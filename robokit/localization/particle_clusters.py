@@ -101,6 +101,17 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     return renumber[labels]
 
 
+def _cluster_labels(particles: Any, bin_size: Any, labels: Any) -> np.ndarray:
+    if labels is None:
+        return pose_clusters(particles, bin_size)
+    P = as_array(particles, "particles", ndim=2, min_size=1)
+    lab = np.asarray(labels)
+    if lab.shape != (len(P),) or lab.dtype.kind not in "iu" or np.any(lab < 0):
+        raise ValueError(f"labels: expected one non-negative integer cluster label per particle ({len(P)}), "
+                         f"got {lab.dtype} array of shape {lab.shape}")
+    return lab
+
+
 def _cloud_weights(weights: Any, n: int) -> np.ndarray:
     if weights is None:
         return np.ones(n)
@@ -112,7 +123,8 @@ def _cloud_weights(weights: Any, n: int) -> np.ndarray:
     return w
 
 
-def largest_cluster_share(particles: Any, weights: Any = None, bin_size: Any = ROS_KLD_BIN_SIZE) -> float:
+def largest_cluster_share(particles: Any, weights: Any = None, bin_size: Any = ROS_KLD_BIN_SIZE, *,
+                          labels: Any = None) -> float:
     """The share of the cloud (by weight, or by count) in its largest cluster.
 
     Parameters
@@ -121,6 +133,9 @@ def largest_cluster_share(particles: Any, weights: Any = None, bin_size: Any = R
     weights : array_like, shape (N,), optional
         Non-negative; default equal weights (the share of particles).
     bin_size : array_like, shape (3,), default (0.5 m, 0.5 m, 10 degrees)
+    labels : array_like of int, shape (N,), optional
+        The particles' clusters, when :func:`pose_clusters` has already labelled them (with the same
+        ``bin_size``); default: label them here.
 
     Returns
     -------
@@ -144,13 +159,14 @@ def largest_cluster_share(particles: Any, weights: Any = None, bin_size: Any = R
     >>> largest_cluster_share([[0.1, 0.1, 0.0], [0.6, 0.1, 0.0], [5.0, 0.0, 0.0]], [0.1, 0.1, 0.8])
     0.8
     """
-    labels = pose_clusters(particles, bin_size)
+    labels = _cluster_labels(particles, bin_size, labels)
     w = _cloud_weights(weights, len(labels))
     totals = np.bincount(labels, weights=w)
     return float(totals.max() / totals.sum())
 
 
-def largest_cluster_mean(particles: Any, weights: Any = None, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarray:
+def largest_cluster_mean(particles: Any, weights: Any = None, bin_size: Any = ROS_KLD_BIN_SIZE, *,
+                         labels: Any = None) -> np.ndarray:
     """The weighted mean pose of the heaviest cluster: the estimate ROS amcl publishes.
 
     Parameters
@@ -159,6 +175,8 @@ def largest_cluster_mean(particles: Any, weights: Any = None, bin_size: Any = RO
     weights : array_like, shape (N,), optional
         Non-negative; default equal weights.
     bin_size : array_like, shape (3,), default (0.5 m, 0.5 m, 10 degrees)
+    labels : array_like of int, shape (N,), optional
+        As in :func:`largest_cluster_share`.
 
     Returns
     -------
@@ -181,7 +199,7 @@ def largest_cluster_mean(particles: Any, weights: Any = None, bin_size: Any = RO
     >>> largest_cluster_mean(cloud).round(3).tolist()       # the stray at x = 30 m does not count
     [10.1, 0.0, 0.0]
     """
-    labels = pose_clusters(particles, bin_size)
+    labels = _cluster_labels(particles, bin_size, labels)
     P = np.asarray(particles, float)
     w = _cloud_weights(weights, len(labels))
     heaviest = int(np.argmax(np.bincount(labels, weights=w)))

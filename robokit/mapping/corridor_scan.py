@@ -47,6 +47,8 @@ WIDTH_CASES = ("corridor", "facing doors", "staggered doors")
 _FOOT = 7                 # beams nearest a wall's normal that measure its distance
 _BIN = 0.02               # Hough bin (m) of the lateral coordinate
 _BAND = 0.05              # half-width (m) of a wall's inlier band for the line fit
+_CANDIDATES = np.deg2rad(np.arange(-90.0, 90.0, 1.0))      # the Hough vote's directions, 1 deg apart
+_ACROSS = np.stack([-np.sin(_CANDIDATES), np.cos(_CANDIDATES)])   # unit normal of each direction
 
 
 class NoWallError(ValueError):
@@ -94,28 +96,34 @@ def corridor_axis(ranges: Any, angles: Any) -> float:
     10.0
     """
     r, a = as_scan(ranges, angles)
+    return _axis(r, a)
+
+
+def _axis(r: np.ndarray, a: np.ndarray) -> float:
+    """:func:`corridor_axis` of a scan :func:`as_scan` has checked."""
     ok = np.isfinite(r)
-    if ok.sum() < 3:
+    if np.count_nonzero(ok) < 3:
         raise EmptyScanError(f"ranges: expected at least 3 valid returns to find the corridor axis, got {ok.sum()}")
     pts = r[ok, None] * np.column_stack([np.cos(a[ok]), np.sin(a[ok])])
-    cand = np.deg2rad(np.arange(-90.0, 90.0, 1.0))
-    s = pts @ np.stack([-np.sin(cand), np.cos(cand)])                # (N, 180) lateral coordinates
+    s = pts @ _ACROSS                                                 # (N, 180) lateral coordinates
     lo = np.floor(s.min() / _BIN)
     bins = (np.floor(s / _BIN) - lo).astype(np.int64)
     nb = int(bins.max()) + 1
-    counts = np.bincount((bins + nb * np.arange(len(cand))).ravel(), minlength=nb * len(cand))
-    score = (counts.reshape(len(cand), nb).astype(float) ** 2).sum(axis=1)      # Hough vote
-    axis = float(cand[np.argmax(score)])
+    counts = np.bincount((bins + nb * np.arange(len(_CANDIDATES))).ravel(), minlength=nb * len(_CANDIDATES))
+    counts = counts.reshape(len(_CANDIDATES), nb)
+    score = np.einsum("ij,ij->i", counts, counts)                    # Hough vote: sum of squared counts
+    axis = float(_CANDIDATES[np.argmax(score)])
     for _ in range(2):                                                           # TLS refinement
         s = pts @ np.array([-np.sin(axis), np.cos(axis)])
         scatter = np.zeros((2, 2))
         for side in (s > 0, s < 0):
-            if side.sum() < 3:
+            if np.count_nonzero(side) < 3:
                 continue
-            b = np.floor(s[side] / _BIN)
-            vals, cnt = np.unique(b, return_counts=True)
-            peak = (vals[np.argmax(cnt)] + 0.5) * _BIN
-            inl = pts[side][np.abs(s[side] - peak) < _BAND]
+            across = s[side]
+            b = np.floor(across / _BIN).astype(np.int64)
+            first = b.min()
+            peak = (np.argmax(np.bincount(b - first)) + first + 0.5) * _BIN      # the fullest bin (lowest on a tie)
+            inl = pts[side][np.abs(across - peak) < _BAND]
             if len(inl) >= 2:
                 c = inl - inl.mean(axis=0)
                 scatter += c.T @ c
@@ -123,7 +131,7 @@ def corridor_axis(ranges: Any, angles: Any) -> float:
             break
         u = np.linalg.eigh(scatter)[1][:, -1]
         axis = float(np.arctan2(u[1], u[0]))
-    return float(wrap_angle(2 * axis) / 2)        # modulo pi, in [-pi/2, pi/2)
+    return float(wrap_angle(2 * axis, check=False) / 2)        # modulo pi, in [-pi/2, pi/2)
 
 
 def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[float, float]:
@@ -169,10 +177,15 @@ def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[fl
     (0.8, 1.37)
     """
     r, a = as_scan(ranges, angles)
-    axis = corridor_axis(r, a) if heading is None else check_finite_scalar(heading, "heading")
+    axis = _axis(r, a) if heading is None else check_finite_scalar(heading, "heading")
+    return _wall_distances(r, a, axis)
+
+
+def _wall_distances(r: np.ndarray, a: np.ndarray, axis: float) -> tuple[float, float]:
+    """:func:`wall_distances` of a checked scan and axis."""
     out = []
     for name, normal in (("left", axis + np.pi / 2), ("right", axis - np.pi / 2)):
-        off = wrap_angle(a - normal)
+        off = wrap_angle(a - normal, check=False)
         foot = np.argsort(np.abs(off), kind="stable")[:_FOOT]
         along = r[foot] * np.cos(off[foot])
         if np.count_nonzero(np.isfinite(along)) < (len(foot) + 2) // 2:
@@ -220,12 +233,16 @@ def door_sides(ranges: Any, angles: Any, *, heading: Any = None, recess: float =
     (True, False)
     """
     r, a = as_scan(ranges, angles)
-    axis = corridor_axis(r, a) if heading is None else check_finite_scalar(heading, "heading")
+    axis = _axis(r, a) if heading is None else check_finite_scalar(heading, "heading")
     dda = check_positive(recess, "recess", allow_zero=True)
-    d = wall_distances(r, a, heading=axis)
+    return _door_sides(r, a, axis, dda, _wall_distances(r, a, axis))
+
+
+def _door_sides(r: np.ndarray, a: np.ndarray, axis: float, dda: float, d: tuple[float, float]) -> tuple[bool, bool]:
+    """:func:`door_sides` of a checked scan, axis and recess, given the wall distances ``d``."""
     out = []
     for dist, normal in zip(d, (axis + np.pi / 2, axis - np.pi / 2)):
-        off = wrap_angle(a - normal)
+        off = wrap_angle(a - normal, check=False)
         near = (np.abs(off) <= np.pi / 3) & np.isfinite(r)
         level = np.percentile(r[near] * np.cos(off[near]), 10) if near.any() else dist
         out.append(bool(dist - level > dda / 2))
@@ -420,9 +437,9 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
     n = int(np.sum((areas[:, 2] > lo) & (areas[:, 2] < hi)))      # Eq. (8)
     axis = None
     try:
-        axis = corridor_axis(r, a)
-        d_l, d_r = wall_distances(r, a, heading=axis)
-        at_door = door_sides(r, a, heading=axis, recess=recess)
+        axis = _axis(r, a)
+        d_l, d_r = _wall_distances(r, a, axis)
+        at_door = _door_sides(r, a, axis, recess, (d_l, d_r))
     except (EmptyScanError, NoWallError):
         return CorridorState(n > 0, n == 1, n, areas, (lo, hi), axis, np.inf, np.inf, None, False, None, "none")
     case = width_condition(d_l, d_r, width, recess=recess, tol=width_tol)

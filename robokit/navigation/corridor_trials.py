@@ -37,7 +37,7 @@ import numpy as np
 from ..config import cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays
 from ..controllers import move_to_middle_line
 from ..geometry import wrap_angle
-from ..localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share
+from ..localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share, pose_clusters
 from ..progress import progress_bar
 from ..sim import noisy_odometry, waypoint_path
 from ..vision import detect_orb_features
@@ -325,13 +325,16 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
     for k in range(first, len(truth)):
         if travelled[k] > max_distance:
             break
+        if k > first and not mcl.due(odometry[k]):
+            continue                  # the filter would not use this scan, so it is not simulated
         if not mcl.update(odometry[k], lidar.scan(world, truth[k], rng)):
             continue
-        estimates.append(largest_cluster_mean(mcl.particles, mcl.weights))
+        labels = pose_clusters(mcl.particles)
+        estimates.append(largest_cluster_mean(mcl.particles, mcl.weights, labels=labels))
         seen.append(truth[k])
         if clouds is not None:
             clouds.append(mcl.particles.copy())
-        if converged_at is None and largest_cluster_share(mcl.particles) >= share:
+        if converged_at is None and largest_cluster_share(mcl.particles, labels=labels) >= share:
             converged_at, distance = len(estimates), float(travelled[k])
         if converged_at is not None and len(estimates) >= converged_at + settle:
             break

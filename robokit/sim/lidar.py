@@ -131,7 +131,8 @@ class Lidar:
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
         sp = self.sensor_pose(robot_pose)
         world.check_viewpoint([sp[0], sp[1], self.height], "robot_pose", clearance=0.0)
-        true = world.layout(self.height).raycast(sp[:2], self.angles + sp[2], check=False)
+        # obstacles out of reach are skipped (max_range); a miss within it reads 2 r_max, out of range below
+        true = world.layout(self.height).raycast(sp[:2], self.angles + sp[2], 2 * self.r_max, check=False)
         out = true.copy()
         if self.noise > 0:
             out = out + as_rng(rng).normal(0.0, self.noise, self.beams)
