@@ -1,4 +1,5 @@
 """`robokit course build` keeps going past broken notebooks and reports them (issue: Bad input)."""
+import json
 import re
 import shutil
 
@@ -180,3 +181,32 @@ def test_build_needs_the_site_sources(tmp_path, capsys):
     _notebook(root / "lessons" / "00.ipynb", "x = 1")
     assert main(["course", "build", "--root", str(root), "--no-grading"]) == 2
     assert "book/" in capsys.readouterr().out and not (root / "build" / "executed").exists()
+
+
+def test_a_solution_starts_after_its_lesson_and_the_longest_goes_first(tmp_path):
+    from robokit.course.build import run_notebooks
+    stamp = tmp_path / "stamps.txt"
+    record = "import time\nopen({!r}, 'a').write('{} ' + ('start' if {} else 'end') + f' {{time.time()}}\\n')"
+    for folder, name, seconds in (("lessons", "01_long.ipynb", 3), ("lessons", "02_short.ipynb", 0),
+                                  ("solutions", "01_long.ipynb", 0)):
+        (tmp_path / folder).mkdir(exist_ok=True)
+        tag = f"{folder}/{name}"
+        _notebook(tmp_path / folder / name, record.format(str(stamp), tag, True), f"time.sleep({seconds})",
+                  record.format(str(stamp), tag, False))
+    paths = [tmp_path / "lessons" / "01_long.ipynb", tmp_path / "lessons" / "02_short.ipynb",
+             tmp_path / "solutions" / "01_long.ipynb"]
+    executed = tmp_path / "executed"
+    runs = run_notebooks(paths, executed, root=tmp_path, jobs=2, timeout=120, fast=True, log=lambda line: None)
+    assert [r.status for r in runs] == ["ok"] * 3 and [r.path for r in runs] == paths
+    times = {tuple(line.split()[:2]): float(line.split()[2]) for line in stamp.read_text().splitlines()}
+    # two jobs: the short lesson runs beside the long one, the solution waits for the long lesson
+    assert times[("solutions/01_long.ipynb", "start")] >= times[("lessons/01_long.ipynb", "end")]
+    assert times[("lessons/02_short.ipynb", "start")] < times[("lessons/01_long.ipynb", "end")]
+    timings = json.loads((executed / "timings-fast.json").read_text())
+    assert timings["lessons/01_long.ipynb"] > timings["lessons/02_short.ipynb"]
+    # the next build starts the notebook that took longest last time first, whatever the order given
+    stamp.unlink()
+    run_notebooks(paths[::-1], executed, root=tmp_path, jobs=1, timeout=120, fast=True, log=lambda line: None)
+    first = min(times := {tuple(line.split()[:2]): float(line.split()[2]) for line in stamp.read_text().splitlines()},
+                key=times.get)
+    assert first == ("lessons/01_long.ipynb", "start")

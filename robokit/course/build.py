@@ -13,8 +13,9 @@ stays in the repository's private ``build/`` whatever the sites' folders are::
 from __future__ import annotations
 
 import html
+import json
 import os
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from pathlib import Path
 from typing import Callable, Sequence
 
@@ -181,6 +182,12 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
                   timeout: float = 900, fast: bool = False, log: Callable[[str], None] = print) -> list[NotebookRun]:
     """Execute ``paths``, ``jobs`` at a time, each in a fresh kernel (:func:`run_notebook`).
 
+    Order: a solution starts only once its lesson (``lessons/`` notebook of the same name, when it
+    is among ``paths``) has finished, so it finds the datasets the lesson cached instead of building
+    them a second time beside it; among the notebooks ready to start, the longest by the last build's
+    times (``executed/timings-full.json`` or ``timings-fast.json``) goes first, then the order of
+    ``paths``. The times of this build are written there afterwards.
+
     Parameters
     ----------
     paths : sequence of Path
@@ -215,9 +222,34 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
         log(f"  {run.status:<8} {run.seconds:6.1f}s  {path.relative_to(root) if path.is_relative_to(root) else path}")
         return run
 
+    timings = executed / f"timings-{'fast' if fast else 'full'}.json"
+    try:
+        expected = {str(k): float(v) for k, v in json.loads(timings.read_text()).items()}
+    except (OSError, ValueError, TypeError, AttributeError):
+        expected = {}                         # no earlier build (or an unreadable record): the order of paths
+    paths = list(paths)
+    names = [f"{p.parent.name}/{p.name}" for p in paths]
+    lesson_of = {i: names.index(f"lessons/{p.name}") for i, p in enumerate(paths)
+                 if p.parent.name == "solutions" and f"lessons/{p.name}" in names}
     log(f"running {len(paths)} notebooks with {jobs} parallel jobs ({'fast' if fast else 'full'} mode) ...")
-    with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        return list(pool.map(one, paths))
+    runs: dict[int, NotebookRun] = {}
+    waiting, running = list(range(len(paths))), {}
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        while waiting or running:
+            ready = [i for i in waiting if lesson_of.get(i, -1) in runs or i not in lesson_of]
+            ready.sort(key=lambda i: (-expected.get(names[i], 0.0), i))
+            for i in ready[:jobs - len(running)]:
+                waiting.remove(i)
+                running[pool.submit(one, paths[i])] = i
+            finished, _ = wait(list(running), return_when=FIRST_COMPLETED)
+            for future in finished:
+                runs[running.pop(future)] = future.result()
+    out = [runs[i] for i in range(len(paths))]
+    try:
+        timings.write_text(json.dumps({**expected, **{n: round(r.seconds, 1) for n, r in zip(names, out)}}, indent=1))
+    except OSError:
+        pass                                  # the order of the next build is only a preference
+    return out
 
 
 def write_sites(root: Path, runs: Sequence[NotebookRun], outs: dict[str, Path], pages: Sequence[BookPage] = (),

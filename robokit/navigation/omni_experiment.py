@@ -163,7 +163,8 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
             "code": code_version("sim", "geometry", "vision", "mapping")}
 
     def build():
-        run = record(world, tour, {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
+        # the map is cached (below), so the recording itself is not: it would only be written, never read
+        run = record(world, tour, {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2, cache=False)
         tmap = build_topological_map(run.images["omni"], run.odometry, camera, n_features=params["n_features"],
                                      odometry_alphas=TOUR_ALPHAS, progress=progress)
         return tmap, run.poses[tmap.frames], len(run)

@@ -198,10 +198,12 @@ def l1_score(v_a, v_b) -> float:
 
 def _majority(desc: np.ndarray, labels: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
     """Per-bit majority of each cluster's members (ties give 1, as DBoW2) and the cluster sizes."""
-    bits = np.unpackbits(desc, axis=1).astype(np.int64)
-    sums = np.zeros((k, bits.shape[1]), np.int64)
-    np.add.at(sums, labels, bits)
+    bits = np.unpackbits(desc, axis=1)
     size = np.bincount(labels, minlength=k)
+    sums = np.zeros((k, bits.shape[1]), np.int64)
+    filled = np.flatnonzero(size)             # the members of each cluster sit together once sorted by label
+    sums[filled] = np.add.reduceat(bits[np.argsort(labels, kind="stable")], (np.cumsum(size) - size)[filled],
+                                   axis=0, dtype=np.int64)
     return np.packbits(2 * sums >= size[:, None], axis=1), size
 
 
