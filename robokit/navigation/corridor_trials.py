@@ -29,13 +29,14 @@ References
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 from typing import Any, Callable
 
 import numpy as np
 
 from ..config import cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays
-from ..controllers import move_to_middle_line
+from ..controllers import CenteringResult, move_to_middle_line
 from ..geometry import wrap_angle
 from ..localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share, pose_clusters
 from ..progress import progress_bar
@@ -234,7 +235,8 @@ def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0) -> MonteCa
 def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any = 0, max_distance: float = 40.0,
                        share: float = CLUSTER_SHARE, sigma_x: float = ELLIPSE_SIGMA[0],
                        sigma_y: float = ELLIPSE_SIGMA[1],
-                       settle: int = SETTLE, keep_particles: bool = False) -> TrialResult:
+                       settle: int = SETTLE, keep_particles: bool = False,
+                       centred: CenteringResult | None = None) -> TrialResult:
     """One global localization from ``start``: AMCL from a uniform cloud, or ours from the image.
 
     Parameters
@@ -257,6 +259,10 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
         Updates to run on after convergence before the second judgement (``TrialResult.settled``).
     keep_particles : bool, default False
         Keep the particles after every update (``TrialResult.particles``), to draw the cloud.
+    centred : robokit.controllers.CenteringResult, optional
+        The moving strategy already driven from ``start`` with this ``rng``, which must be in the
+        state that run left it in (:func:`localization_trials` drives it once for both methods);
+        default: drive it here.
 
     Returns
     -------
@@ -295,8 +301,13 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
         raise ValueError(f"share: expected a fraction in (0, 1], got {share}")
     world, lidar = setup.world, setup.lidar
     setup.world.check_viewpoint([start[0], start[1], lidar.height], "start")
+    if centred is None:           # the moving strategy first; the localizer starts after it
+        centred = move_to_middle_line(world, start, lidar, rng=rng)
+    elif not isinstance(centred, CenteringResult) or not np.array_equal(centred.poses[0], start):
+        raise ValueError(f"centred: expected the moving strategy's run from start {start.tolist()}, got "
+                         f"{type(centred).__name__}" + (f" from {centred.poses[0].tolist()}"
+                                                         if isinstance(centred, CenteringResult) else ""))
     mcl = corridor_localizer(setup, method, rng)
-    centred = move_to_middle_line(world, start, lidar, rng=rng)
     before = centred.poses
     retrieval_error = np.nan
     if method == "ours":
@@ -418,7 +429,9 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
         See :func:`localization_trial`.
     cache : bool, default True
         Load from / save to ``robokit.cache_dir("corridor")``, keyed by every parameter, the map and
-        the code (the AMCL runs take minutes at full size).
+        the code (the AMCL runs take minutes at full size). When the other method's runs are not
+        cached either, they are made too and cached: both methods start each run with the same
+        moving strategy (same start, same seed), which is then driven only once.
     progress : callable ``(done, total)``, optional
 
     Returns
@@ -450,27 +463,41 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     seed = check_int(seed, "seed", minimum=0)
     max_distance = check_positive(max_distance, "max_distance")
     progress = check_callable(progress, "progress")
-    target = None
+    code = code_version("sim", "geometry", "vision", "mapping", "localization", "controllers",
+                        "navigation.corridor_experiment", "navigation.corridor_trials")
+
+    def cache_file(m: str) -> tuple[Any, dict]:
+        meta = {"setup": setup.key, "method": m, "trials": trials, "starts": starts, "seed": seed,
+                "max_distance": max_distance, "code": code}
+        return cache_dir("corridor") / f"trials-{cache_key(**meta)}.npz", meta
+
+    todo = [method]
     if cache:
-        meta = {"setup": setup.key, "method": method, "trials": trials, "starts": starts, "seed": seed,
-                "max_distance": max_distance, "code": code_version("sim", "geometry", "vision", "mapping", "localization",
-                                                                    "controllers", "navigation.corridor_experiment",
-                                                                    "navigation.corridor_trials")}
-        target = cache_dir("corridor") / f"trials-{cache_key(**meta)}.npz"
+        target, meta = cache_file(method)
         data = read_arrays(target, _SET_FIELDS, meta)
         if data is not None:          # else a missing, corrupt or foreign cache file: run again
             return TrialSet(method, **data)
-    runs = []
-    with progress_bar(len(starts) * trials, f"localization trials ({method})", unit="trial", callback=progress) as bar:
+        other = METHODS[1 - METHODS.index(method)]
+        target, meta = cache_file(other)
+        if read_arrays(target, _SET_FIELDS, meta) is None:
+            todo.append(other)
+    runs: dict[str, list] = {m: [] for m in todo}
+    with progress_bar(len(starts) * trials * len(todo), f"localization trials ({' and '.join(todo)})", unit="trial",
+                      callback=progress) as bar:
         for i in starts:
             for j in range(trials):
-                runs.append(localization_trial(setup, START_POSES[i], method, rng=np.random.default_rng([seed, i, j]),
-                                               max_distance=max_distance))
-                bar.update()
-    out = TrialSet(method, np.repeat(starts, trials).astype(int), np.array([r.converged for r in runs]),
-                   np.array([r.iterations for r in runs], int), np.array([r.distance for r in runs]),
-                   np.array([r.error for r in runs]).reshape(-1, 2), np.array([r.settled for r in runs]).reshape(-1, 2),
-                   np.array([r.retrieval_error for r in runs]))
-    if target is not None:
-        write_arrays(target, {name: getattr(out, name) for name in _SET_FIELDS}, meta)
-    return out
+                rng = np.random.default_rng([seed, i, j])
+                centred = move_to_middle_line(setup.world, START_POSES[i], setup.lidar, rng=rng)
+                for m in todo:    # each method goes on from the generator's state after the moving strategy
+                    runs[m].append(localization_trial(setup, START_POSES[i], m, rng=copy.deepcopy(rng),
+                                                      max_distance=max_distance, centred=centred))
+                    bar.update()
+    sets = {m: TrialSet(m, np.repeat(starts, trials).astype(int), np.array([r.converged for r in rs]),
+                        np.array([r.iterations for r in rs], int), np.array([r.distance for r in rs]),
+                        np.array([r.error for r in rs]).reshape(-1, 2), np.array([r.settled for r in rs]).reshape(-1, 2),
+                        np.array([r.retrieval_error for r in rs])) for m, rs in runs.items()}
+    if cache:
+        for m, out in sets.items():
+            target, meta = cache_file(m)
+            write_arrays(target, {name: getattr(out, name) for name in _SET_FIELDS}, meta)
+    return sets[method]

@@ -39,7 +39,7 @@ ORB_BYTES = 32
 ORB_MATCH_DISTANCE = 50
 #: Default nearest / second-nearest ratio for ORB matches (ORB-SLAM's relocalisation value).
 ORB_RATIO = 0.75
-_BLOCK = 1 << 22          # 64-bit words compared per block of hamming_distances
+_BLOCK = 1 << 22          # distances computed per block of hamming_distances
 
 
 def as_binary_descriptors(value, name: str = "descriptors", *, n_bytes: int | None = None) -> np.ndarray:
@@ -154,8 +154,11 @@ def hamming_distance(a, b, *, check: bool = True) -> np.ndarray:
             np.broadcast_shapes(a.shape[:-1], b.shape[:-1])
         except ValueError:
             raise ValueError(f"a, b: expected leading shapes that broadcast, got {a.shape} and {b.shape}") from None
-    x = np.bitwise_xor(_words64(a), _words64(b))
-    return np.bitwise_count(x).sum(axis=-1, dtype=np.int64)
+    a64, b64 = _words64(a), _words64(b)
+    out = np.zeros(np.broadcast_shapes(a64.shape[:-1], b64.shape[:-1]), np.int64)
+    for w in range(a64.shape[-1]):      # word by word: adding a few columns beats a reduction over them
+        out += np.bitwise_count(np.bitwise_xor(a64[..., w], b64[..., w]))
+    return out[()]                      # a numpy integer for two single rows
 
 
 def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
@@ -179,8 +182,9 @@ def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
 
     Notes
     -----
-    Rublee et al. (2011), Sec. 5; computed with :func:`hamming_distance` in blocks of rows of
-    ``a`` so that no more than about 4 million 64-bit words are held at once.
+    Rublee et al. (2011), Sec. 5: the XOR of two rows, its set bits counted (``numpy.bitwise_count``)
+    and added 64-bit word by word, in blocks of rows of ``a`` so that no more than about 4 million
+    distances are held at once.
 
     Examples
     --------
@@ -190,13 +194,13 @@ def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
     if check:
         a, b = as_binary_descriptors(a, "a"), as_binary_descriptors(b, "b")
         same_width(a, b, "a", "b")
-    out = np.empty((a.shape[0], b.shape[0]), np.int64)
-    words = max(1, -(-a.shape[1] // 8))
-    step = max(1, _BLOCK // max(1, b.shape[0] * words))
-    b64 = _words64(b)[None]
+    out = np.zeros((a.shape[0], b.shape[0]), np.int64)
+    step = max(1, _BLOCK // max(1, b.shape[0]))
+    b64 = _words64(b).T.copy()                          # (words, Nb): one row per 64-bit word
     for s in range(0, a.shape[0], step):
-        x = np.bitwise_xor(_words64(a[s:s + step])[:, None], b64)
-        out[s:s + step] = np.bitwise_count(x).sum(axis=-1, dtype=np.int64)
+        a64 = _words64(a[s:s + step])
+        for w in range(b64.shape[0]):                   # word by word: no (Na, Nb, words) array to reduce
+            out[s:s + step] += np.bitwise_count(np.bitwise_xor(a64[:, w, None], b64[w][None]))
     return out
 
 
