@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 __all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest", "code_version",
-           "write_atomically", "write_arrays", "read_arrays", "CACHE_READ_ERRORS", "records_to_arrays",
+           "write_atomically", "save_npz", "write_arrays", "read_arrays", "CACHE_READ_ERRORS", "records_to_arrays",
            "record_names", "records_from_arrays"]
 
 _TRUE = {"1", "true", "yes", "on"}
@@ -332,8 +332,51 @@ def _meta_text(meta: dict) -> str:
         raise TypeError(f"meta: expected a JSON-serialisable dict of parameters ({exc})") from None
 
 
+def save_npz(target: Any, arrays: dict) -> Any:
+    """Write named arrays as an ``.npz`` that ``numpy.load`` reads, compressed for speed over size.
+
+    The layout of ``numpy.savez_compressed`` (a zip of ``.npy`` files, never pickles) with zlib's
+    fastest level, 1: rendered images and depths compress hardly better at numpy's default level 6,
+    which takes about 1.5 times as long to write.
+
+    Parameters
+    ----------
+    target : str, Path or binary file object
+    arrays : dict of str to array_like
+
+    Returns
+    -------
+    The ``target`` it was given.
+
+    Raises
+    ------
+    TypeError
+        For ``arrays`` that is not a dict of names, or an array of Python objects.
+
+    Examples
+    --------
+    >>> import io
+    >>> import numpy as np
+    >>> buffer = save_npz(io.BytesIO(), {"a": np.arange(3)})
+    >>> np.load(io.BytesIO(buffer.getvalue()))["a"].tolist()
+    [0, 1, 2]
+    """
+    import numpy as np
+
+    if not isinstance(arrays, dict) or not all(isinstance(k, str) and k for k in arrays):
+        raise TypeError(f"arrays: expected a dict of array names to arrays, got {type(arrays).__name__}")
+    with zipfile.ZipFile(target, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1, allowZip64=True) as zf:
+        for name, value in arrays.items():
+            arr = np.asanyarray(value)
+            if arr.dtype.hasobject:
+                raise TypeError(f"arrays: expected numeric or text arrays, got Python objects under {name!r}")
+            with zf.open(f"{name}.npy", "w", force_zip64=True) as fh:
+                np.lib.format.write_array(fh, arr, allow_pickle=False)
+    return target
+
+
 def write_arrays(target: str | Path, arrays: dict, meta: dict | None = None) -> Path:
-    """Write named arrays as a compressed ``.npz`` cache file, with the parameters that made them.
+    """Write named arrays as a compressed ``.npz`` cache file (:func:`save_npz`), with the parameters that made them.
 
     Parameters
     ----------
@@ -377,7 +420,7 @@ def write_arrays(target: str | Path, arrays: dict, meta: dict | None = None) -> 
     stored = dict(arrays)
     if meta is not None:
         stored[_META] = np.array(_meta_text(meta))
-    return write_atomically(target, lambda path: np.savez_compressed(path, **stored))
+    return write_atomically(target, lambda path: save_npz(path, stored))
 
 
 def read_arrays(target: str | Path, names: Sequence[str], meta: dict | None = None) -> dict | None:

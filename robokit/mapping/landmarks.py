@@ -402,11 +402,13 @@ class LandmarkMap:
             return out
         fi = np.repeat(np.arange(n), counts)
         li = np.concatenate([np.asarray(x, int) for x in lists if x])
+        dd = np.linalg.norm(desc[fi] - self.descriptors[li], axis=1)
+        alike = dd <= max_distance                 # the cheap test first: only these need the gate
+        fi, li, dd = fi[alike], li[alike], dd[alike]
         err = pts[fi] - predicted[li]
         joint = cov[fi] + rot.T @ self.covariances[li] @ rot
         m2 = np.einsum("ni,ni->n", err, np.linalg.solve(joint, err[:, :, None])[:, :, 0])
-        dd = np.linalg.norm(desc[fi] - self.descriptors[li], axis=1)
-        ok = (m2 <= gate) & (dd <= max_distance)
+        ok = m2 <= gate
         fi, li, dd = fi[ok], li[ok], dd[ok]
         order = np.argsort(dd, kind="stable")
         return _greedy_one_to_one(fi[order], li[order], out)

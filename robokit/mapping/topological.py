@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from ..config import save_npz
 from ..validation import as_array, check_choice, check_int, check_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
@@ -343,7 +344,7 @@ class TopologicalMap:
         """
         target = FsPath(path)
         with open(target, "wb") as f:
-            np.savez_compressed(f, format=np.array(_FORMAT), **self.to_arrays())
+            save_npz(f, {"format": np.array(_FORMAT), **self.to_arrays()})
         return target
 
     @classmethod

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ..config import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, write_atomically
+from ..config import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, save_npz, write_atomically
 from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .motion import Path, noisy_odometry
@@ -83,7 +83,7 @@ class Run:
 
         Notes
         -----
-        ``numpy.savez_compressed``; loading uses ``allow_pickle=False`` so a run file can never
+        :func:`robokit.config.save_npz`; loading uses ``allow_pickle=False`` so a run file can never
         execute code (course convention, DESIGN.md "Caching").
         """
         arrays = {"t": self.t, "poses": self.poses, "odometry": self.odometry,
@@ -93,7 +93,7 @@ class Run:
                 arrays[f"{group}:{name}"] = arr
         path = FsPath(path)
         with open(path, "wb") as fh:
-            np.savez_compressed(fh, **arrays)
+            save_npz(fh, arrays)
         return path
 
     @classmethod

@@ -33,6 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..config import save_npz
 from ..validation import as_array, as_rng, check_int, describe
 from .hamming import as_binary_descriptors, hamming_distance
 
@@ -473,7 +474,7 @@ class Vocabulary:
         """Write the vocabulary to ``path`` (numpy ``.npz``); returns the path written."""
         path = Path(path)
         with open(path, "wb") as fh:
-            np.savez_compressed(fh, **self.arrays())
+            save_npz(fh, self.arrays())
         return path
 
     @classmethod

@@ -29,6 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..config import save_npz
 from ..validation import check_int, describe
 from .bag_of_words import BowVector, Vocabulary, VocabularyFileError, as_bow_vector
 
@@ -180,7 +181,7 @@ class BowDatabase:
                       entry_words=np.concatenate(self._words) if self._words else np.zeros(0, np.int64),
                       entry_weights=np.concatenate(self._weights) if self._weights else np.zeros(0))
         with open(path, "wb") as fh:
-            np.savez_compressed(fh, **arrays)
+            save_npz(fh, arrays)
         return path
 
     @classmethod

@@ -359,17 +359,35 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
             if dy > 3 * tol:
                 raise NotRectifiedError(f"left, right: expected a rectified pair (matches on the same rows), "
                                         f"got a median row difference of {dy:.1f} px")
-    disp = kl.xy[:, None, 0] - kr.xy[None, :, 0]
-    ok = (np.abs(kl.xy[:, None, 1] - kr.xy[None, :, 1]) <= tol) & (disp >= dmin) & (disp <= dmax)
-    dtheta = np.abs((kl.orientation[:, None] - kr.orientation[None, :] + np.pi) % (2 * np.pi) - np.pi)
+    li, ri = _row_candidates(kl.xy[:, 1], kr.xy[:, 1], tol)
+    disp = kl.xy[li, 0] - kr.xy[ri, 0]
+    ok = (np.abs(kl.xy[li, 1] - kr.xy[ri, 1]) <= tol) & (disp >= dmin) & (disp <= dmax)
+    dtheta = np.abs((kl.orientation[li] - kr.orientation[ri] + np.pi) % (2 * np.pi) - np.pi)
     ok &= dtheta <= dori
-    sr = kl.scale[:, None] / kr.scale[None, :]
+    sr = kl.scale[li] / kr.scale[ri]
     ok &= (sr <= srat) & (sr >= 1 / srat)
-    li, ri = np.nonzero(ok)
+    li, ri = li[ok], ri[ok]
     m = gated_ratio_match(left.descriptors, right.descriptors, li, ri, ratio=ratio, max_distance=max_distance)
     unique = np.bincount(m.train, minlength=len(kr))[m.train] == 1   # one left feature per right one
     li, ri = m.query[unique], m.train[unique]
     return StereoMatches(li, ri, kl.xy[li, 0] - kr.xy[ri, 0], m.distance[unique])
+
+
+def _row_candidates(y_left: np.ndarray, y_right: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair (left, right), in row-major order, whose rows may lie within ``tol`` of each other.
+
+    A superset of ``|y_left - y_right| <= tol`` (the window is widened by a rounding margin; the
+    caller applies the exact test), found by sorting the right rows instead of comparing all pairs.
+    """
+    order = np.argsort(y_right, kind="stable")
+    ys = y_right[order]
+    margin = tol + 1e-9 * (1.0 + np.abs(y_left).max(initial=0.0))
+    lo = np.searchsorted(ys, y_left - margin, side="left")
+    count = np.searchsorted(ys, y_left + margin, side="right") - lo
+    li = np.repeat(np.arange(len(y_left)), count)
+    ri = order[np.arange(count.sum()) - np.repeat(np.cumsum(count) - count - lo, count)]
+    pairs = np.lexsort((ri, li))          # row-major, as numpy.nonzero of the all-pairs test gives them
+    return li[pairs], ri[pairs]
 
 
 def observe_stereo(left: Features, right: Features, rig: StereoCalibration, *, sigma_c: float = 1.0,
