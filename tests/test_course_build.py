@@ -210,3 +210,17 @@ def test_a_solution_starts_after_its_lesson_and_the_longest_goes_first(tmp_path)
     first = min(times := {tuple(line.split()[:2]): float(line.split()[2]) for line in stamp.read_text().splitlines()},
                 key=times.get)
     assert first == ("lessons/01_long.ipynb", "start")
+
+
+def test_a_fresh_full_build_starts_the_notebook_declaring_the_longest_cold_time(tmp_path):
+    from robokit.course.build import run_notebooks
+    stamp = tmp_path / "stamps.txt"
+    paths = []
+    for name, declared in (("01_quick.ipynb", None), ("02_slow.ipynb", 120)):
+        paths.append(_notebook(tmp_path / name, f"open({str(stamp)!r}, 'a').write('{name}\\n')"))
+        if declared:
+            nb = nbformat.read(paths[-1], as_version=4)
+            nb.metadata["robokit"] = {"cold_seconds": declared}
+            nbformat.write(nb, paths[-1])
+    run_notebooks(paths, tmp_path / "executed", root=tmp_path, jobs=1, timeout=120, log=lambda line: None)
+    assert stamp.read_text().split() == ["02_slow.ipynb", "01_quick.ipynb"]

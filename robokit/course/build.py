@@ -186,7 +186,9 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     is among ``paths``) has finished, so it finds the datasets the lesson cached instead of building
     them a second time beside it; among the notebooks ready to start, the longest by the last build's
     times (``executed/timings-full.json`` or ``timings-fast.json``) goes first, then the order of
-    ``paths``. The times of this build are written there afterwards.
+    ``paths``. The times of this build are written there afterwards. Before any build (a fresh
+    clone, an empty cache), a full build takes the times a notebook declares in its metadata,
+    ``robokit.cold_seconds`` (docs/LESSON_GUIDE.md).
 
     Parameters
     ----------
@@ -223,12 +225,13 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
         return run
 
     timings = executed / f"timings-{'fast' if fast else 'full'}.json"
-    try:
-        expected = {str(k): float(v) for k, v in json.loads(timings.read_text()).items()}
-    except (OSError, ValueError, TypeError, AttributeError):
-        expected = {}                         # no earlier build (or an unreadable record): the order of paths
     paths = list(paths)
     names = [f"{p.parent.name}/{p.name}" for p in paths]
+    expected = {} if fast else {n: _declared_seconds(p) for n, p in zip(names, paths)}
+    try:
+        expected.update({str(k): float(v) for k, v in json.loads(timings.read_text()).items()})
+    except (OSError, ValueError, TypeError, AttributeError):
+        pass                                  # no earlier build (or an unreadable record): declared times only
     lesson_of = {i: names.index(f"lessons/{p.name}") for i, p in enumerate(paths)
                  if p.parent.name == "solutions" and f"lessons/{p.name}" in names}
     log(f"running {len(paths)} notebooks with {jobs} parallel jobs ({'fast' if fast else 'full'} mode) ...")
@@ -250,6 +253,15 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     except OSError:
         pass                                  # the order of the next build is only a preference
     return out
+
+
+def _declared_seconds(path: Path) -> float:
+    """``metadata.robokit.cold_seconds`` of a notebook (0 when absent or unreadable)."""
+    try:
+        value = json.loads(path.read_text(encoding="utf-8"))["metadata"]["robokit"]["cold_seconds"]
+        return float(value) if isinstance(value, (int, float)) and value >= 0 else 0.0
+    except (OSError, ValueError, KeyError, TypeError):
+        return 0.0
 
 
 def write_sites(root: Path, runs: Sequence[NotebookRun], outs: dict[str, Path], pages: Sequence[BookPage] = (),
