@@ -494,7 +494,8 @@ def touchdown_detectors():
 SPECS: dict[str, Call] = {
     # --- about, geometry --------------------------------------------------------------------
     "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
-    "robokit.geometry.planar.wrap_angle": Call({"angle": Array(np.array([0.5, 4.0]), "|N|N,N", min_rows=0)}),
+    "robokit.geometry.planar.wrap_angle": Call({"angle": Array(np.array([0.5, 4.0]), "|N|N,N", min_rows=0),
+                                                "check": Flag(True)}),
     "robokit.geometry.planar.se2_compose": Call({"a": Array(np.array([1.0, 2.0, 0.5]), "3|N,3"),
                                                  "b": Array(np.array([0.5, -1.0, 3.0]), "3|N,3"), "check": Flag(True)}),
     "robokit.geometry.paper_frames.paper_world_to_robokit": Call({
@@ -1205,11 +1206,13 @@ SPECS: dict[str, Call] = {
     "robokit.localization.particle_clusters.largest_cluster_share": Call({
         "particles": Array(np.array([[0.1, 0.1, 0.0], [0.6, 0.1, 0.0], [5.0, 0.0, 0.0]]), "N,3"),
         "weights": Array(np.array([0.1, 0.1, 0.8]), "N", optional=True),
-        "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3")}),
+        "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3"),
+        "labels": Array(np.array([0, 0, 1]), "N", optional=True)}),
     "robokit.localization.particle_clusters.largest_cluster_mean": Call({
         "particles": Array(np.array([[10.0, 0.0, 0.0], [10.2, 0.0, 0.0], [30.0, 0.0, 0.0]]), "N,3"),
         "weights": Array(np.array([0.4, 0.4, 0.2]), "N", optional=True),
-        "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3")}),
+        "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3"),
+        "labels": Array(np.array([0, 0, 1]), "N", optional=True)}),
     "robokit.navigation.corridor_trials.corridor_localizer": Call({
         "setup": Obj(corridor_setup), "method": Choice("ours"), "rng": Rng(0)}, cheap=False),
     "robokit.navigation.corridor_aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),

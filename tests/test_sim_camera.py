@@ -167,3 +167,25 @@ def test_lighting_and_noise_change_the_image_reproducibly():
 def test_bad_input_is_named(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
         call()
+
+
+def test_a_view_that_sees_no_surface_is_black_with_infinite_depth():
+    import warnings
+    from robokit.sim.render import render_pinhole
+    cam = CAM
+    T = np.eye(4)
+    T[:3, 3] = [100.0, 100.0, 1.0]                  # far outside the room, looking away from it
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        image, depth = render_pinhole(box_room(), cam.K, cam.width, cam.height, T)
+    assert image.shape == (cam.height, cam.width, 3) and not image.any() and np.isinf(depth).all()
+
+
+@pytest.mark.parametrize("builder", [box_room, lab_room])
+def test_the_renderers_mip_sizes_are_the_pyramids(builder):
+    world = builder()
+    arrays = world.surface_arrays
+    for k, s in enumerate(world.surfaces):
+        assert arrays["mip_levels"][k] == len(s.pyramid)
+        assert [tuple(size) for size in arrays["mip_sizes"][k, :len(s.pyramid)]] == \
+            [lv.shape[1::-1] for lv in s.pyramid]

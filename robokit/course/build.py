@@ -5,7 +5,8 @@ stays in the repository's private ``build/`` whatever the sites' folders are::
 
     build/course/           the student site: lessons, blank assignments, library reference, references
     build/instructor/       the instructor site: that plus solutions, grading self-check, build report
-    build/executed/         the executed notebooks (lessons/NN_slug.ipynb, solutions/NN_slug.ipynb)
+    build/executed/         the executed notebooks (lessons/NN_slug.ipynb, solutions/NN_slug.ipynb) and each
+                            notebook's last run time (timings-full.json, timings-fast.json)
     build/reports/          grades.csv of the grading self-check
     build/.site/<site>/     Sphinx's sources (src/), output before it is moved (html/), doctrees,
                             myst-nb's jupyter_execute/ and sphinx-warnings.txt, per site
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import html
 import json
+import math
 import os
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from pathlib import Path
@@ -185,10 +187,11 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     Order: a solution starts only once its lesson (``lessons/`` notebook of the same name, when it
     is among ``paths``) has finished, so it finds the datasets the lesson cached instead of building
     them a second time beside it; among the notebooks ready to start, the longest by the last build's
-    times (``executed/timings-full.json`` or ``timings-fast.json``) goes first, then the order of
-    ``paths``. The times of this build are written there afterwards. Before any build (a fresh
-    clone, an empty cache), a full build takes the times a notebook declares in its metadata,
-    ``robokit.cold_seconds`` (docs/LESSON_GUIDE.md).
+    times (``executed/timings-full.json`` or ``timings-fast.json``, written afterwards) or, in a
+    full build, by the time it declares for an empty cache in its metadata (``robokit.cold_seconds``,
+    docs/LESSON_GUIDE.md), whichever is longer, goes first; then the order of ``paths``. So a fresh
+    clone, and a build after a code change (whose caches are stale) after a warm one, start the
+    slow lessons first.
 
     Parameters
     ----------
@@ -227,11 +230,13 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     timings = executed / f"timings-{'fast' if fast else 'full'}.json"
     paths = list(paths)
     names = [f"{p.parent.name}/{p.name}" for p in paths]
-    expected = {} if fast else {n: _declared_seconds(p) for n, p in zip(names, paths)}
     try:
-        expected.update({str(k): float(v) for k, v in json.loads(timings.read_text()).items()})
+        recorded = {str(k): float(v) for k, v in json.loads(timings.read_text()).items()}
     except (OSError, ValueError, TypeError, AttributeError):
-        pass                                  # no earlier build (or an unreadable record): declared times only
+        recorded = {}                         # no earlier build (or an unreadable record): declared times only
+    # the longer of the declared cold time and the last build's (which may have been warm)
+    expected = {n: max([t for t in (0.0 if fast else _declared_seconds(p), recorded.get(n, 0.0))
+                        if math.isfinite(t)] + [0.0]) for n, p in zip(names, paths)}
     lesson_of = {i: names.index(f"lessons/{p.name}") for i, p in enumerate(paths)
                  if p.parent.name == "solutions" and f"lessons/{p.name}" in names}
     log(f"running {len(paths)} notebooks with {jobs} parallel jobs ({'fast' if fast else 'full'} mode) ...")
@@ -249,7 +254,7 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
                 runs[running.pop(future)] = future.result()
     out = [runs[i] for i in range(len(paths))]
     try:
-        timings.write_text(json.dumps({**expected, **{n: round(r.seconds, 1) for n, r in zip(names, out)}}, indent=1))
+        timings.write_text(json.dumps({**recorded, **{n: round(r.seconds, 1) for n, r in zip(names, out)}}, indent=1))
     except OSError:
         pass                                  # the order of the next build is only a preference
     return out

@@ -105,10 +105,17 @@ def _cluster_labels(particles: Any, bin_size: Any, labels: Any) -> np.ndarray:
     if labels is None:
         return pose_clusters(particles, bin_size)
     P = as_array(particles, "particles", ndim=2, min_size=1)
-    lab = np.asarray(labels)
-    if lab.shape != (len(P),) or lab.dtype.kind not in "iu" or np.any(lab < 0):
-        raise ValueError(f"labels: expected one non-negative integer cluster label per particle ({len(P)}), "
-                         f"got {lab.dtype} array of shape {lab.shape}")
+    if P.shape[1] != 3:
+        raise ValueError(f"particles: expected poses of shape (N, 3), got shape {P.shape}")
+    as_array(bin_size, "bin_size", shape=(3,))
+    try:
+        lab = np.asarray(labels)
+    except (ValueError, TypeError):
+        lab = np.empty(0, object)               # ragged: refused below
+    if lab.shape != (len(P),) or lab.dtype.kind not in "iu" or np.any(lab < 0) or np.any(lab >= len(P)):
+        raise ValueError(f"labels: expected one cluster label per particle ({len(P)}), integers from 0 to "
+                         f"{len(P) - 1} as pose_clusters numbers them, got a {lab.dtype} array of shape {lab.shape}"
+                         + (f" from {lab.min()} to {lab.max()}" if lab.size and lab.dtype.kind in "iu" else ""))
     return lab
 
 

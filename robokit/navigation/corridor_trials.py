@@ -235,8 +235,7 @@ def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0) -> MonteCa
 def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any = 0, max_distance: float = 40.0,
                        share: float = CLUSTER_SHARE, sigma_x: float = ELLIPSE_SIGMA[0],
                        sigma_y: float = ELLIPSE_SIGMA[1],
-                       settle: int = SETTLE, keep_particles: bool = False,
-                       centred: CenteringResult | None = None) -> TrialResult:
+                       settle: int = SETTLE, keep_particles: bool = False) -> TrialResult:
     """One global localization from ``start``: AMCL from a uniform cloud, or ours from the image.
 
     Parameters
@@ -259,10 +258,6 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
         Updates to run on after convergence before the second judgement (``TrialResult.settled``).
     keep_particles : bool, default False
         Keep the particles after every update (``TrialResult.particles``), to draw the cloud.
-    centred : robokit.controllers.CenteringResult, optional
-        The moving strategy already driven from ``start`` with this ``rng``, which must be in the
-        state that run left it in (:func:`localization_trials` drives it once for both methods);
-        default: drive it here.
 
     Returns
     -------
@@ -299,14 +294,18 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
     settle = check_int(settle, "settle", minimum=0)
     if share > 1:
         raise ValueError(f"share: expected a fraction in (0, 1], got {share}")
+    setup.world.check_viewpoint([start[0], start[1], setup.lidar.height], "start")
+    centred = move_to_middle_line(setup.world, start, setup.lidar, rng=rng)   # first; the localizer starts after it
+    return _run_trial(setup, method, centred, rng, max_distance, share, sigma_x, sigma_y, settle, keep_particles)
+
+
+def _run_trial(setup: CorridorMap, method: str, centred: CenteringResult, rng: np.random.Generator,
+               max_distance: float, share: float, sigma_x: float, sigma_y: float, settle: int,
+               keep_particles: bool) -> TrialResult:
+    """:func:`localization_trial` (checked arguments) after the moving strategy ``centred``, with
+    ``rng`` in the state that run left it in."""
     world, lidar = setup.world, setup.lidar
-    setup.world.check_viewpoint([start[0], start[1], lidar.height], "start")
-    if centred is None:           # the moving strategy first; the localizer starts after it
-        centred = move_to_middle_line(world, start, lidar, rng=rng)
-    elif not isinstance(centred, CenteringResult) or not np.array_equal(centred.poses[0], start):
-        raise ValueError(f"centred: expected the moving strategy's run from start {start.tolist()}, got "
-                         f"{type(centred).__name__}" + (f" from {centred.poses[0].tolist()}"
-                                                         if isinstance(centred, CenteringResult) else ""))
+    start = centred.poses[0]
     mcl = corridor_localizer(setup, method, rng)
     before = centred.poses
     retrieval_error = np.nan
@@ -337,7 +336,7 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
         if travelled[k] > max_distance:
             break
         if k > first and not mcl.due(odometry[k]):
-            continue                  # the filter would not use this scan, so it is not simulated
+            continue                  # after the first (which starts the odometry), no scan the filter will not use
         if not mcl.update(odometry[k], lidar.scan(world, truth[k], rng)):
             continue
         labels = pose_clusters(mcl.particles)
@@ -429,7 +428,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
         See :func:`localization_trial`.
     cache : bool, default True
         Load from / save to ``robokit.cache_dir("corridor")``, keyed by every parameter, the map and
-        the code (the AMCL runs take minutes at full size). When the other method's runs are not
+        the code. When the other method's runs are not
         cached either, they are made too and cached: both methods start each run with the same
         moving strategy (same start, same seed), which is then driven only once.
     progress : callable ``(done, total)``, optional
@@ -489,8 +488,8 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
                 rng = np.random.default_rng([seed, i, j])
                 centred = move_to_middle_line(setup.world, START_POSES[i], setup.lidar, rng=rng)
                 for m in todo:    # each method goes on from the generator's state after the moving strategy
-                    runs[m].append(localization_trial(setup, START_POSES[i], m, rng=copy.deepcopy(rng),
-                                                      max_distance=max_distance, centred=centred))
+                    runs[m].append(_run_trial(setup, m, centred, copy.deepcopy(rng), max_distance, CLUSTER_SHARE,
+                                              *ELLIPSE_SIGMA, SETTLE, False))
                     bar.update()
     sets = {m: TrialSet(m, np.repeat(starts, trials).astype(int), np.array([r.converged for r in rs]),
                         np.array([r.iterations for r in rs], int), np.array([r.distance for r in rs]),

@@ -8,7 +8,8 @@ per pixel. Surfaces outside the view frustum are culled before any pixel work, p
 against a near plane (so no point behind the camera is ever projected) and far, small-looking
 textures are read from a coarser mip-map level (Williams 1983) to avoid aliasing. What needs no
 pixels (projection, bounding box, plane, mip level, homography) is computed for every surface of
-a frame at once; only the rasterisation and the z-test go surface by surface, in the world's order.
+a frame at once; the rest (clipping a polygon that reaches behind the near plane, rasterisation,
+z-test, texture warp) goes surface by surface, in the world's order.
 
 Pixel convention (OpenCV): the centre of pixel ``(col, row)`` is at image coordinates
 ``(u, v) = (col, row)``.
@@ -95,21 +96,21 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     # 1. every surface in view at once: its polygon in the image, bounding box, plane and texture map
     Pk, arrays = P[idx], world.surface_arrays
     with np.errstate(divide="ignore", invalid="ignore"):
-        polygons = np.stack([fx * Pk[..., 0] / Pk[..., 2] + cx, fy * Pk[..., 1] / Pk[..., 2] + cy], axis=-1)
-        simple = (Pk[..., 2] >= near).all(axis=1) & (np.abs(polygons).max(axis=(1, 2)) <= _FAR_PIXELS)
-    polygons = list(polygons)
-    lo, hi = np.floor(np.min(polygons, axis=1, initial=np.inf)), np.ceil(np.max(polygons, axis=1, initial=-np.inf))
+        uv = _project(Pk, fx, fy, cx, cy)                                    # (n, 4, 2)
+        simple = (Pk[..., 2] >= near).all(axis=1) & (np.abs(uv).max(axis=(1, 2), initial=0.0) <= _FAR_PIXELS)
+    lo, hi = np.floor(uv.min(axis=1, initial=np.inf)), np.ceil(uv.max(axis=1, initial=-np.inf))
     zmin, zmax = Pk[..., 2].min(axis=1, initial=np.inf), Pk[..., 2].max(axis=1, initial=-np.inf)
-    seen = simple.copy()
+    polygons, seen = list(uv), simple.copy()
     for i in np.flatnonzero(~simple):   # a corner behind the near plane, or very far off the image: clip
         poly = _clip_to_view(Pk[i], fx, fy, cx, cy, width, height, near)
         if poly is not None:
-            polygons[i] = np.column_stack([fx * poly[:, 0] / poly[:, 2] + cx, fy * poly[:, 1] / poly[:, 2] + cy])
+            polygons[i] = _project(poly, fx, fy, cx, cy)
             lo[i], hi[i] = np.floor(polygons[i].min(axis=0)), np.ceil(polygons[i].max(axis=0))
             zmin[i], zmax[i] = poly[:, 2].min(), poly[:, 2].max()
             seen[i] = True
     box = np.column_stack([np.maximum(lo, 0), np.minimum(hi, [width - 1, height - 1])])  # x0, y0, x1, y1
     seen &= (box[:, 2] >= box[:, 0]) & (box[:, 3] >= box[:, 1])
+    box[~seen] = 0                      # never drawn; keeps inf and NaN out of the integer box
     # inverse depth is affine in the pixel: plane n.X = d in the camera frame, 1/Z = (K^-T n / d) . [u, v, 1]
     n_c = arrays["normal"][idx] @ R_cw.T
     d = np.einsum("ij,ij->i", n_c, Pk[:, 0])
@@ -153,6 +154,11 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     return image, depth
 
 
+def _project(points: np.ndarray, fx: float, fy: float, cx: float, cy: float) -> np.ndarray:
+    """Pixel coordinates ``(..., 2)`` of camera-frame points ``(..., 3)`` (Hartley & Zisserman, Eq. (6.1))."""
+    return np.stack([fx * points[..., 0] / points[..., 2] + cx, fy * points[..., 1] / points[..., 2] + cy], axis=-1)
+
+
 def _clip_to_view(corners: np.ndarray, fx: float, fy: float, cx: float, cy: float, width: int, height: int,
                   near: float) -> np.ndarray | None:
     """The part of a surface (camera frame) in front of the near plane, also clipped to the view's
@@ -160,8 +166,7 @@ def _clip_to_view(corners: np.ndarray, fx: float, fy: float, cx: float, cy: floa
     poly = _clip(corners, np.array([0.0, 0.0, 1.0]), near)
     if len(poly) < 3:
         return None
-    uv = np.column_stack([fx * poly[:, 0] / poly[:, 2] + cx, fy * poly[:, 1] / poly[:, 2] + cy])
-    if np.abs(uv).max() > _FAR_PIXELS:
+    if np.abs(_project(poly, fx, fy, cx, cy)).max() > _FAR_PIXELS:
         # clip to planes through the optical centre 2 px outside the image: what falls inside the
         # image is unchanged, and projected coordinates stay small
         for normal in ([fx, 0.0, cx + 2], [-fx, 0.0, width + 1 - cx], [0.0, fy, cy + 2], [0.0, -fy, height + 1 - cy]):

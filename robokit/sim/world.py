@@ -91,9 +91,22 @@ class Surface:
     def pyramid(self) -> list[np.ndarray]:
         """Texture mip-map levels (Gaussian pyramid), used against aliasing when far away."""
         levels = [self.texture]
-        while min(levels[-1].shape[:2]) >= 8:
+        while min(levels[-1].shape[:2]) >= _MIP_MIN:
             levels.append(cv2.pyrDown(levels[-1]))
         return levels
+
+
+#: A texture is halved into another mip-map level while both its sides are at least this long.
+_MIP_MIN = 8
+
+
+def _mip_sizes(width: int, height: int) -> list[tuple[int, int]]:
+    """(width, height) of each :attr:`Surface.pyramid` level, without building it (``cv2.pyrDown``
+    halves a side of n pixels to ``(n + 1) // 2``)."""
+    sizes = [(width, height)]
+    while min(sizes[-1]) >= _MIP_MIN:
+        sizes.append(((sizes[-1][0] + 1) // 2, (sizes[-1][1] + 1) // 2))
+    return sizes
 
 
 @dataclasses.dataclass(frozen=True)
@@ -196,14 +209,13 @@ class World:
         height of each :attr:`Surface.pyramid` level (``mip_levels`` (N,) of them; the last repeats
         beyond).
         """
-        pyramids = [s.pyramid for s in self.surfaces]
-        depth = max(len(p) for p in pyramids)
-        sizes = np.array([[lv.shape[1::-1] for lv in p] + [p[-1].shape[1::-1]] * (depth - len(p)) for p in pyramids],
-                         float)
+        levels = [_mip_sizes(s.texture.shape[1], s.texture.shape[0]) for s in self.surfaces]
+        depth = max(len(sizes) for sizes in levels)
         return {"u": np.stack([s.u for s in self.surfaces]), "v": np.stack([s.v for s in self.surfaces]),
                 "normal": np.stack([s.normal for s in self.surfaces]),
                 "u_length": np.array([np.linalg.norm(s.u) for s in self.surfaces]),
-                "mip_levels": np.array([len(p) for p in pyramids]), "mip_sizes": sizes}
+                "mip_levels": np.array([len(sizes) for sizes in levels]),
+                "mip_sizes": np.array([sizes + sizes[-1:] * (depth - len(sizes)) for sizes in levels], float)}
 
     @functools.lru_cache(maxsize=8)
     def slice(self, z: float) -> np.ndarray:
