@@ -319,7 +319,10 @@ class MonteCarloLocalizer:
         >>> mcl.due([0.5, 0, 0]), mcl.update([0, 0, 0], [1.0]), mcl.due([0.1, 0, 0]), mcl.due([0.3, 0, 0])
         (False, False, False, True)
         """
-        odom = as_array(odometry_pose, "odometry_pose", shape=(3,))
+        return self._moved(as_array(odometry_pose, "odometry_pose", shape=(3,)))
+
+    def _moved(self, odom: np.ndarray) -> bool:
+        """:meth:`due` for a checked odometry pose."""
         if self._odom is None:
             return False
         d = odom - self._odom
@@ -373,7 +376,7 @@ class MonteCarloLocalizer:
         if self._odom is None:
             self._odom = odom
             return False
-        if not (force or self.due(odom)):
+        if not (force or self._moved(odom)):
             return False
         step = mcl_step(self.particles, self.weights, self._odom, odom, r, a, self.field, alphas=self.alphas,
                         resample=False, rng=self.rng, **self.model)

@@ -102,9 +102,9 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     zmin, zmax = Pk[..., 2].min(axis=1, initial=np.inf), Pk[..., 2].max(axis=1, initial=-np.inf)
     polygons, seen = list(uv), simple.copy()
     for i in np.flatnonzero(~simple):   # a corner behind the near plane, or very far off the image: clip
-        poly = _clip_to_view(Pk[i], fx, fy, cx, cy, width, height, near)
-        if poly is not None:
-            polygons[i] = _project(poly, fx, fy, cx, cy)
+        clipped = _clip_to_view(Pk[i], fx, fy, cx, cy, width, height, near)
+        if clipped is not None:
+            poly, polygons[i] = clipped
             lo[i], hi[i] = np.floor(polygons[i].min(axis=0)), np.ceil(polygons[i].max(axis=0))
             zmin[i], zmax[i] = poly[:, 2].min(), poly[:, 2].max()
             seen[i] = True
@@ -160,17 +160,20 @@ def _project(points: np.ndarray, fx: float, fy: float, cx: float, cy: float) -> 
 
 
 def _clip_to_view(corners: np.ndarray, fx: float, fy: float, cx: float, cy: float, width: int, height: int,
-                  near: float) -> np.ndarray | None:
+                  near: float) -> tuple[np.ndarray, np.ndarray] | None:
     """The part of a surface (camera frame) in front of the near plane, also clipped to the view's
-    sides when its image would reach beyond :data:`_FAR_PIXELS`; ``None`` if nothing is left."""
+    sides when its image would reach beyond :data:`_FAR_PIXELS`, and its image (:func:`_project`);
+    ``None`` if nothing is left."""
     poly = _clip(corners, np.array([0.0, 0.0, 1.0]), near)
     if len(poly) < 3:
         return None
-    if np.abs(_project(poly, fx, fy, cx, cy)).max() > _FAR_PIXELS:
+    uv = _project(poly, fx, fy, cx, cy)
+    if np.abs(uv).max() > _FAR_PIXELS:
         # clip to planes through the optical centre 2 px outside the image: what falls inside the
         # image is unchanged, and projected coordinates stay small
         for normal in ([fx, 0.0, cx + 2], [-fx, 0.0, width + 1 - cx], [0.0, fy, cy + 2], [0.0, -fy, height + 1 - cy]):
             poly = _clip(poly, np.array(normal), 0.0)
         if len(poly) < 3:
             return None
-    return poly
+        uv = _project(poly, fx, fy, cx, cy)
+    return poly, uv

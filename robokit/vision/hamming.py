@@ -182,9 +182,8 @@ def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
 
     Notes
     -----
-    Rublee et al. (2011), Sec. 5: the XOR of two rows, its set bits counted (``numpy.bitwise_count``)
-    and added 64-bit word by word, in blocks of rows of ``a`` so that no more than about 4 million
-    distances are held at once.
+    Rublee et al. (2011), Sec. 5; computed with :func:`hamming_distance` in blocks of rows of
+    ``a`` so that no more than about 4 million distances are held at once.
 
     Examples
     --------
@@ -194,13 +193,10 @@ def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
     if check:
         a, b = as_binary_descriptors(a, "a"), as_binary_descriptors(b, "b")
         same_width(a, b, "a", "b")
-    out = np.zeros((a.shape[0], b.shape[0]), np.int64)
+    out = np.empty((a.shape[0], b.shape[0]), np.int64)
     step = max(1, _BLOCK // max(1, b.shape[0]))
-    b64 = _words64(b).T.copy()                          # (words, Nb): one row per 64-bit word
     for s in range(0, a.shape[0], step):
-        a64 = _words64(a[s:s + step])
-        for w in range(b64.shape[0]):                   # word by word: no (Na, Nb, words) array to reduce
-            out[s:s + step] += np.bitwise_count(np.bitwise_xor(a64[:, w, None], b64[w][None]))
+        out[s:s + step] = hamming_distance(a[s:s + step, None], b[None], check=False)
     return out
 
 

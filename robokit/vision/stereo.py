@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry import wrap_angle
 from ..validation import as_array, check_finite_result, check_finite_scalar, check_positive
 from .features import Features
 from .matching import gated_ratio_match, ratio_match
@@ -362,7 +363,7 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
     li, ri = _row_candidates(kl.xy[:, 1], kr.xy[:, 1], tol)
     disp = kl.xy[li, 0] - kr.xy[ri, 0]
     ok = (np.abs(kl.xy[li, 1] - kr.xy[ri, 1]) <= tol) & (disp >= dmin) & (disp <= dmax)
-    dtheta = np.abs((kl.orientation[li] - kr.orientation[ri] + np.pi) % (2 * np.pi) - np.pi)
+    dtheta = np.abs(wrap_angle(kl.orientation[li] - kr.orientation[ri], check=False))
     ok &= dtheta <= dori
     sr = kl.scale[li] / kr.scale[ri]
     ok &= (sr <= srat) & (sr >= 1 / srat)
