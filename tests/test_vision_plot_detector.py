@@ -124,11 +124,12 @@ def test_scale_space_levels_are_subsampled_consistently(photo):
     from robokit.vision.plot_detector import detect_plot_levels
     kp, space = detect_plot_levels(photo)
     assert np.allclose(space.sigmas, plot_scales())
-    assert space.steps.tolist() == [1, 1, 1, 2, 2, 2, 4, 4, 4]
-    assert space.images[0].shape == (480, 640) and space.images[3].shape == (240, 320)
-    assert space.images[6].shape == (120, 160)
+    # a level moves to a coarser grid once its sigma is 4 samples wide (4.03 px, then 8.06 px)
+    assert space.steps.tolist() == [1, 1, 1, 1, 2, 2, 2, 4, 4]
+    assert space.images[3].shape == (480, 640) and space.images[4].shape == (240, 320)
+    assert space.images[7].shape == (120, 160)
     # a coarse level sampled every 2 (4) pixels equals the full-resolution smoothing at those pixels
-    for n, step in ((3, 2), (6, 4)):
+    for n, step in ((4, 2), (7, 4)):
         ref = cv2.GaussianBlur(photo.astype(np.float32) / 255, (0, 0), plot_scales()[n])
         assert np.abs(space.images[n][20:-20, 20:-20] - ref[20 * step:-20 * step:step, 20 * step:-20 * step:step]).max() < 0.01
     assert np.array_equal(kp.xy, detect_plot(photo).xy)
@@ -153,7 +154,9 @@ def test_fast_detector_agrees_with_the_plain_reference(photo):
 @pytest.mark.parametrize("zoom", [0.7, 1.4])
 def test_selected_scale_follows_a_zoom(photo, zoom):
     # the scale of a repeated keypoint grows with the zoom (a detector that keeps its keypoints on
-    # the finest level, as the four-level PLOT did, fails this: median ratio near 1)
+    # the finest level, as the four-level PLOT did, fails this: median ratio near 1); with the
+    # 26-neighbour test and the joint quadratic refinement most scales follow it to within a quarter
+    # octave (the 8-neighbour, per-axis-parabola version: 65 % and 76 %, median off by 0.11 / 0.10)
     h = similarity_homography(photo.shape, zoom)
     warped = cv2.warpPerspective(photo, h, (640, 480))
     a, b = detect_plot(photo), detect_plot(warped)
@@ -162,5 +165,6 @@ def test_selected_scale_follows_a_zoom(photo, zoom):
     d, i = cKDTree(b.xy).query(pa[inside])
     ok = d < 2.5
     assert ok.sum() > 50
-    ratio = np.log2(b.scale[i[ok]] / a.scale[inside][ok])
-    assert abs(np.median(ratio) - np.log2(zoom)) < 0.15
+    error = np.log2(b.scale[i[ok]] / a.scale[inside][ok]) - np.log2(zoom)
+    assert abs(np.median(error)) < 0.09
+    assert np.mean(np.abs(error) < 0.25) > 0.75

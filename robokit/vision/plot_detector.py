@@ -13,21 +13,23 @@ small ``n`` ("n = 3 to accelerate the computation") and an 8-neighbour maximum s
 value of ``k`` and does not say how a keypoint's scale is chosen (our copy's equations are
 unnumbered, so we cite the section). Within that series we use three levels per octave
 (``k = 2^(1/3)``) over nine levels (``sigma`` from 1.6 to 10.2 px, about three octaves), and keep a
-point when its junction strength is an 8-neighbour maximum at its level *and* no weaker than the
-same place on both adjacent levels: an extremum in scale of the scale-normalised response, as in
-Lindeberg's scale selection [3] and SIFT's difference-of-Gaussian extrema [4]. Only inner levels can hold
-one, so the outermost levels 1.6 and 10.2 px only bracket the search. The scale is refined by a
-parabola through the three levels (``log sigma`` axis); positions by parabolas in x and y. With four
-levels at ``k = sqrt(2)`` and one-sided comparisons at the ends, most keypoints sat on the finest
-level whatever the zoom, and the matching score under a 0.7x or 1.4x zoom was far below SIFT's;
-``benchmarks/bench_vision.py`` measures where this selection stands (six real photographs).
+point when its junction strength is the maximum of its 26 neighbours in scale space (the paper's 8
+at its level and 9 on each adjacent level): an extremum in scale of the scale-normalised response,
+as in Lindeberg's scale selection [3] and SIFT's difference-of-Gaussian extrema [4]. Only inner
+levels can hold one, so the outermost levels 1.6 and 10.2 px only bracket the search. Position and
+scale are refined together by the peak of a quadratic through the 3 x 3 x 3 neighbourhood (Lowe's
+Eq. 3 [4]). Comparing only the same place on the adjacent levels, and refining each axis by its own
+parabola, left the selected scale biased under zoom (PLOT's scales followed a 0.7x zoom only
+about three quarters of the way); ``benchmarks/bench_vision.py`` measures where the selection
+stands (six real photographs).
 
-Speed. Each level is one incremental Gaussian blur of the previous one; once ``sigma`` reaches
-``2 sigma_0`` the level is subsampled by two (SIFT's octaves) and the maxima are searched on each
-level's own grid (an adjacent level on a grid twice as fine or as coarse is read by bilinear lookup
-at the candidates only). The normalisation is folded into the derivative kernels and the tensor is
-built in place in float32. :mod:`robokit.vision.plot_reference` keeps the plain full-resolution
-algorithm, and the tests compare the two.
+Speed. Each level is one incremental Gaussian blur of the previous one; once ``sigma`` is 4
+samples wide the level is subsampled by two (SIFT's octaves, but SIFT halves at 3.2: PLOT's second
+derivatives need the finer sampling), and the maxima are searched on each level's own grid (an
+adjacent level on a grid twice as fine or as coarse is read by bilinear lookup at the candidates'
+neighbourhoods only). The normalisation is folded into the derivative kernels and the tensor is
+accumulated in place in float32 by OpenCV. :mod:`robokit.vision.plot_reference` keeps the plain
+full-resolution algorithm, and the tests compare the two.
 
 OpenCV does the filtering; the tensor, the eigenvalues and the maximum search are the lesson and
 are written here, vectorised with numpy.
@@ -72,9 +74,11 @@ class PlotParams:
         Number of levels, 3 to 16; keypoints lie on the inner ones (the paper suggests
         ``n = 0..3``; nine levels cover three octaves).
     gamma : float
-        Weight of the odd (linear) part ``b b^T`` against the even part ``A A^T``.
+        Weight of the odd (linear) part ``b b^T`` against the even part ``A A^T`` (the paper gives
+        none; 2.0, chosen with ``integration`` by the matching score on the benchmark photographs,
+        see docs/DECISIONS.md).
     integration : float
-        Tensor averaging window as a multiple of ``sigma_n``.
+        Tensor averaging window as a multiple of ``sigma_n`` (0.5).
     threshold : float
         Keep maxima whose junction strength exceeds this fraction of the image's largest one
         (the paper thresholds "in advance" without a value; 0.01 keeps about as many keypoints as
@@ -91,8 +95,8 @@ class PlotParams:
     sigma0: float = 1.6
     k: float = 2 ** (1 / 3)
     n_scales: int = 9
-    gamma: float = 0.5
-    integration: float = 1.0
+    gamma: float = 2.0
+    integration: float = 0.5
     threshold: float = 0.01
     min_response: float = 1e-6
     max_keypoints: int = 2000
@@ -121,8 +125,7 @@ class ScaleSpace:
         Scale of each level in pixels of the original image.
     images : list of numpy.ndarray
         Smoothed images, float32; level ``n`` is sampled every ``steps[n]`` pixels (the grid is
-        halved each time the Gaussian reaches twice the width it had when the grid was last halved,
-        ``2 sigma_0`` at first, as in SIFT's octaves).
+        halved each time the Gaussian is 4 samples wide on it, as in SIFT's octaves).
     steps : numpy.ndarray of int, shape (n,)
         Pixel spacing of each level: sample ``(i, j)`` is original pixel ``(steps[n] i, steps[n] j)``.
     """
@@ -242,28 +245,26 @@ def _tensor_components(smoothed: np.ndarray, sigma: float, gamma: float, integra
     s2 = float(sigma) ** 2
     half, root = np.float32(0.5 * s2), np.float32(np.sqrt(float(gamma) * s2))
 
-    def filt(kx, ky):
-        return cv2.sepFilter2D(smoothed, cv2.CV_32F, kx, ky, borderType=cv2.BORDER_REFLECT)
+    def along(kernel):    # a 1-D kernel along x (a row vector) or y (a column vector)
+        return cv2.filter2D(smoothed, cv2.CV_32F, kernel, borderType=cv2.BORDER_REFLECT)
 
-    bx, by = filt(_FIRST * root, _IDENT), filt(_IDENT, _FIRST * root)
-    axx, ayy, axy = filt(_SECOND * half, _IDENT), filt(_IDENT, _SECOND * half), filt(_FIRST * half, _FIRST)
-    # T = A A^T + b b^T of the scaled terms (A symmetric, so A A^T = A^2), in place in float32
-    axy2 = axy * axy
-    t11 = axx * axx
-    t11 += axy2
-    t11 += bx * bx
-    t22 = ayy * ayy
-    t22 += axy2
-    t22 += by * by
-    t12 = axx
-    t12 += ayy
-    t12 *= axy
-    t12 += bx * by
-    # one 3-channel blur is cheaper than three single-channel ones
-    return cv2.split(_blur(cv2.merge([t11, t12, t22]), float(integration * sigma)))
+    bx, by = along((_FIRST * root)[None, :]), along((_FIRST * root)[:, None])
+    axx, ayy = along((_SECOND * half)[None, :]), along((_SECOND * half)[:, None])
+    axy = cv2.sepFilter2D(smoothed, cv2.CV_32F, _FIRST * half, _FIRST, borderType=cv2.BORDER_REFLECT)
+    # T = A A^T + b b^T of the scaled terms (A symmetric, so A A^T = A^2), accumulated in place
+    t11 = cv2.multiply(axx, axx)
+    cv2.accumulateSquare(axy, t11)
+    cv2.accumulateSquare(bx, t11)
+    t22 = cv2.multiply(ayy, ayy)
+    cv2.accumulateSquare(axy, t22)
+    cv2.accumulateSquare(by, t22)
+    t12 = cv2.multiply(cv2.add(axx, ayy), axy)
+    cv2.accumulateProduct(bx, by, t12)
+    window = float(integration * sigma)
+    return _blur(t11, window), _blur(t12, window), _blur(t22, window)
 
 
-def orientation_tensor(image, sigma: float, *, gamma: float = 0.5, integration: float = 1.0) -> np.ndarray:
+def orientation_tensor(image, sigma: float, *, gamma: float = 2.0, integration: float = 0.5) -> np.ndarray:
     """Normalised local orientation tensor field ``T`` at scale ``sigma``.
 
     Parameters
@@ -272,9 +273,9 @@ def orientation_tensor(image, sigma: float, *, gamma: float = 0.5, integration: 
         Grey image.
     sigma : float
         Character scale in pixels.
-    gamma : float, default 0.5
-        Weight of the linear (odd) part.
-    integration : float, default 1.0
+    gamma : float, default 2.0
+        Weight of the linear (odd) part (the detector's default, :class:`PlotParams`).
+    integration : float, default 0.5
         Averaging window as a multiple of ``sigma``.
 
     Returns
@@ -303,16 +304,9 @@ def _eig_sym(t11, t12, t22):
 
 
 def _junction(t11, t12, t22) -> np.ndarray:
-    """``lambda_2`` of :func:`_eig_sym` for float32 component images, computed in place."""
-    root = cv2.subtract(t11, t22)
-    root *= 0.5
-    root *= root
-    t12 *= t12
-    root += t12
-    np.sqrt(root, out=root)
-    lam2 = t11
-    lam2 += t22
-    lam2 *= 0.5
+    """``lambda_2`` of :func:`_eig_sym` for float32 component images (OpenCV passes, no temporaries)."""
+    root = cv2.magnitude(cv2.addWeighted(t11, 0.5, t22, -0.5, 0.0), t12)   # sqrt(((t11 - t22)/2)^2 + t12^2)
+    lam2 = cv2.addWeighted(t11, 0.5, t22, 0.5, 0.0)
     lam2 -= root
     return np.maximum(lam2, 0.0, out=lam2)
 
@@ -389,21 +383,6 @@ def edge_strength(tensor) -> np.ndarray:
     return lam1 - lam2
 
 
-def _subpixel(resp: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Quadratic interpolation of a 3-point peak along each axis, offsets clipped to +-0.5 px."""
-    c0 = resp[rows, cols]
-
-    def offset(m, p):
-        den = m - 2 * c0 + p
-        with np.errstate(divide="ignore", invalid="ignore"):
-            off = np.where(den < 0, 0.5 * (m - p) / den, 0.0)
-        return np.clip(off, -0.5, 0.5)
-
-    dx = offset(resp[rows, cols - 1], resp[rows, cols + 1])
-    dy = offset(resp[rows - 1, cols], resp[rows + 1, cols])
-    return cols + dx, rows + dy
-
-
 def detect_plot(image, params: PlotParams | None = None, **overrides) -> Keypoints:
     """Detect PLOT keypoints (position, scale, junction response) in a grey image.
 
@@ -431,9 +410,9 @@ def detect_plot(image, params: PlotParams | None = None, **overrides) -> Keypoin
     -----
     Lin et al. Sec. 2.i. At each scale ``sigma_n = sigma_0 k^n`` the junction strength ``lambda_2``
     of the normalised orientation tensor is thresholded and kept where it is the maximum of its 8
-    neighbours (the paper) and no weaker than the same place on both adjacent scales (our scale
-    selection, see the module notes); positions and scales are refined by parabolas through the
-    peak and its neighbours (in x, y and ``log sigma``).
+    neighbours (the paper) and of the 9 places around it on both adjacent scales (our scale
+    selection, see the module notes); position and scale (``log sigma``) are refined together by
+    the peak of a quadratic through that 3 x 3 x 3 neighbourhood (Lowe 2004, Eq. 3).
 
     Examples
     --------
@@ -495,6 +474,12 @@ def _params(params, overrides) -> PlotParams:
     return PlotParams(**{**p.__dict__, **overrides}) if overrides else p
 
 
+#: A level moves to a grid twice as coarse only if its sigma stays at least this many samples wide
+#: there. SIFT's octaves halve at 1.6 samples; PLOT's second derivatives need the finer sampling
+#: (halving at 1.6 lowered its matching score under a 0.7x zoom, docs/DECISIONS.md).
+_MIN_SAMPLES = 2.0
+
+
 def _scale_space(img: np.ndarray, p: PlotParams) -> ScaleSpace:
     """Smoothed levels ``L(x, sigma_n)``, each level one incremental blur of the previous one."""
     sigmas = p.sigma0 * p.k ** np.arange(p.n_scales)
@@ -504,7 +489,7 @@ def _scale_space(img: np.ndarray, p: PlotParams) -> ScaleSpace:
         local = s / step                      # sigma in pixels of the current grid
         # incremental smoothing: G_s = G_sqrt(s^2 - prev^2) * G_prev
         smoothed = _blur(smoothed, float(np.sqrt(local * local - prev * prev)))
-        if local >= 2 * p.sigma0 - 1e-9 and min(smoothed.shape) >= 32:
+        if local / 2 >= _MIN_SAMPLES - 1e-9 and min(smoothed.shape) >= 32:
             # a Gaussian this wide leaves nothing at the pixel scale: halve the grid (as SIFT's octaves)
             smoothed, step, local = smoothed[::2, ::2], step * 2, local / 2
         prev = local
@@ -514,29 +499,81 @@ def _scale_space(img: np.ndarray, p: PlotParams) -> ScaleSpace:
 
 
 def _lookup(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Bilinear samples of ``img`` at grid positions ``(x, y)`` (clamped to the grid)."""
-    return cv2.remap(img, x.astype(np.float32)[:, None], y.astype(np.float32)[:, None], cv2.INTER_LINEAR,
-                     borderMode=cv2.BORDER_REPLICATE).ravel() if x.size else np.zeros(0, img.dtype)
+    """Bilinear samples of ``img`` at grid positions ``(x, y)`` (clamped to the grid), shaped as ``x``."""
+    n = x.size
+    if not n:
+        return np.zeros(x.shape, img.dtype)
+    # OpenCV's maps must be under 32767 on each side: lay the samples out in rows of 1024
+    width = min(n, 1024)
+    rows = -(-n // width)
+    mx, my = np.zeros((2, rows * width), np.float32)
+    mx[:n], my[:n] = x.ravel(), y.ravel()
+    out = cv2.remap(img, mx.reshape(rows, width), my.reshape(rows, width), cv2.INTER_LINEAR,
+                    borderMode=cv2.BORDER_REPLICATE)
+    return out.ravel()[:n].reshape(x.shape)
+
+
+#: Offsets (level, row, col) of a 3 x 3 x 3 neighbourhood, level-major: index 13 is the centre.
+_CUBE = np.stack(np.meshgrid([-1, 0, 1], [-1, 0, 1], [-1, 0, 1], indexing="ij"), -1).reshape(27, 3)
+
+
+def _cubes(n: int, responses: list, steps: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """The responses around each candidate of level ``n``: shape (N, 3, 3, 3) as (level, row, col).
+
+    The candidate's own level is read directly; the adjacent levels, whose grids may be twice as
+    fine or as coarse, by bilinear lookup at the same places in original pixels.
+    """
+    cube = np.empty((rows.size, 3, 3, 3), np.float32)
+    dr, dc = _CUBE[:9, 1], _CUBE[:9, 2]
+    r, c = rows[:, None] + dr, cols[:, None] + dc
+    cube[:, 1] = responses[n][r, c].reshape(-1, 3, 3)
+    for side, m in ((0, n - 1), (2, n + 1)):
+        ratio = steps[n] / steps[m]
+        cube[:, side] = _lookup(responses[m], c * ratio, r * ratio).reshape(-1, 3, 3)
+    return cube
+
+
+def _quadratic_peak(cube: np.ndarray) -> np.ndarray:
+    """Offset (level, row, col) of the peak of the quadratic through each 3 x 3 x 3 cube.
+
+    One Newton step ``offset = -H^-1 g`` with the gradient ``g`` and Hessian ``H`` from central
+    differences (Lowe 2004, Sec. 4, Eq. 3), clipped to +-0.5 so that a keypoint never leaves its
+    cell; a cube whose Hessian is not negative definite keeps offset zero.
+    """
+    c = cube.astype(float)
+    centre = c[:, 1, 1, 1]
+    g = 0.5 * np.stack([c[:, 2, 1, 1] - c[:, 0, 1, 1], c[:, 1, 2, 1] - c[:, 1, 0, 1], c[:, 1, 1, 2] - c[:, 1, 1, 0]], 1)
+    h = np.empty((len(c), 3, 3))
+    h[:, 0, 0] = c[:, 2, 1, 1] - 2 * centre + c[:, 0, 1, 1]
+    h[:, 1, 1] = c[:, 1, 2, 1] - 2 * centre + c[:, 1, 0, 1]
+    h[:, 2, 2] = c[:, 1, 1, 2] - 2 * centre + c[:, 1, 1, 0]
+    h[:, 0, 1] = h[:, 1, 0] = 0.25 * (c[:, 2, 2, 1] - c[:, 2, 0, 1] - c[:, 0, 2, 1] + c[:, 0, 0, 1])
+    h[:, 0, 2] = h[:, 2, 0] = 0.25 * (c[:, 2, 1, 2] - c[:, 2, 1, 0] - c[:, 0, 1, 2] + c[:, 0, 1, 0])
+    h[:, 1, 2] = h[:, 2, 1] = 0.25 * (c[:, 1, 2, 2] - c[:, 1, 2, 0] - c[:, 1, 0, 2] + c[:, 1, 0, 0])
+    # negative definite: leading principal minors alternate in sign (-, +, -)
+    m2 = h[:, 0, 0] * h[:, 1, 1] - h[:, 0, 1] ** 2
+    peak = (h[:, 0, 0] < 0) & (m2 > 0) & (np.linalg.det(h) < 0)
+    offset = np.zeros((len(c), 3))
+    if peak.any():
+        offset[peak] = -np.linalg.solve(h[peak], g[peak][:, :, None])[:, :, 0]
+    return np.clip(offset, -0.5, 0.5)
 
 
 def _level_maxima(n: int, responses: list, dilated: list, steps: np.ndarray, thr: float, border: int):
-    """Keypoints at inner level ``n``: thresholded 3 x 3 maxima no weaker than both adjacent levels.
+    """Keypoints at inner level ``n``: thresholded maxima of their 3 x 3 x 3 scale-space neighbourhood.
 
-    Returns ``(xy, level, strength)``: positions in original pixels (refined by parabolas in x and
-    y) and the level refined by a parabola through the responses at the same place on the levels
-    ``n - 1`` and ``n + 1`` (log-scale axis, offset clipped to +-0.5 level).
+    Returns ``(xy, level, strength)``: positions in original pixels and fractional levels, both
+    refined by the peak of a quadratic through the neighbourhood (:func:`_quadratic_peak`).
     """
     resp, step = responses[n], int(steps[n])
     b = max(1, min(-(-border // step), (min(resp.shape) - 1) // 2))   # border in this grid's pixels
     is_max = (resp >= dilated[n]) & (resp > thr)
     is_max[:b], is_max[-b:], is_max[:, :b], is_max[:, -b:] = False, False, False, False
     rows, cols = np.nonzero(is_max)
-    strength = resp[rows, cols]
-    # the same place on the adjacent levels (their grids may be twice as fine or as coarse)
-    below, above = (_lookup(responses[m], cols * (step / steps[m]), rows * (step / steps[m])) for m in (n - 1, n + 1))
-    keep = (strength >= below) & (strength >= above)
-    rows, cols, strength, below, above = rows[keep], cols[keep], strength[keep], below[keep], above[keep]
-    x, y = _subpixel(resp, rows, cols)
-    den = below - 2 * strength + above
-    shift = np.clip(np.divide(0.5 * (below - above), den, out=np.zeros(rows.size), where=den < 0), -0.5, 0.5)
-    return np.column_stack([x, y]) * step, n + shift, strength
+    cube = _cubes(n, responses, steps, rows, cols)
+    strength = cube[:, 1, 1, 1]
+    keep = strength >= cube.reshape(-1, 27).max(axis=1)     # no weaker than any of its 26 neighbours
+    rows, cols, cube, strength = rows[keep], cols[keep], cube[keep], strength[keep]
+    offset = _quadratic_peak(cube)
+    xy = np.column_stack([cols + offset[:, 2], rows + offset[:, 1]]) * step
+    return xy, n + offset[:, 0], strength

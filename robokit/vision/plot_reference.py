@@ -3,8 +3,8 @@
 :func:`reference_detect_plot` follows Lin et al. Sec. 2.i step by step on the full image grid at
 every scale: smooth, build the normalised orientation tensor with the public
 :func:`~robokit.vision.plot_detector.orientation_tensor`, take its junction strength ``lambda_2``,
-and keep the thresholded points that are 8-neighbour maxima at their level and no weaker than the
-same place on the two adjacent levels. :func:`~robokit.vision.plot_detector.detect_plot` computes
+and keep the thresholded points that are maxima of their 26 neighbours in scale space (8 at their
+level, 9 on each adjacent level). :func:`~robokit.vision.plot_detector.detect_plot` computes
 the same keypoints faster (coarse levels on subsampled grids, in-place float32 arithmetic); the
 tests compare the two.
 
@@ -39,7 +39,7 @@ def reference_detect_plot(image, params: PlotParams | None = None) -> Keypoints:
     Keypoints
         Sorted by decreasing response, at most ``params.max_keypoints``, orientation zero. Positions
         are whole pixels (no sub-pixel refinement); the scale is refined by a parabola in
-        ``log sigma`` as in :func:`~robokit.vision.plot_detector.detect_plot`.
+        ``log sigma`` through the three levels (the fast detector fits position and scale together).
 
     Raises
     ------
@@ -49,8 +49,9 @@ def reference_detect_plot(image, params: PlotParams | None = None) -> Keypoints:
     Notes
     -----
     Lin et al. Sec. 2.i: junction strength ``lambda_2`` of the normalised orientation tensor at the
-    scales ``sigma_n = sigma_0 k^n``, thresholded, 8-neighbour maxima. The comparison across scale
-    (inner levels only) is our addition, which the paper does not describe (docs/DECISIONS.md).
+    scales ``sigma_n = sigma_0 k^n``, thresholded, 8-neighbour maxima. The comparison with the
+    adjacent scales' 3 x 3 neighbourhoods (inner levels only) is our addition, which the paper does
+    not describe (docs/DECISIONS.md).
 
     Examples
     --------
@@ -59,8 +60,9 @@ def reference_detect_plot(image, params: PlotParams | None = None) -> Keypoints:
     >>> square = np.zeros((64, 64), np.float32)
     >>> square[20:44, 20:44] = 1.0
     >>> kp = reference_detect_plot(square)
-    >>> kp.xy[0].tolist(), bool(kp.scale[0] > 5)    # strongest: the whole square, a blob at a coarse scale
-    ([31.0, 31.0], True)
+    >>> # strongest: the whole square, a blob at a coarse scale, on a whole pixel next to its centre 31.5
+    >>> bool(np.abs(kp.xy[0] - 31.5).max() == 0.5), bool(kp.scale[0] > 5)
+    (True, True)
     >>> corners = kp.xy[np.abs(kp.xy - 31.5).min(axis=1) > 6]     # the next ones sit near its 4 corners
     >>> len(corners) >= 4, bool(np.all(np.abs(np.abs(corners - 31.5) - 9.5) < 2))
     (True, True)
@@ -73,8 +75,7 @@ def reference_detect_plot(image, params: PlotParams | None = None) -> Keypoints:
     resp = np.stack([junction_strength(orientation_tensor(img, s, gamma=p.gamma, integration=p.integration))
                      for s in sigmas])                                   # (levels, H, W)
     thr = max(p.threshold * resp.max(), p.min_response)
-    is_max = (resp == maximum_filter(resp, size=(1, 3, 3), mode="nearest")) & (resp > thr)
-    is_max[1:-1] &= (resp[1:-1] >= resp[:-2]) & (resp[1:-1] >= resp[2:])
+    is_max = (resp == maximum_filter(resp, size=(3, 3, 3), mode="nearest")) & (resp > thr)
     is_max[0], is_max[-1] = False, False                                 # inner levels only
     b = min(p.border, (min(img.shape) - 1) // 2)
     is_max[:, :b], is_max[:, -b:], is_max[:, :, :b], is_max[:, :, -b:] = False, False, False, False
