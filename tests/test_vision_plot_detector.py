@@ -156,7 +156,8 @@ def test_selected_scale_follows_a_zoom(photo, zoom):
     # the scale of a repeated keypoint grows with the zoom (a detector that keeps its keypoints on
     # the finest level, as the four-level PLOT did, fails this: median ratio near 1); with the
     # 26-neighbour test and the joint quadratic refinement most scales follow it to within a quarter
-    # octave (the 8-neighbour, per-axis-parabola version: 65 % and 76 %, median off by 0.11 / 0.10)
+    # octave (measured 83 % and 92 %, median off by 0.04 / 0.05; the 8-neighbour selection with
+    # per-axis parabolas: 74 % and 89 %, 0.07 / 0.08 with today's filters, worse before them)
     h = similarity_homography(photo.shape, zoom)
     warped = cv2.warpPerspective(photo, h, (640, 480))
     a, b = detect_plot(photo), detect_plot(warped)
@@ -166,8 +167,8 @@ def test_selected_scale_follows_a_zoom(photo, zoom):
     ok = d < 2.5
     assert ok.sum() > 50
     error = np.log2(b.scale[i[ok]] / a.scale[inside][ok]) - np.log2(zoom)
-    assert abs(np.median(error)) < 0.09
-    assert np.mean(np.abs(error) < 0.25) > 0.75
+    assert abs(np.median(error)) < 0.06
+    assert np.mean(np.abs(error) < 0.25) > 0.8
 
 
 def test_an_image_with_very_many_candidates():
@@ -177,3 +178,21 @@ def test_an_image_with_very_many_candidates():
     kp = detect_plot(noise, threshold=0.0, max_keypoints=50000)
     assert len(kp) > 1000
     assert np.all(np.isfinite(kp.xy)) and np.all(np.isfinite(kp.scale))
+
+
+@pytest.mark.parametrize("centre", [(100.3, 80.7), (120.6, 99.2)])
+def test_a_blob_is_found_at_its_centre_and_at_a_scale_proportional_to_its_size(centre):
+    # a Gaussian blob off the pixel grid: the quadratic fit through the 3 x 3 x 3 neighbourhood puts
+    # the keypoint within a fraction of a pixel of the centre, at every level and grid spacing, and
+    # the selected scale is nearly the same multiple of the blob's sigma whatever its size (0.90-0.91;
+    # a blob of sigma 4, whose peak lies just above the first grid change, reads its coarser
+    # neighbour by bilinear lookup and comes out at 0.86-0.88; with three-point differences the
+    # coarse levels lost about 5 % of their response and the spread was about 0.075)
+    y, x = np.mgrid[0:200, 0:240].astype(float)
+    ratios = []
+    for sigma in (2.5, 3.0, 4.0, 5.0, 6.5, 8.0):
+        blob = np.exp(-((x - centre[0]) ** 2 + (y - centre[1]) ** 2) / (2 * sigma ** 2))
+        kp = detect_plot(blob)
+        assert np.hypot(*(kp.xy[0] - centre)) < 0.2, (sigma, kp.xy[0])
+        ratios.append(kp.scale[0] / sigma)
+    assert np.ptp(ratios) < 0.06, ratios

@@ -18,18 +18,20 @@ at its level and 9 on each adjacent level): an extremum in scale of the scale-no
 as in Lindeberg's scale selection [3] and SIFT's difference-of-Gaussian extrema [4]. Only inner
 levels can hold one, so the outermost levels 1.6 and 10.2 px only bracket the search. Position and
 scale are refined together by the peak of a quadratic through the 3 x 3 x 3 neighbourhood (Lowe's
-Eq. 3 [4]). Comparing only the same place on the adjacent levels, and refining each axis by its own
-parabola, left the selected scale biased under zoom (PLOT's scales followed a 0.7x zoom only
-about three quarters of the way); ``benchmarks/bench_vision.py`` measures where the selection
-stands (six real photographs).
+Eq. 3 [4]). Comparing only the same place on the adjacent levels, with a parabola per axis,
+kept twice as many keypoints and let their scales follow a zoom less closely;
+``benchmarks/bench_vision.py`` measures where the selection stands (six real photographs) and
+docs/DECISIONS.md what each choice contributed.
 
-Speed. Each level is one incremental Gaussian blur of the previous one; once ``sigma`` is 4
-samples wide the level is subsampled by two (SIFT's octaves, but SIFT halves at 3.2: PLOT's second
-derivatives need the finer sampling), and the maxima are searched on each level's own grid (an
-adjacent level on a grid twice as fine or as coarse is read by bilinear lookup at the candidates'
-neighbourhoods only). The normalisation is folded into the derivative kernels and the tensor is
-accumulated in place in float32 by OpenCV. :mod:`robokit.vision.plot_reference` keeps the plain
-full-resolution algorithm, and the tests compare the two.
+Speed. Each level is one incremental Gaussian blur of the previous one; once ``sigma`` is 4 px on
+the current grid the level is subsampled by two (SIFT's octaves, though SIFT halves at 3.2 px: PLOT's
+tensor, averaged over half a sigma, needs the finer sampling), and the maxima are searched on each
+level's own grid (an adjacent level on a grid twice as fine or as coarse is read by bilinear lookup
+at the candidates' neighbourhoods only). Derivatives are fourth-order central differences, so that
+a level's response does not depend on how finely its grid samples it. The normalisation is folded
+into the derivative kernels and the tensor is accumulated in place in float32 by OpenCV.
+:mod:`robokit.vision.plot_reference` keeps the plain full-resolution algorithm, and the tests compare
+the two.
 
 OpenCV does the filtering; the tensor, the eigenvalues and the maximum search are the lesson and
 are written here, vectorised with numpy.
@@ -81,8 +83,8 @@ class PlotParams:
         Tensor averaging window as a multiple of ``sigma_n`` (0.5).
     threshold : float
         Keep maxima whose junction strength exceeds this fraction of the image's largest one
-        (the paper thresholds "in advance" without a value; 0.01 keeps about as many keypoints as
-        OpenCV's SIFT on the benchmark photographs).
+        (the paper thresholds "in advance" without a value; 0.01 gives about four fifths as many
+        features as OpenCV's SIFT on the six benchmark photographs).
     min_response : float
         Absolute floor on the junction strength (image in [0, 1]), so that a textureless image
         yields no keypoints rather than amplified noise.
@@ -180,9 +182,12 @@ def _blur(img: np.ndarray, sigma: float) -> np.ndarray:
     return cv2.GaussianBlur(img, (size, size), sigma, borderType=cv2.BORDER_REFLECT)
 
 
-_FIRST = np.float32([-0.5, 0.0, 0.5])     # central first difference
-_SECOND = np.float32([1.0, -2.0, 1.0])    # second difference
-_IDENT = np.float32([0.0, 1.0, 0.0])
+# Fourth-order central differences: on a Gaussian of sigma = 2 samples (a level just moved to a
+# coarser grid) the three-point ones lose about 4 % of a first derivative, against 0.2 % for these,
+# so a level's response would otherwise depend on how finely its grid samples it.
+_FIRST = np.float32([1.0, -8.0, 0.0, 8.0, -1.0]) / np.float32(12.0)     # d/dx
+_SECOND = np.float32([-1.0, 16.0, -30.0, 16.0, -1.0]) / np.float32(12.0)  # d2/dx2
+_IDENT = np.float32([0.0, 0.0, 1.0, 0.0, 0.0])
 
 
 def _derivative(img: np.ndarray, dx: int, dy: int) -> np.ndarray:
@@ -304,7 +309,7 @@ def _eig_sym(t11, t12, t22):
 
 
 def _junction(t11, t12, t22) -> np.ndarray:
-    """``lambda_2`` of :func:`_eig_sym` for float32 component images (OpenCV passes, no temporaries)."""
+    """``lambda_2`` of :func:`_eig_sym` for float32 component images, in a few OpenCV passes."""
     root = cv2.magnitude(cv2.addWeighted(t11, 0.5, t22, -0.5, 0.0), t12)   # sqrt(((t11 - t22)/2)^2 + t12^2)
     lam2 = cv2.addWeighted(t11, 0.5, t22, 0.5, 0.0)
     lam2 -= root
@@ -475,8 +480,8 @@ def _params(params, overrides) -> PlotParams:
 
 
 #: A level moves to a grid twice as coarse only if its sigma stays at least this many samples wide
-#: there. SIFT's octaves halve at 1.6 samples; PLOT's second derivatives need the finer sampling
-#: (halving at 1.6 lowered its matching score under a 0.7x zoom, docs/DECISIONS.md).
+#: there (sigma = 4 px before halving). SIFT halves when sigma is 3.2 px, 1.6 samples after; PLOT's
+#: tensor, averaged over only half a sigma, needs the finer sampling (docs/DECISIONS.md).
 _MIN_SAMPLES = 2.0
 
 
@@ -513,19 +518,21 @@ def _lookup(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return out.ravel()[:n].reshape(x.shape)
 
 
-#: Offsets (level, row, col) of a 3 x 3 x 3 neighbourhood, level-major: index 13 is the centre.
-_CUBE = np.stack(np.meshgrid([-1, 0, 1], [-1, 0, 1], [-1, 0, 1], indexing="ij"), -1).reshape(27, 3)
+#: Row and column offsets of a 3 x 3 neighbourhood, row-major (index 4 is the centre).
+_ROW_OFFSETS, _COL_OFFSETS = (g.ravel() for g in np.meshgrid([-1, 0, 1], [-1, 0, 1], indexing="ij"))
 
 
 def _cubes(n: int, responses: list, steps: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """The responses around each candidate of level ``n``: shape (N, 3, 3, 3) as (level, row, col).
 
     The candidate's own level is read directly; the adjacent levels, whose grids may be twice as
-    fine or as coarse, by bilinear lookup at the same places in original pixels.
+    fine or as coarse, by bilinear lookup at the same places in original pixels. (Bilinear lookup
+    flattens a peak between coarse samples, which pulls the selected scale of a structure just
+    above a grid change towards the finer level, by up to 0.07 octave for a Gaussian blob; bicubic
+    lookup removes that but overshoots at step edges and lost two corners of a plain square.)
     """
     cube = np.empty((rows.size, 3, 3, 3), np.float32)
-    dr, dc = _CUBE[:9, 1], _CUBE[:9, 2]
-    r, c = rows[:, None] + dr, cols[:, None] + dc
+    r, c = rows[:, None] + _ROW_OFFSETS, cols[:, None] + _COL_OFFSETS
     cube[:, 1] = responses[n][r, c].reshape(-1, 3, 3)
     for side, m in ((0, n - 1), (2, n + 1)):
         ratio = steps[n] / steps[m]
