@@ -1236,7 +1236,7 @@ SPECS: dict[str, Call] = {
     "robokit.navigation.corridor_trials.localization_trials": Call({
         "setup": Obj(corridor_setup), "method": Choice("ours"), "trials": Int(1, optional=True),
         "positions": Given([0]), "seed": Int(0), "max_distance": Real(3.0), "cache": Flag(False),
-        "progress": Func(None, optional=True)}, cheap=False),
+        "progress": Func(None, optional=True), "workers": Int(1, optional=True)}, cheap=False),
     "robokit.navigation.corridor_kidnapping.kidnapping": Call({
         "setup": Obj(corridor_setup), "origin": Int(0), "destination": Int(2), "period": Real(5.0), "after": Real(3.0),
         "kidnap_distance": Real(1.0), "seed": Int(0)}, cheap=False),

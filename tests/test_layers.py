@@ -24,6 +24,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "robokit"
 LAYERS: list[set[str]] = [
     {"validation", "config", "about", "course"},   # base: input checks, settings, notebook tooling
     {"progress"},                                   # the one progress bar (reads fast/headless from config)
+    {"parallel"},                                   # independent runs in worker processes
     {"geometry"},                                   # SE(2)/SE(3)/SO(3), the papers' frames
     {"vision"},                                     # detectors, descriptors, matching
     {"sim"},                                        # worlds, sensors, motion (its feature check uses vision)

@@ -39,7 +39,7 @@ from ..config import cache_dir, cache_key, code_version, fast_mode, read_arrays,
 from ..controllers import CenteringResult, move_to_middle_line
 from ..geometry import wrap_angle
 from ..localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share, pose_clusters
-from ..progress import progress_bar
+from ..parallel import map_runs
 from ..sim import noisy_odometry, waypoint_path
 from ..vision import detect_orb_features
 from ..validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive
@@ -406,12 +406,25 @@ class TrialSet:
         return self.converged & (err[:, 0] <= tol[0]) & (err[:, 1] <= tol[1])
 
 
+def _trials_from_start(shared: tuple, task: tuple) -> list:
+    """Run ``j`` from start ``i`` for each method (``task = (i, j)``), seeded by ``(seed, i, j)``.
+
+    Both methods go on from the generator's state after one shared moving strategy.
+    """
+    setup, methods, seed, max_distance = shared
+    i, j = task
+    rng = np.random.default_rng([seed, i, j])
+    centred = move_to_middle_line(setup.world, START_POSES[i], setup.lidar, rng=rng)
+    return [_run_trial(setup, m, centred, copy.deepcopy(rng), max_distance, CLUSTER_SHARE, *ELLIPSE_SIGMA, SETTLE,
+                       False) for m in methods]
+
+
 _SET_FIELDS = ("positions", "converged", "iterations", "distance", "error", "settled", "retrieval_error")
 
 
 def localization_trials(setup: CorridorMap, method: str, *, trials: int | None = None, positions: Any = None,
                         seed: int = 0, max_distance: float = 40.0, cache: bool = True,
-                        progress: Callable | None = None) -> TrialSet:
+                        progress: Callable | None = None, workers: int | None = None) -> TrialSet:
     """Table 2 re-run: ``trials`` global localizations of ``method`` from each start pose.
 
     Parameters
@@ -432,6 +445,11 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
         cached either, they are made too and cached: both methods start each run with the same
         moving strategy (same start, same seed), which is then driven only once.
     progress : callable ``(done, total)``, optional
+        Told as each start's runs finish.
+    workers : int, optional
+        Worker processes for the runs (default :func:`robokit.parallel.worker_count`; 1 makes them
+        in this process). Every run is seeded from its start and number, so the results do not
+        depend on it.
 
     Returns
     -------
@@ -462,6 +480,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     seed = check_int(seed, "seed", minimum=0)
     max_distance = check_positive(max_distance, "max_distance")
     progress = check_callable(progress, "progress")
+    workers = None if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
     code = code_version("sim", "geometry", "vision", "mapping", "localization", "controllers",
                         "navigation.corridor_experiment", "navigation.corridor_trials")
 
@@ -480,17 +499,10 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
         target, meta = cache_file(other)
         if read_arrays(target, _SET_FIELDS, meta) is None:
             todo.append(other)
-    runs: dict[str, list] = {m: [] for m in todo}
-    with progress_bar(len(starts) * trials * len(todo), f"localization trials ({' and '.join(todo)})", unit="trial",
-                      callback=progress) as bar:
-        for i in starts:
-            for j in range(trials):
-                rng = np.random.default_rng([seed, i, j])
-                centred = move_to_middle_line(setup.world, START_POSES[i], setup.lidar, rng=rng)
-                for m in todo:    # each method goes on from the generator's state after the moving strategy
-                    runs[m].append(_run_trial(setup, m, centred, copy.deepcopy(rng), max_distance, CLUSTER_SHARE,
-                                              *ELLIPSE_SIGMA, SETTLE, False))
-                    bar.update()
+    tasks = [(i, j) for i in starts for j in range(trials)]
+    pairs = map_runs(_trials_from_start, (setup, tuple(todo), seed, max_distance), tasks, workers=workers,
+                     desc=f"localization trials ({' and '.join(todo)})", unit="start", progress=progress)
+    runs = {m: [pair[k] for pair in pairs] for k, m in enumerate(todo)}
     sets = {m: TrialSet(m, np.repeat(starts, trials).astype(int), np.array([r.converged for r in rs]),
                         np.array([r.iterations for r in rs], int), np.array([r.distance for r in rs]),
                         np.array([r.error for r in rs]).reshape(-1, 2), np.array([r.settled for r in rs]).reshape(-1, 2),
