@@ -2,9 +2,11 @@
 
 An experiment made of many independent, separately seeded runs (lesson 03's Table 2 trials)
 gives the same results whatever order the runs are made in, so a student's multi-core laptop can
-make them side by side. :func:`map_runs` does that with spawned worker processes (spawn, not fork:
-a forked Jupyter kernel can inherit a held lock of OpenCV's or ZeroMQ's threads). The object every
-run needs (a map, a world) is sent to each worker once, not with every run. With one worker, or
+make them side by side. :func:`map_runs` does that in worker processes started by Python's fork
+server (spawn where there is none), not forked from the caller: a forked Jupyter kernel can inherit
+a held lock of OpenCV's or ZeroMQ's threads. The fork server imports robokit once, so only the first
+pool of a session pays the import (about a second); a spawned worker pays it every time. The object
+every run needs (a map, a world) is sent to each worker once, not with every run. With one worker, or
 fewer runs than :data:`MIN_RUNS`, the runs are made here, one after the other, exactly as a plain
 loop would; the results are the same either way (the tests compare them).
 
@@ -77,6 +79,17 @@ def _run_shared(run: Callable, task: Any) -> Any:
     return run(_SHARED["value"], task)
 
 
+def _context(run: Callable):
+    """The fork server's context, which imports ``run``'s module once for every later worker."""
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("forkserver")
+    module = getattr(run, "__module__", None)
+    if isinstance(module, str) and module.startswith("robokit."):
+        context.set_forkserver_preload([module])     # no effect once the server runs
+    return context
+
+
 def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None = None, desc: str = "runs",
              unit: str = "run", progress: Callable | None = None) -> list:
     """``[run(shared, task) for task in tasks]``, made side by side in worker processes.
@@ -130,7 +143,7 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
                 results[k] = run(shared, task)
                 bar.update()
             return results
-        context = multiprocessing.get_context("spawn")
+        context = _context(run)
         with ProcessPoolExecutor(workers, mp_context=context, initializer=_receive, initargs=(shared,)) as pool:
             futures = {pool.submit(_run_shared, run, task): k for k, task in enumerate(tasks)}
             for done in as_completed(futures):

@@ -40,7 +40,7 @@ import numpy as np
 from ..config import (CACHE_READ_ERRORS, cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays,
                       write_atomically)
 from ..mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
-from ..progress import progress_bar
+from ..parallel import map_runs
 from ..sim import Lidar, PinholeCamera, camera_mount, corridor_path, describe_sensor, long_corridor, waypoint_path
 from ..sim.world import World
 from ..validation import as_array, check_callable, check_int, check_positive
@@ -126,15 +126,25 @@ def _descriptor_list(flat: np.ndarray, counts: np.ndarray) -> list:
     return np.split(flat, np.cumsum(counts)[:-1]) if len(counts) else []
 
 
-def _orb_frames(world: World, camera: PinholeCamera, poses: np.ndarray, rng: np.random.Generator,
-                progress: Callable | None, desc: str) -> list:
-    out = []
-    with progress_bar(len(poses), desc, unit="frame", callback=progress) as bar:
-        for pose in poses:
-            image = camera.observe(world, pose, rng=rng).image
-            out.append(detect_orb_features(image, N_FEATURES).descriptors)
-            bar.update()
-    return out
+#: Frames per task when a recording is rendered in worker processes (a frame takes about 10 ms).
+_FRAMES_PER_TASK = 64
+
+
+def _orb_batch(shared: tuple, task: tuple) -> list:
+    """ORB descriptors of frames ``first ..`` at ``poses``; frame ``k``'s pixel noise is seeded by ``(seed, k)``."""
+    world, camera, seed = shared
+    first, poses = task
+    return [detect_orb_features(camera.observe(world, pose, rng=np.random.default_rng([seed, first + k])).image,
+                                N_FEATURES).descriptors for k, pose in enumerate(poses)]
+
+
+def _orb_frames(world: World, camera: PinholeCamera, poses: np.ndarray, seed: int, progress: Callable | None,
+                desc: str) -> list:
+    """Render every pose and detect its ORB features, batches side by side (:func:`robokit.parallel.map_runs`)."""
+    tasks = [(k, poses[k:k + _FRAMES_PER_TASK]) for k in range(0, len(poses), _FRAMES_PER_TASK)]
+    batches = map_runs(_orb_batch, (world, camera, seed), tasks, desc=desc,
+                       unit=f"{_FRAMES_PER_TASK} frames", progress=progress)
+    return [d for batch in batches for d in batch]
 
 
 # --- the calibration run and Table 1 -------------------------------------------------------------
@@ -224,7 +234,7 @@ def calibration_run(*, fast: bool | None = None, start: float = 12.0, length: fl
     target = cache_dir("corridor") / f"calibration-{cache_key(**meta)}.npz"
     data = read_arrays(target, ("flat", "counts", "positions"), meta)
     if data is None:
-        flat, counts = _descriptor_stack(_orb_frames(world, camera, path.poses, np.random.default_rng(5), progress,
+        flat, counts = _descriptor_stack(_orb_frames(world, camera, path.poses, 5, progress,
                                                         "calibration run"))
         data = {"flat": flat, "counts": counts, "positions": path.poses[:, :2]}
         write_arrays(target, data, meta)
@@ -343,7 +353,7 @@ def training_vocabulary(*, fast: bool | None = None, branching: int = 10, levels
             return Vocabulary.load(target)
         except CACHE_READ_ERRORS:
             pass  # a corrupt or foreign cache file is rebuilt
-    images = _orb_frames(world, camera, poses, np.random.default_rng(7), progress, "vocabulary images")
+    images = _orb_frames(world, camera, poses, 7, progress, "vocabulary images")
     vocabulary = Vocabulary.train(images, branching=branching, levels=levels, rng=0)
     write_atomically(target, vocabulary.save)
     return vocabulary
@@ -500,7 +510,7 @@ def _build_map(world: World, lidar: Lidar, camera: PinholeCamera, path, f_min: f
     # grid's pose log is the truth here, so Eq. (18) is exact; with a SLAM pose log it would carry
     # the log's error
     frame_truth = geo_tag(frame_times, times, poses)
-    descriptors = _orb_frames(world, camera, frame_truth, rng, progress, "camera frames")
+    descriptors = _orb_frames(world, camera, frame_truth, 3, progress, "camera frames")
     positions = frame_truth[:, :2]
     index = np.asarray(select_keyframes(descriptors, positions, f_min, min_frame_gap=gap,
                                        shared_range=SHARED_RANGE, below_band="take"), int)
