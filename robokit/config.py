@@ -15,7 +15,7 @@ import zlib
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-__all__ = ["fast_mode", "FAST", "headless", "cache_dir", "cache_key", "source_digest", "code_version",
+__all__ = ["fast_mode", "FAST", "headless", "available_cpus", "cache_dir", "cache_key", "source_digest", "code_version",
            "write_atomically", "save_npz", "write_arrays", "read_arrays", "CACHE_READ_ERRORS", "records_to_arrays",
            "record_names", "records_from_arrays"]
 
@@ -95,6 +95,26 @@ def headless(environ: "os._Environ[str] | dict[str, str] | None" = None) -> bool
     (True, False)
     """
     return _flag(environ, "ROBOKIT_HEADLESS")
+
+
+def available_cpus() -> int:
+    """Number of CPUs this process may run on (its affinity mask where the system has one).
+
+    Returns
+    -------
+    int
+        At least 1.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Independent runs"); not from a paper.
+
+    Examples
+    --------
+    >>> available_cpus() >= 1
+    True
+    """
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 def cache_dir(*parts: str, create: bool = True) -> Path:

@@ -19,6 +19,7 @@ import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, Callable, Sequence
 
+from .config import available_cpus
 from .progress import progress_bar
 from .validation import check_callable, check_int
 
@@ -42,7 +43,8 @@ def worker_count(environ: "os._Environ[str] | dict[str, str] | None" = None) -> 
     Returns
     -------
     int
-        ``ROBOKIT_WORKERS`` when set, else the number of CPUs this process may run on.
+        ``ROBOKIT_WORKERS`` when set (the course build sets it to share the cores between the
+        notebooks it runs at once), else the number of CPUs this process may run on.
 
     Raises
     ------
@@ -68,7 +70,7 @@ def worker_count(environ: "os._Environ[str] | dict[str, str] | None" = None) -> 
         if not 1 <= value <= 64:
             raise ValueError(f"ROBOKIT_WORKERS: expected a whole number from 1 to 64, got {raw!r}")
         return value
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    return available_cpus()
 
 
 def _receive(shared: Any) -> None:

@@ -224,3 +224,17 @@ def test_a_fresh_full_build_starts_the_notebook_declaring_the_longest_cold_time(
             nbformat.write(nb, paths[-1])
     run_notebooks(paths, tmp_path / "executed", root=tmp_path, jobs=1, timeout=120, log=lambda line: None)
     assert stamp.read_text().split() == ["02_slow.ipynb", "01_quick.ipynb"]
+
+
+def test_the_notebooks_running_at_once_share_the_cores(tmp_path, monkeypatch):
+    # each kernel gets ROBOKIT_WORKERS = cores // jobs, so the build never runs more worker
+    # processes than cores (two notebooks on two cores: one worker each, the runs made in place)
+    import robokit.course.build as build
+    monkeypatch.setattr(build, "available_cpus", lambda: 4)
+    out = tmp_path / "workers.txt"
+    path = _notebook(tmp_path / "nb.ipynb", f"import os\nopen({str(out)!r}, 'a').write(os.environ['ROBOKIT_WORKERS'] + '\\n')")
+    for jobs, expected in ((2, "2"), (4, "1"), (1, "4"), (8, "1")):
+        out.unlink(missing_ok=True)
+        build.run_notebooks([path], tmp_path / "executed", root=tmp_path, jobs=jobs, timeout=120, fast=True,
+                            log=lambda line: None)
+        assert out.read_text().split() == [expected], jobs

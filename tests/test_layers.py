@@ -22,7 +22,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "robokit"
 
 #: Bottom to top. A unit may import from units of earlier rows (and from itself).
 LAYERS: list[set[str]] = [
-    {"validation", "config", "about", "course"},   # base: input checks, settings, notebook tooling
+    {"validation", "config", "about"},              # base: input checks, settings
+    {"course"},                                     # notebook tooling (the CPU count from config)
     {"progress"},                                   # the one progress bar (reads fast/headless from config)
     {"parallel"},                                   # independent runs in worker processes
     {"geometry"},                                   # SE(2)/SE(3)/SO(3), the papers' frames

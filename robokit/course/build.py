@@ -16,11 +16,11 @@ from __future__ import annotations
 import html
 import json
 import math
-import os
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from pathlib import Path
 from typing import Callable, Sequence
 
+from ..config import available_cpus
 from .book import (API_MODULES, SITES, BookPage, SiteBuild, site_out_problem, site_tool_problems, sphinx_build,
                    write_sources)
 from .execute import NotebookRun, run_notebook
@@ -203,7 +203,9 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     root : Path
         Repository root (progress lines name notebooks relative to it).
     jobs : int, optional
-        Notebooks at once; the number of available cores by default.
+        Notebooks at once; the number of available cores by default. Each notebook gets the cores
+        divided by ``jobs`` (at least 1) as ``ROBOKIT_WORKERS`` for its independent runs
+        (:mod:`robokit.parallel`), so that the build never runs more processes than cores.
     timeout : float, default 900
         Per-notebook wall-clock limit in seconds.
     fast : bool, default False
@@ -218,12 +220,14 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     """
     if jobs is not None and (not isinstance(jobs, int) or jobs < 1):
         raise ValueError(f"jobs: expected a positive number of notebooks at once, got {jobs!r}")
-    if not jobs:
-        jobs = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    cpus = available_cpus()
+    jobs = jobs or cpus
+    workers = max(1, cpus // jobs)      # the notebooks running at once share the cores between them
     executed.mkdir(parents=True, exist_ok=True)
 
     def one(path: Path) -> NotebookRun:
-        run = run_notebook(path, timeout=timeout, fast=fast, output=executed / path.parent.name / path.name)
+        run = run_notebook(path, timeout=timeout, fast=fast, output=executed / path.parent.name / path.name,
+                           workers=workers)
         log(f"  {run.status:<8} {run.seconds:6.1f}s  {path.relative_to(root) if path.is_relative_to(root) else path}")
         return run
 

@@ -69,7 +69,7 @@ def _tail(text: str, lines: int = 12) -> str:
     return "\n".join(text.strip().splitlines()[-lines:])
 
 
-def _kernel_env(workdir: Path, fast: bool) -> dict[str, str]:
+def _kernel_env(workdir: Path, fast: bool, workers: int | None = None) -> dict[str, str]:
     ipydir = workdir / ".ipython"
     startup = ipydir / "profile_default" / "startup"
     startup.mkdir(parents=True, exist_ok=True)
@@ -84,6 +84,8 @@ def _kernel_env(workdir: Path, fast: bool) -> dict[str, str]:
         PYDEVD_DISABLE_FILE_VALIDATION="1",
     )
     env.pop("MPLBACKEND", None)  # the inline backend must stay in charge inside the kernel
+    if workers is not None:
+        env["ROBOKIT_WORKERS"] = str(workers)   # robokit.parallel's worker processes for this notebook
     return env
 
 
@@ -141,7 +143,8 @@ def execute_in_process(src: Path, dst: Path, *, cwd: Path, cell_timeout: int,
 
 
 def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
-                 output: str | Path | None = None, assignment: bool | None = None) -> NotebookRun:
+                 output: str | Path | None = None, assignment: bool | None = None,
+                 workers: int | None = None) -> NotebookRun:
     """Execute a notebook in a fresh kernel in a worker process and report the outcome.
 
     Parameters
@@ -158,6 +161,9 @@ def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
     assignment : bool, optional
         Treat the notebook as a student assignment (``NotImplementedError`` from stubs is allowed).
         Defaults to whether the notebook lives in an ``assignments`` directory.
+    workers : int, optional
+        ``ROBOKIT_WORKERS`` inside the kernel (worker processes for independent runs); default:
+        inherited.
 
     Returns
     -------
@@ -179,6 +185,8 @@ def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
         raise FileNotFoundError(f"path: notebook {path} does not exist")
     if not timeout > 0:
         raise ValueError(f"timeout: expected a positive number of seconds, got {timeout!r}")
+    if workers is not None and (not isinstance(workers, int) or isinstance(workers, bool) or not 1 <= workers <= 64):
+        raise ValueError(f"workers: expected a whole number of worker processes from 1 to 64, got {workers!r}")
     if assignment is None:
         assignment = path.parent.name == "assignments"
     workdir = Path(tempfile.mkdtemp(prefix="robokit-nb-"))
@@ -193,7 +201,7 @@ def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
     if assignment:
         cmd += ["--allow-errors", *STUB_ERRORS]
     start = time.perf_counter()
-    proc = subprocess.Popen(cmd, env=_kernel_env(workdir, fast), cwd=cwd, start_new_session=True,
+    proc = subprocess.Popen(cmd, env=_kernel_env(workdir, fast, workers), cwd=cwd, start_new_session=True,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         log, _ = proc.communicate(timeout=timeout)
