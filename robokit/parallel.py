@@ -1,22 +1,26 @@
 """Independent runs of an experiment in worker processes, results in order, the one way for robokit.
 
-An experiment made of many independent, separately seeded runs (lesson 03's Table 2 trials)
-gives the same results whatever order the runs are made in, so a student's multi-core laptop can
-make them side by side. :func:`map_runs` does that in worker processes started by Python's fork
-server (spawn where there is none), not forked from the caller: a forked Jupyter kernel can inherit
-a held lock of OpenCV's or ZeroMQ's threads. The fork server imports robokit once, so only the first
-pool of a session pays the import (about a second); a spawned worker pays it every time. The object
-every run needs (a map, a world) is sent to each worker once, not with every run. With one worker, or
-fewer runs than :data:`MIN_RUNS`, the runs are made here, one after the other, exactly as a plain
-loop would; the results are the same either way (the tests compare them).
+An experiment made of many independent, separately seeded runs (lesson 03's Table 2 trials and its
+rendered recordings) gives the same results whatever order the runs are made in, so a student's
+multi-core laptop can make them side by side. :func:`map_runs` does that in worker processes started
+by Python's fork server (spawn where there is none), not forked from the caller: a forked Jupyter
+kernel can inherit a held lock of OpenCV's or ZeroMQ's threads. The fork server imports robokit
+once, so only the first pool of a session pays the import (about a second) when robokit is the
+first to use the fork server (its preload list is the process's, :func:`map_runs` sets it to the
+run's module); a spawned worker pays it every time. The object every run needs (a map, a world) is
+sent to each worker once, not with every run, together with the caller's ``ROBOKIT_*`` settings.
+With one worker, or fewer runs than :data:`MIN_RUNS`, the runs are made here, one after the other,
+exactly as a plain loop would; the results are the same either way (the tests compare them).
 
-``ROBOKIT_WORKERS`` sets the number of workers (default: the CPUs this process may use).
+``ROBOKIT_WORKERS`` sets the number of workers (default: the CPUs this process may use). A plain
+script that makes runs in workers needs the ``if __name__ == "__main__":`` guard, as every use of
+:mod:`multiprocessing` does (workers import the script's top level); notebooks need nothing.
 """
 from __future__ import annotations
 
 import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor, as_completed
+import pickle
 from typing import Any, Callable, Sequence
 
 from .config import available_cpus
@@ -70,14 +74,17 @@ def worker_count(environ: "os._Environ[str] | dict[str, str] | None" = None) -> 
         if not 1 <= value <= 64:
             raise ValueError(f"ROBOKIT_WORKERS: expected a whole number from 1 to 64, got {raw!r}")
         return value
-    return available_cpus()
+    return min(64, available_cpus())
 
 
-def _receive(shared: Any) -> None:
+def _receive(shared: Any, settings: dict) -> None:
     _SHARED["value"] = shared
+    os.environ.update(settings)            # the caller's ROBOKIT_* settings, not the fork server's
+    os.environ["ROBOKIT_WORKERS"] = "1"     # a run that makes runs of its own makes them in place
 
 
-def _run_shared(run: Callable, task: Any) -> Any:
+def _run_shared(job: tuple) -> Any:
+    run, task = job
     return run(_SHARED["value"], task)
 
 
@@ -90,6 +97,17 @@ def _context(run: Callable):
     if isinstance(module, str) and module.startswith("robokit."):
         context.set_forkserver_preload([module])     # no effect once the server runs
     return context
+
+
+def _check_importable(run: Callable) -> None:
+    """Workers find ``run`` by its module and name: a lambda, a nested function or one defined in a
+    notebook cell cannot be found there."""
+    name = getattr(run, "__qualname__", "")
+    module = getattr(run, "__module__", None)
+    main = module == "__main__" and not getattr(__import__("__main__"), "__file__", None)
+    if "<lambda>" in name or "<locals>" in name or main or module is None:
+        raise TypeError(f"run: expected a function defined at the top of an importable module (workers "
+                        f"import it by name), got {name or type(run).__name__!r} from {module!r}")
 
 
 def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None = None, desc: str = "runs",
@@ -120,8 +138,11 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
     Raises
     ------
     TypeError, ValueError
-        For a ``run`` or ``progress`` that is not callable, or a bad ``workers``. An error inside a
-        run is raised here, as the plain loop would raise it.
+        For a ``run`` or ``progress`` that is not callable, ``tasks`` that is not a sequence, a bad
+        ``workers``; with workers, a ``run`` they cannot import (a lambda, a nested function, one
+        defined in a notebook) or a ``shared`` object that does not pickle. An error inside a run is
+        raised here, the first in the order of ``tasks`` (as the plain loop would raise it), and
+        the workers are stopped at once, as they are when the caller is interrupted.
 
     Notes
     -----
@@ -135,20 +156,30 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
     """
     run = check_callable(run, "run", optional=False)
     progress = check_callable(progress, "progress")
+    if isinstance(tasks, (str, bytes)) or not hasattr(tasks, "__iter__"):
+        raise TypeError(f"tasks: expected a sequence of tasks, got {type(tasks).__name__}")
     tasks = list(tasks)
     workers = worker_count() if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
     workers = min(workers, len(tasks))
-    results: list = [None] * len(tasks)
+    results: list = []
     with progress_bar(len(tasks), desc, unit=unit, callback=progress) as bar:
         if workers <= 1 or len(tasks) < MIN_RUNS:
-            for k, task in enumerate(tasks):
-                results[k] = run(shared, task)
+            for task in tasks:
+                results.append(run(shared, task))
                 bar.update()
             return results
-        context = _context(run)
-        with ProcessPoolExecutor(workers, mp_context=context, initializer=_receive, initargs=(shared,)) as pool:
-            futures = {pool.submit(_run_shared, run, task): k for k, task in enumerate(tasks)}
-            for done in as_completed(futures):
-                results[futures[done]] = done.result()
+        _check_importable(run)
+        settings = {k: v for k, v in os.environ.items() if k.startswith("ROBOKIT_")}
+        try:
+            pool = _context(run).Pool(workers, initializer=_receive, initargs=(shared, settings))
+        except (pickle.PicklingError, TypeError, AttributeError) as exc:
+            raise TypeError(f"shared: expected an object that pickles (it is sent to the workers), "
+                            f"got {type(shared).__name__}: {exc}") from exc
+        try:
+            for result in pool.imap(_run_shared, [(run, task) for task in tasks]):   # in order
+                results.append(result)
                 bar.update()
+        finally:
+            pool.terminate()       # at the end, and at once on an error or an interrupt
+            pool.join()
     return results

@@ -227,14 +227,22 @@ def test_a_fresh_full_build_starts_the_notebook_declaring_the_longest_cold_time(
 
 
 def test_the_notebooks_running_at_once_share_the_cores(tmp_path, monkeypatch):
-    # each kernel gets ROBOKIT_WORKERS = cores // jobs, so the build never runs more worker
-    # processes than cores (two notebooks on two cores: one worker each, the runs made in place)
+    # each kernel gets ROBOKIT_WORKERS = cores // notebooks at once, so the build never runs more
+    # worker processes than cores (two notebooks on two cores: one worker each, the runs made in
+    # place), and a notebook built alone gets every core
     import robokit.course.build as build
     monkeypatch.setattr(build, "available_cpus", lambda: 4)
     out = tmp_path / "workers.txt"
     path = _notebook(tmp_path / "nb.ipynb", f"import os\nopen({str(out)!r}, 'a').write(os.environ['ROBOKIT_WORKERS'] + '\\n')")
-    for jobs, expected in ((2, "2"), (4, "1"), (1, "4"), (8, "1")):
+    other = _notebook(tmp_path / "other.ipynb", "1 + 1")
+    monkeypatch.delenv("ROBOKIT_WORKERS", raising=False)
+    # (jobs, notebooks, the caller's own setting) -> workers per kernel
+    for jobs, paths, own, expected in ((2, [path, other], None, "2"), (4, [path, other], None, "2"),
+                                       (1, [path], None, "4"), (None, [path], None, "4"),
+                                       (None, [path, other], None, "2"), (None, [path], "3", "3")):
         out.unlink(missing_ok=True)
-        build.run_notebooks([path], tmp_path / "executed", root=tmp_path, jobs=jobs, timeout=120, fast=True,
+        if own:
+            monkeypatch.setenv("ROBOKIT_WORKERS", own)
+        build.run_notebooks(paths, tmp_path / "executed", root=tmp_path, jobs=jobs, timeout=120, fast=True,
                             log=lambda line: None)
-        assert out.read_text().split() == [expected], jobs
+        assert out.read_text().split() == [expected], (jobs, len(paths), own)

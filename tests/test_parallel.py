@@ -1,4 +1,7 @@
 """Independent runs in worker processes: same results, same order, same errors as a plain loop."""
+import threading
+import time
+
 import numpy as np
 import pytest
 
@@ -22,11 +25,47 @@ def test_runs_in_workers_come_back_in_order_and_equal_the_loop():
     assert done[-1] == (len(tasks), len(tasks))
 
 
+def _slow_fail(folder, task):
+    """A run for the workers: note that it started, wait, then fail if told to."""
+    name, wait, fail = task
+    (folder / name).touch()
+    time.sleep(wait)
+    if fail:
+        raise ValueError(name)
+    return name
+
+
 def test_an_error_in_a_run_reaches_the_caller():
     with pytest.raises(ZeroDivisionError):
         map_runs(divmod, 1, [3, 2, 0, 1, 4], workers=2)
     with pytest.raises(ZeroDivisionError):
         map_runs(divmod, 1, [3, 0], workers=1)
+
+
+def test_the_first_error_in_task_order_is_raised_as_by_the_loop(tmp_path):
+    # run "b" fails late, run "c" early: the loop would raise "b", and so do the workers
+    tasks = [("a", 0.0, False), ("b", 0.6, True), ("c", 0.0, True), ("d", 0.0, False)]
+    for workers in (1, 2):
+        with pytest.raises(ValueError, match="^b$"):
+            map_runs(_slow_fail, tmp_path, tasks, workers=workers)
+
+
+def test_a_failed_run_stops_the_workers_at_once(tmp_path):
+    # the first run fails; the other 30 would take a second each: they are not all made
+    tasks = [("first", 0.0, True)] + [(f"run{k}", 1.0, False) for k in range(30)]
+    with pytest.raises(ValueError, match="first"):
+        map_runs(_slow_fail, tmp_path, tasks, workers=2)
+    time.sleep(1.5)                               # a worker left running would go on starting runs
+    assert len(list(tmp_path.iterdir())) < 8
+
+
+def test_what_the_workers_cannot_receive_is_named():
+    with pytest.raises(TypeError, match="run"):
+        map_runs(lambda shared, task: task, 1, [1, 2, 3, 4], workers=2)
+    with pytest.raises(TypeError, match="shared"):
+        map_runs(divmod, threading.Lock(), [1, 2, 3, 4], workers=2)
+    with pytest.raises(TypeError, match="tasks"):
+        map_runs(divmod, 1, 5)
 
 
 def test_bad_arguments_are_named():
@@ -44,7 +83,9 @@ def test_table_2_runs_do_not_depend_on_the_number_of_workers(monkeypatch):
     from robokit.navigation.corridor_experiment import corridor_map
     from robokit.navigation.corridor_trials import localization_trials
     setup = corridor_map(fast=True)
-    a = localization_trials(setup, "amcl", trials=2, positions=[0, 1], max_distance=6.0, cache=False, workers=1)
-    b = localization_trials(setup, "amcl", trials=2, positions=[0, 1], max_distance=6.0, cache=False, workers=2)
-    for name in ("positions", "converged", "iterations", "distance", "error", "settled", "retrieval_error"):
-        assert np.array_equal(getattr(a, name), getattr(b, name), equal_nan=getattr(a, name).dtype.kind == "f"), name
+    for method in ("amcl", "ours"):
+        a = localization_trials(setup, method, trials=2, positions=[0, 1], max_distance=6.0, cache=False, workers=1)
+        b = localization_trials(setup, method, trials=2, positions=[0, 1], max_distance=6.0, cache=False, workers=2)
+        for name in ("positions", "converged", "iterations", "distance", "error", "settled", "retrieval_error"):
+            assert np.array_equal(getattr(a, name), getattr(b, name), equal_nan=getattr(a, name).dtype.kind == "f"), \
+                (method, name)

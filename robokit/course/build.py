@@ -16,6 +16,7 @@ from __future__ import annotations
 import html
 import json
 import math
+import os
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from pathlib import Path
 from typing import Callable, Sequence
@@ -203,8 +204,9 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     root : Path
         Repository root (progress lines name notebooks relative to it).
     jobs : int, optional
-        Notebooks at once; the number of available cores by default. Each notebook gets the cores
-        divided by ``jobs`` (at least 1) as ``ROBOKIT_WORKERS`` for its independent runs
+        Notebooks at once; the number of available cores by default (never more than there are
+        notebooks). Each notebook gets the cores divided by that number (at least 1, at most the
+        caller's own ``ROBOKIT_WORKERS``) as ``ROBOKIT_WORKERS`` for its independent runs
         (:mod:`robokit.parallel`), so that the build never runs more processes than cores.
     timeout : float, default 900
         Per-notebook wall-clock limit in seconds.
@@ -221,8 +223,11 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
     if jobs is not None and (not isinstance(jobs, int) or jobs < 1):
         raise ValueError(f"jobs: expected a positive number of notebooks at once, got {jobs!r}")
     cpus = available_cpus()
-    jobs = jobs or cpus
+    jobs = min(jobs or cpus, max(1, len(paths)))
     workers = max(1, cpus // jobs)      # the notebooks running at once share the cores between them
+    own = os.environ.get("ROBOKIT_WORKERS", "").strip()
+    if own.isdigit() and int(own) >= 1:
+        workers = min(workers, int(own))  # and never more than the caller allows
     executed.mkdir(parents=True, exist_ok=True)
 
     def one(path: Path) -> NotebookRun:

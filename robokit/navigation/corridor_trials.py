@@ -445,7 +445,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
         cached either, they are made too and cached: both methods start each run with the same
         moving strategy (same start, same seed), which is then driven only once.
     progress : callable ``(done, total)``, optional
-        Told as each start's runs finish.
+        Told as runs finish (one step per start and number, both methods' runs together).
     workers : int, optional
         Worker processes for the runs (default :func:`robokit.parallel.worker_count`; 1 makes them
         in this process). Every run is seeded from its start and number, so the results do not
@@ -501,7 +501,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
             todo.append(other)
     tasks = [(i, j) for i in starts for j in range(trials)]
     pairs = map_runs(_trials_from_start, (setup, tuple(todo), seed, max_distance), tasks, workers=workers,
-                     desc=f"localization trials ({' and '.join(todo)})", unit="start", progress=progress)
+                     desc=f"localization trials ({' and '.join(todo)})", unit="run", progress=progress)
     runs = {m: [pair[k] for pair in pairs] for k, m in enumerate(todo)}
     sets = {m: TrialSet(m, np.repeat(starts, trials).astype(int), np.array([r.converged for r in rs]),
                         np.array([r.iterations for r in rs], int), np.array([r.distance for r in rs]),
