@@ -15,7 +15,7 @@ import zlib
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-__all__ = ["fast_mode", "FAST", "headless", "available_cpus", "cache_dir", "cache_key", "source_digest", "code_version",
+__all__ = ["fast_mode", "FAST", "headless", "available_cpus", "worker_count", "cache_dir", "cache_key", "source_digest", "code_version",
            "write_atomically", "save_npz", "write_arrays", "read_arrays", "CACHE_READ_ERRORS", "records_to_arrays",
            "record_names", "records_from_arrays"]
 
@@ -115,6 +115,47 @@ def available_cpus() -> int:
     True
     """
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+def worker_count(environ: "os._Environ[str] | dict[str, str] | None" = None) -> int:
+    """Number of worker processes for :func:`robokit.parallel.map_runs`.
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        Environment to read (default :data:`os.environ`).
+
+    Returns
+    -------
+    int
+        ``ROBOKIT_WORKERS`` when set (the course build sets it to share the cores between the
+        notebooks it runs at once), else the number of CPUs this process may run on.
+
+    Raises
+    ------
+    ValueError
+        If ``ROBOKIT_WORKERS`` is not a whole number from 1 to 64.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Independent runs"); not from a paper.
+
+    Examples
+    --------
+    >>> worker_count({"ROBOKIT_WORKERS": "1"})
+    1
+    """
+    env = os.environ if environ is None else environ
+    raw = str(env.get("ROBOKIT_WORKERS", "")).strip()
+    if raw:
+        try:
+            value = int(raw)
+        except ValueError:
+            value = 0
+        if not 1 <= value <= 64:
+            raise ValueError(f"ROBOKIT_WORKERS: expected a whole number from 1 to 64, got {raw!r}")
+        return value
+    return min(64, available_cpus())
 
 
 def cache_dir(*parts: str, create: bool = True) -> Path:

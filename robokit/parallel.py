@@ -21,60 +21,20 @@ from __future__ import annotations
 import multiprocessing
 import os
 import pickle
+import sys
 from typing import Any, Callable, Sequence
 
-from .config import available_cpus
+from .config import worker_count
 from .progress import progress_bar
 from .validation import check_callable, check_int
 
-__all__ = ["MIN_RUNS", "worker_count", "map_runs"]
+__all__ = ["MIN_RUNS", "worker_count", "map_runs"]   # worker_count lives in config (the course build reads it too)
 
 #: Fewer runs than this are made in this process: starting workers (each imports robokit, numpy
 #: and OpenCV) costs more than a few runs save.
 MIN_RUNS = 4
 
 _SHARED: dict = {}    # in a worker: the object every run needs, sent once by _receive
-
-
-def worker_count(environ: "os._Environ[str] | dict[str, str] | None" = None) -> int:
-    """Number of worker processes for :func:`map_runs`.
-
-    Parameters
-    ----------
-    environ : mapping, optional
-        Environment to read (default :data:`os.environ`).
-
-    Returns
-    -------
-    int
-        ``ROBOKIT_WORKERS`` when set (the course build sets it to share the cores between the
-        notebooks it runs at once), else the number of CPUs this process may run on.
-
-    Raises
-    ------
-    ValueError
-        If ``ROBOKIT_WORKERS`` is not a whole number from 1 to 64.
-
-    Notes
-    -----
-    Course convention (DESIGN.md, "Independent runs"); not from a paper.
-
-    Examples
-    --------
-    >>> worker_count({"ROBOKIT_WORKERS": "1"})
-    1
-    """
-    env = os.environ if environ is None else environ
-    raw = str(env.get("ROBOKIT_WORKERS", "")).strip()
-    if raw:
-        try:
-            value = int(raw)
-        except ValueError:
-            value = 0
-        if not 1 <= value <= 64:
-            raise ValueError(f"ROBOKIT_WORKERS: expected a whole number from 1 to 64, got {raw!r}")
-        return value
-    return min(64, available_cpus())
 
 
 def _receive(shared: Any, settings: dict) -> None:
@@ -104,7 +64,7 @@ def _check_importable(run: Callable) -> None:
     notebook cell cannot be found there."""
     name = getattr(run, "__qualname__", "")
     module = getattr(run, "__module__", None)
-    main = module == "__main__" and not getattr(__import__("__main__"), "__file__", None)
+    main = module == "__main__" and not getattr(sys.modules.get("__main__"), "__file__", None)
     if "<lambda>" in name or "<locals>" in name or main or module is None:
         raise TypeError(f"run: expected a function defined at the top of an importable module (workers "
                         f"import it by name), got {name or type(run).__name__!r} from {module!r}")

@@ -230,8 +230,10 @@ def test_the_notebooks_running_at_once_share_the_cores(tmp_path, monkeypatch):
     # each kernel gets ROBOKIT_WORKERS = cores // notebooks at once, so the build never runs more
     # worker processes than cores (two notebooks on two cores: one worker each, the runs made in
     # place), and a notebook built alone gets every core
+    import robokit.config as config
     import robokit.course.build as build
     monkeypatch.setattr(build, "available_cpus", lambda: 4)
+    monkeypatch.setattr(config, "available_cpus", lambda: 4)    # what worker_count falls back to
     out = tmp_path / "workers.txt"
     path = _notebook(tmp_path / "nb.ipynb", f"import os\nopen({str(out)!r}, 'a').write(os.environ['ROBOKIT_WORKERS'] + '\\n')")
     other = _notebook(tmp_path / "other.ipynb", "1 + 1")

@@ -16,12 +16,11 @@ from __future__ import annotations
 import html
 import json
 import math
-import os
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from pathlib import Path
 from typing import Callable, Sequence
 
-from ..config import available_cpus
+from ..config import available_cpus, worker_count
 from .book import (API_MODULES, SITES, BookPage, SiteBuild, site_out_problem, site_tool_problems, sphinx_build,
                    write_sources)
 from .execute import NotebookRun, run_notebook
@@ -224,10 +223,8 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
         raise ValueError(f"jobs: expected a positive number of notebooks at once, got {jobs!r}")
     cpus = available_cpus()
     jobs = min(jobs or cpus, max(1, len(paths)))
-    workers = max(1, cpus // jobs)      # the notebooks running at once share the cores between them
-    own = os.environ.get("ROBOKIT_WORKERS", "").strip()
-    if own.isdigit() and int(own) >= 1:
-        workers = min(workers, int(own))  # and never more than the caller allows
+    # the notebooks running at once share the cores between them, and never get more than the caller allows
+    workers = min(max(1, cpus // jobs), worker_count())
     executed.mkdir(parents=True, exist_ok=True)
 
     def one(path: Path) -> NotebookRun:
