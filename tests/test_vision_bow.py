@@ -53,6 +53,29 @@ def test_hamming_match_agrees_with_bfmatcher_knn_and_ratio():
                                                                          mutual.train.tolist()))
 
 
+@pytest.mark.parametrize("n_train", [1, 2, 300])
+def test_hamming_match_equals_the_distance_table_with_ties(n_train):
+    train = random_descriptors(n_train, 6)
+    if n_train > 2:
+        train[250:] = train[:50]                        # some train rows twice: ties at the nearest
+        train[60:70] = flip_bits(train[70:80], 1, 9)    # and near-ties one bit apart
+    query = np.concatenate([flip_bits(train[: min(n_train, 80)], 6, 7), random_descriptors(30, 8)])
+    query = np.concatenate([query, query[-40:-20]])     # repeated queries: ties for the cross check
+    table = hamming_distances(query, train)
+    best = np.argmin(table, axis=1)                     # first minimum: the lowest index
+    nearest = table[np.arange(len(query)), best].astype(float)
+    second = np.sort(table, axis=1)[:, 1] if n_train > 1 else np.full(len(query), np.inf)
+    for ratio, bound, cross in ((1.0, None, False), (0.75, 50, False), (1.0, None, True), (0.9, 80, True)):
+        keep = (nearest < ratio * second) & (nearest <= (np.inf if bound is None else bound))
+        if cross:
+            keep &= np.argmin(table, axis=0)[best] == np.arange(len(query))
+        m = hamming_match(query, train, ratio=ratio, max_distance=bound, cross_check=cross)
+        np.testing.assert_array_equal(m.query, np.flatnonzero(keep))
+        np.testing.assert_array_equal(m.train, best[keep])
+        np.testing.assert_array_equal(m.distance, nearest[keep])
+        assert len(m) > 0 or n_train == 2
+
+
 def test_hamming_rejects_bad_descriptors():
     with pytest.raises(ValueError, match="query"):
         hamming_match([[0, 256]], [[0, 1]])
@@ -150,6 +173,22 @@ def test_training_centres_are_bit_majorities():
     voc = Vocabulary.train([low, high], branching=2, levels=1, rng=3)
     centres = {tuple(c) for c in voc.centres[1:]}
     assert centres == {(0,) * 32, (255,) * 32}
+
+
+@pytest.mark.parametrize("n", [1, 7, 100, 639, 640, 5000])
+def test_bit_majority_counts_equal_a_per_cluster_bit_count(n):
+    from robokit.vision.bag_of_words import _majority      # both of its counting ways, either side of 64 k rows
+    rng = np.random.default_rng(n)
+    k = 10
+    desc = rng.integers(0, 256, (n, 32), dtype=np.uint8)
+    desc[: n // 2, :4] = 0b10101010                          # some columns where members agree, some ties
+    labels = rng.integers(0, k - 2, n)                       # the last two clusters stay empty
+    centres, size = _majority(desc, labels, k)
+    for j in range(k):
+        members = np.unpackbits(desc[labels == j], axis=1)
+        assert size[j] == len(members)
+        expect = np.packbits(2 * members.sum(axis=0) >= len(members))     # ties give 1
+        np.testing.assert_array_equal(centres[j], expect, err_msg=f"cluster {j} of {n} rows")
 
 
 def test_too_few_descriptors_and_empty_images():

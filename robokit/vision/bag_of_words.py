@@ -197,15 +197,44 @@ def l1_score(v_a, v_b) -> float:
     return float(min(1.0, max(0.0, s)))
 
 
+#: The bits of every byte value, most significant first (``np.unpackbits``' order): row ``v`` is ``v``'s bits.
+_BYTE_BITS = np.unpackbits(np.arange(256, dtype=np.uint8)[:, None], axis=1).astype(np.float64)
+
+
 def _majority(desc: np.ndarray, labels: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per-bit majority of each cluster's members (ties give 1, as DBoW2) and the cluster sizes."""
-    bits = np.unpackbits(desc, axis=1)
+    """Per-bit majority of each cluster's members (ties give 1, as DBoW2) and the cluster sizes.
+
+    A bit is set in the centre when at least half the members set it. The per-cluster bit sums are
+    counted one of two ways, with the same result: a small set unpacks every bit and sums them per
+    cluster (the plain reading); a large one counts how often each byte value occurs in each
+    cluster's byte column (one ``bincount``) and turns those counts into bit sums with the table of
+    each byte value's bits, touching each byte once instead of each of its eight bits (about 15x
+    faster for 50 000 descriptors; the two ways are compared in the tests).
+    """
     size = np.bincount(labels, minlength=k)
-    sums = np.zeros((k, bits.shape[1]), np.int64)
+    if len(desc) < 64 * k:
+        sums = _bit_sums_unpacked(desc, labels, size)
+    else:
+        sums = _bit_sums_by_byte_value(desc, labels, k)
+    return np.packbits(2 * sums >= size[:, None], axis=1), size
+
+
+def _bit_sums_unpacked(desc: np.ndarray, labels: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """How many members of each cluster set each bit: unpack the bits and sum them per cluster."""
+    bits = np.unpackbits(desc, axis=1)
+    sums = np.zeros((len(size), bits.shape[1]), np.int64)
     filled = np.flatnonzero(size)             # the members of each cluster sit together once sorted by label
     sums[filled] = np.add.reduceat(bits[np.argsort(labels, kind="stable")], (np.cumsum(size) - size)[filled],
                                    axis=0, dtype=np.int64)
-    return np.packbits(2 * sums >= size[:, None], axis=1), size
+    return sums
+
+
+def _bit_sums_by_byte_value(desc: np.ndarray, labels: np.ndarray, k: int) -> np.ndarray:
+    """The same sums as :func:`_bit_sums_unpacked`, from a histogram of byte values per cluster and column."""
+    n_bytes = desc.shape[1]
+    cell = (labels[:, None] * n_bytes + np.arange(n_bytes)) * 256 + desc    # (cluster, column, value)
+    counts = np.bincount(cell.ravel(), minlength=k * n_bytes * 256).reshape(k * n_bytes, 256)
+    return np.rint(counts @ _BYTE_BITS).astype(np.int64).reshape(k, 8 * n_bytes)
 
 
 def _k_majority(desc: np.ndarray, k: int, iterations: int, rng: np.random.Generator) -> list[np.ndarray]:
@@ -373,7 +402,7 @@ class Vocabulary:
         todo = [(0, np.arange(len(desc)), 0)]                 # (node, member rows, depth)
         while todo:
             node, rows, depth = todo.pop()
-            if depth == levels or len(np.unique(desc[rows], axis=0)) <= 1:
+            if depth == levels or np.all(desc[rows] == desc[rows[0]]):     # a node of one distinct descriptor
                 continue
             for j, members in enumerate(_k_majority(desc[rows], branching, iterations, rng)):
                 child = len(centres)
