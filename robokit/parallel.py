@@ -24,7 +24,9 @@ import pickle
 import sys
 from typing import Any, Callable, Sequence
 
-from .config import worker_count
+import cv2
+
+from .config import available_cpus, worker_count
 from .progress import progress_bar
 from .validation import check_callable, check_int
 
@@ -37,10 +39,11 @@ MIN_RUNS = 4
 _SHARED: dict = {}    # in a worker: the object every run needs, sent once by _receive
 
 
-def _receive(shared: Any, settings: dict) -> None:
+def _receive(shared: Any, settings: dict, threads: int) -> None:
     _SHARED["value"] = shared
     os.environ.update(settings)            # the caller's ROBOKIT_* settings, not the fork server's
     os.environ["ROBOKIT_WORKERS"] = "1"     # a run that makes runs of its own makes them in place
+    cv2.setNumThreads(threads)             # the workers already fill the cores: no OpenCV threads on top
 
 
 def _run_shared(job: tuple) -> Any:
@@ -131,7 +134,8 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
         _check_importable(run)
         settings = {k: v for k, v in os.environ.items() if k.startswith("ROBOKIT_")}
         try:
-            pool = _context(run).Pool(workers, initializer=_receive, initargs=(shared, settings))
+            threads = max(1, available_cpus() // workers)
+            pool = _context(run).Pool(workers, initializer=_receive, initargs=(shared, settings, threads))
         except (pickle.PicklingError, TypeError, AttributeError) as exc:
             raise TypeError(f"shared: expected an object that pickles (it is sent to the workers), "
                             f"got {type(shared).__name__}: {exc}") from exc

@@ -89,3 +89,28 @@ def test_table_2_runs_do_not_depend_on_the_number_of_workers(monkeypatch):
         for name in ("positions", "converged", "iterations", "distance", "error", "settled", "retrieval_error"):
             assert np.array_equal(getattr(a, name), getattr(b, name), equal_nan=getattr(a, name).dtype.kind == "f"), \
                 (method, name)
+
+
+def _opencv_threads(shared, task):
+    import cv2
+    return cv2.getNumThreads()
+
+
+def test_workers_leave_the_cores_to_each_other():
+    # two workers on this machine's CPUs: OpenCV inside each uses its share, not every core again
+    from robokit.config import available_cpus
+    threads = map_runs(_opencv_threads, None, list(range(MIN_RUNS)), workers=2)
+    assert set(threads) == {max(1, available_cpus() // 2)}
+
+
+def test_navigation_runs_do_not_depend_on_the_number_of_workers(monkeypatch):
+    # lesson 02's runs are each seeded by their number: side by side they follow the same paths
+    from robokit.navigation.omni_experiment import office_setup
+    from robokit.navigation.omni_navigation import navigation_trials
+    setup = office_setup(fast=True)
+    runs = {}
+    for workers in ("1", "2"):
+        monkeypatch.setenv("ROBOKIT_WORKERS", workers)
+        runs[workers] = navigation_trials(setup, MIN_RUNS, n_path_nodes=3, max_time=6.0, cache=False).runs
+    for a, b in zip(runs["1"], runs["2"]):
+        assert np.array_equal(a.true_poses, b.true_poses) and np.array_equal(a.fixes, b.fixes)

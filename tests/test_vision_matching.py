@@ -81,6 +81,23 @@ def test_kdtree_and_opencv_agree():
     assert d.shape == (100, 2) and np.all(d[:, 0] <= d[:, 1])
 
 
+@pytest.mark.parametrize("method", ["kdtree", "opencv", "flann"])
+def test_a_descriptor_index_survives_pickling(method):
+    # sent to worker processes, an index rebuilds its search structure (OpenCV's does not pickle)
+    import pickle
+    from robokit.vision.matching import DescriptorIndex
+    rng = np.random.default_rng(8)
+    train = rng.normal(size=(500, 32)).astype(np.float32)
+    query = train[::5] + rng.normal(scale=0.2, size=(100, 32)).astype(np.float32)
+    index = DescriptorIndex(train, method, seed=4)
+    copy = pickle.loads(pickle.dumps(index))
+    for a, b in zip(index.query(query, 3), copy.query(query, 3)):
+        np.testing.assert_array_equal(a, b)
+    assert len(copy.match(query)) > 50
+    empty = pickle.loads(pickle.dumps(DescriptorIndex(np.zeros((0, 32), np.float32), method)))
+    assert len(empty) == 0
+
+
 @pytest.mark.parametrize("dim", [16, 128])
 def test_k_nearest_methods_agree_including_the_distance_bound(dim):
     rng = np.random.default_rng(5)

@@ -49,10 +49,10 @@ LAB_TEST_POSES = np.array([
 #: the outdoor worlds does not rebuild the lab's map; ``tests/test_localization_lab_experiment.py``
 #: checks that the list covers every module reached that way.
 EXPERIMENT_MODULES = (
-    "validation", "config", "progress",
+    "validation", "config", "progress", "parallel",
     "geometry.paper_frames", "geometry.planar", "geometry.procrustes", "geometry.rotations", "geometry.spatial",
-    "sim.build", "sim.camera", "sim.layout", "sim.motion", "sim.render", "sim.runs", "sim.textures", "sim.world",
-    "sim.worlds",
+    "sim.build", "sim.camera", "sim.layout", "sim.lidar", "sim.motion", "sim.render", "sim.runs", "sim.textures",
+    "sim.world", "sim.worlds",
     "vision.descriptors", "vision.features", "vision.matching", "vision.plot_detector", "vision.ransac",
     "vision.stereo",
     "mapping.landmarks",

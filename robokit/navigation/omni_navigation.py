@@ -25,7 +25,7 @@ from ..config import (cache_dir, cache_key, code_version, read_arrays, record_na
                       records_to_arrays, write_arrays)
 from ..controllers.path_geometry import VisualPath, path_from_poses
 from ..localization.hierarchical import HierarchicalLocalizer, Localization
-from ..progress import progress_bar
+from ..parallel import map_runs
 from ..validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive
 from .omni_experiment import OfficeSetup, check_setup
 from .visual_path import FollowResult, follow_path, perturbed_starts
@@ -172,7 +172,9 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
     localize : callable, optional
         Default :func:`omni_localizer` (the omni camera in the loop).
     seed : int, default 3
-        Seeds the starts, the odometry noise and the rendering noise.
+        Seeds the starts; run ``k`` draws its odometry and rendering noise from ``(seed, k)``, so the
+        runs are independent: with the default localizer they are made side by side
+        (:func:`robokit.parallel.map_runs`, ``ROBOKIT_WORKERS``), a given ``localize`` is called here.
     cache : bool, default True
         With the default localizer, load the runs from / save them to
         ``robokit.cache_dir("navigation")``, keyed by every parameter, the map and the code (each
@@ -230,15 +232,23 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
         if data is not None:
             results = records_from_arrays(data, FollowResult, n_starts)
             return _judged(setup, path, first, count, results, radius)
-    results = []
-    with progress_bar(n_starts, "following the path", unit="run", callback=progress) as bar:
-        for start in starts:
-            results.append(follow_path(path, start, localize=localize, fix_period=fix_period, alpha=alpha,
-                                       max_time=max_time, rng=rng))
-            bar.update()
+    # each run seeded by its own number, so the runs are independent and made side by side (the
+    # default localizer is rebuilt in each worker; a given one is called here, in order)
+    follow = {"fix_period": fix_period, "alpha": alpha, "max_time": max_time}
+    results = map_runs(_follow_from_start, (setup, path, None if default_localizer else localize, follow, seed),
+                       list(enumerate(starts)), workers=None if default_localizer else 1,
+                       desc="following the path", progress=progress)
     if target is not None:
         write_arrays(target, records_to_arrays(results, FollowResult), meta)
     return _judged(setup, path, first, count, results, radius)
+
+
+def _follow_from_start(shared: tuple, task: tuple) -> FollowResult:
+    """Run ``k`` of :func:`navigation_trials` from ``start`` (``task = (k, start)``), seeded by ``(seed, k)``."""
+    setup, path, localize, follow, seed = shared
+    k, start = task
+    localize = omni_localizer(setup) if localize is None else localize
+    return follow_path(path, start, localize=localize, rng=np.random.default_rng([seed, k]), **follow)
 
 
 def _judged(setup: OfficeSetup, path: VisualPath, first: int, count: int, runs: list, radius: float

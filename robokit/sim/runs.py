@@ -26,8 +26,9 @@ from typing import Any
 import numpy as np
 
 from ..config import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, save_npz, write_atomically
-from ..progress import progress_bar
+from ..parallel import map_runs
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
+from .lidar import Lidar
 from .motion import Path, noisy_odometry
 from .world import World
 
@@ -192,6 +193,22 @@ def _readings(name: str, observation: Any) -> list[tuple[str, str, np.ndarray]]:
     return out
 
 
+#: Camera frames per task when a recording is rendered in worker processes.
+_FRAMES_PER_TASK = 16
+
+
+def _camera_frames(shared: tuple, poses: np.ndarray) -> list:
+    """The readings of every camera at each pose (no noise drawn): one worker task of :func:`record`."""
+    world, cameras = shared
+    return [[r for name, camera in cameras.items() for r in _readings(name, camera.observe(world, pose))]
+            for pose in poses]
+
+
+def _log(logs: dict, readings: list) -> None:
+    for group, key, array in readings:
+        logs[group].setdefault(key, []).append(array)
+
+
 def _timed_poses(path: Any, rate: float | None) -> tuple[np.ndarray, np.ndarray]:
     """Timestamps and poses of ``path``, resampled at ``rate`` (linear, heading unwrapped) if given."""
     if isinstance(path, tuple) and len(path) == 2 and not isinstance(path, Path):
@@ -248,7 +265,9 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     Ge et al. (2023, Sec. 3.4) record scans and keyframes with timestamps while the robot is
     remote-controlled; Se, Lowe & Little (2002, Sec. 3.6) record stereo frames and odometry
     around the lab. Every sensor goes through the one interface ``observe`` (see
-    :func:`_readings`); deterministic, hence cacheable (DESIGN.md, "Caching").
+    :func:`_readings`); deterministic, hence cacheable (DESIGN.md, "Caching"). Camera frames draw
+    no noise here, so they are rendered side by side in batches (:func:`robokit.parallel.map_runs`,
+    ``ROBOKIT_WORKERS``); a LiDAR's scans draw theirs from ``seed`` in order, here.
 
     Examples
     --------
@@ -285,12 +304,19 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     rng = as_rng(int(seed))
     odometry = noisy_odometry(poses, alphas, rng)
     logs: dict[str, dict[str, list]] = {"images": {}, "depths": {}, "scans": {}}
-    with progress_bar(len(poses), f"recording in {world.name}", unit="frame") as bar:
-        for pose in poses:
-            for name, sensor in sensors.items():
-                for group, key, array in _readings(name, sensor.observe(world, pose, rng=rng)):
-                    logs[group].setdefault(key, []).append(array)
-            bar.update()
+    # scans draw their noise from rng one after the other; camera frames draw none here (no noise is
+    # asked for), so they are rendered side by side in batches, in order
+    scanners = {k: s for k, s in sensors.items() if isinstance(s, Lidar)}
+    cameras = {k: s for k, s in sensors.items() if k not in scanners}
+    for pose in poses:
+        for name, sensor in scanners.items():
+            _log(logs, _readings(name, sensor.observe(world, pose, rng=rng)))
+    if cameras:
+        tasks = [poses[k:k + _FRAMES_PER_TASK] for k in range(0, len(poses), _FRAMES_PER_TASK)]
+        for batch in map_runs(_camera_frames, (world, cameras), tasks, desc=f"recording in {world.name}",
+                              unit=f"{_FRAMES_PER_TASK} frames"):
+            for readings in batch:
+                _log(logs, readings)
     stacked = {group: {k: np.stack(v) for k, v in arrays.items()} for group, arrays in logs.items()}
     run = Run(t, poses, odometry, stacked["images"], stacked["depths"], stacked["scans"], meta)
     if target is not None:

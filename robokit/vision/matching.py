@@ -172,21 +172,32 @@ class DescriptorIndex:
         self.method = check_choice(method, "method", METHODS)
         self.checks = check_int(checks, "checks", minimum=1, maximum=1 << 20)
         self.trees = check_int(trees, "trees", minimum=1, maximum=64)
-        seed = check_int(seed, "seed", minimum=0, maximum=2 ** 31 - 1)
+        self._seed = check_int(seed, "seed", minimum=0, maximum=2 ** 31 - 1)
         self.descriptors = np.ascontiguousarray(_descriptors(descriptors, "descriptors"))
-        self._index = None
+        self._index = self._build()
+
+    def _build(self):
+        """The search structure of ``self.method`` over ``self.descriptors`` (``None`` when empty)."""
         if len(self.descriptors) == 0:
-            return
+            return None
         if self.method == "kdtree":
-            self._index = cKDTree(self.descriptors)
-        elif self.method == "opencv":
-            self._index = cv2.BFMatcher(cv2.NORM_L2)
-        elif self.method == "flann":
-            cv2.setRNGSeed(seed)
-            flann = cv2.FlannBasedMatcher({"algorithm": 1, "trees": self.trees}, {"checks": self.checks})
-            flann.add([self.descriptors])     # algorithm 1: FLANN_INDEX_KDTREE
-            flann.train()
-            self._index = flann
+            return cKDTree(self.descriptors)
+        if self.method == "opencv":
+            return cv2.BFMatcher(cv2.NORM_L2)
+        cv2.setRNGSeed(self._seed)
+        flann = cv2.FlannBasedMatcher({"algorithm": 1, "trees": self.trees}, {"checks": self.checks})
+        flann.add([self.descriptors])     # algorithm 1: FLANN_INDEX_KDTREE
+        flann.train()
+        return flann
+
+    def __getstate__(self) -> dict:
+        # OpenCV's matchers do not pickle: an index is sent (e.g. to worker processes) without its
+        # search structure and rebuilds it, the same one for the same seed, where it arrives
+        return {k: v for k, v in self.__dict__.items() if k != "_index"}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._index = self._build()
 
     def __len__(self) -> int:
         return int(self.descriptors.shape[0])
