@@ -131,16 +131,21 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     M[:, 1] -= box[:, 1:2] * M[:, 2]
     # 2. each surface in turn (in the world's order, which settles ties): rasterise, z-test, texture
     box = box.astype(int).tolist()
-    cols, rows = np.arange(width, dtype=np.float32)[None, :], np.arange(height, dtype=np.float32)[:, None]
+    cols, rows = np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32)
     for i in np.flatnonzero(seen).tolist():
         x0, y0, x1, y1 = box[i]
         w = plane[i]
-        zi = (w[0] * cols[:, x0:x1 + 1] + w[1] * rows[y0:y1 + 1] + w[2]).astype(np.float32)
+        # 1/Z = (w0 u + w1 v) + w2 in float64, as one expression over the box would give it, with the
+        # products made once per column and per row instead of once per pixel
+        zi = np.add.outer(w[1] * rows[y0:y1 + 1], w[0] * cols[x0:x1 + 1])
+        zi += w[2]
+        zi = zi.astype(np.float32)
         mask = np.zeros((y1 - y0 + 1, x1 - x0 + 1), np.uint8)
         cv2.fillPoly(mask, [np.round((polygons[i] - [x0, y0]) * 16).astype(np.int32)], 1, lineType=cv2.LINE_8,
                      shift=4)
         sub_z = zinv_buf[y0:y1 + 1, x0:x1 + 1]
-        update = (mask > 0) & (zi > sub_z)
+        update = zi > sub_z
+        update &= mask.view(bool)           # fillPoly wrote 0 or 1
         if not update.any():
             continue
         tex = world.surfaces[idx[i]].pyramid[level[i]]
