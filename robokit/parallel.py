@@ -26,7 +26,7 @@ from typing import Any, Callable, Sequence
 
 import cv2
 
-from .config import available_cpus, worker_count
+from .config import worker_count
 from .progress import progress_bar
 from .validation import check_callable, check_int
 
@@ -39,16 +39,39 @@ MIN_RUNS = 4
 _SHARED: dict = {}    # in a worker: the object every run needs, sent once by _receive
 
 
-def _receive(shared: Any, settings: dict, threads: int) -> None:
-    _SHARED["value"] = shared
+def _receive(blob: bytes, settings: dict, threads: int) -> None:
     os.environ.update(settings)            # the caller's ROBOKIT_* settings, not the fork server's
     os.environ["ROBOKIT_WORKERS"] = "1"     # a run that makes runs of its own makes them in place
     cv2.setNumThreads(threads)             # the workers already fill the cores: no OpenCV threads on top
+    _SHARED.clear()
+    try:                                   # a failure here would make the pool restart workers forever
+        _SHARED["value"] = pickle.loads(blob)
+    except Exception as exc:               # noqa: BLE001 - reported by every run instead
+        _SHARED["error"] = _unreadable("shared", exc)
+
+
+def _unreadable(name: str, exc: Exception) -> TypeError:
+    return TypeError(f"{name}: the worker processes could not rebuild it ({type(exc).__name__}: {exc}); "
+                     f"its classes must be defined in an importable module, not in a notebook or with python -c")
 
 
 def _run_shared(job: tuple) -> Any:
-    run, task = job
+    run, blob = job
+    if "error" in _SHARED:
+        raise _SHARED["error"]
+    try:
+        task = pickle.loads(blob)
+    except Exception as exc:               # noqa: BLE001 - a task the worker cannot rebuild is named
+        raise _unreadable("tasks", exc) from None
     return run(_SHARED["value"], task)
+
+
+def _pickled(value: Any, name: str) -> bytes:
+    try:
+        return pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+    except (pickle.PicklingError, TypeError, AttributeError) as exc:
+        raise TypeError(f"{name}: expected objects that pickle (they are sent to the workers), "
+                        f"got {type(value).__name__}: {exc}") from exc
 
 
 def _context(run: Callable):
@@ -103,13 +126,16 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
     TypeError, ValueError
         For a ``run`` or ``progress`` that is not callable, ``tasks`` that is not a sequence, a bad
         ``workers``; with workers, a ``run`` they cannot import (a lambda, a nested function, one
-        defined in a notebook) or a ``shared`` object that does not pickle. An error inside a run is
+        defined in a notebook), a ``shared`` object or task that does not pickle, or one whose
+        class the workers cannot import (defined in a notebook). An error inside a run is
         raised here, the first in the order of ``tasks`` (as the plain loop would raise it), and
         the workers are stopped at once, as they are when the caller is interrupted.
 
     Notes
     -----
-    Course convention (DESIGN.md, "Independent runs"); not from a paper.
+    Course convention (DESIGN.md, "Independent runs"); not from a paper. Each worker lets OpenCV use
+    its share of this process's cores (:func:`worker_count` divided by the workers), since the
+    workers already fill them.
 
     Examples
     --------
@@ -133,14 +159,12 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
             return results
         _check_importable(run)
         settings = {k: v for k, v in os.environ.items() if k.startswith("ROBOKIT_")}
+        # sent as bytes: a worker that cannot rebuild them reports it as the runs' error
+        blob, jobs = _pickled(shared, "shared"), [(run, _pickled(task, "tasks")) for task in tasks]
+        threads = max(1, worker_count() // workers)     # this process's share of the cores, per worker
+        pool = _context(run).Pool(workers, initializer=_receive, initargs=(blob, settings, threads))
         try:
-            threads = max(1, available_cpus() // workers)
-            pool = _context(run).Pool(workers, initializer=_receive, initargs=(shared, settings, threads))
-        except (pickle.PicklingError, TypeError, AttributeError) as exc:
-            raise TypeError(f"shared: expected an object that pickles (it is sent to the workers), "
-                            f"got {type(shared).__name__}: {exc}") from exc
-        try:
-            for result in pool.imap(_run_shared, [(run, task) for task in tasks]):   # in order
+            for result in pool.imap(_run_shared, jobs):   # in order
                 results.append(result)
                 bar.update()
         finally:

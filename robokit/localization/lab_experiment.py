@@ -51,8 +51,8 @@ LAB_TEST_POSES = np.array([
 EXPERIMENT_MODULES = (
     "validation", "config", "progress", "parallel",
     "geometry.paper_frames", "geometry.planar", "geometry.procrustes", "geometry.rotations", "geometry.spatial",
-    "sim.build", "sim.camera", "sim.layout", "sim.lidar", "sim.motion", "sim.render", "sim.runs", "sim.textures",
-    "sim.world", "sim.worlds",
+    "sim.build", "sim.camera", "sim.layout", "sim.lidar", "sim.motion", "sim.omni", "sim.render", "sim.runs",
+    "sim.textures", "sim.world", "sim.worlds",
     "vision.descriptors", "vision.features", "vision.matching", "vision.plot_detector", "vision.ransac",
     "vision.stereo",
     "mapping.landmarks",
@@ -120,6 +120,8 @@ def mapping_run(rate: float = 1.0, *, baseline: float = 0.12, seed: int = 0):
     Notes
     -----
     Se et al. Sec. 3.6: the robot "traverses around" the 10 m x 10 m lab while building the map.
+    The frames are rendered in worker processes (:func:`robokit.sim.record`): a plain script needs
+    the ``if __name__ == "__main__":`` guard.
     """
     world = lab_room()
     rig = _lab_rig(baseline)
@@ -236,7 +238,8 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     Se, Lowe & Little (2002), Sec. 6. The run time per test pose covers feature extraction in both
     images, stereo matching and the Hough transform with refinement, as in the paper (for a cached
     result, the times measured when it was built). Deterministic, hence cacheable (DESIGN.md,
-    "Caching").
+    "Caching"). Its recording is rendered in worker processes (:func:`mapping_run`): a plain script
+    needs the ``if __name__ == "__main__":`` guard.
 
     Examples
     --------

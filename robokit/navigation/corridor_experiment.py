@@ -17,7 +17,9 @@ This module re-runs that stage on :func:`robokit.sim.long_corridor`:
 
 Everything is cached (keyed by the parameters and the code that makes it); a cache is never needed
 for correctness. Poses are robokit's ``[x, y, theta]``: the corridor runs along +x from 0 to
-36.10 m with its middle line on y = 0.
+36.10 m with its middle line on y = 0. The recordings are rendered in worker processes
+(:func:`robokit.parallel.map_runs`): a plain script that makes them needs the
+``if __name__ == "__main__":`` guard.
 
 References
 ----------

@@ -18,7 +18,9 @@ triggers in this corridor; docs/DECISIONS.md). Ours starts as one cluster, so by
 has converged at its first update. An iteration is one filter update, which ROS runs after 0.2 m or
 30 degrees of odometry. A run is judged on the truth, with the estimate amcl publishes (the mean of
 the heaviest cluster), at convergence and :data:`SETTLE` updates later (the paper's criterion is
-0.05 m and 0.5 degrees, Sec. 4.1). Runs are cached like recorded datasets.
+0.05 m and 0.5 degrees, Sec. 4.1). Runs are cached like recorded datasets, and made in worker
+processes (:func:`robokit.parallel.map_runs`; a plain script needs the ``if __name__ == "__main__":``
+guard).
 
 References
 ----------

@@ -140,7 +140,8 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     -----
     Sec. "Experimental results" (Fig. 6a: the tour; Fig. 8: the map) and Sec. "Environment map"
     (key images, local-map partitioning, loop closure, Eqs. (1)-(3)). The paper records 640 x 480
-    colour images; fast mode uses 320 x 240.
+    colour images; fast mode uses 320 x 240. The tour's frames are rendered in worker processes
+    (:func:`robokit.sim.record`): a plain script needs the ``if __name__ == "__main__":`` guard.
 
     Examples
     --------

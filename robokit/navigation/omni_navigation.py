@@ -80,7 +80,7 @@ def omni_localizer(setup: OfficeSetup, *, noise: float = 1.0, map: str = "relaxe
     def localize(true_pose: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
         localize.calls += 1
         try:
-            image = setup.camera.observe(setup.world, np.asarray(true_pose, float), rng=rng).image
+            image = setup.camera.observe(setup.world, np.asarray(true_pose, float), noise=noise, rng=rng).image
         except ValueError:       # the (non-colliding) simulated robot drove into furniture: no view
             localize.failures += 1
             return None
@@ -172,9 +172,10 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
     localize : callable, optional
         Default :func:`omni_localizer` (the omni camera in the loop).
     seed : int, default 3
-        Seeds the starts; run ``k`` draws its odometry and rendering noise from ``(seed, k)``, so the
-        runs are independent: with the default localizer they are made side by side
-        (:func:`robokit.parallel.map_runs`, ``ROBOKIT_WORKERS``), a given ``localize`` is called here.
+        Seeds the starts; run ``k`` draws its odometry noise and its localizer's (the default's pixel
+        noise) from ``(seed, k)``, so the runs are independent: with the default localizer they are
+        made side by side (:func:`robokit.parallel.map_runs`, ``ROBOKIT_WORKERS``; a plain script needs
+        the ``if __name__ == "__main__":`` guard), a given ``localize`` is called here, in order.
     cache : bool, default True
         With the default localizer, load the runs from / save them to
         ``robokit.cache_dir("navigation")``, keyed by every parameter, the map and the code (each
@@ -216,7 +217,7 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
         first = check_int(first_node, "first_node", minimum=0, maximum=len(setup.relaxed) - count)
     progress = check_callable(progress, "progress")
     default_localizer = localize is None
-    localize = omni_localizer(setup) if default_localizer else check_callable(localize, "localize", optional=False)
+    localize = None if default_localizer else check_callable(localize, "localize", optional=False)
     seed = check_int(seed, "seed", minimum=0)
     rng = as_rng(seed)
     path = path_from_poses(as_array(setup.relaxed.poses[first:first + count], "poses"))
@@ -235,7 +236,7 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
     # each run seeded by its own number, so the runs are independent and made side by side (the
     # default localizer is rebuilt in each worker; a given one is called here, in order)
     follow = {"fix_period": fix_period, "alpha": alpha, "max_time": max_time}
-    results = map_runs(_follow_from_start, (setup, path, None if default_localizer else localize, follow, seed),
+    results = map_runs(_follow_from_start, (setup, path, localize, follow, seed),
                        list(enumerate(starts)), workers=None if default_localizer else 1,
                        desc="following the path", progress=progress)
     if target is not None:

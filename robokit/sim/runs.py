@@ -27,9 +27,11 @@ import numpy as np
 
 from ..config import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, save_npz, write_atomically
 from ..parallel import map_runs
+from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
-from .lidar import Lidar
+from .camera import PinholeCamera, StereoRig
 from .motion import Path, noisy_odometry
+from .omni import OmniCamera
 from .world import World
 
 __all__ = ["Run", "record", "describe_sensor"]
@@ -197,8 +199,15 @@ def _readings(name: str, observation: Any) -> list[tuple[str, str, np.ndarray]]:
 _FRAMES_PER_TASK = 16
 
 
+def _noise_free_camera(sensor: Any) -> bool:
+    """A robokit camera (exactly, not a subclass of the caller's): its ``observe`` draws nothing from rng."""
+    if type(sensor) is StereoRig:
+        return type(sensor.camera) is PinholeCamera
+    return type(sensor) in (PinholeCamera, OmniCamera)
+
+
 def _camera_frames(shared: tuple, poses: np.ndarray) -> list:
-    """The readings of every camera at each pose (no noise drawn): one worker task of :func:`record`."""
+    """The readings of every noise-free camera at each pose: one worker task of :func:`record`."""
     world, cameras = shared
     return [[r for name, camera in cameras.items() for r in _readings(name, camera.observe(world, pose))]
             for pose in poses]
@@ -246,7 +255,8 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     odometry_alphas : array_like (4,)
         Odometry noise parameters (Thrun et al. 2005, Table 5.6).
     seed : int, default 0
-        Seeds odometry, image and LiDAR noise.
+        Seeds the odometry noise and the noise of every sensor that draws any (robokit's LiDAR;
+        robokit's cameras render without noise here).
     cache : bool, default True
         Load from / save to ``robokit.cache_dir("runs")``, keyed by all parameters and the code
         that renders (a corrupt or foreign cache file is rebuilt, never loaded).
@@ -265,9 +275,12 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     Ge et al. (2023, Sec. 3.4) record scans and keyframes with timestamps while the robot is
     remote-controlled; Se, Lowe & Little (2002, Sec. 3.6) record stereo frames and odometry
     around the lab. Every sensor goes through the one interface ``observe`` (see
-    :func:`_readings`); deterministic, hence cacheable (DESIGN.md, "Caching"). Camera frames draw
-    no noise here, so they are rendered side by side in batches (:func:`robokit.parallel.map_runs`,
-    ``ROBOKIT_WORKERS``); a LiDAR's scans draw theirs from ``seed`` in order, here.
+    :func:`_readings`); deterministic, hence cacheable (DESIGN.md, "Caching"). The frames of
+    robokit's cameras (``PinholeCamera``, ``OmniCamera``, a ``StereoRig`` of pinhole cameras) draw
+    no noise here, so they are rendered side by side in worker processes
+    (:func:`robokit.parallel.map_runs`, ``ROBOKIT_WORKERS``): a plain script that records needs the
+    ``if __name__ == "__main__":`` guard. Every other sensor is observed in this process, in order,
+    drawing its noise from ``seed``; the recording is the same either way.
 
     Examples
     --------
@@ -304,20 +317,26 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     rng = as_rng(int(seed))
     odometry = noisy_odometry(poses, alphas, rng)
     logs: dict[str, dict[str, list]] = {"images": {}, "depths": {}, "scans": {}}
-    # scans draw their noise from rng one after the other; camera frames draw none here (no noise is
-    # asked for), so they are rendered side by side in batches, in order
-    scanners = {k: s for k, s in sensors.items() if isinstance(s, Lidar)}
-    cameras = {k: s for k, s in sensors.items() if k not in scanners}
-    for pose in poses:
-        for name, sensor in scanners.items():
-            _log(logs, _readings(name, sensor.observe(world, pose, rng=rng)))
+    # robokit's cameras draw no noise here (none is asked for), so their frames are rendered side by
+    # side in batches; every other sensor (a LiDAR's noisy scans, a sensor of the caller's) is
+    # observed here, in order, drawing from rng as before
+    cameras = {k: s for k, s in sensors.items() if _noise_free_camera(s)}
+    others = {k: s for k, s in sensors.items() if k not in cameras}
+    if others:
+        with progress_bar(len(poses), f"recording in {world.name}", unit="frame") as bar:
+            for pose in poses:
+                for name, sensor in others.items():
+                    _log(logs, _readings(name, sensor.observe(world, pose, rng=rng)))
+                bar.update()
     if cameras:
         tasks = [poses[k:k + _FRAMES_PER_TASK] for k in range(0, len(poses), _FRAMES_PER_TASK)]
-        for batch in map_runs(_camera_frames, (world, cameras), tasks, desc=f"recording in {world.name}",
-                              unit=f"{_FRAMES_PER_TASK} frames"):
+        for batch in map_runs(_camera_frames, (world, cameras), tasks, desc=f"rendering in {world.name}",
+                              unit="batch"):
             for readings in batch:
                 _log(logs, readings)
-    stacked = {group: {k: np.stack(v) for k, v in arrays.items()} for group, arrays in logs.items()}
+    rank = {name: i for i, name in enumerate(sensors)}       # keys in the order of the sensors, as given
+    stacked = {group: {k: np.stack(v) for k, v in sorted(arrays.items(), key=lambda kv: rank[kv[0].split("/")[0]])}
+               for group, arrays in logs.items()}
     run = Run(t, poses, odometry, stacked["images"], stacked["depths"], stacked["scans"], meta)
     if target is not None:
         write_atomically(target, run.save)   # notebooks running in parallel never read a half-written file

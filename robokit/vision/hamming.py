@@ -2,9 +2,9 @@
 
 A binary descriptor is a row of bytes (ORB: 256 intensity tests, Ge et al. (2023) Eqs. (13)-(14),
 packed into 32 uint8); the distance between two is the number of bits in which they differ
-(Rublee et al. 2011, Sec. 5). :func:`hamming_distance` is the one kernel: it XORs 64-bit words and
-counts their set bits with ``numpy.bitwise_count``; :func:`hamming_distances` is its all-pairs form,
-in row blocks so memory stays bounded. :func:`hamming_match`, the nearest-neighbour matcher, finds each
+(Rublee et al. 2011, Sec. 5). :func:`hamming_distance` is the readable kernel: it XORs 64-bit words
+and counts their set bits with ``numpy.bitwise_count``; :func:`hamming_distances` is its all-pairs
+form, in row blocks so memory stays bounded. :func:`hamming_match`, the nearest-neighbour matcher, finds each
 row's two nearest with OpenCV's ``cv2.batchDistance`` (its fast path; the tests check it against
 :func:`hamming_distances` and against ``cv2.BFMatcher(cv2.NORM_HAMMING)``).
 
@@ -202,20 +202,21 @@ def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
     return out
 
 
-def _two_nearest(q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distances (float, ``inf`` where there is no second) and indices of each query row's two nearest train rows.
+def _two_nearest(q: np.ndarray, t: np.ndarray, k: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """Distances (float, ``inf`` where there is no second) and indices of each query row's ``k`` (1 or 2)
+    nearest train rows.
 
     OpenCV's ``cv2.batchDistance`` keeps the ``K`` nearest while it scans the train rows with
     SIMD bit counts, about six times faster than the full table of :func:`hamming_distances` for
     500 x 500 ORB rows; a train row displaces a kept one only when strictly nearer, so ties go to
     the lowest index, as ``numpy.argmin`` over that table gives them (the tests compare the two).
     """
-    k = min(2, len(t))
+    found = min(k, len(t))
     d, i = cv2.batchDistance(np.ascontiguousarray(q), np.ascontiguousarray(t), cv2.CV_32S,
-                             normType=cv2.NORM_HAMMING, K=k)
-    dist, index = np.full((len(q), 2), np.inf), np.empty((len(q), 2), np.int64)
-    dist[:, :k], index[:, :k] = d, i
-    index[:, k:] = index[:, :1]
+                             normType=cv2.NORM_HAMMING, K=found)
+    dist, index = np.full((len(q), k), np.inf), np.empty((len(q), k), np.int64)
+    dist[:, :found], index[:, :found] = d, i
+    index[:, found:] = index[:, :1]
     return dist, index
 
 
@@ -268,6 +269,9 @@ def hamming_match(query, train, *, ratio: float = ORB_RATIO, max_distance: float
     dist, index = _two_nearest(q, t)
     m = ratio_test(dist, index, ratio=ratio, max_distance=max_distance)
     if cross_check and len(m):
-        mutual = _two_nearest(t, q)[1][m.train, 0] == m.query
+        matched = np.unique(m.train)                  # only these train rows need their nearest query row
+        nearest = np.empty(len(t), np.int64)
+        nearest[matched] = _two_nearest(t[matched], q, k=1)[1][:, 0]
+        mutual = nearest[m.train] == m.query
         m = Matches(m.query[mutual], m.train[mutual], m.distance[mutual], m.ratio[mutual])
     return m
