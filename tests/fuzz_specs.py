@@ -1004,7 +1004,8 @@ SPECS: dict[str, Call] = {
         "progress": Func(None, optional=True), "log": Func(None, optional=True)}, cheap=False),
     "robokit.mapping.omni_views.omni_view": Call({"image": Array(lambda: office_views()[0][0], "120,160,3"),
                                                   "camera": Obj(small_omni), "bins": Int(32), "n_features": Int(100),
-                                                  "features": Flag(True), "times": Mapping(None, optional=True)}),
+                                                  "features": Flag(True), "times": Mapping(None, optional=True),
+                                                  "histogram": Array(lambda: np.full(32, 1 / 32), "32", optional=True)}),
     "robokit.mapping.omni_views.check_omni_image": Call({"image": Array(lambda: office_views()[0][0], "120,160,3"),
                                                          "camera": Obj(small_omni), "name": Text("image")}),
     "robokit.mapping.omni_views.relative_pose": Call({

@@ -143,3 +143,19 @@ def test_the_pose_is_always_the_node_pose_composed_with_the_relative_pose():
     for pose in ([11.6, 2.0, 2.5], [14.1, 1.0, 2.0]):                     # a crossing and a floor fix
         r = loc.localize(camera().observe(office(), pose).image)
         assert np.allclose(se2_compose(r.node_pose, r.relative.pose), r.pose)
+
+
+def test_a_view_given_its_histogram_equals_the_view_computed_whole():
+    # the map builder adds SIFT to a histogram-only view without computing the histogram again
+    image = camera().observe(office(), [3.0, 2.0, 0.4]).image
+    whole = omni_view(image, camera(), n_features=200)
+    coarse = omni_view(image, camera(), n_features=200, features=False)
+    added = omni_view(image, camera(), n_features=200, histogram=coarse.histogram)
+    assert np.array_equal(added.histogram, whole.histogram) and np.array_equal(coarse.histogram, whole.histogram)
+    assert np.array_equal(added.features.descriptors, whole.features.descriptors)
+    assert np.array_equal(added.bearings, whole.bearings) and len(added) > 20
+    given = np.full(32, 1 / 32)
+    np.testing.assert_array_equal(omni_view(image, camera(), features=False, histogram=given).histogram, given)
+    for bad, match in ((np.full(16, 1 / 16), "histogram"), (-given, "histogram"), (np.full(32, np.nan), "histogram")):
+        with pytest.raises(ValueError, match=match):
+            omni_view(image, camera(), histogram=bad)

@@ -110,7 +110,7 @@ HISTOGRAM_STEP = 2
 
 
 def omni_view(image: Any, camera: OmniCamera, *, bins: int = 32, n_features: int = 500,
-              features: bool = True, times: dict | None = None) -> OmniView:
+              features: bool = True, times: dict | None = None, histogram: Any = None) -> OmniView:
     """Describe an omni image by its hue histogram and its SIFT features with their bearings.
 
     Parameters
@@ -128,6 +128,9 @@ def omni_view(image: Any, camera: OmniCamera, *, bins: int = 32, n_features: int
         ``False`` skips SIFT (the view then has no features): the coarse stage needs none.
     times : dict, optional
         Receives the seconds spent on ``"histogram"`` and ``"sift"``.
+    histogram : array_like, shape (bins,), optional
+        This image's hue histogram, already computed (e.g. by an earlier ``features=False`` view of
+        it): it is used as given instead of being computed again.
 
     Returns
     -------
@@ -158,7 +161,12 @@ def omni_view(image: Any, camera: OmniCamera, *, bins: int = 32, n_features: int
     bins = check_int(bins, "bins", minimum=1)
     times = check_mapping(times, "times")
     t0 = time.perf_counter()
-    histogram = hue_histogram(img[::HISTOGRAM_STEP, ::HISTOGRAM_STEP], bins)
+    if histogram is None:
+        histogram = hue_histogram(img[::HISTOGRAM_STEP, ::HISTOGRAM_STEP], bins)
+    else:
+        histogram = as_array(histogram, "histogram", shape=(bins,))
+        if np.any(histogram < 0):
+            raise ValueError(f"histogram: expected non-negative bin values, got {histogram.min()}")
     t1 = time.perf_counter()
     if features:
         found = omni_sift(img, (camera.cx, camera.cy), camera.radii, orientation="radial", n_features=n_features)

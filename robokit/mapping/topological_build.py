@@ -335,7 +335,9 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
 
     def view(k, features=True):
         if k not in cache or (features and not has_sift[k]):
-            cache[k] = omni_view(raw[k], camera, bins=bins, n_features=n_features, features=features)
+            known = cache[k].histogram if k in cache else None      # adding SIFT keeps the histogram
+            cache[k] = omni_view(raw[k], camera, bins=bins, n_features=n_features, features=features,
+                                 histogram=known)
             has_sift[k] = features
         return cache[k]
 
