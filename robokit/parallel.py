@@ -22,6 +22,7 @@ import multiprocessing
 import os
 import pickle
 import sys
+import traceback
 from typing import Any, Callable, Sequence
 
 import cv2
@@ -36,34 +37,55 @@ __all__ = ["MIN_RUNS", "worker_count", "map_runs"]   # worker_count lives in con
 #: and OpenCV) costs more than a few runs save.
 MIN_RUNS = 4
 
-_SHARED: dict = {}    # in a worker: the object every run needs, sent once by _receive
+_SHARED: dict = {}    # in a worker: the run and the object every run needs, sent once by _receive
 
 
-def _receive(blob: bytes, settings: dict, threads: int) -> None:
+def _receive(blobs: dict, settings: dict, threads: int) -> None:
     os.environ.update(settings)            # the caller's ROBOKIT_* settings, not the fork server's
     os.environ["ROBOKIT_WORKERS"] = "1"     # a run that makes runs of its own makes them in place
     cv2.setNumThreads(threads)             # the workers already fill the cores: no OpenCV threads on top
     _SHARED.clear()
-    try:                                   # a failure here would make the pool restart workers forever
-        _SHARED["value"] = pickle.loads(blob)
-    except Exception as exc:               # noqa: BLE001 - reported by every run instead
-        _SHARED["error"] = _unreadable("shared", exc)
+    for name, blob in blobs.items():       # "run", then "shared"
+        try:                               # a failure here would make the pool restart workers forever
+            _SHARED[name] = pickle.loads(blob)
+        except BaseException as exc:       # noqa: BLE001 - reported by every run instead
+            _SHARED["error"] = _unreadable(name, exc)
+            return
 
 
-def _unreadable(name: str, exc: Exception) -> TypeError:
+def _unreadable(name: str, exc: BaseException) -> TypeError:
     return TypeError(f"{name}: the worker processes could not rebuild it ({type(exc).__name__}: {exc}); "
                      f"its classes must be defined in an importable module, not in a notebook or with python -c")
 
 
-def _run_shared(job: tuple) -> Any:
-    run, blob = job
+def _run_shared(blob: bytes) -> bytes:
+    """One run in a worker: everything goes in and comes out as bytes, and every failure comes back as
+    an error the caller can rebuild, so no failure can kill a worker (the pool would lose the run and
+    wait for it forever) or the caller's result thread."""
     if "error" in _SHARED:
         raise _SHARED["error"]
     try:
         task = pickle.loads(blob)
-    except Exception as exc:               # noqa: BLE001 - a task the worker cannot rebuild is named
+    except BaseException as exc:           # noqa: BLE001 - a task the worker cannot rebuild is named
         raise _unreadable("tasks", exc) from None
-    return run(_SHARED["value"], task)
+    try:
+        return pickle.dumps(_SHARED["run"](_SHARED["shared"], task), protocol=pickle.HIGHEST_PROTOCOL)
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:           # noqa: BLE001 - sys.exit in a run, or an error that does not pickle
+        raise _portable(exc) from None
+
+
+def _portable(exc: BaseException) -> BaseException:
+    """``exc`` if it survives the trip to the caller, else a RuntimeError carrying its text and traceback."""
+    if isinstance(exc, Exception):
+        try:
+            pickle.loads(pickle.dumps(exc))
+            return exc
+        except Exception:                  # noqa: BLE001 - any failure of the round trip
+            pass
+    trace = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
+    return RuntimeError(f"{type(exc).__name__} in a worker: {exc}\n{trace}")
 
 
 def _pickled(value: Any, name: str) -> bytes:
@@ -127,9 +149,11 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
         For a ``run`` or ``progress`` that is not callable, ``tasks`` that is not a sequence, a bad
         ``workers``; with workers, a ``run`` they cannot import (a lambda, a nested function, one
         defined in a notebook), a ``shared`` object or task that does not pickle, or one whose
-        class the workers cannot import (defined in a notebook). An error inside a run is
-        raised here, the first in the order of ``tasks`` (as the plain loop would raise it), and
-        the workers are stopped at once, as they are when the caller is interrupted.
+        class the workers cannot import (defined in a notebook), or a result that cannot be
+        rebuilt here. An error inside a run is raised here, the first in the order of ``tasks`` (as
+        the plain loop would raise it), and the workers are stopped at once, as they are when the
+        caller is interrupted. With workers, an error that cannot travel back (it does not pickle,
+        or it is ``SystemExit``) comes as a ``RuntimeError`` carrying its text and traceback.
 
     Notes
     -----
@@ -160,12 +184,17 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
         _check_importable(run)
         settings = {k: v for k, v in os.environ.items() if k.startswith("ROBOKIT_")}
         # sent as bytes: a worker that cannot rebuild them reports it as the runs' error
-        blob, jobs = _pickled(shared, "shared"), [(run, _pickled(task, "tasks")) for task in tasks]
+        blobs = {"run": _pickled(run, "run"), "shared": _pickled(shared, "shared")}
+        jobs = [_pickled(task, "tasks") for task in tasks]
         threads = max(1, worker_count() // workers)     # this process's share of the cores, per worker
-        pool = _context(run).Pool(workers, initializer=_receive, initargs=(blob, settings, threads))
+        pool = _context(run).Pool(workers, initializer=_receive, initargs=(blobs, settings, threads))
         try:
             for result in pool.imap(_run_shared, jobs):   # in order
-                results.append(result)
+                try:
+                    results.append(pickle.loads(result))
+                except Exception as exc:                  # noqa: BLE001 - named, then the workers stop
+                    raise TypeError(f"run: its result could not be rebuilt here ({type(exc).__name__}: "
+                                    f"{exc})") from exc
                 bar.update()
         finally:
             pool.terminate()       # at the end, and at once on an error or an interrupt

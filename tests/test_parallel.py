@@ -130,3 +130,41 @@ def test_navigation_runs_do_not_depend_on_the_number_of_workers(monkeypatch):
         runs[workers] = navigation_trials(setup, MIN_RUNS, n_path_nodes=3, max_time=6.0, cache=False).runs
     for a, b in zip(runs["1"], runs["2"]):
         assert np.array_equal(a.true_poses, b.true_poses) and np.array_equal(a.fixes, b.fixes)
+
+
+class _Unrebuildable(Exception):
+    """An error whose constructor takes two arguments: it pickles but does not unpickle."""
+
+    def __init__(self, a, b):
+        super().__init__(f"{a} and {b}")
+
+
+class _BadResult:
+    def __reduce__(self):
+        return (_refuse, ())
+
+
+def _refuse():
+    raise ValueError("cannot rebuild")
+
+
+def _awkward(shared, task):
+    """Runs that end in ways a worker pool cannot carry back as they are."""
+    if task == "unrebuildable":
+        raise _Unrebuildable(1, 2)
+    if task == "exit":
+        raise SystemExit(3)
+    if task == "result":
+        return _BadResult()
+    return task
+
+
+@pytest.mark.parametrize("task, error, text", [("unrebuildable", RuntimeError, "_Unrebuildable"),
+                                               ("exit", RuntimeError, "SystemExit"),
+                                               ("result", TypeError, "result")])
+def test_a_run_that_ends_badly_is_an_error_not_a_hang(task, error, text):
+    # each of these used to leave the pool waiting forever for a lost run
+    started = time.perf_counter()
+    with pytest.raises(error, match=text):
+        map_runs(_awkward, None, ["fine", task, "fine", "fine"], workers=2)
+    assert time.perf_counter() - started < 60

@@ -117,6 +117,7 @@ def test_record_omni_and_lab_lap(cache):
 @pytest.mark.parametrize("kwargs, match", [
     ({"sensors": {}}, "sensors"),
     ({"sensors": {"x": object()}}, "sensors"),
+    ({"sensors": {0: Lidar(beams=8)}}, "sensors"),
     ({"path": np.array([[1.0, 1.0, 0.0], [9.0, 1.0, 0.0]])}, "path"),
     ({"path": np.array([[1.0, np.nan, 0.0]])}, "path"),
     ({"rate": 0.0}, "rate"),

@@ -234,7 +234,7 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
             results = records_from_arrays(data, FollowResult, n_starts)
             return _judged(setup, path, first, count, results, radius)
     # each run seeded by its own number, so the runs are independent and made side by side (the
-    # default localizer is rebuilt in each worker; a given one is called here, in order)
+    # default localizer is built for each run, in its worker; a given one is called here, in order)
     follow = {"fix_period": fix_period, "alpha": alpha, "max_time": max_time}
     results = map_runs(_follow_from_start, (setup, path, localize, follow, seed),
                        list(enumerate(starts)), workers=None if default_localizer else 1,

@@ -295,9 +295,10 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     if not isinstance(sensors, dict) or not sensors:
         raise ValueError(f"sensors: expected a non-empty dict name -> sensor, got {sensors!r}")
     for name, s in sensors.items():
-        if not (dataclasses.is_dataclass(s) and callable(getattr(s, "observe", None))) or "/" in str(name) \
-                or ":" in str(name):
-            raise TypeError(f"sensors: expected camera/LiDAR objects under plain names, got {name!r}: {type(s).__name__}")
+        if not (dataclasses.is_dataclass(s) and callable(getattr(s, "observe", None))) or not isinstance(name, str) \
+                or "/" in name or ":" in name:
+            raise TypeError(f"sensors: expected camera/LiDAR objects under plain string names, got {name!r}: "
+                            f"{type(s).__name__}")
     t, poses = _timed_poses(path, rate)
     bad = ~world.is_free(poses[:, :2], clearance=0.05)
     if bad.any():

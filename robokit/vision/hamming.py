@@ -203,8 +203,9 @@ def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
 
 
 def _two_nearest(q: np.ndarray, t: np.ndarray, k: int = 2) -> tuple[np.ndarray, np.ndarray]:
-    """Distances (float, ``inf`` where there is no second) and indices of each query row's ``k`` (1 or 2)
-    nearest train rows.
+    """Distances (floats, ``inf`` for a missing second) and indices of each query row's ``k`` nearest.
+
+    ``k`` is 1 or 2; the neighbours are train rows.
 
     OpenCV's ``cv2.batchDistance`` keeps the ``K`` nearest while it scans the train rows with
     SIMD bit counts, about six times faster than the full table of :func:`hamming_distances` for
