@@ -207,15 +207,10 @@ def _noise_free_camera(sensor: Any) -> bool:
 
 
 def _camera_frames(shared: tuple, poses: np.ndarray) -> list:
-    """The readings of every noise-free camera at each pose: one worker task of :func:`record`."""
+    """Each noise-free camera's readings at each pose (a dict per pose): one worker task of :func:`record`."""
     world, cameras = shared
-    return [[r for name, camera in cameras.items() for r in _readings(name, camera.observe(world, pose))]
+    return [{name: _readings(name, camera.observe(world, pose)) for name, camera in cameras.items()}
             for pose in poses]
-
-
-def _log(logs: dict, readings: list) -> None:
-    for group, key, array in readings:
-        logs[group].setdefault(key, []).append(array)
 
 
 def _timed_poses(path: Any, rate: float | None) -> tuple[np.ndarray, np.ndarray]:
@@ -317,27 +312,30 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
         return cached
     rng = as_rng(int(seed))
     odometry = noisy_odometry(poses, alphas, rng)
-    logs: dict[str, dict[str, list]] = {"images": {}, "depths": {}, "scans": {}}
     # robokit's cameras draw no noise here (none is asked for), so their frames are rendered side by
     # side in batches; every other sensor (a LiDAR's noisy scans, a sensor of the caller's) is
     # observed here, in order, drawing from rng as before
     cameras = {k: s for k, s in sensors.items() if _noise_free_camera(s)}
-    others = {k: s for k, s in sensors.items() if k not in cameras}
-    if others:
+    per_sensor: dict[str, list] = {name: [] for name in sensors}     # each sensor's readings, pose by pose
+    if len(cameras) < len(sensors):
         with progress_bar(len(poses), f"recording in {world.name}", unit="frame") as bar:
             for pose in poses:
-                for name, sensor in others.items():
-                    _log(logs, _readings(name, sensor.observe(world, pose, rng=rng)))
+                for name, sensor in sensors.items():
+                    if name not in cameras:
+                        per_sensor[name].append(_readings(name, sensor.observe(world, pose, rng=rng)))
                 bar.update()
     if cameras:
         tasks = [poses[k:k + _FRAMES_PER_TASK] for k in range(0, len(poses), _FRAMES_PER_TASK)]
         for batch in map_runs(_camera_frames, (world, cameras), tasks, desc=f"rendering in {world.name}",
                               unit="batch"):
-            for readings in batch:
-                _log(logs, readings)
-    rank = {name: i for i, name in enumerate(sensors)}       # keys in the order of the sensors, as given
-    stacked = {group: {k: np.stack(v) for k, v in sorted(arrays.items(), key=lambda kv: rank[kv[0].split("/")[0]])}
-               for group, arrays in logs.items()}
+            for frame in batch:
+                for name, readings in frame.items():
+                    per_sensor[name].append(readings)
+    logs: dict[str, dict[str, list]] = {"images": {}, "depths": {}, "scans": {}}
+    for readings in (r for name in sensors for r in per_sensor[name]):      # keys in the sensors' order
+        for group, key, array in readings:
+            logs[group].setdefault(key, []).append(array)
+    stacked = {group: {k: np.stack(v) for k, v in arrays.items()} for group, arrays in logs.items()}
     run = Run(t, poses, odometry, stacked["images"], stacked["depths"], stacked["scans"], meta)
     if target is not None:
         write_atomically(target, run.save)   # notebooks running in parallel never read a half-written file
