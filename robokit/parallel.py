@@ -11,6 +11,9 @@ run's module); a spawned worker pays it every time. The object every run needs (
 sent to each worker once, not with every run, together with the caller's ``ROBOKIT_*`` settings.
 With one worker, or fewer runs than :data:`MIN_RUNS`, the runs are made here, one after the other,
 exactly as a plain loop would; the results are the same either way (the tests compare them).
+:func:`iter_runs` gives the same results one by one as they come, for a caller that works on the
+first ones while the workers make the next (lesson 02 builds its map from a tour's images as they are
+rendered).
 
 ``ROBOKIT_WORKERS`` sets the number of workers (default: the CPUs this process may use). A plain
 script that makes runs in workers needs the ``if __name__ == "__main__":`` guard, as every use of
@@ -23,7 +26,7 @@ import os
 import pickle
 import sys
 import traceback
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Iterator, Sequence
 
 import cv2
 
@@ -31,7 +34,7 @@ from .config import worker_count
 from .progress import progress_bar
 from .validation import check_callable, check_int
 
-__all__ = ["MIN_RUNS", "worker_count", "map_runs"]   # worker_count lives in config (the course build reads it too)
+__all__ = ["MIN_RUNS", "worker_count", "map_runs", "iter_runs"]   # worker_count lives in config (the course build reads it too)
 
 #: Fewer runs than this are made in this process: starting workers (each imports robokit, numpy
 #: and OpenCV) costs more than a few runs save.
@@ -167,6 +170,46 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
     >>> map_runs(divmod, 7, [1, 2, 3], workers=1)
     [(7, 0), (3, 1), (2, 1)]
     """
+    return list(iter_runs(run, shared, tasks, workers=workers, desc=desc, unit=unit, progress=progress))
+
+
+def iter_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None = None, desc: str = "runs",
+              unit: str = "run", progress: Callable | None = None) -> Iterator:
+    """The results of :func:`map_runs`, one by one in the order of ``tasks``, as the workers make them.
+
+    A caller that consumes the results while the workers make the next ones (a map builder taking
+    the frames of a recording as they are rendered) overlaps its own work with theirs.
+
+    Parameters
+    ----------
+    run, shared, tasks, workers, desc, unit, progress
+        As for :func:`map_runs`.
+
+    Returns
+    -------
+    iterator
+        ``run(shared, task)`` for each task, in order. The workers start at the first result asked
+        for and stop when the last is taken, when the iterator is closed or dropped, or at the
+        first error; results not yet taken wait in this process (the workers do not wait for the
+        caller).
+
+    Raises
+    ------
+    TypeError, ValueError
+        Bad arguments, at once (as :func:`map_runs`); errors of the runs, when their result is
+        reached.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Independent runs"); not from a paper.
+
+    Examples
+    --------
+    >>> from robokit.parallel import iter_runs
+    >>> results = iter_runs(divmod, 7, [1, 2, 3], workers=1)
+    >>> next(results), list(results)
+    ((7, 0), [(3, 1), (2, 1)])
+    """
     run = check_callable(run, "run", optional=False)
     progress = check_callable(progress, "progress")
     if isinstance(tasks, (str, bytes)) or not hasattr(tasks, "__iter__"):
@@ -174,29 +217,39 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
     tasks = list(tasks)
     workers = worker_count() if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
     workers = min(workers, len(tasks))
-    results: list = []
+    if workers <= 1 or len(tasks) < MIN_RUNS:
+        return _in_place(run, shared, tasks, desc, unit, progress)
+    _check_importable(run)
+    settings = {k: v for k, v in os.environ.items() if k.startswith("ROBOKIT_")}
+    # sent as bytes: a worker that cannot rebuild them reports it as the runs' error
+    blobs = {"run": _pickled(run, "run"), "shared": _pickled(shared, "shared")}
+    jobs = [_pickled(task, "tasks") for task in tasks]
+    return _in_workers(run, blobs, settings, jobs, workers, desc, unit, progress)
+
+
+def _in_place(run: Callable, shared: Any, tasks: list, desc: str, unit: str, progress: Callable | None) -> Iterator:
+    """The runs made here, one after the other, exactly as a plain loop would."""
     with progress_bar(len(tasks), desc, unit=unit, callback=progress) as bar:
-        if workers <= 1 or len(tasks) < MIN_RUNS:
-            for task in tasks:
-                results.append(run(shared, task))
-                bar.update()
-            return results
-        _check_importable(run)
-        settings = {k: v for k, v in os.environ.items() if k.startswith("ROBOKIT_")}
-        # sent as bytes: a worker that cannot rebuild them reports it as the runs' error
-        blobs = {"run": _pickled(run, "run"), "shared": _pickled(shared, "shared")}
-        jobs = [_pickled(task, "tasks") for task in tasks]
-        threads = max(1, worker_count() // workers)     # this process's share of the cores, per worker
+        for task in tasks:
+            result = run(shared, task)
+            bar.update()
+            yield result
+
+
+def _in_workers(run: Callable, blobs: dict, settings: dict, jobs: list, workers: int, desc: str, unit: str,
+                progress: Callable | None) -> Iterator:
+    """The runs made by a pool of ``workers`` processes, results rebuilt here in order."""
+    threads = max(1, worker_count() // workers)     # this process's share of the cores, per worker
+    with progress_bar(len(jobs), desc, unit=unit, callback=progress) as bar:
         pool = _context(run).Pool(workers, initializer=_receive, initargs=(blobs, settings, threads))
         try:
-            for result in pool.imap(_run_shared, jobs):   # in order
+            for blob in pool.imap(_run_shared, jobs):     # in order
                 try:
-                    results.append(pickle.loads(result))
+                    result = pickle.loads(blob)
                 except Exception as exc:                  # noqa: BLE001 - named, then the workers stop
                     raise TypeError(f"run: its result could not be rebuilt here ({type(exc).__name__}: "
                                     f"{exc})") from exc
                 bar.update()
+                yield result
         finally:
-            pool.terminate()       # at the end, and at once on an error or an interrupt
-            pool.join()
-    return results
+            pool.terminate()       # at the end, and at once on an error, an interrupt or a closed iterator

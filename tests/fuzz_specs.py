@@ -681,6 +681,10 @@ SPECS: dict[str, Call] = {
                                      "sensors": Mapping(_sensors), "rate": Real(1.0, optional=True),
                                      "odometry_alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"), "seed": Int(0),
                                      "cache": Flag(False)}, cheap=False),
+    "robokit.sim.runs.record_stream": Call({
+        "world": Obj(lab), "path": Obj(lambda: lap()._replace(t=lap().t[:3], poses=lap().poses[:3])),
+        "camera": Obj(small_omni), "rate": Real(1.0, optional=True),
+        "odometry_alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"), "seed": Int(0)}, cheap=False),
     "robokit.sim.textures.illuminate": Call({"image": Array(image, "N,N|N,N,3"), "gain": Real(0.5), "offset": Real(0.0),
                                              "gradient": Array(np.array([0.4, 0.0]), "2")}),
     "robokit.sim.textures.photo": Call({"name": Choice("grace_hopper")}),
@@ -1522,6 +1526,7 @@ NOT_FUZZED: dict[str, str] = {
 #: the functions the issue's fuzz named.
 EXTRA: tuple[str, ...] = (
     "robokit.sim.vehicle.unicycle_step",
+    "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view
     # lesson 02 (path following, pose EKF, navigation), fuzzed before the lesson exists
     *(f"robokit.controllers.path_geometry.{n}" for n in ("VisualPath", "path_from_poses", "reference_point")),

@@ -207,6 +207,32 @@ def test_build_refuses_empty_runs_wrong_sizes_and_bad_odometry():
         build_topological_map(run.images["omni"][:2], run.odometry[:2], "omni")
 
 
+def test_a_map_built_from_images_as_they_arrive_is_the_map_of_the_array():
+    import dataclasses
+    run = short_run()
+    images, odometry = run.images["omni"][:24], run.odometry[:24]
+    whole = build_topological_map(images, odometry, camera(), loop_exclude=2)
+    arriving = build_topological_map(iter(list(images)), odometry, camera(), loop_exclude=2)
+    assert len(whole) >= 2
+    for field in dataclasses.fields(whole):
+        a, b = getattr(whole, field.name), getattr(arriving, field.name)
+        if isinstance(a, np.ndarray):
+            assert np.array_equal(a, b), field.name
+
+
+def test_images_that_arrive_must_be_one_per_pose_and_the_camera_s_size():
+    run = short_run()
+    images, odometry = list(run.images["omni"][:3]), run.odometry[:3]
+    with pytest.raises(ValueError, match="images: expected 3 images .* ended after 2"):
+        build_topological_map(iter(images[:2]), odometry, camera())
+    with pytest.raises(ValueError, match="images: expected 3 images .* has more"):
+        build_topological_map(iter(images + images[:1]), odometry, camera())
+    with pytest.raises(ImageSizeError, match=r"images\[1\]"):
+        build_topological_map(iter([images[0], images[1][:240], images[2]]), odometry, camera())
+    with pytest.raises(EmptyMapError, match="odometry"):
+        build_topological_map(iter([]), np.zeros((0, 3)), camera())
+
+
 def test_frames_similar_in_colour_skip_sift_and_the_feature_count():
     """A transient blocker's features never fill the local map (they only count while it looks alike)."""
     calls = []

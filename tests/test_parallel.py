@@ -5,7 +5,7 @@ import time
 import numpy as np
 import pytest
 
-from robokit.parallel import MIN_RUNS, map_runs, worker_count
+from robokit.parallel import MIN_RUNS, iter_runs, map_runs, worker_count
 
 
 def test_worker_count_reads_the_environment():
@@ -23,6 +23,26 @@ def test_runs_in_workers_come_back_in_order_and_equal_the_loop():
     assert map_runs(divmod, 100, tasks, workers=1) == loop
     assert map_runs(divmod, 100, tasks, workers=2, progress=lambda k, n: done.append((k, n))) == loop
     assert done[-1] == (len(tasks), len(tasks))
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_results_one_by_one_come_in_order_and_errors_when_reached(workers):
+    tasks = [5, 4, 3, 2, 1, 0, 7]
+    results = iter_runs(divmod, 100, tasks, workers=workers)
+    assert [next(results) for _ in range(5)] == [divmod(100, t) for t in tasks[:5]]   # before the bad run
+    with pytest.raises(ZeroDivisionError):
+        next(results)
+    with pytest.raises(TypeError, match="tasks"):                 # bad arguments: at once, not when iterated
+        iter_runs(divmod, 100, 7, workers=workers)
+
+
+def test_closing_the_results_early_stops_the_workers(tmp_path):
+    tasks = [(f"run{k}", 0.2, False) for k in range(40)]           # 4 s of runs on two workers
+    results = iter_runs(_slow_fail, tmp_path, tasks, workers=2)
+    assert next(results) == "run0"
+    results.close()
+    time.sleep(2.0)                                # workers left running would have made most runs
+    assert len(list(tmp_path.iterdir())) < 20
 
 
 def _slow_fail(folder, task):

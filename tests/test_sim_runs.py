@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from robokit.sim import (Lidar, OmniCamera, PinholeCamera, Run, StereoRig, box_room, lab_lap, lab_room, record,
-                         waypoint_path)
+                         record_stream, waypoint_path)
 
 
 @pytest.fixture()
@@ -103,6 +103,37 @@ def test_a_corrupt_or_stale_cache_file_is_rebuilt_not_loaded(cache):
     stale.save(target)
     assert np.array_equal(record(world, path, small_sensors(), seed=1).odometry, fresh.odometry)
     assert fresh.meta["code"]["numpy"] == np.__version__
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_a_stream_is_the_recording_without_storing_it(cache, monkeypatch, workers):
+    monkeypatch.setenv("ROBOKIT_WORKERS", workers)
+    world = box_room()
+    path = waypoint_path([[1.0, 1.0], [4.5, 1.0], [4.5, 3.0]], speed=0.5, rate=2)
+    cam = PinholeCamera.from_fov(width=48, height=36)
+    run = record(world, path, {"cam": cam}, rate=5.0, seed=6, cache=False)
+    stream = record_stream(world, path, cam, rate=5.0, seed=6)
+    assert len(stream) == len(run) >= 2 * 16                     # several batches of frames
+    for name in ("t", "poses", "odometry"):
+        assert np.array_equal(getattr(stream, name), getattr(run, name)), name
+    images = list(stream.frames)
+    assert len(images) == len(run) and np.array_equal(np.stack(images), run.images["cam"])
+    assert list(stream.frames) == []                              # made once
+    assert not (cache / "runs").exists() or not list((cache / "runs").glob("*.npz"))     # nothing stored
+
+
+def test_a_stream_takes_one_robokit_camera():
+    world, path = box_room(), [[1.0, 1.0, 0.0], [1.5, 1.0, 0.0]]
+    cam = PinholeCamera.from_fov(width=48, height=36)
+    for bad in (StereoRig(cam, 0.1), Lidar(beams=8), NoisyCamera.from_fov(width=24, height=18), "cam"):
+        with pytest.raises(TypeError, match="camera"):
+            record_stream(world, path, bad, rate=1.0)
+    with pytest.raises(TypeError, match="world"):
+        record_stream("box_room", path, cam, rate=1.0)
+    with pytest.raises(ValueError, match="path"):
+        record_stream(world, [[-5.0, 1.0, 0.0], [1.0, 1.0, 0.0]], cam, rate=1.0)
+    with pytest.raises(ValueError, match="seed"):
+        record_stream(world, path, cam, rate=1.0, seed=-1)
 
 
 def test_record_omni_and_lab_lap(cache):

@@ -33,7 +33,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
@@ -248,8 +248,10 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
 
     Parameters
     ----------
-    images : array_like, shape (N, H, W, 3)
-        The run's omni images (``run.images["omni"]`` of :func:`robokit.sim.record`).
+    images : array_like, shape (N, H, W, 3), or iterator of N images
+        The run's omni images: ``run.images["omni"]`` of :func:`robokit.sim.record`, or
+        ``stream.frames`` of :func:`robokit.sim.record_stream`, whose images are used as they are
+        rendered (the map is built while the workers render the next ones).
     odometry : array_like, shape (N, 3)
         Odometry poses ``[x, y, theta]`` of the same frames (they become the nodes' poses).
     camera : OmniCamera
@@ -312,14 +314,20 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     >>> len(tmap), tmap.n_edges, tmap.frames.tolist()
     (1, 0, [0])
     """
-    raw = as_array(images, "images", dtype=None)
-    if raw.ndim != 4 or len(raw) == 0:
-        if raw.ndim == 4 or raw.size == 0:
-            raise EmptyMapError(f"images: expected at least one image to build a map from, got shape {raw.shape}")
-        raise ValueError(f"images: expected shape (N, H, W, 3), got shape {raw.shape}")
-    n = len(raw)
+    if isinstance(images, Iterator):             # taken as they arrive (e.g. rendered by workers)
+        odo = as_array(odometry, "odometry", shape=(None, 3))
+        if len(odo) == 0:
+            raise EmptyMapError("odometry: expected at least one pose to build a map from, got none")
+        raw: Any = _Arrivals(images, len(odo), camera)
+    else:
+        raw = as_array(images, "images", dtype=None)
+        if raw.ndim != 4 or len(raw) == 0:
+            if raw.ndim == 4 or raw.size == 0:
+                raise EmptyMapError(f"images: expected at least one image to build a map from, got shape {raw.shape}")
+            raise ValueError(f"images: expected shape (N, H, W, 3), got shape {raw.shape}")
+        odo = as_array(odometry, "odometry", shape=(len(raw), 3))
+    n = len(odo)
     check_omni_image(raw[0], camera, "images[0]")
-    odo = as_array(odometry, "odometry", shape=(n, 3))
     sigma = as_array(sigma_visual, "sigma_visual", shape=(3,))
     if np.any(sigma <= 0):
         raise ValueError(f"sigma_visual: expected three positive standard deviations, got {sigma.tolist()}")
@@ -363,6 +371,8 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
                                           occlusion_frames=occlusion_frames, max_features=max_features,
                                           max_variance=max_variance)
     key_views = [view(k) for k in keys]
+    if isinstance(raw, _Arrivals):
+        raw.check_ended()
     edge_cov = [odometry_covariance(odo[a:b + 1], alphas)[-1] + _COVARIANCE_FLOOR for a, b in zip(keys[:-1], keys[1:])]
     variances = np.concatenate([[0.0], np.cumsum(position_variance(np.reshape(edge_cov, (-1, 3, 3))))])
     counts = np.array([len(v) for v in key_views])
@@ -392,6 +402,31 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     return tmap.with_edges(np.vstack([tmap.edges, e]), np.vstack([tmap.measurements, meas]),
                            np.concatenate([tmap.covariances, cov]),
                            np.concatenate([tmap.kinds, np.full(len(e), LOOP_EDGE)]))
+
+
+_END = object()     # what an exhausted iterator gives
+
+
+class _Arrivals:
+    """The images of an iterator as a sequence: each taken (and checked) when first asked for, then kept."""
+
+    def __init__(self, images: Iterator, n: int, camera: OmniCamera):
+        self._images, self._n, self._camera, self._taken = images, n, camera, []
+
+    def __getitem__(self, k: int) -> np.ndarray:
+        while len(self._taken) <= k:
+            got = len(self._taken)
+            image = next(self._images, _END)
+            if image is _END:
+                raise ValueError(f"images: expected {self._n} images (one per odometry pose), the iterator "
+                                 f"ended after {got}")
+            self._taken.append(check_omni_image(image, self._camera, f"images[{got}]"))
+        return self._taken[k]
+
+    def check_ended(self) -> None:
+        """Every image was taken: the iterator must have no more."""
+        if next(self._images, _END) is not _END:
+            raise ValueError(f"images: expected {self._n} images (one per odometry pose), the iterator has more")
 
 
 def _stack(arrays: list, width: int) -> np.ndarray:

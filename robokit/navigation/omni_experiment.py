@@ -4,8 +4,9 @@ The paper's experiments (Sec. "Experimental results") re-run on :func:`robokit.s
 
 1. :func:`office_setup` drives the exploration tour (Fig. 6a) with an omni camera and noisy
    odometry, builds the topological map from the recording, and aligns it twice: by relaxation
-   (Eqs. (1)-(3)) and by least squares. The recording and the map are cached (keyed by their
-   parameters and the code that makes them).
+   (Eqs. (1)-(3)) and by least squares. The map is cached (keyed by its parameters and the code
+   that makes it); the recording is not stored: the map is built from its images as they are
+   rendered.
 2. :func:`localization_trials` localizes omni images taken at test places (Figs. 8, 9 and 11) with
    the coarse stage only, the fine stage only and the hierarchy, timing each stage.
 3. :func:`route_recognition` asks which node the robot is at, at key nodes along the route (Fig. 12).
@@ -39,7 +40,7 @@ from ..localization.hierarchical import HierarchicalLocalizer
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
                        optimize_pose_graph, relax)
 from ..progress import progress_bar
-from ..sim import OmniCamera, describe_sensor, office_floor, office_tour, record
+from ..sim import OmniCamera, describe_sensor, office_floor, office_tour, record_stream
 from ..sim.world import World
 from ..validation import as_points, as_rng, check_callable, check_choice, check_int, check_positive
 
@@ -141,7 +142,8 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     Sec. "Experimental results" (Fig. 6a: the tour; Fig. 8: the map) and Sec. "Environment map"
     (key images, local-map partitioning, loop closure, Eqs. (1)-(3)). The paper records 640 x 480
     colour images; fast mode uses 320 x 240. The tour's frames are rendered in worker processes
-    (:func:`robokit.sim.record`): a plain script needs the ``if __name__ == "__main__":`` guard.
+    while the map is built from them (:func:`robokit.sim.record_stream`): a plain script needs the
+    ``if __name__ == "__main__":`` guard.
 
     Examples
     --------
@@ -164,9 +166,10 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
             "code": code_version("sim", "geometry", "vision", "mapping")}
 
     def build():
-        # the map is cached (below), so the recording itself is not: it would only be written, never read
-        run = record(world, tour, {"omni": camera}, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2, cache=False)
-        tmap = build_topological_map(run.images["omni"], run.odometry, camera, n_features=params["n_features"],
+        # the map is cached (below), so the recording is not stored at all: its images are used as the
+        # workers render them, the map being built meanwhile
+        run = record_stream(world, tour, camera, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
+        tmap = build_topological_map(run.frames, run.odometry, camera, n_features=params["n_features"],
                                      odometry_alphas=TOUR_ALPHAS, progress=progress)
         return tmap, run.poses[tmap.frames], len(run)
 

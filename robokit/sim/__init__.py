@@ -45,7 +45,9 @@ LiDAR, vehicles and motion
 Recorded runs
     ``record(world, path, sensors={"cam": cam, "laser": lidar}, rate=5)`` -> :class:`Run`
     (``t``, ``poses``, ``odometry``, ``images``, ``depths``, ``scans``), cached as ``.npz``; every
-    sensor is driven through ``observe(world, robot_pose, rng=...)``.
+    sensor is driven through ``observe(world, robot_pose, rng=...)``; ``record_stream(world, path,
+    camera, rate)`` -> :class:`FrameStream`, the same drive with one camera whose images arrive
+    as worker processes render them.
 
 Checks
     ``sift_view_pair(world, camera, robot_pose)``: OpenCV SIFT between two views, matches judged
@@ -69,7 +71,7 @@ from .lidar import Lidar, scan_points
 from .motion import (OFFICE_TEST_POSES, Path, corridor_path, increment_variances, lab_lap, noisy_odometry,
                      odometry_covariance, odometry_increment, office_tour, sample_motion_model_odometry, waypoint_path)
 from .omni import OmniCamera, omni_mount
-from .runs import Run, describe_sensor, record
+from .runs import FrameStream, Run, describe_sensor, record, record_stream
 from .textures import illuminate, photo
 from .vehicle import diff_drive_velocities, skid_steer_velocities, skid_steer_wheel_speeds, unicycle_step
 from .world import FreeSpace, Surface, World
@@ -85,6 +87,6 @@ __all__ = [
     "odometry_increment",
     "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap", "office_tour",
     "OFFICE_TEST_POSES", "increment_variances", "odometry_covariance",
-    "Run", "record", "describe_sensor", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair", "omni_ground_truth_inliers",
+    "Run", "record", "record_stream", "FrameStream", "describe_sensor", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair", "omni_ground_truth_inliers",
     "omni_view_pair",
 ]

@@ -94,8 +94,10 @@ def finish_image(image: np.ndarray, noise: float, rng: Any, lighting: dict | Non
         image = illuminate(image, **lighting)
     sigma = check_positive(noise, "noise", allow_zero=True)
     if sigma > 0:
-        gen = as_rng(rng)
-        image = np.clip(image + gen.normal(0.0, sigma, image.shape), 0, 255).astype(np.uint8)
+        noisy = as_rng(rng).standard_normal(image.shape)   # the draws of normal(0, sigma), made in place
+        noisy *= sigma
+        noisy += image
+        image = np.clip(noisy, 0, 255, out=noisy).astype(np.uint8)
     return image
 
 

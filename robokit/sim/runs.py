@@ -21,12 +21,12 @@ import dataclasses
 import hashlib
 import json
 from pathlib import Path as FsPath
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
 from ..config import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, save_npz, write_atomically
-from ..parallel import map_runs
+from ..parallel import iter_runs, map_runs
 from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
 from .camera import PinholeCamera, StereoRig
@@ -34,7 +34,7 @@ from .motion import Path, noisy_odometry
 from .omni import OmniCamera
 from .world import World
 
-__all__ = ["Run", "record", "describe_sensor"]
+__all__ = ["Run", "record", "describe_sensor", "FrameStream", "record_stream"]
 
 _FORMAT = 1
 
@@ -232,6 +232,19 @@ def _timed_poses(path: Any, rate: float | None) -> tuple[np.ndarray, np.ndarray]
                                np.angle(np.exp(1j * np.interp(t, t0, unwrapped)))])
 
 
+def _drive(world: World, path: Any, rate: float | None, odometry_alphas: Any, seed: Any
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """The validated timestamps, poses, odometry noise and seed of a recording (see :func:`record`)."""
+    if not isinstance(world, World):
+        raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
+    t, poses = _timed_poses(path, rate)
+    bad = ~world.is_free(poses[:, :2], clearance=0.05)
+    if bad.any():
+        raise ValueError(f"path: expected poses inside the free space of {world.name!r}, got {bad.sum()} outside "
+                         f"(first at {poses[np.argmax(bad), :2].round(3).tolist()})")
+    return t, poses, as_array(odometry_alphas, "odometry_alphas", shape=(4,)), check_int(seed, "seed", minimum=0)
+
+
 def record(world: World, path: Path, sensors: dict, rate: float | None = None, *,
            odometry_alphas: Any = (0.01, 0.001, 0.01, 0.001), seed: int = 0, cache: bool = True) -> Run:
     """Drive ``path`` through ``world`` and record every sensor at ``rate``.
@@ -285,8 +298,6 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     >>> len(run), run.scans["laser"].shape
     (4, (4, 8))
     """
-    if not isinstance(world, World):
-        raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
     if not isinstance(sensors, dict) or not sensors:
         raise ValueError(f"sensors: expected a non-empty dict name -> sensor, got {sensors!r}")
     for name, s in sensors.items():
@@ -294,13 +305,7 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
                 or "/" in name or ":" in name:
             raise TypeError(f"sensors: expected camera/LiDAR objects under plain string names, got {name!r}: "
                             f"{type(s).__name__}")
-    t, poses = _timed_poses(path, rate)
-    bad = ~world.is_free(poses[:, :2], clearance=0.05)
-    if bad.any():
-        raise ValueError(f"path: expected poses inside the free space of {world.name!r}, got {bad.sum()} outside "
-                         f"(first at {poses[np.argmax(bad), :2].round(3).tolist()})")
-    alphas = as_array(odometry_alphas, "odometry_alphas", shape=(4,))
-    seed = check_int(seed, "seed", minimum=0)
+    t, poses, alphas, seed = _drive(world, path, rate, odometry_alphas, seed)
     digest = hashlib.sha256(np.ascontiguousarray(poses).tobytes() + t.tobytes()).hexdigest()[:16]
     geometry = hashlib.sha256(np.round(world.corner_array, 9).tobytes()).hexdigest()[:16]
     meta = {"world": world.name, "world_info": json.loads(json.dumps(world.info, default=str)), "geometry": geometry,
@@ -340,3 +345,97 @@ def record(world: World, path: Path, sensors: dict, rate: float | None = None, *
     if target is not None:
         write_atomically(target, run.save)   # notebooks running in parallel never read a half-written file
     return run
+
+
+@dataclasses.dataclass
+class FrameStream:
+    """A drive whose camera images come one by one, as worker processes render them (:func:`record_stream`).
+
+    Attributes
+    ----------
+    t, poses, odometry : numpy.ndarray
+        As in :class:`Run`, all known at once.
+    frames : iterator of numpy.ndarray (H, W, 3) uint8
+        The camera's images in the order of ``poses``, each rendered once: iterate once. Closing it
+        (or dropping it) stops the rendering.
+    meta : dict
+        Recording parameters, as in :class:`Run`.
+    """
+
+    t: np.ndarray
+    poses: np.ndarray
+    odometry: np.ndarray
+    frames: Iterator
+    meta: dict
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+
+def _camera_images(shared: tuple, poses: np.ndarray) -> list:
+    """The camera's image at each pose (no depth): one worker task of :func:`record_stream`."""
+    world, camera = shared
+    return [camera.observe(world, pose).image for pose in poses]
+
+
+def _images(batches: Iterator) -> Iterator:
+    try:
+        for batch in batches:
+            yield from batch
+    finally:
+        batches.close()         # the workers stop when the caller stops taking images
+
+
+def record_stream(world: World, path: Path, camera: Any, rate: float | None = None, *,
+                  odometry_alphas: Any = (0.01, 0.001, 0.01, 0.001), seed: int = 0) -> FrameStream:
+    """Drive ``path`` through ``world`` with one camera whose images arrive as they are rendered.
+
+    The same drive as :func:`record` with the same arguments and ``sensors={name: camera}`` (the
+    same timestamps, poses, odometry and images), but nothing is stored: a consumer that takes the
+    images one by one (:func:`robokit.mapping.build_topological_map`) works on the first ones while
+    worker processes render the next, and no depth images are made.
+
+    Parameters
+    ----------
+    world : World
+    path : Path, (t, poses) tuple or array_like (N, 3)
+    camera : PinholeCamera or OmniCamera
+        A robokit camera (its frames draw no noise, so the workers can render them in any order).
+    rate : float, optional
+    odometry_alphas : array_like (4,)
+    seed : int, default 0
+        Seeds the odometry noise, as in :func:`record`.
+
+    Returns
+    -------
+    FrameStream
+
+    Raises
+    ------
+    TypeError, ValueError
+        For another kind of camera (a stereo rig, a LiDAR, a subclass of the caller's), a bad path
+        or rate, or a path leaving the world's free space.
+
+    Notes
+    -----
+    As :func:`record` (Thrun et al. 2005, Table 5.6 odometry noise); the images are made by
+    :func:`robokit.parallel.iter_runs` in batches, so a plain script needs the
+    ``if __name__ == "__main__":`` guard.
+
+    Examples
+    --------
+    >>> from robokit.sim import OmniCamera, office_floor
+    >>> poses = [[14.0, 4.0, np.pi], [13.8, 4.0, np.pi]]
+    >>> stream = record_stream(office_floor(), poses, OmniCamera(width=80, height=60), rate=1.0)
+    >>> len(stream), [image.shape for image in stream.frames]
+    (2, [(60, 80, 3), (60, 80, 3)])
+    """
+    if type(camera) not in (PinholeCamera, OmniCamera):
+        raise TypeError(f"camera: expected a robokit PinholeCamera or OmniCamera, got {type(camera).__name__}")
+    t, poses, alphas, seed = _drive(world, path, rate, odometry_alphas, seed)
+    odometry = noisy_odometry(poses, alphas, as_rng(seed))
+    meta = {"world": world.name, "rate": rate, "camera": describe_sensor(camera), "odometry_alphas": alphas.tolist(),
+            "seed": seed}
+    tasks = [poses[k:k + _FRAMES_PER_TASK] for k in range(0, len(poses), _FRAMES_PER_TASK)]
+    batches = iter_runs(_camera_images, (world, camera), tasks, desc=f"rendering in {world.name}", unit="batch")
+    return FrameStream(t, poses, odometry, _images(batches), meta)
