@@ -24,6 +24,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 import pickle
+import signal
 import sys
 import traceback
 from typing import Any, Callable, Iterator, Sequence
@@ -44,6 +45,9 @@ _SHARED: dict = {}    # in a worker: the run and the object every run needs, sen
 
 
 def _receive(blobs: dict, settings: dict, threads: int) -> None:
+    # an interrupt is the caller's to handle (it stops the workers): a worker that died of it would
+    # be replaced and its run lost, and a caller still taking results would wait for it forever
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     os.environ.update(settings)            # the caller's ROBOKIT_* settings, not the fork server's
     os.environ["ROBOKIT_WORKERS"] = "1"     # a run that makes runs of its own makes them in place
     cv2.setNumThreads(threads)             # the workers already fill the cores: no OpenCV threads on top
@@ -189,9 +193,10 @@ def iter_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | Non
     -------
     iterator
         ``run(shared, task)`` for each task, in order. The workers start at the first result asked
-        for and stop when the last is taken, when the iterator is closed or dropped, or at the
-        first error; results not yet taken wait in this process (the workers do not wait for the
-        caller).
+        for and stop once the iterator is asked past its last result (as a ``for`` loop does), at
+        the first error, or when it is closed (``close()``, or ``with contextlib.closing(...)``);
+        an iterator left unfinished keeps its workers until it is freed, so close it. Results not
+        yet taken wait in this process (the workers do not wait for the caller).
 
     Raises
     ------

@@ -12,7 +12,7 @@ from robokit.mapping import (LOOP_EDGE, ODOMETRY_EDGE, Comparison, EmptyMapError
                              optimize_pose_graph, relax, select_key_frames)
 from robokit.sim import odometry_covariance
 from robokit.vision import ImageSizeError, histogram_distance, ratio_match
-from tests.office_runs import camera, room_of, short_map, short_map_and_log, short_run
+from tests.office_runs import camera, office, room_of, short_map, short_map_and_log, short_run
 
 
 # --- the criteria, one by one --------------------------------------------------------------------
@@ -231,6 +231,24 @@ def test_images_that_arrive_must_be_one_per_pose_and_the_camera_s_size():
         build_topological_map(iter([images[0], images[1][:240], images[2]]), odometry, camera())
     with pytest.raises(EmptyMapError, match="odometry"):
         build_topological_map(iter([]), np.zeros((0, 3)), camera())
+
+
+def test_every_argument_is_checked_before_an_image_is_taken():
+    def never():
+        raise AssertionError("an image was taken")
+        yield
+    odometry = short_run().odometry[:3]
+    for change, error, match in [({"camera": "omni"}, TypeError, "camera"), ({"index": "octree"}, ValueError, "index"),
+                                 ({"sigma_visual": (0.1, 0.0, 0.1)}, ValueError, "sigma_visual"),
+                                 ({"loop_top_k": 0}, ValueError, "loop_top_k"), ({"bins": 0}, ValueError, "bins"),
+                                 ({"similarity": -1.0}, ValueError, "similarity"),
+                                 ({"odometry": [[0.0, 0.0]]}, ValueError, "odometry")]:
+        args = {"images": never(), "odometry": odometry, "camera": camera(), **change}
+        with pytest.raises(error, match=match):
+            build_topological_map(**args)
+    from robokit.sim import record_stream
+    with pytest.raises(TypeError, match=r"\.frames"):
+        build_topological_map(record_stream(office(), short_run().poses[:2], camera()), odometry[:2], camera())
 
 
 def test_frames_similar_in_colour_skip_sift_and_the_feature_count():

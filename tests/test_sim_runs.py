@@ -116,9 +116,13 @@ def test_a_stream_is_the_recording_without_storing_it(cache, monkeypatch, worker
     assert len(stream) == len(run) >= 2 * 16                     # several batches of frames
     for name in ("t", "poses", "odometry"):
         assert np.array_equal(getattr(stream, name), getattr(run, name)), name
-    images = list(stream.frames)
+    with stream:
+        images = list(stream.frames)
     assert len(images) == len(run) and np.array_equal(np.stack(images), run.images["cam"])
     assert list(stream.frames) == []                              # made once
+    with record_stream(world, path, cam, rate=5.0, seed=6) as again:  # left early: the rendering stops
+        assert np.array_equal(next(again.frames), images[0])
+    assert list(again.frames) == []
     assert not (cache / "runs").exists() or not list((cache / "runs").glob("*.npz"))     # nothing stored
 
 

@@ -37,6 +37,19 @@ def test_hsi_of_hand_computed_pixels():
     assert np.allclose(rgb_to_hsi([[0.2, 0.4, 0.8, 0.1]]), hsi[7])
 
 
+def test_saturation_and_intensity_are_the_reductions_of_eq_4_bit_for_bit():
+    # Eq. (4)'s max - min and mean over the colour axis, written as reductions: the elementwise
+    # form rgb_to_hsi uses must give the very same float32 numbers (lesson 02's maps depend on them)
+    rng = np.random.default_rng(7)
+    for rgb in (rng.integers(0, 256, (60, 80, 3)).astype(np.uint8), rng.uniform(0, 1, (500, 3)).astype(np.float32),
+                rng.integers(0, 65536, (40, 3)).astype(np.uint16), np.linspace(0, 1, 3 * 999).reshape(-1, 3)):
+        scale = np.float32(np.iinfo(rgb.dtype).max) if rgb.dtype.kind == "u" else np.float32(1)
+        x = rgb.astype(np.float32) / scale
+        hsi = rgb_to_hsi(rgb)
+        assert np.array_equal(hsi[..., 1], x.max(axis=-1) - x.min(axis=-1))
+        assert np.array_equal(hsi[..., 2], x.mean(axis=-1))
+
+
 def test_hsi_hue_agrees_with_opencv_hsv_within_the_hexcone_difference():
     rng = np.random.default_rng(0)
     rgb = rng.uniform(0, 1, (100000, 3)).astype(np.float32)

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import intersect_lines, se2_between, se2_compose, wrap_angle
-from ..mapping.omni_views import OmniView, RelativePose, omni_view, relative_pose
+from ..mapping.omni_views import OmniView, RelativePose, check_omni_camera, omni_view, relative_pose
 from ..mapping.topological import EmptyMapError, TopologicalMap
 from ..sim.omni import OmniCamera
 from ..validation import check_choice, check_int, check_positive, describe
@@ -166,9 +166,7 @@ class HierarchicalLocalizer:
             raise TypeError(f"map: expected a robokit.mapping.TopologicalMap, got {describe(map)}")
         if len(map) == 0:
             raise EmptyMapError("map: expected a map with at least one node, got none")
-        if not isinstance(camera, OmniCamera):
-            raise TypeError(f"camera: expected a robokit.sim.OmniCamera, got {describe(camera)}")
-        self.map, self.camera = map, camera
+        self.map, self.camera = map, check_omni_camera(camera)
         self.top_k = check_int(top_k, "top_k", minimum=1)
         self.ratio = check_positive(ratio, "ratio")
         if self.ratio > 1:

@@ -45,7 +45,26 @@ from ..vision.omni_features import ImageSizeError, omni_sift
 from ..vision.ransac import ransac_se2
 from ..vision.spherical import decompose_essential, floor_points, ransac_essential
 
-__all__ = ["HISTOGRAM_STEP", "OmniView", "omni_view", "check_omni_image", "RelativePose", "relative_pose"]
+__all__ = ["HISTOGRAM_STEP", "OmniView", "omni_view", "check_omni_camera", "check_omni_image", "RelativePose", "relative_pose"]
+
+
+def check_omni_camera(camera: Any) -> OmniCamera:
+    """``camera`` if it is an :class:`~robokit.sim.OmniCamera`, else a TypeError naming it.
+
+    Notes
+    -----
+    Validation only (DESIGN.md, "Errors").
+
+    Examples
+    --------
+    >>> check_omni_camera("omni")
+    Traceback (most recent call last):
+    ...
+    TypeError: camera: expected a robokit.sim.OmniCamera, got 'omni'
+    """
+    if not isinstance(camera, OmniCamera):
+        raise TypeError(f"camera: expected a robokit.sim.OmniCamera, got {describe(camera)}")
+    return camera
 
 
 def check_omni_image(image: Any, camera: OmniCamera, name: str = "image") -> np.ndarray:
@@ -72,8 +91,7 @@ def check_omni_image(image: Any, camera: OmniCamera, name: str = "image") -> np.
     (48, 64, 3)
     """
     name = check_text(name, "name", empty=False)
-    if not isinstance(camera, OmniCamera):
-        raise TypeError(f"camera: expected a robokit.sim.OmniCamera, got {describe(camera)}")
+    check_omni_camera(camera)
     img = as_array(image, name, dtype=None)
     want = (camera.height, camera.width, 3)
     if img.shape != want:
@@ -288,8 +306,7 @@ def relative_pose(query: OmniView, node: OmniView, matches: Matches, camera: Omn
             raise TypeError(f"{name}: expected an OmniView, got {describe(view)}")
     if not isinstance(matches, Matches):
         raise TypeError(f"matches: expected a robokit.vision.Matches, got {describe(matches)}")
-    if not isinstance(camera, OmniCamera):
-        raise TypeError(f"camera: expected a robokit.sim.OmniCamera, got {describe(camera)}")
+    check_omni_camera(camera)
     qi, ni = np.asarray(matches.query, int), np.asarray(matches.train, int)
     if len(qi) and (qi.min() < 0 or qi.max() >= len(query.bearings) or ni.min() < 0 or ni.max() >= len(node.bearings)):
         raise ValueError(f"matches: expected indices of the query's {len(query.bearings)} and the node's "

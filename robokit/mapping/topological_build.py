@@ -41,10 +41,11 @@ from ..geometry import se2_between, wrap_angle
 from ..progress import progress_bar
 from ..sim.motion import odometry_covariance
 from ..sim.omni import OmniCamera
+from ..sim.runs import FrameStream
 from ..validation import as_array, check_callable, check_choice, check_int, check_positive, describe
 from ..vision.colour import histogram_distance
 from ..vision.matching import METHODS, DescriptorIndex
-from .omni_views import check_omni_image, omni_view, relative_pose
+from .omni_views import check_omni_camera, check_omni_image, omni_view, relative_pose
 from .pose_graph import position_variance
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
 
@@ -251,7 +252,8 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     images : array_like, shape (N, H, W, 3), or iterator of N images
         The run's omni images: ``run.images["omni"]`` of :func:`robokit.sim.record`, or
         ``stream.frames`` of :func:`robokit.sim.record_stream`, whose images are used as they are
-        rendered (the map is built while the workers render the next ones).
+        rendered (the map is built while the workers render the next ones) and let go once their
+        frame is compared. Every other argument is checked before the first image is taken.
     odometry : array_like, shape (N, 3)
         Odometry poses ``[x, y, theta]`` of the same frames (they become the nodes' poses).
     camera : OmniCamera
@@ -314,20 +316,24 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     >>> len(tmap), tmap.n_edges, tmap.frames.tolist()
     (1, 0, [0])
     """
-    if isinstance(images, Iterator):             # taken as they arrive (e.g. rendered by workers)
+    if isinstance(images, FrameStream):
+        raise TypeError("images: expected an array of images or an iterator of them (a FrameStream's .frames), "
+                        "got the FrameStream itself")
+    streamed = isinstance(images, Iterator)      # taken as they arrive (e.g. rendered by workers)
+    if streamed:
+        check_omni_camera(camera)
         odo = as_array(odometry, "odometry", shape=(None, 3))
         if len(odo) == 0:
             raise EmptyMapError("odometry: expected at least one pose to build a map from, got none")
-        raw: Any = _Arrivals(images, len(odo), camera)
     else:
         raw = as_array(images, "images", dtype=None)
         if raw.ndim != 4 or len(raw) == 0:
             if raw.ndim == 4 or raw.size == 0:
                 raise EmptyMapError(f"images: expected at least one image to build a map from, got shape {raw.shape}")
             raise ValueError(f"images: expected shape (N, H, W, 3), got shape {raw.shape}")
+        check_omni_image(raw[0], camera, "images[0]")
         odo = as_array(odometry, "odometry", shape=(len(raw), 3))
     n = len(odo)
-    check_omni_image(raw[0], camera, "images[0]")
     sigma = as_array(sigma_visual, "sigma_visual", shape=(3,))
     if np.any(sigma <= 0):
         raise ValueError(f"sigma_visual: expected three positive standard deviations, got {sigma.tolist()}")
@@ -336,6 +342,13 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     progress = check_callable(progress, "progress")
     log = check_callable(log, "log")
     ratio = check_positive(ratio, "ratio")
+    bins = check_int(bins, "bins", minimum=1)
+    n_features = check_int(n_features, "n_features", minimum=0)
+    loop = {"top_k": check_int(loop_top_k, "loop_top_k", minimum=1),
+            "min_matches": check_int(loop_min_matches, "loop_min_matches", minimum=8),
+            "exclude": check_int(loop_exclude, "loop_exclude", minimum=1)}
+    if streamed:          # every argument checked (the key-image criteria by select_key_frames): start taking images
+        raw = _Arrivals(images, n, camera)
     cache: dict[int, Any] = {}            # frame -> OmniView: the key frames and the latest frame only
     has_sift: dict[int, bool] = {}
     key_frames: set[int] = set()
@@ -357,6 +370,8 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
             current["index"] = DescriptorIndex(features.descriptors) if len(features) >= 2 else None
         for f in [f for f in cache if f not in key_frames and f != k]:
             del cache[f], has_sift[f]
+        if streamed:          # the key's features are known: no image before frame k is asked for again
+            raw.release(before=k)
         bar(k + 1, n)
         var = float(position_variance(odometry_covariance(odo[key:k + 1], alphas)[-1]))
         d = float(histogram_distance(view(k, features=False).histogram, view(key).histogram))   # Eq. (5)
@@ -371,7 +386,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
                                           occlusion_frames=occlusion_frames, max_features=max_features,
                                           max_variance=max_variance)
     key_views = [view(k) for k in keys]
-    if isinstance(raw, _Arrivals):
+    if streamed:
         raw.check_ended()
     edge_cov = [odometry_covariance(odo[a:b + 1], alphas)[-1] + _COVARIANCE_FLOOR for a, b in zip(keys[:-1], keys[1:])]
     variances = np.concatenate([[0.0], np.cumsum(position_variance(np.reshape(edge_cov, (-1, 3, 3))))])
@@ -392,10 +407,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
             log(f"node {i}: frame {k} ({r}), {counts[i]} features")
     if not loop_closure:
         return tmap
-    extra = _loop_closures(tmap, key_views, odo, alphas, camera, sigma, ratio=ratio,
-                           top_k=check_int(loop_top_k, "loop_top_k", minimum=1),
-                           min_matches=check_int(loop_min_matches, "loop_min_matches", minimum=8),
-                           exclude=check_int(loop_exclude, "loop_exclude", minimum=1), log=log)
+    extra = _loop_closures(tmap, key_views, odo, alphas, camera, sigma, ratio=ratio, log=log, **loop)
     if not extra:
         return tmap
     e, meas, cov = (np.array(x) for x in zip(*extra))
@@ -408,20 +420,29 @@ _END = object()     # what an exhausted iterator gives
 
 
 class _Arrivals:
-    """The images of an iterator as a sequence: each taken (and checked) when first asked for, then kept."""
+    """The images of an iterator as a sequence: each taken (and checked) when first asked for, and
+    kept until :meth:`release` lets it go (the builder needs only the current frame and the next)."""
 
     def __init__(self, images: Iterator, n: int, camera: OmniCamera):
-        self._images, self._n, self._camera, self._taken = images, n, camera, []
+        self._images, self._n, self._camera = images, n, camera
+        self._kept: dict[int, np.ndarray] = {}
+        self._taken = 0
 
     def __getitem__(self, k: int) -> np.ndarray:
-        while len(self._taken) <= k:
-            got = len(self._taken)
+        while self._taken <= k:
             image = next(self._images, _END)
             if image is _END:
                 raise ValueError(f"images: expected {self._n} images (one per odometry pose), the iterator "
-                                 f"ended after {got}")
-            self._taken.append(check_omni_image(image, self._camera, f"images[{got}]"))
-        return self._taken[k]
+                                 f"ended after {self._taken}")
+            self._kept[self._taken] = check_omni_image(image, self._camera, f"images[{self._taken}]")
+            self._taken += 1
+        if k not in self._kept:
+            raise RuntimeError(f"images[{k}] was asked for after it was released (a bug of the builder)")
+        return self._kept[k]
+
+    def release(self, *, before: int) -> None:
+        for k in [k for k in self._kept if k < before]:
+            del self._kept[k]
 
     def check_ended(self) -> None:
         """Every image was taken: the iterator must have no more."""

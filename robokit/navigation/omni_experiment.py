@@ -168,9 +168,9 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     def build():
         # the map is cached (below), so the recording is not stored at all: its images are used as the
         # workers render them, the map being built meanwhile
-        run = record_stream(world, tour, camera, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2)
-        tmap = build_topological_map(run.frames, run.odometry, camera, n_features=params["n_features"],
-                                     odometry_alphas=TOUR_ALPHAS, progress=progress)
+        with record_stream(world, tour, camera, rate=rate, odometry_alphas=TOUR_ALPHAS, seed=2) as run:
+            tmap = build_topological_map(run.frames, run.odometry, camera, n_features=params["n_features"],
+                                         odometry_alphas=TOUR_ALPHAS, progress=progress)
         return tmap, run.poses[tmap.frames], len(run)
 
     raw, truth, frames, seconds, key = _map_cached(meta, build)

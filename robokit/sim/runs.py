@@ -356,10 +356,14 @@ class FrameStream:
     t, poses, odometry : numpy.ndarray
         As in :class:`Run`, all known at once.
     frames : iterator of numpy.ndarray (H, W, 3) uint8
-        The camera's images in the order of ``poses``, each rendered once: iterate once. Closing it
-        (or dropping it) stops the rendering.
+        The camera's images in the order of ``poses``, each rendered once: iterate once.
     meta : dict
-        Recording parameters, as in :class:`Run`.
+        The recording's parameters (world, rate, camera, odometry noise, seed).
+
+    Notes
+    -----
+    Use it in a ``with`` block (or call :meth:`close`): the workers stop at its end even if the
+    consumer stops early or fails, which a Jupyter kernel's kept traceback would otherwise delay.
     """
 
     t: np.ndarray
@@ -370,6 +374,16 @@ class FrameStream:
 
     def __len__(self) -> int:
         return len(self.t)
+
+    def close(self) -> None:
+        """Stop the rendering (images not yet taken are dropped); the frames then end."""
+        self.frames.close()
+
+    def __enter__(self) -> "FrameStream":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
 
 
 def _camera_images(shared: tuple, poses: np.ndarray) -> list:
@@ -393,7 +407,7 @@ def record_stream(world: World, path: Path, camera: Any, rate: float | None = No
     The same drive as :func:`record` with the same arguments and ``sensors={name: camera}`` (the
     same timestamps, poses, odometry and images), but nothing is stored: a consumer that takes the
     images one by one (:func:`robokit.mapping.build_topological_map`) works on the first ones while
-    worker processes render the next, and no depth images are made.
+    worker processes render the next, and no depth images are made. Use it in a ``with`` block.
 
     Parameters
     ----------
@@ -426,8 +440,9 @@ def record_stream(world: World, path: Path, camera: Any, rate: float | None = No
     --------
     >>> from robokit.sim import OmniCamera, office_floor
     >>> poses = [[14.0, 4.0, np.pi], [13.8, 4.0, np.pi]]
-    >>> stream = record_stream(office_floor(), poses, OmniCamera(width=80, height=60), rate=1.0)
-    >>> len(stream), [image.shape for image in stream.frames]
+    >>> with record_stream(office_floor(), poses, OmniCamera(width=80, height=60), rate=1.0) as stream:
+    ...     shapes = [image.shape for image in stream.frames]
+    >>> len(stream), shapes
     (2, [(60, 80, 3), (60, 80, 3)])
     """
     if type(camera) not in (PinholeCamera, OmniCamera):
