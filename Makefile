@@ -30,7 +30,7 @@ lab: $(STAMP)
 	$(BIN)/jupyter lab lessons/
 
 bench: $(STAMP)
-	@for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f || exit 1; done
+	@for f in benchmarks/bench_*.py; do echo "== $$f"; PYTHONPATH=$(CURDIR) $(BIN)/python $$f || exit 1; done
 
 clean:
 	rm -rf build .pytest_cache
