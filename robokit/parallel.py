@@ -258,3 +258,4 @@ def _in_workers(run: Callable, blobs: dict, settings: dict, jobs: list, workers:
                 yield result
         finally:
             pool.terminate()       # at the end, and at once on an error, an interrupt or a closed iterator
+            pool.join()

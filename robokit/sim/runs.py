@@ -445,7 +445,7 @@ def record_stream(world: World, path: Path, camera: Any, rate: float | None = No
     >>> len(stream), shapes
     (2, [(60, 80, 3), (60, 80, 3)])
     """
-    if type(camera) not in (PinholeCamera, OmniCamera):
+    if isinstance(camera, StereoRig) or not _noise_free_camera(camera):      # one noise-free image per pose
         raise TypeError(f"camera: expected a robokit PinholeCamera or OmniCamera, got {type(camera).__name__}")
     t, poses, alphas, seed = _drive(world, path, rate, odometry_alphas, seed)
     odometry = noisy_odometry(poses, alphas, as_rng(seed))
