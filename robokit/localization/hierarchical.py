@@ -31,9 +31,9 @@ from typing import Any
 import numpy as np
 
 from ..geometry import intersect_lines, se2_between, se2_compose, wrap_angle
-from ..mapping.omni_views import OmniView, RelativePose, check_omni_camera, omni_view, relative_pose
+from ..mapping.omni_views import OmniView, RelativePose, omni_view, relative_pose
 from ..mapping.topological import EmptyMapError, TopologicalMap
-from ..sim.omni import OmniCamera
+from ..sim.omni import OmniCamera, check_omni_camera
 from ..validation import check_choice, check_int, check_positive, describe
 
 __all__ = ["MODES", "Localization", "HierarchicalLocalizer"]

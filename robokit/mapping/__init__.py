@@ -42,7 +42,7 @@ from .pose_graph_optimize import (PoseGraphResult, optimize_pose_graph, pose_gra
                                   pose_graph_residuals)
 from .occupancy_grid import (FREE_THRESHOLD, LOG_ODDS_MAX, LOG_ODDS_MIN, OCCUPIED_THRESHOLD, LikelihoodField,
                              OccupancyGrid, likelihood_field, log_odds, probability)
-from .omni_views import OmniView, RelativePose, check_omni_camera, check_omni_image, omni_view, relative_pose
+from .omni_views import OmniView, RelativePose, check_omni_image, omni_view, relative_pose
 from .relaxation import RelaxationResult, initial_variances, relax, relax_sweep
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
 from .topological_build import (Comparison, appearance_changed, build_topological_map, local_map_full,
@@ -54,7 +54,7 @@ __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
            "pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph",
            "RelaxationResult", "relax", "relax_sweep", "initial_variances",
            "G2OFormatError", "read_g2o", "write_g2o", "manhattan_world_graph",
-           "OmniView", "RelativePose", "check_omni_camera", "check_omni_image", "omni_view", "relative_pose",
+           "OmniView", "RelativePose", "check_omni_image", "omni_view", "relative_pose",
            "LOOP_EDGE", "ODOMETRY_EDGE", "EmptyMapError", "TopologicalMap", "Comparison", "appearance_changed",
            "build_topological_map", "local_map_full", "select_key_frames",
            "FREE_THRESHOLD", "OCCUPIED_THRESHOLD", "LOG_ODDS_MIN", "LOG_ODDS_MAX", "log_odds", "probability",

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from ..sim.omni import OmniCamera
+from ..sim.omni import OmniCamera, check_omni_camera
 from ..validation import as_array, as_rng, check_int, check_mapping, check_positive, check_text, describe
 from ..vision.colour import hue_histogram
 from ..vision.features import Features, Keypoints
@@ -45,26 +45,7 @@ from ..vision.omni_features import ImageSizeError, omni_sift
 from ..vision.ransac import ransac_se2
 from ..vision.spherical import decompose_essential, floor_points, ransac_essential
 
-__all__ = ["HISTOGRAM_STEP", "OmniView", "omni_view", "check_omni_camera", "check_omni_image", "RelativePose", "relative_pose"]
-
-
-def check_omni_camera(camera: Any) -> OmniCamera:
-    """``camera`` if it is an :class:`~robokit.sim.OmniCamera`, else a TypeError naming it.
-
-    Notes
-    -----
-    Validation only (DESIGN.md, "Errors").
-
-    Examples
-    --------
-    >>> check_omni_camera("omni")
-    Traceback (most recent call last):
-    ...
-    TypeError: camera: expected a robokit.sim.OmniCamera, got 'omni'
-    """
-    if not isinstance(camera, OmniCamera):
-        raise TypeError(f"camera: expected a robokit.sim.OmniCamera, got {describe(camera)}")
-    return camera
+__all__ = ["HISTOGRAM_STEP", "OmniView", "omni_view", "check_omni_image", "RelativePose", "relative_pose"]
 
 
 def check_omni_image(image: Any, camera: OmniCamera, name: str = "image") -> np.ndarray:

@@ -40,12 +40,12 @@ import numpy as np
 from ..geometry import se2_between, wrap_angle
 from ..progress import progress_bar
 from ..sim.motion import odometry_covariance
-from ..sim.omni import OmniCamera
+from ..sim.omni import OmniCamera, check_omni_camera
 from ..sim.runs import FrameStream
 from ..validation import as_array, check_callable, check_choice, check_int, check_positive, describe
 from ..vision.colour import histogram_distance
 from ..vision.matching import METHODS, DescriptorIndex
-from .omni_views import check_omni_camera, check_omni_image, omni_view, relative_pose
+from .omni_views import check_omni_image, omni_view, relative_pose
 from .pose_graph import position_variance
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
 

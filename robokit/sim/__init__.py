@@ -70,7 +70,7 @@ from .layout import Layout, box_corners, obstacle_array
 from .lidar import Lidar, scan_points
 from .motion import (OFFICE_TEST_POSES, Path, corridor_path, increment_variances, lab_lap, noisy_odometry,
                      odometry_covariance, odometry_increment, office_tour, sample_motion_model_odometry, waypoint_path)
-from .omni import OmniCamera, omni_mount
+from .omni import OmniCamera, check_omni_camera, omni_mount
 from .runs import FrameStream, Run, describe_sensor, record, record_stream
 from .textures import illuminate, photo
 from .vehicle import diff_drive_velocities, skid_steer_velocities, skid_steer_wheel_speeds, unicycle_step
@@ -81,7 +81,7 @@ from .worlds_outdoor import field_world, open_field, scatter_obstacles
 __all__ = [
     "World", "Surface", "FreeSpace", "box_room", "lab_room", "long_corridor", "office_floor",
     "open_field", "field_world", "scatter_obstacles",
-    "Frame", "PinholeCamera", "StereoRig", "camera_mount", "OmniCamera", "omni_mount", "illuminate", "photo",
+    "Frame", "PinholeCamera", "StereoRig", "camera_mount", "OmniCamera", "omni_mount", "check_omni_camera", "illuminate", "photo",
     "Layout", "box_corners", "obstacle_array", "Lidar", "scan_points",
     "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
     "odometry_increment",

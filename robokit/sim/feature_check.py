@@ -31,7 +31,7 @@ from ..validation import as_array, as_points, check_positive
 from ..vision.matching import LOWE_RATIO, DescriptorIndex, ratio_match
 from ..vision.omni_features import omni_sift
 from .camera import PinholeCamera
-from .omni import OmniCamera
+from .omni import OmniCamera, check_omni_camera
 from .world import World
 
 __all__ = ["ViewPairCheck", "ground_truth_inliers", "sift_view_pair", "omni_ground_truth_inliers", "omni_view_pair"]
@@ -216,8 +216,7 @@ def omni_ground_truth_inliers(camera: OmniCamera, ranges: Any, T1: Any, T2: Any,
     >>> omni_ground_truth_inliers(cam, ranges, T1, T2, uv1, uv2[::-1]).tolist()   # swapped: wrong
     [False, False]
     """
-    if not isinstance(camera, OmniCamera):
-        raise TypeError(f"camera: expected robokit.sim.OmniCamera, got {type(camera).__name__}")
+    check_omni_camera(camera)
     return _reprojects(camera, ranges, "ranges", T1, T2, uv1, uv2, tol)
 
 
@@ -268,8 +267,7 @@ def omni_view_pair(world: World, camera: OmniCamera, pose1: Any, pose2: Any, *, 
     """
     if not isinstance(world, World):
         raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
-    if not isinstance(camera, OmniCamera):
-        raise TypeError(f"camera: expected robokit.sim.OmniCamera, got {type(camera).__name__}")
+    check_omni_camera(camera)
     tol = check_positive(tol, "tol")
     T1 = camera.transform_at(as_array(pose1, "pose1", shape=(3,)))
     T2 = camera.transform_at(as_array(pose2, "pose2", shape=(3,)))

@@ -44,12 +44,12 @@ import cv2
 import numpy as np
 
 from ..geometry import as_se3, se3_from_rt
-from ..validation import as_array, as_points, check_int, check_positive
+from ..validation import as_array, as_points, check_int, check_positive, describe
 from .camera import Frame, MountedSensor, finish_image
 from .render import render_pinhole
 from .world import World
 
-__all__ = ["OmniCamera", "omni_mount"]
+__all__ = ["OmniCamera", "omni_mount", "check_omni_camera"]
 
 # cube faces: rotation omni <- face optical frame (columns: face x, y, z in omni axes)
 _FACES = {
@@ -302,3 +302,22 @@ class OmniCamera(MountedSensor):
         depth[~inside] = np.inf
         image[~inside] = 0
         return Frame(finish_image(image, noise, rng, lighting), depth.astype(np.float32))
+
+
+def check_omni_camera(camera: Any) -> OmniCamera:
+    """``camera`` if it is an :class:`~robokit.sim.OmniCamera`, else a TypeError naming it.
+
+    Notes
+    -----
+    Validation only (DESIGN.md, "Errors").
+
+    Examples
+    --------
+    >>> check_omni_camera("omni")
+    Traceback (most recent call last):
+    ...
+    TypeError: camera: expected a robokit.sim.OmniCamera, got 'omni'
+    """
+    if not isinstance(camera, OmniCamera):
+        raise TypeError(f"camera: expected a robokit.sim.OmniCamera, got {describe(camera)}")
+    return camera
