@@ -69,6 +69,25 @@ def test_latency_and_a_slow_servo_hurt_tracking():
     assert 0.2 < lossy.link["lost"] / lossy.link["sent"] < 0.4
 
 
+@pytest.mark.parametrize("rate", [250.0, 40.0])
+def test_a_servo_period_that_does_not_divide_the_host_period_keeps_its_own_clock(rate):
+    """The servo ticks every 1 / rate s of simulated time, not afresh in every 10 ms host period.
+
+    The host logs the voltage the servo holds at each host cycle, so the logged voltage changes at
+    cycle k exactly when a tick fell in the period before it. (A 250 Hz servo used to overrun the
+    tick arrays, and a 40 Hz one ticked once every 10 ms with a 25 ms time step.)
+    """
+    plan = walking_plan(trot_gait(), 0.05)
+    out = simulate_walk(plan, LoopSettings(servo_rate=rate), rng=3)
+    servo_ms, n = round(1000 / rate), len(plan.t)
+    # ms, up to the last host cycle; the tick at 0 holds 0 V (the robot starts in the plan's posture)
+    ticks = np.arange(servo_ms, 10 * (n - 1), servo_ms)
+    expected = np.unique(ticks // 10 + 1)                            # the first cycle to see each tick
+    changed = np.nonzero(np.any(np.diff(out.log.voltage, axis=0) != 0, axis=1))[0] + 1
+    np.testing.assert_array_equal(changed, expected)
+    assert not out.fell and out.log.meta["servo_rate"] == rate
+
+
 def test_bad_settings_are_named():
     with pytest.raises(ValueError, match="servo_rate"):
         LoopSettings(servo_rate=300)

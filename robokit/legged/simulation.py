@@ -181,6 +181,120 @@ def _tipped(quat: np.ndarray) -> bool:
     return 1 - 2 * (quat[1] ** 2 + quat[2] ** 2) < np.cos(np.pi / 4)
 
 
+class _Probes(NamedTuple):
+    """Where the model keeps what the host reads: feet, force sensors, IMU and trunk."""
+
+    foot_geoms: list
+    foot_sites: list
+    force_adr: list
+    imu: slice
+    trunk: int
+
+    @classmethod
+    def of(cls, model: mujoco.MjModel) -> "_Probes":
+        gyro = model.sensor_adr[model.sensor("imu_gyro").id]
+        if model.sensor_adr[model.sensor("imu_acc").id] != gyro + 3:
+            raise RuntimeError("the model's IMU sensors are not gyro then accelerometer")
+        return cls([model.geom(f"{leg}_foot").id for leg in LEGS], [model.site(f"{leg}_foot").id for leg in LEGS],
+                   [model.sensor_adr[model.sensor(f"{leg}_force").id] + 2 for leg in LEGS],
+                   slice(gyro, gyro + 6), model.body("trunk").id)
+
+
+class _Servo:
+    """The robot's joint servo: every tick it takes the newest set-point and holds a new voltage.
+
+    It also keeps each tick's voltage and mean joint speed, from which the trial's energy comes.
+    """
+
+    def __init__(self, q_ref: np.ndarray, q: np.ndarray, gains: tuple, dt: float, motor: DCMotor, max_ticks: int):
+        self.q_ref, self.q_prev, self.voltage = q_ref.copy(), q.copy(), np.zeros(12)
+        self.kp, self.kd = gains
+        self.dt, self.motor = dt, motor
+        self.tick_voltage, self.tick_speed, self.ticks = np.zeros((max_ticks + 1, 12)), np.zeros((max_ticks + 1, 12)), 0
+
+    def tick(self, arrived: np.ndarray | None, q_now: np.ndarray) -> np.ndarray:
+        """One servo period: the set-point that ``arrived`` (if any), then the PD voltage for ``q_now``."""
+        if arrived is not None:
+            self.q_ref = arrived
+        self.tick_speed[self.ticks] = (q_now - self.q_prev) / self.dt        # the tick that just ended
+        self.voltage = pd_servo_step(self.q_ref, q_now, self.q_prev, self.kp, self.kd, self.dt,
+                                     self.motor.voltage_max, check=False)
+        self.ticks += 1
+        self.tick_voltage[self.ticks] = self.voltage
+        self.q_prev = q_now
+        return self.voltage
+
+    def energy(self, q_end: np.ndarray) -> float:
+        """Electrical energy drawn over the ticks so far, the last one ending at ``q_end`` (J)."""
+        self.tick_speed[self.ticks] = (q_end - self.q_prev) / self.dt
+        # the voltage is held over a tick and the current is linear in the speed, so each tick's V i is
+        # the one at its mean speed; no regeneration (trial_power clips a braking joint's power)
+        n = self.ticks + 1
+        return float(trial_power(self.tick_voltage[1:n], self.tick_speed[1:n], self.motor).sum()) * self.dt
+
+
+def _host_period(plan: WalkPlan) -> tuple[float, int]:
+    """The plan's host period (s) and its number of physics steps, or a ValueError naming the plan."""
+    t = as_array(plan.t, "plan.t", ndim=1, min_size=2)
+    as_array(plan.feet_world, "plan.feet_world", shape=(len(t), 4, 3))
+    as_se3(plan.T_world_body, "plan.T_world_body", batch=True)
+    host_dt = float(t[1] - t[0])
+    host_steps = int(round(host_dt / TIMESTEP))
+    if host_steps < 1 or abs(host_steps * TIMESTEP - host_dt) > 1e-9 or np.any(np.abs(np.diff(t) - host_dt) > 1e-9):
+        raise ValueError(f"plan.t: expected even steps of a whole number of {1000 * TIMESTEP:.0f} ms physics steps "
+                         f"(the host period), got a first step of {host_dt} s")
+    if len(plan.T_world_body) != len(t):
+        raise ValueError(f"plan.T_world_body: expected {len(t)} poses (one per plan.t), got {len(plan.T_world_body)}")
+    return host_dt, host_steps
+
+
+def _place(model: mujoco.MjModel, T_world_body: np.ndarray, q: np.ndarray) -> mujoco.MjData:
+    """The robot standing at the plan's first body pose with joint angles ``q``."""
+    data = mujoco.MjData(model)
+    data.qpos[:3] = T_world_body[:3, 3]
+    mujoco.mju_mat2Quat(data.qpos[3:7], T_world_body[:3, :3].ravel())
+    data.qpos[7:] = q
+    mujoco.mj_forward(model, data)
+    return data
+
+
+def _snapshot(rec: dict, k: int, model: mujoco.MjModel, data: mujoco.MjData, probes: _Probes, servo: _Servo) -> None:
+    """Host cycle ``k``'s record of the true state, the servo and the foot contacts (guide Sec. 3)."""
+    rec["q"][k] = data.qpos[7:]
+    rec["qd"][k] = data.qvel[6:]
+    rec["q_ref"][k] = servo.q_ref
+    rec["voltage"][k] = servo.voltage
+    rec["tau"][k] = data.actuator_force
+    rec["current"][k] = motor_current(servo.voltage, data.qvel[6:], servo.motor, check=False)
+    rec["body_pos"][k] = data.qpos[:3]
+    rec["body_quat"][k] = data.qpos[3:7]
+    rec["body_vel"][k, :3] = data.qvel[:3]
+    rec["body_vel"][k, 3:] = data.qvel[3:6]
+    rec["com"][k] = data.subtree_com[probes.trunk]
+    rec["feet"][k] = data.site_xpos[probes.foot_sites]
+    rec["foot_force"][k] = -data.sensordata[probes.force_adr]      # compression along the shank
+    wrench = np.zeros(6)
+    for c in range(data.ncon):
+        pair = (data.contact.geom1[c], data.contact.geom2[c])
+        for i, g in enumerate(probes.foot_geoms):
+            if g in pair:
+                mujoco.mj_contactForce(model, data, c, wrench)
+                rec["contact"][k, i] |= wrench[0] > CONTACT_FORCE      # normal force, contact frame
+
+
+def _sensed(streams: dict, gyro: np.ndarray, acc: np.ndarray, sensors: SensorSettings, gen: np.random.Generator) -> dict:
+    """The true streams with the sensors corrupted as :class:`SensorSettings` says (forces, IMU, MoCap)."""
+    streams["foot_force"] = streams["foot_force"] + gen.normal(0.0, sensors.force_noise, (len(gyro), 4))
+    streams["imu_gyro"], streams["imu_acc"] = simulate_imu(
+        gyro, acc, gen, gyro_noise=sensors.gyro_noise, acc_noise=sensors.acc_noise,
+        gyro_bias=np.asarray(sensors.gyro_bias), acc_bias=np.asarray(sensors.acc_bias))
+    T_true = se3_from_rt(quat_to_matrix(streams["body_quat"]), streams["body_pos"])
+    streams["mocap"], streams["mocap_visible"] = simulate_mocap(
+        T_true, MARKERS, sensors.mocap_noise, sensors.mocap_dropout, gen, bursts=sensors.mocap_bursts,
+        burst_length=sensors.mocap_burst_length)
+    return streams
+
+
 def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors: SensorSettings = SensorSettings(),
                   *, motor: DCMotor = LITTLEDOG_MOTOR, rng: Any = 0) -> TrialOutcome:
     """Walk LittleDog through a plan in MuJoCo with the servo and host loops of the guide.
@@ -202,6 +316,20 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     -------
     TrialOutcome
 
+    Raises
+    ------
+    TypeError
+        If ``plan``, ``loops``, ``sensors`` or ``motor`` is not of its class.
+    ValueError
+        If the plan's times are not even steps of whole physics steps, its arrays disagree in
+        length, or it asks for feet out of reach.
+
+    Notes
+    -----
+    LittleDog User Guide, Sec. 2: the servo runs on its own clock (every ``1 / servo_rate`` s of
+    simulated time, whether or not that divides the host period) and the host every
+    ``plan.t[1] - plan.t[0]``.
+
     Examples
     --------
     >>> from robokit.legged import crawl_gait, walking_plan
@@ -209,129 +337,53 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     >>> out.fell, len(out.log) == len(walking_plan(crawl_gait(), 0.05).t)
     (False, True)
     """
-    if not isinstance(plan, WalkPlan):
-        raise TypeError(f"plan: expected a WalkPlan (robokit.legged.walking_plan), got {type(plan).__name__}")
-    if not isinstance(loops, LoopSettings):
-        raise TypeError(f"loops: expected LoopSettings, got {type(loops).__name__}")
-    if not isinstance(sensors, SensorSettings):
-        raise TypeError(f"sensors: expected SensorSettings, got {type(sensors).__name__}")
-    if not isinstance(motor, DCMotor):
-        raise TypeError(f"motor: expected a DCMotor, got {type(motor).__name__}")
+    for name, value, cls in (("plan", plan, WalkPlan), ("loops", loops, LoopSettings),
+                             ("sensors", sensors, SensorSettings), ("motor", motor, DCMotor)):
+        if not isinstance(value, cls):
+            raise TypeError(f"{name}: expected a {cls.__name__}, got {type(value).__name__}")
     seed = rng if isinstance(rng, int) and not isinstance(rng, bool) else None
     gen = as_rng(rng)
-    t = as_array(plan.t, "plan.t", ndim=1, min_size=2)
-    as_array(plan.feet_world, "plan.feet_world", shape=(len(t), 4, 3))
-    as_se3(plan.T_world_body, "plan.T_world_body", batch=True)
-    host_dt = float(t[1] - t[0])
-    host_steps = int(round(host_dt / TIMESTEP))
-    if host_steps < 1 or abs(host_steps * TIMESTEP - host_dt) > 1e-9 or np.any(np.abs(np.diff(t) - host_dt) > 1e-9):
-        raise ValueError(f"plan.t: expected even steps of a whole number of {1000 * TIMESTEP:.0f} ms physics steps "
-                         f"(the host period), got a first step of {host_dt} s")
-    if len(plan.T_world_body) != len(t):
-        raise ValueError(f"plan.T_world_body: expected {len(t)} poses (one per plan.t), got {len(plan.T_world_body)}")
+    host_dt, host_steps = _host_period(plan)
     servo_steps = int(round(1.0 / (loops.servo_rate * TIMESTEP)))
-    servo_dt = servo_steps * TIMESTEP
     q_cmd, ok = body_ik(plan.feet_world, plan.T_world_body, check=False)
     if not ok.all():
         raise ValueError(f"plan: {int((~ok).sum())} host cycles ask for feet out of reach (first at "
                          f"t = {plan.t[~ok][0]:.2f} s)")
     model = littledog_model(motor=motor)
-    data = mujoco.MjData(model)
-    T0 = plan.T_world_body[0]
-    data.qpos[:3] = T0[:3, 3]
-    mujoco.mju_mat2Quat(data.qpos[3:7], T0[:3, :3].ravel())
-    data.qpos[7:] = q_cmd[0]
-    mujoco.mj_forward(model, data)
+    data = _place(model, plan.T_world_body[0], q_cmd[0])
+    probes = _Probes.of(model)
     channel = SetpointChannel(period=host_dt, latency=loops.latency, jitter=loops.jitter, loss=loops.loss, rng=gen)
-    kp, kd = loops.gains if loops.gains is not None else littledog_servo_gains(motor=motor)
     n = len(plan.t)
+    gains = loops.gains if loops.gains is not None else littledog_servo_gains(motor=motor)
+    servo = _Servo(q_cmd[0], data.qpos[7:], gains, servo_steps * TIMESTEP, motor, -(-n * host_steps // servo_steps))
     rec = empty_streams(n, 1.0 / host_dt)
-    rec["t"][:] = plan.t
-    rec["q_cmd"][:] = q_cmd
-    gyro_true, acc_true = np.zeros((n, 3)), np.zeros((n, 3))
-    foot_geoms = [model.geom(f"{leg}_foot").id for leg in LEGS]
-    foot_sites = [model.site(f"{leg}_foot").id for leg in LEGS]
-    force_adr = [model.sensor_adr[model.sensor(f"{leg}_force").id] + 2 for leg in LEGS]
-    gyro_adr = model.sensor_adr[model.sensor("imu_gyro").id]
-    acc_adr = model.sensor_adr[model.sensor("imu_acc").id]
-    trunk = model.body("trunk").id
-    if acc_adr != gyro_adr + 3:
-        raise RuntimeError("the model's IMU sensors are not gyro then accelerometer")
-    imu_span = slice(gyro_adr, gyro_adr + 6)
-    imu_sum = np.zeros(6)
-    wrench = np.zeros(6)
-    q_ref = q_cmd[0].copy()
-    q_prev = data.qpos[7:].copy()
-    voltage = np.zeros(12)
-    n_ticks = n * host_steps // servo_steps + 1
-    tick_voltage, tick_speed, ticks = np.zeros((n_ticks + 1, 12)), np.zeros((n_ticks + 1, 12)), 0
-    fell = False
-    rows = n
+    rec["t"][:], rec["q_cmd"][:] = plan.t, q_cmd
+    imu_true, imu_sum = np.zeros((n, 6)), data.sensordata[probes.imu] * host_steps
+    fell, rows = False, n
     for k in range(n):
         now = k * host_dt
         # host cycle: snapshot of the state and sensors, then the next set-point goes out
-        rec["q"][k] = data.qpos[7:]
-        rec["qd"][k] = data.qvel[6:]
-        rec["q_ref"][k] = q_ref
-        rec["voltage"][k] = voltage
-        rec["tau"][k] = data.actuator_force
-        rec["current"][k] = motor_current(voltage, data.qvel[6:], motor, check=False)
-        rec["body_pos"][k] = data.qpos[:3]
-        rec["body_quat"][k] = data.qpos[3:7]
-        rec["body_vel"][k, :3] = data.qvel[:3]
-        rec["body_vel"][k, 3:] = data.qvel[3:6]
-        rec["com"][k] = data.subtree_com[trunk]
-        rec["feet"][k] = data.site_xpos[foot_sites]
-        rec["foot_force"][k] = -data.sensordata[force_adr]      # compression along the shank
-        if k == 0:
-            imu_sum[:] = data.sensordata[imu_span] * host_steps
-        gyro_true[k], acc_true[k] = np.split(imu_sum / host_steps, 2)       # the IMU's average
-        imu_sum[:] = 0.0
-        for c in range(data.ncon):
-            pair = (data.contact.geom1[c], data.contact.geom2[c])
-            for i, g in enumerate(foot_geoms):
-                if g in pair:
-                    mujoco.mj_contactForce(model, data, c, wrench)
-                    rec["contact"][k, i] |= wrench[0] > CONTACT_FORCE      # normal force, contact frame
+        _snapshot(rec, k, model, data, probes, servo)
+        imu_true[k], imu_sum = imu_sum / host_steps, np.zeros(6)          # the IMU's average over the period
         if data.qpos[2] < FALL_HEIGHT or _tipped(data.qpos[3:7]):
             fell, rows = True, k + 1
             break
         channel.send(now, q_cmd[k])
         for s in range(host_steps):
-            if s % servo_steps == 0:
-                arrived = channel.receive(now + s * TIMESTEP)
-                if arrived is not None:
-                    q_ref = arrived
-                q_now = data.qpos[7:].copy()
-                tick_speed[ticks] = (q_now - q_prev) / servo_dt       # the tick that just ended
-                voltage = pd_servo_step(q_ref, q_now, q_prev, kp, kd, servo_dt, motor.voltage_max, check=False)
-                data.ctrl[:] = voltage          # MuJoCo's actuators apply joint_torque(voltage, dq/dt)
-                ticks += 1
-                tick_voltage[ticks] = voltage
-                q_prev = q_now
+            if (k * host_steps + s) % servo_steps == 0:                   # the servo's own clock
+                data.ctrl[:] = servo.tick(channel.receive(now + s * TIMESTEP), data.qpos[7:].copy())
+                # MuJoCo's actuators apply joint_torque(voltage, dq/dt)
             mujoco.mj_step(model, data)
-            imu_sum += data.sensordata[imu_span]
-    tick_speed[ticks] = (data.qpos[7:] - q_prev) / servo_dt
-    # the voltage is held over a tick and the current is linear in the speed, so each tick's V i is the
-    # one at its mean speed; no regeneration (trial_power clips a braking joint's power)
-    energy = float(trial_power(tick_voltage[1:ticks + 1], tick_speed[1:ticks + 1], motor).sum()) * servo_dt
-    streams = {key: value[:rows] for key, value in rec.items()}
-    streams["foot_force"] = streams["foot_force"] + gen.normal(0.0, sensors.force_noise, (rows, 4))
-    streams["imu_gyro"], streams["imu_acc"] = simulate_imu(
-        gyro_true[:rows], acc_true[:rows], gen, gyro_noise=sensors.gyro_noise, acc_noise=sensors.acc_noise,
-        gyro_bias=np.asarray(sensors.gyro_bias), acc_bias=np.asarray(sensors.acc_bias))
-    T_true = se3_from_rt(quat_to_matrix(streams["body_quat"]), streams["body_pos"])
-    streams["mocap"], streams["mocap_visible"] = simulate_mocap(
-        T_true, MARKERS, sensors.mocap_noise, sensors.mocap_dropout, gen, bursts=sensors.mocap_bursts,
-        burst_length=sensors.mocap_burst_length)
+            imu_sum += data.sensordata[probes.imu]
+    energy = servo.energy(data.qpos[7:])
+    streams = _sensed({key: value[:rows] for key, value in rec.items()}, imu_true[:rows, :3], imu_true[:rows, 3:],
+                      sensors, gen)
     meta = trial_meta(gait=plan.gait, host_rate=1.0 / host_dt, servo_rate=loops.servo_rate,
                       link_latency=loops.latency, link_jitter=loops.jitter, link_loss=loops.loss, seed=seed,
-                      notes="simulated in MuJoCo by robokit.legged.simulate_walk", kp=kp, kd=kd)
-    log = TrialLog(streams, meta)
+                      notes="simulated in MuJoCo by robokit.legged.simulate_walk", kp=servo.kp, kd=servo.kd)
     heading = plan.T_world_body[-1, :3, 3] - plan.T_world_body[0, :3, 3]
     heading = heading / max(np.linalg.norm(heading), 1e-12)
     distance = float((streams["body_pos"][-1] - streams["body_pos"][0]) @ heading)
     tracking = float(np.sqrt(np.mean((streams["q_cmd"][:-1] - streams["q"][1:]) ** 2)))
     counters = {name: getattr(channel, name) for name in ("sent", "delivered", "lost", "stale", "rejected")}
-    return TrialOutcome(log, fell, distance, energy, tracking, counters)
-
+    return TrialOutcome(TrialLog(streams, meta), fell, distance, energy, tracking, counters)
