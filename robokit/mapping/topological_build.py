@@ -5,16 +5,17 @@ images and odometry "at a constant rate"; the sequence is then cut into local ma
 ``M_i`` is closed and ``M_{i+1}`` started when
 
 1. the current image is no longer "similar enough" to the local map's images (we measure it by
-   the hue-histogram distance of Eq. (5) to the node's key image, :func:`appearance_changed`),
+   the hue-histogram distance of Eq. (5) to the node's key image,
+   :func:`~robokit.mapping.local_maps.appearance_changed`),
 2. and the change is not just "someone ... blocking the camera view": we also ask the SIFT match
    count with the key image to fall, and the change to persist for ``occlusion_frames``
-   consecutive frames (the *occlusion guard*, :func:`select_key_frames`); a transient change that
-   reverts sooner starts no node. SIFT runs only on frames whose histogram has changed: the
-   cheap global feature first, the costly local ones when it asks for them, as in the
-   localizer;
+   consecutive frames (the *occlusion guard*,
+   :func:`~robokit.mapping.local_maps.select_key_frames`); a transient change that reverts sooner
+   starts no node. SIFT runs only on frames whose histogram has changed: the cheap global feature
+   first, the costly local ones when it asks for them, as in the localizer;
 3. or the local map's number of features reaches a maximum, or its uncertainty a limit
-   (:func:`local_map_full`; the uncertainty is the odometry covariance accumulated since the key
-   image, :func:`robokit.sim.odometry_covariance`).
+   (:func:`~robokit.mapping.local_maps.local_map_full`; the uncertainty is the odometry
+   covariance accumulated since the key image, :func:`robokit.sim.odometry_covariance`).
 
 The new node's base is "the current robot position", joined to the previous node by an odometry
 edge. Loop closure (Sec. "Loop closure alignment": "when a node is added or recognized in the
@@ -32,7 +33,6 @@ References
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, Callable, Iterator
 
 import numpy as np
@@ -42,200 +42,19 @@ from ..progress import progress_bar
 from ..sim.motion import odometry_covariance
 from ..sim.omni import OmniCamera, check_omni_camera
 from ..sim.runs import FrameStream
-from ..validation import as_array, check_callable, check_choice, check_int, check_positive, describe
+from ..validation import as_array, check_callable, check_choice, check_int, check_positive
 from ..vision.colour import histogram_distance
 from ..vision.matching import METHODS, DescriptorIndex
 from .omni_views import check_omni_image, omni_view, relative_pose
 from .pose_graph import position_variance
+from .local_maps import Comparison, select_key_frames
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
 
-__all__ = ["Comparison", "appearance_changed", "local_map_full", "select_key_frames", "build_topological_map"]
+__all__ = ["build_topological_map"]
 
 #: chi-square bound of 3 degrees of freedom at 99.9 %: the odometry gate of a loop closure.
 GATE_3DOF = 16.27
 _COVARIANCE_FLOOR = np.diag([1e-6, 1e-6, 1e-8])   # a robot that stood still still has a proper edge
-
-
-@dataclass(frozen=True)
-class Comparison:
-    """How frame ``k`` compares with the current key image (what the criteria look at).
-
-    Attributes
-    ----------
-    distance : float
-        Hue-histogram distance, Eq. (5).
-    matches : int or None
-        SIFT matches with the key image (``None``: not computed, the histogram being similar).
-    n_features : int or None
-        Features the local map would hold: the key image's plus the frame's unmatched ones
-        (``None`` with ``matches``).
-    variance : float
-        Mean position variance (m^2) of the odometry since the key image.
-    """
-
-    distance: float
-    matches: int | None
-    n_features: int | None
-    variance: float
-
-
-def appearance_changed(distance: Any, matches: Any, *, similarity: float = 0.1, min_matches: int = 80) -> Any:
-    """Whether a frame no longer looks like the key image: histogram far AND few SIFT matches.
-
-    Parameters
-    ----------
-    distance : float or array_like
-        Hue-histogram distance to the key image (Eq. (5)).
-    matches : int or array_like
-        SIFT matches with the key image.
-    similarity : float, default 0.1
-        Distance above which the images are not "similar enough". On the office tour images less
-        than 0.5 m apart are at median 0.03 (95 % below 0.12), images 1-2 m apart at 0.24 (5 %
-        below 0.09).
-    min_matches : int, default 80
-        Match count below which the place has changed (ratio 0.7, 500 features: office views less
-        than 1 m apart share about 120, 1-2 m apart 46, unrelated ones 9): nodes about 1-2 m
-        apart, close enough for the floor to give a metric pose between them.
-
-    Returns
-    -------
-    bool or numpy.ndarray of bool
-
-    Notes
-    -----
-    Sec. "Partitioning for the local map": the first condition (similar enough) and the second,
-    "necessary, as the first condition can be satisfied even when someone is blocking the camera
-    view" (our reading: a person in view changes the colours, but most of the place's features
-    still match).
-
-    Examples
-    --------
-    >>> appearance_changed([0.05, 0.3, 0.3], [20, 80, 20]).tolist()
-    [False, False, True]
-    """
-    d, m = _paired(distance, "distance", matches, "matches")
-    s = check_positive(similarity, "similarity")
-    mm = check_int(min_matches, "min_matches", minimum=0)
-    out = (d > s) & (m < mm)
-    return bool(out) if out.ndim == 0 else out
-
-
-def _paired(a: Any, a_name: str, b: Any, b_name: str) -> tuple[np.ndarray, np.ndarray]:
-    """Two non-negative scalars or 1-D arrays of one length (a scalar pairs with any length)."""
-    x, y = as_array(a, a_name), as_array(b, b_name)
-    for arr, name in ((x, a_name), (y, b_name)):
-        if arr.ndim > 1:
-            raise ValueError(f"{name}: expected a number or a 1-D array, got shape {arr.shape}")
-        if np.any(arr < 0):
-            raise ValueError(f"{name}: expected non-negative values, got {arr.min()}")
-    if x.ndim and y.ndim and x.shape != y.shape:
-        raise ValueError(f"{b_name}: expected the shape of {a_name} {x.shape}, got {y.shape}")
-    return x, y
-
-
-def local_map_full(n_features: Any, variance: Any, *, max_features: int = 930, max_variance: float = 0.1) -> Any:
-    """Whether the local map has reached its feature count or its uncertainty limit.
-
-    Parameters
-    ----------
-    n_features : int or array_like
-        Features the local map holds.
-    variance : float or array_like
-        Its accumulated odometry position variance (m^2).
-    max_features : int, default 930
-        With 500 features per image (about 470 found) this binds only when the current image
-        shares few matches with the key image while its colours have hardly changed: a backstop
-        the appearance test (which needs both to change) would miss. The builder counts only frames
-        whose SIFT features it computed (frames with an unchanged histogram skip SIFT).
-    max_variance : float, default 0.1
-        m^2 (about 0.3 m standard deviation along each axis).
-
-    Returns
-    -------
-    bool or numpy.ndarray of bool
-
-    Notes
-    -----
-    Sec. "Partitioning for the local map": "the number of features in the current local map
-    reaches a maximum, or the uncertainty of the current map reaches a limit".
-
-    Examples
-    --------
-    >>> local_map_full([100, 2500, 100], [0.001, 0.001, 0.5]).tolist()
-    [False, True, True]
-    """
-    n, v = _paired(n_features, "n_features", variance, "variance")
-    mf = check_int(max_features, "max_features", minimum=1)
-    mv = check_positive(max_variance, "max_variance")
-    out = (n >= mf) | (v >= mv)
-    return bool(out) if out.ndim == 0 else out
-
-
-def select_key_frames(n_frames: int, compare: Callable[[int, int], Comparison], *, similarity: float = 0.1,
-                      min_matches: int = 80, occlusion_frames: int = 3, max_features: int = 930,
-                      max_variance: float = 0.1) -> tuple[list[int], list[str]]:
-    """Cut a sequence of frames into local maps: the key frames and why each was started.
-
-    Parameters
-    ----------
-    n_frames : int
-        Frames in the sequence (>= 1).
-    compare : callable ``(key, k) -> Comparison``
-        Compares frame ``k`` with the current key frame ``key``.
-    similarity, min_matches : see :func:`appearance_changed`.
-    occlusion_frames : int, default 3
-        A change of appearance must hold for this many consecutive frames to start a node (1: at
-        once); a shorter one (someone walking past the camera) is ignored.
-    max_features, max_variance : see :func:`local_map_full` (they act at once; a frame whose
-        appearance has changed adds no features, so a transient blocker cannot fill the local map).
-
-    Returns
-    -------
-    keys : list of int
-        Key frames, starting with 0.
-    reasons : list of str
-        ``"start"``, ``"appearance"``, ``"features"`` or ``"variance"`` per key.
-
-    Notes
-    -----
-    Sec. "Partitioning for the local map". A node starts at the frame that confirms the change
-    (``occlusion_frames - 1`` frames after it began).
-
-    Examples
-    --------
-    A person blocks the camera for two frames (4, 5); the place changes for good at frame 8:
-
-    >>> far = {4, 5} | set(range(8, 12))
-    >>> compare = lambda key, k: Comparison(0.5 if (k in far) != (key in far) else 0.0,
-    ...                                     10 if (k in far) != (key in far) else 90, 300, 0.0)
-    >>> select_key_frames(12, compare, occlusion_frames=3)
-    ([0, 10], ['start', 'appearance'])
-    """
-    n = check_int(n_frames, "n_frames", minimum=1)
-    compare = check_callable(compare, "compare", optional=False)
-    occlusion_frames = check_int(occlusion_frames, "occlusion_frames", minimum=1)
-    appearance_changed(0.0, 0, similarity=similarity, min_matches=min_matches)      # validate once
-    local_map_full(0, 0.0, max_features=max_features, max_variance=max_variance)
-    keys, reasons, key, run = [0], ["start"], 0, 0
-    for k in range(1, n):
-        c = compare(key, k)
-        if not isinstance(c, Comparison):
-            raise TypeError(f"compare: expected a callable returning a Comparison, got {describe(c)}")
-        changed = c.matches is not None and appearance_changed(c.distance, c.matches, similarity=similarity,
-                                                               min_matches=min_matches)
-        run = run + 1 if changed else 0
-        # a frame that no longer looks like the local map (perhaps someone blocking the camera) adds
-        # none of its features to it: the occlusion guard, not the feature count, decides on it
-        reason, n_local = None, 0 if c.n_features is None or changed else c.n_features
-        if local_map_full(n_local, c.variance, max_features=max_features, max_variance=max_variance):
-            reason = "features" if n_local >= max_features else "variance"
-        elif run >= occlusion_frames:
-            reason = "appearance"
-        if reason is not None:
-            keys.append(k)
-            reasons.append(reason)
-            key, run = k, 0
-    return keys, reasons
 
 
 def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, similarity: float = 0.1,
@@ -259,7 +78,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     camera : OmniCamera
         The camera that took the images.
     similarity, min_matches, occlusion_frames, max_features, max_variance
-        Key-image criteria, see :func:`select_key_frames`.
+        Key-image criteria, see :func:`~robokit.mapping.local_maps.select_key_frames`.
     odometry_alphas : array_like, shape (4,)
         Odometry noise the builder assumes (Thrun et al. 2005, Table 5.6), for the edges'
         covariances and the loop-closure gate.
@@ -316,23 +135,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     >>> len(tmap), tmap.n_edges, tmap.frames.tolist()
     (1, 0, [0])
     """
-    if isinstance(images, FrameStream):
-        raise TypeError("images: expected an array of images or an iterator of them (a FrameStream's .frames), "
-                        "got the FrameStream itself")
-    streamed = isinstance(images, Iterator)      # taken as they arrive (e.g. rendered by workers)
-    if streamed:
-        check_omni_camera(camera)
-        odo = as_array(odometry, "odometry", shape=(None, 3))
-        if len(odo) == 0:
-            raise EmptyMapError("odometry: expected at least one pose to build a map from, got none")
-    else:
-        raw = as_array(images, "images", dtype=None)
-        if raw.ndim != 4 or len(raw) == 0:
-            if raw.ndim == 4 or raw.size == 0:
-                raise EmptyMapError(f"images: expected at least one image to build a map from, got shape {raw.shape}")
-            raise ValueError(f"images: expected shape (N, H, W, 3), got shape {raw.shape}")
-        check_omni_image(raw[0], camera, "images[0]")
-        odo = as_array(odometry, "odometry", shape=(len(raw), 3))
+    raw, odo = _images_and_odometry(images, odometry, camera)
     n = len(odo)
     sigma = as_array(sigma_visual, "sigma_visual", shape=(3,))
     if np.any(sigma <= 0):
@@ -347,73 +150,128 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     loop = {"top_k": check_int(loop_top_k, "loop_top_k", minimum=1),
             "min_matches": check_int(loop_min_matches, "loop_min_matches", minimum=8),
             "exclude": check_int(loop_exclude, "loop_exclude", minimum=1)}
-    if streamed:          # every argument checked (the key-image criteria by select_key_frames): start taking images
+    if raw is None:       # every argument checked (the key-image criteria by select_key_frames): start taking images
         raw = _Arrivals(images, n, camera)
-    cache: dict[int, Any] = {}            # frame -> OmniView: the key frames and the latest frame only
-    has_sift: dict[int, bool] = {}
-    key_frames: set[int] = set()
-    current: dict[str, Any] = {"key": None, "index": None}
-
-    def view(k, features=True):
-        if k not in cache or (features and not has_sift[k]):
-            known = cache[k].histogram if k in cache else None      # adding SIFT keeps the histogram
-            cache[k] = omni_view(raw[k], camera, bins=bins, n_features=n_features, features=features,
-                                 histogram=known)
-            has_sift[k] = features
-        return cache[k]
-
-    def compare(key, k):
-        if current["key"] != key:
-            key_frames.add(key)
-            features = view(key).features
-            current["key"] = key
-            current["index"] = DescriptorIndex(features.descriptors) if len(features) >= 2 else None
-        for f in [f for f in cache if f not in key_frames and f != k]:
-            del cache[f], has_sift[f]
-        if streamed:          # the key's features are known: no image before frame k is asked for again
-            raw.release(before=k)
-        bar(k + 1, n)
-        var = float(position_variance(odometry_covariance(odo[key:k + 1], alphas)[-1]))
-        d = float(histogram_distance(view(k, features=False).histogram, view(key).histogram))   # Eq. (5)
-        if d <= similarity:           # similar enough: the global feature answers, SIFT is not needed
-            return Comparison(d, None, None, var)
-        v = view(k)
-        m = len(current["index"].match(v.features.descriptors, ratio=ratio)) if current["index"] and len(v) else 0
-        return Comparison(d, m, len(view(key)) + len(v) - m, var)
-
+    views = _Views(raw, camera, bins=bins, n_features=n_features)
     with progress_bar(n, "building the map", unit="frame", callback=progress) as bar:
+        compare = _Comparisons(views, odo, alphas, similarity=similarity, ratio=ratio, bar=bar)
         keys, reasons = select_key_frames(n, compare, similarity=similarity, min_matches=min_matches,
                                           occlusion_frames=occlusion_frames, max_features=max_features,
                                           max_variance=max_variance)
-    key_views = [view(k) for k in keys]
-    if streamed:
+    key_views = [views(k) for k in keys]
+    if isinstance(raw, _Arrivals):
         raw.check_ended()
-    edge_cov = [odometry_covariance(odo[a:b + 1], alphas)[-1] + _COVARIANCE_FLOOR for a, b in zip(keys[:-1], keys[1:])]
-    variances = np.concatenate([[0.0], np.cumsum(position_variance(np.reshape(edge_cov, (-1, 3, 3))))])
-    counts = np.array([len(v) for v in key_views])
-    tmap = TopologicalMap(
-        poses=odo[keys], variances=variances, histograms=np.stack([v.histogram for v in key_views]),
-        frames=np.array(keys), keypoints=_stack([np.column_stack([v.features.keypoints.xy, v.features.keypoints.scale,
-                                                                  v.features.keypoints.orientation])
-                                                 for v in key_views], 4),
-        bearings=_stack([v.bearings for v in key_views], 3),
-        descriptors=_stack([v.features.descriptors for v in key_views], 128),
-        offsets=np.concatenate([[0], np.cumsum(counts)]),
-        edges=np.array([[i, i + 1] for i in range(len(keys) - 1)]).reshape(-1, 2),
-        measurements=se2_between(odo[keys[:-1]], odo[keys[1:]]).reshape(-1, 3),
-        covariances=np.array(edge_cov).reshape(-1, 3, 3), kinds=np.full(len(keys) - 1, ODOMETRY_EDGE), index=index)
+    tmap = _odometry_map(keys, key_views, odo, alphas, index)
     if log is not None:
         for i, (k, r) in enumerate(zip(keys, reasons)):
-            log(f"node {i}: frame {k} ({r}), {counts[i]} features")
-    if not loop_closure:
-        return tmap
-    extra = _loop_closures(tmap, key_views, odo, alphas, camera, sigma, ratio=ratio, log=log, **loop)
+            log(f"node {i}: frame {k} ({r}), {len(key_views[i])} features")
+    extra = _loop_closures(tmap, key_views, odo, alphas, camera, sigma, ratio=ratio, log=log, **loop) if loop_closure else []
     if not extra:
         return tmap
     e, meas, cov = (np.array(x) for x in zip(*extra))
     return tmap.with_edges(np.vstack([tmap.edges, e]), np.vstack([tmap.measurements, meas]),
                            np.concatenate([tmap.covariances, cov]),
                            np.concatenate([tmap.kinds, np.full(len(e), LOOP_EDGE)]))
+
+
+def _images_and_odometry(images: Any, odometry: Any, camera: OmniCamera) -> tuple[np.ndarray | None, np.ndarray]:
+    """The images as an array (``None`` for an iterator, whose images are checked as they come) and the
+    odometry, checked against each other and the camera."""
+    if isinstance(images, FrameStream):
+        raise TypeError("images: expected an array of images or an iterator of them (a FrameStream's .frames), "
+                        "got the FrameStream itself")
+    if isinstance(images, Iterator):      # taken as they arrive (e.g. rendered by workers)
+        check_omni_camera(camera)
+        odo = as_array(odometry, "odometry", shape=(None, 3))
+        if len(odo) == 0:
+            raise EmptyMapError("odometry: expected at least one pose to build a map from, got none")
+        return None, odo
+    raw = as_array(images, "images", dtype=None)
+    if raw.ndim != 4 or len(raw) == 0:
+        if raw.ndim == 4 or raw.size == 0:
+            raise EmptyMapError(f"images: expected at least one image to build a map from, got shape {raw.shape}")
+        raise ValueError(f"images: expected shape (N, H, W, 3), got shape {raw.shape}")
+    check_omni_image(raw[0], camera, "images[0]")
+    return raw, as_array(odometry, "odometry", shape=(len(raw), 3))
+
+
+class _Views:
+    """The frames' omni views, each computed once and kept while the builder may need it again.
+
+    ``views(k)`` is frame ``k``'s view with SIFT; ``views(k, features=False)`` its hue histogram
+    alone (the first stage of every comparison), completed with SIFT, histogram kept, if a later
+    comparison needs it. Only the key frames and the frame being compared are kept.
+    """
+
+    def __init__(self, images: Any, camera: OmniCamera, *, bins: int, n_features: int):
+        self.images, self.camera = images, camera       # an array, or _Arrivals
+        self.bins, self.n_features = bins, n_features
+        self._cache: dict[int, Any] = {}      # frame -> OmniView
+        self._has_sift: dict[int, bool] = {}
+        self.keys: set[int] = set()
+
+    def __call__(self, k: int, features: bool = True):
+        if k not in self._cache or (features and not self._has_sift[k]):
+            known = self._cache[k].histogram if k in self._cache else None      # adding SIFT keeps the histogram
+            self._cache[k] = omni_view(self.images[k], self.camera, bins=self.bins, n_features=self.n_features,
+                                       features=features, histogram=known)
+            self._has_sift[k] = features
+        return self._cache[k]
+
+    def keep_only(self, k: int) -> None:
+        """Let go of every view but the key frames' and frame ``k``'s (and of the images before ``k``)."""
+        for f in [f for f in self._cache if f not in self.keys and f != k]:
+            del self._cache[f], self._has_sift[f]
+        if isinstance(self.images, _Arrivals):      # the key's features are known: no image before k is asked for again
+            self.images.release(before=k)
+
+
+class _Comparisons:
+    """``compare(key, k)`` for :func:`select_key_frames`: the hue histograms' distance (Eq. (5)) first,
+    SIFT matches against the key frame only when that is not similar enough, and the odometry's
+    position variance since the key frame."""
+
+    def __init__(self, views: _Views, odo: np.ndarray, alphas: np.ndarray, *, similarity: float, ratio: float,
+                 bar: Callable):
+        self.views, self.odo, self.alphas, self.bar = views, odo, alphas, bar
+        self.similarity, self.ratio = similarity, ratio
+        self.key: int | None = None
+        self.index: DescriptorIndex | None = None        # the key frame's descriptors
+
+    def __call__(self, key: int, k: int) -> Comparison:
+        views = self.views
+        if self.key != key:
+            views.keys.add(key)
+            features = views(key).features
+            self.key = key
+            self.index = DescriptorIndex(features.descriptors) if len(features) >= 2 else None
+        views.keep_only(k)
+        self.bar(k + 1, len(self.odo))
+        var = float(position_variance(odometry_covariance(self.odo[key:k + 1], self.alphas)[-1]))
+        d = float(histogram_distance(views(k, features=False).histogram, views(key).histogram))   # Eq. (5)
+        if d <= self.similarity:      # similar enough: the global feature answers, SIFT is not needed
+            return Comparison(d, None, None, var)
+        v = views(k)
+        m = len(self.index.match(v.features.descriptors, ratio=self.ratio)) if self.index and len(v) else 0
+        return Comparison(d, m, len(views(key)) + len(v) - m, var)
+
+
+def _odometry_map(keys: list, views: list, odo: np.ndarray, alphas: np.ndarray, index: str) -> TopologicalMap:
+    """The map of the key frames joined by odometry edges (Eq. (1)'s variances accumulated along them)."""
+    edge_cov = [odometry_covariance(odo[a:b + 1], alphas)[-1] + _COVARIANCE_FLOOR for a, b in zip(keys[:-1], keys[1:])]
+    variances = np.concatenate([[0.0], np.cumsum(position_variance(np.reshape(edge_cov, (-1, 3, 3))))])
+    counts = np.array([len(v) for v in views])
+    return TopologicalMap(
+        poses=odo[keys], variances=variances, histograms=np.stack([v.histogram for v in views]),
+        frames=np.array(keys), keypoints=_stack([np.column_stack([v.features.keypoints.xy, v.features.keypoints.scale,
+                                                                  v.features.keypoints.orientation])
+                                                 for v in views], 4),
+        bearings=_stack([v.bearings for v in views], 3),
+        descriptors=_stack([v.features.descriptors for v in views], 128),
+        offsets=np.concatenate([[0], np.cumsum(counts)]),
+        edges=np.array([[i, i + 1] for i in range(len(keys) - 1)]).reshape(-1, 2),
+        measurements=se2_between(odo[keys[:-1]], odo[keys[1:]]).reshape(-1, 3),
+        covariances=np.array(edge_cov).reshape(-1, 3, 3), kinds=np.full(len(keys) - 1, ODOMETRY_EDGE), index=index)
 
 
 _END = object()     # what an exhausted iterator gives
