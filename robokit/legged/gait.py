@@ -302,13 +302,7 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     """
     schedule = as_gait_schedule(schedule)
     distance = check_positive(distance, "distance")
-    feet0 = STANCE_FEET if nominal_feet is None else as_array(nominal_feet, "nominal_feet", shape=(4, 3))
-    if not (np.all(feet0[:, 2] < 0) and np.all(np.abs(feet0) <= 10.0)):
-        raise ValueError(f"nominal_feet: expected feet below the body (z < 0) within 10 m of it, got {feet0.tolist()}")
-    try:
-        support_polygon(feet0[:, :2])
-    except ValueError as exc:
-        raise ValueError(f"nominal_feet: the standing feet span no support polygon ({exc})") from None
+    feet0 = _standing_feet(nominal_feet)
     height = check_positive(body_height, "body_height")
     dt = check_positive(dt, "dt")
     settle = check_positive(settle, "settle", allow_zero=True)
@@ -333,22 +327,10 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
         return _progress(np.asarray(tau) - tau0, distance, schedule.speed, T)
 
     if static:
-        knots_t, knots_p, now = [tau0], [np.zeros(2)], footholds.copy()
-        for sw in swings:
-            others = [i for i in range(4) if i != sw.leg]
-            try:
-                triangle = support_polygon(now[others, :2])
-            except SupportPolygonError:
-                raise ValueError(f"nominal_feet: the three feet that stay down when {LEGS[sw.leg]} lifts are "
-                                 "collinear: no support triangle") from None
-            goal = np.array([progress(sw.lift + schedule.swing_duration / 2), 0.0])
-            target = _nearest_point_inside(triangle, margin + _EPS, goal, LEGS[sw.leg])
-            knots_t += [sw.lift, sw.touchdown]
-            knots_p += [target, target]
-            now[sw.leg] = sw.end
-        tau_end = swings[-1].touchdown + window
-        knots_t.append(tau_end)
+        knots_t, knots_p = _crawl_body_knots(swings, footholds, progress, schedule.swing_duration, margin, tau0)
+        knots_t.append(swings[-1].touchdown + window)                # the last shift: to standing, distance ahead
         knots_p.append(np.array([distance, 0.0]))
+        tau_end = knots_t[-1]
     else:
         tau_end = max(swings[-1].touchdown, tau0 + distance / schedule.speed + T)
     t_walk = settle - tau0                                          # world time of gait time 0
@@ -359,17 +341,54 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
         body_xy = _rest_to_rest(np.array(knots_t), np.array(knots_p), tau)
     else:
         body_xy = np.column_stack([progress(tau), np.zeros(n)])
-
-    feet = np.broadcast_to(footholds, (n, 4, 3)).copy()
-    stance = np.ones((n, 4), bool)
-    for sw in swings:
-        i0, i1 = np.searchsorted(tau, [sw.lift - _EPS, sw.touchdown - _EPS])
-        phase = np.clip((tau[i0:i1] - sw.lift) / (sw.touchdown - sw.lift), 0.0, 1.0)
-        feet[i0:i1, sw.leg] = swing_trajectory(sw.start, sw.end, phase, schedule.step_height)
-        feet[i1:, sw.leg] = sw.end
-        stance[i0:i1, sw.leg] = False
-
+    feet, stance = _feet_along(swings, footholds, tau, schedule.step_height)
     T_world_body = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
     T_world_body[:, :2, 3], T_world_body[:, 2, 3] = body_xy, height
     margins = stability_margins(feet[..., :2], stance, body_xy)
     return WalkPlan(t, T_world_body, feet, stance, margins, schedule.name)
+
+
+def _standing_feet(nominal_feet: Any) -> np.ndarray:
+    """The standing feet in the body frame (default LittleDog's), checked to span a support polygon."""
+    feet0 = STANCE_FEET if nominal_feet is None else as_array(nominal_feet, "nominal_feet", shape=(4, 3))
+    if not (np.all(feet0[:, 2] < 0) and np.all(np.abs(feet0) <= 10.0)):
+        raise ValueError(f"nominal_feet: expected feet below the body (z < 0) within 10 m of it, got {feet0.tolist()}")
+    try:
+        support_polygon(feet0[:, :2])
+    except ValueError as exc:
+        raise ValueError(f"nominal_feet: the standing feet span no support polygon ({exc})") from None
+    return feet0
+
+
+def _crawl_body_knots(swings: list[_Swing], footholds: np.ndarray, progress: Any, swing_duration: float,
+                      margin: float, tau0: float) -> tuple[list, list]:
+    """A crawl's body stops: before each lift-off, the point nearest the nominal progress at mid-swing
+    with ``margin`` over the three feet that stay down, held until touchdown (McGhee & Frank 1968)."""
+    knots_t, knots_p, now = [tau0], [np.zeros(2)], footholds.copy()
+    for sw in swings:
+        others = [i for i in range(4) if i != sw.leg]
+        try:
+            triangle = support_polygon(now[others, :2])
+        except SupportPolygonError:
+            raise ValueError(f"nominal_feet: the three feet that stay down when {LEGS[sw.leg]} lifts are "
+                             "collinear: no support triangle") from None
+        goal = np.array([progress(sw.lift + swing_duration / 2), 0.0])
+        target = _nearest_point_inside(triangle, margin + _EPS, goal, LEGS[sw.leg])
+        knots_t += [sw.lift, sw.touchdown]
+        knots_p += [target, target]
+        now[sw.leg] = sw.end
+    return knots_t, knots_p
+
+
+def _feet_along(swings: list[_Swing], footholds: np.ndarray, tau: np.ndarray, step_height: float) -> tuple:
+    """Every foot's world position and stance flag at gait times ``tau``: on the ground between swings,
+    on :func:`swing_trajectory` during them."""
+    feet = np.broadcast_to(footholds, (len(tau), 4, 3)).copy()
+    stance = np.ones((len(tau), 4), bool)
+    for sw in swings:
+        i0, i1 = np.searchsorted(tau, [sw.lift - _EPS, sw.touchdown - _EPS])
+        phase = np.clip((tau[i0:i1] - sw.lift) / (sw.touchdown - sw.lift), 0.0, 1.0)
+        feet[i0:i1, sw.leg] = swing_trajectory(sw.start, sw.end, phase, step_height)
+        feet[i1:, sw.leg] = sw.end
+        stance[i0:i1, sw.leg] = False
+    return feet, stance
