@@ -83,18 +83,57 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     Planar homography: Hartley & Zisserman (2004), Sec. 8.1.1; z-buffer: Catmull (1974).
     """
     R_cw = T_world_cam[:3, :3].T
-    C = T_world_cam[:3, 3]
-    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
-    P = (world.corner_array - C) @ R_cw.T  # (N, 4, 3) corners in the camera frame
-    x, y, z = P[..., 0], P[..., 1], P[..., 2]
-    # a surface is culled when all its corners lie outside one side of the view frustum
-    outside = [z < near, fx * x + (cx + 0.5) * z < 0, fx * x - (width - 0.5 - cx) * z > 0,
-               fy * y + (cy + 0.5) * z < 0, fy * y - (height - 0.5 - cy) * z > 0]
-    idx = np.flatnonzero(~np.any([o.all(axis=1) for o in outside], axis=0))
+    P = (world.corner_array - T_world_cam[:3, 3]) @ R_cw.T  # (N, 4, 3) corners in the camera frame
+    idx = _in_view(P, K, width, height, near)
+    polygons, box, zmin, zmax, seen = _image_polygons(P[idx], K, width, height, near)
+    plane, level, M = _texture_maps(world.surface_arrays, idx, P[idx], R_cw, K, box, zmin, zmax)
+    seen &= np.isfinite(plane).all(axis=1)          # a plane seen edge-on covers no pixel area
     image = np.zeros((height, width, 3), np.uint8)
     zinv_buf = np.zeros((height, width), np.float32)
-    # 1. every surface in view at once: its polygon in the image, bounding box, plane and texture map
-    Pk, arrays = P[idx], world.surface_arrays
+    # each surface in turn (in the world's order, which settles ties): rasterise, z-test, texture
+    box = box.astype(int).tolist()
+    cols, rows = np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32)
+    for i in np.flatnonzero(seen).tolist():
+        x0, y0, x1, y1 = box[i]
+        w = plane[i]
+        # 1/Z = (w0 u + w1 v) + w2 in float64, as one expression over the box would give it, with the
+        # products made once per column and per row instead of once per pixel
+        zi = np.add.outer(w[1] * rows[y0:y1 + 1], w[0] * cols[x0:x1 + 1])
+        zi += w[2]
+        zi = zi.astype(np.float32)
+        mask = np.zeros((y1 - y0 + 1, x1 - x0 + 1), np.uint8)
+        cv2.fillPoly(mask, [np.round((polygons[i] - [x0, y0]) * 16).astype(np.int32)], 1, lineType=cv2.LINE_8,
+                     shift=4)
+        sub_z = zinv_buf[y0:y1 + 1, x0:x1 + 1]
+        update = zi > sub_z                 # the z-buffer keeps the largest inverse depth (Catmull 1974)
+        update &= mask.view(bool)           # fillPoly wrote 0 or 1
+        if not update.any():
+            continue
+        tex = world.surfaces[idx[i]].pyramid[level[i]]
+        warped = cv2.warpPerspective(tex, M[i], (x1 - x0 + 1, y1 - y0 + 1), flags=cv2.INTER_LINEAR,
+                                     borderMode=cv2.BORDER_REPLICATE)
+        # OpenCV's masked copy writes into the views (the image and the z-buffer) in place
+        cv2.copyTo(warped, update.view(np.uint8), image[y0:y1 + 1, x0:x1 + 1])
+        cv2.copyTo(zi, update.view(np.uint8), sub_z)
+    with np.errstate(divide="ignore"):
+        depth = np.where(zinv_buf > 0, 1.0 / zinv_buf, np.inf).astype(np.float32)
+    return image, depth
+
+
+def _in_view(P: np.ndarray, K: np.ndarray, width: int, height: int, near: float) -> np.ndarray:
+    """Indices of the surfaces (corners ``P``, camera frame) not culled: a surface is culled when all
+    its corners lie outside one side of the view frustum."""
+    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
+    x, y, z = P[..., 0], P[..., 1], P[..., 2]
+    outside = [z < near, fx * x + (cx + 0.5) * z < 0, fx * x - (width - 0.5 - cx) * z > 0,
+               fy * y + (cy + 0.5) * z < 0, fy * y - (height - 0.5 - cy) * z > 0]
+    return np.flatnonzero(~np.any([o.all(axis=1) for o in outside], axis=0))
+
+
+def _image_polygons(Pk: np.ndarray, K: np.ndarray, width: int, height: int, near: float) -> tuple:
+    """Every surface in view at once: its polygon in the image (clipped where needed), its bounding
+    box ``(x0, y0, x1, y1)`` in the image, its depth range and whether it covers any pixel."""
+    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
     with np.errstate(divide="ignore", invalid="ignore"):
         uv = _project(Pk, fx, fy, cx, cy)                                    # (n, 4, 2)
         simple = (Pk[..., 2] >= near).all(axis=1) & (np.abs(uv).max(axis=(1, 2), initial=0.0) <= _FAR_PIXELS)
@@ -111,10 +150,18 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     box = np.column_stack([np.maximum(lo, 0), np.minimum(hi, [width - 1, height - 1])])  # x0, y0, x1, y1
     seen &= (box[:, 2] >= box[:, 0]) & (box[:, 3] >= box[:, 1])
     box[~seen] = 0                      # never drawn; keeps inf and NaN out of the integer box
+    return polygons, box, zmin, zmax, seen
+
+
+def _texture_maps(arrays: dict, idx: np.ndarray, Pk: np.ndarray, R_cw: np.ndarray, K: np.ndarray, box: np.ndarray,
+                  zmin: np.ndarray, zmax: np.ndarray) -> tuple:
+    """Per surface: its inverse-depth plane over the pixels (non-finite when seen edge-on), the mip
+    level of its texture and the homography from that level to its bounding box (H&Z Sec. 8.1.1)."""
+    fx = K[0, 0]
     # inverse depth is affine in the pixel: plane n.X = d in the camera frame, 1/Z = (K^-T n / d) . [u, v, 1]
     n_c = arrays["normal"][idx] @ R_cw.T
     d = np.einsum("ij,ij->i", n_c, Pk[:, 0])
-    seen &= np.abs(d) >= 1e-12          # a plane seen edge-on covers no pixel area
+    d[np.abs(d) < 1e-12] = np.nan       # a plane seen edge-on covers no pixel area
     with np.errstate(divide="ignore", invalid="ignore"):
         plane = np.linalg.solve(K.T, n_c.T).T / d[:, None]
         # mip level: texels per pixel at a representative depth of the visible part
@@ -129,34 +176,7 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     M = K @ np.stack([a_col, b_col, Pk[:, 0] + 0.5 * (a_col + b_col)], axis=-1)
     M[:, 0] -= box[:, :1] * M[:, 2]
     M[:, 1] -= box[:, 1:2] * M[:, 2]
-    # 2. each surface in turn (in the world's order, which settles ties): rasterise, z-test, texture
-    box = box.astype(int).tolist()
-    cols, rows = np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32)
-    for i in np.flatnonzero(seen).tolist():
-        x0, y0, x1, y1 = box[i]
-        w = plane[i]
-        # 1/Z = (w0 u + w1 v) + w2 in float64, as one expression over the box would give it, with the
-        # products made once per column and per row instead of once per pixel
-        zi = np.add.outer(w[1] * rows[y0:y1 + 1], w[0] * cols[x0:x1 + 1])
-        zi += w[2]
-        zi = zi.astype(np.float32)
-        mask = np.zeros((y1 - y0 + 1, x1 - x0 + 1), np.uint8)
-        cv2.fillPoly(mask, [np.round((polygons[i] - [x0, y0]) * 16).astype(np.int32)], 1, lineType=cv2.LINE_8,
-                     shift=4)
-        sub_z = zinv_buf[y0:y1 + 1, x0:x1 + 1]
-        update = zi > sub_z
-        update &= mask.view(bool)           # fillPoly wrote 0 or 1
-        if not update.any():
-            continue
-        tex = world.surfaces[idx[i]].pyramid[level[i]]
-        warped = cv2.warpPerspective(tex, M[i], (x1 - x0 + 1, y1 - y0 + 1), flags=cv2.INTER_LINEAR,
-                                     borderMode=cv2.BORDER_REPLICATE)
-        # OpenCV's masked copy writes into the views (the image and the z-buffer) in place
-        cv2.copyTo(warped, update.view(np.uint8), image[y0:y1 + 1, x0:x1 + 1])
-        cv2.copyTo(zi, update.view(np.uint8), sub_z)
-    with np.errstate(divide="ignore"):
-        depth = np.where(zinv_buf > 0, 1.0 / zinv_buf, np.inf).astype(np.float32)
-    return image, depth
+    return plane, level, M
 
 
 def _project(points: np.ndarray, fx: float, fy: float, cx: float, cy: float) -> np.ndarray:
