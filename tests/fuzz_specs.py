@@ -727,6 +727,9 @@ SPECS: dict[str, Call] = {
                                                                 "params": Obj(None, optional=True)}),
     "robokit.vision.plot_detector.plot_scales": Call({"sigma0": Real(1.6, optional=True), "k": Real(1.26, optional=True),
                                                       "n_scales": Int(9, optional=True)}),
+    "robokit.vision.scale_space_maxima.scale_space_maxima": Call({
+        "responses": Obj(lambda: [np.random.default_rng(0).random((12, 12), np.float32) for _ in range(3)]),
+        "steps": Array(np.array([1, 1, 2]), "3"), "threshold": Real(0.1), "border": Int(1), "check": Flag(True)}),
     "robokit.vision.plot_detector.junction_strength": Call({"tensor": Array(np.tile([[1.0, 0.1], [0.1, 2.0]], (4, 5, 1, 1)),
                                                                             "...,2,2")}),
     "robokit.vision.stereo.observe_stereo": Call({"left": Obj(features), "right": Obj(features), "rig": Obj(calibration),
@@ -1528,6 +1531,7 @@ EXTRA: tuple[str, ...] = (
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view
+    "robokit.vision.scale_space_maxima.scale_space_maxima",   # public since PLOT's search moved out
     # lesson 02 (path following, pose EKF, navigation), fuzzed before the lesson exists
     *(f"robokit.controllers.path_geometry.{n}" for n in ("VisualPath", "path_from_poses", "reference_point")),
     *(f"robokit.controllers.path_following.{n}" for n in (

@@ -26,12 +26,11 @@ docs/DECISIONS.md what each choice contributed.
 Speed. Each level is one incremental Gaussian blur of the previous one; once ``sigma`` is 4 px on
 the current grid the level is subsampled by two (SIFT's octaves, though SIFT halves at 3.2 px: PLOT's
 tensor, averaged over half a sigma, needs the finer sampling), and the maxima are searched on each
-level's own grid (an adjacent level on a grid twice as fine or as coarse is read by bilinear lookup
-at the candidates' neighbourhoods only). Derivatives are fourth-order central differences, so that
-a level's response does not depend on how finely its grid samples it. The normalisation is folded
-into the derivative kernels and the tensor is accumulated in place in float32 by OpenCV.
-:mod:`robokit.vision.plot_reference` keeps the plain full-resolution algorithm, and the tests compare
-the two.
+level's own grid (:mod:`robokit.vision.scale_space_maxima`). Derivatives are fourth-order central
+differences, so that a level's response does not depend on how finely its grid samples it. The
+normalisation is folded into the derivative kernels and the tensor is accumulated in place in
+float32 by OpenCV. :mod:`robokit.vision.plot_reference` keeps the plain full-resolution algorithm,
+and the tests compare the two.
 
 OpenCV does the filtering; the tensor, the eigenvalues and the maximum search are the lesson and
 are written here, vectorised with numpy.
@@ -56,6 +55,7 @@ import numpy as np
 
 from ..validation import as_array, check_finite_result, check_int, check_positive
 from .features import Keypoints, as_gray_image
+from .scale_space_maxima import scale_space_maxima
 
 __all__ = ["PlotParams", "ScaleSpace", "plot_scales", "polynomial_expansion", "orientation_tensor",
            "tensor_eigenvalues", "junction_strength", "edge_strength", "detect_plot", "detect_plot_levels"]
@@ -462,10 +462,7 @@ def detect_plot_levels(image, params: PlotParams | None = None, **overrides):
     thr = max(p.threshold * peak, p.min_response)
     if peak <= thr:
         return Keypoints.empty(), space
-    dilated = [cv2.dilate(r, np.ones((3, 3), np.uint8)) for r in responses]
-    found = [_level_maxima(n, responses, dilated, space.steps, thr, p.border)
-             for n in range(1, len(responses) - 1)]
-    xy, level, strength = (np.concatenate([f[i] for f in found]) for i in range(3))
+    xy, level, strength = scale_space_maxima(responses, space.steps, thr, p.border, check=False)
     order = np.argsort(-strength, kind="stable")[: p.max_keypoints]
     scale = p.sigma0 * p.k ** level[order]
     keypoints = Keypoints(xy[order], scale, strength[order].astype(float), np.zeros(order.size))
@@ -501,86 +498,3 @@ def _scale_space(img: np.ndarray, p: PlotParams) -> ScaleSpace:
         levels.append(smoothed)
         steps.append(step)
     return ScaleSpace(sigmas, levels, np.array(steps))
-
-
-def _lookup(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Bilinear samples of ``img`` at grid positions ``(x, y)`` (clamped to the grid), shaped as ``x``."""
-    n = x.size
-    if not n:
-        return np.zeros(x.shape, img.dtype)
-    # OpenCV's maps must be under 32767 on each side: lay the samples out in rows of 1024
-    width = min(n, 1024)
-    rows = -(-n // width)
-    mx, my = np.zeros((2, rows * width), np.float32)
-    mx[:n], my[:n] = x.ravel(), y.ravel()
-    out = cv2.remap(img, mx.reshape(rows, width), my.reshape(rows, width), cv2.INTER_LINEAR,
-                    borderMode=cv2.BORDER_REPLICATE)
-    return out.ravel()[:n].reshape(x.shape)
-
-
-#: Row and column offsets of a 3 x 3 neighbourhood, row-major (index 4 is the centre).
-_ROW_OFFSETS, _COL_OFFSETS = (g.ravel() for g in np.meshgrid([-1, 0, 1], [-1, 0, 1], indexing="ij"))
-
-
-def _cubes(n: int, responses: list, steps: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """The responses around each candidate of level ``n``: shape (N, 3, 3, 3) as (level, row, col).
-
-    The candidate's own level is read directly; the adjacent levels, whose grids may be twice as
-    fine or as coarse, by bilinear lookup at the same places in original pixels. (Bilinear lookup
-    flattens a peak between coarse samples, which pulls the selected scale of a structure just
-    above a grid change towards the finer level, by up to 0.07 octave for a Gaussian blob; bicubic
-    lookup removes that but overshoots at step edges and lost two corners of a plain square.)
-    """
-    cube = np.empty((rows.size, 3, 3, 3), np.float32)
-    r, c = rows[:, None] + _ROW_OFFSETS, cols[:, None] + _COL_OFFSETS
-    cube[:, 1] = responses[n][r, c].reshape(-1, 3, 3)
-    for side, m in ((0, n - 1), (2, n + 1)):
-        ratio = steps[n] / steps[m]
-        cube[:, side] = _lookup(responses[m], c * ratio, r * ratio).reshape(-1, 3, 3)
-    return cube
-
-
-def _quadratic_peak(cube: np.ndarray) -> np.ndarray:
-    """Offset (level, row, col) of the peak of the quadratic through each 3 x 3 x 3 cube.
-
-    One Newton step ``offset = -H^-1 g`` with the gradient ``g`` and Hessian ``H`` from central
-    differences (Lowe 2004, Sec. 4, Eq. 3), clipped to +-0.5 so that a keypoint never leaves its
-    cell; a cube whose Hessian is not negative definite keeps offset zero.
-    """
-    c = cube.astype(float)
-    centre = c[:, 1, 1, 1]
-    g = 0.5 * np.stack([c[:, 2, 1, 1] - c[:, 0, 1, 1], c[:, 1, 2, 1] - c[:, 1, 0, 1], c[:, 1, 1, 2] - c[:, 1, 1, 0]], 1)
-    h = np.empty((len(c), 3, 3))
-    h[:, 0, 0] = c[:, 2, 1, 1] - 2 * centre + c[:, 0, 1, 1]
-    h[:, 1, 1] = c[:, 1, 2, 1] - 2 * centre + c[:, 1, 0, 1]
-    h[:, 2, 2] = c[:, 1, 1, 2] - 2 * centre + c[:, 1, 1, 0]
-    h[:, 0, 1] = h[:, 1, 0] = 0.25 * (c[:, 2, 2, 1] - c[:, 2, 0, 1] - c[:, 0, 2, 1] + c[:, 0, 0, 1])
-    h[:, 0, 2] = h[:, 2, 0] = 0.25 * (c[:, 2, 1, 2] - c[:, 2, 1, 0] - c[:, 0, 1, 2] + c[:, 0, 1, 0])
-    h[:, 1, 2] = h[:, 2, 1] = 0.25 * (c[:, 1, 2, 2] - c[:, 1, 2, 0] - c[:, 1, 0, 2] + c[:, 1, 0, 0])
-    # negative definite: leading principal minors alternate in sign (-, +, -)
-    m2 = h[:, 0, 0] * h[:, 1, 1] - h[:, 0, 1] ** 2
-    peak = (h[:, 0, 0] < 0) & (m2 > 0) & (np.linalg.det(h) < 0)
-    offset = np.zeros((len(c), 3))
-    if peak.any():
-        offset[peak] = -np.linalg.solve(h[peak], g[peak][:, :, None])[:, :, 0]
-    return np.clip(offset, -0.5, 0.5)
-
-
-def _level_maxima(n: int, responses: list, dilated: list, steps: np.ndarray, thr: float, border: int):
-    """Keypoints at inner level ``n``: thresholded maxima of their 3 x 3 x 3 scale-space neighbourhood.
-
-    Returns ``(xy, level, strength)``: positions in original pixels and fractional levels, both
-    refined by the peak of a quadratic through the neighbourhood (:func:`_quadratic_peak`).
-    """
-    resp, step = responses[n], int(steps[n])
-    b = max(1, min(-(-border // step), (min(resp.shape) - 1) // 2))   # border in this grid's pixels
-    is_max = (resp >= dilated[n]) & (resp > thr)
-    is_max[:b], is_max[-b:], is_max[:, :b], is_max[:, -b:] = False, False, False, False
-    rows, cols = np.nonzero(is_max)
-    cube = _cubes(n, responses, steps, rows, cols)
-    strength = cube[:, 1, 1, 1]
-    keep = strength >= cube.reshape(-1, 27).max(axis=1)     # no weaker than any of its 26 neighbours
-    rows, cols, cube, strength = rows[keep], cols[keep], cube[keep], strength[keep]
-    offset = _quadratic_peak(cube)
-    xy = np.column_stack([cols + offset[:, 2], rows + offset[:, 1]]) * step
-    return xy, n + offset[:, 0], strength
