@@ -913,7 +913,7 @@ SPECS: dict[str, Call] = {
                                                                           min_rows=0),
                                                      "method": Choice("flann"), "checks": Int(32), "trees": Int(2),
                                                      "seed": Int(0)}),
-    "robokit.vision.matching.ratio_test": Call({"dist": Array(np.array([[0.1, 1.0], [0.5, np.inf]]), "N,2", inf_ok=True,
+    "robokit.vision.ratio.ratio_test": Call({"dist": Array(np.array([[0.1, 1.0], [0.5, np.inf]]), "N,2", inf_ok=True,
                                                               min_rows=0),
                                                 "index": Array(np.array([[3, 1], [0, 2]]), "N,2", min_rows=0),
                                                 "ratio": Real(0.8), "max_distance": Real(0.8, optional=True, inf_ok=True)}),
@@ -1549,7 +1549,7 @@ EXTRA: tuple[str, ...] = (
     # robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02)
     "robokit.vision.omni_features.omni_sift", "robokit.vision.omni_features.annulus_mask",
     "robokit.vision.omni_features.radial_orientation", "robokit.vision.matching.DescriptorIndex",
-    "robokit.vision.matching.ratio_test", "robokit.vision.descriptors.detect_sift_features",
+    "robokit.vision.ratio.ratio_test", "robokit.vision.descriptors.detect_sift_features",
     "robokit.sim.feature_check.omni_ground_truth_inliers",
     "robokit.sim.feature_check.omni_view_pair",
     # robokit.mapping's pose graphs (lesson 02), fuzzed before the lesson exists

@@ -7,7 +7,8 @@ from ..controllers.path_following import path_following_command
 from ..localization.pose_ekf import ekf_update
 from ..mapping.relaxation import relax_sweep
 from ..vision.colour import histogram_distance, hue_histogram, rgb_to_hsi
-from ..vision.matching import DescriptorIndex, check_ratio
+from ..vision.matching import DescriptorIndex
+from ..vision.ratio import check_ratio
 from ..validation import as_array, check_int
 from .compare import close, exact
 from .spec import Case, Exercise
@@ -353,7 +354,7 @@ EXERCISES = [
                     "robokit.exercises.omni_localization.recognise_node",
                     "robokit.exercises.omni_localization._counts", "robokit.exercises.omni_localization._node_list",
                     "robokit.vision.matching.DescriptorIndex", "robokit.vision.matching.ratio_match",
-                    "robokit.vision.matching.ratio_test", "robokit.vision.matching.k_nearest",
+                    "robokit.vision.ratio.ratio_test", "robokit.vision.matching.k_nearest",
                     "robokit.vision.matching.two_nearest"),
         description="For each candidate node, how many query descriptors pass the nearest/second-nearest "
                     "distance-ratio test against that node's descriptors (the fine stage); ValueError for an "

@@ -316,7 +316,7 @@ EXERCISES = [
         points=2, cases=_ratio_cases, reference=match_ratio, compare=unordered_rows(atol=0),
         references=("robokit.exercises.visual_slam.match_ratio", "robokit.vision.matching.ratio_match",
                     "robokit.vision.matching.two_nearest", "robokit.vision.matching.k_nearest",
-                    "robokit.vision.matching.ratio_test", "robokit.vision.matching.DescriptorIndex"),
+                    "robokit.vision.ratio.ratio_test", "robokit.vision.matching.DescriptorIndex"),
         description="Pairs [query_row, train_row] whose nearest / second-nearest Euclidean distance ratio is below "
                     "`ratio` (Lin et al. Sec. 3); (0, 2) when train has fewer than two rows; ValueError for "
                     "different descriptor lengths or a ratio outside (0, 1]."),

@@ -54,7 +54,7 @@ EXPERIMENT_MODULES = (
     "sim.build", "sim.camera", "sim.layout", "sim.lidar", "sim.motion", "sim.omni", "sim.render", "sim.runs",
     "sim.textures", "sim.world", "sim.worlds",
     "vision.descriptors", "vision.features", "vision.matching", "vision.plot_detector", "vision.ransac",
-    "vision.scale_space_maxima", "vision.stereo",
+    "vision.ratio", "vision.scale_space_maxima", "vision.stereo",
     "mapping.landmarks",
     "localization.egomotion", "localization.hough", "localization.visual_slam", "localization.lab_experiment")
 

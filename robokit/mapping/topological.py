@@ -38,7 +38,8 @@ from ..config import save_npz
 from ..validation import as_array, check_choice, check_int, check_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
-from ..vision.matching import METHODS, DescriptorIndex, Matches
+from ..vision.matching import METHODS, DescriptorIndex
+from ..vision.ratio import Matches
 from .omni_views import OmniView
 from .pose_graph import PoseGraph, information_from_covariance
 

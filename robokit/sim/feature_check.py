@@ -28,7 +28,8 @@ import numpy as np
 
 from ..geometry import as_se3
 from ..validation import as_array, as_points, check_positive
-from ..vision.matching import LOWE_RATIO, DescriptorIndex, ratio_match
+from ..vision.matching import DescriptorIndex, ratio_match
+from ..vision.ratio import LOWE_RATIO
 from ..vision.omni_features import omni_sift
 from .camera import PinholeCamera
 from .omni import OmniCamera, check_omni_camera

@@ -2,8 +2,8 @@
 
 Modules: :mod:`.features` (containers), :mod:`.plot_detector` (Lin et al. Sec. 2.i; its plain
 reference :mod:`.plot_reference`),
-:mod:`.descriptors` (Lin et al. Sec. 2.ii, Se et al. Sec. 4, OpenCV SIFT), :mod:`.matching`
-(Lin et al. Sec. 3), :mod:`.evaluation` (recall vs 1-precision, matching score), :mod:`.stereo` (Lin et al. Sec. 3,
+:mod:`.descriptors` (Lin et al. Sec. 2.ii, Se et al. Sec. 4, OpenCV SIFT), :mod:`.ratio` (the
+distance-ratio test, Lin et al. Sec. 3), :mod:`.matching` (the neighbour searches behind it), :mod:`.evaluation` (recall vs 1-precision, matching score), :mod:`.stereo` (Lin et al. Sec. 3,
 Se et al. Sec. 2.2 and 3.1), :mod:`.colour` (HSI hue histograms, lesson 02's paper, Sec. "Global
 image features"), :mod:`.omni_features` (SIFT in an omni image's annulus, Sec. "Local image
 features"; its KD-tree per map node is :class:`.matching.DescriptorIndex`), :mod:`.ransac` (the
@@ -27,7 +27,8 @@ from .features import Features, Keypoints, as_gray_image
 from .hamming import as_binary_descriptors, hamming_distance, hamming_distances, hamming_match
 from .keyframes import (KeyframeConditions, KeyframeSelector, feature_threshold, select_keyframes,
                         select_keyframes_orbslam, shared_fraction)
-from .matching import DescriptorIndex, Matches, k_nearest, ratio_match, ratio_test, two_nearest
+from .matching import DescriptorIndex, k_nearest, ratio_match, two_nearest
+from .ratio import Matches, ratio_test
 from .orb import detect_orb_features
 from .omni_features import ImageSizeError, annulus_mask, omni_sift, radial_orientation
 from .ransac import PlanarFit, ransac_sample_count, ransac_se2

@@ -28,7 +28,8 @@ from scipy.spatial import cKDTree
 
 from ..validation import as_array, as_points, check_finite_scalar, check_positive
 from .features import Features
-from .matching import distance_ratio, two_nearest
+from .matching import two_nearest
+from .ratio import distance_ratio
 
 __all__ = ["apply_homography", "warp_image", "similarity_homography", "recall_precision", "matching_score"]
 

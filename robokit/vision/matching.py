@@ -1,8 +1,9 @@
 """Nearest-neighbour distance-ratio matching of descriptors (Lin et al. Sec. 3).
 
 A descriptor ``D_A`` is matched to its nearest neighbour ``D_B`` when
-``||D_A - D_B|| / ||D_A - D_C|| < t`` with ``D_C`` the second nearest (Lin et al. use t = 0.65).
-The neighbour search (:func:`k_nearest`, or a :class:`DescriptorIndex` built once and queried many
+``||D_A - D_B|| / ||D_A - D_C|| < t`` with ``D_C`` the second nearest (Lin et al. use t = 0.65;
+the test itself and the :class:`~robokit.vision.ratio.Matches` it keeps are in
+:mod:`robokit.vision.ratio`). The neighbour search (:func:`k_nearest`, or a :class:`DescriptorIndex` built once and queried many
 times) is scipy's KD-tree, exact blocked matrix products (faster than a KD-tree for 128-element
 descriptors), OpenCV's brute-force matcher (the library reference), all three exact and giving the
 same matches, or OpenCV's FLANN randomised KD-trees (approximate: measured below).
@@ -29,21 +30,17 @@ References
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import cv2
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..validation import as_array, check_choice, check_int, check_positive
+from ..validation import as_array, check_choice, check_int
+from .ratio import LIN_RATIO, LOWE_RATIO, Matches, check_distance_bound, check_ratio, distance_ratio, ratio_test
 
-__all__ = ["Matches", "LIN_RATIO", "LOWE_RATIO", "FLANN_TREES", "FLANN_CHECKS", "METHODS", "DescriptorIndex", "check_ratio",
-           "k_nearest", "two_nearest", "distance_ratio", "ratio_test", "ratio_match", "gated_ratio_match"]
+__all__ = ["FLANN_TREES", "FLANN_CHECKS", "METHODS", "DescriptorIndex", "k_nearest", "two_nearest", "ratio_match",
+           "gated_ratio_match"]
 
-#: Lin et al.'s nearest-neighbour ratio threshold ``t`` (PLOT paper, Sec. 3: "t is set equal to 0.65").
-LIN_RATIO = 0.65
-#: Lowe's (2004, Sec. 7.1) ratio threshold, 0.8 (lesson 02's paper gives none).
-LOWE_RATIO = 0.8
 #: FLANN's randomised KD-trees and the leaves it checks per query. Measured on two omni views of
 #: ``office_floor()`` (about 680 SIFT descriptors each): 97.6 % of first neighbours exact, 99.85 %
 #: of the ratio tests (0.8) decided as by an exact search, and every accepted match found.
@@ -51,35 +48,6 @@ FLANN_TREES = 4
 FLANN_CHECKS = 128
 #: The neighbour searches :func:`k_nearest` and :class:`DescriptorIndex` offer.
 METHODS = ("kdtree", "bruteforce", "opencv", "flann")
-
-
-@dataclass(frozen=True)
-class Matches:
-    """Index pairs of matched descriptors.
-
-    Attributes
-    ----------
-    query, train : numpy.ndarray of int, shape (M,)
-        Row in the first and the second descriptor set.
-    distance : numpy.ndarray, shape (M,)
-        Euclidean descriptor distance to the nearest neighbour.
-    ratio : numpy.ndarray, shape (M,)
-        Nearest / second-nearest distance.
-    """
-
-    query: np.ndarray
-    train: np.ndarray
-    distance: np.ndarray
-    ratio: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.query.size)
-
-    @classmethod
-    def empty(cls) -> "Matches":
-        """Return zero matches."""
-        z = np.zeros(0, int)
-        return cls(z, z.copy(), np.zeros(0), np.zeros(0))
 
 
 def _descriptors(value, name):
@@ -234,7 +202,7 @@ class DescriptorIndex:
             raise ValueError(f"train: expected at least {k} descriptors, got {t.shape[0]}")
         if q.shape[0] and q.shape[1] != t.shape[1]:
             raise ValueError(f"query: expected descriptors of length {t.shape[1]}, got {q.shape[1]}")
-        bound = _distance_bound(max_distance)
+        bound = check_distance_bound(max_distance)
         if q.shape[0] == 0:
             return np.zeros((0, k)), np.zeros((0, k), int)
         if self.method == "kdtree":
@@ -273,7 +241,7 @@ class DescriptorIndex:
 
         Notes
         -----
-        :func:`ratio_test` on :meth:`query` (Lowe 2004, Sec. 7.1).
+        :func:`~robokit.vision.ratio.ratio_test` on :meth:`query` (Lowe 2004, Sec. 7.1).
         """
         ratio = check_ratio(ratio)
         q = _descriptors(query_descriptors, "query")
@@ -356,105 +324,6 @@ def two_nearest(query, train, *, method: str = "kdtree") -> tuple[np.ndarray, np
     if t.shape[0] < 2:
         raise ValueError(f"train: expected at least 2 descriptors for a distance ratio, got {t.shape[0]}")
     return k_nearest(query, t, 2, method=method)
-
-
-def distance_ratio(best, second) -> np.ndarray:
-    """Nearest over second-nearest descriptor distance, the quantity the ratio test thresholds.
-
-    Parameters
-    ----------
-    best, second : array_like, shape (N,)
-        Distances to the nearest and the second-nearest candidate (``second`` may be ``inf`` when
-        there is only one candidate).
-
-    Returns
-    -------
-    numpy.ndarray, shape (N,)
-        ``best / second``; 1 where ``second`` is 0 (two exact duplicates are ambiguous, so a test
-        ``ratio < t`` with ``t <= 1`` rejects them) and 0 where ``second`` is infinite.
-
-    Raises
-    ------
-    ValueError
-        For different shapes, NaN, a negative ``best``, an infinite ``best`` or ``second < best``.
-
-    Notes
-    -----
-    Lin et al. Sec. 3, ``||D_A - D_B|| / ||D_A - D_C|| < t``; Lowe (2004), Sec. 7.1.
-    """
-    b = as_array(best, "best")
-    c = as_array(second, "second", finite=False)
-    if b.shape != c.shape:
-        raise ValueError(f"second: expected the shape of best {b.shape}, got {c.shape}")
-    if np.any(b < 0) or np.any(np.isnan(c)) or np.any(c < b):
-        raise ValueError("best, second: expected distances 0 <= best <= second (second may be inf)")
-    return np.divide(b, c, out=np.ones(b.shape), where=c > 0)
-
-
-def _distance_bound(max_distance) -> float:
-    """``max_distance`` as a bound: ``None`` or ``inf`` mean none; otherwise a positive number."""
-    if max_distance is None:
-        return np.inf
-    bound = as_array(max_distance, "max_distance", shape=(), finite=False).item()
-    if not bound > 0:        # also catches NaN
-        raise ValueError(f"max_distance: expected a positive number or inf, got {bound}")
-    return bound
-
-
-def check_ratio(ratio) -> float:
-    """A distance-ratio bound in (0, 1], or a ValueError/TypeError naming ``ratio``."""
-    ratio = check_positive(ratio, "ratio")
-    if ratio > 1:
-        raise ValueError(f"ratio: expected a value in (0, 1], got {ratio}")
-    return ratio
-
-
-def ratio_test(dist, index, *, ratio: float = LIN_RATIO, max_distance: float | None = None) -> Matches:
-    """Keep the query rows whose nearest neighbour passes the distance-ratio test.
-
-    Parameters
-    ----------
-    dist : array_like, shape (N, 2)
-        Distances to the nearest and second-nearest neighbour (second may be ``inf``).
-    index : array_like of int, shape (N, 2)
-        Their indices (only the first column is used).
-    ratio : float, default 0.65
-        Keep a row when ``dist[:, 0] / dist[:, 1] < ratio``, in (0, 1].
-    max_distance : float, optional
-        Also reject rows whose nearest distance exceeds this.
-
-    Returns
-    -------
-    Matches
-
-    Raises
-    ------
-    ValueError
-        For mismatched shapes, distances that are not ``0 <= best <= second`` or a ratio
-        outside (0, 1].
-
-    Notes
-    -----
-    Lin et al. Sec. 3; Lowe 2004, Sec. 7.1. The one place the ratio test is applied: used by
-    :func:`ratio_match` and :meth:`DescriptorIndex.match`.
-
-    Examples
-    --------
-    >>> m = ratio_test([[0.1, 1.0], [0.9, 1.0]], [[4, 2], [0, 1]], ratio=0.8)
-    >>> m.query.tolist(), m.train.tolist(), m.ratio.tolist()
-    ([0], [4], [0.1])
-    """
-    ratio = check_ratio(ratio)
-    d = as_array(dist, "dist", shape=(None, 2), finite=False)
-    idx = as_array(index, "index", shape=(d.shape[0], 2), dtype=int)
-    if not (np.all(np.isfinite(d[:, 0])) and np.all(d[:, 0] >= 0) and np.all(d[:, 1] >= d[:, 0])):
-        raise ValueError("dist: expected rows 0 <= nearest <= second (finite nearest; second may be inf)")
-    if idx.size and idx.min() < 0:
-        raise ValueError(f"index: expected non-negative indices, got {idx.min()}")
-    r = distance_ratio(d[:, 0], d[:, 1])
-    keep = (r < ratio) & (d[:, 0] <= _distance_bound(max_distance))
-    rows = np.nonzero(keep)[0]
-    return Matches(rows, idx[rows, 0], d[rows, 0], r[rows])
 
 
 def ratio_match(query, train, *, ratio: float = LIN_RATIO, method: str = "kdtree",
@@ -564,6 +433,6 @@ def gated_ratio_match(query, train, query_index, train_index, *, ratio: float = 
     best = dist[start]
     r = distance_ratio(best, second)
     keep = r < ratio
-    keep &= best <= _distance_bound(max_distance)
+    keep &= best <= check_distance_bound(max_distance)
     rows = start[keep]
     return Matches(qi[rows], ti[rows], best[keep], r[keep])
