@@ -8,7 +8,8 @@ enforces the order): ``geometry``; ``sim``, ``vision``; ``mapping``; ``localizat
 ``robokit.FAST`` is true when ``ROBOKIT_FAST=1`` asks experiments to shrink (tests, course build);
 ``robokit.cache_dir()`` is where deterministic generated data are cached.
 """
-from .config import FAST, cache_dir, cache_key, fast_mode
+from .config import FAST, fast_mode
+from .cache import cache_dir, cache_key
 
 __version__ = "0.1.0"
 

@@ -165,7 +165,7 @@ def test_compiled_code_is_cached_in_robokits_cache_not_in_the_package():
 
     import robokit
     from robokit.arm import jit
-    from robokit.config import cache_dir
+    from robokit.cache import cache_dir
 
     ik_srs(IIWA, IIWA.fk(np.zeros(7)))                       # compiled or loaded by now
     if not os.environ.get("NUMBA_CACHE_DIR") and jit.CACHING:

@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 import robokit
-from robokit.config import cache_dir, cache_key, fast_mode
+from robokit.config import fast_mode
+from robokit.cache import cache_dir, cache_key
 
 
 @pytest.mark.parametrize("raw, expected", [("1", True), ("true", True), ("ON", True), ("0", False),
@@ -56,13 +57,13 @@ def test_cache_key_rejects_unserialisable():
 # --- cache files: a corrupt, truncated or stale file is rebuilt, never loaded -------------------
 
 def _cache_file(tmp_path, meta):
-    from robokit.config import write_arrays
+    from robokit.cache import write_arrays
 
     return write_arrays(tmp_path / "c.npz", {"a": np.arange(1000.0), "b": np.eye(3)}, meta)
 
 
 def test_write_arrays_round_trip_needs_equal_parameters(tmp_path):
-    from robokit.config import code_version, read_arrays
+    from robokit.cache import code_version, read_arrays
 
     meta = {"n": 3, "x": [0.5, 1.0], "code": code_version("geometry")}
     target = _cache_file(tmp_path, meta)
@@ -76,7 +77,7 @@ def test_write_arrays_round_trip_needs_equal_parameters(tmp_path):
 
 
 def test_a_file_without_parameters_is_not_served_to_a_caller_with_them(tmp_path):
-    from robokit.config import read_arrays, write_arrays
+    from robokit.cache import read_arrays, write_arrays
 
     target = write_arrays(tmp_path / "c.npz", {"a": np.arange(3)})
     assert read_arrays(target, ["a"]) is not None and read_arrays(target, ["a"], {"n": 3}) is None
@@ -84,7 +85,7 @@ def test_a_file_without_parameters_is_not_served_to_a_caller_with_them(tmp_path)
 
 @pytest.mark.parametrize("damage", ["truncated", "zeroed middle", "flipped byte", "empty", "text", "directory"])
 def test_a_damaged_cache_file_reads_as_none(tmp_path, damage):
-    from robokit.config import read_arrays
+    from robokit.cache import read_arrays
 
     meta = {"n": 3}
     target = _cache_file(tmp_path, meta)
@@ -108,7 +109,7 @@ def test_a_damaged_cache_file_reads_as_none(tmp_path, damage):
 
 
 def test_write_arrays_refuses_bad_input(tmp_path):
-    from robokit.config import write_arrays
+    from robokit.cache import write_arrays
 
     with pytest.raises(TypeError, match="meta"):
         write_arrays(tmp_path / "c.npz", {"a": np.zeros(2)}, {"a": np.zeros(2)})
@@ -120,7 +121,7 @@ def test_write_arrays_refuses_bad_input(tmp_path):
 
 
 def test_code_version_names_the_code_and_the_numerics():
-    from robokit.config import code_version, source_digest
+    from robokit.cache import code_version, source_digest
 
     v = code_version("sim", "geometry")
     assert v["robokit"] == source_digest("sim", "geometry") and v["numpy"] == np.__version__

@@ -22,7 +22,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "robokit"
 
 #: Bottom to top. A unit may import from units of earlier rows (and from itself).
 LAYERS: list[set[str]] = [
-    {"validation", "config", "about"},              # base: input checks, settings
+    {"validation", "config", "cache", "about"},     # base: input checks, settings, the dataset cache
     {"course"},                                     # notebook tooling (the CPU count from config)
     {"progress"},                                   # the one progress bar (reads fast/headless from config)
     {"parallel"},                                   # independent runs in worker processes

@@ -4,7 +4,7 @@ import importlib
 from pathlib import Path
 
 import robokit
-from robokit.config import code_version
+from robokit.cache import code_version
 from robokit.localization.lab_experiment import EXPERIMENT_MODULES
 
 ROOT = Path(robokit.__file__).resolve().parent

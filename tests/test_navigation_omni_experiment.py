@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robokit.config import cache_dir
+from robokit.cache import cache_dir
 from robokit.geometry import se2_compose
 from robokit.navigation import omni_experiment as experiment
 from robokit.navigation import omni_navigation as navigation

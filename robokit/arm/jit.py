@@ -23,7 +23,7 @@ from pathlib import Path
 import numba
 from numba.core import config as _numba_config
 
-from ..config import cache_dir
+from ..cache import cache_dir
 
 __all__ = ["njit", "CACHING", "compile_notice", "compiled"]
 

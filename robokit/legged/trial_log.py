@@ -38,7 +38,7 @@ from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 
-from ..config import save_npz, write_atomically
+from ..cache import save_npz, write_atomically
 from ..geometry import quat_to_matrix, se3_from_rt
 from ..validation import as_array, check_finite_scalar, check_int, check_positive, check_text, describe
 from .littledog import GUIDE, TIMESTEP
@@ -394,7 +394,7 @@ def save_trial(path: Any, log: TrialLog) -> Path:
 
     Notes
     -----
-    :func:`robokit.config.save_npz` through :func:`robokit.config.write_atomically`: a reader finds the
+    :func:`robokit.cache.save_npz` through :func:`robokit.cache.write_atomically`: a reader finds the
     old file, the complete new one or none, never half of one. The layout is in the module docstring.
 
     Examples

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..config import FAST, cache_dir, cache_key, code_version, read_arrays, write_arrays
+from ..config import FAST
+from ..cache import cache_dir, cache_key, code_version, read_arrays, write_arrays
 from ..geometry import paper_world_to_robokit, se2_to_pqt, wrap_angle
 from ..progress import progress_bar
 from ..sim import PinholeCamera, StereoRig, World, lab_lap, lab_room, record
@@ -44,12 +45,12 @@ LAB_TEST_POSES = np.array([
     [6.0, 8.2, 3.0], [4.2, 7.7, -2.9], [2.8, 6.5, -1.4], [2.9, 3.5, -1.75]])
 
 #: The robokit modules whose code decides the experiment's result, and so its cache key
-#: (:func:`robokit.config.code_version`): what this module imports, followed to the module that
+#: (:func:`robokit.cache.code_version`): what this module imports, followed to the module that
 #: defines each name, and so on. Listed by module rather than by package so that an edit to, say,
 #: the outdoor worlds does not rebuild the lab's map; ``tests/test_localization_lab_experiment.py``
 #: checks that the list covers every module reached that way.
 EXPERIMENT_MODULES = (
-    "validation", "config", "progress", "parallel",
+    "validation", "config", "cache", "progress", "parallel",
     "geometry.paper_frames", "geometry.planar", "geometry.procrustes", "geometry.rotations", "geometry.spatial",
     "sim.build", "sim.camera", "sim.layout", "sim.lidar", "sim.motion", "sim.omni", "sim.render", "sim.runs",
     "sim.textures", "sim.world", "sim.worlds",
@@ -225,7 +226,7 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     -------
     LabExperiment
         Cached under ``robokit.cache_dir("lab")`` keyed by every parameter and the code that makes
-        it (:func:`robokit.config.code_version`): a second run loads the map and the test-pose
+        it (:func:`robokit.cache.code_version`): a second run loads the map and the test-pose
         results instead of rebuilding them; a corrupt or stale cache file is rebuilt.
 
     Raises

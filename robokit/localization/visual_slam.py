@@ -157,7 +157,7 @@ class VisualSLAM:
     def to_arrays(self) -> dict:
         """What the pipeline has built (map, frame reports, odometry, RANSAC generator) as plain arrays.
 
-        For a cache file (:func:`robokit.config.write_arrays`); :meth:`load_arrays` restores it into
+        For a cache file (:func:`robokit.cache.write_arrays`); :meth:`load_arrays` restores it into
         a pipeline made with the same parameters.
 
         Returns

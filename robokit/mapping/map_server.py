@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from ..config import write_atomically
+from ..cache import write_atomically
 from ..validation import check_choice, check_int, check_text, describe
 from .occupancy_grid import FREE_THRESHOLD, OCCUPIED_THRESHOLD, OccupancyGrid
 

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..config import save_npz
+from ..cache import save_npz
 from ..validation import as_array, check_choice, check_int, check_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints

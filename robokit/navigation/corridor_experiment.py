@@ -39,8 +39,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import (CACHE_READ_ERRORS, cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays,
-                      write_atomically)
+from ..config import fast_mode
+from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, read_arrays, write_arrays, write_atomically
 from ..mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
 from ..parallel import map_runs
 from ..sim import Lidar, PinholeCamera, camera_mount, corridor_path, describe_sensor, long_corridor, waypoint_path

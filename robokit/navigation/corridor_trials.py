@@ -37,7 +37,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays
+from ..config import fast_mode
+from ..cache import cache_dir, cache_key, code_version, read_arrays, write_arrays
 from ..controllers import CenteringResult, move_to_middle_line
 from ..geometry import wrap_angle
 from ..localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share, pose_clusters

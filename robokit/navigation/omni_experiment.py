@@ -33,8 +33,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..config import (CACHE_READ_ERRORS, cache_dir, cache_key, code_version, fast_mode, read_arrays, write_arrays,
-                      write_atomically)
+from ..config import fast_mode
+from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, read_arrays, write_arrays, write_atomically
 from ..geometry import se2_between, se2_compose
 from ..localization.hierarchical import HierarchicalLocalizer
 from ..mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,

@@ -21,8 +21,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..config import (cache_dir, cache_key, code_version, read_arrays, record_names, records_from_arrays,
-                      records_to_arrays, write_arrays)
+from ..cache import (cache_dir, cache_key, code_version, read_arrays, record_names, records_from_arrays,
+                     records_to_arrays, write_arrays)
 from ..controllers.path_geometry import VisualPath, path_from_poses
 from ..localization.hierarchical import HierarchicalLocalizer, Localization
 from ..parallel import map_runs

@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from ..config import (cache_dir, cache_key, code_version, read_arrays, record_names, records_from_arrays,
-                      records_to_arrays, write_arrays)
+from ..cache import (cache_dir, cache_key, code_version, read_arrays, record_names, records_from_arrays,
+                     records_to_arrays, write_arrays)
 from ..progress import progress_bar
 from ..validation import check_callable, check_choice, check_int, check_mapping, check_positive, describe
 from .field import Course, random_course
@@ -316,7 +316,7 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
         ``progress(i, n)`` after each run, besides the progress bar (:func:`robokit.progress.progress_bar`).
     cache : bool, default True
         Load from / save to ``robokit.cache_dir("outdoor")``, keyed by the seeds, every option and
-        the code (:func:`robokit.config.code_version`); a corrupt or stale cache file is rebuilt,
+        the code (:func:`robokit.cache.code_version`); a corrupt or stale cache file is rebuilt,
         never loaded. Options that are not plain data (a custom ``truck``) are not cached.
     **options
         Passed to :func:`simulate`.

@@ -25,7 +25,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ..config import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, save_npz, write_atomically
+from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, save_npz, write_atomically
 from ..parallel import iter_runs, map_runs
 from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, check_int, check_positive
@@ -86,7 +86,7 @@ class Run:
 
         Notes
         -----
-        :func:`robokit.config.save_npz`; loading uses ``allow_pickle=False`` so a run file can never
+        :func:`robokit.cache.save_npz`; loading uses ``allow_pickle=False`` so a run file can never
         execute code (course convention, DESIGN.md "Caching").
         """
         arrays = {"t": self.t, "poses": self.poses, "odometry": self.odometry,

@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..config import save_npz
+from ..cache import save_npz
 from ..validation import as_array, as_rng, check_int, describe
 from .hamming import as_binary_descriptors, hamming_distance
 

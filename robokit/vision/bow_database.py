@@ -29,7 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..config import save_npz
+from ..cache import save_npz
 from ..validation import check_int, describe
 from .bag_of_words import BowVector, Vocabulary, VocabularyFileError, as_bow_vector
 
