@@ -1175,9 +1175,9 @@ SPECS: dict[str, Call] = {
         "descriptor_list": Obj(lambda: [orb_descriptors(40, 0)] * 3),
         "positions": Array(np.zeros((3, 2)), "N,2|N,3", optional=True), "min_frame_gap": Int(1),
         "min_tracked": Int(10), "max_tracked_fraction": Real(0.9), "max_distance": Real(50.0)}),
-    "robokit.vision.bag_of_words.tf_idf": Call({"word_ids": Array(np.array([0, 0, 1, 2]), "N", min_rows=0),
+    "robokit.vision.bow_vector.tf_idf": Call({"word_ids": Array(np.array([0, 0, 1, 2]), "N", min_rows=0),
                                                 "idf": Array(np.log2([3.0, 3.0, 1.5, 1.0]), "N")}),
-    "robokit.vision.bag_of_words.l1_score": Call({"v_a": Obj(([0, 2], [0.5, 0.5])), "v_b": Obj(([0, 3], [0.2, 0.8]))}),
+    "robokit.vision.bow_vector.l1_score": Call({"v_a": Obj(([0, 2], [0.5, 0.5])), "v_b": Obj(([0, 3], [0.2, 0.8]))}),
     "robokit.vision.bag_of_words.Vocabulary": Call({
         "children": Array(lambda: bow_vocabulary().children, "N,N"), "centres": Array(lambda: bow_vocabulary().centres, "N,N"),
         "idf": Array(lambda: bow_vocabulary().idf, "N"), "levels": Int(2)}),
@@ -1604,7 +1604,7 @@ EXTRA: tuple[str, ...] = (
         "orb.detect_orb_features", "hamming.hamming_distance",
         "hamming.hamming_distances", "hamming.hamming_match", "keyframes.feature_threshold",
         "keyframes.shared_fraction", "keyframes.KeyframeSelector", "keyframes.select_keyframes",
-        "keyframes.select_keyframes_orbslam", "bag_of_words.tf_idf", "bag_of_words.l1_score",
+        "keyframes.select_keyframes_orbslam", "bow_vector.tf_idf", "bow_vector.l1_score",
         "bag_of_words.Vocabulary", "bag_of_words.Vocabulary.train",
         "bow_database.BowDatabase")),
     # lesson 04's sensing: the one rigid fit, MoCap, IMU, fusion, touchdowns

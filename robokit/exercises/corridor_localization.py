@@ -9,7 +9,7 @@ from ..mapping.corridor_areas import invalid_areas
 from ..mapping.corridor_scan import width_condition
 from ..mapping.occupancy_grid import LikelihoodField, log_odds
 from ..validation import as_array, check_finite_scalar, check_positive
-from ..vision.bag_of_words import l1_score, tf_idf
+from ..vision.bow_vector import l1_score, tf_idf
 from ..vision.hamming import as_binary_descriptors, hamming_match
 from .compare import close, exact
 from .spec import Case, Exercise
@@ -365,8 +365,8 @@ EXERCISES = [
         id="03.bow_similarity", function="bow_similarity",
         signature="bow_similarity(words_a: list of int, words_b: list of int, idf: (m,)) -> float",
         points=2, cases=_bow_cases, reference=bow_similarity, compare=close(rtol=1e-9, atol=1e-12),
-        references=("robokit.exercises.corridor_localization.bow_similarity", "robokit.vision.bag_of_words.tf_idf",
-                    "robokit.vision.bag_of_words.l1_score", "robokit.vision.bag_of_words.Vocabulary",
+        references=("robokit.exercises.corridor_localization.bow_similarity", "robokit.vision.bow_vector.tf_idf",
+                    "robokit.vision.bow_vector.l1_score", "robokit.vision.bag_of_words.Vocabulary",
                     "robokit.vision.bow_database.BowDatabase"),
         description="TF-IDF vectors, Eq. (16), of two images' words, then the L1 score, Eq. (17); ValueError for "
                     "a word outside the vocabulary."),

@@ -12,12 +12,12 @@ points below the horizon). Vision depends only on :mod:`robokit.validation` and
 :mod:`robokit.geometry` (never on ``viz`` or ``sim``). Lesson 03 (Ge et al. 2023) adds :mod:`.orb`
 (OpenCV ORB as :class:`Features`), :mod:`.hamming` (the one Hamming distance for binary
 descriptors), :mod:`.keyframes` (Sec. 3.2's keyframe conditions and an ORB-SLAM-like rule),
-:mod:`.bag_of_words` (vocabulary tree, TF-IDF and L1 score, Sec. 3.3) and :mod:`.bow_database`
-(the inverted index, Fig. 7).
+:mod:`.bag_of_words` (the vocabulary tree, Sec. 3.3), :mod:`.bow_vector` (TF-IDF and the L1
+score, Eqs. (16)-(17)) and :mod:`.bow_database` (the inverted index, Fig. 7).
 """
-from .bag_of_words import (BowVector, TooFewDescriptorsError, Vocabulary, VocabularyFileError, as_bow_vector, l1_score,
-                           tf_idf)
+from .bag_of_words import TooFewDescriptorsError, Vocabulary, VocabularyFileError
 from .bow_database import BowDatabase, DatabaseFileError, QueryResult
+from .bow_vector import BowVector, as_bow_vector, l1_score, tf_idf
 from .colour import (histogram_distance, histogram_intersection, hue_histogram, hue_histogram_opencv, hue_mask,
                      rgb_to_hsi)
 from .descriptors import (assign_orientations, detect_and_describe, gradient_histogram_descriptor,

@@ -31,7 +31,8 @@ import numpy as np
 
 from ..cache import save_npz
 from ..validation import check_int, describe
-from .bag_of_words import BowVector, Vocabulary, VocabularyFileError, as_bow_vector
+from .bag_of_words import Vocabulary, VocabularyFileError
+from .bow_vector import BowVector, as_bow_vector
 
 __all__ = ["QueryResult", "BowDatabase", "DatabaseFileError"]
 
