@@ -25,25 +25,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = [
-    "as_array",
-    "array_ndim",
-    "broadcast_to",
-    "as_points",
-    "check_finite_scalar",
-    "check_positive",
-    "check_int",
-    "check_choice",
-    "check_text",
-    "check_callable",
-    "check_mapping",
-    "check_finite_result",
-    "check_sample_count",
-    "MAX_SAMPLES",
-    "as_rng",
-    "describe",
-    "check_covariance",
-]
+__all__ = ["as_array", "array_ndim", "broadcast_to", "as_points", "check_finite_scalar", "check_positive", "check_int",
+           "check_choice", "check_text", "check_callable", "check_mapping", "check_finite_result", "check_sample_count",
+           "MAX_SAMPLES", "as_rng", "describe", "check_covariance"]
 
 
 def describe(value: Any) -> str:

@@ -455,7 +455,7 @@ def trial_folder():
 
 @functools.cache
 def saved_trial():
-    from robokit.legged.trial_log import save_trial
+    from robokit.legged.trial_file import save_trial
     return str(save_trial(trial_folder() / "saved.npz", trial_log()))
 
 
@@ -1396,10 +1396,10 @@ SPECS: dict[str, Call] = {
         "link_latency": Real(0.01), "link_jitter": Real(0.002), "link_loss": Real(0.01), "seed": Int(0, optional=True),
         "notes": Text(""), "extra": Given({})}),
     "robokit.legged.trial_log.empty_streams": Call({"n": Int(4), "host_rate": Real(100.0)}),
-    "robokit.legged.trial_log.save_trial": Call({"path": Text(lambda: str(trial_folder() / "t.npz")),
+    "robokit.legged.trial_file.save_trial": Call({"path": Text(lambda: str(trial_folder() / "t.npz")),
                                                  "log": Obj(trial_log)}),
-    "robokit.legged.trial_log.load_trial": Call({"path": Text(saved_trial)}),
-    "robokit.legged.trial_log.describe_layout": Call({}),
+    "robokit.legged.trial_file.load_trial": Call({"path": Text(saved_trial)}),
+    "robokit.legged.trial_file.describe_layout": Call({}),
     "robokit.viz.animation.animate_tracks": Call({
         "scene": Obj(scene), "tracks": Mapping(lambda: {"a": {"position": np.zeros((3, 3)), "scale": np.ones((3, 3))}}),
         "fps": Real(10.0), "repetitions": Int(1), "check": Flag(True)}),
@@ -1635,8 +1635,8 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.legged.power.{n}" for n in ("battery_energy", "trial_power", "endurance", "cost_of_transport")),
     # lesson 04's trial log, LittleDog scenes and figures (fuzzed before the lesson exists)
     "robokit.geometry.rotations.quat_to_matrix",
-    *(f"robokit.legged.trial_log.{n}" for n in (
-        "TrialLog", "trial_meta", "empty_streams", "save_trial", "load_trial", "describe_layout")),
+    *(f"robokit.legged.trial_log.{n}" for n in ("TrialLog", "trial_meta", "empty_streams")),
+    *(f"robokit.legged.trial_file.{n}" for n in ("save_trial", "load_trial", "describe_layout")),
     "robokit.viz.animation.animate_tracks",
     *(f"robokit.viz.legged.{n}" for n in ("joint_path", "add_littledog", "pose_littledog", "animate_trial")),
     *(f"robokit.viz.legged_plots.{n}" for n in (
