@@ -1461,10 +1461,10 @@ SPECS: dict[str, Call] = {
         "q": Array(np.array([0.0, 0.5, -1.5]), "...,3"), "leg": Choice("FL", optional=True)}),
     "robokit.legged.leg_kinematics.reachable_workspace": Call({
         "leg": Choice("FL"), "n": Int(200), "rng": Rng(0), "branch": Int(-1, optional=True, accepts=("a list",))}),
-    "robokit.legged.leg_kinematics.torques_from_foot_force": Call({
+    "robokit.legged.leg_statics.torques_from_foot_force": Call({
         "q_leg": Array(np.array([0.0, 0.6, -1.2]), "...,3"), "force": Array(np.array([0.0, 0.0, -7.4]), "...,3"),
         "leg": Choice("FL")}),
-    "robokit.legged.leg_kinematics.foot_force_from_torques": Call({
+    "robokit.legged.leg_statics.foot_force_from_torques": Call({
         "q_leg": Array(np.array([0.0, 0.6, -1.2]), "...,3"), "tau": Array(np.array([-0.175, 0.112, 0.426]), "...,3"),
         "leg": Choice("FL"), "gravity_torque": Array(np.array([0.0, 0.01, 0.02]), "...,3", optional=True)}),
     "robokit.legged.leg_kinematics.body_fk": Call({"q": Array(stance_q, "...,12")}),

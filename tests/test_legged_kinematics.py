@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from robokit.legged import leg_kinematics as lk
+from robokit.legged import leg_statics as ls
 from robokit.legged.littledog import (GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_NAMES, LEGS, LOWER_LEG, MARKERS,
                                       STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG, littledog_mjcf,
                                       littledog_model)
@@ -109,7 +110,7 @@ def test_bad_input_is_named():
     with pytest.raises(ValueError, match="branch"):
         lk.leg_ik(STANCE_FEET[0], "FL", branch=0)
     with pytest.raises(ValueError, match="singular"):
-        lk.foot_force_from_torques([0, 0, 0], [0, 0, 0], "FL")
+        ls.foot_force_from_torques([0, 0, 0], [0, 0, 0], "FL")
     with pytest.raises(ValueError, match="timestep"):
         littledog_mjcf(timestep=0.02)
 
@@ -119,18 +120,18 @@ def test_statics_name_the_argument_whose_batch_does_not_fit_and_refuse_an_overfl
     # the largest float gave a silent inf/NaN force
     q2 = np.tile([0.0, 0.6, -1.2], (2, 1))
     with pytest.raises(ValueError, match=r"^force: .*broadcast"):
-        lk.torques_from_foot_force(q2, np.ones((5, 3)), "FL")
+        ls.torques_from_foot_force(q2, np.ones((5, 3)), "FL")
     with pytest.raises(ValueError, match=r"^tau: .*broadcast"):
-        lk.foot_force_from_torques(q2, np.ones((5, 3)), "FL")
+        ls.foot_force_from_torques(q2, np.ones((5, 3)), "FL")
     with pytest.raises(ValueError, match=r"^gravity_torque: .*broadcast"):
-        lk.foot_force_from_torques(q2[0], np.ones((2, 3)), "FL", np.ones((5, 3)))
+        ls.foot_force_from_torques(q2[0], np.ones((2, 3)), "FL", np.ones((5, 3)))
     with pytest.raises(ValueError, match="tau, gravity_torque"):
-        lk.foot_force_from_torques(q2[0], np.full(3, 1e308), "FL", np.full(3, -1e308))
+        ls.foot_force_from_torques(q2[0], np.full(3, 1e308), "FL", np.full(3, -1e308))
     # batches that do broadcast still give each row's own answer
     f = np.array([[0.0, 0.0, -7.4], [1.0, 0.5, -3.0]])
-    tau = lk.torques_from_foot_force(q2[0], f, "FL")
+    tau = ls.torques_from_foot_force(q2[0], f, "FL")
     assert np.allclose(tau[1], lk.foot_jacobian(q2[0], "FL").T @ f[1])
-    back = lk.foot_force_from_torques(q2, tau[:, None, :], "FL")      # (2, 1, 3) against q's (2,)
+    back = ls.foot_force_from_torques(q2, tau[:, None, :], "FL")      # (2, 1, 3) against q's (2,)
     assert back.shape == (2, 2, 3) and np.allclose(back[:, 0], -f)
 
 
@@ -163,10 +164,10 @@ def test_jt_force_mapping_matches_mujoco_contact_forces():
     assert total[2] == pytest.approx(3.0 * 9.81, rel=1e-3)        # the feet carry the 3 kg robot
     for i, leg in enumerate(LEGS):
         s = slice(6 + 3 * i, 9 + 3 * i)
-        est = R @ lk.foot_force_from_torques(d.qpos[7 + 3 * i:10 + 3 * i], d.qfrc_actuator[s], i,
+        est = R @ ls.foot_force_from_torques(d.qpos[7 + 3 * i:10 + 3 * i], d.qfrc_actuator[s], i,
                                              gravity_torque=d.qfrc_bias[s])
         np.testing.assert_allclose(est, contacts[leg], atol=0.01)  # 10 mN of 7.4 N
-        massless = R @ lk.foot_force_from_torques(d.qpos[7 + 3 * i:10 + 3 * i], d.qfrc_actuator[s], i)
+        massless = R @ ls.foot_force_from_torques(d.qpos[7 + 3 * i:10 + 3 * i], d.qfrc_actuator[s], i)
         assert np.linalg.norm(massless - contacts[leg]) > 0.1      # the legs' own weight matters
 
 
@@ -178,7 +179,7 @@ def test_force_sensor_reads_the_axial_part_of_the_foot_force():
         shank = d.site(f"{leg}_force").xmat.reshape(3, 3)[:, 2]   # the shank's z axis in the world
         q = d.qpos[7 + 3 * i:10 + 3 * i]
         R = d.xmat[m.body("trunk").id].reshape(3, 3)
-        ground = R @ lk.foot_force_from_torques(q, d.qfrc_actuator[6 + 3 * i:9 + 3 * i], i,
+        ground = R @ ls.foot_force_from_torques(q, d.qfrc_actuator[6 + 3 * i:9 + 3 * i], i,
                                                 gravity_torque=d.qfrc_bias[6 + 3 * i:9 + 3 * i])
         # compression: the ground's push along the shank, less the lower leg's own weight along it
         lower = m.body_subtreemass[m.body(f"{leg}_lower").id]
