@@ -32,7 +32,6 @@ References
 from __future__ import annotations
 
 import copy
-import dataclasses
 from typing import Any, Callable
 
 import numpy as np
@@ -47,9 +46,10 @@ from ..sim import noisy_odometry, waypoint_path
 from ..vision import detect_orb_features
 from ..validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive
 from .corridor_experiment import MAPPING_ALPHAS, N_FEATURES, CorridorMap, check_corridor_map
+from .corridor_results import TrialResult, TrialSet
 
-__all__ = ["START_POSES", "PAPER_TOLERANCE", "ELLIPSE_SIGMA", "CLUSTER_SHARE", "PARTICLES", "SETTLE", "TrialResult",
-           "TrialSet", "retrieve_pose", "localization_trial", "localization_trials", "corridor_localizer"]
+__all__ = ["START_POSES", "ELLIPSE_SIGMA", "CLUSTER_SHARE", "PARTICLES", "SETTLE", "retrieve_pose",
+           "localization_trial", "localization_trials", "corridor_localizer"]
 
 #: Ten start poses ``[x, y, theta]`` in the corridor, numbered like the paper's positions #1-#10
 #: (Fig. 12; the paper gives no coordinates, so these are ours): off the middle line and turned, some
@@ -68,48 +68,7 @@ CLUSTER_SHARE = 0.95
 ELLIPSE_SIGMA = (0.3, 0.1)
 #: Updates a run goes on after convergence before it is judged a second time.
 SETTLE = 5
-#: The paper's success criterion (Sec. 4.1): 0.05 m and 0.5 degrees.
-PAPER_TOLERANCE = (0.05, float(np.deg2rad(0.5)))
 SPEED, RATE = 0.3, 10.0
-
-
-@dataclasses.dataclass
-class TrialResult:
-    """One global-localization run.
-
-    Attributes
-    ----------
-    method : str
-    start : numpy.ndarray (3,)
-    converged : bool
-    iterations : int
-        Filter updates until convergence (or until the run gave up).
-    distance : float
-        Metres driven from the start (the moving strategy included).
-    error : numpy.ndarray (2,)
-        Position (m) and heading (rad) error of the estimate against the truth at convergence (NaN
-        when the filter never converged).
-    settled : numpy.ndarray (2,)
-        The same, ``settle`` updates later (or when the run ended).
-    retrieval_error : float
-        Ours: distance from the retrieved keyframe's geo-tag to the true position (NaN for AMCL).
-    truth, estimates : numpy.ndarray (K, 3)
-        True poses and the filter's estimates at each update.
-    particles : list of numpy.ndarray or None
-        The cloud at the start and after each update (only when asked for).
-    """
-
-    method: str
-    start: np.ndarray
-    converged: bool
-    iterations: int
-    distance: float
-    error: np.ndarray
-    settled: np.ndarray
-    retrieval_error: float
-    truth: np.ndarray
-    estimates: np.ndarray
-    particles: list | None = None
 
 
 def _drive(start: np.ndarray, length: float, distance: float) -> np.ndarray:
@@ -359,56 +318,6 @@ def _run_trial(setup: CorridorMap, method: str, centred: CenteringResult, rng: n
                        retrieval_error, np.array(seen).reshape(-1, 3), np.array(estimates).reshape(-1, 3), clouds)
 
 
-@dataclasses.dataclass
-class TrialSet:
-    """The runs of one method from every start (Table 2).
-
-    Attributes
-    ----------
-    method : str
-    positions : numpy.ndarray of int, shape (n,)
-        The start's index in :data:`START_POSES` (0-based) for each run.
-    converged : numpy.ndarray of bool, shape (n,)
-    iterations : numpy.ndarray of int, shape (n,)
-    distance : numpy.ndarray, shape (n,)
-        Metres driven.
-    error : numpy.ndarray, shape (n, 2)
-        Position (m) and heading (rad) error at convergence (NaN when not converged).
-    settled : numpy.ndarray, shape (n, 2)
-        The same, :data:`SETTLE` updates after convergence.
-    retrieval_error : numpy.ndarray, shape (n,)
-        Ours: the retrieved keyframe's distance from the truth (NaN for AMCL).
-    """
-
-    method: str
-    positions: np.ndarray
-    converged: np.ndarray
-    iterations: np.ndarray
-    distance: np.ndarray
-    error: np.ndarray
-    settled: np.ndarray
-    retrieval_error: np.ndarray
-
-    def success(self, tolerance: Any = PAPER_TOLERANCE, *, settled: bool = False) -> np.ndarray:
-        """Runs that converged within ``tolerance`` = (metres, radians) of the truth (default the paper's).
-
-        ``settled=True`` judges the estimate :data:`SETTLE` updates after convergence instead.
-
-        Examples
-        --------
-        >>> errors = np.array([[0.03, 0.001], [np.nan, np.nan]])
-        >>> runs = TrialSet("ours", np.zeros(2, int), np.array([True, False]), np.array([3, 40]),
-        ...                 np.array([0.5, 40.0]), errors, errors / 2, np.full(2, np.nan))
-        >>> runs.success().tolist(), runs.success((0.01, 0.1)).tolist(), runs.success((0.02, 0.1), settled=True).tolist()
-        ([True, False], [False, False], [True, False])
-        """
-        tol = as_array(tolerance, "tolerance", shape=(2,))
-        if np.any(tol <= 0):
-            raise ValueError(f"tolerance: expected positive (metres, radians), got {tol.tolist()}")
-        err = np.nan_to_num(self.settled if settled else self.error, nan=np.inf)
-        return self.converged & (err[:, 0] <= tol[0]) & (err[:, 1] <= tol[1])
-
-
 def _trials_from_start(shared: tuple, task: tuple) -> list:
     """Run ``j`` from start ``i`` for each method (``task = (i, j)``), seeded by ``(seed, i, j)``.
 
@@ -485,7 +394,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     progress = check_callable(progress, "progress")
     workers = None if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
     code = code_version("sim", "geometry", "vision", "mapping", "localization", "controllers",
-                        "navigation.corridor_experiment", "navigation.corridor_trials")
+                        "navigation.corridor_experiment", "navigation.corridor_trials", "navigation.corridor_results")
 
     def cache_file(m: str) -> tuple[Any, dict]:
         meta = {"setup": setup.key, "method": m, "trials": trials, "starts": starts, "seed": seed,
