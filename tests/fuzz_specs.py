@@ -1224,8 +1224,8 @@ SPECS: dict[str, Call] = {
     "robokit.navigation.corridor_trials.corridor_localizer": Call({
         "setup": Obj(corridor_setup), "method": Choice("ours"), "rng": Rng(0)}, cheap=False),
     "robokit.navigation.corridor_aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),
-    "robokit.navigation.corridor_experiment.corridor_lidar": Call({}),
-    "robokit.navigation.corridor_experiment.corridor_camera": Call({"fast": Flag(True, optional=True)}),
+    "robokit.navigation.corridor_sensors.corridor_lidar": Call({}),
+    "robokit.navigation.corridor_sensors.corridor_camera": Call({"fast": Flag(True, optional=True)}),
     "robokit.navigation.corridor_experiment.calibration_run": Call({
         "fast": Flag(True, optional=True), "start": Real(12.0), "length": Real(10.0), "speed": Real(0.2),
         "frame_rate": Real(30.0), "progress": Func(None, optional=True)}, cheap=False),

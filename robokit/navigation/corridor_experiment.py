@@ -43,14 +43,15 @@ from ..config import fast_mode
 from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, read_arrays, write_arrays, write_atomically
 from ..mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
 from ..parallel import map_runs
-from ..sim import Lidar, PinholeCamera, camera_mount, corridor_path, describe_sensor, long_corridor, waypoint_path
+from ..sim import Lidar, PinholeCamera, corridor_path, describe_sensor, long_corridor, waypoint_path
 from ..sim.world import World
 from ..validation import as_array, check_callable, check_int, check_positive
 from ..vision import BowDatabase, Vocabulary, detect_orb_features, feature_threshold, select_keyframes, \
     select_keyframes_orbslam
+from .corridor_sensors import corridor_camera, corridor_lidar
 
-__all__ = ["CorridorMap", "corridor_map", "check_corridor_map", "corridor_lidar", "corridor_camera",
-           "CalibrationRun", "calibration_run", "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS"]
+__all__ = ["CorridorMap", "corridor_map", "check_corridor_map", "CalibrationRun", "calibration_run",
+           "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS"]
 
 #: Odometry noise of the simulated Kobuki base (Thrun et al. 2005, Table 5.6 alphas, our choice).
 MAPPING_ALPHAS = (0.01, 0.001, 0.01, 0.001)
@@ -66,56 +67,9 @@ MAPPING_FRAME_GAP = 3
 SHARED_RANGE = (0.70, 0.90)
 
 
-def corridor_lidar() -> Lidar:
-    """The RPLIDAR-A2-like scanner of the lesson: 360 beams, 8 m range, 1 cm noise, 0.45 m high.
-
-    Returns
-    -------
-    Lidar
-
-    Notes
-    -----
-    Ge et al. (2023), Sec. 4: an RPLIDAR A2 (360 degrees, effective radius 8-10 m), mounted above the
-    camera so the camera does not block its beams.
-
-    Examples
-    --------
-    >>> corridor_lidar().r_max, corridor_lidar().beams
-    (8.0, 360)
-    """
-    return Lidar(noise=0.01, height=0.45)
-
-
-def corridor_camera(fast: bool | None = None) -> PinholeCamera:
-    """The forward-looking camera of the lesson: 65 degrees wide, 0.35 m high, below the LiDAR.
-
-    Parameters
-    ----------
-    fast : bool, optional
-        320 x 240 pixels instead of 640 x 480 (default: :func:`robokit.config.fast_mode`).
-
-    Returns
-    -------
-    PinholeCamera
-
-    Notes
-    -----
-    Ge et al. (2023), Sec. 4: a monocular camera with 1280 x 960 pixels at 30 frames per second,
-    mounted lower than the LiDAR. We render at half (or a quarter of) that size to keep the lesson
-    fast; ORB's 500 features fit either.
-
-    Examples
-    --------
-    >>> corridor_camera(fast=True).width, corridor_camera(fast=False).width
-    (320, 640)
-    """
-    fast = fast_mode() if fast is None else bool(fast)
-    w, h = (320, 240) if fast else (640, 480)
-    return PinholeCamera.from_fov(np.deg2rad(65.0), w, h, mount=camera_mount(0.35))
-
-
 def _code() -> dict:
-    return code_version("sim", "geometry", "vision", "mapping", "navigation.corridor_experiment")
+    return code_version("sim", "geometry", "vision", "mapping", "navigation.corridor_sensors",
+                        "navigation.corridor_experiment")
 
 
 def _descriptor_stack(descriptors: list) -> tuple[np.ndarray, np.ndarray]:

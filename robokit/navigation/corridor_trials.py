@@ -394,7 +394,8 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     progress = check_callable(progress, "progress")
     workers = None if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
     code = code_version("sim", "geometry", "vision", "mapping", "localization", "controllers",
-                        "navigation.corridor_experiment", "navigation.corridor_trials", "navigation.corridor_results")
+                        "navigation.corridor_sensors", "navigation.corridor_experiment", "navigation.corridor_trials",
+                        "navigation.corridor_results")
 
     def cache_file(m: str) -> tuple[Any, dict]:
         meta = {"setup": setup.key, "method": m, "trials": trials, "starts": starts, "seed": seed,
