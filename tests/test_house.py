@@ -1,9 +1,11 @@
 """Sizes a student can read, enforced on the source with ``ast`` (docs/DESIGN.md, "Readable sizes").
 
+* A module is at most ``MAX_MODULE_LINES`` lines: a longer one holds more than one idea, and the
+  ideas go to modules named for them.
 * A function's body (its docstring left out) is at most ``MAX_FUNCTION_LINES`` lines: a longer one
   is split into its phases, each a function with a name that says what it does. The speed-tuned
-  ``*_kernels.py`` modules are exempt: each keeps a readable reference beside it that a test
-  compares it against.
+  ``*_kernels.py`` modules are exempt from this one: each keeps a readable reference beside it that
+  a test compares it against.
 """
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "robokit"
 
+MAX_MODULE_LINES = 500
 MAX_FUNCTION_LINES = 70
 
 
@@ -31,7 +34,14 @@ def _functions(path: Path) -> list[tuple[str, int]]:
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))]
 
 
-SOURCES = [p for p in sorted(PACKAGE.rglob("*.py")) if not p.stem.endswith("_kernels")]
+MODULES = sorted(PACKAGE.rglob("*.py"))
+SOURCES = [p for p in MODULES if not p.stem.endswith("_kernels")]
+
+
+@pytest.mark.parametrize("path", MODULES, ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_modules_hold_one_idea_in_a_readable_length(path):
+    n = len(path.read_text(encoding="utf-8").splitlines())
+    assert n <= MAX_MODULE_LINES, f"{n} lines: split it by idea (at most {MAX_MODULE_LINES} lines a module)"
 
 
 @pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(PACKAGE)))
