@@ -728,7 +728,8 @@ SPECS: dict[str, Call] = {
     "robokit.vision.plot_detector.plot_scales": Call({"sigma0": Real(1.6, optional=True), "k": Real(1.26, optional=True),
                                                       "n_scales": Int(9, optional=True)}),
     "robokit.vision.scale_space_maxima.scale_space_maxima": Call({
-        "responses": Obj(lambda: [np.random.default_rng(0).random((12, 12), np.float32) for _ in range(3)]),
+        "responses": Obj(lambda: [np.random.default_rng(n).random(shape, np.float32)
+                                  for n, shape in enumerate([(12, 12), (12, 12), (6, 6)])]),
         "steps": Array(np.array([1, 1, 2]), "3"), "threshold": Real(0.1), "border": Int(1), "check": Flag(True)}),
     "robokit.vision.plot_detector.junction_strength": Call({"tensor": Array(np.tile([[1.0, 0.1], [0.1, 2.0]], (4, 5, 1, 1)),
                                                                             "...,2,2")}),

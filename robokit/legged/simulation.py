@@ -282,7 +282,8 @@ def _snapshot(rec: dict, k: int, model: mujoco.MjModel, data: mujoco.MjData, pro
                 rec["contact"][k, i] |= wrench[0] > CONTACT_FORCE      # normal force, contact frame
 
 
-def _sensed(streams: dict, gyro: np.ndarray, acc: np.ndarray, sensors: SensorSettings, gen: np.random.Generator) -> dict:
+def _sensed(streams: dict, gyro: np.ndarray, acc: np.ndarray, sensors: SensorSettings,
+            gen: np.random.Generator) -> dict:
     """The true streams with the sensors corrupted as :class:`SensorSettings` says (forces, IMU, MoCap)."""
     streams["foot_force"] = streams["foot_force"] + gen.normal(0.0, sensors.force_noise, (len(gyro), 4))
     streams["imu_gyro"], streams["imu_acc"] = simulate_imu(
@@ -340,7 +341,8 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     for name, value, cls in (("plan", plan, WalkPlan), ("loops", loops, LoopSettings),
                              ("sensors", sensors, SensorSettings), ("motor", motor, DCMotor)):
         if not isinstance(value, cls):
-            raise TypeError(f"{name}: expected a {cls.__name__}, got {type(value).__name__}")
+            hint = " (robokit.legged.walking_plan)" if cls is WalkPlan else ""
+            raise TypeError(f"{name}: expected a {cls.__name__}{hint}, got {type(value).__name__}")
     seed = rng if isinstance(rng, int) and not isinstance(rng, bool) else None
     gen = as_rng(rng)
     host_dt, host_steps = _host_period(plan)

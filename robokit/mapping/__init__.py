@@ -12,8 +12,9 @@ and :mod:`.manhattan` (generated graphs with ground truth).
 
 Topological maps (lesson 02's environment map): :mod:`.omni_views` (an image's hue histogram, SIFT
 features and bearings; the relative pose of two views), :mod:`.topological` (the map: nodes, edges,
-KD-trees, the coarse and fine searches) and :mod:`.topological_build` (key images, local-map
-partitioning, loop closure, from a recorded run). Unlike the rest of mapping they use
+KD-trees, the coarse and fine searches), :mod:`.local_maps` (when a key image starts a node: the
+paper's local-map partitioning) and :mod:`.topological_build` (the map from a recorded run, loop
+closure). Unlike the rest of mapping they use
 :mod:`robokit.sim`'s omni camera model (its rays and mount) and odometry noise model, never its
 renderer.
 

@@ -73,7 +73,7 @@ class TrialSet:
     ----------
     method : str
     positions : numpy.ndarray of int, shape (n,)
-        The start's index in :data:`START_POSES` (0-based) for each run.
+        The start's index in :data:`~robokit.navigation.corridor_trials.START_POSES` (0-based) for each run.
     converged : numpy.ndarray of bool, shape (n,)
     iterations : numpy.ndarray of int, shape (n,)
     distance : numpy.ndarray, shape (n,)

@@ -29,6 +29,7 @@ from .keyframes import (KeyframeConditions, KeyframeSelector, feature_threshold,
                         select_keyframes_orbslam, shared_fraction)
 from .matching import DescriptorIndex, k_nearest, ratio_match, two_nearest
 from .ratio import Matches, ratio_test
+from .scale_space_maxima import scale_space_maxima
 from .orb import detect_orb_features
 from .omni_features import ImageSizeError, annulus_mask, omni_sift, radial_orientation
 from .ransac import PlanarFit, ransac_sample_count, ransac_se2
@@ -47,7 +48,8 @@ __all__ = ["assign_orientations", "detect_and_describe", "gradient_histogram_des
            "tensor_eigenvalues", "NotRectifiedError", "StereoMatches", "StereoCalibration", "disparity_to_point",
            "match_stereo", "triangulate_svd", "StereoObservations", "observe_stereo",
            "rgb_to_hsi", "hue_mask", "hue_histogram", "hue_histogram_opencv", "histogram_distance",
-           "histogram_intersection", "DescriptorIndex", "ratio_test", "ImageSizeError", "annulus_mask", "omni_sift",
+           "histogram_intersection", "DescriptorIndex", "ratio_test", "scale_space_maxima", "ImageSizeError",
+           "annulus_mask", "omni_sift",
            "radial_orientation", "PlanarFit", "ransac_sample_count", "ransac_se2", "EssentialFit", "as_bearings",
            "decompose_essential", "epipolar_error", "essential_from_bearings", "floor_points", "ransac_essential",
            "detect_orb_features", "as_binary_descriptors", "hamming_distance", "hamming_distances", "hamming_match",

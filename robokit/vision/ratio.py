@@ -155,7 +155,8 @@ def ratio_test(dist, index, *, ratio: float = LIN_RATIO, max_distance: float | N
     Notes
     -----
     Lin et al. Sec. 3; Lowe 2004, Sec. 7.1. The one place the ratio test is applied: used by
-    :func:`ratio_match` and :meth:`DescriptorIndex.match`.
+    :func:`~robokit.vision.matching.ratio_match` and
+    :meth:`~robokit.vision.matching.DescriptorIndex.match`.
 
     Examples
     --------

@@ -25,7 +25,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..validation import as_array, check_int, check_positive
+from ..validation import as_array, check_int, check_positive, describe
 
 __all__ = ["scale_space_maxima"]
 
@@ -59,10 +59,13 @@ def scale_space_maxima(responses: Any, steps: Any, threshold: float, border: int
 
     Raises
     ------
-    ValueError, TypeError
-        For fewer than three levels, a level that is not 2-D or not finite, ``steps`` of another
-        length or not positive integers, adjacent steps that are not equal or in ratio 2, a
-        negative threshold or a border below 1.
+    TypeError
+        If ``responses`` is not a sequence of levels (or a 3-D array).
+    ValueError
+        For fewer than three levels, a level that is not 2-D, not finite or smaller than 3 x 3,
+        ``steps`` of another length or not positive integers, adjacent steps that are not equal or
+        in ratio 2, a level whose shape does not match its neighbour's at those steps (the coarser
+        is the finer sampled every second pixel), a negative threshold or a border below 1.
 
     Notes
     -----
@@ -80,19 +83,7 @@ def scale_space_maxima(responses: Any, steps: Any, threshold: float, border: int
     ([[5.0, 4.0]], [1.0], [1.0])
     """
     if check:
-        if isinstance(responses, np.ndarray) and responses.ndim == 3:
-            responses = list(responses)
-        if not isinstance(responses, (list, tuple)) or len(responses) < 3:
-            raise ValueError(f"responses: expected a sequence of at least 3 levels, got "
-                             f"{len(responses) if isinstance(responses, (list, tuple)) else type(responses).__name__}")
-        responses = [as_array(r, f"responses[{n}]", ndim=2, dtype=np.float32) for n, r in enumerate(responses)]
-        steps = as_array(steps, "steps", shape=(len(responses),), dtype=None)
-        if steps.dtype.kind not in "iu" or np.any(steps < 1):
-            raise ValueError(f"steps: expected positive integers, got {steps.tolist()}")
-        ratio = steps[1:] / steps[:-1]
-        if not np.all((ratio == 1) | (ratio == 2) | (ratio == 0.5)):
-            raise ValueError(f"steps: expected adjacent levels with equal spacing or one twice the other, got "
-                             f"{steps.tolist()}")
+        responses, steps = _checked_levels(responses, steps)
         threshold = check_positive(threshold, "threshold", allow_zero=True)
         border = check_int(border, "border", minimum=1)
     dilated = [cv2.dilate(r, np.ones((3, 3), np.uint8)) for r in responses]
@@ -100,6 +91,41 @@ def scale_space_maxima(responses: Any, steps: Any, threshold: float, border: int
              for n in range(1, len(responses) - 1)]
     xy, level, strength = (np.concatenate([f[i] for f in found]) for i in range(3))
     return xy, level, strength
+
+
+def _checked_levels(responses: Any, steps: Any) -> tuple[list, np.ndarray]:
+    """The levels as float32 arrays and their steps, or a named error: at least three finite 2-D levels
+    of at least 3 x 3 samples, each adjacent pair on the same grid or one subsampled by two from the
+    other (``level[::2, ::2]``, as the detector's octaves are)."""
+    if isinstance(responses, np.ndarray):
+        if responses.ndim != 3:
+            raise ValueError(f"responses: expected a sequence of 2-D levels or a 3-D array, got shape "
+                             f"{responses.shape}")
+        responses = list(responses)
+    if not isinstance(responses, (list, tuple)):
+        raise TypeError(f"responses: expected a sequence of 2-D levels, got {describe(responses)}")
+    if len(responses) < 3:
+        raise ValueError(f"responses: expected at least 3 levels (maxima lie on inner ones), got {len(responses)}")
+    levels = [as_array(r, f"responses[{n}]", ndim=2, dtype=np.float32) for n, r in enumerate(responses)]
+    for n, r in enumerate(levels):
+        if min(r.shape) < 3:
+            raise ValueError(f"responses[{n}]: expected at least 3 x 3 samples, got shape {r.shape}")
+    steps = as_array(steps, "steps", shape=(len(levels),), dtype=None)
+    if steps.dtype.kind not in "iu" or np.any(steps < 1):
+        raise ValueError(f"steps: expected positive integers, got {steps.tolist()}")
+    for n in range(len(levels) - 1):
+        (fine, coarse), ratio = (levels[n], levels[n + 1]), steps[n + 1] / steps[n]
+        if ratio == 0.5:
+            fine, coarse, ratio = coarse, fine, 2.0
+        expected = fine.shape if ratio == 1 else tuple(-(-d // 2) for d in fine.shape) if ratio == 2 else None
+        if expected is None:
+            raise ValueError(f"steps: expected adjacent levels with equal spacing or one twice the other, got "
+                             f"{steps.tolist()}")
+        if coarse.shape != expected:
+            raise ValueError(f"responses[{n}], responses[{n + 1}]: expected shapes that match steps {int(steps[n])} "
+                             f"and {int(steps[n + 1])} (the coarser level is the finer one sampled every second "
+                             f"pixel), got {levels[n].shape} and {levels[n + 1].shape}")
+    return levels, steps
 
 
 def _lookup(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
