@@ -85,9 +85,10 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     R_cw = T_world_cam[:3, :3].T
     P = (world.corner_array - T_world_cam[:3, 3]) @ R_cw.T  # (N, 4, 3) corners in the camera frame
     idx = _in_view(P, K, width, height, near)
-    polygons, box, zmin, zmax, seen = _image_polygons(P[idx], K, width, height, near)
-    plane, level, M = _texture_maps(world.surface_arrays, idx, P[idx], R_cw, K, box, zmin, zmax)
-    seen &= np.isfinite(plane).all(axis=1)          # a plane seen edge-on covers no pixel area
+    Pk = P[idx]
+    polygons, box, zmin, zmax, seen = _image_polygons(Pk, K, width, height, near)
+    plane, edge_on, level, M = _texture_maps(world.surface_arrays, idx, Pk, R_cw, K, box, zmin, zmax)
+    seen &= ~edge_on                    # a plane seen edge-on covers no pixel area
     image = np.zeros((height, width, 3), np.uint8)
     zinv_buf = np.zeros((height, width), np.float32)
     # each surface in turn (in the world's order, which settles ties): rasterise, z-test, texture
@@ -155,13 +156,13 @@ def _image_polygons(Pk: np.ndarray, K: np.ndarray, width: int, height: int, near
 
 def _texture_maps(arrays: dict, idx: np.ndarray, Pk: np.ndarray, R_cw: np.ndarray, K: np.ndarray, box: np.ndarray,
                   zmin: np.ndarray, zmax: np.ndarray) -> tuple:
-    """Per surface: its inverse-depth plane over the pixels (non-finite when seen edge-on), the mip
-    level of its texture and the homography from that level to its bounding box (H&Z Sec. 8.1.1)."""
+    """Per surface: its inverse-depth plane over the pixels, whether it is seen edge-on (no plane), the
+    mip level of its texture and the homography from that level to its bounding box (H&Z Sec. 8.1.1)."""
     fx = K[0, 0]
     # inverse depth is affine in the pixel: plane n.X = d in the camera frame, 1/Z = (K^-T n / d) . [u, v, 1]
     n_c = arrays["normal"][idx] @ R_cw.T
     d = np.einsum("ij,ij->i", n_c, Pk[:, 0])
-    d[np.abs(d) < 1e-12] = np.nan       # a plane seen edge-on covers no pixel area
+    edge_on = ~(np.abs(d) >= 1e-12)
     with np.errstate(divide="ignore", invalid="ignore"):
         plane = np.linalg.solve(K.T, n_c.T).T / d[:, None]
         # mip level: texels per pixel at a representative depth of the visible part
@@ -176,7 +177,7 @@ def _texture_maps(arrays: dict, idx: np.ndarray, Pk: np.ndarray, R_cw: np.ndarra
     M = K @ np.stack([a_col, b_col, Pk[:, 0] + 0.5 * (a_col + b_col)], axis=-1)
     M[:, 0] -= box[:, :1] * M[:, 2]
     M[:, 1] -= box[:, 1:2] * M[:, 2]
-    return plane, level, M
+    return plane, edge_on, level, M
 
 
 def _project(points: np.ndarray, fx: float, fy: float, cx: float, cy: float) -> np.ndarray:
