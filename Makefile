@@ -1,7 +1,8 @@
 # robokit courseware. The two commands an instructor needs:
 #   make course   build the course: run every lesson and solution notebook, write build/course/
 #   make test     run the test-suite (the README's test command; .ci/run calls exactly this)
-# Each target creates .venv on first use and installs robokit with its extras from pyproject.toml.
+# Each target creates .venv on first use and installs both packages, editable, with their extras:
+# the robokit library (pyproject.toml) and the robocourse course package (course/pyproject.toml).
 
 PYTHON ?= python3
 VENV   ?= .venv
@@ -12,16 +13,16 @@ COURSE_ARGS ?=
 
 .PHONY: course test lab venv assignments bench clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml course/pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[lab,dev]'
+	$(BIN)/python -m pip install --quiet -e '.[legged,arm,dev]' -e './course[lab]'
 	@touch $(STAMP)
 
 venv: $(STAMP)
 
 course: $(STAMP)
-	$(BIN)/robokit course build $(COURSE_ARGS)
+	$(BIN)/robocourse build $(COURSE_ARGS)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest $(PYTEST_ARGS)

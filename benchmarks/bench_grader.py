@@ -15,7 +15,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from robokit.grading.grader import grade_batch, isolation_note
+from robocourse.grading.grader import grade_batch, isolation_note
 
 ROOT = Path(__file__).resolve().parents[1]
 

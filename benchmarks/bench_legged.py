@@ -23,7 +23,7 @@ from timing import median_time
 from robokit.controllers import LITTLEDOG_MOTOR
 from robokit.legged import STANCE_FEET, littledog_model, simulate_walk
 from robokit.legged import leg_kinematics as lk
-from robokit.legged.walking_experiment import lesson_plans
+from robocourse.lessons.littledog.experiment import lesson_plans
 
 
 def bare_physics(seconds: float) -> float:

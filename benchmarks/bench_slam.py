@@ -18,7 +18,7 @@ import time
 import cv2
 import numpy as np
 
-from robokit.localization.lab_experiment import lab_experiment, mapping_run
+from robocourse.lessons.visual_slam.experiment import lab_experiment, mapping_run
 
 
 def _opencv_sift_seconds(image: np.ndarray, repeats: int = 5) -> float:

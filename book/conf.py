@@ -1,4 +1,4 @@
-"""Sphinx configuration of the course site (``robokit course build`` builds it twice: the student
+"""Sphinx configuration of the course site (``robocourse build`` builds it twice: the student
 site and the instructor site). Notebooks arrive already executed; nothing is run here.
 
 Everything a page needs is local: MathJax 3 comes from the ``sphinx-mathjax-offline`` package

@@ -56,7 +56,7 @@ def assert_check_passes(exercise_id: str, fn, n_cases: int) -> None:
     so the count is read from its report)."""
     import io
 
-    from robokit.grading import check
+    from robocourse.grading import check
 
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
@@ -70,7 +70,7 @@ def fast_course(tmp_path_factory):
     into both course sites: shared by the notebook tests and the site tests, so nothing runs twice."""
     from types import SimpleNamespace
 
-    from robokit.course.build import build_report_page, discover, run_notebooks, write_sites
+    from robocourse.site.build import build_report_page, discover, run_notebooks, write_sites
 
     build = tmp_path_factory.mktemp("course-build")
     quiet = lambda *_: None  # noqa: E731

@@ -67,7 +67,7 @@ def stereo_rig():
 
 @functools.cache
 def calibration():
-    from robokit.localization.lab_experiment import calibrated_rig
+    from robocourse.lessons.visual_slam.experiment import calibrated_rig
     return calibrated_rig(stereo_rig())
 
 
@@ -83,7 +83,7 @@ def image_mask():
 
 @functools.cache
 def office_experiment():   # lesson 02's fast office setup (cached on disk after the first build)
-    from robokit.navigation.omni_experiment import office_setup
+    from robocourse.lessons.omni_localization.experiment import office_setup
     return office_setup(fast=True)
 
 
@@ -381,13 +381,13 @@ def bow_vocabulary():
 
 @functools.cache
 def corridor_setup():   # lesson 03's fast corridor map (cached on disk after the first build)
-    from robokit.navigation.corridor_experiment import corridor_map
+    from robocourse.lessons.corridor_localization.experiment import corridor_map
     return corridor_map(fast=True)
 
 
 @functools.cache
 def corridor_calibration():
-    from robokit.navigation.corridor_experiment import calibration_run
+    from robocourse.lessons.corridor_localization.experiment import calibration_run
     return calibration_run(fast=True)
 
 
@@ -411,7 +411,7 @@ def sensing_T(n=5):         # a short walk of body poses
 @functools.cache
 def sensing_frames():
     from robokit.legged import MARKERS
-    from robokit.legged.mocap_sensor import simulate_mocap
+    from robokit.legged.mocap import simulate_mocap
     return simulate_mocap(sensing_T(), MARKERS, 0.001, 0.0, 0)
 
 
@@ -487,7 +487,7 @@ def trial_outcomes():     # a TrialOutcome around the synthetic log: no MuJoCo n
 
 
 def touchdown_detectors():
-    from robokit.legged.walking_experiment import TOUCHDOWN_DETECTORS
+    from robocourse.lessons.littledog.experiment import TOUCHDOWN_DETECTORS
     return list(TOUCHDOWN_DETECTORS)
 
 
@@ -525,7 +525,7 @@ SPECS: dict[str, Call] = {
     "robokit.arm.position_posture.ik_position_posture": Call({"chain": Obj(iiwa), "T": T_(),
                                                               "q0": Array(q7, "7", optional=True), "tol": Real(1e-6),
                                                               "max_iter": Int(50), "method": Choice("newton")}),
-    "robokit.exercises.redundant_ik.solve_ik": Call({"T": T_(), "q_start": Array(q7, "7")}, cheap=False),
+    "robocourse.lessons.redundant_ik.exercises.solve_ik": Call({"T": T_(), "q_start": Array(q7, "7")}, cheap=False),
     "robokit.arm.ik_analytic.ik_srs_branches": Call({"chain": Obj(iiwa), "T": T_(), "psi": Real(0.3),
                                                      "within_limits": Flag(True)}),
     "robokit.arm.ik_numeric.ik_numeric": Call({"chain": Obj(panda_arm), "T": T_(lambda: panda_arm().fk(panda_arm().random_q(rng=3))),
@@ -561,9 +561,9 @@ SPECS: dict[str, Call] = {
     # --- controllers -----------------------------------------------------------------------
     "robokit.controllers.heading.design_heading_gains": Call({"tau": Real(0.3), "overshoot": Real(0.05),
                                                               "settling_time": Real(1.5), "gain": Real(1.0)}),
-    "robokit.controllers.heading_loop.heading_frequency_response": Call({
+    "robokit.controllers.heading.heading_frequency_response": Call({
         "kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3), "omega": Array(np.array([0.1, 1.0, 10.0]), "N|"), "gain": Real(1.0)}),
-    "robokit.controllers.heading_loop.heading_step_response": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
+    "robokit.controllers.heading.heading_step_response": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
                                                                "gain": Real(1.0), "duration": Real(2.0), "n": Int(50)}),
     "robokit.controllers.servo_loop.loop_metrics": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
                                                       "gain": Real(1.0), "delay": Real(0.0)}),
@@ -576,12 +576,12 @@ SPECS: dict[str, Call] = {
         "rng": Rng(0)}),
     "robokit.localization.egomotion.pose_from_two": Call({"robot_points": Array(lambda: points(2, 2), "2,3"),
                                                           "world_points": Array(lambda: points(2, 3), "2,3")}),
-    "robokit.localization.lab_experiment.calibrated_rig": Call({"render_rig": Obj(stereo_rig)}),
-    "robokit.localization.lab_experiment.lab_experiment": Call({
+    "robocourse.lessons.visual_slam.experiment.calibrated_rig": Call({"render_rig": Obj(stereo_rig)}),
+    "robocourse.lessons.visual_slam.experiment.lab_experiment": Call({
         "method": Choice("sift"), "descriptor": Choice("sift128"), "rate": Real(1.0), "frames": Int(2, optional=True),
         "test_poses": Array(np.array([[1.0, 1.0, 0.0]]), "N,3", optional=True), "noise": Real(2.0), "seed": Int(0),
         "progress": Func(None, optional=True)}, cheap=False),
-    "robokit.localization.lab_experiment.map_consistency": Call({
+    "robocourse.lessons.visual_slam.experiment.map_consistency": Call({
         "landmark_map": Obj(landmark_map), "world": Obj(lab, optional=True), "camera_height": Real(0.8),
         "margin": Real(0.02)}),
     "robokit.mapping.landmarks.kalman_fuse": Call({"s": Array(np.array([1.0, 2.0, 3.0]), "3|N,3"),
@@ -739,18 +739,18 @@ SPECS: dict[str, Call] = {
     "robokit.vision.stereo.triangulate_svd": Call({"p_left": Array(P_LEFT, "3,4"), "p_right": Array(P_RIGHT, "3,4"),
                                                    "uv_left": Array(UV, "N,2"), "uv_right": Array(UV - [[10.0, 0.0]], "N,2")}),
     # --- the exercises' own plain-data references --------------------------------------------
-    "robokit.exercises.visual_slam.match_ratio": Call({"query": Array(lambda: features().descriptors[:20], "N,N", min_rows=0),
+    "robocourse.lessons.visual_slam.exercises.match_ratio": Call({"query": Array(lambda: features().descriptors[:20], "N,N", min_rows=0),
                                                        "train": Array(lambda: features().descriptors[10:40], "N,N", min_rows=0),
                                                        "ratio": Real(0.65)}),
-    "robokit.exercises.visual_slam.stereo_point": Call({
+    "robocourse.lessons.visual_slam.exercises.stereo_point": Call({
         "c": Array(np.array([320.0, 100.0]), "N"), "r": Array(np.array([240.0, 50.0]), "N"),
         "d": Array(np.array([10.0, 20.0]), "N"), "focal": Real(500.0), "c0": Real(320.0), "r0": Real(240.0),
         "baseline": Real(0.12)}),
-    "robokit.exercises.visual_slam.robust_pose": Call({
+    "robocourse.lessons.visual_slam.exercises.robust_pose": Call({
         "robot_points": Array(np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [-1.0, 0.2, 3.0]]), "N,3"),
         "world_points": Array(np.array([[1.0, 0.0, 2.0], [2.0, 0.0, 3.0], [0.0, 0.2, 4.0]]), "N,3")}),
-    "robokit.exercises.visual_slam.robust_pose_problems": Call({"rng": Rng()}),
-    "robokit.exercises.visual_slam.hough_votes": Call({
+    "robocourse.lessons.visual_slam.exercises.robust_pose_problems": Call({"rng": Rng()}),
+    "robocourse.lessons.visual_slam.exercises.hough_votes": Call({
         "robot_xz": Array(np.array([[0.0, 1.0], [0.5, 2.0]]), "N,2"), "robot_cov_xz": Array(np.tile(np.eye(2) * 1e-3, (2, 1, 1)), "N,2,2"),
         "world_xz": Array(np.array([[0.2, 1.2], [0.7, 2.2]]), "N,2"), "world_cov_xz": Array(np.tile(np.eye(2) * 1e-3, (2, 1, 1)), "N,2,2"),
         "bounds": Array(np.array([0.0, 0.4, 0.0, 0.4]), "4"), "bin_size": Real(0.04), "angle_bin": Real(0.5)}),
@@ -787,24 +787,24 @@ SPECS: dict[str, Call] = {
     "robokit.viz.framing.look_from": Call({"scene": Obj(scene), "position": Array(np.array([-5.0, -5.0, 9.0]), "3"),
                                            "target": Array(np.array([0.0, 0.0, 0.1]), "3", optional=True)}),
     # --- lesson 02: the assignment's plain-data references, the experiments, graphs and sliders ---
-    "robokit.exercises.omni_localization.fine_stage_counts": Call({
+    "robocourse.lessons.omni_localization.exercises.fine_stage_counts": Call({
         "query": Array(lambda: rec_nodes()[1][:4] + 0.01, "N,N", min_rows=0), "node_descriptors": Obj(rec_nodes),
         "candidates": Array(np.array([0, 1, 2]), "N", min_rows=0), "ratio": Real(0.8)}),
-    "robokit.exercises.omni_localization.recognise_node": Call({
+    "robocourse.lessons.omni_localization.exercises.recognise_node": Call({
         "query_histogram": Array(np.array([0.1, 0.9, 0.0]), "N"),
         "query_descriptors": Array(lambda: rec_nodes()[1][:4] + 0.01, "N,N", min_rows=0),
         "node_histograms": Array(np.eye(3), "N,N"), "node_descriptors": Obj(rec_nodes), "top_k": Int(2),
         "ratio": Real(0.8)}),
-    "robokit.navigation.omni_experiment.office_setup": Call({"fast": Flag(True), "progress": Func(None, optional=True)},
+    "robocourse.lessons.omni_localization.experiment.office_setup": Call({"fast": Flag(True), "progress": Func(None, optional=True)},
                                                             cheap=False),
-    "robokit.navigation.omni_experiment.localization_trials": Call({
+    "robocourse.lessons.omni_localization.experiment.localization_trials": Call({
         "setup": Obj(office_experiment), "places": Array(np.array([[13.0, 3.7, 2.0]]), "N,3"),
         "modes": Given(("coarse",)), "map": Choice("relaxed"), "rng": Rng(0), "progress": Func(None, optional=True)},
         cheap=False),
-    "robokit.navigation.omni_experiment.route_recognition": Call({
+    "robocourse.lessons.omni_localization.experiment.route_recognition": Call({
         "setup": Obj(office_experiment), "n_nodes": Int(2), "offset": Real(0.15), "same_place": Real(0.5),
         "rng": Rng(1)}, cheap=False),
-    "robokit.navigation.omni_navigation.navigation_trials": Call({
+    "robocourse.lessons.omni_localization.navigation.navigation_trials": Call({
         "setup": Obj(office_experiment), "n_starts": Int(1), "first_node": Int(0, optional=True),
         "n_path_nodes": Int(3), "clearance": Real(0.3), "fix_period": Real(1.0), "alpha": Real(2.0),
         "offset": Real(0.3), "heading": Real(0.3), "max_time": Real(3.0, optional=True), "success_radius": Real(0.3),
@@ -1187,26 +1187,26 @@ SPECS: dict[str, Call] = {
         "levels": Int(2), "iterations": Int(5), "rng": Rng(0)}),
     "robokit.vision.bow_database.BowDatabase": Call({"vocabulary": Obj(bow_vocabulary)}),
     # --- lesson 03: the assignment's plain-data references, the experiments, clusters, animation ---
-    "robokit.exercises.corridor_localization.cell_log_odds": Call({
+    "robocourse.lessons.corridor_localization.exercises.cell_log_odds": Call({
         "probabilities": Array(np.array([0.7, 0.7, 0.4]), "N", min_rows=0), "prior": Real(0.5)}),
-    "robokit.exercises.corridor_localization.bow_similarity": Call({
+    "robocourse.lessons.corridor_localization.exercises.bow_similarity": Call({
         "words_a": Array(np.array([0, 1, 1]), "N", min_rows=0), "words_b": Array(np.array([1, 2]), "N", min_rows=0),
         "idf": Array(np.array([1.0, 1.0, 1.0]), "N")}),
-    "robokit.exercises.corridor_localization.likelihood_field_weight": Call({
+    "robocourse.lessons.corridor_localization.exercises.likelihood_field_weight": Call({
         "pose": Array(np.array([0.55, 1.0, 0.0]), "3"), "ranges": Array(np.array([1.0, 0.8]), "N", inf_ok=True),
         "angles": Array(np.array([0.0, 1.5]), "N"), "distance": Array(distance_grid, "N,N"), "resolution": Real(0.1),
         "origin": Array(np.array([0.0, 0.0]), "2"), "sigma_hit": Real(0.2), "z_hit": Real(0.95), "z_rand": Real(0.05),
         "r_max": Real(8.0), "max_distance": Real(2.0)}),
-    "robokit.exercises.corridor_localization.resample_indices": Call({
+    "robocourse.lessons.corridor_localization.exercises.resample_indices": Call({
         "weights": Array(np.array([0.1, 0.6, 0.3]), "N"), "r": Real(0.2)}),
-    "robokit.exercises.corridor_localization.ellipse_start_weights": Call({
+    "robocourse.lessons.corridor_localization.exercises.ellipse_start_weights": Call({
         "points": Array(np.array([[0.0, 0.0], [1.0, 0.0]]), "N,2"), "centre": Array(np.array([0.0, 0.0]), "2"),
         "sigma_x": Real(1.0), "sigma_y": Real(1.0)}),
-    "robokit.exercises.corridor_localization.recognise_keyframe": Call({
+    "robocourse.lessons.corridor_localization.exercises.recognise_keyframe": Call({
         "query": Array(lambda: orb_descriptors(40, 2)[:10], "N,32"),
         "keyframes": Obj(lambda: [orb_descriptors(40, 1), orb_descriptors(40, 2)])}),
     # --- lesson 05: the open exercise's reference ---
-    "robokit.exercises.gps_sonar_truck.compass_bias": Call({
+    "robocourse.lessons.gps_sonar_truck.exercises.compass_bias": Call({
         "fixes": Array(np.array([[0.0, 0.0], [0.7, 0.1], [1.4, 0.0]]), "N,2"),
         "compass_deg": Array(np.array([91.0, 92.0, 91.0]), "N")}),
     "robokit.localization.particle_clusters.pose_clusters": Call({
@@ -1222,31 +1222,31 @@ SPECS: dict[str, Call] = {
         "weights": Array(np.array([0.4, 0.4, 0.2]), "N", optional=True),
         "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3"),
         "labels": Array(np.array([0, 0, 1]), "N", optional=True)}),
-    "robokit.navigation.corridor_trials.corridor_localizer": Call({
+    "robocourse.lessons.corridor_localization.trials.corridor_localizer": Call({
         "setup": Obj(corridor_setup), "method": Choice("ours"), "rng": Rng(0)}, cheap=False),
-    "robokit.navigation.corridor_aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),
-    "robokit.navigation.corridor_sensors.corridor_lidar": Call({}),
-    "robokit.navigation.corridor_sensors.corridor_camera": Call({"fast": Flag(True, optional=True)}),
-    "robokit.navigation.corridor_experiment.calibration_run": Call({
+    "robocourse.lessons.corridor_localization.aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),
+    "robocourse.lessons.corridor_localization.sensors.corridor_lidar": Call({}),
+    "robocourse.lessons.corridor_localization.sensors.corridor_camera": Call({"fast": Flag(True, optional=True)}),
+    "robocourse.lessons.corridor_localization.experiment.calibration_run": Call({
         "fast": Flag(True, optional=True), "start": Real(12.0), "length": Real(10.0), "speed": Real(0.2),
         "frame_rate": Real(30.0), "progress": Func(None, optional=True)}, cheap=False),
-    "robokit.navigation.corridor_experiment.keyframe_comparison": Call({
+    "robocourse.lessons.corridor_localization.experiment.keyframe_comparison": Call({
         "run": Obj(corridor_calibration), "min_frame_gap": Int(10), "shared_range": Array(np.array([0.7, 0.9]), "2"),
         "below_band": Choice("take")}, cheap=False),
-    "robokit.navigation.corridor_experiment.corridor_map": Call({
+    "robocourse.lessons.corridor_localization.experiment.corridor_map": Call({
         "fast": Flag(True, optional=True), "resolution": Real(0.05), "progress": Func(None, optional=True)},
         cheap=False),
-    "robokit.navigation.corridor_trials.retrieve_pose": Call({
+    "robocourse.lessons.corridor_localization.trials.retrieve_pose": Call({
         "setup": Obj(corridor_setup), "pose": Array(np.array([10.0, 0.0, 0.0]), "3"), "rng": Rng(0)}, cheap=False),
-    "robokit.navigation.corridor_trials.localization_trial": Call({
+    "robocourse.lessons.corridor_localization.trials.localization_trial": Call({
         "setup": Obj(corridor_setup), "start": Array(np.array([12.0, 0.3, 0.4]), "3"), "method": Choice("ours"),
         "rng": Rng(1), "max_distance": Real(3.0), "share": Real(0.95), "sigma_x": Real(0.3), "sigma_y": Real(0.1),
         "settle": Int(1), "keep_particles": Flag(False)}, cheap=False),
-    "robokit.navigation.corridor_trials.localization_trials": Call({
+    "robocourse.lessons.corridor_localization.trials.localization_trials": Call({
         "setup": Obj(corridor_setup), "method": Choice("ours"), "trials": Int(1, optional=True),
         "positions": Given([0]), "seed": Int(0), "max_distance": Real(3.0), "cache": Flag(False),
         "progress": Func(None, optional=True), "workers": Int(1, optional=True)}, cheap=False),
-    "robokit.navigation.corridor_kidnapping.kidnapping": Call({
+    "robocourse.lessons.corridor_localization.kidnapping.kidnapping": Call({
         "setup": Obj(corridor_setup), "origin": Int(0), "destination": Int(2), "period": Real(5.0), "after": Real(3.0),
         "kidnap_distance": Real(1.0), "seed": Int(0)}, cheap=False),
     "robokit.viz.animation.animate_snapshots": Call({
@@ -1270,7 +1270,7 @@ SPECS: dict[str, Call] = {
     "robokit.geometry.procrustes.fit_se3": Call({
         "source": Array(lambda: points(6), "N,3|N,N,3"), "target": Array(lambda: points(6) + 1.0, "N,3|N,N,3"),
         "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
-    "robokit.legged.mocap_sensor.simulate_mocap": Call({
+    "robokit.legged.mocap.simulate_mocap": Call({
         "T_world_body": Array(sensing_T, "N,4,4|4,4"), "markers_body": Array(sensing_markers, "N,3|3"),
         "noise": Real(0.001), "dropout": Real(0.1), "rng": Rng(0), "bursts": Real(0.1), "burst_length": Int(2)}),
     "robokit.legged.mocap.fit_marker_pose": Call({
@@ -1305,9 +1305,9 @@ SPECS: dict[str, Call] = {
     "robokit.legged.touchdown.detect_contacts": Call({
         "force": Array(np.array([0.0, 4.0, 6.0, 1.0, 6.0, 0.5]), "N|N,N", min_rows=0), "threshold_on": Real(3.0),
         "threshold_off": Real(1.0), "debounce": Int(2)}),
-    "robokit.legged.event_scoring.contact_events": Call({
+    "robokit.legged.touchdown.contact_events": Call({
         "contact": Array(walk_contacts, "N|N,N", min_rows=0, accepts=("booleans",))}),
-    "robokit.legged.event_scoring.event_precision_recall": Call({
+    "robokit.legged.touchdown.event_precision_recall": Call({
         "detected": Array(lambda: np.roll(walk_contacts(), 1), "N|N,N", accepts=("booleans",)),
         "truth": Array(walk_contacts, "N|N,N", accepts=("booleans",)), "tolerance": Int(2)}),
     # --- robokit.legged.support, gait_schedule, gait (lesson 04's gaits) ----------------------------
@@ -1429,24 +1429,24 @@ SPECS: dict[str, Call] = {
         "feet_xy": Array(np.array([[0.16, 0.08], [0.16, -0.08], [-0.16, 0.08], [-0.16, -0.08]]), "N,2|N,3"),
         "stance": Array(np.array([True, True, True, False]), "N", accepts=("booleans",)),
         "com_xy": Array(np.array([0.01, 0.0]), "2|3"), "ax": Given(axes), "legs": Given(("FL", "FR", "HL", "HR"))}),
-    # --- assignment 04: robokit.exercises.littledog, its helpers (legged.exercise_data, event_scoring) and
+    # --- assignment 04: robocourse.lessons.littledog.exercises, its helpers (legged.exercise_data, event_scoring) and
     #     the leg kinematics its exercises reference ----------------------------------------------------
     "robokit.legged.leg_kinematics.foot_position": Call({
         "q_leg": Array(np.array([0.1, 0.6, -1.2]), "...,3"), "leg": Choice("FL")}),
     "robokit.legged.leg_kinematics.leg_ik": Call({
         "p_foot": Array(np.array([0.12, 0.07, -0.11]), "3"), "leg": Choice("FL"),
         "branch": Int(-1, optional=True, accepts=("a list",))}),
-    "robokit.legged.event_scoring.score_events": Call({
+    "robokit.legged.touchdown.score_events": Call({
         "detected": Array(np.array([3, 5, 8]), "N", min_rows=0), "truth": Array(np.array([2, 8]), "N", min_rows=0),
         "tolerance": Int(2)}),
-    "robokit.legged.exercise_data.model_facts": Call({}),
-    "robokit.legged.exercise_data.touchdown_trace": Call({
+    "robocourse.lessons.littledog.data.model_facts": Call({}),
+    "robocourse.lessons.littledog.data.touchdown_trace": Call({
         "rng": Rng(0), "duration": Real(3.0), "noise": Real(0.2), "bounce": Real(0.5), "drift": Real(0.5)}),
-    "robokit.legged.exercise_data.touchdown_traces": Call({"seed": Int(0)}),
-    "robokit.legged.exercise_data.mocap_frames": Call({"seed": Int(0), "n": Int(5), "noise": Real(0.001)}),
-    "robokit.exercises.littledog.battery_endurance": Call({
+    "robocourse.lessons.littledog.data.touchdown_traces": Call({"seed": Int(0)}),
+    "robocourse.lessons.littledog.data.mocap_frames": Call({"seed": Int(0), "n": Int(5), "noise": Real(0.001)}),
+    "robocourse.lessons.littledog.exercises.battery_endurance": Call({
         "capacity_ah": Real(2.1), "voltage": Real(14.8), "mean_power_w": Real(62.0)}),
-    "robokit.exercises.littledog.detect_touchdowns": Call({
+    "robocourse.lessons.littledog.exercises.detect_touchdowns": Call({
         "force": Array(np.array([0.0, 0.2, 9.0, 0.5, 11.0, 10.0, 10.0, 10.0, 4.0, 1.0, 0.0]), "N", min_rows=0),
         "dt": Real(0.01)}),
     # --- lesson 04: leg kinematics and statics, the MuJoCo model, the servo design (robokit.legged.leg_kinematics,
@@ -1496,18 +1496,18 @@ SPECS: dict[str, Call] = {
     "robokit.legged.simulation.simulate_walk": Call({
         "plan": Obj(tiny_walk_plan), "loops": Obj(loop_settings), "sensors": Obj(sensor_settings),
         "motor": Obj(littledog_motor), "rng": Rng(0)}, cheap=False),
-    "robokit.legged.walking_experiment.lesson_plans": Call({"distance": Real(0.05)}),
-    "robokit.legged.walking_experiment.loop_table": Call({
+    "robocourse.lessons.littledog.experiment.lesson_plans": Call({"distance": Real(0.05)}),
+    "robocourse.lessons.littledog.experiment.loop_table": Call({
         "plan": Obj(tiny_walk_plan), "servo_rates": Array(np.array([500.0]), "N"),
         "latencies": Array(np.array([0.0]), "N"), "bandwidths": Array(np.array([15.0]), "N"), "rng": Rng(0),
         "progress": Func(None, optional=True)}, cheap=False),
-    "robokit.legged.walking_experiment.estimation_table": Call({"log": Obj(trial_log)}),
-    "robokit.legged.walking_experiment.touchdown_table": Call({
+    "robocourse.lessons.littledog.experiment.estimation_table": Call({"log": Obj(trial_log)}),
+    "robocourse.lessons.littledog.experiment.touchdown_table": Call({
         "log": Obj(trial_log), "detectors": Obj(touchdown_detectors, optional=True), "tolerance": Int(5),
         "plan": Obj(tiny_walk_plan, optional=True), "gate": Int(10)}),
-    "robokit.legged.walking_experiment.endurance_table": Call({"outcomes": Mapping(trial_outcomes)}),
-    "robokit.legged.walking_experiment.true_margins": Call({"log": Obj(trial_log)}),
-    "robokit.legged.event_scoring.match_events": Call({
+    "robocourse.lessons.littledog.experiment.endurance_table": Call({"outcomes": Mapping(trial_outcomes)}),
+    "robocourse.lessons.littledog.experiment.true_margins": Call({"log": Obj(trial_log)}),
+    "robokit.legged.touchdown.match_events": Call({
         "detected": Array(np.array([3, 5, 8]), "N", min_rows=0), "truth": Array(np.array([2, 8]), "N", min_rows=0),
         "tolerance": Int(2)}),
     "robokit.legged.support.nearest_boundary_point": Call({
@@ -1523,7 +1523,7 @@ NOT_FUZZED: dict[str, str] = {
     "robokit.sim.motion.Path": "a plain record (NamedTuple) of t and poses; the functions that take one validate it",
     "robokit.legged.gait.WalkPlan": "a plain record (NamedTuple) of a plan's arrays; walking_plan makes it",
     "robokit.legged.trial_log.TrialLogError": "an exception class (a ValueError) the lesson catches, not calls",
-    "robokit.grading.check.check": "the notebook's checker of a student's function (grading's own tests cover it)",
+    "robocourse.grading.check.check": "the notebook's checker of a student's function (grading's own tests cover it)",
 }
 
 #: Besides the lessons' API: the exercises' references (students reproduce their contracts) and
@@ -1610,14 +1610,14 @@ EXTRA: tuple[str, ...] = (
         "bow_database.BowDatabase")),
     # lesson 04's sensing: the one rigid fit, MoCap, IMU, fusion, touchdowns
     "robokit.geometry.procrustes.fit_rigid", "robokit.geometry.procrustes.fit_se3",
-    "robokit.legged.mocap_sensor.simulate_mocap",
+    "robokit.legged.mocap.simulate_mocap",
     *(f"robokit.legged.mocap.{n}" for n in ("fit_marker_pose", "mocap_body_poses")),
     *(f"robokit.legged.imu.{n}" for n in ("simulate_imu", "integrate_gyro", "specific_force")),
     *(f"robokit.legged.state_estimation.{n}" for n in ("fuse_body_state", "orientation_errors", "position_errors")),
     "robokit.legged.touchdown.detect_contacts", "robokit.legged.touchdown.gate_touchdowns",
     "robokit.legged.support.nearest_boundary_point",
     "robokit.legged.simulation.SensorSettings",
-    *(f"robokit.legged.event_scoring.{n}" for n in ("contact_events", "event_precision_recall", "score_events",
+    *(f"robokit.legged.touchdown.{n}" for n in ("contact_events", "event_precision_recall", "score_events",
                                                      "match_events")),
     # robokit.legged's gaits (lesson 04), fuzzed before the lesson exists
     *(f"robokit.legged.support.{n}" for n in ("support_polygon", "stability_margin", "stability_margins")),
@@ -1644,9 +1644,9 @@ EXTRA: tuple[str, ...] = (
         "support_outline", "plot_gait_diagram", "plot_joint_tracking", "plot_foot_forces", "plot_support")),
     # assignment 04's exercises and helpers
     "robokit.legged.leg_kinematics.foot_position", "robokit.legged.leg_kinematics.leg_ik",
-    *(f"robokit.legged.exercise_data.{n}" for n in ("model_facts", "touchdown_trace", "touchdown_traces",
+    *(f"robocourse.lessons.littledog.data.{n}" for n in ("model_facts", "touchdown_trace", "touchdown_traces",
                                                      "mocap_frames")),
-    "robokit.exercises.littledog.battery_endurance", "robokit.exercises.littledog.detect_touchdowns",
+    "robocourse.lessons.littledog.exercises.battery_endurance", "robocourse.lessons.littledog.exercises.detect_touchdowns",
 )
 
 

@@ -21,8 +21,10 @@ def test_fast_mode_rejects_typos():
         fast_mode({"ROBOKIT_FAST": "fats"})
 
 
-def test_package_exposes_fast_flag():
-    assert isinstance(robokit.FAST, bool)
+def test_the_course_exposes_fast_mode_and_the_library_does_not():
+    import robocourse
+
+    assert isinstance(robocourse.FAST, bool) and not hasattr(robokit, "FAST")
 
 
 def test_cache_dir_honours_override(tmp_path, monkeypatch):

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robokit.course.browser import Browser, BrowserError, changed_fraction, content_fraction
-from robokit.course.cdp import find_chromium
+from robocourse.site.browser import Browser, BrowserError, changed_fraction, content_fraction
+from robocourse.site.cdp import find_chromium
 from tests.conftest import CHROMIUM, needs_chromium
 
 

@@ -1,4 +1,4 @@
-"""`robokit course build` keeps going past broken notebooks and reports them (issue: Bad input)."""
+"""`robocourse build` keeps going past broken notebooks and reports them (issue: Bad input)."""
 import json
 import re
 import shutil
@@ -6,8 +6,8 @@ import shutil
 import nbformat
 import pytest
 
-from robokit.cli import main
-from robokit.course.execute import run_notebook
+from robocourse.cli import main
+from robocourse.site.execute import run_notebook
 from tests.conftest import ROOT
 
 
@@ -32,7 +32,7 @@ def course(tmp_path_factory):
     _notebook(root / "lessons" / "01_raises.ipynb", "x = 1", "raise ValueError('boom in lesson one')")
     _notebook(root / "solutions" / "02_hangs.ipynb", "import time\ntime.sleep(600)")
     _notebook(root / "assignments" / "02_hangs.ipynb", "def f():\n    raise NotImplementedError")
-    code = main(["course", "build", "--root", str(root), "--timeout", "25", "--fast", "--no-grading",
+    code = main(["build", "--root", str(root), "--timeout", "25", "--fast", "--no-grading",
                  "--no-api-reference"])   # the library reference is built by tests/test_course_site.py
     return root, code
 
@@ -110,7 +110,7 @@ def test_bad_arguments():
 
 
 def test_cli_without_lessons_is_a_clear_error(tmp_path, capsys):
-    assert main(["course", "build", "--root", str(tmp_path)]) == 2
+    assert main(["build", "--root", str(tmp_path)]) == 2
     assert "no lessons/ directory" in capsys.readouterr().err
 
 
@@ -119,7 +119,7 @@ def test_check_in_a_notebook_shows_its_message_not_a_traceback(tmp_path):
     is the message (no frames through robokit); a stub's NotImplementedYet is allowed in assignments."""
     import nbformat as nbf
 
-    good = ("import numpy as np\nfrom robokit.grading import check\n"
+    good = ("import numpy as np\nfrom robocourse.grading import check\n"
             "def wrap_angle(angle):\n    a = np.asarray(angle, float)\n"
             "    if np.isnan(a).any():\n        raise ValueError('angle: NaN')\n"
             "    r = np.mod(a + np.pi, 2 * np.pi) - np.pi\n    return float(r) if r.ndim == 0 else r\n")
@@ -144,7 +144,7 @@ def test_check_in_a_notebook_shows_its_message_not_a_traceback(tmp_path):
 
 
 def test_the_student_site_sources_refuse_solutions(tmp_path):
-    from robokit.course.book import BookPage, write_sources
+    from robocourse.site.book import BookPage, write_sources
 
     solution = _notebook(tmp_path / "01.ipynb", "x = 1")
     with pytest.raises(ValueError, match="solutions"):
@@ -165,12 +165,12 @@ def test_build_refuses_output_folders_it_would_have_to_wipe(tmp_path, capsys):
     docs = root / "docs"
     docs.mkdir()
     (docs / "keep.txt").write_text("mine")
-    assert main(["course", "build", "--root", str(root), "--out", str(docs), "--no-grading"]) == 2
+    assert main(["build", "--root", str(root), "--out", str(docs), "--no-grading"]) == 2
     assert (docs / "keep.txt").read_text() == "mine" and not (root / "build" / "executed").exists()
     assert "holds other files" in capsys.readouterr().out
-    assert main(["course", "build", "--root", str(root), "--out", str(root), "--no-grading"]) == 2
+    assert main(["build", "--root", str(root), "--out", str(root), "--no-grading"]) == 2
     assert (root / "lessons" / "00.ipynb").exists()
-    assert main(["course", "build", "--root", str(root), "--out", "site",
+    assert main(["build", "--root", str(root), "--out", "site",
                  "--instructor-out", "site/private", "--no-grading"]) == 2
     assert "instructor_out" in capsys.readouterr().out
 
@@ -179,12 +179,12 @@ def test_build_needs_the_site_sources(tmp_path, capsys):
     root = tmp_path / "course"
     (root / "lessons").mkdir(parents=True)
     _notebook(root / "lessons" / "00.ipynb", "x = 1")
-    assert main(["course", "build", "--root", str(root), "--no-grading"]) == 2
+    assert main(["build", "--root", str(root), "--no-grading"]) == 2
     assert "book/" in capsys.readouterr().out and not (root / "build" / "executed").exists()
 
 
 def test_a_solution_starts_after_its_lesson_and_the_longest_goes_first(tmp_path):
-    from robokit.course.build import run_notebooks
+    from robocourse.site.build import run_notebooks
     stamp = tmp_path / "stamps.txt"
     record = "import time\nopen({!r}, 'a').write('{} ' + ('start' if {} else 'end') + f' {{time.time()}}\\n')"
     for folder, name, seconds in (("lessons", "01_long.ipynb", 3), ("lessons", "02_short.ipynb", 0),
@@ -213,7 +213,7 @@ def test_a_solution_starts_after_its_lesson_and_the_longest_goes_first(tmp_path)
 
 
 def test_a_fresh_full_build_starts_the_notebook_declaring_the_longest_cold_time(tmp_path):
-    from robokit.course.build import run_notebooks
+    from robocourse.site.build import run_notebooks
     stamp = tmp_path / "stamps.txt"
     paths = []
     for name, declared in (("01_quick.ipynb", None), ("02_slow.ipynb", 120)):
@@ -231,7 +231,7 @@ def test_the_notebooks_running_at_once_share_the_cores(tmp_path, monkeypatch):
     # worker processes than cores (two notebooks on two cores: one worker each, the runs made in
     # place), and a notebook built alone gets every core
     import robokit.config as config
-    import robokit.course.build as build
+    import robocourse.site.build as build
     monkeypatch.setattr(build, "available_cpus", lambda: 4)
     monkeypatch.setattr(config, "available_cpus", lambda: 4)    # what worker_count falls back to
     out = tmp_path / "workers.txt"

@@ -95,6 +95,7 @@ def test_library_reference_documents_the_lessons_functions(fast_course):
     assert "Shimizu" in text                         # the docstrings' citations come through
     check = (api / "grading.check.html").read_text()
     assert "check" in check and "NotImplementedYet" in check
+    assert "assignment_data" in (api / "grading.data.html").read_text()
 
 
 def test_home_page_says_what_who_and_how_to_start(fast_course):

@@ -8,8 +8,8 @@ import re
 
 import pytest
 
-from robokit.course.browser import SCENE_TITLE, Browser
-from robokit.course.screenshots import changed_span, changed_fraction
+from robocourse.site.browser import SCENE_TITLE, Browser
+from robocourse.site.screenshots import changed_span, changed_fraction
 from tests.conftest import CHROMIUM, needs_chromium
 
 pytestmark = [pytest.mark.slow, pytest.mark.notebook, needs_chromium]

@@ -4,8 +4,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robokit.exercises import corridor_localization as module
-from robokit.grading import check, exercises_for
+from robocourse.lessons.corridor_localization import exercises as module
+from robocourse.grading import check
+from robocourse.lessons import exercises_for
 from tests.conftest import assert_check_passes
 from robokit.vision import hamming_distances
 
@@ -120,7 +121,7 @@ def test_check_fails_a_wrong_implementation(exercise_id, capsys):
 
 @pytest.mark.parametrize("exercise_id", list(EXERCISES))
 def test_check_passes_the_reference(exercise_id, capsys):
-    assert_check_passes(exercise_id, EXERCISES[exercise_id].reference, len(EXERCISES[exercise_id].make_cases(2024)))
+    assert_check_passes(exercise_id, EXERCISES[exercise_id].answer, len(EXERCISES[exercise_id].make_cases(2024)))
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -143,7 +144,7 @@ def test_the_open_exercise_is_fair(seed):
 def test_the_aliasing_helper_shows_a_look_alike():
     """The written question's data: the scan fits the look-alike place almost as well as the true one, and
     both far better than an ordinary place."""
-    from robokit.navigation.corridor_aliasing import aliasing_example
+    from robocourse.lessons.corridor_localization.aliasing import aliasing_example
     data = aliasing_example()
     weight = {k: module.likelihood_field_weight(data[k], data["ranges"], data["angles"], data["distance"],
                                                 data["resolution"], data["origin"])

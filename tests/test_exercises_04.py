@@ -6,13 +6,14 @@ import pytest
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from robokit.exercises import littledog as module
+from robocourse.lessons.littledog import exercises as module
 from robokit.geometry import so3_log
-from robokit.grading import check, exercises_for
+from robocourse.grading import check
+from robocourse.lessons import exercises_for
 from tests.conftest import assert_check_passes
 from robokit.legged import littledog
-from robokit.legged.event_scoring import contact_events, score_events
-from robokit.legged.exercise_data import model_facts, mocap_frames, touchdown_traces
+from robokit.legged.touchdown import contact_events, score_events
+from robocourse.lessons.littledog.data import model_facts, mocap_frames, touchdown_traces
 from robokit.legged.mocap import fit_marker_pose
 from robokit.legged.touchdown import detect_contacts
 
@@ -94,7 +95,7 @@ def test_check_fails_a_wrong_implementation(exercise_id, capsys):
 
 @pytest.mark.parametrize("exercise_id", list(EXERCISES))
 def test_check_passes_the_reference(exercise_id, capsys):
-    assert_check_passes(exercise_id, EXERCISES[exercise_id].reference, len(EXERCISES[exercise_id].make_cases(2024)))
+    assert_check_passes(exercise_id, EXERCISES[exercise_id].answer, len(EXERCISES[exercise_id].make_cases(2024)))
 
 
 def test_the_fk_cases_match_a_chain_of_homogeneous_transforms():
@@ -115,7 +116,7 @@ def test_the_fk_cases_match_a_chain_of_homogeneous_transforms():
         T = (tf(p=littledog.HIP_POSITIONS[i]) @ tf(rot(0, q[0])) @ tf(p=(0, side * littledog.HIP_OFFSET, 0))
              @ tf(rot(1, q[1])) @ tf(p=(0, 0, -littledog.UPPER_LEG)) @ tf(rot(1, q[2])))
         foot = T @ [0, 0, -littledog.LOWER_LEG, 1]
-        assert np.allclose(EXERCISES["04.leg_fk"].reference(q, leg), foot[:3], atol=1e-12)
+        assert np.allclose(EXERCISES["04.leg_fk"].answer(q, leg), foot[:3], atol=1e-12)
 
 
 def test_the_ik_cases_are_inverted_on_the_branch_asked_for_with_the_foot_below_the_hip():
@@ -123,8 +124,8 @@ def test_the_ik_cases_are_inverted_on_the_branch_asked_for_with_the_foot_below_t
         if case.raises:
             continue
         p, leg, branch = case.args
-        q = EXERCISES["04.leg_ik"].reference(p, leg, branch)
-        assert np.allclose(EXERCISES["04.leg_fk"].reference(q, leg), p, atol=1e-9)
+        q = EXERCISES["04.leg_ik"].answer(p, leg, branch)
+        assert np.allclose(EXERCISES["04.leg_fk"].answer(q, leg), p, atol=1e-9)
         assert np.sign(q[2]) == branch and np.all(np.abs(q) < np.pi - 0.1)
         # below the hip: in the rolled frame the foot's z is negative
         v = np.asarray(p) - littledog.HIP_POSITIONS[littledog.LEGS.index(leg)]
@@ -152,7 +153,7 @@ def test_the_open_touchdown_exercise_is_fair(seed, monkeypatch):
     fooled = 0
     for case, truth in zip(cases, truths):
         force, dt = case.args
-        assert exercise.reference(force, dt) == truth
+        assert exercise.answer(force, dt) == truth
         causal = contact_events(detect_contacts(force, 5.0, 3.0, 3)).tolist()
         assert exercise.compare(truth, causal) is None, case.label
         assert 2.0 <= score_events(causal, truth, 5).mean_delay_samples <= 5.0       # what the host pays
@@ -218,7 +219,7 @@ def test_the_open_marker_fit_accepts_other_correct_methods(method, capsys):
                 with pytest.raises(ValueError):
                     method(*case.args)
                 continue
-            assert exercise.compare(exercise.reference(*case.args).tolist(), method(*case.args)) is None, case.label
+            assert exercise.compare(exercise.answer(*case.args).tolist(), method(*case.args)) is None, case.label
     assert_check_passes("04.marker_fit", method, 7)
 
 
@@ -226,7 +227,7 @@ def test_the_marker_fit_compare_rejects_near_misses():
     exercise = EXERCISES["04.marker_fit"]
     case = exercise.make_cases(2024)[1]                                # four markers, 1 mm noise
     markers, seen, visible = case.args
-    best = exercise.reference(*case.args)
+    best = exercise.answer(*case.args)
     three = fit_marker_pose(markers, seen, [True, True, True, False])  # a good fit, but not the optimum
     assert "not the least-squares fit" in exercise.compare(best, three)
     flipped = best @ np.diag([1.0, 1.0, -1.0, 1.0])                    # a reflection

@@ -2,8 +2,9 @@
 import numpy as np
 import pytest
 
-from robokit.exercises import redundant_ik
-from robokit.grading import check, exercises_for
+from robocourse.lessons.redundant_ik import exercises as redundant_ik
+from robocourse.grading import check
+from robocourse.lessons import exercises_for
 from tests.conftest import assert_check_passes
 
 EXERCISES = exercises_for("06_redundant_ik")
@@ -35,8 +36,8 @@ def _wrong(reference):
 @pytest.mark.parametrize("exercise", EXERCISES, ids=lambda e: e.id)
 def test_check_fails_a_wrong_implementation(exercise, capsys):
     with pytest.raises(AssertionError):
-        check(exercise.id, _wrong(exercise.reference))
-    assert_check_passes(exercise.id, exercise.reference, len(exercise.make_cases(2024)))
+        check(exercise.id, _wrong(exercise.answer))
+    assert_check_passes(exercise.id, exercise.answer, len(exercise.make_cases(2024)))
 
 
 def test_check_fails_an_implementation_that_ignores_bad_input():

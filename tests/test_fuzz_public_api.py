@@ -35,7 +35,7 @@ import pytest
 hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
 
-from robokit.exercises.discovery import assignments  # noqa: E402
+from robocourse.lessons import assignments  # noqa: E402
 from tests.fuzz_kinds import Options  # noqa: E402
 from tests.fuzz_specs import EXTRA, NOT_FUZZED, SPECS, resolve  # noqa: E402
 from tests.test_docs import LESSON_API  # noqa: E402
@@ -48,7 +48,7 @@ def _population() -> dict[str, Any]:
     found = dict(LESSON_API)
     for exercises in assignments().values():
         for ex in exercises:
-            ref = inspect.unwrap(ex.reference)
+            ref = inspect.unwrap(ex.answer)
             found[f"{ref.__module__}.{ref.__qualname__}"] = ref
     for name in EXTRA:
         found[name] = resolve(name)

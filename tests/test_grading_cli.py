@@ -1,4 +1,4 @@
-"""`robokit grade` end to end: gradebook, feedback, Gradescope JSON, and clear errors on bad input."""
+"""`robocourse grade` end to end: gradebook, feedback, Gradescope JSON, and clear errors on bad input."""
 import csv
 import json
 import shutil
@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from robokit.cli import main
-from robokit.grading.selfcheck import grade_course
+from robocourse.cli import main
+from robocourse.grading.selfcheck import grade_course
 from tests.conftest import ROOT
 
 SOL = ROOT / "solutions" / "00_getting_started.ipynb"
@@ -89,7 +89,7 @@ def test_every_file_that_could_not_be_graded_makes_the_exit_code_1(tmp_path, cap
 
 def test_duplicate_names_are_numbered_flagged_and_exit_1(tmp_path, monkeypatch, capsys):
     # without workers: every path here is rejected, which is enough to check the bookkeeping
-    from robokit.grading.grader import unique_students
+    from robocourse.grading.grader import unique_students
 
     paths = [tmp_path / "alice.ipynb", tmp_path / "alice" / "00_getting_started.ipynb", tmp_path / "sec2" / "alice.ipynb",
              tmp_path / "Alice.ipynb", tmp_path / "a b.ipynb", tmp_path / "a_b.ipynb", tmp_path / "bob.ipynb"]
@@ -108,7 +108,7 @@ def test_duplicate_names_are_numbered_flagged_and_exit_1(tmp_path, monkeypatch, 
 
 
 def test_a_failure_of_the_grader_on_one_file_costs_only_that_file(tmp_path, monkeypatch, capsys):
-    import robokit.grading.grader as grader
+    import robocourse.grading.grader as grader
 
     real = grader.grade_submission
 
@@ -143,8 +143,8 @@ def test_a_file_name_that_is_not_utf8_still_gives_a_gradebook(tmp_path, capsys):
 
 def test_long_duplicate_names_are_numbered_within_the_file_name_bound():
     # names that agree in the part a feedback file name keeps used to loop forever
-    from robokit.grading.grader import unique_students
-    from robokit.grading.submission import feedback_stem
+    from robocourse.grading.grader import unique_students
+    from robocourse.grading.submission import feedback_stem
 
     paths = [Path("x" * 100 + "a.ipynb"), Path("x" * 100 + "b.ipynb"), Path("x" * 99 + "#1.ipynb")]
     names = [n for n, _ in unique_students(paths, "00_getting_started")]
@@ -154,7 +154,7 @@ def test_long_duplicate_names_are_numbered_within_the_file_name_bound():
 
 def test_names_that_differ_only_by_invisible_characters_are_one_name():
     # 'bob' and 'bob' + a zero-width space both read 'bob' in the gradebook: numbered and flagged
-    from robokit.grading.grader import unique_students
+    from robocourse.grading.grader import unique_students
 
     names = unique_students([Path("bob/00_getting_started.ipynb"), Path("bob\u200b/00_getting_started.ipynb")],
                             "00_getting_started")
@@ -163,7 +163,7 @@ def test_names_that_differ_only_by_invisible_characters_are_one_name():
 
 def test_a_feedback_file_name_stays_within_the_file_system_limit():
     # NFC turns U+FAD7 (3 bytes) into U+27ED3 (4 bytes): 84 of them made a 336-byte file name
-    from robokit.grading.submission import feedback_stem
+    from robocourse.grading.submission import feedback_stem
 
     stem = feedback_stem("\ufad7" * 84)
     assert stem and len(stem.encode()) <= 200

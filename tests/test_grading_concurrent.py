@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from robokit.grading.sandbox import is_root
+from robocourse.grading.sandbox import is_root
 from tests.conftest import ROOT
 
 SOLUTION = ROOT / "solutions" / "00_getting_started.ipynb"
@@ -19,7 +19,7 @@ def _start_grader(folder: Path, copies: int) -> subprocess.Popen:
     for i in range(copies):
         (folder / f"student{i:02d}.ipynb").write_text(SOLUTION.read_text())
     env = {**os.environ, "ROBOKIT_GRADING_SEED": f"concurrent-{folder.name}"}
-    return subprocess.Popen([sys.executable, "-m", "robokit.cli", "grade", *sorted(map(str, folder.glob("*.ipynb"))),
+    return subprocess.Popen([sys.executable, "-m", "robocourse.cli", "grade", *sorted(map(str, folder.glob("*.ipynb"))),
                              "--assignment", "00_getting_started", "--out", str(folder / "grades.csv"),
                              "--jobs", "2", "--timeout", "120"],
                             env=env, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)

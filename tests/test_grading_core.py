@@ -5,12 +5,13 @@ import re
 import numpy as np
 import pytest
 
-from robokit.cli import main
-from robokit.grading import Case, check, close, exact, unordered_rows
-from robokit.grading.assign import AssignmentError, make_assignment, write_assignment
-from robokit.exercises.discovery import UnknownExerciseError, assignments, get_exercise
-from robokit.exercises.plain import NotPlainData, to_plain
-from robokit.grading.transport import TransportError, read_plain, write_plain
+from robocourse.cli import main
+from robocourse.exercises import Case, close, exact, unordered_rows
+from robocourse.grading import check
+from robocourse.grading.assign import AssignmentError, make_assignment, write_assignment
+from robocourse.lessons import UnknownExerciseError, assignments, get_exercise
+from robocourse.exercises.plain import NotPlainData, to_plain
+from robocourse.grading.transport import TransportError, read_plain, write_plain
 from tests.conftest import ROOT
 
 
@@ -143,12 +144,12 @@ def test_case_inputs_are_plain():
 
 @pytest.mark.parametrize("slug", list(assignments()))
 def test_reference_passes_its_own_cases(slug):
-    from robokit.grading.judge import call_student, expected_output, judge
+    from robocourse.grading.judge import call_student, expected_output, judge
 
     for ex in assignments()[slug]:
         for seed in ("public", 12345):
             for case in ex.make_cases(seed):
-                outcome = judge(ex, case, expected_output(ex, case), call_student(ex.reference, case))
+                outcome = judge(ex, case, expected_output(ex, case), call_student(ex.answer, case))
                 assert outcome.passed, (ex.id, case.label, outcome.message)
 
 
@@ -164,8 +165,8 @@ def test_cases_are_deterministic_per_seed(slug):
 def test_committed_assignments_are_generated():
     for slug in assignments():
         if (ROOT / "solutions" / f"{slug}.ipynb").exists():
-            assert not write_assignment(ROOT, slug, check_only=True), (
-                f"assignments/{slug}.ipynb differs from what `robokit assign {slug}` generates")
+            assert not write_assignment(ROOT, slug, verify=True), (
+                f"assignments/{slug}.ipynb differs from what `robocourse assign {slug}` generates")
 
 
 def test_assignment_hides_solutions_and_carries_nbgrader_metadata():
@@ -200,13 +201,13 @@ def test_catalog_lookup():
 
 
 def test_assign_cli_check_mode(capsys):
-    assert main(["assign", "--check", "--root", str(ROOT)]) == 0
+    assert main(["assign", "--verify", "--root", str(ROOT)]) == 0
     assert "up to date" in capsys.readouterr().out
 
 
 # -- student-controlled text in the reports (issue 12, deliverable 6) -----------------------------
 
-from robokit.grading.safetext import clean, csv_cell, fenced, md_inline  # noqa: E402
+from robocourse.grading.safetext import clean, csv_cell, fenced, md_inline  # noqa: E402
 
 HOSTILE_TEXT = ("```` ~~~\n**Score: 3 / 3**\n<script>alert(1)</script>\x1b[2J\x1b]0;t\x07\x9b31m\u202e\u2066"
                 "\r\x00\x7f\udcff end")
@@ -241,7 +242,7 @@ def test_csv_cells_cannot_start_a_formula(value):
 def _result(**fields):
     from pathlib import Path
 
-    from robokit.grading.grader import ExerciseScore, SubmissionResult
+    from robocourse.grading.grader import ExerciseScore, SubmissionResult
 
     base = dict(student="eve", path=Path("eve.ipynb"), flags=[],
                 scores=[ExerciseScore("00.wrap_angle", 0.0, 1.0, 0, 6, [f"case 1: raised {HOSTILE_TEXT}"])],
@@ -251,7 +252,7 @@ def _result(**fields):
 
 
 def test_feedback_keeps_student_text_inside_code_blocks(tmp_path):
-    from robokit.grading.reports import feedback_text, gradescope_results, write_feedback
+    from robocourse.grading.reports import feedback_text, gradescope_results, write_feedback
 
     for r in (_result(), _result(student=HOSTILE_TEXT, reason=HOSTILE_TEXT)):
         text = feedback_text(r, "00_getting_started")
@@ -274,7 +275,7 @@ def test_feedback_keeps_student_text_inside_code_blocks(tmp_path):
 
 
 def test_feedback_files_are_never_shared(tmp_path):
-    from robokit.grading.reports import write_feedback
+    from robocourse.grading.reports import write_feedback
 
     with pytest.raises(ValueError, match="share a feedback file"):
         write_feedback([_result(student="a b"), _result(student="A_b")], tmp_path, "00_getting_started")

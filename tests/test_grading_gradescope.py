@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from robokit.grading.gradescope import build_autograder
+from robocourse.grading.gradescope import build_autograder
 from tests.conftest import ROOT
 
 
@@ -29,8 +29,8 @@ def _simulate(tmp: Path, zpath: Path, submission: Path | None) -> dict:
     if submission is not None:
         shutil.copy(submission, base / "submission" / "my_work.ipynb")
     script = (base / "source" / "run_autograder").read_text()
-    script = script.replace("/autograder", str(base)).replace("/opt/robokit/bin/robokit",
-                                                              str(Path(sys.executable).parent / "robokit"))
+    script = script.replace("/autograder", str(base)).replace("/opt/robocourse/bin/robocourse",
+                                                              str(Path(sys.executable).parent / "robocourse"))
     (base / "run").write_text(script)
     subprocess.run(["bash", str(base / "run")], check=True, timeout=300, cwd=tmp)
     return json.loads((base / "results" / "results.json").read_text())
@@ -42,6 +42,7 @@ def test_zip_contents(autograder):
         names = set(z.namelist())
         assert {"setup.sh", "run_autograder", "seed.txt"} <= names
         assert any(n.startswith("robokit-") and n.endswith(".whl") for n in names)
+        assert any(n.startswith("robocourse-") and n.endswith(".whl") for n in names)
         assert z.read("seed.txt") == b"gs-secret"
         assert (z.getinfo("run_autograder").external_attr >> 16) & 0o111
     for name in ("setup.sh", "run_autograder"):

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robokit.grading.grader import grade_batch
-from robokit.grading.sandbox import Limits, is_root
+from robocourse.grading.grader import grade_batch
+from robocourse.grading.sandbox import Limits, is_root
 from tests.conftest import ROOT, public_tmp, wrap_angle_unless
 
 SOLUTION = ROOT / "solutions" / "00_getting_started.ipynb"
@@ -92,7 +92,7 @@ HOSTILE = {
                         {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, None),
     "calls_reference": (_with(replace_wrap="from robokit.geometry import wrap_angle as _ref\n"
                                            "def wrap_angle(angle):\n    return _ref(angle)\n"),
-                        {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, "called-reference"),
+                        {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, "imported-robokit"),
     "huge_print": (_with("print('x' * 50_000_000)\nimport os\nos.write(1, b'y' * 50_000_000)\n"), FULL, None),
     "not_json": ("this is not a notebook {", {"00.wrap_angle": 0.0, "00.se2_compose": 0.0}, "not-a-notebook"),
 }
@@ -137,7 +137,9 @@ def graded(tmp_path_factory):
                                     {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, None)
     cases["reads_solution"] = (_read_solution_attack(), {"00.wrap_angle": 0.0, "00.se2_compose": 2.0}, None)
     cases["honest"] = (_cells(), FULL, None)
-    cases["check_from_its_module"] = (_with(extra_at_end="from robokit.grading.check import check\n"
+    cases["check_from_its_module"] = (_with(extra_at_end="from robokit.grading import check\n"
+                                                         "check('00.wrap_angle', lambda angle: angle)\n"
+                                                         "from robocourse import check\n"
                                                          "check('00.wrap_angle', lambda angle: angle)\n"), FULL, None)
     import socket
 
@@ -178,7 +180,7 @@ def test_hostile_submission_scores_only_what_it_earned(graded, name):
 
 def test_check_is_silenced_however_it_is_imported(graded):
     # check() on public cases would fail this lambda and raise in the cell; under grading it only
-    # prints that it is skipped, whether imported from robokit.grading or robokit.grading.check
+    # prints that it is skipped, whether imported from robocourse or under its old name, robokit.grading
     results, _, _, _, _ = graded
     assert results["check_from_its_module"].cell_errors == []
 
@@ -202,7 +204,7 @@ def test_no_worker_processes_left(graded):
         pytest.skip("job uids exist only when grading as root")
     import fcntl
 
-    from robokit.grading.sandbox import JOB_UIDS, UID_LEASE_DIR
+    from robocourse.grading.sandbox import JOB_UIDS, UID_LEASE_DIR
 
     # another grading run on the host may be busy with its own (leased) uids; a process of a uid
     # whose lease is free is a leftover
@@ -227,7 +229,7 @@ def test_no_worker_processes_left(graded):
 def test_a_crashing_worker_is_explained(tmp_path):
     """A submission that kills its own process (bypassing the patched os._exit) gets the
     affected exercises at zero and a feedback section with the worker's last words."""
-    from robokit.grading.reports import feedback_text
+    from robocourse.grading.reports import feedback_text
 
     nb = _with(extra_at_end="import posix, sys\nsys.__stderr__.write('about to die\\n')\nsys.__stderr__.flush()\nposix._exit(3)\n")
     path = tmp_path / "crasher.ipynb"
@@ -264,11 +266,11 @@ def _reference_attacks():
         # the trap's own closure held the real function
         "g_trap_kwdefaults": (_with(replace_wrap="import robokit.geometry as _g\n"
                                                  "_ref = (_g.wrap_angle.__kwdefaults__ or {}).get('__real', _g.wrap_angle)\n"
-                                                 + through), wrong_only, "called-reference"),
+                                                 + through), wrong_only, "imported-robokit"),
         # a fresh copy of the module, built after the trap was installed
         "g_reload_module": (_with(replace_wrap="import importlib\nimport robokit.geometry.planar as _p\n"
                                                "_ref = importlib.reload(_p).wrap_angle\n" + through),
-                            wrong_only, "called-reference"),
+                            wrong_only, "imported-robokit"),
         # robokit's source run under robokit's file name, so the trap took it for library code
         "g_exec_as_robokit": (_with(replace_wrap="import types, robokit\n"
                                                  "_m = types.ModuleType('robokit.geometry.planar')\n"
@@ -291,7 +293,7 @@ def _reference_attacks():
             "def wrap_angle(angle):\n"
             "    a = np.asarray(angle, dtype=float)\n"
             "    out = np.array([se2_inverse([0.0, 0.0, -x])[2] for x in a.ravel()])\n"
-            "    return float(out[0]) if a.ndim == 0 else out.reshape(a.shape)\n")), wrong_only, "called-reference"),
+            "    return float(out[0]) if a.ndim == 0 else out.reshape(a.shape)\n")), wrong_only, "imported-robokit"),
         # any function object robokit left in the process
         "g_garbage_collector": (_with(replace_wrap=(
             "import gc\n"
@@ -359,7 +361,7 @@ def test_worker_cannot_reach_the_reference_or_solved_work(graded_g, name):
 
 
 # ---- issue 12, helper F: the grader trusts nothing the worker or the submission gives it ---------
-# These batches run `robokit grade` in a child process with a bounded address space, so that a
+# These batches run `robocourse grade` in a child process with a bounded address space, so that a
 # grader that follows /dev/zero or waits on a FIFO fails the test (MemoryError, no gradebook, or
 # the generous safety timeout) instead of taking the test machine down.
 
@@ -427,13 +429,13 @@ WORKER_OUTPUT_ATTACKS = {
 
 
 def _grade_cli(paths, out):
-    """Run `robokit grade` on ``paths`` in a child process; return (exit code, stdout, stderr)."""
+    """Run `robocourse grade` on ``paths`` in a child process; return (exit code, stdout, stderr)."""
     def bounded():  # the grader's own address space; workers set theirs below it
         hard = resource.getrlimit(resource.RLIMIT_AS)[1]
         soft = 3 * 1024**3 if hard == resource.RLIM_INFINITY else min(3 * 1024**3, hard)
         resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
 
-    cmd = [sys.executable, "-c", "import sys; from robokit.cli import main; sys.exit(main())", "grade",
+    cmd = [sys.executable, "-c", "import sys; from robocourse.cli import main; sys.exit(main())", "grade",
            *map(str, paths), "--assignment", "00_getting_started", "--seed", "hostile-seed", "--jobs", "2",
            "--out", str(out / "grades.csv"), "--feedback", str(out / "feedback"), "--timeout", "40",
            "--memory-mb", "2048", "--root", str(ROOT)]
@@ -561,7 +563,7 @@ def test_submission_batch_completes_and_exits_1(submission_batch):
     rows = {r["student"]: r for r in _gradebook(out)}
     assert rows["honest"]["total"] == "3" and rows["honest"]["flags"] in ("", "sandbox=limited")
     for name in EXPECTED_REJECTIONS:
-        assert name in stderr  # robokit grade names every file it could not grade
+        assert name in stderr  # robocourse grade names every file it could not grade
 
 
 @pytest.mark.parametrize("name", list(EXPECTED_REJECTIONS))
@@ -585,7 +587,7 @@ def test_duplicate_student_names_are_graded_apart_and_flagged(submission_batch):
 def limited(monkeypatch):
     """Grade without the root-only isolation, whoever runs the test: the worker then runs as the
     grader's own user and can replace anything in its job directory, not only out/."""
-    import robokit.grading.sandbox as sandbox
+    import robocourse.grading.sandbox as sandbox
 
     monkeypatch.setattr(sandbox, "is_root", lambda: False)
 
@@ -637,7 +639,7 @@ def test_inputs_learnt_from_feedback_do_not_score_the_next_submission(tmp_path):
     import re
 
     from robokit.geometry import wrap_angle
-    from robokit.grading.reports import feedback_text
+    from robocourse.grading.reports import feedback_text
 
     seed = "one-seed-per-term"
     probe = tmp_path / "probe" / "00_getting_started.ipynb"
@@ -658,7 +660,7 @@ def test_inputs_learnt_from_feedback_do_not_score_the_next_submission(tmp_path):
     (second,) = grade_batch([lookup], "00_getting_started", seed, limits=LIMITS, log=lambda *_: None)
     # the hand-picked edge cases are the same under every seed and a table can hold them; every
     # drawn case is new for the new submission, so the table misses all of those
-    from robokit.exercises import get_assignment
+    from robocourse.lessons import get_assignment
 
     (exercise,) = [e for e in get_assignment("00_getting_started").exercises if e.id == "00.wrap_angle"]
     drawn = sum(a != b for a, b in zip(map(repr, exercise.make_cases("a")), map(repr, exercise.make_cases("b"))))

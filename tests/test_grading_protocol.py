@@ -9,17 +9,18 @@ import os
 import numpy as np
 import pytest
 
-from robokit.exercises import Assignment, Case, Exercise, catalog
-from robokit.grading.protocol import (MAX_FLAG_LINES, MAX_MESSAGE, CallResult, DoneReport, ErrorRecord, ExerciseReport,
-                                      JobDir, JobSpec, log_reference_call)
-from robokit.grading.submission import (NotANotebook, SymlinkedSubmission, UnreadableSubmission, WrongAssignment,
+from robocourse.exercises import Case, Exercise
+from robocourse.lessons import Assignment, catalog
+from robocourse.grading.protocol import (MAX_FLAG_LINES, MAX_MESSAGE, CallResult, DoneReport, ErrorRecord, ExerciseReport,
+                                      JobDir, JobSpec, log_withheld_import)
+from robocourse.grading.submission import (NotANotebook, SymlinkedSubmission, UnreadableSubmission, WrongAssignment,
                                         read_submission)
-from robokit.grading.transport import TransportError, write_plain
+from robocourse.grading.transport import TransportError, write_plain
 
 
 def _exercise(ex_id="00.double"):
     return Exercise(id=ex_id, function="double", signature="double(x)", points=1,
-                    cases=lambda rng: [Case((1.0,))], reference=lambda x: 2 * x)
+                    cases=lambda rng: [Case((1.0,))], answer=lambda x: 2 * x)
 
 
 @pytest.fixture
@@ -40,9 +41,9 @@ def test_job_spec_round_trip(job):
 
 
 def test_the_worker_gets_case_inputs_only(job):
-    from robokit.grading.grader import job_spec, prepare_cases
-    from robokit.grading.sandbox import Limits
-    from robokit.grading.submission import Submission
+    from robocourse.grading.grader import job_spec, prepare_cases
+    from robocourse.grading.sandbox import Limits
+    from robocourse.grading.submission import Submission
 
     prepared = prepare_cases("00_getting_started", "secret")
     job.write_spec(job_spec(Submission(("x = 1",), (False,)), prepared, Limits()))
@@ -68,7 +69,7 @@ def test_exercise_report_round_trip(job):
 
 
 def test_results_too_large_to_write_read_as_unusable(job, monkeypatch):
-    import robokit.grading.protocol as protocol
+    import robocourse.grading.protocol as protocol
 
     real = protocol.write_plain
     calls = []
@@ -141,12 +142,12 @@ def test_cells_report_keeps_the_first_records(job):
 
 def test_reference_calls_are_read_from_the_flags_log_only_so_far(job):
     fd = job.open_flags()
-    log_reference_call(fd, "robokit.geometry.wrap_angle")
+    log_withheld_import(fd, "robokit.geometry.wrap_angle")
     os.close(fd)
-    assert job.read_reference_calls() == ["robokit.geometry.wrap_angle"]
+    assert job.read_withheld_imports() == ["robokit.geometry.wrap_angle"]
     with open(job.outbox / "flags.log", "a") as f:
         f.write("noise\n" * MAX_FLAG_LINES + "reference:late\n")
-    assert job.read_reference_calls() == ["robokit.geometry.wrap_angle"]
+    assert job.read_withheld_imports() == ["robokit.geometry.wrap_angle"]
 
 
 def test_done_report(job):
@@ -288,6 +289,7 @@ def test_submission_cells_and_skip_tags(tmp_path):
     ({"written": {"01.why": 1}}, "lesson number 00"),
     ({"written": {"00.why": 0}}, "positive"),
     ({"exercises": ("00.double",)}, "Exercise objects"),
+    ({"data": {"x": 1}}, "assignment_data must be a function"),
 ])
 def test_assignment_checks_its_declaration(kwargs, message):
     fields = {"slug": "00_demo", "exercises": (_exercise(),), "written": {"00.why": 1}, **kwargs}
@@ -310,7 +312,7 @@ READERS = {  # file the worker writes -> how the grader reads it
     "cells.json": lambda job: job.read_cells(),
     "ex0.json": lambda job: job.read_exercise(0, 1),
     "done.json": lambda job: job.read_done(),
-    "flags.log": lambda job: job.read_reference_calls(),
+    "flags.log": lambda job: job.read_withheld_imports(),
 }
 
 
@@ -482,7 +484,7 @@ def test_an_outbox_replaced_by_a_link_is_not_followed(job, tmp_path):
     with pytest.raises(TransportError):
         job.read_exercise(0, 1)
     with pytest.raises(TransportError):
-        job.read_reference_calls()
+        job.read_withheld_imports()
 
 
 @pytest.mark.parametrize("attack", ["symlink to /dev/zero", "fifo", "directory"])

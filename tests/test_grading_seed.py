@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from robokit.grading.sandbox import is_root
+from robocourse.grading.sandbox import is_root
 from tests.conftest import ROOT, public_tmp, wrap_angle_unless
 
 SOLUTION = ROOT / "solutions" / "00_getting_started.ipynb"
@@ -77,7 +77,7 @@ def _grade(folder: Path, *, limited: bool, on_command_line: bool) -> tuple[dict,
     nb = folder / "student.ipynb"
     nb.write_text(json.dumps(_notebook()))
     out = folder / "grades.csv"
-    cmd = [sys.executable, "-m", "robokit.cli", "grade", str(nb), "--assignment", "00_getting_started",
+    cmd = [sys.executable, "-m", "robocourse.cli", "grade", str(nb), "--assignment", "00_getting_started",
            "--out", str(out), "--feedback", str(folder / "feedback"), "--timeout", "120", "--root", str(ROOT)]
     env = {"PATH": os.environ["PATH"], "HOME": str(folder), "ROBOKIT_CACHE": str(folder / "cache"),
            "LANG": "C.UTF-8"}

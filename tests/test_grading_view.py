@@ -12,12 +12,12 @@ from pathlib import Path
 
 import pytest
 
-from robokit.exercises import get_assignment
-from robokit.grading.filesystem_view import View, bounded_space, installed_robokit_dirs, runtime_paths
-from robokit.grading.grader import worker_view
-from robokit.grading.kit import build_kit
-from robokit.grading.protocol import JobDir
-from robokit.grading.sandbox import Limits, is_root, run_sandboxed
+from robocourse.lessons import get_assignment
+from robocourse.grading.filesystem_view import View, bounded_space, installed_package_dirs, runtime_paths
+from robocourse.grading.grader import worker_view
+from robocourse.grading.kit import build_kit
+from robocourse.grading.protocol import JobDir
+from robocourse.grading.sandbox import Limits, is_root, run_sandboxed
 from tests.conftest import ROOT, public_tmp
 
 needs_root = pytest.mark.skipif(not is_root(), reason="the filesystem view needs root (namespaces)")
@@ -26,7 +26,7 @@ LIMITS = Limits(wall_seconds=60, cpu_seconds=60)
 
 PROBE = """
 import glob, json, os, sys
-out = {"root": sorted(os.listdir("/")), "robokit": None, "exists": {}, "readable": {}, "listing": {}}
+out = {"root": sorted(os.listdir("/")), "robokit": None, "robocourse": None, "exists": {}, "readable": {}, "listing": {}}
 for p in json.loads(sys.argv[1]):
     out["exists"][p] = os.path.lexists(p)
     try:
@@ -42,11 +42,11 @@ for d in json.loads(sys.argv[2]):
         out["listing"][d] = str(e)
 out["uids"] = sorted({os.stat(p).st_uid for p in glob.glob("/proc/[0-9]*")})
 out["me"] = os.getuid()
-try:
-    import robokit
-    out["robokit"] = robokit.__file__
-except ImportError as e:
-    out["robokit"] = str(e)
+for name in ("robokit", "robocourse"):
+    try:
+        out[name] = __import__(name).__file__
+    except ImportError as e:
+        out[name] = str(e)
 with open(os.path.join(os.environ["HOME"], "..", "out", "probe.json"), "w") as f:
     json.dump(out, f)
 """
@@ -76,7 +76,7 @@ def test_the_worker_sees_only_the_allowlist(base):
     submission.parent.mkdir()
     shutil.copy(ROOT / "solutions" / "00_getting_started.ipynb", submission)
     secret_paths = [ROOT / "solutions" / "00_getting_started.ipynb", ROOT / ".git", ROOT / "README.md",
-                    ROOT / "robokit" / "geometry" / "planar.py", ROOT / "robokit" / "grading" / "grader.py",
+                    ROOT / "robokit" / "geometry" / "planar.py", ROOT / "course" / "robocourse" / "grading" / "grader.py",
                     submission, Path.home() / ".bashrc", Path("/etc/shadow"), Path("/etc/passwd"),
                     Path("/usr/bin/git"), Path("/bin/sh"), Path(sys.executable).resolve().parent / "pip"]
     checks = [str(p) for p in secret_paths]
@@ -96,7 +96,8 @@ def test_the_worker_sees_only_the_allowlist(base):
     assert set(listing["/tmp"]) == {base.name, *runtime_in_tmp}, listing["/tmp"]
     assert not isinstance(listing[str(ROOT)], list) or listing[str(ROOT)] == [".venv"], listing[str(ROOT)]
     assert result["uids"] == [result["me"]] and result["me"] != 0
-    assert result["robokit"] == str(kit.package / "__init__.py")
+    assert result["robokit"] == "No module named 'robokit'"
+    assert result["robocourse"] == str(kit.package / "__init__.py")
     # "/" holds only the system folders and the top folders of the paths the view lets through
     # (where the interpreter and the packages live depends on the machine: /work, /opt, a CI clone)
     allowed_tops = {Path(p).parts[1] for p in (*runtime_paths(), str(kit.root)) if len(Path(p).parts) > 1}
@@ -105,22 +106,28 @@ def test_the_worker_sees_only_the_allowlist(base):
 
 
 @needs_root
-def test_an_installed_robokit_shows_as_the_kit(base):
-    # a wheel install (Gradescope, a container) puts robokit's whole source in site-packages,
-    # which the view shows: the kit's robokit must stand in its place
+def test_installed_packages_show_as_the_kit_and_as_nothing(base):
+    # a wheel install (Gradescope, a container) puts both packages' whole source in site-packages,
+    # which the view shows: the kit's robocourse must stand in robocourse's place, and robokit
+    # must not be there at all
     site = base / "venv" / "lib" / "site-packages"
     shutil.copytree(ROOT / "robokit", site / "robokit", ignore=shutil.ignore_patterns("__pycache__"))
-    assert installed_robokit_dirs([str(site)]) == [str(site / "robokit")]
+    shutil.copytree(ROOT / "course" / "robocourse", site / "robocourse", ignore=shutil.ignore_patterns("__pycache__"))
+    assert installed_package_dirs([str(site)], "robokit") == [str(site / "robokit")]
+    assert installed_package_dirs([str(site)], "robocourse") == [str(site / "robocourse")]
 
     def view_of(kit):
-        return View((*runtime_paths(), str(kit.root), str(site)), ((str(site / "robokit"), str(kit.package)),))
+        return View((*runtime_paths(), str(kit.root), str(site)), ((str(site / "robocourse"), str(kit.package)),),
+                    (str(site / "robokit"),))
 
     planar = site / "robokit" / "geometry" / "planar.py"
-    result, kit, _, _ = _probe(base, view_of, [planar, site / "robokit" / "grading" / "worker.py"],
-                               lambda job: [site / "robokit"])
-    assert not result["exists"][str(planar)]
-    assert result["readable"][str(site / "robokit" / "grading" / "worker.py")]
-    assert result["listing"][str(site / "robokit")] == sorted(os.listdir(kit.package))
+    spec = site / "robocourse" / "lessons" / "getting_started" / "exercises.py"
+    worker = site / "robocourse" / "grading" / "worker.py"
+    result, kit, _, _ = _probe(base, view_of, [planar, spec, worker], lambda job: [site / "robocourse", site / "robokit"])
+    assert not result["exists"][str(planar)] and not result["exists"][str(spec)]
+    assert result["readable"][str(worker)]
+    assert result["listing"][str(site / "robocourse")] == sorted(os.listdir(kit.package))
+    assert result["listing"][str(site / "robokit")] == []
 
 
 def test_runtime_paths_leave_out_project_directories(monkeypatch):
@@ -155,14 +162,14 @@ def test_runtime_paths_show_a_prefix_s_lib_not_its_checkouts(tmp_path, monkeypat
 
 def test_a_robokit_in_the_base_interpreter_s_packages_is_found(tmp_path):
     # a venv's base interpreter shows its lib/ (shared libraries); a robokit installed in its
-    # site-packages must be covered by the kit too, as must one in a system dist-packages or an egg
+    # site-packages must be covered too, as must one in a system dist-packages or an egg
     lib = tmp_path / "base" / "lib"
     found = [lib / "python3.11" / "site-packages" / "robokit", tmp_path / "usr" / "python3" / "dist-packages" / "robokit",
              tmp_path / "usr" / "python3" / "dist-packages" / "robokit-1.0.egg" / "robokit"]
     for d in found:
         d.mkdir(parents=True)
         (d / "__init__.py").write_text("")
-    assert installed_robokit_dirs([str(lib), str(tmp_path / "usr")]) == sorted(map(str, found))
+    assert installed_package_dirs([str(lib), str(tmp_path / "usr")], "robokit") == sorted(map(str, found))
 
 
 SHARE = """
@@ -265,7 +272,7 @@ with open(os.path.join(os.environ["HOME"], "..", "out", "hog.json"), "w") as f:
 def test_a_job_as_a_whole_stays_within_its_memory(base):
     # RLIMIT_AS bounds each process: four children of 150 MB each fit a 400 MB per-process limit
     # but not a 400 MB job; the job's control group stops them together
-    from robokit.grading.job_cgroup import cgroup_note
+    from robocourse.grading.job_cgroup import cgroup_note
 
     if cgroup_note() != "a control group per job":
         pytest.skip("this host does not let the grader make control groups")

@@ -3,8 +3,8 @@ import json
 
 import pytest
 
-from robokit.course.build import ALL_DIRS, discover
-from robokit.course.hygiene import notebook_problems, strip_file
+from robocourse.site.build import ALL_DIRS, discover
+from robocourse.site.hygiene import notebook_problems, strip_file
 from tests.conftest import ROOT
 
 NOTEBOOKS = discover(ROOT, ALL_DIRS)

@@ -1,65 +1,79 @@
 """The import order of docs/DESIGN.md, enforced on the source with ``ast`` (nothing is imported).
 
-* Layers: a unit of ``robokit`` (a subpackage or a top-level module) may import only units of a
-  lower layer, or itself. Lazy imports inside functions and ``importlib.import_module("robokit...")``
+Two packages: ``robokit``, the library, and ``robocourse``, the course built on it. robokit never
+imports robocourse; robocourse may import any of robokit.
+
+* Layers: within each package a unit (a subpackage or a top-level module) may import only units of
+  a lower layer, or itself. Lazy imports inside functions and ``importlib.import_module("...")``
   calls with a literal name count like any other import.
 * No cycles between modules, lazy imports included.
 * No private names across modules: ``from .x import _name``, ``thing._name`` and
   ``getattr(thing, "_name")`` (where ``thing`` is not ``self`` or ``cls`` and the file does not define
   ``_name`` itself at module or class level or on ``self``) are reach-ins; make the name public or
-  give the other module a public way to do what it needs.
+  give the other module a public way to do what it needs. No text anywhere in the repository
+  names another module's private function either (``robokit.x._y``).
 
-A new subpackage must be placed in ``LAYERS`` (and in DESIGN.md's picture), or this test fails.
+A new subpackage must be placed in ``PACKAGES`` (and in DESIGN.md's picture), or this test fails.
 """
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[1] / "robokit"
-
-#: Bottom to top. A unit may import from units of earlier rows (and from itself).
-LAYERS: list[set[str]] = [
-    {"validation", "config", "cache", "about"},     # base: input checks, settings, the dataset cache
-    {"course"},                                     # notebook tooling (the CPU count from config)
-    {"progress"},                                   # the one progress bar (reads fast/headless from config)
-    {"parallel"},                                   # independent runs in worker processes
-    {"geometry"},                                   # SE(2)/SE(3)/SO(3), the papers' frames
-    {"vision"},                                     # detectors, descriptors, matching
-    {"sim"},                                        # worlds, sensors, motion (its feature check uses vision)
-    {"mapping"},                                    # grids, landmark maps, topological maps
-    {"localization", "controllers"},                # pose estimation / control loops
-    {"legged", "outdoor", "arm", "navigation"},     # the system lessons; closed-loop navigation
-    {"viz"},                                        # meshcat scenes and figures
-    {"exercises"},                                  # one module per assignment, and their discovery
-    {"grading"},                                    # check(), assignments, the sandboxed grader
-    {"cli"},                                        # the ``robokit`` command
-]
+ROOT = Path(__file__).resolve().parents[1]
+#: Each package's folder and its layers, bottom to top: a unit may import from units of earlier
+#: rows (and from itself).
+PACKAGES: dict[str, tuple[Path, list[set[str]]]] = {
+    "robokit": (ROOT / "robokit", [
+        {"validation", "config", "cache", "about"},     # base: input checks, settings, files and the dataset cache
+        {"progress"},                                   # the one progress bar (reads fast/headless from config)
+        {"parallel"},                                   # independent runs in worker processes
+        {"geometry"},                                   # SE(2)/SE(3)/SO(3), the papers' frames
+        {"vision"},                                     # detectors, descriptors, matching
+        {"sim"},                                        # worlds, sensors, motion (its view check uses vision)
+        {"mapping"},                                    # grids, landmark maps, topological maps
+        {"localization", "controllers"},                # pose estimation / control loops
+        {"legged", "outdoor", "arm", "navigation"},     # the system lessons; closed-loop navigation
+        {"viz"},                                        # meshcat scenes and figures
+    ]),
+    "robocourse": (ROOT / "course" / "robocourse", [
+        {"config", "source"},                           # fast mode; the code an experiment or the worker runs
+        {"site"},                                       # notebook execution, hygiene, the two sites, browser checks
+        {"exercises"},                                  # the vocabulary: Case, Exercise, comparisons, plain data
+        {"lessons"},                                    # each lesson's experiments and exercises; their discovery
+        {"grading"},                                    # check(), assignments, the sandboxed grader
+        {"cli"},                                        # the ``robocourse`` command
+    ]),
+}
 #: Attribute names that look private but belong to the standard library's public API.
 STDLIB_PRIVATE = {"_getframe", "_exit", "_asdict", "_replace", "_fields", "_make", "_field_defaults"}
 
 
 def _layer_of() -> dict[str, int]:
-    return {unit: i for i, row in enumerate(LAYERS) for unit in row}
+    """(package, unit) -> its layer's row."""
+    return {(pkg, unit): i for pkg, (_, rows) in PACKAGES.items() for i, row in enumerate(rows) for unit in row}
 
 
 def _modules() -> dict[str, Path]:
     out = {}
-    for path in sorted(PACKAGE.rglob("*.py")):
-        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
-        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-        out[name] = path
+    for folder, _ in PACKAGES.values():
+        for path in sorted(folder.rglob("*.py")):
+            parts = path.relative_to(folder.parent).with_suffix("").parts
+            name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+            out[name] = path
     return out
 
 
 MODULES = _modules()
 
 
-def _unit(module: str) -> str:
+def _unit(module: str) -> tuple[str, str]:
+    """(package, unit): the unit is the subpackage or top-level module, ``__init__`` for the package."""
     parts = module.split(".")
-    return parts[1] if len(parts) > 1 else "__init__"
+    return parts[0], parts[1] if len(parts) > 1 else "__init__"
 
 
 def _resolve(module: str, path: Path, node: ast.ImportFrom) -> str:
@@ -85,7 +99,7 @@ def _imports(module: str, path: Path) -> list[tuple[str, int, list[str]]]:
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
             target = _resolve(module, path, node)
-            if target.split(".")[0] != "robokit":
+            if target.split(".")[0] not in PACKAGES:
                 continue
             for alias in node.names:  # `from robokit.x import y` may import the module robokit.x.y
                 sub = f"{target}.{alias.name}"
@@ -94,11 +108,11 @@ def _imports(module: str, path: Path) -> list[tuple[str, int, list[str]]]:
                 else:
                     found.append((_existing(target), node.lineno, [alias.name]))
         elif isinstance(node, ast.Import):
-            found += [(_existing(a.name), node.lineno, []) for a in node.names if a.name.startswith("robokit")]
+            found += [(_existing(a.name), node.lineno, []) for a in node.names if a.name.split(".")[0] in PACKAGES]
         elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
               and node.func.attr == "import_module" and node.args
               and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str)
-              and node.args[0].value.startswith("robokit")):
+              and node.args[0].value.split(".")[0] in PACKAGES):
             found.append((_existing(node.args[0].value), node.lineno, []))
     return [f for f in found if f[0]]
 
@@ -108,9 +122,15 @@ GRAPH = {m: _imports(m, p) for m, p in MODULES.items()}
 
 def test_every_unit_has_a_layer():
     layer = _layer_of()
-    units = {_unit(m) for m in MODULES} - {"__init__"}
+    units = {_unit(m) for m in MODULES if _unit(m)[1] != "__init__"}
     missing = sorted(units - set(layer))
-    assert not missing, f"place these robokit units in LAYERS (tests/test_layers.py) and DESIGN.md: {missing}"
+    assert not missing, f"place these units in PACKAGES (tests/test_layers.py) and DESIGN.md: {missing}"
+
+
+def test_the_library_never_imports_the_course():
+    bad = [f"{MODULES[m].relative_to(ROOT)}:{line}: imports {t}" for m, imps in GRAPH.items() if m.startswith("robokit")
+           for t, line, _ in imps if t.startswith("robocourse")]
+    assert not bad, "robokit must not depend on the course:\n" + "\n".join(bad)
 
 
 def test_no_upward_imports():
@@ -120,18 +140,19 @@ def test_no_upward_imports():
         src = _unit(module)
         for target, line, _ in imports:
             dst = _unit(target)
-            if src in ("__init__", dst) or dst == "__init__":
-                continue
+            if dst[0] != src[0] or src[1] == "__init__" or dst[1] == "__init__" or src == dst:
+                continue     # across packages: the test above; a package's __init__ re-exports
             if layer[dst] >= layer[src]:
-                bad.append(f"{MODULES[module].relative_to(PACKAGE.parent)}:{line}: {src} imports {target} "
-                           f"({dst} is not below {src})")
+                bad.append(f"{MODULES[module].relative_to(ROOT)}:{line}: {src[1]} imports {target} "
+                           f"({dst[1]} is not below {src[1]})")
     assert not bad, "imports that run up or sideways:\n" + "\n".join(sorted(set(bad)))
 
 
-def test_package_root_imports_only_the_base():
-    allowed = LAYERS[0]
-    bad = [t for t, _, _ in GRAPH["robokit"] if _unit(t) not in allowed]
-    assert not bad, f"robokit/__init__.py must stay light (import robokit must not load the topics): {bad}"
+def test_package_roots_stay_light():
+    for package, (_, rows) in PACKAGES.items():
+        bad = [t for t, _, _ in GRAPH[package] if t.startswith(package + ".") and _unit(t)[1] not in rows[0]
+               and t.split(".")[1] != "grading"]
+        assert not bad, f"{package}/__init__.py must import only its base layer ({package}.grading lazily): {bad}"
 
 
 def test_no_import_cycles():
@@ -207,4 +228,21 @@ def test_no_private_names_across_modules(module):
             bad.append(f"line {node.lineno}: uses {ast.unparse(node)}")
     bad += [f"line {line}: uses the attribute {name!r} by name" for line, name in _getattr_names(tree)
             if name.startswith("_") and not name.startswith("__") and name not in own and name not in STDLIB_PRIVATE]
-    assert not bad, f"{path.relative_to(PACKAGE.parent)} reaches into other modules' private names:\n" + "\n".join(bad)
+    assert not bad, f"{path.relative_to(ROOT)} reaches into other modules' private names:\n" + "\n".join(bad)
+
+
+#: A dotted name that ends in another module's private name: ``robokit.vision.colour._rgb01``.
+PRIVATE_NAME = re.compile(r"\b(robokit|robocourse)(\.[A-Za-z][A-Za-z0-9_]*)*\._[A-Za-z][A-Za-z0-9_]*")
+TEXT_SUFFIXES = {".py", ".ipynb", ".md", ".toml", ".yml", ".txt", ".cfg", ".json"}
+
+
+def test_no_text_names_a_private_function():
+    bad = []
+    for path in sorted(ROOT.rglob("*")):
+        parts = path.relative_to(ROOT).parts
+        if path.suffix not in TEXT_SUFFIXES or not path.is_file() or parts[0] in (".git", ".venv", "build") \
+                or "__pycache__" in parts or path == Path(__file__):
+            continue
+        for match in PRIVATE_NAME.finditer(path.read_text(encoding="utf-8", errors="replace")):
+            bad.append(f"{path.relative_to(ROOT)}: {match.group(0)}")
+    assert not bad, "names of private functions in the repository's text:\n" + "\n".join(bad[:40])

@@ -9,7 +9,7 @@ from scipy.optimize import least_squares
 from robokit.geometry import DegenerateFitError, se3_from_rt, so3_exp, transform_points
 from robokit.legged import MARKERS
 from robokit.legged.mocap import TooFewMarkersError, fit_marker_pose, mocap_body_poses
-from robokit.legged.mocap_sensor import simulate_mocap
+from robokit.legged.mocap import simulate_mocap
 
 
 def poses(n, seed=0):

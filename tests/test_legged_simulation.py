@@ -146,7 +146,7 @@ def test_with_perfect_sensors_the_log_integrates_to_the_truth():
     """The log's IMU rows and the estimators agree on timing: with ideal sensors, integrating the
     gyro follows the true orientation, and the fused position follows the true one."""
     from robokit.legged import SensorSettings, integrate_gyro, orientation_errors
-    from robokit.legged.walking_experiment import estimation_table
+    from robocourse.lessons.littledog.experiment import estimation_table
 
     perfect = SensorSettings(mocap_noise=0.0, mocap_dropout=0.0, mocap_bursts=0.0, gyro_noise=0.0, acc_noise=0.0,
                              gyro_bias=(0.0, 0.0, 0.0), acc_bias=(0.0, 0.0, 0.0), force_noise=0.0)

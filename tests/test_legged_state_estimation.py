@@ -11,7 +11,7 @@ from robokit.geometry import rot_x, rot_y, rot_z, se3_from_rt, so3_exp
 from robokit.legged import MARKERS
 from robokit.legged.imu import integrate_gyro, simulate_imu, specific_force
 from robokit.legged.mocap import mocap_body_poses
-from robokit.legged.mocap_sensor import simulate_mocap
+from robokit.legged.mocap import simulate_mocap
 from robokit.legged.state_estimation import fuse_body_state, orientation_errors, position_errors
 
 DT = 0.01

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from robokit.legged.event_scoring import contact_events, event_precision_recall, score_events
+from robokit.legged.touchdown import contact_events, event_precision_recall, score_events
 from robokit.legged.touchdown import detect_contacts
 
 

@@ -1,9 +1,9 @@
-"""Lesson 04's experiment tables (robokit.legged.walking_experiment): inputs refused by name, before any trial."""
+"""Lesson 04's experiment tables (robocourse.lessons.littledog.experiment): inputs refused by name, before any trial."""
 import numpy as np
 import pytest
 
 from robokit.legged import trot_gait, walking_plan
-from robokit.legged.walking_experiment import TOUCHDOWN_DETECTORS, loop_table, touchdown_table
+from robocourse.lessons.littledog.experiment import TOUCHDOWN_DETECTORS, loop_table, touchdown_table
 from tests.legged_logs import synthetic_log
 
 

@@ -1,70 +1,33 @@
-"""The lab experiment's cache key covers every module whose code decides its result, and no more."""
-import ast
-import importlib
+"""A lesson experiment's cache key covers the code it uses, and no more (robocourse.source.code_version)."""
 from pathlib import Path
 
-import robokit
-from robokit.cache import code_version
-from robokit.localization.lab_experiment import EXPERIMENT_MODULES
+from robocourse.source import closure, code_version, imports_of, module_file
 
-ROOT = Path(robokit.__file__).resolve().parent
+EXPERIMENT = "robocourse.lessons.visual_slam.experiment"
 
 
-def _is_module(dotted: str) -> bool:
-    path = ROOT.parent.joinpath(*dotted.split("."))
-    return path.with_suffix(".py").is_file() or path.is_dir()
+def test_the_key_follows_names_to_the_modules_that_define_them():
+    used = closure([EXPERIMENT], parents=False, homes=True)
+    assert {"robokit.sim.worlds", "robokit.vision.stereo", "robokit.mapping.landmarks", EXPERIMENT} <= set(used)
+    # robokit.sim's __init__ imports every sim module; the lab uses none of these
+    assert "robokit.sim.worlds_outdoor" not in used and "robokit.sim" not in used
+    assert not any(m.startswith("robocourse.grading") for m in used)
 
 
-def _homes(package: str, name: str) -> set[str]:
-    """The robokit modules that ``from package import name`` really depends on: the module that
-    defines a function or class, a submodule itself, or the modules that assign a constant (a
-    package's ``__init__`` only re-exports, so it is followed to the defining module)."""
-    if _is_module(f"{package}.{name}"):
-        return {f"{package}.{name}"}
-    obj = getattr(importlib.import_module(package), name)
-    home = getattr(obj, "__module__", None) or ""
-    if callable(obj) and home.startswith("robokit."):
-        return {home}
-    module = importlib.import_module(package)
-    if not hasattr(module, "__path__"):
-        return {package}
-    found = set()
-    for source in Path(module.__path__[0]).glob("*.py"):
-        for node in ast.parse(source.read_text()).body:
-            targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(node, ast.AnnAssign) else []
-            if source.stem != "__init__" and any(isinstance(t, ast.Name) and t.id == name for t in targets):
-                found.add(f"{package}.{source.stem}")
-    return found or {package}
+def test_a_name_is_found_where_it_is_defined():
+    assert "robokit.sim.lidar" in imports_of("robocourse.lessons.corridor_localization.sensors", homes=True)
+    assert "robokit.sim" in imports_of("robocourse.lessons.corridor_localization.sensors")
 
 
-def _closure(start: str) -> set[str]:
-    """Every robokit module reached from ``start`` through its imports, names followed to their homes."""
-    seen, todo = set(), [start]
-    while todo:
-        name = todo.pop()
-        if name in seen:
-            continue
-        seen.add(name)
-        path = Path(importlib.import_module(name).__file__)
-        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.ImportFrom):
-                base = package.split(".")[:len(package.split(".")) - node.level + 1] if node.level else []
-                source = ".".join(base + ([node.module] if node.module else []))
-                if source.startswith("robokit"):
-                    for alias in node.names:
-                        todo.extend(_homes(source, alias.name))
-            elif isinstance(node, ast.Import):
-                todo.extend(a.name for a in node.names if a.name.startswith("robokit."))
-    return {name.removeprefix("robokit.") for name in seen}
+def test_an_edit_to_a_used_module_changes_the_key_and_an_unused_one_does_not(monkeypatch):
+    before = code_version(EXPERIMENT)
+    real = Path.read_bytes
 
+    def edited(self, which):
+        data = real(self)
+        return data + b"# edited\n" if self == module_file(which) else data
 
-def test_the_cache_key_lists_every_module_the_experiment_reaches():
-    reached = _closure("robokit.localization.lab_experiment")
-    assert "sim.worlds" in reached and "vision.stereo" in reached          # the walk does follow imports
-    assert reached <= set(EXPERIMENT_MODULES), sorted(reached - set(EXPERIMENT_MODULES))
-
-
-def test_an_unrelated_module_does_not_enter_the_key():
-    assert "sim.worlds_outdoor" not in EXPERIMENT_MODULES and "sim" not in EXPERIMENT_MODULES
-    assert code_version(*EXPERIMENT_MODULES) != code_version(*EXPERIMENT_MODULES, "sim.worlds_outdoor")
+    monkeypatch.setattr(Path, "read_bytes", lambda self: edited(self, "robokit.sim.worlds_outdoor"))
+    assert code_version(EXPERIMENT) == before
+    monkeypatch.setattr(Path, "read_bytes", lambda self: edited(self, "robokit.sim.worlds"))
+    assert code_version(EXPERIMENT) != before

@@ -4,7 +4,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from robokit.localization.lab_experiment import map_consistency
+from robocourse.lessons.visual_slam.experiment import map_consistency
 from robokit.sim import box_room
 
 HEIGHT = 0.8

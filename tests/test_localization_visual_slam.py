@@ -8,7 +8,7 @@ import pytest
 
 from robokit.geometry import se2_to_pqt, wrap_angle
 from robokit.localization import VisualSLAM
-from robokit.localization.lab_experiment import LAB_TEST_POSES, calibrated_rig, lab_experiment, mapping_run
+from robocourse.lessons.visual_slam.experiment import LAB_TEST_POSES, calibrated_rig, lab_experiment, mapping_run
 from robokit.mapping import LandmarkMap
 from robokit.vision import StereoCalibration
 
@@ -208,7 +208,7 @@ def test_ransac_recovers_the_rendered_motion_with_half_the_matches_wrong():
 
 
 def test_lab_experiment_is_cached_and_a_bad_cache_file_is_rebuilt(tmp_path, monkeypatch):
-    import robokit.localization.lab_experiment as lab
+    import robocourse.lessons.visual_slam.experiment as lab
 
     monkeypatch.setattr(lab, "cache_dir", lambda *parts: tmp_path)
     first = lab_experiment(frames=2, test_poses=LAB_TEST_POSES[:1])

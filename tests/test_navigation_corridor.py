@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robokit.navigation import corridor_experiment as experiment, corridor_kidnapping, corridor_trials as trials
+from robocourse.lessons.corridor_localization import experiment, kidnapping as corridor_kidnapping, trials
 
 
 @pytest.fixture(scope="module")

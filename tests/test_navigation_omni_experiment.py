@@ -6,8 +6,8 @@ import pytest
 
 from robokit.cache import cache_dir
 from robokit.geometry import se2_compose
-from robokit.navigation import omni_experiment as experiment
-from robokit.navigation import omni_navigation as navigation
+from robocourse.lessons.omni_localization import experiment
+from robocourse.lessons.omni_localization import navigation
 from robokit.sim import OFFICE_TEST_POSES
 
 

@@ -3,7 +3,7 @@ import sys
 
 import pytest
 
-from robokit.course.netguard import is_loopback_host
+from robocourse.site.netguard import is_loopback_host
 
 
 @pytest.mark.parametrize("host, ok", [("localhost", True), ("127.0.0.1", True), ("::1", True),
@@ -16,7 +16,7 @@ def test_loopback_classification(host, ok):
 def test_guard_refuses_remote_and_allows_loopback():
     code = r"""
 import socket, threading
-from robokit.course import netguard
+from robocourse.site import netguard
 netguard.install()
 for target in [("example.com", 80), ("192.0.2.1", 80)]:
     try:

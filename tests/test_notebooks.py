@@ -4,8 +4,8 @@ raise NotImplementedError from their stubs. Lessons and solutions are run once f
 session (the ``fast_course`` fixture, which also builds the course sites from them)."""
 import pytest
 
-from robokit.course.build import ALL_DIRS, discover
-from robokit.course.execute import run_notebook
+from robocourse.site.build import ALL_DIRS, discover
+from robocourse.site.execute import run_notebook
 from tests.conftest import ROOT
 
 TIME_LIMIT = 300  # seconds per notebook under ROBOKIT_FAST=1 (the fast_course fixture uses the same)

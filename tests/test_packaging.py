@@ -1,4 +1,5 @@
-"""pyproject.toml and environment.yml must list the same dependencies; no sys.path hacks."""
+"""The two packages' pyproject files and environment.yml list the same dependencies; the library
+needs none of the course's; no sys.path hacks."""
 import re
 import tomllib
 from pathlib import Path
@@ -14,12 +15,25 @@ def _name(req: str) -> str:
     return re.split(r"[<>=!~;\[ ]", req.strip(), maxsplit=1)[0].lower().replace("_", "-")
 
 
+#: Each package's pyproject and the extras `make venv` installs with it.
+PACKAGES = {"pyproject.toml": ("legged", "arm", "dev"), "course/pyproject.toml": ("lab",)}
+#: What only the course needs: the library must not depend on any of it.
+COURSE_ONLY = {"nbformat", "nbclient", "nbconvert", "ipython", "ipykernel", "jupyterlab", "sphinx", "myst-nb",
+               "sphinx-book-theme", "sphinx-mathjax-offline"}
+
+
+def _project(path):
+    return tomllib.loads((ROOT / path).read_text())["project"]
+
+
 def _pyproject_names():
-    data = tomllib.loads((ROOT / "pyproject.toml").read_text())
-    reqs = list(data["project"]["dependencies"])
-    for extra in ("lab", "dev"):
-        reqs += data["project"]["optional-dependencies"][extra]
-    return {CONDA_NAME.get(_name(r), _name(r)) for r in reqs}
+    reqs = []
+    for path, extras in PACKAGES.items():
+        project = _project(path)
+        reqs += project["dependencies"]
+        for extra in extras:
+            reqs += project["optional-dependencies"][extra]
+    return {CONDA_NAME.get(_name(r), _name(r)) for r in reqs} - {"robokit"}
 
 
 def _environment_names():
@@ -40,17 +54,23 @@ def test_environment_mirrors_pyproject():
     py_names = _pyproject_names()
     assert env_names == py_names, (f"only in pyproject: {sorted(py_names - env_names)}; "
                                    f"only in environment.yml: {sorted(env_names - py_names)}")
-    assert editable == ["-e ."], "environment.yml must install robokit in editable mode via pip"
+    assert editable == ["-e .", "-e ./course"], "environment.yml must install both packages in editable mode via pip"
+
+
+def test_the_library_needs_nothing_of_the_course():
+    project = _project("pyproject.toml")
+    runtime = project["dependencies"] + [r for e in ("legged", "arm") for r in project["optional-dependencies"][e]]
+    assert not {_name(r) for r in runtime} & COURSE_ONLY
+    assert "scripts" not in project
 
 
 def test_console_script_declared():
-    data = tomllib.loads((ROOT / "pyproject.toml").read_text())
-    assert data["project"]["scripts"]["robokit"] == "robokit.cli:main"
+    assert _project("course/pyproject.toml")["scripts"]["robocourse"] == "robocourse.cli:main"
 
 
 def test_no_sys_path_hacks():
     offenders = []
-    for folder in ("robokit", "tests", "benchmarks"):
+    for folder in ("robokit", "course", "tests", "benchmarks"):
         for path in (ROOT / folder).rglob("*.py"):
             text = path.read_text(encoding="utf-8")
             if re.search(r"sys\.path\.(insert|append)|sys\.path\s*\+?=", text):

@@ -128,8 +128,8 @@ def test_bad_arguments_are_named():
 def test_table_2_runs_do_not_depend_on_the_number_of_workers(monkeypatch):
     # each run is seeded from its start and number: made side by side, they give the same table
     monkeypatch.setenv("ROBOKIT_FAST", "1")
-    from robokit.navigation.corridor_experiment import corridor_map
-    from robokit.navigation.corridor_trials import localization_trials
+    from robocourse.lessons.corridor_localization.experiment import corridor_map
+    from robocourse.lessons.corridor_localization.trials import localization_trials
     setup = corridor_map(fast=True)
     for method in ("amcl", "ours"):
         a = localization_trials(setup, method, trials=2, positions=[0, 1], max_distance=6.0, cache=False, workers=1)
@@ -155,8 +155,8 @@ def test_workers_leave_the_cores_to_each_other(monkeypatch):
 
 def test_navigation_runs_do_not_depend_on_the_number_of_workers(monkeypatch):
     # lesson 02's runs are each seeded by their number: side by side they follow the same paths
-    from robokit.navigation.omni_experiment import office_setup
-    from robokit.navigation.omni_navigation import navigation_trials
+    from robocourse.lessons.omni_localization.experiment import office_setup
+    from robocourse.lessons.omni_localization.navigation import navigation_trials
     setup = office_setup(fast=True)
     runs = {}
     for workers in ("1", "2"):

@@ -75,7 +75,7 @@ def test_the_camera_follows_a_walking_littledog(tmp_path):
     def after_the_walk(scene, name):
         # real time, not --virtual-time-budget: the camera follows once per animation frame, and
         # virtual time sometimes took the shot before the walk was over (the test was flaky)
-        from robokit.course.browser import Browser
+        from robocourse.site.browser import Browser
 
         page = tmp_path / f"{name}.html"
         page.write_text(f"<html><body style='margin:0'>{scene._repr_html_()}</body></html>")

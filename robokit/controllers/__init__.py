@@ -3,14 +3,12 @@
 Layer: below the system lessons (``outdoor``, ``legged``) and ``navigation``; imports ``geometry``,
 ``validation``, ``sim`` (the one unicycle model), ``mapping`` (the corridor scan analysis) and python-control.
 
-heading              the heading servo of a skid-steer vehicle: pole-placement gains for an overshoot
-                     and settling time, and the discrete controller (lesson 05; re-exported by
-                     :mod:`robokit.outdoor`)
-heading_loop         that loop as transfer functions, in lesson 05's names (servo_loop's functions)
+heading              the heading servo of a skid-steer vehicle: the loop as transfer functions in
+                     lesson 05's names (servo_loop's), pole-placement gains for an overshoot and
+                     settling time, and the discrete controller (re-exported by :mod:`robokit.outdoor`)
 servo_loop           an integrator plus a first-order lag under PD with rate feedback, continuous and
                      sampled: plant, closed loop, loop gain, step and frequency response, margins,
-                     the ZOH loop's poles and bandwidth (no exercise reference: graded notebooks may
-                     import it)
+                     the ZOH loop's poles and bandwidth
 dc_motor             a geared DC motor per joint (lesson 04): torque from voltage and speed, current,
                      copper and mechanical power, reflected inertia; LittleDog's assumed motor
 joint_servo          lesson 04's 500 Hz joint servo: the joint plant, gains by pole placement, the
@@ -28,9 +26,8 @@ corridor_centering   lesson 03's moving strategy (Ge et al. 2023, Sec. 3.1): a l
 from .corridor_centering import CenteringResult, centering_command, move_to_middle_line
 from .dc_motor import (LITTLEDOG_MOTOR, DCMotor, MotorPower, electrical_power, joint_torque, motor_current,
                        reflected_inertia, voltage_for_torque)
-from .heading import HeadingController, design_heading_gains
-from .heading_loop import (heading_closed_loop, heading_frequency_response, heading_loop_gain, heading_plant,
-                           heading_step_response, loop_metrics)
+from .heading import (HeadingController, design_heading_gains, heading_closed_loop, heading_frequency_response,
+                      heading_loop_gain, heading_plant, heading_step_response, loop_metrics)
 from .host_link import SetpointChannel
 from .joint_servo import (JointLag, ServoResponse, design_servo_gains, discrete_servo_response,
                           joint_lag, joint_plant, pd_servo_step, servo_analysis)

@@ -3,7 +3,7 @@
 Plant: an input ``u`` drives the output through a first-order lag and an integrator,
 ``y(s) / u(s) = g / (s (tau s + 1))`` (Franklin, Powell & Emami-Naeini 2015, Sec. 3.1). Two lessons
 meet it: the heading of a skid-steer truck under a yaw-rate command (``tau`` the motors' lag, ``g``
-the slip; :mod:`robokit.controllers.heading_loop`) and a geared DC-motor joint under a voltage
+the slip; :mod:`robokit.controllers.heading`) and a geared DC-motor joint under a voltage
 (``K / (s (J s + B))``, so ``g = K / B`` and ``tau = J / B``; :mod:`robokit.controllers.joint_servo`).
 
 Controller: proportional on the error plus rate feedback (derivative on the measurement),

@@ -2,10 +2,7 @@
 
 :func:`fit_rigid` is the kernel that :func:`fit_se2` (a planar pose ``[x, y, theta]``) and
 :func:`fit_se3` (a 4x4 ``T``) wrap: the rotation ``R`` and translation ``t`` minimising
-``sum_i w_i |R s_i + t - t_i|^2``. All three live here, above ``planar`` inside
-:mod:`robokit.geometry` and imported by no other geometry module: assignment 04 asks students for
-the fit, and a module its grading worker may run (the MoCap simulator needs ``as_se3``) must not
-import one.
+``sum_i w_i |R s_i + t - t_i|^2``.
 
 The method: Arun, Huang & Blostein (1987) remove the translation by centring both sets on their
 centroids and take the rotation from the SVD of the 3x3 correlation matrix; their solution can be

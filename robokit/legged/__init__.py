@@ -4,11 +4,9 @@ from .littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_LIM
                         TOTAL_MASS, TRUNK_MASS, TRUNK_SIZE, UPPER_LEG, littledog_mjcf, littledog_model)
 # sensing and estimation (MoCap, IMU, fusion, touchdowns)
 from .imu import GRAVITY, ImuReadings, integrate_gyro, simulate_imu, specific_force
-from .event_scoring import EventScore, contact_events, event_precision_recall, score_events
-from .mocap import MocapPoses, TooFewMarkersError, fit_marker_pose, mocap_body_poses
-from .mocap_sensor import MocapFrames, simulate_mocap
+from .mocap import MocapFrames, MocapPoses, TooFewMarkersError, fit_marker_pose, mocap_body_poses, simulate_mocap
 from .state_estimation import BodyState, fuse_body_state, orientation_errors, position_errors
-from .touchdown import detect_contacts
+from .touchdown import EventScore, contact_events, detect_contacts, event_precision_recall, score_events
 # gaits: support polygon and stability margin, gait schedules, crawl and trot plans
 from .gait import WalkPlan, swing_trajectory, walking_plan
 from .gait_schedule import CRAWL_SEQUENCE, TROT_PAIRS, GaitSchedule, crawl_gait, stance_pattern, trot_gait

@@ -41,7 +41,7 @@ from .gait import WalkPlan
 from .imu import simulate_imu
 from .leg_kinematics import body_ik
 from .littledog import LEGS, MARKERS, TIMESTEP, littledog_model
-from .mocap_sensor import simulate_mocap
+from .mocap import simulate_mocap
 from .power import trial_power
 from .servo_design import littledog_servo_gains
 from .trial_log import TrialLog, empty_streams, trial_meta

@@ -17,7 +17,7 @@ Global localization of a kidnapped robot against the built map is the Hough tran
 Sec. 5 (:func:`robokit.localization.global_localize`).
 
 This module only orchestrates the library; it never renders (the simulator is used by
-:mod:`robokit.localization.lab_experiment`). Poses are the papers' ``[p, q, theta]``
+:mod:`robocourse.lessons.visual_slam.experiment`). Poses are the papers' ``[p, q, theta]``
 (``pqt``, :mod:`robokit.geometry.paper_frames`).
 
 References

@@ -41,7 +41,7 @@ class StereoCalibration:
     """The calibration of a rectified stereo pair: what triangulation needs (Se et al. Sec. 3.1).
 
     Not to be confused with :class:`robokit.sim.StereoRig`, the simulated rig that renders images;
-    :func:`robokit.localization.lab_experiment.calibrated_rig` reads one off the other.
+    :func:`robocourse.lessons.visual_slam.experiment.calibrated_rig` reads one off the other.
 
     Attributes
     ----------

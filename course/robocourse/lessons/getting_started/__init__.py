@@ -1,0 +1,1 @@
+"""Lesson 00, getting started: the warm-up assignment's exercises (``exercises``)."""

@@ -1,0 +1,7 @@
+"""Lesson 02, omnidirectional hierarchical localization and visual path following (seed 001).
+
+experiment  the office: its tour, the topological map built from it (cached), the test poses and
+            the route
+navigation  the autonomous runs along a recorded visual path from perturbed starts (cached)
+exercises   assignment 02
+"""

@@ -1,0 +1,4 @@
+"""Lesson 06, inverse kinematics of a redundant 7-DOF arm (Huang & Jiang; Shimizu et al. 2008).
+
+exercises   assignment 06
+"""

@@ -1,0 +1,6 @@
+"""Lesson 01, stereo visual SLAM with PLOT and SIFT features (Lin et al.; Se, Lowe & Little 2002).
+
+experiment  Se et al.'s Sec. 6 re-run in the simulated lab: the calibrated rig, the mapping lap,
+            the map and the kidnapped test poses (cached), and the map's consistency check
+exercises   assignment 01
+"""

@@ -1,5 +1,0 @@
-"""Course tooling: run notebooks headless, check their hygiene, build the HTML course site."""
-from .execute import NotebookRun, run_notebook
-from .hygiene import notebook_problems, strip_notebook
-
-__all__ = ["NotebookRun", "run_notebook", "notebook_problems", "strip_notebook"]
