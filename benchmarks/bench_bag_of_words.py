@@ -44,7 +44,7 @@ def _loop_words(voc, desc):
         node = 0
         while voc.children[node, 0] >= 0:
             kids = voc.children[node][voc.children[node] >= 0]
-            node = kids[int(np.argmin(hamming_distance(d[None], voc.centres[kids], check=False)))]
+            node = kids[int(np.argmin(hamming_distance(d[None], voc.centres[kids], validate=False)))]
         out[i] = voc.word_of_node[node]
     return out
 

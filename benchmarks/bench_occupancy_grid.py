@@ -49,7 +49,7 @@ def main() -> None:
     t_field = median_time(lambda: likelihood_field(grid), reps)
     field = likelihood_field(grid)
     pts = np.random.default_rng(0).uniform([0, -1.2], [36, 1.2], (1000, 360, 2))
-    t_look = median_time(lambda: field.lookup(pts, check=False), reps)
+    t_look = median_time(lambda: field.lookup(pts, validate=False), reps)
 
     print(f"run: {len(scans)} scans x {lidar.beams} beams, {duration:.1f} s; grid {grid.shape[0]} x {grid.shape[1]} "
           f"cells at 0.05 m")

@@ -75,7 +75,7 @@ def main() -> None:
     print(f"detect_contacts, {n} x 4: {det * 1e3:.2f} ms; plain loop x{median_time(lambda: loop_detector(force, 3.0, 1.0, 3), reps) / det:.0f}")
     rng = np.random.default_rng(1)
     s2 = rng.normal(size=(128, 2, 2))
-    se2 = median_time(lambda: fit_se2(s2, s2 + 1.0, check=False), reps * 20)
+    se2 = median_time(lambda: fit_se2(s2, s2 + 1.0, validate=False), reps * 20)
     svd = median_time(lambda: np.linalg.svd(s2), reps * 20)
     print(f"fit_se2, 128 two-point problems: {se2 * 1e6:.0f} us; its SVD alone x{svd / se2:.2f}")
 

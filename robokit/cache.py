@@ -257,7 +257,7 @@ def _meta_text(meta: dict) -> str:
         raise TypeError(f"meta: expected a JSON-serialisable dict of parameters ({exc})") from None
 
 
-def _check_named_arrays(arrays: Any) -> None:
+def _require_named_arrays(arrays: Any) -> None:
     if not isinstance(arrays, dict) or not all(isinstance(k, str) and k for k in arrays):
         raise TypeError(f"arrays: expected a dict of array names to arrays, got {type(arrays).__name__}")
 
@@ -293,7 +293,7 @@ def save_npz(target: Any, arrays: dict) -> Any:
     """
     import numpy as np
 
-    _check_named_arrays(arrays)
+    _require_named_arrays(arrays)
     with zipfile.ZipFile(target, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1, allowZip64=True) as zf:
         for name, value in arrays.items():
             arr = np.asanyarray(value)
@@ -342,7 +342,7 @@ def write_arrays(target: str | Path, arrays: dict, meta: dict | None = None) -> 
     """
     import numpy as np
 
-    _check_named_arrays(arrays)
+    _require_named_arrays(arrays)
     if _META in arrays:
         raise ValueError(f"arrays: expected names other than the reserved {_META!r}, got {sorted(arrays)}")
     stored = dict(arrays)

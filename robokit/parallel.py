@@ -33,7 +33,7 @@ import cv2
 
 from .config import worker_count
 from .progress import progress_bar
-from .validation import check_callable, check_int
+from .validation import as_callable, as_int
 
 __all__ = ["MIN_RUNS", "worker_count", "map_runs", "iter_runs"]   # worker_count lives in config (the course build reads it too)
 
@@ -114,7 +114,7 @@ def _context(run: Callable):
     return context
 
 
-def _check_importable(run: Callable) -> None:
+def _require_importable(run: Callable) -> None:
     """Workers find ``run`` by its module and name: a lambda, a nested function or one defined in a
     notebook cell cannot be found there."""
     name = getattr(run, "__qualname__", "")
@@ -215,16 +215,16 @@ def iter_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | Non
     >>> next(results), list(results)
     ((7, 0), [(3, 1), (2, 1)])
     """
-    run = check_callable(run, "run", optional=False)
-    progress = check_callable(progress, "progress")
+    run = as_callable(run, "run", optional=False)
+    progress = as_callable(progress, "progress")
     if isinstance(tasks, (str, bytes)) or not hasattr(tasks, "__iter__"):
         raise TypeError(f"tasks: expected a sequence of tasks, got {type(tasks).__name__}")
     tasks = list(tasks)
-    workers = worker_count() if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
+    workers = worker_count() if workers is None else as_int(workers, "workers", minimum=1, maximum=64)
     workers = min(workers, len(tasks))
     if workers <= 1 or len(tasks) < MIN_RUNS:
         return _in_place(run, shared, tasks, desc, unit, progress)
-    _check_importable(run)
+    _require_importable(run)
     settings = {k: v for k, v in os.environ.items() if k.startswith("ROBOKIT_")}
     # sent as bytes: a worker that cannot rebuild them reports it as the runs' error
     blobs = {"run": _pickled(run, "run"), "shared": _pickled(shared, "shared")}

@@ -11,7 +11,7 @@ import time
 from typing import Callable
 
 from .config import fast_mode, headless
-from .validation import check_int
+from .validation import as_int
 
 __all__ = ["ProgressBar", "progress_bar"]
 
@@ -125,7 +125,7 @@ def progress_bar(total: int, desc: str, *, unit: str = "step", callback: Callabl
     >>> bar.done
     3
     """
-    total = check_int(total, "total", minimum=0)
+    total = as_int(total, "total", minimum=0)
     for name, value in (("desc", desc), ("unit", unit)):
         if not isinstance(value, str) or not value.strip():
             raise ValueError(f"{name}: expected a non-empty string, got {value!r}")

@@ -25,9 +25,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = ["as_array", "array_ndim", "broadcast_to", "as_points", "check_finite_scalar", "check_positive", "check_int",
-           "check_choice", "check_text", "check_callable", "check_mapping", "check_finite_result", "check_sample_count",
-           "MAX_SAMPLES", "as_rng", "describe", "check_covariance"]
+__all__ = ["as_array", "array_ndim", "broadcast_to", "as_points", "as_finite_scalar", "as_positive", "as_int",
+           "as_choice", "as_text", "as_callable", "as_mapping", "require_finite_result", "require_sample_count",
+           "MAX_SAMPLES", "as_rng", "describe", "as_covariance"]
 
 
 def describe(value: Any) -> str:
@@ -245,7 +245,7 @@ def as_points(value: Any, name: str, dim: int, *, min_count: int = 0) -> np.ndar
     return arr
 
 
-def check_finite_scalar(value: Any, name: str) -> float:
+def as_finite_scalar(value: Any, name: str) -> float:
     """Return ``value`` as a finite float.
 
     Raises
@@ -265,7 +265,7 @@ def check_finite_scalar(value: Any, name: str) -> float:
     return out
 
 
-def check_positive(value: Any, name: str, *, allow_zero: bool = False) -> float:
+def as_positive(value: Any, name: str, *, allow_zero: bool = False) -> float:
     """Return ``value`` as a finite float that is > 0 (or >= 0 with ``allow_zero``).
 
     Raises
@@ -273,7 +273,7 @@ def check_positive(value: Any, name: str, *, allow_zero: bool = False) -> float:
     ValueError
         If the number is not positive.
     """
-    out = check_finite_scalar(value, name)
+    out = as_finite_scalar(value, name)
     if out < 0 or (out == 0 and not allow_zero):
         raise ValueError(f"{name}: expected a {'non-negative' if allow_zero else 'positive'} number, got {out}")
     return out
@@ -282,7 +282,7 @@ def check_positive(value: Any, name: str, *, allow_zero: bool = False) -> float:
 INT64_MAX = 2 ** 63 - 1
 
 
-def check_int(value: Any, name: str, *, minimum: int | None = None, maximum: int | None = INT64_MAX) -> int:
+def as_int(value: Any, name: str, *, minimum: int | None = None, maximum: int | None = INT64_MAX) -> int:
     """Return ``value`` as an int within ``[minimum, maximum]``.
 
     ``maximum`` defaults to the largest int64 (and ``minimum`` is at least the smallest): a count,
@@ -305,7 +305,7 @@ def check_int(value: Any, name: str, *, minimum: int | None = None, maximum: int
     return out
 
 
-def check_choice(value: Any, name: str, choices: Sequence[Any]) -> Any:
+def as_choice(value: Any, name: str, choices: Sequence[Any]) -> Any:
     """Return ``value`` if it is one of ``choices`` (of the same type: ``1`` is not ``"1"`` and an
     array is never a choice).
 
@@ -321,7 +321,7 @@ def check_choice(value: Any, name: str, choices: Sequence[Any]) -> Any:
     raise ValueError(f"{name}: expected one of {list(choices)}, got {describe(value)}")
 
 
-def check_text(value: Any, name: str, *, empty: bool = True) -> str:
+def as_text(value: Any, name: str, *, empty: bool = True) -> str:
     """Return ``value`` if it is a ``str`` (non-empty unless ``empty``).
 
     Raises
@@ -333,7 +333,7 @@ def check_text(value: Any, name: str, *, empty: bool = True) -> str:
 
     Examples
     --------
-    >>> check_text("GP", "talker")
+    >>> as_text("GP", "talker")
     'GP'
     """
     if not isinstance(value, str):
@@ -343,7 +343,7 @@ def check_text(value: Any, name: str, *, empty: bool = True) -> str:
     return value
 
 
-def check_callable(value: Any, name: str, *, optional: bool = True) -> Any:
+def as_callable(value: Any, name: str, *, optional: bool = True) -> Any:
     """Return ``value`` if it is callable (or ``None`` when ``optional``).
 
     Raises
@@ -353,7 +353,7 @@ def check_callable(value: Any, name: str, *, optional: bool = True) -> Any:
 
     Examples
     --------
-    >>> check_callable(print, "progress") is print
+    >>> as_callable(print, "progress") is print
     True
     """
     if value is None and optional:
@@ -363,7 +363,7 @@ def check_callable(value: Any, name: str, *, optional: bool = True) -> Any:
     return value
 
 
-def check_mapping(value: Any, name: str, *, optional: bool = True) -> Any:
+def as_mapping(value: Any, name: str, *, optional: bool = True) -> Any:
     """Return ``value`` if it is a mapping (a dict of options; ``None`` when ``optional``).
 
     Raises
@@ -373,7 +373,7 @@ def check_mapping(value: Any, name: str, *, optional: bool = True) -> Any:
 
     Examples
     --------
-    >>> check_mapping({"n_waypoints": 1}, "course_options")
+    >>> as_mapping({"n_waypoints": 1}, "course_options")
     {'n_waypoints': 1}
     """
     if value is None and optional:
@@ -383,7 +383,7 @@ def check_mapping(value: Any, name: str, *, optional: bool = True) -> Any:
     return value
 
 
-def check_finite_result(names: str, *results: Any) -> None:
+def require_finite_result(names: str, *results: Any) -> None:
     """Refuse a result that holds NaN or infinity: finite inputs too large for the computation.
 
     Valid inputs that overflow an intermediate (a square, a determinant, a time step) would
@@ -396,8 +396,8 @@ def check_finite_result(names: str, *results: Any) -> None:
 
     Examples
     --------
-    >>> check_finite_result("d_se, d_ew", np.array([1.0, 2.0]))
-    >>> check_finite_result("J", np.array([np.inf]))
+    >>> require_finite_result("d_se, d_ew", np.array([1.0, 2.0]))
+    >>> require_finite_result("J", np.array([np.inf]))
     Traceback (most recent call last):
     ...
     ValueError: J: expected values whose result is finite, got NaN or infinity (an overflow: values too large?)
@@ -413,7 +413,7 @@ def check_finite_result(names: str, *results: Any) -> None:
 MAX_SAMPLES = 10 ** 7
 
 
-def check_sample_count(count: float, names: str, maximum: int = MAX_SAMPLES) -> None:
+def require_sample_count(count: float, names: str, maximum: int = MAX_SAMPLES) -> None:
     """Refuse a number of samples (a duration times a rate) above ``maximum``.
 
     Raises
@@ -423,8 +423,8 @@ def check_sample_count(count: float, names: str, maximum: int = MAX_SAMPLES) -> 
 
     Examples
     --------
-    >>> check_sample_count(784, "speed, rate")
-    >>> check_sample_count(1e300, "rate")
+    >>> require_sample_count(784, "speed, rate")
+    >>> require_sample_count(1e300, "rate")
     Traceback (most recent call last):
     ...
     ValueError: rate: expected at most 10000000 samples, got 1e+300
@@ -453,7 +453,7 @@ def as_rng(rng: Any = None, name: str = "rng") -> np.random.Generator:
     raise TypeError(f"{name}: expected a numpy Generator or a non-negative integer seed, got {describe(rng)}")
 
 
-def check_covariance(value: Any, name: str, n: int, *, semidefinite: bool = False) -> np.ndarray:
+def as_covariance(value: Any, name: str, n: int, *, semidefinite: bool = False) -> np.ndarray:
     """Return ``value`` as a finite, symmetric, positive-definite ``(n, n)`` covariance matrix.
 
     Parameters
@@ -479,9 +479,9 @@ def check_covariance(value: Any, name: str, n: int, *, semidefinite: bool = Fals
 
     Examples
     --------
-    >>> check_covariance([[1.0, 0.1], [0.1, 2.0]], "R", 2).tolist()
+    >>> as_covariance([[1.0, 0.1], [0.1, 2.0]], "R", 2).tolist()
     [[1.0, 0.1], [0.1, 2.0]]
-    >>> check_covariance([[1.0, 2.0], [2.0, 1.0]], "R", 2)
+    >>> as_covariance([[1.0, 2.0], [2.0, 1.0]], "R", 2)
     Traceback (most recent call last):
     ...
     ValueError: R: expected a positive-definite covariance, got an eigenvalue -1

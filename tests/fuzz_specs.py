@@ -495,19 +495,19 @@ SPECS: dict[str, Call] = {
     # --- about, geometry --------------------------------------------------------------------
     "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
     "robokit.geometry.planar.wrap_angle": Call({"angle": Array(np.array([0.5, 4.0]), "|N|N,N", min_rows=0),
-                                                "check": Flag(True)}),
+                                                "validate": Flag(True)}),
     "robokit.geometry.planar.se2_compose": Call({"a": Array(np.array([1.0, 2.0, 0.5]), "3|N,3"),
-                                                 "b": Array(np.array([0.5, -1.0, 3.0]), "3|N,3"), "check": Flag(True)}),
+                                                 "b": Array(np.array([0.5, -1.0, 3.0]), "3|N,3"), "validate": Flag(True)}),
     "robokit.geometry.paper_frames.paper_world_to_robokit": Call({
         "points": Array(lambda: points(5), "N,3", min_rows=0), "covariances": Array(lambda: covs(5), "N,3,3", optional=True),
         "camera_height": Real(0.8)}),
     "robokit.geometry.paper_frames.pqt_robot_to_world": Call({
         "points": Array(lambda: points(5), "3|N,3|N,N,3", min_rows=0), "pqt": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"),
-        "check": Flag(True)}),
+        "validate": Flag(True)}),
     "robokit.geometry.paper_frames.pqt_to_se2": Call({"pqt": Array(np.array([0.1, 0.2, 0.3]), "3|N,3")}),
     "robokit.geometry.paper_frames.pqt_to_se3": Call({"pqt": Array(np.array([0.1, 0.2, 0.3]), "3")}),
     "robokit.geometry.paper_frames.se2_to_pqt": Call({"pose": Array(np.array([0.1, 0.2, 0.3]), "3|N,3")}),
-    "robokit.geometry.spatial.pose_error": Call({"T_target": Ts(), "T": Ts(lambda: iiwa().fk(q7())), "check": Flag(True)}),
+    "robokit.geometry.spatial.pose_error": Call({"T_target": Ts(), "T": Ts(lambda: iiwa().fk(q7())), "validate": Flag(True)}),
     "robokit.geometry.spatial.se2_to_se3": Call({"pose": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"), "z": Real(0.0)}),
     "robokit.geometry.spatial.se3_compose": Call({"transforms": Ts()}, star="transforms",
                                                  aliases={"transforms": "transforms[0]"}),
@@ -549,12 +549,12 @@ SPECS: dict[str, Call] = {
     "robokit.arm.srs.wrist_centre": Call({"T": T_(), "d_wf": Real(0.126)}),
     "robokit.arm.dh.dh_transform": Call({"theta": Array(np.array([0.1, 0.2]), "*"), "d": Array(np.array([0.3, 0.0]), "*"),
                                          "a": Array(np.array([0.0, 0.1]), "*"), "alpha": Array(np.array([0.5, -0.5]), "*"),
-                                         "check": Flag(True)}),
+                                         "validate": Flag(True)}),
     "robokit.arm.chain.dh_fk": Call({"dh": Array(DH, "N,3"), "q": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"),
                                      "modified": Flag(False)}),
     "robokit.arm.jacobian.dh_jacobian": Call({"dh": Array(DH, "N,3"), "q": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"),
                                               "modified": Flag(False)}),
-    "robokit.arm.limits.limit_distance_gradient": Call({"chain": Obj(iiwa), "q": Array(q7, "7|N,7"), "check": Flag(True)}),
+    "robokit.arm.limits.limit_distance_gradient": Call({"chain": Obj(iiwa), "q": Array(q7, "7|N,7"), "validate": Flag(True)}),
     "robokit.arm.ik_steps.null_space_step": Call({"J": Array(lambda: np.eye(6, 7) + 0.1, "6,N|N,6,N"),
                                                   "e": Array(np.full(6, 0.01), "6"), "gradient": Array(np.full(7, 0.1), "7"),
                                                   "damping": Real(0.01), "gain": Real(1.0)}),
@@ -690,7 +690,7 @@ SPECS: dict[str, Call] = {
     "robokit.sim.textures.photo": Call({"name": Choice("grace_hopper")}),
     "robokit.sim.vehicle.unicycle_step": Call({"pose": Array(np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]), "3|N,3"),
                                                "v": Array(np.array([1.0, 0.5]), "|N"), "omega": Array(np.array([0.3, 0.0]), "|N"),
-                                               "dt": Real(0.1), "check": Flag(True)}),
+                                               "dt": Real(0.1), "validate": Flag(True)}),
     "robokit.sim.worlds.lab_room": Call({"seed": Int(3)}, cheap=False),
     "robokit.sim.worlds.long_corridor": Call({"layout": Choice("mixed"), "seed": Int(2)}, cheap=False),
     "robokit.sim.worlds.office_floor": Call({"seed": Int(1)}, cheap=False),
@@ -730,7 +730,7 @@ SPECS: dict[str, Call] = {
     "robokit.vision.scale_space_maxima.scale_space_maxima": Call({
         "responses": Obj(lambda: [np.random.default_rng(n).random(shape, np.float32)
                                   for n, shape in enumerate([(12, 12), (12, 12), (6, 6)])]),
-        "steps": Array(np.array([1, 1, 2]), "3"), "threshold": Real(0.1), "border": Int(1), "check": Flag(True)}),
+        "steps": Array(np.array([1, 1, 2]), "3"), "threshold": Real(0.1), "border": Int(1), "validate": Flag(True)}),
     "robokit.vision.plot_detector.junction_strength": Call({"tensor": Array(np.tile([[1.0, 0.1], [0.1, 2.0]], (4, 5, 1, 1)),
                                                                             "...,2,2")}),
     "robokit.vision.stereo.observe_stereo": Call({"left": Obj(features), "right": Obj(features), "rig": Obj(calibration),
@@ -833,15 +833,15 @@ SPECS: dict[str, Call] = {
     "robokit.controllers.path_geometry.path_from_poses": Call({"poses": Array(KEY_POSES, "N,3"), "spacing": Real(0.1)}),
     "robokit.controllers.path_geometry.reference_point": Call({
         "path": Obj(visual_path), "pose": Array(np.array([1.0, 0.2, 0.1]), "3"), "previous": Int(5, optional=True),
-        "window": Real(1.0, optional=True), "check": Flag(True)}),
+        "window": Real(1.0, optional=True), "validate": Flag(True)}),
     "robokit.controllers.path_following.path_following_gains": Call({"alpha": Real(2.0), "xi": Real(0.7)}),
     "robokit.controllers.path_following.path_following_command": Call({
         "d": Array(np.array([0.1, -0.2]), "*"), "theta_tilde": Array(np.array([0.1, 0.0]), "*"),
         "curvature": Array(np.array([0.0, 0.5]), "*"), "v": Array(np.array([0.3, 0.3]), "*"), "k2": Real(4.0),
-        "k3": Real(2.8), "check": Flag(True)}),
+        "k3": Real(2.8), "validate": Flag(True)}),
     "robokit.controllers.path_following.saturate_command": Call({
         "v": Array(np.array([0.3, 0.3]), "*"), "omega": Array(np.array([2.0, 0.1]), "*"), "v_max": Real(0.3),
-        "w_max": Real(0.5), "check": Flag(True)}),
+        "w_max": Real(0.5), "validate": Flag(True)}),
     "robokit.controllers.path_following.PathFollower": Call({
         "path": Obj(visual_path), "alpha": Real(2.0), "v_max": Real(0.3), "w_max": Real(1.0), "xi": Real(0.7),
         "goal_tolerance": Real(0.1), "window": Real(1.0, optional=True)}),
@@ -856,15 +856,15 @@ SPECS: dict[str, Call] = {
     "robokit.controllers.path_following_loop.simulate_path_following": Call({
         "path": Obj(visual_path), "start_pose": Array(np.array([0.0, 0.1, 0.0]), "3"), "alpha": Real(2.0),
         "v": Real(0.3), "duration": Real(2.0), "dt": Real(0.1), "w_max": Real(1.0, optional=True), "xi": Real(0.7)}),
-    "robokit.localization.pose_ekf.unicycle_jacobian": Call({"x": Array(EKF_X, "5"), "dt": Real(0.1), "check": Flag(True)}),
+    "robokit.localization.pose_ekf.unicycle_jacobian": Call({"x": Array(EKF_X, "5"), "dt": Real(0.1), "validate": Flag(True)}),
     "robokit.localization.pose_ekf.unicycle_process_noise": Call({
-        "x": Array(EKF_X, "5"), "dt": Real(0.1), "sigma_accel": Real(0.5), "sigma_alpha": Real(1.0), "check": Flag(True)}),
+        "x": Array(EKF_X, "5"), "dt": Real(0.1), "sigma_accel": Real(0.5), "sigma_alpha": Real(1.0), "validate": Flag(True)}),
     "robokit.localization.pose_ekf.ekf_predict": Call({
         "x": Array(EKF_X, "5"), "P": Array(np.eye(5) * 0.01, "5,5"), "dt": Real(0.1),
-        "Q": Array(np.eye(5) * 1e-4, "5,5"), "check": Flag(True)}),
+        "Q": Array(np.eye(5) * 1e-4, "5,5"), "validate": Flag(True)}),
     "robokit.localization.pose_ekf.ekf_update": Call({
         "x": Array(EKF_X, "N"), "P": Array(np.eye(5) * 0.01, "N,N"), "z": Array(np.array([0.1, 0.2, 3.1]), "N"),
-        "H": Array(np.eye(3, 5), "N,N"), "R": Array(np.eye(3) * 0.01, "N,N"), "angles": Obj((2,)), "check": Flag(True)}),
+        "H": Array(np.eye(3, 5), "N,N"), "R": Array(np.eye(3) * 0.01, "N,N"), "angles": Obj((2,)), "validate": Flag(True)}),
     "robokit.localization.pose_ekf.nees": Call({"error": Array(np.array([0.1, -0.2]), "N|N,N"),
                                                 "P": Array(np.diag([0.01, 0.04]), "N,N|N,N,N")}),
     "robokit.localization.pose_ekf.nees_bounds": Call({"dof": Int(5), "runs": Int(50), "confidence": Real(0.95)}),
@@ -898,7 +898,7 @@ SPECS: dict[str, Call] = {
                                                       "H": Array(np.eye(8)[:3], "N|N,N")}),
     "robokit.vision.colour.histogram_intersection": Call({"h": Array(np.full(8, 0.125), "N"),
                                                           "H": Array(np.eye(8)[:3], "N|N,N")}),
-    # --- robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02) ---
+    # --- robokit.vision.omni_features, matching.DescriptorIndex, sim.view_matches (lesson 02) ---
     "robokit.vision.omni_features.omni_sift": Call({"image": Array(image, "N,N|N,N,3|N,N,4"),
                                                     "centre": Array(np.array([80.0, 60.0]), "2"),
                                                     "radii": Array(np.array([10.0, 55.0]), "2"), "orientation": Choice("radial"),
@@ -918,12 +918,12 @@ SPECS: dict[str, Call] = {
                                                               min_rows=0),
                                                 "index": Array(np.array([[3, 1], [0, 2]]), "N,2", min_rows=0),
                                                 "ratio": Real(0.8), "max_distance": Real(0.8, optional=True, inf_ok=True)}),
-    "robokit.sim.feature_check.omni_ground_truth_inliers": Call({
+    "robokit.sim.view_matches.omni_ground_truth_inliers": Call({
         "camera": Obj(small_omni), "ranges": Array(lambda: np.full((120, 160), 2.0), "120,160", inf_ok=True),
         "T1": T_(lambda: small_omni().transform_at([2.0, 6.0, 0.0])), "T2": T_(lambda: small_omni().transform_at([2.2, 6.0, 0.3])),
         "uv1": Array(np.array([[120.0, 60.0], [40.0, 70.0]]), "N,2", min_rows=0),
         "uv2": Array(np.array([[118.0, 61.0], [45.0, 66.0]]), "N,2", min_rows=0), "tol": Real(3.0)}),
-    "robokit.sim.feature_check.omni_view_pair": Call({
+    "robokit.sim.view_matches.omni_view_pair": Call({
         "world": Obj(office), "camera": Obj(small_omni), "pose1": Array(np.array([12.0, 3.5, 0.0]), "3"),
         "pose2": Array(np.array([12.2, 3.5, 0.5]), "3"), "orientation": Choice("radial"), "ratio": Real(0.8),
         "tol": Real(3.0), "method": Choice("kdtree")}, cheap=False),
@@ -936,7 +936,7 @@ SPECS: dict[str, Call] = {
     "robokit.mapping.pose_graph.edge_variances": Call({"graph": Obj(pose_graph)}),
     "robokit.mapping.pose_graph.unreachable_nodes": Call({"graph": Obj(pose_graph)}),
     "robokit.mapping.pose_graph.is_connected": Call({"graph": Obj(pose_graph)}),
-    "robokit.mapping.pose_graph.check_connected": Call({"graph": Obj(pose_graph)}),
+    "robokit.mapping.pose_graph.require_connected": Call({"graph": Obj(pose_graph)}),
     "robokit.mapping.pose_graph.pose_graph_from_odometry": Call({
         "odometry_poses": Array(lambda: pose_graph().poses[:6], "N,3"),
         "loop_edges": Array(np.array([[5, 0]]), "N,2", optional=True, min_rows=0),
@@ -966,7 +966,7 @@ SPECS: dict[str, Call] = {
     # --- lesson 02's topological map and hierarchical localization (helper D) -----------------
     "robokit.geometry.procrustes.fit_se2": Call({"source": Array(lambda: points(6)[:, :2], "N,2|N,N,2"),
                                              "target": Array(lambda: points(6)[:, :2] + 1.0, "N,2|N,N,2"),
-                                             "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
+                                             "weights": Array(np.ones(6), "N|N,N", optional=True), "validate": Flag(True)}),
     "robokit.vision.ransac.ransac_sample_count": Call({"contamination": Real(0.3), "sample_size": Int(2),
                                                        "confidence": Real(0.99)}),
     "robokit.vision.ransac.ransac_se2": Call({"source": Array(lambda: points(8)[:, :2], "N,2", min_rows=0),
@@ -976,7 +976,7 @@ SPECS: dict[str, Call] = {
     "robokit.vision.spherical.essential_from_bearings": Call({"b1": Array(bearings, "N,3"),
                                                               "b2": Array(moved_bearings, "N,3")}),
     "robokit.vision.spherical.epipolar_error": Call({"E": Array(essential, "3,3|N,3,3"), "b1": Array(bearings, "N,3"),
-                                                     "b2": Array(moved_bearings, "N,3"), "check": Flag(True)}),
+                                                     "b2": Array(moved_bearings, "N,3"), "validate": Flag(True)}),
     "robokit.vision.spherical.ransac_essential": Call({"b1": Array(bearings, "N,3"), "b2": Array(moved_bearings, "N,3"),
                                                        "threshold": Real(0.01), "confidence": Real(0.99),
                                                        "min_inliers": Int(8), "max_iterations": Int(64), "rng": Rng(0)}),
@@ -988,7 +988,7 @@ SPECS: dict[str, Call] = {
     "robokit.sim.motion.office_tour": Call({"world": Obj(office), "speed": Real(0.3), "rate": Real(2.0)}),
     "robokit.sim.motion.increment_variances": Call({"delta": Array(np.array([[0.1, 1.0, -0.1]]), "3|N,3"),
                                                     "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"),
-                                                    "check": Flag(True)}),
+                                                    "validate": Flag(True)}),
     "robokit.sim.motion.odometry_covariance": Call({"odometry": Array(lambda: lap().poses[:20], "N,3"),
                                                     "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4")}),
     "robokit.mapping.local_maps.appearance_changed": Call({"distance": Array(np.array([0.01, 0.3]), "|N"),
@@ -1014,7 +1014,7 @@ SPECS: dict[str, Call] = {
                                                   "camera": Obj(small_omni), "bins": Int(32), "n_features": Int(100),
                                                   "features": Flag(True), "times": Mapping(None, optional=True),
                                                   "histogram": Array(lambda: np.full(32, 1 / 32), "32", optional=True)}),
-    "robokit.mapping.omni_views.check_omni_image": Call({"image": Array(lambda: office_views()[0][0], "120,160,3"),
+    "robokit.mapping.omni_views.as_omni_image": Call({"image": Array(lambda: office_views()[0][0], "120,160,3"),
                                                          "camera": Obj(small_omni), "name": Text("image")}),
     "robokit.mapping.omni_views.relative_pose": Call({
         "query": Obj(lambda: omni_views()[1]), "node": Obj(lambda: omni_views()[0]), "matches": Obj(omni_matches),
@@ -1097,7 +1097,7 @@ SPECS: dict[str, Call] = {
     "robokit.mapping.grid_mapping.inverse_range_sensor_model": Call({
         "xy": Array(np.array([[0.5, 0.0], [0.0, 0.7]]), "N,2", min_rows=0), "pose": Array(np.zeros(3), "3"),
         "ranges": Array(np.array([1.0, np.inf, 3.0, 0.5]), "N", inf_ok=True),
-        "angles": Array(np.arange(4) * np.pi / 2, "N"), **grid_model_kinds(), "check": Flag(True)}),
+        "angles": Array(np.arange(4) * np.pi / 2, "N"), **grid_model_kinds(), "validate": Flag(True)}),
     "robokit.mapping.grid_mapping.update_log_odds": Call({
         "grid": Obj(small_grid), "pose": Array(np.array([0.1, 0.0, 0.3]), "3"),
         "ranges": Array(np.array([1.0, np.inf, 3.0, 0.5]), "N", inf_ok=True),
@@ -1152,10 +1152,10 @@ SPECS: dict[str, Call] = {
                                                                   accepts=("booleans",))}),
     "robokit.vision.hamming.hamming_distance": Call({"a": Array(orb_descriptors, "...,32"),
                                                      "b": Array(lambda: orb_descriptors(40, 1), "...,32"),
-                                                     "check": Flag(True)}),
+                                                     "validate": Flag(True)}),
     "robokit.vision.hamming.hamming_distances": Call({"a": Array(orb_descriptors, "N,32", min_rows=0),
                                                       "b": Array(lambda: orb_descriptors(30, 1), "N,32", min_rows=0),
-                                                      "check": Flag(True)}),
+                                                      "validate": Flag(True)}),
     "robokit.vision.hamming.hamming_match": Call({"query": Array(orb_descriptors, "N,32", min_rows=0),
                                                   "train": Array(lambda: orb_descriptors(30, 1), "N,32", min_rows=0),
                                                   "ratio": Real(0.75), "max_distance": Real(50.0, optional=True, inf_ok=True),
@@ -1266,10 +1266,10 @@ SPECS: dict[str, Call] = {
         "source": Array(lambda: points(6), "N,2|N,3|N,N,2|N,N,3"),
         "target": Array(lambda: points(6) @ np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]]).T + 1.0,
                         "N,2|N,3|N,N,2|N,N,3"),
-        "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
+        "weights": Array(np.ones(6), "N|N,N", optional=True), "validate": Flag(True)}),
     "robokit.geometry.procrustes.fit_se3": Call({
         "source": Array(lambda: points(6), "N,3|N,N,3"), "target": Array(lambda: points(6) + 1.0, "N,3|N,N,3"),
-        "weights": Array(np.ones(6), "N|N,N", optional=True), "check": Flag(True)}),
+        "weights": Array(np.ones(6), "N|N,N", optional=True), "validate": Flag(True)}),
     "robokit.legged.mocap.simulate_mocap": Call({
         "T_world_body": Array(sensing_T, "N,4,4|4,4"), "markers_body": Array(sensing_markers, "N,3|3"),
         "noise": Real(0.001), "dropout": Real(0.1), "rng": Rng(0), "bursts": Real(0.1), "burst_length": Int(2)}),
@@ -1360,7 +1360,7 @@ SPECS: dict[str, Call] = {
         "voltage_max": Real(14.8), "continuous_current": Real(1.2, inf_ok=True)}),
     **{f"robokit.controllers.dc_motor.{n}": Call({
         first: Array(np.array([1.0, -2.0, 20.0]), "*"), "joint_velocity": Array(np.array([0.5, 0.0, -3.0]), "*"),
-        "motor": Obj(littledog_motor), "check": Flag(True)})
+        "motor": Obj(littledog_motor), "validate": Flag(True)})
        for n, first in (("joint_torque", "voltage"), ("motor_current", "voltage"), ("electrical_power", "voltage"),
                         ("voltage_for_torque", "torque"))},
     "robokit.controllers.dc_motor.reflected_inertia": Call({"motor": Obj(littledog_motor)}),
@@ -1374,7 +1374,7 @@ SPECS: dict[str, Call] = {
     "robokit.controllers.joint_servo.pd_servo_step": Call({
         "q_ref": Array(np.array([0.1, 0.2, -0.3]), "|3"), "q": Array(np.array([0.0, 0.25, -0.3]), "3"),
         "q_prev": Array(np.array([0.0, 0.24, -0.31]), "3"), "kp": Array(np.array([96.0, 90.0, 80.0]), "|3"),
-        "kd": Array(np.array(0.42), "|3"), "dt": Real(0.002), "voltage_max": Real(14.8), "check": Flag(True)}),
+        "kd": Array(np.array(0.42), "|3"), "dt": Real(0.002), "voltage_max": Real(14.8), "validate": Flag(True)}),
     "robokit.controllers.joint_servo.discrete_servo_response": Call({
         "kp": Real(96.0), "kd": Real(0.42), "motor": Obj(littledog_motor), "inertia": Real(2.76e-3),
         "rate_hz": Real(500.0), "steps": Int(50), "q_ref": Real(0.1), "saturate": Flag(True)}),
@@ -1390,7 +1390,7 @@ SPECS: dict[str, Call] = {
                                                      "g": Real(9.81)}),
     # --- lesson 04: robokit.legged.trial_log, viz.legged, viz.legged_plots, viz.animation.animate_tracks ---
     "robokit.geometry.rotations.quat_to_matrix": Call({"quat": Array(np.array([0.9, 0.1, -0.2, 0.3]), "...,4"),
-                                                       "check": Flag(True)}),
+                                                       "validate": Flag(True)}),
     "robokit.legged.trial_log.TrialLog": Call({"streams": Mapping(trial_streams), "meta": Mapping(trial_meta_dict)}),
     "robokit.legged.trial_log.trial_meta": Call({
         "gait": Text("crawl"), "host_rate": Real(100.0), "servo_rate": Real(500.0), "physics_timestep": Real(0.001),
@@ -1403,7 +1403,7 @@ SPECS: dict[str, Call] = {
     "robokit.legged.trial_file.describe_layout": Call({}),
     "robokit.viz.animation.animate_tracks": Call({
         "scene": Obj(scene), "tracks": Mapping(lambda: {"a": {"position": np.zeros((3, 3)), "scale": np.ones((3, 3))}}),
-        "fps": Real(10.0), "repetitions": Int(1), "check": Flag(True)}),
+        "fps": Real(10.0), "repetitions": Int(1), "validate": Flag(True)}),
     "robokit.viz.legged.joint_path": Call({"path": Text("littledog"), "leg": Choice("HL"), "joint": Choice("knee")}),
     "robokit.viz.legged.add_littledog": Call({"scene": Obj(scene), "path": Text("littledog"),
                                               "T_world_body": T_(lambda: np.eye(4), optional=True),
@@ -1472,7 +1472,7 @@ SPECS: dict[str, Call] = {
     "robokit.legged.leg_kinematics.body_ik": Call({
         "feet": Array(lambda: np.array([[0.16, 0.08, -0.1215], [0.16, -0.08, -0.1215],
                                         [-0.16, 0.08, -0.1215], [-0.16, -0.08, -0.1215]]), "N,4,3|4,3"),
-        "T_world_body": T_(lambda: np.eye(4), optional=True), "check": Flag(True)}),
+        "T_world_body": T_(lambda: np.eye(4), optional=True), "validate": Flag(True)}),
     "robokit.legged.littledog.littledog_mjcf": Call({
         "armature": Real(0.0), "damping": Real(0.0), "friction": Real(1.0), "timestep": Real(0.001),
         "motor": Obj(littledog_motor, optional=True)}),
@@ -1512,7 +1512,7 @@ SPECS: dict[str, Call] = {
         "tolerance": Int(2)}),
     "robokit.legged.support.nearest_boundary_point": Call({
         "polygon": Array(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]), "N,2"),
-        "point": Array(np.array([0.5, 0.2]), "2"), "check": Flag(True)}),
+        "point": Array(np.array([0.5, 0.2]), "2"), "validate": Flag(True)}),
     "robokit.legged.touchdown.gate_touchdowns": Call({
         "detected": Array(np.array([3, 40, 52, 95]), "N", min_rows=0), "expected": Array(np.array([50, 100]), "N", min_rows=0),
         "window": Int(10)}),
@@ -1547,16 +1547,16 @@ EXTRA: tuple[str, ...] = (
     "robokit.vision.colour.rgb_to_hsi", "robokit.vision.colour.hue_mask",
     "robokit.vision.colour.hue_histogram", "robokit.vision.colour.hue_histogram_opencv",
     "robokit.vision.colour.histogram_distance", "robokit.vision.colour.histogram_intersection",
-    # robokit.vision.omni_features, matching.DescriptorIndex, sim.feature_check (lesson 02)
+    # robokit.vision.omni_features, matching.DescriptorIndex, sim.view_matches (lesson 02)
     "robokit.vision.omni_features.omni_sift", "robokit.vision.omni_features.annulus_mask",
     "robokit.vision.omni_features.radial_orientation", "robokit.vision.matching.DescriptorIndex",
     "robokit.vision.ratio.ratio_test", "robokit.vision.descriptors.detect_sift_features",
-    "robokit.sim.feature_check.omni_ground_truth_inliers",
-    "robokit.sim.feature_check.omni_view_pair",
+    "robokit.sim.view_matches.omni_ground_truth_inliers",
+    "robokit.sim.view_matches.omni_view_pair",
     # robokit.mapping's pose graphs (lesson 02), fuzzed before the lesson exists
     "robokit.mapping.pose_graph.PoseGraph", "robokit.mapping.pose_graph.edge_variances",
     "robokit.mapping.pose_graph.unreachable_nodes", "robokit.mapping.pose_graph.is_connected",
-    "robokit.mapping.pose_graph.check_connected", "robokit.mapping.pose_graph.pose_graph_from_odometry",
+    "robokit.mapping.pose_graph.require_connected", "robokit.mapping.pose_graph.pose_graph_from_odometry",
     "robokit.mapping.pose_graph_optimize.pose_graph_residuals", "robokit.mapping.pose_graph_optimize.pose_graph_cost",
     "robokit.mapping.pose_graph_optimize.pose_graph_jacobian",
     "robokit.mapping.pose_graph_optimize.optimize_pose_graph", "robokit.mapping.relaxation.relax",
@@ -1575,7 +1575,7 @@ EXTRA: tuple[str, ...] = (
     "robokit.mapping.local_maps.local_map_full",
     "robokit.mapping.local_maps.select_key_frames",
     "robokit.mapping.topological_build.build_topological_map",
-    "robokit.mapping.omni_views.omni_view", "robokit.mapping.omni_views.check_omni_image",
+    "robokit.mapping.omni_views.omni_view", "robokit.mapping.omni_views.as_omni_image",
     "robokit.mapping.omni_views.relative_pose", "robokit.mapping.topological.TopologicalMap",
     "robokit.localization.hierarchical.HierarchicalLocalizer",
     # lesson 03's occupancy grid (robokit.mapping.occupancy_grid, grid_mapping, map_server)

@@ -199,13 +199,13 @@ def test_public_frames_flange_and_jacobian_kernels_match_the_checked_functions()
     q = chain.random_q(6, rng=15)
     frames = chain.frames(q)
     assert frames.shape == (6, 8, 4, 4)
-    np.testing.assert_array_equal(chain.frames(q, check=False), frames)
+    np.testing.assert_array_equal(chain.frames(q, validate=False), frames)
     np.testing.assert_array_equal(chain.flange_transform(frames), chain.fk(q))
     np.testing.assert_array_equal(jacobian_from_frames(chain, frames), geometric_jacobian(chain, q))
-    np.testing.assert_array_equal(jacobian_from_frames(chain, frames, check=False), geometric_jacobian(chain, q))
+    np.testing.assert_array_equal(jacobian_from_frames(chain, frames, validate=False), geometric_jacobian(chain, q))
     with pytest.raises(ValueError, match=r"frames: expected shape \(\.\.\., 8, 4, 4\)"):
         chain.flange_transform(frames[:, :5])
-    np.testing.assert_array_equal(chain.joint_frames(frames), chain.joint_frames(frames, check=False))
+    np.testing.assert_array_equal(chain.joint_frames(frames), chain.joint_frames(frames, validate=False))
     for bad in (np.eye(3), frames[:, :5]):                  # (3, 3) raised IndexError inside numpy
         with pytest.raises(ValueError, match=r"frames: expected shape \(\.\.\., 8, 4, 4\)"):
             chain.joint_frames(bad)

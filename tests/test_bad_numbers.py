@@ -9,7 +9,7 @@ from robokit.arm import iiwa14, ik_numeric, ik_srs, ik_srs_batch
 from robokit.geometry import wrap_angle
 from robokit.outdoor.geodesy import GeodesyError, vincenty_inverse
 from robokit.sim.vehicle import unicycle_step
-from robokit.validation import as_array, check_finite_scalar
+from robokit.validation import as_array, as_finite_scalar
 from robokit.vision.stereo import triangulate_svd
 
 K = np.array([[100.0, 0.0, 80.0], [0.0, 100.0, 60.0], [0.0, 0.0, 1.0]])
@@ -21,7 +21,7 @@ def test_numeric_strings_are_not_numbers(value):
     with pytest.raises(TypeError, match=r"^angle: expected real numbers, got (a string|bytes)"):
         wrap_angle(value)
     with pytest.raises(TypeError, match="x:"):
-        check_finite_scalar(value, "x")
+        as_finite_scalar(value, "x")
 
 
 @pytest.mark.parametrize("value", [1 + 2j, np.array([1 + 0j, 2 + 0j]), [0.5, 1j], np.complex64(1)])
@@ -34,7 +34,7 @@ def test_booleans_are_refused_where_numbers_are_expected_and_kept_where_a_mask_i
     with pytest.raises(TypeError, match="angle: expected real numbers, got booleans.*astype"):
         wrap_angle(np.array([True, False]))
     with pytest.raises(TypeError, match="x: expected a real number, got True"):
-        check_finite_scalar(True, "x")
+        as_finite_scalar(True, "x")
     assert as_array([True, False], "mask", dtype=bool).tolist() == [True, False]
     assert as_array([1, 0], "mask", dtype=bool).tolist() == [True, False]
 

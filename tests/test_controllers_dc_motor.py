@@ -45,7 +45,7 @@ def test_voltage_for_torque_inverts_joint_torque_vectorised():
     np.testing.assert_allclose(joint_torque(v, w, LITTLEDOG_MOTOR)[inside], tau[inside], rtol=0, atol=1e-12)
     # elementwise equal to scalar calls (vectorisation), and the fast path agrees
     assert joint_torque(v[3, 4], w[3, 4], LITTLEDOG_MOTOR) == pytest.approx(joint_torque(v, w, LITTLEDOG_MOTOR)[3, 4])
-    np.testing.assert_array_equal(joint_torque(v, w, LITTLEDOG_MOTOR, check=False), joint_torque(v, w, LITTLEDOG_MOTOR))
+    np.testing.assert_array_equal(joint_torque(v, w, LITTLEDOG_MOTOR, validate=False), joint_torque(v, w, LITTLEDOG_MOTOR))
 
 
 def test_power_balance_and_gearbox_output():

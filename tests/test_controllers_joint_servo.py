@@ -130,7 +130,7 @@ def test_pd_servo_step_vectorised_fast_path_and_bad_input():
     expected = [float(np.clip(kp[j] * (q_ref[j] - q[j]) - KD * (q[j] - q_prev[j]) / 0.002, -14.8, 14.8))
                 for j in range(12)]
     np.testing.assert_allclose(v, expected, atol=1e-12)
-    np.testing.assert_array_equal(pd_servo_step(q_ref, q, q_prev, kp, KD, 0.002, 14.8, check=False), v)
+    np.testing.assert_array_equal(pd_servo_step(q_ref, q, q_prev, kp, KD, 0.002, 14.8, validate=False), v)
     assert isinstance(pd_servo_step(0.1, 0.0, 0.0, KP, KD, 0.002, 14.8), float)
     bad = q_ref.copy()
     bad[5] = np.nan

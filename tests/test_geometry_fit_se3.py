@@ -127,7 +127,7 @@ def test_degenerate_sets_raise_a_named_value_error():
     with pytest.raises(ValueError, match="source"):
         fit_se3(np.eye(3)[:, :2], np.eye(3)[:, :2])       # planar points: fit_se2's job
     # the fast path flags the degenerate problem instead of raising
-    fit = fit_rigid(np.stack([line, np.eye(5, 3)]), np.stack([line, np.eye(5, 3)]), check=False)
+    fit = fit_rigid(np.stack([line, np.eye(5, 3)]), np.stack([line, np.eye(5, 3)]), validate=False)
     assert fit.degenerate.tolist() == [True, False]
 
 
@@ -166,10 +166,10 @@ def test_the_planar_closed_form_equals_the_svd_rotation():
         want, sv = _umeyama_svd_2d(src, tgt)
         if sv[0] - sv[1] < 1e-6 * sv[0]:
             continue                                  # no unique rotation: nothing to compare
-        fit = fit_rigid(src, tgt, check=False)
+        fit = fit_rigid(src, tgt, validate=False)
         np.testing.assert_allclose(fit.R, want, atol=1e-9)
         assert np.isclose(np.linalg.det(fit.R), 1.0)
     # a set whose best reflection and best rotation tie has no unique rotation: flagged
     sq = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
-    assert fit_rigid(sq, sq * [1.0, -1.0], check=False).degenerate
-    assert not fit_rigid(sq, sq, check=False).degenerate
+    assert fit_rigid(sq, sq * [1.0, -1.0], validate=False).degenerate
+    assert not fit_rigid(sq, sq, validate=False).degenerate

@@ -80,7 +80,7 @@ def test_ground_plane_action_is_batched_over_poses_and_points():
         for r, w in zip(xz, m):
             np.testing.assert_allclose(g.se2_compose(pqt, [r[0], r[1], 0.0])[:2], w, atol=1e-12)
         np.testing.assert_allclose(g.pqt_transform_xz(pqt, m, inverse=True), xz, atol=1e-12)
-    np.testing.assert_array_equal(g.pqt_transform_xz(poses[:, None, :], xz, check=False), moved)
+    np.testing.assert_array_equal(g.pqt_transform_xz(poses[:, None, :], xz, validate=False), moved)
     # the rotation alone is the action of [0, 0, theta]
     np.testing.assert_array_equal(g.pqt_rotate_xz(poses[:, 2:], xz),
                                   g.pqt_transform_xz(np.column_stack([0 * poses[:, :2], poses[:, 2]])[:, None], xz))

@@ -33,7 +33,7 @@ def test_se2_functions_take_stacks_and_broadcast_one_pose():
     np.testing.assert_array_equal(g.se2_between(a, b), [g.se2_between(x, y) for x, y in zip(a, b)])
     np.testing.assert_array_equal(g.se2_compose(a[0], b), [g.se2_compose(a[0], y) for y in b])
     np.testing.assert_array_equal(g.se2_compose(a, b[:1]), [g.se2_compose(x, b[0]) for x in a])
-    np.testing.assert_array_equal(g.se2_compose(a, b, check=False), g.se2_compose(a, b))
+    np.testing.assert_array_equal(g.se2_compose(a, b, validate=False), g.se2_compose(a, b))
     assert g.se2_compose(a[0], b[0]).shape == g.se2_inverse(a[0]).shape == (3,)
     out = g.se2_compose([[0.0, 0.0, 3.0]] * 2, [[0.0, 0.0, 0.5], [0.0, 0.0, -0.5]])
     np.testing.assert_allclose(out[:, 2], [3.5 - 2 * np.pi, 2.5])          # headings wrapped
@@ -144,7 +144,7 @@ def test_pose_error_is_validated_and_exact_for_known_motions():
     assert np.isclose(np.linalg.norm(g.pose_error(near_pi, T)[3:]), np.pi - 1e-9)
     # a stack against one transform, and the unchecked fast path gives the same numbers
     stack = np.stack([T2, near_pi, T])
-    np.testing.assert_array_equal(g.pose_error(stack, T), g.pose_error(stack, T, check=False))
+    np.testing.assert_array_equal(g.pose_error(stack, T), g.pose_error(stack, T, validate=False))
     assert g.pose_error(stack, T).shape == (3, 6)
     with pytest.raises(ValueError, match="T_target"):
         g.pose_error(np.ones((4, 4)), T)

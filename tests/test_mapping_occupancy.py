@@ -76,10 +76,10 @@ def test_likelihood_field_matches_brute_force():
     np.testing.assert_allclose(clipped.distance, np.minimum(brute, 0.1), atol=1e-9, rtol=0)
     pts = every + rng.uniform(-0.49, 0.49, every.shape) * res
     np.testing.assert_allclose(field.lookup(pts), brute.ravel(), atol=1e-9, rtol=0)
-    np.testing.assert_allclose(field.lookup(pts.reshape(17, 23, 2), check=False), brute, atol=1e-9, rtol=0)
+    np.testing.assert_allclose(field.lookup(pts.reshape(17, 23, 2), validate=False), brute, atol=1e-9, rtol=0)
     off = np.array([[-0.31, 1.2], [5.0, 1.2], [0.0, np.nan]])
     assert field.lookup(off[:2]).tolist() == [10.0, 10.0]
-    assert field.lookup(off, check=False).tolist() == [10.0, 10.0, 10.0]
+    assert field.lookup(off, validate=False).tolist() == [10.0, 10.0, 10.0]
     with pytest.raises(ValueError, match="xy"):
         field.lookup(off)
 

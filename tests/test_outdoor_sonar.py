@@ -135,7 +135,7 @@ def test_true_ranges_needs_a_field():
     ({"half_angle": "wide"}, r"half_angle: expected a real number"),
 ])
 def test_sensor_parameters_are_checked_when_made(kwargs, match):
-    # true_ranges casts with check=False using max_range: a bad sensor must not get that far
+    # true_ranges casts with validate=False using max_range: a bad sensor must not get that far
     with pytest.raises((ValueError, TypeError), match=match):
         LVMaxSonarEZ(**kwargs)
 

@@ -79,7 +79,7 @@ def test_truck_validation(kwargs, words):
     (lambda: PAPER_TRUCK.step(TruckState(np.zeros(3)), [0.1, 0.1], 0.0), r"dt: expected a positive number"),
 ])
 def test_truck_methods_name_bad_input(call, words):
-    # both methods pass their values on with check=False: bad input must stop at the boundary
+    # both methods pass their values on with validate=False: bad input must stop at the boundary
     with pytest.raises((ValueError, TypeError), match=words):
         call()
 
@@ -89,9 +89,9 @@ def test_wheel_commands_take_arrays_and_the_fast_paths_agree():
     batch = PAPER_TRUCK.wheel_commands(v, om)
     assert batch.shape == (3, 2)
     np.testing.assert_array_equal(batch, [PAPER_TRUCK.wheel_commands(a, b) for a, b in zip(v, om)])
-    np.testing.assert_array_equal(PAPER_TRUCK.wheel_commands(0.4, 0.8, check=False), PAPER_TRUCK.wheel_commands(0.4, 0.8))
+    np.testing.assert_array_equal(PAPER_TRUCK.wheel_commands(0.4, 0.8, validate=False), PAPER_TRUCK.wheel_commands(0.4, 0.8))
     s0 = TruckState(np.array([1.0, 2.0, 0.3]), np.array([0.1, 0.2]))
-    a, b = PAPER_TRUCK.step(s0, [0.5, 0.7], 0.049), PAPER_TRUCK.step(s0, np.array([0.5, 0.7]), 0.049, check=False)
+    a, b = PAPER_TRUCK.step(s0, [0.5, 0.7], 0.049), PAPER_TRUCK.step(s0, np.array([0.5, 0.7]), 0.049, validate=False)
     np.testing.assert_array_equal(a.pose, b.pose)
     np.testing.assert_array_equal(a.wheels, b.wheels)
     assert (a.v, a.omega) == (b.v, b.omega)

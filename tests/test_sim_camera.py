@@ -9,7 +9,7 @@ from robokit.geometry import se2_to_se3, se3_from_rt
 from robokit.sim import camera as cm
 from robokit.sim.omni import OmniCamera
 from robokit.sim.world import World
-from robokit.sim.feature_check import ground_truth_inliers, sift_view_pair
+from robokit.sim.view_matches import ground_truth_inliers, sift_view_pair
 from robokit.sim.worlds_outdoor import open_field
 from robokit.sim.worlds import box_room, lab_room, long_corridor, office_floor
 

@@ -111,7 +111,7 @@ def test_kernel_matches_the_per_ray_reference_on_random_layouts():
 def test_fast_path_gives_the_checked_answer():
     lay = Layout(segments=[[[3.0, -5.0], [3.0, 5.0]]], circles=[[0.0, 4.0, 1.0]], boxes=[[-4.0, 0.0, 1.0, 2.0, 0.2]])
     angles = np.linspace(-np.pi, np.pi, 37)
-    np.testing.assert_array_equal(lay.raycast(np.zeros(2), angles, check=False), lay.raycast([0.0, 0.0], angles))
+    np.testing.assert_array_equal(lay.raycast(np.zeros(2), angles, validate=False), lay.raycast([0.0, 0.0], angles))
 
 
 def test_contains_clearance_and_collision_queries():

@@ -34,7 +34,7 @@ def test_arc_special_cases_batches_and_fast_path():
     out = unicycle_step(batch, v, w, 0.7)
     for k in range(3):
         np.testing.assert_array_equal(out[k], unicycle_step(batch[k], v[k], w[k], 0.7))
-    np.testing.assert_array_equal(unicycle_step(batch, v, w, 0.7, check=False), out)
+    np.testing.assert_array_equal(unicycle_step(batch, v, w, 0.7, validate=False), out)
 
 
 def test_drive_kinematics():

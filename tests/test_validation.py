@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from robokit.validation import (MAX_SAMPLES, array_ndim, as_array, as_points, as_rng, broadcast_to, check_callable,
-                                check_choice, check_finite_result, check_finite_scalar, check_int, check_mapping,
-                                check_positive, check_sample_count, check_text)
+from robokit.validation import (MAX_SAMPLES, array_ndim, as_array, as_points, as_rng, broadcast_to, as_callable,
+                                as_choice, require_finite_result, as_finite_scalar, as_int, as_mapping,
+                                as_positive, require_sample_count, as_text)
 
 
 def test_as_array_checks_shape_and_names_argument():
@@ -26,24 +26,24 @@ def test_as_points_promotes_single_point():
 
 
 def test_scalars():
-    assert check_finite_scalar(np.float32(2), "a") == 2.0
+    assert as_finite_scalar(np.float32(2), "a") == 2.0
     with pytest.raises(TypeError, match="a: expected a real number"):
-        check_finite_scalar(True, "a")
+        as_finite_scalar(True, "a")
     with pytest.raises(ValueError, match="f: expected a positive number, got -1.0"):
-        check_positive(-1, "f")
-    assert check_positive(0, "f", allow_zero=True) == 0
+        as_positive(-1, "f")
+    assert as_positive(0, "f", allow_zero=True) == 0
     with pytest.raises(ValueError):
-        check_positive(float("inf"), "f")
+        as_positive(float("inf"), "f")
 
 
 def test_ints_and_choices():
-    assert check_int(np.int64(3), "n", minimum=1) == 3
+    assert as_int(np.int64(3), "n", minimum=1) == 3
     with pytest.raises(TypeError):
-        check_int(3.0, "n")
+        as_int(3.0, "n")
     with pytest.raises(ValueError, match="n: expected an integer >= 1, got 0"):
-        check_int(0, "n", minimum=1)
+        as_int(0, "n", minimum=1)
     with pytest.raises(ValueError, match="mode"):
-        check_choice("x", "mode", ["a", "b"])
+        as_choice("x", "mode", ["a", "b"])
 
 
 def test_rng_is_reproducible():
@@ -88,21 +88,21 @@ def test_integer_arrays_take_whole_numbers_only():
 def test_scalars_refuse_strings_complex_and_string_arrays():
     for bad in ("1.0", np.array("1.0"), 1j, np.complex128(1), np.array(True), np.True_):
         with pytest.raises(TypeError, match="a: expected a real number"):
-            check_finite_scalar(bad, "a")
-    assert check_finite_scalar(np.array(2), "a") == 2.0
+            as_finite_scalar(bad, "a")
+    assert as_finite_scalar(np.array(2), "a") == 2.0
 
 
 def test_ints_fit_int64_and_choices_compare_by_type():
     with pytest.raises(ValueError, match="n: expected an integer <= 9223372036854775807"):
-        check_int(2**63, "n")
+        as_int(2**63, "n")
     with pytest.raises(ValueError, match="n: expected an integer >= -9223372036854775808"):
-        check_int(-(2**63) - 1, "n")
-    assert check_int(2**70, "seed", maximum=None) == 2**70
+        as_int(-(2**63) - 1, "n")
+    assert as_int(2**70, "seed", maximum=None) == 2**70
     with pytest.raises(ValueError, match="mode: expected one of"):
-        check_choice(np.array(["a", "b"]), "mode", ["a", "b"])     # no ambiguous truth value
+        as_choice(np.array(["a", "b"]), "mode", ["a", "b"])     # no ambiguous truth value
     with pytest.raises(ValueError, match="mode"):
-        check_choice(b"a", "mode", ["a", "b"])
-    assert check_choice(np.str_("a"), "mode", ["a", "b"]) == "a"
+        as_choice(b"a", "mode", ["a", "b"])
+    assert as_choice(np.str_("a"), "mode", ["a", "b"]) == "a"
 
 
 def test_shape_helpers_name_the_argument():
@@ -115,20 +115,20 @@ def test_shape_helpers_name_the_argument():
 
 
 def test_text_callables_mappings_results_and_sample_counts():
-    assert check_text("GP", "talker") == "GP"
+    assert as_text("GP", "talker") == "GP"
     for bad in (42, b"GP", None):
         with pytest.raises(TypeError, match="talker: expected a str"):
-            check_text(bad, "talker")
+            as_text(bad, "talker")
     with pytest.raises(ValueError, match="name: expected a non-empty str"):
-        check_text("", "name", empty=False)
-    assert check_callable(None, "progress") is None
+        as_text("", "name", empty=False)
+    assert as_callable(None, "progress") is None
     with pytest.raises(TypeError, match="progress: expected a callable or None"):
-        check_callable(42, "progress")
+        as_callable(42, "progress")
     with pytest.raises(TypeError, match="options: expected a dict"):
-        check_mapping("a=1", "options")
-    check_finite_result("J", np.ones(3), 2.0)
+        as_mapping("a=1", "options")
+    require_finite_result("J", np.ones(3), 2.0)
     with pytest.raises(ValueError, match="^J, e: expected values whose result is finite"):
-        check_finite_result("J, e", np.ones(3), np.array([np.nan]))
-    check_sample_count(MAX_SAMPLES, "rate")
+        require_finite_result("J, e", np.ones(3), np.array([np.nan]))
+    require_sample_count(MAX_SAMPLES, "rate")
     with pytest.raises(ValueError, match="rate: expected at most"):
-        check_sample_count(MAX_SAMPLES + 1, "rate")
+        require_sample_count(MAX_SAMPLES + 1, "rate")

@@ -36,7 +36,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..geometry import as_se3
-from ..validation import check_int
+from ..validation import as_int
 from .chain import Chain
 from .ik_analytic import BRANCHES, SRSArm
 
@@ -248,8 +248,8 @@ def ik_srs_reference(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 32) -
     """
     arm = SRSArm(chain)
     T = as_se3(T, "T")
-    q0 = arm.mid if q0 is None else chain.check_q(q0, "q0")
-    h = 2 * np.pi / check_int(n_psi, "n_psi", minimum=4)
+    q0 = arm.mid if q0 is None else chain.as_q(q0, "q0")
+    h = 2 * np.pi / as_int(n_psi, "n_psi", minimum=4)
     coeffs = arm.coefficients(arm.to_link7(T))
 
     def joints(b, psi):

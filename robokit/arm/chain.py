@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3
-from ..validation import array_ndim, as_array, as_rng, check_choice, check_int
+from ..validation import array_ndim, as_array, as_rng, as_choice, as_int
 from .dh import dh_transform, mdh_transform
 
 __all__ = ["Chain", "dh_fk", "chain_from_table", "LIMIT_TOL"]
@@ -80,7 +80,7 @@ class Chain:
             i = int(bad[0])
             raise ValueError(f"qmin, qmax: expected qmin <= qmax for every joint, got joint {i + 1} with "
                              f"qmin = {self.qmin[i]:.4g} > qmax = {self.qmax[i]:.4g} rad")
-        self.convention = check_choice(convention, "convention", ("standard", "modified"))
+        self.convention = as_choice(convention, "convention", ("standard", "modified"))
         self.tool = np.eye(4) if tool is None else as_se3(tool, "tool")
         self.base = np.eye(4) if base is None else as_se3(base, "base")
         self._has_tool = not np.array_equal(self.tool, np.eye(4))
@@ -88,7 +88,7 @@ class Chain:
         # Each link transform is affine in (cos theta, sin theta): A = K + cos U + sin V. Sampling the
         # DH formula at theta = 0, pi, +-pi/2 gives K, U, V, so FK needs no trig of the twists.
         link = mdh_transform if self.modified else dh_transform
-        A = {t: link(np.full(n, t), self.d, self.a, self.alpha, check=False) for t in (0.0, np.pi, np.pi / 2, -np.pi / 2)}
+        A = {t: link(np.full(n, t), self.d, self.a, self.alpha, validate=False) for t in (0.0, np.pi, np.pi / 2, -np.pi / 2)}
         self._K = 0.5 * (A[0.0] + A[np.pi])
         self._U = 0.5 * (A[0.0] - A[np.pi])
         self._V = 0.5 * (A[np.pi / 2] - A[-np.pi / 2])
@@ -116,7 +116,7 @@ class Chain:
         return f"Chain({self.name!r}, n={self.n}, convention={self.convention!r})"
 
     # --- validation ------------------------------------------------------------------------------
-    def check_q(self, q: Any, name: str = "q", *, batch: bool = False) -> np.ndarray:
+    def as_q(self, q: Any, name: str = "q", *, batch: bool = False) -> np.ndarray:
         """Return ``q`` as a finite float array of shape ``(n,)`` (or ``(N, n)`` with ``batch``).
 
         Raises
@@ -147,7 +147,7 @@ class Chain:
         -------
         bool or numpy.ndarray of bool, shape (N,)
         """
-        q = self.check_q(q, batch=array_ndim(q, "q") == 2)
+        q = self.as_q(q, batch=array_ndim(q, "q") == 2)
         ok = np.all((q >= self.qmin - tol) & (q <= self.qmax + tol), axis=-1)
         return bool(ok) if ok.ndim == 0 else ok
 
@@ -168,7 +168,7 @@ class Chain:
         gen = as_rng(rng)
         if size is None:
             return gen.uniform(self.qmin, self.qmax)
-        size = check_int(size, "size", minimum=1)
+        size = as_int(size, "size", minimum=1)
         return gen.uniform(self.qmin, self.qmax, size=(size, self.n))
 
     def reach(self) -> float:
@@ -180,14 +180,14 @@ class Chain:
         return float(np.sum(np.hypot(self.a, self.d)) + np.linalg.norm(self.tool[:3, 3]))
 
     # --- kinematics ------------------------------------------------------------------------------
-    def frames(self, q: Any, *, check: bool = True) -> np.ndarray:
+    def frames(self, q: Any, *, validate: bool = True) -> np.ndarray:
         """Transforms of frames 0..n (base, then every link) in the world, in one vectorised pass.
 
         Parameters
         ----------
         q : array_like, shape (..., n)
-            Joint angles [rad]; with ``check=True`` one ``(n,)`` vector or a batch ``(N, n)``.
-        check : bool, default True
+            Joint angles [rad]; with ``validate=True`` one ``(n,)`` vector or a batch ``(N, n)``.
+        validate : bool, default True
             Validate ``q``; ``False`` skips it (solvers' inner loops, float arrays).
 
         Returns
@@ -210,8 +210,8 @@ class Chain:
         >>> iiwa14().frames([0.0] * 7)[-1, :3, 3].tolist()
         [0.0, 0.0, 1.306]
         """
-        if check:
-            q = self.check_q(q, batch=array_ndim(q, "q") == 2)
+        if validate:
+            q = self.as_q(q, batch=array_ndim(q, "q") == 2)
         th = q + self.offset if self._has_offset else q
         links = self._K + np.cos(th)[..., None, None] * self._U + np.sin(th)[..., None, None] * self._V
         out = np.empty(q.shape[:-1] + (self.n + 1, 4, 4))
@@ -220,7 +220,7 @@ class Chain:
             np.matmul(out[..., i, :, :], links[..., i, :, :], out=out[..., i + 1, :, :])
         return out
 
-    def check_frames(self, frames: Any) -> np.ndarray:
+    def as_frames(self, frames: Any) -> np.ndarray:
         """Return ``frames`` (of :meth:`frames`) as a finite float array of shape ``(..., n + 1, 4, 4)``.
 
         Raises
@@ -234,13 +234,13 @@ class Chain:
                              f"got shape {frames.shape}")
         return frames
 
-    def flange_transform(self, frames: Any, *, check: bool = True) -> np.ndarray:
+    def flange_transform(self, frames: Any, *, validate: bool = True) -> np.ndarray:
         """The flange's transform (last link frame times the tool) from the frames of :meth:`frames`.
 
         Parameters
         ----------
         frames : array_like, shape (..., n + 1, 4, 4)
-        check : bool, default True
+        validate : bool, default True
             Check the shape and values of ``frames``; ``False`` skips it.
 
         Returns
@@ -267,17 +267,17 @@ class Chain:
         >>> print(round(float(np.linalg.norm(T[:3, 3] - frames[-1, :3, 3])), 3))
         0.107
         """
-        if check:
-            frames = self.check_frames(frames)
+        if validate:
+            frames = self.as_frames(frames)
         return frames[..., -1, :, :] @ self.tool if self._has_tool else frames[..., -1, :, :]
 
-    def joint_frames(self, frames: Any, *, check: bool = True) -> np.ndarray:
+    def joint_frames(self, frames: Any, *, validate: bool = True) -> np.ndarray:
         """Select, from frames 0..n of :meth:`frames`, the frame whose z axis is each joint's axis.
 
         Parameters
         ----------
         frames : array_like, shape (..., n + 1, 4, 4)
-        check : bool, default True
+        validate : bool, default True
             Check the shape and values of ``frames``; ``False`` skips it (the Jacobian's kernel).
 
         Returns
@@ -308,8 +308,8 @@ class Chain:
          [ 0.  1.  0.]
          [ 0.  0.  1.]]
         """
-        if check:
-            frames = self.check_frames(frames)
+        if validate:
+            frames = self.as_frames(frames)
         return frames[..., 1:, :, :] if self.modified else frames[..., :-1, :, :]
 
     def link_frames(self, q: Any) -> np.ndarray:
@@ -335,7 +335,7 @@ class Chain:
         Product of link transforms, Spong et al. (2006), Eq. (3.5).
         """
         frames = self.frames(q)
-        return np.concatenate([frames, self.flange_transform(frames, check=False)[..., None, :, :]], axis=-3)
+        return np.concatenate([frames, self.flange_transform(frames, validate=False)[..., None, :, :]], axis=-3)
 
     def fk(self, q: Any) -> np.ndarray:
         """Transform of the flange for joint angles ``q`` (one ``(n,)`` vector or a batch ``(N, n)``).
@@ -353,7 +353,7 @@ class Chain:
         -----
         Spong et al. (2006), Eq. (3.5), followed by the fixed tool transform.
         """
-        return self.flange_transform(self.frames(q), check=False)
+        return self.flange_transform(self.frames(q), validate=False)
 
 
 def chain_from_table(dh: Any, *, modified: bool = False) -> Chain:
@@ -396,4 +396,4 @@ def dh_fk(dh: Any, q: Any, *, modified: bool = False) -> np.ndarray:
     Spong et al. (2006), Eq. (3.5).
     """
     chain = chain_from_table(dh, modified=modified)
-    return chain.fk(chain.check_q(q))
+    return chain.fk(chain.as_q(q))

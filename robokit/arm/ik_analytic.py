@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3, zyz_angles
-from ..validation import array_ndim, as_array, check_int, check_positive
+from ..validation import array_ndim, as_array, as_int, as_positive
 from .chain import LIMIT_TOL, Chain
 from .result import IKBatchResult, IKResult, verify
 from .srs_geometry import ARRAY, SCALAR, arm_angle_terms, coefficient_terms, mirror_angle
@@ -139,7 +139,7 @@ class SRSArm:
         N, K = psi.shape
         basis = np.empty((N, K, 3))
         basis[..., 0], basis[..., 1], basis[..., 2] = np.sin(psi), np.cos(psi), 1.0
-        abc = zyz_angles((basis @ G).reshape(N, K, 2, 2, 3, 3), check=False)   # of A sin psi + B cos psi + C
+        abc = zyz_angles((basis @ G).reshape(N, K, 2, 2, 3, 3), validate=False)   # of A sin psi + B cos psi + C
         return abc[..., 0], abc[..., 1], abc[..., 2]
 
     def joints(self, coeffs, psi: np.ndarray) -> np.ndarray:
@@ -180,7 +180,7 @@ def _srs_cached(chain: Chain) -> SRSArm:
     return SRSArm(chain)
 
 
-def _check_psi(psi: Any) -> float:
+def _as_psi(psi: Any) -> float:
     return float(as_array(psi, "psi", shape=()))
 
 
@@ -215,7 +215,7 @@ def arm_angle(chain: Chain, q: Any) -> float | np.ndarray:
     -29.971
     """
     arm = _srs(chain)
-    return arm.arm_angle(chain.check_q(q, batch=array_ndim(q, "q") == 2))
+    return arm.arm_angle(chain.as_q(q, batch=array_ndim(q, "q") == 2))
 
 
 def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = True) -> np.ndarray:
@@ -259,7 +259,7 @@ def ik_srs_branches(chain: Chain, T: Any, psi: float, *, within_limits: bool = T
     """
     arm = _srs(chain)
     T7 = arm.to_link7(as_se3(T, "T"))
-    p = _check_psi(psi)
+    p = _as_psi(psi)
     coeffs = arm.coefficients(T7)
     if abs(coeffs[2][0]) > 1.0 + 1e-12:
         return np.zeros((0, 7))
@@ -303,7 +303,7 @@ _XATOL = 1e-10
 def _options(n_psi: Any, tol: Any):
     if type(n_psi) is int and type(tol) is float and n_psi == 32 and tol == 1e-6:   # the defaults
         return 32, 1e-6
-    return check_int(n_psi, "n_psi", minimum=4), check_positive(tol, "tol")
+    return as_int(n_psi, "n_psi", minimum=4), as_positive(tol, "tol")
 
 
 def _reason(arm: SRSArm, status: int, ok: bool, pos: float, rot: float, c4: float) -> str:
@@ -358,7 +358,7 @@ def ik_srs(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_psi: in
     else:
         if array_ndim(q0, "q0") != 1:
             raise ValueError(f"q0: expected one joint vector of shape (7,), got shape {np.shape(q0)}")
-        near = chain.check_q(q0, "q0")
+        near = chain.as_q(q0, "q0")
     n_psi, tol = _options(n_psi, tol)
     K = _kernels()
     q, info = np.empty(7), np.zeros(5)
@@ -372,12 +372,12 @@ def ik_srs(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_psi: in
         T = as_se3(T, "T")                      # raises the named error (or passes within rounding)
         status = K.solve(T, near, psi0, *args[0], -1.0, n_psi, *args[1], q, info)
     if status == 4:
-        chain.check_q(q0, "q0")                 # raises: NaN or infinity in q0
+        chain.as_q(q0, "q0")                 # raises: NaN or infinity in q0
     if status == 0:
         pos, rot = float(info[0]), float(info[1])
         e = math.hypot(pos, rot)
     else:
-        v = verify(chain, T[None], q[None], tol, check=False)
+        v = verify(chain, T[None], q[None], tol, validate=False)
         pos, rot, e = float(v.position_error[0]), float(v.orientation_error[0]), float(v.residual[0])
     ok = status == 0 and pos < tol and rot < tol
     return IKResult(q=q, success=ok, reason=_reason(arm, status, ok, pos, rot, float(info[3])), residual=e,
@@ -450,7 +450,7 @@ def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_p
     if q0 is None:
         near = np.broadcast_to(arm.mid, (N, 7)).copy()
     else:
-        near = chain.check_q(q0, "q0", batch=True)
+        near = chain.as_q(q0, "q0", batch=True)
         if near.shape[0] == 1 and N > 1:
             near = np.broadcast_to(near, (N, 7))
         elif near.shape[0] != N:
@@ -463,7 +463,7 @@ def ik_srs_batch(chain: Chain, T: Any, q0: Any = None, *, tol: float = 1e-6, n_p
                   q, status, info)
     if record is not None:
         _compiled(record)
-    out = verify(chain, Tt, q, tol, check=False)
+    out = verify(chain, Tt, q, tol, validate=False)
     found = status == 0
     out.success &= found
     for i in np.flatnonzero(~out.success):

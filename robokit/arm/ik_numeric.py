@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import ROTATION_TOL, as_se3, pose_error
-from ..validation import array_ndim, as_rng, check_choice, check_int, check_positive
+from ..validation import array_ndim, as_rng, as_choice, as_int, as_positive
 from .chain import Chain
 from .ik_steps import PROJECTION_EPS, METHODS, NULL_SPACE_FADE, STEP_RULES
 from .jacobian import jacobian_from_frames
@@ -131,7 +131,7 @@ class _Attempts:
 def _step(chain: Chain, step, frames, e, err2, q, rows, max_step: float, clamp: bool) -> np.ndarray:
     """Unchecked: the joints after one step of the rule ``step``, scaled down to ``max_step`` (as a
     whole, not per joint) and clipped to the limits with ``clamp``."""
-    dq = step(jacobian_from_frames(chain, frames, check=False), e, err2, q, rows)
+    dq = step(jacobian_from_frames(chain, frames, validate=False), e, err2, q, rows)
     big = np.sqrt(np.einsum("ij,ij->i", dq, dq))
     over = big > max_step
     if over.any():
@@ -154,8 +154,8 @@ def _search(chain: Chain, T: np.ndarray, q0: np.ndarray, skip: np.ndarray, step,
         sel = slice(None) if full else active            # common case: views, no fancy-index copies
         q = att.q[sel]
         # 1. pose error of every live attempt
-        frames = chain.frames(q, check=False)
-        e = pose_error(Tr[sel], chain.flange_transform(frames, check=False), check=False)
+        frames = chain.frames(q, validate=False)
+        e = pose_error(Tr[sel], chain.flange_transform(frames, validate=False), validate=False)
         e2 = e * e
         pos2, rot2 = e2[:, :3].sum(1), e2[:, 3:].sum(1)
         err2 = pos2 + rot2
@@ -213,11 +213,11 @@ def _kernels():
 
 def _settings(method, tol, max_iter, restarts, damping, gain, clamp, max_step, patience, parallel):
     """The checked options of the solvers."""
-    return (check_choice(method, "method", METHODS), check_positive(tol, "tol"),
-            check_int(max_iter, "max_iter", minimum=1), check_int(restarts, "restarts", minimum=0),
-            check_positive(damping, "damping", allow_zero=True), check_positive(gain, "gain", allow_zero=True),
-            bool(clamp), check_positive(max_step, "max_step"), check_int(patience, "patience", minimum=1),
-            check_int(parallel, "parallel", minimum=1))
+    return (as_choice(method, "method", METHODS), as_positive(tol, "tol"),
+            as_int(max_iter, "max_iter", minimum=1), as_int(restarts, "restarts", minimum=0),
+            as_positive(damping, "damping", allow_zero=True), as_positive(gain, "gain", allow_zero=True),
+            bool(clamp), as_positive(max_step, "max_step"), as_int(patience, "patience", minimum=1),
+            as_int(parallel, "parallel", minimum=1))
 
 
 def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult:
@@ -276,7 +276,7 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
     if not (type(T) is np.ndarray and T.dtype == np.float64 and T.shape == (4, 4) and T.flags.c_contiguous
             and K.check_se3(T, ROTATION_TOL) == 0):
         T = np.ascontiguousarray(as_se3(T, "T"))
-    q = 0.5 * (chain.qmin + chain.qmax) if q0 is None else np.ascontiguousarray(chain.check_q(q0, "q0"))
+    q = 0.5 * (chain.qmin + chain.qmax) if q0 is None else np.ascontiguousarray(chain.as_q(q0, "q0"))
     args, reach, base_p, lo, hi = _chain_data(chain)
     if math.dist(T[:3, 3], base_p) > reach:                          # the batch says why
         return ik_numeric_batch(chain, T, q, **opts)[0]
@@ -296,7 +296,7 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
     if winner >= 0 and pos < tol and rot < tol:          # converged strictly inside the limits
         return IKResult(q=q_out, success=True, reason="converged", residual=math.hypot(pos, rot),
                         iterations=iterations, position_error=pos, orientation_error=rot, restarts=used)
-    out = verify(chain, T[None], q_out[None], tol, check=False)[0]
+    out = verify(chain, T[None], q_out[None], tol, validate=False)[0]
     out.reason += f" after {used + P} attempts of up to {max_iter} iterations"
     if out.reason.startswith("pose error"):
         out.reason += " (target may be unreachable)"
@@ -404,7 +404,7 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     if q0 is None:
         q = np.tile(0.5 * (chain.qmin + chain.qmax), (N, 1))
     else:
-        q = chain.check_q(q0, "q0", batch=True).copy()
+        q = chain.as_q(q0, "q0", batch=True).copy()
         if q.shape[0] == 1 and N > 1:
             q = np.tile(q, (N, 1))
         elif q.shape[0] != N:
@@ -416,7 +416,7 @@ def ik_numeric_batch(chain: Chain, T: Any, q0: Any = None, *, method: str = "wln
     att, trail = _search(chain, Tt, q, too_far, step, tol=tol, max_iter=max_iter, restarts=restarts,
                          patience=patience, parallel=parallel, clamp=bool(clamp), max_step=max_step, gen=gen,
                          history=history)
-    out = verify(chain, Tt, att.answers(), tol, check=False)
+    out = verify(chain, Tt, att.answers(), tol, validate=False)
     for i in np.flatnonzero(too_far):
         out.reason[i] = (f"out of reach: target {dist[i]:.3f} m from the base, beyond the arm's reach "
                          f"bound {chain.reach():.3f} m")

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3, pose_error
-from ..validation import check_choice, check_int, check_positive
+from ..validation import as_choice, as_int, as_positive
 from .chain import Chain
 from .ik_steps import METHODS, NULL_SPACE_FADE, dls_step, null_space_step
 from .jacobian import geometric_jacobian
@@ -78,12 +78,12 @@ def ik_numeric_reference(chain: Chain, T: Any, q0: Any, *, method: str = "wln", 
     (True, 4, (5, 7))
     """
     T = as_se3(T, "T")
-    q = chain.check_q(q0, "q0")
-    method = check_choice(method, "method", METHODS)
-    tol, max_step = check_positive(tol, "tol"), check_positive(max_step, "max_step")
-    damping = check_positive(damping, "damping", allow_zero=True)
-    gain = check_positive(gain, "gain", allow_zero=True)
-    max_iter, patience = check_int(max_iter, "max_iter", minimum=1), check_int(patience, "patience", minimum=1)
+    q = chain.as_q(q0, "q0")
+    method = as_choice(method, "method", METHODS)
+    tol, max_step = as_positive(tol, "tol"), as_positive(max_step, "max_step")
+    damping = as_positive(damping, "damping", allow_zero=True)
+    gain = as_positive(gain, "gain", allow_zero=True)
+    max_iter, patience = as_int(max_iter, "max_iter", minimum=1), as_int(patience, "patience", minimum=1)
     iterates, best, stall, previous = [q], np.inf, 0, None
     for k in range(max_iter + 1):
         e = pose_error(T, chain.fk(q))

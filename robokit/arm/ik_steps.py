@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_finite_result, check_positive
+from ..validation import as_array, require_finite_result, as_positive
 from .chain import Chain
 from .limits import limit_distance_gradient, wln_weights
 
@@ -102,7 +102,7 @@ def dls_step(J: Any, e: Any, damping: float = 1e-2, weights: Any = None) -> np.n
     [0.1 0.  0.  0.  0.  0.  0. ]
     """
     J, e = _jacobian_and_error(J, e)
-    lam = check_positive(damping, "damping", allow_zero=True)
+    lam = as_positive(damping, "damping", allow_zero=True)
     winv = None
     if weights is not None:
         w = as_array(weights, "weights", shape=J.shape[:-2] + (J.shape[-1],))
@@ -166,10 +166,10 @@ def null_space_step(J: Any, e: Any, gradient: Any, damping: float = 1e-2, gain: 
     if g.shape != J.shape[:-2] + (J.shape[-1],):
         raise ValueError(f"gradient: expected shape {J.shape[:-2] + (J.shape[-1],)} to match J of shape {J.shape}, "
                          f"got shape {g.shape}")
-    lam = check_positive(damping, "damping", allow_zero=True)
-    k = check_positive(gain, "gain", allow_zero=True)
+    lam = as_positive(damping, "damping", allow_zero=True)
+    k = as_positive(gain, "gain", allow_zero=True)
     dq = _gp(J, e, g, np.full(J.shape[:-2], np.square(lam)), k)
-    check_finite_result("J, e, gradient, damping, gain", dq)
+    require_finite_result("J, e, gradient, damping, gain", dq)
     return dq
 
 
@@ -229,8 +229,8 @@ class DampedLeastSquares:
             raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
         if not (isinstance(attempts, (int, np.integer)) and attempts >= 1):
             raise ValueError(f"attempts: expected a positive integer, got {attempts!r}")
-        damping = check_positive(damping, "damping", allow_zero=True)
-        self.chain, self.lam2_0, self.gain = chain, damping**2, check_positive(gain, "gain", allow_zero=True)
+        damping = as_positive(damping, "damping", allow_zero=True)
+        self.chain, self.lam2_0, self.gain = chain, damping**2, as_positive(gain, "gain", allow_zero=True)
 
     def restart(self, rows) -> None:
         """Forget what the step rule remembers about the attempts ``rows`` (none here)."""
@@ -273,7 +273,7 @@ class GradientProjection(DampedLeastSquares):
 
     def __call__(self, J, e, err2, q, rows) -> np.ndarray:
         fade = np.minimum(1.0, np.sqrt(err2) / NULL_SPACE_FADE)
-        g = limit_distance_gradient(self.chain, q, check=False)         # Liégeois Eq. (14)
+        g = limit_distance_gradient(self.chain, q, validate=False)         # Liégeois Eq. (14)
         return _gp(J, e, g, self.damping(err2), self.gain * fade)
 
 
@@ -322,7 +322,7 @@ class WeightedLeastNorm(DampedLeastSquares):
         self.previous[rows] = np.nan
 
     def __call__(self, J, e, err2, q, rows) -> np.ndarray:
-        w, grad = wln_weights(self.chain, q, self.previous[rows], check=False)   # Eq. (13)
+        w, grad = wln_weights(self.chain, q, self.previous[rows], validate=False)   # Eq. (13)
         self.previous[rows] = grad
         return _dls(J, e, self.damping(err2), 1.0 / w)                           # Eq. (7), damped
 

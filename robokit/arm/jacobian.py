@@ -13,13 +13,13 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_finite_result
+from ..validation import as_array, require_finite_result
 from .chain import Chain, chain_from_table
 
 __all__ = ["geometric_jacobian", "jacobian_from_frames", "dh_jacobian", "manipulability"]
 
 
-def jacobian_from_frames(chain: Chain, frames: Any, *, check: bool = True) -> np.ndarray:
+def jacobian_from_frames(chain: Chain, frames: Any, *, validate: bool = True) -> np.ndarray:
     """The geometric Jacobian from link frames already computed (e.g. for FK in the same step).
 
     Parameters
@@ -27,7 +27,7 @@ def jacobian_from_frames(chain: Chain, frames: Any, *, check: bool = True) -> np
     chain : Chain
     frames : array_like, shape (..., n + 1, 4, 4)
         Frames 0..n of :meth:`Chain.frames`.
-    check : bool, default True
+    validate : bool, default True
         Check ``chain`` and the shape of ``frames``; ``False`` skips it (solvers' inner loops).
 
     Returns
@@ -54,14 +54,14 @@ def jacobian_from_frames(chain: Chain, frames: Any, *, check: bool = True) -> np
     >>> print(np.round(J[:, 1], 3) + 0.0)    # joint 2 tilts the straight arm forward
     [0.946 0.    0.    0.    1.    0.   ]
     """
-    if check:
+    if validate:
         if not isinstance(chain, Chain):
             raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
-        frames = chain.check_frames(frames)
-    jf = chain.joint_frames(frames, check=False)
+        frames = chain.as_frames(frames)
+    jf = chain.joint_frames(frames, validate=False)
     z = jf[..., :3, 2]                       # (..., n, 3) joint axes
     p = jf[..., :3, 3]                       # (..., n, 3) points on the axes
-    p_e = chain.flange_transform(frames, check=False)[..., None, :3, 3]
+    p_e = chain.flange_transform(frames, validate=False)[..., None, :3, 3]
     r = p_e - p
     J = np.empty(z.shape[:-2] + (6, z.shape[-2]))
     J[..., 0, :] = z[..., 1] * r[..., 2] - z[..., 2] * r[..., 1]   # z x (p_e - p), Eq. (3.30)
@@ -106,7 +106,7 @@ def geometric_jacobian(chain: Chain, q: Any) -> np.ndarray:
     """
     if not isinstance(chain, Chain):
         raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
-    return jacobian_from_frames(chain, chain.frames(q), check=False)
+    return jacobian_from_frames(chain, chain.frames(q), validate=False)
 
 
 def dh_jacobian(dh: Any, q: Any, *, modified: bool = False) -> np.ndarray:
@@ -132,7 +132,7 @@ def dh_jacobian(dh: Any, q: Any, *, modified: bool = False) -> np.ndarray:
      [1.  1. ]]
     """
     chain = chain_from_table(dh, modified=modified)
-    return geometric_jacobian(chain, chain.check_q(q))
+    return geometric_jacobian(chain, chain.as_q(q))
 
 
 def manipulability(J: Any) -> float | np.ndarray:
@@ -170,6 +170,6 @@ def manipulability(J: Any) -> float | np.ndarray:
     if J.ndim not in (2, 3) or not 1 <= J.shape[-2] <= J.shape[-1]:
         raise ValueError(f"J: expected a Jacobian of shape (m, n) or (N, m, n) with 1 <= m <= n, got shape {J.shape}")
     det = np.linalg.det(J @ np.swapaxes(J, -1, -2))
-    check_finite_result("J", det)
+    require_finite_result("J", det)
     w = np.sqrt(np.clip(det, 0.0, None))
     return float(w) if w.ndim == 0 else w

@@ -26,10 +26,10 @@ __all__ = ["limit_distance_gradient", "wln_weights"]
 def _limits(chain: Chain, q: Any, name: str = "q") -> np.ndarray:
     if not isinstance(chain, Chain):
         raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
-    return chain.check_q(q, name, batch=array_ndim(q, name) == 2)
+    return chain.as_q(q, name, batch=array_ndim(q, name) == 2)
 
 
-def limit_distance_gradient(chain: Chain, q: Any, *, check: bool = True) -> np.ndarray:
+def limit_distance_gradient(chain: Chain, q: Any, *, validate: bool = True) -> np.ndarray:
     """Gradient of the joint-range criterion ``H(q) = -1/2 sum(((q_i - mid_i) / half_i)^2)``.
 
     Ascending this gradient moves every joint towards the middle of its range; projected into the
@@ -39,7 +39,7 @@ def limit_distance_gradient(chain: Chain, q: Any, *, check: bool = True) -> np.n
     ----------
     chain : Chain
     q : array_like, shape (n,) or (N, n)
-    check : bool, default True
+    validate : bool, default True
         Validate ``chain`` and ``q``; ``False`` skips it (solvers' inner loops).
 
     Returns
@@ -64,14 +64,14 @@ def limit_distance_gradient(chain: Chain, q: Any, *, check: bool = True) -> np.n
     >>> print(np.round(limit_distance_gradient(arm, 0.5 * arm.qmax), 3))
     [-0.169 -0.239 -0.169 -0.239 -0.169 -0.239 -0.164]
     """
-    if check:
+    if validate:
         q = _limits(chain, q)
     mid = 0.5 * (chain.qmin + chain.qmax)
     half = np.maximum(0.5 * (chain.qmax - chain.qmin), 1e-9)
     return -(q - mid) / half**2                                 # dH/dq, Liégeois Eq. (14)
 
 
-def wln_weights(chain: Chain, q: Any, previous: Any = None, *, check: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def wln_weights(chain: Chain, q: Any, previous: Any = None, *, validate: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """Diagonal weights of Chan & Dubey's weighted least-norm (WLN) solution.
 
     Parameters
@@ -81,9 +81,9 @@ def wln_weights(chain: Chain, q: Any, previous: Any = None, *, check: bool = Tru
         Joint angles, strictly inside the limits for finite weights.
     previous : array_like, optional
         ``|dH/dq|`` of the previous step (same shape as ``q``); without it every joint counts as
-        moving towards its limit. (With ``check=False`` a NaN entry gives that joint weight 1,
+        moving towards its limit. (With ``validate=False`` a NaN entry gives that joint weight 1,
         which the numerical solver uses for the first step of an attempt.)
-    check : bool, default True
+    validate : bool, default True
         Validate the arguments; ``False`` skips it (solvers' inner loops).
 
     Returns
@@ -111,7 +111,7 @@ def wln_weights(chain: Chain, q: Any, previous: Any = None, *, check: bool = Tru
     >>> print(np.round(w, 3))
     [1. 1. 1. 1. 1. 1. 1.]
     """
-    if check:
+    if validate:
         q = _limits(chain, q)
         if previous is not None:
             previous = as_array(previous, "previous", shape=q.shape)

@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3, wrap_angle, zyz_angles
-from ..validation import check_choice, check_int, check_positive
+from ..validation import as_choice, as_int, as_positive
 from .ik_analytic import SRSArm
 from .result import IKResult, verify
 from .srs import elbow_angle
@@ -61,7 +61,7 @@ def _wrist_and_jacobian(arm: SRSArm, q: np.ndarray) -> tuple[np.ndarray, np.ndar
     along ``z_4`` from frame 4's, so it depends on joints 1-4 only.
     """
     chain = arm.chain
-    frames = np.linalg.inv(chain.base) @ chain.frames(np.concatenate([q, np.zeros(3)]), check=False)
+    frames = np.linalg.inv(chain.base) @ chain.frames(np.concatenate([q, np.zeros(3)]), validate=False)
     w = frames[4, :3, 3] + arm.d_ew * frames[4, :3, 2]
     z, p = frames[:4, :3, 2], frames[:4, :3, 3]
     return w, np.cross(z, w - p).T, frames[4, :3, :3]
@@ -90,7 +90,7 @@ def _shoulder_for_q3(arm: SRSArm, u: np.ndarray, q3: float, q4: float) -> list[n
 def _wrist_joints(arm: SRSArm, q4: np.ndarray, T7: np.ndarray, q0: np.ndarray) -> np.ndarray:
     """Unchecked: joints 1-7 from joints 1-4 by the ZYZ angles of ``R_4^7``, the branch inside the limits (nearer q0)."""
     _, _, R04 = _wrist_and_jacobian(arm, q4)
-    a, b, c = zyz_angles(R04.T @ T7[:3, :3], check=False)          # step 3: R_4^7 = Rz(q5) Ry(q6) Rz(q7)
+    a, b, c = zyz_angles(R04.T @ T7[:3, :3], validate=False)          # step 3: R_4^7 = Rz(q5) Ry(q6) Rz(q7)
     wrists = wrap_angle(np.array([[a, b, c], [a + np.pi, -b, c + np.pi]]))
     inside = ((wrists >= arm.chain.qmin[4:]) & (wrists <= arm.chain.qmax[4:])).all(1)
     distance = (wrap_angle(wrists - q0[4:]) ** 2).sum(1) + np.where(inside, 0.0, 100.0)   # inside first, then nearer
@@ -206,21 +206,21 @@ def ik_position_posture(chain: Any, T: Any, q0: Any = None, *, tol: float = 1e-6
     arm = SRSArm(chain)
     T = as_se3(T, "T")
     T7 = arm.to_link7(T)
-    q0 = arm.mid.copy() if q0 is None else arm.chain.check_q(q0, "q0")
-    tol = check_positive(tol, "tol")
-    max_iter = check_int(max_iter, "max_iter", minimum=1)
-    method = check_choice(method, "method", METHODS)
+    q0 = arm.mid.copy() if q0 is None else arm.chain.as_q(q0, "q0")
+    tol = as_positive(tol, "tol")
+    max_iter = as_int(max_iter, "max_iter", minimum=1)
+    method = as_choice(method, "method", METHODS)
     target = arm.wrist_centre(T7)
     shoulder = np.array([0.0, 0.0, arm.d_bs])
     unreachable = arm.out_of_reach(float(np.linalg.norm(target - shoulder)))
     if unreachable:
-        result = verify(arm.chain, T[None], q0[None], tol, check=False)[0]
+        result = verify(arm.chain, T[None], q0[None], tol, validate=False)[0]
         result.success, result.iterations, result.reason = False, 0, unreachable
         return result
     if method == "newton":
         q_all, steps = _newton(arm, target, T7, q0, tol, max_iter)
     else:
         q_all, steps = _joint_parameter(arm, shoulder, target, T7, q0, max_iter)
-    result = verify(arm.chain, T[None], q_all[None], tol, check=False)[0]
+    result = verify(arm.chain, T[None], q_all[None], tol, validate=False)[0]
     result.iterations = steps
     return result

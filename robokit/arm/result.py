@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3, pose_error
-from ..validation import check_positive
+from ..validation import as_positive
 from .chain import LIMIT_TOL, Chain
 
 __all__ = ["IKResult", "IKBatchResult", "verify"]
@@ -91,7 +91,7 @@ class IKBatchResult:
                         orientation_error=float(self.orientation_error[i]), restarts=int(self.restarts[i]))
 
 
-def verify(chain, T_target: Any, q: Any, tol: float = 1e-6, *, check: bool = True) -> IKBatchResult:
+def verify(chain, T_target: Any, q: Any, tol: float = 1e-6, *, validate: bool = True) -> IKBatchResult:
     """FK-verify joint vectors against their targets: success needs the pose AND the joint limits.
 
     Parameters
@@ -103,7 +103,7 @@ def verify(chain, T_target: Any, q: Any, tol: float = 1e-6, *, check: bool = Tru
         Candidate solutions.
     tol : float, default 1e-6
         Tolerance on the position error [m] and on the orientation error [rad].
-    check : bool, default True
+    validate : bool, default True
         Validate the arguments; ``False`` skips it (the solvers, on their own checked arrays).
 
     Returns
@@ -132,15 +132,15 @@ def verify(chain, T_target: Any, q: Any, tol: float = 1e-6, *, check: bool = Tru
     >>> r.success.tolist(), r.reason[0]
     ([True, False], 'converged')
     """
-    if check:
+    if validate:
         if not isinstance(chain, Chain):
             raise TypeError(f"chain: expected a robokit.arm.Chain, got {type(chain).__name__}")
         T_target = as_se3(T_target, "T_target", batch=True)
-        q = chain.check_q(q, batch=True)
+        q = chain.as_q(q, batch=True)
         if len(q) != len(T_target):
             raise ValueError(f"q: expected {len(T_target)} joint vectors (one per target), got {len(q)}")
-        tol = check_positive(tol, "tol")
-    err = pose_error(T_target, chain.flange_transform(chain.frames(q, check=False), check=False), check=False)
+        tol = as_positive(tol, "tol")
+    err = pose_error(T_target, chain.flange_transform(chain.frames(q, validate=False), validate=False), validate=False)
     err *= err
     pos2, rot2 = err[:, :3].sum(1), err[:, 3:].sum(1)
     pos, rot, residual = np.sqrt(pos2), np.sqrt(rot2), np.sqrt(pos2 + rot2)

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3, rot_y, rot_z, so3_exp, zyz_angles
-from ..validation import as_array, check_finite_result, check_finite_scalar, check_positive
+from ..validation import as_array, require_finite_result, as_finite_scalar, as_positive
 
 __all__ = ["wrist_centre", "elbow_angle", "shoulder_angles"]
 
@@ -76,7 +76,7 @@ def wrist_centre(T: Any, d_wf: float) -> np.ndarray:
     [0.5   0.    0.674]
     """
     T = as_se3(T, "T")
-    d = check_positive(d_wf, "d_wf", allow_zero=True)
+    d = as_positive(d_wf, "d_wf", allow_zero=True)
     return T[:3, 3] - d * T[:3, 2]
 
 
@@ -115,7 +115,7 @@ def elbow_angle(shoulder: Any, wrist: Any, d_se: float, d_ew: float) -> float:
     """
     S = as_array(shoulder, "shoulder", shape=(3,))
     W = as_array(wrist, "wrist", shape=(3,))
-    l1, l2 = check_positive(d_se, "d_se"), check_positive(d_ew, "d_ew")
+    l1, l2 = as_positive(d_se, "d_se"), as_positive(d_ew, "d_ew")
     L = float(np.linalg.norm(W - S))
     try:
         c = (L**2 - l1**2 - l2**2) / (2 * l1 * l2)
@@ -170,14 +170,14 @@ def shoulder_angles(shoulder: Any, wrist: Any, q4: float, psi: float, d_se: floa
     """
     S = as_array(shoulder, "shoulder", shape=(3,))
     W = as_array(wrist, "wrist", shape=(3,))
-    q4 = check_finite_scalar(q4, "q4")
-    psi = check_finite_scalar(psi, "psi")
-    l1, l2 = check_positive(d_se, "d_se"), check_positive(d_ew, "d_ew")
+    q4 = as_finite_scalar(q4, "q4")
+    psi = as_finite_scalar(psi, "psi")
+    l1, l2 = as_positive(d_se, "d_se"), as_positive(d_ew, "d_ew")
     sw = W - S
     L = float(np.linalg.norm(sw))
     if L < 1e-12:
         raise ValueError("wrist: expected a wrist centre away from the shoulder, got |W - S| = 0")
-    R_psi = so3_exp(psi * sw / L, check=False)                 # rotation by psi about S-W (Rodrigues)
+    R_psi = so3_exp(psi * sw / L, validate=False)                 # rotation by psi about S-W (Rodrigues)
     M = R_psi @ _reference_rotation(sw, np.asarray(q4), l1, l2)   # R_0^3(psi) = R_psi R_0^3(0), Eqs. (9)-(15)
-    check_finite_result("shoulder, wrist, q4, psi, d_se, d_ew", M)
-    return zyz_angles(M, check=False)
+    require_finite_result("shoulder, wrist, q4, psi, d_se, d_ew", M)
+    return zyz_angles(M, validate=False)

@@ -30,7 +30,7 @@ import numpy as np
 from ..geometry import wrap_angle
 from ..mapping.corridor_scan import CorridorState, corridor_state
 from ..sim import Lidar, World, unicycle_step
-from ..validation import as_array, as_rng, check_choice, check_finite_scalar, check_int, check_positive
+from ..validation import as_array, as_rng, as_choice, as_finite_scalar, as_int, as_positive
 
 __all__ = ["centering_command", "CenteringResult", "move_to_middle_line"]
 
@@ -79,13 +79,13 @@ def centering_command(lateral_offset: float, heading_error: float, *, lookahead:
     >>> [round(u, 4) for u in centering_command(0.005, 0.1, deadband=0.01)]   # inside: turn only
     [0.0, -0.15]
     """
-    y = check_finite_scalar(lateral_offset, "lateral_offset")
-    e = check_finite_scalar(heading_error, "heading_error")
-    L = check_positive(lookahead, "lookahead")
-    kw, kv = check_positive(k_omega, "k_omega"), check_positive(k_v, "k_v")
-    vmin, vmax = check_positive(v_min, "v_min", allow_zero=True), check_positive(v_max, "v_max")
-    wmax = check_positive(w_max, "w_max")
-    band = check_positive(deadband, "deadband", allow_zero=True)
+    y = as_finite_scalar(lateral_offset, "lateral_offset")
+    e = as_finite_scalar(heading_error, "heading_error")
+    L = as_positive(lookahead, "lookahead")
+    kw, kv = as_positive(k_omega, "k_omega"), as_positive(k_v, "k_v")
+    vmin, vmax = as_positive(v_min, "v_min", allow_zero=True), as_positive(v_max, "v_max")
+    wmax = as_positive(w_max, "w_max")
+    band = as_positive(deadband, "deadband", allow_zero=True)
     if vmin > vmax:
         raise ValueError(f"v_min: expected at most v_max = {vmax}, got {vmin}")
     inside = abs(y) <= band
@@ -181,15 +181,15 @@ def move_to_middle_line(world: World, pose: Any, lidar: Lidar, *, rng: Any = 0, 
         raise TypeError(f"lidar: expected a robokit.sim Lidar, got {type(lidar).__name__}")
     p = as_array(pose, "pose", shape=(3,))
     gen = as_rng(rng)
-    e4 = check_positive(tol, "tol")
-    etol = check_positive(heading_tol, "heading_tol")
-    steps = check_int(max_steps, "max_steps", minimum=0, maximum=10 ** 6)
-    dt = check_positive(dt, "dt")
-    opposite = check_choice("nearest" if direction is None else direction, "direction",
+    e4 = as_positive(tol, "tol")
+    etol = as_positive(heading_tol, "heading_tol")
+    steps = as_int(max_steps, "max_steps", minimum=0, maximum=10 ** 6)
+    dt = as_positive(dt, "dt")
+    opposite = as_choice("nearest" if direction is None else direction, "direction",
                             ["nearest", "opposite"]) == "opposite"
-    w = check_positive(world.info.get("width", np.nan) if width is None else width, "width")
-    dda = check_positive(world.info.get("recess", 0.0) if recess is None else recess, "recess", allow_zero=True)
-    n_settle = check_int(settle, "settle", minimum=1)
+    w = as_positive(world.info.get("width", np.nan) if width is None else width, "width")
+    dda = as_positive(world.info.get("recess", 0.0) if recess is None else recess, "recess", allow_zero=True)
+    n_settle = as_int(settle, "settle", minimum=1)
     poses, dist, good = [p.copy()], 0.0, 0
     e_prev, y, e = None, 0.0, 0.0
     for _ in range(steps + 1):
@@ -207,7 +207,7 @@ def move_to_middle_line(world: World, pose: Any, lidar: Lidar, *, rng: Any = 0, 
         if good >= n_settle or len(poses) > steps:
             break
         v, omega = centering_command(y, float(wrap_angle(e)), deadband=e4 / 4)
-        p = unicycle_step(p, v, omega, dt, check=False)
+        p = unicycle_step(p, v, omega, dt, validate=False)
         poses.append(p)
         dist += abs(v) * dt
     return CenteringResult(np.array(poses), good >= n_settle, float(dist), state, float(y),

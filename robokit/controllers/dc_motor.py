@@ -39,7 +39,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..validation import as_array, check_finite_result, check_positive
+from ..validation import as_array, require_finite_result, as_positive
 
 __all__ = ["DCMotor", "LITTLEDOG_MOTOR", "MotorPower", "joint_torque", "motor_current", "voltage_for_torque",
            "electrical_power", "reflected_inertia"]
@@ -100,16 +100,16 @@ class DCMotor:
 
     def __post_init__(self) -> None:
         for name in ("resistance", "torque_constant", "back_emf_constant", "gear_ratio", "voltage_max"):
-            object.__setattr__(self, name, check_positive(getattr(self, name), name))
+            object.__setattr__(self, name, as_positive(getattr(self, name), name))
         for name in ("rotor_inertia", "viscous_friction"):
-            object.__setattr__(self, name, check_positive(getattr(self, name), name, allow_zero=True))
-        eta = check_positive(self.efficiency, "efficiency")
+            object.__setattr__(self, name, as_positive(getattr(self, name), name, allow_zero=True))
+        eta = as_positive(self.efficiency, "efficiency")
         if eta > 1:
             raise ValueError(f"efficiency: expected a fraction in (0, 1], got {eta}")
         object.__setattr__(self, "efficiency", eta)
         current = self.continuous_current
         if not (isinstance(current, float) and current == math.inf):
-            current = check_positive(current, "continuous_current")
+            current = as_positive(current, "continuous_current")
         object.__setattr__(self, "continuous_current", float(current))
 
     @property
@@ -157,10 +157,10 @@ class MotorPower(NamedTuple):
     total: float | np.ndarray       #: ``V i`` = copper + mechanical, drawn from the supply
 
 
-def _inputs(voltage: Any, joint_velocity: Any, motor: Any, check: bool,
+def _inputs(voltage: Any, joint_velocity: Any, motor: Any, validate: bool,
             first: str = "voltage") -> tuple[np.ndarray, np.ndarray]:
     """Validated, broadcast (first, joint_velocity) arrays; as given on the fast path."""
-    if not check:
+    if not validate:
         return voltage, joint_velocity
     if not isinstance(motor, DCMotor):
         raise TypeError(f"motor: expected a DCMotor, got {type(motor).__name__}")
@@ -178,7 +178,7 @@ def _out(x: np.ndarray) -> float | np.ndarray:
     return float(x) if np.ndim(x) == 0 else x
 
 
-def motor_current(voltage: Any, joint_velocity: Any, motor: DCMotor, check: bool = True) -> float | np.ndarray:
+def motor_current(voltage: Any, joint_velocity: Any, motor: DCMotor, validate: bool = True) -> float | np.ndarray:
     """Winding current (A): ``i = (V - k_e N dq/dt) / R``, with ``V`` saturated at ``+-voltage_max``.
 
     Parameters
@@ -188,7 +188,7 @@ def motor_current(voltage: Any, joint_velocity: Any, motor: DCMotor, check: bool
     joint_velocity : float or array_like
         Joint speed (rad/s), broadcast against ``voltage``.
     motor : DCMotor
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` is the simulation's fast path (finite arrays of matching shapes).
 
     Returns
@@ -207,19 +207,19 @@ def motor_current(voltage: Any, joint_velocity: Any, motor: DCMotor, check: bool
     >>> round(motor_current(20.0, 0.0, LITTLEDOG_MOTOR), 4)           # saturated at 14.8 V
     4.9333
     """
-    v, w = _inputs(voltage, joint_velocity, motor, check)
+    v, w = _inputs(voltage, joint_velocity, motor, validate)
     vm = motor.voltage_max
     v = np.clip(v, -vm, vm)
     omega_m = motor.gear_ratio * w                                      # gearbox: omega_m = N dq/dt
     return _out((v - motor.back_emf_constant * omega_m) / motor.resistance)     # Sec. 2.3: R i = V - k_e omega_m
 
 
-def joint_torque(voltage: Any, joint_velocity: Any, motor: DCMotor, check: bool = True) -> float | np.ndarray:
+def joint_torque(voltage: Any, joint_velocity: Any, motor: DCMotor, validate: bool = True) -> float | np.ndarray:
     """Torque at the joint (N m): ``eta N k_t i - b dq/dt``, with ``V`` saturated at ``+-voltage_max``.
 
     Parameters
     ----------
-    voltage, joint_velocity, motor, check
+    voltage, joint_velocity, motor, validate
         As in :func:`motor_current`.
 
     Returns
@@ -239,13 +239,13 @@ def joint_torque(voltage: Any, joint_velocity: Any, motor: DCMotor, check: bool 
     >>> np.round(joint_torque([2.0, -2.0], [1.0, 0.0], LITTLEDOG_MOTOR), 4).tolist()
     [0.245, -0.5]
     """
-    v, w = _inputs(voltage, joint_velocity, motor, check)
-    i = motor_current(v, w, motor, check=False)
+    v, w = _inputs(voltage, joint_velocity, motor, validate)
+    i = motor_current(v, w, motor, validate=False)
     tau = motor.efficiency * motor.gear_ratio * motor.torque_constant * np.asarray(i)    # Sec. 2.3: tau_m = k_t i
     return _out(tau - motor.viscous_friction * w)
 
 
-def voltage_for_torque(torque: Any, joint_velocity: Any, motor: DCMotor, check: bool = True) -> float | np.ndarray:
+def voltage_for_torque(torque: Any, joint_velocity: Any, motor: DCMotor, validate: bool = True) -> float | np.ndarray:
     """Voltage that gives ``torque`` at ``joint_velocity``: the exact inverse of :func:`joint_torque` before saturation.
 
     Parameters
@@ -273,18 +273,18 @@ def voltage_for_torque(torque: Any, joint_velocity: Any, motor: DCMotor, check: 
     >>> round(v, 6), round(joint_torque(v, 1.0, LITTLEDOG_MOTOR), 6)
     (2.0, 0.245)
     """
-    tau, w = _inputs(torque, joint_velocity, motor, check, first="torque")
+    tau, w = _inputs(torque, joint_velocity, motor, validate, first="torque")
     n = motor.gear_ratio
     current = (tau + motor.viscous_friction * w) / (motor.efficiency * n * motor.torque_constant)
     return _out(current * motor.resistance + motor.back_emf_constant * n * w)     # Sec. 2.3: V = R i + k_e omega_m
 
 
-def electrical_power(voltage: Any, joint_velocity: Any, motor: DCMotor, check: bool = True) -> MotorPower:
+def electrical_power(voltage: Any, joint_velocity: Any, motor: DCMotor, validate: bool = True) -> MotorPower:
     """Electrical power per motor (W): copper loss, mechanical (shaft) power and their sum ``V i``.
 
     Parameters
     ----------
-    voltage, joint_velocity, motor, check
+    voltage, joint_velocity, motor, validate
         As in :func:`motor_current` (the voltage saturated at ``+-voltage_max``).
 
     Returns
@@ -310,16 +310,16 @@ def electrical_power(voltage: Any, joint_velocity: Any, motor: DCMotor, check: b
     >>> round(p.copper, 4), round(p.mechanical, 4), round(p.total, 4)
     (8.3333, 8.3333, 16.6667)
     """
-    v, w = _inputs(voltage, joint_velocity, motor, check)
-    i = np.asarray(motor_current(v, w, motor, check=False))
+    v, w = _inputs(voltage, joint_velocity, motor, validate)
+    i = np.asarray(motor_current(v, w, motor, validate=False))
     v = np.clip(v, -motor.voltage_max, motor.voltage_max)
     shape = np.shape(i)
     with np.errstate(over="ignore", invalid="ignore"):
         copper = motor.resistance * i ** 2                                          # Joule loss R i^2
         mechanical = motor.back_emf_constant * motor.gear_ratio * np.asarray(w) * i     # k_e omega_m i
         total = np.asarray(v) * i                                                   # V i = R i^2 + k_e omega_m i
-    if check:
-        check_finite_result("voltage, joint_velocity", copper, mechanical)
+    if validate:
+        require_finite_result("voltage, joint_velocity", copper, mechanical)
     return MotorPower(_out(copper), _out(np.broadcast_to(mechanical, shape)), _out(np.broadcast_to(total, shape)))
 
 

@@ -38,7 +38,7 @@ import control
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import check_finite_scalar, check_positive
+from ..validation import as_finite_scalar, as_positive
 from .servo_loop import (loop_metrics, servo_closed_loop, servo_frequency_response, servo_loop_gain, servo_plant,
                          servo_step_response)
 
@@ -83,12 +83,12 @@ def design_heading_gains(tau: float, overshoot: float, settling_time: float, gai
     >>> np.round(design_heading_gains(0.3, overshoot=0.05, settling_time=1.5), 3).tolist()
     [4.479, 0.6]
     """
-    t = check_positive(tau, "tau")
-    m = check_positive(overshoot, "overshoot")
+    t = as_positive(tau, "tau")
+    m = as_positive(overshoot, "overshoot")
     if not m < 1:
         raise ValueError(f"overshoot: expected a fraction in (0, 1), got {m}")
-    ts = check_positive(settling_time, "settling_time")
-    g = check_positive(gain, "gain")
+    ts = as_positive(settling_time, "settling_time")
+    g = as_positive(gain, "gain")
     zeta = -math.log(m) / math.sqrt(math.pi ** 2 + math.log(m) ** 2)    # Nise Sec. 4.6, overshoot
     wn = 4.0 / (zeta * ts)                                              # Nise Sec. 4.6, 2 % settling
     kp = t * wn ** 2 / g                                                # tau omega_n^2 = g kp
@@ -124,10 +124,10 @@ class HeadingController:
     """
 
     def __init__(self, kp: float, kd: float, max_rate: float, rate_filter: float = 0.1) -> None:
-        self.kp = check_positive(kp, "kp")
-        self.kd = check_positive(kd, "kd", allow_zero=True)
-        self.max_rate = check_positive(max_rate, "max_rate")
-        self.rate_filter = check_positive(rate_filter, "rate_filter", allow_zero=True)
+        self.kp = as_positive(kp, "kp")
+        self.kd = as_positive(kd, "kd", allow_zero=True)
+        self.max_rate = as_positive(max_rate, "max_rate")
+        self.rate_filter = as_positive(rate_filter, "rate_filter", allow_zero=True)
         self.reset()
 
     def reset(self) -> None:
@@ -142,9 +142,9 @@ class HeadingController:
         -----
         Backward difference plus first-order low-pass (Franklin et al. 2015, Sec. 8.3).
         """
-        h = check_finite_scalar(heading, "heading")
+        h = as_finite_scalar(heading, "heading")
         if self._last is not None:
-            raw = wrap_angle(h - self._last) / check_positive(dt, "dt")
+            raw = wrap_angle(h - self._last) / as_positive(dt, "dt")
             a = dt / (dt + self.rate_filter) if self.rate_filter else 1.0
             self.rate += a * (raw - self.rate)
         self._last = h

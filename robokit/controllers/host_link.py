@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, as_rng, check_finite_scalar, check_positive
+from ..validation import as_array, as_rng, as_finite_scalar, as_positive
 
 __all__ = ["SetpointChannel"]
 
@@ -71,10 +71,10 @@ class SetpointChannel:
 
     def __init__(self, period: float = 0.01, latency: float = 0.0, jitter: float = 0.0, loss: float = 0.0,
                  rng: Any = 0) -> None:
-        self.period = check_positive(period, "period")
-        self.latency = check_positive(latency, "latency", allow_zero=True)
-        self.jitter = check_positive(jitter, "jitter", allow_zero=True)
-        p = check_positive(loss, "loss", allow_zero=True)
+        self.period = as_positive(period, "period")
+        self.latency = as_positive(latency, "latency", allow_zero=True)
+        self.jitter = as_positive(jitter, "jitter", allow_zero=True)
+        p = as_positive(loss, "loss", allow_zero=True)
         if not p < 1:
             raise ValueError(f"loss: expected a probability in [0, 1), got {p}")
         self.loss = p
@@ -101,7 +101,7 @@ class SetpointChannel:
         >>> link.due(0.0), link.send(0.0, [0.0]), link.due(0.005), link.due(0.01)
         (True, True, False, True)
         """
-        now = check_finite_scalar(t, "t")
+        now = as_finite_scalar(t, "t")
         return now >= self._last_send + self.period * (1 - 1e-9)
 
     def send(self, t: float, setpoint: Any) -> bool:
@@ -131,7 +131,7 @@ class SetpointChannel:
         >>> [link.send(0.01 * k, [0.0]) for k in range(6)], link.lost
         ([True, True, False, True, False, False], 3)
         """
-        now = check_finite_scalar(t, "t")
+        now = as_finite_scalar(t, "t")
         if now < self._last_send:
             raise ValueError(f"t: expected send times that do not go backwards, got {now} after {self._last_send}")
         value = np.array(as_array(setpoint, "setpoint", finite=False), dtype=float)
@@ -174,7 +174,7 @@ class SetpointChannel:
         >>> [link.receive(t).tolist() for t in (0.03, 0.1)], link.delivered, link.stale   # 3 overtook 1 and 2
         ([[0.0], [3.0]], 2, 2)
         """
-        now = check_finite_scalar(t, "t")
+        now = as_finite_scalar(t, "t")
         if now < self._last_receive:
             raise ValueError(f"t: expected a clock that does not go backwards, got {now} after {self._last_receive}")
         self._last_receive = now

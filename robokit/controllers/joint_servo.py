@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 import control
 import numpy as np
 
-from ..validation import as_array, check_int, check_positive, check_sample_count
+from ..validation import as_array, as_int, as_positive, require_sample_count
 from .dc_motor import DCMotor, reflected_inertia
 from .servo_loop import MIN_DT_OVER_TAU, ServoAnalysis, discrete_servo_analysis, servo_plant
 
@@ -81,7 +81,7 @@ def joint_lag(motor: DCMotor, inertia: float) -> JointLag:
     """
     if not isinstance(motor, DCMotor):
         raise TypeError(f"motor: expected a DCMotor, got {type(motor).__name__}")
-    J = check_positive(inertia, "inertia")
+    J = as_positive(inertia, "inertia")
     rotor = reflected_inertia(motor)
     if J <= rotor:
         raise ValueError(f"inertia: expected the total inertia at the joint, link + reflected_inertia(motor) "
@@ -155,8 +155,8 @@ def design_servo_gains(motor: DCMotor, inertia: float, bandwidth_hz: float, damp
     (96.12, 0.4222)
     """
     tau, gain = joint_lag(motor, inertia)
-    fb = check_positive(bandwidth_hz, "bandwidth_hz")
-    zeta = check_positive(damping, "damping")
+    fb = as_positive(bandwidth_hz, "bandwidth_hz")
+    zeta = as_positive(damping, "damping")
     # omega_BW / omega_n = sqrt(a + sqrt(a^2 + 1)), a = 1 - 2 zeta^2 (Nise Sec. 10.8), without cancellation
     a = 1 - 2 * zeta * zeta
     ratio2 = a + math.hypot(a, 1.0) if a >= 0 else 1.0 / (math.hypot(a, 1.0) - a)
@@ -213,7 +213,7 @@ def servo_analysis(kp: float, kd: float, motor: DCMotor, inertia: float, rate_hz
     False
     """
     tau, gain = joint_lag(motor, inertia)
-    rate = check_positive(rate_hz, "rate_hz")
+    rate = as_positive(rate_hz, "rate_hz")
     if not 1.0 / (rate * tau) > MIN_DT_OVER_TAU:       # the lag must be visible at the sample rate
         raise ValueError(f"inertia, rate_hz: expected a joint whose time constant J / B = {tau:.3g} s the servo "
                          f"period {1 / rate:.3g} s can resolve")
@@ -221,7 +221,7 @@ def servo_analysis(kp: float, kd: float, motor: DCMotor, inertia: float, rate_hz
 
 
 def pd_servo_step(q_ref: Any, q: Any, q_prev: Any, kp: Any, kd: Any, dt: float, voltage_max: float,
-                  check: bool = True) -> float | np.ndarray:
+                  validate: bool = True) -> float | np.ndarray:
     """One tick of the joint servo: ``V = kp (q_ref - q) - kd (q - q_prev) / dt``, saturated at ``+-voltage_max``.
 
     Parameters
@@ -240,7 +240,7 @@ def pd_servo_step(q_ref: Any, q: Any, q_prev: Any, kp: Any, kd: Any, dt: float, 
         Servo period (s, > 0): 0.002 at 500 Hz.
     voltage_max : float
         Saturation (V, > 0): the battery's 14.8 V.
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` is the simulation's fast path (called 500 times per simulated
         second): plain numpy arithmetic on what it is given.
 
@@ -269,7 +269,7 @@ def pd_servo_step(q_ref: Any, q: Any, q_prev: Any, kp: Any, kd: Any, dt: float, 
     >>> pd_servo_step([0.5, 0.0], [0.0, 0.01], [0.0, 0.0], 96.12, 0.4222, 0.002, 14.8).round(3).tolist()
     [14.8, -3.072]
     """
-    if check:
+    if validate:
         qn = as_array(q, "q")
         shape = qn.shape
         qp = as_array(q_prev, "q_prev")
@@ -278,8 +278,8 @@ def pd_servo_step(q_ref: Any, q: Any, q_prev: Any, kp: Any, kd: Any, dt: float, 
         ref = _per_joint(q_ref, "q_ref", shape)
         p = _per_joint(kp, "kp", shape, nonnegative=True)
         d = _per_joint(kd, "kd", shape, nonnegative=True)
-        period = check_positive(dt, "dt")
-        vmax = check_positive(voltage_max, "voltage_max")
+        period = as_positive(dt, "dt")
+        vmax = as_positive(voltage_max, "voltage_max")
         v = p * (ref - qn) - d * ((qn - qp) / period)
         if not np.all(np.isfinite(v)):
             raise ValueError("kp, kd, dt: expected values whose voltage is finite, got an overflow (values too large?)")
@@ -352,11 +352,11 @@ def discrete_servo_response(kp: float, kd: float, motor: DCMotor, inertia: float
     (1.056, 0.1, 9.612)
     """
     tau, g = joint_lag(motor, inertia)
-    p = check_positive(kp, "kp")
-    d = check_positive(kd, "kd", allow_zero=True)
-    rate = check_positive(rate_hz, "rate_hz")
-    n = check_int(steps, "steps", minimum=1)
-    check_sample_count(n, "steps")
+    p = as_positive(kp, "kp")
+    d = as_positive(kd, "kd", allow_zero=True)
+    rate = as_positive(rate_hz, "rate_hz")
+    n = as_int(steps, "steps", minimum=1)
+    require_sample_count(n, "steps")
     ref = float(as_array(q_ref, "q_ref", shape=()))
     dt = 1.0 / rate
     a = math.exp(-dt / tau)
@@ -367,7 +367,7 @@ def discrete_servo_response(kp: float, kd: float, motor: DCMotor, inertia: float
     with np.errstate(over="ignore", invalid="ignore"):
         for k in range(n):
             q[k] = angle
-            v = float(pd_servo_step(ref, angle, prev, p, d, dt, vmax, check=False))
+            v = float(pd_servo_step(ref, angle, prev, p, d, dt, vmax, validate=False))
             volts[k] = v
             prev = angle
             angle = angle + tau * (1 - a) * w + g * (dt - tau * (1 - a)) * v     # ZOH: q+

@@ -50,7 +50,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_finite_result, check_positive, describe
+from ..validation import as_array, require_finite_result, as_positive, describe
 from .path_geometry import ReferencePoint, VisualPath, path_from_poses, reference_point
 
 # the path's names are re-exported: the lesson's API reaches them through this module too
@@ -95,15 +95,15 @@ def path_following_gains(alpha: float, xi: float = XI) -> tuple[float, float]:
     >>> round(k2, 4), round(k3, 4)
     (4.0, 2.8284)
     """
-    a = check_positive(alpha, "alpha")
-    z = check_positive(xi, "xi")
+    a = as_positive(alpha, "alpha")
+    z = as_positive(xi, "xi")
     k2, k3 = a * a, 2.0 * z * a
-    check_finite_result("alpha, xi", k2, k3)
+    require_finite_result("alpha, xi", k2, k3)
     return k2, k3
 
 
 def path_following_command(d: Any, theta_tilde: Any, curvature: Any, v: Any, k2: float, k3: float, *,
-                           check: bool = True) -> Any:
+                           validate: bool = True) -> Any:
     """Turn rate ``omega`` of the path-following law, Eq. (8).
 
     ``omega = -k3 |v| theta_tilde - k2 v d sin(theta_tilde)/theta_tilde + v cos(theta_tilde) c / (1 - c d)``
@@ -120,7 +120,7 @@ def path_following_command(d: Any, theta_tilde: Any, curvature: Any, v: Any, k2:
         Forward speed (m/s).
     k2, k3 : float
         Gains (>= 0), e.g. from :func:`path_following_gains`.
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` is the fast path for a control loop that already did (the
         singularity is still refused).
 
@@ -152,10 +152,10 @@ def path_following_command(d: Any, theta_tilde: Any, curvature: Any, v: Any, k2:
     >>> round(path_following_command(0.0, 0.0, 0.5, 0.3, k2=4.0, k3=2.83), 4)     # on a circle: v c
     0.15
     """
-    if check:
+    if validate:
         dd, th, c, vv = (as_array(x, n) for x, n in ((d, "d"), (theta_tilde, "theta_tilde"),
                                                    (curvature, "curvature"), (v, "v")))
-        g2, g3 = check_positive(k2, "k2", allow_zero=True), check_positive(k3, "k3", allow_zero=True)
+        g2, g3 = as_positive(k2, "k2", allow_zero=True), as_positive(k3, "k3", allow_zero=True)
         try:
             shape = np.broadcast_shapes(dd.shape, th.shape, c.shape, vv.shape)
         except ValueError:
@@ -169,14 +169,14 @@ def path_following_command(d: Any, theta_tilde: Any, curvature: Any, v: Any, k2:
                                    "the path's centre of curvature), got 1 - c d <= 0")
     with np.errstate(over="ignore", invalid="ignore"):
         omega = -g3 * np.abs(vv) * th - g2 * vv * dd * np.sinc(th / np.pi) + vv * np.cos(th) * c / den   # Eq. (8)
-    if not check:
+    if not validate:
         return float(omega) if np.ndim(omega) == 0 else omega
-    check_finite_result("d, theta_tilde, curvature, v, k2, k3", omega)
+    require_finite_result("d, theta_tilde, curvature, v, k2, k3", omega)
     omega = np.broadcast_to(omega, shape)
     return float(omega) if omega.ndim == 0 else np.array(omega)
 
 
-def saturate_command(v: Any, omega: Any, v_max: float, w_max: float, *, check: bool = True) -> tuple[Any, Any]:
+def saturate_command(v: Any, omega: Any, v_max: float, w_max: float, *, validate: bool = True) -> tuple[Any, Any]:
     """Limit ``|v| <= v_max`` and ``|omega| <= w_max`` keeping the curvature ``omega / v``.
 
     Parameters
@@ -185,7 +185,7 @@ def saturate_command(v: Any, omega: Any, v_max: float, w_max: float, *, check: b
         Commanded forward speed (m/s) and turn rate (rad/s).
     v_max, w_max : float
         Limits (> 0).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` for scalars a control loop computed itself.
 
     Returns
@@ -211,11 +211,11 @@ def saturate_command(v: Any, omega: Any, v_max: float, w_max: float, *, check: b
     >>> round(v, 4), round(w, 4), round(w / v, 4)                   # curvature 2 / 0.3 kept
     (0.075, 0.5, 6.6667)
     """
-    if not check:
+    if not validate:
         scale = min(1.0, v_max / abs(v) if v else 1.0, w_max / abs(omega) if omega else 1.0)
         return v * scale, omega * scale
     vv, ww = as_array(v, "v"), as_array(omega, "omega")
-    vm, wm = check_positive(v_max, "v_max"), check_positive(w_max, "w_max")
+    vm, wm = as_positive(v_max, "v_max"), as_positive(w_max, "w_max")
     try:
         vv, ww = np.broadcast_arrays(vv, ww)
     except ValueError:
@@ -284,10 +284,10 @@ class PathFollower:
             raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
         self.path = path
         self.k2, self.k3 = path_following_gains(alpha, xi)
-        self.v_max = check_positive(v_max, "v_max")
-        self.w_max = check_positive(w_max, "w_max")
-        self.goal_tolerance = check_positive(goal_tolerance, "goal_tolerance")
-        self.window = None if window is None else check_positive(window, "window")
+        self.v_max = as_positive(v_max, "v_max")
+        self.w_max = as_positive(w_max, "w_max")
+        self.goal_tolerance = as_positive(goal_tolerance, "goal_tolerance")
+        self.window = None if window is None else as_positive(window, "window")
         self.reference: ReferencePoint | None = None
         self.done = self.reached = False
 
@@ -302,10 +302,10 @@ class PathFollower:
         """``(v, omega)`` for the robot at ``pose`` (its best estimate), Eq. (8) then saturation."""
         p = as_array(pose, "pose", shape=(3,))
         previous = None if self.reference is None else self.reference.index
-        ref = reference_point(self.path, p, previous=previous, window=self.window, check=False)
+        ref = reference_point(self.path, p, previous=previous, window=self.window, validate=False)
         if previous is not None and self.window is not None and (
                 abs(ref.d) > self.window / 2 or 1 - ref.curvature * ref.d < 0.5):
-            ref = reference_point(self.path, p, check=False)           # lost the thread: search it all
+            ref = reference_point(self.path, p, validate=False)           # lost the thread: search it all
         self.reference = ref
         self.reached = bool(math.hypot(*(p[:2] - self.path.poses[-1, :2])) < self.goal_tolerance)
         self.done = self.reached or ref.s >= self.path.length
@@ -351,7 +351,7 @@ def reference_command(ref: ReferencePoint, v: float, k2: float, k3: float, w_max
     (0.25, -0.2)
     """
     c = ref.curvature if 1 - ref.curvature * ref.d >= 0.1 else 0.0
-    omega = path_following_command(ref.d, ref.theta_tilde, c, v, k2, k3, check=False)
+    omega = path_following_command(ref.d, ref.theta_tilde, c, v, k2, k3, validate=False)
     if w_max is None:
         return float(v), float(omega)
-    return saturate_command(v, omega, v, w_max, check=False)
+    return saturate_command(v, omega, v, w_max, validate=False)

@@ -35,7 +35,7 @@ import control
 import numpy as np
 
 from ..sim import unicycle_step
-from ..validation import (as_array, check_finite_result, check_finite_scalar, check_positive, check_sample_count,
+from ..validation import (as_array, require_finite_result, as_finite_scalar, as_positive, require_sample_count,
                           describe)
 from .path_following import XI, path_following_gains, reference_command
 from .path_geometry import VisualPath, reference_point
@@ -79,10 +79,10 @@ def path_following_linearisation(alpha: float, v: float, xi: float = XI) -> cont
     [[0.0, 0.3], [-1.2, -0.8485]]
     """
     k2, k3 = path_following_gains(alpha, xi)
-    vv = check_positive(v, "v")
+    vv = as_positive(v, "v")
     A = np.array([[0.0, vv], [-k2 * vv, -k3 * vv]])
     B = np.array([[0.0], [k2 * vv]])
-    check_finite_result("alpha, v, xi", A, B)
+    require_finite_result("alpha, v, xi", A, B)
     return control.ss(A, B, [[1.0, 0.0]], [[0.0]], states=["d", "theta_tilde"], inputs=["d_ref"], outputs=["d"])
 
 
@@ -105,7 +105,7 @@ def path_following_poles(alpha: float, v: float, xi: float = XI) -> np.ndarray:
     [(-0.2121-0.2121j), (-0.2121+0.2121j)]
     """
     p = np.asarray(control.poles(path_following_linearisation(alpha, v, xi)), dtype=complex)
-    check_finite_result("alpha, v, xi", p)
+    require_finite_result("alpha, v, xi", p)
     return p[np.argsort(p.imag, kind="stable")]
 
 
@@ -134,7 +134,7 @@ def path_following_damping(alpha: float, v: float, xi: float = XI) -> dict:
     wn, zeta, poles = control.damp(sys, doprint=False)
     order = np.argsort(np.asarray(poles).imag, kind="stable")
     p = np.asarray(poles, dtype=complex)[order]
-    check_finite_result("alpha, v, xi", p, wn, zeta)
+    require_finite_result("alpha, v, xi", p, wn, zeta)
     return {"natural_frequency": float(np.asarray(wn)[0]), "damping": float(np.asarray(zeta)[0]),
             "time_constant": float(-1.0 / p.real.max()), "poles": p}
 
@@ -184,10 +184,10 @@ def lateral_step_response(alpha: float, v: float, xi: float = XI, t: Any = None,
     if tt[0] != 0 or not step[0] > 0 or not np.allclose(step, step[0], rtol=1e-9, atol=0.0):
         raise ValueError(f"t: expected equally spaced increasing times from 0 (np.linspace(0, T, n)), got "
                          f"{describe(t)} from {tt[0]} to {tt[-1]}")
-    d0 = check_finite_scalar(offset, "offset")
+    d0 = as_finite_scalar(offset, "offset")
     resp = control.step_response(path_following_linearisation(alpha, v, xi), T=tt)
     d = float(d0) * (1.0 - np.asarray(resp.outputs, dtype=float).ravel())
-    check_finite_result("alpha, v, xi, t, offset", d)
+    require_finite_result("alpha, v, xi, t, offset", d)
     return np.asarray(resp.time, dtype=float), d
 
 
@@ -251,23 +251,23 @@ def simulate_path_following(path: VisualPath, start_pose: Any, *, alpha: float, 
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
     pose = as_array(start_pose, "start_pose", shape=(3,)).copy()
     k2, k3 = path_following_gains(alpha, xi)
-    speed = check_positive(v, "v")
-    T = check_positive(duration, "duration")
-    h = check_positive(dt, "dt")
-    wm = None if w_max is None else check_positive(w_max, "w_max")
+    speed = as_positive(v, "v")
+    T = as_positive(duration, "duration")
+    h = as_positive(dt, "dt")
+    wm = None if w_max is None else as_positive(w_max, "w_max")
     n = int(math.floor(T / h + 1e-9))
-    check_sample_count(n, "duration, dt")
+    require_sample_count(n, "duration, dt")
     t, poses, d, th, vs, ws = [], [], [], [], [], []
     ref = None
     for k in range(n + 1):
         ref = reference_point(path, pose, previous=None if ref is None else ref.index, window=1.0 + 2 * speed * h,
-                              check=False)
+                              validate=False)
         t.append(k * h), poses.append(pose), d.append(ref.d), th.append(ref.theta_tilde)
         if k == n or ref.s >= path.length:
             vs.append(0.0), ws.append(0.0)
             break
         vc, wc = reference_command(ref, speed, k2, k3, wm)
-        check_finite_result("start_pose, alpha, v, dt, xi", vc, wc)
+        require_finite_result("start_pose, alpha, v, dt, xi", vc, wc)
         vs.append(vc), ws.append(wc)
-        pose = unicycle_step(pose, vc, wc, h, check=False)
+        pose = unicycle_step(pose, vc, wc, h, validate=False)
     return FollowTrace(np.array(t), np.array(poses), np.array(d), np.array(th), np.array(vs), np.array(ws))

@@ -36,7 +36,7 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.interpolate import CubicSpline
 
 from ..geometry import as_planar, wrap_angle
-from ..validation import as_array, check_finite_result, check_positive, check_sample_count, describe
+from ..validation import as_array, require_finite_result, as_positive, require_sample_count, describe
 
 __all__ = ["VisualPath", "path_from_poses", "ReferencePoint", "reference_point"]
 
@@ -143,15 +143,15 @@ def path_from_poses(poses: Any, *, spacing: float = 0.05) -> VisualPath:
     key = as_planar(poses, "poses")
     if key.ndim != 2:
         raise ValueError(f"poses: expected shape (M, 3) with M >= 2, got shape {key.shape}")
-    h = check_positive(spacing, "spacing")
+    h = as_positive(spacing, "spacing")
     xy = key[:, :2]
     keep = np.concatenate([[True], np.linalg.norm(np.diff(xy, axis=0), axis=1) > 1e-9])
     xy = xy[keep]
     if len(xy) < 2:
         raise ValueError(f"poses: expected at least two distinct positions, got {len(xy)} ({describe(poses)})")
     u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
-    check_finite_result("poses", u)
-    check_sample_count(8 * u[-1] / h, "poses, spacing")
+    require_finite_result("poses", u)
+    require_sample_count(8 * u[-1] / h, "poses, spacing")
     spline = CubicSpline(u, xy, axis=0)
     fine = np.linspace(0.0, u[-1], max(int(math.ceil(8 * u[-1] / h)), 16) + 1)
     speed = np.linalg.norm(spline(fine, 1), axis=1)
@@ -164,7 +164,7 @@ def path_from_poses(poses: Any, *, spacing: float = 0.05) -> VisualPath:
     r, r1, r2 = spline(uu), spline(uu, 1), spline(uu, 2)
     theta = np.arctan2(r1[:, 1], r1[:, 0])
     curvature = (r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]) / np.linalg.norm(r1, axis=1) ** 3   # c = dtheta/ds
-    check_finite_result("poses, spacing", curvature)
+    require_finite_result("poses, spacing", curvature)
     return VisualPath(np.column_stack([r, theta]), s, curvature, key)
 
 
@@ -182,7 +182,7 @@ class ReferencePoint(NamedTuple):
 
 
 def reference_point(path: VisualPath, pose: Any, *, previous: int | None = None,
-                    window: float | None = None, check: bool = True) -> ReferencePoint:
+                    window: float | None = None, validate: bool = True) -> ReferencePoint:
     """The nearest point of the path (Eq. (7)) and the distance and heading errors of Eq. (8).
 
     Parameters
@@ -196,7 +196,7 @@ def reference_point(path: VisualPath, pose: Any, *, previous: int | None = None,
         back through a doorway, is not mistaken for its other pass).
     window : float, optional
         Half-width (m) of that search window; ignored without ``previous``.
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` is the fast path for a control loop that already did.
 
     Returns
@@ -227,15 +227,15 @@ def reference_point(path: VisualPath, pose: Any, *, previous: int | None = None,
     >>> round(ref.s, 3), round(ref.d, 3), round(ref.theta_tilde, 3)
     (1.2, 0.3, 0.1)
     """
-    if check and not isinstance(path, VisualPath):
+    if validate and not isinstance(path, VisualPath):
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
     n = len(path.poses)
-    if check:
+    if validate:
         p = as_array(pose, "pose", shape=(3,))
         if previous is not None and (isinstance(previous, bool) or not isinstance(previous, (int, np.integer))
                                      or not 0 <= previous < n):
             raise ValueError(f"previous: expected a path index in [0, {n - 1}], got {describe(previous)}")
-        w = None if window is None else check_positive(window, "window")
+        w = None if window is None else as_positive(window, "window")
     else:
         p, w = pose, window
     lo, hi = 0, n - 1
@@ -261,6 +261,6 @@ def reference_point(path: VisualPath, pose: Any, *, previous: int | None = None,
         s += float((p[:2] - point) @ tangent)
     d = float((p[:2] - point) @ normal)                            # Eq. (8): d = [x - x_ref, y - y_ref] n
     theta_tilde = float(wrap_angle(p[2] - heading))                # Eq. (8): theta - theta_ref
-    if check:
-        check_finite_result("pose", s, d)
+    if validate:
+        require_finite_result("pose", s, d)
     return ReferencePoint(i + int(tk > 0.5), point, heading, curvature, normal, s, d, theta_tilde)

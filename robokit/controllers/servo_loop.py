@@ -39,7 +39,7 @@ import control
 import numpy as np
 from scipy.optimize import brentq
 
-from ..validation import as_array, check_int, check_positive, check_sample_count
+from ..validation import as_array, as_int, as_positive, require_sample_count
 
 __all__ = ["MIN_DT_OVER_TAU", "servo_plant", "servo_closed_loop", "servo_loop_gain", "servo_step_response", "servo_frequency_response",
            "loop_metrics", "DiscreteServoLoop", "discrete_servo_loop", "ServoAnalysis", "discrete_servo_analysis"]
@@ -68,8 +68,8 @@ def servo_plant(tau: float, gain: float = 1.0) -> control.TransferFunction:
     >>> servo_plant(0.3).den[0][0].tolist()      # 0.3 s^2 + s
     [0.3, 1.0, 0.0]
     """
-    t = check_positive(tau, "tau")
-    g = check_positive(gain, "gain")
+    t = as_positive(tau, "tau")
+    g = as_positive(gain, "gain")
     return control.tf([g], [t, 1.0, 0.0])
 
 
@@ -86,10 +86,10 @@ def servo_closed_loop(kp: float, kd: float, tau: float, gain: float = 1.0) -> co
     >>> servo_closed_loop(4.0, 0.5, 0.3).den[0][0].tolist()
     [0.3, 1.5, 4.0]
     """
-    p = check_positive(kp, "kp")
-    d = check_positive(kd, "kd", allow_zero=True)
-    t = check_positive(tau, "tau")
-    g = check_positive(gain, "gain")
+    p = as_positive(kp, "kp")
+    d = as_positive(kd, "kd", allow_zero=True)
+    t = as_positive(tau, "tau")
+    g = as_positive(gain, "gain")
     return control.tf([g * p], [t, 1 + g * d, g * p])
 
 
@@ -105,8 +105,8 @@ def servo_loop_gain(kp: float, kd: float, tau: float, gain: float = 1.0) -> cont
     >>> servo_loop_gain(4.0, 0.5, 0.3).num[0][0].tolist()    # (0.5 s + 4) / (0.3 s^2 + s)
     [0.5, 4.0]
     """
-    p = check_positive(kp, "kp")
-    d = check_positive(kd, "kd", allow_zero=True)
+    p = as_positive(kp, "kp")
+    d = as_positive(kd, "kd", allow_zero=True)
     return control.tf([d, p], [1.0]) * servo_plant(tau, gain)
 
 
@@ -129,7 +129,7 @@ def servo_step_response(kp: float, kd: float, tau: float, gain: float = 1.0,
     (400, 1.05, 1.0)
     """
     T = servo_closed_loop(kp, kd, tau, gain)
-    t = np.linspace(0.0, check_positive(duration, "duration"), max(check_int(n, "n", minimum=0), 2))
+    t = np.linspace(0.0, as_positive(duration, "duration"), max(as_int(n, "n", minimum=0), 2))
     resp = control.step_response(T, t)
     y = np.asarray(resp.outputs).ravel()
     if np.isnan(y).any():
@@ -192,7 +192,7 @@ def loop_metrics(kp: float, kd: float, tau: float, gain: float = 1.0, delay: flo
     59
     """
     L = servo_loop_gain(kp, kd, tau, gain)
-    dly = check_positive(delay, "delay", allow_zero=True)
+    dly = as_positive(delay, "delay", allow_zero=True)
     if dly > 0:
         num, den = control.pade(dly, 1)
         pade = control.tf(num, den)
@@ -265,10 +265,10 @@ def discrete_servo_loop(kp: float, kd: float, tau: float, rate_hz: float, gain: 
     >>> round(float(loop.closed_loop.dcgain()), 6), loop.closed_loop.dt
     (1.0, 0.1)
     """
-    p = check_positive(kp, "kp")
-    d = check_positive(kd, "kd", allow_zero=True)
-    rate = check_positive(rate_hz, "rate_hz")
-    t = check_positive(tau, "tau")
+    p = as_positive(kp, "kp")
+    d = as_positive(kd, "kd", allow_zero=True)
+    rate = as_positive(rate_hz, "rate_hz")
+    t = as_positive(tau, "tau")
     dt = 1.0 / rate
     if not dt / t > MIN_DT_OVER_TAU:
         raise ValueError(f"tau, rate_hz: expected a sample period the lag can see (dt / tau > {MIN_DT_OVER_TAU:g}), "
@@ -385,8 +385,8 @@ def discrete_servo_analysis(kp: float, kd: float, tau: float, rate_hz: float, ga
     """
     loop = discrete_servo_loop(kp, kd, tau, rate_hz, gain)
     dt = 1.0 / float(rate_hz)
-    span = check_positive(duration, "duration")
-    check_sample_count(span / dt, "duration, rate_hz")
+    span = as_positive(duration, "duration")
+    require_sample_count(span / dt, "duration, rate_hz")
     poles = np.asarray(loop.closed_loop.poles(), dtype=complex)
     stable = bool(np.all(np.abs(poles) < 1.0))
     with warnings.catch_warnings(), np.errstate(all="ignore"):

@@ -7,7 +7,7 @@ optical frame (x right, y down, z forward). The source papers' planar pose ``[p,
 (sideways X, forward Z, heading; a left-handed frame) converts with :func:`se2_to_pqt` /
 :func:`pqt_to_se2` and acts on points with the ``pqt_*`` functions; the papers' world points become
 robokit's with :func:`paper_world_to_robokit`. Functions accept one element or a stack along leading
-axes where their docstrings say so; those that solvers call in loops take ``check=False``.
+axes where their docstrings say so; those that solvers call in loops take ``validate=False``.
 
 Submodules: :mod:`~robokit.geometry.planar` (SE(2)), :mod:`~robokit.geometry.rotations` (SO(3)),
 :mod:`~robokit.geometry.spatial` (SE(3)), :mod:`~robokit.geometry.procrustes` (the one weighted
@@ -20,7 +20,7 @@ from .paper_frames import (R_BODY_OPTICAL, as_pqt, optical_to_y_up, paper_world_
 from .planar import (as_planar, intersect_lines, matrix_to_se2, se2_between, se2_compose, se2_inverse, se2_to_matrix,
                      wrap_angle)
 from .procrustes import FIT_TOL, DegenerateFitError, RigidFit, fit_rigid, fit_se2, fit_se3
-from .rotations import (ROTATION_TOL, as_rotation, check_rotation_block, euler_matrix, quat_to_matrix, rot_x, rot_y,
+from .rotations import (ROTATION_TOL, as_rotation, require_rotation_block, euler_matrix, quat_to_matrix, rot_x, rot_y,
                         rot_z, skew, so3_exp, so3_log, zyz_angles)
 from .spatial import (as_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, se3_inverse, se3_to_se2,
                       transform_points)
@@ -28,7 +28,7 @@ from .spatial import (as_se3, pose_error, se2_to_se3, se3_compose, se3_from_rt, 
 __all__ = [
     "as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
     "fit_se2", "intersect_lines",
-    "ROTATION_TOL", "as_rotation", "check_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y",
+    "ROTATION_TOL", "as_rotation", "require_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y",
     "rot_z", "euler_matrix", "zyz_angles", "quat_to_matrix",
     "as_se3", "se3_from_rt", "se3_inverse", "se3_compose", "transform_points", "se2_to_se3", "se3_to_se2",
     "pose_error", "fit_se3",

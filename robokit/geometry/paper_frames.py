@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, as_points, check_positive
+from ..validation import as_array, as_points, as_positive
 from .planar import as_planar, wrap_angle
 from .rotations import rot_y
 
@@ -182,7 +182,7 @@ def _broadcast(pqt: np.ndarray, points: np.ndarray, name: str) -> None:
                          f"{points.shape}") from None
 
 
-def pqt_rotate_xz(theta: Any, xz: Any, *, check: bool = True) -> np.ndarray:
+def pqt_rotate_xz(theta: Any, xz: Any, *, validate: bool = True) -> np.ndarray:
     """Turn ground-plane points ``(X, Z)`` by the papers' heading ``theta``: ``R(theta) (X, Z)``.
 
     Parameters
@@ -191,7 +191,7 @@ def pqt_rotate_xz(theta: Any, xz: Any, *, check: bool = True) -> np.ndarray:
         Headings (radians); broadcast against the leading axes of ``xz``.
     xz : array_like, shape (..., 2)
         Ground-plane points ``(X, Z)`` (sideways, forward).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` skips it (RANSAC's and the Hough vote's inner loops).
 
     Returns
@@ -218,7 +218,7 @@ def pqt_rotate_xz(theta: Any, xz: Any, *, check: bool = True) -> np.ndarray:
     >>> pqt_rotate_xz(np.zeros((5, 1)), np.ones((40, 2))).shape          # 5 headings x 40 points
     (5, 40, 2)
     """
-    if check:
+    if validate:
         th = as_array(theta, "theta")
         xz = _stack(xz, "xz", 2)
         try:
@@ -236,7 +236,7 @@ def pqt_rotate_xz(theta: Any, xz: Any, *, check: bool = True) -> np.ndarray:
     return out.transpose(*range(1, out.ndim), 0)
 
 
-def pqt_transform_xz(pqt: Any, xz: Any, *, inverse: bool = False, jacobian: bool = False, check: bool = True):
+def pqt_transform_xz(pqt: Any, xz: Any, *, inverse: bool = False, jacobian: bool = False, validate: bool = True):
     """The papers' pose ``[p, q, theta]`` acting on ground-plane points: robot ``(X', Z')`` to world.
 
     Parameters
@@ -249,7 +249,7 @@ def pqt_transform_xz(pqt: Any, xz: Any, *, inverse: bool = False, jacobian: bool
         Map world points into the robot frame instead: ``R(theta)^T ((X, Z) - (p, q))``.
     jacobian : bool, default False
         Also return the derivative with respect to ``[p, q, theta]`` (not with ``inverse``).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` skips it (solvers' inner loops).
 
     Returns
@@ -293,14 +293,14 @@ def pqt_transform_xz(pqt: Any, xz: Any, *, inverse: bool = False, jacobian: bool
     >>> print(pqt_transform_xz([0.0, 0.0, 0.0], [0.0, 2.0], jacobian=True)[1].tolist())
     [[1.0, 0.0, -2.0], [0.0, 1.0, 0.0]]
     """
-    if check:
+    if validate:
         pqt, xz = _stack(pqt, "pqt", 3), _stack(xz, "xz", 2)
         _broadcast(pqt, xz, "xz")
         if inverse and jacobian:
             raise ValueError("inverse, jacobian: expected at most one of them, got both")
     if inverse:
-        return pqt_rotate_xz(-pqt[..., 2], xz - pqt[..., :2], check=False)
-    out = pqt_rotate_xz(pqt[..., 2], xz, check=False)
+        return pqt_rotate_xz(-pqt[..., 2], xz - pqt[..., :2], validate=False)
+    out = pqt_rotate_xz(pqt[..., 2], xz, validate=False)
     if jacobian:
         J = np.zeros(out.shape[:-1] + (2, 3))
         J[..., 0, 0] = J[..., 1, 1] = 1.0
@@ -311,7 +311,7 @@ def pqt_transform_xz(pqt: Any, xz: Any, *, inverse: bool = False, jacobian: bool
     return (out, J) if jacobian else out
 
 
-def pqt_robot_to_world(points: Any, pqt: Any, *, check: bool = True) -> np.ndarray:
+def pqt_robot_to_world(points: Any, pqt: Any, *, validate: bool = True) -> np.ndarray:
     """Map points from the papers' robot frame (X right, Y up, Z forward) to their world frame.
 
     For the papers' pose ``[p, q, theta]`` only: a robokit pose ``[x, y, theta]`` must first go
@@ -323,7 +323,7 @@ def pqt_robot_to_world(points: Any, pqt: Any, *, check: bool = True) -> np.ndarr
         ``(X, Y, Z)``: right, up, forward from the robot (camera).
     pqt : array_like, shape (..., 3)
         Robot pose(s) ``[p, q, theta]``, broadcast against the points' leading axes.
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` skips it.
 
     Returns
@@ -350,10 +350,10 @@ def pqt_robot_to_world(points: Any, pqt: Any, *, check: bool = True) -> np.ndarr
     >>> print(np.round(pqt_robot_to_world([[0.0, 0.5, 1.0]], [2.0, 1.0, np.pi / 2]), 6))
     [[1.  0.5 1. ]]
     """
-    return _points(points, pqt, check, inverse=False)
+    return _points(points, pqt, validate, inverse=False)
 
 
-def pqt_world_to_robot(points: Any, pqt: Any, *, check: bool = True) -> np.ndarray:
+def pqt_world_to_robot(points: Any, pqt: Any, *, validate: bool = True) -> np.ndarray:
     """Map points from the papers' world frame into their robot frame at ``pqt`` (inverse of
     :func:`pqt_robot_to_world`).
 
@@ -362,7 +362,7 @@ def pqt_world_to_robot(points: Any, pqt: Any, *, check: bool = True) -> np.ndarr
     points : array_like, shape (..., 3)
     pqt : array_like, shape (..., 3)
         The papers' pose(s) ``[p, q, theta]`` (not robokit's ``[x, y, theta]``).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` skips it.
 
     Returns
@@ -385,14 +385,14 @@ def pqt_world_to_robot(points: Any, pqt: Any, *, check: bool = True) -> np.ndarr
     >>> print(np.round(pqt_world_to_robot([[1.0, 0.5, 1.0]], [2.0, 1.0, np.pi / 2]), 6))
     [[0.  0.5 1. ]]
     """
-    return _points(points, pqt, check, inverse=True)
+    return _points(points, pqt, validate, inverse=True)
 
 
-def _points(points, pqt, check, inverse):
-    if check:
+def _points(points, pqt, validate, inverse):
+    if validate:
         points, pqt = _stack(points, "points", 3), _stack(pqt, "pqt", 3)
         _broadcast(pqt, points, "points")
-    xz = pqt_transform_xz(pqt, points[..., ::2], inverse=inverse, check=False)
+    xz = pqt_transform_xz(pqt, points[..., ::2], inverse=inverse, validate=False)
     out = np.empty(xz.shape[:-1] + (3,))
     out[..., ::2] = xz
     out[..., 1] = points[..., 1]
@@ -440,7 +440,7 @@ def paper_world_to_robokit(points: Any, covariances: Any = None, camera_height: 
     [[3. 5. 1.]]
     """
     pts = as_array(points, "points", shape=(None, 3))
-    out = pts[:, _PAPER_TO_ROBOKIT] + [0.0, 0.0, check_positive(camera_height, "camera_height")]
+    out = pts[:, _PAPER_TO_ROBOKIT] + [0.0, 0.0, as_positive(camera_height, "camera_height")]
     if covariances is None:
         return out, None
     cov = as_array(covariances, "covariances", shape=(pts.shape[0], 3, 3))

@@ -54,14 +54,14 @@ def as_planar(value: Any, name: str) -> np.ndarray:
     return p
 
 
-def wrap_angle(angle: Any, *, check: bool = True) -> Any:
+def wrap_angle(angle: Any, *, validate: bool = True) -> Any:
     """Wrap angles to the interval [-pi, pi).
 
     Parameters
     ----------
     angle : float or array_like
         Angles in radians (finite).
-    check : bool, default True
+    validate : bool, default True
         Validate ``angle``; ``False`` is the fast path for inner loops whose angles are already
         finite floats (a non-finite angle then comes back NaN instead of raising).
 
@@ -85,7 +85,7 @@ def wrap_angle(angle: Any, *, check: bool = True) -> Any:
     >>> print(round(wrap_angle(3 * np.pi / 2), 6))
     -1.570796
     """
-    a = as_array(angle, "angle") if check else np.asarray(angle, float)
+    a = as_array(angle, "angle") if validate else np.asarray(angle, float)
     out = np.mod(a + np.pi, 2 * np.pi) - np.pi
     return float(out) if out.ndim == 0 else out
 
@@ -97,14 +97,14 @@ def _pair(a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
     return pa, pb
 
 
-def se2_compose(a: Any, b: Any, *, check: bool = True) -> np.ndarray:
+def se2_compose(a: Any, b: Any, *, validate: bool = True) -> np.ndarray:
     """Compose planar poses: the pose ``b`` expressed in frame ``a``, mapped to the world.
 
     Parameters
     ----------
     a, b : array_like, shape (3,) or (N, 3)
         Poses ``[x, y, theta]``; a single pose broadcasts against a stack.
-    check : bool, default True
+    validate : bool, default True
         Validate both; ``False`` skips it (float arrays only).
 
     Returns
@@ -132,7 +132,7 @@ def se2_compose(a: Any, b: Any, *, check: bool = True) -> np.ndarray:
     [[0.9      2.2      2.070796]
      [1.1      2.2      1.070796]]
     """
-    pa, pb = _pair(a, b) if check else (a, b)
+    pa, pb = _pair(a, b) if validate else (a, b)
     c, s = np.cos(pa[..., 2]), np.sin(pa[..., 2])
     return np.stack([pa[..., 0] + c * pb[..., 0] - s * pb[..., 1], pa[..., 1] + s * pb[..., 0] + c * pb[..., 1],
                      wrap_angle(pa[..., 2] + pb[..., 2])], axis=-1)
@@ -206,7 +206,7 @@ def se2_between(a: Any, b: Any) -> np.ndarray:
      [1.005 0.    0.1  ]]
     """
     pa, pb = _pair(a, b)
-    return se2_compose(se2_inverse(pa), pb, check=False)
+    return se2_compose(se2_inverse(pa), pb, validate=False)
 
 
 def se2_to_matrix(pose: Any) -> np.ndarray:

@@ -71,7 +71,7 @@ def _rotation_2d(cov: np.ndarray, gap: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return R, degenerate
 
 
-def fit_rigid(source: Any, target: Any, weights: Any = None, *, check: bool = True) -> RigidFit:
+def fit_rigid(source: Any, target: Any, weights: Any = None, *, validate: bool = True) -> RigidFit:
     """Weighted least-squares rotation and translation taking ``source`` onto ``target``.
 
     Parameters
@@ -81,7 +81,7 @@ def fit_rigid(source: Any, target: Any, weights: Any = None, *, check: bool = Tr
     weights : array_like, shape (..., N), optional
         Non-negative weight per correspondence (default: all 1); a zero weight drops a point (a
         MoCap marker that was not seen).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs and raise :class:`DegenerateFitError` for a degenerate problem;
         ``False`` is the fast path (float arrays of matching shapes, positive weight sums): the
         result's ``degenerate`` flags say which problems have no unique rotation.
@@ -95,7 +95,7 @@ def fit_rigid(source: Any, target: Any, weights: Any = None, *, check: bool = Tr
     Raises
     ------
     DegenerateFitError
-        (With ``check``; a ``ValueError``) for fewer than ``d`` points, or points that do not fix
+        (With ``validate``; a ``ValueError``) for fewer than ``d`` points, or points that do not fix
         the rotation: the correlation matrix of Eq. (38) has rank below ``d - 1`` (all points
         coincide; in 3-D all lie on a line), or a reflection fits better and its two smallest
         singular values are equal (then no rotation is unique). "Below" and "equal" are relative to
@@ -127,7 +127,7 @@ def fit_rigid(source: Any, target: Any, weights: Any = None, *, check: bool = Tr
     ...
     robokit.geometry.procrustes.DegenerateFitError: source, target: expected points that fix the rotation (not all coincident; in 3-D not all on one line), got a degenerate set (problem 0)
     """
-    if check:
+    if validate:
         s = as_array(source, "source")
         if s.ndim < 2 or s.shape[-1] not in (2, 3):
             raise ValueError(f"source: expected shape (..., N, 2) or (..., N, 3), got shape {s.shape}")
@@ -165,7 +165,7 @@ def fit_rigid(source: Any, target: Any, weights: Any = None, *, check: bool = Tr
         degenerate = ((gap <= 0) | (sv[..., d - 2] <= gap)
                       | ((sign < 0) & (sv[..., d - 2] - sv[..., d - 1] <= gap)))
     trans = mu_t - np.einsum("...ij,...j->...i", R, mu_s)                         # Eq. (41), c = 1
-    if check and np.any(degenerate):
+    if validate and np.any(degenerate):
         i = int(np.argmax(degenerate.reshape(-1)))
         names = "source, target" if weights is None else "source, target, weights"
         raise DegenerateFitError(f"{names}: expected points that fix the rotation (not all coincident; "
@@ -173,7 +173,7 @@ def fit_rigid(source: Any, target: Any, weights: Any = None, *, check: bool = Tr
     return RigidFit(R, trans, degenerate)
 
 
-def fit_se2(source: Any, target: Any, weights: Any = None, *, check: bool = True) -> np.ndarray:
+def fit_se2(source: Any, target: Any, weights: Any = None, *, validate: bool = True) -> np.ndarray:
     """Least-squares planar pose taking ``source`` points onto ``target`` points (2-D Procrustes).
 
     Parameters
@@ -182,7 +182,7 @@ def fit_se2(source: Any, target: Any, weights: Any = None, *, check: bool = True
         Corresponding points, N >= 2; leading axes are a batch of independent problems.
     weights : array_like, shape (..., N), optional
         Non-negative weight per correspondence (default: all 1).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs and refuse a degenerate set; ``False`` (float arrays of matching shapes
         only) is the fast path that RANSAC loops take: a degenerate set then gives ``theta = 0``.
 
@@ -195,7 +195,7 @@ def fit_se2(source: Any, target: Any, weights: Any = None, *, check: bool = True
     Raises
     ------
     DegenerateFitError
-        (A ``ValueError``, with ``check``) for fewer than two points, or points that all coincide,
+        (A ``ValueError``, with ``validate``) for fewer than two points, or points that all coincide,
         which leave the heading undetermined.
     ValueError
         For shapes that do not agree, NaN/inf, or negative or all-zero weights.
@@ -217,16 +217,16 @@ def fit_se2(source: Any, target: Any, weights: Any = None, *, check: bool = True
     >>> print(np.round(fit_se2(src, tgt), 6))
     [1.  2.  0.5]
     """
-    if check:
+    if validate:
         s = as_array(source, "source")
         if s.ndim < 2 or s.shape[-1] != 2:
             raise ValueError(f"source: expected shape (..., N, 2) with N >= 2, got shape {s.shape}")
         source = s
-    R, t, _ = fit_rigid(source, target, weights, check=check)
+    R, t, _ = fit_rigid(source, target, weights, validate=validate)
     return np.stack([t[..., 0], t[..., 1], wrap_angle(np.arctan2(R[..., 1, 0], R[..., 0, 0]))], axis=-1)
 
 
-def fit_se3(source: Any, target: Any, weights: Any = None, *, check: bool = True) -> np.ndarray:
+def fit_se3(source: Any, target: Any, weights: Any = None, *, validate: bool = True) -> np.ndarray:
     """Least-squares rigid transform taking ``source`` points onto ``target`` points (3-D Procrustes).
 
     Parameters
@@ -236,7 +236,7 @@ def fit_se3(source: Any, target: Any, weights: Any = None, *, check: bool = True
         independent problems (one per MoCap frame, say).
     weights : array_like, shape (..., N), optional
         Non-negative weight per correspondence (default: all 1); zero drops a point.
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs and refuse a degenerate set; ``False`` (float arrays of matching shapes,
         positive weight sums) is the fast path: a degenerate set then gives one of its minimisers.
 
@@ -250,7 +250,7 @@ def fit_se3(source: Any, target: Any, weights: Any = None, *, check: bool = True
     Raises
     ------
     DegenerateFitError
-        (A ``ValueError``, with ``check``) for fewer than three points, or points that coincide or
+        (A ``ValueError``, with ``validate``) for fewer than three points, or points that coincide or
         lie on one line (a rotation about that line is then free).
     ValueError
         For shapes that do not agree, NaN/inf, or negative or all-zero weights.
@@ -276,12 +276,12 @@ def fit_se3(source: Any, target: Any, weights: Any = None, *, check: bool = True
      [ 0.        0.        1.        0.13    ]
      [ 0.        0.        0.        1.      ]]
     """
-    if check:
+    if validate:
         s = as_array(source, "source")
         if s.ndim < 2 or s.shape[-1] != 3:
             raise ValueError(f"source: expected shape (..., N, 3) with N >= 3, got shape {s.shape}")
         source = s
-    R, t, _ = fit_rigid(source, target, weights, check=check)
+    R, t, _ = fit_rigid(source, target, weights, validate=validate)
     T = np.zeros(R.shape[:-2] + (4, 4))
     T[..., :3, :3], T[..., :3, 3], T[..., 3, 3] = R, t, 1.0
     return T

@@ -3,7 +3,7 @@
 Every function works on one rotation or on a stack: rotation vectors have shape ``(..., 3)`` and
 rotation matrices ``(..., 3, 3)``; angles of the elementary rotations may be arrays of any shape.
 Rotations are right-handed (a positive angle turns counter-clockwise when the axis points at the
-viewer). Functions that solvers call in loops take ``check=False`` to skip validation.
+viewer). Functions that solvers call in loops take ``validate=False`` to skip validation.
 
 References
 ----------
@@ -20,7 +20,7 @@ from scipy.spatial.transform import Rotation
 
 from ..validation import array_ndim, as_array
 
-__all__ = ["ROTATION_TOL", "as_rotation", "check_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y", "rot_z",
+__all__ = ["ROTATION_TOL", "as_rotation", "require_rotation_block", "skew", "so3_exp", "so3_log", "rot_x", "rot_y", "rot_z",
            "euler_matrix", "zyz_angles", "quat_to_matrix"]
 
 #: Default tolerance on ``|R^T R - I|`` and ``|det R - 1|`` when a rotation is checked.
@@ -70,11 +70,11 @@ def as_rotation(value: Any, name: str, *, dim: int = 3, batch: bool = False, tol
     R = as_array(value, name, shape=(dim, dim) if one else (None, dim, dim))
     if batch and one:
         R = R[None]
-    check_rotation_block(R, name, tol, indexed=batch)
+    require_rotation_block(R, name, tol, indexed=batch)
     return R
 
 
-def check_rotation_block(R: np.ndarray, name: str, tol: float = ROTATION_TOL, *, indexed: bool = False) -> None:
+def require_rotation_block(R: np.ndarray, name: str, tol: float = ROTATION_TOL, *, indexed: bool = False) -> None:
     """Raise if any matrix of a float stack ``R`` (..., n, n) is not a rotation within ``tol``.
 
     The kernel of :func:`as_rotation` for callers that have already checked the shape and finiteness
@@ -94,7 +94,7 @@ def check_rotation_block(R: np.ndarray, name: str, tol: float = ROTATION_TOL, *,
     --------
     A stack whose second matrix is scaled by 1.01 (a shear or scale, not a rotation):
 
-    >>> check_rotation_block(np.stack([np.eye(3), 1.01 * np.eye(3)]), "R", indexed=True)
+    >>> require_rotation_block(np.stack([np.eye(3), 1.01 * np.eye(3)]), "R", indexed=True)
     Traceback (most recent call last):
     ...
     ValueError: R: expected a rotation matrix with R^T R = I and det R = 1 (tolerance 1e-06), got max |R^T R - I| = 0.0201 and det = 1.0303 at index 1
@@ -110,13 +110,13 @@ def check_rotation_block(R: np.ndarray, name: str, tol: float = ROTATION_TOL, *,
                          + (f" at index {i}" if indexed else ""))
 
 
-def skew(v: Any, *, check: bool = True) -> np.ndarray:
+def skew(v: Any, *, validate: bool = True) -> np.ndarray:
     """Return the skew-symmetric matrix ``[v]`` with ``[v] x = v x x`` (cross product).
 
     Parameters
     ----------
     v : array_like, shape (..., 3)
-    check : bool, default True
+    validate : bool, default True
         Validate ``v``; ``False`` skips it (for solvers' inner loops).
 
     Returns
@@ -137,7 +137,7 @@ def skew(v: Any, *, check: bool = True) -> np.ndarray:
     >>> skew([1.0, 2.0, 3.0]).tolist()
     [[0.0, -3.0, 2.0], [3.0, 0.0, -1.0], [-2.0, 1.0, 0.0]]
     """
-    v = _vectors(v, "v") if check else np.asarray(v, dtype=float)
+    v = _vectors(v, "v") if validate else np.asarray(v, dtype=float)
     z = np.zeros(v.shape[:-1])
     return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1),
                      np.stack([v[..., 2], z, -v[..., 0]], -1),
@@ -155,17 +155,17 @@ def _rotations(R: Any, tol: float) -> np.ndarray:
     R = as_array(R, "R")
     if R.ndim < 2 or R.shape[-2:] != (3, 3):
         raise ValueError(f"R: expected rotation matrices, shape (..., 3, 3), got shape {R.shape}")
-    check_rotation_block(R, "R", tol, indexed=R.ndim > 2)
+    require_rotation_block(R, "R", tol, indexed=R.ndim > 2)
     return R
 
 
-def so3_exp(rotvec: Any, *, check: bool = True) -> np.ndarray:
+def so3_exp(rotvec: Any, *, validate: bool = True) -> np.ndarray:
     """Rotation matrices of rotation vectors (axis times angle, radians): Rodrigues' formula.
 
     Parameters
     ----------
     rotvec : array_like, shape (..., 3)
-    check : bool, default True
+    validate : bool, default True
         Validate the input; ``False`` skips it.
 
     Returns
@@ -192,24 +192,24 @@ def so3_exp(rotvec: Any, *, check: bool = True) -> np.ndarray:
     >>> so3_exp(np.zeros((5, 3))).shape
     (5, 3, 3)
     """
-    v = _vectors(rotvec, "rotvec") if check else np.asarray(rotvec, dtype=float)
+    v = _vectors(rotvec, "rotvec") if validate else np.asarray(rotvec, dtype=float)
     t2 = np.einsum("...i,...i->...", v, v)
     t = np.sqrt(t2)
     small = t < 1e-6
     ts = np.where(small, 1.0, t)
     a = np.where(small, 1.0 - t2 / 6.0, np.sin(ts) / ts)                       # sin t / t
     b = np.where(small, 0.5 - t2 / 24.0, 2.0 * np.sin(0.5 * ts) ** 2 / ts**2)  # (1 - cos t) / t^2
-    K = skew(v, check=False)
+    K = skew(v, validate=False)
     return _EYE3 + a[..., None, None] * K + b[..., None, None] * (K @ K)
 
 
-def so3_log(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.ndarray:
+def so3_log(R: Any, *, validate: bool = True, tol: float = ROTATION_TOL) -> np.ndarray:
     """Rotation vectors (axis times angle in [0, pi]) of rotation matrices: the SO(3) logarithm.
 
     Parameters
     ----------
     R : array_like, shape (..., 3, 3)
-    check : bool, default True
+    validate : bool, default True
         Check that every matrix is a rotation (within ``tol``); ``False`` skips it.
     tol : float, default :data:`ROTATION_TOL`
 
@@ -236,7 +236,7 @@ def so3_log(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.ndar
     >>> print(np.round(np.linalg.norm(so3_log(rot_x(np.pi))), 6))
     3.141593
     """
-    R = _rotations(R, tol) if check else np.asarray(R, dtype=float)
+    R = _rotations(R, tol) if validate else np.asarray(R, dtype=float)
     vee = np.empty(R.shape[:-2] + (3,))
     np.subtract(R[..., 2, 1], R[..., 1, 2], out=vee[..., 0])
     np.subtract(R[..., 0, 2], R[..., 2, 0], out=vee[..., 1])
@@ -368,13 +368,13 @@ def euler_matrix(angles: Any, seq: str = "xyz") -> np.ndarray:
     return Rotation.from_euler(seq, a).as_matrix()
 
 
-def zyz_angles(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.ndarray:
+def zyz_angles(R: Any, *, validate: bool = True, tol: float = ROTATION_TOL) -> np.ndarray:
     """ZYZ Euler angles ``(a, b, c)`` of rotations ``R = rot_z(a) @ rot_y(b) @ rot_z(c)``.
 
     Parameters
     ----------
     R : array_like, shape (..., 3, 3)
-    check : bool, default True
+    validate : bool, default True
         Check that every matrix is a rotation (within ``tol``); ``False`` skips it (the analytic IK
         calls it on thousands of arm angles per target).
     tol : float, default :data:`ROTATION_TOL`
@@ -405,7 +405,7 @@ def zyz_angles(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.n
     >>> print(np.round(zyz_angles(rot_z(0.3) @ rot_z(0.4)), 6))       # b = 0: a + c only
     [0.  0.  0.7]
     """
-    R = _rotations(R, tol) if check else np.asarray(R, dtype=float)
+    R = _rotations(R, tol) if validate else np.asarray(R, dtype=float)
     m02, m12 = R[..., 0, 2], R[..., 1, 2]
     sb = np.hypot(m02, m12)
     out = np.empty((3,) + sb.shape)                  # a, b, c: each a contiguous block
@@ -419,7 +419,7 @@ def zyz_angles(R: Any, *, check: bool = True, tol: float = ROTATION_TOL) -> np.n
     return out.transpose(*range(1, out.ndim), 0)
 
 
-def quat_to_matrix(quat: Any, *, check: bool = True) -> np.ndarray:
+def quat_to_matrix(quat: Any, *, validate: bool = True) -> np.ndarray:
     """Rotation matrices of quaternions ``[w, x, y, z]`` (scalar first, MuJoCo's order).
 
     Parameters
@@ -429,7 +429,7 @@ def quat_to_matrix(quat: Any, *, check: bool = True) -> np.ndarray:
         huge and tiny ones do not overflow), so one a little off unit length (rounding in a
         simulator's integration) still gives a proper rotation. ``q`` and ``-q`` give the same
         matrix.
-    check : bool, default True
+    validate : bool, default True
         Validate the input (shape, finite values, not zero); ``False`` skips it.
 
     Returns
@@ -459,11 +459,11 @@ def quat_to_matrix(quat: Any, *, check: bool = True) -> np.ndarray:
     >>> quat_to_matrix(np.tile([1.0, 0.0, 0.0, 0.0], (5, 1))).shape
     (5, 3, 3)
     """
-    q = as_array(quat, "quat") if check else np.asarray(quat, dtype=float)
-    if check and (q.ndim == 0 or q.shape[-1] != 4):
+    q = as_array(quat, "quat") if validate else np.asarray(quat, dtype=float)
+    if validate and (q.ndim == 0 or q.shape[-1] != 4):
         raise ValueError(f"quat: expected quaternions [w, x, y, z], shape (..., 4), got shape {q.shape}")
     big = np.max(np.abs(q), axis=-1, keepdims=True)
-    if check and np.any(big == 0):
+    if validate and np.any(big == 0):
         raise ValueError("quat: expected non-zero quaternions (a zero one is no rotation), got [0, 0, 0, 0]")
     q = q / big
     w, x, y, z = np.moveaxis(q / np.linalg.norm(q, axis=-1, keepdims=True), -1, 0)

@@ -4,7 +4,7 @@ the pose error that inverse kinematics drives to zero.
 
 Functions take one transform ``(4, 4)`` or, where the docstring says so, a stack ``(N, 4, 4)``.
 :func:`as_se3` is the one SE(3) validator of robokit; functions that solvers call in loops take
-``check=False`` to skip it.
+``validate=False`` to skip it.
 
 References
 ----------
@@ -19,9 +19,9 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import array_ndim, as_array, as_points, check_finite_scalar
+from ..validation import array_ndim, as_array, as_points, as_finite_scalar
 from .planar import as_planar
-from .rotations import ROTATION_TOL, as_rotation, check_rotation_block, rot_z, so3_log
+from .rotations import ROTATION_TOL, as_rotation, require_rotation_block, rot_z, so3_log
 
 __all__ = ["as_se3", "se3_from_rt", "se3_inverse", "se3_compose", "transform_points", "se2_to_se3",
            "se3_to_se2", "pose_error"]
@@ -77,7 +77,7 @@ def as_se3(value: Any, name: str, *, batch: bool = False, tol: float = ROTATION_
         i = int(np.argmax(np.atleast_1d(last_dev)))
         raise ValueError(f"{name}: expected an SE(3) matrix with last row [0, 0, 0, 1], got "
                          f"{np.asarray(T[..., 3, :]).reshape(-1, 4)[i].tolist()}" + (f" at index {i}" if batch else ""))
-    check_rotation_block(T[..., :3, :3], f"{name}[:3, :3]", tol, indexed=batch)
+    require_rotation_block(T[..., :3, :3], f"{name}[:3, :3]", tol, indexed=batch)
     return T
 
 
@@ -191,14 +191,14 @@ def se3_compose(*transforms: Any) -> np.ndarray:
     return out
 
 
-def transform_points(transform: Any, points: Any, *, check: bool = True) -> np.ndarray:
+def transform_points(transform: Any, points: Any, *, validate: bool = True) -> np.ndarray:
     """Apply a 4x4 rigid transform to points: ``R p + t`` for each row of ``points``.
 
     Parameters
     ----------
     transform : array_like, shape (4, 4)
     points : array_like, shape (N, 3) or (3,)
-    check : bool, default True
+    validate : bool, default True
         Validate both arguments; ``False`` skips it (the caller passes a float (4, 4) transform and
         (N, 3) points).
 
@@ -221,7 +221,7 @@ def transform_points(transform: Any, points: Any, *, check: bool = True) -> np.n
     >>> print(np.round(transform_points(T, [1.0, 0.0, 0.0]), 6))
     [[1. 1. 0.]]
     """
-    if check:
+    if validate:
         T = as_se3(transform, "transform")
         P = as_points(points, "points", 3)
     else:
@@ -264,7 +264,7 @@ def se2_to_se3(pose: Any, z: float = 0.0) -> np.ndarray:
     p = as_planar(pose, "pose")
     T = np.zeros(p.shape[:-1] + (4, 4))
     T[..., :3, :3] = rot_z(p[..., 2])
-    T[..., 0, 3], T[..., 1, 3], T[..., 2, 3], T[..., 3, 3] = p[..., 0], p[..., 1], check_finite_scalar(z, "z"), 1.0
+    T[..., 0, 3], T[..., 1, 3], T[..., 2, 3], T[..., 3, 3] = p[..., 0], p[..., 1], as_finite_scalar(z, "z"), 1.0
     return T
 
 
@@ -298,14 +298,14 @@ def se3_to_se2(transform: Any) -> np.ndarray:
     return np.stack([T[..., 0, 3], T[..., 1, 3], np.arctan2(T[..., 1, 0], T[..., 0, 0])], axis=-1)
 
 
-def pose_error(T_target: Any, T: Any, *, check: bool = True) -> np.ndarray:
+def pose_error(T_target: Any, T: Any, *, validate: bool = True) -> np.ndarray:
     """Return the 6-vector pose error ``[p_t - p, log(R_t R^T)]`` in the base frame.
 
     Parameters
     ----------
     T_target, T : array_like, shape (4, 4) or (N, 4, 4)
         Desired and current transforms (a single one broadcasts against a stack).
-    check : bool, default True
+    validate : bool, default True
         Validate both; ``False`` skips it (solvers' inner loops, on float arrays).
 
     Returns
@@ -331,12 +331,12 @@ def pose_error(T_target: Any, T: Any, *, check: bool = True) -> np.ndarray:
     >>> print(np.round(pose_error(T, np.eye(4)), 6))
     [0.1 0.  0.  0.  0.  0.3]
     """
-    if check:
+    if validate:
         T_target = as_se3(T_target, "T_target", batch=array_ndim(T_target, "T_target") == 3)
         T = as_se3(T, "T", batch=array_ndim(T, "T") == 3)
         if T_target.ndim == 3 and T.ndim == 3 and len(T_target) != len(T):
             raise ValueError(f"T_target, T: expected stacks of equal length, got {len(T_target)} and {len(T)}")
-    dw = so3_log(T_target[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2), check=False)
+    dw = so3_log(T_target[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2), validate=False)
     out = np.empty(dw.shape[:-1] + (6,))
     np.subtract(T_target[..., :3, 3], T[..., :3, 3], out=out[..., :3])
     out[..., 3:] = dw

@@ -37,7 +37,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..validation import array_ndim, as_array, broadcast_to, check_positive, check_sample_count
+from ..validation import array_ndim, as_array, broadcast_to, as_positive, require_sample_count
 from .gait_schedule import (CRAWL_SEQUENCE, TROT_PAIRS, GaitSchedule, as_gait_schedule, crawl_gait,
                             stance_pattern, trot_gait)
 from .littledog import LEGS, STANCE_FEET, STANDING_HEIGHT
@@ -102,7 +102,7 @@ def swing_trajectory(p_start: Any, p_end: Any, phase: Any, height: float) -> np.
         raise ValueError(f"phase: expected a scalar or shape (M,), got shape {u.shape}")
     if not np.all((u >= 0) & (u <= 1)):
         raise ValueError(f"phase: expected fractions of the swing in [0, 1], got values from {u.min()} to {u.max()}")
-    h = check_positive(height, "height", allow_zero=True)
+    h = as_positive(height, "height", allow_zero=True)
     shape = np.broadcast_shapes(u.shape, a.shape[:-1], b.shape[:-1]) if _broadcasts(u, a, b) else None
     if shape is None:
         raise ValueError(f"phase, p_start, p_end: expected one phase per position (M,) with (M, 3) or (3,), "
@@ -216,7 +216,7 @@ def _nearest_point_inside(triangle: np.ndarray, inset: float, point: np.ndarray,
                          f"lifts, got {inset:.4f} (shorter steps or a wider stance make room)")
     incentre = side @ triangle / side.sum()
     inner = incentre + (r - inset) / r * (triangle - incentre)        # shrinking about the incentre keeps edges parallel
-    near, inside = nearest_boundary_point(inner, point, check=False)
+    near, inside = nearest_boundary_point(inner, point, validate=False)
     return point if inside >= 0 else near
 
 
@@ -301,17 +301,17 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     0.02
     """
     schedule = as_gait_schedule(schedule)
-    distance = check_positive(distance, "distance")
+    distance = as_positive(distance, "distance")
     feet0 = _standing_feet(nominal_feet)
-    height = check_positive(body_height, "body_height")
-    dt = check_positive(dt, "dt")
-    settle = check_positive(settle, "settle", allow_zero=True)
-    margin = check_positive(margin, "margin")
+    height = as_positive(body_height, "body_height")
+    dt = as_positive(dt, "dt")
+    settle = as_positive(settle, "settle", allow_zero=True)
+    margin = as_positive(margin, "margin")
     T, beta = schedule.period, schedule.duty_factor
     if not distance / schedule.step_length <= MAX_STEPS:
         raise ValueError(f"distance, schedule: expected at most {MAX_STEPS} steps of step_length, got "
                          f"{distance / schedule.step_length:.3g}")
-    check_sample_count((2 * settle + (distance / schedule.step_length + 4) * T) / dt, "distance, dt, settle, schedule")
+    require_sample_count((2 * settle + (distance / schedule.step_length + 4) * T) / dt, "distance, dt, settle, schedule")
 
     static = schedule.max_swinging == 1
     gaps = np.diff(np.sort(schedule.phase_offsets), append=schedule.phase_offsets.min() + 1) * T

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_positive, check_text, describe
+from ..validation import as_array, as_positive, as_text, describe
 from .littledog import LEGS
 
 __all__ = ["GaitSchedule", "crawl_gait", "trot_gait", "stance_pattern", "as_gait_schedule", "CRAWL_SEQUENCE", "TROT_PAIRS"]
@@ -85,9 +85,9 @@ class GaitSchedule:
     step_height: float
 
     def __post_init__(self) -> None:
-        check_text(self.name, "name", empty=False)
-        period = check_positive(self.period, "period")
-        beta = check_positive(self.duty_factor, "duty_factor")
+        as_text(self.name, "name", empty=False)
+        period = as_positive(self.period, "period")
+        beta = as_positive(self.duty_factor, "duty_factor")
         if not beta < 1:
             raise ValueError(f"duty_factor: expected a fraction of the cycle in (0, 1), got {beta}")
         offsets = as_array(self.phase_offsets, "phase_offsets", shape=(4,)).copy()
@@ -95,8 +95,8 @@ class GaitSchedule:
             raise ValueError(f"phase_offsets: expected fractions of the cycle in [0, 1), got {offsets.tolist()}")
         offsets.setflags(write=False)
         for name, value in (("period", period), ("duty_factor", beta), ("phase_offsets", offsets),
-                            ("step_length", check_positive(self.step_length, "step_length")),
-                            ("step_height", check_positive(self.step_height, "step_height", allow_zero=True))):
+                            ("step_length", as_positive(self.step_length, "step_length")),
+                            ("step_height", as_positive(self.step_height, "step_height", allow_zero=True))):
             object.__setattr__(self, name, value)
 
     @property
@@ -158,7 +158,7 @@ def crawl_gait(period: float = 4.0, step_length: float = 0.08, step_height: floa
     >>> dict(zip(("FL", "FR", "HL", "HR"), g.phase_offsets.tolist()))
     {'FL': 0.25, 'FR': 0.75, 'HL': 0.0, 'HR': 0.5}
     """
-    beta = check_positive(duty_factor, "duty_factor")
+    beta = as_positive(duty_factor, "duty_factor")
     if not beta >= 0.75:
         raise ValueError(f"duty_factor: expected >= 0.75 for a crawl (one leg up at a time), got {beta}")
     offsets = np.zeros(4)
@@ -203,7 +203,7 @@ def trot_gait(period: float = 0.5, step_length: float = 0.06, step_height: float
     >>> trot_gait().phase_offsets.tolist()
     [0.0, 0.5, 0.5, 0.0]
     """
-    beta = check_positive(duty_factor, "duty_factor")
+    beta = as_positive(duty_factor, "duty_factor")
     if not beta >= 0.5:
         raise ValueError(f"duty_factor: expected >= 0.5 for a walking trot (no flight phase), got {beta}")
     offsets = np.zeros(4)

@@ -33,7 +33,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import as_rotation, so3_exp
-from ..validation import as_array, as_rng, check_finite_result, check_positive
+from ..validation import as_array, as_rng, require_finite_result, as_positive
 
 __all__ = ["GRAVITY", "ImuReadings", "simulate_imu", "integrate_gyro", "specific_force", "as_vector_series"]
 
@@ -124,14 +124,14 @@ def simulate_imu(omega_body: Any, specific_force_body: Any, rng: Any = None, *, 
     """
     w = as_vector_series(omega_body, "omega_body")
     f = as_vector_series(specific_force_body, "specific_force_body", len(w))
-    sg = check_positive(gyro_noise, "gyro_noise", allow_zero=True)
-    sa = check_positive(acc_noise, "acc_noise", allow_zero=True)
+    sg = as_positive(gyro_noise, "gyro_noise", allow_zero=True)
+    sa = as_positive(acc_noise, "acc_noise", allow_zero=True)
     bg, ba = _bias(gyro_bias, "gyro_bias"), _bias(acc_bias, "acc_bias")
     gen = as_rng(rng)
     gyro = w + bg + gen.normal(0.0, 1.0, w.shape) * sg
     acc = f + ba + gen.normal(0.0, 1.0, f.shape) * sa
-    check_finite_result("omega_body, gyro_noise, gyro_bias", gyro)
-    check_finite_result("specific_force_body, acc_noise, acc_bias", acc)
+    require_finite_result("omega_body, gyro_noise, gyro_bias", gyro)
+    require_finite_result("specific_force_body, acc_noise, acc_bias", acc)
     return ImuReadings(gyro, acc)
 
 
@@ -174,9 +174,9 @@ def integrate_gyro(R0: Any, gyro: Any, dt: float) -> np.ndarray:
     """
     R = as_rotation(R0, "R0")
     w = as_vector_series(gyro, "gyro")
-    step = check_positive(dt, "dt")
-    incr = so3_exp(w[1:] * step, check=False)
-    check_finite_result("gyro, dt", incr)
+    step = as_positive(dt, "dt")
+    incr = so3_exp(w[1:] * step, validate=False)
+    require_finite_result("gyro, dt", incr)
     out = np.empty((len(w), 3, 3))
     out[0] = R
     for k in range(1, len(w)):
@@ -220,7 +220,7 @@ def specific_force(acc_world: Any, R_world_body: Any, g: float = GRAVITY) -> np.
     R = as_rotation(R_world_body, "R_world_body", batch=True)
     if len(R) != len(a):
         raise ValueError(f"R_world_body: expected {len(a)} rotations (one per acceleration), got {len(R)}")
-    gz = check_positive(g, "g", allow_zero=True)
+    gz = as_positive(g, "g", allow_zero=True)
     out = np.einsum("nji,nj->ni", R, a + [0.0, 0.0, gz])
-    check_finite_result("acc_world, g", out)
+    require_finite_result("acc_world, g", out)
     return out

@@ -34,7 +34,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import as_se3
-from ..validation import as_array, as_rng, check_int, describe
+from ..validation import as_array, as_rng, as_int, describe
 from .littledog import HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, LEGS, LOWER_LEG, UPPER_LEG
 
 __all__ = ["KNEE_BRANCH", "UnreachableFootError", "leg_index", "foot_position", "leg_points",
@@ -63,7 +63,7 @@ def leg_index(leg: Any) -> int:
         if leg not in LEGS:
             raise ValueError(f"leg: expected one of {LEGS} or 0-3, got {leg!r}")
         return LEGS.index(leg)
-    return check_int(leg, "leg", minimum=0, maximum=3)
+    return as_int(leg, "leg", minimum=0, maximum=3)
 
 
 def _side(i: int) -> float:
@@ -335,7 +335,7 @@ def reachable_workspace(leg: Any, n: int = 20000, *, rng: Any = 0, branch: Any =
     True
     """
     i = leg_index(leg)
-    n = check_int(n, "n", minimum=1, maximum=10_000_000)
+    n = as_int(n, "n", minimum=1, maximum=10_000_000)
     g = as_rng(rng)
     b = KNEE_BRANCH[i] if branch is None else int(_branch(branch, i, 1)[0])
     lim = JOINT_LIMITS[3 * i:3 * i + 3]
@@ -368,7 +368,7 @@ def body_fk(q: Any) -> np.ndarray:
     return np.stack([_chain(legs[..., i, :], i)[2] for i in range(4)], axis=-2)
 
 
-def body_ik(feet: Any, T_world_body: Any = None, *, check: bool = True) -> LegIK:
+def body_ik(feet: Any, T_world_body: Any = None, *, validate: bool = True) -> LegIK:
     """Joint angles that put the four feet at given points: the host's set-points for a body pose.
 
     Parameters
@@ -377,7 +377,7 @@ def body_ik(feet: Any, T_world_body: Any = None, *, check: bool = True) -> LegIK
         Foot centres, in the world frame if ``T_world_body`` is given, else in the body frame (m).
     T_world_body : array_like, shape (N, 4, 4) or (4, 4), optional
         Where the body is (or is planned to be).
-    check : bool, default True
+    validate : bool, default True
         Validate inputs; ``False`` is the fast path for the host loop.
 
     Returns
@@ -393,7 +393,7 @@ def body_ik(feet: Any, T_world_body: Any = None, *, check: bool = True) -> LegIK
     >>> bool(ok[0]), np.allclose(body_fk(q[0]), STANCE_FEET)
     (True, True)
     """
-    if check:
+    if validate:
         f = as_array(feet, "feet")
         single = f.ndim == 2
         f = f[None] if single else f

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_finite_result, describe
+from ..validation import as_array, require_finite_result, describe
 from .leg_kinematics import foot_jacobian
 
 __all__ = ["torques_from_foot_force", "foot_force_from_torques"]
@@ -60,7 +60,7 @@ def torques_from_foot_force(q_leg: Any, force: Any, leg: Any) -> np.ndarray:
     f = _vectors(force, "force", J.shape[:-2])
     with np.errstate(over="ignore", invalid="ignore"):
         tau = np.einsum("...ji,...j->...i", J, f)  # Eq. (2.98)
-    check_finite_result("force", tau)
+    require_finite_result("force", tau)
     return tau
 
 
@@ -107,5 +107,5 @@ def foot_force_from_torques(q_leg: Any, tau: Any, leg: Any, gravity_torque: Any 
     JT = np.swapaxes(J, -1, -2)
     with np.errstate(over="ignore", invalid="ignore"):
         f = -np.linalg.solve(JT, t[..., None])[..., 0]
-    check_finite_result("tau, gravity_torque", f)
+    require_finite_result("tau, gravity_torque", f)
     return f

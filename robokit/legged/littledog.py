@@ -43,7 +43,7 @@ import functools
 import numpy as np
 
 from ..controllers.dc_motor import DCMotor, reflected_inertia
-from ..validation import check_finite_scalar, check_positive
+from ..validation import as_finite_scalar, as_positive
 
 __all__ = ["LEGS", "JOINTS", "JOINT_NAMES", "GUIDE", "HIP_POSITIONS", "HIP_OFFSET", "UPPER_LEG",
            "LOWER_LEG", "FOOT_RADIUS", "TRUNK_SIZE", "TRUNK_MASS", "LEG_MASSES", "TOTAL_MASS",
@@ -186,16 +186,16 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
     >>> model.nu, model.nq, round(float(sum(model.body_mass)), 4)
     (12, 19, 3.0)
     """
-    armature = check_positive(armature, "armature", allow_zero=True)
-    damping = check_positive(damping, "damping", allow_zero=True)
+    armature = as_positive(armature, "armature", allow_zero=True)
+    damping = as_positive(damping, "damping", allow_zero=True)
     if motor is not None:
         if not isinstance(motor, DCMotor):
             raise TypeError(f"motor: expected a DCMotor or None, got {type(motor).__name__}")
         if damping:
             raise ValueError(f"damping: expected 0 with a motor (its damping holds the joint's friction), got {damping}")
         armature = armature or reflected_inertia(motor)
-    friction = check_positive(friction, "friction")
-    timestep = check_positive(timestep, "timestep")
+    friction = as_positive(friction, "friction")
+    timestep = as_positive(timestep, "timestep")
     if timestep > 0.01:
         raise ValueError(f"timestep: expected at most 0.01 s (the host period), got {timestep}")
     legs = "".join(_leg_xml(i, armature, damping) for i in range(4))
@@ -265,7 +265,7 @@ def littledog_model(*, armature: float = 0.0, damping: float = 0.0, friction: fl
     (0.001, 18)
     """
     import copy
-    args = [check_finite_scalar(v, n) for v, n in ((armature, "armature"), (damping, "damping"),
+    args = [as_finite_scalar(v, n) for v, n in ((armature, "armature"), (damping, "damping"),
                                                    (friction, "friction"), (timestep, "timestep"))]
     littledog_mjcf(armature=args[0], damping=args[1], friction=args[2], timestep=args[3], motor=motor)  # validates
     return copy.deepcopy(_compiled(*args, motor))

@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import DegenerateFitError, as_se3, fit_rigid, fit_se3
-from ..validation import as_array, as_points, as_rng, check_int, check_positive, check_sample_count
+from ..validation import as_array, as_points, as_rng, as_int, as_positive, require_sample_count
 
 __all__ = ["TooFewMarkersError", "MocapPoses", "fit_marker_pose", "mocap_body_poses", "MocapFrames",
            "simulate_mocap"]
@@ -45,7 +45,7 @@ class MocapFrames(NamedTuple):
 
 
 def _fraction(value: Any, name: str) -> float:
-    p = check_positive(value, name, allow_zero=True)
+    p = as_positive(value, name, allow_zero=True)
     if p > 1.0:
         raise ValueError(f"{name}: expected a probability in [0, 1], got {p}")
     return p
@@ -113,11 +113,11 @@ def simulate_mocap(T_world_body: Any, markers_body: Any, noise: float, dropout: 
     """
     T = _poses(T_world_body)
     m = as_points(markers_body, "markers_body", 3, min_count=1)
-    sigma = check_positive(noise, "noise", allow_zero=True)
+    sigma = as_positive(noise, "noise", allow_zero=True)
     p_drop = _fraction(dropout, "dropout")
     p_burst = _fraction(bursts, "bursts")
-    length = check_int(burst_length, "burst_length", minimum=1)
-    check_sample_count(len(T) * len(m) * 3, "T_world_body, markers_body")
+    length = as_int(burst_length, "burst_length", minimum=1)
+    require_sample_count(len(T) * len(m) * 3, "T_world_body, markers_body")
     gen = as_rng(rng)
     n = len(T)
     positions = np.einsum("nij,mj->nmi", T[:, :3, :3], m) + T[:, None, :3, 3]
@@ -265,7 +265,7 @@ def mocap_body_poses(markers_body: Any, observed: Any, visible: Any) -> MocapPos
     T = np.zeros((n, 4, 4))
     if ok.any():
         fit = fit_rigid(np.broadcast_to(m, (int(ok.sum()),) + m.shape), np.where(vis[ok][..., None], obs[ok], 0.0),
-                        vis[ok].astype(float), check=False)
+                        vis[ok].astype(float), validate=False)
         T[ok, :3, :3], T[ok, :3, 3], T[:, 3, 3] = fit.R, fit.t, 1.0
         ok[ok] = ~fit.degenerate
     if not ok.any():

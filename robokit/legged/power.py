@@ -24,7 +24,7 @@ import numpy as np
 
 from ..controllers.dc_motor import DCMotor, electrical_power
 from .littledog import GUIDE
-from ..validation import as_array, check_finite_result, check_positive
+from ..validation import as_array, require_finite_result, as_positive
 
 __all__ = ["battery_energy", "trial_power", "endurance", "cost_of_transport"]
 
@@ -53,10 +53,10 @@ def battery_energy(capacity_ah: float = GUIDE["battery_capacity"], voltage: floa
     >>> battery_energy(), round(battery_energy() / 3600, 2)     # J, Wh
     (111888.0, 31.08)
     """
-    ah = check_positive(capacity_ah, "capacity_ah")
-    v = check_positive(voltage, "voltage")
+    ah = as_positive(capacity_ah, "capacity_ah")
+    v = as_positive(voltage, "voltage")
     energy = ah * 3600.0 * v                                   # 1 A h = 3600 C; E = Q V
-    check_finite_result("capacity_ah, voltage", energy)
+    require_finite_result("capacity_ah, voltage", energy)
     return energy
 
 
@@ -115,10 +115,10 @@ def endurance(energy_j: float, mean_power_w: float) -> float:
     >>> round(endurance(battery_energy(), 62.0) / 60, 1)     # the guide's "about 30 minutes"
     30.1
     """
-    e = check_positive(energy_j, "energy_j")
-    p = check_positive(mean_power_w, "mean_power_w")
+    e = as_positive(energy_j, "energy_j")
+    p = as_positive(mean_power_w, "mean_power_w")
     t = e / p                                                   # t = E / P
-    check_finite_result("energy_j, mean_power_w", t)
+    require_finite_result("energy_j, mean_power_w", t)
     return t
 
 
@@ -145,10 +145,10 @@ def cost_of_transport(energy_j: float, mass: float, distance: float, g: float = 
     >>> round(cost_of_transport(62.0 * 10.0, 3.0, 1.0), 2)     # 62 W for 10 s to walk 1 m
     21.07
     """
-    e = check_positive(energy_j, "energy_j", allow_zero=True)
-    m = check_positive(mass, "mass")
-    d = check_positive(distance, "distance")
-    gravity = check_positive(g, "g")
+    e = as_positive(energy_j, "energy_j", allow_zero=True)
+    m = as_positive(mass, "mass")
+    d = as_positive(distance, "distance")
+    gravity = as_positive(g, "g")
     cot = e / (m * gravity * d)                                 # COT = E / (m g d)
-    check_finite_result("energy_j, mass, distance, g", cot)
+    require_finite_result("energy_j, mass, distance, g", cot)
     return cot

@@ -19,7 +19,7 @@ import mujoco
 import numpy as np
 
 from ..controllers import LITTLEDOG_MOTOR, DCMotor, design_servo_gains, reflected_inertia
-from ..validation import check_positive
+from ..validation import as_positive
 from .leg_kinematics import body_ik
 from .littledog import STANCE_FEET, STANDING_HEIGHT, littledog_model
 
@@ -92,6 +92,6 @@ def littledog_servo_gains(bandwidth_hz: float = SERVO_BANDWIDTH, motor: DCMotor 
     >>> kp > 0 and kd > 0
     True
     """
-    bandwidth_hz = check_positive(bandwidth_hz, "bandwidth_hz")
+    bandwidth_hz = as_positive(bandwidth_hz, "bandwidth_hz")
     kp, kd = design_servo_gains(motor, servo_inertia(motor), bandwidth_hz)
     return float(kp), float(kd)

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..controllers import LITTLEDOG_MOTOR, DCMotor, SetpointChannel, motor_current, pd_servo_step
 from ..geometry import as_se3, quat_to_matrix, se3_from_rt
-from ..validation import as_array, as_rng, check_int, check_positive
+from ..validation import as_array, as_rng, as_int, as_positive
 from .gait import WalkPlan
 from .imu import simulate_imu
 from .leg_kinematics import body_ik
@@ -89,21 +89,21 @@ class LoopSettings:
     gains: tuple | None = None
 
     def __post_init__(self):
-        rate = check_positive(self.servo_rate, "servo_rate")
+        rate = as_positive(self.servo_rate, "servo_rate")
         steps = 1.0 / (rate * TIMESTEP)
         if abs(steps - round(steps)) > 1e-9 or round(steps) < 1:
             raise ValueError(f"servo_rate: expected a rate that divides the {1 / TIMESTEP:.0f} Hz physics "
                              f"rate (e.g. 500, 250, 100), got {self.servo_rate}")
-        check_positive(self.latency, "latency", allow_zero=True)
-        check_positive(self.jitter, "jitter", allow_zero=True)
-        loss = check_positive(self.loss, "loss", allow_zero=True)
+        as_positive(self.latency, "latency", allow_zero=True)
+        as_positive(self.jitter, "jitter", allow_zero=True)
+        loss = as_positive(self.loss, "loss", allow_zero=True)
         if loss >= 1:
             raise ValueError(f"loss: expected a probability in [0, 1), got {loss}")
         if self.gains is not None:
             if not isinstance(self.gains, (tuple, list)) or len(self.gains) != 2:
                 raise ValueError(f"gains: expected (kp, kd) or None, got {self.gains!r}")
-            check_positive(self.gains[0], "gains[0] (kp)")
-            check_positive(self.gains[1], "gains[1] (kd)", allow_zero=True)
+            as_positive(self.gains[0], "gains[0] (kp)")
+            as_positive(self.gains[1], "gains[1] (kd)", allow_zero=True)
 
 
 @dataclass(frozen=True)
@@ -136,11 +136,11 @@ class SensorSettings:
     def __post_init__(self):
         # refused here, by name, rather than after the whole walk has run (the sensors are corrupted last)
         for name in ("mocap_noise", "gyro_noise", "acc_noise", "force_noise"):
-            check_positive(getattr(self, name), name, allow_zero=True)
+            as_positive(getattr(self, name), name, allow_zero=True)
         for name in ("mocap_dropout", "mocap_bursts"):
-            if check_positive(getattr(self, name), name, allow_zero=True) > 1:
+            if as_positive(getattr(self, name), name, allow_zero=True) > 1:
                 raise ValueError(f"{name}: expected a probability in [0, 1], got {getattr(self, name)}")
-        check_int(self.mocap_burst_length, "mocap_burst_length", minimum=1)
+        as_int(self.mocap_burst_length, "mocap_burst_length", minimum=1)
         for name in ("gyro_bias", "acc_bias"):
             as_array(getattr(self, name), name, shape=(3,))
 
@@ -218,7 +218,7 @@ class _Servo:
             self.q_ref = arrived
         self.tick_speed[self.ticks] = (q_now - self.q_prev) / self.dt        # the tick that just ended
         self.voltage = pd_servo_step(self.q_ref, q_now, self.q_prev, self.kp, self.kd, self.dt,
-                                     self.motor.voltage_max, check=False)
+                                     self.motor.voltage_max, validate=False)
         self.ticks += 1
         self.tick_voltage[self.ticks] = self.voltage
         self.q_prev = q_now
@@ -265,7 +265,7 @@ def _snapshot(rec: dict, k: int, model: mujoco.MjModel, data: mujoco.MjData, pro
     rec["q_ref"][k] = servo.q_ref
     rec["voltage"][k] = servo.voltage
     rec["tau"][k] = data.actuator_force
-    rec["current"][k] = motor_current(servo.voltage, data.qvel[6:], servo.motor, check=False)
+    rec["current"][k] = motor_current(servo.voltage, data.qvel[6:], servo.motor, validate=False)
     rec["body_pos"][k] = data.qpos[:3]
     rec["body_quat"][k] = data.qpos[3:7]
     rec["body_vel"][k, :3] = data.qvel[:3]
@@ -347,7 +347,7 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     gen = as_rng(rng)
     host_dt, host_steps = _host_period(plan)
     servo_steps = int(round(1.0 / (loops.servo_rate * TIMESTEP)))
-    q_cmd, ok = body_ik(plan.feet_world, plan.T_world_body, check=False)
+    q_cmd, ok = body_ik(plan.feet_world, plan.T_world_body, validate=False)
     if not ok.all():
         raise ValueError(f"plan: {int((~ok).sum())} host cycles ask for feet out of reach (first at "
                          f"t = {plan.t[~ok][0]:.2f} s)")

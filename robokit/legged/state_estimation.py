@@ -41,7 +41,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import as_rotation, as_se3, so3_exp, so3_log
-from ..validation import as_array, check_finite_result, check_positive
+from ..validation import as_array, require_finite_result, as_positive
 from .imu import GRAVITY, as_vector_series
 
 __all__ = ["BodyState", "fuse_body_state", "orientation_errors", "position_errors"]
@@ -136,19 +136,19 @@ def fuse_body_state(gyro: Any, acc: Any, dt: float, T_mocap: Any, mocap_ok: Any,
     w = as_vector_series(gyro, "gyro")
     f = as_vector_series(acc, "acc", len(w))
     n = len(w)
-    step = np.float64(check_positive(dt, "dt"))
+    step = np.float64(as_positive(dt, "dt"))
     T = as_se3(T_mocap, "T_mocap", batch=True)
     if len(T) != n:
         raise ValueError(f"T_mocap: expected {n} poses (one per IMU sample), got {len(T)}")
     ok = as_array(mocap_ok, "mocap_ok", shape=(n,), dtype=bool)
-    kp = check_positive(k_p, "k_p", allow_zero=True)
-    ki = check_positive(k_i, "k_i", allow_zero=True)
-    var_acc = np.float64(check_positive(sigma_acc, "sigma_acc")) ** 2      # numpy: overflow gives inf, not an error
-    var_mocap = np.float64(check_positive(sigma_mocap, "sigma_mocap")) ** 2
-    gz = check_positive(g, "g", allow_zero=True)
+    kp = as_positive(k_p, "k_p", allow_zero=True)
+    ki = as_positive(k_i, "k_i", allow_zero=True)
+    var_acc = np.float64(as_positive(sigma_acc, "sigma_acc")) ** 2      # numpy: overflow gives inf, not an error
+    var_mocap = np.float64(as_positive(sigma_mocap, "sigma_mocap")) ** 2
+    gz = as_positive(g, "g", allow_zero=True)
     R_hat = T[0, :3, :3].copy() if R0 is None else as_rotation(R0, "R0")
     p_start = T[0, :3, 3] if p0 is None else as_array(p0, "p0", shape=(3,))
-    check_finite_result("gyro, dt", w * step)
+    require_finite_result("gyro, dt", w * step)
     R_out, p_out, v_out, b_out = np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     b_hat = np.zeros(3)
     x = np.column_stack([p_start, np.zeros(3)])          # per axis [p, v]
@@ -162,11 +162,11 @@ def fuse_body_state(gyro: Any, acc: Any, dt: float, T_mocap: Any, mocap_ok: Any,
         # --- orientation: predict with the gyro, correct with the MoCap (Mahony et al., Eq. (32))
         # the IMU's sample k covers (t_{k-1}, t_k]: it carries the state from k - 1 to k
         a_world = R_hat @ f[k] - gravity
-        R_hat = R_hat @ so3_exp((w[k] - b_hat) * step, check=False)           # Eq. (32a), gyro part
+        R_hat = R_hat @ so3_exp((w[k] - b_hat) * step, validate=False)           # Eq. (32a), gyro part
         if ok[k]:
             R_y = T[k, :3, :3]
             omega_mes = 0.5 * np.cross(R_y, R_hat).sum(0)                     # Eq. (32c), v_i = R_y^T e_i
-            R_hat = R_hat @ so3_exp(kp * step * omega_mes, check=False)        # Eq. (32a), correction
+            R_hat = R_hat @ so3_exp(kp * step * omega_mes, validate=False)        # Eq. (32a), correction
             b_hat = b_hat - ki * step * omega_mes                              # Eq. (32b)
         # --- position and velocity: Kalman filter per axis (Thrun et al., Table 3.1)
         x = x @ A.T + np.outer(a_world, B)                                     # line 2
@@ -176,7 +176,7 @@ def fuse_body_state(gyro: Any, acc: Any, dt: float, T_mocap: Any, mocap_ok: Any,
             x = x + np.outer(T[k, :3, 3] - x[:, 0], K)                         # line 5
             P = P - np.outer(K, P[0])                                          # line 6
         R_out[k], p_out[k], v_out[k], b_out[k] = R_hat, x[:, 0], x[:, 1], b_hat
-    check_finite_result("gyro, acc, dt, k_p, k_i, sigma_acc, sigma_mocap, p0, g", p_out, v_out, b_out, R_out)
+    require_finite_result("gyro, acc, dt, k_p, k_i, sigma_acc, sigma_mocap, p0, g", p_out, v_out, b_out, R_out)
     return BodyState(R_out, p_out, v_out, b_out)
 
 
@@ -216,7 +216,7 @@ def orientation_errors(R_est: Any, R_true: Any) -> np.ndarray:
     Rt = as_rotation(R_true, "R_true", batch=True)
     if len(Re) != len(Rt):
         raise ValueError(f"R_true: expected {len(Re)} rotations (one per estimate), got {len(Rt)}")
-    return np.linalg.norm(so3_log(np.swapaxes(Rt, -1, -2) @ Re, check=False), axis=-1)
+    return np.linalg.norm(so3_log(np.swapaxes(Rt, -1, -2) @ Re, validate=False), axis=-1)
 
 
 def position_errors(p_est: Any, p_true: Any) -> np.ndarray:
@@ -248,5 +248,5 @@ def position_errors(p_est: Any, p_true: Any) -> np.ndarray:
     pe = as_vector_series(p_est, "p_est")
     pt = as_vector_series(p_true, "p_true", len(pe))
     out = np.linalg.norm(pe - pt, axis=-1)
-    check_finite_result("p_est, p_true", out)
+    require_finite_result("p_est, p_true", out)
     return out

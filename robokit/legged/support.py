@@ -148,10 +148,10 @@ def stability_margin(feet_xy: Any, com_xy: Any) -> float:
     (-1.0, 0.0)
     """
     polygon = support_polygon(feet_xy)
-    return nearest_boundary_point(polygon, _as_xy(com_xy, "com_xy", (2,)), check=False)[1]
+    return nearest_boundary_point(polygon, _as_xy(com_xy, "com_xy", (2,)), validate=False)[1]
 
 
-def nearest_boundary_point(polygon: Any, point: Any, *, check: bool = True) -> tuple[np.ndarray, float]:
+def nearest_boundary_point(polygon: Any, point: Any, *, validate: bool = True) -> tuple[np.ndarray, float]:
     """The point of a convex polygon's boundary nearest to ``point``, and the signed distance to it.
 
     Parameters
@@ -159,7 +159,7 @@ def nearest_boundary_point(polygon: Any, point: Any, *, check: bool = True) -> t
     polygon : array_like, shape (k, 2)
         Vertices of a convex polygon, counter-clockwise (as :func:`support_polygon` gives), k >= 3.
     point : array_like, shape (2,)
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` is the fast path for callers that built the polygon.
 
     Returns
@@ -175,7 +175,7 @@ def nearest_boundary_point(polygon: Any, point: Any, *, check: bool = True) -> t
     >>> near.tolist(), d
     ([0.5, 0.0], 0.2)
     """
-    if check:
+    if validate:
         polygon = _as_xy(polygon, "polygon", (None, 2))
         if len(polygon) < 3:
             raise SupportPolygonError(f"polygon: expected at least 3 vertices, got {len(polygon)}")

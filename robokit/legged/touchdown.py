@@ -27,7 +27,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..validation import as_array, check_finite_scalar, check_int, describe
+from ..validation import as_array, as_finite_scalar, as_int, describe
 
 __all__ = ["detect_contacts", "gate_touchdowns", "EventScore", "contact_events", "match_events", "score_events",
            "score_leg_events", "event_precision_recall"]
@@ -135,7 +135,7 @@ def match_events(detected: Any, truth: Any, tolerance: int) -> np.ndarray:
     [[3, 2], [8, 8]]
     """
     d, t = _indices(detected, "detected"), _indices(truth, "truth")
-    return _pairs(d, t, check_int(tolerance, "tolerance", minimum=0))
+    return _pairs(d, t, as_int(tolerance, "tolerance", minimum=0))
 
 
 def _score(delays: np.ndarray, n_detected: int, n_true: int) -> EventScore:
@@ -193,7 +193,7 @@ def score_events(detected: Any, truth: Any, tolerance: int) -> EventScore:
     EventScore(precision=0.6666666666666666, recall=1.0, mean_delay_samples=0.5)
     """
     d, t = _indices(detected, "detected"), _indices(truth, "truth")
-    tol = check_int(tolerance, "tolerance", minimum=0)
+    tol = as_int(tolerance, "tolerance", minimum=0)
     return _score(_match(d, t, tol), len(d), len(t))
 
 
@@ -217,7 +217,7 @@ def score_leg_events(detected: Any, truth: Any, tolerance: int) -> EventScore:
     >>> score_leg_events([[3, 5, 8], [10]], [[2, 8], [30]], tolerance=2)
     EventScore(precision=0.5, recall=0.6666666666666666, mean_delay_samples=0.5)
     """
-    tol = check_int(tolerance, "tolerance", minimum=0)
+    tol = as_int(tolerance, "tolerance", minimum=0)
     if isinstance(detected, (str, bytes, np.ndarray)) or isinstance(truth, (str, bytes, np.ndarray)) or \
             not hasattr(detected, "__len__") or not hasattr(truth, "__len__") or len(detected) != len(truth):
         raise ValueError("detected, truth: expected two lists with one array of indices per leg, as many legs in "
@@ -336,11 +336,11 @@ def detect_contacts(force: Any, threshold_on: float, threshold_off: float, debou
     f = as_array(force, "force")
     if f.ndim not in (1, 2):
         raise ValueError(f"force: expected shape (N,) or (N, L), got shape {f.shape}")
-    on = check_finite_scalar(threshold_on, "threshold_on")
-    off = check_finite_scalar(threshold_off, "threshold_off")
+    on = as_finite_scalar(threshold_on, "threshold_on")
+    off = as_finite_scalar(threshold_off, "threshold_off")
     if not off < on:
         raise ValueError(f"threshold_off: expected a value below threshold_on = {on}, got {off}")
-    count = check_int(debounce, "debounce", minimum=1)
+    count = as_int(debounce, "debounce", minimum=1)
     if len(f) == 0:
         return np.zeros(f.shape, bool)
     decisive = (f > on) | (f < off)
@@ -382,4 +382,4 @@ def gate_touchdowns(detected: Any, expected: Any, window: int) -> np.ndarray:
     >>> gate_touchdowns([3, 40, 52, 95], [50, 100], 10).tolist()
     [40, 95]
     """
-    return match_events(detected, expected, check_int(window, "window", minimum=0))[:, 0]
+    return match_events(detected, expected, as_int(window, "window", minimum=0))[:, 0]

@@ -32,7 +32,7 @@ from .trial_log import LOG_FORMAT, LOG_LAYOUT, LOG_VERSION, META_KEYS, TrialLog,
 __all__ = ["save_trial", "load_trial", "describe_layout"]
 
 
-def _check_path(path: Any) -> Path:
+def _as_path(path: Any) -> Path:
     if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
         raise TypeError(f"path: expected a file path (str or pathlib.Path), got {describe(path)}")
     if not str(path):
@@ -79,7 +79,7 @@ def save_trial(path: Any, log: TrialLog) -> Path:
     >>> len(load_trial(target))
     5
     """
-    target = _check_path(path)
+    target = _as_path(path)
     if not isinstance(log, TrialLog):
         raise TypeError(f"log: expected a TrialLog, got {describe(log)}")
     log.validate()
@@ -128,7 +128,7 @@ def load_trial(path: Any) -> TrialLog:
     ...
     robokit.legged.trial_log.TrialLogError: ...cut.npz: not a readable trial log (truncated or corrupt: ...)
     """
-    source = _check_path(path)
+    source = _as_path(path)
     try:
         data = np.load(source, allow_pickle=False)
         if not isinstance(data, np.lib.npyio.NpzFile):      # a lone .npy array

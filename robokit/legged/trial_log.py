@@ -27,7 +27,7 @@ from typing import Any, Mapping, NamedTuple
 import numpy as np
 
 from ..geometry import quat_to_matrix, se3_from_rt
-from ..validation import as_array, check_finite_scalar, check_int, check_positive, check_text, describe
+from ..validation import as_array, as_finite_scalar, as_int, as_positive, as_text, describe
 from .littledog import GUIDE, TIMESTEP
 
 __all__ = ["LOG_FORMAT", "LOG_VERSION", "LOG_LAYOUT", "META_KEYS", "StreamSpec", "TrialLogError", "TrialLog",
@@ -128,15 +128,15 @@ def _checked_meta(meta: Any) -> dict:
     if missing:
         raise TrialLogError(f"meta: expected the keys {list(META_KEYS)}, missing {missing} (trial_meta fills them)")
     for key in ("host_rate", "servo_rate", "physics_timestep"):
-        check_positive(meta[key], f"meta['{key}']")
+        as_positive(meta[key], f"meta['{key}']")
     for key in ("link_latency", "link_jitter"):
-        check_positive(meta[key], f"meta['{key}']", allow_zero=True)
-    if not 0 <= check_finite_scalar(meta["link_loss"], "meta['link_loss']") <= 1:
+        as_positive(meta[key], f"meta['{key}']", allow_zero=True)
+    if not 0 <= as_finite_scalar(meta["link_loss"], "meta['link_loss']") <= 1:
         raise ValueError(f"meta['link_loss']: expected a fraction in [0, 1], got {meta['link_loss']}")
     if meta["seed"] is not None:
-        check_int(meta["seed"], "meta['seed']", minimum=0)
-    check_text(meta["gait"], "meta['gait']")
-    check_text(meta["notes"], "meta['notes']")
+        as_int(meta["seed"], "meta['seed']", minimum=0)
+    as_text(meta["gait"], "meta['gait']")
+    as_text(meta["notes"], "meta['notes']")
     try:    # a copy through JSON: what is kept is exactly what a file gives back
         return json.loads(json.dumps(meta, default=_json_default, allow_nan=False))
     except (TypeError, ValueError) as err:
@@ -266,7 +266,7 @@ class TrialLog:
         >>> TrialLog(streams, trial_meta()).T_world_body()[1, :3, 3].tolist()
         [0.1, 0.0, 0.13]
         """
-        return se3_from_rt(quat_to_matrix(self.streams["body_quat"], check=False), self.streams["body_pos"])
+        return se3_from_rt(quat_to_matrix(self.streams["body_quat"], validate=False), self.streams["body_pos"])
 
     def slice(self, start: int, stop: int) -> "TrialLog":
         """Rows ``start`` to ``stop`` (excluded; Python's slicing rules) as a log of their own, with
@@ -279,8 +279,8 @@ class TrialLog:
         >>> len(part), part.t[0]
         (5, np.float64(0.02))
         """
-        start = check_int(start, "start")
-        stop = check_int(stop, "stop")
+        start = as_int(start, "start")
+        stop = as_int(stop, "stop")
         rows = range(len(self))[start:stop]
         if len(rows) == 0:
             raise ValueError(f"start, stop: expected a range that holds rows of this {len(self)}-row log, "
@@ -339,8 +339,8 @@ def empty_streams(n: int, host_rate: float = GUIDE["host_rate"]) -> dict:
     >>> streams["feet"].shape, streams["contact"].dtype, streams["body_quat"][0].tolist()
     ((4, 4, 3), dtype('bool'), [1.0, 0.0, 0.0, 0.0])
     """
-    n = check_int(n, "n", minimum=1, maximum=100_000_000)
-    rate = check_positive(host_rate, "host_rate")
+    n = as_int(n, "n", minimum=1, maximum=100_000_000)
+    rate = as_positive(host_rate, "host_rate")
     streams = {name: np.zeros((n,) + spec.shape, spec.dtype) for name, spec in LOG_LAYOUT.items()}
     streams["t"][:] = np.arange(n) / rate
     streams["body_quat"][:, 0] = 1.0

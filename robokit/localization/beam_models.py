@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import se2_compose
-from ..validation import as_array, as_points, check_choice, check_int, check_positive, describe
+from ..validation import as_array, as_points, as_choice, as_int, as_positive, describe
 
 __all__ = ["COMBINE_RULES", "subsample_beams", "valid_beams", "likelihood_field_log_weights",
            "likelihood_field_log_weight_reference"]
@@ -76,10 +76,10 @@ def subsample_beams(count: int, max_beams: int | None = None) -> np.ndarray:
     >>> len(subsample_beams(360, 30)), subsample_beams(360, 30)[:3].tolist()
     (30, [0, 12, 24])
     """
-    n = check_int(count, "count", minimum=1)
+    n = as_int(count, "count", minimum=1)
     if max_beams is None:
         return np.arange(n)
-    m = check_int(max_beams, "max_beams", minimum=2)
+    m = as_int(max_beams, "max_beams", minimum=2)
     step = max(1, (n - 1) // (m - 1))
     return np.arange(0, n, step)
 
@@ -126,13 +126,13 @@ def valid_beams(ranges: Any, angles: Any, r_max: float, max_beams: int | None = 
     a = as_array(angles, "angles", ndim=1)
     if a.shape != r.shape:
         raise ValueError(f"angles: expected one angle per range ({r.size}), got {a.size}")
-    rm = check_positive(r_max, "r_max")
+    rm = as_positive(r_max, "r_max")
     keep = subsample_beams(r.size, max_beams)
     keep = keep[r[keep] < rm]
     return r[keep], a[keep]
 
 
-def _check_field(field: Any) -> Any:
+def _as_field(field: Any) -> Any:
     if not (callable(getattr(field, "lookup", None)) and hasattr(field, "max_distance")):
         raise TypeError(f"field: expected a robokit.mapping.LikelihoodField (with lookup() and max_distance), "
                         f"got {describe(field)}")
@@ -141,12 +141,12 @@ def _check_field(field: Any) -> Any:
 
 def _model_args(sensor_offset: Any, sigma_hit: float, z_hit: float, z_rand: float, combine: str) -> tuple:
     offset = as_array(sensor_offset, "sensor_offset", shape=(3,))
-    s = check_positive(sigma_hit, "sigma_hit")
-    zh = check_positive(z_hit, "z_hit", allow_zero=True)
-    zr = check_positive(z_rand, "z_rand", allow_zero=True)
+    s = as_positive(sigma_hit, "sigma_hit")
+    zh = as_positive(z_hit, "z_hit", allow_zero=True)
+    zr = as_positive(z_rand, "z_rand", allow_zero=True)
     if zh + zr == 0:
         raise ValueError("z_hit, z_rand: expected mixture weights with a positive sum, got 0 and 0")
-    return offset, s, zh, zr, check_choice(combine, "combine", COMBINE_RULES)
+    return offset, s, zh, zr, as_choice(combine, "combine", COMBINE_RULES)
 
 
 def likelihood_field_log_weights(particles: Any, ranges: Any, angles: Any, field: Any, *,
@@ -206,12 +206,12 @@ def likelihood_field_log_weights(particles: Any, ranges: Any, angles: Any, field
     [0.642, -0.476]
     """
     P = as_points(particles, "particles", 3, min_count=1)
-    _check_field(field)
+    _as_field(field)
     offset, s, zh, zr, rule = _model_args(sensor_offset, sigma_hit, z_hit, z_rand, combine)
     r, a = valid_beams(ranges, angles, r_max, max_beams)
     if r.size == 0:
         return np.zeros(len(P))
-    sensor = se2_compose(P, offset, check=False)
+    sensor = se2_compose(P, offset, validate=False)
     c, sn = np.cos(sensor[:, 2:3]), np.sin(sensor[:, 2:3])
     bx, by = r * np.cos(a), r * np.sin(a)                           # the end point in the sensor frame
     ends = np.empty((len(P), r.size, 2))                            # written in place: one pass each
@@ -220,7 +220,7 @@ def likelihood_field_log_weights(particles: Any, ranges: Any, angles: Any, field
     ex -= np.multiply(sn, by, out=tmp)                              # Table 6.3, line 5
     np.add(np.multiply(sn, bx, out=ey), sensor[:, 1:2], out=ey)
     ey += np.multiply(c, by, out=tmp)                               # line 6
-    d = field.lookup(ends, check=False)                             # line 7
+    d = field.lookup(ends, validate=False)                             # line 7
     g = np.exp(np.multiply(d, d, out=d) * (-0.5 / (s * s)), out=d)
     if rule == "product":
         g *= zh / math.sqrt(2.0 * math.pi * s * s)
@@ -274,7 +274,7 @@ def likelihood_field_log_weight_reference(pose: Any, ranges: Any, angles: Any, f
     0.642
     """
     x, y, theta = as_array(pose, "pose", shape=(3,))
-    _check_field(field)
+    _as_field(field)
     (xs, ys, ts), s, zh, zr, rule = _model_args(sensor_offset, sigma_hit, z_hit, z_rand, combine)
     r, a = valid_beams(ranges, angles, r_max, max_beams)
     log_q, ros_sum = 0.0, 0.0

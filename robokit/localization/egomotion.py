@@ -33,7 +33,7 @@ from scipy.spatial import cKDTree
 from ..geometry import (as_pqt, pqt_robot_to_world, pqt_rotate_xz,
                         pqt_transform_xz, pqt_world_to_robot, wrap_angle)
 from ..mapping.landmarks import LandmarkMap
-from ..validation import as_array, as_points, as_rng, check_int, check_positive
+from ..validation import as_array, as_points, as_rng, as_int, as_positive
 from ..vision.matching import gated_ratio_match, ratio_match
 from ..vision.ransac import ransac_sample_count
 
@@ -90,7 +90,7 @@ def _poses_from_pairs(r1, r2, w1, w2):
     """Vectorised two-point poses; inputs (K, 2) ground-plane (X, Z) coordinates."""
     dr, dw = r2 - r1, w2 - w1
     theta = np.arctan2(dr[:, 0] * dw[:, 1] - dr[:, 1] * dw[:, 0], (dr * dw).sum(1))
-    pq = 0.5 * (w1 + w2) - pqt_rotate_xz(theta, 0.5 * (r1 + r2), check=False)    # midpoints align, Sec. 5
+    pq = 0.5 * (w1 + w2) - pqt_rotate_xz(theta, 0.5 * (r1 + r2), validate=False)    # midpoints align, Sec. 5
     return np.column_stack([pq, theta])
 
 
@@ -176,7 +176,7 @@ def fit_pose(robot_points, world_points, robot_covariances=None, world_covarianc
     if w.shape[0] != n:
         raise ValueError(f"world_points: expected {n} points, got {w.shape[0]}")
     w = w[:, [0, 2]]
-    iterations = check_int(iterations, "iterations", minimum=0)
+    iterations = as_int(iterations, "iterations", minimum=0)
     weighted = robot_covariances is not None or world_covariances is not None
     rcov = _xz_covariances(robot_covariances, "robot_covariances", n)
     wcov = _xz_covariances(world_covariances, "world_covariances", n)
@@ -185,14 +185,14 @@ def fit_pose(robot_points, world_points, robot_covariances=None, world_covarianc
         raise DegenerateCorrespondenceError("robot_points, world_points: expected points spread on the ground "
                                             "plane, got (nearly) coincident ones")
     theta = np.arctan2((rc[:, 0] * wc[:, 1] - rc[:, 1] * wc[:, 0]).sum(), (rc * wc).sum())
-    pqt = np.concatenate([w.mean(0) - pqt_rotate_xz(theta, r.mean(0), check=False), [theta]])
+    pqt = np.concatenate([w.mean(0) - pqt_rotate_xz(theta, r.mean(0), validate=False), [theta]])
 
     def linearise(pqt):
-        moved, jac = pqt_transform_xz(pqt, r, jacobian=True, check=False)
+        moved, jac = pqt_transform_xz(pqt, r, jacobian=True, validate=False)
         return w - moved, jac                                          # Lin et al. Sec. 6 residuals
 
     def information(pqt):                                              # (Sigma_w + R Sigma_r R^T)^-1
-        rot = pqt_rotate_xz(pqt[2], _EYE2, check=False).T              # R(theta): columns R e_X, R e_Z
+        rot = pqt_rotate_xz(pqt[2], _EYE2, validate=False).T              # R(theta): columns R e_X, R e_Z
         return np.linalg.inv(wcov + rot @ rcov @ rot.T + 1e-12 * _EYE2)
 
     if weighted:
@@ -277,9 +277,9 @@ def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_cov
                                                            shape=(r.shape[0], 3, 3))
     wcov = None if world_covariances is None else as_array(world_covariances, "world_covariances",
                                                            shape=(r.shape[0], 3, 3))
-    thr = check_positive(threshold, "threshold")
-    min_matches = check_int(min_matches, "min_matches", minimum=2)
-    max_iterations = check_int(max_iterations, "max_iterations", minimum=1)
+    thr = as_positive(threshold, "threshold")
+    min_matches = as_int(min_matches, "min_matches", minimum=2)
+    max_iterations = as_int(max_iterations, "max_iterations", minimum=1)
     gen = as_rng(rng)
     # the fall-back is checked now, not when (rarely) it is needed
     odometry = None if odometry is None else as_pqt(odometry, "odometry")
@@ -301,7 +301,7 @@ def ransac_pose(robot_points, world_points, *, robot_covariances=None, world_cov
         if not ok.any():
             continue
         poses = _poses_from_pairs(rg[i[ok]], rg[j[ok]], wg[i[ok]], wg[j[ok]])
-        moved = pqt_transform_xz(poses[:, None, :], rg, check=False)      # (hypotheses, matches, 2)
+        moved = pqt_transform_xz(poses[:, None, :], rg, validate=False)      # (hypotheses, matches, 2)
         px, pz = moved[..., 0] - wg[:, 0], moved[..., 1] - wg[:, 1]
         dist = np.sqrt(px * px + pz * pz + (r[None, :, 1] - w[None, :, 1]) ** 2)
         support = dist < thr
@@ -362,8 +362,8 @@ def continuation_matches(points, descriptors, landmarks: LandmarkMap, predicted_
     """
     pts = as_array(points, "points", shape=(None, 3))
     desc = as_array(descriptors, "descriptors", shape=(pts.shape[0], landmarks.descriptor_size), dtype=np.float32)
-    rad = check_positive(window, "window")
-    ratio = check_positive(ratio, "ratio")
+    rad = as_positive(window, "window")
+    ratio = as_positive(ratio, "ratio")
     none = (np.zeros(0, int), np.zeros(0, int))
     if len(landmarks) == 0 or pts.shape[0] == 0:
         return none

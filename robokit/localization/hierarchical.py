@@ -33,8 +33,8 @@ import numpy as np
 from ..geometry import intersect_lines, se2_between, se2_compose, wrap_angle
 from ..mapping.omni_views import OmniView, RelativePose, omni_view, relative_pose
 from ..mapping.topological import EmptyMapError, TopologicalMap
-from ..sim.omni import OmniCamera, check_omni_camera
-from ..validation import check_choice, check_int, check_positive, describe
+from ..sim.omni import OmniCamera, as_omni_camera
+from ..validation import as_choice, as_int, as_positive, describe
 
 __all__ = ["MODES", "Localization", "HierarchicalLocalizer"]
 
@@ -166,19 +166,19 @@ class HierarchicalLocalizer:
             raise TypeError(f"map: expected a robokit.mapping.TopologicalMap, got {describe(map)}")
         if len(map) == 0:
             raise EmptyMapError("map: expected a map with at least one node, got none")
-        self.map, self.camera = map, check_omni_camera(camera)
-        self.top_k = check_int(top_k, "top_k", minimum=1)
-        self.ratio = check_positive(ratio, "ratio")
+        self.map, self.camera = map, as_omni_camera(camera)
+        self.top_k = as_int(top_k, "top_k", minimum=1)
+        self.ratio = as_positive(ratio, "ratio")
         if self.ratio > 1:
             raise ValueError(f"ratio: expected a value in (0, 1], got {self.ratio}")
-        self.min_matches = check_int(min_matches, "min_matches", minimum=1)
-        self.ambiguity = check_positive(ambiguity, "ambiguity")
-        self.n_features = check_int(n_features, "n_features", minimum=0)
-        self.mode = check_choice(mode, "mode", MODES)
-        self.min_crossing = check_positive(min_crossing, "min_crossing")
+        self.min_matches = as_int(min_matches, "min_matches", minimum=1)
+        self.ambiguity = as_positive(ambiguity, "ambiguity")
+        self.n_features = as_int(n_features, "n_features", minimum=0)
+        self.mode = as_choice(mode, "mode", MODES)
+        self.min_crossing = as_positive(min_crossing, "min_crossing")
         if self.min_crossing > np.pi / 2:
             raise ValueError(f"min_crossing: expected an angle in (0, pi/2], got {self.min_crossing}")
-        self.max_range = check_positive(max_range, "max_range")
+        self.max_range = as_positive(max_range, "max_range")
         self.bins = map.histograms.shape[1]
 
     def __repr__(self) -> str:

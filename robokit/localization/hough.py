@@ -24,7 +24,7 @@ import numpy as np
 from ..geometry import pqt_rotate_xz, pqt_transform_xz
 from ..mapping.landmarks import LandmarkMap
 from ..vision.matching import k_nearest
-from ..validation import as_array, check_choice, check_int, check_positive
+from ..validation import as_array, as_choice, as_int, as_positive
 from .egomotion import InsufficientMatchesError, fit_pose
 
 __all__ = ["Hypothesis", "candidate_matches", "hough_accumulator", "global_localize"]
@@ -94,12 +94,12 @@ def candidate_matches(points, descriptors, landmarks: LandmarkMap, *, k: int = 3
     """
     pts = as_array(points, "points", shape=(None, 3))
     desc = as_array(descriptors, "descriptors", shape=(pts.shape[0], landmarks.descriptor_size), dtype=np.float32)
-    k = check_int(k, "k", minimum=1)
-    max_distance = check_positive(max_distance, "max_distance")
-    height_tol = check_positive(height_tol, "height_tol")
+    k = as_int(k, "k", minimum=1)
+    max_distance = as_positive(max_distance, "max_distance")
+    height_tol = as_positive(height_tol, "height_tol")
     if pts.shape[0] == 0 or len(landmarks) == 0:
         return np.zeros(0, int), np.zeros(0, int)
-    method = check_choice(method, "method", ("auto", "kdtree", "bruteforce"))
+    method = as_choice(method, "method", ("auto", "kdtree", "bruteforce"))
     if method == "auto":
         method = "kdtree" if landmarks.descriptor_size <= 32 else "bruteforce"
     k = min(k, len(landmarks))
@@ -155,9 +155,9 @@ def hough_accumulator(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, *,
     b = as_array(bounds, "bounds", shape=(4,))
     if b[1] <= b[0] or b[3] <= b[2]:
         raise ValueError(f"bounds: expected x_min < x_max and z_min < z_max, got {b.tolist()}")
-    size = check_positive(bin_size, "bin_size")
-    dth = check_positive(angle_bin, "angle_bin")
-    spread = check_positive(spread, "spread")
+    size = as_positive(bin_size, "bin_size")
+    dth = as_positive(angle_bin, "angle_bin")
+    spread = as_positive(spread, "spread")
     nt = int(round(2 * np.pi / dth))
     # sizes rounded up to multiples of 4 bins: the peak search works on 4 x 4 blocks without copying
     nx, nz = 4 * int(np.ceil((b[1] - b[0]) / size / 4)), 4 * int(np.ceil((b[3] - b[2]) / size / 4))
@@ -170,7 +170,7 @@ def hough_accumulator(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, *,
     flat = lambda ti, xi, zi: (ti * (nx + 1) + xi) * (nz + 1) + zi  # noqa: E731
     for k in range(0, m, _BLOCK):  # blocks of matches keep the (matches, headings) arrays small
         r_, w_, rc_, wc_ = r[k:k + _BLOCK], w[k:k + _BLOCK], rc[k:k + _BLOCK], wc[k:k + _BLOCK]
-        rr = pqt_rotate_xz(thetas, r_[:, None, :], check=False)          # (matches, headings, 2)
+        rr = pqt_rotate_xz(thetas, r_[:, None, :], validate=False)          # (matches, headings, 2)
         px, pz = w_[:, :1] - rr[..., 0], w_[:, 1:] - rr[..., 1]          # (p, q) aligning each match
         sxx, sxz, szz = rc_[:, 0, 0, None], rc_[:, 0, 1, None], rc_[:, 1, 1, None]
         var_x = wc_[:, 0, 0, None] + c * c * sxx - 2 * c * s * sxz + s * s * szz
@@ -239,7 +239,7 @@ def _refine(pqt, pts, world, fi, li, gates, pts_cov, world_cov):
     """Iterated least squares: keep each feature's best match within the gate, refit (weighted)."""
     h = None
     for gate in gates:
-        e = world[li][:, ::2] - pqt_transform_xz(pqt, pts[fi][:, ::2], check=False)
+        e = world[li][:, ::2] - pqt_transform_xz(pqt, pts[fi][:, ::2], validate=False)
         d = np.hypot(e[:, 0], e[:, 1])
         order = np.lexsort((d, fi))
         first = order[np.r_[True, fi[order][1:] != fi[order][:-1]]]
@@ -299,8 +299,8 @@ def global_localize(points, covariances, descriptors, landmarks: LandmarkMap, *,
     """
     pts = as_array(points, "points", shape=(None, 3))
     cov = as_array(covariances, "covariances", shape=(pts.shape[0], 3, 3))
-    n_hypotheses = check_int(n_hypotheses, "n_hypotheses", minimum=1)
-    min_matches = check_int(min_matches, "min_matches", minimum=2)
+    n_hypotheses = as_int(n_hypotheses, "n_hypotheses", minimum=1)
+    min_matches = as_int(min_matches, "min_matches", minimum=2)
     gates = as_array(gates, "gates", ndim=1, min_size=1)
     if not isinstance(landmarks, LandmarkMap):
         raise TypeError(f"landmarks: expected LandmarkMap, got {type(landmarks).__name__}")

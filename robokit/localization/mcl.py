@@ -68,7 +68,7 @@ import numpy as np
 
 from ..geometry import wrap_angle
 from ..mapping import LikelihoodField, OccupancyGrid, likelihood_field
-from ..validation import as_array, as_rng, check_covariance, check_int, check_positive, describe
+from ..validation import as_array, as_rng, as_covariance, as_int, as_positive, describe
 from .beam_models import likelihood_field_log_weights
 from .mcl_step import mcl_step, uniform_free_poses
 from .particle_filter import (ROS_KLD_BIN_SIZE, ellipse_weights, kld_resample, low_variance_resample,
@@ -175,24 +175,24 @@ class MonteCarloLocalizer:
         if not isinstance(self.field, LikelihoodField):
             raise TypeError(f"field: expected a robokit.mapping.LikelihoodField, got {describe(field)}")
         self._free = grid.free_cells()                  # EmptyMapError: nowhere to put a particle
-        self.n_particles = check_int(n_particles, "n_particles", minimum=1, maximum=10 ** 6)
+        self.n_particles = as_int(n_particles, "n_particles", minimum=1, maximum=10 ** 6)
         self.alphas = as_array(alphas, "alphas", shape=(4,))
         if np.any(self.alphas < 0):
             raise ValueError(f"alphas: expected four non-negative noise parameters, got {self.alphas.tolist()}")
         self.model = dict(sigma_hit=sigma_hit, z_hit=z_hit, z_rand=z_rand, r_max=r_max, max_beams=max_beams,
                           combine=combine, sensor_offset=sensor_offset)
         likelihood_field_log_weights(np.zeros((1, 3)), [1.0], [0.0], self.field, **self.model)  # validates model
-        self.update_min_d = check_positive(update_min_d, "update_min_d", allow_zero=True)
-        self.update_min_a = check_positive(update_min_a, "update_min_a", allow_zero=True)
-        self.resample_interval = check_int(resample_interval, "resample_interval", minimum=1)
+        self.update_min_d = as_positive(update_min_d, "update_min_d", allow_zero=True)
+        self.update_min_a = as_positive(update_min_a, "update_min_a", allow_zero=True)
+        self.resample_interval = as_int(resample_interval, "resample_interval", minimum=1)
         if kld is not None and not isinstance(kld, KLDConfig):
             raise TypeError(f"kld: expected None or a KLDConfig, got {describe(kld)}")
         if kld is not None:
-            check_int(kld.min_particles, "kld.min_particles", minimum=1)
-            check_int(kld.max_particles, "kld.max_particles", minimum=kld.min_particles, maximum=10 ** 6)
+            as_int(kld.min_particles, "kld.min_particles", minimum=1)
+            as_int(kld.max_particles, "kld.max_particles", minimum=kld.min_particles, maximum=10 ** 6)
         self.kld = kld
-        self.alpha_slow = check_positive(alpha_slow, "alpha_slow", allow_zero=True)
-        self.alpha_fast = check_positive(alpha_fast, "alpha_fast", allow_zero=True)
+        self.alpha_slow = as_positive(alpha_slow, "alpha_slow", allow_zero=True)
+        self.alpha_fast = as_positive(alpha_fast, "alpha_fast", allow_zero=True)
         if self.alpha_slow > 1 or self.alpha_fast > 1:
             raise ValueError(f"alpha_slow, alpha_fast: expected rates in [0, 1], got {alpha_slow} and {alpha_fast}")
         self.rng = as_rng(rng)
@@ -227,7 +227,7 @@ class MonteCarloLocalizer:
         >>> mcl.initialize_uniform(20); mcl.particles.shape
         (20, 3)
         """
-        count = self.n_particles if n is None else check_int(n, "n", minimum=1, maximum=10 ** 6)
+        count = self.n_particles if n is None else as_int(n, "n", minimum=1, maximum=10 ** 6)
         self._reset(self._random_poses(count, self.rng))
 
     def initialize_gaussian(self, pose: Any, cov: Any, n: int | None = None) -> None:
@@ -254,8 +254,8 @@ class MonteCarloLocalizer:
         np.True_
         """
         mean = as_array(pose, "pose", shape=(3,))
-        C = check_covariance(cov, "cov", 3, semidefinite=True)
-        count = self.n_particles if n is None else check_int(n, "n", minimum=1, maximum=10 ** 6)
+        C = as_covariance(cov, "cov", 3, semidefinite=True)
+        count = self.n_particles if n is None else as_int(n, "n", minimum=1, maximum=10 ** 6)
         P = self.rng.multivariate_normal(mean, C, size=count, method="eigh")
         P[:, 2] = wrap_angle(P[:, 2])
         self._reset(P)
@@ -446,6 +446,6 @@ class MonteCarloLocalizer:
         >>> mcl.converged(), (mcl.initialize_ellipse([5.0, 5.0, 0.0], 0.1, 0.1), mcl.converged())[1]
         (False, True)
         """
-        t = check_positive(dist_threshold, "dist_threshold")
+        t = as_positive(dist_threshold, "dist_threshold")
         mean = self.particles[:, :2].mean(axis=0)          # ROS: the unweighted mean
         return bool(np.all(np.abs(self.particles[:, :2] - mean) <= t))

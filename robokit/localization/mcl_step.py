@@ -24,7 +24,7 @@ import numpy as np
 
 from ..mapping import LikelihoodField
 from ..sim import sample_motion_model_odometry
-from ..validation import as_array, as_points, as_rng, check_int, check_positive, describe
+from ..validation import as_array, as_points, as_rng, as_int, as_positive, describe
 from .beam_models import likelihood_field_log_weights
 from .particle_filter import low_variance_resample, normalise_log_weights
 
@@ -139,8 +139,8 @@ def uniform_free_poses(free_cells: Any, resolution: float, n: int, rng: Any = No
     [[0.64, 0.27], [0.04, 0.02], [0.81, 0.91]]
     """
     cells = as_array(free_cells, "free_cells", shape=(None, 2), min_size=2)
-    res = check_positive(resolution, "resolution")
-    count = check_int(n, "n", minimum=0)
+    res = as_positive(resolution, "resolution")
+    count = as_int(n, "n", minimum=0)
     g = as_rng(rng)
     xy = cells[g.integers(0, len(cells), count)] + g.uniform(-res / 2, res / 2, (count, 2))
     return np.column_stack([xy, g.uniform(-np.pi, np.pi, count)])

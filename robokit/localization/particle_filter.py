@@ -41,8 +41,8 @@ from scipy.special import logsumexp
 from scipy.stats import norm
 
 from ..geometry import wrap_angle
-from ..validation import (as_array, as_points, as_rng, check_callable, check_finite_result, check_finite_scalar,
-                          check_int, check_positive, check_sample_count, describe)
+from ..validation import (as_array, as_points, as_rng, as_callable, require_finite_result, as_finite_scalar,
+                          as_int, as_positive, require_sample_count, describe)
 
 __all__ = ["NormalisedWeights", "normalise_log_weights", "low_variance_resample", "kld_sample_count",
            "kld_resample", "pose_bins", "weighted_pose_mean", "sample_ellipse_poses", "ellipse_weights",
@@ -173,13 +173,13 @@ def low_variance_resample(weights: Any, rng: Any = None, count: int | None = Non
     [0, 1, 2]
     """
     w = _weights(weights)
-    m = w.size if count is None else check_int(count, "count", minimum=1)
-    check_sample_count(m, "count")
+    m = w.size if count is None else as_int(count, "count", minimum=1)
+    require_sample_count(m, "count")
     g = as_rng(rng)                                                 # checked even when start is given
     if start is None:
         r = g.uniform(0.0, 1.0 / m)                                 # Table 4.4, line 3
     else:
-        r = check_finite_scalar(start, "start")
+        r = as_finite_scalar(start, "start")
         if not 0.0 <= r < 1.0 / m:
             raise ValueError(f"start: expected r in [0, 1/M) = [0, {1.0 / m:.6g}), got {r}")
     pointers = r + np.arange(m) / m                                 # line 7
@@ -236,7 +236,7 @@ def kld_sample_count(k: Any, *, epsilon: float = 0.01, z: float = KLD_Z_99) -> A
         raise ValueError(f"k: expected whole bin counts, got {describe(k)}")
     if np.any(kk < 1) or np.any(kk > MAX_BINS):
         raise ValueError(f"k: expected bin counts in [1, {MAX_BINS}], got values in [{kk.min()}, {kk.max()}]")
-    eps = check_positive(epsilon, "epsilon")
+    eps = as_positive(epsilon, "epsilon")
     zz = float(as_array(z, "z", shape=()))
     km1 = np.maximum(kk.astype(float) - 1.0, 1.0)
     a = 2.0 / (9.0 * km1)
@@ -324,13 +324,13 @@ def kld_resample(particles: Any, weights: Any, rng: Any = None, *, min_count: in
     w = _weights(weights)
     if w.size != len(P):
         raise ValueError(f"weights: expected {len(P)} weights (one per particle), got {w.size}")
-    lo = check_int(min_count, "min_count", minimum=1)
-    hi = check_int(max_count, "max_count", minimum=lo)
-    check_sample_count(hi, "max_count")
-    p_inj = check_positive(inject_probability, "inject_probability", allow_zero=True)
+    lo = as_int(min_count, "min_count", minimum=1)
+    hi = as_int(max_count, "max_count", minimum=lo)
+    require_sample_count(hi, "max_count")
+    p_inj = as_positive(inject_probability, "inject_probability", allow_zero=True)
     if p_inj > 1:
         raise ValueError(f"inject_probability: expected a probability in [0, 1], got {p_inj}")
-    check_callable(random_pose, "random_pose")
+    as_callable(random_pose, "random_pose")
     if p_inj > 0 and random_pose is None:
         raise ValueError("random_pose: expected a callable random_pose(n, rng) when inject_probability > 0")
     g = as_rng(rng)
@@ -386,8 +386,8 @@ def weighted_pose_mean(particles: Any, weights: Any = None) -> np.ndarray:
 
 
 def _ellipse_args(pose: Any, sigma_x: Any, sigma_y: Any) -> tuple[np.ndarray, float, float]:
-    return (as_array(pose, "pose", shape=(3,)), check_positive(sigma_x, "sigma_x"),
-            check_positive(sigma_y, "sigma_y"))
+    return (as_array(pose, "pose", shape=(3,)), as_positive(sigma_x, "sigma_x"),
+            as_positive(sigma_y, "sigma_y"))
 
 
 def sample_ellipse_poses(pose: Any, sigma_x: float, sigma_y: float, n: int = 50, *, nsigma: float = 2.0,
@@ -427,10 +427,10 @@ def sample_ellipse_poses(pose: Any, sigma_x: float, sigma_y: float, n: int = 50,
     True
     """
     c, sx, sy = _ellipse_args(pose, sigma_x, sigma_y)
-    count = check_int(n, "n", minimum=1)
-    check_sample_count(count, "n")
-    k = check_positive(nsigma, "nsigma")
-    st = check_positive(sigma_theta, "sigma_theta", allow_zero=True)
+    count = as_int(n, "n", minimum=1)
+    require_sample_count(count, "n")
+    k = as_positive(nsigma, "nsigma")
+    st = as_positive(sigma_theta, "sigma_theta", allow_zero=True)
     g = as_rng(rng)
     radius = np.sqrt(g.random(count))
     phi = g.uniform(-np.pi, np.pi, count)
@@ -478,7 +478,7 @@ def ellipse_weights(particles: Any, pose: Any, sigma_x: float, sigma_y: float, *
     sx, sy = np.float64(sx), np.float64(sy)                  # an overflow is inf, not an OverflowError
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         log_w = -(along ** 2 / (2 * sx ** 2) + across ** 2 / (2 * sy ** 2)) - np.log(2 * np.pi * sx * sy)  # Eq. (19)
-    check_finite_result("particles, pose, sigma_x, sigma_y", log_w)
+    require_finite_result("particles, pose, sigma_x, sigma_y", log_w)
     if not normalise:
         return np.exp(log_w)
     return normalise_log_weights(log_w).weights

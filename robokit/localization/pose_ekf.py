@@ -37,8 +37,8 @@ from scipy.stats import chi2
 
 from ..geometry import wrap_angle
 from ..sim import unicycle_step
-from ..validation import (as_array, check_covariance, check_finite_result, check_int, check_positive,
-                          check_finite_scalar, describe)
+from ..validation import (as_array, as_covariance, require_finite_result, as_int, as_positive,
+                          as_finite_scalar, describe)
 
 __all__ = ["unicycle_jacobian", "unicycle_process_noise", "ekf_predict", "ekf_update", "nees", "nees_bounds",
            "UnicycleEKF"]
@@ -59,7 +59,7 @@ def _sinc_and_slope(u: float) -> tuple[float, float]:
     return np.sin(u) / u, (u * np.cos(u) - np.sin(u)) / (u * u)
 
 
-def unicycle_jacobian(x: Any, dt: float, *, check: bool = True) -> np.ndarray:
+def unicycle_jacobian(x: Any, dt: float, *, validate: bool = True) -> np.ndarray:
     """Jacobian ``F = df/dx`` of the constant-velocity unicycle step over ``dt`` seconds.
 
     Parameters
@@ -68,7 +68,7 @@ def unicycle_jacobian(x: Any, dt: float, *, check: bool = True) -> np.ndarray:
         State ``[x, y, theta, v, omega]``.
     dt : float
         Step (s, >= 0).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` for a filter loop that already did.
 
     Returns
@@ -89,9 +89,9 @@ def unicycle_jacobian(x: Any, dt: float, *, check: bool = True) -> np.ndarray:
     >>> np.round(F[:3, 2:], 4).tolist()          # d(x, y, theta) / d(theta, v, omega)
     [[0.0, 0.5, 0.0], [0.5, 0.0, 0.125], [1.0, 0.0, 0.5]]
     """
-    if check:
+    if validate:
         x = _state(x)
-        dt = check_positive(dt, "dt", allow_zero=True)
+        dt = as_positive(dt, "dt", allow_zero=True)
     th, v, w = float(x[2]), float(x[3]), float(x[4])
     u = w * dt / 2
     S, dS = _sinc_and_slope(u)
@@ -103,13 +103,13 @@ def unicycle_jacobian(x: Any, dt: float, *, check: bool = True) -> np.ndarray:
     F[0, 3], F[1, 3] = dt * S * c, dt * S * s                                # d/dv
     F[0, 4], F[1, 4] = dL_dw * c - L * s * dt / 2, dL_dw * s + L * c * dt / 2   # d/domega
     F[2, 4] = dt
-    if check:
-        check_finite_result("x, dt", F)
+    if validate:
+        require_finite_result("x, dt", F)
     return F
 
 
 def unicycle_process_noise(x: Any, dt: float, sigma_accel: float, sigma_alpha: float, *,
-                           check: bool = True) -> np.ndarray:
+                           validate: bool = True) -> np.ndarray:
     """Process noise ``Q = G diag(sigma_accel^2, sigma_alpha^2) G^T`` of one step.
 
     Parameters
@@ -121,7 +121,7 @@ def unicycle_process_noise(x: Any, dt: float, sigma_accel: float, sigma_alpha: f
     sigma_accel, sigma_alpha : float
         Standard deviations (>= 0) of the linear (m/s^2) and angular (rad/s^2) accelerations the
         filter assumes, each constant over a step.
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs.
 
     Returns
@@ -145,23 +145,23 @@ def unicycle_process_noise(x: Any, dt: float, sigma_accel: float, sigma_alpha: f
     >>> np.round(np.sqrt(np.diag(Q)), 5).tolist()     # 0.5 * 0.1^2 / 2 = 0.0025 on x
     [0.0025, 0.00025, 0.005, 0.05, 0.1]
     """
-    if check:
+    if validate:
         x = _state(x)
-        dt = check_positive(dt, "dt", allow_zero=True)
-        sigma_accel = check_positive(sigma_accel, "sigma_accel", allow_zero=True)
-        sigma_alpha = check_positive(sigma_alpha, "sigma_alpha", allow_zero=True)
-    F = unicycle_jacobian(x, dt, check=False)
+        dt = as_positive(dt, "dt", allow_zero=True)
+        sigma_accel = as_positive(sigma_accel, "sigma_accel", allow_zero=True)
+        sigma_alpha = as_positive(sigma_alpha, "sigma_alpha", allow_zero=True)
+    F = unicycle_jacobian(x, dt, validate=False)
     G = np.zeros((5, 2))
     G[:3] = F[:3, 3:5] * (dt / 2)
     G[3, 0] = G[4, 1] = dt
     G = G * np.array([sigma_accel, sigma_alpha])
     Q = G @ G.T
-    if check:
-        check_finite_result("x, dt, sigma_accel, sigma_alpha", Q)
+    if validate:
+        require_finite_result("x, dt, sigma_accel, sigma_alpha", Q)
     return Q
 
 
-def ekf_predict(x: Any, P: Any, dt: float, Q: Any, *, check: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def ekf_predict(x: Any, P: Any, dt: float, Q: Any, *, validate: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """EKF prediction over ``dt`` seconds with the constant-velocity unicycle (Eq. (6)).
 
     Parameters
@@ -174,7 +174,7 @@ def ekf_predict(x: Any, P: Any, dt: float, Q: Any, *, check: bool = True) -> tup
         Step (s, >= 0).
     Q : array_like, shape (5, 5)
         Process noise of the step (positive semidefinite), e.g. :func:`unicycle_process_noise`.
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs.
 
     Returns
@@ -200,18 +200,18 @@ def ekf_predict(x: Any, P: Any, dt: float, Q: Any, *, check: bool = True) -> tup
     >>> np.round(x, 3).tolist(), round(float(P[1, 1]), 4)    # heading variance spreads sideways
     ([1.0, 0.0, 0.0, 1.0, 0.0], 0.0225)
     """
-    if check:
+    if validate:
         x = _state(x)
-        P = check_covariance(P, "P", 5)
-        dt = check_positive(dt, "dt", allow_zero=True)
-        Q = check_covariance(Q, "Q", 5, semidefinite=True)
-    F = unicycle_jacobian(x, dt, check=False)
+        P = as_covariance(P, "P", 5)
+        dt = as_positive(dt, "dt", allow_zero=True)
+        Q = as_covariance(Q, "Q", 5, semidefinite=True)
+    F = unicycle_jacobian(x, dt, validate=False)
     x_new = np.empty(5)
-    x_new[:3] = unicycle_step(x[:3], x[3], x[4], dt, check=False)         # Eq. (6), exact arc
+    x_new[:3] = unicycle_step(x[:3], x[3], x[4], dt, validate=False)         # Eq. (6), exact arc
     x_new[3:] = x[3:]
     P_new = F @ P @ F.T + Q
     P_new = 0.5 * (P_new + P_new.T)
-    check_finite_result("x, P, dt, Q", x_new, P_new)
+    require_finite_result("x, P, dt, Q", x_new, P_new)
     return x_new, P_new
 
 
@@ -225,7 +225,7 @@ def _innovation(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: n
 
 
 def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] = (),
-               check: bool = True) -> tuple[np.ndarray, np.ndarray]:
+               validate: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """Kalman update with a linear measurement ``z = H x + noise``, covariance in Joseph form.
 
     Parameters
@@ -242,7 +242,7 @@ def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] 
         Measurement noise covariance (positive definite).
     angles : sequence of int, default ()
         Components of ``z`` that are angles: their innovation is wrapped to ``[-pi, pi)``.
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs.
 
     Returns
@@ -268,17 +268,17 @@ def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] 
     >>> x.tolist(), P.tolist()
     ([0.5, 0.0], [[0.5, 0.0], [0.0, 1.0]])
     """
-    if check:
+    if validate:
         x = as_array(x, "x", ndim=1, min_size=1)
         n = len(x)
-        P = check_covariance(P, "P", n)
+        P = as_covariance(P, "P", n)
         z = as_array(z, "z", ndim=1, min_size=1)
         m = len(z)
         H = as_array(H, "H", shape=(m, n))
-        R = check_covariance(R, "R", m)
+        R = as_covariance(R, "R", m)
         if not isinstance(angles, (list, tuple, range, np.ndarray)):
             raise TypeError(f"angles: expected a sequence of indices into z, got {describe(angles)}")
-        angles = [check_int(i, "angles", minimum=0, maximum=m - 1) for i in np.asarray(angles, dtype=object).ravel()]
+        angles = [as_int(i, "angles", minimum=0, maximum=m - 1) for i in np.asarray(angles, dtype=object).ravel()]
     y, S = _innovation(x, P, z, H, R, angles)
     try:
         K = np.linalg.solve(S, H @ P).T                  # K = P H^T S^-1 (S symmetric)
@@ -289,7 +289,7 @@ def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] 
     P_new = I_KH @ P @ I_KH.T + K @ R @ K.T              # Joseph form
     x_new = x + K @ y
     P_new = 0.5 * (P_new + P_new.T)
-    check_finite_result("x, P, z, H, R", x_new, P_new)
+    require_finite_result("x, P, z, H, R", x_new, P_new)
     return x_new, P_new
 
 
@@ -331,7 +331,7 @@ def nees(error: Any, P: Any) -> Any:
         out = np.einsum("...i,...i->...", e, np.linalg.solve(C, e[..., None])[..., 0])
     except np.linalg.LinAlgError:
         raise ValueError("P: expected invertible covariances, got a singular one") from None
-    check_finite_result("error, P", out)
+    require_finite_result("error, P", out)
     return float(out) if out.ndim == 0 else out
 
 
@@ -363,9 +363,9 @@ def nees_bounds(dof: int, runs: int, confidence: float = 0.95) -> tuple[float, f
     >>> round(lo, 3), round(hi, 3)
     (4.162, 5.914)
     """
-    n = check_int(dof, "dof", minimum=1, maximum=10 ** 6)
-    r = check_int(runs, "runs", minimum=1, maximum=10 ** 9)
-    c = check_positive(confidence, "confidence")
+    n = as_int(dof, "dof", minimum=1, maximum=10 ** 6)
+    r = as_int(runs, "runs", minimum=1, maximum=10 ** 9)
+    c = as_positive(confidence, "confidence")
     if not c < 1:
         raise ValueError(f"confidence: expected a probability in (0, 1), got {c}")
     lo, hi = chi2.ppf([(1 - c) / 2, (1 + c) / 2], n * r) / r
@@ -417,9 +417,9 @@ class UnicycleEKF:
     def __init__(self, x0: Any, P0: Any, *, sigma_accel: float = 0.5, sigma_alpha: float = 1.0) -> None:
         self._x = _state(x0, "x0").copy()
         self._x[2] = wrap_angle(self._x[2])
-        self._P = check_covariance(P0, "P0", 5)
-        self.sigma_accel = check_positive(sigma_accel, "sigma_accel", allow_zero=True)
-        self.sigma_alpha = check_positive(sigma_alpha, "sigma_alpha", allow_zero=True)
+        self._P = as_covariance(P0, "P0", 5)
+        self.sigma_accel = as_positive(sigma_accel, "sigma_accel", allow_zero=True)
+        self.sigma_alpha = as_positive(sigma_alpha, "sigma_alpha", allow_zero=True)
         self.nis: float | None = None
 
     @property
@@ -439,14 +439,14 @@ class UnicycleEKF:
 
     def predict(self, dt: float) -> None:
         """Move the estimate ``dt`` seconds along Eq. (6) (:func:`ekf_predict`)."""
-        h = check_positive(dt, "dt", allow_zero=True)
-        Q = unicycle_process_noise(self._x, h, self.sigma_accel, self.sigma_alpha, check=False)
-        self._x, self._P = ekf_predict(self._x, self._P, h, Q, check=False)
+        h = as_positive(dt, "dt", allow_zero=True)
+        Q = unicycle_process_noise(self._x, h, self.sigma_accel, self.sigma_alpha, validate=False)
+        self._x, self._P = ekf_predict(self._x, self._P, h, Q, validate=False)
 
     def update_velocity(self, v: float, omega: float, R: Any) -> None:
         """Fuse odometry's ``(v, omega)`` with covariance ``R`` (2 x 2, positive definite)."""
-        z = np.array([check_finite_scalar(v, "v"), check_finite_scalar(omega, "omega")])
-        self._x, self._P = ekf_update(self._x, self._P, z, H_VELOCITY, check_covariance(R, "R", 2), check=False)
+        z = np.array([as_finite_scalar(v, "v"), as_finite_scalar(omega, "omega")])
+        self._x, self._P = ekf_update(self._x, self._P, z, H_VELOCITY, as_covariance(R, "R", 2), validate=False)
 
     def update_pose(self, z: Any, R: Any, *, gate: float | None = None) -> bool:
         """Fuse a pose fix ``[x, y, theta]`` with covariance ``R`` (3 x 3); heading innovation wrapped.
@@ -466,12 +466,12 @@ class UnicycleEKF:
             Whether the fix was used.
         """
         zz = as_array(z, "z", shape=(3,))
-        RR = check_covariance(R, "R", 3)
-        g = None if gate is None else check_positive(gate, "gate")
+        RR = as_covariance(R, "R", 3)
+        g = None if gate is None else as_positive(gate, "gate")
         y, S = _innovation(self._x, self._P, zz, H_POSE, RR, (2,))
         self.nis = float(y @ np.linalg.solve(S, y))
         if g is not None and self.nis > g:
             return False
-        self._x, self._P = ekf_update(self._x, self._P, zz, H_POSE, RR, angles=(2,), check=False)
+        self._x, self._P = ekf_update(self._x, self._P, zz, H_POSE, RR, angles=(2,), validate=False)
         self._x[2] = wrap_angle(self._x[2])
         return True

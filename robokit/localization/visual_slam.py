@@ -35,7 +35,7 @@ import numpy as np
 
 from ..geometry import as_pqt, pqt_world_to_robot, se2_between, se2_compose
 from ..mapping.landmarks import LandmarkMap
-from ..validation import as_array, as_rng, check_choice, check_int, check_positive
+from ..validation import as_array, as_rng, as_choice, as_int, as_positive
 from ..vision.descriptors import detect_and_describe
 from ..vision.stereo import StereoObservations, StereoCalibration, observe_stereo
 from .egomotion import track
@@ -133,16 +133,16 @@ class VisualSLAM:
         if not isinstance(rig, StereoCalibration):
             raise TypeError(f"rig: expected robokit.vision.StereoCalibration, got {type(rig).__name__}")
         self.rig = rig
-        self.method = check_choice(method, "method", FEATURE_METHODS)
-        self.descriptor = check_choice(descriptor, "descriptor", DESCRIPTORS)
-        self.min_matches = check_int(min_matches, "min_matches", minimum=2)
-        self.window = check_positive(window, "window")
-        self.threshold = check_positive(threshold, "threshold")
+        self.method = as_choice(method, "method", FEATURE_METHODS)
+        self.descriptor = as_choice(descriptor, "descriptor", DESCRIPTORS)
+        self.min_matches = as_int(min_matches, "min_matches", minimum=2)
+        self.window = as_positive(window, "window")
+        self.threshold = as_positive(threshold, "threshold")
         self.odometry_sigma = as_array(odometry_sigma, "odometry_sigma", shape=(3,))
         if np.any(self.odometry_sigma < 0):
             raise ValueError(f"odometry_sigma: expected non-negative values, got {self.odometry_sigma.tolist()}")
-        self.max_range = check_positive(max_range, "max_range")
-        self.association_window = check_positive(association_window, "association_window")
+        self.max_range = as_positive(max_range, "max_range")
+        self.association_window = as_positive(association_window, "association_window")
         self.feature_options = feature_options
         self.map = LandmarkMap(16 if self.descriptor == "reduced16" else 128, max_missed=max_missed)
         self.rng = as_rng(rng)

@@ -36,14 +36,14 @@ from .grid_mapping import (L_FREE, L_OCC, inverse_range_sensor_model, occupancy_
 from .landmarks import LandmarkMap, kalman_fuse, transform_covariance
 from .map_server import FREE_VALUE, OCCUPIED_VALUE, UNKNOWN_VALUE, MapFileError, load_map, save_map
 from .manhattan import manhattan_world_graph
-from .pose_graph import (DisconnectedGraphError, PoseGraph, as_pose_graph, check_connected, edge_variances, is_connected,
+from .pose_graph import (DisconnectedGraphError, PoseGraph, as_pose_graph, require_connected, edge_variances, is_connected,
                          pose_graph_from_odometry, positive_definite, unreachable_nodes,
                          information_from_covariance, position_variance)
 from .pose_graph_optimize import (PoseGraphResult, optimize_pose_graph, pose_graph_cost, pose_graph_jacobian,
                                   pose_graph_residuals)
 from .occupancy_grid import (FREE_THRESHOLD, LOG_ODDS_MAX, LOG_ODDS_MIN, OCCUPIED_THRESHOLD, LikelihoodField,
                              OccupancyGrid, likelihood_field, log_odds, probability)
-from .omni_views import OmniView, RelativePose, check_omni_image, omni_view, relative_pose
+from .omni_views import OmniView, RelativePose, as_omni_image, omni_view, relative_pose
 from .relaxation import RelaxationResult, initial_variances, relax, relax_sweep
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
 from .local_maps import Comparison, appearance_changed, local_map_full, select_key_frames
@@ -51,11 +51,11 @@ from .topological_build import build_topological_map
 
 __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
            "PoseGraph", "DisconnectedGraphError", "as_pose_graph", "positive_definite", "edge_variances", "unreachable_nodes",
-           "is_connected", "check_connected", "pose_graph_from_odometry", "information_from_covariance", "position_variance",
+           "is_connected", "require_connected", "pose_graph_from_odometry", "information_from_covariance", "position_variance",
            "pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph",
            "RelaxationResult", "relax", "relax_sweep", "initial_variances",
            "G2OFormatError", "read_g2o", "write_g2o", "manhattan_world_graph",
-           "OmniView", "RelativePose", "check_omni_image", "omni_view", "relative_pose",
+           "OmniView", "RelativePose", "as_omni_image", "omni_view", "relative_pose",
            "LOOP_EDGE", "ODOMETRY_EDGE", "EmptyMapError", "TopologicalMap", "Comparison", "appearance_changed",
            "build_topological_map", "local_map_full", "select_key_frames",
            "FREE_THRESHOLD", "OCCUPIED_THRESHOLD", "LOG_ODDS_MIN", "LOG_ODDS_MAX", "log_odds", "probability",

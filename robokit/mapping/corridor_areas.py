@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, check_positive
+from ..validation import as_array, as_positive
 
 __all__ = ["EmptyScanError", "as_scan", "invalid_areas", "theta_limits", "theta_limits_geometric", "MAX_RANGE"]
 
@@ -164,7 +164,7 @@ def theta_limits(width: float, r_max: float) -> tuple[float, float]:
     >>> [round(float(np.rad2deg(t)), 3) for t in theta_limits(2.17, 8.0)]
     [7.795, 15.739]
     """
-    w, rm = check_positive(width, "width"), check_positive(r_max, "r_max")
+    w, rm = as_positive(width, "width"), as_positive(r_max, "r_max")
     if w > rm:
         raise ValueError(f"width: expected a width no larger than r_max = {rm}, got {w}")
     return float(np.arcsin(w / (2 * rm))), float(np.arcsin(w / rm))  # Eqs. (7), (6)
@@ -203,7 +203,7 @@ def theta_limits_geometric(width: float, r_max: float, recess: float = 0.0) -> t
     """
     lo, _ = theta_limits(width, r_max)
     w, rm = width, r_max
-    dda = check_positive(recess, "recess", allow_zero=True)
+    dda = as_positive(recess, "recess", allow_zero=True)
     if w + 2 * dda > rm:
         raise ValueError(f"recess: expected width + 2 recess <= r_max = {rm}, got {dda}")
     return 2 * lo, float(np.arcsin(dda / rm) + np.arcsin((w + dda) / rm))

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import check_choice, check_finite_scalar, check_positive
+from ..validation import as_choice, as_finite_scalar, as_positive
 from .corridor_areas import EmptyScanError, as_scan, invalid_areas, theta_limits, theta_limits_geometric
 
 __all__ = ["NoWallError", "CorridorState", "corridor_axis", "wall_distances", "door_sides", "width_condition",
@@ -131,7 +131,7 @@ def _axis(r: np.ndarray, a: np.ndarray) -> float:
             break
         u = np.linalg.eigh(scatter)[1][:, -1]
         axis = float(np.arctan2(u[1], u[0]))
-    return float(wrap_angle(2 * axis, check=False) / 2)        # modulo pi, in [-pi/2, pi/2)
+    return float(wrap_angle(2 * axis, validate=False) / 2)        # modulo pi, in [-pi/2, pi/2)
 
 
 def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[float, float]:
@@ -177,7 +177,7 @@ def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[fl
     (0.8, 1.37)
     """
     r, a = as_scan(ranges, angles)
-    axis = _axis(r, a) if heading is None else check_finite_scalar(heading, "heading")
+    axis = _axis(r, a) if heading is None else as_finite_scalar(heading, "heading")
     return _wall_distances(r, a, axis)
 
 
@@ -185,7 +185,7 @@ def _wall_distances(r: np.ndarray, a: np.ndarray, axis: float) -> tuple[float, f
     """:func:`wall_distances` of a checked scan and axis."""
     out = []
     for name, normal in (("left", axis + np.pi / 2), ("right", axis - np.pi / 2)):
-        off = wrap_angle(a - normal, check=False)
+        off = wrap_angle(a - normal, validate=False)
         foot = np.argsort(np.abs(off), kind="stable")[:_FOOT]
         along = r[foot] * np.cos(off[foot])
         if np.count_nonzero(np.isfinite(along)) < (len(foot) + 2) // 2:
@@ -233,8 +233,8 @@ def door_sides(ranges: Any, angles: Any, *, heading: Any = None, recess: float =
     (True, False)
     """
     r, a = as_scan(ranges, angles)
-    axis = _axis(r, a) if heading is None else check_finite_scalar(heading, "heading")
-    dda = check_positive(recess, "recess", allow_zero=True)
+    axis = _axis(r, a) if heading is None else as_finite_scalar(heading, "heading")
+    dda = as_positive(recess, "recess", allow_zero=True)
     return _door_sides(r, a, axis, dda, _wall_distances(r, a, axis))
 
 
@@ -242,7 +242,7 @@ def _door_sides(r: np.ndarray, a: np.ndarray, axis: float, dda: float, d: tuple[
     """:func:`door_sides` of a checked scan, axis and recess, given the wall distances ``d``."""
     out = []
     for dist, normal in zip(d, (axis + np.pi / 2, axis - np.pi / 2)):
-        off = wrap_angle(a - normal, check=False)
+        off = wrap_angle(a - normal, validate=False)
         near = (np.abs(off) <= np.pi / 3) & np.isfinite(r)
         level = np.percentile(r[near] * np.cos(off[near]), 10) if near.any() else dist
         out.append(bool(dist - level > dda / 2))
@@ -277,9 +277,9 @@ def width_condition(d_l: float, d_r: float, width: float, *, recess: float = 0.0
     >>> width_condition(1.085, 1.085, 2.17), width_condition(1.155, 1.085, 2.17), width_condition(1.2, 1.2, 2.17)
     ('corridor', 'staggered doors', None)
     """
-    dl, dr = check_positive(d_l, "d_l"), check_positive(d_r, "d_r")
-    w, dda = check_positive(width, "width"), check_positive(recess, "recess", allow_zero=True)
-    e = check_positive(tol, "tol", allow_zero=True)
+    dl, dr = as_positive(d_l, "d_l"), as_positive(d_r, "d_r")
+    w, dda = as_positive(width, "width"), as_positive(recess, "recess", allow_zero=True)
+    e = as_positive(tol, "tol", allow_zero=True)
     err = np.abs(dl + dr - np.array([w, w + 2 * dda, w + dda]))   # Eqs. (1), (2), (3)
     k = int(np.argmin(err))
     return WIDTH_CASES[k] if err[k] <= e else None
@@ -328,17 +328,17 @@ def middle_line_condition(d_l: float, d_r: float, *, tol: float = 0.04, width: A
     >>> middle_line_condition(1.155, 1.085)                      # raw Eq. (4) sees 7 cm
     (False, -0.035, 'none')
     """
-    dl, dr = check_positive(d_l, "d_l"), check_positive(d_r, "d_r")
-    e4 = check_positive(tol, "tol", allow_zero=True)
-    dda = check_positive(recess, "recess", allow_zero=True)
-    e_w = check_positive(width_tol, "width_tol", allow_zero=True)
+    dl, dr = as_positive(d_l, "d_l"), as_positive(d_r, "d_r")
+    e4 = as_positive(tol, "tol", allow_zero=True)
+    dda = as_positive(recess, "recess", allow_zero=True)
+    e_w = as_positive(width_tol, "width_tol", allow_zero=True)
     doors = "none"
     if width is not None:
         case = width_condition(dl, dr, width, recess=dda, tol=e_w)
         if case == "facing doors":
             doors = "both"
         elif case == "staggered doors":
-            side = None if door is None else check_choice(door, "door", ["left", "right"])
+            side = None if door is None else as_choice(door, "door", ["left", "right"])
             doors = side or ("left" if dl > dr else "right")
             dl, dr = (dl - dda, dr) if doors == "left" else (dl, dr - dda)
     holds = bool(abs(dl - dr) <= e4 + 1e-12)                  # Eq. (4)
@@ -426,10 +426,10 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
     (True, False, 2, [14.0, 15.0])
     """
     r, a = as_scan(ranges, angles)
-    check_choice(bounds, "bounds", ["paper", "geometric"])
-    recess = check_positive(recess, "recess", allow_zero=True)
-    tol = check_positive(tol, "tol", allow_zero=True)
-    width_tol = check_positive(width_tol, "width_tol", allow_zero=True)
+    as_choice(bounds, "bounds", ["paper", "geometric"])
+    recess = as_positive(recess, "recess", allow_zero=True)
+    tol = as_positive(tol, "tol", allow_zero=True)
+    width_tol = as_positive(width_tol, "width_tol", allow_zero=True)
     lo, hi = theta_limits(width, r_max) if bounds == "paper" else theta_limits_geometric(width, r_max, recess)
     if bounds == "geometric" and len(a) > 1:
         lo -= 2 * float(np.min(np.diff(a)))

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import check_text, describe
+from ..validation import as_text, describe
 from .pose_graph import PoseGraph, as_pose_graph, positive_definite
 
 __all__ = ["G2OFormatError", "read_g2o", "write_g2o"]
@@ -86,7 +86,7 @@ def _text_of(source: Any) -> tuple[str, str]:
     if isinstance(source, os.PathLike):
         path = Path(source)
     else:
-        path = Path(check_text(source, "source", empty=False))
+        path = Path(as_text(source, "source", empty=False))
     try:
         return path.read_text(encoding="utf-8"), str(path)
     except UnicodeDecodeError:
@@ -240,7 +240,7 @@ def write_g2o(graph: PoseGraph, path: Any = None) -> str:
     """
     as_pose_graph(graph)
     if path is not None and not isinstance(path, os.PathLike):
-        check_text(path, "path", empty=False)
+        as_text(path, "path", empty=False)
 
     def num(values) -> str:
         return " ".join(repr(float(v)) for v in values)

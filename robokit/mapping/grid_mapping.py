@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import se2_compose, wrap_angle
-from ..validation import as_array, check_finite_scalar, check_positive, describe
+from ..validation import as_array, as_finite_scalar, as_positive, describe
 from .occupancy_grid import LOG_ODDS_MAX, LOG_ODDS_MIN, OccupancyGrid
 
 __all__ = ["L_OCC", "L_FREE", "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping",
@@ -44,7 +44,7 @@ __all__ = ["L_OCC", "L_FREE", "inverse_range_sensor_model", "update_log_odds", "
 L_OCC, L_FREE = math.log(0.7 / 0.3), math.log(0.4 / 0.6)
 
 
-def _check_scan(ranges: Any, angles: Any, name: str = "ranges") -> tuple[np.ndarray, np.ndarray]:
+def _as_scan(ranges: Any, angles: Any, name: str = "ranges") -> tuple[np.ndarray, np.ndarray]:
     r = as_array(ranges, name, finite=False)
     a = as_array(angles, "angles", ndim=1)
     if r.ndim == 0 or r.shape[-1] == 0:
@@ -64,12 +64,12 @@ def _check_scan(ranges: Any, angles: Any, name: str = "ranges") -> tuple[np.ndar
 
 def _model_options(r_max: Any, l_occ: Any, l_free: Any, l0: Any, thickness: Any, beam_width: Any,
                    beams: int) -> tuple:
-    z_max = check_positive(r_max, "r_max")
-    lo = check_finite_scalar(l_occ, "l_occ")
-    lf = check_finite_scalar(l_free, "l_free")
-    prior = check_finite_scalar(l0, "l0")
-    alpha = check_positive(thickness, "thickness")
-    beta = 2 * np.pi / beams if beam_width is None else check_positive(beam_width, "beam_width")
+    z_max = as_positive(r_max, "r_max")
+    lo = as_finite_scalar(l_occ, "l_occ")
+    lf = as_finite_scalar(l_free, "l_free")
+    prior = as_finite_scalar(l0, "l0")
+    alpha = as_positive(thickness, "thickness")
+    beta = 2 * np.pi / beams if beam_width is None else as_positive(beam_width, "beam_width")
     return z_max, lo, lf, prior, alpha, beta
 
 
@@ -87,7 +87,7 @@ def _nearest_beam(phi: np.ndarray, angles: np.ndarray) -> np.ndarray:
 
 def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, r_max: float, l_occ: float = L_OCC,
                                l_free: float = L_FREE, l0: float = 0.0, thickness: float = 0.1,
-                               beam_width: float | None = None, check: bool = True) -> np.ndarray:
+                               beam_width: float | None = None, validate: bool = True) -> np.ndarray:
     """Log odds that one scan gives each cell (Thrun et al. 2005, Table 9.2), vectorised over cells.
 
     Parameters
@@ -109,7 +109,7 @@ def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, 
         ``alpha``: the depth of an obstacle (metres) around a return.
     beam_width : float, optional
         ``beta``: the opening angle of a beam; default ``2 pi / B`` (a full-turn scan's spacing).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` skips it (float arrays only).
 
     Returns
@@ -136,12 +136,12 @@ def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, 
     ...                            r_max=2.0, l_occ=1.0, l_free=-0.5).tolist()
     [-0.5, 1.0, 0.0, -0.5]
     """
-    if check:
+    if validate:
         pts = as_array(xy, "xy")
         if pts.ndim != 2 or pts.shape[1] != 2:
             raise ValueError(f"xy: expected shape (N, 2), got shape {pts.shape}")
         p = as_array(pose, "pose", shape=(3,))
-        z, a = _check_scan(ranges, angles)
+        z, a = _as_scan(ranges, angles)
         if z.ndim != 1:
             raise ValueError(f"ranges: expected one scan of shape ({a.size},), got shape {z.shape}")
         z_max, lo, lf, prior, alpha, beta = _model_options(r_max, l_occ, l_free, l0, thickness, beam_width, a.size)
@@ -173,13 +173,13 @@ def _update(L: np.ndarray, xs: np.ndarray, ys: np.ndarray, sensor: np.ndarray, z
     gx, gy = np.meshgrid(xs[j0:j1], ys[i0:i1])
     cells = np.column_stack([gx.ravel(), gy.ravel()])
     ism = inverse_range_sensor_model(cells, sensor, z, a, r_max=z_max, l_occ=lo, l_free=lf, l0=prior,
-                                     thickness=alpha, beam_width=beta, check=False)
+                                     thickness=alpha, beam_width=beta, validate=False)
     block = L[i0:i1, j0:j1]
     block += (ism - prior).reshape(block.shape)                            # Table 9.1, line 4
     np.clip(block, clamp[0], clamp[1], out=block)
 
 
-def _check_clamp(clamp: Any) -> tuple[float, float]:
+def _as_clamp(clamp: Any) -> tuple[float, float]:
     c = as_array(clamp, "clamp", shape=(2,))
     if not c[0] < c[1]:
         raise ValueError(f"clamp: expected (low, high) with low < high, got {c.tolist()}")
@@ -230,11 +230,11 @@ def update_log_odds(grid: OccupancyGrid, pose: Any, ranges: Any, angles: Any, *,
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"grid: expected an OccupancyGrid, got {describe(grid)}")
     p = as_array(pose, "pose", shape=(3,))
-    z, a = _check_scan(ranges, angles)
+    z, a = _as_scan(ranges, angles)
     if z.ndim != 1:
         raise ValueError(f"ranges: expected one scan of shape ({a.size},), got shape {z.shape}")
     opts = _model_options(r_max, l_occ, l_free, l0, thickness, beam_width, a.size)
-    bounds = _check_clamp(clamp)
+    bounds = _as_clamp(clamp)
     L = grid.log_odds.copy()
     xs = grid.origin[0] + (np.arange(grid.shape[1]) + 0.5) * grid.resolution
     ys = grid.origin[1] + (np.arange(grid.shape[0]) + 0.5) * grid.resolution
@@ -242,11 +242,11 @@ def update_log_odds(grid: OccupancyGrid, pose: Any, ranges: Any, angles: Any, *,
     return OccupancyGrid(L, grid.resolution, grid.origin)
 
 
-def _check_run(poses: Any, scans: Any, angles: Any, sensor_offset: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _as_run(poses: Any, scans: Any, angles: Any, sensor_offset: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     P = as_array(poses, "poses")
     if P.ndim != 2 or P.shape[1] != 3 or P.shape[0] == 0:
         raise ValueError(f"poses: expected shape (N, 3) with N >= 1, got shape {P.shape}")
-    z, a = _check_scan(scans, angles, "scans")
+    z, a = _as_scan(scans, angles, "scans")
     if z.ndim != 2 or z.shape[0] != P.shape[0]:
         raise ValueError(f"scans: expected shape ({P.shape[0]}, {a.size}), one scan per pose, got shape {z.shape}")
     offset = as_array(sensor_offset, "sensor_offset", shape=(3,))
@@ -305,9 +305,9 @@ def occupancy_grid_mapping(poses: Any, scans: Any, angles: Any, bounds: Any, res
     >>> np.round(grid.log_odds, 3).tolist()                     # two scans: free, free, hit
     [[-0.811, -0.811, 1.695]]
     """
-    sensors, z, a = _check_run(poses, scans, angles, sensor_offset)
+    sensors, z, a = _as_run(poses, scans, angles, sensor_offset)
     opts = _model_options(r_max, l_occ, l_free, l0, thickness, beam_width, a.size)
-    lims = _check_clamp(clamp)
+    lims = _as_clamp(clamp)
     grid = OccupancyGrid.empty(bounds, resolution)
     L = grid.log_odds
     xs = grid.origin[0] + (np.arange(grid.shape[1]) + 0.5) * grid.resolution
@@ -336,9 +336,9 @@ def occupancy_grid_mapping_reference(poses: Any, scans: Any, angles: Any, bounds
     >>> np.round(grid.log_odds, 3).tolist()
     [[-0.405, -0.405, 0.847]]
     """
-    sensors, z, a = _check_run(poses, scans, angles, sensor_offset)
+    sensors, z, a = _as_run(poses, scans, angles, sensor_offset)
     z_max, lo, lf, prior, alpha, beta = _model_options(r_max, l_occ, l_free, l0, thickness, beam_width, a.size)
-    low, high = _check_clamp(clamp)
+    low, high = _as_clamp(clamp)
     grid = OccupancyGrid.empty(bounds, resolution)
     H, W = grid.shape
     beams = a.tolist()

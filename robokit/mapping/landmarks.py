@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..geometry import as_pqt, pqt_robot_to_world, pqt_to_se3, pqt_transform_xz, pqt_world_to_robot
-from ..validation import array_ndim, as_array, check_int, check_positive
+from ..validation import array_ndim, as_array, as_int, as_positive
 
 __all__ = ["transform_covariance", "kalman_fuse", "LandmarkMap"]
 
@@ -70,9 +70,9 @@ def transform_covariance(points, covariances, pqt, pqt_covariance) -> tuple[np.n
     p = as_pqt(pqt)
     pcov = as_array(pqt_covariance, "pqt_covariance", shape=(3, 3))
     rot = pqt_to_se3(p)[:3, :3]
-    world = pqt_robot_to_world(pts, p, check=False)              # r_new = P(r_obs) + V, Sec. 3.3
+    world = pqt_robot_to_world(pts, p, validate=False)              # r_new = P(r_obs) + V, Sec. 3.3
     jac = np.zeros((pts.shape[0], 3, 3))                       # d r_new / d(p, q, theta); Y is fixed
-    jac[:, ::2] = pqt_transform_xz(p, pts[:, ::2], jacobian=True, check=False)[1]
+    jac[:, ::2] = pqt_transform_xz(p, pts[:, ::2], jacobian=True, validate=False)[1]
     out = rot @ cov @ rot.T + jac @ pcov @ np.swapaxes(jac, 1, 2)   # first-order propagation, Sec. 3.4
     return world, out
 
@@ -177,8 +177,8 @@ class LandmarkMap:
     """
 
     def __init__(self, descriptor_size: int, *, max_missed: int = 20):
-        self.descriptor_size = check_int(descriptor_size, "descriptor_size", minimum=1)
-        self.max_missed = check_int(max_missed, "max_missed", minimum=0)
+        self.descriptor_size = as_int(descriptor_size, "descriptor_size", minimum=1)
+        self.max_missed = as_int(max_missed, "max_missed", minimum=0)
         self.positions = np.zeros((0, 3))
         self.covariances = np.zeros((0, 3, 3))
         self.descriptors = np.zeros((0, self.descriptor_size), np.float32)
@@ -388,9 +388,9 @@ class LandmarkMap:
         n = pts.shape[0]
         cov = as_array(covariances, "covariances", shape=(n, 3, 3))
         desc = as_array(descriptors, "descriptors", shape=(n, self.descriptor_size), dtype=np.float32)
-        window = check_positive(window, "window")
-        gate = check_positive(gate, "gate")
-        max_distance = check_positive(max_distance, "max_distance")
+        window = as_positive(window, "window")
+        gate = as_positive(gate, "gate")
+        max_distance = as_positive(max_distance, "max_distance")
         out = -np.ones(n, int)
         if n == 0 or len(self) == 0:
             return out

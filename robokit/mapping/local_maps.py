@@ -21,7 +21,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..validation import as_array, check_callable, check_int, check_positive, describe
+from ..validation import as_array, as_callable, as_int, as_positive, describe
 
 __all__ = ["Comparison", "appearance_changed", "local_map_full", "select_key_frames"]
 
@@ -84,8 +84,8 @@ def appearance_changed(distance: Any, matches: Any, *, similarity: float = 0.1, 
     [False, False, True]
     """
     d, m = _paired(distance, "distance", matches, "matches")
-    s = check_positive(similarity, "similarity")
-    mm = check_int(min_matches, "min_matches", minimum=0)
+    s = as_positive(similarity, "similarity")
+    mm = as_int(min_matches, "min_matches", minimum=0)
     out = (d > s) & (m < mm)
     return bool(out) if out.ndim == 0 else out
 
@@ -135,8 +135,8 @@ def local_map_full(n_features: Any, variance: Any, *, max_features: int = 930, m
     [False, True, True]
     """
     n, v = _paired(n_features, "n_features", variance, "variance")
-    mf = check_int(max_features, "max_features", minimum=1)
-    mv = check_positive(max_variance, "max_variance")
+    mf = as_int(max_features, "max_features", minimum=1)
+    mv = as_positive(max_variance, "max_variance")
     out = (n >= mf) | (v >= mv)
     return bool(out) if out.ndim == 0 else out
 
@@ -181,9 +181,9 @@ def select_key_frames(n_frames: int, compare: Callable[[int, int], Comparison], 
     >>> select_key_frames(12, compare, occlusion_frames=3)
     ([0, 10], ['start', 'appearance'])
     """
-    n = check_int(n_frames, "n_frames", minimum=1)
-    compare = check_callable(compare, "compare", optional=False)
-    occlusion_frames = check_int(occlusion_frames, "occlusion_frames", minimum=1)
+    n = as_int(n_frames, "n_frames", minimum=1)
+    compare = as_callable(compare, "compare", optional=False)
+    occlusion_frames = as_int(occlusion_frames, "occlusion_frames", minimum=1)
     appearance_changed(0.0, 0, similarity=similarity, min_matches=min_matches)      # validate once
     local_map_full(0, 0.0, max_features=max_features, max_variance=max_variance)
     keys, reasons, key, run = [0], ["start"], 0, 0

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import se2_between, se2_compose, wrap_angle
-from ..validation import as_array, as_rng, broadcast_to, check_finite_scalar, check_int
+from ..validation import as_array, as_rng, broadcast_to, as_finite_scalar, as_int
 from .pose_graph import PoseGraph
 
 __all__ = ["manhattan_world_graph"]
@@ -92,18 +92,18 @@ def manhattan_world_graph(n_poses: int = 3500, *, seed: int = 0, noise: Any = (0
      [1. 0. 0.]
      [2. 0. 0.]]
     """
-    n = check_int(n_poses, "n_poses", minimum=1, maximum=10 ** 6)
-    seed = check_int(seed, "seed", minimum=0)
+    n = as_int(n_poses, "n_poses", minimum=1, maximum=10 ** 6)
+    seed = as_int(seed, "seed", minimum=0)
     sig = broadcast_to(as_array(noise, "noise"), (3,), "noise", "[x, y, theta] standard deviations")
     with np.errstate(over="ignore", under="ignore", divide="ignore"):
         info = 1.0 / sig ** 2
     if not np.all((sig > 0) & (info > 0) & np.isfinite(info)):
         raise ValueError(f"noise: expected positive standard deviations between 1e-150 and 1e150, got {sig.tolist()}")
-    extent = check_int(extent, "extent", minimum=1, maximum=10 ** 6)
-    p = check_finite_scalar(closure_probability, "closure_probability")
+    extent = as_int(extent, "extent", minimum=1, maximum=10 ** 6)
+    p = as_finite_scalar(closure_probability, "closure_probability")
     if not 0.0 <= p <= 1.0:
         raise ValueError(f"closure_probability: expected a probability in [0, 1], got {p}")
-    min_gap = check_int(min_gap, "min_gap", minimum=1)
+    min_gap = as_int(min_gap, "min_gap", minimum=1)
     rng = as_rng(seed, "seed")
     truth = _walk(n, extent, 0.3, rng)
     visits: dict[tuple[int, int], list[int]] = {}

@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from ..cache import write_atomically
-from ..validation import check_choice, check_int, check_text, describe
+from ..validation import as_choice, as_int, as_text, describe
 from .occupancy_grid import FREE_THRESHOLD, OCCUPIED_THRESHOLD, OccupancyGrid
 
 __all__ = ["MapFileError", "save_map", "load_map", "OCCUPIED_VALUE", "FREE_VALUE", "UNKNOWN_VALUE"]
@@ -126,10 +126,10 @@ def save_map(grid: OccupancyGrid, stem: Any, *, occupied_thresh: float = OCCUPIE
     """
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"grid: expected an OccupancyGrid, got {describe(grid)}")
-    base = Path(check_text(stem, "stem", empty=False) if not isinstance(stem, Path) else stem)
+    base = Path(as_text(stem, "stem", empty=False) if not isinstance(stem, Path) else stem)
     f, o = _thresholds(free_thresh, occupied_thresh, _value_error)
-    neg = check_int(negate, "negate", minimum=0, maximum=1)
-    check_choice(mode, "mode", ["trinary", "scale"])
+    neg = as_int(negate, "negate", minimum=0, maximum=1)
+    as_choice(mode, "mode", ["trinary", "scale"])
     free, occ = grid.free_mask(f), grid.occupied_mask(o)
     if mode == "trinary":
         img = np.full(grid.shape, UNKNOWN_VALUE, dtype=np.uint8)
@@ -276,7 +276,7 @@ def load_map(yaml_path: Any) -> OccupancyGrid:
     >>> back.origin.tolist(), back.resolution, back.occupied_mask().tolist(), back.unknown_mask().tolist()
     ([3.0, 4.0], 0.1, [[False, True], [False, False]], [[False, False], [True, False]])
     """
-    path = Path(check_text(yaml_path, "yaml_path", empty=False) if not isinstance(yaml_path, Path) else yaml_path)
+    path = Path(as_text(yaml_path, "yaml_path", empty=False) if not isinstance(yaml_path, Path) else yaml_path)
     keys = _parse_yaml(path)
 
     def fail(message: str) -> None:

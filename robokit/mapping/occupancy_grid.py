@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage, special
 
-from ..validation import as_array, check_finite_scalar, check_positive, check_sample_count, describe
+from ..validation import as_array, as_finite_scalar, as_positive, require_sample_count, describe
 from .topological import EmptyMapError
 
 __all__ = ["FREE_THRESHOLD", "OCCUPIED_THRESHOLD", "LOG_ODDS_MIN", "LOG_ODDS_MAX", "EmptyMapError", "log_odds",
@@ -43,7 +43,7 @@ LOG_ODDS_MIN, LOG_ODDS_MAX = -2.0, 3.5
 
 
 def _probability_in(value: Any, name: str, *, closed: bool = False) -> float:
-    p = check_finite_scalar(value, name)
+    p = as_finite_scalar(value, name)
     if not (0.0 <= p <= 1.0 if closed else 0.0 < p < 1.0):
         raise ValueError(f"{name}: expected a probability in {'[0, 1]' if closed else '(0, 1)'}, got {p}")
     return p
@@ -154,7 +154,7 @@ class OccupancyGrid:
         if arr.size == 0:
             raise ValueError(f"log_odds: expected a grid with at least one cell, got shape {arr.shape}")
         self.log_odds = np.array(arr, dtype=float)
-        self.resolution = check_positive(resolution, "resolution")
+        self.resolution = as_positive(resolution, "resolution")
         self.origin = np.array(as_array(origin, "origin", shape=(2,)), dtype=float)
 
     def __repr__(self) -> str:
@@ -197,11 +197,11 @@ class OccupancyGrid:
         OccupancyGrid(shape=(48, 722), resolution=0.05, origin=(0.0, -1.2))
         """
         b = as_array(bounds, "bounds", shape=(4,))
-        r = check_positive(resolution, "resolution")
+        r = as_positive(resolution, "resolution")
         if not (b[2] > b[0] and b[3] > b[1]):
             raise ValueError(f"bounds: expected (x0, y0, x1, y1) with x1 > x0 and y1 > y0, got {b.tolist()}")
         nx, ny = (b[2] - b[0]) / r, (b[3] - b[1]) / r
-        check_sample_count(nx * ny, "bounds, resolution")
+        require_sample_count(nx * ny, "bounds, resolution")
         # a tolerance so that (36.1 - 0) / 0.05 = 722.0000000000001 is 722 columns, not 723
         w, h = (max(1, int(np.ceil(n - 1e-9))) for n in (nx, ny))
         return cls(np.zeros((h, w)), r, b[:2])
@@ -367,14 +367,14 @@ class LikelihoodField:
     origin: np.ndarray
     max_distance: float
 
-    def lookup(self, xy: Any, *, check: bool = True) -> np.ndarray:
+    def lookup(self, xy: Any, *, validate: bool = True) -> np.ndarray:
         """Distance to the nearest obstacle at world points (``max_distance`` off the map).
 
         Parameters
         ----------
         xy : array_like, shape (..., 2)
             World points, e.g. ``(N, 2)`` scan endpoints or ``(particles, beams, 2)``.
-        check : bool, default True
+        validate : bool, default True
             Validate ``xy``; ``False`` skips it (a float array; NaN points read as off the map),
             the fast path of a particle filter's inner loop.
 
@@ -389,7 +389,7 @@ class LikelihoodField:
         >>> field.lookup([[0.5, 0.5], [2.9, 0.1], [9.0, 0.0]]).tolist()
         [0.0, 2.0, 2.5]
         """
-        if check:
+        if validate:
             pts = as_array(xy, "xy")
             if pts.ndim < 1 or pts.shape[-1] != 2:
                 raise ValueError(f"xy: expected shape (..., 2), got shape {pts.shape}")
@@ -468,7 +468,7 @@ def likelihood_field(grid: OccupancyGrid, *, occupied_threshold: float = OCCUPIE
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"grid: expected an OccupancyGrid, got {describe(grid)}")
     occupied = grid.occupied_mask(occupied_threshold)
-    d_max = check_positive(max_distance, "max_distance")
+    d_max = as_positive(max_distance, "max_distance")
     if occupied.any():
         dist = ndimage.distance_transform_edt(~occupied, sampling=grid.resolution)  # dist of Table 6.3
         dist = np.minimum(dist, d_max)

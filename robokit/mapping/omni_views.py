@@ -36,8 +36,8 @@ from typing import Any
 
 import numpy as np
 
-from ..sim.omni import OmniCamera, check_omni_camera
-from ..validation import as_array, as_rng, check_int, check_mapping, check_positive, check_text, describe
+from ..sim.omni import OmniCamera, as_omni_camera
+from ..validation import as_array, as_rng, as_int, as_mapping, as_positive, as_text, describe
 from ..vision.colour import hue_histogram
 from ..vision.features import Features, Keypoints
 from ..vision.ratio import Matches
@@ -45,10 +45,10 @@ from ..vision.omni_features import ImageSizeError, omni_sift
 from ..vision.ransac import ransac_se2
 from ..vision.spherical import decompose_essential, floor_points, ransac_essential
 
-__all__ = ["HISTOGRAM_STEP", "OmniView", "omni_view", "check_omni_image", "RelativePose", "relative_pose"]
+__all__ = ["HISTOGRAM_STEP", "OmniView", "omni_view", "as_omni_image", "RelativePose", "relative_pose"]
 
 
-def check_omni_image(image: Any, camera: OmniCamera, name: str = "image") -> np.ndarray:
+def as_omni_image(image: Any, camera: OmniCamera, name: str = "image") -> np.ndarray:
     """Validate an RGB image of ``camera``'s size (uint8, or float in [0, 1]).
 
     Raises
@@ -68,11 +68,11 @@ def check_omni_image(image: Any, camera: OmniCamera, name: str = "image") -> np.
     Examples
     --------
     >>> cam = OmniCamera(width=64, height=48)
-    >>> check_omni_image(np.zeros((48, 64, 3), np.uint8), cam).shape
+    >>> as_omni_image(np.zeros((48, 64, 3), np.uint8), cam).shape
     (48, 64, 3)
     """
-    name = check_text(name, "name", empty=False)
-    check_omni_camera(camera)
+    name = as_text(name, "name", empty=False)
+    as_omni_camera(camera)
     img = as_array(image, name, dtype=None)
     want = (camera.height, camera.width, 3)
     if img.shape != want:
@@ -155,10 +155,10 @@ def omni_view(image: Any, camera: OmniCamera, *, bins: int = 32, n_features: int
     >>> view.histogram.shape, len(view) == len(view.bearings), round(float(view.histogram.sum()), 6)
     ((32,), True, 1.0)
     """
-    img = check_omni_image(image, camera)
-    n_features = check_int(n_features, "n_features", minimum=0)
-    bins = check_int(bins, "bins", minimum=1)
-    times = check_mapping(times, "times")
+    img = as_omni_image(image, camera)
+    n_features = as_int(n_features, "n_features", minimum=0)
+    bins = as_int(bins, "bins", minimum=1)
+    times = as_mapping(times, "times")
     t0 = time.perf_counter()
     if histogram is None:
         histogram = hue_histogram(img[::HISTOGRAM_STEP, ::HISTOGRAM_STEP], bins)
@@ -287,20 +287,20 @@ def relative_pose(query: OmniView, node: OmniView, matches: Matches, camera: Omn
             raise TypeError(f"{name}: expected an OmniView, got {describe(view)}")
     if not isinstance(matches, Matches):
         raise TypeError(f"matches: expected a robokit.vision.Matches, got {describe(matches)}")
-    check_omni_camera(camera)
+    as_omni_camera(camera)
     qi, ni = np.asarray(matches.query, int), np.asarray(matches.train, int)
     if len(qi) and (qi.min() < 0 or qi.max() >= len(query.bearings) or ni.min() < 0 or ni.max() >= len(node.bearings)):
         raise ValueError(f"matches: expected indices of the query's {len(query.bearings)} and the node's "
                          f"{len(node.bearings)} features, got up to {qi.max()} and {ni.max()}")
-    threshold_epipolar = check_positive(threshold_epipolar, "threshold_epipolar")
-    threshold_floor = check_positive(threshold_floor, "threshold_floor")
-    min_epipolar = check_int(min_epipolar, "min_epipolar", minimum=8)
-    min_floor = check_int(min_floor, "min_floor", minimum=2)
-    min_depression = check_positive(min_depression, "min_depression")
+    threshold_epipolar = as_positive(threshold_epipolar, "threshold_epipolar")
+    threshold_floor = as_positive(threshold_floor, "threshold_floor")
+    min_epipolar = as_int(min_epipolar, "min_epipolar", minimum=8)
+    min_floor = as_int(min_floor, "min_floor", minimum=2)
+    min_depression = as_positive(min_depression, "min_depression")
     if min_depression >= np.pi / 2:
         raise ValueError(f"min_depression: expected an angle in (0, pi/2), got {min_depression}")
-    direction_tolerance = check_positive(direction_tolerance, "direction_tolerance")
-    min_baseline = check_positive(min_baseline, "min_baseline", allow_zero=True)
+    direction_tolerance = as_positive(direction_tolerance, "direction_tolerance")
+    min_baseline = as_positive(min_baseline, "min_baseline", allow_zero=True)
     rng = as_rng(rng)
     bq, bn = query.bearings[qi], node.bearings[ni]
     M = camera.mount[:3, :3]

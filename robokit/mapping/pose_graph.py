@@ -30,10 +30,10 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..geometry import se2_between
-from ..validation import as_array, check_int
+from ..validation import as_array, as_int
 
 __all__ = ["PoseGraph", "DisconnectedGraphError", "as_pose_graph", "positive_definite", "edge_variances", "unreachable_nodes",
-           "is_connected", "check_connected", "pose_graph_from_odometry", "information_from_covariance",
+           "is_connected", "require_connected", "pose_graph_from_odometry", "information_from_covariance",
            "position_variance"]
 
 
@@ -150,7 +150,7 @@ class PoseGraph:
             values, counts = np.unique(ids, return_counts=True)
             raise ValueError(f"ids: expected unique vertex ids, got {int(values[counts > 1][0])} more than once")
         self.poses, self.edges, self.measurements, self.information, self.ids = poses, edges, meas, info, ids
-        self.fixed = check_int(self.fixed, "fixed", minimum=0, maximum=n - 1)
+        self.fixed = as_int(self.fixed, "fixed", minimum=0, maximum=n - 1)
 
     @property
     def n_poses(self) -> int:
@@ -374,7 +374,7 @@ def is_connected(graph: PoseGraph) -> bool:
     return unreachable_nodes(graph).size == 0
 
 
-def check_connected(graph: PoseGraph) -> None:
+def require_connected(graph: PoseGraph) -> None:
     """Raise :class:`DisconnectedGraphError` naming the nodes the fixed node cannot reach.
 
     Raises
@@ -384,7 +384,7 @@ def check_connected(graph: PoseGraph) -> None:
 
     Examples
     --------
-    >>> check_connected(PoseGraph(np.zeros((3, 3)), [[0, 1]], [[1.0, 0.0, 0.0]], ids=[10, 11, 12]))
+    >>> require_connected(PoseGraph(np.zeros((3, 3)), [[0, 1]], [[1.0, 0.0, 0.0]], ids=[10, 11, 12]))
     Traceback (most recent call last):
     ...
     robokit.mapping.pose_graph.DisconnectedGraphError: graph: expected a connected pose graph, but 1 node (vertex

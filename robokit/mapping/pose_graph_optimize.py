@@ -48,8 +48,8 @@ from scipy.optimize import least_squares
 from scipy.sparse.linalg import splu
 
 from ..geometry import se2_between, wrap_angle
-from ..validation import as_array, check_choice, check_finite_result, check_int, check_positive
-from .pose_graph import PoseGraph, as_pose_graph, check_connected
+from ..validation import as_array, as_choice, require_finite_result, as_int, as_positive
+from .pose_graph import PoseGraph, as_pose_graph, require_connected
 
 __all__ = ["pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph"]
 
@@ -130,7 +130,7 @@ def pose_graph_cost(graph: PoseGraph, poses: Any = None) -> float:
     g = as_pose_graph(graph)
     e = pose_graph_residuals(g, poses)
     cost = float(np.einsum("ka,kab,kb->", e, g.information, e))
-    check_finite_result("poses", cost)
+    require_finite_result("poses", cost)
     return cost
 
 
@@ -340,15 +340,15 @@ def optimize_pose_graph(graph: PoseGraph, *, method: str = "gauss-newton", max_i
      [-0.06  0.99]]
     """
     as_pose_graph(graph)
-    method = check_choice(method, "method", ("gauss-newton", "scipy"))
-    max_iterations = check_int(max_iterations, "max_iterations", minimum=0)
-    tolerance = check_positive(tolerance, "tolerance")
-    check_connected(graph)
+    method = as_choice(method, "method", ("gauss-newton", "scipy"))
+    max_iterations = as_int(max_iterations, "max_iterations", minimum=0)
+    tolerance = as_positive(tolerance, "tolerance")
+    require_connected(graph)
     start = time.perf_counter()
     white = _whitening(graph)
     initial = white @ pose_graph_residuals(graph).ravel()
     initial_cost = float(initial @ initial)
-    check_finite_result("graph", initial_cost)
+    require_finite_result("graph", initial_cost)
     free = np.flatnonzero(np.arange(graph.n_poses) != graph.fixed)
     if max_iterations == 0 or free.size == 0 or graph.n_edges == 0:
         poses, iterations, converged = graph.poses.copy(), 0, free.size == 0 or graph.n_edges == 0
@@ -358,6 +358,6 @@ def optimize_pose_graph(graph: PoseGraph, *, method: str = "gauss-newton", max_i
         poses, iterations, converged = _scipy(graph, white, free, max_iterations, tolerance)
     r = white @ pose_graph_residuals(graph, poses).ravel()
     cost = float(r @ r)
-    check_finite_result("graph", cost, poses)
+    require_finite_result("graph", cost, poses)
     return PoseGraphResult(poses, cost, initial_cost, iterations, bool(converged), time.perf_counter() - start,
                            method)

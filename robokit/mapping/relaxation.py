@@ -53,8 +53,8 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import dijkstra
 
 from ..geometry import se2_compose, se2_inverse, wrap_angle
-from ..validation import as_array, check_finite_result, check_int, check_positive
-from .pose_graph import PoseGraph, as_pose_graph, check_connected, edge_variances
+from ..validation import as_array, require_finite_result, as_int, as_positive
+from .pose_graph import PoseGraph, as_pose_graph, require_connected, edge_variances
 
 __all__ = ["RelaxationResult", "relax", "relax_sweep", "initial_variances"]
 
@@ -105,7 +105,7 @@ def _arrays(poses, variances, edges, measurements, omega_edges, fixed):
     w = as_array(omega_edges, "edge_variances", shape=(len(e),)) if len(e) else np.zeros(0)
     if np.any(w <= 0):
         raise ValueError(f"edge_variances: expected positive variances, got {float(w[w <= 0][0])}")
-    fixed = check_int(fixed, "fixed", minimum=0, maximum=n - 1)
+    fixed = as_int(fixed, "fixed", minimum=0, maximum=n - 1)
     return p, var, e, z, w, fixed
 
 
@@ -276,9 +276,9 @@ def relax(graph: PoseGraph, *, max_iterations: int = 1000, tolerance: float = 1e
      [-0.01  0.98]]
     """
     as_pose_graph(graph)
-    max_iterations = check_int(max_iterations, "max_iterations", minimum=0)
-    tolerance = check_positive(tolerance, "tolerance")
-    check_connected(graph)
+    max_iterations = as_int(max_iterations, "max_iterations", minimum=0)
+    tolerance = as_positive(tolerance, "tolerance")
+    require_connected(graph)
     n = graph.n_poses
     if variances is None:
         var = initial_variances(graph)
@@ -300,7 +300,7 @@ def relax(graph: PoseGraph, *, max_iterations: int = 1000, tolerance: float = 1e
     changes = []
     converged = False
     for _ in range(max_iterations):
-        guess = se2_compose(poses[source], relative, check=False)          # Eq. (1), all edges at once
+        guess = se2_compose(poses[source], relative, validate=False)          # Eq. (1), all edges at once
         weight = 1.0 / (var[source] + omega_edge)                          # 1 / (omega'_i)_j, Eq. (1)
         total = np.bincount(target, weight, minlength=n)
         new = poses.copy()
@@ -318,6 +318,6 @@ def relax(graph: PoseGraph, *, max_iterations: int = 1000, tolerance: float = 1e
         if change < tolerance:
             converged = True
             break
-    check_finite_result("graph, variances", poses, var, changes)
+    require_finite_result("graph, variances", poses, var, changes)
     poses[:, 2] = wrap_angle(poses[:, 2])                                  # arctan2 gives (-pi, pi]
     return RelaxationResult(poses, var, len(changes), np.array(changes), converged, time.perf_counter() - start)

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..cache import save_npz
-from ..validation import as_array, check_choice, check_int, check_positive
+from ..validation import as_array, as_choice, as_int, as_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
 from ..vision.matching import METHODS, DescriptorIndex
@@ -184,7 +184,7 @@ class TopologicalMap:
                             ("measurements", measurements), ("covariances", covariances), ("kinds", kinds)):
             object.__setattr__(self, name, value)
         # one KD-tree per node, built once (Sec. "Environment map": "based on KD-tree")
-        index = check_choice(str(self.index) if isinstance(self.index, np.ndarray) else self.index, "index", METHODS)
+        index = as_choice(str(self.index) if isinstance(self.index, np.ndarray) else self.index, "index", METHODS)
         object.__setattr__(self, "index", index)
         object.__setattr__(self, "_indices", [DescriptorIndex(descriptors[a:b], index) if b - a >= 2 else None
                                               for a, b in zip(offsets[:-1], offsets[1:])])
@@ -203,7 +203,7 @@ class TopologicalMap:
         return len(self.edges)
 
     def _node(self, i: Any) -> int:
-        return check_int(i, "node", minimum=0, maximum=len(self) - 1)
+        return as_int(i, "node", minimum=0, maximum=len(self) - 1)
 
     def node_features(self, i: int) -> Features:
         """The SIFT features of node ``i``'s key image (keypoint response is not kept: zeros)."""
@@ -280,7 +280,7 @@ class TopologicalMap:
         q = as_array(descriptors, "descriptors", dtype=np.float32)
         q = q.reshape(0, self.descriptors.shape[1]) if q.size == 0 else q
         q = as_array(q, "descriptors", shape=(None, self.descriptors.shape[1]), dtype=np.float32)
-        ratio = check_positive(ratio, "ratio")
+        ratio = as_positive(ratio, "ratio")
         idx = np.atleast_1d(as_array(nodes, "nodes", dtype=np.int64))
         out = []
         for i in idx:

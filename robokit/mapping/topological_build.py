@@ -40,12 +40,12 @@ import numpy as np
 from ..geometry import se2_between, wrap_angle
 from ..progress import progress_bar
 from ..sim.motion import odometry_covariance
-from ..sim.omni import OmniCamera, check_omni_camera
+from ..sim.omni import OmniCamera, as_omni_camera
 from ..sim.runs import FrameStream
-from ..validation import as_array, check_callable, check_choice, check_int, check_positive
+from ..validation import as_array, as_callable, as_choice, as_int, as_positive
 from ..vision.colour import histogram_distance
 from ..vision.matching import METHODS, DescriptorIndex
-from .omni_views import check_omni_image, omni_view, relative_pose
+from .omni_views import as_omni_image, omni_view, relative_pose
 from .pose_graph import position_variance
 from .local_maps import Comparison, select_key_frames
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
@@ -141,15 +141,15 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
     if np.any(sigma <= 0):
         raise ValueError(f"sigma_visual: expected three positive standard deviations, got {sigma.tolist()}")
     alphas = as_array(odometry_alphas, "odometry_alphas", shape=(4,))
-    index = check_choice(index, "index", METHODS)
-    progress = check_callable(progress, "progress")
-    log = check_callable(log, "log")
-    ratio = check_positive(ratio, "ratio")
-    bins = check_int(bins, "bins", minimum=1)
-    n_features = check_int(n_features, "n_features", minimum=0)
-    loop = {"top_k": check_int(loop_top_k, "loop_top_k", minimum=1),
-            "min_matches": check_int(loop_min_matches, "loop_min_matches", minimum=8),
-            "exclude": check_int(loop_exclude, "loop_exclude", minimum=1)}
+    index = as_choice(index, "index", METHODS)
+    progress = as_callable(progress, "progress")
+    log = as_callable(log, "log")
+    ratio = as_positive(ratio, "ratio")
+    bins = as_int(bins, "bins", minimum=1)
+    n_features = as_int(n_features, "n_features", minimum=0)
+    loop = {"top_k": as_int(loop_top_k, "loop_top_k", minimum=1),
+            "min_matches": as_int(loop_min_matches, "loop_min_matches", minimum=8),
+            "exclude": as_int(loop_exclude, "loop_exclude", minimum=1)}
     if raw is None:       # every argument checked (the key-image criteria by select_key_frames): start taking images
         raw = _Arrivals(images, n, camera)
     views = _Views(raw, camera, bins=bins, n_features=n_features)
@@ -160,7 +160,7 @@ def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, sim
                                           max_variance=max_variance)
     key_views = [views(k) for k in keys]
     if isinstance(raw, _Arrivals):
-        raw.check_ended()
+        raw.require_ended()
     tmap = _odometry_map(keys, key_views, odo, alphas, index)
     if log is not None:
         for i, (k, r) in enumerate(zip(keys, reasons)):
@@ -181,7 +181,7 @@ def _images_and_odometry(images: Any, odometry: Any, camera: OmniCamera) -> tupl
         raise TypeError("images: expected an array of images or an iterator of them (a FrameStream's .frames), "
                         "got the FrameStream itself")
     if isinstance(images, Iterator):      # taken as they arrive (e.g. rendered by workers)
-        check_omni_camera(camera)
+        as_omni_camera(camera)
         odo = as_array(odometry, "odometry", shape=(None, 3))
         if len(odo) == 0:
             raise EmptyMapError("odometry: expected at least one pose to build a map from, got none")
@@ -191,7 +191,7 @@ def _images_and_odometry(images: Any, odometry: Any, camera: OmniCamera) -> tupl
         if raw.ndim == 4 or raw.size == 0:
             raise EmptyMapError(f"images: expected at least one image to build a map from, got shape {raw.shape}")
         raise ValueError(f"images: expected shape (N, H, W, 3), got shape {raw.shape}")
-    check_omni_image(raw[0], camera, "images[0]")
+    as_omni_image(raw[0], camera, "images[0]")
     return raw, as_array(odometry, "odometry", shape=(len(raw), 3))
 
 
@@ -292,7 +292,7 @@ class _Arrivals:
             if image is _END:
                 raise ValueError(f"images: expected {self._n} images (one per odometry pose), the iterator "
                                  f"ended after {self._taken}")
-            self._kept[self._taken] = check_omni_image(image, self._camera, f"images[{self._taken}]")
+            self._kept[self._taken] = as_omni_image(image, self._camera, f"images[{self._taken}]")
             self._taken += 1
         if k not in self._kept:
             raise RuntimeError(f"images[{k}] was asked for after it was released (a bug of the builder)")
@@ -302,7 +302,7 @@ class _Arrivals:
         for k in [k for k in self._kept if k < before]:
             del self._kept[k]
 
-    def check_ended(self) -> None:
+    def require_ended(self) -> None:
         """Every image was taken: the iterator must have no more."""
         if next(self._images, _END) is not _END:
             raise ValueError(f"images: expected {self._n} images (one per odometry pose), the iterator has more")

@@ -38,8 +38,8 @@ from ..controllers.path_geometry import VisualPath, reference_point
 from ..geometry import wrap_angle
 from ..localization.pose_ekf import UnicycleEKF
 from ..sim import unicycle_step
-from ..validation import (as_array, as_rng, check_callable, check_finite_result, check_int, check_positive,
-                          check_sample_count, describe)
+from ..validation import (as_array, as_rng, as_callable, require_finite_result, as_int, as_positive,
+                          require_sample_count, describe)
 
 __all__ = ["FollowResult", "follow_path", "gaussian_localizer", "perturbed_starts"]
 
@@ -116,12 +116,12 @@ def gaussian_localizer(noise: Any = (0.10, 0.15, 0.05), *, dropout: float = 0.0,
     sd = as_array(noise, "noise", shape=(3,))
     if np.any(sd < 0):
         raise ValueError(f"noise: expected non-negative standard deviations, got {sd.tolist()}")
-    p_none = check_positive(dropout, "dropout", allow_zero=True)
-    p_out = check_positive(outlier_rate, "outlier_rate", allow_zero=True)
+    p_none = as_positive(dropout, "dropout", allow_zero=True)
+    p_out = as_positive(outlier_rate, "outlier_rate", allow_zero=True)
     for name, p in (("dropout", p_none), ("outlier_rate", p_out)):
         if p > 1:
             raise ValueError(f"{name}: expected a probability in [0, 1], got {p}")
-    jump = check_positive(outlier_offset, "outlier_offset", allow_zero=True)
+    jump = as_positive(outlier_offset, "outlier_offset", allow_zero=True)
 
     def localize(true_pose: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
         if p_none and rng.random() < p_none:
@@ -172,9 +172,9 @@ def perturbed_starts(path: VisualPath, n: int, *, offset: float = 0.3, heading: 
     """
     if not isinstance(path, VisualPath):
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
-    count = check_int(n, "n", minimum=0, maximum=10 ** 6)
-    r = check_positive(offset, "offset", allow_zero=True)
-    h = check_positive(heading, "heading", allow_zero=True)
+    count = as_int(n, "n", minimum=0, maximum=10 ** 6)
+    r = as_positive(offset, "offset", allow_zero=True)
+    h = as_positive(heading, "heading", allow_zero=True)
     g = as_rng(rng)
     s = g.uniform(0.0, min(r, path.length), count)
     x, y, th = (np.interp(s, path.s, path.poses[:, i]) for i in range(3))
@@ -252,9 +252,9 @@ def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: fl
     if not isinstance(path, VisualPath):
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
     pose = as_array(start_pose, "start_pose", shape=(3,)).copy()
-    find = check_callable(localize, "localize", optional=False)
-    h = check_positive(dt, "dt")
-    every = max(1, int(round(check_positive(fix_period, "fix_period") / h)))
+    find = as_callable(localize, "localize", optional=False)
+    h = as_positive(dt, "dt")
+    every = max(1, int(round(as_positive(fix_period, "fix_period") / h)))
     follower = PathFollower(path, alpha, v_max, w_max, xi, goal_tolerance=goal_tolerance)
     odo_sd = as_array(odometry_noise, "odometry_noise", shape=(2,))
     if np.any(odo_sd < 0):
@@ -266,11 +266,11 @@ def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: fl
         if np.any(sd <= 0):
             raise ValueError(f"{name}: expected positive standard deviations, got {sd.tolist()}")
     R_fix, R_odo = np.diag(fix_sd ** 2), np.diag(odo_sigma ** 2)
-    check_finite_result("sigma_fix, sigma_odometry", R_fix, R_odo)
-    g = None if gate is None else check_positive(gate, "gate")
-    restart = check_int(relocalize_after, "relocalize_after", minimum=1)
-    limit = 3 * path.length / follower.v_max + 30 if max_time is None else check_positive(max_time, "max_time")
-    check_sample_count(limit / h, "max_time, dt")
+    require_finite_result("sigma_fix, sigma_odometry", R_fix, R_odo)
+    g = None if gate is None else as_positive(gate, "gate")
+    restart = as_int(relocalize_after, "relocalize_after", minimum=1)
+    limit = 3 * path.length / follower.v_max + 30 if max_time is None else as_positive(max_time, "max_time")
+    require_sample_count(limit / h, "max_time, dt")
     rng = as_rng(rng)
 
     def ask(t: float) -> np.ndarray | None:
@@ -293,14 +293,14 @@ def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: fl
         step, ref, rejected = 0, None, 0
         while True:
             v, w = follower.command(ekf.pose)
-            ref = reference_point(path, pose, previous=None if ref is None else ref.index, window=1.0, check=False)
+            ref = reference_point(path, pose, previous=None if ref is None else ref.index, window=1.0, validate=False)
             times.append(t), truth.append(pose.copy()), est.append(ekf.pose), cross.append(ref.d)
             covs.append(ekf.covariance[:3, :3])
             if follower.done or t + h > limit + 1e-9:
                 cmds.append((0.0, 0.0))
                 break
             cmds.append((v, w))
-            pose = unicycle_step(pose, v, w, h, check=False)       # Eq. (6), the true robot
+            pose = unicycle_step(pose, v, w, h, validate=False)       # Eq. (6), the true robot
             noisy = np.array([v, w]) + odo_sd * rng.standard_normal(2)
             ekf.update_velocity(noisy[0], noisy[1], R_odo)         # the velocity over the step just driven
             ekf.predict(h)

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..sim.worlds_outdoor import field_world, scatter_obstacles
 from ..sim.layout import Layout
-from ..validation import as_array, check_int, check_positive
+from ..validation import as_array, as_int, as_positive
 
 __all__ = ["Field", "random_course", "Course", "UNIMAP_ORIGIN"]
 
@@ -78,7 +78,7 @@ class Field(Layout):
                  origin: Any = UNIMAP_ORIGIN) -> None:
         sz = as_array(size, "size", shape=(2,))
         super().__init__(circles=circles, boxes=boxes)
-        self.size = (check_positive(sz[0], "size[0]"), check_positive(sz[1], "size[1]"))
+        self.size = (as_positive(sz[0], "size[0]"), as_positive(sz[1], "size[1]"))
         lat, lon = as_array(origin, "origin", shape=(2,))
         self.origin = (float(lat), float(lon))
 
@@ -167,13 +167,13 @@ def random_course(seed: int = 0, *, n_waypoints: int = 4, n_obstacles: int = 14,
     >>> bool(np.all(course.field.clearance(course.waypoints) >= 2 * 2.5))   # waypoints kept clear
     True
     """
-    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
-    k = check_int(n_waypoints, "n_waypoints", minimum=1, maximum=20)
-    n = check_int(n_obstacles, "n_obstacles", minimum=0, maximum=200)
-    frac = check_positive(on_path, "on_path", allow_zero=True)
-    gap = check_positive(min_gap, "min_gap")
+    rng = np.random.default_rng(as_int(seed, "seed", minimum=0))
+    k = as_int(n_waypoints, "n_waypoints", minimum=1, maximum=20)
+    n = as_int(n_obstacles, "n_obstacles", minimum=0, maximum=200)
+    frac = as_positive(on_path, "on_path", allow_zero=True)
+    gap = as_positive(min_gap, "min_gap")
     sz = as_array(size, "size", shape=(2,))
-    w, h = check_positive(sz[0], "size[0]"), check_positive(sz[1], "size[1]")
+    w, h = as_positive(sz[0], "size[0]"), as_positive(sz[1], "size[1]")
     margin = 6.0
     start_xy = np.array([margin, rng.uniform(margin, h - margin)])
     points = [start_xy]

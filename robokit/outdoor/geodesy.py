@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import array_ndim, as_array, check_choice, check_int, check_positive
+from ..validation import array_ndim, as_array, as_choice, as_int, as_positive
 
 __all__ = [
     "WGS84_A", "WGS84_F", "WGS84_B", "WGS84_E2", "EARTH_MEAN_RADIUS", "GeodesyError",
@@ -149,7 +149,7 @@ def haversine_distance(lat1: Any, lon1: Any, lat2: Any, lon2: Any, radius: float
     Sinnott (1984); well conditioned for short distances, unlike the spherical law of cosines.
     """
     p1, l1, p2, l2 = _two_points(lat1, lon1, lat2, lon2)
-    r = check_positive(radius, "radius")
+    r = as_positive(radius, "radius")
     h = np.sin((p2 - p1) / 2) ** 2 + np.cos(p1) * np.cos(p2) * np.sin((l2 - l1) / 2) ** 2
     return _out(2 * r * np.arcsin(np.sqrt(np.clip(h, 0.0, 1.0))))
 
@@ -256,8 +256,8 @@ def vincenty_inverse(lat1: Any, lon1: Any, lat2: Any, lon2: Any, *, tol: float =
     (62.5665, 0.7855)
     """
     p1, l1, p2, l2 = _two_points(lat1, lon1, lat2, lon2)
-    check_positive(tol, "tol")
-    n_iter = check_int(max_iter, "max_iter", minimum=1)
+    as_positive(tol, "tol")
+    n_iter = as_int(max_iter, "max_iter", minimum=1)
     a, b, f = WGS84_A, WGS84_B, WGS84_F
     L = np.asarray(wrap_angle(l2 - l1), dtype=float)
     U1, U2 = np.arctan((1 - f) * np.tan(p1)), np.arctan((1 - f) * np.tan(p2))
@@ -330,7 +330,7 @@ def distance_bearing(lat1: Any, lon1: Any, lat2: Any, lon2: Any, model: str = "s
     sphere 62.567 0.7822
     wgs84 62.567 0.7855
     """
-    check_choice(model, "model", ("sphere", "mean_sphere", "wgs84"))
+    as_choice(model, "model", ("sphere", "mean_sphere", "wgs84"))
     if model == "wgs84":
         s, az1, _ = vincenty_inverse(lat1, lon1, lat2, lon2)
         return s, az1

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, as_rng, check_finite_scalar, check_positive
+from ..validation import as_array, as_rng, as_finite_scalar, as_positive
 from .geodesy import LocalTangentPlane, haversine_distance_bearing
 from .nmea_write import gga_sentence, hdg_sentence, rmb_sentence, rmc_sentence
 
@@ -45,7 +45,7 @@ def heading_to_compass(theta: float) -> float:
     -----
     ``psi = 90 deg - theta`` modulo 360 (navigation convention, NMEA 0183 Sec. 6.3 HDG/RMC course).
     """
-    return (90.0 - math.degrees(check_finite_scalar(theta, "theta"))) % 360.0
+    return (90.0 - math.degrees(as_finite_scalar(theta, "theta"))) % 360.0
 
 
 def compass_to_heading(psi_deg: float) -> float:
@@ -60,7 +60,7 @@ def compass_to_heading(psi_deg: float) -> float:
     >>> round(compass_to_heading(90.0), 6), round(compass_to_heading(0.0), 6)     # east, north
     (0.0, 1.570796)
     """
-    return wrap_angle(math.radians(90.0 - check_finite_scalar(psi_deg, "psi_deg")))
+    return wrap_angle(math.radians(90.0 - as_finite_scalar(psi_deg, "psi_deg")))
 
 
 class GPSReceiver:
@@ -101,10 +101,10 @@ class GPSReceiver:
         if not isinstance(plane, LocalTangentPlane):
             raise TypeError(f"plane: expected a LocalTangentPlane, got {type(plane).__name__}")
         self.plane = plane
-        self.noise = check_positive(noise, "noise", allow_zero=True)
-        self.tau = check_positive(tau, "tau")
-        self.white_noise = check_positive(white_noise, "white_noise", allow_zero=True)
-        self.period = check_positive(period, "period")
+        self.noise = as_positive(noise, "noise", allow_zero=True)
+        self.tau = as_positive(tau, "tau")
+        self.white_noise = as_positive(white_noise, "white_noise", allow_zero=True)
+        self.period = as_positive(period, "period")
         self.rng = as_rng(rng)
         self.bias = self.rng.normal(0.0, self.noise, 2) if self.noise else np.zeros(2)
         self.last_error = np.zeros(2)
@@ -166,17 +166,17 @@ class GPSReceiver:
         ['0.002', 'L']
         """
         p = as_array(position, "position", shape=(2,))
-        ts = check_positive(t, "t", allow_zero=True)
+        ts = as_positive(t, "t", allow_zero=True)
         goal = None if destination is None else as_array(destination, "destination", shape=(2,))
         leg_start = None if origin is None else as_array(origin, "origin", shape=(2,))
-        radius = check_positive(arrival_radius, "arrival_radius", allow_zero=True)
+        radius = as_positive(arrival_radius, "arrival_radius", allow_zero=True)
         phi = math.exp(-self.period / self.tau)
         self.bias = phi * self.bias + math.sqrt(1 - phi * phi) * self.noise * self.rng.normal(size=2)  # Gauss-Markov
         self.last_error = self.bias + self.white_noise * self.rng.normal(size=2)
         lat, lon = self.plane.to_geodetic(p + self.last_error)
         when = MISSION_START + _dt.timedelta(seconds=round(ts, 2))
         lat_d, lon_d = math.degrees(lat), math.degrees(lon)
-        v = abs(check_finite_scalar(speed, "speed"))
+        v = abs(as_finite_scalar(speed, "speed"))
         hdop = 1.0 + float(np.hypot(*self.bias)) / 4
         out = [rmc_sentence(when, lat_d, lon_d, speed_mps=v, course_deg=heading_to_compass(heading)),
                gga_sentence(when.time(), lat_d, lon_d, quality=1, satellites=8, hdop=hdop, altitude_m=12.0)]
@@ -248,10 +248,10 @@ class Compass:
     def __init__(self, *, noise: float = math.radians(0.5), accuracy: float = math.radians(2.0),
                  resolution: float = math.radians(1.0), variation: float = math.radians(-0.3),
                  rng: Any = None) -> None:
-        self.noise = check_positive(noise, "noise", allow_zero=True)
-        self.accuracy = check_positive(accuracy, "accuracy", allow_zero=True)
-        self.resolution = check_positive(resolution, "resolution")
-        self.variation = check_finite_scalar(variation, "variation")
+        self.noise = as_positive(noise, "noise", allow_zero=True)
+        self.accuracy = as_positive(accuracy, "accuracy", allow_zero=True)
+        self.resolution = as_positive(resolution, "resolution")
+        self.variation = as_finite_scalar(variation, "variation")
         self.rng = as_rng(rng)
         self.bound = max(0.0, self.accuracy - self.resolution / 2)     # bias + noise, before rounding
         self.bias = float(self.rng.uniform(-self.bound, self.bound)) if self.bound else 0.0

@@ -27,7 +27,7 @@ import numpy as np
 from ..cache import (cache_dir, cache_key, code_version, read_arrays, record_names, records_from_arrays,
                      records_to_arrays, write_arrays)
 from ..progress import progress_bar
-from ..validation import check_callable, check_choice, check_int, check_mapping, check_positive, describe
+from ..validation import as_callable, as_choice, as_int, as_mapping, as_positive, describe
 from .field import Course, random_course
 from .geodesy import LocalTangentPlane
 from .gps import Compass, GPSReceiver
@@ -174,17 +174,17 @@ def simulate(course: Course, seed: int = 0, *, firing: str = "chained", crosstal
     """
     if not isinstance(course, Course):
         raise TypeError(f"course: expected a Course from random_course(), got {type(course).__name__}")
-    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
-    check_choice(firing, "firing", ("chained", "free", "off"))
+    rng = np.random.default_rng(as_int(seed, "seed", minimum=0))
+    as_choice(firing, "firing", ("chained", "free", "off"))
     if not isinstance(crosstalk, (bool, np.bool_)):
         raise TypeError(f"crosstalk: expected True or False, got {describe(crosstalk)}")
     if truck is not None and not isinstance(truck, SkidSteerTruck):
         raise TypeError(f"truck: expected a SkidSteerTruck or None, got {describe(truck)}")
-    max_time = None if max_time is None else check_positive(max_time, "max_time")
-    gps_noise = check_positive(gps_noise, "gps_noise", allow_zero=True)
-    compass_accuracy = check_positive(compass_accuracy, "compass_accuracy", allow_zero=True)
-    navigator_options = check_mapping(navigator_options, "navigator_options")
-    mission = _Mission(course, rng, firing, bool(crosstalk), truck, check_positive(dt, "dt"), check_int(keep_nmea, "keep_nmea", minimum=0),
+    max_time = None if max_time is None else as_positive(max_time, "max_time")
+    gps_noise = as_positive(gps_noise, "gps_noise", allow_zero=True)
+    compass_accuracy = as_positive(compass_accuracy, "compass_accuracy", allow_zero=True)
+    navigator_options = as_mapping(navigator_options, "navigator_options")
+    mission = _Mission(course, rng, firing, bool(crosstalk), truck, as_positive(dt, "dt"), as_int(keep_nmea, "keep_nmea", minimum=0),
                        gps_noise, compass_accuracy, navigator_options, max_time)
     while mission.t < mission.limit and not mission.nav.done and not mission.collisions:
         mission.send_nmea()
@@ -273,7 +273,7 @@ class _Mission:
 
     def drive(self, v: float, omega: float) -> None:
         """Truck: the nominal model's wheel commands drive the real truck; a contact ends the run."""
-        new = self.real.step(self.state, self.nav.truck.wheel_commands(v, omega, check=False), self.dt, check=False)
+        new = self.real.step(self.state, self.nav.truck.wheel_commands(v, omega, validate=False), self.dt, validate=False)
         self.length += math.hypot(*(new.pose[:2] - self.state.pose[:2]))
         self.state = new
         self.collisions = int(self.field.collides(self.state.pose, self.real.length, self.real.width))
@@ -348,9 +348,9 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
         items = None
     if items is None:
         raise TypeError(f"seeds: expected an iterable of non-negative integers, got {describe(seeds)}")
-    seeds = [check_int(s, f"seeds[{i}]", minimum=0) for i, s in enumerate(items)]
-    course_options = check_mapping(course_options, "course_options")
-    progress = check_callable(progress, "progress")
+    seeds = [as_int(s, f"seeds[{i}]", minimum=0) for i, s in enumerate(items)]
+    course_options = as_mapping(course_options, "course_options")
+    progress = as_callable(progress, "progress")
     target = meta = None
     if cache:
         meta = {"seeds": seeds, "firing": firing, "course_options": course_options or {}, "options": options,

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..controllers import HeadingController, design_heading_gains
 from ..geometry import wrap_angle
-from ..validation import as_array, as_points, check_choice, check_positive
+from ..validation import as_array, as_points, as_choice, as_positive
 from .geodesy import LocalTangentPlane
 from .gps import compass_to_heading
 from .nmea import GGA, HDG, RMB, RMC, NMEAError, parse_sentence
@@ -75,9 +75,9 @@ def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefe
     r = as_array(ranges, "ranges", shape=(4,), finite=False)
     if np.any(np.isnan(r)) or np.any(r < 0):
         raise ValueError(f"ranges: expected four non-negative distances, got {r.tolist()}")
-    f = check_positive(front, "front")
-    s = check_positive(side, "side")
-    check_choice(prefer, "prefer", ("left", "right"))
+    f = as_positive(front, "front")
+    s = as_positive(side, "side")
+    as_choice(prefer, "prefer", ("left", "right"))
     outer_l, mid_l, mid_r, outer_r = r
     front_blocked = min(mid_l, mid_r) < f
     left_blocked, right_blocked = outer_l < s, outer_r < s
@@ -157,18 +157,18 @@ class Navigator:
         self.truck = truck
         self.plane = LocalTangentPlane(float(wp[0, 0]), float(wp[0, 1]))
         self.waypoints = self.plane.to_local(wp[:, 0], wp[:, 1]).reshape(-1, 2)
-        self.cruise_speed = check_positive(cruise_speed, "cruise_speed")
-        self.arrival_radius = check_positive(arrival_radius, "arrival_radius")
-        self.gps_gain = check_positive(gps_gain, "gps_gain")
-        self.front = check_positive(front, "front")
-        self.side = check_positive(side, "side")
-        self.bypass_distance = check_positive(bypass_distance, "bypass_distance")
-        self.bypass_side = check_positive(bypass_side, "bypass_side")
+        self.cruise_speed = as_positive(cruise_speed, "cruise_speed")
+        self.arrival_radius = as_positive(arrival_radius, "arrival_radius")
+        self.gps_gain = as_positive(gps_gain, "gps_gain")
+        self.front = as_positive(front, "front")
+        self.side = as_positive(side, "side")
+        self.bypass_distance = as_positive(bypass_distance, "bypass_distance")
+        self.bypass_side = as_positive(bypass_side, "bypass_side")
         if self.bypass_side > self.side:
             raise ValueError(f"bypass_side: expected at most side = {self.side}, got {self.bypass_side}")
         kp, kd = design_heading_gains(truck.motor_tau, 0.05, 1.5) if gains is None else as_array(gains, "gains", shape=(2,))
         self.heading_loop = HeadingController(kp, kd, max_rate=0.8 * truck.max_turn_rate)
-        self.guidance = check_choice(guidance, "guidance", GUIDANCE)
+        self.guidance = as_choice(guidance, "guidance", GUIDANCE)
         self.rmb: tuple[float, float] | None = None     # latest (range m, field bearing rad) about the target
         self.rmb_arrived = False                         # and its arrival status
         self.state = "GOTO"
@@ -235,7 +235,7 @@ class Navigator:
         GOTO / AVOID / BYPASS behaviour of Hamid et al. (2009); see the module docstring.
         """
         r = as_array(ranges, "ranges", shape=(4,), finite=False)
-        h = check_positive(dt, "dt")
+        h = as_positive(dt, "dt")
         self._heading_age += h
         if self.position is None or self.heading is None or self.state == "DONE":
             return 0.0, 0.0

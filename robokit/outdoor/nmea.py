@@ -34,7 +34,7 @@ from functools import reduce
 from operator import xor
 from typing import Any, BinaryIO, Callable, Iterator, NamedTuple
 
-from ..validation import check_callable, check_int, describe
+from ..validation import as_callable, as_int, describe
 from .nmea_fields import (RECORD_PARSERS, NMEAChecksumError, NMEAError, NMEAFieldError, NMEAFormatError, parse_date,
                           parse_latitude, parse_longitude, parse_time, salvage_record)
 from .nmea_records import GGA, HDG, RMB, RMC, Sentence
@@ -312,9 +312,9 @@ class NMEAReader:
         else:
             raise TypeError(f"source: expected bytes, a path or a binary file-like, got {describe(source)}")
         self.require_checksum = bool(require_checksum)
-        self.on_error = check_callable(on_error, "on_error")
-        self.chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
-        self.max_line = check_int(max_line, "max_line", minimum=82)
+        self.on_error = as_callable(on_error, "on_error")
+        self.chunk_size = as_int(chunk_size, "chunk_size", minimum=1)
+        self.max_line = as_int(max_line, "max_line", minimum=82)
         self.errors: list[BadSentence] = []
         self.field_errors: list[BadFields] = []
         self.junk_bytes = 0

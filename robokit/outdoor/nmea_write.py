@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import datetime as _dt
 
-from ..validation import as_rng, check_finite_scalar, check_int, check_positive, check_text, describe
+from ..validation import as_rng, as_finite_scalar, as_int, as_positive, as_text, describe
 from .nmea import NMEAFormatError, nmea_checksum
 from .nmea_records import KNOT
 
@@ -63,7 +63,7 @@ def format_sentence(address: str, fields: list) -> str:
 def _angle(deg: float | None, name: str, width: int, limit: float, pos: str, neg: str, decimals: int) -> tuple[str, str]:
     if deg is None:
         return "", ""
-    x = check_finite_scalar(deg, name)
+    x = as_finite_scalar(deg, name)
     if abs(x) > limit:
         raise ValueError(f"{name}: expected degrees in [-{limit:g}, {limit:g}], got {x}")
     a = abs(x)
@@ -86,7 +86,7 @@ def format_latitude(deg: float | None, decimals: int = 4, *, name: str = "deg") 
     -----
     NMEA 0183 v4.11, Sec. 6.2 (latitude field). Four decimals of a minute are about 0.2 m.
     """
-    return _angle(deg, name, 2, 90.0, "N", "S", check_int(decimals, "decimals", minimum=0, maximum=8))
+    return _angle(deg, name, 2, 90.0, "N", "S", as_int(decimals, "decimals", minimum=0, maximum=8))
 
 
 def format_longitude(deg: float | None, decimals: int = 4, *, name: str = "deg") -> tuple[str, str]:
@@ -101,7 +101,7 @@ def format_longitude(deg: float | None, decimals: int = 4, *, name: str = "deg")
     -----
     NMEA 0183 v4.11, Sec. 6.2 (longitude field).
     """
-    return _angle(deg, name, 3, 180.0, "E", "W", check_int(decimals, "decimals", minimum=0, maximum=8))
+    return _angle(deg, name, 3, 180.0, "E", "W", as_int(decimals, "decimals", minimum=0, maximum=8))
 
 
 def format_time(t: _dt.time | None, *, name: str = "t") -> str:
@@ -126,7 +126,7 @@ def format_date(d: _dt.date | None) -> str:
 
 
 def _num(x: float | None, name: str, fmt: str) -> str:
-    return "" if x is None else format(check_finite_scalar(x, name), fmt)
+    return "" if x is None else format(as_finite_scalar(x, name), fmt)
 
 
 def _talker(talker: str) -> str:
@@ -181,9 +181,9 @@ def rmc_sentence(when: _dt.datetime, latitude: float | None, longitude: float | 
     talker = _talker(talker)
     lat, ns = format_latitude(latitude, name="latitude")
     lon, ew = format_longitude(longitude, name="longitude")
-    speed = None if speed_mps is None else check_positive(speed_mps, "speed_mps", allow_zero=True) / KNOT
-    course = None if course_deg is None else round(check_finite_scalar(course_deg, "course_deg"), 1) % 360.0
-    var = None if magnetic_variation_deg is None else check_finite_scalar(magnetic_variation_deg, "magnetic_variation_deg")
+    speed = None if speed_mps is None else as_positive(speed_mps, "speed_mps", allow_zero=True) / KNOT
+    course = None if course_deg is None else round(as_finite_scalar(course_deg, "course_deg"), 1) % 360.0
+    var = None if magnetic_variation_deg is None else as_finite_scalar(magnetic_variation_deg, "magnetic_variation_deg")
     return format_sentence(talker + "RMC", [
         format_time(when.time()), "A" if valid else "V", lat, ns, lon, ew,
         _num(speed, "speed_mps", ".2f"), _num(course, "course_deg", ".1f"), format_date(when.date()),
@@ -229,10 +229,10 @@ def gga_sentence(when: _dt.time, latitude: float | None, longitude: float | None
     when_text = format_time(when, name="when")
     lat, ns = format_latitude(latitude, name="latitude")
     lon, ew = format_longitude(longitude, name="longitude")
-    q = check_int(quality, "quality", minimum=0, maximum=9)
-    n = check_int(satellites, "satellites", minimum=0, maximum=99)
+    q = as_int(quality, "quality", minimum=0, maximum=9)
+    n = as_int(satellites, "satellites", minimum=0, maximum=99)
     return format_sentence(talker + "GGA", [
-        when_text, lat, ns, lon, ew, q, f"{n:02d}", _num(check_positive(hdop, "hdop"), "hdop", ".1f"),
+        when_text, lat, ns, lon, ew, q, f"{n:02d}", _num(as_positive(hdop, "hdop"), "hdop", ".1f"),
         _num(altitude_m, "altitude_m", ".1f"), "M", _num(geoid_separation_m, "geoid_separation_m", ".1f"), "M", "", ""])
 
 
@@ -262,12 +262,12 @@ def hdg_sentence(heading_deg: float, *, deviation_deg: float | None = None,
     '$HCHDG,36.8,0.0,E,0.3,W*6E'
     """
     talker = _talker(talker)
-    h = round(check_finite_scalar(heading_deg, "heading_deg"), 1) % 360.0
+    h = round(as_finite_scalar(heading_deg, "heading_deg"), 1) % 360.0
 
     def signed(x, name):
         if x is None:
             return ["", ""]
-        v = check_finite_scalar(x, name)
+        v = as_finite_scalar(x, name)
         return [f"{abs(v):.1f}", "W" if v < 0 else "E"]
 
     return format_sentence(talker + "HDG", [f"{h:.1f}"] + signed(deviation_deg, "deviation_deg")
@@ -310,11 +310,11 @@ def rmb_sentence(destination_latitude: float, destination_longitude: float, rang
     talker = _talker(talker)
     lat, ns = format_latitude(destination_latitude, name="destination_latitude")
     lon, ew = format_longitude(destination_longitude, name="destination_longitude")
-    origin_id, destination_id = check_text(origin_id, "origin_id"), check_text(destination_id, "destination_id")
-    xte = check_finite_scalar(cross_track_m, "cross_track_m") / 1852.0
-    rng = check_positive(range_m, "range_m", allow_zero=True) / 1852.0
-    brg = round(check_finite_scalar(bearing_deg, "bearing_deg"), 1) % 360.0
-    vel = check_finite_scalar(closing_velocity_mps, "closing_velocity_mps") / KNOT
+    origin_id, destination_id = as_text(origin_id, "origin_id"), as_text(destination_id, "destination_id")
+    xte = as_finite_scalar(cross_track_m, "cross_track_m") / 1852.0
+    rng = as_positive(range_m, "range_m", allow_zero=True) / 1852.0
+    brg = round(as_finite_scalar(bearing_deg, "bearing_deg"), 1) % 360.0
+    vel = as_finite_scalar(closing_velocity_mps, "closing_velocity_mps") / KNOT
     return format_sentence(talker + "RMB", [
         "A", f"{abs(xte):.3f}", "L" if xte >= 0 else "R", origin_id, destination_id, lat, ns, lon, ew,
         f"{rng:.3f}", f"{brg:.1f}", f"{vel:.1f}", "A" if arrived else "V", "A"])
@@ -348,8 +348,8 @@ def random_sentences(count: int, rng=None, *, empty_fraction: float = 0.1) -> li
     >>> random_sentences(3, rng=5)[2]
     '$HCHDG,97.7,,,,*7B'
     """
-    n = check_int(count, "count", minimum=0)
-    p = check_positive(empty_fraction, "empty_fraction", allow_zero=True)
+    n = as_int(count, "count", minimum=0)
+    p = as_positive(empty_fraction, "empty_fraction", allow_zero=True)
     if p > 1:
         raise ValueError(f"empty_fraction: expected a probability in [0, 1], got {p}")
     g = as_rng(rng)

@@ -31,8 +31,8 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..geometry import se2_compose
-from ..validation import (as_array, as_rng, check_choice, check_finite_scalar, check_int, check_positive,
-                          check_sample_count)
+from ..validation import (as_array, as_rng, as_choice, as_finite_scalar, as_int, as_positive,
+                          require_sample_count)
 from ..sim.layout import Layout
 
 __all__ = ["INCH", "SECONDS_PER_INCH", "SPEED_OF_SOUND", "LVMaxSonarEZ", "SonarMount", "PAPER_LAYOUT",
@@ -88,10 +88,10 @@ class LVMaxSonarEZ:
 
     def __post_init__(self) -> None:
         for name in ("min_range", "max_range", "cycle", "resolution"):
-            check_positive(getattr(self, name), name)
+            as_positive(getattr(self, name), name)
         if not self.max_range > self.min_range:
             raise ValueError(f"max_range: expected a value above min_range = {self.min_range}, got {self.max_range}")
-        if not 0.0 <= check_finite_scalar(self.half_angle, "half_angle") < np.pi / 2:
+        if not 0.0 <= as_finite_scalar(self.half_angle, "half_angle") < np.pi / 2:
             raise ValueError(f"half_angle: expected radians in [0, pi/2), got {self.half_angle}")
 
     @property
@@ -179,7 +179,7 @@ def pulse_width_to_cm_inches(pulse_width_us: float) -> dict:
     >>> pulse_width_to_cm_inches(1470)
     {'inches': 10.0, 'cm': 25.4}
     """
-    pw = check_positive(pulse_width_us, "pulse_width_us", allow_zero=True)
+    pw = as_positive(pulse_width_us, "pulse_width_us", allow_zero=True)
     if pw > 60000:
         raise ValueError(f"pulse_width_us: expected at most 60000 us (one reading cycle), got {pw:g}")
     inches = pw / 147.0                                   # Eq. (1)
@@ -205,7 +205,7 @@ class SonarMount:
         if not isinstance(self.name, str):
             raise TypeError(f"name: expected a string, got {self.name!r}")
         for field in ("x", "y", "yaw"):
-            check_finite_scalar(getattr(self, field), field)
+            as_finite_scalar(getattr(self, field), field)
 
 
 #: The paper's layout on the 50 cm truck's front bumper (x = 0.25 m from the centre): the outer pair
@@ -259,12 +259,12 @@ def firing_schedule(n_sensors: int, duration: float, mode: str = "chained", *, c
     >>> [np.round(t, 3).tolist() for t in firing_schedule(4, 0.4)]      # one ping at a time
     [[0.0, 0.196, 0.392], [0.049, 0.245], [0.098, 0.294], [0.147, 0.343]]
     """
-    n = check_int(n_sensors, "n_sensors", minimum=1)
-    T = check_positive(duration, "duration")
-    c = check_positive(cycle, "cycle")
-    check_choice(mode, "mode", ("chained", "free"))
+    n = as_int(n_sensors, "n_sensors", minimum=1)
+    T = as_positive(duration, "duration")
+    c = as_positive(cycle, "cycle")
+    as_choice(mode, "mode", ("chained", "free"))
     g = as_rng(rng)     # checked in either mode; only "free" draws from it
-    check_sample_count((1 if mode == "chained" else n) * T / c + n, "n_sensors, duration, cycle")
+    require_sample_count((1 if mode == "chained" else n) * T / c + n, "n_sensors, duration, cycle")
     if mode == "chained":
         return [np.arange(k * c, T, n * c) for k in range(n)]
     return [np.arange(p, T, c) for p in g.uniform(0, c, n)]
@@ -299,8 +299,8 @@ def sensor_poses(pose: Any, mounts: Sequence[SonarMount] = PAPER_LAYOUT) -> np.n
     >>> np.round(sensor_poses([0.0, 0.0, 0.0]), 3).tolist()     # x forward, y left, yaw
     [[0.25, 0.1, 0.785], [0.25, 0.05, 0.0], [0.25, -0.05, 0.0], [0.25, -0.1, -0.785]]
     """
-    m = np.array([[mt.x, mt.y, mt.yaw] for mt in _check_sensors(mounts)])
-    return se2_compose(as_array(pose, "pose", shape=(3,)), m, check=False)    # pose ⊕ mount
+    m = np.array([[mt.x, mt.y, mt.yaw] for mt in _as_sensors(mounts)])
+    return se2_compose(as_array(pose, "pose", shape=(3,)), m, validate=False)    # pose ⊕ mount
 
 
 def _cone(sensor: LVMaxSonarEZ, rays: int) -> np.ndarray:
@@ -308,7 +308,7 @@ def _cone(sensor: LVMaxSonarEZ, rays: int) -> np.ndarray:
     return np.linspace(-sensor.half_angle, sensor.half_angle, rays) if rays > 1 else np.zeros(1)
 
 
-def _check_sensors(mounts: Any, sensor: Any = LVMaxSonarEZ()) -> tuple:
+def _as_sensors(mounts: Any, sensor: Any = LVMaxSonarEZ()) -> tuple:
     """``mounts`` as a non-empty tuple of :class:`SonarMount` (each checked when it was made); ``sensor`` typed."""
     if not isinstance(sensor, LVMaxSonarEZ):
         raise TypeError(f"sensor: expected an LVMaxSonarEZ, got {type(sensor).__name__}")
@@ -363,13 +363,13 @@ def true_ranges(field: Layout, pose: Any, mounts: Sequence[SonarMount] = PAPER_L
     if not isinstance(field, Layout):
         raise TypeError(f"field: expected a robokit.outdoor.Field (or any robokit.sim.Layout), got "
                         f"{type(field).__name__}")
-    k = check_int(rays, "rays", minimum=1)
-    mounts = _check_sensors(mounts, sensor)
+    k = as_int(rays, "rays", minimum=1)
+    mounts = _as_sensors(mounts, sensor)
     sp = sensor_poses(pose, mounts)
     offs = _cone(sensor, k)
     angles = (sp[:, 2:3] + offs[None, :]).ravel()
     origins = np.repeat(sp[:, :2], k, axis=0)
-    d = field.raycast(origins, angles, sensor.max_range * 1.0001, check=False).reshape(len(sp), k)
+    d = field.raycast(origins, angles, sensor.max_range * 1.0001, validate=False).reshape(len(sp), k)
     j = d.argmin(axis=1)
     r = d[np.arange(len(sp)), j]
     hit = r < sensor.max_range
@@ -430,14 +430,14 @@ def read_sensors(field: Any, pose: Any, which: Sequence[int], ping_times: Sequen
     [1.9558, 1.9558]
     """
     g = as_rng(rng)
-    mounts = _check_sensors(mounts, sensor)
-    idx = [check_int(int(i), f"which[{k}]", minimum=0, maximum=len(mounts) - 1)
+    mounts = _as_sensors(mounts, sensor)
+    idx = [as_int(int(i), f"which[{k}]", minimum=0, maximum=len(mounts) - 1)
            for k, i in enumerate(as_array(which, "which", ndim=1, dtype=int))]
     times = as_array(ping_times, "ping_times", shape=(len(idx),))
-    sigma = check_positive(noise, "noise", allow_zero=True)
+    sigma = as_positive(noise, "noise", allow_zero=True)
     if not isinstance(others, (dict, type(None))):
         raise TypeError(f"others: expected a dict {{sensor index: ping time}}, got {type(others).__name__}")
-    pending = {check_int(j, "others key", minimum=0, maximum=len(mounts) - 1): check_finite_scalar(t, f"others[{j}]")
+    pending = {as_int(j, "others key", minimum=0, maximum=len(mounts) - 1): as_finite_scalar(t, f"others[{j}]")
                for j, t in (others or {}).items()}
     if not pending:  # no ping in flight but our own: only the wanted sensors need a ray fan
         ranges = np.full(len(mounts), np.inf)

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from ..sim.vehicle import skid_steer_velocities, skid_steer_wheel_speeds, unicycle_step
-from ..validation import as_array, check_finite_scalar, check_positive
+from ..validation import as_array, as_finite_scalar, as_positive
 
 __all__ = ["SkidSteerTruck", "TruckState", "PAPER_TRUCK"]
 
@@ -71,10 +71,10 @@ class SkidSteerTruck:
 
     def __post_init__(self):
         for name in ("length", "width", "height", "track", "max_wheel_speed", "motor_tau"):
-            check_positive(getattr(self, name), name)
-        if not 1.0 <= check_finite_scalar(self.icr_factor, "icr_factor") <= 5.0:
+            as_positive(getattr(self, name), name)
+        if not 1.0 <= as_finite_scalar(self.icr_factor, "icr_factor") <= 5.0:
             raise ValueError(f"icr_factor: expected a number in [1, 5], got {self.icr_factor!r}")
-        if not 0.0 <= check_finite_scalar(self.slip, "slip") < 0.5:
+        if not 0.0 <= as_finite_scalar(self.slip, "slip") < 0.5:
             raise ValueError(f"slip: expected a ratio in [0, 0.5), got {self.slip!r}")
 
     @property
@@ -97,9 +97,9 @@ class SkidSteerTruck:
         (0.38, 0.603)
         """
         wl, wr = as_array(wheel_speeds, "wheel_speeds", shape=(2,))
-        return skid_steer_velocities(wl, wr, self.track, self.icr_factor, self.slip, check=False)
+        return skid_steer_velocities(wl, wr, self.track, self.icr_factor, self.slip, validate=False)
 
-    def wheel_commands(self, v: float, omega: float, *, check: bool = True) -> np.ndarray:
+    def wheel_commands(self, v: float, omega: float, *, validate: bool = True) -> np.ndarray:
         """``[left, right]`` wheel speeds that give ``v`` and ``omega`` under this model, saturated.
 
         When a side would exceed ``max_wheel_speed`` the forward speed is reduced first, so the turn
@@ -109,7 +109,7 @@ class SkidSteerTruck:
         ----------
         v, omega : float or array_like
             Wanted forward speed (m/s) and yaw rate (rad/s); arrays give ``(..., 2)`` speeds.
-        check : bool, default True
+        validate : bool, default True
             Validate ``v`` and ``omega``; ``False`` is the fast path for a control loop whose
             navigator computed them (:func:`robokit.outdoor.simulate`).
 
@@ -127,12 +127,12 @@ class SkidSteerTruck:
         >>> np.round(PAPER_TRUCK.wheel_commands(0.5, 0.0), 3).tolist()
         [0.526, 0.526]
         """
-        if check:
+        if validate:
             v, omega = as_array(v, "v"), as_array(omega, "omega")
         return skid_steer_wheel_speeds(v, omega, self.track, self.max_wheel_speed, self.icr_factor, self.slip,
-                                       check=False)
+                                       validate=False)
 
-    def step(self, state: "TruckState", command: Any, dt: float, *, check: bool = True) -> "TruckState":
+    def step(self, state: "TruckState", command: Any, dt: float, *, validate: bool = True) -> "TruckState":
         """Advance ``dt`` seconds with ``command = [left, right]`` wheel-speed set points.
 
         The motors respond with an exact first-order lag; the pose moves along the arc of constant
@@ -145,7 +145,7 @@ class SkidSteerTruck:
             Wheel-speed set points (m/s), clipped to ``max_wheel_speed``.
         dt : float
             Step (s, > 0).
-        check : bool, default True
+        validate : bool, default True
             Validate the inputs; ``False`` is the fast path for a simulation loop whose states come
             from this method and whose commands come from :meth:`wheel_commands`.
 
@@ -167,18 +167,18 @@ class SkidSteerTruck:
         >>> np.round(s.pose, 3).tolist(), np.round(s.wheels, 3).tolist()
         ([0.229, 0.0, 0.0], [0.482, 0.482])
         """
-        if check:
+        if validate:
             if not isinstance(state, TruckState):
                 raise TypeError(f"state: expected a TruckState, got {type(state).__name__}")
             pose, w0 = as_array(state.pose, "state.pose", shape=(3,)), as_array(state.wheels, "state.wheels", shape=(2,))
-            command, dt = as_array(command, "command", shape=(2,)), check_positive(dt, "dt")
+            command, dt = as_array(command, "command", shape=(2,)), as_positive(dt, "dt")
         else:
             pose, w0 = state.pose, state.wheels
         cmd = np.clip(command, -self.max_wheel_speed, self.max_wheel_speed)
         a = 1 - np.exp(-dt / self.motor_tau)
         w1 = w0 + (cmd - w0) * a                                    # exact first-order lag
-        v, om = skid_steer_velocities(*((w0 + w1) / 2), self.track, self.icr_factor, self.slip, check=False)
-        return TruckState(unicycle_step(pose, v, om, dt, check=False), w1, v, om)
+        v, om = skid_steer_velocities(*((w0 + w1) / 2), self.track, self.icr_factor, self.slip, validate=False)
+        return TruckState(unicycle_step(pose, v, om, dt, validate=False), w1, v, om)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

@@ -17,7 +17,7 @@ Worlds (textured planar rectangles + 2D footprint; world frame right-handed, z u
 The 2D world (:mod:`robokit.sim.layout`)
     ``Layout(segments, circles, boxes)``: walls, circles ``[x, y, r]`` and rotated boxes
     ``[cx, cy, length, width, yaw]``, with the course's one ray caster ``.raycast(origins, angles,
-    max_range, check=True)`` (one documented tie rule), ``.contains``, ``.clearance`` and
+    max_range, validate=True)`` (one documented tie rule), ``.contains``, ``.clearance`` and
     ``.collides(pose, length, width)``; ``obstacle_array`` checks obstacle arrays, ``box_corners``.
     The LiDAR, lesson 05's field (``robokit.outdoor.Field`` is a Layout) and its sonars use it.
 
@@ -65,12 +65,12 @@ Example
 ((480, 640, 3), dtype('float32'))
 """
 from .camera import Frame, PinholeCamera, StereoRig, camera_mount
-from .feature_check import ViewPairCheck, ground_truth_inliers, omni_ground_truth_inliers, omni_view_pair, sift_view_pair
+from .view_matches import ViewPairMatches, ground_truth_inliers, omni_ground_truth_inliers, omni_view_pair, sift_view_pair
 from .layout import Layout, box_corners, obstacle_array
 from .lidar import Lidar, scan_points
 from .motion import (OFFICE_TEST_POSES, Path, corridor_path, increment_variances, lab_lap, noisy_odometry,
                      odometry_covariance, odometry_increment, office_tour, sample_motion_model_odometry, waypoint_path)
-from .omni import OmniCamera, check_omni_camera, omni_mount
+from .omni import OmniCamera, as_omni_camera, omni_mount
 from .runs import FrameStream, Run, describe_sensor, record, record_stream
 from .textures import illuminate, photo
 from .vehicle import diff_drive_velocities, skid_steer_velocities, skid_steer_wheel_speeds, unicycle_step
@@ -81,12 +81,12 @@ from .worlds_outdoor import field_world, open_field, scatter_obstacles
 __all__ = [
     "World", "Surface", "FreeSpace", "box_room", "lab_room", "long_corridor", "office_floor",
     "open_field", "field_world", "scatter_obstacles",
-    "Frame", "PinholeCamera", "StereoRig", "camera_mount", "OmniCamera", "omni_mount", "check_omni_camera", "illuminate", "photo",
+    "Frame", "PinholeCamera", "StereoRig", "camera_mount", "OmniCamera", "omni_mount", "as_omni_camera", "illuminate", "photo",
     "Layout", "box_corners", "obstacle_array", "Lidar", "scan_points",
     "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
     "odometry_increment",
     "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap", "office_tour",
     "OFFICE_TEST_POSES", "increment_variances", "odometry_covariance",
-    "Run", "record", "record_stream", "FrameStream", "describe_sensor", "ViewPairCheck", "ground_truth_inliers", "sift_view_pair", "omni_ground_truth_inliers",
+    "Run", "record", "record_stream", "FrameStream", "describe_sensor", "ViewPairMatches", "ground_truth_inliers", "sift_view_pair", "omni_ground_truth_inliers",
     "omni_view_pair",
 ]

@@ -16,7 +16,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..validation import as_array, as_rng, check_positive
+from ..validation import as_array, as_rng, as_positive
 from . import textures as tx
 from .world import Surface, World
 
@@ -48,8 +48,8 @@ class Builder:
 
     def __init__(self, rng: Any = None, density: float = 120.0, tile: float = 2.0) -> None:
         self.rng = as_rng(rng)
-        self.density = check_positive(density, "density")
-        self.tile = check_positive(tile, "tile")
+        self.density = as_positive(density, "density")
+        self.tile = as_positive(tile, "tile")
         self.surfaces: list[Surface] = []
 
     def _pixels(self, length: float, density: float) -> int:
@@ -140,7 +140,7 @@ class Builder:
         poly = as_array(polygon, "polygon", shape=(None, 2))
         if len(poly) < 3:
             raise ValueError(f"polygon: expected at least 3 corners, got {len(poly)}")
-        h = check_positive(height, "height")
+        h = as_positive(height, "height")
         for k in range(len(poly)):
             self.wall(f"{name}/side{k}", poly[k], poly[(k + 1) % len(poly)], 0.0, h, texture_fn)
         if lid is not None:

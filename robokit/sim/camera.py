@@ -23,7 +23,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import R_BODY_OPTICAL, as_se3, euler_matrix, se2_to_se3, se3_from_rt, se3_inverse, transform_points
-from ..validation import as_array, as_points, as_rng, check_int, check_positive
+from ..validation import as_array, as_points, as_rng, as_int, as_positive
 from .render import render_pinhole
 from .textures import illuminate
 from .world import World
@@ -64,7 +64,7 @@ def camera_mount(height: float, forward: float = 0.0, pitch: float = 0.0) -> np.
     Optical-frame convention of OpenCV / Hartley & Zisserman (2004), Sec. 6.1; body frame of
     ROS REP 103.
     """
-    h = check_positive(height, "height")
+    h = as_positive(height, "height")
     R = euler_matrix([0.0, pitch, 0.0]) @ R_BODY_OPTICAL  # pitch about the body's y axis (left)
     return se3_from_rt(R, [as_array(forward, "forward", shape=()).item(), 0.0, h])
 
@@ -92,7 +92,7 @@ def finish_image(image: np.ndarray, noise: float, rng: Any, lighting: dict | Non
     """
     if lighting:
         image = illuminate(image, **lighting)
-    sigma = check_positive(noise, "noise", allow_zero=True)
+    sigma = as_positive(noise, "noise", allow_zero=True)
     if sigma > 0:
         noisy = as_rng(rng).standard_normal(image.shape)   # the draws of normal(0, sigma), made in place
         noisy *= sigma
@@ -141,7 +141,7 @@ class MountedSensor:
         if world is not None:
             if not isinstance(world, World):
                 raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
-            world.check_viewpoint(T[:3, 3], "robot_pose")
+            world.as_viewpoint(T[:3, 3], "robot_pose")
         return T
 
     def observe(self, world: World, robot_pose: Any, **kwargs: Any) -> Frame:
@@ -203,10 +203,10 @@ class PinholeCamera(MountedSensor):
     mount: Any = None
 
     def __post_init__(self) -> None:
-        self.fx = check_positive(self.fx, "fx")
-        self.fy = check_positive(self.fy, "fy")
-        self.width = check_int(self.width, "width", minimum=8)
-        self.height = check_int(self.height, "height", minimum=8)
+        self.fx = as_positive(self.fx, "fx")
+        self.fy = as_positive(self.fy, "fy")
+        self.width = as_int(self.width, "width", minimum=8)
+        self.height = as_int(self.height, "height", minimum=8)
         self.cx = float(as_array(self.cx, "cx", shape=()))
         self.cy = float(as_array(self.cy, "cy", shape=()))
         self.mount = camera_mount(0.8) if self.mount is None else as_se3(self.mount, "mount")
@@ -220,12 +220,12 @@ class PinholeCamera(MountedSensor):
         -----
         ``fx = (width / 2) / tan(hfov / 2)`` (Hartley & Zisserman 2004, Sec. 6.1).
         """
-        fov = check_positive(hfov, "hfov")
+        fov = as_positive(hfov, "hfov")
         if fov >= np.pi:
             raise ValueError(f"hfov: expected a field of view below pi rad, got {fov}")
-        w = check_int(width, "width", minimum=8)
+        w = as_int(width, "width", minimum=8)
         f = (w / 2) / np.tan(fov / 2)
-        h = check_int(height, "height", minimum=8)
+        h = as_int(height, "height", minimum=8)
         return cls(f, f, (w - 1) / 2, (h - 1) / 2, w, h, mount)
 
     @property
@@ -332,7 +332,7 @@ class PinholeCamera(MountedSensor):
         if not isinstance(world, World):
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
         T = as_se3(T_world_cam, "T_world_cam")
-        world.check_viewpoint(T[:3, 3], "T_world_cam")
+        world.as_viewpoint(T[:3, 3], "T_world_cam")
         image, depth = render_pinhole(world, self.K, self.width, self.height, T)
         return Frame(finish_image(image, noise, rng, lighting), depth)
 
@@ -372,7 +372,7 @@ class StereoRig:
     def __post_init__(self) -> None:
         if not isinstance(self.camera, PinholeCamera):
             raise TypeError(f"camera: expected a PinholeCamera, got {type(self.camera).__name__}")
-        self.baseline = check_positive(self.baseline, "baseline")
+        self.baseline = as_positive(self.baseline, "baseline")
 
     @property
     def offsets(self) -> dict[str, np.ndarray]:

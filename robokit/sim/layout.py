@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, as_points, check_positive
+from ..validation import as_array, as_points, as_positive
 
 __all__ = ["Layout", "obstacle_array", "box_corners", "PARALLEL"]
 
@@ -186,7 +186,7 @@ class Layout:
         """
         return self.corners.copy()
 
-    def raycast(self, origins: Any, angles: Any, max_range: float = math.inf, *, check: bool = True) -> np.ndarray:
+    def raycast(self, origins: Any, angles: Any, max_range: float = math.inf, *, validate: bool = True) -> np.ndarray:
         """Distance along rays to the first obstacle they touch (``max_range`` where none is nearer).
 
         The tie rule: the range is the smallest ``t >= 0`` at which the ray ``o + t d`` touches an
@@ -208,7 +208,7 @@ class Layout:
         max_range : float, default inf
             Returned where nothing is hit nearer; a finite value also skips obstacles that cannot
             be within reach of any origin.
-        check : bool, default True
+        validate : bool, default True
             Validate the inputs; ``False`` is the fast path for callers that already did
             (``origins`` as a float array, ``angles`` a 1-D float array, ``max_range`` > 0).
 
@@ -237,13 +237,13 @@ class Layout:
         >>> walls.raycast([[0.0, 0.0], [2.0, 0.0]], [np.pi, 0.5], max_range=5.0).tolist()
         [5.0, 0.0]
         """
-        if check:
+        if validate:
             o = as_array(origins, "origins")
             o = o[None] if o.shape == (2,) else as_points(o, "origins", 2)
             a = as_array(angles, "angles", ndim=1)
             if len(o) not in (1, len(a)):
                 raise ValueError(f"origins: expected one origin or one per angle ({len(a)}), got {len(o)}")
-            rmax = math.inf if max_range == math.inf else check_positive(max_range, "max_range")
+            rmax = math.inf if max_range == math.inf else as_positive(max_range, "max_range")
         else:
             o, a, rmax = np.reshape(origins, (-1, 2)), angles, max_range
         d = np.stack([np.cos(a), np.sin(a)], axis=1)                    # ray directions, (K, 2)
@@ -376,7 +376,7 @@ class Layout:
         (True, False)
         """
         x, y, th = as_array(pose, "pose", shape=(3,))
-        L, W = check_positive(length, "length") / 2, check_positive(width, "width") / 2
+        L, W = as_positive(length, "length") / 2, as_positive(width, "width") / 2
         c, s = np.cos(th), np.sin(th)
         reach = math.hypot(L, W)
         circles = self.circles[np.abs(self.circles[:, :2] - [x, y]).max(axis=1) <= self.circles[:, 2] + reach] \

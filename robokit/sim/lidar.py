@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import se2_compose
-from ..validation import as_array, as_rng, check_int, check_positive
+from ..validation import as_array, as_rng, as_int, as_positive
 from .world import World
 
 __all__ = ["Lidar", "scan_points"]
@@ -70,13 +70,13 @@ class Lidar:
     offset: Any = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
-        self.beams = check_int(self.beams, "beams", minimum=1)
-        self.r_min = check_positive(self.r_min, "r_min", allow_zero=True)
-        self.r_max = check_positive(self.r_max, "r_max")
+        self.beams = as_int(self.beams, "beams", minimum=1)
+        self.r_min = as_positive(self.r_min, "r_min", allow_zero=True)
+        self.r_max = as_positive(self.r_max, "r_max")
         if self.r_max <= self.r_min:
             raise ValueError(f"r_max: expected a value above r_min = {self.r_min}, got {self.r_max}")
-        self.noise = check_positive(self.noise, "noise", allow_zero=True)
-        self.height = check_positive(self.height, "height")
+        self.noise = as_positive(self.noise, "noise", allow_zero=True)
+        self.height = as_positive(self.height, "height")
         self.offset = as_array(self.offset, "offset", shape=(3,))
 
     @property
@@ -130,9 +130,9 @@ class Lidar:
         if not isinstance(world, World):
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
         sp = self.sensor_pose(robot_pose)
-        world.check_viewpoint([sp[0], sp[1], self.height], "robot_pose", clearance=0.0)
+        world.as_viewpoint([sp[0], sp[1], self.height], "robot_pose", clearance=0.0)
         # obstacles out of reach are skipped (max_range); a miss within it reads 2 r_max, out of range below
-        true = world.layout(self.height).raycast(sp[:2], self.angles + sp[2], 2 * self.r_max, check=False)
+        true = world.layout(self.height).raycast(sp[:2], self.angles + sp[2], 2 * self.r_max, validate=False)
         out = true.copy()
         if self.noise > 0:
             out = out + as_rng(rng).normal(0.0, self.noise, self.beams)

@@ -27,7 +27,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import (as_array, as_points, as_rng, check_finite_result, check_positive, check_sample_count,
+from ..validation import (as_array, as_points, as_rng, require_finite_result, as_positive, require_sample_count,
                           describe)
 from .world import World
 
@@ -78,7 +78,7 @@ def _alphas(alphas: Any) -> np.ndarray:
     return a
 
 
-def increment_variances(delta: Any, alphas: Any, *, check: bool = True) -> np.ndarray:
+def increment_variances(delta: Any, alphas: Any, *, validate: bool = True) -> np.ndarray:
     """Variances of the noise on odometry increments ``[delta_rot1, delta_trans, delta_rot2]``.
 
     Parameters
@@ -87,7 +87,7 @@ def increment_variances(delta: Any, alphas: Any, *, check: bool = True) -> np.nd
         Increments from :func:`odometry_increment`.
     alphas : array_like, shape (4,)
         Noise parameters ``a1..a4`` (non-negative).
-    check : bool, default True
+    validate : bool, default True
         Validate; ``False`` is the fast path (float arrays).
 
     Returns
@@ -104,21 +104,21 @@ def increment_variances(delta: Any, alphas: Any, *, check: bool = True) -> np.nd
     >>> increment_variances([0.0, 1.0, 0.5], [0.01, 0.001, 0.01, 0.001]).tolist()
     [0.001, 0.01025, 0.0035]
     """
-    d = as_array(delta, "delta") if check else delta
-    a = _alphas(alphas) if check else alphas
-    if check and (d.shape[-1:] != (3,) or d.ndim > 2):
+    d = as_array(delta, "delta") if validate else delta
+    a = _alphas(alphas) if validate else alphas
+    if validate and (d.shape[-1:] != (3,) or d.ndim > 2):
         raise ValueError(f"delta: expected shape (3,) or (N, 3), got shape {d.shape}")
     r1, t, r2 = d[..., 0], d[..., 1], d[..., 2]
     out = np.stack([a[0] * r1 ** 2 + a[1] * t ** 2,                     # Table 5.6, line 5
                     a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2),          # line 6
                     a[0] * r2 ** 2 + a[1] * t ** 2], axis=-1)            # line 7
-    if check:
-        check_finite_result("delta, alphas", out)
+    if validate:
+        require_finite_result("delta, alphas", out)
     return out
 
 
 def _perturb(delta: np.ndarray, a: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    sd = np.sqrt(increment_variances(delta, a, check=False))
+    sd = np.sqrt(increment_variances(delta, a, validate=False))
     noise = rng.standard_normal(delta.shape)
     return np.stack([delta[..., 0] - sd[..., 0] * noise[..., 0], delta[..., 1] - sd[..., 1] * noise[..., 1],
                      delta[..., 2] - sd[..., 2] * noise[..., 2]], axis=-1)
@@ -177,7 +177,7 @@ def odometry_covariance(odometry: Any, alphas: Any) -> np.ndarray:
     delta[back, 0] = wrap_angle(delta[back, 0] + np.pi)
     delta[back, 1] = -delta[back, 1]
     delta[back, 2] = wrap_angle(delta[back, 2] - np.pi)
-    var = increment_variances(delta, a, check=False)
+    var = increment_variances(delta, a, validate=False)
     r1, t = delta[:, 0], delta[:, 1]
     c1, s1 = np.cos(r1), np.sin(r1)
     zeros, ones = np.zeros_like(t), np.ones_like(t)
@@ -322,9 +322,9 @@ def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, ra
     ([0.0, 0.5, 1.0, 1.5, 2.0], [0.0, 0.25, 0.5, 0.75, 1.0])
     """
     W = as_points(waypoints, "waypoints", 2, min_count=2)
-    v = check_positive(speed, "speed")
-    w = check_positive(turn_rate, "turn_rate")
-    dt = 1.0 / check_positive(rate, "rate")
+    v = as_positive(speed, "speed")
+    w = as_positive(turn_rate, "turn_rate")
+    dt = 1.0 / as_positive(rate, "rate")
     heading = np.arctan2(*(W[1] - W[0])[::-1])
     knots_t, knots = [0.0], [np.array([W[0, 0], W[0, 1], heading])]
     for a, b in zip(W[:-1], W[1:]):
@@ -338,7 +338,7 @@ def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, ra
             knots_t.append(knots_t[-1] + length / v)
             knots.append(np.array([b[0], b[1], knots[-1][2]]))
     kt, kp = np.array(knots_t), np.array(knots)
-    check_sample_count(kt[-1] / dt, "speed, turn_rate, rate")
+    require_sample_count(kt[-1] / dt, "speed, turn_rate, rate")
     t = np.arange(0.0, kt[-1] + 1e-9, dt)
     poses = np.column_stack([np.interp(t, kt, kp[:, i]) for i in range(3)])
     poses[:, 2] = wrap_angle(poses[:, 2])
@@ -354,7 +354,7 @@ def corridor_path(world: Any, speed: float = 0.3, rate: float = 10.0, margin: fl
     0.8 m from the end wall.
     """
     length = float(world.info["length"])
-    m = check_positive(margin, "margin")
+    m = as_positive(margin, "margin")
     return waypoint_path([[m, 0.0], [length - m, 0.0]], speed, rate=rate)
 
 

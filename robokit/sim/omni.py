@@ -44,12 +44,12 @@ import cv2
 import numpy as np
 
 from ..geometry import as_se3, se3_from_rt
-from ..validation import as_array, as_points, check_int, check_positive, describe
+from ..validation import as_array, as_points, as_int, as_positive, describe
 from .camera import Frame, MountedSensor, finish_image
 from .render import render_pinhole
 from .world import World
 
-__all__ = ["OmniCamera", "omni_mount", "check_omni_camera"]
+__all__ = ["OmniCamera", "omni_mount", "as_omni_camera"]
 
 # cube faces: rotation omni <- face optical frame (columns: face x, y, z in omni axes)
 _FACES = {
@@ -79,7 +79,7 @@ def omni_mount(height: float = 1.0) -> np.ndarray:
     Lesson 02's paper mounts the camera on top of the robot looking up at the mirror; the omni frame's z axis
     is the mirror axis pointing down, as in Mei & Rives (2007), Sec. II.
     """
-    return se3_from_rt(np.diag([1.0, -1.0, -1.0]), [0.0, 0.0, check_positive(height, "height")])
+    return se3_from_rt(np.diag([1.0, -1.0, -1.0]), [0.0, 0.0, as_positive(height, "height")])
 
 
 @dataclasses.dataclass
@@ -124,9 +124,9 @@ class OmniCamera(MountedSensor):
     face_size: int = 400
 
     def __post_init__(self) -> None:
-        self.width = check_int(self.width, "width", minimum=16)
-        self.height = check_int(self.height, "height", minimum=16)
-        self.xi = check_positive(self.xi, "xi")
+        self.width = as_int(self.width, "width", minimum=16)
+        self.height = as_int(self.height, "height", minimum=16)
+        self.xi = as_positive(self.xi, "xi")
         if self.xi > 1:
             raise ValueError(f"xi: expected a mirror parameter in (0, 1], got {self.xi}")
         lo, hi = as_array(self.elevation_range, "elevation_range", shape=(2,))
@@ -137,8 +137,8 @@ class OmniCamera(MountedSensor):
         self.cx, self.cy = (self.width - 1) / 2, (self.height - 1) / 2
         if self.f is None:
             self.f = (min(self.width, self.height) / 2 - 4) / self._radius(hi)
-        self.f = check_positive(self.f, "f")
-        self.face_size = check_int(self.face_size, "face_size", minimum=16)
+        self.f = as_positive(self.f, "f")
+        self.face_size = as_int(self.face_size, "face_size", minimum=16)
         self.mount = omni_mount() if self.mount is None else as_se3(self.mount, "mount")
 
     def _radius(self, elevation: float) -> float:
@@ -286,7 +286,7 @@ class OmniCamera(MountedSensor):
         if not isinstance(world, World):
             raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
         T = as_se3(T_world_omni, "T_world_omni")
-        world.check_viewpoint(T[:3, 3], "T_world_omni")
+        world.as_viewpoint(T[:3, 3], "T_world_omni")
         used, K, size, mapx, mapy, factor, inside = self._lookup
         images, depths = [], []
         for name in used:
@@ -304,7 +304,7 @@ class OmniCamera(MountedSensor):
         return Frame(finish_image(image, noise, rng, lighting), depth.astype(np.float32))
 
 
-def check_omni_camera(camera: Any) -> OmniCamera:
+def as_omni_camera(camera: Any) -> OmniCamera:
     """``camera`` if it is an :class:`~robokit.sim.OmniCamera`, else a TypeError naming it.
 
     Notes
@@ -313,7 +313,7 @@ def check_omni_camera(camera: Any) -> OmniCamera:
 
     Examples
     --------
-    >>> check_omni_camera("omni")
+    >>> as_omni_camera("omni")
     Traceback (most recent call last):
     ...
     TypeError: camera: expected a robokit.sim.OmniCamera, got 'omni'

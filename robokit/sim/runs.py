@@ -28,7 +28,7 @@ import numpy as np
 from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, save_npz, write_atomically
 from ..parallel import iter_runs, map_runs
 from ..progress import progress_bar
-from ..validation import as_array, as_points, as_rng, check_int, check_positive
+from ..validation import as_array, as_points, as_rng, as_int, as_positive
 from .camera import PinholeCamera, StereoRig
 from .motion import Path, noisy_odometry
 from .omni import OmniCamera
@@ -221,12 +221,12 @@ def _timed_poses(path: Any, rate: float | None) -> tuple[np.ndarray, np.ndarray]
         t0, p0 = as_array(path.t, "path.t", ndim=1), as_points(path.poses, "path.poses", 3, min_count=1)
     else:
         p0 = as_points(path, "path", 3, min_count=1)
-        t0 = np.arange(len(p0)) / check_positive(rate if rate is not None else 10.0, "rate")
+        t0 = np.arange(len(p0)) / as_positive(rate if rate is not None else 10.0, "rate")
     if len(t0) != len(p0) or np.any(np.diff(t0) <= 0):
         raise ValueError("path: expected strictly increasing timestamps, one per pose")
     if rate is None:
         return t0, p0
-    t = np.arange(t0[0], t0[-1] + 1e-9, 1.0 / check_positive(rate, "rate"))
+    t = np.arange(t0[0], t0[-1] + 1e-9, 1.0 / as_positive(rate, "rate"))
     unwrapped = np.unwrap(p0[:, 2])
     return t, np.column_stack([np.interp(t, t0, p0[:, 0]), np.interp(t, t0, p0[:, 1]),
                                np.angle(np.exp(1j * np.interp(t, t0, unwrapped)))])
@@ -242,7 +242,7 @@ def _drive(world: World, path: Any, rate: float | None, odometry_alphas: Any, se
     if bad.any():
         raise ValueError(f"path: expected poses inside the free space of {world.name!r}, got {bad.sum()} outside "
                          f"(first at {poses[np.argmax(bad), :2].round(3).tolist()})")
-    return t, poses, as_array(odometry_alphas, "odometry_alphas", shape=(4,)), check_int(seed, "seed", minimum=0)
+    return t, poses, as_array(odometry_alphas, "odometry_alphas", shape=(4,)), as_int(seed, "seed", minimum=0)
 
 
 def record(world: World, path: Path, sensors: dict, rate: float | None = None, *,

@@ -28,7 +28,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..validation import as_array, as_rng, check_choice, check_finite_scalar, check_int, check_positive
+from ..validation import as_array, as_rng, as_choice, as_finite_scalar, as_int, as_positive
 
 __all__ = ["PHOTOS", "photo", "noise_texture", "plaster", "floor_tiles", "ceiling_panels", "wood",
            "poster", "notice_board", "door", "room_plate", "illuminate"]
@@ -44,7 +44,7 @@ PHOTOS = {
 
 
 def _size(width: Any, height: Any) -> tuple[int, int]:
-    return check_int(width, "width", minimum=8), check_int(height, "height", minimum=8)
+    return as_int(width, "width", minimum=8), as_int(height, "height", minimum=8)
 
 
 @functools.lru_cache(maxsize=None)
@@ -99,7 +99,7 @@ def photo(name: str) -> np.ndarray:
     >>> img.shape, img.dtype
     ((600, 512, 3), dtype('uint8'))
     """
-    check_choice(name, "name", list(PHOTOS))
+    as_choice(name, "name", list(PHOTOS))
     return _load_photo(name).copy()
 
 
@@ -139,14 +139,14 @@ def noise_texture(width: int, height: int, rng: Any = None, *, base: Any = (180,
     w, h = _size(width, height)
     rng = as_rng(rng)
     base = as_array(base, "base", shape=(3,))
-    amp = check_positive(amplitude, "amplitude", allow_zero=True)
+    amp = as_positive(amplitude, "amplitude", allow_zero=True)
     acc = np.zeros((h, w), np.float32)
     for s in scales:
-        s = check_int(s, "scales", minimum=1)
+        s = as_int(s, "scales", minimum=1)
         small = rng.standard_normal((max(2, h // s + 2), max(2, w // s + 2))).astype(np.float32)
         acc += cv2.resize(small, (w, h), interpolation=cv2.INTER_CUBIC)
     acc *= amp / max(float(acc.std()), 1e-6)
-    shift = rng.normal(0, check_positive(tint, 'tint', allow_zero=True), 3)
+    shift = rng.normal(0, as_positive(tint, 'tint', allow_zero=True), 3)
     img = base[None, None, :] * (1 + shift) + acc[..., None]
     return np.clip(img, 0, 255).astype(np.uint8)
 
@@ -192,7 +192,7 @@ def floor_tiles(width: int, height: int, rng: Any = None, tile: int = 64) -> np.
     Procedural pattern (course design, no paper): speckle gives texture to feature detectors.
     """
     rng = as_rng(rng)
-    tile = check_int(tile, "tile", minimum=4)
+    tile = as_int(tile, "tile", minimum=4)
     img = noise_texture(width, height, rng, base=(150, 140, 125), amplitude=22.0, scales=(2, 8), tint=0.01)
     h, w = img.shape[:2]
     shade = rng.normal(0, 12, (h // tile + 1, w // tile + 1))
@@ -405,8 +405,8 @@ def illuminate(image: Any, gain: float = 1.0, offset: float = 0.0, gradient: Any
     img = as_array(image, "image", dtype=None)
     if img.dtype != np.uint8 or img.ndim not in (2, 3) or img.ndim == 3 and img.shape[2] != 3:
         raise TypeError(f"image: expected a uint8 image of shape (H, W) or (H, W, 3), got {img.dtype} {img.shape}")
-    g = check_positive(gain, "gain")
-    b = check_finite_scalar(offset, "offset")
+    g = as_positive(gain, "gain")
+    b = as_finite_scalar(offset, "offset")
     gx, gy = as_array(gradient, "gradient", shape=(2,))
     h, w = img.shape[:2]
     field = 1 + gx * (np.arange(w, dtype=np.float32) / w - 0.5)[None, :] \

@@ -24,7 +24,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..validation import as_rng, check_int
+from ..validation import as_rng, as_int
 from .textures import noise_texture
 
 __all__ = ["grass", "hedge", "bark", "straw", "planks", "painted_post", "sky", "STAINS", "PAINTS"]
@@ -46,7 +46,7 @@ def _grain(width: int, height: int, rng: np.random.Generator, base: Any, shrink:
            amplitude: float, scales: tuple, tint: float, wobble: float = 0.0, blob: float = 2.0) -> np.ndarray:
     """Noise stretched along one axis (drawn ``shrink`` times smaller, then resized: fibres, ridges,
     grain) with an optional brightness wobble of relative size ``wobble`` and blobs ``blob`` px wide."""
-    w, h = check_int(width, "width", minimum=8), check_int(height, "height", minimum=8)
+    w, h = as_int(width, "width", minimum=8), as_int(height, "height", minimum=8)
     small = noise_texture(max(8, w // shrink[0]), max(8, h // shrink[1]), rng, base=base, amplitude=amplitude,
                           scales=scales, tint=tint)
     img = cv2.resize(small, (w, h), interpolation=cv2.INTER_CUBIC)
@@ -188,7 +188,7 @@ def sky(width: int, height: int, rng: Any = None, top: float = 1.0, bottom: floa
     colour and a finite depth.
     """
     rng = as_rng(rng)
-    w, h = check_int(width, "width", minimum=8), check_int(height, "height", minimum=8)
+    w, h = as_int(width, "width", minimum=8), as_int(height, "height", minimum=8)
     t = np.linspace(top, bottom, h, dtype=np.float32)[:, None, None]
     horizon, zenith = np.array([206, 222, 236], np.float32), np.array([84, 134, 204], np.float32)
     img = horizon * (1 - t) + zenith * t + np.zeros((h, w, 1), np.float32)

@@ -28,12 +28,12 @@ from typing import Any
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, as_points, broadcast_to, check_positive
+from ..validation import as_array, as_points, broadcast_to, as_positive
 
 __all__ = ["unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds"]
 
 
-def unicycle_step(pose: Any, v: Any, omega: Any, dt: float, *, check: bool = True) -> np.ndarray:
+def unicycle_step(pose: Any, v: Any, omega: Any, dt: float, *, validate: bool = True) -> np.ndarray:
     """Advance poses by driving at speed ``v`` and turn rate ``omega`` for ``dt`` seconds (exact arc).
 
     Parameters
@@ -43,7 +43,7 @@ def unicycle_step(pose: Any, v: Any, omega: Any, dt: float, *, check: bool = Tru
         Forward speed (m/s) and turn rate (rad/s), constant over the step.
     dt : float
         Duration (s, >= 0).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` is the fast path for a simulation loop that already did.
 
     Returns
@@ -67,13 +67,13 @@ def unicycle_step(pose: Any, v: Any, omega: Any, dt: float, *, check: bool = Tru
     >>> np.round(unicycle_step([0.0, 0.0, 0.0], 1.0, np.pi / 2, 1.0), 4).tolist()   # a quarter circle
     [0.6366, 0.6366, 1.5708]
     """
-    if check:
+    if validate:
         P = as_array(pose, "pose")
         single = P.ndim == 1
         P = as_points(P, "pose", 3)
         v = broadcast_to(as_array(v, "v"), (len(P),), "v", "one per pose")
         w = broadcast_to(as_array(omega, "omega"), (len(P),), "omega", "one per pose")
-        dt = check_positive(dt, "dt", allow_zero=True)
+        dt = as_positive(dt, "dt", allow_zero=True)
     else:
         P = np.asarray(pose, dtype=float)
         single = P.ndim == 1
@@ -126,25 +126,25 @@ def diff_drive_velocities(omega_left: Any, omega_right: Any, wheel_radius: float
     >>> round(float(v), 3), round(float(w), 3)
     (0.1, 0.4)
     """
-    r = check_positive(wheel_radius, "wheel_radius")
-    b = check_positive(track, "track")
+    r = as_positive(wheel_radius, "wheel_radius")
+    b = as_positive(track, "track")
     wl, wr = as_array(omega_left, "omega_left"), as_array(omega_right, "omega_right")
     return r * (wr + wl) / 2, r * (wr - wl) / b
 
 
 def _skid_parameters(track: float, icr_factor: float, slip: float) -> tuple[float, float, float]:
-    b = check_positive(track, "track")
-    c = check_positive(icr_factor, "icr_factor")
+    b = as_positive(track, "track")
+    c = as_positive(icr_factor, "icr_factor")
     if c < 1:
         raise ValueError(f"icr_factor: expected an expansion factor >= 1, got {c}")
-    s = check_positive(slip, "slip", allow_zero=True)
+    s = as_positive(slip, "slip", allow_zero=True)
     if s >= 1:
         raise ValueError(f"slip: expected a ratio in [0, 1), got {s}")
     return b, c, s
 
 
 def skid_steer_velocities(v_left: Any, v_right: Any, track: float, icr_factor: float = 1.5, slip: float = 0.0,
-                          *, check: bool = True) -> tuple:
+                          *, validate: bool = True) -> tuple:
     """Body speed and turn rate of a skid-steer vehicle from its left and right wheel speeds.
 
     Parameters
@@ -158,7 +158,7 @@ def skid_steer_velocities(v_left: Any, v_right: Any, track: float, icr_factor: f
         ``icr_factor * track``; 1 is the ideal differential drive.
     slip : float, default 0
         Longitudinal slip ratio ``s`` in [0, 1): the ground moves at ``(1 - s)`` times the wheel speed.
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs; ``False`` for callers whose parameters are already checked.
 
     Returns
@@ -183,7 +183,7 @@ def skid_steer_velocities(v_left: Any, v_right: Any, track: float, icr_factor: f
     >>> round(float(v), 4), round(float(w), 4)
     (0.3, 0.3333)
     """
-    if check:
+    if validate:
         track, icr_factor, slip = _skid_parameters(track, icr_factor, slip)
         v_left, v_right = as_array(v_left, "v_left"), as_array(v_right, "v_right")
     k = 1 - slip
@@ -191,7 +191,7 @@ def skid_steer_velocities(v_left: Any, v_right: Any, track: float, icr_factor: f
 
 
 def skid_steer_wheel_speeds(v: Any, omega: Any, track: float, max_wheel_speed: float, icr_factor: float = 1.5,
-                            slip: float = 0.0, *, check: bool = True) -> np.ndarray:
+                            slip: float = 0.0, *, validate: bool = True) -> np.ndarray:
     """Left and right wheel speeds that give ``v`` and ``omega`` (inverse of :func:`skid_steer_velocities`), saturated.
 
     When a side would exceed ``max_wheel_speed`` the forward speed gives way first, so the turn
@@ -205,7 +205,7 @@ def skid_steer_wheel_speeds(v: Any, omega: Any, track: float, max_wheel_speed: f
         As in :func:`skid_steer_velocities`.
     max_wheel_speed : float
         Largest speed of one side (m/s).
-    check : bool, default True
+    validate : bool, default True
         Validate the inputs.
 
     Returns
@@ -230,9 +230,9 @@ def skid_steer_wheel_speeds(v: Any, omega: Any, track: float, max_wheel_speed: f
     >>> np.round(skid_steer_wheel_speeds(5.0, 2.0, track=0.21, max_wheel_speed=1.0), 3).tolist()
     [0.37, 1.0]
     """
-    if check:
+    if validate:
         track, icr_factor, slip = _skid_parameters(track, icr_factor, slip)
-        max_wheel_speed = check_positive(max_wheel_speed, "max_wheel_speed")
+        max_wheel_speed = as_positive(max_wheel_speed, "max_wheel_speed")
         v, omega = as_array(v, "v"), as_array(omega, "omega")
     k = 1 - slip
     half = np.clip(omega * icr_factor * track / (2 * k), -max_wheel_speed, max_wheel_speed)  # (v_r - v_l) / 2

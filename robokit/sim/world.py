@@ -26,7 +26,7 @@ from typing import Any, Sequence
 import cv2
 import numpy as np
 
-from ..validation import as_array, as_points, check_finite_scalar, check_positive
+from ..validation import as_array, as_points, as_finite_scalar, as_positive
 from .layout import Layout
 
 __all__ = ["Surface", "World", "FreeSpace"]
@@ -156,7 +156,7 @@ class World:
         Builder facts (dimensions, door positions, seed), for lessons and tests.
     free_resolution : float, default 0.02
         Cell size (metres) of the free-space grid behind :meth:`is_free` and
-        :meth:`check_viewpoint`; large outdoor worlds use coarser cells to keep the grid small.
+        :meth:`as_viewpoint`; large outdoor worlds use coarser cells to keep the grid small.
 
     Raises
     ------
@@ -176,11 +176,11 @@ class World:
             raise ValueError(f"surfaces: expected a non-empty list of Surface, got {len(surfaces)} items")
         self.surfaces = surfaces
         self.name = str(name)
-        self.height = check_positive(height, "height")
-        self.footprint_height = check_positive(footprint_height, "footprint_height")
+        self.height = as_positive(height, "height")
+        self.footprint_height = as_positive(footprint_height, "footprint_height")
         self.interior = as_array(interior, "interior", shape=(2,))
         self.info = dict(info or {})
-        self.free_resolution = check_positive(free_resolution, "free_resolution")
+        self.free_resolution = as_positive(free_resolution, "free_resolution")
         self.segments = self.slice(self.footprint_height)
         if len(self.segments) == 0:
             raise ValueError(f"surfaces: expected walls crossing footprint_height={self.footprint_height} m, got none")
@@ -236,7 +236,7 @@ class World:
         Plane-polygon intersection: each rectangle edge crossing the plane contributes its crossing
         point (linear interpolation); a convex polygon crosses a plane in one segment.
         """
-        z = check_finite_scalar(z, "z")
+        z = as_finite_scalar(z, "z")
         segs = []
         for s in self.surfaces:
             if not s.solid or abs(s.normal[2]) > 1e-9:
@@ -295,7 +295,7 @@ class World:
         Scan-line flood fill (``cv2.floodFill``) and Euclidean distance transform (Felzenszwalb &
         Huttenlocher 2012) for the clearance.
         """
-        res = check_positive(self.free_resolution if resolution is None else resolution, "resolution")
+        res = as_positive(self.free_resolution if resolution is None else resolution, "resolution")
         origin = self.segments.reshape(-1, 2).min(axis=0) - 4 * res
         size = np.ceil((self.segments.reshape(-1, 2).max(axis=0) + 4 * res - origin) / res).astype(int)
         walls = np.zeros((size[1], size[0]), np.uint8)
@@ -333,12 +333,12 @@ class World:
         answer is exact to about one cell.
         """
         pts = as_points(xy, "xy", 2)
-        c = check_positive(clearance, "clearance", allow_zero=True)
+        c = as_positive(clearance, "clearance", allow_zero=True)
         fs = self.free_space()
         rows, cols, inside = fs.cells(pts)
         return inside & fs.free[rows, cols] & (fs.clearance[rows, cols] >= c)
 
-    def check_viewpoint(self, position: Any, name: str = "pose", clearance: float = 0.05) -> np.ndarray:
+    def as_viewpoint(self, position: Any, name: str = "pose", clearance: float = 0.05) -> np.ndarray:
         """Raise ``ValueError`` unless a sensor at ``position`` (3,) is inside the free space.
 
         Parameters

@@ -26,7 +26,7 @@ import functools
 
 import numpy as np
 
-from ..validation import check_choice, check_int, check_positive
+from ..validation import as_choice, as_int, as_positive
 from . import textures as tx
 from .build import Builder, random_decoration, wall_with_doors
 from .world import World
@@ -75,8 +75,8 @@ def box_room(width: float = 6.0, depth: float = 4.0, height: float = 2.5, seed: 
     >>> box_room()
     World('box_room', 22 surfaces, 10 wall segments, 6.00 m x 4.00 m)
     """
-    w, d, h = (check_positive(v, n) for v, n in ((width, "width"), (depth, "depth"), (height, "height")))
-    b = Builder(check_int(seed, "seed", minimum=0), density=100)
+    w, d, h = (as_positive(v, n) for v, n in ((width, "width"), (depth, "depth"), (height, "height")))
+    b = Builder(as_int(seed, "seed", minimum=0), density=100)
     _rect_walls(b, "wall", 0, 0, w, d, h)
     b.horizontal("floor", 0, 0, w, d, 0.0, True, tx.floor_tiles)
     b.horizontal("ceiling", 0, 0, w, d, h, False, tx.ceiling_panels)
@@ -116,7 +116,7 @@ def lab_room(seed: int = 3) -> World:
     >>> bool(lab.is_free([5.0, 2.0])[0])      # where lesson 01's robot stands
     True
     """
-    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
+    rng = np.random.default_rng(as_int(seed, "seed", minimum=0))
     H = 2.8
     b = Builder(rng, density=110)
     _rect_walls(b, "wall", 0, 0, 10, 10, H)
@@ -197,8 +197,8 @@ def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
     >>> corridor.info["length"], corridor.info["width"], corridor.info["doors"][0]
     (36.1, 2.17, ('north', 2.5, 3.5))
     """
-    layout = check_choice(layout, "layout", ["mixed", "facing", "staggered"])
-    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
+    layout = as_choice(layout, "layout", ["mixed", "facing", "staggered"])
+    rng = np.random.default_rng(as_int(seed, "seed", minimum=0))
     L, W, D, H = 36.10, 2.17, 0.07, 2.6
     b = Builder(rng, density=100)
     north, south = _door_plan(layout)
@@ -266,7 +266,7 @@ def office_floor(seed: int = 1) -> World:
     >>> sorted(office.info["rooms"]), office.info["corridor"]
     (['R1', 'R2', 'R3', 'R4'], (5.0, 7.0))
     """
-    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
+    rng = np.random.default_rng(as_int(seed, "seed", minimum=0))
     H = 2.7
     b = Builder(rng, density=100)
     _rect_walls(b, "wall/outer", 0, 0, 16, 12, H)

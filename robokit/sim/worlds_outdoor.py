@@ -38,7 +38,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..validation import as_array, as_rng, check_int, check_positive
+from ..validation import as_array, as_rng, as_int, as_positive
 from . import textures as tx
 from . import textures_outdoor as tox
 from .build import Builder
@@ -58,7 +58,7 @@ SKY_HEIGHT = 60.0     # skybox ceiling; the world's height (cameras must be belo
 
 def _size(size: Any) -> tuple[float, float]:
     s = as_array(size, "size", shape=(2,))
-    return check_positive(s[0], "size[0]"), check_positive(s[1], "size[1]")
+    return as_positive(s[0], "size[0]"), as_positive(s[1], "size[1]")
 
 
 def scatter_obstacles(rng: Any, n_obstacles: int, size: Any = (100.0, 60.0), *, waypoints: Any = None,
@@ -116,14 +116,14 @@ def scatter_obstacles(rng: Any, n_obstacles: int, size: Any = (100.0, 60.0), *, 
     ((3, 3), (1, 5))
     """
     rng = as_rng(rng, "rng")
-    n = check_int(n_obstacles, "n_obstacles", minimum=0)
+    n = as_int(n_obstacles, "n_obstacles", minimum=0)
     w, h = _size(size)
-    frac = check_positive(on_path, "on_path", allow_zero=True)
-    gap = check_positive(min_gap, "min_gap")
-    tries = check_int(tries, "tries", minimum=1)
+    frac = as_positive(on_path, "on_path", allow_zero=True)
+    gap = as_positive(min_gap, "min_gap")
+    tries = as_int(tries, "tries", minimum=1)
     pts = np.zeros((0, 2)) if waypoints is None else as_array(waypoints, "waypoints", shape=(None, 2))
     k = len(pts) - 1
-    clear = [(as_array(p, "keep_clear point", shape=(2,)), check_positive(r, "keep_clear radius", allow_zero=True))
+    clear = [(as_array(p, "keep_clear point", shape=(2,)), as_positive(r, "keep_clear radius", allow_zero=True))
              for p, r in keep_clear]
     pre = obstacle_array(boxes, "boxes")
     shapes: list[tuple[str, np.ndarray, float]] = [("box", q, float(np.hypot(q[2], q[3]) / 2)) for q in pre]
@@ -221,8 +221,8 @@ def field_world(size: Any = (100.0, 60.0), circles: Any = None, boxes: Any = Non
     ((-3.0, -3.0, 23.0, 15.0), ['tree', 'crate'])
     """
     w, h = _size(size)
-    bd = check_positive(border, "border")
-    rng = np.random.default_rng(check_int(seed, "seed", minimum=0))
+    bd = as_positive(border, "border")
+    rng = np.random.default_rng(as_int(seed, "seed", minimum=0))
     x0, y0, x1, y1 = -bd, -bd, w + bd, h + bd
     circles, boxes = obstacle_array(circles, "circles"), obstacle_array(boxes, "boxes")
     _inside_hedge(circles, circles[:, 2], "circles", -bd, (x1, y1))
@@ -331,8 +331,8 @@ def open_field(seed: int = 0, *, size: Any = (100.0, 60.0), n_obstacles: int = 1
     if w < (12.0 if shed else 6.0) or h < (10.0 if shed else 6.0):
         raise ValueError(f"size: expected at least {'12 m x 10 m with a shed' if shed else '6 m x 6 m'}, "
                          f"got {w:g} m x {h:g} m")
-    return _open_field(check_int(seed, "seed", minimum=0), w, h, check_int(n_obstacles, "n_obstacles", minimum=0),
-                       bool(shed), check_positive(border, "border"))
+    return _open_field(as_int(seed, "seed", minimum=0), w, h, as_int(n_obstacles, "n_obstacles", minimum=0),
+                       bool(shed), as_positive(border, "border"))
 
 
 @functools.lru_cache(maxsize=4)

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ..cache import save_npz
-from ..validation import as_array, as_rng, check_int, describe
+from ..validation import as_array, as_rng, as_int, describe
 from .bow_vector import BowVector, tf_idf
 from .hamming import as_binary_descriptors, hamming_distance
 
@@ -101,22 +101,22 @@ def _k_majority(desc: np.ndarray, k: int, iterations: int, rng: np.random.Genera
         labels = np.unique(desc, axis=0, return_inverse=True)[1].reshape(-1)
         return [np.nonzero(labels == j)[0] for j in range(len(unique))]
     centres = [desc[rng.integers(len(desc))]]
-    nearest = hamming_distance(desc, centres[0][None], check=False).astype(float)
+    nearest = hamming_distance(desc, centres[0][None], validate=False).astype(float)
     for _ in range(1, k):
         p = nearest ** 2
         pick = rng.choice(len(desc), p=p / p.sum()) if p.sum() > 0 else rng.integers(len(desc))
         centres.append(desc[pick])
-        nearest = np.minimum(nearest, hamming_distance(desc, desc[pick][None], check=False))
+        nearest = np.minimum(nearest, hamming_distance(desc, desc[pick][None], validate=False))
     centres = np.array(centres)
     labels = None
     for _ in range(max(1, iterations)):
-        new = np.argmin(hamming_distance(desc[:, None], centres[None], check=False), axis=1)
+        new = np.argmin(hamming_distance(desc[:, None], centres[None], validate=False), axis=1)
         if labels is not None and np.array_equal(new, labels):
             break
         labels = new
         majority, size = _majority(desc, labels, len(centres))
         centres = np.where((size > 0)[:, None], majority, centres)
-    labels = np.argmin(hamming_distance(desc[:, None], centres[None], check=False), axis=1)
+    labels = np.argmin(hamming_distance(desc[:, None], centres[None], validate=False), axis=1)
     return [rows for rows in (np.nonzero(labels == j)[0] for j in range(len(centres))) if rows.size]
 
 
@@ -166,7 +166,7 @@ class Vocabulary:
         self.children = np.ascontiguousarray(as_array(children, "children", dtype=np.int64, ndim=2))
         n_nodes, self.branching = self.children.shape
         self.centres = as_binary_descriptors(centres, "centres")
-        self.levels = check_int(levels, "levels", minimum=1, maximum=16)
+        self.levels = as_int(levels, "levels", minimum=1, maximum=16)
         if self.centres.shape[0] != n_nodes or n_nodes < 2:
             raise ValueError(f"centres: expected one row per node ({n_nodes} >= 2), got {self.centres.shape[0]}")
         rows, cols = np.nonzero(self.children >= 0)
@@ -237,9 +237,9 @@ class Vocabulary:
         >>> Vocabulary.train([d[:30], d[30:]], branching=3, levels=2).branching
         3
         """
-        branching = check_int(branching, "branching", minimum=2, maximum=256)
-        levels = check_int(levels, "levels", minimum=1, maximum=8)
-        iterations = check_int(iterations, "iterations", minimum=1, maximum=1000)
+        branching = as_int(branching, "branching", minimum=2, maximum=256)
+        levels = as_int(levels, "levels", minimum=1, maximum=8)
+        iterations = as_int(iterations, "iterations", minimum=1, maximum=1000)
         rng = as_rng(rng)
         images = [descriptors] if isinstance(descriptors, np.ndarray) else descriptors
         if not isinstance(images, (list, tuple)):
@@ -268,17 +268,17 @@ class Vocabulary:
         n_i = np.zeros(voc.n_words)
         for d in images:
             if len(d):
-                n_i[np.unique(voc.words(d, check=False))] += 1
+                n_i[np.unique(voc.words(d, validate=False))] += 1
         voc.idf = np.where(n_i > 0, np.log2(len(images) / np.maximum(n_i, 1)), 0.0)   # Eq. (16): log2(N / n_i)
         return voc
 
-    def words(self, descriptors, *, check: bool = True) -> np.ndarray:
+    def words(self, descriptors, *, validate: bool = True) -> np.ndarray:
         """The word (leaf) of every descriptor, all descending the tree together.
 
         Parameters
         ----------
         descriptors : array_like of uint8, shape (N, B)
-        check : bool, default True
+        validate : bool, default True
             ``False`` skips validation.
 
         Returns
@@ -295,7 +295,7 @@ class Vocabulary:
         >>> voc.n_words, bool(w[0] == w[2] != w[1] == w[3])
         (2, True)
         """
-        d = as_binary_descriptors(descriptors, "descriptors", n_bytes=self.centres.shape[1]) if check else descriptors
+        d = as_binary_descriptors(descriptors, "descriptors", n_bytes=self.centres.shape[1]) if validate else descriptors
         node = np.zeros(len(d), np.int64)
         for _ in range(self.levels):                       # one Hamming array per level
             kids = self.children[node]                     # (N, k)
@@ -303,7 +303,7 @@ class Vocabulary:
             if not inner.any():
                 break
             kids, rows = kids[inner], np.nonzero(inner)[0]
-            dist = hamming_distance(d[rows][:, None], self.centres[np.maximum(kids, 0)], check=False)
+            dist = hamming_distance(d[rows][:, None], self.centres[np.maximum(kids, 0)], validate=False)
             dist[kids < 0] = np.iinfo(np.int64).max
             node[rows] = kids[np.arange(len(rows)), np.argmin(dist, axis=1)]
         return self.word_of_node[node]
@@ -332,7 +332,7 @@ class Vocabulary:
         [1.0]
         """
         d = as_binary_descriptors(descriptors, "descriptors", n_bytes=self.centres.shape[1])
-        v = tf_idf(self.words(d, check=False), self.idf)
+        v = tf_idf(self.words(d, validate=False), self.idf)
         total = v.weights.sum()
         return BowVector(v.words, v.weights / total) if total > 0 else BowVector.empty()
 

@@ -30,7 +30,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..cache import save_npz
-from ..validation import check_int, describe
+from ..validation import as_int, describe
 from .bag_of_words import Vocabulary, VocabularyFileError
 from .bow_vector import BowVector, as_bow_vector
 
@@ -106,7 +106,7 @@ class BowDatabase:
 
     def vector(self, entry: int) -> BowVector:
         """The stored (L1-normalised) vector of an entry."""
-        entry = check_int(entry, "entry", minimum=0, maximum=len(self) - 1)
+        entry = as_int(entry, "entry", minimum=0, maximum=len(self) - 1)
         return BowVector(self._words[entry], self._weights[entry])
 
     def _inverted(self):
@@ -144,7 +144,7 @@ class BowDatabase:
         (|a_i - b_i| - |a_i| - |b_i|)`` for L1-normalised vectors (module docstring).
         """
         if max_results is not None:
-            max_results = check_int(max_results, "max_results", minimum=1)
+            max_results = as_int(max_results, "max_results", minimum=1)
         q = self._vector(item, "item")
         if len(q) == 0 or len(self) == 0:
             return []

@@ -35,7 +35,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from ..validation import as_array, check_int, check_positive
+from ..validation import as_array, as_int, as_positive
 
 __all__ = ["rgb_to_hsi", "hue_mask", "hue_histogram", "hue_histogram_opencv", "histogram_distance",
            "histogram_intersection", "MIN_SATURATION", "MIN_INTENSITY", "MAX_INTENSITY"]
@@ -141,9 +141,9 @@ def rgb_to_hsi(image) -> np.ndarray:
 
 
 def _thresholds(min_saturation, min_intensity, max_intensity) -> tuple[float, float, float]:
-    s = check_positive(min_saturation, "min_saturation", allow_zero=True)
-    lo = check_positive(min_intensity, "min_intensity", allow_zero=True)
-    hi = check_positive(max_intensity, "max_intensity", allow_zero=True)
+    s = as_positive(min_saturation, "min_saturation", allow_zero=True)
+    lo = as_positive(min_intensity, "min_intensity", allow_zero=True)
+    hi = as_positive(max_intensity, "max_intensity", allow_zero=True)
     if s > 1:
         raise ValueError(f"min_saturation: expected a value in [0, 1], got {s}")
     if not lo <= hi <= 1:
@@ -257,7 +257,7 @@ def hue_histogram(image, bins: int = 32, *, min_saturation: float = MIN_SATURATI
     >>> hue_histogram(np.full((4, 4, 3), 128, np.uint8), bins=4).tolist()   # no hue: zeros
     [0.0, 0.0, 0.0, 0.0]
     """
-    bins = check_int(bins, "bins", minimum=1, maximum=1 << 16)
+    bins = as_int(bins, "bins", minimum=1, maximum=1 << 16)
     s, lo, hi = _thresholds(min_saturation, min_intensity, max_intensity)
     rgb = _rgb01(image, ndim=3)
     extra = _image_mask(mask, rgb.shape[:2])
@@ -313,7 +313,7 @@ def hue_histogram_opencv(image, bins: int = 32, *, min_saturation: float = MIN_S
     >>> hue_histogram_opencv(image, bins=4).tolist()
     [0.3333333333333333, 0.0, 0.6666666666666666, 0.0]
     """
-    bins = check_int(bins, "bins", minimum=1, maximum=1 << 16)
+    bins = as_int(bins, "bins", minimum=1, maximum=1 << 16)
     s, lo, hi = _thresholds(min_saturation, min_intensity, max_intensity)
     rgb = _rgb01(image, ndim=3)
     extra = _image_mask(mask, rgb.shape[:2])

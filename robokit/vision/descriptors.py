@@ -26,7 +26,7 @@ from typing import Callable
 import cv2
 import numpy as np
 
-from ..validation import as_array, check_callable, check_choice, check_int, check_positive
+from ..validation import as_array, as_callable, as_choice, as_int, as_positive
 from .features import Features, Keypoints, as_gray_image
 from .plot_detector import PlotParams, ScaleSpace, detect_plot_levels
 
@@ -166,7 +166,7 @@ def _histograms(grads, keypoints: Keypoints, cells: int, bins: int, clip: float)
     return np.divide(out, norm, out=np.zeros_like(out), where=norm > 1e-12).astype(np.float32)
 
 
-def _check_keypoints(keypoints):
+def _as_keypoints(keypoints):
     if not isinstance(keypoints, Keypoints):
         raise TypeError(f"keypoints: expected Keypoints, got {type(keypoints).__name__}")
 
@@ -202,8 +202,8 @@ def assign_orientations(image, keypoints: Keypoints, *, peak_ratio: float = 0.8)
     Gaussian of 1.5 x scale; peaks correspond to dominant directions of local gradients.
     """
     img = as_gray_image(image)
-    _check_keypoints(keypoints)
-    ratio = check_positive(peak_ratio, "peak_ratio")
+    _as_keypoints(keypoints)
+    ratio = as_positive(peak_ratio, "peak_ratio")
     if ratio > 1:
         raise ValueError(f"peak_ratio: expected a value in (0, 1], got {ratio}")
     if len(keypoints) == 0:
@@ -240,10 +240,10 @@ def gradient_histogram_descriptor(image, keypoints: Keypoints, *, cells: int = 4
     accumulated with trilinear interpolation into the spatial cells and orientation bins.
     """
     img = as_gray_image(image)
-    _check_keypoints(keypoints)
-    cells = check_int(cells, "cells", minimum=1, maximum=8)
-    bins = check_int(bins, "bins", minimum=2, maximum=36)
-    clip = check_positive(clip, "clip")
+    _as_keypoints(keypoints)
+    cells = as_int(cells, "cells", minimum=1, maximum=8)
+    bins = as_int(bins, "bins", minimum=2, maximum=36)
+    clip = as_positive(clip, "clip")
     if len(keypoints) == 0:
         return np.zeros((0, cells * cells * bins), np.float32)
     space = _quarter_octave_levels(img, keypoints.scale)
@@ -322,7 +322,7 @@ def detect_plot_features(image, params: PlotParams | None = None, *, descriptor:
     >>> detect_plot_features(image, descriptor="reduced16").descriptors.shape[1]   # Se et al.'s vector
     16
     """
-    descriptor = check_choice(descriptor, "descriptor", ("sift128", "reduced16"))
+    descriptor = as_choice(descriptor, "descriptor", ("sift128", "reduced16"))
     cells, bins = (4, 8) if descriptor == "sift128" else (2, 4)
     kp, space = detect_plot_levels(image, params, **overrides)
     if len(kp) == 0:
@@ -387,9 +387,9 @@ def detect_sift_features(image, *, n_features: int = 0, descriptor: str = "sift1
     >>> bool(np.all(up.keypoints.orientation == 0)), len(up) < len(f)
     (True, True)
     """
-    descriptor = check_choice(descriptor, "descriptor", ("sift128", "reduced16"))
-    n_features = check_int(n_features, "n_features", minimum=0)
-    orientation = check_callable(orientation, "orientation")
+    descriptor = as_choice(descriptor, "descriptor", ("sift128", "reduced16"))
+    n_features = as_int(n_features, "n_features", minimum=0)
+    orientation = as_callable(orientation, "orientation")
     img = as_gray_image(image)
     where = None
     if mask is not None:
@@ -461,7 +461,7 @@ def detect_and_describe(image, method: str = "plot", *, descriptor: str = "sift1
     plot 16 True
     sift 16 True
     """
-    method = check_choice(method, "method", ("plot", "sift"))
+    method = as_choice(method, "method", ("plot", "sift"))
     if method == "plot":
         return detect_plot_features(image, descriptor=descriptor, **kwargs)
     return detect_sift_features(image, descriptor=descriptor, **kwargs)

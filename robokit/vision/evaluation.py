@@ -26,7 +26,7 @@ import cv2
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..validation import as_array, as_points, check_finite_scalar, check_positive
+from ..validation import as_array, as_points, as_finite_scalar, as_positive
 from .features import Features
 from .matching import two_nearest
 from .ratio import distance_ratio
@@ -155,15 +155,15 @@ def similarity_homography(shape, zoom: float = 1.0, angle: float = 0.0) -> np.nd
     dims = as_array(shape, "shape")
     if dims.ndim != 1 or dims.size < 2 or np.any(dims[:2] < 1):
         raise ValueError(f"shape: expected (H, W) with positive sizes, got {shape!r}")
-    zoom = check_positive(zoom, "zoom")
-    angle = check_finite_scalar(angle, "angle")
+    zoom = as_positive(zoom, "zoom")
+    angle = as_finite_scalar(angle, "angle")
     cx, cy = (dims[1] - 1) / 2, (dims[0] - 1) / 2
     c, s = zoom * np.cos(angle), zoom * np.sin(angle)
     # y points down, so a counter-clockwise on-screen rotation is [[c, s], [-s, c]]
     return np.array([[c, s, cx - c * cx - s * cy], [-s, c, cy + s * cx - c * cy], [0.0, 0.0, 1.0]])
 
 
-def _check_features(*features):
+def _require_features(*features):
     for name, f in zip(("features_a", "features_b"), features):
         if not isinstance(f, Features):
             raise TypeError(f"{name}: expected Features, got {type(f).__name__}")
@@ -229,9 +229,9 @@ def recall_precision(features_a: Features, features_b: Features, homography, ima
     >>> round(float(r["recall"][0]), 2), int(r["n_correct"][0]), int(r["n_false"][0])
     (0.72, 472, 0)
     """
-    _check_features(features_a, features_b)
+    _require_features(features_a, features_b)
     h = _homography(homography)
-    tol = check_positive(tolerance, "tolerance")
+    tol = as_positive(tolerance, "tolerance")
     ts = np.linspace(0.15, 0.7, 12) if thresholds is None else as_array(thresholds, "thresholds", ndim=1, min_size=1)
     shape = _shape(image_shape_b, "image_shape_b")
     nt = ts.size
@@ -310,13 +310,13 @@ def matching_score(features_a: Features, features_b: Features, homography, image
     >>> bool(0.3 < m["score"] <= 1), m["n_correct"] <= m["n_matches"]
     (True, True)
     """
-    _check_features(features_a, features_b)
+    _require_features(features_a, features_b)
     h = _homography(homography)
     shape_a, shape_b = _shape(image_shape_a, "image_shape_a"), _shape(image_shape_b, "image_shape_b")
-    t = check_positive(ratio, "ratio")
+    t = as_positive(ratio, "ratio")
     if t > 1:
         raise ValueError(f"ratio: expected a threshold in (0, 1], got {t}")
-    tol = check_positive(tolerance, "tolerance")
+    tol = as_positive(tolerance, "tolerance")
     if len(features_a) == 0 or len(features_b) < 2:
         return {"score": 0.0, "n_correct": 0, "n_matches": 0, "n_overlap": 0}
     warped = apply_homography(h, features_a.keypoints.xy)

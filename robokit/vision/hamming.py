@@ -30,7 +30,7 @@ import cv2
 import numpy as np
 
 from ..validation import as_array, describe
-from .ratio import Matches, check_ratio, ratio_test
+from .ratio import Matches, as_ratio, ratio_test
 
 __all__ = ["ORB_BYTES", "ORB_MATCH_DISTANCE", "ORB_RATIO", "as_binary_descriptors", "same_width", "hamming_distance",
            "hamming_distances", "hamming_match"]
@@ -118,7 +118,7 @@ def _words64(d: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(d).view(np.uint64)
 
 
-def hamming_distance(a, b, *, check: bool = True) -> np.ndarray:
+def hamming_distance(a, b, *, validate: bool = True) -> np.ndarray:
     """Hamming distance between descriptor rows, broadcasting over the leading axes.
 
     Parameters
@@ -126,7 +126,7 @@ def hamming_distance(a, b, *, check: bool = True) -> np.ndarray:
     a, b : array_like of uint8, shape (..., B)
         Binary descriptors; the leading axes broadcast (``a[:, None]`` against ``b[None]`` gives
         all pairs; :func:`hamming_distances` does that in bounded memory).
-    check : bool, default True
+    validate : bool, default True
         ``False`` skips validation (the fast path for callers holding uint8 arrays).
 
     Returns
@@ -146,10 +146,10 @@ def hamming_distance(a, b, *, check: bool = True) -> np.ndarray:
 
     Examples
     --------
-    >>> hamming_distance([[0b1011, 0]], [[0b0001, 255]], check=True).tolist()
+    >>> hamming_distance([[0b1011, 0]], [[0b0001, 255]], validate=True).tolist()
     [10]
     """
-    if check:
+    if validate:
         a, b = _leading_rows(a, "a"), _leading_rows(b, "b")
         same_width(a, b, "a", "b")
         try:
@@ -163,14 +163,14 @@ def hamming_distance(a, b, *, check: bool = True) -> np.ndarray:
     return out[()]                      # a numpy integer for two single rows
 
 
-def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
+def hamming_distances(a, b, *, validate: bool = True) -> np.ndarray:
     """All-pairs Hamming distances between two sets of binary descriptors.
 
     Parameters
     ----------
     a : array_like of uint8, shape (Na, B)
     b : array_like of uint8, shape (Nb, B)
-    check : bool, default True
+    validate : bool, default True
         ``False`` skips validation.
 
     Returns
@@ -192,13 +192,13 @@ def hamming_distances(a, b, *, check: bool = True) -> np.ndarray:
     >>> hamming_distances([[0], [3]], [[1], [2], [255]]).tolist()
     [[1, 1, 8], [1, 1, 6]]
     """
-    if check:
+    if validate:
         a, b = as_binary_descriptors(a, "a"), as_binary_descriptors(b, "b")
         same_width(a, b, "a", "b")
     out = np.empty((a.shape[0], b.shape[0]), np.int64)
     step = max(1, _BLOCK // max(1, b.shape[0]))
     for s in range(0, a.shape[0], step):
-        out[s:s + step] = hamming_distance(a[s:s + step, None], b[None], check=False)
+        out[s:s + step] = hamming_distance(a[s:s + step, None], b[None], validate=False)
     return out
 
 
@@ -260,7 +260,7 @@ def hamming_match(query, train, *, ratio: float = ORB_RATIO, max_distance: float
     >>> m.query.tolist(), m.train.tolist(), m.distance.tolist()
     ([0, 1], [0, 1], [1.0, 1.0])
     """
-    ratio = check_ratio(ratio)
+    ratio = as_ratio(ratio)
     q = as_binary_descriptors(query, "query")
     t = as_binary_descriptors(train, "train")
     same_width(q, t, "query", "train")

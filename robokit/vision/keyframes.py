@@ -41,7 +41,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..validation import as_array, check_choice, check_finite_scalar, check_int, describe
+from ..validation import as_array, as_choice, as_finite_scalar, as_int, describe
 from .hamming import ORB_MATCH_DISTANCE, as_binary_descriptors, hamming_match, same_width
 
 __all__ = ["KeyframeConditions", "KeyframeSelector", "feature_threshold", "shared_fraction", "select_keyframes",
@@ -108,7 +108,7 @@ def shared_fraction(desc_current, desc_keyframe, *, max_distance: float = ORB_MA
     """
     cur = as_binary_descriptors(desc_current, "desc_current")
     key = as_binary_descriptors(desc_keyframe, "desc_keyframe")
-    max_distance = check_finite_scalar(max_distance, "max_distance")
+    max_distance = as_finite_scalar(max_distance, "max_distance")
     if max_distance <= 0:
         raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
     same_width(cur, key, "desc_current", "desc_keyframe")
@@ -189,17 +189,17 @@ class KeyframeSelector:
 
     def __init__(self, f_min: float, *, min_frame_gap: int = 10, shared_range=(0.70, 0.90), min_distance: float = 0.02,
                  max_distance: float = ORB_MATCH_DISTANCE, below_band: str = "skip") -> None:
-        self.f_min = check_finite_scalar(f_min, "f_min")
-        self.min_frame_gap = check_int(min_frame_gap, "min_frame_gap", minimum=0)
+        self.f_min = as_finite_scalar(f_min, "f_min")
+        self.min_frame_gap = as_int(min_frame_gap, "min_frame_gap", minimum=0)
         rng = as_array(shared_range, "shared_range", shape=(2,))
         if not 0 <= rng[0] < rng[1] <= 1:
             raise ValueError(f"shared_range: expected 0 <= low < high <= 1, got {rng.tolist()}")
         self.shared_range = (float(rng[0]), float(rng[1]))
-        self.min_distance = check_finite_scalar(min_distance, "min_distance")
+        self.min_distance = as_finite_scalar(min_distance, "min_distance")
         if self.min_distance < 0:
             raise ValueError(f"min_distance: expected a non-negative distance, got {self.min_distance}")
-        self.max_distance = check_finite_scalar(max_distance, "max_distance")
-        self.below_band = check_choice(below_band, "below_band", ("skip", "take"))
+        self.max_distance = as_finite_scalar(max_distance, "max_distance")
+        self.below_band = as_choice(below_band, "below_band", ("skip", "take"))
         self.reset()
 
     def reset(self) -> None:
@@ -210,10 +210,10 @@ class KeyframeSelector:
         self._key_desc = None
         self._key_pos = None
 
-    def check(self, descriptors, position) -> KeyframeConditions:
+    def evaluate(self, descriptors, position) -> KeyframeConditions:
         """Evaluate conditions (1)-(4) for a frame against the last keyframe, without recording it."""
         if self._key_desc is None:
-            raise ValueError("check: no keyframe yet (offer the first frame, which is always one)")
+            raise ValueError("evaluate: no keyframe yet (offer the first frame, which is always one)")
         d = as_binary_descriptors(descriptors, "descriptors")
         p = _position(position)
         fraction = shared_fraction(d, self._key_desc, max_distance=self.max_distance)
@@ -239,7 +239,7 @@ class KeyframeSelector:
             d = as_binary_descriptors(descriptors, "descriptors")
             self._accept(d, _position(position))
             return True
-        self.conditions = self.check(descriptors, position)
+        self.conditions = self.evaluate(descriptors, position)
         if self.conditions.all:
             self._accept(as_binary_descriptors(descriptors, "descriptors"), _position(position))
             return True
@@ -335,12 +335,12 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
     [0, 3]
     """
     frames, _ = _stream(descriptor_list, positions)
-    min_frame_gap = check_int(min_frame_gap, "min_frame_gap", minimum=0)
-    min_tracked = check_int(min_tracked, "min_tracked", minimum=0)
-    top = check_finite_scalar(max_tracked_fraction, "max_tracked_fraction")
+    min_frame_gap = as_int(min_frame_gap, "min_frame_gap", minimum=0)
+    min_tracked = as_int(min_tracked, "min_tracked", minimum=0)
+    top = as_finite_scalar(max_tracked_fraction, "max_tracked_fraction")
     if not 0 < top <= 1:
         raise ValueError(f"max_tracked_fraction: expected a value in (0, 1], got {top}")
-    max_distance = check_finite_scalar(max_distance, "max_distance")
+    max_distance = as_finite_scalar(max_distance, "max_distance")
     if max_distance <= 0:
         raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
     keys: list[int] = []

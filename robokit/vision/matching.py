@@ -35,8 +35,8 @@ import cv2
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..validation import as_array, check_choice, check_int
-from .ratio import LIN_RATIO, LOWE_RATIO, Matches, check_distance_bound, check_ratio, distance_ratio, ratio_test
+from ..validation import as_array, as_choice, as_int
+from .ratio import LIN_RATIO, LOWE_RATIO, Matches, as_distance_bound, as_ratio, distance_ratio, ratio_test
 
 __all__ = ["FLANN_TREES", "FLANN_CHECKS", "METHODS", "DescriptorIndex", "k_nearest", "two_nearest", "ratio_match",
            "gated_ratio_match"]
@@ -137,10 +137,10 @@ class DescriptorIndex:
 
     def __init__(self, descriptors, method: str = "kdtree", *, checks: int = FLANN_CHECKS,
                  trees: int = FLANN_TREES, seed: int = 0) -> None:
-        self.method = check_choice(method, "method", METHODS)
-        self.checks = check_int(checks, "checks", minimum=1, maximum=1 << 20)
-        self.trees = check_int(trees, "trees", minimum=1, maximum=64)
-        self._seed = check_int(seed, "seed", minimum=0, maximum=2 ** 31 - 1)
+        self.method = as_choice(method, "method", METHODS)
+        self.checks = as_int(checks, "checks", minimum=1, maximum=1 << 20)
+        self.trees = as_int(trees, "trees", minimum=1, maximum=64)
+        self._seed = as_int(seed, "seed", minimum=0, maximum=2 ** 31 - 1)
         self.descriptors = np.ascontiguousarray(_descriptors(descriptors, "descriptors"))
         self._index = self._build()
 
@@ -196,13 +196,13 @@ class DescriptorIndex:
         -----
         See :func:`k_nearest`.
         """
-        k = check_int(k, "k", minimum=1)
+        k = as_int(k, "k", minimum=1)
         q, t = _descriptors(query_descriptors, "query"), self.descriptors
         if t.shape[0] < k:
             raise ValueError(f"train: expected at least {k} descriptors, got {t.shape[0]}")
         if q.shape[0] and q.shape[1] != t.shape[1]:
             raise ValueError(f"query: expected descriptors of length {t.shape[1]}, got {q.shape[1]}")
-        bound = check_distance_bound(max_distance)
+        bound = as_distance_bound(max_distance)
         if q.shape[0] == 0:
             return np.zeros((0, k)), np.zeros((0, k), int)
         if self.method == "kdtree":
@@ -243,7 +243,7 @@ class DescriptorIndex:
         -----
         :func:`~robokit.vision.ratio.ratio_test` on :meth:`query` (Lowe 2004, Sec. 7.1).
         """
-        ratio = check_ratio(ratio)
+        ratio = as_ratio(ratio)
         q = _descriptors(query_descriptors, "query")
         if q.shape[0] == 0 or len(self) < 2:
             return Matches.empty()
@@ -290,8 +290,8 @@ def k_nearest(query, train, k: int = 2, *, method: str = "kdtree",
     matches for global localization (Sec. 5) and lesson 02's KD-tree matching (Sec. "Local image
     features"); a one-off :class:`DescriptorIndex`.
     """
-    method = check_choice(method, "method", METHODS)
-    k = check_int(k, "k", minimum=1)
+    method = as_choice(method, "method", METHODS)
+    k = as_int(k, "k", minimum=1)
     return DescriptorIndex(train, method).query(query, k, max_distance=max_distance)
 
 
@@ -319,7 +319,7 @@ def two_nearest(query, train, *, method: str = "kdtree") -> tuple[np.ndarray, np
     -----
     The search behind Lin et al.'s nearest-neighbour ratio (Sec. 3).
     """
-    method = check_choice(method, "method", METHODS)
+    method = as_choice(method, "method", METHODS)
     t = _descriptors(train, "train")
     if t.shape[0] < 2:
         raise ValueError(f"train: expected at least 2 descriptors for a distance ratio, got {t.shape[0]}")
@@ -366,7 +366,7 @@ def ratio_match(query, train, *, ratio: float = LIN_RATIO, method: str = "kdtree
     >>> len(ratio_match(np.vstack([train[:1], train[:1]]), np.vstack([train[:1], train[:1]])))  # ambiguous
     0
     """
-    ratio = check_ratio(ratio)
+    ratio = as_ratio(ratio)
     q, t = _descriptors(query, "query"), _descriptors(train, "train")
     if q.shape[0] == 0 or t.shape[0] < 2:
         return Matches.empty()
@@ -412,7 +412,7 @@ def gated_ratio_match(query, train, query_index, train_index, *, ratio: float = 
     orientation, scale and continuation constraints; Se, Lowe & Little (2002), Sec. 3.2 (search
     only the landmarks predicted near each feature).
     """
-    ratio = check_ratio(ratio)
+    ratio = as_ratio(ratio)
     q, t = _descriptors(query, "query"), _descriptors(train, "train")
     qi = as_array(query_index, "query_index", ndim=1, dtype=int)
     ti = as_array(train_index, "train_index", shape=(qi.size,), dtype=int)
@@ -433,6 +433,6 @@ def gated_ratio_match(query, train, query_index, train_index, *, ratio: float = 
     best = dist[start]
     r = distance_ratio(best, second)
     keep = r < ratio
-    keep &= best <= check_distance_bound(max_distance)
+    keep &= best <= as_distance_bound(max_distance)
     rows = start[keep]
     return Matches(qi[rows], ti[rows], best[keep], r[keep])

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..validation import as_array, as_points, check_choice
+from ..validation import as_array, as_points, as_choice
 from .descriptors import detect_sift_features
 from .features import Features, as_gray_image
 
@@ -54,7 +54,7 @@ def _annulus(centre, radii) -> tuple[np.ndarray, float, float]:
     return c, float(r_in), float(r_out)
 
 
-def _check_holds(shape: tuple[int, int], c: np.ndarray, r_out: float, name: str) -> None:
+def _require_holds(shape: tuple[int, int], c: np.ndarray, r_out: float, name: str) -> None:
     h, w = shape
     # one pixel of slack: the default camera's rim touches the image's top and bottom rows
     if c[0] - r_out < -1 or c[0] + r_out > w or c[1] - r_out < -1 or c[1] + r_out > h:
@@ -105,7 +105,7 @@ def annulus_mask(shape, centre, radii) -> np.ndarray:
     if hw.min() < 1 or hw.max() > 1 << 15:
         raise ValueError(f"shape: expected (height, width) between 1 and 32768, got {tuple(hw)}")
     c, r_in, r_out = _annulus(centre, radii)
-    _check_holds((int(hw[0]), int(hw[1])), c, r_out, "shape")
+    _require_holds((int(hw[0]), int(hw[1])), c, r_out, "shape")
     y, x = np.ogrid[:hw[0], :hw[1]]
     r2 = (x - c[0]) ** 2 + (y - c[1]) ** 2
     return (r2 >= r_in ** 2) & (r2 <= r_out ** 2)
@@ -200,10 +200,10 @@ def omni_sift(image, centre, radii, *, orientation: str = "radial", n_features: 
     >>> len(m) > 40, bool(np.all(np.hypot(*(moved - b.keypoints.xy[m.query]).T) < 2))
     (True, True)
     """
-    orientation = check_choice(orientation, "orientation", ORIENTATIONS)
+    orientation = as_choice(orientation, "orientation", ORIENTATIONS)
     img = as_gray_image(image)
     c, r_in, r_out = _annulus(centre, radii)
-    _check_holds(img.shape, c, r_out, "image")
+    _require_holds(img.shape, c, r_out, "image")
     where = annulus_mask(img.shape, c, (r_in, r_out))
     if mask is not None:
         where &= as_array(mask, "mask", shape=img.shape, dtype=bool)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from ..validation import as_array, check_finite_scalar, check_int
+from ..validation import as_array, as_finite_scalar, as_int
 from .features import Features, Keypoints, as_gray_image
 from .hamming import ORB_BYTES
 
@@ -79,12 +79,12 @@ def detect_orb_features(image, n_features: int = ORB_FEATURES, *, scale_factor: 
     >>> len(blank), blank.descriptors.shape, blank.keypoints.xy.shape
     (0, (0, 32), (0, 2))
     """
-    n_features = check_int(n_features, "n_features", minimum=1, maximum=1 << 20)
-    scale_factor = check_finite_scalar(scale_factor, "scale_factor")
+    n_features = as_int(n_features, "n_features", minimum=1, maximum=1 << 20)
+    scale_factor = as_finite_scalar(scale_factor, "scale_factor")
     if not 1.0 < scale_factor <= 2.0:
         raise ValueError(f"scale_factor: expected a value in (1, 2], got {scale_factor}")
-    n_levels = check_int(n_levels, "n_levels", minimum=1, maximum=32)
-    fast_threshold = check_int(fast_threshold, "fast_threshold", minimum=1, maximum=255)
+    n_levels = as_int(n_levels, "n_levels", minimum=1, maximum=32)
+    fast_threshold = as_int(fast_threshold, "fast_threshold", minimum=1, maximum=255)
     raw = np.asarray(image) if isinstance(image, np.ndarray) else None
     if raw is not None and raw.dtype == np.uint8 and raw.ndim == 2 and min(raw.shape) >= 3:
         grey = np.ascontiguousarray(raw)           # no round trip through floats for 8-bit grey input

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..validation import as_array, check_finite_result, check_int, check_positive
+from ..validation import as_array, require_finite_result, as_int, as_positive
 from .features import Keypoints, as_gray_image
 from .scale_space_maxima import scale_space_maxima
 
@@ -105,16 +105,16 @@ class PlotParams:
     border: int = 5
 
     def __post_init__(self):
-        check_positive(self.sigma0, "sigma0")
-        if check_positive(self.k, "k") <= 1:
+        as_positive(self.sigma0, "sigma0")
+        if as_positive(self.k, "k") <= 1:
             raise ValueError(f"k: expected a scale factor > 1, got {self.k}")
-        check_int(self.n_scales, "n_scales", minimum=3, maximum=16)
-        check_positive(self.gamma, "gamma", allow_zero=True)
-        check_positive(self.integration, "integration")
-        check_positive(self.threshold, "threshold", allow_zero=True)
-        check_positive(self.min_response, "min_response", allow_zero=True)
-        check_int(self.max_keypoints, "max_keypoints", minimum=1)
-        check_int(self.border, "border", minimum=1)
+        as_int(self.n_scales, "n_scales", minimum=3, maximum=16)
+        as_positive(self.gamma, "gamma", allow_zero=True)
+        as_positive(self.integration, "integration")
+        as_positive(self.threshold, "threshold", allow_zero=True)
+        as_positive(self.min_response, "min_response", allow_zero=True)
+        as_int(self.max_keypoints, "max_keypoints", minimum=1)
+        as_int(self.border, "border", minimum=1)
 
 
 @dataclass(frozen=True)
@@ -172,7 +172,7 @@ def plot_scales(sigma0: float = 1.6, k: float = 2 ** (1 / 3), n_scales: int = 9)
     p = PlotParams(sigma0=sigma0, k=k, n_scales=n_scales)
     with np.errstate(over="ignore"):
         levels = p.sigma0 * p.k ** np.arange(p.n_scales)
-    check_finite_result("sigma0, k, n_scales", levels)
+    require_finite_result("sigma0, k, n_scales", levels)
     return levels
 
 
@@ -227,7 +227,7 @@ def polynomial_expansion(image, sigma: float):
     Coordinates are ``x = (col, row)``.
     """
     img = as_gray_image(image)
-    sigma = check_positive(sigma, "sigma")
+    sigma = as_positive(sigma, "sigma")
     c = _blur(img, sigma)
     lx, ly, axx, axy, ayy = _coefficients(c)
     a = np.stack([np.stack([axx, axy], -1), np.stack([axy, ayy], -1)], -2)
@@ -295,10 +295,10 @@ def orientation_tensor(image, sigma: float, *, gamma: float = 2.0, integration: 
     tensor estimation.
     """
     img = as_gray_image(image)
-    sigma = check_positive(sigma, "sigma")
+    sigma = as_positive(sigma, "sigma")
     smoothed = _blur(img, sigma)
-    t11, t12, t22 = _tensor_components(smoothed, sigma, check_positive(gamma, "gamma", allow_zero=True),
-                                       check_positive(integration, "integration"))
+    t11, t12, t22 = _tensor_components(smoothed, sigma, as_positive(gamma, "gamma", allow_zero=True),
+                                       as_positive(integration, "integration"))
     return np.stack([np.stack([t11, t12], -1), np.stack([t12, t22], -1)], -2)
 
 
@@ -462,7 +462,7 @@ def detect_plot_levels(image, params: PlotParams | None = None, **overrides):
     thr = max(p.threshold * peak, p.min_response)
     if peak <= thr:
         return Keypoints.empty(), space
-    xy, level, strength = scale_space_maxima(responses, space.steps, thr, p.border, check=False)
+    xy, level, strength = scale_space_maxima(responses, space.steps, thr, p.border, validate=False)
     order = np.argsort(-strength, kind="stable")[: p.max_keypoints]
     scale = p.sigma0 * p.k ** level[order]
     keypoints = Keypoints(xy[order], scale, strength[order].astype(float), np.zeros(order.size))

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import fit_se2
-from ..validation import as_points, as_rng, check_int, check_positive
+from ..validation import as_points, as_rng, as_int, as_positive
 
 __all__ = ["ransac_sample_count", "PlanarFit", "ransac_se2"]
 
@@ -65,11 +65,11 @@ def ransac_sample_count(contamination: float, sample_size: int = 2, confidence: 
     >>> ransac_sample_count(0.5, confidence=0.999), ransac_sample_count(0.8)
     (25, 113)
     """
-    eps = check_positive(contamination, "contamination", allow_zero=True)
+    eps = as_positive(contamination, "contamination", allow_zero=True)
     if eps >= 1:
         raise ValueError(f"contamination: expected a ratio in [0, 1), got {eps}")
-    p = check_int(sample_size, "sample_size", minimum=1)
-    conf = check_positive(confidence, "confidence")
+    p = as_int(sample_size, "sample_size", minimum=1)
+    conf = as_positive(confidence, "confidence")
     if conf >= 1:
         raise ValueError(f"confidence: expected a probability in (0, 1), got {conf}")
     good = (1 - eps) ** p
@@ -162,9 +162,9 @@ def ransac_se2(source: Any, target: Any, *, threshold: float = 0.1, confidence: 
     t = as_points(target, "target", 2)
     if len(t) != len(s):
         raise ValueError(f"target: expected {len(s)} points (one per source point), got {len(t)}")
-    thr = check_positive(threshold, "threshold")
-    min_inliers = check_int(min_inliers, "min_inliers", minimum=2)
-    max_iterations = check_int(max_iterations, "max_iterations", minimum=1)
+    thr = as_positive(threshold, "threshold")
+    min_inliers = as_int(min_inliers, "min_inliers", minimum=2)
+    max_iterations = as_int(max_iterations, "max_iterations", minimum=1)
     gen = as_rng(rng)
     needed, drawn, n = ransac_sample_count(0.99, 2, confidence), 0, len(s)
     failed = PlanarFit(np.zeros(3), np.zeros(n, bool), np.inf, 0, False)
@@ -179,7 +179,7 @@ def ransac_se2(source: Any, target: Any, *, threshold: float = 0.1, confidence: 
         ok = (np.linalg.norm(s[j] - s[i], axis=1) > 1e-9) & (np.linalg.norm(t[j] - t[i], axis=1) > 1e-9)
         if not ok.any():
             continue
-        poses = fit_se2(np.stack([s[i[ok]], s[j[ok]]], 1), np.stack([t[i[ok]], t[j[ok]]], 1), check=False)
+        poses = fit_se2(np.stack([s[i[ok]], s[j[ok]]], 1), np.stack([t[i[ok]], t[j[ok]]], 1), validate=False)
         dist = _residuals(poses, s, t)                           # (hypotheses, matches)
         support = dist < thr
         count = support.sum(1)
@@ -195,7 +195,7 @@ def ransac_se2(source: Any, target: Any, *, threshold: float = 0.1, confidence: 
         inliers = _residuals(pose[None], s, t)[0] < thr
         if inliers.sum() < 2:
             break
-        pose = fit_se2(s[inliers], t[inliers], check=False)
+        pose = fit_se2(s[inliers], t[inliers], validate=False)
     dist = _residuals(pose[None], s, t)[0]
     inliers = dist < thr
     ok = bool(inliers.sum() >= min_inliers)

@@ -20,9 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..validation import as_array, check_positive
+from ..validation import as_array, as_positive
 
-__all__ = ["Matches", "LIN_RATIO", "LOWE_RATIO", "distance_ratio", "check_ratio", "check_distance_bound", "ratio_test"]
+__all__ = ["Matches", "LIN_RATIO", "LOWE_RATIO", "distance_ratio", "as_ratio", "as_distance_bound", "ratio_test"]
 
 #: Lin et al.'s nearest-neighbour ratio threshold ``t`` (PLOT paper, Sec. 3: "t is set equal to 0.65").
 LIN_RATIO = 0.65
@@ -91,7 +91,7 @@ def distance_ratio(best, second) -> np.ndarray:
     return np.divide(b, c, out=np.ones(b.shape), where=c > 0)
 
 
-def check_distance_bound(max_distance) -> float:
+def as_distance_bound(max_distance) -> float:
     """``max_distance`` as a bound on a match's descriptor distance: ``inf`` for none, else positive.
 
     Parameters
@@ -120,9 +120,9 @@ def check_distance_bound(max_distance) -> float:
     return bound
 
 
-def check_ratio(ratio) -> float:
+def as_ratio(ratio) -> float:
     """A distance-ratio bound in (0, 1], or a ValueError/TypeError naming ``ratio``."""
-    ratio = check_positive(ratio, "ratio")
+    ratio = as_positive(ratio, "ratio")
     if ratio > 1:
         raise ValueError(f"ratio: expected a value in (0, 1], got {ratio}")
     return ratio
@@ -164,7 +164,7 @@ def ratio_test(dist, index, *, ratio: float = LIN_RATIO, max_distance: float | N
     >>> m.query.tolist(), m.train.tolist(), m.ratio.tolist()
     ([0], [4], [0.1])
     """
-    ratio = check_ratio(ratio)
+    ratio = as_ratio(ratio)
     d = as_array(dist, "dist", shape=(None, 2), finite=False)
     idx = as_array(index, "index", shape=(d.shape[0], 2), dtype=int)
     if not (np.all(np.isfinite(d[:, 0])) and np.all(d[:, 0] >= 0) and np.all(d[:, 1] >= d[:, 0])):
@@ -172,6 +172,6 @@ def ratio_test(dist, index, *, ratio: float = LIN_RATIO, max_distance: float | N
     if idx.size and idx.min() < 0:
         raise ValueError(f"index: expected non-negative indices, got {idx.min()}")
     r = distance_ratio(d[:, 0], d[:, 1])
-    keep = (r < ratio) & (d[:, 0] <= check_distance_bound(max_distance))
+    keep = (r < ratio) & (d[:, 0] <= as_distance_bound(max_distance))
     rows = np.nonzero(keep)[0]
     return Matches(rows, idx[rows, 0], d[rows, 0], r[rows])

@@ -25,13 +25,13 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ..validation import as_array, check_int, check_positive, describe
+from ..validation import as_array, as_int, as_positive, describe
 
 __all__ = ["scale_space_maxima"]
 
 
 def scale_space_maxima(responses: Any, steps: Any, threshold: float, border: int, *,
-                       check: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                       validate: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Keypoints where a response is the maximum of its 3 x 3 x 3 neighbourhood in scale space.
 
     Parameters
@@ -45,7 +45,7 @@ def scale_space_maxima(responses: Any, steps: Any, threshold: float, border: int
         Keep maxima whose response exceeds this (>= 0).
     border : int
         Ignore maxima closer than this to the image border (original pixels, >= 1).
-    check : bool, default True
+    validate : bool, default True
         ``False`` skips the input checks (the detector's fast path; float32 responses expected).
 
     Returns
@@ -82,10 +82,10 @@ def scale_space_maxima(responses: Any, steps: Any, threshold: float, border: int
     >>> xy.tolist(), level.tolist(), strength.tolist()
     ([[5.0, 4.0]], [1.0], [1.0])
     """
-    if check:
+    if validate:
         responses, steps = _checked_levels(responses, steps)
-        threshold = check_positive(threshold, "threshold", allow_zero=True)
-        border = check_int(border, "border", minimum=1)
+        threshold = as_positive(threshold, "threshold", allow_zero=True)
+        border = as_int(border, "border", minimum=1)
     dilated = [cv2.dilate(r, np.ones((3, 3), np.uint8)) for r in responses]
     found = [_level_maxima(n, responses, dilated, np.asarray(steps), threshold, border)
              for n in range(1, len(responses) - 1)]

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import as_se3
-from ..validation import as_array, as_rng, check_int, check_positive
+from ..validation import as_array, as_rng, as_int, as_positive
 from .ransac import ransac_sample_count
 
 __all__ = ["as_bearings", "essential_from_bearings", "epipolar_error", "EssentialFit", "ransac_essential",
@@ -135,7 +135,7 @@ def essential_from_bearings(b1: Any, b2: Any) -> np.ndarray:
     return _eight_point(p, q)
 
 
-def epipolar_error(E: Any, b1: Any, b2: Any, *, check: bool = True) -> np.ndarray:
+def epipolar_error(E: Any, b1: Any, b2: Any, *, validate: bool = True) -> np.ndarray:
     """Sampson distance of bearing pairs to the epipolar constraint, as an angle on the sphere.
 
     Parameters
@@ -144,7 +144,7 @@ def epipolar_error(E: Any, b1: Any, b2: Any, *, check: bool = True) -> np.ndarra
         Essential matrices (one per hypothesis).
     b1, b2 : array_like, shape (N, 3)
         Unit bearings.
-    check : bool, default True
+    validate : bool, default True
         Validate; ``False`` is the fast path (unit float bearings, float ``E``).
 
     Returns
@@ -173,7 +173,7 @@ def epipolar_error(E: Any, b1: Any, b2: Any, *, check: bool = True) -> np.ndarra
     >>> print(np.round(epipolar_error(E, [[0.0, 0.0, 1.0]], [[0.0, 0.1, 1.0]]), 4))
     [0.0707]
     """
-    if check:
+    if validate:
         E = as_array(E, "E")
         if E.shape[-2:] != (3, 3) or E.ndim > 3:
             raise ValueError(f"E: expected shape (3, 3) or (K, 3, 3), got shape {E.shape}")
@@ -267,9 +267,9 @@ def ransac_essential(b1: Any, b2: Any, *, threshold: float = 0.01, confidence: f
     """
     p = as_bearings(b1, "b1")
     q = as_bearings(b2, "b2", count=len(p))
-    thr = check_positive(threshold, "threshold")
-    min_inliers = check_int(min_inliers, "min_inliers", minimum=8)
-    max_iterations = check_int(max_iterations, "max_iterations", minimum=1)
+    thr = as_positive(threshold, "threshold")
+    min_inliers = as_int(min_inliers, "min_inliers", minimum=8)
+    max_iterations = as_int(max_iterations, "max_iterations", minimum=1)
     gen = as_rng(rng)
     n = len(p)
     needed, drawn = ransac_sample_count(0.5, 8, confidence), 0
@@ -282,7 +282,7 @@ def ransac_essential(b1: Any, b2: Any, *, threshold: float = 0.01, confidence: f
         sample = np.argsort(gen.random((k, n)), axis=1)[:, :8]   # eight distinct pairs per hypothesis
         drawn += k
         E = _eight_point(p[sample], q[sample])
-        err = epipolar_error(E, p, q, check=False)
+        err = epipolar_error(E, p, q, validate=False)
         support = err < thr
         count = support.sum(1)
         cost = np.where(support, err, thr).sum(1)                   # MSAC tie-break
@@ -292,11 +292,11 @@ def ransac_essential(b1: Any, b2: Any, *, threshold: float = 0.01, confidence: f
             needed = ransac_sample_count(min(1 - best_count / n, 0.9), 8, confidence)   # 0.9: ~4.6e8, the cap rules
     E = best
     for _ in range(2):                                              # refit on the support
-        inliers = epipolar_error(E, p, q, check=False) < thr
+        inliers = epipolar_error(E, p, q, validate=False) < thr
         if inliers.sum() < 8:
             break
         E = _eight_point(p[inliers], q[inliers])
-    errors = epipolar_error(E, p, q, check=False)
+    errors = epipolar_error(E, p, q, validate=False)
     inliers = errors < thr
     if inliers.sum() < min_inliers:
         return EssentialFit(failed.E, inliers, errors, drawn, False)
@@ -430,7 +430,7 @@ def floor_points(bearings: Any, T_body_camera: Any, *, min_depression: float = 0
     """
     d = as_bearings(bearings, "bearings")
     T = as_se3(T_body_camera, "T_body_camera")
-    dep = check_positive(min_depression, "min_depression")
+    dep = as_positive(min_depression, "min_depression")
     if dep >= np.pi / 2:
         raise ValueError(f"min_depression: expected an angle in (0, pi/2), got {dep}")
     h = T[2, 3]

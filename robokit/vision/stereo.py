@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, check_finite_result, check_finite_scalar, check_positive
+from ..validation import as_array, require_finite_result, as_finite_scalar, as_positive
 from .features import Features
 from .matching import gated_ratio_match, ratio_match
 
@@ -59,10 +59,10 @@ class StereoCalibration:
     baseline: float
 
     def __post_init__(self):
-        check_positive(self.focal, "focal")
-        check_finite_scalar(self.c0, "c0")
-        check_finite_scalar(self.r0, "r0")
-        check_positive(self.baseline, "baseline")
+        as_positive(self.focal, "focal")
+        as_finite_scalar(self.c0, "c0")
+        as_finite_scalar(self.r0, "r0")
+        as_positive(self.baseline, "baseline")
 
     def projection_matrices(self) -> tuple[np.ndarray, np.ndarray]:
         """Return the 3 x 4 projection matrices ``(P_L, P_R)`` in the camera frame (X right, Y up).
@@ -207,9 +207,9 @@ def disparity_to_point(c, r, d, rig: StereoCalibration, *, sigma_c: float = 1.0,
     d = as_array(d, "d", shape=(c.size,))
     if np.any(d <= 0):
         raise ValueError("d: expected positive disparities (points in front of the rig), got d <= 0")
-    var = np.square([check_positive(sigma_c, "sigma_c", allow_zero=True),
-                     check_positive(sigma_r, "sigma_r", allow_zero=True),
-                     check_positive(sigma_d, "sigma_d", allow_zero=True)])
+    var = np.square([as_positive(sigma_c, "sigma_c", allow_zero=True),
+                     as_positive(sigma_r, "sigma_r", allow_zero=True),
+                     as_positive(sigma_d, "sigma_d", allow_zero=True)])
     ib = rig.baseline / d
     pts = np.column_stack([(c - rig.c0) * ib, (rig.r0 - r) * ib, rig.focal * ib])
     jac = np.zeros((c.size, 3, 3))
@@ -217,7 +217,7 @@ def disparity_to_point(c, r, d, rig: StereoCalibration, *, sigma_c: float = 1.0,
     jac[:, 1, 1] = -ib
     jac[:, :, 2] = -pts / d[:, None]          # d(X, Y, Z)/dd = -(X, Y, Z)/d
     cov = np.einsum("nij,j,nkj->nik", jac, var, jac)
-    check_finite_result("c, r, d, rig (focal, c0, r0, baseline), sigma_c, sigma_r, sigma_d", pts, cov)
+    require_finite_result("c, r, d, rig (focal, c0, r0, baseline), sigma_c, sigma_r, sigma_d", pts, cov)
     return pts, cov
 
 
@@ -333,17 +333,17 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
     for name, f in (("left", left), ("right", right)):
         if not isinstance(f, Features):
             raise TypeError(f"{name}: expected Features, got {type(f).__name__}")
-    tol = check_positive(epipolar_tol, "epipolar_tol")
-    dmin = check_finite_scalar(min_disparity, "min_disparity")
-    dmax = check_finite_scalar(max_disparity, "max_disparity")
+    tol = as_positive(epipolar_tol, "epipolar_tol")
+    dmin = as_finite_scalar(min_disparity, "min_disparity")
+    dmax = as_finite_scalar(max_disparity, "max_disparity")
     if dmax <= dmin:
         raise ValueError(f"max_disparity: expected a value > min_disparity={dmin}, got {dmax}")
-    dori = check_positive(max_orientation_diff, "max_orientation_diff")
-    srat = check_positive(max_scale_ratio, "max_scale_ratio")
+    dori = as_positive(max_orientation_diff, "max_orientation_diff")
+    srat = as_positive(max_scale_ratio, "max_scale_ratio")
     if srat < 1:
         raise ValueError(f"max_scale_ratio: expected a value >= 1, got {srat}")
-    ratio = check_positive(ratio, "ratio")
-    max_distance = check_positive(max_distance, "max_distance")
+    ratio = as_positive(ratio, "ratio")
+    max_distance = as_positive(max_distance, "max_distance")
     empty = StereoMatches(np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros(0))
     if len(left) == 0 or len(right) == 0:
         return empty
@@ -363,7 +363,7 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
     li, ri = _row_candidates(kl.xy[:, 1], kr.xy[:, 1], tol)
     disp = kl.xy[li, 0] - kr.xy[ri, 0]
     ok = (np.abs(kl.xy[li, 1] - kr.xy[ri, 1]) <= tol) & (disp >= dmin) & (disp <= dmax)
-    dtheta = np.abs(wrap_angle(kl.orientation[li] - kr.orientation[ri], check=False))
+    dtheta = np.abs(wrap_angle(kl.orientation[li] - kr.orientation[ri], validate=False))
     ok &= dtheta <= dori
     sr = kl.scale[li] / kr.scale[ri]
     ok &= (sr <= srat) & (sr >= 1 / srat)
@@ -433,7 +433,7 @@ def observe_stereo(left: Features, right: Features, rig: StereoCalibration, *, s
     if not isinstance(rig, StereoCalibration):
         raise TypeError(f"rig: expected StereoCalibration, got {type(rig).__name__}")
     for name, sigma in (("sigma_c", sigma_c), ("sigma_r", sigma_r), ("sigma_d", sigma_d)):
-        check_positive(sigma, name, allow_zero=True)      # now, not only when there are matches
+        as_positive(sigma, name, allow_zero=True)      # now, not only when there are matches
     match_options.setdefault("max_disparity", rig.focal * rig.baseline / 0.3)
     m = match_stereo(left, right, **match_options)
     if len(m) == 0:

@@ -16,8 +16,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..geometry import se2_to_se3
-from ..validation import as_array, check_int, check_positive, describe
-from .scene import Scene, check_scene
+from ..validation import as_array, as_int, as_positive, describe
+from .scene import Scene, as_scene
 
 __all__ = ["animate_tracks", "animate_poses", "animate_snapshots", "HIDDEN_SCALE"]
 
@@ -41,7 +41,7 @@ def _checked_tracks(tracks: Any, scene: Scene) -> dict:
         raise TypeError(f"tracks: expected a non-empty dict of scene path -> {{property: array}}, got {describe(tracks)}")
     out, frames = {}, None
     for path, props in tracks.items():
-        check_scene(scene, path)
+        as_scene(scene, path)
         if not isinstance(props, Mapping) or not props:
             raise TypeError(f"tracks[{path!r}]: expected a non-empty dict of property -> array, got {describe(props)}")
         out[path] = {}
@@ -61,7 +61,7 @@ def _checked_tracks(tracks: Any, scene: Scene) -> dict:
 
 
 def animate_tracks(scene: Scene, tracks: Any, fps: float = 10.0, repetitions: int = 1, *,
-                   check: bool = True) -> Scene:
+                   validate: bool = True) -> Scene:
     """Play one clip in which objects move, turn and scale, frame by frame (meshcat animation).
 
     Parameters
@@ -74,7 +74,7 @@ def animate_tracks(scene: Scene, tracks: Any, fps: float = 10.0, repetitions: in
     fps : float, default 10
         Frames per second of playback.
     repetitions : int, default 1
-    check : bool, default True
+    validate : bool, default True
         Validate the tracks; ``False`` is the fast path for helpers that built them.
 
     Returns
@@ -103,11 +103,11 @@ def animate_tracks(scene: Scene, tracks: Any, fps: float = 10.0, repetitions: in
     """
     from meshcat.commands import SetAnimation
 
-    if check:
-        check_scene(scene)
+    if validate:
+        as_scene(scene)
         tracks = _checked_tracks(tracks, scene)
-        fps = check_positive(fps, "fps")
-        repetitions = check_int(repetitions, "repetitions", minimum=1)
+        fps = as_positive(fps, "fps")
+        repetitions = as_int(repetitions, "repetitions", minimum=1)
     clips = []
     for path, props in tracks.items():
         lowered = []
@@ -153,10 +153,10 @@ def animate_poses(scene: Scene, path: str, transforms: Any, fps: float = 10.0, r
     >>> animate_poses(scene, "robot", [[0.0, 0.0, 0.0], [1.0, 0.0, 0.5], [2.0, 1.0, 1.0]], fps=2)
     Scene(title='robokit scene', commands=3)
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     T = _transforms(transforms, "transforms")
-    return animate_tracks(scene, {path: _pose_tracks(T)}, check_positive(fps, "fps"),
-                          check_int(repetitions, "repetitions", minimum=1), check=False)
+    return animate_tracks(scene, {path: _pose_tracks(T)}, as_positive(fps, "fps"),
+                          as_int(repetitions, "repetitions", minimum=1), validate=False)
 
 
 def animate_snapshots(scene: Scene, paths: Sequence[str], fps: float = 4.0, repetitions: int = 1, *,
@@ -199,7 +199,7 @@ def animate_snapshots(scene: Scene, paths: Sequence[str], fps: float = 4.0, repe
     """
     if isinstance(paths, str) or len(paths) < 2:
         raise ValueError(f"paths: expected a sequence of at least two scene paths, got {paths!r}")
-    check_scene(scene, *paths)
+    as_scene(scene, *paths)
     n = len(paths)
     tracks = {}
     for k, path in enumerate(paths):
@@ -207,12 +207,12 @@ def animate_snapshots(scene: Scene, paths: Sequence[str], fps: float = 4.0, repe
     if moving is not None:
         if not isinstance(moving, str):
             raise TypeError(f"moving: expected a scene path (str), got {type(moving).__name__}")
-        check_scene(scene, moving)
+        as_scene(scene, moving)
         T = _transforms(transforms, "transforms")
         if len(T) != n:
             raise ValueError(f"transforms: expected one pose per path ({n}), got {len(T)}")
         tracks[moving] = _pose_tracks(T)
     elif transforms is not None:
         raise ValueError("transforms: given without the object to move (moving=None)")
-    return animate_tracks(scene, tracks, check_positive(fps, "fps"), check_int(repetitions, "repetitions", minimum=1),
-                          check=False)
+    return animate_tracks(scene, tracks, as_positive(fps, "fps"), as_int(repetitions, "repetitions", minimum=1),
+                          validate=False)

@@ -13,8 +13,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..validation import as_array, check_finite_result, check_int, check_positive
-from .scene import Scene, check_scene
+from ..validation import as_array, require_finite_result, as_int, as_positive
+from .scene import Scene, as_scene
 
 __all__ = ["look_from", "fit_view", "FOV", "NEAR", "FAR", "VIEW_WIDTH"]
 
@@ -73,7 +73,7 @@ def look_from(scene: Scene, position: Any, target: Any = None) -> Scene:
     >>> look_from(Scene(), [0.6, -0.7, 0.45], target=[0.1, 0.0, 0.1])   # a small robot, close up
     Scene(title='robokit scene', commands=2)
     """
-    check_scene(scene)
+    as_scene(scene)
     p = as_array(position, "position", shape=(3,))
     t = np.zeros(3) if target is None else as_array(target, "target", shape=(3,))
     if np.linalg.norm(p - t) == 0:
@@ -172,15 +172,15 @@ def fit_view(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence
     >>> [round(c["value"], 1) for c in scene.commands if c.get("property") == "far"]   # not cut at 100 m
     [174.2]
     """
-    check_scene(scene)
+    as_scene(scene)
     d = as_array(direction, "direction", shape=(3,))
     if not np.any(d):
         raise ValueError(f"direction: expected a non-zero vector from the target towards the camera, got {d.tolist()}")
     d = d / np.max(np.abs(d))                          # no overflow in its norm
     if np.hypot(d[0], d[1]) < 1e-3 * abs(d[2]):        # straight up or down: tilt to keep +y up in the image
         d = np.array([0.0, -1e-3 * abs(d[2]), d[2]])
-    margin = check_positive(margin, "margin", allow_zero=True)
-    aspect = check_int(width, "width", minimum=1) / scene.height
+    margin = as_positive(margin, "margin", allow_zero=True)
+    aspect = as_int(width, "width", minimum=1) / scene.height
     if bounds is None:
         found = scene.bounding_box(paths)
         if found is None:
@@ -208,7 +208,7 @@ def fit_view(scene: Scene, direction: Any = (0.5, -1.0, 0.9), *, paths: Sequence
         ahead = min(-h / (2 * t_x), -v / (2 * t_y), qf.min() - 0.05 * np.linalg.norm(half))
         depths = qf - ahead
         shift = _centred(qr, depths) * right + _centred(qu, depths) * up
-        check_finite_result(("scene" if bounds is None else "bounds") + ", margin, width", centre + shift,
+        require_finite_result(("scene" if bounds is None else "bounds") + ", margin, width", centre + shift,
                             4 * depths, ahead * back)
     camera = centre + shift - ahead * back
     # orbit about the point looked at where the view axis meets the level of the box's centre

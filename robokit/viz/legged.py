@@ -38,10 +38,10 @@ from ..legged.leg_kinematics import body_ik, leg_index
 from ..legged.littledog import (FOOT_RADIUS, HIP_OFFSET, HIP_POSITIONS, JOINTS, LEGS, LOWER_LEG, MARKERS,
                                 STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG)
 from ..legged.trial_log import TrialLog
-from ..validation import as_array, check_choice, check_int, check_positive, check_text, describe
+from ..validation import as_array, as_choice, as_int, as_positive, as_text, describe
 from .animation import HIDDEN_SCALE, animate_tracks
 from .legged_plots import support_outline
-from .scene import Scene, check_scene
+from .scene import Scene, as_scene
 from . import framing
 
 __all__ = ["joint_path", "add_littledog", "pose_littledog", "animate_trial", "GROUND_Z"]
@@ -76,9 +76,9 @@ def joint_path(path: str, leg: Any, joint: str) -> str:
     >>> joint_path("littledog", "HR", "knee")
     'littledog/HR/hip_roll/hip_pitch/knee'
     """
-    check_text(path, "path", empty=False)
+    as_text(path, "path", empty=False)
     leg = LEGS[leg_index(leg)]
-    depth = JOINTS.index(check_choice(joint, "joint", JOINTS)) + 1
+    depth = JOINTS.index(as_choice(joint, "joint", JOINTS)) + 1
     return "/".join([path.strip("/"), leg, *JOINTS[:depth]])
 
 
@@ -137,7 +137,7 @@ def add_littledog(scene: Scene, path: str = "littledog", T_world_body: Any = Non
     >>> fit_view(scene, direction=(0.55, -1.0, 0.6))        # seen from its front right, filling the view
     Scene(title='robokit scene', commands=59)
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     T, q = _pose_args(T_world_body, q)
     root = path.strip("/")
     scene.add_box(f"{root}/trunk", TRUNK_SIZE, color=_COLORS["trunk"])
@@ -186,7 +186,7 @@ def pose_littledog(scene: Scene, path: str, T_world_body: Any, q: Any) -> Scene:
     >>> pose_littledog(scene, "littledog", np.eye(4), np.zeros(12)).commands[-1]["path"]
     '/meshcat/littledog/HR/hip_roll/hip_pitch/knee'
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     if T_world_body is None or q is None:
         raise TypeError(f"T_world_body, q: expected a 4x4 pose and 12 joint angles, got "
                         f"{describe(T_world_body)} and {describe(q)}")
@@ -331,16 +331,16 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
     >>> clip["fps"], len(clip["tracks"][0]["keys"])           # 3 frames of rows 0, 2, 4
     (50.0, 3)
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     if not isinstance(log, TrialLog):
         raise TypeError(f"log: expected a robokit.legged.TrialLog, got {describe(log)}")
-    every = check_int(every, "every", minimum=1)
+    every = as_int(every, "every", minimum=1)
     rows = np.arange(0, len(log), every)
     if len(rows) < 2:
         raise ValueError(f"log: expected at least 2 rows after taking every {every}th (an animation needs two frames), "
                          f"got {len(log)} row(s)")
-    fps = float(log.meta["host_rate"]) / every if fps is None else check_positive(fps, "fps")
-    force_scale = check_positive(force_scale, "force_scale")
+    fps = float(log.meta["host_rate"]) / every if fps is None else as_positive(fps, "fps")
+    force_scale = as_positive(force_scale, "force_scale")
     root, overlay = path.strip("/"), path.strip("/") + "_overlay"
     add_littledog(scene, root, log.T_world_body()[0], log.q[0])
     if frame:                     # on the robot alone: its unit force arrows are scaled by the animation
@@ -369,4 +369,4 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
             seen = log.mocap_visible[rows, k]
             tracks[f"{overlay}/mocap/{k}"] = {"position": log.mocap[rows, k],
                                               "scale": np.where(seen[:, None], 1.0, HIDDEN_SCALE) * np.ones(3)}
-    return animate_tracks(scene, tracks, fps, check=False)
+    return animate_tracks(scene, tracks, fps, validate=False)

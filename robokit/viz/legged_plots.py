@@ -335,7 +335,7 @@ def plot_support(feet_xy: Any, stance: Any, com_xy: Any, ax: Any = None, legs: S
         ax.fill(v[:, 0], v[:, 1], color="tab:green", alpha=0.25, label="support polygon")
         ax.plot(closed[:, 0], closed[:, 1], color="tab:green", lw=1.5)
         margin = stability_margin(v, p)                    # validates com_xy by name
-        near = nearest_boundary_point(v, p, check=False)[0]
+        near = nearest_boundary_point(v, p, validate=False)[0]
         color = "tab:green" if margin >= 0 else "tab:red"
         ax.plot([p[0], near[0]], [p[1], near[1]], "--", color=color, lw=1.5, label=f"margin {1000 * margin:.0f} mm")
         title = f"support: stability margin {1000 * margin:.0f} mm"

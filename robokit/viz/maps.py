@@ -11,9 +11,9 @@ import numpy as np
 
 from ..sim.lidar import scan_points
 from ..sim.world import World
-from ..validation import as_array, as_points, check_int, check_positive, check_text
+from ..validation import as_array, as_points, as_int, as_positive, as_text
 
-__all__ = ["map_axes", "plot_footprint", "plot_scan", "plot_trajectory", "plot_graph", "check_graph", "plot_occupancy",
+__all__ = ["map_axes", "plot_footprint", "plot_scan", "plot_trajectory", "plot_graph", "as_graph", "plot_occupancy",
            "plot_covariance"]
 
 
@@ -146,8 +146,8 @@ def plot_trajectory(poses: Any, ax: Any = None, label: str | None = None, every:
     ('truth', 1.0)
     """
     P = as_points(poses, "poses", 3, min_count=1)
-    label = None if label is None else check_text(label, "label")
-    every = check_int(every, "every", minimum=0)
+    label = None if label is None else as_text(label, "label")
+    every = as_int(every, "every", minimum=0)
     ax = map_axes(ax)
     line, = ax.plot(P[:, 0], P[:, 1], label=label, **kwargs)
     if every:
@@ -157,7 +157,7 @@ def plot_trajectory(poses: Any, ax: Any = None, label: str | None = None, every:
     return ax
 
 
-def check_graph(poses: Any, edges: Any) -> tuple[np.ndarray, np.ndarray]:
+def as_graph(poses: Any, edges: Any) -> tuple[np.ndarray, np.ndarray]:
     """``poses`` (N, 3) and ``edges`` (M, 2) node indices, checked (errors name both)."""
     P = as_points(poses, "poses", 3, min_count=1)
     E = as_array(edges, "edges", dtype=np.int64)
@@ -207,10 +207,10 @@ def plot_graph(poses: Any, edges: Any, ax: Any = None, label: str | None = None,
     >>> len(ax.lines), ax.lines[0].get_label()
     (3, 'map')
     """
-    P, E = check_graph(poses, edges)
+    P, E = as_graph(poses, edges)
     mask = np.zeros(len(E), bool) if highlight is None else as_array(highlight, "highlight", shape=(len(E),),
                                                                      dtype=bool)
-    label = None if label is None else check_text(label, "label")
+    label = None if label is None else as_text(label, "label")
     ax = map_axes(ax)
     nodes, = ax.plot(P[:, 0], P[:, 1], "o", ms=3, label=label, **kwargs)
     for dashed in (False, True):
@@ -258,7 +258,7 @@ def plot_occupancy(grid: Any, origin: Any, resolution: float, ax: Any = None, cm
     if np.any((G < 0) | (G > 1)):
         raise ValueError(f"grid: expected probabilities in [0, 1], got values in [{G.min():.3g}, {G.max():.3g}]")
     o = as_array(origin, "origin", shape=(2,))
-    r = check_positive(resolution, "resolution")
+    r = as_positive(resolution, "resolution")
     ax = map_axes(ax)
     if not isinstance(cmap, str) or cmap not in mpl.colormaps:
         raise ValueError(f"cmap: expected a matplotlib colormap name, got {cmap!r}")
@@ -313,7 +313,7 @@ def plot_covariance(mean: Any, cov: Any, ax: Any = None, nsigma: float = 1.0, **
     lam, V = np.linalg.eigh((C + C.T) / 2)
     if lam.min() < -1e-12:
         raise ValueError("cov: expected a positive semi-definite matrix")
-    s = check_positive(nsigma, "nsigma")
+    s = as_positive(nsigma, "nsigma")
     w, h = 2 * s * np.sqrt(np.clip(lam[::-1], 0, None))
     angle = np.degrees(np.arctan2(V[1, 1], V[0, 1]))
     ax = map_axes(ax)

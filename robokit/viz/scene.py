@@ -19,9 +19,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..validation import as_array, as_points, check_int, check_positive, check_text, describe
+from ..validation import as_array, as_points, as_int, as_positive, as_text, describe
 
-__all__ = ["Scene", "viewer_javascript", "as_color", "check_scene"]
+__all__ = ["Scene", "viewer_javascript", "as_color", "as_scene"]
 
 
 @functools.lru_cache(maxsize=1)
@@ -123,8 +123,8 @@ class Scene:
     """
 
     def __init__(self, title: str = "robokit scene", height: int = 420, live: bool = False) -> None:
-        self.title = check_text(title, "title")
-        self.height = check_int(height, "height", minimum=1)
+        self.title = as_text(title, "title")
+        self.height = as_int(height, "height", minimum=1)
         self._commands: list[Any] = []
         self._extents: dict[tuple, np.ndarray] = {}      # object node -> (8, 3) corners in its node's frame
         self._poses: dict[tuple, np.ndarray] = {}        # node -> 4x4 transform relative to its parent
@@ -224,7 +224,7 @@ class Scene:
                 raise TypeError(f"paths: expected a scene path or a non-empty list of them, got {describe(paths)}")
             prefixes = []
             for name in names:
-                if not check_text(name, "paths").strip("/"):
+                if not as_text(name, "paths").strip("/"):
                     raise ValueError(f"paths: expected scene paths like 'robot', got {name!r}")
                 prefixes.append(tuple(self.meshcat_path(name).entries))
         corners = []
@@ -263,7 +263,7 @@ class Scene:
     def _material(self, color: Any, opacity: float):
         from meshcat.geometry import MeshLambertMaterial
 
-        opacity = check_positive(opacity, "opacity")
+        opacity = as_positive(opacity, "opacity")
         if opacity > 1:
             raise ValueError(f"opacity: expected a value in (0, 1], got {opacity}")
         return MeshLambertMaterial(color=as_color(color), opacity=opacity, transparent=opacity < 1)
@@ -284,7 +284,7 @@ class Scene:
         """Add a sphere of ``radius`` metres centred at ``transform``."""
         from meshcat.geometry import Sphere
 
-        self.set_object(path, Sphere(check_positive(radius, "radius")), self._material(color, opacity))
+        self.set_object(path, Sphere(as_positive(radius, "radius")), self._material(color, opacity))
         return self.set_transform(path, transform)
 
     def add_cylinder(self, path: str, length: float, radius: float, transform: Any = None, color: Any = 0x8899AA,
@@ -294,8 +294,8 @@ class Scene:
         makes a cone or a frustum (0: a cone with its tip at +y)."""
         from meshcat.geometry import Cylinder
 
-        length, radius = check_positive(length, "length"), check_positive(radius, "radius")
-        top = radius if radius_top is None else check_positive(radius_top, "radius_top", allow_zero=True)
+        length, radius = as_positive(length, "length"), as_positive(radius, "radius")
+        top = radius if radius_top is None else as_positive(radius_top, "radius_top", allow_zero=True)
         geometry = Cylinder(length, radiusTop=top, radiusBottom=radius)
         self.set_object(path, geometry, self._material(color, opacity))
         return self.set_transform(path, transform)
@@ -350,7 +350,7 @@ class Scene:
         """Add a coordinate frame: x red, y green, z blue, each ``scale`` metres long."""
         from meshcat.geometry import LineBasicMaterial, LineSegments, PointsGeometry
 
-        s = check_positive(scale, "scale")
+        s = as_positive(scale, "scale")
         position = np.array([[0, 0, 0], [s, 0, 0], [0, 0, 0], [0, s, 0], [0, 0, 0], [0, 0, s]], np.float32).T
         color = np.array([[1, 0, 0], [1, 0.6, 0], [0, 1, 0], [0.6, 1, 0], [0, 0, 1], [0, 0.6, 1]], np.float32).T
         self.set_object(path, LineSegments(PointsGeometry(position, color),
@@ -372,7 +372,7 @@ class Scene:
                 raise ValueError(f"colors: expected shape {pts.shape} to match points, got {cols.shape}")
             if np.any((cols < 0) | (cols > 1)):
                 raise ValueError("colors: expected RGB values in [0, 1]")
-        material = PointsMaterial(size=check_positive(size, "size"))
+        material = PointsMaterial(size=as_positive(size, "size"))
         return self.set_object(path, PointsGeometry(pts.T, cols.T), material)
 
     def add_line(self, path: str, points: Any, color: Any = 0x222222) -> "Scene":
@@ -442,7 +442,7 @@ class Scene:
         return f"Scene(title={self.title!r}, commands={len(self._commands)})"
 
 
-def check_scene(scene: Any, *paths: Any) -> Scene:
+def as_scene(scene: Any, *paths: Any) -> Scene:
     """Return ``scene`` if it is a :class:`Scene`, and check each of ``paths`` as a scene path.
 
     For the drawing helpers, whose first two arguments these are: a wrong one would otherwise fail
@@ -457,12 +457,12 @@ def check_scene(scene: Any, *paths: Any) -> Scene:
 
     Examples
     --------
-    >>> check_scene(Scene(), "robot/body")
+    >>> as_scene(Scene(), "robot/body")
     Scene(title='robokit scene', commands=0)
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: expected a robokit.viz.Scene, got {describe(scene)}")
     for path in paths:
-        check_text(path, "path")
+        as_text(path, "path")
         Scene.meshcat_path(path)
     return scene

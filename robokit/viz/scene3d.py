@@ -14,9 +14,9 @@ import numpy as np
 from ..geometry import as_se3, se2_to_se3
 from ..sim.camera import PinholeCamera
 from ..sim.world import World
-from ..validation import as_array, as_points, check_finite_scalar, check_int, check_positive
-from .maps import check_graph
-from .scene import Scene, as_color, check_scene
+from ..validation import as_array, as_points, as_finite_scalar, as_int, as_positive
+from .maps import as_graph
+from .scene import Scene, as_color, as_scene
 
 __all__ = ["add_world", "add_camera", "add_trajectory", "add_graph", "add_image", "add_particles", "add_landmarks"]
 
@@ -78,12 +78,12 @@ def add_world(scene: Scene, world: World, path: str = "world", cell: int = 48, c
     >>> scene.html().count("meshcat") > 0
     True
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     from meshcat.geometry import ImageTexture, Mesh, MeshBasicMaterial, PngImage
 
     if not isinstance(world, World):
         raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
-    cell = check_int(cell, "cell", minimum=4)
+    cell = as_int(cell, "cell", minimum=4)
     atlas, cols = _atlas(world, cell)
     verts, faces, uvs = [], [], []
     size = cols * cell
@@ -145,10 +145,10 @@ def add_camera(scene: Scene, path: str, camera: PinholeCamera, T_world_cam: Any,
     >>> add_camera(Scene(), "camera", camera, camera.transform_at([1.0, 1.0, 0.0]))   # frustum and axes
     Scene(title='robokit scene', commands=3)
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     if not isinstance(camera, PinholeCamera):
         raise TypeError(f"camera: expected a PinholeCamera, got {type(camera).__name__}")
-    d = check_positive(depth, "depth")
+    d = as_positive(depth, "depth")
     T_world_cam = as_se3(T_world_cam, "T_world_cam")
     corners = np.array([[0, 0], [camera.width - 1, 0], [camera.width - 1, camera.height - 1], [0, camera.height - 1]], float)
     P = camera.backproject(corners, np.full(4, d), T_world_cam)
@@ -190,10 +190,10 @@ def add_trajectory(scene: Scene, path: str, poses: Any, z: float = 0.02, color: 
     >>> add_trajectory(Scene(), "path", [[0, 0, 0], [1, 0, 0.5], [2, 1, 1.0]], every=2)   # line + 2 triads
     Scene(title='robokit scene', commands=5)
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     P = as_points(poses, "poses", 3, min_count=2)
-    z = check_finite_scalar(z, "z")
-    step = check_int(every, "every", minimum=0)
+    z = as_finite_scalar(z, "z")
+    step = as_int(every, "every", minimum=0)
     scene.add_line(f"{path}/line", np.column_stack([P[:, :2], np.full(len(P), z)]), color=color)
     if step:
         for k in range(0, len(P), step):
@@ -238,11 +238,11 @@ def add_graph(scene: Scene, path: str, poses: Any, edges: Any, z: float = 0.05, 
     >>> add_graph(Scene(), "map", [[0, 0, 0], [1, 0, 0], [1, 1, 0]], [[0, 1], [1, 2], [2, 0]])
     Scene(title='robokit scene', commands=2)
     """
-    check_scene(scene, path)
-    P, E = check_graph(poses, edges)
-    z = check_finite_scalar(z, "z")
+    as_scene(scene, path)
+    P, E = as_graph(poses, edges)
+    z = as_finite_scalar(z, "z")
     lifted = np.column_stack([P[:, :2], np.full(len(P), z)])
-    scene.add_points(f"{path}/nodes", lifted, size=check_positive(size, "size"), color=node_color)
+    scene.add_points(f"{path}/nodes", lifted, size=as_positive(size, "size"), color=node_color)
     if len(E):
         _segments(scene, f"{path}/edges", lifted[E.reshape(-1)], edge_color)
     return scene
@@ -281,14 +281,14 @@ def add_image(scene: Scene, path: str, image: Any, centre: Any, width: float = 1
     >>> add_image(Scene(), "view", np.zeros((4, 6, 3), np.uint8), [1.0, 2.0, 3.0])
     Scene(title='robokit scene', commands=1)
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     from meshcat.geometry import ImageTexture, Mesh, MeshBasicMaterial, PngImage
 
     img = np.asarray(image)
     if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8 or min(img.shape[:2]) < 1:
         raise ValueError(f"image: expected an (H, W, 3) uint8 RGB image, got {img.dtype} of shape {img.shape}")
     c = as_array(centre, "centre", shape=(3,))
-    w = check_positive(width, "width")
+    w = as_positive(width, "width")
     h = w * img.shape[0] / img.shape[1]
     verts = c + np.array([[-w / 2, -h / 2, 0], [w / 2, -h / 2, 0], [w / 2, h / 2, 0], [-w / 2, h / 2, 0]])
     uvs = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
@@ -314,7 +314,7 @@ def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, 
     >>> add_particles(Scene(), "cloud", [[0.0, 0.0, 0.0], [1.0, 0.5, 1.5]], weights=[0.2, 0.8])
     Scene(title='robokit scene', commands=2)
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     P = as_points(particles, "particles", 3, min_count=1)
     if weights is None:
         w = np.ones(len(P))
@@ -323,10 +323,10 @@ def add_particles(scene: Scene, path: str, particles: Any, weights: Any = None, 
         if np.any(w < 0) or w.sum() <= 0:
             raise ValueError("weights: expected non-negative weights with a positive sum")
         w = w / w.max()
-    L = check_positive(arrow, "arrow") * (0.3 + 0.7 * w)
-    base = np.column_stack([P[:, :2], np.full(len(P), check_finite_scalar(z, "z"))])
+    L = as_positive(arrow, "arrow") * (0.3 + 0.7 * w)
+    base = np.column_stack([P[:, :2], np.full(len(P), as_finite_scalar(z, "z"))])
     tip = base + np.column_stack([L * np.cos(P[:, 2]), L * np.sin(P[:, 2]), np.zeros(len(P))])
-    scene.add_points(f"{path}/points", base, size=check_positive(size, "size"), color=color)
+    scene.add_points(f"{path}/points", base, size=as_positive(size, "size"), color=color)
     return _segments(scene, f"{path}/headings", np.stack([base, tip], axis=1).reshape(-1, 3), color)
 
 
@@ -369,7 +369,7 @@ def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None,
     >>> add_landmarks(Scene(), "landmarks", points, np.stack([0.01 * np.eye(3)] * 2))  # points + 2 ellipsoids
     Scene(title='robokit scene', commands=5)
     """
-    check_scene(scene, path)
+    as_scene(scene, path)
     from meshcat.geometry import Ellipsoid, MeshLambertMaterial
 
     P = as_points(points, "points", 3, min_count=1)
@@ -382,8 +382,8 @@ def add_landmarks(scene: Scene, path: str, points: Any, covariances: Any = None,
     lam, V = np.linalg.eigh(C)
     if np.any(lam < -1e-12):
         raise ValueError("covariances: expected positive semi-definite matrices, got a negative eigenvalue")
-    s = check_positive(nsigma, "nsigma")
-    for k in range(min(len(P), check_int(max_ellipsoids, "max_ellipsoids", minimum=0))):
+    s = as_positive(nsigma, "nsigma")
+    for k in range(min(len(P), as_int(max_ellipsoids, "max_ellipsoids", minimum=0))):
         R = V[k] * np.sign(np.linalg.det(V[k]))
         T = np.eye(4)
         T[:3, :3], T[:3, 3] = R, P[k]

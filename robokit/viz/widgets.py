@@ -16,7 +16,7 @@ import json
 from typing import Any, Callable, Sequence
 
 from ..config import headless
-from ..validation import check_callable, check_int, check_text
+from ..validation import as_callable, as_int, as_text
 
 __all__ = ["slider", "static_slider_html"]
 
@@ -34,10 +34,10 @@ def _values(values: Any) -> list:
 
 
 def _checked(draw: Any, values: Any, label: Any, fmt: Any, start: Any) -> tuple:
-    draw = check_callable(draw, "draw", optional=False)
+    draw = as_callable(draw, "draw", optional=False)
     vals = _values(values)
-    return (draw, vals, check_text(label, "label"), check_text(fmt, "fmt", empty=False),
-            check_int(start, "start", minimum=0, maximum=len(vals) - 1))
+    return (draw, vals, as_text(label, "label"), as_text(fmt, "fmt", empty=False),
+            as_int(start, "start", minimum=0, maximum=len(vals) - 1))
 
 
 def _figure_png(draw: Callable[[Any], Any], value: Any) -> str:

@@ -16,7 +16,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from robocourse.exercises.compare import Comparison, close
-from robokit.validation import check_int, check_text
+from robokit.validation import as_int, as_text
 from robocourse.exercises.plain import numeric_array, summarize, to_plain
 
 __all__ = ["Case", "Exercise", "EXERCISE_ID"]
@@ -66,8 +66,8 @@ class Case:
         TypeError, ValueError
             If ``function`` is not a non-empty string or ``limit`` is not an integer >= 16.
         """
-        function = check_text(function, "function", empty=False)
-        limit = check_int(limit, "limit", minimum=16)
+        function = as_text(function, "function", empty=False)
+        limit = as_int(limit, "limit", minimum=16)
         def show(value: Any) -> str:          # a list of numbers reads as the array it stands for
             arr = numeric_array(value) if isinstance(value, list) else None
             return summarize(value if arr is None or arr.size < 2 else arr, 160)

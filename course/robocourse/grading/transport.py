@@ -181,7 +181,7 @@ def _read_npy(raw: bytes, name: str) -> np.ndarray:
     return np.frombuffer(body, dtype=dtype, count=count).reshape(shape, order="F" if fortran else "C")
 
 
-def _check_directory_end(data: bytes, name: str) -> None:
+def _require_directory_end(data: bytes, name: str) -> None:
     """Check an ``.npz``'s layout before :mod:`zipfile` parses it: what :func:`numpy.savez` writes
     and nothing else.
 
@@ -198,8 +198,8 @@ def _check_directory_end(data: bytes, name: str) -> None:
         raise TooLarge(f"{name} holds more than {MAX_ARRAYS} arrays")
 
 
-def _check_layout(members: list[zipfile.ZipInfo], data: bytes, name: str) -> None:
-    """Members stored, named once, in order and not overlapping (see :func:`_check_directory_end`)."""
+def _require_zip_layout(members: list[zipfile.ZipInfo], data: bytes, name: str) -> None:
+    """Members stored, named once, in order and not overlapping (see :func:`_require_directory_end`)."""
     seen: set[str] = set()
     position = 0
     for member in sorted(members, key=lambda m: m.header_offset):
@@ -220,13 +220,13 @@ def _check_layout(members: list[zipfile.ZipInfo], data: bytes, name: str) -> Non
 
 def _parse_npz(data: bytes, name: str) -> dict[str, np.ndarray]:
     """The arrays of an ``.npz`` held in memory; its layout and members' sizes are checked before reading."""
-    _check_directory_end(data, name)
+    _require_directory_end(data, name)
     try:
         with zipfile.ZipFile(io.BytesIO(data)) as archive:
             members = archive.infolist()
             if len(members) > MAX_ARRAYS:
                 raise TooLarge(f"{name} holds more than {MAX_ARRAYS} arrays")
-            _check_layout(members, data, name)
+            _require_zip_layout(members, data, name)
             arrays = {}
             for member in members:
                 if not member.filename.endswith(".npy"):

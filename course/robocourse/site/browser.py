@@ -18,7 +18,7 @@ import time
 from os import PathLike
 from pathlib import Path
 
-from robocourse.site.cdp import BrowserError, DevToolsPipe, check_seconds
+from robocourse.site.cdp import BrowserError, DevToolsPipe, as_seconds
 from robocourse.site.page_report import ConsoleMessage, FailedRequest, MathReport, PageReport, SceneShot
 from robocourse.site.screenshots import changed_fraction, content_fraction, decode_png
 
@@ -129,7 +129,7 @@ class Browser:
     def __init__(self, executable: str | None = None, *, width: int = 1280, height: int = 900,
                  timeout: float = 30.0) -> None:
         self.width, self.height = _pixels(width, "width"), _pixels(height, "height")
-        self.timeout = check_seconds(timeout, "timeout")
+        self.timeout = as_seconds(timeout, "timeout")
         self._pipe = DevToolsPipe(executable, args=(f"--window-size={self.width},{self.height}",))
         self._pipe.on_event = self._on_event
         self._page: _PageState | None = None
@@ -178,9 +178,9 @@ class Browser:
         (42, True, 2)
         """
         url = _as_url(page)
-        timeout = self.timeout if timeout is None else check_seconds(timeout, "timeout")
-        math_timeout = check_seconds(math_timeout, "math_timeout")
-        scene_wait = check_seconds(scene_wait, "scene_wait", allow_zero=True)
+        timeout = self.timeout if timeout is None else as_seconds(timeout, "timeout")
+        math_timeout = as_seconds(math_timeout, "math_timeout")
+        scene_wait = as_seconds(scene_wait, "scene_wait", allow_zero=True)
         if scene_wait > 60:
             raise ValueError(f"scene_wait: expected seconds in [0, 60], got {scene_wait!r}")
         report = PageReport(url=url)

@@ -28,7 +28,7 @@ from typing import Any, Callable, Sequence
 
 from robocourse.site.execute import kill_process_group
 
-__all__ = ["find_chromium", "DevToolsPipe", "BrowserError", "CHROMIUM_NAMES", "check_seconds"]
+__all__ = ["find_chromium", "DevToolsPipe", "BrowserError", "CHROMIUM_NAMES", "as_seconds"]
 
 #: Executable names tried, in order, by :func:`find_chromium`.
 CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome")
@@ -53,7 +53,7 @@ class BrowserError(RuntimeError):
     """Chromium is missing, failed to start, died, or answered a command with an error."""
 
 
-def check_seconds(value: Any, name: str, *, allow_zero: bool = False) -> float:
+def as_seconds(value: Any, name: str, *, allow_zero: bool = False) -> float:
     """Return ``value`` as a finite, positive (or zero, if allowed) number of seconds.
 
     The course tooling sits beside :mod:`robokit.validation` in the layers, not above it, so it
@@ -68,9 +68,9 @@ def check_seconds(value: Any, name: str, *, allow_zero: bool = False) -> float:
 
     Examples
     --------
-    >>> check_seconds(2, "timeout")
+    >>> as_seconds(2, "timeout")
     2.0
-    >>> check_seconds(-1, "timeout")
+    >>> as_seconds(-1, "timeout")
     Traceback (most recent call last):
     ...
     ValueError: timeout: expected a positive, finite number of seconds, got -1
@@ -168,7 +168,7 @@ class DevToolsPipe:
             raise BrowserError(f"executable: {exe!r} is not an executable file")
         if isinstance(args, str) or not all(isinstance(a, str) for a in args):
             raise TypeError(f"args: expected a sequence of str flags, got {args!r:.60}")
-        check_seconds(timeout, "timeout")
+        as_seconds(timeout, "timeout")
         self.on_event: Callable[[dict], Any] | None = None
         self._next_id = 0
         self._buffer = bytearray()
@@ -241,7 +241,7 @@ class DevToolsPipe:
         ``timeout`` seconds (the message says ``what`` was awaited)."""
         if not callable(done):
             raise TypeError(f"done: expected a callable, got {done!r:.60}")
-        check_seconds(timeout, "timeout", allow_zero=True)
+        as_seconds(timeout, "timeout", allow_zero=True)
         deadline = time.monotonic() + timeout
         while not done():
             left = deadline - time.monotonic()

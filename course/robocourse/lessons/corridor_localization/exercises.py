@@ -8,7 +8,7 @@ from robokit.localization.particle_filter import ellipse_weights, low_variance_r
 from robokit.mapping.corridor_areas import invalid_areas
 from robokit.mapping.corridor_scan import width_condition
 from robokit.mapping.occupancy_grid import LikelihoodField, log_odds
-from robokit.validation import as_array, check_finite_scalar, check_positive
+from robokit.validation import as_array, as_finite_scalar, as_positive
 from robokit.vision.bow_vector import l1_score, tf_idf
 from robokit.vision.hamming import as_binary_descriptors, hamming_match
 from robocourse.exercises.compare import close, exact
@@ -49,7 +49,7 @@ def cell_log_odds(probabilities, prior: float = 0.5) -> float:
     p = as_array(probabilities, "probabilities", ndim=1, min_size=0)
     if np.any((p <= 0) | (p >= 1)):
         raise ValueError(f"probabilities: expected readings strictly between 0 and 1, got {p.tolist()}")
-    prior = check_finite_scalar(prior, "prior")
+    prior = as_finite_scalar(prior, "prior")
     if not 0 < prior < 1:
         raise ValueError(f"prior: expected a probability strictly between 0 and 1, got {prior}")
     l0 = float(log_odds(prior))
@@ -128,8 +128,8 @@ def likelihood_field_weight(pose, ranges, angles, distance, resolution, origin, 
     >>> round(likelihood_field_weight([0.55, 1.0, 0.0], [1.0], [0.0], d, 0.1, [0.0, 0.0]), 3)
     0.642
     """
-    field = LikelihoodField(as_array(distance, "distance", ndim=2), check_positive(resolution, "resolution"),
-                            as_array(origin, "origin", shape=(2,)), check_positive(max_distance, "max_distance"))
+    field = LikelihoodField(as_array(distance, "distance", ndim=2), as_positive(resolution, "resolution"),
+                            as_array(origin, "origin", shape=(2,)), as_positive(max_distance, "max_distance"))
     return float(likelihood_field_log_weights([as_array(pose, "pose", shape=(3,))], ranges, angles, field,
                                               sigma_hit=sigma_hit, z_hit=z_hit, z_rand=z_rand, r_max=r_max,
                                               combine="product")[0])
@@ -144,7 +144,7 @@ def resample_indices(weights, r: float) -> list:
     [1, 1, 2]
     """
     w = as_array(weights, "weights", ndim=1, min_size=1)
-    r = check_finite_scalar(r, "r")
+    r = as_finite_scalar(r, "r")
     if not 0 <= r < 1 / len(w):
         raise ValueError(f"r: expected a number in [0, 1/M) = [0, {1 / len(w):.6g}), got {r}")
     return low_variance_resample(w, start=r).tolist()

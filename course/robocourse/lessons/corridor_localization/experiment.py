@@ -46,12 +46,12 @@ from robokit.mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_
 from robokit.parallel import map_runs
 from robokit.sim import Lidar, PinholeCamera, corridor_path, describe_sensor, long_corridor, waypoint_path
 from robokit.sim.world import World
-from robokit.validation import as_array, check_callable, check_int, check_positive
+from robokit.validation import as_array, as_callable, as_int, as_positive
 from robokit.vision import BowDatabase, Vocabulary, detect_orb_features, feature_threshold, select_keyframes, \
     select_keyframes_orbslam
 from robocourse.lessons.corridor_localization.sensors import corridor_camera, corridor_lidar
 
-__all__ = ["CorridorMap", "corridor_map", "check_corridor_map", "CalibrationRun", "calibration_run",
+__all__ = ["CorridorMap", "corridor_map", "as_corridor_map", "CalibrationRun", "calibration_run",
            "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS"]
 
 #: Odometry noise of the simulated Kobuki base (Thrun et al. 2005, Table 5.6 alphas, our choice).
@@ -172,11 +172,11 @@ def calibration_run(*, fast: bool | None = None, start: float = 12.0, length: fl
     (True, True)
     """
     fast = fast_mode() if fast is None else bool(fast)
-    length = check_positive(length, "length")
+    length = as_positive(length, "length")
     length = 2.0 if fast else length
-    start = check_positive(start, "start")
-    speed, frame_rate = check_positive(speed, "speed"), check_positive(frame_rate, "frame_rate")
-    progress = check_callable(progress, "progress")
+    start = as_positive(start, "start")
+    speed, frame_rate = as_positive(speed, "speed"), as_positive(frame_rate, "frame_rate")
+    progress = as_callable(progress, "progress")
     world = long_corridor()
     if start + length > world.info["length"] - 0.5:
         raise ValueError(f"start, length: expected a section inside the corridor (0 .. {world.info['length']} m), "
@@ -239,7 +239,7 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     """
     if not isinstance(run, CalibrationRun):
         raise TypeError(f"run: expected a CalibrationRun (calibration_run()), got {type(run).__name__}")
-    gap = check_int(min_frame_gap, "min_frame_gap", minimum=0)
+    gap = as_int(min_frame_gap, "min_frame_gap", minimum=0)
     flat, counts = _descriptor_stack(run.descriptors)
     content = hashlib.sha256(flat.tobytes() + counts.tobytes() + np.asarray(run.positions, float).tobytes())
     band = as_array(shared_range, "shared_range", shape=(2,)).tolist()   # checked before any cache lookup
@@ -292,9 +292,9 @@ def training_vocabulary(*, fast: bool | None = None, branching: int = 10, levels
     True
     """
     fast = fast_mode() if fast is None else bool(fast)
-    branching = check_int(branching, "branching", minimum=2, maximum=64)
-    levels = 3 if fast else check_int(levels, "levels", minimum=1, maximum=8)
-    progress = check_callable(progress, "progress")
+    branching = as_int(branching, "branching", minimum=2, maximum=64)
+    levels = 3 if fast else as_int(levels, "levels", minimum=1, maximum=8)
+    progress = as_callable(progress, "progress")
     world = long_corridor(layout="facing", seed=7)
     camera = corridor_camera(fast)
     step = 1.0 if fast else 0.25
@@ -368,12 +368,12 @@ class CorridorMap:
         return len(self.keyframe_poses)
 
 
-def check_corridor_map(value: Any) -> CorridorMap:
+def as_corridor_map(value: Any) -> CorridorMap:
     """Return ``value`` if it is a :class:`CorridorMap`, else raise a TypeError naming it.
 
     Examples
     --------
-    >>> check_corridor_map(3)
+    >>> as_corridor_map(3)
     Traceback (most recent call last):
     ...
     TypeError: setup: expected a CorridorMap (corridor_map()), got int
@@ -423,10 +423,10 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress
     (True, 0.05)
     """
     fast = fast_mode() if fast is None else bool(fast)
-    resolution = check_positive(resolution, "resolution")
+    resolution = as_positive(resolution, "resolution")
     if not 0.01 <= resolution <= 1.0:
         raise ValueError(f"resolution: expected a cell size between 0.01 and 1 m, got {resolution}")
-    progress = check_callable(progress, "progress")
+    progress = as_callable(progress, "progress")
     world, lidar, camera = long_corridor(), corridor_lidar(), corridor_camera(fast)
     f_min = calibration_run(fast=fast).f_min
     vocabulary = training_vocabulary(fast=fast)

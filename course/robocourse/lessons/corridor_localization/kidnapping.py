@@ -19,8 +19,8 @@ import numpy as np
 
 from robokit.localization import largest_cluster_mean
 from robokit.sim import noisy_odometry, waypoint_path
-from robokit.validation import as_rng, check_int, check_positive
-from robocourse.lessons.corridor_localization.experiment import MAPPING_ALPHAS, CorridorMap, check_corridor_map
+from robokit.validation import as_rng, as_int, as_positive
+from robocourse.lessons.corridor_localization.experiment import MAPPING_ALPHAS, CorridorMap, as_corridor_map
 from robocourse.lessons.corridor_localization.trials import ELLIPSE_SIGMA, METHODS, PARTICLES, RATE, SPEED, START_POSES, corridor_localizer, retrieve_pose
 
 __all__ = ["KidnapResult", "kidnapping"]
@@ -93,12 +93,12 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
     >>> sorted(result.errors), round(result.jump, 1)
     (['amcl', 'ours'], 11.5)
     """
-    setup = check_corridor_map(setup)
-    a = check_int(origin, "origin", minimum=0, maximum=len(START_POSES) - 1)
-    b = check_int(destination, "destination", minimum=0, maximum=len(START_POSES) - 1)
-    period, after = check_positive(period, "period"), check_positive(after, "after")
-    kidnap_distance = check_positive(kidnap_distance, "kidnap_distance", allow_zero=True)
-    rng = as_rng(check_int(seed, "seed", minimum=0))
+    setup = as_corridor_map(setup)
+    a = as_int(origin, "origin", minimum=0, maximum=len(START_POSES) - 1)
+    b = as_int(destination, "destination", minimum=0, maximum=len(START_POSES) - 1)
+    period, after = as_positive(period, "period"), as_positive(after, "after")
+    kidnap_distance = as_positive(kidnap_distance, "kidnap_distance", allow_zero=True)
+    rng = as_rng(as_int(seed, "seed", minimum=0))
     x_a, x_b = START_POSES[a][0], START_POSES[b][0]
     if x_b + SPEED * after > setup.world.info["length"] - 0.8:
         raise ValueError(f"after: expected the drive after the kidnapping to end before the corridor does, got "

@@ -45,8 +45,8 @@ from robokit.localization import KLDConfig, MonteCarloLocalizer, largest_cluster
 from robokit.parallel import map_runs
 from robokit.sim import noisy_odometry, waypoint_path
 from robokit.vision import detect_orb_features
-from robokit.validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive
-from robocourse.lessons.corridor_localization.experiment import MAPPING_ALPHAS, N_FEATURES, CorridorMap, check_corridor_map
+from robokit.validation import as_array, as_rng, as_callable, as_choice, as_int, as_positive
+from robocourse.lessons.corridor_localization.experiment import MAPPING_ALPHAS, N_FEATURES, CorridorMap, as_corridor_map
 from robocourse.lessons.corridor_localization.results import TrialResult, TrialSet
 
 __all__ = ["START_POSES", "ELLIPSE_SIGMA", "CLUSTER_SHARE", "PARTICLES", "SETTLE", "retrieve_pose",
@@ -135,7 +135,7 @@ def retrieve_pose(setup: CorridorMap, pose: Any, rng: Any = None) -> tuple[np.nd
     >>> bool(abs(pose_k[0] - 10.0) < 1.0), 0 < score <= 1
     (True, True)
     """
-    setup = check_corridor_map(setup)
+    setup = as_corridor_map(setup)
     p = as_array(pose, "pose", shape=(3,))
     image = setup.camera.observe(setup.world, p, rng=as_rng(rng)).image
     found = setup.database.query(detect_orb_features(image, N_FEATURES).descriptors, max_results=1)
@@ -187,8 +187,8 @@ def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0) -> MonteCa
     >>> corridor_localizer(corridor_map(fast=True), "ours").n_particles
     50
     """
-    setup = check_corridor_map(setup)
-    method = check_choice(method, "method", METHODS)
+    setup = as_corridor_map(setup)
+    method = as_choice(method, "method", METHODS)
     lidar = setup.lidar
     return MonteCarloLocalizer(setup.grid, field=setup.field, n_particles=PARTICLES[method], alphas=MAPPING_ALPHAS,
                                r_max=lidar.r_max, sensor_offset=lidar.offset,
@@ -246,18 +246,18 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
     >>> run.method, run.converged, bool(run.distance < 5.0)
     ('ours', True, True)
     """
-    setup = check_corridor_map(setup)
+    setup = as_corridor_map(setup)
     start = as_array(start, "start", shape=(3,))
-    method = check_choice(method, "method", METHODS)
+    method = as_choice(method, "method", METHODS)
     rng = as_rng(rng)
-    max_distance = check_positive(max_distance, "max_distance")
+    max_distance = as_positive(max_distance, "max_distance")
     if max_distance > 1000:
         raise ValueError(f"max_distance: expected at most 1000 m, got {max_distance}")
-    share = check_positive(share, "share")
-    settle = check_int(settle, "settle", minimum=0)
+    share = as_positive(share, "share")
+    settle = as_int(settle, "settle", minimum=0)
     if share > 1:
         raise ValueError(f"share: expected a fraction in (0, 1], got {share}")
-    setup.world.check_viewpoint([start[0], start[1], setup.lidar.height], "start")
+    setup.world.as_viewpoint([start[0], start[1], setup.lidar.height], "start")
     centred = move_to_middle_line(setup.world, start, setup.lidar, rng=rng)   # first; the localizer starts after it
     return _run_trial(setup, method, centred, rng, max_distance, share, sigma_x, sigma_y, settle, keep_particles)
 
@@ -384,16 +384,16 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     >>> runs.converged.tolist(), runs.iterations.shape
     ([True], (1,))
     """
-    setup = check_corridor_map(setup)
-    method = check_choice(method, "method", METHODS)
+    setup = as_corridor_map(setup)
+    method = as_choice(method, "method", METHODS)
     fast = fast_mode()
-    trials = (1 if fast else 10) if trials is None else check_int(trials, "trials", minimum=1, maximum=1000)
+    trials = (1 if fast else 10) if trials is None else as_int(trials, "trials", minimum=1, maximum=1000)
     starts = list(range(3 if fast else len(START_POSES))) if positions is None else \
-        [check_int(p, "positions", minimum=0, maximum=len(START_POSES) - 1) for p in positions]
-    seed = check_int(seed, "seed", minimum=0)
-    max_distance = check_positive(max_distance, "max_distance")
-    progress = check_callable(progress, "progress")
-    workers = None if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
+        [as_int(p, "positions", minimum=0, maximum=len(START_POSES) - 1) for p in positions]
+    seed = as_int(seed, "seed", minimum=0)
+    max_distance = as_positive(max_distance, "max_distance")
+    progress = as_callable(progress, "progress")
+    workers = None if workers is None else as_int(workers, "workers", minimum=1, maximum=64)
     code = code_version(__name__)
 
     def cache_file(m: str) -> tuple[Any, dict]:

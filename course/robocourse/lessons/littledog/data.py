@@ -21,7 +21,7 @@ import numpy as np
 
 from robokit.geometry.rotations import rot_x, rot_y, rot_z
 from robokit.geometry.spatial import se3_from_rt
-from robokit.validation import as_rng, check_int, check_positive
+from robokit.validation import as_rng, as_int, as_positive
 from robokit.legged.littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, JOINTS, LEGS, LOWER_LEG,
                         MARKERS, STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG)
 from robokit.legged.mocap import simulate_mocap
@@ -67,7 +67,7 @@ def model_facts() -> dict:
 
 
 def _bounded(value: Any, name: str, high: float) -> float:
-    v = check_positive(value, name, allow_zero=True)
+    v = as_positive(value, name, allow_zero=True)
     if v > high:
         raise ValueError(f"{name}: expected a value in [0, {high:g}], got {v}")
     return v
@@ -124,7 +124,7 @@ def touchdown_trace(rng: Any = None, *, duration: float = 8.0, noise: float = 0.
     ([33, 100, 172], [0.0, 16.39, 13.06])
     """
     g = as_rng(rng)
-    seconds = check_positive(duration, "duration")
+    seconds = as_positive(duration, "duration")
     if not 1.0 <= seconds <= 600.0:
         raise ValueError(f"duration: expected 1 to 600 s (a step to ten minutes), got {seconds}")
     sigma = _bounded(noise, "noise", MAX_TRACE_NOISE)
@@ -182,7 +182,7 @@ def touchdown_traces(seed: int = 0) -> dict:
     >>> sorted(traces), len(traces["clean"]["force"]), len(traces["noisy"]["touchdowns"])
     (['bouncy', 'clean', 'noisy'], 2000, 22)
     """
-    seed = check_int(seed, "seed", minimum=0)
+    seed = as_int(seed, "seed", minimum=0)
     settings = {"clean": (0.05, 0.0, 0.0), "bouncy": (0.1, 0.9, 0.2), "noisy": (0.4, 0.3, 1.0)}
     return {name: touchdown_trace(np.random.default_rng([seed, i]), duration=20.0, noise=noise, bounce=bounce,
                                   drift=drift)
@@ -220,9 +220,9 @@ def mocap_frames(seed: int = 0, n: int = 200, noise: float = 0.001) -> dict:
     >>> np.allclose(data["observed"][0], np.array(data["markers_body"]) @ T[:3, :3].T + T[:3, 3])
     True
     """
-    g = as_rng(check_int(seed, "seed", minimum=0))
-    count = check_int(n, "n", minimum=1, maximum=10_000)
-    sigma = check_positive(noise, "noise", allow_zero=True)
+    g = as_rng(as_int(seed, "seed", minimum=0))
+    count = as_int(n, "n", minimum=1, maximum=10_000)
+    sigma = as_positive(noise, "noise", allow_zero=True)
     roll, pitch = g.uniform(-0.1, 0.1, (2, count))
     yaw = g.uniform(-np.pi, np.pi, count)
     T = se3_from_rt(rot_z(yaw) @ rot_y(pitch) @ rot_x(roll),

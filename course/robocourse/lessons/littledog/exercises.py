@@ -26,7 +26,7 @@ from robokit.legged.littledog import HIP_POSITIONS, JOINT_LIMITS, LEGS, MARKERS,
 from robokit.legged.mocap import fit_marker_pose
 from robokit.legged.power import battery_energy, endurance
 from robokit.legged.support import stability_margin
-from robokit.validation import as_array, check_positive
+from robokit.validation import as_array, as_positive
 from robocourse.exercises.compare import close
 from robocourse.exercises.plain import summarize
 from robocourse.exercises.spec import Case, Exercise
@@ -103,7 +103,7 @@ def detect_touchdowns(force: Any, dt: float) -> list:
     [2]
     """
     f = as_array(force, "force", ndim=1)
-    period = check_positive(dt, "dt")
+    period = as_positive(dt, "dt")
     on, off = 5.0, 3.0
     debounce, look_back = max(1, round(0.03 / period)), max(1, round(0.08 / period))
     found = []

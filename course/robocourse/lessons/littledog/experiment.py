@@ -32,7 +32,7 @@ import numpy as np
 from robocourse import FAST
 from robokit.controllers import LITTLEDOG_MOTOR, servo_analysis
 from robokit.progress import progress_bar
-from robokit.validation import as_array, check_callable, check_int, check_positive, describe
+from robokit.validation import as_array, as_callable, as_int, as_positive, describe
 from robokit.legged.gait import WalkPlan, walking_plan
 from robokit.legged.gait_schedule import crawl_gait, trot_gait
 from robokit.legged.littledog import GUIDE, MARKERS, TOTAL_MASS
@@ -83,7 +83,7 @@ def lesson_plans(distance: float = LESSON_DISTANCE) -> dict:
     >>> sorted(plans), round(float(plans["trot"].T_world_body[-1, 0, 3]), 6)
     (['crawl', 'trot'], 0.2)
     """
-    distance = check_positive(distance, "distance")
+    distance = as_positive(distance, "distance")
     return {"crawl": walking_plan(crawl_gait(**LESSON_CRAWL), distance),
             "trot": walking_plan(trot_gait(**LESSON_TROT), distance)}
 
@@ -125,7 +125,7 @@ def loop_table(plan: WalkPlan, *, servo_rates: Any = (500.0, 100.0), latencies: 
     rates = as_array(servo_rates, "servo_rates", ndim=1, min_size=1)
     lats = as_array(latencies, "latencies", ndim=1, min_size=1)
     bws = as_array(bandwidths, "bandwidths", ndim=1, min_size=1)
-    progress = check_callable(progress, "progress")
+    progress = as_callable(progress, "progress")
     for rate in rates:              # every setting is refused by name before the first trial runs
         try:
             LoopSettings(servo_rate=float(rate))
@@ -267,8 +267,8 @@ def touchdown_table(log: TrialLog, detectors: Any = None, *, tolerance: int = 5,
     if not isinstance(log, TrialLog):
         raise TypeError(f"log: expected a TrialLog, got {type(log).__name__}")
     detectors = _detectors(detectors, log)
-    tolerance = check_int(tolerance, "tolerance", minimum=0)
-    gate = check_int(gate, "gate", minimum=0)
+    tolerance = as_int(tolerance, "tolerance", minimum=0)
+    gate = as_int(gate, "gate", minimum=0)
     dt_ms = 1000.0 * float(log.t[1] - log.t[0])
     truth = np.asarray(log.contact)
     rows = []

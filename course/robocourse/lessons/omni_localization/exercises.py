@@ -8,8 +8,8 @@ from robokit.localization.pose_ekf import ekf_update
 from robokit.mapping.relaxation import relax_sweep
 from robokit.vision.colour import histogram_distance, hue_histogram, rgb_to_hsi
 from robokit.vision.matching import DescriptorIndex
-from robokit.vision.ratio import check_ratio
-from robokit.validation import as_array, check_int
+from robokit.vision.ratio import as_ratio
+from robokit.validation import as_array, as_int
 from robocourse.exercises.compare import close, exact
 from robocourse.exercises.spec import Case, Exercise
 
@@ -77,7 +77,7 @@ def fine_stage_counts(query, node_descriptors, candidates, ratio: float = RATIO)
     cand = as_array(candidates, "candidates", ndim=1)
     if cand.size and (np.any(cand != np.round(cand)) or cand.min() < 0 or cand.max() >= len(nodes)):
         raise ValueError(f"candidates: expected node indices in [0, {len(nodes)}), got {cand.tolist()}")
-    return _counts(q, nodes, cand, check_ratio(ratio), "query")
+    return _counts(q, nodes, cand, as_ratio(ratio), "query")
 
 
 def _counts(q: np.ndarray, nodes: list, cand: np.ndarray, ratio: float, qname: str) -> np.ndarray:
@@ -138,9 +138,9 @@ def recognise_node(query_histogram, query_descriptors, node_histograms, node_des
     nodes = _node_list(node_descriptors, q.shape[1])
     if len(nodes) != len(H):
         raise ValueError(f"node_descriptors: expected one array per node ({len(H)}), got {len(nodes)}")
-    k = check_int(top_k, "top_k", minimum=1)
+    k = as_int(top_k, "top_k", minimum=1)
     coarse = np.argsort(histogram_distance(h, H), kind="stable")[:k]
-    counts = _counts(q, nodes, coarse, check_ratio(ratio), "query_descriptors")
+    counts = _counts(q, nodes, coarse, as_ratio(ratio), "query_descriptors")
     return int(coarse[int(np.argmax(counts))])
 
 

@@ -43,9 +43,9 @@ from robokit.mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, 
 from robokit.progress import progress_bar
 from robokit.sim import OmniCamera, describe_sensor, office_floor, office_tour, record_stream
 from robokit.sim.world import World
-from robokit.validation import as_points, as_rng, check_callable, check_choice, check_int, check_positive
+from robokit.validation import as_points, as_rng, as_callable, as_choice, as_int, as_positive
 
-__all__ = ["OfficeSetup", "office_setup", "check_setup", "localization_trials",
+__all__ = ["OfficeSetup", "office_setup", "as_setup", "localization_trials",
            "LocalizationTrials", "route_recognition"]
 
 MODES = ("coarse", "fine", "hierarchical")
@@ -156,7 +156,7 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     (True, True)
     """
     fast = fast_mode() if fast is None else bool(fast)
-    progress = check_callable(progress, "progress")
+    progress = as_callable(progress, "progress")
     world = office_floor()
     camera = OmniCamera(width=320, height=240, face_size=200) if fast else OmniCamera()
     rate = 0.7 if fast else 1.0
@@ -183,7 +183,7 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
                        relaxation, least_squares, truth, seconds, key)
 
 
-def check_setup(setup: Any) -> OfficeSetup:
+def as_setup(setup: Any) -> OfficeSetup:
     """``setup`` if it is an :class:`OfficeSetup`, else a TypeError naming it."""
     if not isinstance(setup, OfficeSetup):
         raise TypeError(f"setup: expected an OfficeSetup from office_setup(), got {type(setup).__name__}")
@@ -261,13 +261,13 @@ def localization_trials(setup: OfficeSetup, places: Any, *, modes: tuple = MODES
     >>> trials.errors["coarse"].shape, sorted(trials.times["coarse"])[:2]
     ((2, 2), ['coarse', 'histogram'])
     """
-    setup = check_setup(setup)
+    setup = as_setup(setup)
     P = as_points(places, "places", 3, min_count=1)
     if not isinstance(modes, tuple) or not modes:
         raise TypeError(f"modes: expected a non-empty tuple of {MODES}, got {modes!r}")
-    modes = tuple(check_choice(m, "modes", MODES) for m in modes)
-    tmap = getattr(setup, check_choice(map, "map", ("relaxed", "optimized", "raw")))
-    progress = check_callable(progress, "progress")
+    modes = tuple(as_choice(m, "modes", MODES) for m in modes)
+    tmap = getattr(setup, as_choice(map, "map", ("relaxed", "optimized", "raw")))
+    progress = as_callable(progress, "progress")
     rng = as_rng(rng)
     images = [_render(setup, p, rng) for p in P]
     estimates, errors, local_errors, times, results = {}, {}, {}, {}, {}
@@ -327,10 +327,10 @@ def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 
     >>> len(route["nodes"]), 0.0 <= route["rate"] <= 1.0
     (3, True)
     """
-    setup = check_setup(setup)
-    n_nodes = check_int(n_nodes, "n_nodes", minimum=1, maximum=len(setup.raw))
-    offset = check_positive(offset, "offset", allow_zero=True)
-    same_place = check_positive(same_place, "same_place")
+    setup = as_setup(setup)
+    n_nodes = as_int(n_nodes, "n_nodes", minimum=1, maximum=len(setup.raw))
+    offset = as_positive(offset, "offset", allow_zero=True)
+    same_place = as_positive(same_place, "same_place")
     target = meta = None
     if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):   # a seed: the answer is deterministic
         meta = {"setup": setup.key, "n_nodes": n_nodes, "offset": offset, "same_place": same_place, "rng": int(rng),

@@ -27,8 +27,8 @@ from robokit.cache import (cache_dir, cache_key, read_arrays, record_names, reco
 from robokit.controllers.path_geometry import VisualPath, path_from_poses
 from robokit.localization.hierarchical import HierarchicalLocalizer, Localization
 from robokit.parallel import map_runs
-from robokit.validation import as_array, as_rng, check_callable, check_choice, check_int, check_positive
-from robocourse.lessons.omni_localization.experiment import OfficeSetup, check_setup
+from robokit.validation import as_array, as_rng, as_callable, as_choice, as_int, as_positive
+from robocourse.lessons.omni_localization.experiment import OfficeSetup, as_setup
 from robokit.navigation.visual_path import FollowResult, follow_path, perturbed_starts
 
 __all__ = ["omni_localizer", "navigation_trials", "NavigationTrials"]
@@ -73,9 +73,9 @@ def omni_localizer(setup: OfficeSetup, *, noise: float = 1.0, map: str = "relaxe
     >>> bool(fix is None or np.hypot(*(fix[:2] - setup.truth[3, :2])) < 3.0), localize.calls
     (True, 1)
     """
-    setup = check_setup(setup)
-    noise = check_positive(noise, "noise", allow_zero=True)
-    tmap = getattr(setup, check_choice(map, "map", ("relaxed", "optimized", "raw")))
+    setup = as_setup(setup)
+    noise = as_positive(noise, "noise", allow_zero=True)
+    tmap = getattr(setup, as_choice(map, "map", ("relaxed", "optimized", "raw")))
     loc = HierarchicalLocalizer(tmap, setup.camera, n_features=setup.n_features)
 
     def localize(true_pose: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
@@ -206,20 +206,20 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
     >>> len(trials.runs), trials.goal_errors.shape, trials.nodes.size
     (1, (1,), 5)
     """
-    setup = check_setup(setup)
-    n_starts = check_int(n_starts, "n_starts", minimum=1, maximum=1000)
-    clearance = check_positive(clearance, "clearance", allow_zero=True)
-    offset = check_positive(offset, "offset", allow_zero=True)
-    radius = check_positive(success_radius, "success_radius")
-    count = check_int(n_path_nodes, "n_path_nodes", minimum=2, maximum=len(setup.relaxed))
+    setup = as_setup(setup)
+    n_starts = as_int(n_starts, "n_starts", minimum=1, maximum=1000)
+    clearance = as_positive(clearance, "clearance", allow_zero=True)
+    offset = as_positive(offset, "offset", allow_zero=True)
+    radius = as_positive(success_radius, "success_radius")
+    count = as_int(n_path_nodes, "n_path_nodes", minimum=2, maximum=len(setup.relaxed))
     if first_node is None:
         first = _open_stretch(setup, count, clearance + offset)
     else:
-        first = check_int(first_node, "first_node", minimum=0, maximum=len(setup.relaxed) - count)
-    progress = check_callable(progress, "progress")
+        first = as_int(first_node, "first_node", minimum=0, maximum=len(setup.relaxed) - count)
+    progress = as_callable(progress, "progress")
     default_localizer = localize is None
-    localize = None if default_localizer else check_callable(localize, "localize", optional=False)
-    seed = check_int(seed, "seed", minimum=0)
+    localize = None if default_localizer else as_callable(localize, "localize", optional=False)
+    seed = as_int(seed, "seed", minimum=0)
     rng = as_rng(seed)
     path = path_from_poses(as_array(setup.relaxed.poses[first:first + count], "poses"))
     starts = perturbed_starts(path, n_starts, offset=offset, heading=heading, rng=rng)

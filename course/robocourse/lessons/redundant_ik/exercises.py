@@ -70,7 +70,7 @@ def solve_ik(T: Any, q_start: Any) -> np.ndarray:
     True
     """
     T = as_se3(T, "T")
-    q0 = _IIWA.check_q(q_start, "q_start")
+    q0 = _IIWA.as_q(q_start, "q_start")
     q, _, cost = ik_srs_reference(_IIWA, T, q0)
     if not np.isfinite(cost):
         raise ValueError("T: no posture of the iiwa reaches this target inside its joint limits "

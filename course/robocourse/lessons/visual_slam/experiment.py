@@ -32,7 +32,7 @@ from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
 from robokit.geometry import paper_world_to_robokit, se2_to_pqt, wrap_angle
 from robokit.progress import progress_bar
 from robokit.sim import PinholeCamera, StereoRig, World, lab_lap, lab_room, record
-from robokit.validation import as_points, check_callable, check_choice, check_int, check_positive, describe
+from robokit.validation import as_points, as_callable, as_choice, as_int, as_positive, describe
 from robokit.vision.stereo import StereoCalibration
 from robokit.localization.visual_slam import DESCRIPTORS, FEATURE_METHODS, VisualSLAM
 
@@ -112,12 +112,12 @@ def mapping_run(rate: float = 1.0, *, baseline: float = 0.12, seed: int = 0):
     """
     world = lab_room()
     rig = _lab_rig(baseline)
-    run = record(world, lab_lap(world), {"stereo": rig}, rate=check_positive(rate, "rate"), seed=seed)
+    run = record(world, lab_lap(world), {"stereo": rig}, rate=as_positive(rate, "rate"), seed=seed)
     return run, rig
 
 
 def _lab_rig(baseline: float = 0.12) -> StereoRig:
-    return StereoRig(PinholeCamera.from_fov(), baseline=check_positive(baseline, "baseline"))
+    return StereoRig(PinholeCamera.from_fov(), baseline=as_positive(baseline, "baseline"))
 
 
 #: The test-pose results in a cache file of :func:`lab_experiment`.
@@ -238,16 +238,16 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     (1, True)
     """
     # every argument is checked before the (long) mapping run
-    method = check_choice(method, "method", FEATURE_METHODS)
-    descriptor = check_choice(descriptor, "descriptor", DESCRIPTORS)
-    rate = check_positive(rate, "rate")
-    frames = None if frames is None else check_int(frames, "frames", minimum=2)
+    method = as_choice(method, "method", FEATURE_METHODS)
+    descriptor = as_choice(descriptor, "descriptor", DESCRIPTORS)
+    rate = as_positive(rate, "rate")
+    frames = None if frames is None else as_int(frames, "frames", minimum=2)
     if test_poses is None:
         test_poses = LAB_TEST_POSES[:1] if FAST else LAB_TEST_POSES
     poses = as_points(test_poses, "test_poses", 3, min_count=1)
-    noise = check_positive(noise, "noise", allow_zero=True)
-    seed = check_int(seed, "seed", minimum=0)
-    progress = check_callable(progress, "progress")
+    noise = as_positive(noise, "noise", allow_zero=True)
+    seed = as_int(seed, "seed", minimum=0)
+    progress = as_callable(progress, "progress")
     world = lab_room()
     if not np.all(world.is_free(poses[:, :2], clearance=0.05)):
         raise ValueError("test_poses: expected poses in the lab's free space, got one inside furniture or walls")
@@ -410,7 +410,7 @@ def map_consistency(landmark_map, world=None, *, camera_height: float = 0.8,
     for attr in ("positions", "covariances", "observations"):
         if not hasattr(landmark_map, attr):
             raise TypeError(f"landmark_map: expected a LandmarkMap with .{attr}, got {type(landmark_map).__name__}")
-    margin = check_positive(margin, "margin", allow_zero=True)
+    margin = as_positive(margin, "margin", allow_zero=True)
     world = lab_room() if world is None else world
     if not isinstance(world, World):
         raise TypeError(f"world: expected a robokit.sim.World or None, got {describe(world)}")

@@ -27,15 +27,15 @@ import cv2
 import numpy as np
 
 from ..geometry import as_se3
-from ..validation import as_array, as_points, check_positive
+from ..validation import as_array, as_points, as_positive
 from ..vision.matching import DescriptorIndex, ratio_match
 from ..vision.ratio import LOWE_RATIO
 from ..vision.omni_features import omni_sift
 from .camera import PinholeCamera
-from .omni import OmniCamera, check_omni_camera
+from .omni import OmniCamera, as_omni_camera
 from .world import World
 
-__all__ = ["ViewPairCheck", "ground_truth_inliers", "sift_view_pair", "omni_ground_truth_inliers", "omni_view_pair"]
+__all__ = ["ViewPairMatches", "ground_truth_inliers", "sift_view_pair", "omni_ground_truth_inliers", "omni_view_pair"]
 
 
 def ground_truth_inliers(camera: PinholeCamera, depth: Any, T1: Any, T2: Any, uv1: Any, uv2: Any,
@@ -85,7 +85,7 @@ def _reprojects(camera: Any, depth: Any, depth_name: str, T1: Any, T2: Any, uv1:
     if np.isnan(depth).any():
         raise ValueError(f"{depth_name}: expected {depth_name} or inf (no surface), got NaN")
     T1, T2 = as_se3(T1, "T1"), as_se3(T2, "T2")
-    tol = check_positive(tol, "tol")
+    tol = as_positive(tol, "tol")
     uv1 = as_points(uv1, "uv1", 2)
     uv2 = as_points(uv2, "uv2", 2)
     if len(uv1) != len(uv2):
@@ -104,7 +104,7 @@ def _reprojects(camera: Any, depth: Any, depth_name: str, T1: Any, T2: Any, uv1:
 
 
 @dataclass(frozen=True)
-class ViewPairCheck:
+class ViewPairMatches:
     """Result of :func:`sift_view_pair`: ``keypoints`` in view 1, ratio-test ``matches`` and the
     fraction of them that agree with the true geometry (``inlier_ratio``)."""
 
@@ -114,7 +114,7 @@ class ViewPairCheck:
 
 
 def sift_view_pair(world: World, camera: PinholeCamera, robot_pose: Any, step: float = 0.3,
-                   ratio: float = 0.8, tol: float = 3.0) -> ViewPairCheck:
+                   ratio: float = 0.8, tol: float = 3.0) -> ViewPairMatches:
     """OpenCV SIFT on two views ``step`` metres apart, matches judged by :func:`ground_truth_inliers`.
 
     Parameters
@@ -133,7 +133,7 @@ def sift_view_pair(world: World, camera: PinholeCamera, robot_pose: Any, step: f
 
     Returns
     -------
-    ViewPairCheck
+    ViewPairMatches
 
     Raises
     ------
@@ -145,8 +145,8 @@ def sift_view_pair(world: World, camera: PinholeCamera, robot_pose: Any, step: f
     The simulator's acceptance check: rendered textures must give a detector what a camera
     image would, hundreds of keypoints and mostly correct matches.
     """
-    step = check_positive(step, "step")
-    ratio = check_positive(ratio, "ratio")
+    step = as_positive(step, "step")
+    ratio = as_positive(ratio, "ratio")
     pose = as_array(robot_pose, "robot_pose", shape=(3,))
     T1 = camera.transform_at(pose)
     T2 = camera.transform_at(pose + [step * np.cos(pose[2]), step * np.sin(pose[2]), 0.0])
@@ -155,14 +155,14 @@ def sift_view_pair(world: World, camera: PinholeCamera, robot_pose: Any, step: f
     k1, d1 = sift.detectAndCompute(cv2.cvtColor(frame1.image, cv2.COLOR_RGB2GRAY), None)
     k2, d2 = sift.detectAndCompute(cv2.cvtColor(frame2.image, cv2.COLOR_RGB2GRAY), None)
     if d1 is None or d2 is None:
-        return ViewPairCheck(len(k1), 0, 0.0)
+        return ViewPairMatches(len(k1), 0, 0.0)
     good = ratio_match(d1, d2, ratio=ratio, method="opencv")
     if not len(good):
-        return ViewPairCheck(len(k1), 0, 0.0)
+        return ViewPairMatches(len(k1), 0, 0.0)
     uv1 = np.array([k1[i].pt for i in good.query])
     uv2 = np.array([k2[j].pt for j in good.train])
     inliers = ground_truth_inliers(camera, frame1.depth, T1, T2, uv1, uv2, tol)
-    return ViewPairCheck(len(k1), len(good), float(inliers.mean()))
+    return ViewPairMatches(len(k1), len(good), float(inliers.mean()))
 
 
 def omni_ground_truth_inliers(camera: OmniCamera, ranges: Any, T1: Any, T2: Any, uv1: Any, uv2: Any,
@@ -217,12 +217,12 @@ def omni_ground_truth_inliers(camera: OmniCamera, ranges: Any, T1: Any, T2: Any,
     >>> omni_ground_truth_inliers(cam, ranges, T1, T2, uv1, uv2[::-1]).tolist()   # swapped: wrong
     [False, False]
     """
-    check_omni_camera(camera)
+    as_omni_camera(camera)
     return _reprojects(camera, ranges, "ranges", T1, T2, uv1, uv2, tol)
 
 
 def omni_view_pair(world: World, camera: OmniCamera, pose1: Any, pose2: Any, *, orientation: str = "radial",
-                   ratio: float = LOWE_RATIO, tol: float = 3.0, method: str = "kdtree") -> ViewPairCheck:
+                   ratio: float = LOWE_RATIO, tol: float = 3.0, method: str = "kdtree") -> ViewPairMatches:
     """SIFT matches between omni views from two robot poses, judged by :func:`omni_ground_truth_inliers`.
 
     Parameters
@@ -244,7 +244,7 @@ def omni_view_pair(world: World, camera: OmniCamera, pose1: Any, pose2: Any, *, 
 
     Returns
     -------
-    ViewPairCheck
+    ViewPairMatches
         ``keypoints`` of view 1, ratio-test ``matches``, and ``inlier_ratio``: the paper's
         "matched accurate rate" (0 when nothing matched).
 
@@ -268,19 +268,19 @@ def omni_view_pair(world: World, camera: OmniCamera, pose1: Any, pose2: Any, *, 
     """
     if not isinstance(world, World):
         raise TypeError(f"world: expected a robokit.sim World, got {type(world).__name__}")
-    check_omni_camera(camera)
-    tol = check_positive(tol, "tol")
+    as_omni_camera(camera)
+    tol = as_positive(tol, "tol")
     T1 = camera.transform_at(as_array(pose1, "pose1", shape=(3,)))
     T2 = camera.transform_at(as_array(pose2, "pose2", shape=(3,)))
-    world.check_viewpoint(T1[:3, 3], "pose1")
-    world.check_viewpoint(T2[:3, 3], "pose2")
+    world.as_viewpoint(T1[:3, 3], "pose1")
+    world.as_viewpoint(T2[:3, 3], "pose2")
     frame1, frame2 = camera.render(world, T1), camera.render(world, T2)
     centre = (camera.cx, camera.cy)
     f1 = omni_sift(frame1.image, centre, camera.radii, orientation=orientation)
     f2 = omni_sift(frame2.image, centre, camera.radii, orientation=orientation)
     good = DescriptorIndex(f1.descriptors, method).match(f2.descriptors, ratio=ratio)
     if not len(good):
-        return ViewPairCheck(len(f1), 0, 0.0)
+        return ViewPairMatches(len(f1), 0, 0.0)
     ok = omni_ground_truth_inliers(camera, frame1.depth, T1, T2, f1.keypoints.xy[good.train],
                                    f2.keypoints.xy[good.query], tol)
-    return ViewPairCheck(len(f1), len(good), float(ok.mean()))
+    return ViewPairMatches(len(f1), len(good), float(ok.mean()))
