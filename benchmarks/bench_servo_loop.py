@@ -4,8 +4,8 @@ Run: ``.venv/bin/python -m benchmarks.bench_servo_loop`` (add ``--quick`` for fe
 
 The simulation calls :func:`robokit.controllers.pd_servo_step` and
 :meth:`robokit.controllers.SetpointChannel.receive` every 2 ms servo tick and
-:func:`robokit.controllers.joint_torque` every 1 ms physics step, for 12 joints. Prints the median
-time per call (microseconds) of each, checked and on its ``validate=False`` fast path, against the
+joint_torque's law (MuJoCo's affine actuator) every 1 ms physics step, for 12 joints. Prints the median
+time per call (microseconds) of each (the servo step also on its ``validate=False`` fast path), against the
 bare numpy expression of the same law timed in the same process (the peer): the ratio says what
 the validation and the call cost on top of the arithmetic. One simulated second takes 500 servo
 steps, 500 receives and 1000 torques.
@@ -60,8 +60,6 @@ def main() -> None:
         ("pd_servo_step, validate=False",
          per_call(lambda: pd_servo_step(q_ref, q, q_prev, kp, kd, dt, vmax, validate=False), calls, reps), bare_pd),
         ("joint_torque, checked", per_call(lambda: joint_torque(q_ref, qd, m), calls, reps), bare_torque),
-        ("joint_torque, validate=False", per_call(lambda: joint_torque(q_ref, qd, m, validate=False), calls, reps),
-         bare_torque),
         ("link tick (due/send every 10 ms, receive)", per_call(tick, calls, reps), bare_pd),
     ]
     print(f"{'call (12 joints)':<44}{'us/call':>9}{'x numpy peer':>14}")

@@ -838,10 +838,10 @@ SPECS: dict[str, Call] = {
     "robokit.controllers.path_following.path_following_command": Call({
         "d": Array(np.array([0.1, -0.2]), "*"), "theta_tilde": Array(np.array([0.1, 0.0]), "*"),
         "curvature": Array(np.array([0.0, 0.5]), "*"), "v": Array(np.array([0.3, 0.3]), "*"), "k2": Real(4.0),
-        "k3": Real(2.8), "validate": Flag(True)}),
+        "k3": Real(2.8)}),
     "robokit.controllers.path_following.saturate_command": Call({
         "v": Array(np.array([0.3, 0.3]), "*"), "omega": Array(np.array([2.0, 0.1]), "*"), "v_max": Real(0.3),
-        "w_max": Real(0.5), "validate": Flag(True)}),
+        "w_max": Real(0.5)}),
     "robokit.controllers.path_following.PathFollower": Call({
         "path": Obj(visual_path), "alpha": Real(2.0), "v_max": Real(0.3), "w_max": Real(1.0), "xi": Real(0.7),
         "goal_tolerance": Real(0.1), "window": Real(1.0, optional=True)}),
@@ -856,15 +856,15 @@ SPECS: dict[str, Call] = {
     "robokit.controllers.path_following_loop.simulate_path_following": Call({
         "path": Obj(visual_path), "start_pose": Array(np.array([0.0, 0.1, 0.0]), "3"), "alpha": Real(2.0),
         "v": Real(0.3), "duration": Real(2.0), "dt": Real(0.1), "w_max": Real(1.0, optional=True), "xi": Real(0.7)}),
-    "robokit.localization.pose_ekf.unicycle_jacobian": Call({"x": Array(EKF_X, "5"), "dt": Real(0.1), "validate": Flag(True)}),
+    "robokit.localization.pose_ekf.unicycle_jacobian": Call({"x": Array(EKF_X, "5"), "dt": Real(0.1)}),
     "robokit.localization.pose_ekf.unicycle_process_noise": Call({
-        "x": Array(EKF_X, "5"), "dt": Real(0.1), "sigma_accel": Real(0.5), "sigma_alpha": Real(1.0), "validate": Flag(True)}),
+        "x": Array(EKF_X, "5"), "dt": Real(0.1), "sigma_accel": Real(0.5), "sigma_alpha": Real(1.0)}),
     "robokit.localization.pose_ekf.ekf_predict": Call({
         "x": Array(EKF_X, "5"), "P": Array(np.eye(5) * 0.01, "5,5"), "dt": Real(0.1),
-        "Q": Array(np.eye(5) * 1e-4, "5,5"), "validate": Flag(True)}),
+        "Q": Array(np.eye(5) * 1e-4, "5,5")}),
     "robokit.localization.pose_ekf.ekf_update": Call({
         "x": Array(EKF_X, "N"), "P": Array(np.eye(5) * 0.01, "N,N"), "z": Array(np.array([0.1, 0.2, 3.1]), "N"),
-        "H": Array(np.eye(3, 5), "N,N"), "R": Array(np.eye(3) * 0.01, "N,N"), "angles": Obj((2,)), "validate": Flag(True)}),
+        "H": Array(np.eye(3, 5), "N,N"), "R": Array(np.eye(3) * 0.01, "N,N"), "angles": Obj((2,))}),
     "robokit.localization.pose_ekf.nees": Call({"error": Array(np.array([0.1, -0.2]), "N|N,N"),
                                                 "P": Array(np.diag([0.01, 0.04]), "N,N|N,N,N")}),
     "robokit.localization.pose_ekf.nees_bounds": Call({"dof": Int(5), "runs": Int(50), "confidence": Real(0.95)}),
@@ -976,7 +976,7 @@ SPECS: dict[str, Call] = {
     "robokit.vision.spherical.essential_from_bearings": Call({"b1": Array(bearings, "N,3"),
                                                               "b2": Array(moved_bearings, "N,3")}),
     "robokit.vision.spherical.epipolar_error": Call({"E": Array(essential, "3,3|N,3,3"), "b1": Array(bearings, "N,3"),
-                                                     "b2": Array(moved_bearings, "N,3"), "validate": Flag(True)}),
+                                                     "b2": Array(moved_bearings, "N,3")}),
     "robokit.vision.spherical.ransac_essential": Call({"b1": Array(bearings, "N,3"), "b2": Array(moved_bearings, "N,3"),
                                                        "threshold": Real(0.01), "confidence": Real(0.99),
                                                        "min_inliers": Int(8), "max_iterations": Int(64), "rng": Rng(0)}),
@@ -987,8 +987,7 @@ SPECS: dict[str, Call] = {
                                                    "min_depression": Real(0.35)}),
     "robokit.sim.motion.office_tour": Call({"world": Obj(office), "speed": Real(0.3), "rate": Real(2.0)}),
     "robokit.sim.motion.increment_variances": Call({"delta": Array(np.array([[0.1, 1.0, -0.1]]), "3|N,3"),
-                                                    "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"),
-                                                    "validate": Flag(True)}),
+                                                    "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4")}),
     "robokit.sim.motion.odometry_covariance": Call({"odometry": Array(lambda: lap().poses[:20], "N,3"),
                                                     "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4")}),
     "robokit.mapping.local_maps.appearance_changed": Call({"distance": Array(np.array([0.01, 0.3]), "|N"),
@@ -1097,7 +1096,7 @@ SPECS: dict[str, Call] = {
     "robokit.mapping.grid_mapping.inverse_range_sensor_model": Call({
         "xy": Array(np.array([[0.5, 0.0], [0.0, 0.7]]), "N,2", min_rows=0), "pose": Array(np.zeros(3), "3"),
         "ranges": Array(np.array([1.0, np.inf, 3.0, 0.5]), "N", inf_ok=True),
-        "angles": Array(np.arange(4) * np.pi / 2, "N"), **grid_model_kinds(), "validate": Flag(True)}),
+        "angles": Array(np.arange(4) * np.pi / 2, "N"), **grid_model_kinds()}),
     "robokit.mapping.grid_mapping.update_log_odds": Call({
         "grid": Obj(small_grid), "pose": Array(np.array([0.1, 0.0, 0.3]), "3"),
         "ranges": Array(np.array([1.0, np.inf, 3.0, 0.5]), "N", inf_ok=True),
@@ -1154,8 +1153,7 @@ SPECS: dict[str, Call] = {
                                                      "b": Array(lambda: orb_descriptors(40, 1), "...,32"),
                                                      "validate": Flag(True)}),
     "robokit.vision.hamming.hamming_distances": Call({"a": Array(orb_descriptors, "N,32", min_rows=0),
-                                                      "b": Array(lambda: orb_descriptors(30, 1), "N,32", min_rows=0),
-                                                      "validate": Flag(True)}),
+                                                      "b": Array(lambda: orb_descriptors(30, 1), "N,32", min_rows=0)}),
     "robokit.vision.hamming.hamming_match": Call({"query": Array(orb_descriptors, "N,32", min_rows=0),
                                                   "train": Array(lambda: orb_descriptors(30, 1), "N,32", min_rows=0),
                                                   "ratio": Real(0.75), "max_distance": Real(50.0, optional=True, inf_ok=True),
@@ -1269,7 +1267,7 @@ SPECS: dict[str, Call] = {
         "weights": Array(np.ones(6), "N|N,N", optional=True), "validate": Flag(True)}),
     "robokit.geometry.procrustes.fit_se3": Call({
         "source": Array(lambda: points(6), "N,3|N,N,3"), "target": Array(lambda: points(6) + 1.0, "N,3|N,N,3"),
-        "weights": Array(np.ones(6), "N|N,N", optional=True), "validate": Flag(True)}),
+        "weights": Array(np.ones(6), "N|N,N", optional=True)}),
     "robokit.legged.mocap.simulate_mocap": Call({
         "T_world_body": Array(sensing_T, "N,4,4|4,4"), "markers_body": Array(sensing_markers, "N,3|3"),
         "noise": Real(0.001), "dropout": Real(0.1), "rng": Rng(0), "bursts": Real(0.1), "burst_length": Int(2)}),
@@ -1360,7 +1358,7 @@ SPECS: dict[str, Call] = {
         "voltage_max": Real(14.8), "continuous_current": Real(1.2, inf_ok=True)}),
     **{f"robokit.controllers.dc_motor.{n}": Call({
         first: Array(np.array([1.0, -2.0, 20.0]), "*"), "joint_velocity": Array(np.array([0.5, 0.0, -3.0]), "*"),
-        "motor": Obj(littledog_motor), "validate": Flag(True)})
+        "motor": Obj(littledog_motor)} | ({"validate": Flag(True)} if n == "motor_current" else {}))
        for n, first in (("joint_torque", "voltage"), ("motor_current", "voltage"), ("electrical_power", "voltage"),
                         ("voltage_for_torque", "torque"))},
     "robokit.controllers.dc_motor.reflected_inertia": Call({"motor": Obj(littledog_motor)}),

@@ -214,12 +214,12 @@ def motor_current(voltage: Any, joint_velocity: Any, motor: DCMotor, validate: b
     return _out((v - motor.back_emf_constant * omega_m) / motor.resistance)     # Sec. 2.3: R i = V - k_e omega_m
 
 
-def joint_torque(voltage: Any, joint_velocity: Any, motor: DCMotor, validate: bool = True) -> float | np.ndarray:
+def joint_torque(voltage: Any, joint_velocity: Any, motor: DCMotor) -> float | np.ndarray:
     """Torque at the joint (N m): ``eta N k_t i - b dq/dt``, with ``V`` saturated at ``+-voltage_max``.
 
     Parameters
     ----------
-    voltage, joint_velocity, motor, validate
+    voltage, joint_velocity, motor
         As in :func:`motor_current`.
 
     Returns
@@ -239,20 +239,20 @@ def joint_torque(voltage: Any, joint_velocity: Any, motor: DCMotor, validate: bo
     >>> np.round(joint_torque([2.0, -2.0], [1.0, 0.0], LITTLEDOG_MOTOR), 4).tolist()
     [0.245, -0.5]
     """
-    v, w = _inputs(voltage, joint_velocity, motor, validate)
+    v, w = _inputs(voltage, joint_velocity, motor, True)
     i = motor_current(v, w, motor, validate=False)
     tau = motor.efficiency * motor.gear_ratio * motor.torque_constant * np.asarray(i)    # Sec. 2.3: tau_m = k_t i
     return _out(tau - motor.viscous_friction * w)
 
 
-def voltage_for_torque(torque: Any, joint_velocity: Any, motor: DCMotor, validate: bool = True) -> float | np.ndarray:
+def voltage_for_torque(torque: Any, joint_velocity: Any, motor: DCMotor) -> float | np.ndarray:
     """Voltage that gives ``torque`` at ``joint_velocity``: the exact inverse of :func:`joint_torque` before saturation.
 
     Parameters
     ----------
     torque : float or array_like
         Wanted joint torque (N m).
-    joint_velocity, motor, check
+    joint_velocity, motor
         As in :func:`motor_current`.
 
     Returns
@@ -273,18 +273,18 @@ def voltage_for_torque(torque: Any, joint_velocity: Any, motor: DCMotor, validat
     >>> round(v, 6), round(joint_torque(v, 1.0, LITTLEDOG_MOTOR), 6)
     (2.0, 0.245)
     """
-    tau, w = _inputs(torque, joint_velocity, motor, validate, first="torque")
+    tau, w = _inputs(torque, joint_velocity, motor, True, first="torque")
     n = motor.gear_ratio
     current = (tau + motor.viscous_friction * w) / (motor.efficiency * n * motor.torque_constant)
     return _out(current * motor.resistance + motor.back_emf_constant * n * w)     # Sec. 2.3: V = R i + k_e omega_m
 
 
-def electrical_power(voltage: Any, joint_velocity: Any, motor: DCMotor, validate: bool = True) -> MotorPower:
+def electrical_power(voltage: Any, joint_velocity: Any, motor: DCMotor) -> MotorPower:
     """Electrical power per motor (W): copper loss, mechanical (shaft) power and their sum ``V i``.
 
     Parameters
     ----------
-    voltage, joint_velocity, motor, validate
+    voltage, joint_velocity, motor
         As in :func:`motor_current` (the voltage saturated at ``+-voltage_max``).
 
     Returns
@@ -310,7 +310,7 @@ def electrical_power(voltage: Any, joint_velocity: Any, motor: DCMotor, validate
     >>> round(p.copper, 4), round(p.mechanical, 4), round(p.total, 4)
     (8.3333, 8.3333, 16.6667)
     """
-    v, w = _inputs(voltage, joint_velocity, motor, validate)
+    v, w = _inputs(voltage, joint_velocity, motor, True)
     i = np.asarray(motor_current(v, w, motor, validate=False))
     v = np.clip(v, -motor.voltage_max, motor.voltage_max)
     shape = np.shape(i)
@@ -318,8 +318,7 @@ def electrical_power(voltage: Any, joint_velocity: Any, motor: DCMotor, validate
         copper = motor.resistance * i ** 2                                          # Joule loss R i^2
         mechanical = motor.back_emf_constant * motor.gear_ratio * np.asarray(w) * i     # k_e omega_m i
         total = np.asarray(v) * i                                                   # V i = R i^2 + k_e omega_m i
-    if validate:
-        require_finite_result("voltage, joint_velocity", copper, mechanical)
+    require_finite_result("voltage, joint_velocity", copper, mechanical)
     return MotorPower(_out(copper), _out(np.broadcast_to(mechanical, shape)), _out(np.broadcast_to(total, shape)))
 
 

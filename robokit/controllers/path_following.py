@@ -102,8 +102,7 @@ def path_following_gains(alpha: float, xi: float = XI) -> tuple[float, float]:
     return k2, k3
 
 
-def path_following_command(d: Any, theta_tilde: Any, curvature: Any, v: Any, k2: float, k3: float, *,
-                           validate: bool = True) -> Any:
+def path_following_command(d: Any, theta_tilde: Any, curvature: Any, v: Any, k2: float, k3: float) -> Any:
     """Turn rate ``omega`` of the path-following law, Eq. (8).
 
     ``omega = -k3 |v| theta_tilde - k2 v d sin(theta_tilde)/theta_tilde + v cos(theta_tilde) c / (1 - c d)``
@@ -120,9 +119,6 @@ def path_following_command(d: Any, theta_tilde: Any, curvature: Any, v: Any, k2:
         Forward speed (m/s).
     k2, k3 : float
         Gains (>= 0), e.g. from :func:`path_following_gains`.
-    validate : bool, default True
-        Validate the inputs; ``False`` is the fast path for a control loop that already did (the
-        singularity is still refused).
 
     Returns
     -------
@@ -152,31 +148,32 @@ def path_following_command(d: Any, theta_tilde: Any, curvature: Any, v: Any, k2:
     >>> round(path_following_command(0.0, 0.0, 0.5, 0.3, k2=4.0, k3=2.83), 4)     # on a circle: v c
     0.15
     """
-    if validate:
-        dd, th, c, vv = (as_array(x, n) for x, n in ((d, "d"), (theta_tilde, "theta_tilde"),
-                                                   (curvature, "curvature"), (v, "v")))
-        g2, g3 = as_positive(k2, "k2", allow_zero=True), as_positive(k3, "k3", allow_zero=True)
-        try:
-            shape = np.broadcast_shapes(dd.shape, th.shape, c.shape, vv.shape)
-        except ValueError:
-            raise ValueError(f"d, theta_tilde, curvature, v: expected shapes that broadcast, got {dd.shape}, "
-                             f"{th.shape}, {c.shape} and {vv.shape}") from None
-    else:
-        dd, th, c, vv, g2, g3 = d, theta_tilde, curvature, v, k2, k3
+    dd, th, c, vv = (as_array(x, n) for x, n in ((d, "d"), (theta_tilde, "theta_tilde"),
+                                               (curvature, "curvature"), (v, "v")))
+    g2, g3 = as_positive(k2, "k2", allow_zero=True), as_positive(k3, "k3", allow_zero=True)
+    try:
+        shape = np.broadcast_shapes(dd.shape, th.shape, c.shape, vv.shape)
+    except ValueError:
+        raise ValueError(f"d, theta_tilde, curvature, v: expected shapes that broadcast, got {dd.shape}, "
+                         f"{th.shape}, {c.shape} and {vv.shape}") from None
+    omega = _command(dd, th, c, vv, g2, g3)
+    require_finite_result("d, theta_tilde, curvature, v, k2, k3", omega)
+    omega = np.broadcast_to(omega, shape)
+    return float(omega) if omega.ndim == 0 else np.array(omega)
+
+
+def _command(dd: Any, th: Any, c: Any, vv: Any, g2: float, g3: float) -> Any:
+    """Unchecked Eq. (8) of :func:`path_following_command` (the singularity is still refused)."""
     den = 1.0 - c * dd
     if np.any(den <= 0):
         raise PathSingularityError("d, curvature: expected 1 - curvature * d > 0 (the robot on the near side of "
                                    "the path's centre of curvature), got 1 - c d <= 0")
     with np.errstate(over="ignore", invalid="ignore"):
         omega = -g3 * np.abs(vv) * th - g2 * vv * dd * np.sinc(th / np.pi) + vv * np.cos(th) * c / den   # Eq. (8)
-    if not validate:
-        return float(omega) if np.ndim(omega) == 0 else omega
-    require_finite_result("d, theta_tilde, curvature, v, k2, k3", omega)
-    omega = np.broadcast_to(omega, shape)
-    return float(omega) if omega.ndim == 0 else np.array(omega)
+    return float(omega) if np.ndim(omega) == 0 else omega
 
 
-def saturate_command(v: Any, omega: Any, v_max: float, w_max: float, *, validate: bool = True) -> tuple[Any, Any]:
+def saturate_command(v: Any, omega: Any, v_max: float, w_max: float) -> tuple[Any, Any]:
     """Limit ``|v| <= v_max`` and ``|omega| <= w_max`` keeping the curvature ``omega / v``.
 
     Parameters
@@ -185,8 +182,6 @@ def saturate_command(v: Any, omega: Any, v_max: float, w_max: float, *, validate
         Commanded forward speed (m/s) and turn rate (rad/s).
     v_max, w_max : float
         Limits (> 0).
-    validate : bool, default True
-        Validate the inputs; ``False`` for scalars a control loop computed itself.
 
     Returns
     -------
@@ -211,9 +206,6 @@ def saturate_command(v: Any, omega: Any, v_max: float, w_max: float, *, validate
     >>> round(v, 4), round(w, 4), round(w / v, 4)                   # curvature 2 / 0.3 kept
     (0.075, 0.5, 6.6667)
     """
-    if not validate:
-        scale = min(1.0, v_max / abs(v) if v else 1.0, w_max / abs(omega) if omega else 1.0)
-        return v * scale, omega * scale
     vv, ww = as_array(v, "v"), as_array(omega, "omega")
     vm, wm = as_positive(v_max, "v_max"), as_positive(w_max, "w_max")
     try:
@@ -224,6 +216,12 @@ def saturate_command(v: Any, omega: Any, v_max: float, w_max: float, *, validate
         scale = np.minimum(1.0, np.minimum(vm / np.abs(vv), wm / np.abs(ww)))
     vs, ws = vv * scale, ww * scale
     return (float(vs), float(ws)) if vs.ndim == 0 else (vs, ws)
+
+
+def _saturate(v: float, omega: float, v_max: float, w_max: float) -> tuple[float, float]:
+    """:func:`saturate_command` on floats a control loop computed itself (unchecked)."""
+    scale = min(1.0, v_max / abs(v) if v else 1.0, w_max / abs(omega) if omega else 1.0)
+    return v * scale, omega * scale
 
 
 class PathFollower:
@@ -351,7 +349,7 @@ def reference_command(ref: ReferencePoint, v: float, k2: float, k3: float, w_max
     (0.25, -0.2)
     """
     c = ref.curvature if 1 - ref.curvature * ref.d >= 0.1 else 0.0
-    omega = path_following_command(ref.d, ref.theta_tilde, c, v, k2, k3, validate=False)
+    omega = _command(ref.d, ref.theta_tilde, c, v, k2, k3)
     if w_max is None:
         return float(v), float(omega)
-    return saturate_command(v, omega, v, w_max, validate=False)
+    return _saturate(v, omega, v, w_max)

@@ -353,7 +353,7 @@ def pqt_robot_to_world(points: Any, pqt: Any, *, validate: bool = True) -> np.nd
     return _points(points, pqt, validate, inverse=False)
 
 
-def pqt_world_to_robot(points: Any, pqt: Any, *, validate: bool = True) -> np.ndarray:
+def pqt_world_to_robot(points: Any, pqt: Any) -> np.ndarray:
     """Map points from the papers' world frame into their robot frame at ``pqt`` (inverse of
     :func:`pqt_robot_to_world`).
 
@@ -362,8 +362,6 @@ def pqt_world_to_robot(points: Any, pqt: Any, *, validate: bool = True) -> np.nd
     points : array_like, shape (..., 3)
     pqt : array_like, shape (..., 3)
         The papers' pose(s) ``[p, q, theta]`` (not robokit's ``[x, y, theta]``).
-    validate : bool, default True
-        Validate the inputs; ``False`` skips it.
 
     Returns
     -------
@@ -385,7 +383,7 @@ def pqt_world_to_robot(points: Any, pqt: Any, *, validate: bool = True) -> np.nd
     >>> print(np.round(pqt_world_to_robot([[1.0, 0.5, 1.0]], [2.0, 1.0, np.pi / 2]), 6))
     [[0.  0.5 1. ]]
     """
-    return _points(points, pqt, validate, inverse=True)
+    return _points(points, pqt, True, inverse=True)
 
 
 def _points(points, pqt, validate, inverse):

@@ -226,7 +226,7 @@ def fit_se2(source: Any, target: Any, weights: Any = None, *, validate: bool = T
     return np.stack([t[..., 0], t[..., 1], wrap_angle(np.arctan2(R[..., 1, 0], R[..., 0, 0]))], axis=-1)
 
 
-def fit_se3(source: Any, target: Any, weights: Any = None, *, validate: bool = True) -> np.ndarray:
+def fit_se3(source: Any, target: Any, weights: Any = None) -> np.ndarray:
     """Least-squares rigid transform taking ``source`` points onto ``target`` points (3-D Procrustes).
 
     Parameters
@@ -236,9 +236,6 @@ def fit_se3(source: Any, target: Any, weights: Any = None, *, validate: bool = T
         independent problems (one per MoCap frame, say).
     weights : array_like, shape (..., N), optional
         Non-negative weight per correspondence (default: all 1); zero drops a point.
-    validate : bool, default True
-        Validate the inputs and refuse a degenerate set; ``False`` (float arrays of matching shapes,
-        positive weight sums) is the fast path: a degenerate set then gives one of its minimisers.
 
     Returns
     -------
@@ -250,7 +247,7 @@ def fit_se3(source: Any, target: Any, weights: Any = None, *, validate: bool = T
     Raises
     ------
     DegenerateFitError
-        (A ``ValueError``, with ``validate``) for fewer than three points, or points that coincide or
+        (A ``ValueError``) for fewer than three points, or points that coincide or
         lie on one line (a rotation about that line is then free).
     ValueError
         For shapes that do not agree, NaN/inf, or negative or all-zero weights.
@@ -276,12 +273,10 @@ def fit_se3(source: Any, target: Any, weights: Any = None, *, validate: bool = T
      [ 0.        0.        1.        0.13    ]
      [ 0.        0.        0.        1.      ]]
     """
-    if validate:
-        s = as_array(source, "source")
-        if s.ndim < 2 or s.shape[-1] != 3:
-            raise ValueError(f"source: expected shape (..., N, 3) with N >= 3, got shape {s.shape}")
-        source = s
-    R, t, _ = fit_rigid(source, target, weights, validate=validate)
+    s = as_array(source, "source")
+    if s.ndim < 2 or s.shape[-1] != 3:
+        raise ValueError(f"source: expected shape (..., N, 3) with N >= 3, got shape {s.shape}")
+    R, t, _ = fit_rigid(s, target, weights)
     T = np.zeros(R.shape[:-2] + (4, 4))
     T[..., :3, :3], T[..., :3, 3], T[..., 3, 3] = R, t, 1.0
     return T

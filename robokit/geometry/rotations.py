@@ -110,14 +110,12 @@ def require_rotation_block(R: np.ndarray, name: str, tol: float = ROTATION_TOL, 
                          + (f" at index {i}" if indexed else ""))
 
 
-def skew(v: Any, *, validate: bool = True) -> np.ndarray:
+def skew(v: Any) -> np.ndarray:
     """Return the skew-symmetric matrix ``[v]`` with ``[v] x = v x x`` (cross product).
 
     Parameters
     ----------
     v : array_like, shape (..., 3)
-    validate : bool, default True
-        Validate ``v``; ``False`` skips it (for solvers' inner loops).
 
     Returns
     -------
@@ -137,7 +135,11 @@ def skew(v: Any, *, validate: bool = True) -> np.ndarray:
     >>> skew([1.0, 2.0, 3.0]).tolist()
     [[0.0, -3.0, 2.0], [3.0, 0.0, -1.0], [-2.0, 1.0, 0.0]]
     """
-    v = _vectors(v, "v") if validate else np.asarray(v, dtype=float)
+    return _skew(_vectors(v, "v"))
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    """Unchecked :func:`skew`."""
     z = np.zeros(v.shape[:-1])
     return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1),
                      np.stack([v[..., 2], z, -v[..., 0]], -1),
@@ -199,7 +201,7 @@ def so3_exp(rotvec: Any, *, validate: bool = True) -> np.ndarray:
     ts = np.where(small, 1.0, t)
     a = np.where(small, 1.0 - t2 / 6.0, np.sin(ts) / ts)                       # sin t / t
     b = np.where(small, 0.5 - t2 / 24.0, 2.0 * np.sin(0.5 * ts) ** 2 / ts**2)  # (1 - cos t) / t^2
-    K = skew(v, validate=False)
+    K = _skew(v)
     return _EYE3 + a[..., None, None] * K + b[..., None, None] * (K @ K)
 
 

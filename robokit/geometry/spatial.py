@@ -191,16 +191,13 @@ def se3_compose(*transforms: Any) -> np.ndarray:
     return out
 
 
-def transform_points(transform: Any, points: Any, *, validate: bool = True) -> np.ndarray:
+def transform_points(transform: Any, points: Any) -> np.ndarray:
     """Apply a 4x4 rigid transform to points: ``R p + t`` for each row of ``points``.
 
     Parameters
     ----------
     transform : array_like, shape (4, 4)
     points : array_like, shape (N, 3) or (3,)
-    validate : bool, default True
-        Validate both arguments; ``False`` skips it (the caller passes a float (4, 4) transform and
-        (N, 3) points).
 
     Returns
     -------
@@ -221,12 +218,8 @@ def transform_points(transform: Any, points: Any, *, validate: bool = True) -> n
     >>> print(np.round(transform_points(T, [1.0, 0.0, 0.0]), 6))
     [[1. 1. 0.]]
     """
-    if validate:
-        T = as_se3(transform, "transform")
-        P = as_points(points, "points", 3)
-    else:
-        T, P = transform, points
-    return P @ T[:3, :3].T + T[:3, 3]
+    T = as_se3(transform, "transform")
+    return as_points(points, "points", 3) @ T[:3, :3].T + T[:3, 3]
 
 
 def se2_to_se3(pose: Any, z: float = 0.0) -> np.ndarray:

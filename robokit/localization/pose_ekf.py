@@ -59,7 +59,7 @@ def _sinc_and_slope(u: float) -> tuple[float, float]:
     return np.sin(u) / u, (u * np.cos(u) - np.sin(u)) / (u * u)
 
 
-def unicycle_jacobian(x: Any, dt: float, *, validate: bool = True) -> np.ndarray:
+def unicycle_jacobian(x: Any, dt: float) -> np.ndarray:
     """Jacobian ``F = df/dx`` of the constant-velocity unicycle step over ``dt`` seconds.
 
     Parameters
@@ -68,8 +68,6 @@ def unicycle_jacobian(x: Any, dt: float, *, validate: bool = True) -> np.ndarray
         State ``[x, y, theta, v, omega]``.
     dt : float
         Step (s, >= 0).
-    validate : bool, default True
-        Validate the inputs; ``False`` for a filter loop that already did.
 
     Returns
     -------
@@ -89,9 +87,13 @@ def unicycle_jacobian(x: Any, dt: float, *, validate: bool = True) -> np.ndarray
     >>> np.round(F[:3, 2:], 4).tolist()          # d(x, y, theta) / d(theta, v, omega)
     [[0.0, 0.5, 0.0], [0.5, 0.0, 0.125], [1.0, 0.0, 0.5]]
     """
-    if validate:
-        x = _state(x)
-        dt = as_positive(dt, "dt", allow_zero=True)
+    F = _jacobian(_state(x), as_positive(dt, "dt", allow_zero=True))
+    require_finite_result("x, dt", F)
+    return F
+
+
+def _jacobian(x: np.ndarray, dt: float) -> np.ndarray:
+    """Unchecked :func:`unicycle_jacobian`."""
     th, v, w = float(x[2]), float(x[3]), float(x[4])
     u = w * dt / 2
     S, dS = _sinc_and_slope(u)
@@ -103,13 +105,10 @@ def unicycle_jacobian(x: Any, dt: float, *, validate: bool = True) -> np.ndarray
     F[0, 3], F[1, 3] = dt * S * c, dt * S * s                                # d/dv
     F[0, 4], F[1, 4] = dL_dw * c - L * s * dt / 2, dL_dw * s + L * c * dt / 2   # d/domega
     F[2, 4] = dt
-    if validate:
-        require_finite_result("x, dt", F)
     return F
 
 
-def unicycle_process_noise(x: Any, dt: float, sigma_accel: float, sigma_alpha: float, *,
-                           validate: bool = True) -> np.ndarray:
+def unicycle_process_noise(x: Any, dt: float, sigma_accel: float, sigma_alpha: float) -> np.ndarray:
     """Process noise ``Q = G diag(sigma_accel^2, sigma_alpha^2) G^T`` of one step.
 
     Parameters
@@ -121,8 +120,6 @@ def unicycle_process_noise(x: Any, dt: float, sigma_accel: float, sigma_alpha: f
     sigma_accel, sigma_alpha : float
         Standard deviations (>= 0) of the linear (m/s^2) and angular (rad/s^2) accelerations the
         filter assumes, each constant over a step.
-    validate : bool, default True
-        Validate the inputs.
 
     Returns
     -------
@@ -145,23 +142,24 @@ def unicycle_process_noise(x: Any, dt: float, sigma_accel: float, sigma_alpha: f
     >>> np.round(np.sqrt(np.diag(Q)), 5).tolist()     # 0.5 * 0.1^2 / 2 = 0.0025 on x
     [0.0025, 0.00025, 0.005, 0.05, 0.1]
     """
-    if validate:
-        x = _state(x)
-        dt = as_positive(dt, "dt", allow_zero=True)
-        sigma_accel = as_positive(sigma_accel, "sigma_accel", allow_zero=True)
-        sigma_alpha = as_positive(sigma_alpha, "sigma_alpha", allow_zero=True)
-    F = unicycle_jacobian(x, dt, validate=False)
+    Q = _process_noise(_state(x), as_positive(dt, "dt", allow_zero=True),
+                       as_positive(sigma_accel, "sigma_accel", allow_zero=True),
+                       as_positive(sigma_alpha, "sigma_alpha", allow_zero=True))
+    require_finite_result("x, dt, sigma_accel, sigma_alpha", Q)
+    return Q
+
+
+def _process_noise(x: np.ndarray, dt: float, sigma_accel: float, sigma_alpha: float) -> np.ndarray:
+    """Unchecked :func:`unicycle_process_noise`."""
+    F = _jacobian(x, dt)
     G = np.zeros((5, 2))
     G[:3] = F[:3, 3:5] * (dt / 2)
     G[3, 0] = G[4, 1] = dt
     G = G * np.array([sigma_accel, sigma_alpha])
-    Q = G @ G.T
-    if validate:
-        require_finite_result("x, dt, sigma_accel, sigma_alpha", Q)
-    return Q
+    return G @ G.T
 
 
-def ekf_predict(x: Any, P: Any, dt: float, Q: Any, *, validate: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def ekf_predict(x: Any, P: Any, dt: float, Q: Any) -> tuple[np.ndarray, np.ndarray]:
     """EKF prediction over ``dt`` seconds with the constant-velocity unicycle (Eq. (6)).
 
     Parameters
@@ -174,8 +172,6 @@ def ekf_predict(x: Any, P: Any, dt: float, Q: Any, *, validate: bool = True) -> 
         Step (s, >= 0).
     Q : array_like, shape (5, 5)
         Process noise of the step (positive semidefinite), e.g. :func:`unicycle_process_noise`.
-    validate : bool, default True
-        Validate the inputs.
 
     Returns
     -------
@@ -200,12 +196,13 @@ def ekf_predict(x: Any, P: Any, dt: float, Q: Any, *, validate: bool = True) -> 
     >>> np.round(x, 3).tolist(), round(float(P[1, 1]), 4)    # heading variance spreads sideways
     ([1.0, 0.0, 0.0, 1.0, 0.0], 0.0225)
     """
-    if validate:
-        x = _state(x)
-        P = as_covariance(P, "P", 5)
-        dt = as_positive(dt, "dt", allow_zero=True)
-        Q = as_covariance(Q, "Q", 5, semidefinite=True)
-    F = unicycle_jacobian(x, dt, validate=False)
+    return _predict(_state(x), as_covariance(P, "P", 5), as_positive(dt, "dt", allow_zero=True),
+                    as_covariance(Q, "Q", 5, semidefinite=True))
+
+
+def _predict(x: np.ndarray, P: np.ndarray, dt: float, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unchecked :func:`ekf_predict` (the result's finiteness is still checked: it can overflow)."""
+    F = _jacobian(x, dt)
     x_new = np.empty(5)
     x_new[:3] = unicycle_step(x[:3], x[3], x[4], dt, validate=False)         # Eq. (6), exact arc
     x_new[3:] = x[3:]
@@ -224,8 +221,7 @@ def _innovation(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: n
     return y, H @ P @ H.T + R
 
 
-def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] = (),
-               validate: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] = ()) -> tuple[np.ndarray, np.ndarray]:
     """Kalman update with a linear measurement ``z = H x + noise``, covariance in Joseph form.
 
     Parameters
@@ -242,8 +238,6 @@ def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] 
         Measurement noise covariance (positive definite).
     angles : sequence of int, default ()
         Components of ``z`` that are angles: their innovation is wrapped to ``[-pi, pi)``.
-    validate : bool, default True
-        Validate the inputs.
 
     Returns
     -------
@@ -268,17 +262,22 @@ def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] 
     >>> x.tolist(), P.tolist()
     ([0.5, 0.0], [[0.5, 0.0], [0.0, 1.0]])
     """
-    if validate:
-        x = as_array(x, "x", ndim=1, min_size=1)
-        n = len(x)
-        P = as_covariance(P, "P", n)
-        z = as_array(z, "z", ndim=1, min_size=1)
-        m = len(z)
-        H = as_array(H, "H", shape=(m, n))
-        R = as_covariance(R, "R", m)
-        if not isinstance(angles, (list, tuple, range, np.ndarray)):
-            raise TypeError(f"angles: expected a sequence of indices into z, got {describe(angles)}")
-        angles = [as_int(i, "angles", minimum=0, maximum=m - 1) for i in np.asarray(angles, dtype=object).ravel()]
+    x = as_array(x, "x", ndim=1, min_size=1)
+    n = len(x)
+    P = as_covariance(P, "P", n)
+    z = as_array(z, "z", ndim=1, min_size=1)
+    m = len(z)
+    H = as_array(H, "H", shape=(m, n))
+    R = as_covariance(R, "R", m)
+    if not isinstance(angles, (list, tuple, range, np.ndarray)):
+        raise TypeError(f"angles: expected a sequence of indices into z, got {describe(angles)}")
+    angles = [as_int(i, "angles", minimum=0, maximum=m - 1) for i in np.asarray(angles, dtype=object).ravel()]
+    return _update(x, P, z, H, R, angles)
+
+
+def _update(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.ndarray,
+            angles: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
+    """Unchecked :func:`ekf_update` (the result's finiteness is still checked: it can overflow)."""
     y, S = _innovation(x, P, z, H, R, angles)
     try:
         K = np.linalg.solve(S, H @ P).T                  # K = P H^T S^-1 (S symmetric)
@@ -440,13 +439,13 @@ class UnicycleEKF:
     def predict(self, dt: float) -> None:
         """Move the estimate ``dt`` seconds along Eq. (6) (:func:`ekf_predict`)."""
         h = as_positive(dt, "dt", allow_zero=True)
-        Q = unicycle_process_noise(self._x, h, self.sigma_accel, self.sigma_alpha, validate=False)
-        self._x, self._P = ekf_predict(self._x, self._P, h, Q, validate=False)
+        Q = _process_noise(self._x, h, self.sigma_accel, self.sigma_alpha)
+        self._x, self._P = _predict(self._x, self._P, h, Q)
 
     def update_velocity(self, v: float, omega: float, R: Any) -> None:
         """Fuse odometry's ``(v, omega)`` with covariance ``R`` (2 x 2, positive definite)."""
         z = np.array([as_finite_scalar(v, "v"), as_finite_scalar(omega, "omega")])
-        self._x, self._P = ekf_update(self._x, self._P, z, H_VELOCITY, as_covariance(R, "R", 2), validate=False)
+        self._x, self._P = _update(self._x, self._P, z, H_VELOCITY, as_covariance(R, "R", 2), ())
 
     def update_pose(self, z: Any, R: Any, *, gate: float | None = None) -> bool:
         """Fuse a pose fix ``[x, y, theta]`` with covariance ``R`` (3 x 3); heading innovation wrapped.
@@ -472,6 +471,6 @@ class UnicycleEKF:
         self.nis = float(y @ np.linalg.solve(S, y))
         if g is not None and self.nis > g:
             return False
-        self._x, self._P = ekf_update(self._x, self._P, zz, H_POSE, RR, angles=(2,), validate=False)
+        self._x, self._P = _update(self._x, self._P, zz, H_POSE, RR, (2,))
         self._x[2] = wrap_angle(self._x[2])
         return True

@@ -87,7 +87,7 @@ def _nearest_beam(phi: np.ndarray, angles: np.ndarray) -> np.ndarray:
 
 def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, r_max: float, l_occ: float = L_OCC,
                                l_free: float = L_FREE, l0: float = 0.0, thickness: float = 0.1,
-                               beam_width: float | None = None, validate: bool = True) -> np.ndarray:
+                               beam_width: float | None = None) -> np.ndarray:
     """Log odds that one scan gives each cell (Thrun et al. 2005, Table 9.2), vectorised over cells.
 
     Parameters
@@ -109,8 +109,6 @@ def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, 
         ``alpha``: the depth of an obstacle (metres) around a return.
     beam_width : float, optional
         ``beta``: the opening angle of a beam; default ``2 pi / B`` (a full-turn scan's spacing).
-    validate : bool, default True
-        Validate the inputs; ``False`` skips it (float arrays only).
 
     Returns
     -------
@@ -136,19 +134,19 @@ def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, 
     ...                            r_max=2.0, l_occ=1.0, l_free=-0.5).tolist()
     [-0.5, 1.0, 0.0, -0.5]
     """
-    if validate:
-        pts = as_array(xy, "xy")
-        if pts.ndim != 2 or pts.shape[1] != 2:
-            raise ValueError(f"xy: expected shape (N, 2), got shape {pts.shape}")
-        p = as_array(pose, "pose", shape=(3,))
-        z, a = _as_scan(ranges, angles)
-        if z.ndim != 1:
-            raise ValueError(f"ranges: expected one scan of shape ({a.size},), got shape {z.shape}")
-        z_max, lo, lf, prior, alpha, beta = _model_options(r_max, l_occ, l_free, l0, thickness, beam_width, a.size)
-    else:
-        pts, p, z, a = xy, pose, ranges, angles
-        z_max, lo, lf, prior, alpha = r_max, l_occ, l_free, l0, thickness
-        beta = 2 * np.pi / a.size if beam_width is None else beam_width
+    pts = as_array(xy, "xy")
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise ValueError(f"xy: expected shape (N, 2), got shape {pts.shape}")
+    p = as_array(pose, "pose", shape=(3,))
+    z, a = _as_scan(ranges, angles)
+    if z.ndim != 1:
+        raise ValueError(f"ranges: expected one scan of shape ({a.size},), got shape {z.shape}")
+    return _inverse_model(pts, p, z, a, _model_options(r_max, l_occ, l_free, l0, thickness, beam_width, a.size))
+
+
+def _inverse_model(pts: np.ndarray, p: np.ndarray, z: np.ndarray, a: np.ndarray, opts: tuple) -> np.ndarray:
+    """Unchecked :func:`inverse_range_sensor_model`; ``opts`` as :func:`_model_options` gives them."""
+    z_max, lo, lf, prior, alpha, beta = opts
     d = pts - p[:2]
     r = np.hypot(d[:, 0], d[:, 1])                                         # Table 9.2: range
     phi = wrap_angle(np.arctan2(d[:, 1], d[:, 0]) - p[2])                  # bearing
@@ -172,8 +170,7 @@ def _update(L: np.ndarray, xs: np.ndarray, ys: np.ndarray, sensor: np.ndarray, z
         return
     gx, gy = np.meshgrid(xs[j0:j1], ys[i0:i1])
     cells = np.column_stack([gx.ravel(), gy.ravel()])
-    ism = inverse_range_sensor_model(cells, sensor, z, a, r_max=z_max, l_occ=lo, l_free=lf, l0=prior,
-                                     thickness=alpha, beam_width=beta, validate=False)
+    ism = _inverse_model(cells, sensor, z, a, opts)
     block = L[i0:i1, j0:j1]
     block += (ism - prior).reshape(block.shape)                            # Table 9.1, line 4
     np.clip(block, clamp[0], clamp[1], out=block)

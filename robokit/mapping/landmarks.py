@@ -124,12 +124,17 @@ def kalman_fuse(s, sigma, r_new, sigma_new) -> tuple[np.ndarray, np.ndarray]:
     new = as_array(r_new, "r_new", shape=pts.shape).reshape(n, 3)
     cov = _covariances(as_array(sigma, "sigma", shape=cshape).reshape(n, 3, 3), "sigma", n)
     cov_new = _covariances(as_array(sigma_new, "sigma_new", shape=cshape).reshape(n, 3, 3), "sigma_new", n)
-    pts = pts.reshape(n, 3)
+    mean, fused = _fuse(pts.reshape(n, 3), cov, new, cov_new)
+    return (mean[0], fused[0]) if single else (mean, fused)
+
+
+def _fuse(pts: np.ndarray, cov: np.ndarray, new: np.ndarray, cov_new: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unchecked :func:`kalman_fuse` on stacks: (N, 3) positions, (N, 3, 3) covariances."""
     info, info_new = np.linalg.inv(cov), np.linalg.inv(cov_new)
     fused = np.linalg.inv(info + info_new)
     fused = 0.5 * (fused + np.swapaxes(fused, 1, 2))
     mean = np.einsum("nij,nj->ni", fused, np.einsum("nij,nj->ni", info, pts) + np.einsum("nij,nj->ni", info_new, new))
-    return (mean[0], fused[0]) if single else (mean, fused)
+    return mean, fused
 
 
 def _greedy_one_to_one(fi: np.ndarray, li: np.ndarray, out: np.ndarray) -> np.ndarray:
@@ -305,12 +310,15 @@ class LandmarkMap:
 
         Notes
         -----
-        Se et al. Sec. 3.5 via :func:`kalman_fuse`; resets the landmarks' missed counters.
+        Se et al. Sec. 3.5, :func:`kalman_fuse` (the map's own landmarks are not checked again, only
+        the observations); resets the landmarks' missed counters.
         """
         idx = self._index(index)
         if idx.size == 0:
             return
-        s, cov = kalman_fuse(self.positions[idx], self.covariances[idx], positions, covariances)
+        new = as_array(positions, "positions", shape=(idx.size, 3))
+        cov_new = _covariances(covariances, "covariances", idx.size)
+        s, cov = _fuse(self.positions[idx], self.covariances[idx], new, cov_new)
         self.positions[idx], self.covariances[idx] = s, cov
         self.missed[idx] = 0
         self.observations[idx] += 1

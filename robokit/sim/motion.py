@@ -78,7 +78,7 @@ def _alphas(alphas: Any) -> np.ndarray:
     return a
 
 
-def increment_variances(delta: Any, alphas: Any, *, validate: bool = True) -> np.ndarray:
+def increment_variances(delta: Any, alphas: Any) -> np.ndarray:
     """Variances of the noise on odometry increments ``[delta_rot1, delta_trans, delta_rot2]``.
 
     Parameters
@@ -87,8 +87,6 @@ def increment_variances(delta: Any, alphas: Any, *, validate: bool = True) -> np
         Increments from :func:`odometry_increment`.
     alphas : array_like, shape (4,)
         Noise parameters ``a1..a4`` (non-negative).
-    validate : bool, default True
-        Validate; ``False`` is the fast path (float arrays).
 
     Returns
     -------
@@ -104,21 +102,24 @@ def increment_variances(delta: Any, alphas: Any, *, validate: bool = True) -> np
     >>> increment_variances([0.0, 1.0, 0.5], [0.01, 0.001, 0.01, 0.001]).tolist()
     [0.001, 0.01025, 0.0035]
     """
-    d = as_array(delta, "delta") if validate else delta
-    a = _alphas(alphas) if validate else alphas
-    if validate and (d.shape[-1:] != (3,) or d.ndim > 2):
+    d = as_array(delta, "delta")
+    if d.shape[-1:] != (3,) or d.ndim > 2:
         raise ValueError(f"delta: expected shape (3,) or (N, 3), got shape {d.shape}")
-    r1, t, r2 = d[..., 0], d[..., 1], d[..., 2]
-    out = np.stack([a[0] * r1 ** 2 + a[1] * t ** 2,                     # Table 5.6, line 5
-                    a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2),          # line 6
-                    a[0] * r2 ** 2 + a[1] * t ** 2], axis=-1)            # line 7
-    if validate:
-        require_finite_result("delta, alphas", out)
+    out = _increment_variances(d, _alphas(alphas))
+    require_finite_result("delta, alphas", out)
     return out
 
 
+def _increment_variances(d: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """Unchecked :func:`increment_variances` (float arrays)."""
+    r1, t, r2 = d[..., 0], d[..., 1], d[..., 2]
+    return np.stack([a[0] * r1 ** 2 + a[1] * t ** 2,                     # Table 5.6, line 5
+                     a[2] * t ** 2 + a[3] * (r1 ** 2 + r2 ** 2),          # line 6
+                     a[0] * r2 ** 2 + a[1] * t ** 2], axis=-1)            # line 7
+
+
 def _perturb(delta: np.ndarray, a: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    sd = np.sqrt(increment_variances(delta, a, validate=False))
+    sd = np.sqrt(_increment_variances(delta, a))
     noise = rng.standard_normal(delta.shape)
     return np.stack([delta[..., 0] - sd[..., 0] * noise[..., 0], delta[..., 1] - sd[..., 1] * noise[..., 1],
                      delta[..., 2] - sd[..., 2] * noise[..., 2]], axis=-1)
@@ -177,7 +178,7 @@ def odometry_covariance(odometry: Any, alphas: Any) -> np.ndarray:
     delta[back, 0] = wrap_angle(delta[back, 0] + np.pi)
     delta[back, 1] = -delta[back, 1]
     delta[back, 2] = wrap_angle(delta[back, 2] - np.pi)
-    var = increment_variances(delta, a, validate=False)
+    var = _increment_variances(delta, a)
     r1, t = delta[:, 0], delta[:, 1]
     c1, s1 = np.cos(r1), np.sin(r1)
     zeros, ones = np.zeros_like(t), np.ones_like(t)

@@ -268,18 +268,16 @@ class Vocabulary:
         n_i = np.zeros(voc.n_words)
         for d in images:
             if len(d):
-                n_i[np.unique(voc.words(d, validate=False))] += 1
+                n_i[np.unique(voc._words(d))] += 1
         voc.idf = np.where(n_i > 0, np.log2(len(images) / np.maximum(n_i, 1)), 0.0)   # Eq. (16): log2(N / n_i)
         return voc
 
-    def words(self, descriptors, *, validate: bool = True) -> np.ndarray:
+    def words(self, descriptors) -> np.ndarray:
         """The word (leaf) of every descriptor, all descending the tree together.
 
         Parameters
         ----------
         descriptors : array_like of uint8, shape (N, B)
-        validate : bool, default True
-            ``False`` skips validation.
 
         Returns
         -------
@@ -295,7 +293,10 @@ class Vocabulary:
         >>> voc.n_words, bool(w[0] == w[2] != w[1] == w[3])
         (2, True)
         """
-        d = as_binary_descriptors(descriptors, "descriptors", n_bytes=self.centres.shape[1]) if validate else descriptors
+        return self._words(as_binary_descriptors(descriptors, "descriptors", n_bytes=self.centres.shape[1]))
+
+    def _words(self, d: np.ndarray) -> np.ndarray:
+        """Unchecked :meth:`words`."""
         node = np.zeros(len(d), np.int64)
         for _ in range(self.levels):                       # one Hamming array per level
             kids = self.children[node]                     # (N, k)
@@ -332,7 +333,7 @@ class Vocabulary:
         [1.0]
         """
         d = as_binary_descriptors(descriptors, "descriptors", n_bytes=self.centres.shape[1])
-        v = tf_idf(self.words(d, validate=False), self.idf)
+        v = tf_idf(self._words(d), self.idf)
         total = v.weights.sum()
         return BowVector(v.words, v.weights / total) if total > 0 else BowVector.empty()
 

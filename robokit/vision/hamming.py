@@ -163,15 +163,13 @@ def hamming_distance(a, b, *, validate: bool = True) -> np.ndarray:
     return out[()]                      # a numpy integer for two single rows
 
 
-def hamming_distances(a, b, *, validate: bool = True) -> np.ndarray:
+def hamming_distances(a, b) -> np.ndarray:
     """All-pairs Hamming distances between two sets of binary descriptors.
 
     Parameters
     ----------
     a : array_like of uint8, shape (Na, B)
     b : array_like of uint8, shape (Nb, B)
-    validate : bool, default True
-        ``False`` skips validation.
 
     Returns
     -------
@@ -192,9 +190,8 @@ def hamming_distances(a, b, *, validate: bool = True) -> np.ndarray:
     >>> hamming_distances([[0], [3]], [[1], [2], [255]]).tolist()
     [[1, 1, 8], [1, 1, 6]]
     """
-    if validate:
-        a, b = as_binary_descriptors(a, "a"), as_binary_descriptors(b, "b")
-        same_width(a, b, "a", "b")
+    a, b = as_binary_descriptors(a, "a"), as_binary_descriptors(b, "b")
+    same_width(a, b, "a", "b")
     out = np.empty((a.shape[0], b.shape[0]), np.int64)
     step = max(1, _BLOCK // max(1, b.shape[0]))
     for s in range(0, a.shape[0], step):

@@ -135,7 +135,7 @@ def essential_from_bearings(b1: Any, b2: Any) -> np.ndarray:
     return _eight_point(p, q)
 
 
-def epipolar_error(E: Any, b1: Any, b2: Any, *, validate: bool = True) -> np.ndarray:
+def epipolar_error(E: Any, b1: Any, b2: Any) -> np.ndarray:
     """Sampson distance of bearing pairs to the epipolar constraint, as an angle on the sphere.
 
     Parameters
@@ -144,8 +144,6 @@ def epipolar_error(E: Any, b1: Any, b2: Any, *, validate: bool = True) -> np.nda
         Essential matrices (one per hypothesis).
     b1, b2 : array_like, shape (N, 3)
         Unit bearings.
-    validate : bool, default True
-        Validate; ``False`` is the fast path (unit float bearings, float ``E``).
 
     Returns
     -------
@@ -173,12 +171,15 @@ def epipolar_error(E: Any, b1: Any, b2: Any, *, validate: bool = True) -> np.nda
     >>> print(np.round(epipolar_error(E, [[0.0, 0.0, 1.0]], [[0.0, 0.1, 1.0]]), 4))
     [0.0707]
     """
-    if validate:
-        E = as_array(E, "E")
-        if E.shape[-2:] != (3, 3) or E.ndim > 3:
-            raise ValueError(f"E: expected shape (3, 3) or (K, 3, 3), got shape {E.shape}")
-        b1 = as_bearings(b1, "b1")
-        b2 = as_bearings(b2, "b2", count=len(b1))
+    E = as_array(E, "E")
+    if E.shape[-2:] != (3, 3) or E.ndim > 3:
+        raise ValueError(f"E: expected shape (3, 3) or (K, 3, 3), got shape {E.shape}")
+    b1 = as_bearings(b1, "b1")
+    return _epipolar_error(E, b1, as_bearings(b2, "b2", count=len(b1)))
+
+
+def _epipolar_error(E: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
+    """Unchecked :func:`epipolar_error` (unit float bearings, float ``E``)."""
     Eb1 = np.einsum("...ij,nj->...ni", E, b1)                  # E b1, (..., N, 3)
     Etb2 = np.einsum("...ji,nj->...ni", E, b2)                 # E^T b2
     algebraic = (b2 * Eb1).sum(-1)
@@ -282,7 +283,7 @@ def ransac_essential(b1: Any, b2: Any, *, threshold: float = 0.01, confidence: f
         sample = np.argsort(gen.random((k, n)), axis=1)[:, :8]   # eight distinct pairs per hypothesis
         drawn += k
         E = _eight_point(p[sample], q[sample])
-        err = epipolar_error(E, p, q, validate=False)
+        err = _epipolar_error(E, p, q)
         support = err < thr
         count = support.sum(1)
         cost = np.where(support, err, thr).sum(1)                   # MSAC tie-break
@@ -292,11 +293,11 @@ def ransac_essential(b1: Any, b2: Any, *, threshold: float = 0.01, confidence: f
             needed = ransac_sample_count(min(1 - best_count / n, 0.9), 8, confidence)   # 0.9: ~4.6e8, the cap rules
     E = best
     for _ in range(2):                                              # refit on the support
-        inliers = epipolar_error(E, p, q, validate=False) < thr
+        inliers = _epipolar_error(E, p, q) < thr
         if inliers.sum() < 8:
             break
         E = _eight_point(p[inliers], q[inliers])
-    errors = epipolar_error(E, p, q, validate=False)
+    errors = _epipolar_error(E, p, q)
     inliers = errors < thr
     if inliers.sum() < min_inliers:
         return EssentialFit(failed.E, inliers, errors, drawn, False)
