@@ -2,7 +2,7 @@
 
 An update is the odometry motion model (Thrun et al. Table 5.6), the likelihood-field weights
 (Table 6.3, ROS amcl's ``1 + sum p^3``) over 60 of a 360-beam scan, and low-variance resampling
-(Table 4.4): :func:`robokit.localization.mcl_step`. The peer, run in the same process on the same
+(Table 4.4): :func:`robokit.localization.mcl`. The peer, run in the same process on the same
 inputs, loops over particles: one motion sample, :func:`likelihood_field_log_weight_reference`
 (beam by beam) and the resampling loop of Table 4.4. Target: under 20 ms for 5000 particles x 60
 beams. The vectorised update is timed ``repeats`` times: the best run (what an unloaded core

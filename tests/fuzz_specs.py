@@ -455,7 +455,7 @@ def trial_folder():
 
 @functools.cache
 def saved_trial():
-    from robokit.legged.trial_file import save_trial
+    from robokit.legged.trial_log import save_trial
     return str(save_trial(trial_folder() / "saved.npz", trial_log()))
 
 
@@ -727,10 +727,10 @@ SPECS: dict[str, Call] = {
                                                                 "params": Obj(None, optional=True)}),
     "robokit.vision.plot_detector.plot_scales": Call({"sigma0": Real(1.6, optional=True), "k": Real(1.26, optional=True),
                                                       "n_scales": Int(9, optional=True)}),
-    "robokit.vision.scale_space_maxima.scale_space_maxima": Call({
+    "robokit.vision.plot_detector.scale_space_maxima": Call({
         "responses": Obj(lambda: [np.random.default_rng(n).random(shape, np.float32)
                                   for n, shape in enumerate([(12, 12), (12, 12), (6, 6)])]),
-        "steps": Array(np.array([1, 1, 2]), "3"), "threshold": Real(0.1), "border": Int(1), "validate": Flag(True)}),
+        "steps": Array(np.array([1, 1, 2]), "3"), "threshold": Real(0.1), "border": Int(1)}),
     "robokit.vision.plot_detector.junction_strength": Call({"tensor": Array(np.tile([[1.0, 0.1], [0.1, 2.0]], (4, 5, 1, 1)),
                                                                             "...,2,2")}),
     "robokit.vision.stereo.observe_stereo": Call({"left": Obj(features), "right": Obj(features), "rig": Obj(calibration),
@@ -914,7 +914,7 @@ SPECS: dict[str, Call] = {
                                                                           min_rows=0),
                                                      "method": Choice("flann"), "checks": Int(32), "trees": Int(2),
                                                      "seed": Int(0)}),
-    "robokit.vision.ratio.ratio_test": Call({"dist": Array(np.array([[0.1, 1.0], [0.5, np.inf]]), "N,2", inf_ok=True,
+    "robokit.vision.matching.ratio_test": Call({"dist": Array(np.array([[0.1, 1.0], [0.5, np.inf]]), "N,2", inf_ok=True,
                                                               min_rows=0),
                                                 "index": Array(np.array([[3, 1], [0, 2]]), "N,2", min_rows=0),
                                                 "ratio": Real(0.8), "max_distance": Real(0.8, optional=True, inf_ok=True)}),
@@ -990,13 +990,13 @@ SPECS: dict[str, Call] = {
                                                     "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4")}),
     "robokit.sim.motion.odometry_covariance": Call({"odometry": Array(lambda: lap().poses[:20], "N,3"),
                                                     "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4")}),
-    "robokit.mapping.local_maps.appearance_changed": Call({"distance": Array(np.array([0.01, 0.3]), "|N"),
+    "robokit.mapping.topological_build.appearance_changed": Call({"distance": Array(np.array([0.01, 0.3]), "|N"),
                                                                   "matches": Array(np.array([90, 10]), "|N"),
                                                                   "similarity": Real(0.05), "min_matches": Int(50)}),
-    "robokit.mapping.local_maps.local_map_full": Call({"n_features": Array(np.array([100, 990]), "|N"),
+    "robokit.mapping.topological_build.local_map_full": Call({"n_features": Array(np.array([100, 990]), "|N"),
                                                               "variance": Array(np.array([0.01, 0.2]), "|N"),
                                                               "max_features": Int(930), "max_variance": Real(0.1)}),
-    "robokit.mapping.local_maps.select_key_frames": Call({
+    "robokit.mapping.topological_build.select_key_frames": Call({
         "n_frames": Int(5), "compare": Func(lambda: (lambda key, k: __import__("robokit").mapping.Comparison(
             0.01, 100, 500, 0.0))),
         "similarity": Real(0.05), "min_matches": Int(50), "occlusion_frames": Int(3), "max_features": Int(930),
@@ -1066,12 +1066,12 @@ SPECS: dict[str, Call] = {
     "robokit.localization.beam_models.likelihood_field_log_weight_reference": Call({
         "pose": Array(np.array([0.2, 0.1, 0.5]), "3"), "ranges": Array(SCAN, "N", inf_ok=True),
         "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field), **beam_model_kinds()}),
-    "robokit.localization.mcl_step.mcl_step": Call({
+    "robokit.localization.mcl.mcl_step": Call({
         "particles": Array(np.array([[0.0, 0.0, 0.0], [0.2, 0.1, 0.5]]), "N,3"), "weights": Array(np.array([0.5, 0.5]), "N"),
         "odom_prev": Array(np.zeros(3), "3"), "odom_now": Array(np.array([0.3, 0.0, 0.1]), "3"),
         "ranges": Array(SCAN, "N", inf_ok=True), "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field),
         "alphas": Array(np.full(4, 0.05), "4"), "resample": Flag(True), "rng": Rng(0), "model": Given({})}),
-    "robokit.localization.mcl_step.uniform_free_poses": Call({
+    "robokit.localization.mcl.uniform_free_poses": Call({
         "free_cells": Array(np.array([[0.5, 0.5], [1.5, 0.5]]), "N,2"), "resolution": Real(1.0), "n": Int(3),
         "rng": Rng(0)}),
     "robokit.localization.mcl.MonteCarloLocalizer": Call({
@@ -1174,9 +1174,9 @@ SPECS: dict[str, Call] = {
         "descriptor_list": Obj(lambda: [orb_descriptors(40, 0)] * 3),
         "positions": Array(np.zeros((3, 2)), "N,2|N,3", optional=True), "min_frame_gap": Int(1),
         "min_tracked": Int(10), "max_tracked_fraction": Real(0.9), "max_distance": Real(50.0)}),
-    "robokit.vision.bow_vector.tf_idf": Call({"word_ids": Array(np.array([0, 0, 1, 2]), "N", min_rows=0),
+    "robokit.vision.bag_of_words.tf_idf": Call({"word_ids": Array(np.array([0, 0, 1, 2]), "N", min_rows=0),
                                                 "idf": Array(np.log2([3.0, 3.0, 1.5, 1.0]), "N")}),
-    "robokit.vision.bow_vector.l1_score": Call({"v_a": Obj(([0, 2], [0.5, 0.5])), "v_b": Obj(([0, 3], [0.2, 0.8]))}),
+    "robokit.vision.bag_of_words.l1_score": Call({"v_a": Obj(([0, 2], [0.5, 0.5])), "v_b": Obj(([0, 3], [0.2, 0.8]))}),
     "robokit.vision.bag_of_words.Vocabulary": Call({
         "children": Array(lambda: bow_vocabulary().children, "N,N"), "centres": Array(lambda: bow_vocabulary().centres, "N,N"),
         "idf": Array(lambda: bow_vocabulary().idf, "N"), "levels": Int(2)}),
@@ -1223,8 +1223,8 @@ SPECS: dict[str, Call] = {
     "robocourse.lessons.corridor_localization.trials.corridor_localizer": Call({
         "setup": Obj(corridor_setup), "method": Choice("ours"), "rng": Rng(0)}, cheap=False),
     "robocourse.lessons.corridor_localization.aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),
-    "robocourse.lessons.corridor_localization.sensors.corridor_lidar": Call({}),
-    "robocourse.lessons.corridor_localization.sensors.corridor_camera": Call({"fast": Flag(True, optional=True)}),
+    "robocourse.lessons.corridor_localization.experiment.corridor_lidar": Call({}),
+    "robocourse.lessons.corridor_localization.experiment.corridor_camera": Call({"fast": Flag(True, optional=True)}),
     "robocourse.lessons.corridor_localization.experiment.calibration_run": Call({
         "fast": Flag(True, optional=True), "start": Real(12.0), "length": Real(10.0), "speed": Real(0.2),
         "frame_rate": Real(30.0), "progress": Func(None, optional=True)}, cheap=False),
@@ -1395,10 +1395,10 @@ SPECS: dict[str, Call] = {
         "link_latency": Real(0.01), "link_jitter": Real(0.002), "link_loss": Real(0.01), "seed": Int(0, optional=True),
         "notes": Text(""), "extra": Given({})}),
     "robokit.legged.trial_log.empty_streams": Call({"n": Int(4), "host_rate": Real(100.0)}),
-    "robokit.legged.trial_file.save_trial": Call({"path": Text(lambda: str(trial_folder() / "t.npz")),
+    "robokit.legged.trial_log.save_trial": Call({"path": Text(lambda: str(trial_folder() / "t.npz")),
                                                  "log": Obj(trial_log)}),
-    "robokit.legged.trial_file.load_trial": Call({"path": Text(saved_trial)}),
-    "robokit.legged.trial_file.describe_layout": Call({}),
+    "robokit.legged.trial_log.load_trial": Call({"path": Text(saved_trial)}),
+    "robokit.legged.trial_log.describe_layout": Call({}),
     "robokit.viz.animation.animate_tracks": Call({
         "scene": Obj(scene), "tracks": Mapping(lambda: {"a": {"position": np.zeros((3, 3)), "scale": np.ones((3, 3))}}),
         "fps": Real(10.0), "repetitions": Int(1), "validate": Flag(True)}),
@@ -1460,10 +1460,10 @@ SPECS: dict[str, Call] = {
         "q": Array(np.array([0.0, 0.5, -1.5]), "...,3"), "leg": Choice("FL", optional=True)}),
     "robokit.legged.leg_kinematics.reachable_workspace": Call({
         "leg": Choice("FL"), "n": Int(200), "rng": Rng(0), "branch": Int(-1, optional=True, accepts=("a list",))}),
-    "robokit.legged.leg_statics.torques_from_foot_force": Call({
+    "robokit.legged.leg_kinematics.torques_from_foot_force": Call({
         "q_leg": Array(np.array([0.0, 0.6, -1.2]), "...,3"), "force": Array(np.array([0.0, 0.0, -7.4]), "...,3"),
         "leg": Choice("FL")}),
-    "robokit.legged.leg_statics.foot_force_from_torques": Call({
+    "robokit.legged.leg_kinematics.foot_force_from_torques": Call({
         "q_leg": Array(np.array([0.0, 0.6, -1.2]), "...,3"), "tau": Array(np.array([-0.175, 0.112, 0.426]), "...,3"),
         "leg": Choice("FL"), "gravity_torque": Array(np.array([0.0, 0.01, 0.02]), "...,3", optional=True)}),
     "robokit.legged.leg_kinematics.body_fk": Call({"q": Array(stance_q, "...,12")}),
@@ -1530,7 +1530,7 @@ EXTRA: tuple[str, ...] = (
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view
-    "robokit.vision.scale_space_maxima.scale_space_maxima",   # public since PLOT's search moved out
+    "robokit.vision.plot_detector.scale_space_maxima",   # public since PLOT's search moved out
     # lesson 02 (path following, pose EKF, navigation), fuzzed before the lesson exists
     *(f"robokit.controllers.path_geometry.{n}" for n in ("VisualPath", "path_from_poses", "reference_point")),
     *(f"robokit.controllers.path_following.{n}" for n in (
@@ -1548,7 +1548,7 @@ EXTRA: tuple[str, ...] = (
     # robokit.vision.omni_features, matching.DescriptorIndex, sim.view_matches (lesson 02)
     "robokit.vision.omni_features.omni_sift", "robokit.vision.omni_features.annulus_mask",
     "robokit.vision.omni_features.radial_orientation", "robokit.vision.matching.DescriptorIndex",
-    "robokit.vision.ratio.ratio_test", "robokit.vision.descriptors.detect_sift_features",
+    "robokit.vision.matching.ratio_test", "robokit.vision.descriptors.detect_sift_features",
     "robokit.sim.view_matches.omni_ground_truth_inliers",
     "robokit.sim.view_matches.omni_view_pair",
     # robokit.mapping's pose graphs (lesson 02), fuzzed before the lesson exists
@@ -1569,9 +1569,9 @@ EXTRA: tuple[str, ...] = (
     "robokit.vision.spherical.decompose_essential", "robokit.vision.spherical.floor_points",
     "robokit.sim.motion.office_tour", "robokit.sim.motion.increment_variances",
     "robokit.sim.motion.odometry_covariance",
-    "robokit.mapping.local_maps.appearance_changed",
-    "robokit.mapping.local_maps.local_map_full",
-    "robokit.mapping.local_maps.select_key_frames",
+    "robokit.mapping.topological_build.appearance_changed",
+    "robokit.mapping.topological_build.local_map_full",
+    "robokit.mapping.topological_build.select_key_frames",
     "robokit.mapping.topological_build.build_topological_map",
     "robokit.mapping.omni_views.omni_view", "robokit.mapping.omni_views.as_omni_image",
     "robokit.mapping.omni_views.relative_pose", "robokit.mapping.topological.TopologicalMap",
@@ -1589,7 +1589,7 @@ EXTRA: tuple[str, ...] = (
         "weighted_pose_mean", "sample_ellipse_poses", "ellipse_weights")),
     *(f"robokit.localization.beam_models.{n}" for n in (
         "subsample_beams", "valid_beams", "likelihood_field_log_weights", "likelihood_field_log_weight_reference")),
-    "robokit.localization.mcl_step.mcl_step", "robokit.localization.mcl_step.uniform_free_poses",
+    "robokit.localization.mcl.mcl_step", "robokit.localization.mcl.uniform_free_poses",
     "robokit.localization.mcl.MonteCarloLocalizer",
     # lesson 03's corridor scan, moving strategy and geo-tags, fuzzed before the lesson exists
     *(f"robokit.mapping.corridor_scan.{n}" for n in (
@@ -1603,7 +1603,7 @@ EXTRA: tuple[str, ...] = (
         "orb.detect_orb_features", "hamming.hamming_distance",
         "hamming.hamming_distances", "hamming.hamming_match", "keyframes.feature_threshold",
         "keyframes.shared_fraction", "keyframes.KeyframeSelector", "keyframes.select_keyframes",
-        "keyframes.select_keyframes_orbslam", "bow_vector.tf_idf", "bow_vector.l1_score",
+        "keyframes.select_keyframes_orbslam", "bag_of_words.tf_idf", "bag_of_words.l1_score",
         "bag_of_words.Vocabulary", "bag_of_words.Vocabulary.train",
         "bow_database.BowDatabase")),
     # lesson 04's sensing: the one rigid fit, MoCap, IMU, fusion, touchdowns
@@ -1635,7 +1635,7 @@ EXTRA: tuple[str, ...] = (
     # lesson 04's trial log, LittleDog scenes and figures (fuzzed before the lesson exists)
     "robokit.geometry.rotations.quat_to_matrix",
     *(f"robokit.legged.trial_log.{n}" for n in ("TrialLog", "trial_meta", "empty_streams")),
-    *(f"robokit.legged.trial_file.{n}" for n in ("save_trial", "load_trial", "describe_layout")),
+    *(f"robokit.legged.trial_log.{n}" for n in ("save_trial", "load_trial", "describe_layout")),
     "robokit.viz.animation.animate_tracks",
     *(f"robokit.viz.legged.{n}" for n in ("joint_path", "add_littledog", "pose_littledog", "animate_trial")),
     *(f"robokit.viz.legged_plots.{n}" for n in (

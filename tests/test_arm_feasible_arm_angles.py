@@ -56,19 +56,19 @@ def test_own_arm_angle_is_feasible_and_unreachable_targets_have_none():
 
 
 def test_compiled_steps_match_the_readable_ones():
-    from robokit.arm import arm_angle_kernels, chain_kernels, panda
+    from robokit.arm import chain_kernels, panda, srs_kernels
 
     T, q0 = _targets(10, 2)
     for Ti in T:
         G, q4 = np.empty((2, 2, 3, 9)), np.empty(2)
-        c4 = arm_angle_kernels.coefficients(Ti, ARM.d_bs, ARM.d_se, ARM.d_ew, ARM.d_wf, G, q4)
+        c4 = srs_kernels.coefficients(Ti, ARM.d_bs, ARM.d_se, ARM.d_ew, ARM.d_wf, G, q4)
         W = ARM.wrist_centre(Ti[None])
         terms, q4_ref, c4_ref = coefficient_terms([[Ti[None, i, j] for j in range(3)] for i in range(3)],
                                                   (W[:, 0], W[:, 1], W[:, 2] - ARM.d_bs), ARM.d_se, ARM.d_ew, ARRAY)
         ref = np.stack(terms, -1).reshape(3, 2, 2, 9).transpose(1, 2, 0, 3)
         assert np.allclose(G, ref, atol=1e-14) and abs(c4 - c4_ref[0]) < 1e-14
-        ivl, counts = np.empty((8, arm_angle_kernels.MAX_SPLITS, 2)), np.zeros(8, np.int64)
-        arm_angle_kernels.feasible_intervals(G, q4, IIWA.qmin, IIWA.qmax, LIMIT_TOL, ivl, counts)
+        ivl, counts = np.empty((8, srs_kernels.MAX_SPLITS, 2)), np.zeros(8, np.int64)
+        srs_kernels.feasible_intervals(G, q4, IIWA.qmin, IIWA.qmax, LIMIT_TOL, ivl, counts)
         for b, intervals in enumerate(feasible_arm_angles(IIWA, Ti)):
             assert np.allclose(ivl[b, :counts[b]], intervals, atol=1e-12)
     for chain in (IIWA, panda()):

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from robokit.legged import leg_kinematics as lk
-from robokit.legged import leg_statics as ls
+from robokit.legged import leg_kinematics as ls
 from robokit.legged.littledog import (GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_NAMES, LEGS, LOWER_LEG, MARKERS,
                                       STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG, littledog_mjcf,
                                       littledog_model)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robokit.legged.trial_file import describe_layout, load_trial, save_trial
+from robokit.legged.trial_log import describe_layout, load_trial, save_trial
 from robokit.legged.trial_log import (LOG_FORMAT, LOG_LAYOUT, LOG_VERSION, META_KEYS, TrialLog, TrialLogError,
                                       empty_streams, trial_meta)
 from tests.legged_logs import synthetic_log

@@ -15,8 +15,8 @@ def test_the_key_follows_names_to_the_modules_that_define_them():
 
 
 def test_a_name_is_found_where_it_is_defined():
-    assert "robokit.sim.lidar" in imports_of("robocourse.lessons.corridor_localization.sensors", homes=True)
-    assert "robokit.sim" in imports_of("robocourse.lessons.corridor_localization.sensors")
+    assert "robokit.sim.lidar" in imports_of("robocourse.lessons.corridor_localization.experiment", homes=True)
+    assert "robokit.sim" in imports_of("robocourse.lessons.corridor_localization.experiment")
 
 
 def test_an_edit_to_a_used_module_changes_the_key_and_an_unused_one_does_not(monkeypatch):

@@ -9,7 +9,7 @@ from robokit.vision.descriptors import detect_plot_features, detect_sift_feature
 from robokit.vision.evaluation import apply_homography, matching_score, recall_precision, similarity_homography
 from robokit.vision.features import Features, Keypoints
 from robokit.vision.matching import gated_ratio_match, k_nearest, ratio_match, two_nearest
-from robokit.vision.ratio import distance_ratio
+from robokit.vision.matching import distance_ratio
 
 
 @pytest.fixture(scope="module")

@@ -190,7 +190,7 @@ def feasible_arm_angles(chain: Chain, T: Any) -> list[np.ndarray]:
     for b in range(len(BRANCHES)):
         pieces = []
         for a, c in zip(lo[ok[:, b]], hi[ok[:, b]]):
-            if pieces and pieces[-1][1] >= a - 1e-12:    # adjacent feasible arcs merge (arm_angle_kernels.MERGE)
+            if pieces and pieces[-1][1] >= a - 1e-12:    # adjacent feasible arcs merge (srs_kernels.MERGE)
                 pieces[-1][1] = c
             else:
                 pieces.append([a, c])

@@ -29,7 +29,7 @@ __all__ = ["njit", "CACHING", "compile_notice", "compiled"]
 
 
 #: The kernel modules whose source decides whether the cached machine code is current.
-_SOURCES = ("jit.py", "chain_kernels.py", "arm_angle_kernels.py", "srs_kernels.py", "numeric_kernels.py")
+_SOURCES = ("jit.py", "chain_kernels.py", "srs_kernels.py", "numeric_kernels.py")
 
 
 def _source_digest() -> str:

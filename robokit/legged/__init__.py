@@ -18,7 +18,7 @@ from .simulation import FALL_HEIGHT, LoopSettings, SensorSettings, TrialOutcome,
 from .power import battery_energy, cost_of_transport, endurance, trial_power
 # the trial log
 from .trial_log import LOG_FORMAT, LOG_LAYOUT, LOG_VERSION, META_KEYS, TrialLog, TrialLogError, empty_streams, trial_meta
-from .trial_file import describe_layout, load_trial, save_trial
+from .trial_log import describe_layout, load_trial, save_trial
 
 __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS", "JOINT_NAMES", "JOINTS",
            "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS", "STANCE_FEET", "STANDING_HEIGHT", "TIMESTEP",

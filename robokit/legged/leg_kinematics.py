@@ -1,13 +1,13 @@
-"""Kinematics of one LittleDog leg: forward, closed-form inverse (both knees), Jacobian.
+r"""Kinematics and statics of one LittleDog leg: FK, closed-form IK (both knees), Jacobian, J^T f.
 
 A leg is a hip roll about the body's x axis, then a hip pitch and a knee about the rolled y axis
 (:mod:`robokit.legged.littledog`). In the body frame the foot centre is
 
 .. math::
 
-    p = h + R_x(q_1)\\left(\\begin{bmatrix}0\\\\ s d\\\\ 0\\end{bmatrix}
-        + R_y(q_2)\\left(\\begin{bmatrix}0\\\\0\\\\-L_1\\end{bmatrix}
-        + R_y(q_3)\\begin{bmatrix}0\\\\0\\\\-L_2\\end{bmatrix}\\right)\\right)
+    p = h + R_x(q_1)\left(\begin{bmatrix}0\\ s d\\ 0\end{bmatrix}
+        + R_y(q_2)\left(\begin{bmatrix}0\\0\\-L_1\end{bmatrix}
+        + R_y(q_3)\begin{bmatrix}0\\0\\-L_2\end{bmatrix}\right)\right)
 
 with ``h`` the hip position, ``s`` = +1 for a left leg and -1 for a right one, ``d`` the hip-pitch
 offset, ``L1``, ``L2`` the upper and lower leg (Siciliano & Khatib 2016, Ch. 2, Eq. (2.40) composes
@@ -18,8 +18,11 @@ by the law of cosines, whose two roots are the two knee branches: ``branch = -1`
 backwards (foot ahead of the knee, LittleDog's front legs), ``branch = +1`` forwards (the hind
 legs) - :data:`KNEE_BRANCH`.
 
-The leg's statics (torques and foot forces through :func:`foot_jacobian`) are in
-:mod:`robokit.legged.leg_statics`.
+Statics: joint torques ``tau`` and a force ``f`` at the foot balance when ``tau = J^T f``
+(Siciliano & Khatib 2016, Ch. 2, Eq. (2.98), the principle of virtual work), with ``J`` the foot's
+Jacobian (:func:`foot_jacobian`; :func:`torques_from_foot_force`). The ground's push on a standing foot follows
+from the torques as ``f = J^{-T} (tau_g - tau)``, where ``tau_g`` is what gravity asks of the leg's
+own links (:func:`foot_force_from_torques`): the lesson compares it with MuJoCo's contact forces.
 
 References
 ----------
@@ -34,12 +37,13 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import as_se3
-from ..validation import as_array, as_rng, as_int, describe
+from ..validation import as_array, as_int, as_rng, describe, require_finite_result
 from .littledog import HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, LEGS, LOWER_LEG, UPPER_LEG
 
-__all__ = ["KNEE_BRANCH", "UnreachableFootError", "leg_index", "foot_position", "leg_points",
-           "foot_jacobian", "leg_ik", "leg_ik_batch", "LegIK", "within_limits", "reachable_workspace", "body_ik",
-           "body_fk"]
+__all__ = ["KNEE_BRANCH", "UnreachableFootError", "leg_index", "foot_position", "leg_points", "foot_jacobian",
+           "leg_ik", "leg_ik_batch", "LegIK", "within_limits", "reachable_workspace", "body_ik", "body_fk",
+           "torques_from_foot_force", "foot_force_from_torques"]
+
 
 KNEE_BRANCH = (-1, -1, +1, +1)
 """LittleDog's knee branch per leg (FL, FR, HL, HR): front knees bend backwards, hind forwards."""
@@ -420,3 +424,91 @@ def body_ik(feet: Any, T_world_body: Any = None, *, validate: bool = True) -> Le
         q[:, 3 * i:3 * i + 3] = qi
         ok &= oki
     return LegIK(q, ok)
+
+
+def _vectors(value: Any, name: str, batch: tuple, against: str = "q_leg's") -> np.ndarray:
+    """``value`` as 3-vectors (..., 3) whose leading axes broadcast with ``batch`` (the joint angles')."""
+    v = as_array(value, name)
+    if v.shape[-1:] != (3,):
+        raise ValueError(f"{name}: expected shape (..., 3), got {describe(value)}")
+    try:
+        np.broadcast_shapes(v.shape[:-1], batch)
+    except ValueError:
+        raise ValueError(f"{name}: expected leading axes that broadcast with {against} {batch}, "
+                         f"got shape {v.shape}") from None
+    return v
+
+
+def torques_from_foot_force(q_leg: Any, force: Any, leg: Any) -> np.ndarray:
+    """Joint torques that balance a force applied at the foot: ``tau = J^T f``.
+
+    Parameters
+    ----------
+    q_leg : array_like, shape (..., 3)
+    force : array_like, shape (..., 3)
+        The force the leg must push with, in the body frame (N) - e.g. minus the ground's reaction.
+    leg : str or int
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        N m (Siciliano & Khatib 2016, Eq. (2.98)).
+
+    Examples
+    --------
+    >>> torques_from_foot_force([0, 0.6, -1.2], [0, 0, -7.4], "FL").round(3).tolist()
+    [-0.175, 0.112, 0.426]
+    """
+    J = foot_jacobian(q_leg, leg)
+    f = _vectors(force, "force", J.shape[:-2])
+    with np.errstate(over="ignore", invalid="ignore"):
+        tau = np.einsum("...ji,...j->...i", J, f)  # Eq. (2.98)
+    require_finite_result("force", tau)
+    return tau
+
+
+def foot_force_from_torques(q_leg: Any, tau: Any, leg: Any, gravity_torque: Any = None) -> np.ndarray:
+    """The ground's force on a standing foot, from the leg's joint torques: ``f = J^{-T} (tau_g - tau)``.
+
+    Parameters
+    ----------
+    q_leg : array_like, shape (..., 3)
+    tau : array_like, shape (..., 3)
+        Torques the motors apply at the joints (N m).
+    leg : str or int
+    gravity_torque : array_like, shape (..., 3), optional
+        Joint torques gravity asks of the leg's own links, ``tau_g`` (MuJoCo's ``qfrc_bias`` at
+        rest). Omitted, the legs are taken as massless.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        Body frame (N). A quasi-static estimate: the leg's accelerations are neglected.
+
+    Raises
+    ------
+    ValueError
+        If the leg is singular (fully stretched or folded: ``J`` cannot be inverted), if ``tau`` or
+        ``gravity_torque`` has leading axes that do not broadcast with ``q_leg``'s, or if the force
+        overflows (torques near the largest float).
+
+    Examples
+    --------
+    >>> q = [0, 0.6, -1.2]
+    >>> foot_force_from_torques(q, torques_from_foot_force(q, [0, 0, -7.4], "FL"), "FL").round(3).tolist()
+    [0.0, -0.0, 7.4]
+    """
+    J = foot_jacobian(q_leg, leg)
+    t = _vectors(tau, "tau", J.shape[:-2])
+    if gravity_torque is not None:
+        g = _vectors(gravity_torque, "gravity_torque", np.broadcast_shapes(J.shape[:-2], t.shape[:-1]),
+                     "those of q_leg and tau,")
+        with np.errstate(over="ignore"):
+            t = t - g
+    if np.any(np.abs(np.linalg.det(J)) < 1e-9):
+        raise ValueError("q_leg: the leg is singular there (stretched or folded); J^T cannot be inverted")
+    JT = np.swapaxes(J, -1, -2)
+    with np.errstate(over="ignore", invalid="ignore"):
+        f = -np.linalg.solve(JT, t[..., None])[..., 0]
+    require_finite_result("tau, gravity_torque", f)
+    return f

@@ -23,7 +23,7 @@ from .visual_slam import FrameReport, VisualSLAM
 from .beam_models import (COMBINE_RULES, likelihood_field_log_weight_reference, likelihood_field_log_weights,
                           subsample_beams, valid_beams)
 from .mcl import AMCL_DEFAULTS, KLDConfig, MonteCarloLocalizer
-from .mcl_step import MCLStep, mcl_step, uniform_free_poses
+from .mcl import MCLStep, mcl_step, uniform_free_poses
 from .particle_clusters import largest_cluster_mean, largest_cluster_share, pose_clusters
 from .particle_filter import (KLD_Z_99, ROS_KLD_BIN_SIZE, NormalisedWeights, ellipse_weights, kld_resample,
                               kld_sample_count, low_variance_resample, normalise_log_weights, pose_bins,

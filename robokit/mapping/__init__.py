@@ -46,7 +46,7 @@ from .occupancy_grid import (FREE_THRESHOLD, LOG_ODDS_MAX, LOG_ODDS_MIN, OCCUPIE
 from .omni_views import OmniView, RelativePose, as_omni_image, omni_view, relative_pose
 from .relaxation import RelaxationResult, initial_variances, relax, relax_sweep
 from .topological import LOOP_EDGE, ODOMETRY_EDGE, EmptyMapError, TopologicalMap
-from .local_maps import Comparison, appearance_changed, local_map_full, select_key_frames
+from .topological_build import Comparison, appearance_changed, local_map_full, select_key_frames
 from .topological_build import build_topological_map
 
 __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",

@@ -40,7 +40,7 @@ from ..sim.omni import OmniCamera, as_omni_camera
 from ..validation import as_array, as_rng, as_int, as_mapping, as_positive, as_text, describe
 from ..vision.colour import hue_histogram
 from ..vision.features import Features, Keypoints
-from ..vision.ratio import Matches
+from ..vision.matching import Matches
 from ..vision.omni_features import ImageSizeError, omni_sift
 from ..vision.ransac import ransac_se2
 from ..vision.spherical import decompose_essential, floor_points, ransac_essential

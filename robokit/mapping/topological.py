@@ -39,7 +39,7 @@ from ..validation import as_array, as_choice, as_int, as_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
 from ..vision.matching import METHODS, DescriptorIndex
-from ..vision.ratio import Matches
+from ..vision.matching import Matches
 from .omni_views import OmniView
 from .pose_graph import PoseGraph, information_from_covariance
 

@@ -29,7 +29,7 @@ import numpy as np
 from ..geometry import as_se3
 from ..validation import as_array, as_points, as_positive
 from ..vision.matching import DescriptorIndex, ratio_match
-from ..vision.ratio import LOWE_RATIO
+from ..vision.matching import LOWE_RATIO
 from ..vision.omni_features import omni_sift
 from .camera import PinholeCamera
 from .omni import OmniCamera, as_omni_camera

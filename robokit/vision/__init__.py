@@ -12,12 +12,12 @@ points below the horizon). Vision depends only on :mod:`robokit.validation` and
 :mod:`robokit.geometry` (never on ``viz`` or ``sim``). Lesson 03 (Ge et al. 2023) adds :mod:`.orb`
 (OpenCV ORB as :class:`Features`), :mod:`.hamming` (the one Hamming distance for binary
 descriptors), :mod:`.keyframes` (Sec. 3.2's keyframe conditions and an ORB-SLAM-like rule),
-:mod:`.bag_of_words` (the vocabulary tree, Sec. 3.3), :mod:`.bow_vector` (TF-IDF and the L1
+:mod:`.bag_of_words` (the vocabulary tree, Sec. 3.3), :mod:`.bag_of_words` (TF-IDF and the L1
 score, Eqs. (16)-(17)) and :mod:`.bow_database` (the inverted index, Fig. 7).
 """
 from .bag_of_words import TooFewDescriptorsError, Vocabulary, VocabularyFileError
 from .bow_database import BowDatabase, DatabaseFileError, QueryResult
-from .bow_vector import BowVector, as_bow_vector, l1_score, tf_idf
+from .bag_of_words import BowVector, as_bow_vector, l1_score, tf_idf
 from .colour import (histogram_distance, histogram_intersection, hue_histogram, hue_histogram_opencv, hue_mask,
                      rgb_to_hsi)
 from .descriptors import (assign_orientations, detect_and_describe, gradient_histogram_descriptor,
@@ -27,9 +27,8 @@ from .features import Features, Keypoints, as_gray_image
 from .hamming import as_binary_descriptors, hamming_distance, hamming_distances, hamming_match
 from .keyframes import (KeyframeConditions, KeyframeSelector, feature_threshold, select_keyframes,
                         select_keyframes_orbslam, shared_fraction)
-from .matching import DescriptorIndex, k_nearest, ratio_match, two_nearest
-from .ratio import Matches, ratio_test
-from .scale_space_maxima import scale_space_maxima
+from .matching import DescriptorIndex, Matches, k_nearest, ratio_match, ratio_test, two_nearest
+from .plot_detector import scale_space_maxima
 from .orb import detect_orb_features
 from .omni_features import ImageSizeError, annulus_mask, omni_sift, radial_orientation
 from .ransac import PlanarFit, ransac_sample_count, ransac_se2

@@ -32,7 +32,7 @@ import numpy as np
 from ..cache import save_npz
 from ..validation import as_int, describe
 from .bag_of_words import Vocabulary, VocabularyFileError
-from .bow_vector import BowVector, as_bow_vector
+from .bag_of_words import BowVector, as_bow_vector
 
 __all__ = ["QueryResult", "BowDatabase", "DatabaseFileError"]
 

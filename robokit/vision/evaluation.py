@@ -29,7 +29,7 @@ from scipy.spatial import cKDTree
 from ..validation import as_array, as_points, as_finite_scalar, as_positive
 from .features import Features
 from .matching import two_nearest
-from .ratio import distance_ratio
+from .matching import distance_ratio
 
 __all__ = ["apply_homography", "warp_image", "similarity_homography", "recall_precision", "matching_score"]
 

@@ -10,7 +10,7 @@ row's two nearest with OpenCV's ``cv2.batchDistance`` (its fast path; the tests 
 
 Matching rule: the nearest neighbour is kept when its distance is at most ``max_distance``
 (ORB-SLAM's ``TH_LOW = 50`` bits of 256, Mur-Artal et al. 2015, in its ``ORBmatcher``) and it
-passes the distance-ratio test of :func:`robokit.vision.ratio.ratio_test` (ORB-SLAM uses ratios
+passes the distance-ratio test of :func:`robokit.vision.matching.ratio_test` (ORB-SLAM uses ratios
 0.6-0.9 depending on the search; we default to 0.75, its relocalisation value); with
 ``cross_check=True`` it must also be the mutual best (OpenCV's ``crossCheck``).
 
@@ -30,7 +30,7 @@ import cv2
 import numpy as np
 
 from ..validation import as_array, describe
-from .ratio import Matches, as_ratio, ratio_test
+from .matching import Matches, as_ratio, ratio_test
 
 __all__ = ["ORB_BYTES", "ORB_MATCH_DISTANCE", "ORB_RATIO", "as_binary_descriptors", "same_width", "hamming_distance",
            "hamming_distances", "hamming_match"]
@@ -227,7 +227,7 @@ def hamming_match(query, train, *, ratio: float = ORB_RATIO, max_distance: float
     query : array_like of uint8, shape (N, B)
     train : array_like of uint8, shape (M, B)
     ratio : float, default 0.75
-        Distance-ratio bound in (0, 1] (:func:`robokit.vision.ratio.ratio_test`); ``1`` keeps
+        Distance-ratio bound in (0, 1] (:func:`robokit.vision.matching.ratio_test`); ``1`` keeps
         every nearest neighbour except exact ties. With one train row the ratio is 0 (no second).
     max_distance : float or None, default 50
         Largest accepted distance in bits (ORB-SLAM's ``TH_LOW``); ``None`` or ``inf`` mean no bound.

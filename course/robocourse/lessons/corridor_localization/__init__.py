@@ -1,7 +1,7 @@
 """Lesson 03, coarse-to-fine localization in a long corridor (Ge et al. 2023).
 
-sensors     the lesson's laser and camera
-experiment  the calibration video, the vocabulary, the hybrid map (each cached)
+experiment  the lesson's laser and camera; the calibration video, the vocabulary, the hybrid map
+            (each cached)
 trials      Table 2's runs, AMCL against the retrieval-started MCL (cached), and their records
 kidnapping  Fig. 15's kidnapped robot
 aliasing    one scan and the poses a laser-only filter confuses it with (assignment 03's question)

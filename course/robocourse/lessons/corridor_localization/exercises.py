@@ -9,7 +9,7 @@ from robokit.mapping.corridor_areas import invalid_areas
 from robokit.mapping.corridor_scan import width_condition
 from robokit.mapping.occupancy_grid import LikelihoodField, log_odds
 from robokit.validation import as_array, as_finite_scalar, as_positive
-from robokit.vision.bow_vector import l1_score, tf_idf
+from robokit.vision.bag_of_words import l1_score, tf_idf
 from robokit.vision.hamming import as_binary_descriptors, hamming_match
 from robocourse.exercises.compare import close, exact
 from robocourse.exercises.spec import Case, Exercise

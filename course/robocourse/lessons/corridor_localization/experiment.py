@@ -3,7 +3,10 @@
 Ge et al. (2023) drive their robot once along the corridor's middle line and build a *hybrid map*
 (Sec. 3.4, Fig. 8): an occupancy grid from the LiDAR, and an image map of ORB keyframes turned into
 bag-of-words vectors, each keyframe geo-tagged with the robot's pose at its timestamp (Eq. (18)).
-This module re-runs that stage on :func:`robokit.sim.long_corridor`:
+This module re-runs that stage on :func:`robokit.sim.long_corridor`, with the lesson's two sensors
+(Sec. 4: an RPLIDAR A2, 360 degrees and 8-10 m, above a monocular camera of 1280 x 960 pixels at
+30 frames per second; :func:`corridor_lidar`, :func:`corridor_camera`), which every recording, map
+and run of the lesson uses:
 
 1. :func:`calibration_run` records the paper's 10 m calibration video (30 frames per second,
    1502 frames in the paper) and returns every frame's ORB descriptors: Eq. (15) takes ``F_min``
@@ -39,20 +42,69 @@ from typing import Any, Callable
 
 import numpy as np
 
-from robokit.config import fast_mode
 from robocourse.source import code_version
 from robokit.cache import CACHE_READ_ERRORS, cache_dir, cache_key, read_arrays, write_arrays, write_atomically
+from robokit.config import fast_mode
 from robokit.mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
 from robokit.parallel import map_runs
-from robokit.sim import Lidar, PinholeCamera, corridor_path, describe_sensor, long_corridor, waypoint_path
+from robokit.sim import (Lidar, PinholeCamera, camera_mount, corridor_path, describe_sensor, long_corridor,
+                         waypoint_path)
 from robokit.sim.world import World
 from robokit.validation import as_array, as_callable, as_int, as_positive
-from robokit.vision import BowDatabase, Vocabulary, detect_orb_features, feature_threshold, select_keyframes, \
-    select_keyframes_orbslam
-from robocourse.lessons.corridor_localization.sensors import corridor_camera, corridor_lidar
+from robokit.vision import (BowDatabase, Vocabulary, detect_orb_features, feature_threshold, select_keyframes,
+                            select_keyframes_orbslam)
 
 __all__ = ["CorridorMap", "corridor_map", "as_corridor_map", "CalibrationRun", "calibration_run",
-           "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS"]
+           "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS", "corridor_lidar", "corridor_camera"]
+
+
+def corridor_lidar() -> Lidar:
+    """The RPLIDAR-A2-like scanner of the lesson: 360 beams, 8 m range, 1 cm noise, 0.45 m high.
+
+    Returns
+    -------
+    Lidar
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 4: an RPLIDAR A2 (360 degrees, effective radius 8-10 m), mounted above the
+    camera so the camera does not block its beams.
+
+    Examples
+    --------
+    >>> corridor_lidar().r_max, corridor_lidar().beams
+    (8.0, 360)
+    """
+    return Lidar(noise=0.01, height=0.45)
+
+
+def corridor_camera(fast: bool | None = None) -> PinholeCamera:
+    """The forward-looking camera of the lesson: 65 degrees wide, 0.35 m high, below the LiDAR.
+
+    Parameters
+    ----------
+    fast : bool, optional
+        320 x 240 pixels instead of 640 x 480 (default: :func:`robokit.config.fast_mode`).
+
+    Returns
+    -------
+    PinholeCamera
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 4: a monocular camera with 1280 x 960 pixels at 30 frames per second,
+    mounted lower than the LiDAR. We render at half (or a quarter of) that size to keep the lesson
+    fast; ORB's 500 features fit either.
+
+    Examples
+    --------
+    >>> corridor_camera(fast=True).width, corridor_camera(fast=False).width
+    (320, 640)
+    """
+    fast = fast_mode() if fast is None else bool(fast)
+    w, h = (320, 240) if fast else (640, 480)
+    return PinholeCamera.from_fov(np.deg2rad(65.0), w, h, mount=camera_mount(0.35))
+
 
 #: Odometry noise of the simulated Kobuki base (Thrun et al. 2005, Table 5.6 alphas, our choice).
 MAPPING_ALPHAS = (0.01, 0.001, 0.01, 0.001)

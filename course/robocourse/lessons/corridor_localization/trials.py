@@ -20,7 +20,8 @@ has converged at its first update. An iteration is one filter update, which ROS 
 the heaviest cluster), at convergence and :data:`SETTLE` updates later (the paper's criterion is
 0.05 m and 0.5 degrees, Sec. 4.1). Runs are cached like recorded datasets, and made in worker
 processes (:func:`robokit.parallel.map_runs`; a plain script needs the ``if __name__ == "__main__":``
-guard).
+guard). :class:`TrialResult` holds one run and :class:`TrialSet` the runs of one method, with the
+test of the paper's criterion (:data:`PAPER_TOLERANCE`).
 
 References
 ----------
@@ -32,25 +33,121 @@ References
 from __future__ import annotations
 
 import copy
+import dataclasses
 from typing import Any, Callable
 
 import numpy as np
 
-from robokit.config import fast_mode
+from robocourse.lessons.corridor_localization.experiment import CorridorMap, MAPPING_ALPHAS, N_FEATURES, as_corridor_map
 from robocourse.source import code_version
 from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
+from robokit.config import fast_mode
 from robokit.controllers import CenteringResult, move_to_middle_line
 from robokit.geometry import wrap_angle
-from robokit.localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share, pose_clusters
+from robokit.localization import (KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share,
+                                  pose_clusters)
 from robokit.parallel import map_runs
 from robokit.sim import noisy_odometry, waypoint_path
+from robokit.validation import as_array, as_callable, as_choice, as_int, as_positive, as_rng
 from robokit.vision import detect_orb_features
-from robokit.validation import as_array, as_rng, as_callable, as_choice, as_int, as_positive
-from robocourse.lessons.corridor_localization.experiment import MAPPING_ALPHAS, N_FEATURES, CorridorMap, as_corridor_map
-from robocourse.lessons.corridor_localization.results import TrialResult, TrialSet
 
 __all__ = ["START_POSES", "ELLIPSE_SIGMA", "CLUSTER_SHARE", "PARTICLES", "SETTLE", "retrieve_pose",
-           "localization_trial", "localization_trials", "corridor_localizer"]
+           "localization_trial", "localization_trials", "corridor_localizer", "PAPER_TOLERANCE", "TrialResult",
+           "TrialSet"]
+
+
+#: The paper's success criterion (Sec. 4.1): 0.05 m and 0.5 degrees.
+PAPER_TOLERANCE = (0.05, float(np.deg2rad(0.5)))
+
+
+@dataclasses.dataclass
+class TrialResult:
+    """One global-localization run.
+
+    Attributes
+    ----------
+    method : str
+    start : numpy.ndarray (3,)
+    converged : bool
+    iterations : int
+        Filter updates until convergence (or until the run gave up).
+    distance : float
+        Metres driven from the start (the moving strategy included).
+    error : numpy.ndarray (2,)
+        Position (m) and heading (rad) error of the estimate against the truth at convergence (NaN
+        when the filter never converged).
+    settled : numpy.ndarray (2,)
+        The same, ``settle`` updates later (or when the run ended).
+    retrieval_error : float
+        Ours: distance from the retrieved keyframe's geo-tag to the true position (NaN for AMCL).
+    truth, estimates : numpy.ndarray (K, 3)
+        True poses and the filter's estimates at each update.
+    particles : list of numpy.ndarray or None
+        The cloud at the start and after each update (only when asked for).
+    """
+
+    method: str
+    start: np.ndarray
+    converged: bool
+    iterations: int
+    distance: float
+    error: np.ndarray
+    settled: np.ndarray
+    retrieval_error: float
+    truth: np.ndarray
+    estimates: np.ndarray
+    particles: list | None = None
+
+
+@dataclasses.dataclass
+class TrialSet:
+    """The runs of one method from every start (Table 2).
+
+    Attributes
+    ----------
+    method : str
+    positions : numpy.ndarray of int, shape (n,)
+        The start's index in :data:`~robocourse.lessons.corridor_localization.trials.START_POSES` (0-based) for each run.
+    converged : numpy.ndarray of bool, shape (n,)
+    iterations : numpy.ndarray of int, shape (n,)
+    distance : numpy.ndarray, shape (n,)
+        Metres driven.
+    error : numpy.ndarray, shape (n, 2)
+        Position (m) and heading (rad) error at convergence (NaN when not converged).
+    settled : numpy.ndarray, shape (n, 2)
+        The same, :data:`~robocourse.lessons.corridor_localization.trials.SETTLE` updates after convergence.
+    retrieval_error : numpy.ndarray, shape (n,)
+        Ours: the retrieved keyframe's distance from the truth (NaN for AMCL).
+    """
+
+    method: str
+    positions: np.ndarray
+    converged: np.ndarray
+    iterations: np.ndarray
+    distance: np.ndarray
+    error: np.ndarray
+    settled: np.ndarray
+    retrieval_error: np.ndarray
+
+    def success(self, tolerance: Any = PAPER_TOLERANCE, *, settled: bool = False) -> np.ndarray:
+        """Runs that converged within ``tolerance`` = (metres, radians) of the truth (default the paper's).
+
+        ``settled=True`` judges the estimate :data:`~robocourse.lessons.corridor_localization.trials.SETTLE` updates after convergence instead.
+
+        Examples
+        --------
+        >>> errors = np.array([[0.03, 0.001], [np.nan, np.nan]])
+        >>> runs = TrialSet("ours", np.zeros(2, int), np.array([True, False]), np.array([3, 40]),
+        ...                 np.array([0.5, 40.0]), errors, errors / 2, np.full(2, np.nan))
+        >>> runs.success().tolist(), runs.success((0.01, 0.1)).tolist(), runs.success((0.02, 0.1), settled=True).tolist()
+        ([True, False], [False, False], [True, False])
+        """
+        tol = as_array(tolerance, "tolerance", shape=(2,))
+        if np.any(tol <= 0):
+            raise ValueError(f"tolerance: expected positive (metres, radians), got {tol.tolist()}")
+        err = np.nan_to_num(self.settled if settled else self.error, nan=np.inf)
+        return self.converged & (err[:, 0] <= tol[0]) & (err[:, 1] <= tol[1])
+
 
 #: Ten start poses ``[x, y, theta]`` in the corridor, numbered like the paper's positions #1-#10
 #: (Fig. 12; the paper gives no coordinates, so these are ours): off the middle line and turned, some

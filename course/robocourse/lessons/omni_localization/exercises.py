@@ -8,7 +8,7 @@ from robokit.localization.pose_ekf import ekf_update
 from robokit.mapping.relaxation import relax_sweep
 from robokit.vision.colour import histogram_distance, hue_histogram, rgb_to_hsi
 from robokit.vision.matching import DescriptorIndex
-from robokit.vision.ratio import as_ratio
+from robokit.vision.matching import as_ratio
 from robokit.validation import as_array, as_int
 from robocourse.exercises.compare import close, exact
 from robocourse.exercises.spec import Case, Exercise
