@@ -3,7 +3,7 @@
 An update is the odometry motion model (Thrun et al. Table 5.6), the likelihood-field weights
 (Table 6.3, ROS amcl's ``1 + sum p^3``) over 60 of a 360-beam scan, and low-variance resampling
 (Table 4.4): :func:`robokit.localization.mcl`. The peer, run in the same process on the same
-inputs, loops over particles: one motion sample, :func:`likelihood_field_log_weight_reference`
+inputs, loops over particles: one motion sample, :func:`likelihood_field_log_weight_readable`
 (beam by beam) and the resampling loop of Table 4.4. Target: under 20 ms for 5000 particles x 60
 beams. The vectorised update is timed ``repeats`` times: the best run (what an unloaded core
 gives; timeit's advice) decides the target, the median is printed beside it.
@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from robokit.localization import likelihood_field_log_weight_reference, mcl_step, normalise_log_weights
+from robokit.localization import likelihood_field_log_weight_readable, mcl_step, normalise_log_weights
 from robokit.mapping import OccupancyGrid, likelihood_field
 from robokit.sim import sample_motion_model_odometry
 
@@ -39,7 +39,7 @@ def room_field():
 def loop_update(particles, weights, odom_prev, odom_now, ranges, angles, field, rng):
     n = len(particles)
     moved = np.array([sample_motion_model_odometry(odom_prev, odom_now, p, ALPHAS, rng) for p in particles])
-    log_w = np.array([np.log(w) + likelihood_field_log_weight_reference(p, ranges, angles, field, **MODEL)
+    log_w = np.array([np.log(w) + likelihood_field_log_weight_readable(p, ranges, angles, field, **MODEL)
                       for p, w in zip(moved, weights)])
     w = normalise_log_weights(log_w).weights
     r, c, i, out = rng.uniform(0.0, 1.0 / n), w[0], 0, []          # Table 4.4

@@ -6,7 +6,7 @@ The run is :func:`robokit.sim.corridor_path` through :func:`robokit.sim.long_cor
 (0.3 m/s, 115 s, 1151 scans of a 360-beam :class:`robokit.sim.Lidar`); the scans are computed
 first, untimed. Prints the median time of :func:`robokit.mapping.occupancy_grid_mapping` of the
 whole run at 0.05 m, its real-time factor (run duration / mapping time; issue target >= 10x), and
-its speed per scan against :func:`robokit.mapping.occupancy_grid_mapping_reference` (Tables 9.1 and
+its speed per scan against :func:`robokit.mapping.occupancy_grid_mapping_readable` (Tables 9.1 and
 9.2 in plain Python loops) on the first few scans of the same run, timed in the same process.
 Then the likelihood field of the map (``distance_transform_edt``) and a lookup of 1000 particles x
 360 beam endpoints, the inner step of a Monte-Carlo localizer.
@@ -20,7 +20,7 @@ import numpy as np
 
 from timing import median_time
 
-from robokit.mapping import likelihood_field, occupancy_grid_mapping, occupancy_grid_mapping_reference
+from robokit.mapping import likelihood_field, occupancy_grid_mapping, occupancy_grid_mapping_readable
 from robokit.sim import Lidar, corridor_path, long_corridor
 
 
@@ -43,7 +43,7 @@ def main() -> None:
     t_fast_few = median_time(lambda: occupancy_grid_mapping(path.poses[:n_ref], scans[:n_ref], lidar.angles, bounds,
                                                             0.05, **kw), reps)
     t0 = time.perf_counter()
-    occupancy_grid_mapping_reference(path.poses[:n_ref], scans[:n_ref], lidar.angles, bounds, 0.05, **kw)
+    occupancy_grid_mapping_readable(path.poses[:n_ref], scans[:n_ref], lidar.angles, bounds, 0.05, **kw)
     t_ref = time.perf_counter() - t0
     grid = occupancy_grid_mapping(path.poses, scans, lidar.angles, bounds, 0.05, **kw)
     t_field = median_time(lambda: likelihood_field(grid), reps)

@@ -519,7 +519,7 @@ SPECS: dict[str, Call] = {
                                                   "tol": Real(1e-6), "n_psi": Int(32)}),
     "robokit.arm.arm_angle_intervals.feasible_arm_angles": Call({"chain": Obj(iiwa), "T": T_()}),
     "robokit.arm.arm_angle_intervals.split_points": Call({"chain": Obj(iiwa), "T": T_()}),
-    "robokit.arm.arm_angle_intervals.ik_srs_reference": Call({"chain": Obj(iiwa), "T": T_(),
+    "robokit.arm.arm_angle_intervals.ik_srs_readable": Call({"chain": Obj(iiwa), "T": T_(),
                                                               "q0": Array(q7, "7", optional=True), "n_psi": Int(32)},
                                                              cheap=False),
     "robokit.arm.position_posture.ik_position_posture": Call({"chain": Obj(iiwa), "T": T_(),
@@ -723,7 +723,7 @@ SPECS: dict[str, Call] = {
                                                  "train": Array(lambda: features().descriptors[10:40], "N,N", min_rows=0),
                                                  "ratio": Real(0.65), "method": Choice("kdtree"),
                                                  "max_distance": Real(0.8, optional=True, inf_ok=True)}),
-    "robokit.vision.plot_reference.reference_detect_plot": Call({"image": Array(image, "N,N|N,N,3|N,N,4"),
+    "robokit.vision.plot_readable.detect_plot_readable": Call({"image": Array(image, "N,N|N,N,3|N,N,4"),
                                                                 "params": Obj(None, optional=True)}),
     "robokit.vision.plot_detector.plot_scales": Call({"sigma0": Real(1.6, optional=True), "k": Real(1.26, optional=True),
                                                       "n_scales": Int(9, optional=True)}),
@@ -1063,7 +1063,7 @@ SPECS: dict[str, Call] = {
     "robokit.localization.beam_models.likelihood_field_log_weights": Call({
         "particles": Array(np.array([[0.0, 0.0, 0.0], [0.2, 0.1, 0.5]]), "N,3"), "ranges": Array(SCAN, "N", inf_ok=True),
         "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field), **beam_model_kinds()}),
-    "robokit.localization.beam_models.likelihood_field_log_weight_reference": Call({
+    "robokit.localization.beam_models.likelihood_field_log_weight_readable": Call({
         "pose": Array(np.array([0.2, 0.1, 0.5]), "3"), "ranges": Array(SCAN, "N", inf_ok=True),
         "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field), **beam_model_kinds()}),
     "robokit.localization.mcl.mcl_step": Call({
@@ -1103,7 +1103,7 @@ SPECS: dict[str, Call] = {
         "angles": Array(np.arange(4) * np.pi / 2, "N"), **grid_model_kinds(),
         "clamp": Array(np.array([-2.0, 3.5]), "2")}),
     "robokit.mapping.grid_mapping.occupancy_grid_mapping": Call(grid_mapping_kinds()),
-    "robokit.mapping.grid_mapping.occupancy_grid_mapping_reference": Call(grid_mapping_kinds()),
+    "robokit.mapping.grid_mapping.occupancy_grid_mapping_readable": Call(grid_mapping_kinds()),
     "robokit.mapping.map_server.save_map": Call({"grid": Obj(small_grid), "stem": Text(lambda: str(map_folder() / "m")),
                                                  "occupied_thresh": Real(0.65), "free_thresh": Real(0.196),
                                                  "negate": Int(0), "mode": Choice("trinary")}),
@@ -1581,14 +1581,14 @@ EXTRA: tuple[str, ...] = (
         "log_odds", "probability", "OccupancyGrid", "OccupancyGrid.empty", "OccupancyGrid.from_probability",
         "likelihood_field")),
     *(f"robokit.mapping.grid_mapping.{n}" for n in (
-        "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping", "occupancy_grid_mapping_reference")),
+        "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping", "occupancy_grid_mapping_readable")),
     "robokit.mapping.map_server.save_map", "robokit.mapping.map_server.load_map",
     # lesson 03's Monte-Carlo localization (robokit.localization.particle_filter, beam_models, mcl)
     *(f"robokit.localization.particle_filter.{n}" for n in (
         "normalise_log_weights", "low_variance_resample", "kld_sample_count", "pose_bins", "kld_resample",
         "weighted_pose_mean", "sample_ellipse_poses", "ellipse_weights")),
     *(f"robokit.localization.beam_models.{n}" for n in (
-        "subsample_beams", "valid_beams", "likelihood_field_log_weights", "likelihood_field_log_weight_reference")),
+        "subsample_beams", "valid_beams", "likelihood_field_log_weights", "likelihood_field_log_weight_readable")),
     "robokit.localization.mcl.mcl_step", "robokit.localization.mcl.uniform_free_poses",
     "robokit.localization.mcl.MonteCarloLocalizer",
     # lesson 03's corridor scan, moving strategy and geo-tags, fuzzed before the lesson exists

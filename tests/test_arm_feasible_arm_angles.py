@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from robokit.arm import (LIMIT_TOL, arm_angle, feasible_arm_angles, iiwa14, ik_srs, ik_srs_batch, ik_srs_reference,
+from robokit.arm import (LIMIT_TOL, arm_angle, feasible_arm_angles, iiwa14, ik_srs, ik_srs_batch, ik_srs_readable,
                          split_points)
 from robokit.arm.ik_analytic import SRSArm
 from robokit.arm.srs_geometry import ARRAY, coefficient_terms
@@ -91,7 +91,7 @@ def test_fast_solve_equals_the_reference_search():
     T, q0 = _targets(25, 3)
     for Ti, si in zip(T, q0):
         fast = ik_srs(IIWA, Ti, si)
-        q_ref, psi_ref, cost_ref = ik_srs_reference(IIWA, Ti, si)
+        q_ref, psi_ref, cost_ref = ik_srs_readable(IIWA, Ti, si)
         assert fast.success
         assert np.abs(fast.q - q_ref).max() < 1e-6
         assert ((fast.q - si) ** 2).sum() <= cost_ref + 1e-12

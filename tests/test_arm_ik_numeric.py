@@ -129,15 +129,15 @@ def test_bad_input():
 @pytest.mark.parametrize("clamp", [True, False])
 def test_fast_solver_follows_the_readable_reference_iterate_by_iterate(method, clamp):
     """The vectorised search (one attempt per target, no restarts) and the plain loop of
-    ik_reference take the same steps: every iterate agrees to rounding (measured up to 1e-12 rad:
+    ik_readable take the same steps: every iterate agrees to rounding (measured up to 1e-12 rad:
     the reference passes the damping as lambda = sqrt(lambda^2) to the public step functions and
     takes norms with np.linalg.norm, which round differently in the last bit)."""
-    from robokit.arm import ik_numeric_reference
+    from robokit.arm import ik_numeric_readable
 
     q, T, q0 = _targets(PANDA, 12, seed=27)
     fast = ik_numeric_batch(PANDA, T, q0, method=method, clamp=clamp, restarts=0, history=True, rng=0)
     for i in range(len(T)):
-        ref, iterates = ik_numeric_reference(PANDA, T[i], q0[i], method=method, clamp=clamp)
+        ref, iterates = ik_numeric_readable(PANDA, T[i], q0[i], method=method, clamp=clamp)
         k = len(iterates)
         np.testing.assert_allclose(fast.history[:k, i], iterates, rtol=0, atol=1e-10)
         # after its last step the fast solver only repeats the final iterate

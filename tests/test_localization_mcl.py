@@ -8,7 +8,7 @@ import pytest
 from scipy.stats import chi2
 
 from robokit.localization import (KLD_Z_99, KLDConfig, MonteCarloLocalizer, ellipse_weights, kld_resample,
-                                  kld_sample_count, likelihood_field_log_weight_reference,
+                                  kld_sample_count, likelihood_field_log_weight_readable,
                                   likelihood_field_log_weights, low_variance_resample, mcl_step,
                                   normalise_log_weights, pose_bins, sample_ellipse_poses, subsample_beams,
                                   weighted_pose_mean)
@@ -178,7 +178,7 @@ def test_likelihood_field_vectorised_equals_reference(lab, combine):
     P = np.column_stack([rng.uniform(-1, 11, 40), rng.uniform(-1, 11, 40), rng.uniform(-np.pi, np.pi, 40)])
     kw = dict(sensor_offset=(0.1, -0.05, 0.2), max_beams=45, combine=combine, sigma_hit=0.15)
     fast = likelihood_field_log_weights(P, ranges, lidar.angles, field, **kw)
-    slow = [likelihood_field_log_weight_reference(p, ranges, lidar.angles, field, **kw) for p in P]
+    slow = [likelihood_field_log_weight_readable(p, ranges, lidar.angles, field, **kw) for p in P]
     assert np.allclose(fast, slow, rtol=1e-12, atol=1e-12)
     assert len(subsample_beams(360, 45)) == 45
 

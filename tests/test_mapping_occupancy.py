@@ -94,7 +94,7 @@ def test_likelihood_field_without_obstacles_is_max_distance():
 # ---- mapping with known poses (Thrun et al. 2005, Tables 9.1 and 9.2) ----
 
 from robokit.mapping import (L_FREE, L_OCC, LOG_ODDS_MAX, inverse_range_sensor_model,  # noqa: E402
-                             occupancy_grid_mapping, occupancy_grid_mapping_reference, update_log_odds)
+                             occupancy_grid_mapping, occupancy_grid_mapping_readable, update_log_odds)
 from robokit.sim import Lidar, corridor_path, long_corridor  # noqa: E402
 
 
@@ -169,7 +169,7 @@ def test_fast_mapping_equals_the_reference():
     scans = np.array([lidar.scan(world, p, rng=i) for i, p in enumerate(poses)])
     kw = dict(r_max=lidar.r_max, sensor_offset=lidar.offset, thickness=0.15)
     fast = occupancy_grid_mapping(poses, scans, lidar.angles, (0.0, -1.3, 12.0, 1.3), 0.1, **kw)
-    ref = occupancy_grid_mapping_reference(poses, scans, lidar.angles, (0.0, -1.3, 12.0, 1.3), 0.1, **kw)
+    ref = occupancy_grid_mapping_readable(poses, scans, lidar.angles, (0.0, -1.3, 12.0, 1.3), 0.1, **kw)
     assert fast.shape == ref.shape == (26, 120)
     np.testing.assert_allclose(fast.log_odds, ref.log_odds, rtol=0, atol=1e-12)
     assert (fast.log_odds > 0).sum() > 50 and (fast.log_odds < 0).sum() > 500

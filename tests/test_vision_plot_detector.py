@@ -136,9 +136,9 @@ def test_scale_space_levels_are_subsampled_consistently(photo):
 
 
 def test_fast_detector_agrees_with_the_plain_reference(photo):
-    from robokit.vision.plot_reference import reference_detect_plot
+    from robokit.vision.plot_readable import detect_plot_readable
     small = photo[::2, ::2]
-    ref, fast = reference_detect_plot(small), detect_plot(small)
+    ref, fast = detect_plot_readable(small), detect_plot(small)
     assert 0.8 < len(fast) / len(ref) < 1.25
     d, i = cKDTree(ref.xy).query(fast.xy)
     near = d < 1.5
@@ -147,8 +147,8 @@ def test_fast_detector_agrees_with_the_plain_reference(photo):
     assert np.median(np.abs(np.log2(fast.scale[near] / ref.scale[i[near]]))) < 0.1
     # a stricter parameter set changes both alike
     strict = PlotParams(threshold=0.05)
-    assert abs(len(detect_plot(small, strict)) - len(reference_detect_plot(small, strict))) <= 0.25 * len(
-        reference_detect_plot(small, strict))
+    assert abs(len(detect_plot(small, strict)) - len(detect_plot_readable(small, strict))) <= 0.25 * len(
+        detect_plot_readable(small, strict))
 
 
 @pytest.mark.parametrize("zoom", [0.7, 1.4])

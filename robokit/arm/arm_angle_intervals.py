@@ -17,7 +17,7 @@ and the ZYZ joints of each spherical group:
 Between consecutive split points no joint crosses a limit or jumps, so one test at the middle of
 each arc decides it for all of the arc; the feasible set of a branch is the union of its feasible
 arcs (the intersection over its joints). :func:`feasible_arm_angles` computes these intervals and
-:func:`ik_srs_reference` picks the best arm angle inside them, both step by step with the
+:func:`ik_srs_readable` picks the best arm angle inside them, both step by step with the
 library's checked functions; :func:`robokit.arm.ik_srs` does the same in one compiled call (the
 tests compare them).
 
@@ -40,7 +40,7 @@ from ..validation import as_int
 from .chain import Chain
 from .ik_analytic import BRANCHES, SRSArm
 
-__all__ = ["feasible_arm_angles", "ik_srs_reference", "split_points"]
+__all__ = ["feasible_arm_angles", "ik_srs_readable", "split_points"]
 
 #: ``(numerator entry, denominator entry, denominator sign)`` of the tangent-type joints of a ZYZ
 #: group in its rotation ``M`` (row-major entries): ``a = atan2(M12, M02)``, ``c = atan2(M21, -M20)``.
@@ -198,7 +198,7 @@ def feasible_arm_angles(chain: Chain, T: Any) -> list[np.ndarray]:
     return out
 
 
-def ik_srs_reference(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 32) -> tuple[np.ndarray, float, float]:
+def ik_srs_readable(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 32) -> tuple[np.ndarray, float, float]:
     """The feasible arm angle and branch nearest a start posture, step by step (the readable form of
     :func:`~robokit.arm.ik_srs`'s search).
 
@@ -242,7 +242,7 @@ def ik_srs_reference(chain: Chain, T: Any, q0: Any = None, *, n_psi: int = 32) -
     >>> from robokit.arm import iiwa14
     >>> arm = iiwa14()
     >>> q = np.radians([35, 50, -40, -75, 60, 45, 20])
-    >>> q_best, psi, cost = ik_srs_reference(arm, arm.fk(q), q0=q)
+    >>> q_best, psi, cost = ik_srs_readable(arm, arm.fk(q), q0=q)
     >>> bool(np.abs(q_best - q).max() < 1e-6)
     True
     """

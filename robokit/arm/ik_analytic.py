@@ -15,7 +15,7 @@ joints 1-4, is :func:`robokit.arm.ik_position_posture`):
    that picks the valid solution closest to a preferred configuration ``q0``.
 
 The solvers run as one compiled call per target (:mod:`robokit.arm.srs_kernels`, numba, compiled
-on the first solve and cached on disk); :func:`robokit.arm.arm_angle_intervals.ik_srs_reference`
+on the first solve and cached on disk); :func:`robokit.arm.arm_angle_intervals.ik_srs_readable`
 is the same search step by step.
 
 References

@@ -6,7 +6,7 @@ parallel attempts): each pass evaluates the pose error of every live attempt, en
 converged (pose within tolerance and every joint within its limits), restarts those that stalled
 from a random configuration, and moves the others by one step of the chosen rule. Random restarts
 from configurations drawn inside the limits handle local minima. Success is decided by FK
-verification (:func:`robokit.arm.result.verify`). :mod:`robokit.arm.ik_reference` is the same
+verification (:func:`robokit.arm.result.verify`). :mod:`robokit.arm.ik_readable` is the same
 algorithm for one target as a plain loop; the tests compare the two iterate by iterate.
 
 References

@@ -7,7 +7,7 @@ wins, stalled attempts restart from random configurations in row order), with th
 (:mod:`robokit.arm.ik_steps`: ``0`` DLS, ``1`` gradient projection, ``2`` weighted least norm). The
 random configurations are drawn by the caller, in the order the batch search draws them. The
 tests compare the iterates and answers with :func:`~robokit.arm.ik_numeric_batch` and
-:func:`~robokit.arm.ik_numeric_reference`.
+:func:`~robokit.arm.ik_numeric_readable`.
 
 References
 ----------

@@ -17,9 +17,6 @@ is ``control.c2d(P, dt, "zoh")`` (Franklin et al. 2015, Sec. 8.3). :func:`loop_m
 continuous loop; :func:`discrete_servo_analysis` the sampled one (poles, margins, bandwidth, step),
 and it reports an unstable loop instead of raising.
 
-This module holds no exercise reference, so graded notebooks may import :func:`loop_metrics`
-(assignment 05 declares it in ``HELPERS``; the grading worker provides it).
-
 References
 ----------
 .. [1] G. F. Franklin, J. D. Powell and A. Emami-Naeini, *Feedback Control of Dynamic Systems*,

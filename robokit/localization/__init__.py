@@ -20,7 +20,7 @@ from .egomotion import (DegenerateCorrespondenceError, EgomotionResult, Insuffic
 from .hierarchical import MODES, HierarchicalLocalizer, Localization
 from .hough import Hypothesis, candidate_matches, global_localize, hough_accumulator
 from .visual_slam import FrameReport, VisualSLAM
-from .beam_models import (COMBINE_RULES, likelihood_field_log_weight_reference, likelihood_field_log_weights,
+from .beam_models import (COMBINE_RULES, likelihood_field_log_weight_readable, likelihood_field_log_weights,
                           subsample_beams, valid_beams)
 from .mcl import AMCL_DEFAULTS, KLDConfig, MonteCarloLocalizer
 from .mcl import MCLStep, mcl_step, uniform_free_poses
@@ -33,7 +33,7 @@ __all__ = ["DegenerateCorrespondenceError", "EgomotionResult", "InsufficientMatc
            "fit_pose", "pose_from_two", "ransac_pose", "ransac_sample_count", "track", "Hypothesis",
            "candidate_matches", "global_localize", "hough_accumulator", "FrameReport", "VisualSLAM",
            "MODES", "HierarchicalLocalizer", "Localization",
-           "COMBINE_RULES", "likelihood_field_log_weight_reference", "likelihood_field_log_weights", "subsample_beams",
+           "COMBINE_RULES", "likelihood_field_log_weight_readable", "likelihood_field_log_weights", "subsample_beams",
            "valid_beams", "AMCL_DEFAULTS", "KLDConfig", "MCLStep", "MonteCarloLocalizer", "mcl_step",
            "uniform_free_poses", "KLD_Z_99", "ROS_KLD_BIN_SIZE", "NormalisedWeights", "ellipse_weights",
            "kld_resample", "kld_sample_count", "low_variance_resample", "normalise_log_weights", "pose_bins",

@@ -22,8 +22,8 @@ Beams are subsampled to ``max_beams`` as ROS does: every ``step = (B - 1) // (ma
 beam from the first (:func:`subsample_beams`; ROS's ``laser_max_beams`` defaults to 30).
 
 :func:`likelihood_field_log_weights` is the vectorised model (particles x beams in one array);
-:func:`likelihood_field_log_weight_reference` the same for one pose written as the table's loop,
-the reference it is tested against.
+:func:`likelihood_field_log_weight_readable` the same for one pose written as the table's loop,
+the readable version it is tested against.
 
 References
 ----------
@@ -45,7 +45,7 @@ from ..geometry import se2_compose
 from ..validation import as_array, as_points, as_choice, as_int, as_positive, describe
 
 __all__ = ["COMBINE_RULES", "subsample_beams", "valid_beams", "likelihood_field_log_weights",
-           "likelihood_field_log_weight_reference"]
+           "likelihood_field_log_weight_readable"]
 
 #: The ways of combining per-beam likelihoods: Table 6.3's product, ROS amcl's ``1 + sum p^3``.
 COMBINE_RULES = ("product", "ros")
@@ -240,11 +240,11 @@ def _finite_or_zero_weight(log_w: Any) -> Any:
     return log_w
 
 
-def likelihood_field_log_weight_reference(pose: Any, ranges: Any, angles: Any, field: Any, *,
+def likelihood_field_log_weight_readable(pose: Any, ranges: Any, angles: Any, field: Any, *,
                                           sensor_offset: Any = (0.0, 0.0, 0.0), sigma_hit: float = 0.2,
                                           z_hit: float = 0.95, z_rand: float = 0.05, r_max: float = 8.0,
                                           max_beams: int | None = None, combine: str = "product") -> float:
-    """Table 6.3 for one pose, beam by beam: the readable reference of :func:`likelihood_field_log_weights`.
+    """Table 6.3 for one pose, beam by beam: the readable version of :func:`likelihood_field_log_weights`.
 
     Parameters
     ----------
@@ -270,7 +270,7 @@ def likelihood_field_log_weight_reference(pose: Any, ranges: Any, angles: Any, f
     >>> from robokit.mapping import OccupancyGrid, likelihood_field
     >>> prob = np.zeros((20, 20)); prob[:, 15] = 1.0
     >>> field = likelihood_field(OccupancyGrid.from_probability(prob, 0.1, (0.0, 0.0)))
-    >>> round(likelihood_field_log_weight_reference([0.55, 1.0, 0.0], [1.0], [0.0], field), 3)
+    >>> round(likelihood_field_log_weight_readable([0.55, 1.0, 0.0], [1.0], [0.0], field), 3)
     0.642
     """
     x, y, theta = as_array(pose, "pose", shape=(3,))

@@ -32,7 +32,7 @@ from .corridor_scan import (CorridorState, NoWallError, corridor_axis, corridor_
 from .hybrid_map import GeoIndex, geo_index, geo_tag
 from .g2o import G2OFormatError, read_g2o, write_g2o
 from .grid_mapping import (L_FREE, L_OCC, inverse_range_sensor_model, occupancy_grid_mapping,
-                           occupancy_grid_mapping_reference, update_log_odds)
+                           occupancy_grid_mapping_readable, update_log_odds)
 from .landmarks import LandmarkMap, kalman_fuse, transform_covariance
 from .map_server import FREE_VALUE, OCCUPIED_VALUE, UNKNOWN_VALUE, MapFileError, load_map, save_map
 from .manhattan import manhattan_world_graph
@@ -61,7 +61,7 @@ __all__ = ["transform_covariance", "LandmarkMap", "kalman_fuse",
            "FREE_THRESHOLD", "OCCUPIED_THRESHOLD", "LOG_ODDS_MIN", "LOG_ODDS_MAX", "log_odds", "probability",
            "OccupancyGrid", "LikelihoodField", "likelihood_field",
            "L_OCC", "L_FREE", "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping",
-           "occupancy_grid_mapping_reference", "MapFileError", "save_map", "load_map", "OCCUPIED_VALUE", "FREE_VALUE",
+           "occupancy_grid_mapping_readable", "MapFileError", "save_map", "load_map", "OCCUPIED_VALUE", "FREE_VALUE",
            "UNKNOWN_VALUE",
            "EmptyScanError", "as_scan", "invalid_areas", "theta_limits", "theta_limits_geometric",
            "CorridorState", "NoWallError", "corridor_axis", "corridor_state", "door_sides", "middle_line_condition",

@@ -13,7 +13,7 @@ Hornung et al. 2013) after each scan, so a cell that was free for a long time ca
 occupied after a few hits. The defaults ``l_occ = log_odds(0.7)`` and ``l_free = log_odds(0.4)``
 are OctoMap's hit and miss probabilities.
 
-:func:`occupancy_grid_mapping_reference` is the same algorithm written line by line from the two
+:func:`occupancy_grid_mapping_readable` is the same algorithm written line by line from the two
 tables with plain Python loops (one cell, one beam at a time): the fast version vectorises over
 the cells of a scan's perceptual field and is tested equal to it.
 
@@ -38,7 +38,7 @@ from ..validation import as_array, as_finite_scalar, as_positive, describe
 from .occupancy_grid import LOG_ODDS_MAX, LOG_ODDS_MIN, OccupancyGrid
 
 __all__ = ["L_OCC", "L_FREE", "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping",
-           "occupancy_grid_mapping_reference"]
+           "occupancy_grid_mapping_readable"]
 
 #: Log odds a hit and a pass-through add: log_odds(0.7) and log_odds(0.4) (OctoMap's defaults).
 L_OCC, L_FREE = math.log(0.7 / 0.3), math.log(0.4 / 0.6)
@@ -292,7 +292,7 @@ def occupancy_grid_mapping(poses: Any, scans: Any, angles: Any, bounds: Any, res
     -----
     Each scan updates only the cells of its perceptual field (a square of side ``2 r_max`` around
     the sensor), vectorised over those cells; equal to
-    :func:`occupancy_grid_mapping_reference`.
+    :func:`occupancy_grid_mapping_readable`.
 
     Examples
     --------
@@ -314,12 +314,12 @@ def occupancy_grid_mapping(poses: Any, scans: Any, angles: Any, bounds: Any, res
     return grid
 
 
-def occupancy_grid_mapping_reference(poses: Any, scans: Any, angles: Any, bounds: Any, resolution: float = 0.05, *,
+def occupancy_grid_mapping_readable(poses: Any, scans: Any, angles: Any, bounds: Any, resolution: float = 0.05, *,
                                      r_max: float, sensor_offset: Any = (0.0, 0.0, 0.0), l_occ: float = L_OCC,
                                      l_free: float = L_FREE, l0: float = 0.0, thickness: float = 0.1,
                                      beam_width: float | None = None,
                                      clamp: Any = (LOG_ODDS_MIN, LOG_ODDS_MAX)) -> OccupancyGrid:
-    """Tables 9.1 and 9.2 of Thrun et al. (2005) as written: one cell and one beam at a time (slow; the reference).
+    """Tables 9.1 and 9.2 of Thrun et al. (2005) as written: one cell and one beam at a time (slow; the readable version).
 
     Parameters and result as :func:`occupancy_grid_mapping` (``inf`` in ``scans`` is a max-range
     reading), which it is tested equal to. Plain
@@ -328,7 +328,7 @@ def occupancy_grid_mapping_reference(poses: Any, scans: Any, angles: Any, bounds
     Examples
     --------
     >>> angles = np.arange(4) * np.pi / 2
-    >>> grid = occupancy_grid_mapping_reference([[0.0, 0.0, 0.0]], [[1.0, np.inf, np.inf, np.inf]], angles,
+    >>> grid = occupancy_grid_mapping_readable([[0.0, 0.0, 0.0]], [[1.0, np.inf, np.inf, np.inf]], angles,
     ...                                         (-0.25, -0.25, 1.25, 0.25), 0.5, r_max=3.0, thickness=0.5)
     >>> np.round(grid.log_odds, 3).tolist()
     [[-0.405, -0.405, 0.847]]

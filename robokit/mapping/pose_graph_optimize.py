@@ -13,13 +13,13 @@ Both solvers minimise ``chi2`` over every pose but the fixed one (the gauge), wi
 sparse Jacobian :func:`pose_graph_jacobian`. Each error is whitened first: with ``Omega = L L^T``
 (Cholesky), ``e^T Omega e = |L^T e|^2``, so the problem is an ordinary sum of squares.
 
-* ``method="gauss-newton"``: the readable reference of the lesson. Each iteration solves the
+* ``method="gauss-newton"``: the readable version of the lesson. Each iteration solves the
   sparse normal equations ``(J^T J) dx = -J^T r`` (Kummerle et al. 2011, Sec. III) with SuperLU;
   a step that does not lower the cost is retried with Levenberg-Marquardt damping
   ``J^T J + lambda diag(J^T J)``, so the plain Gauss-Newton step is taken whenever it works.
 * ``method="scipy"``: ``scipy.optimize.least_squares`` (trust-region reflective, LSMR on the
   sparse Jacobian, variables scaled by the Jacobian's columns, no extra regularisation of the
-  subproblem), the library reference.
+  subproblem), the library's version.
 
 The paper aligns its map by relaxation instead (:func:`robokit.mapping.relax`); least squares is
 the optimum relaxation is compared against.

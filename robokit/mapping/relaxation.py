@@ -26,7 +26,7 @@ neighbours' newest values (Gauss-Seidel). :func:`relax` computes every node of a
 previous sweep's values (Jacobi): the sweep is a few vectorised numpy operations over all edges,
 and its result does not depend on the order of the nodes, so a student's loop in any order
 reproduces it exactly. The price is more sweeps (about twice as many on a chain-like graph).
-:func:`relax_sweep` is the readable one-sweep reference that :func:`relax` is tested against.
+:func:`relax_sweep` is the readable one-sweep version that :func:`relax` is tested against.
 
 **Limitations** (what least squares, :func:`robokit.mapping.optimize_pose_graph`, does better):
 one scalar variance per edge replaces the 3 x 3 information matrix (headings weighted as
@@ -111,7 +111,7 @@ def _arrays(poses, variances, edges, measurements, omega_edges, fixed):
 
 def relax_sweep(poses: Any, variances: Any, edges: Any, measurements: Any, edge_variances: Any,
                 fixed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """One relaxation sweep, Eqs. (1)-(3), written node by node (the readable reference).
+    """One relaxation sweep, Eqs. (1)-(3), written node by node (the readable version).
 
     Parameters
     ----------

@@ -1,7 +1,7 @@
 """Vision: PLOT and SIFT features, descriptor matching, evaluation, rectified stereo, colour.
 
 Modules: :mod:`.features` (containers), :mod:`.plot_detector` (Lin et al. Sec. 2.i; its plain
-reference :mod:`.plot_reference`),
+reference :mod:`.plot_readable`),
 :mod:`.descriptors` (Lin et al. Sec. 2.ii, Se et al. Sec. 4, OpenCV SIFT), :mod:`.ratio` (the
 distance-ratio test, Lin et al. Sec. 3), :mod:`.matching` (the neighbour searches behind it), :mod:`.evaluation` (recall vs 1-precision, matching score), :mod:`.stereo` (Lin et al. Sec. 3,
 Se et al. Sec. 2.2 and 3.1), :mod:`.colour` (HSI hue histograms, lesson 02's paper, Sec. "Global

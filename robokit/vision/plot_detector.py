@@ -29,7 +29,7 @@ tensor, averaged over half a sigma, needs the finer sampling), and the maxima ar
 level's own grid (:func:`scale_space_maxima`). Derivatives are fourth-order central
 differences, so that a level's response does not depend on how finely its grid samples it. The
 normalisation is folded into the derivative kernels and the tensor is accumulated in place in
-float32 by OpenCV. :mod:`robokit.vision.plot_reference` keeps the plain full-resolution algorithm,
+float32 by OpenCV. :mod:`robokit.vision.plot_readable` keeps the plain full-resolution algorithm,
 and the tests compare the two.
 
 OpenCV does the filtering; the tensor, the eigenvalues and the maximum search are the lesson and

@@ -11,7 +11,7 @@ import numpy as np
 from typing import Any
 
 from robokit.arm import (LIMIT_TOL, dh_fk, dh_jacobian, dh_transform, elbow_angle, feasible_arm_angles, geometric_jacobian,
-                   iiwa14, ik_srs_reference, limit_distance_gradient, null_space_step, panda, shoulder_angles,
+                   iiwa14, ik_srs_readable, limit_distance_gradient, null_space_step, panda, shoulder_angles,
                    wrist_centre)
 from robokit.geometry import as_se3, pose_error
 from robocourse.exercises.compare import close
@@ -41,7 +41,7 @@ def _iiwa_q(rng: np.random.Generator, n: int) -> np.ndarray:
 def solve_ik(T: Any, q_start: Any) -> np.ndarray:
     """Joints of the KUKA LBR iiwa 14 that reach ``T`` inside the joint limits (the open exercise's reference).
 
-    The arm-angle search of :func:`robokit.arm.ik_srs_reference` (Shimizu et al. 2008): over the
+    The arm-angle search of :func:`robokit.arm.ik_srs_readable` (Shimizu et al. 2008): over the
     eight branches and their exact feasible arm angles, the posture nearest ``q_start``. Any
     posture that reaches the target inside the limits is a right answer; the compare checks that,
     not the posture.
@@ -71,7 +71,7 @@ def solve_ik(T: Any, q_start: Any) -> np.ndarray:
     """
     T = as_se3(T, "T")
     q0 = _IIWA.as_q(q_start, "q_start")
-    q, _, cost = ik_srs_reference(_IIWA, T, q0)
+    q, _, cost = ik_srs_readable(_IIWA, T, q0)
     if not np.isfinite(cost):
         raise ValueError("T: no posture of the iiwa reaches this target inside its joint limits "
                          "(the wrist centre is out of reach, or no arm angle keeps every joint inside)")

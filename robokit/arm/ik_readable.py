@@ -32,10 +32,10 @@ from .jacobian import geometric_jacobian
 from .limits import limit_distance_gradient, wln_weights
 from .result import IKResult, verify
 
-__all__ = ["ik_numeric_reference"]
+__all__ = ["ik_numeric_readable"]
 
 
-def ik_numeric_reference(chain: Chain, T: Any, q0: Any, *, method: str = "wln", tol: float = 1e-6,
+def ik_numeric_readable(chain: Chain, T: Any, q0: Any, *, method: str = "wln", tol: float = 1e-6,
                          max_iter: int = 60, damping: float = 1e-3, gain: float = 0.5, clamp: bool = True,
                          max_step: float = 0.5, patience: int = 15) -> tuple[IKResult, np.ndarray]:
     """One attempt of damped least squares, gradient projection or weighted least norm IK.
@@ -73,7 +73,7 @@ def ik_numeric_reference(chain: Chain, T: Any, q0: Any, *, method: str = "wln", 
     >>> arm = panda()
     >>> q_target = arm.random_q(rng=3)
     >>> q0 = np.clip(q_target + 0.2, arm.qmin, arm.qmax)          # a start near the answer
-    >>> result, iterates = ik_numeric_reference(arm, arm.fk(q_target), q0, method="dls")
+    >>> result, iterates = ik_numeric_readable(arm, arm.fk(q_target), q0, method="dls")
     >>> result.success, result.iterations, iterates.shape
     (True, 4, (5, 7))
     """

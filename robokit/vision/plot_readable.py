@@ -1,6 +1,6 @@
-"""A short, readable reference of the PLOT detector, kept beside the tuned one.
+"""A short, readable version of the PLOT detector, kept beside the tuned one.
 
-:func:`reference_detect_plot` follows Lin et al. Sec. 2.i step by step on the full image grid at
+:func:`detect_plot_readable` follows Lin et al. Sec. 2.i step by step on the full image grid at
 every scale: smooth, build the normalised orientation tensor with the public
 :func:`~robokit.vision.plot_detector.orientation_tensor`, take its junction strength ``lambda_2``,
 and keep the thresholded points that are maxima of their 26 neighbours in scale space (8 at their
@@ -21,10 +21,10 @@ from scipy.ndimage import maximum_filter
 from .features import Keypoints, as_gray_image
 from .plot_detector import PlotParams, junction_strength, orientation_tensor, plot_scales
 
-__all__ = ["reference_detect_plot"]
+__all__ = ["detect_plot_readable"]
 
 
-def reference_detect_plot(image, params: PlotParams | None = None) -> Keypoints:
+def detect_plot_readable(image, params: PlotParams | None = None) -> Keypoints:
     """PLOT keypoints by the plain full-resolution algorithm (slow; the tests' reference).
 
     Parameters
@@ -55,11 +55,11 @@ def reference_detect_plot(image, params: PlotParams | None = None) -> Keypoints:
 
     Examples
     --------
-    >>> from robokit.vision.plot_reference import reference_detect_plot
+    >>> from robokit.vision.plot_readable import detect_plot_readable
     >>> import numpy as np
     >>> square = np.zeros((64, 64), np.float32)
     >>> square[20:44, 20:44] = 1.0
-    >>> kp = reference_detect_plot(square)
+    >>> kp = detect_plot_readable(square)
     >>> # strongest: the whole square, a blob at a coarse scale, on a whole pixel next to its centre 31.5
     >>> bool(np.abs(kp.xy[0] - 31.5).max() == 0.5), bool(kp.scale[0] > 5)
     (True, True)
