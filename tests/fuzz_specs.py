@@ -1518,7 +1518,7 @@ SPECS: dict[str, Call] = {
 
 #: Public functions a lesson uses that the fuzz leaves out, and why.
 NOT_FUZZED: dict[str, str] = {
-    "robokit.sim.motion.Path": "a plain record (NamedTuple) of t and poses; the functions that take one validate it",
+    "robokit.sim.motion.Trajectory": "a plain record (NamedTuple) of t and poses; the functions that take one validate it",
     "robokit.legged.gait.WalkPlan": "a plain record (NamedTuple) of a plan's arrays; walking_plan makes it",
     "robokit.legged.trial_log.TrialLogError": "an exception class (a ValueError) the lesson catches, not calls",
     "robocourse.grading.check.check": "the notebook's checker of a student's function (grading's own tests cover it)",

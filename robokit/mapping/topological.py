@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-from pathlib import Path as FsPath
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -336,20 +336,20 @@ class TopologicalMap:
         return {f.name: np.array(getattr(self, f.name)) if f.name == "index" else getattr(self, f.name)
                 for f in dataclasses.fields(self)}
 
-    def save(self, path: str | FsPath) -> FsPath:
+    def save(self, path: str | Path) -> Path:
         """Write the map as one compressed ``.npz`` of plain arrays.
 
         Returns
         -------
         pathlib.Path
         """
-        target = FsPath(path)
+        target = Path(path)
         with open(target, "wb") as f:
             save_npz(f, {"format": np.array(_FORMAT), **self.to_arrays()})
         return target
 
     @classmethod
-    def load(cls, path: str | FsPath) -> "TopologicalMap":
+    def load(cls, path: str | Path) -> "TopologicalMap":
         """Read a map written by :meth:`save` (validated like a new one).
 
         Raises
@@ -359,7 +359,7 @@ class TopologicalMap:
         """
         names = [f.name for f in dataclasses.fields(cls)]
         try:
-            with np.load(FsPath(path), allow_pickle=False) as data:
+            with np.load(Path(path), allow_pickle=False) as data:
                 if int(data["format"]) != _FORMAT:
                     raise ValueError(f"path: expected a topological map of format {_FORMAT}, got {int(data['format'])}")
                 arrays = {k: data[k] for k in names if k != "index" or k in data.files}

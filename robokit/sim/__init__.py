@@ -68,7 +68,7 @@ from .camera import Frame, PinholeCamera, StereoRig, camera_mount
 from .view_matches import ViewPairMatches, ground_truth_inliers, omni_ground_truth_inliers, omni_view_pair, sift_view_pair
 from .layout import Layout, box_corners, obstacle_array
 from .lidar import Lidar, scan_points
-from .motion import (OFFICE_TEST_POSES, Path, corridor_path, increment_variances, lab_lap, noisy_odometry,
+from .motion import (OFFICE_TEST_POSES, Trajectory, corridor_path, increment_variances, lab_lap, noisy_odometry,
                      odometry_covariance, odometry_increment, office_tour, sample_motion_model_odometry, waypoint_path)
 from .omni import OmniCamera, as_omni_camera, omni_mount
 from .runs import FrameStream, Run, describe_sensor, record, record_stream
@@ -83,7 +83,7 @@ __all__ = [
     "open_field", "field_world", "scatter_obstacles",
     "Frame", "PinholeCamera", "StereoRig", "camera_mount", "OmniCamera", "omni_mount", "as_omni_camera", "illuminate", "photo",
     "Layout", "box_corners", "obstacle_array", "Lidar", "scan_points",
-    "Path", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
+    "Trajectory", "unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds",
     "odometry_increment",
     "sample_motion_model_odometry", "noisy_odometry", "waypoint_path", "corridor_path", "lab_lap", "office_tour",
     "OFFICE_TEST_POSES", "increment_variances", "odometry_covariance",

@@ -32,7 +32,7 @@ from ..validation import (as_array, as_points, as_rng, require_finite_result, as
 from .world import World
 
 __all__ = ["odometry_increment", "increment_variances", "odometry_covariance", "sample_motion_model_odometry",
-           "noisy_odometry", "Path", "waypoint_path",
+           "noisy_odometry", "Trajectory", "waypoint_path",
            "corridor_path", "lab_lap", "office_tour", "OFFICE_TOUR", "OFFICE_TEST_POSES"]
 
 
@@ -279,12 +279,12 @@ def noisy_odometry(poses: Any, alphas: Any, rng: Any = None) -> np.ndarray:
     return out
 
 
-class Path(NamedTuple):
+class Trajectory(NamedTuple):
     """A timed trajectory: ``t`` (N,) seconds and ``poses`` (N, 3) ``[x, y, theta]``.
 
     Examples
     --------
-    >>> path = Path(np.array([0.0, 1.0]), np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0]]))
+    >>> path = Trajectory(np.array([0.0, 1.0]), np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0]]))
     >>> path.t.tolist(), path.poses[-1].tolist()
     ([0.0, 1.0], [0.3, 0.0, 0.0])
     """
@@ -293,7 +293,7 @@ class Path(NamedTuple):
     poses: np.ndarray
 
 
-def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, rate: float = 10.0) -> Path:
+def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, rate: float = 10.0) -> Trajectory:
     """A remote-controlled drive through waypoints: turn on the spot, then drive straight.
 
     Parameters
@@ -309,7 +309,7 @@ def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, ra
 
     Returns
     -------
-    Path
+    Trajectory
 
     Notes
     -----
@@ -343,10 +343,10 @@ def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, ra
     t = np.arange(0.0, kt[-1] + 1e-9, dt)
     poses = np.column_stack([np.interp(t, kt, kp[:, i]) for i in range(3)])
     poses[:, 2] = wrap_angle(poses[:, 2])
-    return Path(t, poses)
+    return Trajectory(t, poses)
 
 
-def corridor_path(world: Any, speed: float = 0.3, rate: float = 10.0, margin: float = 0.8) -> Path:
+def corridor_path(world: Any, speed: float = 0.3, rate: float = 10.0, margin: float = 0.8) -> Trajectory:
     """Drive along the middle line of :func:`robokit.sim.long_corridor`, stopping ``margin`` m from the ends.
 
     Notes
@@ -359,7 +359,7 @@ def corridor_path(world: Any, speed: float = 0.3, rate: float = 10.0, margin: fl
     return waypoint_path([[m, 0.0], [length - m, 0.0]], speed, rate=rate)
 
 
-def lab_lap(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
+def lab_lap(world: Any, speed: float = 0.3, rate: float = 10.0) -> Trajectory:
     """One lap around the middle of :func:`robokit.sim.lab_room`, clear of the furniture.
 
     Notes
@@ -399,7 +399,7 @@ OFFICE_TEST_POSES = ((13.0, 3.7, 2.0), (10.3, 2.2, -1.2), (14.5, 1.1, 0.8), (9.0
                      (14.3, 10.0, -2.5))
 
 
-def office_tour(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
+def office_tour(world: Any, speed: float = 0.3, rate: float = 10.0) -> Trajectory:
     """The exploration drive of :func:`robokit.sim.office_floor`: every room and the corridor, with loops.
 
     Parameters
@@ -415,7 +415,7 @@ def office_tour(world: Any, speed: float = 0.3, rate: float = 10.0) -> Path:
 
     Returns
     -------
-    Path
+    Trajectory
         Starts in R1 (lower right) at ``(14.5, 4.0)`` facing west, laps R1, crosses the corridor
         to R2, R3 and R4, each walked round its table, and returns to R1: it closes the R1 lap and
         the whole-floor loop (work for loop closure), about 98 m in all.

@@ -20,7 +20,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-from pathlib import Path as FsPath
+from pathlib import Path
 from typing import Any, Iterator
 
 import numpy as np
@@ -30,7 +30,7 @@ from ..parallel import iter_runs, map_runs
 from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, as_int, as_positive
 from .camera import PinholeCamera, StereoRig
-from .motion import Path, noisy_odometry
+from .motion import Trajectory, noisy_odometry
 from .omni import OmniCamera
 from .world import World
 
@@ -72,7 +72,7 @@ class Run:
     def __len__(self) -> int:
         return len(self.t)
 
-    def save(self, path: str | FsPath) -> FsPath:
+    def save(self, path: str | Path) -> Path:
         """Write the run as a compressed ``.npz`` (arrays only; ``meta`` as JSON text).
 
         Parameters
@@ -94,13 +94,13 @@ class Run:
         for group in ("images", "depths", "scans"):
             for name, arr in getattr(self, group).items():
                 arrays[f"{group}:{name}"] = arr
-        path = FsPath(path)
+        path = Path(path)
         with open(path, "wb") as fh:
             save_npz(fh, arrays)
         return path
 
     @classmethod
-    def load(cls, path: str | FsPath) -> "Run":
+    def load(cls, path: str | Path) -> "Run":
         """Read a run written by :meth:`save` (``allow_pickle=False``: no code is ever loaded).
 
         Raises
@@ -108,7 +108,7 @@ class Run:
         ValueError
             If the file is not a robokit run.
         """
-        with np.load(FsPath(path), allow_pickle=False) as data:
+        with np.load(Path(path), allow_pickle=False) as data:
             if "meta" not in data.files or "poses" not in data.files:
                 raise ValueError(f"path: expected a robokit run (.npz with meta and poses), got {path}")
             groups: dict[str, dict] = {"images": {}, "depths": {}, "scans": {}}
@@ -120,7 +120,7 @@ class Run:
                        groups["scans"], json.loads(str(data["meta"])))
 
 
-def _cached(target: FsPath, meta: dict) -> Run | None:
+def _cached(target: Path, meta: dict) -> Run | None:
     """The run cached at ``target`` if it is readable and was made with exactly ``meta``; ``None``
     for a missing, corrupt (a killed write, a damaged disk) or foreign file, which is then rebuilt."""
     if not target.exists():
@@ -215,9 +215,9 @@ def _camera_frames(shared: tuple, poses: np.ndarray) -> list:
 
 def _timed_poses(path: Any, rate: float | None) -> tuple[np.ndarray, np.ndarray]:
     """Timestamps and poses of ``path``, resampled at ``rate`` (linear, heading unwrapped) if given."""
-    if isinstance(path, tuple) and len(path) == 2 and not isinstance(path, Path):
-        path = Path(*path)
-    if isinstance(path, Path):
+    if isinstance(path, tuple) and len(path) == 2 and not isinstance(path, Trajectory):
+        path = Trajectory(*path)
+    if isinstance(path, Trajectory):
         t0, p0 = as_array(path.t, "path.t", ndim=1), as_points(path.poses, "path.poses", 3, min_count=1)
     else:
         p0 = as_points(path, "path", 3, min_count=1)
@@ -245,14 +245,14 @@ def _drive(world: World, path: Any, rate: float | None, odometry_alphas: Any, se
     return t, poses, as_array(odometry_alphas, "odometry_alphas", shape=(4,)), as_int(seed, "seed", minimum=0)
 
 
-def record(world: World, path: Path, sensors: dict, rate: float | None = None, *,
+def record(world: World, path: Trajectory, sensors: dict, rate: float | None = None, *,
            odometry_alphas: Any = (0.01, 0.001, 0.01, 0.001), seed: int = 0, cache: bool = True) -> Run:
     """Drive ``path`` through ``world`` and record every sensor at ``rate``.
 
     Parameters
     ----------
     world : World
-    path : Path, (t, poses) tuple or array_like (N, 3)
+    path : Trajectory, (t, poses) tuple or array_like (N, 3)
         Timed ground-truth trajectory (a bare pose array is taken as sampled at ``rate``).
     sensors : dict of str to sensor
         Sensor dataclasses with ``observe(world, robot_pose, rng=...)``: ``PinholeCamera``,
@@ -400,7 +400,7 @@ def _images(batches: Iterator) -> Iterator:
         batches.close()         # the workers stop when the caller stops taking images
 
 
-def record_stream(world: World, path: Path, camera: Any, rate: float | None = None, *,
+def record_stream(world: World, path: Trajectory, camera: Any, rate: float | None = None, *,
                   odometry_alphas: Any = (0.01, 0.001, 0.01, 0.001), seed: int = 0) -> FrameStream:
     """Drive ``path`` through ``world`` with one camera whose images arrive as they are rendered.
 
@@ -412,7 +412,7 @@ def record_stream(world: World, path: Path, camera: Any, rate: float | None = No
     Parameters
     ----------
     world : World
-    path : Path, (t, poses) tuple or array_like (N, 3)
+    path : Trajectory, (t, poses) tuple or array_like (N, 3)
     camera : PinholeCamera or OmniCamera
         A robokit camera (its frames draw no noise, so the workers can render them in any order).
     rate : float, optional
