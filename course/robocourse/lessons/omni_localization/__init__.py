@@ -1,4 +1,4 @@
-"""Lesson 02, omnidirectional hierarchical localization and visual path following (seed 001).
+"""Lesson 02, omnidirectional hierarchical localization and visual path following (Li et al. 2011).
 
 experiment  the office: its tour, the topological map built from it (cached), the test poses and
             the route
