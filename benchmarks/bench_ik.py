@@ -43,7 +43,8 @@ import time
 import numpy as np
 
 import robokit
-from robokit.arm import iiwa14, ik_numeric, ik_numeric_batch, ik_srs, ik_srs_batch, panda, pose_error
+from robokit.arm import iiwa14, ik_numeric, ik_numeric_batch, ik_srs, ik_srs_batch, panda
+from robokit.geometry import pose_error
 
 
 #: ik_LM's tolerance is on E = e^T e / 2; 5e-13 means |e| < 1e-6, the same bar as robokit's.

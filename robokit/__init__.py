@@ -1,11 +1,28 @@
 """robokit: the reference library of the robokit courseware.
 
 Mobile-robot perception, localization, legged systems and robot kinematics, built from the course's
-source papers (see ``README.md``). Each subpackage's docstring is its map; bottom layer first
-(``tests/test_layers.py`` enforces the order): ``geometry``; ``vision``; ``sim``; ``mapping``;
-``localization``, ``controllers``; ``legged``, ``outdoor``, ``arm``, ``navigation``; ``viz``.
-The course around it (lessons' experiments, exercises, grading, the site) is the separate
-``robocourse`` package.
+source papers (see ``README.md``); every function cites the paper and equation it implements. The
+course around it (the lessons' experiments, exercises, grading, the site) is the separate
+``robocourse`` package. Subpackages and modules, bottom layer first (``tests/test_layers.py``
+enforces the order); each subpackage's docstring maps its modules:
+
+validation    the input checks every public function uses (errors that name the argument)
+config        settings from the environment: headless, fast mode, worker processes
+cache         the dataset cache (keys, atomic writes, .npz round trips)
+about         the versions of robokit and what it needs
+progress      the one progress bar of every long step
+parallel      independent, separately seeded runs in worker processes
+geometry      SE(2), SO(3), SE(3), rigid fits, the papers' frames
+vision        features (PLOT, SIFT, ORB), matching, stereo, colour, bags of words
+sim           textured worlds, cameras, LiDAR, vehicles, motion, recorded runs
+mapping       landmark databases, pose graphs, topological maps, occupancy grids, corridor scans
+localization  ego-motion, global localization, visual SLAM, hierarchical and Monte-Carlo localization
+controllers   control loops designed with python-control: servos, heading, path following
+legged        the LittleDog quadruped: model, kinematics, gaits, sensing, MuJoCo simulation
+outdoor       NMEA, geodesy, sonar, a skid-steer truck and its navigator
+arm           DH chains, Jacobians, analytic and numeric IK of redundant arms
+navigation    closed-loop navigation along a visual path
+viz           meshcat scenes and matplotlib figures
 """
 __version__ = "0.1.0"
 

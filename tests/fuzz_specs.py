@@ -223,7 +223,7 @@ def visual_path():
 
 
 def localizer():
-    from robokit.navigation import gaussian_localizer
+    from robokit.navigation.visual_path import gaussian_localizer
     return gaussian_localizer()
 
 
@@ -997,7 +997,7 @@ SPECS: dict[str, Call] = {
                                                               "variance": Array(np.array([0.01, 0.2]), "|N"),
                                                               "max_features": Int(930), "max_variance": Real(0.1)}),
     "robokit.mapping.topological_build.select_key_frames": Call({
-        "n_frames": Int(5), "compare": Func(lambda: (lambda key, k: __import__("robokit").mapping.Comparison(
+        "n_frames": Int(5), "compare": Func(lambda: (lambda key, k: __import__("robokit.mapping.topological_build", fromlist=["Comparison"]).Comparison(
             0.01, 100, 500, 0.0))),
         "similarity": Real(0.05), "min_matches": Int(50), "occlusion_frames": Int(3), "max_features": Int(930),
         "max_variance": Real(0.1)}),
@@ -1523,6 +1523,7 @@ NOT_FUZZED: dict[str, str] = {
     "robokit.legged.trial_log.TrialLogError": "an exception class (a ValueError) the lesson catches, not calls",
     "robocourse.grading.check.check": "the notebook's checker of a student's function (grading's own tests cover it)",
 }
+SPECS["robocourse.grading.data.assignment_data"] = Call({"slug": Choice("04_littledog")})
 
 #: Besides the lessons' API: the exercises' references (students reproduce their contracts) and
 #: the functions the issue's fuzz named.

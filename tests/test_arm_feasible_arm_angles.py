@@ -8,8 +8,8 @@ import sys
 import numpy as np
 import pytest
 
-from robokit.arm import (LIMIT_TOL, arm_angle, feasible_arm_angles, iiwa14, ik_srs, ik_srs_batch, ik_srs_readable,
-                         split_points)
+from robokit.arm import LIMIT_TOL, arm_angle, feasible_arm_angles, iiwa14, ik_srs, ik_srs_batch, ik_srs_readable
+from robokit.arm.arm_angle_intervals import split_points
 from robokit.arm.ik_analytic import SRSArm
 from robokit.arm.srs_geometry import ARRAY, coefficient_terms
 
@@ -79,7 +79,8 @@ def test_compiled_steps_match_the_readable_ones():
         assert np.allclose(F, chain.frames(q), atol=1e-14) and np.allclose(flange, chain.fk(q), atol=1e-14)
         J = np.empty((6, 7))
         chain_kernels.jacobian(F, flange, first, J)
-        from robokit.arm import geometric_jacobian, pose_error
+        from robokit.arm import geometric_jacobian
+        from robokit.geometry import pose_error
         assert np.allclose(J, geometric_jacobian(chain, q), atol=1e-14)
         for target in (chain.fk(chain.random_q(rng=4)), chain.fk(q) @ np.diag([-1.0, -1.0, 1.0, 1.0])):  # near pi too
             e = np.empty(6)

@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from robokit.arm import arm_angle, iiwa14, ik_srs, ik_srs_batch, ik_srs_branches, panda, pose_error
+from robokit.arm import arm_angle, iiwa14, ik_srs, ik_srs_batch, ik_srs_branches, panda
+from robokit.geometry import pose_error
 
 IIWA = iiwa14()
 

@@ -2,8 +2,10 @@
 import numpy as np
 import pytest
 
-from robokit.arm import (dls_step, geometric_jacobian, iiwa14, ik_numeric, ik_numeric_batch,
-                         limit_distance_gradient, null_space_step, panda, pose_error, wln_weights)
+from robokit.arm import (geometric_jacobian, iiwa14, ik_numeric, ik_numeric_batch, limit_distance_gradient, null_space_step, panda)
+from robokit.arm.ik_steps import dls_step
+from robokit.arm.limits import wln_weights
+from robokit.geometry import pose_error
 
 PANDA = panda()
 
@@ -132,7 +134,7 @@ def test_fast_solver_follows_the_readable_reference_iterate_by_iterate(method, c
     ik_readable take the same steps: every iterate agrees to rounding (measured up to 1e-12 rad:
     the reference passes the damping as lambda = sqrt(lambda^2) to the public step functions and
     takes norms with np.linalg.norm, which round differently in the last bit)."""
-    from robokit.arm import ik_numeric_readable
+    from robokit.arm.ik_readable import ik_numeric_readable
 
     q, T, q0 = _targets(PANDA, 12, seed=27)
     fast = ik_numeric_batch(PANDA, T, q0, method=method, clamp=clamp, restarts=0, history=True, rng=0)

@@ -190,9 +190,9 @@ def test_plain_table_functions_match_the_chain():
 
 
 def test_public_frames_flange_and_jacobian_kernels_match_the_checked_functions():
-    from robokit.arm import jacobian_from_frames
+    from robokit.arm.jacobian import jacobian_from_frames
     from robokit.geometry import pose_error as geometry_pose_error
-    from robokit.arm import pose_error
+    from robokit.geometry import pose_error
 
     assert pose_error is geometry_pose_error              # lesson 06 calls arm.pose_error
     chain = panda()
@@ -220,7 +220,7 @@ def test_public_frames_flange_and_jacobian_kernels_match_the_checked_functions()
 
 
 def test_verify_needs_the_pose_and_the_limits():
-    from robokit.arm import verify
+    from robokit.arm.result import verify
 
     chain = panda()
     q = chain.random_q(3, rng=16)

@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from robokit.controllers import centering_command, move_to_middle_line
+from robokit.controllers import move_to_middle_line
+from robokit.controllers.corridor_centering import centering_command
 from robokit.geometry import wrap_angle
 from robokit.sim import Lidar, long_corridor, unicycle_step
 

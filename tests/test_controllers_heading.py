@@ -9,7 +9,7 @@ import pytest
 
 from robokit.controllers import (design_heading_gains, heading_closed_loop, heading_frequency_response,
                                  heading_loop_gain, heading_plant, heading_step_response, loop_metrics)
-from robokit.outdoor import loop_metrics as outdoor_loop_metrics
+from robokit.controllers import loop_metrics as outdoor_loop_metrics
 
 
 def test_outdoor_re_exports_the_loop_design():

@@ -10,9 +10,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from robokit.controllers import (LITTLEDOG_MOTOR, design_servo_gains, discrete_servo_analysis,
-                                 discrete_servo_response, heading_plant, joint_lag, joint_plant, joint_torque,
-                                 pd_servo_step, reflected_inertia, servo_analysis, servo_closed_loop, servo_plant)
+from robokit.controllers import (LITTLEDOG_MOTOR, design_servo_gains, discrete_servo_analysis, heading_plant, joint_plant, joint_torque, pd_servo_step, reflected_inertia, servo_analysis, servo_closed_loop, servo_plant)
+from robokit.controllers.joint_servo import discrete_servo_response, joint_lag
 
 M = LITTLEDOG_MOTOR
 NOMINAL_LINK_INERTIA = 2.0e-4      # a leg's links about a knee, of the order of LittleDog's (kg m^2)

@@ -7,10 +7,9 @@ import control
 import numpy as np
 import pytest
 
-from robokit.controllers import (PathFollower, PathSingularityError, VisualPath, lateral_step_response,
-                                 path_following_command, path_following_damping, path_following_gains,
-                                 path_following_linearisation, path_following_poles, path_from_poses, reference_point,
-                                 saturate_command, simulate_path_following)
+from robokit.controllers import (PathFollower, PathSingularityError, VisualPath, lateral_step_response, path_following_command, path_following_damping, path_following_gains, path_following_poles, path_from_poses, reference_point, simulate_path_following)
+from robokit.controllers.path_following import saturate_command
+from robokit.controllers.path_following_loop import path_following_linearisation
 from robokit.geometry import wrap_angle
 from robokit.sim import unicycle_step
 

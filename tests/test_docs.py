@@ -1,10 +1,12 @@
-"""Documentation the lessons rely on: runnable examples and full citations.
+"""Documentation the lessons rely on: the packages' maps, runnable examples and full citations.
 
-* Every robokit function or class that a lesson or solution notebook uses has an ``Examples``
-  section with at least one ``>>>`` line (they run as doctests under ``make test``, see
-  ``pyproject.toml``).
-* Every module of a topic subpackage that cites a source in its docstrings has a ``References``
-  section in its module docstring giving the full citation.
+* Each package's ``__init__`` docstring is its map (docs/DESIGN.md): one line per module or
+  subpackage, ``name  what it holds``, and exactly the ones that exist.
+* Every robokit or robocourse function or class that a lesson or solution notebook uses has an
+  ``Examples`` section with at least one ``>>>`` line (they run as doctests under ``make test``,
+  see ``pyproject.toml``).
+* Every module of a topic subpackage or a lesson that cites a source in its docstrings has a
+  ``References`` section in its module docstring giving the full citation.
 """
 from __future__ import annotations
 
@@ -42,14 +44,14 @@ def _names_used(source: str) -> set[str]:
     used: set[str] = set()
     for tree in _trees(source):
         for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("robokit"):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(("robokit", "robocourse")):
                 for a in node.names:
                     full = f"{node.module}.{a.name}"
                     aliases[a.asname or a.name] = full
                     used.add(full)
             elif isinstance(node, ast.Import):
                 for a in node.names:
-                    if a.name.startswith("robokit"):
+                    if a.name.startswith(("robokit", "robocourse")):
                         aliases[a.asname or a.name.split(".")[0]] = a.asname and a.name or a.name.split(".")[0]
     for alias, full in aliases.items():
         for m in re.finditer(rf"(?<![\w.]){re.escape(alias)}((?:\.\w+)+)", source):
@@ -81,7 +83,7 @@ def _lesson_api() -> dict[str, object]:
         for name in _names_used(_code(nb)):
             obj = _resolve(name)
             obj = inspect.unwrap(obj) if callable(obj) else obj   # e.g. functools.lru_cache
-            if (inspect.isfunction(obj) or inspect.isclass(obj)) and obj.__module__.startswith("robokit"):
+            if (inspect.isfunction(obj) or inspect.isclass(obj)) and obj.__module__.startswith(("robokit", "robocourse")):
                 found[f"{obj.__module__}.{obj.__qualname__}"] = obj
     return found
 
@@ -108,12 +110,16 @@ def _topic_modules() -> list[str]:
         for path in sorted(base.glob("*.py")) if base.is_dir() else []:
             if path.name != "__init__.py":
                 out.append(f"robokit.{topic}.{path.stem}")
+    for path in sorted((ROOT / "course" / "robocourse" / "lessons").glob("*/*.py")):
+        if path.name != "__init__.py":
+            out.append(f"robocourse.lessons.{path.parent.name}.{path.stem}")
     return out
 
 
 @pytest.mark.parametrize("module", _topic_modules())
 def test_modules_that_cite_sources_give_full_references(module):
-    path = ROOT / Path(*module.split(".")).with_suffix(".py")
+    top = ROOT / "course" if module.startswith("robocourse") else ROOT
+    path = top / Path(*module.split(".")).with_suffix(".py")
     tree = ast.parse(path.read_text(encoding="utf-8"))
     docs = [ast.get_docstring(n) or "" for n in ast.walk(tree)
             if isinstance(n, (ast.Module, ast.FunctionDef, ast.ClassDef, ast.AsyncFunctionDef))]
@@ -123,3 +129,26 @@ def test_modules_that_cite_sources_give_full_references(module):
     assert re.search(r"^References\n-{10}\n", module_doc, re.M), (
         f"{module} cites sources: its module docstring needs a numpydoc 'References' section with the "
         "full citations (authors, title, venue, year)")
+
+
+PACKAGE_DIRS = sorted(p.parent for top in (ROOT / "robokit", ROOT / "course" / "robocourse")
+                      for p in top.rglob("__init__.py"))
+#: A line of a package's map: a module or subpackage name at the start of the line, two spaces,
+#: what it holds (continuation lines are indented).
+MAP_LINE = re.compile(r"^([a-z_][a-z0-9_]*) {2,}\S", re.M)
+
+
+@pytest.mark.parametrize("package", PACKAGE_DIRS, ids=lambda p: str(p.relative_to(ROOT)))
+def test_each_package_docstring_maps_exactly_its_modules(package):
+    children = {p.stem for p in package.glob("*.py") if p.name != "__init__.py"}
+    children |= {d.name for d in package.iterdir() if (d / "__init__.py").is_file()}
+    doc = ast.get_docstring(ast.parse((package / "__init__.py").read_text(encoding="utf-8"))) or ""
+    listed = MAP_LINE.findall(doc)
+    assert len(listed) == len(set(listed)), f"{package.name}: a module is listed twice: {listed}"
+    assert set(listed) == children, (f"{package.relative_to(ROOT)}/__init__.py: its map misses "
+                                     f"{sorted(children - set(listed))} and names {sorted(set(listed) - children)}")
+
+
+def test_the_map_test_reads_a_map():
+    doc = "Summary.\n\nplanar  SE(2)\nrotations   SO(3),\n            continued\nNot a line.\n"
+    assert MAP_LINE.findall(doc) == ["planar", "rotations"]

@@ -17,9 +17,9 @@ def test_pqt_convention():
     poses = _random_se2(np.random.default_rng(5), 20)
     np.testing.assert_allclose(g.pqt_to_se2(g.se2_to_pqt(poses)), poses)
     # the body->optical rotation maps forward to optical z and left to optical -x
-    np.testing.assert_allclose(g.R_BODY_OPTICAL @ [0, 0, 1], [1, 0, 0])
-    np.testing.assert_allclose(g.R_BODY_OPTICAL.T @ [0, 1, 0], [-1, 0, 0])
-    np.testing.assert_allclose(g.optical_to_y_up([[1, 2, 3]]), [[1, -2, 3]])
+    np.testing.assert_allclose(g.paper_frames.R_BODY_OPTICAL @ [0, 0, 1], [1, 0, 0])
+    np.testing.assert_allclose(g.paper_frames.R_BODY_OPTICAL.T @ [0, 1, 0], [-1, 0, 0])
+    np.testing.assert_allclose(g.paper_frames.optical_to_y_up([[1, 2, 3]]), [[1, -2, 3]])
 
 
 def test_pqt_robot_to_world_by_hand():
@@ -72,18 +72,18 @@ def test_ground_plane_action_is_batched_over_poses_and_points():
     rng = np.random.default_rng(7)
     poses = np.column_stack([rng.uniform(-5, 5, (6, 2)), rng.uniform(-4, 4, 6)])
     xz = rng.normal(size=(9, 2))
-    moved = g.pqt_transform_xz(poses[:, None, :], xz)
+    moved = g.paper_frames.pqt_transform_xz(poses[:, None, :], xz)
     assert moved.shape == (6, 9, 2)
     for pqt, m in zip(poses, moved):
         pts = np.column_stack([xz[:, 0], rng.normal(size=9), xz[:, 1]])
         np.testing.assert_array_equal(g.pqt_robot_to_world(pts, pqt)[:, ::2], m)
         for r, w in zip(xz, m):
             np.testing.assert_allclose(g.se2_compose(pqt, [r[0], r[1], 0.0])[:2], w, atol=1e-12)
-        np.testing.assert_allclose(g.pqt_transform_xz(pqt, m, inverse=True), xz, atol=1e-12)
-    np.testing.assert_array_equal(g.pqt_transform_xz(poses[:, None, :], xz, validate=False), moved)
+        np.testing.assert_allclose(g.paper_frames.pqt_transform_xz(pqt, m, inverse=True), xz, atol=1e-12)
+    np.testing.assert_array_equal(g.paper_frames.pqt_transform_xz(poses[:, None, :], xz, validate=False), moved)
     # the rotation alone is the action of [0, 0, theta]
-    np.testing.assert_array_equal(g.pqt_rotate_xz(poses[:, 2:], xz),
-                                  g.pqt_transform_xz(np.column_stack([0 * poses[:, :2], poses[:, 2]])[:, None], xz))
+    np.testing.assert_array_equal(g.paper_frames.pqt_rotate_xz(poses[:, 2:], xz),
+                                  g.paper_frames.pqt_transform_xz(np.column_stack([0 * poses[:, :2], poses[:, 2]])[:, None], xz))
     # many poses, one point each (the 3-D functions broadcast the same way)
     pts = rng.normal(size=(6, 3))
     np.testing.assert_allclose(g.pqt_world_to_robot(g.pqt_robot_to_world(pts, poses), poses), pts, atol=1e-12)
@@ -92,15 +92,15 @@ def test_ground_plane_action_is_batched_over_poses_and_points():
 def test_ground_plane_jacobian_matches_finite_differences():
     rng = np.random.default_rng(8)
     pqt, xz = np.array([0.5, -1.0, 2.5]), rng.normal(size=(5, 2))
-    moved, J = g.pqt_transform_xz(pqt, xz, jacobian=True)
-    np.testing.assert_array_equal(moved, g.pqt_transform_xz(pqt, xz))
+    moved, J = g.paper_frames.pqt_transform_xz(pqt, xz, jacobian=True)
+    np.testing.assert_array_equal(moved, g.paper_frames.pqt_transform_xz(pqt, xz))
     h = 1e-6
     for k in range(3):
         d = np.zeros(3)
         d[k] = h
-        fd = (g.pqt_transform_xz(pqt + d, xz) - g.pqt_transform_xz(pqt - d, xz)) / (2 * h)
+        fd = (g.paper_frames.pqt_transform_xz(pqt + d, xz) - g.paper_frames.pqt_transform_xz(pqt - d, xz)) / (2 * h)
         np.testing.assert_allclose(J[..., k], fd, atol=1e-8)
-    assert g.pqt_transform_xz(np.zeros((4, 1, 3)), xz, jacobian=True)[1].shape == (4, 5, 2, 3)
+    assert g.paper_frames.pqt_transform_xz(np.zeros((4, 1, 3)), xz, jacobian=True)[1].shape == (4, 5, 2, 3)
 
 
 def test_paper_world_to_robokit_is_the_course_identification():
@@ -125,21 +125,21 @@ def test_paper_world_to_robokit_is_the_course_identification():
 
 
 @pytest.mark.parametrize("call, match", [
-    (lambda: g.pqt_transform_xz([0, 0, 0], [[1, 2, 3]]), "xz"),
-    (lambda: g.pqt_transform_xz(np.zeros((4, 3)), np.zeros((5, 2))), "pqt, xz"),
-    (lambda: g.pqt_rotate_xz(np.zeros(4), np.zeros((5, 2))), "theta, xz"),
-    (lambda: g.pqt_transform_xz([0, 0, np.inf], [1, 2], jacobian=True), "pqt"),
-    (lambda: g.pqt_transform_xz([0, 0, 0], [1, 2], jacobian=True, inverse=True), "inverse, jacobian"),
+    (lambda: g.paper_frames.pqt_transform_xz([0, 0, 0], [[1, 2, 3]]), "xz"),
+    (lambda: g.paper_frames.pqt_transform_xz(np.zeros((4, 3)), np.zeros((5, 2))), "pqt, xz"),
+    (lambda: g.paper_frames.pqt_rotate_xz(np.zeros(4), np.zeros((5, 2))), "theta, xz"),
+    (lambda: g.paper_frames.pqt_transform_xz([0, 0, np.inf], [1, 2], jacobian=True), "pqt"),
+    (lambda: g.paper_frames.pqt_transform_xz([0, 0, 0], [1, 2], jacobian=True, inverse=True), "inverse, jacobian"),
     (lambda: g.pqt_robot_to_world(np.zeros((5, 3)), np.zeros((4, 3))), "pqt, points"),
     (lambda: g.paper_world_to_robokit([[1, 2, 3]], camera_height=0.0), "camera_height"),
     (lambda: g.paper_world_to_robokit([[1, 2, 3]], np.eye(3)), "covariances"),
 
     (lambda: g.se2_to_pqt([[1, 2]]), "pose"),
     (lambda: g.pqt_to_se2(np.zeros((2, 2, 3))), "pqt"),
-    (lambda: g.as_pqt([0, 0, np.nan]), "pqt"),
+    (lambda: g.paper_frames.as_pqt([0, 0, np.nan]), "pqt"),
     (lambda: g.pqt_robot_to_world([[0, 0]], [0, 0, 0]), "points"),
     (lambda: g.pqt_world_to_robot([[0, 0, 1]], [0, 0]), "pqt"),
-    (lambda: g.optical_to_y_up([1, 2]), "points"),
+    (lambda: g.paper_frames.optical_to_y_up([1, 2]), "points"),
 ])
 def test_bad_input_is_named(call, match):
     with pytest.raises(ValueError, match=match):

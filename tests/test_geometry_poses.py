@@ -153,7 +153,7 @@ def test_pose_error_is_validated_and_exact_for_known_motions():
 
 
 def test_intersect_lines_least_squares_point_and_cheirality():
-    from robokit.geometry import intersect_lines
+    from robokit.geometry.planar import intersect_lines
     rng = np.random.default_rng(0)
     target = np.array([1.5, -0.5])
     origins = rng.uniform(-3, 3, (4, 2))

@@ -88,15 +88,15 @@ def test_euler_matrix_composes_fixed_axes():
 def test_as_rotation_accepts_rotations_and_names_the_defect():
     rng = np.random.default_rng(4)
     R = g.so3_exp(_rotvecs(rng, 3))
-    assert g.as_rotation(R, "R", batch=True).shape == (3, 3, 3)
-    assert g.as_rotation(R[0], "R", batch=True).shape == (1, 3, 3)
-    assert g.as_rotation([[0.0, -1.0], [1.0, 0.0]], "R", dim=2).shape == (2, 2)
+    assert g.rotations.as_rotation(R, "R", batch=True).shape == (3, 3, 3)
+    assert g.rotations.as_rotation(R[0], "R", batch=True).shape == (1, 3, 3)
+    assert g.rotations.as_rotation([[0.0, -1.0], [1.0, 0.0]], "R", dim=2).shape == (2, 2)
     with pytest.raises(ValueError, match=r"R: expected a rotation matrix .* det = -1"):
-        g.as_rotation(np.diag([1.0, 1.0, -1.0]), "R")
+        g.rotations.as_rotation(np.diag([1.0, 1.0, -1.0]), "R")
     with pytest.raises(ValueError, match=r"at index 2"):
-        g.as_rotation(np.stack([R[0], R[1], 1.01 * R[2]]), "R", batch=True)
+        g.rotations.as_rotation(np.stack([R[0], R[1], 1.01 * R[2]]), "R", batch=True)
     with pytest.raises(ValueError, match=r"R: expected shape \(3, 3\)"):
-        g.as_rotation(np.eye(2), "R")
+        g.rotations.as_rotation(np.eye(2), "R")
 
 
 def test_zyz_angles_agree_with_scipy_and_are_batched():

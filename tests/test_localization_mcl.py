@@ -7,11 +7,9 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
-from robokit.localization import (KLD_Z_99, KLDConfig, MonteCarloLocalizer, ellipse_weights, kld_resample,
-                                  kld_sample_count, likelihood_field_log_weight_readable,
-                                  likelihood_field_log_weights, low_variance_resample, mcl_step,
-                                  normalise_log_weights, pose_bins, sample_ellipse_poses, subsample_beams,
-                                  weighted_pose_mean)
+from robokit.localization import (KLDConfig, MonteCarloLocalizer, ellipse_weights, kld_resample, likelihood_field_log_weight_readable, likelihood_field_log_weights, low_variance_resample, mcl_step, normalise_log_weights, sample_ellipse_poses, weighted_pose_mean)
+from robokit.localization.beam_models import subsample_beams
+from robokit.localization.particle_filter import KLD_Z_99, kld_sample_count, pose_bins
 from robokit.mapping import OccupancyGrid, likelihood_field
 from robokit.sim import Lidar, lab_lap, lab_room, noisy_odometry
 

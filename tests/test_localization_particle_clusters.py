@@ -4,7 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robokit.localization import ROS_KLD_BIN_SIZE, largest_cluster_mean, largest_cluster_share, pose_clusters
+from robokit.localization import largest_cluster_mean, largest_cluster_share, pose_clusters
+from robokit.localization.particle_filter import ROS_KLD_BIN_SIZE
 
 
 def brute_force_clusters(particles, size):

@@ -128,7 +128,8 @@ def test_in_view_uses_the_field_of_view_and_range():
 
 
 def test_warp_image_builds_a_pair_consistent_with_the_homography():
-    from robokit.vision import apply_homography, similarity_homography, warp_image
+    from robokit.vision import similarity_homography, warp_image
+    from robokit.vision.evaluation import apply_homography
 
     img = np.zeros((120, 160), np.uint8)
     img[40:44, 100:104] = 255                               # a bright square centred at (101.5, 41.5)
@@ -144,7 +145,7 @@ def test_warp_image_builds_a_pair_consistent_with_the_homography():
 
 
 def test_candidate_search_methods_agree():
-    from robokit.localization import candidate_matches
+    from robokit.localization.hough import candidate_matches
 
     rng = np.random.default_rng(4)
     for size in (16, 128):

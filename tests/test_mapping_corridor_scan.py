@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from robokit.mapping import (EmptyScanError, NoWallError, as_scan, corridor_axis, corridor_state, door_sides,
-                             invalid_areas, middle_line_condition, theta_limits, theta_limits_geometric,
-                             wall_distances, width_condition)
+from robokit.mapping import (EmptyScanError, NoWallError, corridor_axis, corridor_state, invalid_areas, middle_line_condition, theta_limits, theta_limits_geometric, wall_distances, width_condition)
+from robokit.mapping.corridor_areas import as_scan
+from robokit.mapping.corridor_scan import door_sides
 from robokit.sim import Lidar, long_corridor
 
 ANGLES = 2 * np.pi * np.arange(360) / 360

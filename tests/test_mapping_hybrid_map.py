@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from robokit.mapping import GeoIndex, geo_index, geo_tag
+from robokit.mapping import geo_index, geo_tag
+from robokit.mapping.hybrid_map import GeoIndex
 
 T = [0.0, 1.0, 3.0]
 P = [[0.0, 0.0, 0.0], [2.0, 1.0, math.pi - 0.1], [2.0, 5.0, -math.pi + 0.3]]

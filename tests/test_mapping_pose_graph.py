@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 from robokit.geometry import se2_compose, se2_to_matrix, wrap_angle
-from robokit.mapping import (DisconnectedGraphError, PoseGraph, edge_variances, initial_variances, is_connected,
-                             manhattan_world_graph, optimize_pose_graph, pose_graph_cost, pose_graph_from_odometry,
-                             pose_graph_jacobian, pose_graph_residuals, relax, relax_sweep, unreachable_nodes)
+from robokit.mapping import (DisconnectedGraphError, PoseGraph, manhattan_world_graph, optimize_pose_graph, pose_graph_cost, pose_graph_from_odometry, relax, relax_sweep)
+from robokit.mapping.pose_graph import edge_variances, is_connected, unreachable_nodes
+from robokit.mapping.pose_graph_optimize import pose_graph_jacobian, pose_graph_residuals
+from robokit.mapping.relaxation import initial_variances
 
 SQUARE = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, np.pi / 2], [1.0, 1.0, -np.pi], [0.0, 1.0, -np.pi / 2]])
 
@@ -336,7 +337,7 @@ def test_information_from_covariance_matches_the_spread_of_g2o_errors():
     """Measurements drawn with covariance C in i's frame: the g2o error z^-1 (+) z_true spreads as
     J C J^T (the information's inverse), not as C, once the edge turns."""
     from robokit.geometry import se2_between
-    from robokit.mapping import information_from_covariance
+    from robokit.mapping.pose_graph import information_from_covariance
 
     rng = np.random.default_rng(4)
     z_true = np.array([1.0, 0.5, np.pi / 2])

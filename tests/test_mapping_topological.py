@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 from robokit.geometry import se2_between, wrap_angle
-from robokit.mapping import (LOOP_EDGE, ODOMETRY_EDGE, Comparison, EmptyMapError, PoseGraph, TopologicalMap,
-                             appearance_changed, build_topological_map, edge_variances, local_map_full,
-                             optimize_pose_graph, relax, select_key_frames)
+from robokit.mapping import (LOOP_EDGE, EmptyMapError, PoseGraph, TopologicalMap, build_topological_map, optimize_pose_graph, relax)
+from robokit.mapping.pose_graph import edge_variances
+from robokit.mapping.topological import ODOMETRY_EDGE
+from robokit.mapping.topological_build import Comparison, appearance_changed, local_map_full, select_key_frames
 from robokit.sim import odometry_covariance
 from robokit.vision import ImageSizeError, histogram_distance, ratio_match
 from tests.office_runs import camera, office, room_of, short_map, short_map_and_log, short_run

@@ -8,7 +8,8 @@ import pytest
 from scipy.stats import chi2
 
 from robokit.controllers import path_from_poses, reference_point
-from robokit.navigation import follow_path, gaussian_localizer, perturbed_starts
+from robokit.navigation import follow_path, perturbed_starts
+from robokit.navigation.visual_path import gaussian_localizer
 
 #: Through a doorway and round a corner, like the paper's rooms and corridor (11.5 m, radius >= 1.1 m).
 KEY = [[0, 0, 0], [2, 0, 0], [4, 0.5, 0], [5, 2, 0], [5, 4, 0], [6, 5, 0], [8, 5, 0]]

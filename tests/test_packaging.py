@@ -79,3 +79,16 @@ def test_no_sys_path_hacks():
         if "sys.path" in path.read_text(encoding="utf-8"):
             offenders.append(str(path.relative_to(ROOT)))
     assert not offenders, f"sys.path manipulation in {offenders}"
+
+
+def test_importing_the_library_loads_none_of_the_course_tools():
+    import subprocess
+    import sys
+
+    subpackages = sorted(p.name for p in (ROOT / "robokit").iterdir() if (p / "__init__.py").is_file())
+    code = ("import sys\n" + "".join(f"import robokit.{s}\n" for s in subpackages) +
+            "heavy = sorted(m for m in sys.modules if m.split('.')[0] in "
+            "('IPython', 'nbformat', 'nbclient', 'sphinx', 'robocourse'))\nprint(heavy)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert len(subpackages) >= 11 and out.stdout.strip() == "[]", out.stdout

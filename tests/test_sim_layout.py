@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from robokit.sim import Layout, box_corners, obstacle_array
+from robokit.sim import Layout
+from robokit.sim.layout import box_corners, obstacle_array
 
 RIGHT, UP, LEFT, DOWN = 0.0, np.pi / 2, np.pi, -np.pi / 2
 

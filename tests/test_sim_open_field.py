@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from robokit.outdoor.field import Field, random_course
-from robokit.sim import Layout, Lidar, PinholeCamera, field_world, camera_mount, open_field, scatter_obstacles
+from robokit.sim import Layout, Lidar, PinholeCamera, field_world, camera_mount, open_field
+from robokit.sim.worlds_outdoor import scatter_obstacles
 from robokit.sim.worlds_outdoor import SIDES, _open_field
 from robokit.sim.world import World
 from tests.test_sim_lidar_motion import analytic_box_ranges

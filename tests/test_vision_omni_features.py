@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from robokit.sim import OmniCamera, office_floor, omni_ground_truth_inliers, omni_view_pair
-from robokit.vision import DescriptorIndex, ImageSizeError, annulus_mask, detect_sift_features, omni_sift
+from robokit.vision import DescriptorIndex, ImageSizeError, detect_sift_features, omni_sift
+from robokit.vision.omni_features import annulus_mask
 from robokit.vision.matching import FLANN_CHECKS, k_nearest, ratio_match
 
 CAM = OmniCamera()

@@ -5,7 +5,8 @@ from meshcat.geometry import MeshGeometry
 
 from robokit.geometry import rot_x, rot_z, se3_from_rt
 from robokit.sim import box_room
-from robokit.viz import Scene, add_landmarks, add_littledog, add_world, fit_view, viewer_javascript
+from robokit.viz import Scene, add_landmarks, add_littledog, add_world, fit_view
+from robokit.viz.scene import viewer_javascript
 from robokit.viz.framing import FAR, FOV, NEAR
 
 

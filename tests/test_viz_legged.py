@@ -14,8 +14,9 @@ from scipy.spatial.transform import Rotation
 from robokit.geometry import se3_from_rt, so3_exp, transform_points
 from robokit.legged.leg_kinematics import leg_points
 from robokit.legged.littledog import JOINTS, LEGS, LOWER_LEG, MARKERS
-from robokit.viz import (Scene, add_littledog, animate_tracks, animate_trial, joint_path, look_from, plot_foot_forces,
-                         plot_gait_diagram, plot_joint_tracking, plot_support, pose_littledog, support_outline)
+from robokit.viz import (Scene, add_littledog, animate_tracks, animate_trial, look_from, plot_foot_forces, plot_gait_diagram, plot_joint_tracking, plot_support)
+from robokit.viz.legged import joint_path, pose_littledog
+from robokit.viz.legged_plots import support_outline
 from tests.legged_logs import synthetic_log
 
 matplotlib.use("Agg")

@@ -10,7 +10,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
 
 from robokit.config import headless  # noqa: E402
-from robokit.viz import slider, static_slider_html  # noqa: E402
+from robokit.viz import slider
+from robokit.viz.widgets import static_slider_html  # noqa: E402
 
 
 def _draw(k):

@@ -5,6 +5,8 @@ experiments), :func:`check` (feedback on an exercise's public cases) and :func:`
 (the data an assignment works on). Subpackages, bottom layer first (``tests/test_layers.py``
 enforces the order):
 
+config     fast mode (ROBOKIT_FAST)
+source     the code a module runs, found by reading imports: experiments' cache keys, the grading kit
 site       notebook execution and hygiene, the course build and its two Sphinx sites, browser checks
 exercises  the vocabulary exercises are written in: Case, Exercise, comparisons, plain data
 lessons    one folder per lesson: its experiments (with their fast mode and cache keys) and its

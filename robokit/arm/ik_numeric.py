@@ -24,7 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import ROTATION_TOL, as_se3, pose_error
+from ..geometry import as_se3, pose_error
+from ..geometry.rotations import ROTATION_TOL
 from ..validation import array_ndim, as_rng, as_choice, as_int, as_positive
 from .chain import Chain
 from .ik_steps import PROJECTION_EPS, METHODS, NULL_SPACE_FADE, STEP_RULES

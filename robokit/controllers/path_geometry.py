@@ -35,7 +35,8 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 from scipy.interpolate import CubicSpline
 
-from ..geometry import as_planar, wrap_angle
+from ..geometry import wrap_angle
+from ..geometry.planar import as_planar
 from ..validation import as_array, require_finite_result, as_positive, require_sample_count, describe
 
 __all__ = ["VisualPath", "path_from_poses", "ReferencePoint", "reference_point"]

@@ -1,41 +1,42 @@
-"""LittleDog quadruped: model, kinematics, gaits, sensing, simulation, trial logs, power (lesson 04)."""
-from .littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, JOINT_NAMES, JOINTS,
-                        LEG_MASSES, LEGS, LOWER_LEG, MARKERS, STANCE_FEET, STANDING_HEIGHT, TIMESTEP,
-                        TOTAL_MASS, TRUNK_MASS, TRUNK_SIZE, UPPER_LEG, littledog_mjcf, littledog_model)
-# sensing and estimation (MoCap, IMU, fusion, touchdowns)
-from .imu import GRAVITY, ImuReadings, integrate_gyro, simulate_imu, specific_force
+"""The LittleDog quadruped (lesson 04): model, kinematics, gaits, sensing, simulation, trial logs, power.
+
+littledog         the guide's facts and the MuJoCo model written from them (one set of constants)
+leg_kinematics    one leg's FK, closed-form IK on both knee branches, Jacobian and statics (J^T f)
+support           the support polygon and the static stability margin
+gait_schedule     crawl and trot schedules
+gait              walking plans: body and feet along a crawl or a trot
+servo_design      the joint servo designed on the model's inertia
+simulation        a walk in MuJoCo under the 500 Hz servo and the 100 Hz host over the link
+imu               the body's IMU: gyro and accelerometer readings, gyro integration
+mocap             the Vicon markers a trial reports, and the body pose fitted back from them
+state_estimation  MoCap and IMU fused into the body state; its errors
+touchdown         touchdowns from the foot force sensors, and their score against the truth
+trial_log         the checked trial log and its .npz file
+power             electrical power, cost of transport, the battery's endurance
+"""
+from .littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, JOINT_NAMES, JOINTS, LEG_MASSES,
+                        LEGS, LOWER_LEG, MARKERS, STANCE_FEET, STANDING_HEIGHT, TRUNK_MASS, TRUNK_SIZE, UPPER_LEG,
+                        littledog_mjcf, littledog_model)
+from .support import SupportPolygonError, stability_margin, stability_margins, support_polygon
+from .gait_schedule import GaitSchedule, crawl_gait, trot_gait
+from .gait import WalkPlan, walking_plan
+from .servo_design import SERVO_BANDWIDTH, link_inertias, littledog_servo_gains, servo_inertia
+from .simulation import LoopSettings, SensorSettings, TrialOutcome, simulate_walk
+from .imu import ImuReadings, integrate_gyro, simulate_imu
 from .mocap import MocapFrames, MocapPoses, TooFewMarkersError, fit_marker_pose, mocap_body_poses, simulate_mocap
 from .state_estimation import BodyState, fuse_body_state, orientation_errors, position_errors
 from .touchdown import EventScore, contact_events, detect_contacts, event_precision_recall, score_events
-# gaits: support polygon and stability margin, gait schedules, crawl and trot plans
-from .gait import WalkPlan, swing_trajectory, walking_plan
-from .gait_schedule import CRAWL_SEQUENCE, TROT_PAIRS, GaitSchedule, crawl_gait, stance_pattern, trot_gait
-from .support import SupportPolygonError, stability_margin, stability_margins, support_polygon
-# the servo on the model, and walking in MuJoCo with both loops
-from .servo_design import SERVO_BANDWIDTH, link_inertias, littledog_servo_gains, servo_inertia
-from .simulation import FALL_HEIGHT, LoopSettings, SensorSettings, TrialOutcome, simulate_walk
-# power and endurance
+from .trial_log import LOG_LAYOUT, TrialLog, TrialLogError, describe_layout, load_trial, save_trial
 from .power import battery_energy, cost_of_transport, endurance, trial_power
-# the trial log
-from .trial_log import LOG_FORMAT, LOG_LAYOUT, LOG_VERSION, META_KEYS, TrialLog, TrialLogError, empty_streams, trial_meta
-from .trial_log import describe_layout, load_trial, save_trial
 
 __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSET", "HIP_POSITIONS", "JOINT_LIMITS", "JOINT_NAMES", "JOINTS",
-           "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS", "STANCE_FEET", "STANDING_HEIGHT", "TIMESTEP",
-           "TOTAL_MASS", "TRUNK_MASS", "TRUNK_SIZE", "UPPER_LEG", "littledog_mjcf", "littledog_model",
-           # sensing and estimation
-           "GRAVITY", "ImuReadings", "simulate_imu", "integrate_gyro", "specific_force",
-           "MocapFrames", "MocapPoses", "TooFewMarkersError", "simulate_mocap", "fit_marker_pose", "mocap_body_poses",
-           "BodyState", "fuse_body_state", "orientation_errors", "position_errors",
-           "EventScore", "detect_contacts", "contact_events", "event_precision_recall", "score_events",
-           # gaits
-           "SupportPolygonError", "support_polygon", "stability_margin", "stability_margins", "GaitSchedule", "crawl_gait",
-           "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan", "walking_plan", "CRAWL_SEQUENCE", "TROT_PAIRS",
-           # servo design and simulation
-           "SERVO_BANDWIDTH", "link_inertias", "littledog_servo_gains", "servo_inertia",
-           "FALL_HEIGHT", "LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk",
-           # power
-           "battery_energy", "cost_of_transport", "endurance", "trial_power",
-           # the trial log
-           "LOG_FORMAT", "LOG_LAYOUT", "LOG_VERSION", "META_KEYS", "TrialLog", "TrialLogError", "describe_layout",
-           "empty_streams", "load_trial", "save_trial", "trial_meta"]
+           "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS", "STANCE_FEET", "STANDING_HEIGHT", "TRUNK_MASS",
+           "TRUNK_SIZE", "UPPER_LEG", "littledog_mjcf", "littledog_model", "SupportPolygonError", "stability_margin",
+           "stability_margins", "support_polygon", "GaitSchedule", "crawl_gait", "trot_gait", "WalkPlan",
+           "walking_plan", "SERVO_BANDWIDTH", "link_inertias", "littledog_servo_gains", "servo_inertia",
+           "LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "ImuReadings", "integrate_gyro",
+           "simulate_imu", "MocapFrames", "MocapPoses", "TooFewMarkersError", "fit_marker_pose", "mocap_body_poses",
+           "simulate_mocap", "BodyState", "fuse_body_state", "orientation_errors", "position_errors", "EventScore",
+           "contact_events", "detect_contacts", "event_precision_recall", "score_events", "LOG_LAYOUT", "TrialLog",
+           "TrialLogError", "describe_layout", "load_trial", "save_trial", "battery_energy", "cost_of_transport",
+           "endurance", "trial_power"]

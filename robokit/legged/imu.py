@@ -32,7 +32,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..geometry import as_rotation, so3_exp
+from ..geometry import so3_exp
+from ..geometry.rotations import as_rotation
 from ..validation import as_array, as_rng, require_finite_result, as_positive
 
 __all__ = ["GRAVITY", "ImuReadings", "simulate_imu", "integrate_gyro", "specific_force", "as_vector_series"]

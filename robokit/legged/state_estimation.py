@@ -40,7 +40,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..geometry import as_rotation, as_se3, so3_exp, so3_log
+from ..geometry import as_se3, so3_exp, so3_log
+from ..geometry.rotations import as_rotation
 from ..validation import as_array, require_finite_result, as_positive
 from .imu import GRAVITY, as_vector_series
 

@@ -403,7 +403,7 @@ def save_trial(path: Any, log: TrialLog) -> Path:
     Examples
     --------
     >>> import tempfile
-    >>> from robokit.legged import empty_streams, trial_meta
+    >>> from robokit.legged.trial_log import empty_streams, trial_meta
     >>> target = Path(tempfile.mkdtemp()) / "trial.npz"
     >>> save_trial(target, TrialLog(empty_streams(5), trial_meta())).name
     'trial.npz'

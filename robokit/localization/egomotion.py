@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..geometry import (as_pqt, pqt_robot_to_world, pqt_rotate_xz,
-                        pqt_transform_xz, pqt_world_to_robot, wrap_angle)
+from ..geometry import pqt_robot_to_world, pqt_world_to_robot, wrap_angle
+from ..geometry.paper_frames import as_pqt, pqt_rotate_xz, pqt_transform_xz
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_points, as_rng, as_int, as_positive
 from ..vision.matching import gated_ratio_match, ratio_match

@@ -30,7 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import intersect_lines, se2_between, se2_compose, wrap_angle
+from ..geometry import se2_between, se2_compose, wrap_angle
+from ..geometry.planar import intersect_lines
 from ..mapping.omni_views import OmniView, RelativePose, omni_view, relative_pose
 from ..mapping.topological import EmptyMapError, TopologicalMap
 from ..sim.omni import OmniCamera, as_omni_camera

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ..geometry import pqt_rotate_xz, pqt_transform_xz
+from ..geometry.paper_frames import pqt_rotate_xz, pqt_transform_xz
 from ..mapping.landmarks import LandmarkMap
 from ..vision.matching import k_nearest
 from ..validation import as_array, as_choice, as_int, as_positive

@@ -33,7 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import as_pqt, pqt_world_to_robot, se2_between, se2_compose
+from ..geometry import pqt_world_to_robot, se2_between, se2_compose
+from ..geometry.paper_frames import as_pqt
 from ..mapping.landmarks import LandmarkMap
 from ..validation import as_array, as_rng, as_choice, as_int, as_positive
 from ..vision.descriptors import detect_and_describe

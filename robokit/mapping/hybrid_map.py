@@ -21,7 +21,8 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import as_planar, wrap_angle
+from ..geometry import wrap_angle
+from ..geometry.planar import as_planar
 from ..validation import as_array
 
 __all__ = ["GeoIndex", "geo_tag", "geo_index"]

@@ -19,7 +19,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..geometry import as_pqt, pqt_robot_to_world, pqt_to_se3, pqt_transform_xz, pqt_world_to_robot
+from ..geometry import pqt_robot_to_world, pqt_to_se3, pqt_world_to_robot
+from ..geometry.paper_frames import as_pqt, pqt_transform_xz
 from ..validation import array_ndim, as_array, as_int, as_positive
 
 __all__ = ["transform_covariance", "kalman_fuse", "LandmarkMap"]

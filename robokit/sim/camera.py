@@ -22,7 +22,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..geometry import R_BODY_OPTICAL, as_se3, euler_matrix, se2_to_se3, se3_from_rt, se3_inverse, transform_points
+from ..geometry import as_se3, euler_matrix, se2_to_se3, se3_from_rt, se3_inverse, transform_points
+from ..geometry.paper_frames import R_BODY_OPTICAL
 from ..validation import as_array, as_points, as_rng, as_int, as_positive
 from .render import render_pinhole
 from .textures import illuminate

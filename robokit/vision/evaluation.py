@@ -147,7 +147,8 @@ def similarity_homography(shape, zoom: float = 1.0, angle: float = 0.0) -> np.nd
 
     Examples
     --------
-    >>> from robokit.vision import apply_homography, similarity_homography
+    >>> from robokit.vision import similarity_homography
+    >>> from robokit.vision.evaluation import apply_homography
     >>> H = similarity_homography((480, 640), zoom=2.0)          # zoom about the image centre
     >>> apply_homography(H, [[319.5, 239.5], [329.5, 239.5]]).round(2).tolist()
     [[319.5, 239.5], [339.5, 239.5]]

@@ -321,7 +321,8 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
 
     Examples
     --------
-    >>> from robokit.legged import TrialLog, empty_streams, trial_meta
+    >>> from robokit.legged import TrialLog
+    >>> from robokit.legged.trial_log import empty_streams, trial_meta
     >>> from robokit.viz import Scene
     >>> streams = empty_streams(6)
     >>> streams["body_pos"][:, 2] = 0.13

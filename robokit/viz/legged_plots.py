@@ -194,7 +194,8 @@ def plot_joint_tracking(log: TrialLog, joints: Any = ("FL_hip_pitch", "FL_knee")
 
     Examples
     --------
-    >>> from robokit.legged import TrialLog, empty_streams, trial_meta
+    >>> from robokit.legged import TrialLog
+    >>> from robokit.legged.trial_log import empty_streams, trial_meta
     >>> ax = plot_joint_tracking(TrialLog(empty_streams(5), trial_meta()), ["FR_knee"])
     >>> ax.get_xlabel(), ax.get_ylabel(), len(ax.lines)
     ('time t [s]', 'joint angle [rad]', 3)
@@ -251,7 +252,8 @@ def plot_foot_forces(log: TrialLog, ax: Any = None, detected: Any = None, legs: 
 
     Examples
     --------
-    >>> from robokit.legged import TrialLog, empty_streams, trial_meta
+    >>> from robokit.legged import TrialLog
+    >>> from robokit.legged.trial_log import empty_streams, trial_meta
     >>> axes = plot_foot_forces(TrialLog(empty_streams(5), trial_meta()), legs=["FL", "HR"])
     >>> len(axes), axes[0].get_ylabel(), axes[-1].get_xlabel()
     (2, 'FL axial force [N]', 'time t [s]')

@@ -1,10 +1,8 @@
-"""The vocabulary exercises are written in.
+"""The vocabulary exercises are written in; each lesson's ``exercises`` module writes its assignment in it.
 
-:class:`~.spec.Case` and :class:`~.spec.Exercise` (:mod:`.spec`), the comparisons
-:func:`~.compare.close`, :func:`~.compare.exact` and :func:`~.compare.unordered_rows`
-(:mod:`.compare`) and the plain-data conversion they rely on (:mod:`.plain`). Each lesson's
-``exercises`` module (:mod:`robocourse.lessons`) writes its assignment in it; running and judging
-exercises is :mod:`robocourse.grading`'s job.
+spec     Case (one input case) and Exercise (a function to write, its cases, answer and comparison)
+compare  the comparisons that accept or reject an answer: close, exact, unordered_rows
+plain    the plain data that crosses from student code to the grader
 """
 from robocourse.exercises.compare import close, exact, unordered_rows
 from robocourse.exercises.spec import Case, Exercise

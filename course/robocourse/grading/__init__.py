@@ -1,19 +1,23 @@
 """Grading: feedback in the notebook, the assignment generator and the sandboxed grader.
 
-check       ``check(exercise_id, fn)``: a notebook's feedback on an exercise's public cases
-judge       one case judged: the student's call, the expected answer, the comparison
-assign      ``robocourse assign``: student notebooks (and their data files) from ``solutions/``
-data        the data an assignment's notebook works on, one JSON file each
-submission  a submitted notebook read as hostile input, or rejected with a flag
-protocol    the job directory and the records grader and worker exchange (transport: bounded reads)
-kit         the code the worker runs with: its own modules and the data, no robokit (barrier: its
-            import barrier)
-worker      the process that runs a submission's cells and calls its functions
-sandbox     the worker's limits, namespaces, uid and root filesystem (filesystem_view, job_cgroup)
-grader      ``robocourse grade``: cases from the secret seed, expected answers, scores, flags
-reports     the gradebook, feedback files and Gradescope results (safetext: escaping student text)
-gradescope  an autograder zip for Gradescope
-selfcheck   the course build's step that grades every solution (full marks) and blank (zero)
+check            ``check(exercise_id, fn)``: a notebook's feedback on an exercise's public cases
+judge            one case judged: the student's call, the expected answer, the comparison
+assign           ``robocourse assign``: student notebooks (and their data files) from ``solutions/``
+data             the data an assignment's notebook works on, one JSON file each
+submission       a submitted notebook read as hostile input, or rejected with a flag
+protocol         the job directory and the records grader and worker exchange
+transport        plain data between grader and worker: bounded, no-follow reads of hostile files
+kit              the code the worker runs with: its own modules and the data, no robokit
+barrier          the worker's import barrier: check and assignment_data offered, the rest refused
+worker           the process that runs a submission's cells and calls its functions
+sandbox          the worker's limits, namespaces, uid and root filesystem
+filesystem_view  the worker's root filesystem as an allowlist (root only)
+job_cgroup       a control group that bounds a job's memory, processes and CPU (root only)
+grader           ``robocourse grade``: cases from the secret seed, expected answers, scores, flags
+reports          the gradebook, feedback files and Gradescope results
+safetext         student text escaped for feedback, CSV and Markdown
+gradescope       an autograder zip for Gradescope
+selfcheck        the course build's step that grades every solution (full marks) and blank (zero)
 """
 from robocourse.grading.check import PUBLIC_SEED, check
 

@@ -136,7 +136,7 @@ def seal(manifest: Manifest, log: Callable[[str], None]) -> None:
 
     def data(slug: str) -> dict:
         if slug != manifest.data:
-            raise FileNotFoundError(f"slug: this assignment's data are {manifest.data or 'none'}, not {slug!r}")
+            raise ValueError(f"slug: expected this assignment's data ({manifest.data or 'none'}), got {slug!r}")
         return assignment_data(slug)
 
     sys.modules["robocourse"].__dict__.update(check=quiet_check, assignment_data=data)   # the kit's stand-in

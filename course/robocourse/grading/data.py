@@ -74,9 +74,8 @@ def assignment_data(slug: str) -> dict:
     Raises
     ------
     ValueError
-        For a malformed slug, or a file larger than :data:`MAX_DATA_BYTES` or not a JSON object.
-    FileNotFoundError
-        If the assignment has no data.
+        For a malformed slug or an assignment without data, or a file larger than
+        :data:`MAX_DATA_BYTES` or not a JSON object.
 
     Notes
     -----
@@ -90,7 +89,8 @@ def assignment_data(slug: str) -> dict:
     """
     path = data_file(slug)
     if not path.is_file():
-        raise FileNotFoundError(f"slug: assignment {slug} has no data file ({path.name})")
+        have = sorted(f.stem for f in path.parent.glob("*.json"))
+        raise ValueError(f"slug: expected an assignment with data ({', '.join(have) or 'none'}), got {slug!r}")
     with open(path, "rb") as f:
         raw = f.read(MAX_DATA_BYTES + 1)
     if len(raw) > MAX_DATA_BYTES:

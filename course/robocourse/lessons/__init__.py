@@ -8,6 +8,14 @@ notebook works on data, a function ``assignment_data()`` returning them as plain
 (:mod:`robocourse.grading.data`). Lessons are found automatically, so a new lesson adds its folder
 and touches nothing else. They are read once, on first use, and checked once: an
 :class:`Assignment` refuses duplicate ids and ids of another lesson.
+
+getting_started        lesson 00: the warm-up assignment
+visual_slam            lesson 01: stereo visual SLAM with PLOT and SIFT features
+omni_localization      lesson 02: omnidirectional hierarchical localization and path following
+corridor_localization  lesson 03: coarse-to-fine localization in a long corridor
+littledog              lesson 04: the LittleDog quadruped as a system
+gps_sonar_truck        lesson 05: GPS waypoints and sonar avoidance on a skid-steer truck
+redundant_ik           lesson 06: inverse kinematics of a redundant 7-DOF arm
 """
 from __future__ import annotations
 

@@ -1,4 +1,12 @@
-"""Exercises of assignment 03 (coarse-to-fine localization in a long corridor, Ge et al. 2023)."""
+"""Exercises of assignment 03 (coarse-to-fine localization in a long corridor, Ge et al. 2023).
+
+References
+----------
+.. [1] G. Ge, Y. Zhang, W. Wang, L. Hu, Y. Wang and Q. Jiang, "Visual-feature-assisted mobile robot
+   localization in a long corridor environment", *Frontiers of Information Technology & Electronic
+   Engineering* 24(6), 876-889, 2023, doi:10.1631/FITEE.2200208.
+.. [2] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
+"""
 from __future__ import annotations
 
 import numpy as np

@@ -1,1 +1,4 @@
-"""Lesson 00, getting started: the warm-up assignment's exercises (``exercises``)."""
+"""Lesson 00, getting started.
+
+exercises  the warm-up assignment: wrap an angle, compose two planar poses
+"""

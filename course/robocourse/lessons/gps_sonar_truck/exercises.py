@@ -1,4 +1,14 @@
-"""Exercises of assignment 05 (GPS waypoint navigation and sonar obstacle avoidance, Hamid et al.)."""
+"""Exercises of assignment 05 (GPS waypoint navigation and sonar obstacle avoidance, Hamid et al.).
+
+References
+----------
+.. [1] M. H. A. Hamid, A. H. Adom, N. A. Rahim and M. H. F. Rahiman, "Navigation of mobile robot
+   using Global Positioning System (GPS) and obstacle avoidance system with commanded loop daisy
+   chaining application method", 5th International Colloquium on Signal Processing & Its
+   Applications (CSPA), 2009.
+.. [2] National Marine Electronics Association, *NMEA 0183 Standard for Interfacing Marine
+   Electronic Devices*, version 4.11, 2018.
+"""
 from __future__ import annotations
 
 import datetime as dt

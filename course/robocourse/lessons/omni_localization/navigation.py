@@ -200,7 +200,7 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
     --------
     With Gaussian fixes instead of the camera (fast):
 
-    >>> from robokit.navigation import gaussian_localizer
+    >>> from robokit.navigation.visual_path import gaussian_localizer
     >>> from robocourse.lessons.omni_localization.experiment import office_setup
     >>> trials = navigation_trials(office_setup(fast=True), 1, localize=gaussian_localizer(), cache=False)
     >>> len(trials.runs), trials.goal_errors.shape, trials.nodes.size

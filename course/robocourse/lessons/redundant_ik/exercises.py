@@ -3,6 +3,14 @@ and an open exercise, a whole IK solver for the iiwa by any method.
 
 Inputs are generated from the KUKA LBR iiwa 14 R820 and the Franka Panda of :mod:`robokit.arm`
 (random configurations inside the joint limits), plus small hand-checkable chains.
+
+References
+----------
+.. [1] L. Huang and R. Jiang, "A new method of inverse kinematics solution for industrial 7DOF robot"
+   (question 4 of the course's assignment).
+.. [2] M. Shimizu, H. Kakuya, W.-K. Yoon, K. Kitagaki and K. Kosuge, "Analytical inverse kinematic
+   computation for 7-DOF redundant manipulators with joint limits and its application to redundancy
+   resolution", *IEEE Transactions on Robotics* 24(5), 1131-1142, 2008.
 """
 from __future__ import annotations
 

@@ -3,6 +3,13 @@
 From one formula of Lin et al.'s PLOT detector to one voting step of Se, Lowe & Little's Hough
 transform. Inputs are plain data generated from the seed; the references are robokit's library
 functions (thin wrappers below only turn robokit objects into plain data and back).
+
+References
+----------
+.. [1] R. Lin, Z. Wang, R. Sun and L. Sun, "Vision-based mobile robot localization and mapping using
+   the PLOT features" (question 1 of the course's assignment; our copy gives no venue or year).
+.. [2] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features", Proc.
+   IEEE/RSJ Int. Conf. on Intelligent Robots and Systems (IROS), 2002.
 """
 from __future__ import annotations
 
