@@ -14,7 +14,8 @@ import time
 
 import numpy as np
 
-from robokit.outdoor.mission import run_courses, summarize_runs
+from robocourse.lessons.gps_sonar_truck.experiment import run_courses
+from robokit.outdoor.mission import summarize_runs
 
 
 def main(argv=None) -> None:

@@ -611,7 +611,7 @@ SPECS: dict[str, Call] = {
                                          "variation": Real(-0.005), "rng": Rng(1)}),
     "robokit.outdoor.gps.GPSReceiver": Call({"plane": Obj(plane), "noise": Real(2.5), "tau": Real(60.0),
                                              "white_noise": Real(0.3), "period": Real(1.0), "rng": Rng(2)}),
-    "robokit.outdoor.mission.run_courses": Call({"seeds": Array(np.array([0]), "N"), "firing": Choice("chained"),
+    "robocourse.lessons.gps_sonar_truck.experiment.run_courses": Call({"seeds": Array(np.array([0]), "N"), "firing": Choice("chained"),
                                                  "course_options": Mapping({"n_waypoints": 1}, optional=True),
                                                  "progress": Func(None, optional=True), "cache": Flag(False),
                                                  "options": Options({"max_time": 2.0})}, cheap=False),

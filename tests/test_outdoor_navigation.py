@@ -7,7 +7,8 @@ import pytest
 from robokit.outdoor.field import UNIMAP_ORIGIN, Course, Field, random_course
 from robokit.outdoor.geodesy import LocalTangentPlane
 from robokit.outdoor.gps import Compass, GPSReceiver
-from robokit.outdoor.mission import run_courses, simulate, summarize_runs
+from robocourse.lessons.gps_sonar_truck.experiment import run_courses
+from robokit.outdoor.mission import simulate, summarize_runs
 from robokit.outdoor.geodesy import haversine_distance_bearing
 from robokit.outdoor.gps import heading_to_compass
 from robokit.outdoor.navigator import Navigator, avoidance_decision

@@ -15,7 +15,7 @@ field         the field: a sim Layout of obstacles with a size and a geodetic or
 truck         the paper's truck on the skid-steer kinematics, with motor lag
 gps           1 Hz GPS receiver and compass models that emit NMEA text
 navigator     waypoint following and the sonar obstacle-avoidance state machine
-mission       the simulated experiment: courses, runs (cached), summaries
+mission       one simulated mission through NMEA and sonar, and the summary of many
 """
 from .nmea import (GGA, HDG, NMEAChecksumError, NMEAError, NMEAFieldError, NMEAFormatError, NMEAReader, RMB, RMC,
                    Sentence, fix_position, nmea_checksum, parse_sentence, read_nmea)
@@ -27,7 +27,7 @@ from .field import Course, Field, random_course
 from .truck import PAPER_TRUCK, SkidSteerTruck, TruckState
 from .gps import Compass, GPSReceiver, compass_to_heading
 from .navigator import Navigator, avoidance_decision
-from .mission import RunResult, run_courses, simulate, summarize_runs
+from .mission import RunResult, simulate, summarize_runs
 
 __all__ = ["GGA", "HDG", "NMEAChecksumError", "NMEAError", "NMEAFieldError", "NMEAFormatError", "NMEAReader", "RMB",
            "RMC", "Sentence", "fix_position", "nmea_checksum", "parse_sentence", "read_nmea", "format_sentence",
@@ -35,5 +35,5 @@ __all__ = ["GGA", "HDG", "NMEAChecksumError", "NMEAError", "NMEAFieldError", "NM
            "distance_bearing", "haversine_distance_bearing", "vincenty_inverse", "LVMaxSonarEZ", "PAPER_LAYOUT",
            "firing_schedule", "pulse_width_to_cm_inches", "read_sensors", "sensor_poses", "true_ranges", "Course",
            "Field", "random_course", "PAPER_TRUCK", "SkidSteerTruck", "TruckState", "Compass", "GPSReceiver",
-           "compass_to_heading", "Navigator", "avoidance_decision", "RunResult", "run_courses", "simulate",
+           "compass_to_heading", "Navigator", "avoidance_decision", "RunResult", "simulate",
            "summarize_runs"]

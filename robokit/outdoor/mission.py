@@ -20,22 +20,18 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Any
 
 import numpy as np
 
-from ..cache import (cache_dir, cache_key, code_version, read_arrays, record_names, records_from_arrays,
-                     records_to_arrays, write_arrays)
-from ..progress import progress_bar
-from ..validation import as_callable, as_choice, as_int, as_mapping, as_positive, describe
-from .field import Course, random_course
+from ..validation import as_choice, as_int, as_mapping, as_positive, describe
+from .field import Course
 from .geodesy import LocalTangentPlane
 from .gps import Compass, GPSReceiver
 from .navigator import Navigator
 from .sonar import LVMaxSonarEZ, read_sensors
 from .truck import PAPER_TRUCK, SkidSteerTruck, TruckState
 
-__all__ = ["RunResult", "simulate", "run_courses", "summarize_runs"]
+__all__ = ["RunResult", "simulate", "summarize_runs"]
 
 
 @dataclasses.dataclass(eq=False)
@@ -302,78 +298,6 @@ class _Mission:
                          nmea=self.nmea, parse_errors=len(self.nav.parse_errors))
 
 
-def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | None = None,
-                progress: Any = None, cache: bool = True, **options: Any) -> list[RunResult]:
-    """Simulate one mission per seed on :func:`~robokit.outdoor.field.random_course` ``(seed)``.
-
-    Parameters
-    ----------
-    seeds : iterable of int
-    firing : {"chained", "free"}
-    course_options : dict, optional
-        Keyword arguments of :func:`~robokit.outdoor.field.random_course`.
-    progress : callable, optional
-        ``progress(i, n)`` after each run, besides the progress bar (:func:`robokit.progress.progress_bar`).
-    cache : bool, default True
-        Load from / save to ``robokit.cache_dir("outdoor")``, keyed by the seeds, every option and
-        the code (:func:`robokit.cache.code_version`); a corrupt or stale cache file is rebuilt,
-        never loaded. Options that are not plain data (a custom ``truck``) are not cached.
-    **options
-        Passed to :func:`simulate`.
-
-    Returns
-    -------
-    list of RunResult
-
-    Raises
-    ------
-    ValueError, TypeError
-        For a negative or non-integer seed, or bad options (see :func:`simulate`).
-
-    Notes
-    -----
-    The seeded repetition of Hamid et al.'s experiment (2009) used by the lesson; course
-    ``s`` is driven with ``simulate(..., seed=10_000 + s)``; deterministic, hence cacheable
-    (DESIGN.md, "Caching").
-
-    Examples
-    --------
-    >>> small = {"n_waypoints": 1, "size": (30.0, 20.0), "n_obstacles": 2}
-    >>> [(r.reached, r.collisions) for r in run_courses([0], course_options=small)]
-    [(1, 0)]
-    """
-    try:
-        items = None if isinstance(seeds, (str, bytes)) else list(seeds)
-    except TypeError:   # not iterable (a number, a 0-d array, None)
-        items = None
-    if items is None:
-        raise TypeError(f"seeds: expected an iterable of non-negative integers, got {describe(seeds)}")
-    seeds = [as_int(s, f"seeds[{i}]", minimum=0) for i, s in enumerate(items)]
-    course_options = as_mapping(course_options, "course_options")
-    progress = as_callable(progress, "progress")
-    target = meta = None
-    if cache:
-        meta = {"seeds": seeds, "firing": firing, "course_options": course_options or {}, "options": options,
-                "code": code_version("outdoor", "geometry", "sim", "controllers")}
-        try:
-            target = cache_dir("outdoor") / f"courses-{cache_key(**meta)}.npz"
-        except TypeError:           # an option that is not plain data: run without the cache
-            target = None
-    if target is not None:
-        data = read_arrays(target, record_names(RunResult, len(seeds)), meta)
-        if data is not None:
-            return records_from_arrays(data, RunResult, len(seeds))
-    out = []
-    with progress_bar(len(seeds), f"courses ({firing})", unit="course", callback=progress) as bar:
-        for s in seeds:
-            course = random_course(s, **(course_options or {}))
-            out.append(simulate(course, seed=10_000 + s, firing=firing, **options))
-            bar.update()
-    if target is not None:
-        write_arrays(target, records_to_arrays(out, RunResult), meta)
-    return out
-
-
 def summarize_runs(results: list[RunResult]) -> dict:
     """Distribution of the mission figures over runs (plain data, for tables and tests).
 
@@ -396,13 +320,14 @@ def summarize_runs(results: list[RunResult]) -> dict:
 
     Examples
     --------
-    >>> runs = run_courses([0], course_options={"n_waypoints": 1, "size": (30.0, 20.0), "n_obstacles": 2})
-    >>> summary = summarize_runs(runs)
+    >>> from robokit.outdoor import random_course
+    >>> course = random_course(0, n_waypoints=1, size=(30.0, 20.0), n_obstacles=2)
+    >>> summary = summarize_runs([simulate(course, seed=10_000)])
     >>> summary["waypoints_reached"], summary["collisions_total"], summary["success_rate"]
     ('1/1', 0, 1.0)
     """
     if not isinstance(results, (list, tuple)) or not all(isinstance(r, RunResult) for r in results):
-        raise TypeError(f"results: expected a list of RunResult (from simulate or run_courses), got {describe(results)}")
+        raise TypeError(f"results: expected a list of RunResult (from simulate), got {describe(results)}")
     if not results:
         raise ValueError("results: expected at least one RunResult, got an empty list")
     ratio = np.array([r.path_ratio for r in results])
