@@ -71,7 +71,7 @@ def _cmd_assign(args: argparse.Namespace) -> int:
             print(f"assignments/{slug}.ipynb or its data is out of date: run `robocourse assign {slug}`")
             status = 1
         elif changed:
-            print(f"wrote assignments/{slug}.ipynb")
+            print(f"wrote assignments/{slug}.ipynb (and its data file, if it has one)")
         else:
             print(f"assignments/{slug}.ipynb is up to date")
     return status

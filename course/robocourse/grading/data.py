@@ -38,7 +38,10 @@ def _no_nan(value: Any) -> None:
 
 
 def encode_data(data: Any) -> str:
-    """The file's text for ``data``: JSON, keys sorted, exact floats, ``Infinity`` for inf (deterministic).
+    """The file's text for ``data``: JSON in the dicts' own order, exact floats, ``Infinity`` for inf.
+
+    Deterministic for deterministic ``data``; the order is kept so that a notebook prints the data
+    as the lesson made them.
 
     Raises
     ------
@@ -48,7 +51,7 @@ def encode_data(data: Any) -> str:
         For anything JSON cannot hold (arrays must be given as lists).
     """
     _no_nan(data)
-    return json.dumps(data, sort_keys=True, separators=(",", ":")) + "\n"
+    return json.dumps(data, separators=(",", ":")) + "\n"
 
 
 def _no_nan_token(name: str) -> Any:
