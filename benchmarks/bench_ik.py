@@ -42,7 +42,7 @@ import time
 
 import numpy as np
 
-import robokit
+from robokit.config import fast_mode
 from robokit.arm import iiwa14, ik_numeric, ik_numeric_batch, ik_srs, ik_srs_batch, panda
 from robokit.geometry import pose_error
 
@@ -111,8 +111,8 @@ def peer_model(name, chain):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=200 if robokit.FAST else 10_000, help="targets per arm (batched)")
-    parser.add_argument("--n-single", type=int, default=50 if robokit.FAST else 1000,
+    parser.add_argument("--n", type=int, default=200 if fast_mode() else 10_000, help="targets per arm (batched)")
+    parser.add_argument("--n-single", type=int, default=50 if fast_mode() else 1000,
                         help="targets timed one at a time")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--cold", action="store_true", help="also time import and first calls in fresh processes")

@@ -33,7 +33,7 @@ import time
 
 import numpy as np
 
-import robokit
+from robokit.config import fast_mode
 from robokit.mapping import manhattan_world_graph, optimize_pose_graph, pose_graph_cost, read_g2o, relax
 
 
@@ -106,7 +106,7 @@ def rmse(poses, truth):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("files", nargs="*", help="g2o files (VERTEX_SE2 / EDGE_SE2) to run as well")
-    parser.add_argument("--n", type=int, default=500 if robokit.FAST else 3500,
+    parser.add_argument("--n", type=int, default=500 if fast_mode() else 3500,
                         help="poses of the generated Manhattan graph (0: none)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--relax-iterations", type=int, default=20000, help="most relaxation sweeps")

@@ -1,7 +1,7 @@
 """Recorded runs: drive a path through a world, log ground truth, odometry, images and scans.
 
 A :class:`Run` is plain arrays (no pickled objects), saved as one compressed ``.npz`` file and
-cached under ``robokit.cache_dir("runs")`` keyed by every parameter of the recording and by the
+cached under ``robokit.cache.cache_dir("runs")`` keyed by every parameter of the recording and by the
 code that renders it, so a lesson that records the same run twice renders it once, and a change
 to the simulator never serves an old rendering. Every sensor is driven through one interface,
 ``observe(world, robot_pose, rng=...)``.
@@ -266,7 +266,7 @@ def record(world: World, path: Trajectory, sensors: dict, rate: float | None = N
         Seeds the odometry noise and the noise of every sensor that draws any (robokit's LiDAR;
         robokit's cameras render without noise here).
     cache : bool, default True
-        Load from / save to ``robokit.cache_dir("runs")``, keyed by all parameters and the code
+        Load from / save to ``robokit.cache.cache_dir("runs")``, keyed by all parameters and the code
         that renders (a corrupt or foreign cache file is rebuilt, never loaded).
 
     Returns

@@ -215,7 +215,7 @@ def calibration_run(*, fast: bool | None = None, start: float = 12.0, length: fl
     -----
     Ge et al. (2023), Sec. 3.2, condition (1) and Eq. (15) (a video over 10 m of the corridor
     calibrates ``F_min``) and Table 1 (1502 images of a 10 m section). Cached under
-    ``robokit.cache_dir("corridor")``.
+    ``robokit.cache.cache_dir("corridor")``.
 
     Examples
     --------
@@ -269,7 +269,7 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     -------
     dict
         ``{"ours": indices, "orbslam": indices, "images": N}``; the extraction rate is
-        ``len(indices) / N``. Cached under ``robokit.cache_dir("corridor")``, keyed by the run's
+        ``len(indices) / N``. Cached under ``robokit.cache.cache_dir("corridor")``, keyed by the run's
         descriptors and positions, the parameters and the code (a stale file is rebuilt).
 
     Raises
@@ -335,7 +335,7 @@ def training_vocabulary(*, fast: bool | None = None, branching: int = 10, levels
     -----
     Ge et al. (2023), Sec. 3.3 and Fig. 7: the vocabulary is trained offline on many images; like
     DBoW2's vocabularies (Galvez-Lopez and Tardos 2012) ours never sees the corridor it is used in.
-    Cached under ``robokit.cache_dir("corridor")``.
+    Cached under ``robokit.cache.cache_dir("corridor")``.
 
     Examples
     --------

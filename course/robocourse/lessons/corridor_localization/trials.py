@@ -450,7 +450,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     max_distance : float, default 40.0
         See :func:`localization_trial`.
     cache : bool, default True
-        Load from / save to ``robokit.cache_dir("corridor")``, keyed by every parameter, the map and
+        Load from / save to ``robokit.cache.cache_dir("corridor")``, keyed by every parameter, the map and
         the code. When the other method's runs are not
         cached either, they are made too and cached: both methods start each run with the same
         moving strategy (same start, same seed), which is then driven only once.

@@ -38,7 +38,7 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     progress : callable, optional
         ``progress(i, n)`` after each run, besides the progress bar (:func:`robokit.progress.progress_bar`).
     cache : bool, default True
-        Load from / save to ``robokit.cache_dir("outdoor")``, keyed by the seeds, every option and
+        Load from / save to ``robokit.cache.cache_dir("outdoor")``, keyed by the seeds, every option and
         the code (:func:`robocourse.source.code_version`); a corrupt or stale cache file is rebuilt,
         never loaded. Options that are not plain data (a custom ``truck``) are not cached.
     **options

@@ -179,7 +179,7 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
         the ``if __name__ == "__main__":`` guard), a given ``localize`` is called here, in order.
     cache : bool, default True
         With the default localizer, load the runs from / save them to
-        ``robokit.cache_dir("navigation")``, keyed by every parameter, the map and the code (each
+        ``robokit.cache.cache_dir("navigation")``, keyed by every parameter, the map and the code (each
         run renders and localizes an omni image per fix: minutes at full size the first time).
     progress : callable ``(done, total)``, optional
 

@@ -211,7 +211,7 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     Returns
     -------
     LabExperiment
-        Cached under ``robokit.cache_dir("lab")`` keyed by every parameter and the code that makes
+        Cached under ``robokit.cache.cache_dir("lab")`` keyed by every parameter and the code that makes
         it (:func:`robocourse.source.code_version`): a second run loads the map and the test-pose
         results instead of rebuilding them; a corrupt or stale cache file is rebuilt.
 
