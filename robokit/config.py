@@ -1,15 +1,15 @@
-"""Run-time settings shared by every lesson, read from the environment: fast mode, headless, workers.
+"""Run-time settings read from the environment: fast mode, headless, worker processes.
 
-``ROBOKIT_FAST=1`` (set by the test-suite and the course build) asks every experiment to shrink
-(fewer trials, smaller images) so that a notebook runs in seconds; the full size stays the default
-for students. ``ROBOKIT_HEADLESS`` and ``ROBOKIT_WORKERS`` say whether to draw and how many worker
-processes to use. Generated datasets are cached by :mod:`robokit.cache`.
+``ROBOKIT_FAST=1`` (set by the test-suite and the course build) asks for small runs: the progress
+bar is quiet, and the course's experiments shrink (``robocourse.FAST``). ``ROBOKIT_HEADLESS`` and
+``ROBOKIT_WORKERS`` say whether anyone is watching and how many worker processes to use.
+Generated datasets are cached by :mod:`robokit.cache`.
 """
 from __future__ import annotations
 
 import os
 
-__all__ = ["fast_mode", "FAST", "headless", "available_cpus", "worker_count"]
+__all__ = ["fast_mode", "headless", "available_cpus", "worker_count"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -50,10 +50,6 @@ def fast_mode(environ: "os._Environ[str] | dict[str, str] | None" = None) -> boo
     Course convention (DESIGN.md, "Fast mode"); not from a paper.
     """
     return _flag(environ, "ROBOKIT_FAST")
-
-
-#: Fast mode as read once at import time (``robokit.FAST``).
-FAST: bool = fast_mode()
 
 
 def headless(environ: "os._Environ[str] | dict[str, str] | None" = None) -> bool:

@@ -109,7 +109,7 @@ def _context(run: Callable):
         return multiprocessing.get_context("spawn")
     context = multiprocessing.get_context("forkserver")
     module = getattr(run, "__module__", None)
-    if isinstance(module, str) and module.startswith("robokit."):
+    if isinstance(module, str) and module != "__main__":   # a library's or a lesson's module
         context.set_forkserver_preload([module])     # no effect once the server runs
     return context
 

@@ -51,6 +51,18 @@ def wrap_angle_unless(condition: str) -> str:
 """
 
 
+@pytest.fixture(autouse=True)
+def _judge_answers_by_their_values(request, monkeypatch):
+    """The exercise tests give check() the answers (robokit functions) and wrong variants of them,
+    to test the cases and comparisons: check()'s refusal of any function that uses robokit
+    (tests/test_grading_core.py tests it) is off there, so a wrong variant fails for its values."""
+    if request.module.__name__.rpartition(".")[2].startswith("test_exercises_"):
+        import importlib
+
+        module = importlib.import_module("robocourse.grading.check")   # the module, not the function it exports
+        monkeypatch.setattr(module, "library_use", lambda fn: [])
+
+
 def assert_check_passes(exercise_id: str, fn, n_cases: int) -> None:
     """``check(exercise_id, fn)`` passes all ``n_cases`` public cases (it returns nothing on success,
     so the count is read from its report)."""

@@ -548,8 +548,7 @@ SPECS: dict[str, Call] = {
                                              "psi": Real(0.3), "d_se": Real(0.42), "d_ew": Real(0.40)}),
     "robokit.arm.srs.wrist_centre": Call({"T": T_(), "d_wf": Real(0.126)}),
     "robokit.arm.dh.dh_transform": Call({"theta": Array(np.array([0.1, 0.2]), "*"), "d": Array(np.array([0.3, 0.0]), "*"),
-                                         "a": Array(np.array([0.0, 0.1]), "*"), "alpha": Array(np.array([0.5, -0.5]), "*"),
-                                         "validate": Flag(True)}),
+                                         "a": Array(np.array([0.0, 0.1]), "*"), "alpha": Array(np.array([0.5, -0.5]), "*")}),
     "robokit.arm.chain.dh_fk": Call({"dh": Array(DH, "N,3"), "q": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"),
                                      "modified": Flag(False)}),
     "robokit.arm.jacobian.dh_jacobian": Call({"dh": Array(DH, "N,3"), "q": Array(np.array([0.1, 0.2, 0.3]), "3|N,3"),
@@ -1427,8 +1426,8 @@ SPECS: dict[str, Call] = {
         "feet_xy": Array(np.array([[0.16, 0.08], [0.16, -0.08], [-0.16, 0.08], [-0.16, -0.08]]), "N,2|N,3"),
         "stance": Array(np.array([True, True, True, False]), "N", accepts=("booleans",)),
         "com_xy": Array(np.array([0.01, 0.0]), "2|3"), "ax": Given(axes), "legs": Given(("FL", "FR", "HL", "HR"))}),
-    # --- assignment 04: robocourse.lessons.littledog.exercises, its helpers (legged.exercise_data, event_scoring) and
-    #     the leg kinematics its exercises reference ----------------------------------------------------
+    # --- assignment 04: robocourse.lessons.littledog.exercises, its data (lessons.littledog.data), touchdown scores
+    #     and the leg kinematics its exercises answer with -------------------------------------------------
     "robokit.legged.leg_kinematics.foot_position": Call({
         "q_leg": Array(np.array([0.1, 0.6, -1.2]), "...,3"), "leg": Choice("FL")}),
     "robokit.legged.leg_kinematics.leg_ik": Call({
@@ -1481,7 +1480,7 @@ SPECS: dict[str, Call] = {
     "robokit.legged.servo_design.servo_inertia": Call({"motor": Obj(littledog_motor)}),
     "robokit.legged.servo_design.littledog_servo_gains": Call({"bandwidth_hz": Real(15.0),
                                                                "motor": Obj(littledog_motor)}),
-    # --- lesson 04: the walk in MuJoCo and its tables (robokit.legged.simulation, walking_experiment); every
+    # --- lesson 04: the walk in MuJoCo and its tables (robokit.legged.simulation, lessons.littledog.experiment); every
     #     invalid input is refused before MuJoCo runs, so only the cheap flag keeps huge values out ---------
     "robokit.legged.simulation.LoopSettings": Call({
         "servo_rate": Real(500.0), "latency": Real(0.01), "jitter": Real(0.002), "loss": Real(0.1),

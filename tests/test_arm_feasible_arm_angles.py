@@ -204,10 +204,10 @@ def test_the_compiled_cache_folder_changes_with_any_kernel_source(monkeypatch):
 
     arm = Path(robokit.arm.__file__).parent
     with_kernels = {p.name for p in arm.glob("*.py") if "@njit" in p.read_text()} | {"jit.py"}
-    assert with_kernels <= set(jit._SOURCES)
-    assert jit._source_digest() == jit.SOURCE_DIGEST
+    assert with_kernels <= set(jit.SOURCES)
+    assert jit.source_digest() == jit.SOURCE_DIGEST
     read = Path.read_bytes
-    for name in jit._SOURCES:
+    for name in jit.SOURCES:
         monkeypatch.setattr(Path, "read_bytes", lambda self, n=name: read(self) + (b"#" if self.name == n else b""))
-        assert jit._source_digest() != jit.SOURCE_DIGEST, name
+        assert jit.source_digest() != jit.SOURCE_DIGEST, name
     monkeypatch.setattr(Path, "read_bytes", read)

@@ -73,7 +73,7 @@ def test_fusion_of_equal_covariances_is_the_midpoint():
 
 def test_hough_votes_peak_at_the_true_pose():
     rng = np.random.default_rng(0)
-    args = list(visual_slam._hough_cases(rng)[1].args)
+    args = list(visual_slam.hough_cases(rng)[1].args)
     args[-1] = float(np.deg2rad(2.0))                      # 2 degree bins as in Se et al.
     acc = visual_slam.hough_votes(*args)
     assert acc.max() == 3                                   # all three matches agree somewhere

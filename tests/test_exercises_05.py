@@ -98,7 +98,7 @@ def test_the_reference_is_the_truth(seed):
     rng = np.random.default_rng(seed)
     for label, kwargs in module.BIAS_DRIVES:
         kw = dict(kwargs, poor=int(rng.integers(2, 9)) if kwargs.get("poor") else 0)
-        fixes, compass, bias = module._calibration_drive(rng, **kw)
+        fixes, compass, bias = module.calibration_drive(rng, **kw)
         assert 1.5 <= abs(bias) <= 5.0
         assert abs(module.compass_bias(fixes, compass) - bias) < 0.6, (label, kw)
 
@@ -120,8 +120,8 @@ def test_the_cases_vary_the_bias_sign_and_the_poor_fixes():
     biases, counts = [], set()
     for seed in range(30):
         poor = int(np.random.default_rng(seed).integers(2, 9))
-        fixes, compass, bias = module._calibration_drive(np.random.default_rng(seed), poor=poor)
-        clean = module._calibration_drive(np.random.default_rng(seed), poor=0)[0]
+        fixes, compass, bias = module.calibration_drive(np.random.default_rng(seed), poor=poor)
+        clean = module.calibration_drive(np.random.default_rng(seed), poor=0)[0]
         biases.append(bias)
         counts.add(int(np.sum(np.hypot(*(fixes - clean).T) > 1.0)))
     assert min(biases) < -1.5 and max(biases) > 1.5 and len(counts) >= 3

@@ -279,3 +279,24 @@ def test_feedback_files_are_never_shared(tmp_path):
 
     with pytest.raises(ValueError, match="share a feedback file"):
         write_feedback([_result(student="a b"), _result(student="A_b")], tmp_path, "00_getting_started")
+
+
+def test_check_refuses_a_function_that_uses_robokit_as_the_grader_would():
+    from robokit.geometry import wrap_angle as library_wrap
+    from robocourse.grading.check import CheckFailed, library_use
+
+    def uses_it(angle):
+        return library_wrap(angle)
+
+    def imports_it(angle):
+        from robokit.geometry import wrap_angle
+        return wrap_angle(angle)
+
+    def numpy_only(angle):
+        return (np.asarray(angle, dtype=float) + np.pi) % (2 * np.pi) - np.pi
+
+    assert library_use(uses_it) == ["library_wrap (robokit.geometry.planar)"]
+    assert library_use(imports_it) == ["import of robokit.geometry"] and library_use(numpy_only) == []
+    for fn in (uses_it, imports_it):
+        with pytest.raises(CheckFailed, match="uses robokit .* would score zero"):
+            check("00.wrap_angle", fn)

@@ -96,13 +96,18 @@ check("04.leg_fk", None)
 out["check"] = check is old_check
 out["data"] = assignment_data("04_littledog")["model_facts"]["UPPER_LEG"]
 for name in ["import robokit.legged", "from robokit.legged import leg_ik", "from robokit import legged",
-             "import robocourse.lessons.littledog.exercises", "from robocourse.lessons import catalog",
-             "import robocourse.grading.check", "assignment_data('05_gps_sonar_truck')"]:
+             "import robokit; robokit.geometry", "import robocourse.lessons.littledog.exercises",
+             "from robocourse.lessons import catalog", "import robocourse.grading.check",
+             "assignment_data('05_gps_sonar_truck')"]:
     try:
         exec(name)
         out[name] = "ok"
     except BaseException as exc:
         out[name] = type(exc).__name__
+del sys.modules["robokit"], sys.modules["robokit.grading"]
+import robokit                                   # served again by the barrier, never from a file
+from robokit.grading import check as again
+out["served again"] = getattr(robokit, "__file__", None) is None and again is check
 out["flagged"] = flagged
 out["loaded"] = sorted(m for m in sys.modules if m.split(".")[0] in ("robokit", "robocourse"))
 print(json.dumps(out))
@@ -122,10 +127,11 @@ def test_the_worker_offers_check_and_the_data_and_refuses_the_rest(tmp_path):
         "import robokit.legged": "RobokitWithheld",
         "from robokit.legged import leg_ik": "RobokitWithheld",
         "from robokit import legged": "RobokitWithheld",
+        "import robokit; robokit.geometry": "RobokitWithheld",
         "import robocourse.lessons.littledog.exercises": "RobokitWithheld",
         "from robocourse.lessons import catalog": "RobokitWithheld",
         "import robocourse.grading.check": "RobokitWithheld",
         "assignment_data('05_gps_sonar_truck')": "ValueError",
     }
-    assert len(out["flagged"]) == 6
+    assert len(out["flagged"]) == 7 and out["served again"]
     assert set(out["loaded"]) <= {*kit.manifest.modules, *kit.manifest.stand_ins, "robokit", "robokit.grading"}

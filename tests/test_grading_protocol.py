@@ -289,7 +289,7 @@ def test_submission_cells_and_skip_tags(tmp_path):
     ({"written": {"01.why": 1}}, "lesson number 00"),
     ({"written": {"00.why": 0}}, "positive"),
     ({"exercises": ("00.double",)}, "Exercise objects"),
-    ({"data": {"x": 1}}, "assignment_data must be a function"),
+    ({"data": {"x": 1}}, "data must be a function"),
 ])
 def test_assignment_checks_its_declaration(kwargs, message):
     fields = {"slug": "00_demo", "exercises": (_exercise(),), "written": {"00.why": 1}, **kwargs}

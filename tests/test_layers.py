@@ -11,7 +11,7 @@ imports robocourse; robocourse may import any of robokit.
   ``getattr(thing, "_name")`` (where ``thing`` is not ``self`` or ``cls`` and the file does not define
   ``_name`` itself at module or class level or on ``self``) are reach-ins; make the name public or
   give the other module a public way to do what it needs. No text anywhere in the repository
-  names another module's private function either (``robokit.x._y``).
+  names another module's private function either (a dotted name of ours ending in ``._name``).
 
 A new subpackage must be placed in ``PACKAGES`` (and in DESIGN.md's picture), or this test fails.
 """
@@ -231,18 +231,52 @@ def test_no_private_names_across_modules(module):
     assert not bad, f"{path.relative_to(ROOT)} reaches into other modules' private names:\n" + "\n".join(bad)
 
 
-#: A dotted name that ends in another module's private name: ``robokit.vision.colour._rgb01``.
+#: A dotted name of ours that ends in a private name (a module path, a dot, an underscore, a name).
 PRIVATE_NAME = re.compile(r"\b(robokit|robocourse)(\.[A-Za-z][A-Za-z0-9_]*)*\._[A-Za-z][A-Za-z0-9_]*")
 TEXT_SUFFIXES = {".py", ".ipynb", ".md", ".toml", ".yml", ".txt", ".cfg", ".json"}
 
 
-def test_no_text_names_a_private_function():
-    bad = []
+def _text_files():
     for path in sorted(ROOT.rglob("*")):
         parts = path.relative_to(ROOT).parts
-        if path.suffix not in TEXT_SUFFIXES or not path.is_file() or parts[0] in (".git", ".venv", "build") \
-                or "__pycache__" in parts or path == Path(__file__):
-            continue
-        for match in PRIVATE_NAME.finditer(path.read_text(encoding="utf-8", errors="replace")):
-            bad.append(f"{path.relative_to(ROOT)}: {match.group(0)}")
+        if path.suffix in TEXT_SUFFIXES and path.is_file() and parts[0] not in (".git", ".venv", "build") \
+                and "__pycache__" not in parts and not any(p.endswith(".egg-info") for p in parts):
+            yield path
+
+
+def test_no_text_names_a_private_function():
+    bad = [f"{path.relative_to(ROOT)}: {match.group(0)}" for path in _text_files()
+           for match in PRIVATE_NAME.finditer(path.read_text(encoding="utf-8", errors="replace"))]
     assert not bad, "names of private functions in the repository's text:\n" + "\n".join(bad[:40])
+
+
+def _private_uses(tree: ast.Module) -> list[str]:
+    """Private names of ours a file outside the packages takes: ``from robokit.x import _y`` or
+    ``m._y`` where ``m`` is a module of ours it imported."""
+    ours = lambda name: (name or "").split(".")[0] in PACKAGES
+    modules, bad = set(), []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and ours(node.module):
+            for a in node.names:
+                if a.name.startswith("_") and not a.name.startswith("__"):
+                    bad.append(f"line {node.lineno}: imports {a.name} from {node.module}")
+                elif f"{node.module}.{a.name}" in MODULES:
+                    modules.add(a.asname or a.name)
+        elif isinstance(node, ast.Import):
+            modules.update(a.asname for a in node.names if ours(a.name) and a.asname)
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in modules
+                and node.attr.startswith("_") and not node.attr.startswith("__")):
+            bad.append(f"line {node.lineno}: uses {node.value.id}.{node.attr}")
+    return bad
+
+
+def test_tests_and_benchmarks_use_no_private_names_of_ours():
+    bad = [f"{path.relative_to(ROOT)}: {b}" for folder in ("tests", "benchmarks") for path in sorted((ROOT / folder).glob("*.py"))
+           for b in _private_uses(ast.parse(path.read_text(encoding="utf-8")))]
+    assert not bad, "make these public (or test them through a public function):\n" + "\n".join(bad)
+
+
+def test_the_private_name_checks_can_fail():
+    assert PRIVATE_NAME.search("see robokit.vision.colour" + "._rgb01")
+    assert _private_uses(ast.parse("from robokit.vision.colour import _rgb01\nfrom robokit.arm import jit\njit._x"))

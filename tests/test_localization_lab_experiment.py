@@ -1,7 +1,8 @@
-"""A lesson experiment's cache key covers the code it uses, and no more (robocourse.source.code_version)."""
+"""A lesson experiment's cache key covers the code it uses, and no more (robocourse.source.code_version_of)."""
 from pathlib import Path
 
-from robocourse.source import closure, code_version, imports_of, module_file
+import robocourse.source as source
+from robocourse.source import closure, code_version_of, imports_of, module_file
 
 EXPERIMENT = "robocourse.lessons.visual_slam.experiment"
 
@@ -20,7 +21,7 @@ def test_a_name_is_found_where_it_is_defined():
 
 
 def test_an_edit_to_a_used_module_changes_the_key_and_an_unused_one_does_not(monkeypatch):
-    before = code_version(EXPERIMENT)
+    before = code_version_of(EXPERIMENT)
     real = Path.read_bytes
 
     def edited(self, which):
@@ -28,6 +29,16 @@ def test_an_edit_to_a_used_module_changes_the_key_and_an_unused_one_does_not(mon
         return data + b"# edited\n" if self == module_file(which) else data
 
     monkeypatch.setattr(Path, "read_bytes", lambda self: edited(self, "robokit.sim.worlds_outdoor"))
-    assert code_version(EXPERIMENT) == before
+    assert code_version_of(EXPERIMENT) == before
     monkeypatch.setattr(Path, "read_bytes", lambda self: edited(self, "robokit.sim.worlds"))
-    assert code_version(EXPERIMENT) != before
+    assert code_version_of(EXPERIMENT) != before
+
+
+def test_a_dotted_import_counts_as_every_package_on_its_way(tmp_path, monkeypatch):
+    # `import robokit.sim.runs` binds robokit, and `robokit.sim.office_floor()` then works: the
+    # packages' __init__ modules are code the importer can use
+    (tmp_path / "m.py").write_text("import robokit.sim.runs\n\ndef f():\n    return robokit.sim.office_floor()\n")
+    files = {"robokit.fake": tmp_path / "m.py"}
+    real = source.module_file
+    monkeypatch.setattr(source, "module_file", lambda name: files.get(name) or real(name))
+    assert {"robokit", "robokit.sim", "robokit.sim.runs"} <= imports_of("robokit.fake", homes=True)

@@ -164,7 +164,7 @@ def test_candidate_search_methods_agree():
 
 
 def test_vectorised_greedy_assignment_equals_the_sequential_scan():
-    from robokit.mapping.landmarks import _greedy_one_to_one
+    from robokit.mapping.landmarks import greedy_one_to_one
 
     rng = np.random.default_rng(8)
     for _ in range(20):
@@ -177,7 +177,7 @@ def test_vectorised_greedy_assignment_equals_the_sequential_scan():
             if not taken_f[f] and not taken_l[lmk]:
                 taken_f[f] = taken_l[lmk] = True
                 expected[f] = lmk
-        assert np.array_equal(_greedy_one_to_one(fi, li, -np.ones(30, int)), expected)
+        assert np.array_equal(greedy_one_to_one(fi, li, -np.ones(30, int)), expected)
 
 
 @pytest.mark.slow

@@ -12,7 +12,7 @@ import pytest
 from robokit.outdoor.field import Field, random_course
 from robokit.sim import Layout, Lidar, PinholeCamera, field_world, camera_mount, open_field
 from robokit.sim.worlds_outdoor import scatter_obstacles
-from robokit.sim.worlds_outdoor import SIDES, _open_field
+from robokit.sim.worlds_outdoor import SIDES, build_open_field
 from robokit.sim.world import World
 from tests.test_sim_lidar_motion import analytic_box_ranges
 
@@ -41,7 +41,7 @@ def test_open_field_is_closed_seeded_and_holds_its_layout():
     # the skybox is not solid: nothing of it is in the LiDAR footprint
     assert all(not s.solid for s in w.surfaces if s.name.startswith("backdrop/"))
     # seeded and deterministic
-    fresh = _open_field.__wrapped__(0, 100.0, 60.0, 14, True, 3.0)
+    fresh = build_open_field(0, 100.0, 60.0, 14, True, 3.0)
     assert fresh is not w and np.array_equal(fresh.info["boxes"], w.info["boxes"])
     assert all(np.array_equal(s.texture, t.texture) for s, t in zip(w.surfaces, fresh.surfaces))
     other = open_field(seed=1)

@@ -177,13 +177,13 @@ def test_training_centres_are_bit_majorities():
 
 @pytest.mark.parametrize("n", [1, 7, 100, 639, 640, 5000])
 def test_bit_majority_counts_equal_a_per_cluster_bit_count(n):
-    from robokit.vision.bag_of_words import _majority      # both of its counting ways, either side of 64 k rows
+    from robokit.vision.bag_of_words import bit_majority   # both of its counting ways, either side of 64 k rows
     rng = np.random.default_rng(n)
     k = 10
     desc = rng.integers(0, 256, (n, 32), dtype=np.uint8)
     desc[: n // 2, :4] = 0b10101010                          # some columns where members agree, some ties
     labels = rng.integers(0, k - 2, n)                       # the last two clusters stay empty
-    centres, size = _majority(desc, labels, k)
+    centres, size = bit_majority(desc, labels, k)
     for j in range(k):
         members = np.unpackbits(desc[labels == j], axis=1)
         assert size[j] == len(members)

@@ -130,7 +130,7 @@ def test_ambiguous_and_unrectified_input(photo):
     twin = Keypoints(np.vstack([kp.xy - [10, 0], kp.xy - [10.5, 0]]), np.tile(kp.scale, 2),
                      np.tile(kp.response, 2), np.tile(kp.orientation, 2))
     dup = Features(twin, np.vstack([f.descriptors, f.descriptors]))
-    assert len(match_stereo(f, dup, check_rectified=False)) == 0
+    assert len(match_stereo(f, dup, require_rectified=False)) == 0
     h = similarity_homography(photo.shape, 1.0, np.deg2rad(8))
     rotated = cv2.warpPerspective(photo, h, (640, 480))
     with pytest.raises(NotRectifiedError, match="rectified pair"):
@@ -149,13 +149,13 @@ def _one(x, y, scale, theta, desc):
 def test_orientation_scale_and_disparity_constraints():
     d = np.eye(8)[0]
     left = _one(100.0, 50.0, 2.0, 0.5, d)
-    assert len(match_stereo(left, _one(90.0, 50.4, 2.2, 0.6, d), check_rectified=False)) == 1
-    assert len(match_stereo(left, _one(90.0, 50.4, 2.2, 1.2, d), check_rectified=False)) == 0  # orientation
-    assert len(match_stereo(left, _one(90.0, 50.4, 4.0, 0.6, d), check_rectified=False)) == 0  # scale
-    assert len(match_stereo(left, _one(90.0, 53.0, 2.2, 0.6, d), check_rectified=False)) == 0  # epipolar
-    assert len(match_stereo(left, _one(110.0, 50.0, 2.2, 0.6, d), check_rectified=False)) == 0  # negative d
-    assert len(match_stereo(left, _one(90.0, 50.0, 2.2, 0.6, np.eye(8)[1]), check_rectified=False)) == 0
-    m = match_stereo(left, _one(90.0, 50.4, 2.2, 0.6, d), check_rectified=False)
+    assert len(match_stereo(left, _one(90.0, 50.4, 2.2, 0.6, d), require_rectified=False)) == 1
+    assert len(match_stereo(left, _one(90.0, 50.4, 2.2, 1.2, d), require_rectified=False)) == 0  # orientation
+    assert len(match_stereo(left, _one(90.0, 50.4, 4.0, 0.6, d), require_rectified=False)) == 0  # scale
+    assert len(match_stereo(left, _one(90.0, 53.0, 2.2, 0.6, d), require_rectified=False)) == 0  # epipolar
+    assert len(match_stereo(left, _one(110.0, 50.0, 2.2, 0.6, d), require_rectified=False)) == 0  # negative d
+    assert len(match_stereo(left, _one(90.0, 50.0, 2.2, 0.6, np.eye(8)[1]), require_rectified=False)) == 0
+    m = match_stereo(left, _one(90.0, 50.4, 2.2, 0.6, d), require_rectified=False)
     assert m.disparity[0] == pytest.approx(10.0)
 
 

@@ -1,7 +1,7 @@
 """The robokit and robocourse modules a module runs, found by reading imports with :mod:`ast`.
 
-Two users: the cache key of a lesson's experiment (:func:`code_version`: a dataset is rebuilt when
-any code it runs changes, and only then) and the grading worker's kit (:mod:`.grading.kit`: the
+Two users: the cache key of a lesson's experiment (:func:`code_version_of`: a dataset is rebuilt
+when any code it uses changes, and only then) and the grading worker's kit (:mod:`.grading.kit`: the
 worker's own modules, which must reach no robokit). Nothing is imported to find them; lazy imports
 inside functions and ``importlib.import_module("...")`` calls with a literal name count.
 """
@@ -14,7 +14,7 @@ import importlib.util
 from pathlib import Path
 from typing import Iterable
 
-__all__ = ["PACKAGES", "module_file", "imports_of", "closure", "source_digest", "code_version"]
+__all__ = ["PACKAGES", "module_file", "imports_of", "closure", "digest_of", "code_version_of"]
 
 #: The top-level packages whose modules are followed.
 PACKAGES = ("robokit", "robocourse")
@@ -55,7 +55,7 @@ def _home(package: str, name: str, depth: int = 0) -> str:
     path = module_file(package)
     if path is None or path.name != "__init__.py" or depth > 10:
         return package
-    for node in ast.parse(path.read_text(encoding="utf-8"), str(path)).body:
+    for node in _tree(path, path.stat().st_mtime_ns).body:
         if isinstance(node, ast.ImportFrom) and any((a.asname or a.name) == name for a in node.names):
             source = _absolute(package, path, node)
             original = next(a.name for a in node.names if (a.asname or a.name) == name)
@@ -65,20 +65,29 @@ def _home(package: str, name: str, depth: int = 0) -> str:
     return package
 
 
+@functools.lru_cache(maxsize=None)
+def _tree(path: Path, mtime_ns: int) -> ast.Module:
+    """A source file's syntax tree, parsed once per version of the file."""
+    return ast.parse(path.read_text(encoding="utf-8"), str(path))
+
+
 def imports_of(module: str, *, homes: bool = False) -> set[str]:
     """The modules of :data:`PACKAGES` that ``module``'s source imports (parents not included).
 
     With ``homes``, a name taken from a package (``from robokit.sim import Lidar``) counts as the
     module that defines it (``robokit.sim.lidar``), not as the package, whose ``__init__`` imports
-    every module of it.
+    every module of it. ``import a.b.c`` binds ``a`` and lets the code reach anything through the
+    packages on the way, so it counts as every one of them.
     """
     path = module_file(module)
     if path is None:
         raise ModuleNotFoundError(f"{module} has no source file")
     found: set[str] = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+    for node in ast.walk(_tree(path, path.stat().st_mtime_ns)):
         if isinstance(node, ast.Import):
-            found.update(alias.name for alias in node.names)
+            for alias in node.names:
+                parts = alias.name.split(".")
+                found.update(".".join(parts[:i]) for i in range(1, len(parts) + 1))
         elif isinstance(node, ast.ImportFrom):
             base = _absolute(module, path, node)
             for alias in node.names:  # `from pkg import mod` imports the module pkg.mod
@@ -124,7 +133,7 @@ def closure(roots: Iterable[str], *, parents: bool = True, homes: bool = False) 
     return via
 
 
-def source_digest(modules: Iterable[str]) -> str:
+def digest_of(modules: Iterable[str]) -> str:
     """16 hexadecimal digits of a hash of the named modules' sources (names and bytes, sorted)."""
     digest = hashlib.sha256()
     for name in sorted(set(modules)):
@@ -132,7 +141,7 @@ def source_digest(modules: Iterable[str]) -> str:
     return digest.hexdigest()[:16]
 
 
-def code_version(module: str) -> dict:
+def code_version_of(module: str) -> dict:
     """What decides a lesson experiment's cached result besides its parameters: the code it runs.
 
     A hash of every robokit and robocourse module whose code ``module`` (an experiment's own
@@ -153,7 +162,7 @@ def code_version(module: str) -> dict:
 
     Examples
     --------
-    >>> v = code_version("robocourse.lessons.visual_slam.experiment")
+    >>> v = code_version_of("robocourse.lessons.visual_slam.experiment")
     >>> sorted(v), len(v["code"])
     (['code', 'numpy', 'opencv', 'scipy'], 16)
     """
@@ -161,6 +170,6 @@ def code_version(module: str) -> dict:
     import numpy as np
     import scipy
 
-    return {"code": source_digest(closure([module], parents=False, homes=True)), "numpy": np.__version__,
+    return {"code": digest_of(closure([module], parents=False, homes=True)), "numpy": np.__version__,
             "scipy": scipy.__version__,
             "opencv": cv2.__version__}

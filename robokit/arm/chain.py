@@ -88,7 +88,7 @@ class Chain:
         # Each link transform is affine in (cos theta, sin theta): A = K + cos U + sin V. Sampling the
         # DH formula at theta = 0, pi, +-pi/2 gives K, U, V, so FK needs no trig of the twists.
         link = mdh_transform if self.modified else dh_transform
-        A = {t: link(np.full(n, t), self.d, self.a, self.alpha, validate=False) for t in (0.0, np.pi, np.pi / 2, -np.pi / 2)}
+        A = {t: link(np.full(n, t), self.d, self.a, self.alpha) for t in (0.0, np.pi, np.pi / 2, -np.pi / 2)}
         self._K = 0.5 * (A[0.0] + A[np.pi])
         self._U = 0.5 * (A[0.0] - A[np.pi])
         self._V = 0.5 * (A[np.pi / 2] - A[-np.pi / 2])

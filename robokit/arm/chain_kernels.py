@@ -2,7 +2,7 @@
 
 Unchecked kernels of the IK solvers' single-target paths, imported on their first solve (see
 :mod:`robokit.arm.jit`). They compute what :meth:`robokit.arm.Chain.frames`,
-:func:`robokit.arm.jacobian_from_frames` and :func:`robokit.geometry.pose_error` compute, with
+:func:`robokit.arm.jacobian.jacobian_from_frames` and :func:`robokit.geometry.pose_error` compute, with
 the same formulas (the tests compare them): link ``i`` is ``K_i + cos(theta_i) U_i + sin(theta_i)
 V_i`` with the chain's precomputed ``K, U, V``.
 
@@ -29,7 +29,7 @@ def chain_arrays(chain):
 
 
 @njit
-def check_se3(T, tol):
+def se3_defect(T, tol):
     """0 if ``T`` (4, 4) is a finite SE(3) matrix within ``tol`` (as :func:`robokit.geometry.as_se3`), else 1."""
     for i in range(4):
         for j in range(4):

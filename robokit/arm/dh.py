@@ -30,7 +30,7 @@ def _params(theta: Any, d: Any, a: Any, alpha: Any):
         raise ValueError(f"theta, d, a, alpha: expected broadcastable shapes, got {shapes}") from None
 
 
-def dh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, validate: bool = True) -> np.ndarray:
+def dh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
     """Standard DH link transform ``Rz(theta) Tz(d) Tx(a) Rx(alpha)``.
 
     Parameters
@@ -43,8 +43,6 @@ def dh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, validate: bool = Tru
         Link length along ``x_i`` [m].
     alpha : float or array_like
         Link twist about ``x_i`` [rad].
-    validate : bool, default True
-        Validate and broadcast the inputs; ``False`` skips it (float arrays that broadcast).
 
     Returns
     -------
@@ -68,7 +66,7 @@ def dh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, validate: bool = Tru
      [ 0.   -1.    0.    0.36]
      [ 0.    0.    0.    1.  ]]
     """
-    args = _params(theta, d, a, alpha) if validate else (theta, d, a, alpha)
+    args = _params(theta, d, a, alpha)
     return _link_matrices(*args, modified=False)
 
 
@@ -89,7 +87,7 @@ def _link_matrices(th: np.ndarray, d: np.ndarray, a: np.ndarray, al: np.ndarray,
     return T
 
 
-def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, validate: bool = True) -> np.ndarray:
+def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any) -> np.ndarray:
     """Modified (Craig) DH link transform ``Rx(alpha) Tx(a) Rz(theta) Tz(d)``.
 
     Parameters
@@ -102,8 +100,6 @@ def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, validate: bool = Tr
         Link length ``a_{i-1}`` along ``x_{i-1}`` [m].
     alpha : float or array_like
         Link twist ``alpha_{i-1}`` about ``x_{i-1}`` [rad].
-    validate : bool, default True
-        Validate and broadcast the inputs; ``False`` skips it.
 
     Returns
     -------
@@ -124,5 +120,5 @@ def mdh_transform(theta: Any, d: Any, a: Any, alpha: Any, *, validate: bool = Tr
     >>> mdh_transform(0.0, 0.333, 0.0, 0.0)[:3, 3].tolist()
     [0.0, 0.0, 0.333]
     """
-    args = _params(theta, d, a, alpha) if validate else (theta, d, a, alpha)
+    args = _params(theta, d, a, alpha)
     return _link_matrices(*args, modified=True)

@@ -294,7 +294,7 @@ def _compiled(record) -> None:
     compiled(record)
 
 
-#: Tolerance of the SE(3) check on targets (:data:`robokit.geometry.ROTATION_TOL`).
+#: Tolerance of the SE(3) check on targets (:data:`robokit.geometry.rotations.ROTATION_TOL`).
 _SE3_TOL = 1e-6
 #: Arm-angle tolerance of the bounded minimisation [rad].
 _XATOL = 1e-10

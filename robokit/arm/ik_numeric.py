@@ -275,7 +275,7 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
         from .jit import compile_notice
         record = compile_notice("numeric_search", "the numerical IK solver")
     if not (type(T) is np.ndarray and T.dtype == np.float64 and T.shape == (4, 4) and T.flags.c_contiguous
-            and K.check_se3(T, ROTATION_TOL) == 0):
+            and K.se3_defect(T, ROTATION_TOL) == 0):
         T = np.ascontiguousarray(as_se3(T, "T"))
     q = 0.5 * (chain.qmin + chain.qmax) if q0 is None else np.ascontiguousarray(chain.as_q(q0, "q0"))
     args, reach, base_p, lo, hi = _chain_data(chain)

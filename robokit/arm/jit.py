@@ -29,20 +29,20 @@ __all__ = ["njit", "CACHING", "compile_notice", "compiled"]
 
 
 #: The kernel modules whose source decides whether the cached machine code is current.
-_SOURCES = ("jit.py", "chain_kernels.py", "srs_kernels.py", "numeric_kernels.py")
+SOURCES = ("jit.py", "chain_kernels.py", "srs_kernels.py", "numeric_kernels.py")
 
 
-def _source_digest() -> str:
+def source_digest() -> str:
     """Hash of every kernel module's source with the numba and Python versions."""
     h = hashlib.sha1(f"{numba.__version__} {sys.version_info[:2]}".encode())
     here = Path(__file__).parent
-    for name in _SOURCES:
+    for name in SOURCES:
         h.update((here / name).read_bytes())
     return h.hexdigest()[:12]
 
 
 #: Names the cache folder of the compiled kernels (see the module docstring).
-SOURCE_DIGEST = _source_digest()
+SOURCE_DIGEST = source_digest()
 
 
 def _use_robokit_cache() -> bool:

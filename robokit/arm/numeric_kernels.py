@@ -7,7 +7,7 @@ wins, stalled attempts restart from random configurations in row order), with th
 (:mod:`robokit.arm.ik_steps`: ``0`` DLS, ``1`` gradient projection, ``2`` weighted least norm). The
 random configurations are drawn by the caller, in the order the batch search draws them. The
 tests compare the iterates and answers with :func:`~robokit.arm.ik_numeric_batch` and
-:func:`~robokit.arm.ik_numeric_readable`.
+:func:`~robokit.arm.ik_readable.ik_numeric_readable`.
 
 References
 ----------
@@ -28,10 +28,10 @@ import math
 
 import numpy as np
 
-from .chain_kernels import check_se3, frames, jacobian, pose_error
+from .chain_kernels import se3_defect, frames, jacobian, pose_error
 from .jit import njit
 
-__all__ = ["search", "step", "solve6", "check_se3", "DLS", "GRADIENT_PROJECTION", "WLN"]
+__all__ = ["search", "step", "solve6", "se3_defect", "DLS", "GRADIENT_PROJECTION", "WLN"]
 
 #: Method codes of the kernel.
 DLS, GRADIENT_PROJECTION, WLN = 0, 1, 2

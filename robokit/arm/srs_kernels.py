@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from .chain_kernels import check_se3, frames, matmul4, pose_error
+from .chain_kernels import se3_defect, frames, matmul4, pose_error
 from .jit import njit
 
 __all__ = []
@@ -538,7 +538,7 @@ def solve(T, q0, psi0, base_inv, tool_inv, plain, dims, lo, hi, tol, se3_tol, n_
         if not math.isfinite(q0[j]):
             return 4
         q[j] = q0[j]
-    if se3_tol > 0 and check_se3(T, se3_tol):
+    if se3_tol > 0 and se3_defect(T, se3_tol):
         return 1
     T7 = T if plain else matmul4(matmul4(base_inv, T, np.empty((4, 4))), tool_inv, np.empty((4, 4)))
     G, q4 = np.empty((2, 2, 3, 9)), np.empty(2)

@@ -178,7 +178,7 @@ def _out(x: np.ndarray) -> float | np.ndarray:
     return float(x) if np.ndim(x) == 0 else x
 
 
-def motor_current(voltage: Any, joint_velocity: Any, motor: DCMotor, validate: bool = True) -> float | np.ndarray:
+def motor_current(voltage: Any, joint_velocity: Any, motor: DCMotor, *, validate: bool = True) -> float | np.ndarray:
     """Winding current (A): ``i = (V - k_e N dq/dt) / R``, with ``V`` saturated at ``+-voltage_max``.
 
     Parameters

@@ -322,7 +322,7 @@ class HierarchicalLocalizer:
 
         Each candidate whose essential matrix holds puts the query on a ray from the node's pose;
         the rays of up to three candidates (with ``min_matches``) are intersected
-        (:func:`robokit.geometry.intersect_lines`). The crossing counts when the rays spread by at
+        (:func:`robokit.geometry.planar.intersect_lines`). The crossing counts when the rays spread by at
         least ``min_crossing`` and it lies ahead on each, within ``max_range``.
         """
         done = {c for _, c in tried}

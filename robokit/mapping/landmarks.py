@@ -138,7 +138,7 @@ def _fuse(pts: np.ndarray, cov: np.ndarray, new: np.ndarray, cov_new: np.ndarray
     return mean, fused
 
 
-def _greedy_one_to_one(fi: np.ndarray, li: np.ndarray, out: np.ndarray) -> np.ndarray:
+def greedy_one_to_one(fi: np.ndarray, li: np.ndarray, out: np.ndarray) -> np.ndarray:
     """Greedy one-to-one assignment of pairs listed best first; ``out[f] = l`` for the chosen pairs.
 
     Vectorised in rounds: a pair that comes first for both its feature and its landmark among the
@@ -420,7 +420,7 @@ class LandmarkMap:
         ok = m2 <= gate
         fi, li, dd = fi[ok], li[ok], dd[ok]
         order = np.argsort(dd, kind="stable")
-        return _greedy_one_to_one(fi[order], li[order], out)
+        return greedy_one_to_one(fi[order], li[order], out)
 
     def integrate(self, points, covariances, descriptors, pqt, pqt_covariance, landmark,
                   scales=None, orientations=None, expected=None) -> np.ndarray:

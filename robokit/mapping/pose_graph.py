@@ -194,7 +194,7 @@ def information_from_covariance(measurements: Any, covariances: Any) -> np.ndarr
 
     A relative pose ``z = [dx, dy, dtheta]`` of node ``j`` in node ``i``'s frame usually comes with
     its covariance in that same frame (odometry propagated from ``i``, a visual estimate made at
-    ``i``). g2o's error ``e = z^-1 (+) (p_i^-1 (+) p_j)`` (:func:`robokit.mapping.pose_graph_residuals`)
+    ``i``). g2o's error ``e = z^-1 (+) (p_i^-1 (+) p_j)`` (:func:`robokit.mapping.pose_graph_optimize.pose_graph_residuals`)
     is expressed in the frame of ``z``'s end instead: to first order ``e = J (z_hat - z)`` with
     ``J = blockdiag(R(dtheta)^T, 1)``, so its covariance is ``J C J^T`` and the information
     ``(J C J^T)^-1``. Using ``C^-1`` directly swaps the along- and cross-track weights of every edge

@@ -1,7 +1,7 @@
 """Loop-closure alignment by relaxation (the paper's Eqs. (1)-(3), after Duckett et al. 2000).
 
 Every node has a pose ``[x, y, theta]`` and a scalar variance ``omega_i``; every edge a relative
-pose and a scalar variance ``omega_ij`` (:func:`robokit.mapping.edge_variances`). One sweep
+pose and a scalar variance ``omega_ij`` (:func:`robokit.mapping.pose_graph.edge_variances`). One sweep
 re-estimates each node but the fixed one from its neighbours (Sec. 'Loop closure alignment'):
 
 1. each neighbour ``j`` predicts node ``i``'s pose and variance (Eq. (1));
@@ -229,7 +229,7 @@ def relax(graph: PoseGraph, *, max_iterations: int = 1000, tolerance: float = 1e
     ----------
     graph : PoseGraph
         Connected; ``graph.poses`` is the starting estimate and the edges' scalar variances are
-        :func:`robokit.mapping.edge_variances` of its information matrices.
+        :func:`robokit.mapping.pose_graph.edge_variances` of its information matrices.
     max_iterations : int, default 1000
         Most sweeps (0 returns the start).
     tolerance : float, default 1e-6

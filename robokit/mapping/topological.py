@@ -9,7 +9,7 @@ base references of two local maps, ``rt_ij = (x_ij, z_ij, theta_ij)``, with a va
 frame (x, y on the floor, theta counter-clockwise): the paper's ``(x, z, theta)`` with ``z`` renamed
 ``y``. An edge's measurement is the pose of node ``j`` in node ``i``'s frame, ``[dx, dy, dtheta]``,
 with a full 3 x 3 covariance (the paper's scalar ``omega_ij`` is its mean position variance, see
-:func:`robokit.mapping.edge_variances`).
+:func:`robokit.mapping.pose_graph.edge_variances`).
 
 :class:`TopologicalMap` holds plain arrays (it saves to and loads from one ``.npz``), one KD-tree
 descriptor index per node built when the map is made (the paper: "the implementation of the map
@@ -295,7 +295,7 @@ class TopologicalMap:
         -----
         Sec. "Loop closure alignment": "The first node of the map is considered as the reference
         frame"; the edges' covariances (in each edge's start frame) become information matrices for
-        g2o's error by :func:`robokit.mapping.information_from_covariance`.
+        g2o's error by :func:`robokit.mapping.pose_graph.information_from_covariance`.
         """
         return PoseGraph(self.poses, self.edges, self.measurements,
                          information_from_covariance(self.measurements, self.covariances), fixed=0)

@@ -156,7 +156,7 @@ def random_course(seed: int = 0, *, n_waypoints: int = 4, n_obstacles: int = 14,
     -----
     Modelled on the experiment of Hamid et al. (2009): drive from the first to the last
     waypoint, avoiding the obstacles met on the way. The obstacles come from
-    :func:`robokit.sim.scatter_obstacles` (random sequential adsorption, Feder 1980), the generator
+    :func:`robokit.sim.worlds_outdoor.scatter_obstacles` (random sequential adsorption, Feder 1980), the generator
     :func:`robokit.sim.open_field` also uses; ``course.field.world()`` is the course as a 3D world.
 
     Examples

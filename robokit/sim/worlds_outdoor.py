@@ -331,12 +331,12 @@ def open_field(seed: int = 0, *, size: Any = (100.0, 60.0), n_obstacles: int = 1
     if w < (12.0 if shed else 6.0) or h < (10.0 if shed else 6.0):
         raise ValueError(f"size: expected at least {'12 m x 10 m with a shed' if shed else '6 m x 6 m'}, "
                          f"got {w:g} m x {h:g} m")
-    return _open_field(as_int(seed, "seed", minimum=0), w, h, as_int(n_obstacles, "n_obstacles", minimum=0),
-                       bool(shed), as_positive(border, "border"))
+    return _cached_field(as_int(seed, "seed", minimum=0), w, h, as_int(n_obstacles, "n_obstacles", minimum=0),
+                         bool(shed), as_positive(border, "border"))
 
 
-@functools.lru_cache(maxsize=4)
-def _open_field(seed: int, w: float, h: float, n: int, shed: bool, border: float) -> World:
+def build_open_field(seed: int, w: float, h: float, n: int, shed: bool, border: float) -> World:
+    """Unchecked, uncached :func:`open_field` (its arguments as that function checks them)."""
     rng = np.random.default_rng(seed)
     centre = np.array([w / 2, h / 2])
     sheds = np.zeros((0, 5))
@@ -350,3 +350,6 @@ def _open_field(seed: int, w: float, h: float, n: int, shed: bool, border: float
         raise ValueError(f"n_obstacles: expected at most what fits in a {w:g} m x {h:g} m field with 2.5 m gaps, "
                          f"got {n} (only {placed} placed)")
     return field_world((w, h), circles, boxes, seed=seed, border=border, interior=centre, name="open_field")
+
+
+_cached_field = functools.lru_cache(maxsize=4)(build_open_field)

@@ -205,7 +205,7 @@ class VocabularyFileError(ValueError):
 _BYTE_BITS = np.unpackbits(np.arange(256, dtype=np.uint8)[:, None], axis=1).astype(np.float64)
 
 
-def _majority(desc: np.ndarray, labels: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+def bit_majority(desc: np.ndarray, labels: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
     """Per-bit majority of each cluster's members (ties give 1, as DBoW2) and the cluster sizes.
 
     A bit is set in the centre when at least half the members set it. The per-cluster bit sums are
@@ -265,7 +265,7 @@ def _k_majority(desc: np.ndarray, k: int, iterations: int, rng: np.random.Genera
         if labels is not None and np.array_equal(new, labels):
             break
         labels = new
-        majority, size = _majority(desc, labels, len(centres))
+        majority, size = bit_majority(desc, labels, len(centres))
         centres = np.where((size > 0)[:, None], majority, centres)
     labels = np.argmin(hamming_distance(desc[:, None], centres[None], validate=False), axis=1)
     return [rows for rows in (np.nonzero(labels == j)[0] for j in range(len(centres))) if rows.size]
@@ -412,7 +412,7 @@ class Vocabulary:
             for j, members in enumerate(_k_majority(desc[rows], branching, iterations, rng)):
                 child = len(centres)
                 children.append([-1] * branching)
-                centres.append(_majority(desc[rows[members]], np.zeros(members.size, int), 1)[0][0])
+                centres.append(bit_majority(desc[rows[members]], np.zeros(members.size, int), 1)[0][0])
                 children[node][j] = child
                 todo.append((child, rows[members], depth + 1))
         voc = cls(np.array(children), np.array(centres), np.zeros(sum(c[0] < 0 for c in children)), levels)

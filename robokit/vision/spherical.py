@@ -391,7 +391,7 @@ def floor_points(bearings: Any, T_body_camera: Any, *, min_depression: float = 0
         Viewing directions in the camera frame (e.g. :meth:`robokit.sim.OmniCamera.rays`).
     T_body_camera : array_like, shape (4, 4)
         The camera's mount on the robot (body frame: x forward, y left, z up, floor at ``z = 0``;
-        e.g. :func:`robokit.sim.omni_mount`).
+        e.g. :func:`robokit.sim.omni.omni_mount`).
     min_depression : float, default 0.35
         Rays less than this angle (radians, about 20 deg) below the horizon are not lifted: their
         floor point would be far and its range error large (it grows like ``h / sin^2`` of the

@@ -288,7 +288,7 @@ def triangulate_svd(p_left, p_right, uv_left, uv_right) -> np.ndarray:
 def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
                  min_disparity: float = 0.5, max_disparity: float = 200.0,
                  max_orientation_diff: float = np.deg2rad(20.0), max_scale_ratio: float = 1.5,
-                 ratio: float = 0.65, max_distance: float = 0.8, check_rectified: bool = True) -> StereoMatches:
+                 ratio: float = 0.65, max_distance: float = 0.8, require_rectified: bool = True) -> StereoMatches:
     """Match features of a rectified pair under the epipolar, disparity, orientation and scale constraints.
 
     Parameters
@@ -308,7 +308,7 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
         constraints; above it the feature is ambiguous and discarded.
     max_distance : float, default 0.8
         Maximum descriptor distance (unit-length descriptors) of an accepted match.
-    check_rectified : bool, default True
+    require_rectified : bool, default True
         Refuse input whose unconstrained descriptor matches lie far off the image rows.
 
     Returns
@@ -319,7 +319,7 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
     Raises
     ------
     NotRectifiedError
-        If ``check_rectified`` and at least 12 confident descriptor matches have a median row
+        If ``require_rectified`` and at least 12 confident descriptor matches have a median row
         difference above ``3 * epipolar_tol``.
     ValueError, TypeError
         For invalid arguments.
@@ -351,7 +351,7 @@ def match_stereo(left: Features, right: Features, *, epipolar_tol: float = 1.5,
         raise ValueError(f"right: expected descriptors of length {left.descriptors.shape[1]}, "
                          f"got {right.descriptors.shape[1]}")
     kl, kr = left.keypoints, right.keypoints
-    if check_rectified:
+    if require_rectified:
         # exact search either way; OpenCV's brute force is faster than a KD-tree for long descriptors
         method = "kdtree" if left.descriptors.shape[1] <= 32 else "opencv"
         m = ratio_match(left.descriptors, right.descriptors, ratio=0.6, method=method)

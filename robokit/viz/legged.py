@@ -299,7 +299,7 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
         m of arrow per N (7.4 N, a quarter of the weight, is 3 cm).
     frame : bool, default True
         Look at the robot from its front right, close enough for it to fill most of the view
-        (:func:`robokit.viz.frame` on the robot as it starts), and follow it as it walks
+        (:func:`robokit.viz.fit_view` on the robot as it starts), and follow it as it walks
         (:meth:`Scene.set_camera_follow`, offline pages).
 
     Returns

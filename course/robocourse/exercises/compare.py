@@ -1,4 +1,4 @@
-"""Comparisons between a reference output and a student's (both already plain data).
+"""Comparisons between an expected output and a student's (both already plain data).
 
 A comparison is a callable ``compare(expected, got) -> str | None``: ``None`` means the answer is
 accepted, a string says why not. Build them with :func:`close`, :func:`exact` and

@@ -16,7 +16,7 @@ Conventions in ``solutions/NN_slug.ipynb`` (the single source of the assignment)
   robocourse. A cell that interprets results with the library (for a written question) carries
   the tag; the generator refuses a notebook that breaks the rule.
 
-An assignment whose lesson defines ``assignment_data()`` also gets its data file
+An assignment whose lesson's exercises define ``data()`` also gets its data file
 (:mod:`robocourse.grading.data`), written from what that function returns. The output is deterministic (same input, same bytes) and carries nbgrader metadata
 (``schema_version`` 3) so the same notebooks work with nbgrader's in-kernel autograde.
 """

@@ -22,8 +22,8 @@ root (``sandbox=limited``) the installed packages stay readable on disk, as the 
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import importlib.abc
+import importlib.machinery
 import json
 import sys
 import types
@@ -84,13 +84,31 @@ def _is_ours(name: str) -> bool:
     return name.split(".")[0] in _PACKAGES
 
 
-class _Barrier(importlib.abc.MetaPathFinder):
-    """First on ``sys.meta_path``: lets the kit's modules through, refuses every other name of ours."""
+class _Served(importlib.abc.Loader):
+    """Loads a stand-in module the barrier made (the old name of ``check``), never a file."""
 
-    def __init__(self, allowed: set[str], refuse: Callable[[str], BaseException]):
-        self.allowed, self.refuse = allowed, refuse
+    def __init__(self, module: types.ModuleType):
+        self.module = module
+
+    def create_module(self, spec):
+        return self.module
+
+    def exec_module(self, module):
+        pass
+
+
+class _Barrier(importlib.abc.MetaPathFinder):
+    """First on ``sys.meta_path``: lets the kit's modules through, serves the stand-ins itself (so a
+    submission that drops them from ``sys.modules`` gets them back, never the files), and refuses
+    every other name of ours."""
+
+    def __init__(self, allowed: set[str], served: dict[str, types.ModuleType],
+                 refuse: Callable[[str], BaseException]):
+        self.allowed, self.served, self.refuse = allowed, served, refuse
 
     def find_spec(self, name, path=None, target=None):
+        if name in self.served:
+            return importlib.machinery.ModuleSpec(name, _Served(self.served[name]), is_package=True)
         if not _is_ours(name) or name in self.allowed:
             return None
         raise self.refuse(name)
@@ -107,11 +125,19 @@ def _refusal(log: Callable[[str], None]) -> Callable[[str], BaseException]:
     return refuse
 
 
-def _module(name: str, doc: str, **attributes) -> types.ModuleType:
-    """A package ``name`` registered in ``sys.modules`` and on its parent, holding ``attributes``."""
-    module = sys.modules.get(name) or types.ModuleType(name, doc)
-    module.__path__ = getattr(module, "__path__", [])  # a package, so that a submodule import reaches the barrier
+def _stand_in(name: str, doc: str, refuse: Callable[[str], BaseException], **attributes) -> types.ModuleType:
+    """A package ``name`` registered in ``sys.modules`` and on its parent, holding ``attributes``;
+    any other attribute is refused (and logged) like an import of it."""
+    module = types.ModuleType(name, doc)
+    module.__path__ = []            # a package, so that a submodule import reaches the barrier
     vars(module).update(attributes)
+
+    def __getattr__(attr: str):
+        if attr.startswith("_"):   # probes by Python and tools (__file__, _repr_html_) find nothing
+            raise AttributeError(attr)
+        raise refuse(f"{name}.{attr}")
+
+    module.__getattr__ = __getattr__
     sys.modules[name] = module
     parent, _, child = name.rpartition(".")
     if parent:
@@ -140,6 +166,7 @@ def seal(manifest: Manifest, log: Callable[[str], None]) -> None:
         return assignment_data(slug)
 
     sys.modules["robocourse"].__dict__.update(check=quiet_check, assignment_data=data)   # the kit's stand-in
-    _module("robokit", "robokit while grading: only the old name of check()")
-    _module(OLD_CHECK, "check() while grading: skipped", check=quiet_check)
-    sys.meta_path.insert(0, _Barrier({*kit, "robokit", OLD_CHECK}, _refusal(log)))
+    refuse = _refusal(log)
+    served = {"robokit": _stand_in("robokit", "robokit while grading: only the old name of check()", refuse)}
+    served[OLD_CHECK] = _stand_in(OLD_CHECK, "check() while grading: skipped", refuse, check=quiet_check)
+    sys.meta_path.insert(0, _Barrier(kit, served, refuse))

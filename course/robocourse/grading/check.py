@@ -5,19 +5,55 @@ worker replaces ``check`` by a function that only prints that it is skipped.
 """
 from __future__ import annotations
 
+import types
 from typing import Any, Callable
 
 from robocourse.lessons import get_exercise
 from robocourse.grading.judge import call_student, expected_output, judge
 
-__all__ = ["check", "PUBLIC_SEED", "CheckFailed", "NotImplementedYet"]
+__all__ = ["check", "library_use", "PUBLIC_SEED", "CheckFailed", "NotImplementedYet"]
 
 #: Seed of the public cases used by :func:`check`; official grading uses the instructor's seed.
 PUBLIC_SEED = 2024
 
 
+def library_use(fn: Callable[..., Any]) -> list[str]:
+    """What of robokit a function's own code reaches: names it imports, and globals or closure
+    values that are robokit objects (its nested functions included, not the functions it calls).
+
+    The grading worker has no robokit, so such a function scores zero there; :func:`check` says so
+    at once instead of passing the public cases.
+
+    Examples
+    --------
+    >>> from robokit.geometry import wrap_angle as wrap
+    >>> library_use(lambda angle: wrap(angle)), library_use(lambda angle: angle % 6.28)
+    (['wrap (robokit.geometry.planar)'], [])
+    """
+    code = getattr(fn, "__code__", None)
+    if not isinstance(code, types.CodeType):
+        return []
+    names, stack = set(), [code]
+    while stack:
+        c = stack.pop()
+        names |= set(c.co_names)
+        stack.extend(k for k in c.co_consts if isinstance(k, types.CodeType))
+    values = {n: fn.__globals__[n] for n in names if n in getattr(fn, "__globals__", {})}
+    for name, cell in zip(code.co_freevars, getattr(fn, "__closure__", None) or ()):
+        try:
+            values[name] = cell.cell_contents
+        except ValueError:                      # an empty cell
+            pass
+    found = sorted(f"import of {n}" for n in names if n.split(".")[0] == "robokit")
+    for name, value in sorted(values.items()):
+        home = value.__name__ if isinstance(value, types.ModuleType) else getattr(value, "__module__", None)
+        if isinstance(home, str) and home.split(".")[0] == "robokit":
+            found.append(f"{name} ({home})")
+    return found
+
+
 class _MessageOnly:
-    """Mixin: IPython shows only ``Name: message`` for these errors, not a traceback through robokit.
+    """Mixin: IPython shows only ``Name: message`` for these errors, not a traceback through robocourse.
 
     IPython asks an exception for ``_render_traceback_()`` before formatting a traceback; the cell
     still ends in an error (red, and a failed grade cell for nbgrader), but the student reads only
@@ -61,14 +97,16 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
     NotImplementedYet
         (a ``NotImplementedError``) If ``fn`` is still the stub: the report says "not implemented
         yet". It raises, rather than returning quietly, so that nbgrader's in-kernel autograde
-        scores an untouched stub zero; robokit's harness lets the rest of an assignment notebook
+        scores an untouched stub zero; robocourse's harness lets the rest of an assignment notebook
         run on.
     CheckFailed
         (an ``AssertionError``) If any case fails, so the cell shows red. Its message lists the
-        failed cases; in a notebook only that message is shown, not a traceback through robokit.
+        failed cases; in a notebook only that message is shown, not a traceback through robocourse.
+        Also if ``fn`` uses robokit (:func:`library_use`): the grader has none, so it would score
+        zero there.
     TypeError
         If ``fn`` is not callable.
-    robocourse.exercises.UnknownExerciseError
+    robocourse.lessons.UnknownExerciseError
         If no assignment declares ``exercise_id``.
 
     Notes
@@ -89,6 +127,10 @@ def check(exercise_id: str, fn: Callable[..., Any], *, verbose: bool = True) -> 
     exercise = get_exercise(exercise_id)
     if not callable(fn):
         raise TypeError(f"fn: expected your function {exercise.function}, got {type(fn).__name__}")
+    uses = library_use(fn)
+    if uses:
+        raise CheckFailed(f"{exercise.id}: {exercise.function} uses robokit ({', '.join(uses)}); the grader has no "
+                          "robokit, so it would score zero there: write it with numpy")
     cases = exercise.make_cases(PUBLIC_SEED)
     passes, failures = [], []
     for i, case in enumerate(cases, 1):

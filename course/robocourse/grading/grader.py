@@ -107,7 +107,7 @@ class SubmissionResult:
 @dataclasses.dataclass
 class PreparedCases:
     """The trusted side of a grading run: exercises, their cases for the secret seed, and the
-    reference answers. It stays in the grader's process; workers receive only the case inputs."""
+    expected answers. It stays in the grader's process; workers receive only the case inputs."""
 
     exercises: tuple[Exercise, ...]
     cases: list[list[Case]]
@@ -127,7 +127,7 @@ def cases_seed(seed: str, submission: Submission) -> str:
 
     Feedback shows a case's input when the student's code raised on it (their own message may
     even print it). With one set of cases per seed, a student could collect those inputs, compute
-    the answers at home with robokit's public reference and submit a lookup table. Any change to
+    the answers at home with robokit's public functions and submit a lookup table. Any change to
     the code draws new cases, so what one submission learns is worthless to the next; the same
     file still regrades identically under the same seed.
     """
@@ -136,7 +136,7 @@ def cases_seed(seed: str, submission: Submission) -> str:
 
 
 def prepare_cases(assignment: str, seed: str) -> PreparedCases:
-    """Generate every exercise's cases from ``seed`` and compute the reference answers (trusted)."""
+    """Generate every exercise's cases from ``seed`` and compute the expected answers (trusted)."""
     if not isinstance(seed, str) or not seed:
         raise GradingError("seed: a non-empty secret seed is required (--seed or ROBOKIT_GRADING_SEED)")
     exercises = get_assignment(assignment).exercises

@@ -27,7 +27,7 @@ class Outcome:
 
 
 def expected_output(exercise: Exercise, case: Case) -> Any:
-    """Return the reference answer for ``case`` as plain data (``None`` for raising cases)."""
+    """Return the expected answer for ``case`` as plain data (``None`` for raising cases)."""
     if case.raises:
         return None
     return to_plain(exercise.answer(*case.args, **case.kwargs))

@@ -307,7 +307,7 @@ class JobDir:
         return DoneReport(_seconds(raw.get("compute_seconds")))
 
     def read_withheld_imports(self) -> list[str]:
-        """Dotted names of the references graded code tried to import (the log's first lines);
+        """Dotted names graded code tried to import and the kit withholds (the log's first lines);
         empty if the log was never written.
 
         Raises

@@ -4,7 +4,7 @@ A lesson folder ``robocourse/lessons/<name>/`` holds the experiments its lecture
 (with their fast mode and cache keys) and an ``exercises`` module that sets ``ASSIGNMENT =
 "NN_slug"`` (the notebook name in ``solutions/`` and ``assignments/``), ``EXERCISES =
 [Exercise(...), ...]``, ``WRITTEN = {"NN.name": points}`` (manually graded questions) and, if its
-notebook works on data, a function ``assignment_data()`` returning them as plain data
+notebook works on data, a function ``data()`` returning them as plain data
 (:mod:`robocourse.grading.data`). Lessons are found automatically, so a new lesson adds its folder
 and touches nothing else. They are read once, on first use, and checked once: an
 :class:`Assignment` refuses duplicate ids and ids of another lesson.
@@ -63,7 +63,7 @@ class Assignment:
     Raises
     ------
     ValueError
-        For a malformed slug, an exercise that is not an :class:`~.spec.Exercise`, duplicate ids
+        For a malformed slug, an exercise that is not an :class:`robocourse.exercises.spec.Exercise`, duplicate ids
         (exercises and written questions share one id space), an id of another lesson, a
         written question with a malformed id or non-positive points, or ``data`` that is not callable.
 
@@ -106,7 +106,7 @@ class Assignment:
         if bad_points:
             raise ValueError(f"{self.slug}: WRITTEN points must be positive numbers, got {bad_points}")
         if self.data is not None and not callable(self.data):
-            raise ValueError(f"{self.slug}: assignment_data must be a function, got {type(self.data).__name__}")
+            raise ValueError(f"{self.slug}: data must be a function (the lesson's data()), got {type(self.data).__name__}")
         object.__setattr__(self, "exercises", exercises)
         object.__setattr__(self, "written", MappingProxyType(written))
 
@@ -134,7 +134,7 @@ def catalog() -> Mapping[str, Assignment]:
         if slug in found:
             raise ValueError(f"{module.__name__}: assignment {slug!r} is declared twice")
         found[slug] = Assignment(slug, tuple(module.EXERCISES), getattr(module, "WRITTEN", {}),
-                                 getattr(module, "assignment_data", None))
+                                 getattr(module, "data", None))
     return MappingProxyType(dict(sorted(found.items())))
 
 

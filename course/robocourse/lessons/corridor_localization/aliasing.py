@@ -1,7 +1,7 @@
 """Plain data for lesson 03's question on LiDAR aliasing: one scan, the corridor's distance grid, three poses.
 
-Part of assignment 03's data (:func:`robocourse.lessons.corridor_localization.exercises.assignment_data`);
-the distance grid is the true walls' distance from the simulator.
+Assignment 03's written question on laser aliasing runs the student's likelihood field on it (a
+cell the grader skips); the distance grid is the true walls' distance from the simulator.
 
 References
 ----------

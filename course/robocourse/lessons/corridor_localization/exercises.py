@@ -178,7 +178,7 @@ def ellipse_start_weights(points, centre, sigma_x: float, sigma_y: float) -> np.
 
 
 def recognise_keyframe(query, keyframes) -> int:
-    """The keyframe a query image was taken at, from binary descriptors (the open exercise's reference).
+    """The keyframe a query image was taken at, from binary descriptors (the open exercise's answer).
 
     Counts, for each keyframe, the query descriptors whose nearest keyframe descriptor is within 50
     bits and passes the ratio test (:func:`robokit.vision.hamming_match`), and returns the keyframe

@@ -42,7 +42,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from robocourse.source import code_version
+from robocourse.source import code_version_of
 from robokit.cache import CACHE_READ_ERRORS, cache_dir, cache_key, read_arrays, write_arrays, write_atomically
 from robokit.config import fast_mode
 from robokit.mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
@@ -121,7 +121,7 @@ SHARED_RANGE = (0.70, 0.90)
 
 
 def _code() -> dict:
-    return code_version(__name__)
+    return code_version_of(__name__)
 
 
 def _descriptor_stack(descriptors: list) -> tuple[np.ndarray, np.ndarray]:

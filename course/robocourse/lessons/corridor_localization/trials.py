@@ -39,7 +39,7 @@ from typing import Any, Callable
 import numpy as np
 
 from robocourse.lessons.corridor_localization.experiment import CorridorMap, MAPPING_ALPHAS, N_FEATURES, as_corridor_map
-from robocourse.source import code_version
+from robocourse.source import code_version_of
 from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
 from robokit.config import fast_mode
 from robokit.controllers import CenteringResult, move_to_middle_line
@@ -491,7 +491,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     max_distance = as_positive(max_distance, "max_distance")
     progress = as_callable(progress, "progress")
     workers = None if workers is None else as_int(workers, "workers", minimum=1, maximum=64)
-    code = code_version(__name__)
+    code = code_version_of(__name__)
 
     def cache_file(m: str) -> tuple[Any, dict]:
         meta = {"setup": setup.key, "method": m, "trials": trials, "starts": starts, "seed": seed,

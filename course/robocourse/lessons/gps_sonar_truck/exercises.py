@@ -31,7 +31,7 @@ WRITTEN = {"05.calibration_drive": 2, "05.bearing_near_waypoint": 2, "05.gps_acc
 
 
 def compass_bias(fixes, compass_deg) -> float:
-    """The compass's constant error (degrees, reported minus true) from a straight drive (the open exercise's reference).
+    """The compass's constant error (degrees, reported minus true) from a straight drive (the open exercise's answer).
 
     Parameters
     ----------
@@ -85,7 +85,7 @@ def compass_bias(fixes, compass_deg) -> float:
     return float(bias if bias > -180.0 else 180.0)
 
 
-def _calibration_drive(rng: np.random.Generator, length: float = 120.0, *, heading: float | None = None,
+def calibration_drive(rng: np.random.Generator, length: float = 120.0, *, heading: float | None = None,
                        bias: float | None = None, gps_sigma: float = 0.8, poor: int = 0, poor_at: str = "start",
                        wander: float = 0.0):
     """A straight drive at 0.7 m/s with 1 Hz fixes and whole-degree compass readings: (fixes, compass, true bias).
@@ -117,7 +117,7 @@ def _calibration_drive(rng: np.random.Generator, length: float = 120.0, *, headi
     return np.round(fixes, 2), compass, b
 
 
-#: The kinds of calibration drive in the open exercise's cases: (label, keyword arguments of _calibration_drive).
+#: The kinds of calibration drive in the open exercise's cases: (label, keyword arguments of calibration_drive).
 #: ``poor=True`` means a random number (2-8) of poor fixes.
 BIAS_DRIVES = (
     ("straight drive", {}),
@@ -139,7 +139,7 @@ def _bias_cases(rng: np.random.Generator) -> list[Case]:
         kw = dict(kwargs)
         if kw.get("poor") is True:
             kw["poor"] = int(rng.integers(2, 9))
-        f, c, _ = _calibration_drive(rng, **kw)
+        f, c, _ = calibration_drive(rng, **kw)
         first = first or (f, c)
         cases.append(Case((f.tolist(), c.tolist()), label=label))
     f, c = first

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from robocourse.source import code_version
+from robocourse.source import code_version_of
 from robokit.cache import (cache_dir, cache_key, read_arrays, record_names, records_from_arrays, records_to_arrays,
                            write_arrays)
 from robokit.outdoor import RunResult, random_course, simulate
@@ -39,7 +39,7 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
         ``progress(i, n)`` after each run, besides the progress bar (:func:`robokit.progress.progress_bar`).
     cache : bool, default True
         Load from / save to ``robokit.cache.cache_dir("outdoor")``, keyed by the seeds, every option and
-        the code (:func:`robocourse.source.code_version`); a corrupt or stale cache file is rebuilt,
+        the code (:func:`robocourse.source.code_version_of`); a corrupt or stale cache file is rebuilt,
         never loaded. Options that are not plain data (a custom ``truck``) are not cached.
     **options
         Passed to :func:`robokit.outdoor.simulate`.
@@ -77,7 +77,7 @@ def run_courses(seeds: Any, *, firing: str = "chained", course_options: dict | N
     target = meta = None
     if cache:
         meta = {"seeds": seeds, "firing": firing, "course_options": course_options or {}, "options": options,
-                "code": code_version(__name__)}
+                "code": code_version_of(__name__)}
         try:
             target = cache_dir("outdoor") / f"courses-{cache_key(**meta)}.npz"
         except TypeError:           # an option that is not plain data: run without the cache

@@ -1,6 +1,6 @@
 """Plain data for assignment 04: the model's constants, synthetic foot-force traces, MoCap frames.
 
-Assignment 04's data (:func:`robocourse.lessons.littledog.exercises.assignment_data`). The force
+Assignment 04's data (:func:`robocourse.lessons.littledog.exercises.data`). The force
 traces come from a generator of our own whose true touchdowns are known (the open exercise's cases
 are drawn from it too); the MoCap frames come from :func:`robokit.legged.simulate_mocap`.
 

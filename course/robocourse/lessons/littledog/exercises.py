@@ -36,12 +36,12 @@ ASSIGNMENT = "04_littledog"
 WRITTEN = {"04.architecture": 2, "04.touchdown_tradeoff": 2, "04.marker_geometry": 2}
 
 
-def assignment_data() -> dict:
+def data() -> dict:
     """What the notebook's exercises work on: the model's constants (:func:`~.data.model_facts`).
 
     Examples
     --------
-    >>> assignment_data()["model_facts"]["UPPER_LEG"]
+    >>> data()["model_facts"]["UPPER_LEG"]
     0.0751
     """
     return {"model_facts": model_facts()}
@@ -72,7 +72,7 @@ def battery_endurance(capacity_ah: float, voltage: float, mean_power_w: float) -
 
 
 def detect_touchdowns(force: Any, dt: float) -> list:
-    """The touchdowns of one foot-force trace (the open exercise's reference: it finds the true ones).
+    """The touchdowns of one foot-force trace (the open exercise's answer: it finds the true ones).
 
     Offline: :func:`robokit.legged.touchdown.detect_contacts` with hysteresis (contact above 5 N,
     none below 3 N) and a 30 ms debounce, its touchdowns (:func:`~robokit.legged.touchdown.contact_events`),
@@ -130,7 +130,7 @@ def _touchdowns_found(expected: Any, got: Any) -> str | None:
 
 
 def _same_rigid_fit(expected: Any, got: Any) -> str | None:
-    """Accept a proper rigid transform that is the least-squares optimum (the reference's) within
+    """Accept a proper rigid transform that is the least-squares optimum (the answer's) within
     ``FIT_TOLERANCE`` on every point within 0.2 m of the body's origin."""
     try:
         G = np.array(got, dtype=float)

@@ -92,7 +92,7 @@ def recognise_node(query_histogram, query_descriptors, node_histograms, node_des
                    ratio: float = RATIO) -> int:
     """The node a query was taken at: coarse ranking by Eq. (5), then the most matches among the top k.
 
-    The reference answer of the open exercise (any method that finds the right node passes).
+    The expected answer of the open exercise (any method that finds the right node passes).
 
     Parameters
     ----------

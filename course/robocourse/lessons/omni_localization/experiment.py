@@ -34,7 +34,7 @@ from typing import Any, Callable
 import numpy as np
 
 from robokit.config import fast_mode
-from robocourse.source import code_version
+from robocourse.source import code_version_of
 from robokit.cache import CACHE_READ_ERRORS, cache_dir, cache_key, read_arrays, write_arrays, write_atomically
 from robokit.geometry import se2_between, se2_compose
 from robokit.localization.hierarchical import HierarchicalLocalizer
@@ -164,7 +164,7 @@ def office_setup(*, fast: bool | None = None, progress: Callable | None = None) 
     params = {"n_features": 300 if fast else 500, "alphas": list(TOUR_ALPHAS)}
     meta = {"world": world.name, "world_seed": world.info["seed"], "camera": describe_sensor(camera),
             "tour": cache_key(poses=tour.poses.round(9).tolist()), "rate": rate, "record_seed": 2, "params": params,
-            "code": code_version(__name__)}
+            "code": code_version_of(__name__)}
 
     def build():
         # the map is cached (below), so the recording is not stored at all: its images are used as the
@@ -334,7 +334,7 @@ def route_recognition(setup: OfficeSetup, n_nodes: int = 17, *, offset: float = 
     target = meta = None
     if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):   # a seed: the answer is deterministic
         meta = {"setup": setup.key, "n_nodes": n_nodes, "offset": offset, "same_place": same_place, "rng": int(rng),
-                "code": code_version(__name__)}
+                "code": code_version_of(__name__)}
         target = cache_dir("maps") / f"route-{cache_key(**meta)}.npz"
         data = read_arrays(target, _ROUTE_ARRAYS, meta)
         if data is not None:

@@ -21,7 +21,7 @@ from typing import Callable
 
 import numpy as np
 
-from robocourse.source import code_version
+from robocourse.source import code_version_of
 from robokit.cache import (cache_dir, cache_key, read_arrays, record_names, records_from_arrays,
                      records_to_arrays, write_arrays)
 from robokit.controllers.path_geometry import VisualPath, path_from_poses
@@ -227,7 +227,7 @@ def navigation_trials(setup: OfficeSetup, n_starts: int, *, first_node: int | No
     if cache and default_localizer:
         meta = {"setup": setup.key, "first": first, "count": count, "fix_period": fix_period, "alpha": alpha,
                 "offset": offset, "heading": heading, "max_time": max_time, "rng": seed, "n": n_starts,
-                "code": code_version(__name__)}
+                "code": code_version_of(__name__)}
         target = cache_dir("navigation") / f"office-{cache_key(**meta)}.npz"
         data = read_arrays(target, record_names(FollowResult, n_starts), meta)
         if data is not None:

@@ -47,7 +47,7 @@ def _iiwa_q(rng: np.random.Generator, n: int) -> np.ndarray:
 
 
 def solve_ik(T: Any, q_start: Any) -> np.ndarray:
-    """Joints of the KUKA LBR iiwa 14 that reach ``T`` inside the joint limits (the open exercise's reference).
+    """Joints of the KUKA LBR iiwa 14 that reach ``T`` inside the joint limits (the open exercise's answer).
 
     The arm-angle search of :func:`robokit.arm.ik_srs_readable` (Shimizu et al. 2008): over the
     eight branches and their exact feasible arm angles, the posture nearest ``q_start``. Any
@@ -87,7 +87,7 @@ def solve_ik(T: Any, q_start: Any) -> np.ndarray:
 
 
 def _reaches_target(expected: Any, got: Any) -> str | None:
-    """Accept any 7 joint angles inside the iiwa's limits whose flange pose is the reference's (the target)."""
+    """Accept any 7 joint angles inside the iiwa's limits whose flange pose is the answer's (the target)."""
     q = numeric_array(got)                  # the one rule for what counts as numbers
     if q is None or q.dtype.kind == "b":
         return f"expected 7 joint angles, got {summarize(got)}"

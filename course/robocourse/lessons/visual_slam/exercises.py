@@ -1,7 +1,7 @@
 """Exercises of assignment 01 (stereo visual SLAM with PLOT and SIFT features).
 
 From one formula of Lin et al.'s PLOT detector to one voting step of Se, Lowe & Little's Hough
-transform. Inputs are plain data generated from the seed; the references are robokit's library
+transform. Inputs are plain data generated from the seed; the answers are robokit's library
 functions (thin wrappers below only turn robokit objects into plain data and back).
 
 References
@@ -79,7 +79,7 @@ def hough_votes(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, bin_size
 def robust_pose(robot_points, world_points) -> np.ndarray:
     """The robot pose ``[p, q, theta]`` from tentative matches of which many may be wrong (the open exercise).
 
-    The reference answer: :func:`robokit.localization.ransac_pose` (two-point hypotheses, support
+    The expected answer: :func:`robokit.localization.ransac_pose` (two-point hypotheses, support
     within 10 cm, least-squares refit on the support; Lin et al. Sec. 5-6) with a fixed seed and
     no minimum support beyond two matches.
 
@@ -222,7 +222,7 @@ def _fuse_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
-def _hough_cases(rng: np.random.Generator) -> list[Case]:
+def hough_cases(rng: np.random.Generator) -> list[Case]:
     bounds = [0.0, 0.4, 0.0, 0.4]
     robot = rng.uniform([-1, 1], [1, 3], size=(3, 2))
     pose = np.array([0.2, 0.2, 0.3])
@@ -358,7 +358,7 @@ EXERCISES = [
         id="01.hough_votes", function="hough_votes",
         signature="hough_votes(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, bin_size, angle_bin) "
                   "-> numpy.ndarray (T, NX, NZ) of int",
-        points=3, cases=_hough_cases, answer=hough_votes, compare=close(rtol=0, atol=0),
+        points=3, cases=hough_cases, answer=hough_votes, compare=close(rtol=0, atol=0),
         description="For each heading bin centre, each match votes for every (X, Z) bin within +-2.8 sigma of the "
                     "position (X, Z) - R(theta) (X', Z') (Se et al. Sec. 5); see the notebook for the bin layout; "
                     "ValueError for empty bounds."),

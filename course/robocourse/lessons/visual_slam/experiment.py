@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robocourse import FAST
-from robocourse.source import code_version
+from robocourse.source import code_version_of
 from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
 from robokit.geometry import paper_world_to_robokit, se2_to_pqt, wrap_angle
 from robokit.progress import progress_bar
@@ -212,7 +212,7 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     -------
     LabExperiment
         Cached under ``robokit.cache.cache_dir("lab")`` keyed by every parameter and the code that makes
-        it (:func:`robocourse.source.code_version`): a second run loads the map and the test-pose
+        it (:func:`robocourse.source.code_version_of`): a second run loads the map and the test-pose
         results instead of rebuilding them; a corrupt or stale cache file is rebuilt.
 
     Raises
@@ -255,7 +255,7 @@ def lab_experiment(*, method: str = "sift", descriptor: str = "sift128", rate: f
     slam = VisualSLAM(calibrated_rig(render_rig), method=method, descriptor=descriptor, rng=seed)
     meta = {"method": method, "descriptor": descriptor, "rate": rate, "frames": frames, "fast": bool(FAST),
             "test_poses": np.round(poses, 12).tolist(), "noise": noise, "seed": seed,
-            "code": code_version(__name__)}
+            "code": code_version_of(__name__)}
     target = cache_dir("lab") / f"experiment-{cache_key(**meta)}.npz"
     data = read_arrays(target, (*slam.to_arrays(), *_ROW_ARRAYS, "truth", "mapping_seconds"), meta)
     if data is not None:
