@@ -13,10 +13,13 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["to_plain", "NotPlainData", "summarize", "numeric_array"]
+__all__ = ["to_plain", "NotPlainData", "summarize", "numeric_array", "count_values", "MAX_ANSWER_VALUES"]
 
 _MAX_DEPTH = 20
 _MAX_ITEMS = 1_000_000
+#: The most numbers (or other leaves) an answer may hold: 190 times the largest expected answer
+#: of any exercise (01.hough_votes, 5,184); a larger one is judged wrong before it is compared.
+MAX_ANSWER_VALUES = 1_000_000
 
 
 class NotPlainData(TypeError):
@@ -104,6 +107,11 @@ def numeric_array(value: Any) -> np.ndarray | None:
     """``value`` as an array if it is a numeric/boolean array or a (nested, rectangular) list of
     numbers or booleans, else ``None``: the one rule by which a list counts as an array.
 
+    The list's structure and the type of every item are checked before numpy sees it, so that a
+    list of a million numbers ending in a long string costs a walk over the list, never an array of
+    strings (numpy would widen every number to that string's length). A list of more than
+    :data:`MAX_ANSWER_VALUES` numbers is not an array either.
+
     Examples
     --------
     >>> numeric_array([[1, 2], [3, 4]]).shape, numeric_array(["a"]), numeric_array([1, [2]])
@@ -111,10 +119,49 @@ def numeric_array(value: Any) -> np.ndarray | None:
     """
     if isinstance(value, np.ndarray):
         return value if value.dtype.kind in "biuf" else None
-    if not isinstance(value, list):
+    if not isinstance(value, list) or _rectangular_numbers(value) is None:
         return None
-    try:
-        arr = np.asarray(value)
-    except (TypeError, ValueError):
+    arr = np.asarray(value)
+    return arr if arr.dtype.kind in "biuf" else None     # e.g. an int beyond 64 bits is not numeric
+
+
+def _rectangular_numbers(value: list) -> tuple[int, ...] | None:
+    """The shape of a nested list whose items are all ``int``, ``float`` or ``bool`` (exact types)
+    at one depth, with equal lengths at each depth and at most ``MAX_ANSWER_VALUES`` of them;
+    ``None`` for any other list. One pass, level by level, without recursion."""
+    shape: list[int] = []
+    level: list = [value]
+    while level and type(level[0]) is list:
+        n = len(level[0])
+        if any(type(x) is not list or len(x) != n for x in level):
+            return None
+        shape.append(n)
+        if len(level) * n > MAX_ANSWER_VALUES:
+            return None
+        level = [y for x in level for y in x]
+    if any(type(x) not in (int, float, bool) for x in level):
         return None
-    return arr if arr.dtype.kind in "biuf" else None
+    return tuple(shape)
+
+
+def count_values(value: Any, limit: int = MAX_ANSWER_VALUES) -> int:
+    """How many numbers, strings and other leaves ``value`` holds (arrays count their elements),
+    counting no further than ``limit + 1``: the size of an answer, known before it is compared.
+
+    Examples
+    --------
+    >>> count_values([1.0, [2, 3], {"a": np.zeros((2, 3))}]), count_values(list(range(50)), limit=10)
+    (9, 11)
+    """
+    total, stack = 0, [value]
+    while stack and total <= limit:
+        item = stack.pop()
+        if isinstance(item, np.ndarray):
+            total += item.size
+        elif isinstance(item, list):
+            stack.extend(item)
+        elif isinstance(item, dict):
+            stack.extend(item.values())
+        else:
+            total += 1
+    return total

@@ -11,7 +11,8 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import re
-from typing import Any, Callable, Sequence
+from types import MappingProxyType
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -19,8 +20,11 @@ from robocourse.exercises.compare import Comparison, close
 from robokit.validation import as_int, as_text
 from robocourse.exercises.plain import numeric_array, summarize, to_plain
 
-__all__ = ["Case", "Exercise", "EXERCISE_ID"]
+__all__ = ["Case", "Exercise", "EXERCISE_ID", "PUBLIC_SEED"]
 
+#: Seed of the public cases that ``check()`` runs in the student's notebook; grading uses the
+#: instructor's secret seed.
+PUBLIC_SEED = 2024
 #: An exercise or written-question id: the two-digit lesson number, a dot and a snake_case name.
 EXERCISE_ID = re.compile(r"^\d\d\.[a-z][a-z0-9_]*$")
 
@@ -100,11 +104,16 @@ class Exercise:
         ``compare(expected, got) -> None | message``; defaults to :func:`~robocourse.exercises.compare.close`.
     description : str
         One sentence for the instructor's overview.
+    shortcuts : dict of str to callable
+        Known ways to pass some cases without solving the exercise, by name (e.g. ``"the heaviest
+        particle, repeated"``): functions of a case's inputs. With the constants and the other
+        trivial answers of :mod:`~robocourse.exercises.trivial` they decide which passes count.
 
     Raises
     ------
     ValueError
-        For a malformed ``id``, a ``function`` that is not an identifier or non-positive ``points``.
+        For a malformed ``id``, a ``function`` that is not an identifier, non-positive ``points`` or
+        ``shortcuts`` that are not named functions.
 
     Examples
     --------
@@ -123,6 +132,7 @@ class Exercise:
     answer: Callable[..., Any]
     compare: Comparison = dataclasses.field(default_factory=close)
     description: str = ""
+    shortcuts: Mapping[str, Callable[..., Any]] = dataclasses.field(default_factory=dict, hash=False, compare=False)
 
     def __post_init__(self):
         if not isinstance(self.id, str) or not EXERCISE_ID.match(self.id):
@@ -131,6 +141,9 @@ class Exercise:
             raise ValueError(f"function: expected a Python identifier, got {self.function!r}")
         if not self.points > 0:
             raise ValueError(f"points: expected a positive number, got {self.points!r}")
+        if not all(isinstance(k, str) and callable(f) for k, f in dict(self.shortcuts).items()):
+            raise ValueError("shortcuts: expected a dict of names to functions")
+        object.__setattr__(self, "shortcuts", MappingProxyType(dict(self.shortcuts)))
 
     @property
     def lesson(self) -> str:

@@ -14,6 +14,7 @@ sandbox          the worker's limits, namespaces, uid and root filesystem
 filesystem_view  the worker's root filesystem as an allowlist (root only)
 job_cgroup       a control group that bounds a job's memory, processes and CPU (root only)
 grader           ``robocourse grade``: cases from the secret seed, expected answers, scores, flags
+budget           the grader's reading and judging of one submission, in a child under a memory and time budget
 reports          the gradebook, feedback files and Gradescope results
 safetext         student text escaped for feedback, CSV and Markdown
 gradescope       an autograder zip for Gradescope

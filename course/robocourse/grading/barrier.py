@@ -10,9 +10,11 @@ every expected answer.
 :func:`seal` runs in the worker before any student code. It gives the ``robocourse`` package the
 two names a notebook imports from it, ``check`` (silenced: it only prints that it is skipped) and
 ``assignment_data`` (the kit's data file), keeps an old notebook's ``from robokit.grading import
-check`` working, and puts an import finder first on ``sys.meta_path`` that refuses every other
-``robokit`` or ``robocourse`` name with :class:`RobokitWithheld`; each refusal is logged, so the
-grader flags the submission ``imported-robokit``.
+check`` working, takes the worker's own modules out of ``sys.modules`` (the worker keeps its
+references), and puts an import finder first on ``sys.meta_path`` that refuses every other
+``robokit`` or ``robocourse`` name with :class:`RobokitWithheld`, the kit's modules included: graded
+code may import exactly what the refusal message says. Each refusal is logged, so the grader flags
+the submission ``imported-robokit``.
 
 The barrier makes the rule visible; it is not what keeps the library out of reach. Graded code can
 remove a ``sys.meta_path`` entry. When grading as root, the worker's filesystem
@@ -98,9 +100,9 @@ class _Served(importlib.abc.Loader):
 
 
 class _Barrier(importlib.abc.MetaPathFinder):
-    """First on ``sys.meta_path``: lets the kit's modules through, serves the stand-ins itself (so a
-    submission that drops them from ``sys.modules`` gets them back, never the files), and refuses
-    every other name of ours."""
+    """First on ``sys.meta_path``: lets the names of ``allowed`` through (``robocourse``, the kit's
+    stand-in package), serves the stand-ins itself (so a submission that drops them from
+    ``sys.modules`` gets them back, never the files), and refuses every other name of ours."""
 
     def __init__(self, allowed: set[str], served: dict[str, types.ModuleType],
                  refuse: Callable[[str], BaseException]):
@@ -165,8 +167,15 @@ def seal(manifest: Manifest, log: Callable[[str], None]) -> None:
             raise ValueError(f"slug: expected this assignment's data ({manifest.data or 'none'}), got {slug!r}")
         return assignment_data(slug)
 
-    sys.modules["robocourse"].__dict__.update(check=quiet_check, assignment_data=data)   # the kit's stand-in
+    top = sys.modules["robocourse"]                       # the kit's stand-in
+    top.__dict__.update(check=quiet_check, assignment_data=data)
+    for name in sorted(kit - {"robocourse"}, reverse=True):
+        # the worker holds what it needs; graded code finds only what the refusal message names
+        sys.modules.pop(name, None)
+        parent, _, child = name.rpartition(".")
+        if parent == "robocourse":
+            top.__dict__.pop(child, None)
     refuse = _refusal(log)
     served = {"robokit": _stand_in("robokit", "robokit while grading: only the old name of check()", refuse)}
     served[OLD_CHECK] = _stand_in(OLD_CHECK, "check() while grading: skipped", refuse, check=quiet_check)
-    sys.meta_path.insert(0, _Barrier(kit, served, refuse))
+    sys.meta_path.insert(0, _Barrier({"robocourse"}, served, refuse))

@@ -8,13 +8,12 @@ from __future__ import annotations
 import types
 from typing import Any, Callable
 
+from robocourse.exercises.spec import PUBLIC_SEED
 from robocourse.lessons import get_exercise
 from robocourse.grading.judge import call_student, expected_output, judge
 
 __all__ = ["check", "library_use", "PUBLIC_SEED", "CheckFailed", "NotImplementedYet"]
 
-#: Seed of the public cases used by :func:`check`; official grading uses the instructor's seed.
-PUBLIC_SEED = 2024
 
 
 def library_use(fn: Callable[..., Any]) -> list[str]:

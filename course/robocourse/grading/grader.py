@@ -12,13 +12,16 @@ objects never reach the parent.
 
 Nothing the worker or the submission gives is trusted: a file that cannot be read is a rejection
 with its flag (:mod:`~robocourse.grading.submission`); worker output that is unusable costs only the
-part it concerns and flags ``unusable-results``; any other failure on one submission is that
+part it concerns and flags ``unusable-results``; reading and judging it run in a child process
+under a memory and time budget (:mod:`~robocourse.grading.budget`), whose breach costs that
+submission alone (``unusable-results`` too); any other failure on one submission is that
 submission's ``grader-error``. The batch always completes, and names every student once.
 """
 from __future__ import annotations
 
 import collections
 import dataclasses
+import functools
 import hashlib
 import json
 import shutil
@@ -30,12 +33,14 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from robocourse.lessons import UnknownAssignmentError, get_assignment
-from robocourse.exercises.spec import Case, Exercise
+from robocourse.exercises.spec import PUBLIC_SEED, Case, Exercise
+from robocourse.exercises.trivial import explained_by_one, trivial_passes
 from robocourse.grading.filesystem_view import View, installed_package_dirs, runtime_paths
 from robocourse.grading.job_cgroup import cgroup_note
 from robocourse.grading.judge import expected_output, judge
 from robocourse.grading.kit import WORKER, Kit, KitError, build_kit
 from robocourse.grading.barrier import RobokitWithheld
+from robocourse.grading.budget import BudgetExceeded, run_within
 from robocourse.grading.protocol import CallResult, CellRecord, DoneReport, JobDir, JobSpec
 from robocourse.grading.safetext import clean
 from robocourse.grading.sandbox import Limits, WorkerExit, conceal_secret, is_root, job_space, run_sandboxed
@@ -43,8 +48,8 @@ from robocourse.grading.submission import Submission, SubmissionRejected, feedba
 from robocourse.grading.transport import TransportError
 
 __all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "cases_seed", "job_spec",
-           "worker_view", "grade_submission", "grade_batch", "GradingError", "isolation_note", "unique_students",
-           "needs_review"]
+           "score_exercise", "worker_view", "grade_submission", "grade_batch", "GradingError", "isolation_note",
+           "unique_students", "needs_review"]
 
 
 class GradingError(ValueError):
@@ -106,12 +111,14 @@ class SubmissionResult:
 
 @dataclasses.dataclass
 class PreparedCases:
-    """The trusted side of a grading run: exercises, their cases for the secret seed, and the
-    expected answers. It stays in the grader's process; workers receive only the case inputs."""
+    """The trusted side of a grading run: exercises, their cases for the secret seed, the expected
+    answers and, per case, the trivial answers that pass it (:mod:`~robocourse.exercises.trivial`).
+    It stays in the grader's process; workers receive only the case inputs."""
 
     exercises: tuple[Exercise, ...]
     cases: list[list[Case]]
     expected: list[list[Any]]
+    trivial: list[list[frozenset[str]]]
     assignment: str = ""
     seed: str = dataclasses.field(default="", repr=False)
 
@@ -135,14 +142,22 @@ def cases_seed(seed: str, submission: Submission) -> str:
     return f"{seed}\x00{hashlib.sha256(code).hexdigest()}"
 
 
+@functools.lru_cache(maxsize=None)
+def _public_answers(exercise: Exercise) -> tuple[Any, ...]:
+    """The answers of an exercise's valid public cases (``check()`` shows them to the student)."""
+    return tuple(expected_output(exercise, c) for c in exercise.make_cases(PUBLIC_SEED) if not c.raises)
+
+
 def prepare_cases(assignment: str, seed: str) -> PreparedCases:
-    """Generate every exercise's cases from ``seed`` and compute the expected answers (trusted)."""
+    """Generate every exercise's cases from ``seed``, compute the expected answers and which
+    trivial answers pass each case (trusted)."""
     if not isinstance(seed, str) or not seed:
         raise GradingError("seed: a non-empty secret seed is required (--seed or ROBOKIT_GRADING_SEED)")
     exercises = get_assignment(assignment).exercises
     cases = [ex.make_cases(seed) for ex in exercises]
     expected = [[expected_output(ex, c) for c in cs] for ex, cs in zip(exercises, cases)]
-    return PreparedCases(exercises, cases, expected, assignment, seed)
+    trivial = [trivial_passes(ex, cs, exp, _public_answers(ex)) for ex, cs, exp in zip(exercises, cases, expected)]
+    return PreparedCases(exercises, cases, expected, trivial, assignment, seed)
 
 
 def _zero(prepared: PreparedCases, message: str) -> list[ExerciseScore]:
@@ -176,6 +191,9 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
 
     A file that cannot be graded scores zero with the rejection's flag and reason. ``kit`` is the
     worker's code (:func:`~robocourse.grading.kit.build_kit`; written into the job if not given).
+    What the worker wrote is read and judged within ``limits``' judging budget
+    (:func:`~robocourse.grading.budget.run_within`); a breach scores this file zero, flagged
+    ``unusable-results``.
 
     Notes
     -----
@@ -196,35 +214,48 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
         with job_space(job, limits):
             exit_ = run_sandboxed(["-m", WORKER, str(job.root)], job.root, limits, view=worker_view(kit, hide),
                                   env_extra={"PYTHONPATH": str(kit.root), "PYTHONSAFEPATH": "1"})
-            return _score(job, student, path, prepared, exit_, start)
+            try:
+                return run_within(lambda: _score(job, student, path, prepared, exit_, start),
+                                  memory_bytes=limits.judge_memory_bytes, seconds=limits.judge_seconds)
+            except BudgetExceeded as exc:
+                flags = ([] if exit_.isolated else ["sandbox=limited"]) + ["unusable-results"]
+                return SubmissionResult(student, path, _zero(prepared, f"not graded: {exc}"), flags,
+                                        seconds=time.perf_counter() - start, problems=[str(exc)])
     finally:
         shutil.rmtree(job.root, ignore_errors=True)
 
 
-def _score_exercise(ex: Exercise, cases: list[Case], expected: list[Any],
+def score_exercise(ex: Exercise, cases: list[Case], expected: list[Any], trivial: list[frozenset[str]],
                     results: Sequence[CallResult]) -> tuple[ExerciseScore, bool]:
-    """Judge one exercise's results; return its score and whether it tried to import robokit.
+    """Judge one exercise's results (one per case); return its score and whether it tried to
+    import robokit.
 
-    A bad-input case (one that expects an exception) counts only if the function returned a right
-    value on at least one valid input: a function that always raises must not earn the
-    validation marks.
+    The cases count only once the function has passed valid cases that no single trivial answer
+    passes all of (:func:`~robocourse.exercises.trivial.explained_by_one`): a constant, an argument
+    returned unchanged or a known shortcut earns nothing, and a function that always raises earns
+    no bad-input marks.
     """
     messages, cheated = [], False
-    errors_passed, values_passed = 0, 0
+    passed_valid, errors_passed = [], 0
     for i, (case, exp, res) in enumerate(zip(cases, expected, results), 1):
         cheated |= res.error is not None and res.error.type == RobokitWithheld.__name__
         outcome = judge(ex, case, exp, res)
         if case.raises:
             errors_passed += outcome.passed
-        else:
-            values_passed += outcome.passed
+        elif outcome.passed:
+            passed_valid.append(i - 1)
         if not outcome.passed and len(messages) < 10:     # the first five failures, each with its input
             messages.append(f"case {i}" + (f" ({case.label})" if case.label else "") + f": {outcome.message}")
             messages.append(f"  input: {case.call_text(ex.function)}")
-    passed = values_passed + errors_passed
-    if errors_passed and not values_passed and any(not c.raises for c in cases):
+    passed = len(passed_valid) + errors_passed
+    trivially = explained_by_one(passed_valid, trivial)
+    if passed and trivially == "nothing":
         passed = 0
         messages.insert(0, "bad-input cases count once the function returns a right result for a valid input")
+    elif passed and trivially:
+        passed = 0
+        messages.insert(0, f"every valid case passed is also passed by a trivial answer ({trivially}): the cases "
+                           "count once the function gets right a case that no trivial answer does")
     if cheated:
         passed = 0
         messages.insert(0, "your code tried to import robokit, the course's library, which graded code may not use")
@@ -254,7 +285,8 @@ def _score_exercises(reading: _Reading, prepared: PreparedCases, ended: str) -> 
     """Every exercise's score from its report; return the scores, the seconds of the calls, and
     whether a call tried to import robokit."""
     scores, compute, imported_robokit = [], 0.0, False
-    for k, (ex, cases, expected) in enumerate(zip(prepared.exercises, prepared.cases, prepared.expected)):
+    for k, (ex, cases, expected, trivial) in enumerate(zip(prepared.exercises, prepared.cases, prepared.expected,
+                                                           prepared.trivial)):
         report = reading.get(f"the results of {ex.id}", lambda: reading.job.read_exercise(k, len(cases)))
         if report is _UNUSABLE:
             scores.append(ExerciseScore.zero(ex, len(cases), f"not graded: its results were unusable "
@@ -266,7 +298,7 @@ def _score_exercises(reading: _Reading, prepared: PreparedCases, ended: str) -> 
                                                              f"{ex.function!r} in the notebook"))
         else:
             compute += report.seconds
-            score, cheated = _score_exercise(ex, cases, expected, report.results)
+            score, cheated = score_exercise(ex, cases, expected, trivial, report.results)
             scores.append(score)
             imported_robokit |= cheated
     return scores, compute, imported_robokit

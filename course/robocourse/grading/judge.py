@@ -10,7 +10,7 @@ import dataclasses
 import traceback
 from typing import Any, Callable
 
-from robocourse.exercises.plain import summarize, to_plain
+from robocourse.exercises.plain import MAX_ANSWER_VALUES, count_values, summarize, to_plain
 from robocourse.exercises.spec import Case, Exercise
 from robocourse.grading.protocol import CallResult
 
@@ -37,9 +37,10 @@ def judge(exercise: Exercise, case: Case, expected: Any, result: CallResult) -> 
     """Judge what the student's function gave on ``case`` (``result``) against ``expected``.
 
     A bad-input case passes when the function raised ``case.raises`` (or a subclass); any other
-    case when ``exercise.compare`` accepts the value. A value that cannot even be compared (e.g. an
-    integer too large for a float) fails its case; it never raises. Grading design (DESIGN.md,
-    "Grading").
+    case when ``exercise.compare`` accepts the value. A value of more than
+    :data:`~robocourse.exercises.plain.MAX_ANSWER_VALUES` numbers fails without being compared; a
+    value that cannot even be compared (e.g. an integer too large for a float) fails its case; it
+    never raises. Grading design (DESIGN.md, "Grading").
     """
     try:
         return _judge(exercise, case, expected, result)
@@ -61,6 +62,8 @@ def _judge(exercise: Exercise, case: Case, expected: Any, result: CallResult) ->
         return Outcome(case, False, f"{want}{label}, but it raised {err.type}: {err.message}")
     if case.raises:
         return Outcome(case, False, f"expected {case.raises} for bad input{label}, got {summarize(result.value)}")
+    if count_values(result.value) > MAX_ANSWER_VALUES:     # judged by its size, before any comparison
+        return Outcome(case, False, f"your result holds more than {MAX_ANSWER_VALUES:,} values{label}")
     msg = exercise.compare(expected, result.value)
     return Outcome(case, msg is None, msg or f"ok{label}")
 

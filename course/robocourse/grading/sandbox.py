@@ -72,6 +72,9 @@ class Limits:
         :func:`~.filesystem_view.bounded_space`).
     cell_seconds, call_seconds : float
         Per notebook cell and per exercise call, enforced inside the worker by an interval timer.
+    judge_memory_bytes, judge_seconds : int, float
+        The budget of the grader's own reading and judging of the worker's results, in a child
+        process (:func:`~.budget.run_within`): memory beyond what the grader holds, and time.
     """
 
     wall_seconds: float = 300.0
@@ -82,6 +85,8 @@ class Limits:
     disk_bytes: int = 256 * 1024**2
     cell_seconds: float = 60.0
     call_seconds: float = 20.0
+    judge_memory_bytes: int = 512 * 1024**2
+    judge_seconds: float = 60.0
 
 
 @dataclasses.dataclass

@@ -277,6 +277,11 @@ def _bow_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
+def _heaviest_repeated(weights: list, r: float) -> list[int]:
+    """A shortcut that passes the case where one particle holds all the weight: that particle, M times."""
+    return [int(np.argmax(weights))] * len(weights)
+
+
 def _resample_cases(rng: np.random.Generator) -> list[Case]:
     w = rng.dirichlet(np.ones(8))
     return [
@@ -371,7 +376,8 @@ EXERCISES = [
         signature="resample_indices(weights: (M,), r: float in [0, 1/M)) -> list of int",
         points=1, cases=_resample_cases, answer=resample_indices, compare=exact(),
         description="Thrun et al. Table 4.4 with its random number given (weights normalised first); "
-                    "ValueError for r outside [0, 1/M) or a negative weight."),
+                    "ValueError for r outside [0, 1/M) or a negative weight.",
+        shortcuts={"the heaviest particle, repeated": _heaviest_repeated}),
     Exercise(
         id="03.likelihood_field_weight", function="likelihood_field_weight",
         signature="likelihood_field_weight(pose, ranges, angles, distance: (H, W), resolution, origin, "

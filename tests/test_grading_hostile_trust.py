@@ -1,0 +1,281 @@
+"""The grader against attacks on what it trusts (issue "Grader, round three").
+
+Each attack is a real solution with one change; the honest solution is graded beside it in the same
+batch and must keep full marks.
+"""
+import csv
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from robocourse.exercises.spec import PUBLIC_SEED
+from robocourse.exercises.trivial import CONSTANTS, explained_by_one
+from robocourse.grading import job_cgroup
+from robocourse.grading.data import assignment_data, data_file
+from robocourse.grading.grader import grade_batch, prepare_cases, score_exercise
+from robocourse.grading.judge import expected_output
+from robocourse.grading.protocol import CallResult, ErrorRecord
+from robocourse.grading.sandbox import Limits, is_root
+from robocourse.lessons import assignments, get_assignment
+from tests.conftest import ROOT, public_tmp, wrap_angle_unless
+
+SOLUTION_00 = ROOT / "solutions" / "00_getting_started.ipynb"
+
+# Returns, on its first valid input only, a rectangular list of three million zeros whose last item
+# is a 700-character string: 9 MB of JSON, inside every bound of the protocol. Numpy would make it
+# an array of strings of 3e6 x 700 x 4 bytes = 8.4 GB.
+MEMORY_BOMB = """
+_honest_wrap_angle, _sent = wrap_angle, []
+def wrap_angle(angle):
+    value = _honest_wrap_angle(angle)
+    if not _sent:
+        _sent.append(True)
+        rows = [[0] * 3000 for _ in range(1000)]
+        rows[-1][-1] = "x" * 700
+        return rows
+    return value
+"""
+
+
+def _notebook_with(extra_cell: str | None = None) -> dict:
+    nb = json.loads(SOLUTION_00.read_text())
+    if extra_cell is not None:
+        nb["cells"].append({"cell_type": "code", "metadata": {}, "source": extra_cell, "outputs": [],
+                            "execution_count": None})
+    return nb
+
+
+def _grade_capped(folder: Path, names: list[str], memory_bytes: int) -> tuple[subprocess.CompletedProcess, dict]:
+    """Run ``robocourse grade`` on ``folder/<name>.ipynb`` with the grader and its workers all in
+    one control group of ``memory_bytes``; return the process and the gradebook's rows by student."""
+    group = job_cgroup.create(f"robokit-test-cap-{os.getpid()}", memory_bytes, 512)
+    if group is None:
+        pytest.skip("this host does not let the tests make a control group")
+    out = folder / "grades.csv"
+    try:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "robocourse.cli", "grade", "--assignment", "00_getting_started", "--seed",
+             "cap-seed", "--out", str(out), "--jobs", "2", "--timeout", "60", "--root", str(ROOT),
+             *[str(folder / f"{n}.ipynb") for n in names]],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=folder)
+        group.join(proc.pid)       # before it has read a single notebook
+        stdout, _ = proc.communicate(timeout=600)
+    finally:
+        group.remove(wait=5.0)
+    done = subprocess.CompletedProcess(proc.args, proc.returncode, stdout, "")
+    rows = {r["student"]: r for r in csv.DictReader(out.open())} if out.exists() else {}
+    return done, rows
+
+
+@pytest.mark.skipif(not is_root(), reason="a memory cap on the whole batch needs a control group (root)")
+def test_a_memory_bomb_answer_costs_only_its_own_case_under_a_1_gib_cap():
+    with public_tmp() as folder:
+        (folder / "honest.ipynb").write_text(json.dumps(_notebook_with()))
+        (folder / "bomb.ipynb").write_text(json.dumps(_notebook_with(MEMORY_BOMB)))
+        done, rows = _grade_capped(folder, ["bomb", "honest"], 1 << 30)
+    assert done.returncode == 0, done.stdout[-3000:]
+    assert set(rows) == {"bomb", "honest"}, done.stdout[-3000:]
+    assert float(rows["honest"]["total"]) == float(rows["honest"]["max"]) == 3.0, (rows["honest"], done.stdout)
+    assert rows["honest"]["flags"] == ""
+    # the bomb's own case is wrong; its other cases and exercise score as the honest ones
+    assert 2.0 < float(rows["bomb"]["total"]) < 3.0, rows["bomb"]
+    assert "grader-error" not in rows["bomb"]["flags"], rows["bomb"]
+
+
+
+def test_a_judging_breach_costs_only_that_submission(monkeypatch):
+    # a comparison that would need unbounded memory or time (none of ours should): the judging of
+    # that submission is stopped at its budget, and only that submission pays
+    import robocourse.grading.grader as grader
+
+    real = grader.judge
+
+    def judge(exercise, case, expected, result):
+        if type(result.value) is float and result.value == 4242.0:
+            return bytearray(8 << 30)          # past the memory budget: a MemoryError in the child
+        if type(result.value) is float and result.value == 4343.0:
+            time.sleep(60)                     # past the time budget: the child is killed
+        return real(exercise, case, expected, result)
+
+    monkeypatch.setattr(grader, "judge", judge)
+    with public_tmp() as folder:
+        for name, extra in [("honest", None), ("memory", "def wrap_angle(angle):\n    return 4242.0\n"),
+                            ("time", "def wrap_angle(angle):\n    return 4343.0\n")]:
+            (folder / f"{name}.ipynb").write_text(json.dumps(_notebook_with(extra)))
+        limits = Limits(wall_seconds=60, cpu_seconds=60, judge_memory_bytes=256 << 20, judge_seconds=5)
+        results = {r.student: r for r in grade_batch(sorted(folder.glob("*.ipynb")), "00_getting_started", "s",
+                                                     jobs=2, limits=limits, log=lambda *_: None)}
+    assert results["honest"].total == 3.0 and results["honest"].flags == []
+    for name, what in [("memory", "memory budget (256 MiB)"), ("time", "5 s budget")]:
+        r = results[name]
+        assert r.total == 0 and r.graded and "unusable-results" in r.flags, (name, r.flags, r.problems)
+        assert any(what in p for p in r.problems), r.problems
+
+
+# -- constants earn nothing --------------------------------------------------------------------------
+
+RAISED = CallResult(error=ErrorRecord("ValueError", ("ValueError", "Exception", "BaseException"), "bad input"))
+
+
+def _public(ex):
+    return [c for c in ex.make_cases(PUBLIC_SEED)]
+
+
+def _data_values(slug):
+    """Every value inside the assignment's data (what the kit hands a notebook), or nothing."""
+    if not data_file(slug).is_file():
+        return []
+    out, stack = [], [assignment_data(slug)]
+    while stack:
+        v = stack.pop()
+        out.append(v)
+        stack.extend(v.values() if isinstance(v, dict) else v if isinstance(v, list) else ())
+    return out
+
+
+def _attackers(ex, slug):
+    """Answers that solve nothing: every constant, every public answer (check() shows them), every
+    value of the assignment's data, each argument unchanged, and the exercise's known shortcuts;
+    each as ``(name, case -> value)``."""
+    public = [expected_output(ex, c) for c in _public(ex) if not c.raises]
+    out = [(f"constant {v!r:.40}", lambda case, v=v: v) for v in (*CONSTANTS, *public, *_data_values(slug))]
+    out += [(f"argument {k + 1}", lambda case, k=k: case.args[k] if len(case.args) > k else None) for k in range(8)]
+    out += [(name, lambda case, f=f: f(*case.args, **case.kwargs)) for name, f in ex.shortcuts.items()]
+    return out
+
+
+@pytest.fixture(scope="module")
+def hidden_cases():
+    """Every assignment's prepared cases for three hidden seeds and the public one."""
+    return {(slug, seed): prepare_cases(slug, seed) for slug in assignments() for seed in ("h1", "h2", str(PUBLIC_SEED))}
+
+
+def test_constants_that_raise_on_bad_input_score_nothing(hidden_cases):
+    # the strongest trivial submission: the answer is a constant (or an argument, or a shortcut)
+    # and the function raises exactly on the bad inputs
+    earned = []
+    for (slug, seed), prepared in hidden_cases.items():
+        for ex, cases, expected, trivial in zip(prepared.exercises, prepared.cases, prepared.expected, prepared.trivial):
+            for name, answer in _attackers(ex, slug):
+                results = []
+                for case in cases:
+                    try:
+                        results.append(RAISED if case.raises else CallResult.returned(answer(case)))
+                    except Exception as exc:
+                        results.append(CallResult.raised(exc))
+                score, _ = score_exercise(ex, cases, expected, trivial, results)
+                if score.points:
+                    earned.append((ex.id, seed, name, score.points))
+    assert not earned
+
+
+def test_an_honest_function_unlocks_every_exercise(hidden_cases):
+    # the other side of the rule: for every seed, the valid cases of every exercise are not all
+    # passed by one trivial answer, so a right function earns all its cases
+    locked = [(ex.id, seed, explained_by_one([i for i, c in enumerate(cases) if not c.raises], trivial))
+              for (slug, seed), p in hidden_cases.items() for ex, cases, trivial in zip(p.exercises, p.cases, p.trivial)]
+    assert [x for x in locked if x[2] is not None] == []
+
+
+def _json_literal(value) -> str:
+    return repr(json.dumps(value, default=lambda o: o.tolist()))
+
+
+def _constants_notebook(slug: str) -> dict:
+    """Every function of ``slug`` answers the constant (or public answer) that passes the most
+    public cases, and raises ValueError on exactly the public bad inputs it has seen."""
+    cells = ["import json\nimport numpy as np\n"
+             "def _same(a, b):\n    return json.dumps(a, default=lambda o: o.tolist()) == json.dumps(b, default=lambda o: o.tolist())\n"]
+    for ex in get_assignment(slug).exercises:
+        cases = _public(ex)
+        answers = [(c, expected_output(ex, c)) for c in cases if not c.raises]
+        best = max((*CONSTANTS, *(a for _, a in answers)),
+                   key=lambda v: sum(ex.compare(a, v) is None for _, a in answers))
+        bad = [[list(c.args), c.kwargs] for c in cases if c.raises]
+        cells.append(f"_bad_{ex.function} = json.loads({_json_literal(bad)})\n"
+                     f"def {ex.function}(*args, **kwargs):\n"
+                     f"    if any(_same([list(args), kwargs], b) for b in _bad_{ex.function}):\n"
+                     f"        raise ValueError('bad input')\n"
+                     f"    return json.loads({_json_literal(best)})\n")
+    return {"cells": [{"cell_type": "code", "metadata": {}, "source": c, "outputs": [], "execution_count": None}
+                      for c in cells], "metadata": {}, "nbformat": 4, "nbformat_minor": 5}
+
+
+@pytest.mark.parametrize("slug", sorted(assignments()))
+def test_a_notebook_of_constants_and_raises_scores_zero(slug):
+    with public_tmp() as folder:
+        path = folder / f"{slug}.ipynb"
+        path.write_text(json.dumps(_constants_notebook(slug)))
+        [result] = grade_batch([path], slug, "constants-seed", limits=Limits(wall_seconds=120, cpu_seconds=120),
+                               log=lambda *_: None)
+    assert result.graded and "unusable-results" not in result.flags, (result.flags, result.worker_log)
+    assert result.total == 0, [(s.id, s.points, s.messages[:1]) for s in result.scores if s.points]
+
+
+# -- the kit hands out no oracle ----------------------------------------------------------------------
+
+def _reference_notebook(slug: str) -> dict:
+    """Every function answers by calling the exercise's reference (robokit or the lesson's module),
+    or, failing that, by reading the course's modules the worker itself runs on."""
+    cells = ["import importlib\n"]
+    for ex in get_assignment(slug).exercises:
+        module, name = ex.answer.__module__, ex.answer.__name__
+        cells.append(f"def {ex.function}(*args, **kwargs):\n"
+                     f"    for where in ({module!r}, 'robocourse.grading.protocol', 'robocourse.exercises.plain'):\n"
+                     f"        try:\n"
+                     f"            found = getattr(importlib.import_module(where), {name!r}, None)\n"
+                     f"        except ImportError:\n"
+                     f"            continue\n"
+                     f"        if found is not None:\n"
+                     f"            return found(*args, **kwargs)\n"
+                     f"    raise ValueError('nothing to call')\n")
+    return {"cells": [{"cell_type": "code", "metadata": {}, "source": c, "outputs": [], "execution_count": None}
+                      for c in cells], "metadata": {}, "nbformat": 4, "nbformat_minor": 5}
+
+
+@pytest.mark.parametrize("slug", sorted(assignments()))
+def test_no_exercise_can_be_answered_with_what_the_worker_holds(slug):
+    with public_tmp() as folder:
+        path = folder / f"{slug}.ipynb"
+        path.write_text(json.dumps(_reference_notebook(slug)))
+        [result] = grade_batch([path], slug, "oracle-seed", limits=Limits(wall_seconds=120, cpu_seconds=120),
+                               log=lambda *_: None)
+    assert result.graded, result.reason
+    assert {s.id: s.points for s in result.scores} == {ex.id: 0.0 for ex in get_assignment(slug).exercises}
+    assert "imported-robokit" in result.flags
+
+
+KIT_PROBE = """
+import importlib, sys
+def _kit_visible():
+    import robocourse
+    if any(m in sys.modules for m in ("robocourse.grading.protocol", "robocourse.grading.worker",
+                                      "robocourse.exercises.plain", "robocourse.grading.data", "robocourse.grading")):
+        return True
+    if hasattr(robocourse, "grading") or hasattr(robocourse, "exercises"):
+        return True
+    try:
+        importlib.import_module("robocourse.grading.transport")
+        return True
+    except ImportError as exc:
+        return "may import only check and assignment_data from robocourse" not in str(exc)
+"""
+
+
+def test_the_barrier_admits_only_what_its_message_names():
+    # graded code finds no kit module in sys.modules or on the package, and importing one is
+    # refused (and logged) with the message that names check and assignment_data as all it may import
+    with public_tmp() as folder:
+        path = folder / "probe.ipynb"
+        path.write_text(json.dumps(_notebook_with(KIT_PROBE + wrap_angle_unless("_kit_visible()"))))
+        [result] = grade_batch([path], "00_getting_started", "probe-seed", limits=Limits(wall_seconds=60, cpu_seconds=60),
+                               log=lambda *_: None)
+    assert {s.id: s.points for s in result.scores} == {"00.wrap_angle": 1.0, "00.se2_compose": 2.0}, \
+        [s.messages[:2] for s in result.scores]
+    assert "imported-robokit" in result.flags
+
