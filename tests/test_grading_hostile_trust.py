@@ -279,3 +279,89 @@ def test_the_barrier_admits_only_what_its_message_names():
         [s.messages[:2] for s in result.scores]
     assert "imported-robokit" in result.flags
 
+
+# -- the worker offers no new namespaces and no privilege gain; nothing of the job outlives it --------
+
+NAMESPACE_PROBE = """
+import ctypes, os
+def _escape_possible():
+    status = open("/proc/self/status").read()
+    if "NoNewPrivs:\\t1" not in status or "Seccomp:\\t2" not in status:
+        return True
+    libc = ctypes.CDLL(None, use_errno=True)
+    pid = os.fork()
+    if pid == 0:      # in a child, so that a success changes nothing of the worker
+        ok = libc.unshare(0x10000000 | 0x00020000) == 0                       # a user + mount namespace
+        ok = ok or libc.unshare(0x20000000) == 0                              # a pid namespace
+        ok = ok or libc.mount(b"none", b"/tmp", b"tmpfs", 0, None) == 0
+        ok = ok or libc.syscall(56, 0x10000000 | 17, 0, 0, 0, 0) > 0          # clone(CLONE_NEWUSER)
+        os._exit(1 if ok else 0)
+    return os.waitpid(pid, 0)[1] != 0
+"""
+
+
+def test_the_worker_can_make_no_namespace_and_gain_no_privilege():
+    with public_tmp() as folder:
+        path = folder / "namespaces.ipynb"
+        path.write_text(json.dumps(_notebook_with(NAMESPACE_PROBE + wrap_angle_unless("_escape_possible()"))))
+        [result] = grade_batch([path], "00_getting_started", "ns-seed", limits=Limits(wall_seconds=60, cpu_seconds=60),
+                               log=lambda *_: None)
+    assert {s.id: s.points for s in result.scores} == {"00.wrap_angle": 1.0, "00.se2_compose": 2.0}, \
+        [s.messages[:2] for s in result.scores]
+
+
+HOPPER = """
+import os, sys
+_HOP = "import os\\nwhile True:\\n    try:\\n        if os.fork():\\n            os._exit(0)\\n    except OSError:\\n        pass\\n"
+if os.fork() == 0:            # a small process that forks and exits as fast as it can, in its own session
+    os.setsid()
+    os.execv(sys.executable, [sys.executable, "-S", "-c", _HOP])
+"""
+
+# Runs a command as a child subreaper that reaps every orphan at once: the init of a host where a
+# fork-and-exit hopper changes its pid faster than /proc can be read.
+REAPING_INIT = """
+import ctypes, os, subprocess, sys
+ctypes.CDLL(None).prctl(36, 1, 0, 0, 0)         # PR_SET_CHILD_SUBREAPER
+child = subprocess.Popen(sys.argv[1:])
+while True:
+    pid, status = os.waitpid(-1, 0)
+    if pid == child.pid:
+        sys.exit(os.waitstatus_to_exitcode(status))
+"""
+
+
+def _job_uid_processes() -> list[int]:
+    from robocourse.grading.sandbox import JOB_UIDS
+
+    found = []
+    for entry in os.listdir("/proc"):
+        try:
+            if entry.isdigit() and os.stat(f"/proc/{entry}").st_uid in JOB_UIDS:
+                found.append(int(entry))
+        except OSError:
+            continue
+    return found
+
+
+@pytest.mark.skipif(not is_root(), reason="job uids and control groups need root")
+def test_a_fork_and_exit_hopper_does_not_outlive_its_job():
+    before = set(_job_uid_processes())
+    with public_tmp() as folder:
+        (folder / "hopper.ipynb").write_text(json.dumps(_notebook_with(HOPPER)))
+        (folder / "init.py").write_text(REAPING_INIT)
+        done = subprocess.run([sys.executable, str(folder / "init.py"), sys.executable, "-m", "robocourse.cli", "grade",
+                               "--assignment", "00_getting_started", "--seed", "hop", "--out", str(folder / "g.csv"),
+                               "--timeout", "60", "--root", str(ROOT), str(folder / "hopper.ipynb")],
+                              capture_output=True, text=True, timeout=300, cwd=folder)
+        rows = list(csv.DictReader((folder / "g.csv").open())) if (folder / "g.csv").exists() else []
+    time.sleep(1.0)
+    left = set(_job_uid_processes()) - before
+    for _ in range(200):                      # clean up after a failure, as well as one can
+        for pid in _job_uid_processes():
+            try:
+                os.kill(pid, 9)
+            except OSError:
+                pass
+    assert not left, f"processes of the job outlived it: {sorted(left)[:5]}"
+    assert done.returncode == 0 and rows and rows[0]["total"] == "3", done.stdout[-2000:] + done.stderr[-2000:]

@@ -11,8 +11,9 @@ kit              the code the worker runs with: its own modules and the data, no
 barrier          the worker's import barrier: check and assignment_data offered, the rest refused
 worker           the process that runs a submission's cells and calls its functions
 sandbox          the worker's limits, namespaces, uid and root filesystem
+syscall_filter   no_new_privs and a seccomp filter: no namespaces, mounts or privilege gain
 filesystem_view  the worker's root filesystem as an allowlist (root only)
-job_cgroup       a control group that bounds a job's memory, processes and CPU (root only)
+job_cgroup       a control group that bounds a job's memory, processes and CPU, and ends it (root only)
 grader           ``robocourse grade``: cases from the secret seed, expected answers, scores, flags
 budget           the grader's reading and judging of one submission, in a child under a memory and time budget
 reports          the gradebook, feedback files and Gradescope results

@@ -5,7 +5,8 @@ could hold 60 times the memory limit, and children that each start a session (``
 get their own share of the CPU, slowing the other jobs graded at the same time. The launcher
 therefore joins a control group made for the job before it drops privileges, so that every
 process of the job together gets at most ``memory_bytes`` of resident memory (the tmpfs pages it
-writes included), at most ``max_processes`` processes, and one job's share of the CPU.
+writes included), at most ``max_processes`` processes, and one job's share of the CPU; and when
+the worker is done, :meth:`JobCgroup.kill` ends whatever the job left running, all at once.
 
 Both cgroup versions are supported: v1 (one hierarchy per controller, as in many containers)
 and v2 (the unified hierarchy). The group is made below the grader's own group, so a
@@ -17,13 +18,14 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import signal
 import time
 from pathlib import Path
 
 __all__ = ["JobCgroup", "create", "cgroup_note"]
 
-#: The controllers a job's group uses.
-CONTROLLERS = ("memory", "pids", "cpu")
+#: The controllers a job's group uses (v1: ``freezer`` is how the job is ended at once).
+CONTROLLERS = ("memory", "pids", "cpu", "freezer")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -36,6 +38,65 @@ class JobCgroup:
         """Move process ``pid`` (0: this one) into the group; its future children follow."""
         for d in self.dirs:
             Path(d, "cgroup.procs").write_text(str(pid or os.getpid()))
+
+    def processes(self) -> set[int]:
+        """The processes in the group now (every hierarchy's ``cgroup.procs``)."""
+        found: set[int] = set()
+        for d in self.dirs:
+            try:
+                found |= {int(x) for x in Path(d, "cgroup.procs").read_text().split()}
+            except (OSError, ValueError):
+                pass
+        return found
+
+    def kill(self, wait: float = 2.0) -> bool:
+        """End every process in the group at once; return whether the group is empty within ``wait`` s.
+
+        v2: ``cgroup.kill`` (Linux 5.14) kills the whole group in the kernel. Otherwise the group is
+        frozen first (v2 ``cgroup.freeze``, v1 ``freezer.state``), so that no process can fork
+        while its siblings are listed and sent ``SIGKILL``, then thawed, and the frozen processes
+        die. No race with a process that forks and exits faster than ``/proc`` can be read.
+        """
+        for d in self.dirs:
+            if Path(d, "cgroup.kill").exists():
+                Path(d, "cgroup.kill").write_text("1")
+                return self._empty(wait)
+        freeze = next(((Path(d, "cgroup.freeze"), "1", "0") for d in self.dirs if Path(d, "cgroup.freeze").exists()),
+                      None) or next(((Path(d, "freezer.state"), "FROZEN", "THAWED") for d in self.dirs
+                                     if Path(d, "freezer.state").exists()), None)
+        if freeze is None:                  # no freezer: signal what is listed (the uid sweep follows)
+            self._signal_all()
+            return self._empty(wait)
+        path, frozen, thawed = freeze
+        path.write_text(frozen)
+        deadline = time.monotonic() + wait
+        while not self._frozen(path) and time.monotonic() < deadline:
+            time.sleep(0.005)
+        self._signal_all()
+        path.write_text(thawed)
+        return self._empty(wait)
+
+    @staticmethod
+    def _frozen(path: Path) -> bool:
+        if path.name == "freezer.state":
+            return path.read_text().strip() == "FROZEN"
+        events = Path(path.parent, "cgroup.events").read_text().split()   # v2: "frozen 1"
+        return "frozen" in events and events[events.index("frozen") + 1] == "1"
+
+    def _signal_all(self) -> None:
+        for pid in self.processes():
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+
+    def _empty(self, wait: float) -> bool:
+        deadline = time.monotonic() + wait
+        while self.processes():
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.01)
+        return True
 
     def remove(self, wait: float = 2.0) -> bool:
         """Remove the group once its processes are gone (the caller has killed them); return
@@ -122,7 +183,7 @@ def create(name: str, memory_bytes: int, max_processes: int) -> JobCgroup | None
     try:
         if "memory" in v1 and "pids" in v1:
             limits = {"memory": {"memory.limit_in_bytes": str(int(memory_bytes))},
-                      "pids": {"pids.max": str(int(max_processes))}, "cpu": {}}
+                      "pids": {"pids.max": str(int(max_processes))}, "cpu": {}, "freezer": {}}
             for controller, settings in limits.items():
                 if controller in v1 and controller in own:
                     made.append(_make(_below(v1[controller], own[controller]), name, settings))
@@ -130,7 +191,7 @@ def create(name: str, memory_bytes: int, max_processes: int) -> JobCgroup | None
         if v2 is not None and "" in own:
             parent = _below(v2, own[""])
             enabled = (parent / "cgroup.subtree_control").read_text().split()
-            missing = [c for c in CONTROLLERS if c not in enabled]
+            missing = [c for c in CONTROLLERS if c not in enabled and c != "freezer"]   # v2 freezes built in
             if missing:  # fails (EBUSY) if the grader's own group holds processes: then no group
                 (parent / "cgroup.subtree_control").write_text(" ".join(f"+{c}" for c in missing))
             made.append(_make(parent, name, {"memory.max": str(int(memory_bytes)),

@@ -5,17 +5,19 @@ What is enforced, and where:
 * Always (any user): a fresh process session killed as a group at the wall-clock limit;
   ``RLIMIT_CPU`` (CPU seconds), ``RLIMIT_AS`` (address space), ``RLIMIT_FSIZE`` (largest file),
   ``RLIMIT_NOFILE``, ``RLIMIT_CORE = 0``; a scrubbed environment (no inherited variables, ``HOME``
-  and the working directory an empty job directory); single-threaded numeric libraries; and a
+  and the working directory an empty job directory); single-threaded numeric libraries; a
   grader whose secret cannot be read through ``/proc`` by a process of the same user
-  (:func:`conceal_secret`).
+  (:func:`conceal_secret`); and no privilege gain, no new namespaces and no mounts
+  (:mod:`.syscall_filter`: ``no_new_privs`` and a seccomp filter, set last by the launcher).
 * As root (CI, Gradescope, a grading container): additionally a private mount namespace whose
   root holds only what :mod:`.filesystem_view` allows (the interpreter, the installed packages'
   code, the worker's kit, the job's own directories), an empty network namespace (no
   interface but a down loopback), a private ``/proc`` mounted with ``hidepid=2`` (other users'
   processes, the grader's included, are invisible), a unique unprivileged uid/gid per job, leased
   across every grading run on the host (:func:`lease_job_uid`; so ``RLIMIT_NPROC`` caps a fork
-  bomb and leftover processes can be swept by uid without touching another run's workers), and
-  no supplementary groups.
+  bomb), no supplementary groups, and a control group per job (:mod:`.job_cgroup`) through which
+  whatever the job leaves running is ended at once; processes of the job uid are also swept
+  through ``/proc``, for hosts that give no control group.
 * Not root: the namespace and uid steps are skipped; the report marks the run ``sandbox=limited``.
 """
 from __future__ import annotations
@@ -40,6 +42,7 @@ from typing import Iterator, Sequence
 from robocourse.grading import job_cgroup
 from robocourse.grading.filesystem_view import View, bounded_space, enter_view
 from robocourse.grading.protocol import JobDir
+from robocourse.grading.syscall_filter import lock_down
 
 __all__ = ["Limits", "WorkerExit", "run_sandboxed", "is_root", "lease_job_uid", "conceal_secret",
            "job_space", "JOB_UIDS", "UID_LEASE_DIR"]
@@ -139,6 +142,7 @@ def _launch(config_path: str) -> None:
         os.setuid(uid)
     os.chdir(job.work)
     _limits(limits, uid)
+    lock_down()      # last: no privilege gain, no namespaces, no mounts for the worker and its children
     os.execve(cfg["python"], [cfg["python"], *cfg["args"]], cfg["env"])
 
 
@@ -379,6 +383,9 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, view: V
                 returncode, timed_out = _run(config, job, limits, env["PATH"])
             except OSError as exc:  # e.g. a file planted in the job folder (limited mode)
                 return WorkerExit(None, False, 0.0, uid is not None, f"the grader could not start the worker: {exc}")
+            finally:
+                if group is not None:  # whatever the job left running, at once (the uid sweep follows)
+                    group.kill()
             seconds = time.perf_counter() - start
     finally:
         if group is not None:  # after the lease's sweep has killed what was left of the job
