@@ -385,7 +385,8 @@ def run_sandboxed(args: Sequence[str], job_dir: Path, limits: Limits, *, view: V
                 return WorkerExit(None, False, 0.0, uid is not None, f"the grader could not start the worker: {exc}")
             finally:
                 if group is not None:  # whatever the job left running, at once (the uid sweep follows)
-                    group.kill()
+                    with contextlib.suppress(OSError):
+                        group.kill()
             seconds = time.perf_counter() - start
     finally:
         if group is not None:  # after the lease's sweep has killed what was left of the job
