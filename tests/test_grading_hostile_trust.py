@@ -365,3 +365,36 @@ def test_a_fork_and_exit_hopper_does_not_outlive_its_job():
                 pass
     assert not left, f"processes of the job outlived it: {sorted(left)[:5]}"
     assert done.returncode == 0 and rows and rows[0]["total"] == "3", done.stdout[-2000:] + done.stderr[-2000:]
+
+
+MODEL_ORACLE = """
+def leg_fk(q_leg, leg):
+    # the round-two oracle: the kit's LittleDog model in MuJoCo, no kinematics written
+    import mujoco
+    import numpy as np
+    from robokit.legged.littledog import JOINT_NAMES, littledog_mjcf
+    model = mujoco.MjModel.from_xml_string(littledog_mjcf())
+    data = mujoco.MjData(model)
+    for name, q in zip([j for j in JOINT_NAMES if j.startswith(leg)], q_leg):
+        data.qpos[model.jnt_qposadr[model.joint(name).id]] = q
+    mujoco.mj_kinematics(model, data)
+    body = model.body("trunk").id
+    R = data.xmat[body].reshape(3, 3)
+    return (R.T @ (data.site(f"{leg}_foot").xpos - data.xpos[body])).tolist()
+"""
+
+
+def test_the_littledog_model_is_no_oracle():
+    # the 04 solution with leg_fk answered by MuJoCo on the library's model: the model is not in the
+    # worker (no robokit), so the exercise scores 0 and the notebook is flagged; the rest keeps its marks
+    nb = json.loads((ROOT / "solutions" / "04_littledog.ipynb").read_text())
+    nb["cells"].append({"cell_type": "code", "metadata": {}, "source": MODEL_ORACLE, "outputs": [],
+                        "execution_count": None})
+    with public_tmp() as folder:
+        path = folder / "oracle.ipynb"
+        path.write_text(json.dumps(nb))
+        [result] = grade_batch([path], "04_littledog", "model-seed", limits=Limits(wall_seconds=240, cpu_seconds=240),
+                               log=lambda *_: None)
+    points = {s.id: s.points for s in result.scores}
+    assert points["04.leg_fk"] == 0 and "imported-robokit" in result.flags, (points, result.flags)
+    assert all(s.points == s.max_points for s in result.scores if s.id != "04.leg_fk"), points
