@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from robocourse.exercises.spec import PUBLIC_SEED
-from robocourse.exercises.trivial import CONSTANTS, explained_by_one
+from robocourse.exercises.trivial import CONSTANTS, explained
 from robocourse.grading import job_cgroup
 from robocourse.grading.data import assignment_data, data_file
 from robocourse.grading.grader import grade_batch, prepare_cases, score_exercise
@@ -26,16 +26,17 @@ from tests.conftest import ROOT, public_tmp, wrap_angle_unless
 
 SOLUTION_00 = ROOT / "solutions" / "00_getting_started.ipynb"
 
-# Returns, on its first valid input only, a rectangular list of three million zeros whose last item
-# is a 700-character string: 9 MB of JSON, inside every bound of the protocol. Numpy would make it
-# an array of strings of 3e6 x 700 x 4 bytes = 8.4 GB.
+# Returns, on its first valid input only, a rectangular list of zeros whose last item is a
+# 700-character string, inside every bound of the protocol. Numpy would make it an array of
+# strings of 700 x 4 bytes per value: 8.4 GB for 3 million zeros (9 MB of JSON; past the answer-size
+# cap), 2.8 GB for 999,000 (under the cap: the item types stop it).
 MEMORY_BOMB = """
 _honest_wrap_angle, _sent = wrap_angle, []
 def wrap_angle(angle):
     value = _honest_wrap_angle(angle)
     if not _sent:
         _sent.append(True)
-        rows = [[0] * 3000 for _ in range(1000)]
+        rows = [[0] * {columns} for _ in range(1000)]
         rows[-1][-1] = "x" * 700
         return rows
     return value
@@ -76,15 +77,17 @@ def _grade_capped(folder: Path, names: list[str], memory_bytes: int) -> tuple[su
 def test_a_memory_bomb_answer_costs_only_its_own_case_under_a_1_gib_cap():
     with public_tmp() as folder:
         (folder / "honest.ipynb").write_text(json.dumps(_notebook_with()))
-        (folder / "bomb.ipynb").write_text(json.dumps(_notebook_with(MEMORY_BOMB)))
-        done, rows = _grade_capped(folder, ["bomb", "honest"], 1 << 30)
+        (folder / "bomb.ipynb").write_text(json.dumps(_notebook_with(MEMORY_BOMB.format(columns=3000))))
+        (folder / "bomb_under_cap.ipynb").write_text(json.dumps(_notebook_with(MEMORY_BOMB.format(columns=999))))
+        done, rows = _grade_capped(folder, ["bomb", "bomb_under_cap", "honest"], 1 << 30)
     assert done.returncode == 0, done.stdout[-3000:]
-    assert set(rows) == {"bomb", "honest"}, done.stdout[-3000:]
+    assert set(rows) == {"bomb", "bomb_under_cap", "honest"}, done.stdout[-3000:]
     assert float(rows["honest"]["total"]) == float(rows["honest"]["max"]) == 3.0, (rows["honest"], done.stdout)
-    assert rows["honest"]["flags"] == ""
+    assert rows["honest"]["flags"] == ""           # as root (the test runs only then)
     # the bomb's own case is wrong; its other cases and exercise score as the honest ones
-    assert 2.0 < float(rows["bomb"]["total"]) < 3.0, rows["bomb"]
-    assert "grader-error" not in rows["bomb"]["flags"], rows["bomb"]
+    for name in ("bomb", "bomb_under_cap"):
+        assert 2.0 < float(rows[name]["total"]) < 3.0, rows[name]
+        assert rows[name]["flags"] == "", rows[name]
 
 
 
@@ -110,7 +113,7 @@ def test_a_judging_breach_costs_only_that_submission(monkeypatch):
         limits = Limits(wall_seconds=60, cpu_seconds=60, judge_memory_bytes=256 << 20, judge_seconds=5)
         results = {r.student: r for r in grade_batch(sorted(folder.glob("*.ipynb")), "00_getting_started", "s",
                                                      jobs=2, limits=limits, log=lambda *_: None)}
-    assert results["honest"].total == 3.0 and results["honest"].flags == []
+    assert results["honest"].total == 3.0 and set(results["honest"].flags) <= {"sandbox=limited"}
     for name, what in [("memory", "memory budget (256 MiB)"), ("time", "5 s budget")]:
         r = results[name]
         assert r.total == 0 and r.graded and "unusable-results" in r.flags, (name, r.flags, r.problems)
@@ -124,6 +127,15 @@ RAISED = CallResult(error=ErrorRecord("ValueError", ("ValueError", "Exception", 
 
 def _public(ex):
     return [c for c in ex.make_cases(PUBLIC_SEED)]
+
+
+def _listed(value):
+    return value.tolist()
+
+
+def public_all(ex):
+    """The answers of every public case (None for the bad-input ones)."""
+    return [expected_output(ex, c) for c in _public(ex)]
 
 
 def _data_values(slug):
@@ -145,6 +157,10 @@ def _attackers(ex, slug):
     public = [expected_output(ex, c) for c in _public(ex) if not c.raises]
     out = [(f"constant {v!r:.40}", lambda case, v=v: v) for v in (*CONSTANTS, *public, *_data_values(slug))]
     out += [(f"argument {k + 1}", lambda case, k=k: case.args[k] if len(case.args) > k else None) for k in range(8)]
+    seen = {json.dumps([list(c.args), c.kwargs], default=_listed): a for c, a in zip(_public(ex), public_all(ex))}
+    for fallback in (None, 0.0, []):          # the public answers looked up by input, a constant otherwise
+        out.append((f"lookup, else {fallback!r}", lambda case, d=fallback:
+                    seen.get(json.dumps([list(case.args), case.kwargs], default=_listed), d)))
     out += [(name, lambda case, f=f: f(*case.args, **case.kwargs)) for name, f in ex.shortcuts.items()]
     return out
 
@@ -175,11 +191,32 @@ def test_constants_that_raise_on_bad_input_score_nothing(hidden_cases):
 
 
 def test_an_honest_function_unlocks_every_exercise(hidden_cases):
-    # the other side of the rule: for every seed, the valid cases of every exercise are not all
-    # passed by one trivial answer, so a right function earns all its cases
-    locked = [(ex.id, seed, explained_by_one([i for i, c in enumerate(cases) if not c.raises], trivial))
-              for (slug, seed), p in hidden_cases.items() for ex, cases, trivial in zip(p.exercises, p.cases, p.trivial)]
+    # the other side of the rule: in every draw, a right function's passes show work
+    locked = []
+    for (slug, seed), p in hidden_cases.items():
+        for ex, cases, trivial in zip(p.exercises, p.cases, p.trivial):
+            valid = [i for i, c in enumerate(cases) if not c.raises]
+            locked.append((ex.id, seed, explained(valid, valid, trivial)))
     assert [x for x in locked if x[2] is not None] == []
+
+
+def test_a_draw_a_trivial_answer_could_pass_is_drawn_again():
+    # an exercise whose valid cases all expect the same index for some seeds: those draws are
+    # replaced, deterministically, and one that can never show work is a course error
+    from robocourse.exercises.spec import Case, Exercise
+    from robocourse.grading import grader
+
+    same = Exercise(id="00.pick", function="pick", signature="pick(x) -> int", points=1,
+                    cases=lambda rng: [Case((float(v),)) for v in rng.integers(0, 2, 3)] + [Case((float(rng.random()),))],
+                    answer=lambda x: int(x))
+    seeds = [f"s{k}" for k in range(40)]
+    first = [grader.draw_cases(same, s)[0] for s in seeds]
+    assert all(len({int(c.args[0]) for c in cases}) > 1 for cases in first)   # never one answer for all
+    assert [c.args for c in first[0]] == [c.args for c in grader.draw_cases(same, seeds[0])[0]]
+    always = Exercise(id="00.zero", function="zero", signature="zero(x) -> float", points=1,
+                      cases=lambda rng: [Case((float(rng.random()),))], answer=lambda x: 0.0)
+    with pytest.raises(grader.GradingError, match="00.zero"):
+        grader.draw_cases(always, "s")
 
 
 def _json_literal(value) -> str:
@@ -283,7 +320,7 @@ def test_the_barrier_admits_only_what_its_message_names():
 # -- the worker offers no new namespaces and no privilege gain; nothing of the job outlives it --------
 
 NAMESPACE_PROBE = """
-import ctypes, os
+import ctypes, os, posix
 def _escape_possible():
     status = open("/proc/self/status").read()
     if "NoNewPrivs:\\t1" not in status or "Seccomp:\\t2" not in status:
@@ -295,9 +332,46 @@ def _escape_possible():
         ok = ok or libc.unshare(0x20000000) == 0                              # a pid namespace
         ok = ok or libc.mount(b"none", b"/tmp", b"tmpfs", 0, None) == 0
         ok = ok or libc.syscall(56, 0x10000000 | 17, 0, 0, 0, 0) > 0          # clone(CLONE_NEWUSER)
-        os._exit(1 if ok else 0)
+        posix._exit(1 if ok else 0)       # the worker's os._exit is its own; this one ends the child
     return os.waitpid(pid, 0)[1] != 0
 """
+
+
+def test_the_filter_refuses_namespaces_mounts_and_io_uring_and_allows_threads_and_forks():
+    import ctypes
+    import threading
+
+    from robocourse.grading.syscall_filter import filter_supported, lock_down
+
+    if not filter_supported():
+        pytest.skip("the filter's table is x86-64's")
+    read_fd, write_fd = os.pipe()
+    pid = os.fork()
+    if pid == 0:
+        try:
+            lock_down()
+            libc = ctypes.CDLL(None, use_errno=True)
+            got = [libc.unshare(0x10000000) == -1 and ctypes.get_errno() == 1,           # EPERM
+                   libc.unshare(0x20000000 | 0x00020000) == -1,
+                   libc.mount(b"none", b"/mnt", b"tmpfs", 0, None) == -1,
+                   libc.syscall(56, 0x10000000 | 17, 0, 0, 0, 0) == -1,               # clone(CLONE_NEWUSER)
+                   libc.syscall(435, 0, 0) == -1 and ctypes.get_errno() == 38,         # clone3: ENOSYS
+                   libc.syscall(425, 1, 0) == -1 and ctypes.get_errno() == 1]          # io_uring_setup
+            t = threading.Thread(target=lambda: None)
+            t.start()
+            t.join()
+            child = os.fork()
+            if child == 0:
+                os._exit(3)
+            got.append(os.waitpid(child, 0)[1] >> 8 == 3)
+            os.write(write_fd, bytes(int(g) for g in got))
+        finally:
+            os._exit(0)
+    os.close(write_fd)
+    reply = os.read(read_fd, 100)
+    os.close(read_fd)
+    os.waitpid(pid, 0)
+    assert list(reply) == [1] * 7, list(reply)
 
 
 def test_the_worker_can_make_no_namespace_and_gain_no_privilege():

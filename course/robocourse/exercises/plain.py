@@ -132,6 +132,8 @@ def _rectangular_numbers(value: list) -> tuple[int, ...] | None:
     shape: list[int] = []
     level: list = [value]
     while level and type(level[0]) is list:
+        if len(shape) == 32:                  # numpy's own limit is 64 dimensions; no answer has 32
+            return None
         n = len(level[0])
         if any(type(x) is not list or len(x) != n for x in level):
             return None

@@ -11,7 +11,6 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import re
-from types import MappingProxyType
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
@@ -143,7 +142,7 @@ class Exercise:
             raise ValueError(f"points: expected a positive number, got {self.points!r}")
         if not all(isinstance(k, str) and callable(f) for k, f in dict(self.shortcuts).items()):
             raise ValueError("shortcuts: expected a dict of names to functions")
-        object.__setattr__(self, "shortcuts", MappingProxyType(dict(self.shortcuts)))
+        object.__setattr__(self, "shortcuts", dict(self.shortcuts))
 
     @property
     def lesson(self) -> str:

@@ -12,7 +12,10 @@ written by the grader's own code in the child, from the scores it computed, neve
 
 Forking a threaded process (the grader grades several submissions at once) is safe here: the
 child runs only the grader's own pure-Python and numpy code, takes no lock another thread could
-hold (Python takes the import lock across ``fork``), prints nothing and leaves by ``os._exit``.
+hold (Python takes the import lock across ``fork``), closes every file descriptor but its own
+pipe (a sibling's pipe held open would keep its reader waiting), prints nothing, sets its OOM score
+so that the kernel ends it before the grader, and leaves by ``os._exit``. Its reply is
+length-prefixed, so a complete reply is read without waiting for the pipe to close.
 """
 from __future__ import annotations
 
@@ -38,10 +41,6 @@ class BudgetExceeded(RuntimeError):
         self.what = what
 
 
-class _Failed(Exception):
-    """The work raised inside the child (a bug of the grader's, not a breach)."""
-
-
 def _address_space() -> int:
     """This process's current virtual size in bytes (``VmSize``), 0 if unknown."""
     try:
@@ -55,13 +54,24 @@ def _address_space() -> int:
 
 
 def _child(work: Callable[[], Any], memory_bytes: int, fd: int) -> None:
-    """In the forked child: cap the address space, run ``work``, write ``(status, payload)``."""
+    """In the forked child: keep only its own pipe, cap the address space, run ``work``, write the
+    length-prefixed pickle of ``(status, payload)``."""
     try:
-        limit = _address_space() + memory_bytes
-        soft, hard = resource.getrlimit(resource.RLIMIT_AS)
-        if hard != resource.RLIM_INFINITY:
-            limit = min(limit, hard)
-        resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+        # fds of other threads' children and pipes are not ours: holding a sibling's pipe open
+        # would keep its reader waiting for an end of file that this child owes it
+        limit = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
+        os.closerange(3, fd)
+        os.closerange(fd + 1, limit if limit != resource.RLIM_INFINITY else 65536)
+        try:
+            with open("/proc/self/oom_score_adj", "w") as f:    # if memory runs out, this child goes first
+                f.write("1000")
+        except OSError:
+            pass
+        size = _address_space()
+        if size:                  # unknown size: the deadline and the OOM score still bound the child
+            hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+            limit = size + memory_bytes if hard == resource.RLIM_INFINITY else min(size + memory_bytes, hard)
+            resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
         try:
             reply = ("ok", work())
         except MemoryError:
@@ -72,7 +82,9 @@ def _child(work: Callable[[], Any], memory_bytes: int, fd: int) -> None:
             data = pickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL)
         except MemoryError:
             data = pickle.dumps(("memory", None))
-        view = memoryview(data)
+        except Exception as exc:  # a result that does not pickle is the grader's bug
+            data = pickle.dumps(("error", f"unpicklable result: {type(exc).__name__}"))
+        view = memoryview(len(data).to_bytes(8, "little") + data)
         while view:
             view = view[os.write(fd, view):]
     finally:
@@ -80,9 +92,10 @@ def _child(work: Callable[[], Any], memory_bytes: int, fd: int) -> None:
 
 
 def _read_reply(fd: int, deadline: float) -> bytes | None:
-    """Everything the child writes until it closes the pipe; ``None`` at the deadline."""
-    chunks, size = [], 0
-    while True:
+    """The child's reply (its 8-byte length, then that many bytes); ``None`` at the deadline, and
+    ``b""`` if the pipe ends first (the child died)."""
+    buffer, want = bytearray(), None
+    while want is None or len(buffer) < want + 8:
         left = deadline - time.monotonic()
         if left <= 0:
             return None
@@ -91,11 +104,13 @@ def _read_reply(fd: int, deadline: float) -> bytes | None:
             return None
         chunk = os.read(fd, 1 << 20)
         if not chunk:
-            return b"".join(chunks)
-        size += len(chunk)
-        if size > _MAX_REPLY:
-            raise BudgetExceeded("memory", "the grader's judging produced an oversized reply")
-        chunks.append(chunk)
+            return b""
+        buffer += chunk
+        if want is None and len(buffer) >= 8:
+            want = int.from_bytes(buffer[:8], "little")
+            if want > _MAX_REPLY:
+                raise BudgetExceeded("memory", "the grader's judging produced an oversized reply")
+    return bytes(buffer[8:want + 8])
 
 
 def run_within(work: Callable[[], Any], *, memory_bytes: int, seconds: float) -> Any:
@@ -121,9 +136,13 @@ def run_within(work: Callable[[], Any], *, memory_bytes: int, seconds: float) ->
     robocourse.grading.budget.BudgetExceeded: judging your results needed more than the grader's memory budget (256 MiB)
     """
     read_fd, write_fd = os.pipe()
-    pid = os.fork()
-    if pid == 0:
+    try:
+        pid = os.fork()
+    except OSError:
         os.close(read_fd)
+        os.close(write_fd)
+        raise
+    if pid == 0:
         _child(work, memory_bytes, write_fd)
     os.close(write_fd)
     data = None
@@ -131,7 +150,7 @@ def run_within(work: Callable[[], Any], *, memory_bytes: int, seconds: float) ->
         data = _read_reply(read_fd, time.monotonic() + seconds)
     finally:
         os.close(read_fd)
-        if data is None:            # past the deadline (or the reply was refused): end the child
+        if not data:                # past the deadline, refused or died: make sure the child is gone
             try:
                 os.kill(pid, signal.SIGKILL)
             except ProcessLookupError:
@@ -139,9 +158,14 @@ def run_within(work: Callable[[], Any], *, memory_bytes: int, seconds: float) ->
         _, status = os.waitpid(pid, 0)
     if data is None:
         raise BudgetExceeded("time", f"judging your results took longer than the grader's {seconds:g} s budget")
-    if not data:
-        raise BudgetExceeded("ended", f"the grader's judging process ended without a result (wait status {status})")
-    state, payload = pickle.loads(data)
+    try:
+        state, payload = pickle.loads(data) if data else ("ended", None)
+    except Exception:  # a reply cut short (the child killed while writing): as if it had died
+        state, payload = "ended", None
+    if state == "ended":
+        how = f"signal {os.WTERMSIG(status)}" if os.WIFSIGNALED(status) else f"exit status {os.WEXITSTATUS(status)}"
+        raise BudgetExceeded("ended", f"the grader's judging process ended without a result ({how}; "
+                                      "the system may have run out of memory)")
     if state == "memory":
         raise BudgetExceeded("memory", "judging your results needed more than the grader's memory budget "
                                        f"({memory_bytes / 1024**2:.0f} MiB)")

@@ -34,7 +34,7 @@ from typing import Any, Callable, Sequence
 
 from robocourse.lessons import UnknownAssignmentError, get_assignment
 from robocourse.exercises.spec import PUBLIC_SEED, Case, Exercise
-from robocourse.exercises.trivial import explained_by_one, trivial_passes
+from robocourse.exercises.trivial import explained, trivial_passes
 from robocourse.grading.filesystem_view import View, installed_package_dirs, runtime_paths
 from robocourse.grading.job_cgroup import cgroup_note
 from robocourse.grading.judge import expected_output, judge
@@ -44,12 +44,13 @@ from robocourse.grading.budget import BudgetExceeded, run_within
 from robocourse.grading.protocol import CallResult, CellRecord, DoneReport, JobDir, JobSpec
 from robocourse.grading.safetext import clean
 from robocourse.grading.sandbox import Limits, WorkerExit, conceal_secret, is_root, job_space, run_sandboxed
+from robocourse.grading.syscall_filter import probe as probe_filter
 from robocourse.grading.submission import Submission, SubmissionRejected, feedback_stem, read_submission, student_name
 from robocourse.grading.transport import TransportError
 
-__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "cases_seed", "job_spec",
-           "score_exercise", "worker_view", "grade_submission", "grade_batch", "GradingError", "isolation_note",
-           "unique_students", "needs_review"]
+__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "draw_cases", "cases_seed",
+           "job_spec", "score_exercise", "worker_view", "grade_submission", "grade_batch", "GradingError",
+           "isolation_note", "unique_students", "needs_review"]
 
 
 class GradingError(ValueError):
@@ -143,21 +144,54 @@ def cases_seed(seed: str, submission: Submission) -> str:
 
 
 @functools.lru_cache(maxsize=None)
-def _public_answers(exercise: Exercise) -> tuple[Any, ...]:
-    """The answers of an exercise's valid public cases (``check()`` shows them to the student)."""
-    return tuple(expected_output(exercise, c) for c in exercise.make_cases(PUBLIC_SEED) if not c.raises)
+def _public(ex: Exercise) -> tuple[tuple[Case, Any], ...]:
+    """An exercise's valid public cases and their answers (``check()`` shows them to the student)."""
+    return tuple((c, expected_output(ex, c)) for c in ex.make_cases(PUBLIC_SEED) if not c.raises)
+
+
+#: How many further draws :func:`prepare_cases` tries when a draw's cases would let a trivial
+#: answer pass every valid case (so that a right function could not show its work).
+REDRAWS = 20
+
+
+def draw_cases(ex: Exercise, seed: str) -> tuple[list[Case], list[Any], list[frozenset[str]]]:
+    """One exercise's cases, answers and trivial passes for ``seed``: the first draw in which a
+    right function's passes show work (:func:`~robocourse.exercises.trivial.explained`), trying
+    ``seed`` and then up to :data:`REDRAWS` seeds derived from it.
+
+    Raises
+    ------
+    GradingError
+        If no draw shows work (a course error: the exercise's cases must be changed).
+    """
+    for k in range(REDRAWS + 1):
+        cases = ex.make_cases(seed if k == 0 else f"{seed}\x00redraw {k}")
+        expected = [expected_output(ex, c) for c in cases]
+        trivial = trivial_passes(ex, cases, expected, _public(ex))
+        valid = [i for i, c in enumerate(cases) if not c.raises]
+        if explained(valid, valid, trivial) is None:
+            return cases, expected, trivial
+    raise GradingError(f"{ex.id}: in {REDRAWS + 1} draws of its cases, trivial answers pass every valid case; "
+                       "the exercise needs cases that show work")
 
 
 def prepare_cases(assignment: str, seed: str) -> PreparedCases:
     """Generate every exercise's cases from ``seed``, compute the expected answers and which
-    trivial answers pass each case (trusted)."""
+    trivial answers pass each case (trusted).
+
+    A draw in which trivial answers would pass every valid case (a right function could not be
+    told from them) is drawn again from a derived seed, deterministically.
+
+    Raises
+    ------
+    GradingError
+        For a missing seed, or an exercise whose cases never show work (a course error).
+    """
     if not isinstance(seed, str) or not seed:
         raise GradingError("seed: a non-empty secret seed is required (--seed or ROBOKIT_GRADING_SEED)")
     exercises = get_assignment(assignment).exercises
-    cases = [ex.make_cases(seed) for ex in exercises]
-    expected = [[expected_output(ex, c) for c in cs] for ex, cs in zip(exercises, cases)]
-    trivial = [trivial_passes(ex, cs, exp, _public_answers(ex)) for ex, cs, exp in zip(exercises, cases, expected)]
-    return PreparedCases(exercises, cases, expected, trivial, assignment, seed)
+    cases, expected, trivial = zip(*(draw_cases(ex, seed) for ex in exercises))
+    return PreparedCases(exercises, list(cases), list(expected), list(trivial), assignment, seed)
 
 
 def _zero(prepared: PreparedCases, message: str) -> list[ExerciseScore]:
@@ -218,7 +252,8 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
                 return run_within(lambda: _score(job, student, path, prepared, exit_, start),
                                   memory_bytes=limits.judge_memory_bytes, seconds=limits.judge_seconds)
             except BudgetExceeded as exc:
-                flags = ([] if exit_.isolated else ["sandbox=limited"]) + ["unusable-results"]
+                flags = ([] if exit_.isolated else ["sandbox=limited"]) + ["unusable-results"] + \
+                    (["timeout"] if exit_.timed_out else [])
                 return SubmissionResult(student, path, _zero(prepared, f"not graded: {exc}"), flags,
                                         seconds=time.perf_counter() - start, problems=[str(exc)])
     finally:
@@ -230,10 +265,9 @@ def score_exercise(ex: Exercise, cases: list[Case], expected: list[Any], trivial
     """Judge one exercise's results (one per case); return its score and whether it tried to
     import robokit.
 
-    The cases count only once the function has passed valid cases that no single trivial answer
-    passes all of (:func:`~robocourse.exercises.trivial.explained_by_one`): a constant, an argument
-    returned unchanged or a known shortcut earns nothing, and a function that always raises earns
-    no bad-input marks.
+    The cases count only once the passes show work (:func:`~robocourse.exercises.trivial.explained`):
+    a constant, the public answers looked up, an argument returned unchanged or a known shortcut
+    earns nothing, and a function that always raises earns no bad-input marks.
     """
     messages, cheated = [], False
     passed_valid, errors_passed = [], 0
@@ -248,14 +282,15 @@ def score_exercise(ex: Exercise, cases: list[Case], expected: list[Any], trivial
             messages.append(f"case {i}" + (f" ({case.label})" if case.label else "") + f": {outcome.message}")
             messages.append(f"  input: {case.call_text(ex.function)}")
     passed = len(passed_valid) + errors_passed
-    trivially = explained_by_one(passed_valid, trivial)
-    if passed and trivially == "nothing":
+    why = explained(passed_valid, [i for i, c in enumerate(cases) if not c.raises], trivial)
+    if passed and why == "nothing passed":
         passed = 0
         messages.insert(0, "bad-input cases count once the function returns a right result for a valid input")
-    elif passed and trivially:
+    elif passed and why:
         passed = 0
-        messages.insert(0, f"every valid case passed is also passed by a trivial answer ({trivially}): the cases "
-                           "count once the function gets right a case that no trivial answer does")
+        messages.insert(0, f"the valid cases passed are also passed by trivial answers ({why}): the cases count "
+                           "once the passes show work (a case no trivial answer passes, or cases no one trivial "
+                           "answer passes all of)")
     if cheated:
         passed = 0
         messages.insert(0, "your code tried to import robokit, the course's library, which graded code may not use")
@@ -409,8 +444,9 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
     Raises
     ------
     GradingError
-        Only for problems with the request (unknown assignment, missing seed, no submissions) or
-        with the course (a worker module that would bring library code into the worker).
+        Only for problems with the request (unknown assignment, missing seed, no submissions), with
+        the course (a worker module that would bring library code into the worker) or with the host
+        (it refuses the worker's seccomp filter).
     """
     if isinstance(seed, str) and seed:
         conceal_secret(seed)
@@ -420,6 +456,10 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
         raise GradingError(str(exc)) from None
     if not paths:
         raise GradingError("submissions: expected at least one notebook")
+    refused = probe_filter()
+    if refused:
+        raise GradingError(f"this host refuses the worker's no_new_privs or seccomp filter ({refused}); grade on a "
+                           "Linux host or container that allows them")
     paths = [Path(p) for p in paths]
     names = unique_students(paths, assignment)
     work_root = Path(tempfile.mkdtemp(prefix="robocourse-grade-"))

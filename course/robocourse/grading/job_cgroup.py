@@ -69,11 +69,13 @@ class JobCgroup:
             return self._empty(wait)
         path, frozen, thawed = freeze
         path.write_text(frozen)
-        deadline = time.monotonic() + wait
-        while not self._frozen(path) and time.monotonic() < deadline:
-            time.sleep(0.005)
-        self._signal_all()
-        path.write_text(thawed)
+        try:
+            deadline = time.monotonic() + wait
+            while not self._frozen(path) and time.monotonic() < deadline:
+                time.sleep(0.005)
+            self._signal_all()
+        finally:                            # never leave the job frozen: killed, it dies on thawing
+            path.write_text(thawed)
         return self._empty(wait)
 
     @staticmethod

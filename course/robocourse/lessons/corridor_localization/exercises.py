@@ -328,10 +328,11 @@ def _ellipse_cases(rng: np.random.Generator) -> list[Case]:
 def _keyframe_cases(rng: np.random.Generator) -> list[Case]:
     """Keyframes with look-alikes (half their descriptors shared); queries seen again with flipped bits."""
     cases = []
+    n_kf = 6
+    trues = rng.choice(n_kf, 4, replace=False)    # four different answers: no constant index passes them all
     for k in range(4):
-        n_kf = 6
         base = rng.integers(0, 256, (n_kf, 40, 32), dtype=np.uint8)
-        true = int(rng.integers(n_kf))
+        true = int(trues[k])
         decoy = (true + 1 + int(rng.integers(n_kf - 1))) % n_kf
         base[decoy, :20] = base[true, :20]              # a look-alike keyframe shares half its features
         seen = base[true, rng.choice(40, 24, replace=False)].copy()

@@ -239,11 +239,12 @@ def _fine_cases(rng: np.random.Generator) -> list[Case]:
 def _recognise_cases(rng: np.random.Generator) -> list[Case]:
     """Maps where the colour histogram alone picks a wrong node in some cases (a corridor look-alike)."""
     cases = []
+    n, bins = 6, 16
+    trues = rng.choice(n, 4, replace=False)    # four different answers: no constant index passes them all
     for k in range(4):
-        n, bins = 6, 16
         hist = rng.dirichlet(np.ones(bins) * 2, n)
         nodes = _clustered_nodes(rng, n, 30, 16)
-        true = int(rng.integers(n))
+        true = int(trues[k])
         decoy = (true + 1 + int(rng.integers(n - 1))) % n
         q_hist = np.clip(hist[true] + rng.normal(0, 0.004, bins), 0, None)
         q_hist /= q_hist.sum()
