@@ -24,7 +24,6 @@ from robocourse.grading.sandbox import Limits, is_root
 from robocourse.lessons import assignments, get_assignment
 from tests.conftest import ROOT, public_tmp, wrap_angle_unless
 
-SOLUTION_00 = ROOT / "solutions" / "00_getting_started.ipynb"
 
 # Returns, on its first valid input only, a rectangular list of zeros whose last item is a
 # 700-character string, inside every bound of the protocol. Numpy would make it an array of
@@ -43,12 +42,27 @@ def wrap_angle(angle):
 """
 
 
-def _notebook_with(extra_cell: str | None = None) -> dict:
-    nb = json.loads(SOLUTION_00.read_text())
+def _notebook_with(extra_cell: str | None = None, slug: str = "00_getting_started") -> dict:
+    nb = json.loads((ROOT / "solutions" / f"{slug}.ipynb").read_text())
     if extra_cell is not None:
         nb["cells"].append({"cell_type": "code", "metadata": {}, "source": extra_cell, "outputs": [],
                             "execution_count": None})
     return nb
+
+
+def _grade_notebook(nb: dict, slug: str, seed: str):
+    """Grade one notebook for ``slug`` in the sandbox; its result."""
+    with public_tmp() as folder:
+        path = folder / f"{seed}.ipynb"
+        path.write_text(json.dumps(nb))
+        [result] = grade_batch([path], slug, seed, limits=Limits(wall_seconds=240, cpu_seconds=240),
+                               log=lambda *_: None)
+    return result
+
+
+def _grade_with(extra_cell: str, seed: str, slug: str = "00_getting_started"):
+    """Grade the solution of ``slug`` with ``extra_cell`` appended; its result."""
+    return _grade_notebook(_notebook_with(extra_cell, slug), slug, seed)
 
 
 def _grade_capped(folder: Path, names: list[str], memory_bytes: int) -> tuple[subprocess.CompletedProcess, dict]:
@@ -223,7 +237,7 @@ def _json_literal(value) -> str:
     return repr(json.dumps(value, default=lambda o: o.tolist()))
 
 
-def _constants_notebook(slug: str) -> dict:
+def _constants_notebook(slug: str) -> list[str]:
     """Every function of ``slug`` answers the constant (or public answer) that passes the most
     public cases, and raises ValueError on exactly the public bad inputs it has seen."""
     cells = ["import json\nimport numpy as np\n"
@@ -239,24 +253,26 @@ def _constants_notebook(slug: str) -> dict:
                      f"    if any(_same([list(args), kwargs], b) for b in _bad_{ex.function}):\n"
                      f"        raise ValueError('bad input')\n"
                      f"    return json.loads({_json_literal(best)})\n")
-    return {"cells": [{"cell_type": "code", "metadata": {}, "source": c, "outputs": [], "execution_count": None}
-                      for c in cells], "metadata": {}, "nbformat": 4, "nbformat_minor": 5}
+    return cells
+
+
+def _grade_cells(slug: str, cells: list[str], seed: str):
+    """Grade a notebook of these code cells alone for ``slug``; its result."""
+    nb = {"cells": [{"cell_type": "code", "metadata": {}, "source": c, "outputs": [], "execution_count": None}
+                    for c in cells], "metadata": {}, "nbformat": 4, "nbformat_minor": 5}
+    return _grade_notebook(nb, slug, seed)
 
 
 @pytest.mark.parametrize("slug", sorted(assignments()))
 def test_a_notebook_of_constants_and_raises_scores_zero(slug):
-    with public_tmp() as folder:
-        path = folder / f"{slug}.ipynb"
-        path.write_text(json.dumps(_constants_notebook(slug)))
-        [result] = grade_batch([path], slug, "constants-seed", limits=Limits(wall_seconds=120, cpu_seconds=120),
-                               log=lambda *_: None)
+    result = _grade_cells(slug, _constants_notebook(slug), "constants-seed")
     assert result.graded and "unusable-results" not in result.flags, (result.flags, result.worker_log)
     assert result.total == 0, [(s.id, s.points, s.messages[:1]) for s in result.scores if s.points]
 
 
 # -- the kit hands out no oracle ----------------------------------------------------------------------
 
-def _reference_notebook(slug: str) -> dict:
+def _reference_notebook(slug: str) -> list[str]:
     """Every function answers by calling the exercise's reference (robokit or the lesson's module),
     or, failing that, by reading the course's modules the worker itself runs on."""
     cells = ["import importlib\n"]
@@ -271,17 +287,12 @@ def _reference_notebook(slug: str) -> dict:
                      f"        if found is not None:\n"
                      f"            return found(*args, **kwargs)\n"
                      f"    raise ValueError('nothing to call')\n")
-    return {"cells": [{"cell_type": "code", "metadata": {}, "source": c, "outputs": [], "execution_count": None}
-                      for c in cells], "metadata": {}, "nbformat": 4, "nbformat_minor": 5}
+    return cells
 
 
 @pytest.mark.parametrize("slug", sorted(assignments()))
 def test_no_exercise_can_be_answered_with_what_the_worker_holds(slug):
-    with public_tmp() as folder:
-        path = folder / f"{slug}.ipynb"
-        path.write_text(json.dumps(_reference_notebook(slug)))
-        [result] = grade_batch([path], slug, "oracle-seed", limits=Limits(wall_seconds=120, cpu_seconds=120),
-                               log=lambda *_: None)
+    result = _grade_cells(slug, _reference_notebook(slug), "oracle-seed")
     assert result.graded, result.reason
     assert {s.id: s.points for s in result.scores} == {ex.id: 0.0 for ex in get_assignment(slug).exercises}
     assert "imported-robokit" in result.flags
@@ -307,11 +318,7 @@ def _kit_visible():
 def test_the_barrier_admits_only_what_its_message_names():
     # graded code finds no kit module in sys.modules or on the package, and importing one is
     # refused (and logged) with the message that names check and assignment_data as all it may import
-    with public_tmp() as folder:
-        path = folder / "probe.ipynb"
-        path.write_text(json.dumps(_notebook_with(KIT_PROBE + wrap_angle_unless("_kit_visible()"))))
-        [result] = grade_batch([path], "00_getting_started", "probe-seed", limits=Limits(wall_seconds=60, cpu_seconds=60),
-                               log=lambda *_: None)
+    result = _grade_with(KIT_PROBE + wrap_angle_unless("_kit_visible()"), "probe-seed")
     assert {s.id: s.points for s in result.scores} == {"00.wrap_angle": 1.0, "00.se2_compose": 2.0}, \
         [s.messages[:2] for s in result.scores]
     assert "imported-robokit" in result.flags
@@ -375,11 +382,7 @@ def test_the_filter_refuses_namespaces_mounts_and_io_uring_and_allows_threads_an
 
 
 def test_the_worker_can_make_no_namespace_and_gain_no_privilege():
-    with public_tmp() as folder:
-        path = folder / "namespaces.ipynb"
-        path.write_text(json.dumps(_notebook_with(NAMESPACE_PROBE + wrap_angle_unless("_escape_possible()"))))
-        [result] = grade_batch([path], "00_getting_started", "ns-seed", limits=Limits(wall_seconds=60, cpu_seconds=60),
-                               log=lambda *_: None)
+    result = _grade_with(NAMESPACE_PROBE + wrap_angle_unless("_escape_possible()"), "ns-seed")
     assert {s.id: s.points for s in result.scores} == {"00.wrap_angle": 1.0, "00.se2_compose": 2.0}, \
         [s.messages[:2] for s in result.scores]
 
@@ -461,14 +464,7 @@ def leg_fk(q_leg, leg):
 def test_the_littledog_model_is_no_oracle():
     # the 04 solution with leg_fk answered by MuJoCo on the library's model: the model is not in the
     # worker (no robokit), so the exercise scores 0 and the notebook is flagged; the rest keeps its marks
-    nb = json.loads((ROOT / "solutions" / "04_littledog.ipynb").read_text())
-    nb["cells"].append({"cell_type": "code", "metadata": {}, "source": MODEL_ORACLE, "outputs": [],
-                        "execution_count": None})
-    with public_tmp() as folder:
-        path = folder / "oracle.ipynb"
-        path.write_text(json.dumps(nb))
-        [result] = grade_batch([path], "04_littledog", "model-seed", limits=Limits(wall_seconds=240, cpu_seconds=240),
-                               log=lambda *_: None)
+    result = _grade_with(MODEL_ORACLE, "model-seed", "04_littledog")
     points = {s.id: s.points for s in result.scores}
     assert points["04.leg_fk"] == 0 and "imported-robokit" in result.flags, (points, result.flags)
     assert all(s.points == s.max_points for s in result.scores if s.id != "04.leg_fk"), points
