@@ -13,13 +13,15 @@ import functools
 import hashlib
 import json
 import os
+import stat
 import zipfile
 import zlib
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-__all__ = ["cache_dir", "cache_key", "source_digest", "code_version", "write_atomically", "save_npz", "write_arrays",
-           "read_arrays", "CACHE_READ_ERRORS", "records_to_arrays", "record_names", "records_from_arrays"]
+__all__ = ["cache_dir", "cache_key", "source_digest", "code_version", "write_atomically", "save_npz", "read_npz",
+           "NpzFileError", "write_arrays", "read_arrays", "CACHE_READ_ERRORS", "records_to_arrays", "record_names",
+           "records_from_arrays"]
 
 
 def cache_dir(*parts: str, create: bool = True) -> Path:
@@ -246,6 +248,8 @@ def code_version(*packages: str) -> dict:
 #: exactly these and rebuilds (``zlib.error`` is a damaged compressed member; it is not an OSError).
 CACHE_READ_ERRORS: tuple = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, zlib.error)
 
+#: The largest cache file :func:`read_arrays` serves (bytes; also its bound on values per array).
+MAX_CACHE_BYTES = 4 * 1024**3
 #: The entry of a cache file (:func:`write_arrays`) that holds the parameters it was made with.
 _META = "cache_meta"
 
@@ -302,6 +306,101 @@ def save_npz(target: Any, arrays: dict) -> Any:
             with zf.open(f"{name}.npy", "w", force_zip64=True) as fh:
                 np.lib.format.write_array(fh, arr, allow_pickle=False)
     return target
+
+
+class NpzFileError(ValueError):
+    """A file that :func:`read_npz` will not read: not a regular file, too large, not an ``.npz`` of
+    plain arrays, truncated, or declaring more values than its reader allows."""
+
+
+def read_npz(path: Any, *, max_bytes: int = 1 << 30, max_arrays: int = 10_000,
+             max_values: int = 1 << 28) -> dict:
+    """Read every array of an ``.npz`` file within stated bounds, checked before memory is spent.
+
+    The file must be a regular file (not a device, FIFO or directory) of at most ``max_bytes``,
+    hold at most ``max_arrays`` ``.npy`` members, each of at most ``max_bytes`` uncompressed, of a
+    plain dtype (never Python objects: nothing is unpickled) and declaring at most ``max_values``
+    elements in its header, which is read before its data.
+
+    Parameters
+    ----------
+    path : str or Path
+    max_bytes, max_arrays, max_values : int
+        The reader's budget; each file reader of robokit states its own.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+
+    Raises
+    ------
+    NpzFileError
+        (a ``ValueError``) For a file outside the bounds or not such an archive; the message names
+        ``path`` and what was found.
+    FileNotFoundError
+        If there is no such file.
+
+    Notes
+    -----
+    Course convention for file readers (DESIGN.md, "Conventions", Files); the twin of :func:`save_npz`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> import numpy as np
+    >>> target = Path(tempfile.mkdtemp()) / "a.npz"
+    >>> read_npz(save_npz(target, {"a": np.arange(3)}))["a"].tolist()
+    [0, 1, 2]
+    >>> read_npz(target, max_values=2)
+    Traceback (most recent call last):
+    ...
+    robokit.cache.NpzFileError: path: a.npz: array 'a' declares 3 values, more than this reader's 2
+    """
+    path = Path(path)
+    info = os.stat(path)
+    if not stat.S_ISREG(info.st_mode):
+        raise NpzFileError(f"path: {path.name}: expected a regular file, got a device, FIFO or directory")
+    if info.st_size > max_bytes:
+        raise NpzFileError(f"path: {path.name}: {info.st_size} bytes, more than this reader's {max_bytes}")
+    try:
+        with zipfile.ZipFile(path) as archive:
+            members = archive.infolist()
+            if len(members) > max_arrays:
+                raise NpzFileError(f"path: {path.name}: {len(members)} members, more than this reader's {max_arrays}")
+            return {m.filename[:-4]: _read_member(archive, m, path.name, max_bytes, max_values) for m in members}
+    except NpzFileError:
+        raise
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, zlib.error) as err:
+        raise NpzFileError(f"path: {path.name}: not a readable .npz archive (truncated or corrupt: {err})") from None
+
+
+def _read_member(archive: zipfile.ZipFile, member: zipfile.ZipInfo, label: str, max_bytes: int, max_values: int):
+    """One ``.npy`` member, its header checked against the budget before its data are read."""
+    import numpy as np
+
+    name = member.filename
+    if not name.endswith(".npy") or member.file_size > max_bytes:
+        raise NpzFileError(f"path: {label}: member {name[:60]!r} is not an .npy array within {max_bytes} bytes")
+    with archive.open(member) as fh:
+        try:
+            version = np.lib.format.read_magic(fh)
+            header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+            shape, fortran, dtype = header(fh, max_header_size=10_000)
+        except NpzFileError:
+            raise
+        except Exception as err:  # numpy parses the header as a Python literal: a damaged one fails in many ways
+            raise NpzFileError(f"path: {label}: array {name[:-4]!r} has a damaged header ({type(err).__name__})") from None
+        count = int(np.prod(shape, dtype=object))
+        if dtype.hasobject:
+            raise NpzFileError(f"path: {label}: array {name[:-4]!r} holds Python objects, which are never read")
+        if count > max_values:
+            raise NpzFileError(f"path: {label}: array {name[:-4]!r} declares {count} values, more than this "
+                               f"reader's {max_values}")
+        data = fh.read(count * dtype.itemsize)
+        if len(data) != count * dtype.itemsize:
+            raise NpzFileError(f"path: {label}: array {name[:-4]!r} is truncated")
+        arr = np.frombuffer(data, dtype=dtype, count=count).copy()
+        return arr.reshape(shape[::-1]).T if fortran else arr.reshape(shape)
 
 
 def write_arrays(target: str | Path, arrays: dict, meta: dict | None = None) -> Path:
@@ -373,8 +472,8 @@ def read_arrays(target: str | Path, names: Sequence[str], meta: dict | None = No
     Notes
     -----
     Course convention (DESIGN.md, "Caching"), the reading twin of :func:`write_atomically` and
-    :func:`write_arrays`; never unpickles. Every array is read here, so a damaged member is found
-    now rather than by the caller.
+    :func:`write_arrays`; never unpickles. Every array is read here (:func:`read_npz`, within
+    :data:`MAX_CACHE_BYTES`), so a damaged or oversized member is found now rather than by the caller.
 
     Examples
     --------
@@ -389,13 +488,11 @@ def read_arrays(target: str | Path, names: Sequence[str], meta: dict | None = No
     >>> read_arrays(target, ["a"], {"n": 3}) is None     # says nothing of what made it
     True
     """
-    import numpy as np
-
     try:
-        with np.load(target, allow_pickle=False) as data:
-            if meta is not None and (_META not in data.files or str(data[_META]) != _meta_text(meta)):
-                return None
-            return {name: data[name] for name in names}
+        data = read_npz(target, max_bytes=MAX_CACHE_BYTES, max_values=MAX_CACHE_BYTES)
+        if meta is not None and (_META not in data or str(data[_META]) != _meta_text(meta)):
+            return None
+        return {name: data[name] for name in names}
     except CACHE_READ_ERRORS:
         return None
 

@@ -31,8 +31,6 @@ from __future__ import annotations
 
 import json
 import os
-import zipfile
-import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
@@ -40,12 +38,12 @@ from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 
-from ..cache import save_npz, write_atomically
+from ..cache import read_npz, save_npz, write_atomically
 from ..geometry import quat_to_matrix, se3_from_rt
 from ..validation import as_array, as_finite_scalar, as_int, as_positive, as_text, describe
 from .littledog import GUIDE, TIMESTEP
 
-__all__ = ["LOG_FORMAT", "LOG_VERSION", "LOG_LAYOUT", "META_KEYS", "StreamSpec", "TrialLogError", "TrialLog",
+__all__ = ["LOG_FORMAT", "LOG_VERSION", "MAX_LOG_BYTES", "MAX_META_CHARS", "LOG_LAYOUT", "META_KEYS", "StreamSpec", "TrialLogError", "TrialLog",
            "empty_streams", "trial_meta", "save_trial", "load_trial", "describe_layout"]
 
 
@@ -53,6 +51,10 @@ LOG_FORMAT = "robokit-littledog-trial"
 """What a trial log file says it is (``meta["format"]``)."""
 LOG_VERSION = 1
 """The layout version this code writes and reads (``meta["version"]``)."""
+MAX_LOG_BYTES = 2 * 1024**3
+"""The largest trial log :func:`load_trial` reads (bytes; also its bound on values per stream)."""
+MAX_META_CHARS = 1_000_000
+"""The longest ``__meta__`` JSON text :func:`load_trial` parses."""
 
 
 class StreamSpec(NamedTuple):
@@ -447,7 +449,9 @@ def load_trial(path: Any) -> TrialLog:
 
     Notes
     -----
-    ``numpy.load(..., allow_pickle=False)``: a log file can never run code.
+    Read by :func:`robokit.cache.read_npz` within :data:`MAX_LOG_BYTES` (sizes checked before data
+    are read; nothing is unpickled, so a log file can never run code); the metadata JSON within
+    :data:`MAX_META_CHARS`.
 
     Examples
     --------
@@ -461,25 +465,24 @@ def load_trial(path: Any) -> TrialLog:
     """
     source = _as_path(path)
     try:
-        data = np.load(source, allow_pickle=False)
-        if not isinstance(data, np.lib.npyio.NpzFile):      # a lone .npy array
-            raise TrialLogError(f"{source}: not a {LOG_FORMAT} file (one .npy array, not an .npz archive)")
-        with data:
-            names = list(data.files)
-            if "__meta__" not in names:
-                raise TrialLogError(f"{source}: not a {LOG_FORMAT} file (it has no __meta__ record; arrays "
-                                    f"{names[:6]})")
-            arrays = {name: data[name] for name in names}
-    except FileNotFoundError:
+        with open(source, "rb") as fh:
+            if fh.read(6) == b"\x93NUMPY":                 # a lone .npy array
+                raise TrialLogError(f"{source}: not a {LOG_FORMAT} file (one .npy array, not an .npz archive)")
+        arrays = read_npz(source, max_bytes=MAX_LOG_BYTES, max_arrays=len(LOG_LAYOUT) + 8, max_values=MAX_LOG_BYTES)
+    except (FileNotFoundError, TrialLogError):
         raise
-    except TrialLogError:
-        raise
-    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, zlib.error) as err:
+    except (OSError, ValueError) as err:
         raise TrialLogError(f"{source}: not a readable trial log (truncated or corrupt: {err})") from None
+    if "__meta__" not in arrays:
+        raise TrialLogError(f"{source}: not a {LOG_FORMAT} file (it has no __meta__ record; arrays "
+                            f"{list(arrays)[:6]})")
     try:
-        meta = json.loads(str(arrays.pop("__meta__")[()]))
-    except (ValueError, TypeError, IndexError) as err:
-        raise TrialLogError(f"{source}: its __meta__ record is not JSON ({err})") from None
+        text = str(arrays.pop("__meta__")[()])
+        if len(text) > MAX_META_CHARS:
+            raise ValueError(f"{len(text)} characters, more than {MAX_META_CHARS}")
+        meta = json.loads(text)
+    except (ValueError, TypeError, IndexError, RecursionError) as err:
+        raise TrialLogError(f"{source}: its __meta__ record is not JSON ({str(err)[:200]})") from None
     if not isinstance(meta, dict) or meta.get("format") != LOG_FORMAT:
         got = meta.get("format") if isinstance(meta, dict) else describe(meta)
         raise TrialLogError(f"{source}: a file of format {got!r}, not a {LOG_FORMAT!r} trial log")

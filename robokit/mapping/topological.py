@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..cache import save_npz
+from ..cache import NpzFileError, read_npz, save_npz, write_atomically
 from ..validation import as_array, as_choice, as_int, as_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
@@ -43,10 +43,12 @@ from ..vision.matching import Matches
 from .omni_views import OmniView
 from .pose_graph import PoseGraph, information_from_covariance
 
-__all__ = ["EmptyMapError", "ODOMETRY_EDGE", "LOOP_EDGE", "TopologicalMap"]
+__all__ = ["EmptyMapError", "ODOMETRY_EDGE", "LOOP_EDGE", "TopologicalMap", "MAX_MAP_BYTES", "MAX_MAP_VALUES"]
 
 #: Edge kinds: consecutive key images (odometry) and a place recognised again (loop closure).
 ODOMETRY_EDGE, LOOP_EDGE = 0, 1
+#: The largest map file :meth:`TopologicalMap.load` reads (bytes), and values per array.
+MAX_MAP_BYTES, MAX_MAP_VALUES = 256 * 1024**2, 1 << 26
 _FORMAT = 1
 
 
@@ -337,32 +339,41 @@ class TopologicalMap:
                 for f in dataclasses.fields(self)}
 
     def save(self, path: str | Path) -> Path:
-        """Write the map as one compressed ``.npz`` of plain arrays.
+        """Write the map as one compressed ``.npz`` of plain arrays, atomically: an interrupted save
+        leaves the old file (or none), never a partial one.
 
         Returns
         -------
         pathlib.Path
         """
-        target = Path(path)
-        with open(target, "wb") as f:
-            save_npz(f, {"format": np.array(_FORMAT), **self.to_arrays()})
-        return target
+        arrays = {"format": np.array(_FORMAT), **self.to_arrays()}
+        return write_atomically(Path(path), lambda tmp: save_npz(tmp, arrays))
 
     @classmethod
     def load(cls, path: str | Path) -> "TopologicalMap":
         """Read a map written by :meth:`save` (validated like a new one).
 
+        The file is read by :func:`robokit.cache.read_npz` within :data:`MAX_MAP_BYTES` bytes and
+        :data:`MAX_MAP_VALUES` values per array, checked before its data are read.
+
         Raises
         ------
         ValueError
-            For a file that is not such a map (missing arrays, other format version).
+            For a file that is not such a map (missing arrays, other format version, truncated,
+            corrupt, a device, larger than the bounds, arrays of the wrong shape or type).
+        FileNotFoundError
+            If there is no such file.
         """
         names = [f.name for f in dataclasses.fields(cls)]
         try:
-            with np.load(Path(path), allow_pickle=False) as data:
-                if int(data["format"]) != _FORMAT:
-                    raise ValueError(f"path: expected a topological map of format {_FORMAT}, got {int(data['format'])}")
-                arrays = {k: data[k] for k in names if k != "index" or k in data.files}
+            data = read_npz(path, max_bytes=MAX_MAP_BYTES, max_values=MAX_MAP_VALUES)
+            if int(data["format"]) != _FORMAT:
+                raise ValueError(f"path: expected a topological map of format {_FORMAT}, got {int(data['format'])}")
+            arrays = {k: data[k] for k in names if k != "index" or k in data}
+            return cls(**arrays)
         except KeyError as exc:
             raise ValueError(f"path: expected a saved TopologicalMap, {exc.args[0]!r} is missing") from None
-        return cls(**arrays)
+        except NpzFileError:
+            raise
+        except (TypeError, ValueError, IndexError) as exc:
+            raise ValueError(f"path: {Path(path).name} is not a saved TopologicalMap ({exc})") from None

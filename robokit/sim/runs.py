@@ -25,7 +25,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, save_npz, write_atomically
+from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, read_npz, save_npz, write_atomically
 from ..parallel import iter_runs, map_runs
 from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, as_int, as_positive
@@ -34,7 +34,10 @@ from .motion import Trajectory, noisy_odometry
 from .omni import OmniCamera
 from .world import World
 
-__all__ = ["Run", "record", "describe_sensor", "FrameStream", "record_stream"]
+__all__ = ["Run", "record", "describe_sensor", "FrameStream", "record_stream", "MAX_RUN_BYTES"]
+
+#: The largest run file :meth:`Run.load` reads (bytes; also its bound on values per array).
+MAX_RUN_BYTES = 4 * 1024**3
 
 _FORMAT = 1
 
@@ -94,30 +97,32 @@ class Run:
         for group in ("images", "depths", "scans"):
             for name, arr in getattr(self, group).items():
                 arrays[f"{group}:{name}"] = arr
-        path = Path(path)
-        with open(path, "wb") as fh:
-            save_npz(fh, arrays)
-        return path
+        return write_atomically(Path(path), lambda tmp: save_npz(tmp, arrays))
 
     @classmethod
     def load(cls, path: str | Path) -> "Run":
-        """Read a run written by :meth:`save` (``allow_pickle=False``: no code is ever loaded).
+        """Read a run written by :meth:`save` (nothing is unpickled: no code is ever loaded).
+
+        The file is read by :func:`robokit.cache.read_npz` within :data:`MAX_RUN_BYTES`.
 
         Raises
         ------
         ValueError
-            If the file is not a robokit run.
+            If the file is not a robokit run (:class:`robokit.cache.NpzFileError` for one that is
+            truncated, corrupt, a device or beyond the bound).
         """
-        with np.load(Path(path), allow_pickle=False) as data:
-            if "meta" not in data.files or "poses" not in data.files:
-                raise ValueError(f"path: expected a robokit run (.npz with meta and poses), got {path}")
-            groups: dict[str, dict] = {"images": {}, "depths": {}, "scans": {}}
-            for key in data.files:
-                if ":" in key:
-                    group, name = key.split(":", 1)
-                    groups[group][name] = data[key]
-            return cls(data["t"], data["poses"], data["odometry"], groups["images"], groups["depths"],
-                       groups["scans"], json.loads(str(data["meta"])))
+        data = read_npz(path, max_bytes=MAX_RUN_BYTES, max_values=MAX_RUN_BYTES)
+        if "meta" not in data or "poses" not in data:
+            raise ValueError(f"path: expected a robokit run (.npz with meta and poses), got {path}")
+        groups: dict[str, dict] = {"images": {}, "depths": {}, "scans": {}}
+        for key in data:
+            if ":" in key:
+                group, name = key.split(":", 1)
+                if group not in groups:
+                    raise ValueError(f"path: {path} holds an unknown group {group[:40]!r}")
+                groups[group][name] = data[key]
+        return cls(data["t"], data["poses"], data["odometry"], groups["images"], groups["depths"],
+                   groups["scans"], json.loads(str(data["meta"])))
 
 
 def _cached(target: Path, meta: dict) -> Run | None:

@@ -36,12 +36,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..cache import save_npz
+from ..cache import read_npz, save_npz, write_atomically
 from ..validation import as_array, as_int, as_rng, describe
 from .hamming import as_binary_descriptors, hamming_distance
 
 __all__ = ["Vocabulary", "TooFewDescriptorsError", "VocabularyFileError", "BowVector", "as_bow_vector", "tf_idf",
-           "l1_score"]
+           "l1_score", "MAX_FILE_BYTES", "MAX_FILE_VALUES"]
 
 
 class BowVector(NamedTuple):
@@ -191,6 +191,10 @@ def l1_score(v_a, v_b) -> float:
 
 
 _FORMAT = "robokit-vocabulary-1"
+
+
+#: The largest vocabulary or database file robokit reads (bytes), and values per array.
+MAX_FILE_BYTES, MAX_FILE_VALUES = 512 * 1024**2, 1 << 27
 
 
 class TooFewDescriptorsError(ValueError):
@@ -506,25 +510,26 @@ class Vocabulary:
             raise VocabularyFileError(f"{source}: not a vocabulary saved by Vocabulary.save ({err})") from None
 
     def save(self, path) -> Path:
-        """Write the vocabulary to ``path`` (numpy ``.npz``); returns the path written."""
-        path = Path(path)
-        with open(path, "wb") as fh:
-            save_npz(fh, self.arrays())
-        return path
+        """Write the vocabulary to ``path`` (numpy ``.npz``), atomically; returns the path written."""
+        arrays = self.arrays()
+        return write_atomically(Path(path), lambda tmp: save_npz(tmp, arrays))
 
     @classmethod
     def load(cls, path) -> "Vocabulary":
         """Read a vocabulary written by :meth:`save`.
 
+        The file is read by :func:`robokit.cache.read_npz` within :data:`MAX_FILE_BYTES` bytes and
+        :data:`MAX_FILE_VALUES` values per array, checked before its data are read.
+
         Raises
         ------
         VocabularyFileError
-            If the file is not one (corrupt, truncated, another format); FileNotFoundError if absent.
+            If the file is not one (corrupt, truncated, another format, a device, beyond the bounds);
+            FileNotFoundError if absent.
         """
         path = Path(path)
         try:
-            with np.load(path, allow_pickle=False) as npz:
-                return cls.from_arrays(npz, str(path))
+            return cls.from_arrays(read_npz(path, max_bytes=MAX_FILE_BYTES, max_values=MAX_FILE_VALUES), str(path))
         except (VocabularyFileError, FileNotFoundError):
             raise
         except Exception as err:         # zip/pickle/format errors of a foreign file

@@ -29,12 +29,15 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..cache import save_npz
+from ..cache import read_npz, save_npz, write_atomically
 from ..validation import as_int, describe
-from .bag_of_words import Vocabulary, VocabularyFileError
+from .bag_of_words import MAX_FILE_BYTES, MAX_FILE_VALUES, Vocabulary, VocabularyFileError
 from .bag_of_words import BowVector, as_bow_vector
 
-__all__ = ["QueryResult", "BowDatabase", "DatabaseFileError"]
+__all__ = ["QueryResult", "BowDatabase", "DatabaseFileError", "MAX_ENTRIES"]
+
+#: The most images a database file may hold (:meth:`BowDatabase.load` refuses more before adding any).
+MAX_ENTRIES = 100_000
 
 
 class DatabaseFileError(ValueError):
@@ -174,32 +177,37 @@ class BowDatabase:
         return [QueryResult(int(ids[i]), float(min(1.0, score[i]))) for i in order]
 
     def save(self, path) -> Path:
-        """Write the database and its vocabulary to one ``.npz`` file; returns the path."""
+        """Write the database and its vocabulary to one ``.npz`` file, atomically; returns the path."""
         path = Path(path)
         sizes = np.array([w.size for w in self._words], np.int64)
         arrays = {f"vocabulary_{k}": v for k, v in self.vocabulary.arrays().items()}
         arrays.update(entry_sizes=sizes,
                       entry_words=np.concatenate(self._words) if self._words else np.zeros(0, np.int64),
                       entry_weights=np.concatenate(self._weights) if self._weights else np.zeros(0))
-        with open(path, "wb") as fh:
-            save_npz(fh, arrays)
-        return path
+        return write_atomically(path, lambda tmp: save_npz(tmp, arrays))
 
     @classmethod
     def load(cls, path) -> "BowDatabase":
         """Read a database written by :meth:`save` (with its vocabulary).
 
+        The file is read by :func:`robokit.cache.read_npz` within the vocabulary's file bounds and
+        may hold at most :data:`MAX_ENTRIES` images.
+
         Raises
         ------
         DatabaseFileError
-            If the file is not one (corrupt, truncated, another format); FileNotFoundError if absent.
+            If the file is not one (corrupt, truncated, another format, a device, beyond the bounds);
+            FileNotFoundError if absent.
         """
         path = Path(path)
         try:
-            with np.load(path, allow_pickle=False) as npz:
-                voc = Vocabulary.from_arrays({k[len("vocabulary_"):]: npz[k] for k in npz.files
-                                              if k.startswith("vocabulary_")}, str(path))
-                sizes, words, weights = npz["entry_sizes"], npz["entry_words"], npz["entry_weights"]
+            npz = read_npz(path, max_bytes=MAX_FILE_BYTES, max_values=MAX_FILE_VALUES)
+            voc = Vocabulary.from_arrays({k[len("vocabulary_"):]: v for k, v in npz.items()
+                                          if k.startswith("vocabulary_")}, str(path))
+            sizes, words, weights = npz["entry_sizes"], npz["entry_words"], npz["entry_weights"]
+            if sizes.size > MAX_ENTRIES:
+                raise DatabaseFileError(f"path: {path} holds {sizes.size} entries, more than the {MAX_ENTRIES} "
+                                        "a database file may")
             if sizes.sum() != words.size or words.size != weights.size or np.any(sizes < 0):
                 raise DatabaseFileError(f"path: {path} has inconsistent entry arrays")
             db = cls(voc)
