@@ -146,3 +146,17 @@ def test_an_overconfident_filter_fails_the_nees_test():
     lo, hi = nees_bounds(5, runs)
     per_step = N.mean(axis=0)
     assert np.mean((per_step > lo) & (per_step < hi)) < 0.2 and N.mean() > 2 * hi
+
+
+def test_nees_refuses_a_covariance_that_is_not_positive_definite():
+    # a negative-definite P had given a NEES of -1 without a word
+    from robokit.localization.pose_ekf import nees
+
+    for P, what in [(-np.eye(2), "positive-definite"), (np.zeros((2, 2)), "positive-definite"),
+                    ([[1.0, 2.0], [0.0, 1.0]], "symmetric")]:
+        with pytest.raises(ValueError, match=f"P: expected {what}"):
+            nees([0.1, 0.2], P)
+    stack = np.tile(np.eye(2), (3, 1, 1))
+    stack[1] = -np.eye(2)
+    with pytest.raises(ValueError, match="P: expected positive-definite"):
+        nees(np.ones((3, 2)), stack)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -148,3 +149,22 @@ def test_public_files_read_as_gtsam_reads_them(name):
         z = f.measured()
         np.testing.assert_allclose([z.x(), z.y(), z.theta()], ours.measurements[k], atol=1e-12)
         np.testing.assert_allclose(f.noiseModel().R().T @ f.noiseModel().R(), ours.information[k], rtol=1e-9)
+
+
+def test_ids_beyond_64_bits_and_files_beyond_the_budget_are_refused(tmp_path, monkeypatch):
+    # an id of 2^63 had wrapped to a negative number; a device or an oversized file is refused
+    # before it is read
+    import robokit.mapping.g2o as g2o
+
+    with pytest.raises(G2OFormatError, match="line 1: VERTEX_SE2: vertex id '9223372036854775808' does not fit"):
+        read_g2o("VERTEX_SE2 9223372036854775808 0 0 0\n")
+    assert read_g2o("VERTEX_SE2 9223372036854775807 0 0 0\n").ids.tolist() == [2**63 - 1]
+    with pytest.raises(G2OFormatError, match="not a regular file"):
+        read_g2o(Path("/dev/zero"))
+    target = tmp_path / "g.g2o"
+    target.write_text("VERTEX_SE2 0 0 0 0\n" * 10)
+    monkeypatch.setattr(g2o, "MAX_G2O_BYTES", 100)
+    with pytest.raises(G2OFormatError, match="more than the 100"):
+        read_g2o(target)
+    with pytest.raises(G2OFormatError, match="more than the 100"):
+        read_g2o(target.read_text())

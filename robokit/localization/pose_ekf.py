@@ -309,7 +309,8 @@ def nees(error: Any, P: Any) -> Any:
     Raises
     ------
     ValueError
-        For shapes that disagree, NaN or infinity, or a singular covariance.
+        For shapes that disagree, NaN or infinity, or a covariance that is not symmetric positive
+        definite (a singular or negative-definite one would give an infinite or negative NEES).
 
     Notes
     -----
@@ -326,10 +327,13 @@ def nees(error: Any, P: Any) -> Any:
         raise ValueError(f"error: expected shape (n,) or (K, n), got shape {e.shape}")
     n = e.shape[-1]
     C = as_array(P, "P", shape=(n, n) if e.ndim == 1 else (len(e), n, n))
-    try:
-        out = np.einsum("...i,...i->...", e, np.linalg.solve(C, e[..., None])[..., 0])
-    except np.linalg.LinAlgError:
-        raise ValueError("P: expected invertible covariances, got a singular one") from None
+    scale = np.abs(C).max(axis=(-2, -1), initial=0.0)
+    if not np.all(np.abs(C - np.swapaxes(C, -1, -2)) <= 1e-9 * scale[..., None, None]):
+        raise ValueError("P: expected symmetric covariances, got P[i, j] != P[j, i]")
+    low = np.linalg.eigvalsh(C)[..., 0]
+    if np.any(low <= 1e-14 * scale):         # a negative-definite P would give a negative NEES
+        raise ValueError(f"P: expected positive-definite covariances, got an eigenvalue {float(np.min(low)):.3g}")
+    out = np.einsum("...i,...i->...", e, np.linalg.solve(C, e[..., None])[..., 0])
     require_finite_result("error, P", out)
     return float(out) if out.ndim == 0 else out
 

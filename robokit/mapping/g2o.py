@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -37,7 +38,10 @@ import numpy as np
 from ..validation import as_text, describe
 from .pose_graph import PoseGraph, as_pose_graph, positive_definite
 
-__all__ = ["G2OFormatError", "read_g2o", "write_g2o"]
+__all__ = ["G2OFormatError", "read_g2o", "write_g2o", "MAX_G2O_BYTES"]
+
+#: The largest g2o file :func:`read_g2o` reads (bytes): about 300,000 edges.
+MAX_G2O_BYTES = 32 * 1024**2
 
 #: Tags of other g2o types, named in the error so a 3-D or landmark file is recognised as such.
 UNSUPPORTED = ("VERTEX_SE3:QUAT", "EDGE_SE3:QUAT", "VERTEX_XY", "EDGE_SE2_XY", "VERTEX_TRACKXYZ", "EDGE_SE2_TRACKXYZ",
@@ -74,19 +78,29 @@ def _numbers(fields: list[str], count: int, tag: str, fail) -> list[float]:
 
 def _vertex_id(text: str, tag: str, fail) -> int:
     try:
-        return int(text)
+        vid = int(text)
     except ValueError:
         fail(f"{tag}: vertex id {text!r} is not an integer")
+    if not -2**63 <= vid < 2**63:          # ids are kept as int64: a larger one would wrap around
+        fail(f"{tag}: vertex id {text[:30]!r} does not fit in 64 bits")
+    return vid
 
 
 def _text_of(source: Any) -> tuple[str, str]:
     """(text, where) of a path or of g2o text (a str with a newline)."""
     if isinstance(source, str) and "\n" in source:
+        if len(source) > MAX_G2O_BYTES:
+            raise G2OFormatError("<text>", 0, f"{len(source)} characters, more than the {MAX_G2O_BYTES} read_g2o reads")
         return source, "<text>"
     if isinstance(source, os.PathLike):
         path = Path(source)
     else:
         path = Path(as_text(source, "source", empty=False))
+    info = path.stat()
+    if not stat.S_ISREG(info.st_mode):
+        raise G2OFormatError(str(path), 0, "not a regular file (a device, FIFO or directory)")
+    if info.st_size > MAX_G2O_BYTES:
+        raise G2OFormatError(str(path), 0, f"{info.st_size} bytes, more than the {MAX_G2O_BYTES} read_g2o reads")
     try:
         return path.read_text(encoding="utf-8"), str(path)
     except UnicodeDecodeError:
