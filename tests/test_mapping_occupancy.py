@@ -295,3 +295,32 @@ def test_from_probability_refuses_nan_and_out_of_range():
             OccupancyGrid.from_probability(bad, 0.1)
     with pytest.raises(ValueError, match="log_odds"):
         OccupancyGrid(np.zeros((0, 3)), 0.1)
+
+
+@pytest.mark.parametrize("name", ["a #b", "[lead", "colon: x", "it's", " space", 'q"uote', "{brace}", "-dash"])
+def test_save_map_writes_names_that_load_map_reads_back(tmp_path, name):
+    # the YAML's image value was written bare: " #" began a comment, "[" a list, and load_map refused it
+    from robokit.mapping.map_server import load_map, save_map
+
+    grid = OccupancyGrid.from_probability([[0.0, 1.0, 0.5]], 0.05, origin=(-1.0, 2.0))
+    _, yaml = save_map(grid, tmp_path / name)
+    np.testing.assert_array_equal(load_map(yaml).probability, load_map(save_map(grid, tmp_path / "plain")[1]).probability)
+
+
+def test_save_map_refuses_a_name_it_cannot_write_and_load_map_bounds_what_it_reads(tmp_path):
+    from robokit.mapping.map_server import MapFileError, load_map, save_map
+
+    grid = OccupancyGrid.from_probability([[0.0, 1.0]], 0.05)
+    for name in ("new\nline", "both'\""):
+        with pytest.raises(ValueError, match="stem"):
+            save_map(grid, tmp_path / name)
+    assert list(tmp_path.iterdir()) == []
+    device = tmp_path / "device.yaml"
+    device.write_text("image: /dev/zero\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+                      "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    with pytest.raises(MapFileError, match="not a regular file"):
+        load_map(device)
+    big = tmp_path / "big.yaml"
+    big.write_text("# padding\n" * 10_000)
+    with pytest.raises(MapFileError, match="more than"):
+        load_map(big)

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 import re
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -45,7 +46,13 @@ from ..cache import write_atomically
 from ..validation import as_choice, as_int, as_text, describe
 from .occupancy_grid import FREE_THRESHOLD, OCCUPIED_THRESHOLD, OccupancyGrid
 
-__all__ = ["MapFileError", "save_map", "load_map", "OCCUPIED_VALUE", "FREE_VALUE", "UNKNOWN_VALUE"]
+__all__ = ["MapFileError", "save_map", "load_map", "OCCUPIED_VALUE", "FREE_VALUE", "UNKNOWN_VALUE",
+           "MAX_YAML_BYTES", "MAX_PGM_BYTES"]
+
+#: The largest map description (YAML) and map image (PGM) :func:`load_map` reads, in bytes.
+MAX_YAML_BYTES, MAX_PGM_BYTES = 64 * 1024, 256 * 1024**2
+#: Characters that make YAML read a plain value differently: such an image name is written quoted.
+_YAML_SPECIAL = set("#:[]{},'\"&*!|>%@`?")
 
 #: map_saver's trinary pixel values (negate 0).
 OCCUPIED_VALUE, FREE_VALUE, UNKNOWN_VALUE = 0, 254, 205
@@ -127,6 +134,7 @@ def save_map(grid: OccupancyGrid, stem: Any, *, occupied_thresh: float = OCCUPIE
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"grid: expected an OccupancyGrid, got {describe(grid)}")
     base = Path(as_text(stem, "stem", empty=False) if not isinstance(stem, Path) else stem)
+    _yaml_name(base.name + ".pgm")                              # refused before anything is written
     f, o = _thresholds(free_thresh, occupied_thresh, _value_error)
     neg = as_int(negate, "negate", minimum=0, maximum=1)
     as_choice(mode, "mode", ["trinary", "scale"])
@@ -146,10 +154,23 @@ def save_map(grid: OccupancyGrid, stem: Any, *, occupied_thresh: float = OCCUPIE
     data = f"P5\n{w} {h}\n255\n".encode("ascii") + np.ascontiguousarray(img).tobytes()
     write_atomically(pgm, lambda p: p.write_bytes(data))
     x0, y0 = (float(c) for c in grid.origin)
-    text = (f"image: {pgm.name}\nmode: {mode}\nresolution: {grid.resolution!r}\norigin: [{x0!r}, {y0!r}, 0.0]\n"
+    text = (f"image: {_yaml_name(pgm.name)}\nmode: {mode}\nresolution: {grid.resolution!r}\norigin: [{x0!r}, {y0!r}, 0.0]\n"
             f"negate: {neg}\noccupied_thresh: {o!r}\nfree_thresh: {f!r}\n")
     write_atomically(yaml, lambda p: p.write_text(text))
     return pgm, yaml
+
+
+def _yaml_name(name: str) -> str:
+    """``name`` as a YAML value that :func:`load_map` reads back as ``name``: plain if it can be,
+    else quoted with a quote it does not hold."""
+    if any(c in name for c in "\n\r\x00"):
+        raise ValueError(f"stem: a map name cannot hold a line break or NUL, got {name[:60]!r}")
+    if name == name.strip() and not _YAML_SPECIAL & set(name):
+        return name
+    for quote in "'\"":
+        if quote not in name:
+            return f"{quote}{name}{quote}"
+    raise ValueError(f"stem: a map name cannot hold both quote characters, got {name[:60]!r}")
 
 
 def _scalar(text: str, fail) -> Any:
@@ -179,26 +200,41 @@ def _number(text: str, fail) -> float:
     return v
 
 
+def _bounded_bytes(path: Path, limit: int, what: str) -> bytes:
+    """The bytes of the regular file ``path``, refused (MapFileError) if larger than ``limit``."""
+    try:
+        info = path.stat()
+        if not stat.S_ISREG(info.st_mode):
+            raise MapFileError(path, f"the {what} is not a regular file (a device, FIFO or directory)")
+        if info.st_size > limit:
+            raise MapFileError(path, f"the {what} has {info.st_size} bytes, more than the {limit} load_map reads")
+        return path.read_bytes()
+    except FileNotFoundError:
+        raise
+    except OSError as exc:
+        raise MapFileError(path, f"cannot read the {what}: {exc}") from None
+
+
 def _parse_yaml(path: Path) -> dict:
     try:
-        text = path.read_text(encoding="utf-8")
+        text = _bounded_bytes(path, MAX_YAML_BYTES, "map description").decode("utf-8")
     except FileNotFoundError:
         raise MapFileError(path, "no such map file") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError as exc:
         raise MapFileError(path, f"cannot read the map description: {exc}") from None
     out: dict = {}
     for n, raw in enumerate(text.splitlines(), 1):
-        line = "" if raw.lstrip().startswith("#") else re.split(r"\s#", raw)[0].strip()
+        line = raw.strip()
 
         def fail(message: str, n: int = n) -> None:
             raise MapFileError(path, f"line {n}: {message}")
 
-        if not line:
+        if not line or line.startswith("#"):
             continue
         m = _LINE.match(line)
         if not m:
             fail(f"expected 'key: value', got {raw.strip()!r}")
-        key, value = m.group(1), m.group(2).strip()
+        key, value = m.group(1), _without_comment(m.group(2).strip(), fail)
         if key in out:
             fail(f"key {key!r} appears twice")
         if not value:
@@ -207,13 +243,24 @@ def _parse_yaml(path: Path) -> dict:
     return out
 
 
+def _without_comment(value: str, fail) -> str:
+    """A YAML value without its trailing comment; a quoted value keeps a ``#`` inside its quotes."""
+    if value[:1] in ("'", '"'):
+        end = value.find(value[0], 1)
+        if end < 0:
+            fail(f"expected a closing {value[0]} in {value[:60]!r}")
+        tail = value[end + 1:].strip()
+        if tail and not tail.startswith("#"):
+            fail(f"unexpected text after a quoted value: {tail[:40]!r}")
+        return value[:end + 1]
+    return re.split(r"\s#", value)[0].strip()
+
+
 def _read_pgm(path: Path) -> np.ndarray:
     try:
-        data = path.read_bytes()
+        data = _bounded_bytes(path, MAX_PGM_BYTES, "map image")
     except FileNotFoundError:
         raise MapFileError(path, "the map image named by the YAML does not exist") from None
-    except OSError as exc:
-        raise MapFileError(path, f"cannot read the map image: {exc}") from None
     fields, pos = [], 0
     while len(fields) < 4:                                      # magic, width, height, maxval
         while pos < len(data) and (data[pos:pos + 1].isspace() or data[pos:pos + 1] == b"#"):
