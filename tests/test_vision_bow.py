@@ -272,3 +272,11 @@ def test_corridor_place_recognition():
         near += bool(best) and abs(best[0].entry - i) <= 1
     # measured (k=8, L=3, 512 words): 28/29 at the same x, 29/29 within 1 m
     assert near / len(xs) >= 0.9 and exact / len(xs) >= 0.85, (exact, near)
+
+
+def test_identical_training_descriptors_are_too_few_not_an_internal_error():
+    # identical rows cannot be split into `branching` clusters; this had raised a ValueError about
+    # an internal array ("centres: expected one row per node")
+    d = np.zeros((50, 32), np.uint8)
+    with pytest.raises(TooFewDescriptorsError, match="branching=3 distinct training descriptors, got 1 distinct of 100"):
+        Vocabulary.train([d, d], branching=3, levels=2, rng=0)

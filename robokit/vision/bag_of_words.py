@@ -373,7 +373,7 @@ class Vocabulary:
         Raises
         ------
         TooFewDescriptorsError
-            With fewer training descriptors than ``branching`` (no first split exists).
+            With fewer distinct training descriptors than ``branching`` (no first split exists).
         TypeError, ValueError
             For descriptors that are not byte rows of one length, or parameters out of range.
 
@@ -404,9 +404,10 @@ class Vocabulary:
         if len(width) > 1:
             raise ValueError(f"descriptors: expected one descriptor length for every image, got {sorted(width)}")
         desc = np.concatenate(images) if images else np.zeros((0, 32), np.uint8)
-        if len(desc) < branching:
-            raise TooFewDescriptorsError(f"descriptors: expected at least branching={branching} training "
-                                         f"descriptors, got {len(desc)}")
+        distinct = len(np.unique(desc, axis=0)) if len(desc) else 0
+        if distinct < branching:          # k-means cannot split fewer distinct rows into k clusters
+            raise TooFewDescriptorsError(f"descriptors: expected at least branching={branching} distinct training "
+                                         f"descriptors, got {distinct} distinct of {len(desc)}")
         children, centres = [[-1] * branching], [np.zeros(desc.shape[1], np.uint8)]
         todo = [(0, np.arange(len(desc)), 0)]                 # (node, member rows, depth)
         while todo:
