@@ -213,3 +213,24 @@ def test_a_scan_without_walls_is_reported_not_raised():
     s = corridor_state(np.full(360, np.inf), ANGLES, W, RMAX)
     assert (s.in_corridor, s.lateral_offset, s.axis, s.d_l) == (False, None, None, np.inf)
     assert s.areas.shape == (1, 3)
+
+
+def test_zero_ranges_are_no_returns_and_far_returns_cost_no_memory():
+    # a driver that codes "no return" as 0 had stopped corridor_state with an error about an
+    # internal "d_l"; a 9e5 m return had asked the axis vote for tens of GiB
+    r = two_walls(1.0, 1.17)
+    ok = corridor_state(r, ANGLES, W, 8.0)
+    zeroed = np.where(np.isinf(r), 0.0, r)
+    assert as_scan(zeroed, ANGLES)[0].tolist() == r.tolist()
+    again = corridor_state(zeroed, ANGLES, W, 8.0)
+    assert (again.d_l, again.d_r, again.width_case, again.n_areas) == (ok.d_l, ok.d_r, ok.width_case, ok.n_areas)
+    far = np.where(np.isinf(r), 9e5, r)
+    assert round(corridor_axis(far, ANGLES), 9) == round(corridor_axis(r, ANGLES), 9)
+    all_zero = corridor_state(np.zeros_like(r), ANGLES, W, 8.0)
+    assert all_zero.d_l == np.inf and all_zero.lateral_offset is None
+
+
+def test_a_sparse_scan_gives_no_wall_rather_than_a_negative_distance():
+    angles = np.deg2rad(np.arange(0, 360, 45.0)) + 0.3             # eight beams, none near a normal
+    with pytest.raises(NoWallError, match="within 15 deg"):
+        wall_distances(np.full(8, 1.5), angles, heading=0.0)

@@ -52,7 +52,8 @@ def as_scan(ranges: Any, angles: Any) -> tuple[np.ndarray, np.ndarray]:
     ----------
     ranges, angles : array_like, shape (B,)
         Ranges in metres, ``inf`` where a beam has no return within the sensor's range (below
-        ``MAX_RANGE`` = 1e6 m otherwise), and beam angles in radians.
+        ``MAX_RANGE`` = 1e6 m otherwise), and beam angles in radians. A range of exactly 0 is
+        read as no return too (many LiDAR drivers code it so) and returned as ``inf``.
 
     Returns
     -------
@@ -85,6 +86,8 @@ def as_scan(ranges: Any, angles: Any) -> tuple[np.ndarray, np.ndarray]:
     bad = np.isnan(r) | (r < 0) | (np.isfinite(r) & (r >= MAX_RANGE))
     if bad.any():
         raise ValueError(f"ranges: expected non-negative ranges below {MAX_RANGE:g} m or inf (no return), got {r[bad][0]}")
+    if np.any(r == 0):                    # many drivers code "no return" as 0: read it as inf
+        r = np.where(r == 0, np.inf, r)
     if np.any(np.diff(a) <= 0) or a[-1] - a[0] >= 2 * np.pi:
         raise ValueError(f"angles: expected strictly increasing angles spanning less than 2 pi, "
                          f"got {a[0]} ... {a[-1]} (B = {len(a)})")

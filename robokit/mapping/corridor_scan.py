@@ -45,7 +45,9 @@ __all__ = ["NoWallError", "CorridorState", "corridor_axis", "wall_distances", "d
 
 WIDTH_CASES = ("corridor", "facing doors", "staggered doors")
 _FOOT = 7                 # beams nearest a wall's normal that measure its distance
+_FOOT_CONE = np.deg2rad(15.0)   # ... if within this angle of the normal (a sparse scan's are not)
 _BIN = 0.02               # Hough bin (m) of the lateral coordinate
+_VOTE_RANGE = 100.0       # only returns this near (m) vote for the axis: the tables stay under 10,000 bins
 _BAND = 0.05              # half-width (m) of a wall's inlier band for the line fit
 _CANDIDATES = np.deg2rad(np.arange(-90.0, 90.0, 1.0))      # the Hough vote's directions, 1 deg apart
 _ACROSS = np.stack([-np.sin(_CANDIDATES), np.cos(_CANDIDATES)])   # unit normal of each direction
@@ -79,7 +81,9 @@ def corridor_axis(ranges: Any, angles: Any) -> float:
     Ge et al. (2023) assume the robot can align with the corridor (Sec. 3.1, unnumbered) without
     saying how; this is ours. A Hough vote (Duda & Hart 1972) over 180 directions, 1 deg apart,
     scores each direction by how sharply the points' coordinates across it pile up (the sum of the
-    squared counts of 2 cm bins): two parallel walls give two sharp piles. Then a total-least-squares
+    squared counts of 2 cm bins): two parallel walls give two sharp piles. Only returns within
+    100 m vote (farther ones, sentinel values included, cannot help place a 2 cm bin and would
+    size its table by their distance). Then a total-least-squares
     fit (Golub & Van Loan 1980) of the points within 5 cm of the strongest pile on each side, with
     a common direction and one offset per wall (the largest eigenvector of the pooled scatter).
     Door recesses (7 cm behind the wall) fall outside the bands. Close to an end wall its pile
@@ -101,9 +105,10 @@ def corridor_axis(ranges: Any, angles: Any) -> float:
 
 def _axis(r: np.ndarray, a: np.ndarray) -> float:
     """:func:`corridor_axis` of a scan :func:`as_scan` has checked."""
-    ok = np.isfinite(r)
+    ok = r <= _VOTE_RANGE                 # farther returns (sentinels too) would only widen the tables
     if np.count_nonzero(ok) < 3:
-        raise EmptyScanError(f"ranges: expected at least 3 valid returns to find the corridor axis, got {ok.sum()}")
+        raise EmptyScanError(f"ranges: expected at least 3 valid returns within {_VOTE_RANGE:g} m to find the "
+                             f"corridor axis, got {ok.sum()}")
     pts = r[ok, None] * np.column_stack([np.cos(a[ok]), np.sin(a[ok])])
     s = pts @ _ACROSS                                                 # (N, 180) lateral coordinates
     lo = np.floor(s.min() / _BIN)
@@ -154,7 +159,8 @@ def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[fl
     Raises
     ------
     NoWallError
-        If fewer than 4 of the 7 beams nearest a wall's normal have a return.
+        If fewer than 4 of the 7 beams nearest a wall's normal have a return within 15 deg of it
+        (a sparse scan's nearest beams may point away from the wall: they never give a distance).
 
     Notes
     -----
@@ -187,10 +193,11 @@ def _wall_distances(r: np.ndarray, a: np.ndarray, axis: float) -> tuple[float, f
     for name, normal in (("left", axis + np.pi / 2), ("right", axis - np.pi / 2)):
         off = wrap_angle(a - normal, validate=False)
         foot = np.argsort(np.abs(off), kind="stable")[:_FOOT]
-        along = r[foot] * np.cos(off[foot])
-        if np.count_nonzero(np.isfinite(along)) < (len(foot) + 2) // 2:
-            raise NoWallError(f"ranges: expected returns on most of the {len(foot)} beams nearest the {name} "
-                              f"wall's normal, got {np.count_nonzero(np.isfinite(along))}")
+        along = np.where(np.abs(off[foot]) <= _FOOT_CONE, r[foot] * np.cos(off[foot]), np.inf)
+        if np.count_nonzero(np.isfinite(along)) < (_FOOT + 2) // 2:
+            raise NoWallError(f"ranges: expected returns on most of the {_FOOT} beams nearest the {name} wall's "
+                              f"normal, got {np.count_nonzero(np.isfinite(along))} within {np.rad2deg(_FOOT_CONE):g} "
+                              "deg of it")
         out.append(float(np.median(along)))
     return out[0], out[1]
 
