@@ -99,3 +99,20 @@ def test_interchangeable_and_empty_results():
         sift_descriptor(flat, np.zeros((3, 2)))
     with pytest.raises(ValueError, match="scale"):
         Keypoints([[1.0, 2.0]], [0.0], [1.0], [0.0])
+
+
+def test_eight_bit_images_in_other_dtypes_give_the_same_orb_features():
+    # img.astype(int) and 0..255 floats had given no features at all, silently
+    from robokit.vision.orb import detect_orb_features
+
+    rng = np.random.default_rng(0)
+    image = ((rng.random((120, 160)) > 0.5) * 255).astype(np.uint8)
+    want = detect_orb_features(image, 100)
+    for other in (image.astype(int), image.astype(np.int16)):
+        got = detect_orb_features(other, 100)
+        np.testing.assert_array_equal(got.descriptors, want.descriptors)
+    with pytest.raises(ValueError, match=r"image: expected float pixel values in \[0, 1\], got values from 0 to 255"):
+        detect_orb_features(image.astype(float), 100)
+    with pytest.raises(ValueError, match="expected 8-bit pixel values 0..255"):
+        detect_orb_features(image.astype(int) * 4, 100)
+    np.testing.assert_array_equal(detect_orb_features(image / 255.0, 100).descriptors, want.descriptors)

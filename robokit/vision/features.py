@@ -26,14 +26,36 @@ from ..validation import as_array, describe
 __all__ = ["as_gray_image", "Keypoints", "Features"]
 
 
+def _pixel_scale(raw: np.ndarray, name: str) -> float:
+    """What the image's values are divided by to lie in [0, 1]: 255 for 8-bit data (``uint8``, or
+    any other integer type holding 0..255, as ``img.astype(int)`` makes), 65535 for ``uint16``, 1
+    for floats in [0, 1]. Values that fit no such reading are refused (they would give a blank or
+    saturated image, and no features, without a word)."""
+    if raw.dtype == np.uint16:
+        return 65535.0
+    finite = raw[np.isfinite(raw)] if raw.dtype.kind == "f" else raw
+    low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 0.0)
+    if raw.dtype.kind in "iu":
+        if raw.dtype != np.uint8 and (low < 0 or high > 255):
+            raise ValueError(f"{name}: expected 8-bit pixel values 0..255 in a {raw.dtype} image (or uint8/uint16), "
+                             f"got values from {low:g} to {high:g}")
+        return 255.0
+    if low < -0.5 or high > 1.5:         # noise may stray a little outside [0, 1]; 0..255 floats do not fit
+        raise ValueError(f"{name}: expected float pixel values in [0, 1], got values from {low:g} to {high:g} "
+                         "(divide an 8-bit image by 255, or pass it as uint8)")
+    return 1.0
+
+
 def as_gray_image(image, name: str = "image") -> np.ndarray:
     """Return ``image`` as a float32 grey image with values in [0, 1] (for integer input).
 
     Parameters
     ----------
     image : array_like, shape (H, W) or (H, W, 3|4)
-        Grey or RGB(A) image (the alpha channel is ignored). Integer images are divided by their
-        dtype's maximum; float images are kept as they are (expected in [0, 1]). Boolean and
+        Grey or RGB(A) image (the alpha channel is ignored). ``uint16`` images are divided by
+        65535 and every other integer image by 255 (its values must be 0..255: 8-bit data, as
+        ``img.astype(int)`` makes); float images are kept as they are, in [0, 1] (values beyond
+        [-0.5, 1.5], as a 0..255 float image has, are refused). Boolean and
         complex images are refused: convert a mask on purpose (``mask.astype(np.uint8) * 255``).
     name : str
         Argument name for error messages.
@@ -47,8 +69,8 @@ def as_gray_image(image, name: str = "image") -> np.ndarray:
     TypeError
         If the input is not an array of real numbers (strings, booleans, complex, ragged lists).
     ValueError
-        If it is empty, smaller than 3 x 3, has the wrong number of dimensions or channels, or
-        holds NaN/infinity.
+        If it is empty, smaller than 3 x 3, has the wrong number of dimensions or channels, holds
+        NaN/infinity, or holds values outside what its dtype reads as (above).
 
     Notes
     -----
@@ -57,12 +79,11 @@ def as_gray_image(image, name: str = "image") -> np.ndarray:
     raw = as_array(image, name, dtype=None, finite=False)
     if raw.size == 0:
         raise ValueError(f"{name}: expected a non-empty image, got shape {raw.shape}")
+    scale = _pixel_scale(raw, name)
     if raw.ndim == 3 and raw.shape[2] in (3, 4):
-        scale = np.iinfo(raw.dtype).max if np.issubdtype(raw.dtype, np.integer) else 1.0
         rgb = raw[..., :3].astype(np.float32) / np.float32(scale)
         gray = rgb @ np.array([0.299, 0.587, 0.114], dtype=np.float32)
     elif raw.ndim == 2:
-        scale = np.iinfo(raw.dtype).max if np.issubdtype(raw.dtype, np.integer) else 1.0
         gray = raw.astype(np.float32) / np.float32(scale)
     else:
         raise ValueError(f"{name}: expected shape (H, W), (H, W, 3) or (H, W, 4), got shape {raw.shape}")
