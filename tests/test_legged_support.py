@@ -156,3 +156,16 @@ def test_margins_bad_shapes_are_named():
         stability_margins(feet, np.ones((5, 4), bool), np.zeros((4, 2)))
     with pytest.raises(TypeError, match="stance"):
         stability_margins(feet, np.full((5, 4), 0.5), np.zeros((5, 2)))
+
+
+def test_a_closed_or_clockwise_polygon_gives_the_same_margin():
+    # a closed ring had given NaN, a clockwise polygon a negative distance for a point inside
+    from robokit.legged.support import SupportPolygonError, nearest_boundary_point
+
+    square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+    want = nearest_boundary_point(square, [0.5, 0.2])
+    for polygon in (square + [square[0]], square[::-1], (square + [square[0]])[::-1]):
+        near, d = nearest_boundary_point(polygon, [0.5, 0.2])
+        assert near.tolist() == want[0].tolist() and d == want[1] == 0.2
+    with pytest.raises(SupportPolygonError, match="collinear"):
+        nearest_boundary_point([[0, 0], [1, 1], [2, 2]], [0.5, 0.2])

@@ -157,10 +157,12 @@ def nearest_boundary_point(polygon: Any, point: Any, *, validate: bool = True) -
     Parameters
     ----------
     polygon : array_like, shape (k, 2)
-        Vertices of a convex polygon, counter-clockwise (as :func:`support_polygon` gives), k >= 3.
+        Vertices of a convex polygon, k >= 3, in either order (a clockwise one is reversed), open
+        or closed (a last vertex equal to the first is dropped).
     point : array_like, shape (2,)
     validate : bool, default True
-        Validate the inputs; ``False`` is the fast path for callers that built the polygon.
+        Validate the inputs; ``False`` is the fast path for callers that built the polygon
+        (counter-clockwise and open, as :func:`support_polygon` gives).
 
     Returns
     -------
@@ -168,6 +170,13 @@ def nearest_boundary_point(polygon: Any, point: Any, *, validate: bool = True) -
     distance : float
         Positive inside the polygon, negative outside, 0 on an edge: McGhee & Frank's margin when
         ``point`` is the centre of mass's projection.
+
+    Raises
+    ------
+    SupportPolygonError
+        For fewer than 3 distinct vertices or collinear ones (no inside).
+    TypeError, ValueError
+        For arrays of the wrong shape or with NaN or infinity.
 
     Examples
     --------
@@ -177,8 +186,16 @@ def nearest_boundary_point(polygon: Any, point: Any, *, validate: bool = True) -
     """
     if validate:
         polygon = _as_xy(polygon, "polygon", (None, 2))
+        if len(polygon) > 3 and np.array_equal(polygon[0], polygon[-1]):
+            polygon = polygon[:-1]                  # a closed ring (GeoJSON's convention): one vertex twice
         if len(polygon) < 3:
             raise SupportPolygonError(f"polygon: expected at least 3 vertices, got {len(polygon)}")
+        x, y = polygon[:, 0], polygon[:, 1]
+        area = 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+        if area == 0.0:
+            raise SupportPolygonError("polygon: expected a polygon with an area, got collinear vertices")
+        if area < 0:                                # clockwise: the inside is on the other side
+            polygon = polygon[::-1]
         point = _as_xy(point, "point", (2,))
     a, b = polygon, np.roll(polygon, -1, axis=0)           # edge i runs from a[i] to b[i]
     edge, rel = b - a, point - a
