@@ -280,3 +280,14 @@ def test_identical_training_descriptors_are_too_few_not_an_internal_error():
     d = np.zeros((50, 32), np.uint8)
     with pytest.raises(TooFewDescriptorsError, match="branching=3 distinct training descriptors, got 1 distinct of 100"):
         Vocabulary.train([d, d], branching=3, levels=2, rng=0)
+
+
+def test_a_vocabulary_file_with_a_huge_branching_factor_is_refused(tmp_path, clustered_images):
+    # a crafted file with a huge branching factor (10^6) had made transform allocate 15 GB
+    arrays = Vocabulary.train(clustered_images, branching=5, levels=2, rng=0).arrays()
+    wide = np.full((arrays["children"].shape[0], 10**4), -1, np.int64)
+    wide[:, :5] = arrays["children"]
+    arrays["children"] = wide
+    np.savez(tmp_path / "wide.npz", **arrays)
+    with pytest.raises(VocabularyFileError, match="branching factor"):
+        Vocabulary.load(tmp_path / "wide.npz")

@@ -41,7 +41,7 @@ from ..validation import as_array, as_int, as_rng, describe
 from .hamming import as_binary_descriptors, hamming_distance
 
 __all__ = ["Vocabulary", "TooFewDescriptorsError", "VocabularyFileError", "BowVector", "as_bow_vector", "tf_idf",
-           "l1_score", "MAX_FILE_BYTES", "MAX_FILE_VALUES"]
+           "l1_score", "MAX_FILE_BYTES", "MAX_FILE_VALUES", "MAX_BRANCHING"]
 
 
 class BowVector(NamedTuple):
@@ -195,6 +195,8 @@ _FORMAT = "robokit-vocabulary-1"
 
 #: The largest vocabulary or database file robokit reads (bytes), and values per array.
 MAX_FILE_BYTES, MAX_FILE_VALUES = 512 * 1024**2, 1 << 27
+#: The largest branching factor a vocabulary may have (``train`` and a loaded file alike).
+MAX_BRANCHING = 256
 
 
 class TooFewDescriptorsError(ValueError):
@@ -320,6 +322,9 @@ class Vocabulary:
     def __init__(self, children, centres, idf, levels: int) -> None:
         self.children = np.ascontiguousarray(as_array(children, "children", dtype=np.int64, ndim=2))
         n_nodes, self.branching = self.children.shape
+        if not 2 <= self.branching <= MAX_BRANCHING:   # transform's work grows with it (a file could say 10^6)
+            raise ValueError(f"children: expected 2 to {MAX_BRANCHING} columns (the branching factor), "
+                             f"got {self.branching}")
         self.centres = as_binary_descriptors(centres, "centres")
         self.levels = as_int(levels, "levels", minimum=1, maximum=16)
         if self.centres.shape[0] != n_nodes or n_nodes < 2:
@@ -392,7 +397,7 @@ class Vocabulary:
         >>> Vocabulary.train([d[:30], d[30:]], branching=3, levels=2).branching
         3
         """
-        branching = as_int(branching, "branching", minimum=2, maximum=256)
+        branching = as_int(branching, "branching", minimum=2, maximum=MAX_BRANCHING)
         levels = as_int(levels, "levels", minimum=1, maximum=8)
         iterations = as_int(iterations, "iterations", minimum=1, maximum=1000)
         rng = as_rng(rng)
