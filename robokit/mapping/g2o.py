@@ -40,8 +40,8 @@ from .pose_graph import PoseGraph, as_pose_graph, positive_definite
 
 __all__ = ["G2OFormatError", "read_g2o", "write_g2o", "MAX_G2O_BYTES"]
 
-#: The largest g2o file :func:`read_g2o` reads (bytes): about 300,000 edges.
-MAX_G2O_BYTES = 32 * 1024**2
+#: The largest g2o file :func:`read_g2o` reads (bytes): about 45,000 vertices and as many edges.
+MAX_G2O_BYTES = 4 * 1024**2
 
 #: Tags of other g2o types, named in the error so a 3-D or landmark file is recognised as such.
 UNSUPPORTED = ("VERTEX_SE3:QUAT", "EDGE_SE3:QUAT", "VERTEX_XY", "EDGE_SE2_XY", "VERTEX_TRACKXYZ", "EDGE_SE2_TRACKXYZ",
