@@ -56,19 +56,35 @@ def _blocked_ancestor(path: Path) -> Path | None:
     return None
 
 
+def _needed() -> list[Path]:
+    """What the grader needs to read as another user: the interpreter and the clone (its venv)."""
+    return sorted({Path(sys.base_prefix).resolve(), ROOT.resolve()})
+
+
+def _unreadable_by_others() -> list[Path]:
+    """Needed folders that other users cannot read themselves (a clone made mode 0700): no mount
+    can open them to user nobody, so the limited-mode check cannot run there."""
+    return [p for p in _needed() if (os.stat(p).st_mode & 0o005) != 0o005]
+
+
 def _as_nobody(cmd: list[str]) -> list[str]:
-    """``cmd`` as user nobody; as root, in a private mount namespace in which the interpreter's
-    private ancestor (pyenv under /root) is covered and only the interpreter is mounted back."""
+    """``cmd`` as user nobody; as root, in a private mount namespace in which each private ancestor
+    of the interpreter and of the clone (pyenv under /root, a clone in a ``mktemp -d`` folder) is
+    covered by an empty folder and only what is needed is mounted back."""
     if not is_root():
         return cmd
-    prefix = Path(sys.base_prefix).resolve()
-    blocked = _blocked_ancestor(prefix)
+    groups: dict[Path, list[Path]] = {}
+    for path in _needed():
+        blocked = _blocked_ancestor(path)
+        if blocked is not None:
+            groups.setdefault(blocked, []).append(path)
     prep = "set -e\n"
-    if blocked is not None:
-        keep = prefix.relative_to(blocked)
-        prep += (f'S=$(mktemp -d)\nmount --bind "{prefix}" "$S"\n'
-                 f'mount -t tmpfs -o mode=0755 tmpfs "{blocked}"\nmkdir -p "{blocked / keep}"\n'
-                 f'mount --bind "$S" "{blocked / keep}"\n')
+    for k, (blocked, paths) in enumerate(sorted(groups.items())):
+        for j, path in enumerate(paths):
+            prep += f'S{k}_{j}=$(mktemp -d)\nmount --bind "{path}" "$S{k}_{j}"\n'
+        prep += f'mount -t tmpfs -o mode=0755 tmpfs "{blocked}"\n'
+        for j, path in enumerate(paths):
+            prep += f'mkdir -p "{path}"\nmount --bind "$S{k}_{j}" "{path}"\n'
     prep += 'exec setpriv --reuid=65534 --regid=65534 --clear-groups -- "$@"\n'
     return ["unshare", "--mount", "--propagation", "private", "--", "sh", "-c", prep, "sh", *cmd]
 
@@ -108,6 +124,9 @@ def test_seed_never_visible_to_the_submission(folder, limited, on_command_line):
         pytest.skip("full isolation needs root")
     if limited and is_root() and not (shutil.which("unshare") and shutil.which("setpriv")):
         pytest.skip("running the grader as another user needs util-linux's unshare and setpriv")
+    if limited and is_root() and _unreadable_by_others():
+        pytest.skip(f"{_unreadable_by_others()[0]} is readable by its owner only, so the grader cannot run as "
+                    "another user from it (clone into a folder others can read to run this check)")
     row, feedback = _grade(folder, limited=limited, on_command_line=on_command_line)
     assert ("sandbox=limited" in row["flags"]) == limited
     assert row["00.wrap_angle"] == "1" and row["total"] == "3", (row, feedback[-1500:])
