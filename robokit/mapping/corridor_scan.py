@@ -139,6 +139,15 @@ def _axis(r: np.ndarray, a: np.ndarray) -> float:
     return float(wrap_angle(2 * axis, validate=False) / 2)        # modulo pi, in [-pi/2, pi/2)
 
 
+def _as_heading(heading: Any) -> float:
+    """A given corridor axis (rad), within +-2 pi: a larger one is degrees by mistake, or so large
+    that the beams' angles to the wall normals lose their precision."""
+    value = as_finite_scalar(heading, "heading")
+    if abs(value) > 2 * np.pi:
+        raise ValueError(f"heading: expected the corridor axis in radians, within [-2 pi, 2 pi], got {value:g}")
+    return value
+
+
 def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[float, float]:
     """Shortest distances ``(d_L, d_R)`` from the sensor to the left and right walls (Eq. (1)).
 
@@ -161,6 +170,8 @@ def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[fl
     NoWallError
         If fewer than 4 of the 7 beams nearest a wall's normal have a return within 15 deg of it
         (a sparse scan's nearest beams may point away from the wall: they never give a distance).
+    ValueError
+        For a bad scan (:func:`as_scan`) or a ``heading`` that is not finite or beyond +-2 pi.
 
     Notes
     -----
@@ -183,7 +194,7 @@ def wall_distances(ranges: Any, angles: Any, *, heading: Any = None) -> tuple[fl
     (0.8, 1.37)
     """
     r, a = as_scan(ranges, angles)
-    axis = _axis(r, a) if heading is None else as_finite_scalar(heading, "heading")
+    axis = _axis(r, a) if heading is None else _as_heading(heading)
     return _wall_distances(r, a, axis)
 
 
@@ -220,7 +231,7 @@ def door_sides(ranges: Any, angles: Any, *, heading: Any = None, recess: float =
 
     Raises
     ------
-    NoWallError
+    NoWallError, ValueError
         As :func:`wall_distances`.
 
     Notes
@@ -240,7 +251,7 @@ def door_sides(ranges: Any, angles: Any, *, heading: Any = None, recess: float =
     (True, False)
     """
     r, a = as_scan(ranges, angles)
-    axis = _axis(r, a) if heading is None else as_finite_scalar(heading, "heading")
+    axis = _axis(r, a) if heading is None else _as_heading(heading)
     dda = as_positive(recess, "recess", allow_zero=True)
     return _door_sides(r, a, axis, dda, _wall_distances(r, a, axis))
 
