@@ -24,9 +24,10 @@ from __future__ import annotations
 
 import ctypes
 import errno
-import os
 import platform
 import struct
+
+from robocourse.grading.budget import BudgetExceeded, run_within
 
 __all__ = ["lock_down", "filter_supported", "probe", "REFUSED"]
 
@@ -72,30 +73,25 @@ def filter_supported() -> bool:
 
 
 def probe() -> str:
-    """Install the filter in a forked child and report: ``""`` if it can be, else why not.
+    """Install the filter in a forked child (:func:`~.budget.run_within`) and report: ``""`` if it
+    can be, else why not.
 
     The grader calls this once before a batch, so that a host that refuses ``no_new_privs`` or
     seccomp stops the batch with a clear message instead of failing every worker.
     """
-    read_fd, write_fd = os.pipe()
-    pid = os.fork()
-    if pid == 0:
-        try:
-            os.close(read_fd)
-            try:
-                lock_down()
-                os.write(write_fd, b"")
-            except OSError as exc:
-                os.write(write_fd, str(exc).encode()[:500] or b"refused")
-        finally:
-            os._exit(0)
-    os.close(write_fd)
     try:
-        reply = os.read(read_fd, 1000).decode(errors="replace")
-    finally:
-        os.close(read_fd)
-        os.waitpid(pid, 0)
-    return reply
+        return run_within(_refusal, memory_bytes=256 * 1024**2, seconds=30)
+    except BudgetExceeded as exc:
+        return str(exc)
+
+
+def _refusal() -> str:
+    """In the probing child: ``""`` once the filter is installed, else the kernel's refusal."""
+    try:
+        lock_down()
+    except OSError as exc:
+        return str(exc)[:500] or "refused"
+    return ""
 
 
 def _program() -> list[tuple[int, int, int, int]]:
