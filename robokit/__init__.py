@@ -8,8 +8,9 @@ enforces the order); each subpackage's docstring maps its modules:
 
 validation    the input checks every public function uses (errors that name the argument)
 config        settings from the environment: headless, fast mode, worker processes
-cache         the dataset cache (keys, atomic writes, .npz round trips)
 about         the versions of robokit and what it needs
+files         bounded file readers and atomic writers (.npz round trips)
+cache         the dataset cache (keys, meta, rebuilds)
 progress      the one progress bar of every long step
 parallel      independent, separately seeded runs in worker processes
 geometry      SE(2), SO(3), SE(3), rigid fits, the papers' frames

@@ -13,15 +13,15 @@ import functools
 import hashlib
 import json
 import os
-import stat
 import zipfile
 import zlib
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Sequence
 
-__all__ = ["cache_dir", "cache_key", "source_digest", "code_version", "write_atomically", "save_npz", "read_npz",
-           "NpzFileError", "write_arrays", "read_arrays", "CACHE_READ_ERRORS", "records_to_arrays", "record_names",
-           "records_from_arrays"]
+from .files import read_npz, require_named_arrays, save_npz, write_atomically
+
+__all__ = ["cache_dir", "cache_key", "source_digest", "code_version", "write_arrays", "read_arrays",
+           "CACHE_READ_ERRORS", "records_to_arrays", "record_names", "records_from_arrays"]
 
 
 def cache_dir(*parts: str, create: bool = True) -> Path:
@@ -152,56 +152,6 @@ def source_digest(*packages: str) -> str:
     return digest.hexdigest()[:16]
 
 
-def write_atomically(target: str | Path, write: Callable[[Path], Any]) -> Path:
-    """Write a cache file so that no reader ever sees it half written.
-
-    ``write(tmp)`` writes a temporary sibling of ``target`` (same suffix, named after this process);
-    it is then renamed over ``target`` in one step. Notebooks run in parallel (the course build, the
-    tests) and share the cache: each either finds the old file, the complete new one, or none.
-
-    Parameters
-    ----------
-    target : str or Path
-    write : callable ``(path) -> Any``
-        Writes the file at the path it is given.
-
-    Returns
-    -------
-    Path
-        ``target``.
-
-    Raises
-    ------
-    TypeError
-        For a non-callable ``write``. Whatever ``write`` raises propagates; its temporary file is
-        removed.
-
-    Notes
-    -----
-    Course convention (DESIGN.md, "Caching"); a rename within one directory is atomic on POSIX.
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> folder = Path(tempfile.mkdtemp())
-    >>> write_atomically(folder / "a.json", lambda p: p.write_text("{}")).read_text()
-    '{}'
-    >>> sorted(f.name for f in folder.iterdir())
-    ['a.json']
-    """
-    if not callable(write):
-        raise TypeError(f"write: expected a callable that writes a path, got {type(write).__name__}")
-    target = Path(target)
-    tmp = target.with_name(f"{target.stem}.{os.getpid()}.tmp{target.suffix}")
-    try:
-        write(tmp)
-        tmp.replace(target)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return target
-
-
-
 @functools.lru_cache(maxsize=None)
 def code_version(*packages: str) -> dict:
     """What decides a cached dataset besides its parameters: the code that makes it.
@@ -261,148 +211,6 @@ def _meta_text(meta: dict) -> str:
         raise TypeError(f"meta: expected a JSON-serialisable dict of parameters ({exc})") from None
 
 
-def _require_named_arrays(arrays: Any) -> None:
-    if not isinstance(arrays, dict) or not all(isinstance(k, str) and k for k in arrays):
-        raise TypeError(f"arrays: expected a dict of array names to arrays, got {type(arrays).__name__}")
-
-
-def save_npz(target: Any, arrays: dict) -> Any:
-    """Write named arrays as an ``.npz`` that ``numpy.load`` reads, compressed for speed over size.
-
-    The layout of ``numpy.savez_compressed`` (a zip of ``.npy`` files, never pickles) with zlib's
-    fastest level, 1: rendered images and depths compress hardly better at numpy's default level 6,
-    which takes about 1.5 times as long to write.
-
-    Parameters
-    ----------
-    target : str, Path or binary file object
-    arrays : dict of str to array_like
-
-    Returns
-    -------
-    The ``target`` it was given.
-
-    Raises
-    ------
-    TypeError
-        For ``arrays`` that is not a dict of names, or an array of Python objects.
-
-    Examples
-    --------
-    >>> import io
-    >>> import numpy as np
-    >>> buffer = save_npz(io.BytesIO(), {"a": np.arange(3)})
-    >>> np.load(io.BytesIO(buffer.getvalue()))["a"].tolist()
-    [0, 1, 2]
-    """
-    import numpy as np
-
-    _require_named_arrays(arrays)
-    with zipfile.ZipFile(target, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1, allowZip64=True) as zf:
-        for name, value in arrays.items():
-            arr = np.asanyarray(value)
-            if arr.dtype.hasobject:
-                raise TypeError(f"arrays: expected numeric or text arrays, got Python objects under {name!r}")
-            with zf.open(f"{name}.npy", "w", force_zip64=True) as fh:
-                np.lib.format.write_array(fh, arr, allow_pickle=False)
-    return target
-
-
-class NpzFileError(ValueError):
-    """A file that :func:`read_npz` will not read: not a regular file, too large, not an ``.npz`` of
-    plain arrays, truncated, or declaring more values than its reader allows."""
-
-
-def read_npz(path: Any, *, max_bytes: int = 1 << 30, max_arrays: int = 10_000,
-             max_values: int = 1 << 28) -> dict:
-    """Read every array of an ``.npz`` file within stated bounds, checked before memory is spent.
-
-    The file must be a regular file (not a device, FIFO or directory) of at most ``max_bytes``,
-    hold at most ``max_arrays`` ``.npy`` members, each of at most ``max_bytes`` uncompressed, of a
-    plain dtype (never Python objects: nothing is unpickled) and declaring at most ``max_values``
-    elements in its header, which is read before its data.
-
-    Parameters
-    ----------
-    path : str or Path
-    max_bytes, max_arrays, max_values : int
-        The reader's budget; each file reader of robokit states its own.
-
-    Returns
-    -------
-    dict of str to numpy.ndarray
-
-    Raises
-    ------
-    NpzFileError
-        (a ``ValueError``) For a file outside the bounds or not such an archive; the message names
-        ``path`` and what was found.
-    FileNotFoundError
-        If there is no such file.
-
-    Notes
-    -----
-    Course convention for file readers (DESIGN.md, "Conventions", Files); the twin of :func:`save_npz`.
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> import numpy as np
-    >>> target = Path(tempfile.mkdtemp()) / "a.npz"
-    >>> read_npz(save_npz(target, {"a": np.arange(3)}))["a"].tolist()
-    [0, 1, 2]
-    >>> read_npz(target, max_values=2)
-    Traceback (most recent call last):
-    ...
-    robokit.cache.NpzFileError: path: a.npz: array 'a' declares 3 values, more than this reader's 2
-    """
-    path = Path(path)
-    info = os.stat(path)
-    if not stat.S_ISREG(info.st_mode):
-        raise NpzFileError(f"path: {path.name}: expected a regular file, got a device, FIFO or directory")
-    if info.st_size > max_bytes:
-        raise NpzFileError(f"path: {path.name}: {info.st_size} bytes, more than this reader's {max_bytes}")
-    try:
-        with zipfile.ZipFile(path) as archive:
-            members = archive.infolist()
-            if len(members) > max_arrays:
-                raise NpzFileError(f"path: {path.name}: {len(members)} members, more than this reader's {max_arrays}")
-            return {m.filename[:-4]: _read_member(archive, m, path.name, max_bytes, max_values) for m in members}
-    except NpzFileError:
-        raise
-    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, zlib.error) as err:
-        raise NpzFileError(f"path: {path.name}: not a readable .npz archive (truncated or corrupt: {err})") from None
-
-
-def _read_member(archive: zipfile.ZipFile, member: zipfile.ZipInfo, label: str, max_bytes: int, max_values: int):
-    """One ``.npy`` member, its header checked against the budget before its data are read."""
-    import numpy as np
-
-    name = member.filename
-    if not name.endswith(".npy") or member.file_size > max_bytes:
-        raise NpzFileError(f"path: {label}: member {name[:60]!r} is not an .npy array within {max_bytes} bytes")
-    with archive.open(member) as fh:
-        try:
-            version = np.lib.format.read_magic(fh)
-            header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
-            shape, fortran, dtype = header(fh, max_header_size=10_000)
-        except NpzFileError:
-            raise
-        except Exception as err:  # numpy parses the header as a Python literal: a damaged one fails in many ways
-            raise NpzFileError(f"path: {label}: array {name[:-4]!r} has a damaged header ({type(err).__name__})") from None
-        count = int(np.prod(shape, dtype=object))
-        if dtype.hasobject:
-            raise NpzFileError(f"path: {label}: array {name[:-4]!r} holds Python objects, which are never read")
-        if count > max_values:
-            raise NpzFileError(f"path: {label}: array {name[:-4]!r} declares {count} values, more than this "
-                               f"reader's {max_values}")
-        data = fh.read(count * dtype.itemsize)
-        if len(data) != count * dtype.itemsize:
-            raise NpzFileError(f"path: {label}: array {name[:-4]!r} is truncated")
-        arr = np.frombuffer(data, dtype=dtype, count=count).copy()
-        return arr.reshape(shape[::-1]).T if fortran else arr.reshape(shape)
-
-
 def write_arrays(target: str | Path, arrays: dict, meta: dict | None = None) -> Path:
     """Write named arrays as a compressed ``.npz`` cache file (:func:`save_npz`), with the parameters that made them.
 
@@ -441,7 +249,7 @@ def write_arrays(target: str | Path, arrays: dict, meta: dict | None = None) -> 
     """
     import numpy as np
 
-    _require_named_arrays(arrays)
+    require_named_arrays(arrays)
     if _META in arrays:
         raise ValueError(f"arrays: expected names other than the reserved {_META!r}, got {sorted(arrays)}")
     stored = dict(arrays)

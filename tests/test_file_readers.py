@@ -1,6 +1,6 @@
 """Every ``.npz`` reader of robokit against hostile files, and every writer against an interrupted save.
 
-The readers share :func:`robokit.cache.read_npz`, which checks the file's kind and size and each
+The readers share :func:`robokit.files.read_npz`, which checks the file's kind and size and each
 array's declared size before it reads data; each reader refuses a hostile file with its own named
 error (issue "Bad input and hostile files in the lesson 02-04 APIs").
 """
@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robokit.cache import NpzFileError, read_arrays, read_npz, save_npz
+from robokit.cache import read_arrays
+from robokit.files import NpzFileError, read_npz, save_npz
 from robokit.legged.trial_log import TrialLogError, load_trial, save_trial
 from robokit.mapping.topological import TopologicalMap
 from robokit.sim.runs import Run

@@ -28,7 +28,9 @@ ROOT = Path(__file__).resolve().parents[1]
 #: rows (and from itself).
 PACKAGES: dict[str, tuple[Path, list[set[str]]]] = {
     "robokit": (ROOT / "robokit", [
-        {"validation", "config", "cache", "about"},     # base: input checks, settings, files and the dataset cache
+        {"validation", "config", "about"},              # base: input checks, settings
+        {"files"},                                      # bounded readers and atomic writers
+        {"cache"},                                      # the dataset cache (its files through files)
         {"progress"},                                   # the one progress bar (reads fast/headless from config)
         {"parallel"},                                   # independent runs in worker processes
         {"geometry"},                                   # SE(2)/SE(3)/SO(3), the papers' frames

@@ -30,7 +30,6 @@ References
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
@@ -38,7 +37,7 @@ from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 
-from ..cache import read_npz, save_npz, write_atomically
+from ..files import as_file_path, open_regular, read_npz, save_npz, write_atomically
 from ..geometry import quat_to_matrix, se3_from_rt
 from ..validation import as_array, as_finite_scalar, as_int, as_positive, as_text, describe
 from .littledog import GUIDE, TIMESTEP
@@ -365,14 +364,6 @@ def empty_streams(n: int, host_rate: float = GUIDE["host_rate"]) -> dict:
     return streams
 
 
-def _as_path(path: Any) -> Path:
-    if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
-        raise TypeError(f"path: expected a file path (str or pathlib.Path), got {describe(path)}")
-    if not str(path):
-        raise ValueError("path: expected a file path, got ''")
-    return Path(path)
-
-
 def _layout_json() -> str:
     return json.dumps({k: {"shape": list(s.shape), "dtype": s.dtype, "unit": s.unit, "description": s.description}
                        for k, s in LOG_LAYOUT.items()})
@@ -399,7 +390,7 @@ def save_trial(path: Any, log: TrialLog) -> Path:
 
     Notes
     -----
-    :func:`robokit.cache.save_npz` through :func:`robokit.cache.write_atomically`: a reader finds the
+    :func:`robokit.files.save_npz` through :func:`robokit.files.write_atomically`: a reader finds the
     old file, the complete new one or none, never half of one. The layout is in the module docstring.
 
     Examples
@@ -412,7 +403,7 @@ def save_trial(path: Any, log: TrialLog) -> Path:
     >>> len(load_trial(target))
     5
     """
-    target = _as_path(path)
+    target = as_file_path(path, "path")
     if not isinstance(log, TrialLog):
         raise TypeError(f"log: expected a TrialLog, got {describe(log)}")
     log.validate()
@@ -449,7 +440,7 @@ def load_trial(path: Any) -> TrialLog:
 
     Notes
     -----
-    Read by :func:`robokit.cache.read_npz` within :data:`MAX_LOG_BYTES` (sizes checked before data
+    Read by :func:`robokit.files.read_npz` within :data:`MAX_LOG_BYTES` (sizes checked before data
     are read; nothing is unpickled, so a log file can never run code); the metadata JSON within
     :data:`MAX_META_CHARS`.
 
@@ -463,9 +454,13 @@ def load_trial(path: Any) -> TrialLog:
     ...
     robokit.legged.trial_log.TrialLogError: ...cut.npz: not a readable trial log (truncated or corrupt: ...)
     """
-    source = _as_path(path)
+    source = as_file_path(path, "path")
+
+    def refuse(reason: str) -> TrialLogError:
+        return TrialLogError(f"{source}: not a readable trial log (it {reason})")
+
     try:
-        with open(source, "rb") as fh:
+        with open_regular(source, MAX_LOG_BYTES, refuse) as fh:
             if fh.read(6) == b"\x93NUMPY":                 # a lone .npy array
                 raise TrialLogError(f"{source}: not a {LOG_FORMAT} file (one .npy array, not an .npz archive)")
         arrays = read_npz(source, max_bytes=MAX_LOG_BYTES, max_arrays=len(LOG_LAYOUT) + 8, max_values=MAX_LOG_BYTES)

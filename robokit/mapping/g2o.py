@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import math
 import os
-import stat
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..files import as_file_path, read_regular, write_atomically
 from ..validation import as_text, describe
 from .pose_graph import PoseGraph, as_pose_graph, positive_definite
 
@@ -92,17 +92,10 @@ def _text_of(source: Any) -> tuple[str, str]:
         if len(source) > MAX_G2O_BYTES:
             raise G2OFormatError("<text>", 0, f"{len(source)} characters, more than the {MAX_G2O_BYTES} read_g2o reads")
         return source, "<text>"
-    if isinstance(source, os.PathLike):
-        path = Path(source)
-    else:
-        path = Path(as_text(source, "source", empty=False))
-    info = path.stat()
-    if not stat.S_ISREG(info.st_mode):
-        raise G2OFormatError(str(path), 0, "not a regular file (a device, FIFO or directory)")
-    if info.st_size > MAX_G2O_BYTES:
-        raise G2OFormatError(str(path), 0, f"{info.st_size} bytes, more than the {MAX_G2O_BYTES} read_g2o reads")
+    path = as_file_path(source, "source")
+    data = read_regular(path, MAX_G2O_BYTES, lambda reason: G2OFormatError(str(path), 0, reason))
     try:
-        return path.read_text(encoding="utf-8"), str(path)
+        return data.decode("utf-8"), str(path)
     except UnicodeDecodeError:
         raise G2OFormatError(str(path), 0, "not a text file (not UTF-8)") from None
 
@@ -156,6 +149,8 @@ def read_g2o(source: Any) -> PoseGraph:
     if not isinstance(source, (str, os.PathLike)):
         raise TypeError(f"source: expected a path or g2o text (a str), got {describe(source)}")
     text, where = _text_of(source)
+    if "VERTEX_SE2" not in text:                          # refused before the parse, not after it
+        raise G2OFormatError(where, 0, "no VERTEX_SE2 line")
     index: dict[int, int] = {}
     poses, edge_ids, edge_lines, measurements, upper = [], [], [], [], []
     fixed: tuple[int, int] | None = None                  # (vertex id, line)
@@ -266,5 +261,5 @@ def write_g2o(graph: PoseGraph, path: Any = None) -> str:
     lines.append(f"FIX {graph.ids[graph.fixed]}")
     text = "\n".join(lines) + "\n"
     if path is not None:
-        Path(path).write_text(text, encoding="utf-8")
+        write_atomically(Path(path), lambda tmp: tmp.write_text(text, encoding="utf-8"))
     return text

@@ -36,13 +36,12 @@ from __future__ import annotations
 
 import math
 import re
-import stat
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..cache import write_atomically
+from ..files import as_file_path, read_regular, write_atomically
 from ..validation import as_choice, as_int, as_text, describe
 from .occupancy_grid import FREE_THRESHOLD, OCCUPIED_THRESHOLD, OccupancyGrid
 
@@ -202,17 +201,7 @@ def _number(text: str, fail) -> float:
 
 def _bounded_bytes(path: Path, limit: int, what: str) -> bytes:
     """The bytes of the regular file ``path``, refused (MapFileError) if larger than ``limit``."""
-    try:
-        info = path.stat()
-        if not stat.S_ISREG(info.st_mode):
-            raise MapFileError(path, f"the {what} is not a regular file (a device, FIFO or directory)")
-        if info.st_size > limit:
-            raise MapFileError(path, f"the {what} has {info.st_size} bytes, more than the {limit} load_map reads")
-        return path.read_bytes()
-    except FileNotFoundError:
-        raise
-    except OSError as exc:
-        raise MapFileError(path, f"cannot read the {what}: {exc}") from None
+    return read_regular(path, limit, lambda reason: MapFileError(path, f"the {what} {reason}"))
 
 
 def _parse_yaml(path: Path) -> dict:
@@ -323,7 +312,7 @@ def load_map(yaml_path: Any) -> OccupancyGrid:
     >>> back.origin.tolist(), back.resolution, back.occupied_mask().tolist(), back.unknown_mask().tolist()
     ([3.0, 4.0], 0.1, [[False, True], [False, False]], [[False, False], [True, False]])
     """
-    path = Path(as_text(yaml_path, "yaml_path", empty=False) if not isinstance(yaml_path, Path) else yaml_path)
+    path = as_file_path(yaml_path, "yaml_path")
     keys = _parse_yaml(path)
 
     def fail(message: str) -> None:

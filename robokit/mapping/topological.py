@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..cache import NpzFileError, read_npz, save_npz, write_atomically
+from ..files import NpzFileError, read_npz, save_npz, write_atomically
 from ..validation import as_array, as_choice, as_int, as_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
@@ -353,7 +353,7 @@ class TopologicalMap:
     def load(cls, path: str | Path) -> "TopologicalMap":
         """Read a map written by :meth:`save` (validated like a new one).
 
-        The file is read by :func:`robokit.cache.read_npz` within :data:`MAX_MAP_BYTES` bytes and
+        The file is read by :func:`robokit.files.read_npz` within :data:`MAX_MAP_BYTES` bytes and
         :data:`MAX_MAP_VALUES` values per array, checked before its data are read.
 
         Raises

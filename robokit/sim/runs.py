@@ -25,7 +25,8 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version, read_npz, save_npz, write_atomically
+from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version
+from ..files import read_npz, save_npz, write_atomically
 from ..parallel import iter_runs, map_runs
 from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, as_int, as_positive
@@ -89,7 +90,7 @@ class Run:
 
         Notes
         -----
-        :func:`robokit.cache.save_npz`; loading uses ``allow_pickle=False`` so a run file can never
+        :func:`robokit.files.save_npz`; loading uses ``allow_pickle=False`` so a run file can never
         execute code (course convention, DESIGN.md "Caching").
         """
         arrays = {"t": self.t, "poses": self.poses, "odometry": self.odometry,
@@ -103,12 +104,12 @@ class Run:
     def load(cls, path: str | Path) -> "Run":
         """Read a run written by :meth:`save` (nothing is unpickled: no code is ever loaded).
 
-        The file is read by :func:`robokit.cache.read_npz` within :data:`MAX_RUN_BYTES`.
+        The file is read by :func:`robokit.files.read_npz` within :data:`MAX_RUN_BYTES`.
 
         Raises
         ------
         ValueError
-            If the file is not a robokit run (:class:`robokit.cache.NpzFileError` for one that is
+            If the file is not a robokit run (:class:`robokit.files.NpzFileError` for one that is
             truncated, corrupt, a device or beyond the bound).
         """
         data = read_npz(path, max_bytes=MAX_RUN_BYTES, max_values=MAX_RUN_BYTES)
@@ -348,7 +349,7 @@ def record(world: World, path: Trajectory, sensors: dict, rate: float | None = N
     stacked = {group: {k: np.stack(v) for k, v in arrays.items()} for group, arrays in logs.items()}
     run = Run(t, poses, odometry, stacked["images"], stacked["depths"], stacked["scans"], meta)
     if target is not None:
-        write_atomically(target, run.save)   # notebooks running in parallel never read a half-written file
+        run.save(target)                     # atomic: parallel notebooks never read a half-written file
     return run
 
 

@@ -36,7 +36,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..cache import read_npz, save_npz, write_atomically
+from ..files import read_npz, save_npz, write_atomically
 from ..validation import as_array, as_int, as_rng, describe
 from .hamming import as_binary_descriptors, hamming_distance
 
@@ -524,7 +524,7 @@ class Vocabulary:
     def load(cls, path) -> "Vocabulary":
         """Read a vocabulary written by :meth:`save`.
 
-        The file is read by :func:`robokit.cache.read_npz` within :data:`MAX_FILE_BYTES` bytes and
+        The file is read by :func:`robokit.files.read_npz` within :data:`MAX_FILE_BYTES` bytes and
         :data:`MAX_FILE_VALUES` values per array, checked before its data are read.
 
         Raises

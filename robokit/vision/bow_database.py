@@ -29,7 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..cache import read_npz, save_npz, write_atomically
+from ..files import read_npz, save_npz, write_atomically
 from ..validation import as_int, describe
 from .bag_of_words import MAX_FILE_BYTES, MAX_FILE_VALUES, Vocabulary, VocabularyFileError
 from .bag_of_words import BowVector, as_bow_vector
@@ -190,7 +190,7 @@ class BowDatabase:
     def load(cls, path) -> "BowDatabase":
         """Read a database written by :meth:`save` (with its vocabulary).
 
-        The file is read by :func:`robokit.cache.read_npz` within the vocabulary's file bounds and
+        The file is read by :func:`robokit.files.read_npz` within the vocabulary's file bounds and
         may hold at most :data:`MAX_ENTRIES` images.
 
         Raises

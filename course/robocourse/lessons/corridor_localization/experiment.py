@@ -43,7 +43,7 @@ from typing import Any, Callable
 import numpy as np
 
 from robocourse.source import code_version_of
-from robokit.cache import CACHE_READ_ERRORS, cache_dir, cache_key, read_arrays, write_arrays, write_atomically
+from robokit.cache import CACHE_READ_ERRORS, cache_dir, cache_key, read_arrays, write_arrays
 from robokit.config import fast_mode
 from robokit.mapping import LikelihoodField, OccupancyGrid, geo_tag, likelihood_field, occupancy_grid_mapping
 from robokit.parallel import map_runs
@@ -363,7 +363,7 @@ def training_vocabulary(*, fast: bool | None = None, branching: int = 10, levels
             pass  # a corrupt or foreign cache file is rebuilt
     images = _orb_frames(world, camera, poses, 7, progress, "vocabulary images")
     vocabulary = Vocabulary.train(images, branching=branching, levels=levels, rng=0)
-    write_atomically(target, vocabulary.save)
+    vocabulary.save(target)                  # atomic: a parallel build never reads half a file
     return vocabulary
 
 

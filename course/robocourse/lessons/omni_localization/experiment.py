@@ -35,7 +35,8 @@ import numpy as np
 
 from robokit.config import fast_mode
 from robocourse.source import code_version_of
-from robokit.cache import CACHE_READ_ERRORS, cache_dir, cache_key, read_arrays, write_arrays, write_atomically
+from robokit.cache import CACHE_READ_ERRORS, cache_dir, cache_key, read_arrays, write_arrays
+from robokit.files import write_atomically
 from robokit.geometry import se2_between, se2_compose
 from robokit.localization.hierarchical import HierarchicalLocalizer
 from robokit.mapping import (PoseGraphResult, RelaxationResult, TopologicalMap, build_topological_map,
@@ -113,7 +114,7 @@ def _map_cached(meta: dict, build: Callable[[], tuple[TopologicalMap, np.ndarray
     t0 = time.perf_counter()
     tmap, truth, frames = build()
     seconds = time.perf_counter() - t0
-    write_atomically(target, tmap.save)
+    tmap.save(target)                        # atomic, as the sidecar below
     write_atomically(sidecar, lambda path: path.write_text(
         json.dumps({"meta": meta, "seconds": seconds, "frames": frames, "truth": truth.tolist()})))
     return tmap, truth, frames, seconds, key
