@@ -16,7 +16,7 @@ import zlib
 from pathlib import Path
 from typing import Any, BinaryIO, Callable
 
-from .validation import describe
+from .validation import as_int, describe
 
 __all__ = ["as_file_path", "open_regular", "read_regular", "write_atomically", "require_named_arrays", "save_npz", "read_npz",
            "NpzFileError"]
@@ -280,6 +280,8 @@ def read_npz(path: Any, *, max_bytes: int = 1 << 30, max_arrays: int = 10_000,
 
     Raises
     ------
+    TypeError, ValueError
+        For a ``path`` that is not a path, or bounds that are not non-negative integers.
     NpzFileError
         (a ``ValueError``) For a file outside the bounds or not such an archive; the message names
         ``path`` and what was found.
@@ -303,6 +305,9 @@ def read_npz(path: Any, *, max_bytes: int = 1 << 30, max_arrays: int = 10_000,
     robokit.files.NpzFileError: path: a.npz: array 'a' declares 3 values, more than this reader's 2
     """
     path = as_file_path(path, "path")
+    max_bytes = as_int(max_bytes, "max_bytes", minimum=0)
+    max_arrays = as_int(max_arrays, "max_arrays", minimum=0)
+    max_values = as_int(max_values, "max_values", minimum=0)
 
     def refuse(reason: str) -> NpzFileError:
         return NpzFileError(f"path: {path.name}: {reason}")

@@ -19,6 +19,12 @@ random variants: where the NaN sits, which shape is wrong, which string). What "
   ``Mapping`` (a dict), ``Rng`` (a Generator or a non-negative integer seed): values of other
   types (``None`` only where not optional), and for ``Rng`` negative, fractional, boolean and
   string seeds and the legacy ``RandomState``.
+* ``File`` (a path a reader reads): paths of other types and hostile files generated for the run,
+  each of which must get the reader's named error naming the argument or the file: empty,
+  text, noise, truncated, zeroed in the middle, another format's file, one byte over the reader's
+  budget (sparse), a device, a directory, a FIFO, a link to a device, a loop of links, and the
+  reader's own (``extra``: nested archives, oversized headers, deep nesting); a missing file or a
+  dangling link gets ``FileNotFoundError``.
 * ``Flag`` and ``Given`` are not fuzzed: flags follow Python's truthiness, and a given value is
   one that another argument's contract constrains (documented where it is used).
 
@@ -28,8 +34,15 @@ from the invalid values, and the test checks that the docstring mentions ``inf``
 """
 from __future__ import annotations
 
+import atexit
 import copy
+import functools
 import math
+import os
+import re
+import shutil
+import tempfile
+from pathlib import Path
 from typing import Any, Callable, Iterator
 
 import numpy as np
@@ -183,6 +196,100 @@ class Mapping(Kind):
 
     def invalid(self) -> list[tuple[str, Any]]:
         return [("a number", 42), ("a string", "a=1"), ("a list", [1, 2])] + list(self.common())
+
+
+@functools.cache
+def fuzz_folder() -> Path:
+    """One temporary folder for every file the fuzz writes, removed when the test process ends."""
+    folder = Path(tempfile.mkdtemp(prefix="robokit-fuzz-"))
+    atexit.register(shutil.rmtree, folder, True)
+    return folder
+
+
+class File(Kind):
+    """A path to a file a reader reads (``valid``: a factory of a valid file's path).
+
+    ``budget``: the reader's byte bound; ``foreign``: a factory of another format's valid file;
+    ``extra``: ``valid bytes -> {label: bytes}``, the reader's own hostile contents.
+    """
+
+    #: Labels whose right answer is ``FileNotFoundError`` (naming the file), not the reader's error.
+    MISSING = ("a missing file", "a dangling link")
+
+    def __init__(self, valid: Any, *, budget: int, foreign: Callable[[], Any], error: type = ValueError,
+                 extra: Callable[[bytes], dict] | None = None, **kw: Any) -> None:
+        super().__init__(valid, **kw)
+        self.budget, self.foreign, self.error, self.extra = budget, foreign, error, extra
+        self._files: list[tuple[str, Any]] | None = None
+
+    def hostile(self, label: str) -> bool:
+        """Whether ``label`` is a hostile file (which must get ``error``), not a value of another type."""
+        return label in dict(self._files or ())
+
+    def _hostile_files(self) -> list[tuple[str, Any]]:
+        valid = Path(self.valid())
+        data = valid.read_bytes()
+        folder = Path(tempfile.mkdtemp(prefix="file-", dir=fuzz_folder()))
+        n = len(data)
+        contents = {"an empty file": b"", "text": b"this is not the file you are looking for\n",
+                    "binary noise": np.random.default_rng(0).bytes(4096), "truncated": data[: n // 2],
+                    "zeroed in the middle": data[: n // 3] + bytes(n // 3) + data[2 * n // 3:],
+                    "another format's file": Path(self.foreign()).read_bytes(),
+                    **(self.extra(data) if self.extra else {})}
+        out = []
+        for label, content in contents.items():
+            path = folder / (re.sub(r"\W+", "-", label) + valid.suffix)
+            path.write_bytes(content)
+            out.append((label, str(path)))
+        oversized = folder / f"oversized{valid.suffix}"
+        with open(oversized, "wb") as fh:
+            fh.truncate(self.budget + 1)                     # sparse: costs no disk
+        os.mkfifo(folder / "fifo")
+        (folder / "device-link").symlink_to("/dev/zero")
+        (folder / "loop-a").symlink_to(folder / "loop-b")
+        (folder / "loop-b").symlink_to(folder / "loop-a")
+        (folder / "dangling").symlink_to(folder / "nowhere")
+        out += [("one byte over the budget", str(oversized)), ("a device", "/dev/zero"),
+                ("a directory", str(folder)), ("a FIFO", str(folder / "fifo")),
+                ("a link to a device", str(folder / "device-link")), ("a loop of links", str(folder / "loop-a")),
+                ("a dangling link", str(folder / "dangling")), ("a missing file", str(folder / "missing"))]
+        return out
+
+    def invalid(self) -> list[tuple[str, Any]]:
+        if self._files is None:
+            self._files = self._hostile_files()
+        return [("a number", 42), ("bytes", b"x"), ("an empty path", ""), ("a list", [str(self.valid())])] + \
+            self._files + list(self.common())
+
+
+def npy_header(shape: tuple, descr: str = "<f8") -> bytes:
+    """An ``.npy`` header declaring ``shape`` and ``descr``, with no data after it."""
+    text = f"{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape!r}, }}".encode()
+    text += b" " * (63 - (10 + len(text)) % 64) + b"\n"
+    return b"\x93NUMPY\x01\x00" + len(text).to_bytes(2, "little") + text
+
+
+def zip_of(members: dict) -> bytes:
+    """A zip archive holding ``{name: bytes}``."""
+    import io
+    import zipfile
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as archive:
+        for name, data in members.items():
+            archive.writestr(name, data)
+    return buffer.getvalue()
+
+
+def npz_extras(valid: bytes) -> dict:
+    """Hostile ``.npz`` contents (``File(extra=...)``): headers that lie, objects, foreign and nested members."""
+    return {
+        "a 10^12-row header": zip_of({"poses.npy": npy_header((10**12, 3)), "format.npy": npy_header(())}),
+        "Python objects": zip_of({"poses.npy": npy_header((3,), "|O")}),
+        "a foreign member": zip_of({"poses.txt": b"1 2 3"}),
+        "a damaged header": zip_of({"poses.npy": b"\x93NUMPY\x01\x00\x20\x00{'descr': (((((((((((((((\n"}),
+        "a nested archive": zip_of({"poses.npy": valid}),
+        "10^5 empty members": zip_of({f"a{i}.npy": b"" for i in range(100_000)}),
+    }
 
 
 class Options(Kind):

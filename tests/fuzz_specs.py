@@ -12,7 +12,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from tests.fuzz_kinds import Array, Choice, Flag, Func, Given, Int, Kind, Mapping, Obj, Options, Real, Rng, Text
+from tests.fuzz_kinds import (Array, Choice, File, Flag, Func, Given, Int, Kind, Mapping, Obj, Options, Real, Rng, Text,
+                              fuzz_folder, npz_extras)
 
 
 @dataclass
@@ -315,11 +316,8 @@ def grid_mapping_kinds() -> dict:
             "clamp": Array(np.array([-2.0, 3.5]), "2"), **grid_model_kinds()}
 
 
-@functools.cache
 def map_folder():
-    import tempfile
-    from pathlib import Path
-    return Path(tempfile.mkdtemp(prefix="robokit-fuzz-map-"))
+    return fuzz_folder()
 
 
 @functools.cache
@@ -446,11 +444,8 @@ def trial_meta_dict():
     return dict(trial_log().meta)
 
 
-@functools.cache
 def trial_folder():
-    import tempfile
-    from pathlib import Path
-    return Path(tempfile.mkdtemp(prefix="robokit-fuzz-trial-"))
+    return fuzz_folder()
 
 
 @functools.cache
@@ -956,8 +951,6 @@ SPECS: dict[str, Call] = {
         "edges": Array(lambda: pose_graph().edges, "N,2"), "measurements": Array(lambda: pose_graph().measurements, "N,3"),
         "edge_variances": Array(lambda: np.full(pose_graph().n_edges, 0.02), "N"), "fixed": Int(0)}),
     "robokit.mapping.relaxation.initial_variances": Call({"graph": Obj(pose_graph)}),
-    "robokit.mapping.g2o.read_g2o": Call({"source": Text("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n"
-                                                         "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n")}),
     "robokit.mapping.g2o.write_g2o": Call({"graph": Obj(pose_graph), "path": Text(None, optional=True)}),
     "robokit.mapping.manhattan.manhattan_world_graph": Call({
         "n_poses": Int(40), "seed": Int(0), "noise": Array(np.array([0.05, 0.05, 0.01]), "|3"), "extent": Int(5),
@@ -1106,7 +1099,6 @@ SPECS: dict[str, Call] = {
     "robokit.mapping.map_server.save_map": Call({"grid": Obj(small_grid), "stem": Text(lambda: str(map_folder() / "m")),
                                                  "occupied_thresh": Real(0.65), "free_thresh": Real(0.196),
                                                  "negate": Int(0), "mode": Choice("trinary")}),
-    "robokit.mapping.map_server.load_map": Call({"yaml_path": Text(saved_map)}),
     # robokit.mapping.corridor_scan / corridor_areas, controllers.corridor_centering, mapping.hybrid_map (lesson 03)
     **{f"robokit.mapping.corridor_scan.{n}": Call({"ranges": Array(corridor_ranges, "N", inf_ok=True),
                                                     "angles": Array(corridor_angles, "N")} | extra)
@@ -1396,7 +1388,6 @@ SPECS: dict[str, Call] = {
     "robokit.legged.trial_log.empty_streams": Call({"n": Int(4), "host_rate": Real(100.0)}),
     "robokit.legged.trial_log.save_trial": Call({"path": Text(lambda: str(trial_folder() / "t.npz")),
                                                  "log": Obj(trial_log)}),
-    "robokit.legged.trial_log.load_trial": Call({"path": Text(saved_trial)}),
     "robokit.legged.trial_log.describe_layout": Call({}),
     "robokit.viz.animation.animate_tracks": Call({
         "scene": Obj(scene), "tracks": Mapping(lambda: {"a": {"position": np.zeros((3, 3)), "scale": np.ones((3, 3))}}),
@@ -1526,6 +1517,109 @@ SPECS["robocourse.grading.data.assignment_data"] = Call({"slug": Choice("04_litt
 
 #: Besides the lessons' API: the exercises' references (students reproduce their contracts) and
 #: the functions the issue's fuzz named.
+# --- file readers: hostile files (tests/fuzz_kinds.File) ------------------------------------
+
+@functools.cache
+def saved_g2o():
+    from robokit.mapping import write_g2o
+    path = fuzz_folder() / "graph.g2o"
+    write_g2o(pose_graph(), path)
+    return str(path)
+
+
+@functools.cache
+def saved_topological_map():
+    from tests.test_mapping_topological import small_map
+    return str(small_map().save(fuzz_folder() / "topological.npz"))
+
+
+@functools.cache
+def saved_vocabulary():
+    return str(bow_vocabulary().save(fuzz_folder() / "vocabulary.npz"))
+
+
+@functools.cache
+def saved_database():
+    from robokit.vision import BowDatabase
+    db = BowDatabase(bow_vocabulary())
+    db.add(orb_descriptors(30, 7))
+    return str(db.save(fuzz_folder() / "database.npz"))
+
+
+@functools.cache
+def saved_run():
+    from robokit.sim.runs import Run
+    t, poses = np.arange(4.0), np.zeros((4, 3))
+    run = Run(t, poses, poses.copy(), {}, {}, {"lidar": np.ones((4, 8))}, {"world": "test"})
+    return str(run.save(fuzz_folder() / "run.npz"))
+
+
+@functools.cache
+def saved_arrays():
+    from robokit.files import save_npz
+    return str(save_npz(fuzz_folder() / "arrays.npz", {"a": np.arange(5.0), "b": np.eye(2)}))
+
+
+def trial_extras(valid: bytes) -> dict:
+    """npz_extras, and a log whose metadata nests 100,000 deep."""
+    import io
+    from robokit.files import save_npz
+    with np.load(io.BytesIO(valid)) as data:
+        arrays = {k: data[k] for k in data.files}
+    arrays["__meta__"] = np.array("[" * 100_000 + "]" * 100_000)
+    return {**npz_extras(valid), "metadata nested 10^5 deep": save_npz(io.BytesIO(), arrays).getvalue()}
+
+
+def map_extras(valid: bytes) -> dict:
+    """YAML whose image is a device, a directory or missing; 10^4-deep origin; a key past the budget."""
+    import re as _re
+
+    def image(name: bytes) -> bytes:
+        return _re.sub(rb"(?m)^image:.*$", b"image: " + name, valid)
+    return {"an image that is a device": image(b"/dev/zero"), "an image that is a directory": image(b"/tmp"),
+            "a missing image": image(b"no-such.pgm"),
+            "an origin nested 10^4 deep": _re.sub(rb"(?m)^origin:.*$", b"origin: " + b"[" * 10_000 + b"]" * 10_000, valid),
+            "a PGM header declaring 10^6 x 10^6 pixels": image(str(huge_pgm()).encode())}
+
+
+@functools.cache
+def huge_pgm():
+    path = fuzz_folder() / "huge-header.pgm"
+    path.write_bytes(b"P5\n1000000 1000000\n255\n" + bytes(16))
+    return path
+
+
+def _reader_specs() -> dict:
+    from robokit.files import NpzFileError
+    from robokit.legged.trial_log import MAX_LOG_BYTES, TrialLogError
+    from robokit.mapping.g2o import MAX_G2O_BYTES, G2OFormatError
+    from robokit.mapping.map_server import MAX_YAML_BYTES, MapFileError
+    from robokit.mapping.topological import MAX_MAP_BYTES
+    from robokit.sim.runs import MAX_RUN_BYTES
+    from robokit.vision.bag_of_words import MAX_FILE_BYTES, VocabularyFileError
+    from robokit.vision.bow_database import DatabaseFileError
+
+    def npz(valid, budget, error):
+        return File(valid, budget=budget, foreign=saved_g2o, error=error, extra=npz_extras)
+    return {
+        "robokit.files.read_npz": Call({"path": npz(saved_arrays, 1 << 30, NpzFileError), "max_bytes": Int(1 << 20),
+                                        "max_arrays": Int(10), "max_values": Int(1000)}),
+        "robokit.mapping.topological.TopologicalMap.load": Call({"path": npz(saved_topological_map, MAX_MAP_BYTES, ValueError)}),
+        "robokit.vision.bag_of_words.Vocabulary.load": Call({"path": npz(saved_vocabulary, MAX_FILE_BYTES, VocabularyFileError)}),
+        "robokit.vision.bow_database.BowDatabase.load": Call({"path": npz(saved_database, MAX_FILE_BYTES, DatabaseFileError)}),
+        "robokit.sim.runs.Run.load": Call({"path": npz(saved_run, MAX_RUN_BYTES, ValueError)}),
+        "robokit.legged.trial_log.load_trial": Call({"path": File(saved_trial, budget=MAX_LOG_BYTES, foreign=saved_g2o,
+                                                                  error=TrialLogError, extra=trial_extras)}),
+        "robokit.mapping.g2o.read_g2o": Call({"source": File(saved_g2o, budget=MAX_G2O_BYTES, foreign=saved_arrays,
+                                                             error=G2OFormatError)}),
+        "robokit.mapping.map_server.load_map": Call({"yaml_path": File(saved_map, budget=MAX_YAML_BYTES, foreign=saved_g2o,
+                                                                       error=MapFileError, extra=map_extras)}),
+    }
+
+
+SPECS.update(_reader_specs())
+
+
 EXTRA: tuple[str, ...] = (
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
@@ -1560,6 +1654,10 @@ EXTRA: tuple[str, ...] = (
     "robokit.mapping.pose_graph_optimize.optimize_pose_graph", "robokit.mapping.relaxation.relax",
     "robokit.mapping.relaxation.relax_sweep", "robokit.mapping.relaxation.initial_variances",
     "robokit.mapping.g2o.read_g2o", "robokit.mapping.g2o.write_g2o",
+    # every file reader (hostile files: tests/fuzz_kinds.File)
+    "robokit.files.read_npz", "robokit.mapping.topological.TopologicalMap.load",
+    "robokit.vision.bag_of_words.Vocabulary.load", "robokit.vision.bow_database.BowDatabase.load",
+    "robokit.sim.runs.Run.load",
     "robokit.mapping.manhattan.manhattan_world_graph",
     # lesson 02's topological map and hierarchical localization (helper D)
     "robokit.geometry.procrustes.fit_se2", "robokit.geometry.planar.intersect_lines",

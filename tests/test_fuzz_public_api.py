@@ -27,6 +27,7 @@ import re
 import resource
 import signal
 import warnings
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -36,7 +37,7 @@ hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
 
 from robocourse.lessons import assignments  # noqa: E402
-from tests.fuzz_kinds import Options  # noqa: E402
+from tests.fuzz_kinds import File, Options  # noqa: E402
 from tests.fuzz_specs import EXTRA, NOT_FUZZED, SPECS, resolve  # noqa: E402
 from tests.test_docs import LESSON_API  # noqa: E402
 
@@ -147,6 +148,8 @@ def _names(name: str, pname: str, value: Any) -> list[str]:
     out = [pname] + ([spec.aliases[pname]] if pname in spec.aliases else [])
     if isinstance(spec.kinds[pname], Options):
         out = list(value)
+    if isinstance(spec.kinds[pname], File) and isinstance(value, str) and value:
+        out.append(Path(value).name)      # a hostile file: the error may name the file instead
     return out
 
 
@@ -161,9 +164,16 @@ def fuzz_one(name: str, pname: str, label: str, value: Any, *, huge: bool = Fals
         return f"{what}: hang (more than {BUDGET} s)"
     except (ValueError, TypeError) as exc:
         text = str(exc)
+        kind = SPECS[name].kinds[pname]
+        if isinstance(kind, File) and kind.hostile(label) and not isinstance(exc, kind.error):
+            return f"{what}: {type(exc).__name__}, not the reader's {kind.error.__name__}: {text[:160]}"
         if any(re.search(rf"(?<![\w.]){re.escape(n)}(?!\w)", text) for n in _names(name, pname, value)):
             return None
         return f"{what}: {type(exc).__name__} that does not name {pname!r}: {text[:160]}"
+    except FileNotFoundError as exc:
+        if isinstance(SPECS[name].kinds[pname], File) and label in File.MISSING:
+            return None
+        return f"{what}: crash FileNotFoundError: {str(exc)[:160]}"
     except Exception as exc:   # noqa: BLE001 - any other exception is the failure being looked for
         return f"{what}: crash {type(exc).__name__}: {str(exc)[:160]}"
     if huge:

@@ -338,7 +338,10 @@ def load_map(yaml_path: Any) -> OccupancyGrid:
     if not isinstance(keys["image"], str) or not keys["image"]:
         fail(f"image: expected a file name, got {keys['image']!r}")
     image = Path(keys["image"])
-    img = _read_pgm(image if image.is_absolute() else path.parent / image)
+    try:
+        img = _read_pgm(image if image.is_absolute() else path.parent / image)
+    except MapFileError as exc:                                 # say which YAML named the image
+        raise MapFileError(path, f"image: {exc}") from None
     v = img[::-1].astype(float)                                 # row 0 = lowest y
     p = v / 255.0 if keys["negate"] else (255.0 - v) / 255.0
     P = np.where(p > occ_t, 1.0, np.where(p < free_t, 0.0, 0.5 if mode == "trinary" else p))

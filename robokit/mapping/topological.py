@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ..files import NpzFileError, read_npz, save_npz, write_atomically
+from ..files import NpzFileError, as_file_path, read_npz, save_npz, write_atomically
 from ..validation import as_array, as_choice, as_int, as_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
@@ -347,7 +347,7 @@ class TopologicalMap:
         pathlib.Path
         """
         arrays = {"format": np.array(_FORMAT), **self.to_arrays()}
-        return write_atomically(Path(path), lambda tmp: save_npz(tmp, arrays))
+        return write_atomically(as_file_path(path), lambda tmp: save_npz(tmp, arrays))
 
     @classmethod
     def load(cls, path: str | Path) -> "TopologicalMap":
@@ -364,6 +364,7 @@ class TopologicalMap:
         FileNotFoundError
             If there is no such file.
         """
+        path = as_file_path(path)
         names = [f.name for f in dataclasses.fields(cls)]
         try:
             data = read_npz(path, max_bytes=MAX_MAP_BYTES, max_values=MAX_MAP_VALUES)
@@ -376,4 +377,4 @@ class TopologicalMap:
         except NpzFileError:
             raise
         except (TypeError, ValueError, IndexError) as exc:
-            raise ValueError(f"path: {Path(path).name} is not a saved TopologicalMap ({exc})") from None
+            raise ValueError(f"path: {path.name} is not a saved TopologicalMap ({exc})") from None

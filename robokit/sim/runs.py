@@ -26,7 +26,7 @@ from typing import Any, Iterator
 import numpy as np
 
 from ..cache import CACHE_READ_ERRORS, cache_dir, cache_key, code_version
-from ..files import read_npz, save_npz, write_atomically
+from ..files import as_file_path, read_npz, save_npz, write_atomically
 from ..parallel import iter_runs, map_runs
 from ..progress import progress_bar
 from ..validation import as_array, as_points, as_rng, as_int, as_positive
@@ -98,7 +98,7 @@ class Run:
         for group in ("images", "depths", "scans"):
             for name, arr in getattr(self, group).items():
                 arrays[f"{group}:{name}"] = arr
-        return write_atomically(Path(path), lambda tmp: save_npz(tmp, arrays))
+        return write_atomically(as_file_path(path), lambda tmp: save_npz(tmp, arrays))
 
     @classmethod
     def load(cls, path: str | Path) -> "Run":

@@ -36,7 +36,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..files import read_npz, save_npz, write_atomically
+from ..files import as_file_path, read_npz, save_npz, write_atomically
 from ..validation import as_array, as_int, as_rng, describe
 from .hamming import as_binary_descriptors, hamming_distance
 
@@ -518,7 +518,7 @@ class Vocabulary:
     def save(self, path) -> Path:
         """Write the vocabulary to ``path`` (numpy ``.npz``), atomically; returns the path written."""
         arrays = self.arrays()
-        return write_atomically(Path(path), lambda tmp: save_npz(tmp, arrays))
+        return write_atomically(as_file_path(path), lambda tmp: save_npz(tmp, arrays))
 
     @classmethod
     def load(cls, path) -> "Vocabulary":
@@ -533,7 +533,7 @@ class Vocabulary:
             If the file is not one (corrupt, truncated, another format, a device, beyond the bounds);
             FileNotFoundError if absent.
         """
-        path = Path(path)
+        path = as_file_path(path)
         try:
             return cls.from_arrays(read_npz(path, max_bytes=MAX_FILE_BYTES, max_values=MAX_FILE_VALUES), str(path))
         except (VocabularyFileError, FileNotFoundError):

@@ -29,7 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..files import read_npz, save_npz, write_atomically
+from ..files import as_file_path, read_npz, save_npz, write_atomically
 from ..validation import as_int, describe
 from .bag_of_words import MAX_FILE_BYTES, MAX_FILE_VALUES, Vocabulary, VocabularyFileError
 from .bag_of_words import BowVector, as_bow_vector
@@ -178,7 +178,7 @@ class BowDatabase:
 
     def save(self, path) -> Path:
         """Write the database and its vocabulary to one ``.npz`` file, atomically; returns the path."""
-        path = Path(path)
+        path = as_file_path(path)
         sizes = np.array([w.size for w in self._words], np.int64)
         arrays = {f"vocabulary_{k}": v for k, v in self.vocabulary.arrays().items()}
         arrays.update(entry_sizes=sizes,
@@ -199,7 +199,7 @@ class BowDatabase:
             If the file is not one (corrupt, truncated, another format, a device, beyond the bounds);
             FileNotFoundError if absent.
         """
-        path = Path(path)
+        path = as_file_path(path)
         try:
             npz = read_npz(path, max_bytes=MAX_FILE_BYTES, max_values=MAX_FILE_VALUES)
             voc = Vocabulary.from_arrays({k[len("vocabulary_"):]: v for k, v in npz.items()
