@@ -16,6 +16,10 @@ Python objects that are ``numbers.Real`` (``Fraction``, a big ``int``). Refused 
 * ragged nested lists, ``None`` and other objects.
 
 Where integers are expected, floats are accepted only when they are whole (``2.0``, not ``2.5``).
+
+Angles (headings, beam and joint angles) are refused beyond ``MAX_ANGLE`` radians
+(:func:`require_angles`): a larger finite one is a unit mistake, and from about 1e15 rad on float64
+no longer resolves a turn, so every sine, cosine and wrap of it would be an arbitrary number.
 """
 from __future__ import annotations
 
@@ -27,7 +31,7 @@ import numpy as np
 
 __all__ = ["as_array", "array_ndim", "broadcast_to", "as_points", "as_finite_scalar", "as_positive", "as_int",
            "as_choice", "as_text", "as_callable", "as_mapping", "require_finite_result", "require_sample_count",
-           "MAX_SAMPLES", "as_rng", "describe", "as_covariance"]
+           "MAX_SAMPLES", "as_rng", "describe", "as_covariance", "MAX_ANGLE", "require_angles"]
 
 
 def describe(value: Any) -> str:
@@ -243,6 +247,34 @@ def as_points(value: Any, name: str, dim: int, *, min_count: int = 0) -> np.ndar
     if arr.shape[0] < min_count:
         raise ValueError(f"{name}: expected at least {min_count} points, got {arr.shape[0]}")
     return arr
+
+
+#: Largest angle magnitude (rad) a public function accepts: 160,000 turns, far beyond any unwrapped
+#: heading of a lesson's run, where float64 still resolves 1e-10 rad.
+MAX_ANGLE = 1e6
+
+
+def require_angles(angles: np.ndarray, name: str, what: str = "angles") -> None:
+    """Refuse angles (rad) beyond ``MAX_ANGLE``: finite, but meaningless once wrapped.
+
+    ``what`` says which values of ``name`` are the angles (``"headings (column 2)"``).
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``, the largest magnitude and the bound.
+
+    Examples
+    --------
+    >>> require_angles(np.array([0.5, -40.0]), "q")
+    >>> require_angles(np.array([1e300]), "pose", "heading (element 2)")
+    Traceback (most recent call last):
+    ...
+    ValueError: pose: expected heading (element 2) in radians within +-1e+06, got 1e+300
+    """
+    a = np.abs(np.asarray(angles, dtype=float))
+    if a.size and not a.max() <= MAX_ANGLE:
+        raise ValueError(f"{name}: expected {what} in radians within +-{MAX_ANGLE:g}, got {a.max():.3g}")
 
 
 def as_finite_scalar(value: Any, name: str) -> float:

@@ -1620,6 +1620,31 @@ def _reader_specs() -> dict:
 SPECS.update(_reader_specs())
 
 
+#: Arguments whose last element is an angle (a heading, a joint or beam angle, a heading spread or
+#: change): 1e300 there must be refused (robokit.validation.MAX_ANGLE), as a wrapped value means nothing.
+HUGE_ANGLES: dict[str, tuple[str, ...]] = {
+    "robokit.controllers.path_following_loop.simulate_path_following": ("start_pose",),
+    "robokit.legged.leg_kinematics.body_fk": ("q",),
+    "robokit.legged.leg_kinematics.foot_position": ("q_leg",),
+    "robokit.legged.leg_kinematics.foot_jacobian": ("q_leg",),
+    "robokit.legged.leg_kinematics.leg_points": ("q_leg",),
+    "robokit.legged.leg_kinematics.foot_force_from_torques": ("q_leg",),
+    "robokit.localization.mcl.mcl_step": ("particles", "odom_prev", "odom_now", "angles"),
+    "robokit.localization.particle_filter.sample_ellipse_poses": ("pose", "sigma_theta"),
+    "robokit.localization.particle_filter.weighted_pose_mean": ("particles",),
+    "robokit.localization.pose_ekf.ekf_update": ("z", "H"),
+    "robokit.localization.pose_ekf.unicycle_jacobian": ("x", "dt"),
+    "robokit.mapping.hybrid_map.geo_tag": ("poses",),
+    "robokit.mapping.hybrid_map.geo_index": ("poses",),
+    "robokit.mapping.pose_graph.pose_graph_from_odometry": ("odometry_poses",),
+    "robokit.mapping.pose_graph_optimize.pose_graph_residuals": ("poses",),
+    "robokit.navigation.visual_path.follow_path": ("start_pose", "odometry_noise"),
+    "robokit.navigation.visual_path.perturbed_starts": ("heading",),
+    "robokit.geometry.planar.wrap_angle": ("angle",),
+    "robokit.sim.vehicle.unicycle_step": ("pose", "dt"),
+}
+
+
 EXTRA: tuple[str, ...] = (
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup

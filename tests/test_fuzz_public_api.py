@@ -37,8 +37,8 @@ hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
 
 from robocourse.lessons import assignments  # noqa: E402
-from tests.fuzz_kinds import File, Options  # noqa: E402
-from tests.fuzz_specs import EXTRA, NOT_FUZZED, SPECS, resolve  # noqa: E402
+from tests.fuzz_kinds import HUGE, File, Options  # noqa: E402
+from tests.fuzz_specs import EXTRA, HUGE_ANGLES, NOT_FUZZED, SPECS, resolve  # noqa: E402
 from tests.test_docs import LESSON_API  # noqa: E402
 
 BUDGET = 5.0            # seconds per call
@@ -235,4 +235,15 @@ def test_random_invalid_inputs_get_a_clear_error(name, data):
     pname, kind = data.draw(st.sampled_from(_fuzzed_kinds(name)), label="argument")
     label, value = data.draw(kind.strategy(), label="value")
     failure = fuzz_one(name, pname, label, value)
+    assert failure is None, failure
+
+
+@pytest.mark.parametrize("name, pname", [(n, p) for n, ps in sorted(HUGE_ANGLES.items()) for p in ps])
+def test_a_huge_angle_is_refused_not_wrapped(name, pname):
+    """1e300 where an angle sits: finite, but its sine or wrap is an arbitrary number (issue 38)."""
+    kind = SPECS[name].kinds[pname]
+    value = HUGE if np.ndim(kind.valid()) == 0 else np.asarray(kind.valid(), float)
+    if np.ndim(value):
+        value.reshape(-1)[-1] = HUGE
+    failure = fuzz_one(name, pname, "a huge angle", value)
     assert failure is None, failure

@@ -220,3 +220,14 @@ def test_sample_count_of_an_almost_impossible_clean_sample_is_refused_not_overfl
     assert ransac_sample_count(0.5, 8, 0.99) == 1177          # log(0.01) / log(1 - 2^-8)
     with pytest.raises(ValueError, match="sample_size"):
         ransac_sample_count(0.999, 8)                          # (1e-3)^8 = 1e-24: 1 - p rounds to 1
+
+
+def test_huge_but_finite_components_give_the_same_bearings_and_errors():
+    """Scale-free quantities divide the scale out before a norm: 1e300 entries do not overflow (issue 38)."""
+    from robokit.vision.spherical import as_bearings, epipolar_error
+    np.testing.assert_allclose(as_bearings([[1e300, 0.0, 1e300], [0.0, 3.0, 4.0]], "b"),
+                               [[2 ** -0.5, 0.0, 2 ** -0.5], [0.0, 0.6, 0.8]])
+    rng = np.random.default_rng(3)
+    E, b1, b2 = rng.normal(size=(3, 3)), rng.normal(size=(5, 3)), rng.normal(size=(5, 3))
+    np.testing.assert_allclose(epipolar_error(E * 1e300, b1, b2), epipolar_error(E, b1, b2), rtol=1e-12)
+    np.testing.assert_allclose(epipolar_error(E, b1 * 1e300, b2), epipolar_error(E, b1, b2), rtol=1e-12)

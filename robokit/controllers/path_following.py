@@ -50,7 +50,8 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array, require_finite_result, as_positive, describe
+from ..geometry.planar import as_planar
+from ..validation import as_array, as_positive, describe, require_finite_result
 from .path_geometry import ReferencePoint, VisualPath, path_from_poses, reference_point
 
 # the path's names are re-exported: the lesson's API reaches them through this module too
@@ -298,7 +299,7 @@ class PathFollower:
 
     def command(self, pose: Any) -> tuple[float, float]:
         """``(v, omega)`` for the robot at ``pose`` (its best estimate), Eq. (8) then saturation."""
-        p = as_array(pose, "pose", shape=(3,))
+        p = as_planar(pose, "pose")
         previous = None if self.reference is None else self.reference.index
         ref = reference_point(self.path, p, previous=previous, window=self.window, validate=False)
         if previous is not None and self.window is not None and (

@@ -35,8 +35,9 @@ import control
 import numpy as np
 
 from ..sim import unicycle_step
-from ..validation import (as_array, require_finite_result, as_finite_scalar, as_positive, require_sample_count,
-                          describe)
+from ..geometry.planar import as_planar
+from ..validation import (as_array, as_finite_scalar, as_positive, describe, require_finite_result,
+                          require_sample_count)
 from .path_following import XI, path_following_gains, reference_command
 from .path_geometry import VisualPath, reference_point
 
@@ -249,7 +250,7 @@ def simulate_path_following(path: VisualPath, start_pose: Any, *, alpha: float, 
     """
     if not isinstance(path, VisualPath):
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
-    pose = as_array(start_pose, "start_pose", shape=(3,)).copy()
+    pose = as_planar(start_pose, "start_pose").copy()
     k2, k3 = path_following_gains(alpha, xi)
     speed = as_positive(v, "v")
     T = as_positive(duration, "duration")

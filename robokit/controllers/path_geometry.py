@@ -37,7 +37,7 @@ from scipy.interpolate import CubicSpline
 
 from ..geometry import wrap_angle
 from ..geometry.planar import as_planar
-from ..validation import as_array, require_finite_result, as_positive, require_sample_count, describe
+from ..validation import as_array, as_positive, describe, require_finite_result, require_sample_count
 
 __all__ = ["VisualPath", "path_from_poses", "ReferencePoint", "reference_point"]
 
@@ -232,7 +232,7 @@ def reference_point(path: VisualPath, pose: Any, *, previous: int | None = None,
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
     n = len(path.poses)
     if validate:
-        p = as_array(pose, "pose", shape=(3,))
+        p = as_planar(pose, "pose")
         if previous is not None and (isinstance(previous, bool) or not isinstance(previous, (int, np.integer))
                                      or not 0 <= previous < n):
             raise ValueError(f"previous: expected a path index in [0, {n - 1}], got {describe(previous)}")

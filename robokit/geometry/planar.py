@@ -22,22 +22,34 @@ from typing import Any
 
 import numpy as np
 
-from ..validation import as_array
+from ..validation import as_array, require_angles
 from .rotations import as_rotation
 
 __all__ = ["as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
            "intersect_lines"]
 
 
-def as_planar(value: Any, name: str) -> np.ndarray:
-    """Validate one planar pose or a stack of them: shape (3,) or (N, 3), finite.
+def as_planar(value: Any, name: str, *, shape: Any = None, min_count: int = 0) -> np.ndarray:
+    """Validate one planar pose or a stack of them: shape (3,) or (N, 3), finite, headings in range.
 
-    For robokit's ``[x, y, theta]`` and the papers' ``[p, q, theta]`` alike.
+    For robokit's ``[x, y, theta]`` and the papers' ``[p, q, theta]`` alike. The headings must lie
+    within ``robokit.validation.MAX_ANGLE`` rad (:func:`robokit.validation.require_angles`): a larger
+    finite one wraps to an arbitrary angle.
+
+    Parameters
+    ----------
+    value : array_like
+    name : str
+        The argument's name, for errors.
+    shape : tuple, optional
+        A required shape such as ``(3,)``, ``(None, 3)`` or ``(n, 3)``; default: (3,) or (N, 3).
+    min_count : int, default 0
+        Fewest poses a stack must hold.
 
     Raises
     ------
     ValueError
-        If the shape is not (3,) or (N, 3) or a value is not finite.
+        If the shape is not as required, a value is not finite or a heading is beyond ``MAX_ANGLE``.
 
     Notes
     -----
@@ -47,10 +59,17 @@ def as_planar(value: Any, name: str) -> np.ndarray:
     --------
     >>> as_planar([[0, 0, 0], [1, 2, 3]], "poses").shape
     (2, 3)
+    >>> as_planar([0, 0, 1e300], "pose")
+    Traceback (most recent call last):
+    ...
+    ValueError: pose: expected heading (element 2) in radians within +-1e+06, got 1e+300
     """
-    p = as_array(value, name)
+    p = as_array(value, name, shape=shape)
     if p.shape[-1:] != (3,) or p.ndim > 2:
         raise ValueError(f"{name}: expected shape (3,) or (N, 3), got shape {p.shape}")
+    if p.ndim == 2 and p.shape[0] < min_count:
+        raise ValueError(f"{name}: expected at least {min_count} poses, got {p.shape[0]}")
+    require_angles(p[..., 2], name, "heading (element 2)" if p.ndim == 1 else "headings (column 2)")
     return p
 
 
@@ -73,7 +92,8 @@ def wrap_angle(angle: Any, *, validate: bool = True) -> Any:
     Raises
     ------
     ValueError
-        If any angle is NaN or infinite.
+        If any angle is NaN, infinite or beyond ``robokit.validation.MAX_ANGLE`` (1e6 rad), where a
+        wrapped value would no longer mean anything.
 
     Notes
     -----
@@ -85,7 +105,11 @@ def wrap_angle(angle: Any, *, validate: bool = True) -> Any:
     >>> print(round(wrap_angle(3 * np.pi / 2), 6))
     -1.570796
     """
-    a = as_array(angle, "angle") if validate else np.asarray(angle, float)
+    if validate:
+        a = as_array(angle, "angle")
+        require_angles(a, "angle")
+    else:
+        a = np.asarray(angle, float)
     out = np.mod(a + np.pi, 2 * np.pi) - np.pi
     return float(out) if out.ndim == 0 else out
 

@@ -37,7 +37,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import as_se3
-from ..validation import as_array, as_int, as_rng, describe, require_finite_result
+from ..validation import as_array, as_int, as_rng, describe, require_angles, require_finite_result
 from .littledog import HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, LEGS, LOWER_LEG, UPPER_LEG
 
 __all__ = ["KNEE_BRANCH", "UnreachableFootError", "leg_index", "foot_position", "leg_points", "foot_jacobian",
@@ -78,6 +78,7 @@ def _angles(q: Any, name: str = "q_leg") -> np.ndarray:
     q = as_array(q, name)
     if q.ndim == 0 or q.shape[-1] != 3:
         raise ValueError(f"{name}: expected shape (..., 3) (hip roll, hip pitch, knee), got {describe(q)}")
+    require_angles(q, name, "joint angles")
     return q
 
 
@@ -368,6 +369,7 @@ def body_fk(q: Any) -> np.ndarray:
     q = as_array(q, "q")
     if q.ndim == 0 or q.shape[-1] != 12:
         raise ValueError(f"q: expected shape (..., 12), got {describe(q)}")
+    require_angles(q, "q", "joint angles")
     legs = q.reshape(q.shape[:-1] + (4, 3))
     return np.stack([_chain(legs[..., i, :], i)[2] for i in range(4)], axis=-2)
 

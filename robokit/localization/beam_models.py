@@ -42,7 +42,8 @@ from typing import Any
 import numpy as np
 
 from ..geometry import se2_compose
-from ..validation import as_array, as_points, as_choice, as_int, as_positive, describe
+from ..geometry.planar import as_planar
+from ..validation import as_array, as_choice, as_int, as_positive, describe, require_angles
 
 __all__ = ["COMBINE_RULES", "subsample_beams", "valid_beams", "likelihood_field_log_weights",
            "likelihood_field_log_weight_readable"]
@@ -124,6 +125,7 @@ def valid_beams(ranges: Any, angles: Any, r_max: float, max_beams: int | None = 
     if np.any(r < 0):
         raise ValueError(f"ranges: expected non-negative ranges, got a minimum of {r.min()}")
     a = as_array(angles, "angles", ndim=1)
+    require_angles(a, "angles")
     if a.shape != r.shape:
         raise ValueError(f"angles: expected one angle per range ({r.size}), got {a.size}")
     rm = as_positive(r_max, "r_max")
@@ -205,7 +207,7 @@ def likelihood_field_log_weights(particles: Any, ranges: Any, angles: Any, field
     >>> np.round(likelihood_field_log_weights(P, [1.0], [0.0], field), 3).tolist()
     [0.642, -0.476]
     """
-    P = as_points(particles, "particles", 3, min_count=1)
+    P = as_planar(particles, "particles", shape=(None, 3), min_count=1)
     _as_field(field)
     offset, s, zh, zr, rule = _model_args(sensor_offset, sigma_hit, z_hit, z_rand, combine)
     r, a = valid_beams(ranges, angles, r_max, max_beams)
@@ -273,7 +275,7 @@ def likelihood_field_log_weight_readable(pose: Any, ranges: Any, angles: Any, fi
     >>> round(likelihood_field_log_weight_readable([0.55, 1.0, 0.0], [1.0], [0.0], field), 3)
     0.642
     """
-    x, y, theta = as_array(pose, "pose", shape=(3,))
+    x, y, theta = as_planar(pose, "pose")
     _as_field(field)
     (xs, ys, ts), s, zh, zr, rule = _model_args(sensor_offset, sigma_hit, z_hit, z_rand, combine)
     r, a = valid_beams(ranges, angles, r_max, max_beams)

@@ -74,7 +74,8 @@ import numpy as np
 from ..geometry import wrap_angle
 from ..mapping import LikelihoodField, OccupancyGrid, likelihood_field
 from ..sim import sample_motion_model_odometry
-from ..validation import as_array, as_covariance, as_int, as_points, as_positive, as_rng, describe
+from ..geometry.planar import as_planar
+from ..validation import as_array, as_covariance, as_int, as_positive, as_rng, describe
 from .beam_models import likelihood_field_log_weights
 from .particle_filter import (ROS_KLD_BIN_SIZE, ellipse_weights, kld_resample, low_variance_resample, normalise_log_weights, sample_ellipse_poses, weighted_pose_mean)
 
@@ -143,11 +144,11 @@ def mcl_step(particles: Any, weights: Any, odom_prev: Any, odom_now: Any, ranges
     >>> out.particles[:, 0].tolist()                                 # both copies of the one that fits
     [2.0, 2.0]
     """
-    P = as_points(particles, "particles", 3, min_count=1)
+    P = as_planar(particles, "particles", shape=(None, 3), min_count=1)
     w = as_array(weights, "weights", shape=(len(P),))
     if np.any(w < 0) or not w.sum() > 0:
         raise ValueError(f"weights: expected non-negative weights with a positive sum, got {describe(weights)}")
-    u = (as_array(odom_prev, "odom_prev", shape=(3,)), as_array(odom_now, "odom_now", shape=(3,)))
+    u = (as_planar(odom_prev, "odom_prev"), as_planar(odom_now, "odom_now"))
     g = as_rng(rng)
     moved = sample_motion_model_odometry(*u, P, alphas, g)                            # Table 8.2, line 4
     log_lik = likelihood_field_log_weights(moved, ranges, angles, field, **model)    # line 5
@@ -373,7 +374,7 @@ class MonteCarloLocalizer:
         >>> np.abs(mcl.estimate() - [0.5, 0.5, 0.0]).max() < 0.01
         np.True_
         """
-        mean = as_array(pose, "pose", shape=(3,))
+        mean = as_planar(pose, "pose")
         C = as_covariance(cov, "cov", 3, semidefinite=True)
         count = self.n_particles if n is None else as_int(n, "n", minimum=1, maximum=10 ** 6)
         P = self.rng.multivariate_normal(mean, C, size=count, method="eigh")
@@ -439,7 +440,7 @@ class MonteCarloLocalizer:
         >>> mcl.due([0.5, 0, 0]), mcl.update([0, 0, 0], [1.0]), mcl.due([0.1, 0, 0]), mcl.due([0.3, 0, 0])
         (False, False, False, True)
         """
-        return self._moved(as_array(odometry_pose, "odometry_pose", shape=(3,)))
+        return self._moved(as_planar(odometry_pose, "odometry_pose"))
 
     def _moved(self, odom: np.ndarray) -> bool:
         """:meth:`due` for a checked odometry pose."""
@@ -488,7 +489,7 @@ class MonteCarloLocalizer:
         >>> mcl.update([0, 0, 0], [1.0]), mcl.update([0.1, 0, 0], [1.0]), mcl.update([0.3, 0, 0], [1.0])
         (False, False, True)
         """
-        odom = as_array(odometry_pose, "odometry_pose", shape=(3,))
+        odom = as_planar(odometry_pose, "odometry_pose")
         r = as_array(ranges, "ranges", ndim=1, finite=False, min_size=1)
         if np.any(np.isnan(r)):
             raise ValueError("ranges: expected ranges or inf (a max-range return), got NaN")

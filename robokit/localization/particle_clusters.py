@@ -24,6 +24,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from ..geometry.planar import as_planar
 from ..validation import as_array
 from .particle_filter import ROS_KLD_BIN_SIZE, pose_bins, weighted_pose_mean
 
@@ -65,9 +66,7 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     >>> pose_clusters(cloud).tolist()        # two touching cells; a far one; a pair across +-pi
     [0, 0, 1, 2, 2]
     """
-    P = as_array(particles, "particles", ndim=2, min_size=1)
-    if P.shape[1] != 3:
-        raise ValueError(f"particles: expected poses of shape (N, 3), got shape {P.shape}")
+    P = as_planar(particles, "particles", shape=(None, 3), min_count=1)
     size = as_array(bin_size, "bin_size", shape=(3,))
     cells = pose_bins(P, size)
     n_heading = int(np.ceil(2 * np.pi / size[2]))
@@ -104,9 +103,7 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
 def _cluster_labels(particles: Any, bin_size: Any, labels: Any) -> np.ndarray:
     if labels is None:
         return pose_clusters(particles, bin_size)
-    P = as_array(particles, "particles", ndim=2, min_size=1)
-    if P.shape[1] != 3:
-        raise ValueError(f"particles: expected poses of shape (N, 3), got shape {P.shape}")
+    P = as_planar(particles, "particles", shape=(None, 3), min_count=1)
     as_array(bin_size, "bin_size", shape=(3,))
     try:
         lab = np.asarray(labels)

@@ -41,8 +41,9 @@ from scipy.special import logsumexp
 from scipy.stats import norm
 
 from ..geometry import wrap_angle
-from ..validation import (as_array, as_points, as_rng, as_callable, require_finite_result, as_finite_scalar,
-                          as_int, as_positive, require_sample_count, describe)
+from ..geometry.planar import as_planar
+from ..validation import (as_array, as_callable, as_finite_scalar, as_int, as_positive,
+                          as_rng, describe, require_angles, require_finite_result, require_sample_count)
 
 __all__ = ["NormalisedWeights", "normalise_log_weights", "low_variance_resample", "kld_sample_count",
            "kld_resample", "pose_bins", "weighted_pose_mean", "sample_ellipse_poses", "ellipse_weights",
@@ -268,7 +269,7 @@ def pose_bins(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarray:
     >>> pose_bins([[0.2, 0.7, 0.0], [0.3, 0.6, 0.1]]).tolist()
     [[0, 1, 0], [0, 1, 0]]
     """
-    P = as_points(particles, "particles", 3)
+    P = as_planar(particles, "particles", shape=(None, 3))
     size = as_array(bin_size, "bin_size", shape=(3,))
     if np.any(size <= 0):
         raise ValueError(f"bin_size: expected three positive sizes, got {size.tolist()}")
@@ -320,7 +321,7 @@ def kld_resample(particles: Any, weights: Any, rng: Any = None, *, min_count: in
     >>> kld_resample(P, np.ones(10), rng=0, min_count=20, max_count=200).shape
     (20, 3)
     """
-    P = as_points(particles, "particles", 3, min_count=1)
+    P = as_planar(particles, "particles", shape=(None, 3), min_count=1)
     w = _weights(weights)
     if w.size != len(P):
         raise ValueError(f"weights: expected {len(P)} weights (one per particle), got {w.size}")
@@ -340,7 +341,7 @@ def kld_resample(particles: Any, weights: Any, rng: Any = None, *, min_count: in
     cand = P[idx]
     injected = g.random(hi) < p_inj                                  # Table 8.3, max(0, 1 - w_fast / w_slow)
     if injected.any():
-        cand[injected] = as_points(random_pose(int(injected.sum()), g), "random_pose(n, rng)", 3)
+        cand[injected] = as_planar(random_pose(int(injected.sum()), g), "random_pose(n, rng)", shape=(None, 3))
     keys = pose_bins(cand, bin_size)
     _, first = np.unique(keys, axis=0, return_index=True)
     new_bin = np.zeros(hi, dtype=bool)
@@ -377,7 +378,7 @@ def weighted_pose_mean(particles: Any, weights: Any = None) -> np.ndarray:
     >>> weighted_pose_mean([[0.0, 0.0, 3.0], [2.0, 0.0, -3.0]]).round(4).tolist()  # across +-pi
     [1.0, 0.0, 3.1416]
     """
-    P = as_points(particles, "particles", 3, min_count=1)
+    P = as_planar(particles, "particles", shape=(None, 3), min_count=1)
     w = np.full(len(P), 1.0 / len(P)) if weights is None else _weights(weights)
     if w.size != len(P):
         raise ValueError(f"weights: expected {len(P)} weights (one per particle), got {w.size}")
@@ -386,7 +387,7 @@ def weighted_pose_mean(particles: Any, weights: Any = None) -> np.ndarray:
 
 
 def _ellipse_args(pose: Any, sigma_x: Any, sigma_y: Any) -> tuple[np.ndarray, float, float]:
-    return (as_array(pose, "pose", shape=(3,)), as_positive(sigma_x, "sigma_x"),
+    return (as_planar(pose, "pose"), as_positive(sigma_x, "sigma_x"),
             as_positive(sigma_y, "sigma_y"))
 
 
@@ -431,6 +432,7 @@ def sample_ellipse_poses(pose: Any, sigma_x: float, sigma_y: float, n: int = 50,
     require_sample_count(count, "n")
     k = as_positive(nsigma, "nsigma")
     st = as_positive(sigma_theta, "sigma_theta", allow_zero=True)
+    require_angles(st, "sigma_theta", "a heading spread")
     g = as_rng(rng)
     radius = np.sqrt(g.random(count))
     phi = g.uniform(-np.pi, np.pi, count)
@@ -470,7 +472,7 @@ def ellipse_weights(particles: Any, pose: Any, sigma_x: float, sigma_y: float, *
     >>> np.round(w, 6).tolist()                        # 1/(2 pi) and exp(-1/2)/(2 pi)
     [0.159155, 0.096532]
     """
-    P = as_points(particles, "particles", 3, min_count=1)
+    P = as_planar(particles, "particles", shape=(None, 3), min_count=1)
     c, sx, sy = _ellipse_args(pose, sigma_x, sigma_y)
     dx, dy = P[:, 0] - c[0], P[:, 1] - c[1]
     ct, st = np.cos(c[2]), np.sin(c[2])

@@ -37,8 +37,9 @@ from scipy.stats import chi2
 
 from ..geometry import wrap_angle
 from ..sim import unicycle_step
-from ..validation import (as_array, as_covariance, require_finite_result, as_int, as_positive,
-                          as_finite_scalar, describe)
+from ..geometry.planar import as_planar
+from ..validation import (as_array, as_covariance, as_finite_scalar, as_int, as_positive, describe,
+                          require_angles, require_finite_result)
 
 __all__ = ["unicycle_jacobian", "unicycle_process_noise", "ekf_predict", "ekf_update", "nees", "nees_bounds",
            "UnicycleEKF"]
@@ -49,7 +50,9 @@ H_POSE = np.eye(3, 5)
 
 
 def _state(x: Any, name: str = "x") -> np.ndarray:
-    return as_array(x, name, shape=(5,))
+    state = as_array(x, name, shape=(5,))
+    require_angles(state[2], name, "heading (element 2)")
+    return state
 
 
 def _sinc_and_slope(u: float) -> tuple[float, float]:
@@ -87,7 +90,9 @@ def unicycle_jacobian(x: Any, dt: float) -> np.ndarray:
     >>> np.round(F[:3, 2:], 4).tolist()          # d(x, y, theta) / d(theta, v, omega)
     [[0.0, 0.5, 0.0], [0.5, 0.0, 0.125], [1.0, 0.0, 0.5]]
     """
-    F = _jacobian(_state(x), as_positive(dt, "dt", allow_zero=True))
+    state, step = _state(x), as_positive(dt, "dt", allow_zero=True)
+    require_angles(state[4] * step, "x, dt", "a heading change omega * dt")
+    F = _jacobian(state, step)
     require_finite_result("x, dt", F)
     return F
 
@@ -272,6 +277,8 @@ def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] 
     if not isinstance(angles, (list, tuple, range, np.ndarray)):
         raise TypeError(f"angles: expected a sequence of indices into z, got {describe(angles)}")
     angles = [as_int(i, "angles", minimum=0, maximum=m - 1) for i in np.asarray(angles, dtype=object).ravel()]
+    require_angles(z[angles], "z", "angles (the rows named by angles)")
+    require_angles((H @ x)[angles], "H", "predicted angles (H x in the rows named by angles)")
     return _update(x, P, z, H, R, angles)
 
 
@@ -468,7 +475,7 @@ class UnicycleEKF:
         bool
             Whether the fix was used.
         """
-        zz = as_array(z, "z", shape=(3,))
+        zz = as_planar(z, "z")
         RR = as_covariance(R, "R", 3)
         g = None if gate is None else as_positive(gate, "gate")
         y, S = _innovation(self._x, self._P, zz, H_POSE, RR, (2,))

@@ -34,7 +34,8 @@ from typing import Any
 import numpy as np
 
 from ..geometry import se2_compose, wrap_angle
-from ..validation import as_array, as_finite_scalar, as_positive, describe
+from ..geometry.planar import as_planar
+from ..validation import as_array, as_finite_scalar, as_positive, describe, require_angles
 from .occupancy_grid import LOG_ODDS_MAX, LOG_ODDS_MIN, OccupancyGrid
 
 __all__ = ["L_OCC", "L_FREE", "inverse_range_sensor_model", "update_log_odds", "occupancy_grid_mapping",
@@ -47,6 +48,7 @@ L_OCC, L_FREE = math.log(0.7 / 0.3), math.log(0.4 / 0.6)
 def _as_scan(ranges: Any, angles: Any, name: str = "ranges") -> tuple[np.ndarray, np.ndarray]:
     r = as_array(ranges, name, finite=False)
     a = as_array(angles, "angles", ndim=1)
+    require_angles(a, "angles")
     if r.ndim == 0 or r.shape[-1] == 0:
         raise ValueError(f"{name}: expected at least one beam per scan (an empty scan has nothing to map), "
                          f"got shape {r.shape}")
@@ -137,7 +139,7 @@ def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, 
     pts = as_array(xy, "xy")
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise ValueError(f"xy: expected shape (N, 2), got shape {pts.shape}")
-    p = as_array(pose, "pose", shape=(3,))
+    p = as_planar(pose, "pose")
     z, a = _as_scan(ranges, angles)
     if z.ndim != 1:
         raise ValueError(f"ranges: expected one scan of shape ({a.size},), got shape {z.shape}")
@@ -226,7 +228,7 @@ def update_log_odds(grid: OccupancyGrid, pose: Any, ranges: Any, angles: Any, *,
     """
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"grid: expected an OccupancyGrid, got {describe(grid)}")
-    p = as_array(pose, "pose", shape=(3,))
+    p = as_planar(pose, "pose")
     z, a = _as_scan(ranges, angles)
     if z.ndim != 1:
         raise ValueError(f"ranges: expected one scan of shape ({a.size},), got shape {z.shape}")
@@ -240,9 +242,7 @@ def update_log_odds(grid: OccupancyGrid, pose: Any, ranges: Any, angles: Any, *,
 
 
 def _as_run(poses: Any, scans: Any, angles: Any, sensor_offset: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    P = as_array(poses, "poses")
-    if P.ndim != 2 or P.shape[1] != 3 or P.shape[0] == 0:
-        raise ValueError(f"poses: expected shape (N, 3) with N >= 1, got shape {P.shape}")
+    P = as_planar(poses, "poses", shape=(None, 3), min_count=1)
     z, a = _as_scan(scans, angles, "scans")
     if z.ndim != 2 or z.shape[0] != P.shape[0]:
         raise ValueError(f"scans: expected shape ({P.shape[0]}, {a.size}), one scan per pose, got shape {z.shape}")

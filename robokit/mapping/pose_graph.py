@@ -30,6 +30,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..geometry import se2_between
+from ..geometry.planar import as_planar
 from ..validation import as_array, as_int
 
 __all__ = ["PoseGraph", "DisconnectedGraphError", "as_pose_graph", "positive_definite", "edge_variances", "unreachable_nodes",
@@ -117,7 +118,7 @@ class PoseGraph:
     fixed: Any = 0
 
     def __post_init__(self) -> None:
-        poses = as_array(self.poses, "poses", shape=(None, 3))
+        poses = as_planar(self.poses, "poses", shape=(None, 3))
         if len(poses) == 0:
             raise ValueError("poses: expected at least one pose, got shape (0, 3)")
         n = len(poses)
@@ -228,7 +229,7 @@ def information_from_covariance(measurements: Any, covariances: Any) -> np.ndarr
     >>> np.round(np.linalg.inv(info[0]).diagonal(), 6).tolist()
     [0.01, 0.1, 0.01]
     """
-    z = as_array(measurements, "measurements", shape=(None, 3))
+    z = as_planar(measurements, "measurements", shape=(None, 3))
     cov = as_array(covariances, "covariances", shape=(len(z), 3, 3))
     if len(z) and not np.all(positive_definite(0.5 * (cov + np.swapaxes(cov, 1, 2)))):
         raise ValueError("covariances: expected symmetric positive-definite 3 x 3 matrices")
@@ -461,7 +462,7 @@ def pose_graph_from_odometry(odometry_poses: Any, loop_edges: Any = None, loop_m
     >>> g.n_poses, g.n_edges, g.edges.tolist()
     (4, 4, [[0, 1], [1, 2], [2, 3], [3, 0]])
     """
-    odo = as_array(odometry_poses, "odometry_poses", shape=(None, 3))
+    odo = as_planar(odometry_poses, "odometry_poses", shape=(None, 3))
     if len(odo) == 0:
         raise ValueError("odometry_poses: expected at least one pose, got shape (0, 3)")
     n = len(odo)

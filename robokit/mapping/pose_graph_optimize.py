@@ -48,7 +48,8 @@ from scipy.optimize import least_squares
 from scipy.sparse.linalg import splu
 
 from ..geometry import se2_between, wrap_angle
-from ..validation import as_array, as_choice, require_finite_result, as_int, as_positive
+from ..geometry.planar import as_planar
+from ..validation import as_choice, as_int, as_positive, require_finite_result
 from .pose_graph import PoseGraph, as_pose_graph, require_connected
 
 __all__ = ["pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph"]
@@ -66,7 +67,7 @@ MAX_DAMPING = 1e12
 def _poses(poses: Any, graph: PoseGraph) -> np.ndarray:
     if poses is None:
         return graph.poses
-    return as_array(poses, "poses", shape=(graph.n_poses, 3))
+    return as_planar(poses, "poses", shape=(graph.n_poses, 3))
 
 
 def pose_graph_residuals(graph: PoseGraph, poses: Any = None) -> np.ndarray:

@@ -53,7 +53,8 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import dijkstra
 
 from ..geometry import se2_compose, se2_inverse, wrap_angle
-from ..validation import as_array, require_finite_result, as_int, as_positive
+from ..geometry.planar import as_planar
+from ..validation import as_array, as_int, as_positive, require_finite_result
 from .pose_graph import PoseGraph, as_pose_graph, require_connected, edge_variances
 
 __all__ = ["RelaxationResult", "relax", "relax_sweep", "initial_variances"]
@@ -88,7 +89,7 @@ class RelaxationResult:
 
 
 def _arrays(poses, variances, edges, measurements, omega_edges, fixed):
-    p = as_array(poses, "poses", shape=(None, 3))
+    p = as_planar(poses, "poses", shape=(None, 3))
     n = len(p)
     if n == 0:
         raise ValueError("poses: expected at least one pose, got shape (0, 3)")

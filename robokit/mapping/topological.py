@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..files import NpzFileError, as_file_path, read_npz, save_npz, write_atomically
+from ..geometry.planar import as_planar
 from ..validation import as_array, as_choice, as_int, as_positive
 from ..vision.colour import histogram_distance
 from ..vision.features import Features, Keypoints
@@ -161,7 +162,7 @@ class TopologicalMap:
         poses = as_array(self.poses, "poses")
         if poses.size == 0:
             raise EmptyMapError(f"poses: expected a map with at least one node, got shape {poses.shape}")
-        poses = as_array(poses, "poses", shape=(None, 3))
+        poses = as_planar(poses, "poses", shape=(None, 3))
         n = len(poses)
         variances = as_array(self.variances, "variances", shape=(n,))
         if np.any(variances < 0):
@@ -310,7 +311,7 @@ class TopologicalMap:
         ValueError
             For a shape other than (N, 3) or NaN/inf.
         """
-        new = as_array(poses, "poses", shape=(len(self), 3))
+        new = as_planar(poses, "poses", shape=(len(self), 3))
         var = self.variances if variances is None else as_array(variances, "variances", shape=(len(self),))
         if np.any(var < 0):
             raise ValueError(f"variances: expected non-negative node variances, got {var.min()}")

@@ -49,6 +49,7 @@ from ..vision.colour import histogram_distance
 from ..vision.matching import DescriptorIndex, METHODS
 from ..geometry import se2_between, wrap_angle
 from ..progress import progress_bar
+from ..geometry.planar import as_planar
 from ..validation import as_array, as_callable, as_choice, as_int, as_positive, describe
 from .omni_views import as_omni_image, omni_view, relative_pose
 from .pose_graph import position_variance
@@ -369,7 +370,7 @@ def _images_and_odometry(images: Any, odometry: Any, camera: OmniCamera) -> tupl
                         "got the FrameStream itself")
     if isinstance(images, Iterator):      # taken as they arrive (e.g. rendered by workers)
         as_omni_camera(camera)
-        odo = as_array(odometry, "odometry", shape=(None, 3))
+        odo = as_planar(odometry, "odometry", shape=(None, 3))
         if len(odo) == 0:
             raise EmptyMapError("odometry: expected at least one pose to build a map from, got none")
         return None, odo
@@ -379,7 +380,7 @@ def _images_and_odometry(images: Any, odometry: Any, camera: OmniCamera) -> tupl
             raise EmptyMapError(f"images: expected at least one image to build a map from, got shape {raw.shape}")
         raise ValueError(f"images: expected shape (N, H, W, 3), got shape {raw.shape}")
     as_omni_image(raw[0], camera, "images[0]")
-    return raw, as_array(odometry, "odometry", shape=(len(raw), 3))
+    return raw, as_planar(odometry, "odometry", shape=(len(raw), 3))
 
 
 class _Views:

@@ -38,8 +38,9 @@ from ..controllers.path_geometry import VisualPath, reference_point
 from ..geometry import wrap_angle
 from ..localization.pose_ekf import UnicycleEKF
 from ..sim import unicycle_step
-from ..validation import (as_array, as_rng, as_callable, require_finite_result, as_int, as_positive,
-                          require_sample_count, describe)
+from ..geometry.planar import as_planar
+from ..validation import (as_array, as_callable, as_int, as_positive, as_rng, describe,
+                          require_angles, require_finite_result, require_sample_count)
 
 __all__ = ["FollowResult", "follow_path", "gaussian_localizer", "perturbed_starts"]
 
@@ -175,6 +176,7 @@ def perturbed_starts(path: VisualPath, n: int, *, offset: float = 0.3, heading: 
     count = as_int(n, "n", minimum=0, maximum=10 ** 6)
     r = as_positive(offset, "offset", allow_zero=True)
     h = as_positive(heading, "heading", allow_zero=True)
+    require_angles(h, "heading")
     g = as_rng(rng)
     s = g.uniform(0.0, min(r, path.length), count)
     x, y, th = (np.interp(s, path.s, path.poses[:, i]) for i in range(3))
@@ -251,12 +253,13 @@ def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: fl
     """
     if not isinstance(path, VisualPath):
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
-    pose = as_array(start_pose, "start_pose", shape=(3,)).copy()
+    pose = as_planar(start_pose, "start_pose").copy()
     find = as_callable(localize, "localize", optional=False)
     h = as_positive(dt, "dt")
     every = max(1, int(round(as_positive(fix_period, "fix_period") / h)))
     follower = PathFollower(path, alpha, v_max, w_max, xi, goal_tolerance=goal_tolerance)
     odo_sd = as_array(odometry_noise, "odometry_noise", shape=(2,))
+    require_angles(odo_sd[1], "odometry_noise", "an angular-rate spread (element 1, rad/s)")
     if np.any(odo_sd < 0):
         raise ValueError(f"odometry_noise: expected non-negative standard deviations, got {odo_sd.tolist()}")
     fix_sd = as_array(sigma_fix, "sigma_fix", shape=(3,))

@@ -28,7 +28,8 @@ from typing import Any
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..validation import as_array, as_points, broadcast_to, as_positive
+from ..geometry.planar import as_planar
+from ..validation import as_array, as_positive, broadcast_to, require_angles
 
 __all__ = ["unicycle_step", "diff_drive_velocities", "skid_steer_velocities", "skid_steer_wheel_speeds"]
 
@@ -68,12 +69,13 @@ def unicycle_step(pose: Any, v: Any, omega: Any, dt: float, *, validate: bool = 
     [0.6366, 0.6366, 1.5708]
     """
     if validate:
-        P = as_array(pose, "pose")
+        P = as_planar(pose, "pose")
         single = P.ndim == 1
-        P = as_points(P, "pose", 3)
+        P = P.reshape(-1, 3)
         v = broadcast_to(as_array(v, "v"), (len(P),), "v", "one per pose")
         w = broadcast_to(as_array(omega, "omega"), (len(P),), "omega", "one per pose")
         dt = as_positive(dt, "dt", allow_zero=True)
+        require_angles(w * dt, "omega, dt", "heading changes omega * dt")
     else:
         P = np.asarray(pose, dtype=float)
         single = P.ndim == 1

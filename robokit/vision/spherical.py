@@ -65,11 +65,12 @@ def as_bearings(value: Any, name: str, *, count: int | None = None) -> np.ndarra
      [0.6 0.8 0. ]]
     """
     b = as_array(value, name, shape=(count, 3))
-    norm = np.linalg.norm(b, axis=1)
-    if np.any(norm < 1e-12):
+    scale = np.max(np.abs(b), axis=1, initial=0.0)      # divided out first: a 1e300 component cannot overflow
+    if np.any(scale < 1e-12):
         raise ValueError(f"{name}: expected non-zero viewing directions, got a zero vector at row "
-                         f"{int(np.argmax(norm < 1e-12))}")
-    return b / norm[:, None]
+                         f"{int(np.argmax(scale < 1e-12))}")
+    b = b / scale[:, None]
+    return b / np.linalg.norm(b, axis=1)[:, None]
 
 
 def _eight_point(b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
@@ -174,6 +175,8 @@ def epipolar_error(E: Any, b1: Any, b2: Any) -> np.ndarray:
     E = as_array(E, "E")
     if E.shape[-2:] != (3, 3) or E.ndim > 3:
         raise ValueError(f"E: expected shape (3, 3) or (K, 3, 3), got shape {E.shape}")
+    scale = np.max(np.abs(E), axis=(-2, -1), keepdims=True)    # the error is scale-free: divide out first,
+    E = E / np.where(scale > 0, scale, 1.0)                    # so 1e300 entries cannot overflow
     b1 = as_bearings(b1, "b1")
     return _epipolar_error(E, b1, as_bearings(b2, "b2", count=len(b1)))
 
