@@ -1640,7 +1640,6 @@ HUGE_ANGLES: dict[str, tuple[str, ...]] = {
     "robokit.mapping.pose_graph_optimize.pose_graph_residuals": ("poses",),
     "robokit.navigation.visual_path.follow_path": ("start_pose", "odometry_noise"),
     "robokit.navigation.visual_path.perturbed_starts": ("heading",),
-    "robokit.geometry.planar.wrap_angle": ("angle",),
     "robokit.sim.vehicle.unicycle_step": ("pose", "dt"),
 }
 

@@ -299,7 +299,7 @@ class PathFollower:
 
     def command(self, pose: Any) -> tuple[float, float]:
         """``(v, omega)`` for the robot at ``pose`` (its best estimate), Eq. (8) then saturation."""
-        p = as_planar(pose, "pose")
+        p = as_planar(pose, "pose", shape=(3,))
         previous = None if self.reference is None else self.reference.index
         ref = reference_point(self.path, p, previous=previous, window=self.window, validate=False)
         if previous is not None and self.window is not None and (

@@ -250,7 +250,7 @@ def simulate_path_following(path: VisualPath, start_pose: Any, *, alpha: float, 
     """
     if not isinstance(path, VisualPath):
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
-    pose = as_planar(start_pose, "start_pose").copy()
+    pose = as_planar(start_pose, "start_pose", shape=(3,)).copy()
     k2, k3 = path_following_gains(alpha, xi)
     speed = as_positive(v, "v")
     T = as_positive(duration, "duration")

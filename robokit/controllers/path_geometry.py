@@ -232,7 +232,7 @@ def reference_point(path: VisualPath, pose: Any, *, previous: int | None = None,
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
     n = len(path.poses)
     if validate:
-        p = as_planar(pose, "pose")
+        p = as_planar(pose, "pose", shape=(3,))
         if previous is not None and (isinstance(previous, bool) or not isinstance(previous, (int, np.integer))
                                      or not 0 <= previous < n):
             raise ValueError(f"previous: expected a path index in [0, {n - 1}], got {describe(previous)}")

@@ -92,8 +92,7 @@ def wrap_angle(angle: Any, *, validate: bool = True) -> Any:
     Raises
     ------
     ValueError
-        If any angle is NaN, infinite or beyond ``robokit.validation.MAX_ANGLE`` (1e6 rad), where a
-        wrapped value would no longer mean anything.
+        If any angle is NaN or infinite.
 
     Notes
     -----
@@ -105,11 +104,7 @@ def wrap_angle(angle: Any, *, validate: bool = True) -> Any:
     >>> print(round(wrap_angle(3 * np.pi / 2), 6))
     -1.570796
     """
-    if validate:
-        a = as_array(angle, "angle")
-        require_angles(a, "angle")
-    else:
-        a = np.asarray(angle, float)
+    a = as_array(angle, "angle") if validate else np.asarray(angle, float)
     out = np.mod(a + np.pi, 2 * np.pi) - np.pi
     return float(out) if out.ndim == 0 else out
 

@@ -142,7 +142,7 @@ def _as_field(field: Any) -> Any:
 
 
 def _model_args(sensor_offset: Any, sigma_hit: float, z_hit: float, z_rand: float, combine: str) -> tuple:
-    offset = as_array(sensor_offset, "sensor_offset", shape=(3,))
+    offset = as_planar(sensor_offset, "sensor_offset", shape=(3,))
     s = as_positive(sigma_hit, "sigma_hit")
     zh = as_positive(z_hit, "z_hit", allow_zero=True)
     zr = as_positive(z_rand, "z_rand", allow_zero=True)
@@ -275,7 +275,7 @@ def likelihood_field_log_weight_readable(pose: Any, ranges: Any, angles: Any, fi
     >>> round(likelihood_field_log_weight_readable([0.55, 1.0, 0.0], [1.0], [0.0], field), 3)
     0.642
     """
-    x, y, theta = as_planar(pose, "pose")
+    x, y, theta = as_planar(pose, "pose", shape=(3,))
     _as_field(field)
     (xs, ys, ts), s, zh, zr, rule = _model_args(sensor_offset, sigma_hit, z_hit, z_rand, combine)
     r, a = valid_beams(ranges, angles, r_max, max_beams)

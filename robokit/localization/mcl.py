@@ -148,7 +148,7 @@ def mcl_step(particles: Any, weights: Any, odom_prev: Any, odom_now: Any, ranges
     w = as_array(weights, "weights", shape=(len(P),))
     if np.any(w < 0) or not w.sum() > 0:
         raise ValueError(f"weights: expected non-negative weights with a positive sum, got {describe(weights)}")
-    u = (as_planar(odom_prev, "odom_prev"), as_planar(odom_now, "odom_now"))
+    u = (as_planar(odom_prev, "odom_prev", shape=(3,)), as_planar(odom_now, "odom_now", shape=(3,)))
     g = as_rng(rng)
     moved = sample_motion_model_odometry(*u, P, alphas, g)                            # Table 8.2, line 4
     log_lik = likelihood_field_log_weights(moved, ranges, angles, field, **model)    # line 5
@@ -374,7 +374,7 @@ class MonteCarloLocalizer:
         >>> np.abs(mcl.estimate() - [0.5, 0.5, 0.0]).max() < 0.01
         np.True_
         """
-        mean = as_planar(pose, "pose")
+        mean = as_planar(pose, "pose", shape=(3,))
         C = as_covariance(cov, "cov", 3, semidefinite=True)
         count = self.n_particles if n is None else as_int(n, "n", minimum=1, maximum=10 ** 6)
         P = self.rng.multivariate_normal(mean, C, size=count, method="eigh")
@@ -440,7 +440,7 @@ class MonteCarloLocalizer:
         >>> mcl.due([0.5, 0, 0]), mcl.update([0, 0, 0], [1.0]), mcl.due([0.1, 0, 0]), mcl.due([0.3, 0, 0])
         (False, False, False, True)
         """
-        return self._moved(as_planar(odometry_pose, "odometry_pose"))
+        return self._moved(as_planar(odometry_pose, "odometry_pose", shape=(3,)))
 
     def _moved(self, odom: np.ndarray) -> bool:
         """:meth:`due` for a checked odometry pose."""
@@ -489,7 +489,7 @@ class MonteCarloLocalizer:
         >>> mcl.update([0, 0, 0], [1.0]), mcl.update([0.1, 0, 0], [1.0]), mcl.update([0.3, 0, 0], [1.0])
         (False, False, True)
         """
-        odom = as_planar(odometry_pose, "odometry_pose")
+        odom = as_planar(odometry_pose, "odometry_pose", shape=(3,))
         r = as_array(ranges, "ranges", ndim=1, finite=False, min_size=1)
         if np.any(np.isnan(r)):
             raise ValueError("ranges: expected ranges or inf (a max-range return), got NaN")

@@ -387,7 +387,7 @@ def weighted_pose_mean(particles: Any, weights: Any = None) -> np.ndarray:
 
 
 def _ellipse_args(pose: Any, sigma_x: Any, sigma_y: Any) -> tuple[np.ndarray, float, float]:
-    return (as_planar(pose, "pose"), as_positive(sigma_x, "sigma_x"),
+    return (as_planar(pose, "pose", shape=(3,)), as_positive(sigma_x, "sigma_x"),
             as_positive(sigma_y, "sigma_y"))
 
 

@@ -475,7 +475,7 @@ class UnicycleEKF:
         bool
             Whether the fix was used.
         """
-        zz = as_planar(z, "z")
+        zz = as_planar(z, "z", shape=(3,))
         RR = as_covariance(R, "R", 3)
         g = None if gate is None else as_positive(gate, "gate")
         y, S = _innovation(self._x, self._P, zz, H_POSE, RR, (2,))

@@ -139,7 +139,7 @@ def inverse_range_sensor_model(xy: Any, pose: Any, ranges: Any, angles: Any, *, 
     pts = as_array(xy, "xy")
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise ValueError(f"xy: expected shape (N, 2), got shape {pts.shape}")
-    p = as_planar(pose, "pose")
+    p = as_planar(pose, "pose", shape=(3,))
     z, a = _as_scan(ranges, angles)
     if z.ndim != 1:
         raise ValueError(f"ranges: expected one scan of shape ({a.size},), got shape {z.shape}")
@@ -228,7 +228,7 @@ def update_log_odds(grid: OccupancyGrid, pose: Any, ranges: Any, angles: Any, *,
     """
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"grid: expected an OccupancyGrid, got {describe(grid)}")
-    p = as_planar(pose, "pose")
+    p = as_planar(pose, "pose", shape=(3,))
     z, a = _as_scan(ranges, angles)
     if z.ndim != 1:
         raise ValueError(f"ranges: expected one scan of shape ({a.size},), got shape {z.shape}")
@@ -246,7 +246,7 @@ def _as_run(poses: Any, scans: Any, angles: Any, sensor_offset: Any) -> tuple[np
     z, a = _as_scan(scans, angles, "scans")
     if z.ndim != 2 or z.shape[0] != P.shape[0]:
         raise ValueError(f"scans: expected shape ({P.shape[0]}, {a.size}), one scan per pose, got shape {z.shape}")
-    offset = as_array(sensor_offset, "sensor_offset", shape=(3,))
+    offset = as_planar(sensor_offset, "sensor_offset", shape=(3,))
     return se2_compose(P, offset), z, a
 
 

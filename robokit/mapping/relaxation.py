@@ -102,7 +102,7 @@ def _arrays(poses, variances, edges, measurements, omega_edges, fixed):
         raise ValueError(f"edges: expected shape (M, 2), got shape {e.shape}")
     if ((e < 0) | (e >= n)).any() or (e[:, 0] == e[:, 1]).any():
         raise ValueError(f"edges: expected pairs of two different node indices in 0..{n - 1}")
-    z = as_array(measurements, "measurements", shape=(len(e), 3)) if len(e) else np.zeros((0, 3))
+    z = as_planar(measurements, "measurements", shape=(len(e), 3)) if len(e) else np.zeros((0, 3))
     w = as_array(omega_edges, "edge_variances", shape=(len(e),)) if len(e) else np.zeros(0)
     if np.any(w <= 0):
         raise ValueError(f"edge_variances: expected positive variances, got {float(w[w <= 0][0])}")

@@ -253,7 +253,7 @@ def follow_path(path: VisualPath, start_pose: Any, *, localize: Callable, dt: fl
     """
     if not isinstance(path, VisualPath):
         raise TypeError(f"path: expected a VisualPath, got {describe(path)}")
-    pose = as_planar(start_pose, "start_pose").copy()
+    pose = as_planar(start_pose, "start_pose", shape=(3,)).copy()
     find = as_callable(localize, "localize", optional=False)
     h = as_positive(dt, "dt")
     every = max(1, int(round(as_positive(fix_period, "fix_period") / h)))

@@ -187,6 +187,28 @@ class BowDatabase:
         return write_atomically(path, lambda tmp: save_npz(tmp, arrays))
 
     @classmethod
+    def _from_entries(cls, voc: Vocabulary, sizes: np.ndarray, words: np.ndarray, weights: np.ndarray,
+                      path: Path) -> "BowDatabase":
+        """A database from a file's flat entry arrays, checked and normalised as :meth:`add` would,
+        for all entries at once (a Python loop over 10^5 entries took seconds)."""
+        if words.size and (words.min() < 0 or words.max() >= voc.n_words):
+            raise DatabaseFileError(f"path: {path} has word ids outside the vocabulary's {voc.n_words}")
+        if not np.all(np.isfinite(weights)) or np.any(weights < 0):
+            raise DatabaseFileError(f"path: {path} has negative or non-finite weights")
+        entry = np.repeat(np.arange(sizes.size), sizes)
+        order = np.lexsort((words, entry))                       # word ids sorted within each entry
+        entry, words, weights = entry[order], words[order], weights[order]
+        if np.any((entry[1:] == entry[:-1]) & (words[1:] == words[:-1])):
+            raise DatabaseFileError(f"path: {path} repeats a word id within an entry")
+        totals = np.bincount(entry, weights, minlength=sizes.size)
+        keep = totals[entry] > 0                                 # an entry of zero weight is empty, as in add()
+        entry, words, weights = entry[keep], words[keep], weights[keep] / totals[entry[keep]]
+        cuts = np.cumsum(np.bincount(entry, minlength=sizes.size))[:-1]
+        db = cls(voc)
+        db._words, db._weights = np.split(words, cuts), np.split(weights, cuts)
+        return db
+
+    @classmethod
     def load(cls, path) -> "BowDatabase":
         """Read a database written by :meth:`save` (with its vocabulary).
 
@@ -210,11 +232,7 @@ class BowDatabase:
                                         "a database file may")
             if sizes.sum() != words.size or words.size != weights.size or np.any(sizes < 0):
                 raise DatabaseFileError(f"path: {path} has inconsistent entry arrays")
-            db = cls(voc)
-            cuts = np.cumsum(sizes)[:-1]
-            for w, x in zip(np.split(words, cuts), np.split(weights, cuts)):
-                db.add(BowVector(w.astype(np.int64), x.astype(float)))
-            return db
+            return cls._from_entries(voc, sizes, words.astype(np.int64), weights.astype(float), path)
         except (DatabaseFileError, FileNotFoundError):
             raise
         except (VocabularyFileError, Exception) as err:

@@ -15,6 +15,7 @@ from typing import Any, Sequence
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..geometry.planar import as_planar
 from ..geometry import se2_to_se3
 from ..validation import as_array, as_int, as_positive, describe
 from .scene import Scene, as_scene
@@ -29,7 +30,7 @@ _PROPERTIES = {"position": ("vector3", 3), "quaternion": ("quaternion", 4), "sca
 def _transforms(value: Any, name: str) -> np.ndarray:
     T = as_array(value, name)
     if T.ndim == 2 and T.shape[1] == 3:
-        T = np.stack([se2_to_se3(p) for p in T])
+        T = np.stack([se2_to_se3(p) for p in as_planar(T, name)])
     T = as_array(T, name, shape=(None, 4, 4))
     if len(T) < 2:
         raise ValueError(f"{name}: expected at least 2 poses, got {len(T)}")

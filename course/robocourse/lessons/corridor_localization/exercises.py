@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from robokit.geometry.planar import as_planar
 from robokit.localization.beam_models import likelihood_field_log_weights
 from robokit.localization.particle_filter import ellipse_weights, low_variance_resample
 from robokit.mapping.corridor_areas import invalid_areas
@@ -138,7 +139,7 @@ def likelihood_field_weight(pose, ranges, angles, distance, resolution, origin, 
     """
     field = LikelihoodField(as_array(distance, "distance", ndim=2), as_positive(resolution, "resolution"),
                             as_array(origin, "origin", shape=(2,)), as_positive(max_distance, "max_distance"))
-    return float(likelihood_field_log_weights([as_array(pose, "pose", shape=(3,))], ranges, angles, field,
+    return float(likelihood_field_log_weights([as_planar(pose, "pose", shape=(3,))], ranges, angles, field,
                                               sigma_hit=sigma_hit, z_hit=z_hit, z_rand=z_rand, r_max=r_max,
                                               combine="product")[0])
 
