@@ -1619,6 +1619,25 @@ def _reader_specs() -> dict:
 
 SPECS.update(_reader_specs())
 
+# --- public functions of lessons 02-04's modules that no lesson calls directly -------------------
+SPECS.update({
+    "robokit.sim.motion.corridor_path": Call({"world": Obj(corridor_world), "speed": Real(0.3), "rate": Real(10.0),
+                                              "margin": Real(0.8)}),
+    "robokit.sim.motion.odometry_increment": Call({"previous": Array(np.zeros(3), "3|N,3"),
+                                                   "current": Array(np.array([1.0, 1.0, 0.2]), "3|N,3")}),
+    "robokit.sim.motion.sample_motion_model_odometry": Call({
+        "odom_prev": Array(np.zeros(3), "3"), "odom_now": Array(np.array([1.0, 0.0, 0.1]), "3"),
+        "poses": Array(np.zeros((3, 3)), "N,3|3"), "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"),
+        "rng": Rng(0)}),
+    "robokit.sim.motion.waypoint_path": Call({"waypoints": Array(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]), "N,2"),
+                                              "speed": Real(0.5), "turn_rate": Real(0.6), "rate": Real(2.0)}),
+    "robokit.sim.layout.Layout": Call({
+        "segments": Array(np.array([[[0.0, 0.0], [4.0, 0.0]]]), "N,2,2", optional=True),
+        "circles": Array(np.array([[4.0, 1.0, 1.0]]), "N,3", optional=True),
+        "boxes": Array(np.array([[0.0, 5.0, 2.0, 2.0, 0.0]]), "N,5", optional=True)}),
+    "robokit.sim.runs.describe_sensor": Call({"sensor": Obj(corridor_lidar)}),
+})
+
 
 #: Arguments whose last element is an angle (a heading, a joint or beam angle, a heading spread or
 #: change): 1e300 there must be refused (robokit.validation.MAX_ANGLE), as a wrapped value means nothing.
@@ -1678,6 +1697,15 @@ EXTRA: tuple[str, ...] = (
     "robokit.mapping.pose_graph_optimize.optimize_pose_graph", "robokit.mapping.relaxation.relax",
     "robokit.mapping.relaxation.relax_sweep", "robokit.mapping.relaxation.initial_variances",
     "robokit.mapping.g2o.read_g2o", "robokit.mapping.g2o.write_g2o",
+    # public, with a spec, but called by no lesson (lessons 02-04's modules, and readable references)
+    "robokit.localization.particle_clusters.pose_clusters", "robokit.localization.particle_clusters.largest_cluster_mean",
+    "robokit.legged.littledog.littledog_mjcf", "robokit.legged.leg_kinematics.torques_from_foot_force",
+    "robokit.arm.arm_angle_intervals.split_points", "robokit.arm.arm_angle_intervals.ik_srs_readable",
+    "robokit.vision.plot_readable.detect_plot_readable", "robokit.sim.motion.corridor_path",
+    "robokit.sim.motion.odometry_increment", "robokit.sim.motion.sample_motion_model_odometry",
+    "robokit.sim.motion.waypoint_path", "robokit.sim.layout.Layout", "robokit.sim.runs.describe_sensor",
+    "robocourse.lessons.visual_slam.exercises.robust_pose_problems",
+    "robocourse.lessons.corridor_localization.trials.corridor_localizer",
     # every file reader (hostile files: tests/fuzz_kinds.File)
     "robokit.files.read_npz", "robokit.mapping.topological.TopologicalMap.load",
     "robokit.vision.bag_of_words.Vocabulary.load", "robokit.vision.bow_database.BowDatabase.load",

@@ -195,6 +195,12 @@ def test_every_public_function_a_lesson_uses_is_fuzzed_or_excused():
     assert len(FUZZED) >= 90
 
 
+def test_every_spec_is_fuzzed():
+    """A spec whose function is in no population would never run: it must be listed (EXTRA) or go."""
+    dead = sorted(n for n in SPECS if n not in POPULATION)
+    assert not dead, f"add these to EXTRA in tests/fuzz_specs.py (or drop their specs): {dead}"
+
+
 @pytest.mark.parametrize("name", FUZZED)
 def test_the_spec_names_every_parameter(name):
     params = _parameters(POPULATION[name])

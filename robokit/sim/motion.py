@@ -27,6 +27,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..geometry import wrap_angle
+from ..geometry.planar import as_planar
 from ..validation import (as_array, as_points, as_rng, require_finite_result, as_positive, require_sample_count,
                           describe)
 from .world import World
@@ -232,7 +233,7 @@ def sample_motion_model_odometry(odom_prev: Any, odom_now: Any, poses: Any, alph
     >>> np.round(particles, 3).tolist()       # three particles, each about 1 m ahead
     [[1.013, -0.004, -0.024], [1.054, -0.003, -0.015], [0.905, -0.037, -0.019]]
     """
-    delta = odometry_increment(odom_prev, odom_now)
+    delta = odometry_increment(as_planar(odom_prev, "odom_prev", shape=(3,)), as_planar(odom_now, "odom_now", shape=(3,)))
     P = as_array(poses, "poses")
     if P.shape[-1:] != (3,) or P.ndim > 2:
         raise ValueError(f"poses: expected shape (3,) or (N, 3), got shape {P.shape}")
@@ -339,7 +340,7 @@ def waypoint_path(waypoints: Any, speed: float = 0.3, turn_rate: float = 0.6, ra
             knots_t.append(knots_t[-1] + length / v)
             knots.append(np.array([b[0], b[1], knots[-1][2]]))
     kt, kp = np.array(knots_t), np.array(knots)
-    require_sample_count(kt[-1] / dt, "speed, turn_rate, rate")
+    require_sample_count(kt[-1] / dt, "waypoints, speed, turn_rate, rate")
     t = np.arange(0.0, kt[-1] + 1e-9, dt)
     poses = np.column_stack([np.interp(t, kt, kp[:, i]) for i in range(3)])
     poses[:, 2] = wrap_angle(poses[:, 2])
@@ -354,8 +355,12 @@ def corridor_path(world: Any, speed: float = 0.3, rate: float = 10.0, margin: fl
     Ge et al. (2023), Sec. 3.4 and 4.1: remote-controlled along the middle line, stopping about
     0.8 m from the end wall.
     """
+    if not isinstance(world, World) or "length" not in world.info:
+        raise TypeError(f"world: expected the corridor World (long_corridor()), got {describe(world)}")
     length = float(world.info["length"])
     m = as_positive(margin, "margin")
+    if not m < length / 2:
+        raise ValueError(f"margin: expected less than half the corridor's {length:g} m, got {m:g}")
     return waypoint_path([[m, 0.0], [length - m, 0.0]], speed, rate=rate)
 
 

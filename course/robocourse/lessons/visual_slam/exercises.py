@@ -22,7 +22,7 @@ from robokit.mapping.landmarks import kalman_fuse
 from robokit.vision.matching import ratio_match
 from robokit.vision.plot_detector import junction_strength
 from robokit.vision.stereo import StereoCalibration, disparity_to_point, triangulate_svd
-from robokit.validation import as_array
+from robokit.validation import as_array, as_rng
 from robocourse.exercises.compare import close, exact, unordered_rows
 from robocourse.exercises.plain import numeric_array
 from robocourse.exercises.spec import Case, Exercise
@@ -268,6 +268,7 @@ def robust_pose_problems(rng: np.random.Generator) -> list[tuple[np.ndarray, np.
     >>> r.shape == w.shape, eps
     (True, 0.5)
     """
+    rng = as_rng(rng)
     out = []
     for eps in (0.2, 0.4, 0.5, 0.6):
         n = int(rng.integers(40, 81))
