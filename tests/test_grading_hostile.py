@@ -175,7 +175,7 @@ def test_hostile_submission_scores_only_what_it_earned(graded, name):
     if name != "not_json" and is_root():
         assert "sandbox=limited" not in result.flags
     if name == "honest":
-        assert result.flags == [] and result.worker_log == ""
+        assert result.flags == ([] if is_root() else ["sandbox=limited"]) and result.worker_log == ""
 
 
 def test_check_is_silenced_however_it_is_imported(graded):

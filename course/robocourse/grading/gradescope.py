@@ -31,19 +31,20 @@ python3 -m venv /opt/robocourse
 
 _RUN = """#!/usr/bin/env bash
 # Gradescope autograder entry point: grade the submitted notebook in robocourse's sandbox.
+# Every path is quoted, so the script also runs where a path holds a space (its tests rewrite them).
 set -uo pipefail
-mkdir -p /autograder/results
+mkdir -p "/autograder/results"
 shopt -s nullglob
-notebooks=(/autograder/submission/*.ipynb)
+notebooks=("/autograder/submission"/*.ipynb)
 if [ ${{#notebooks[@]}} -eq 0 ]; then
   printf '{{"score": 0, "output": "No .ipynb file was submitted: upload your {slug}.ipynb notebook."}}' \\
-    > /autograder/results/results.json
+    > "/autograder/results/results.json"
   exit 0
 fi
-ROBOKIT_GRADING_SEED="$(cat /autograder/source/seed.txt)" /opt/robocourse/bin/robocourse grade "${{notebooks[0]}}" \\
-  --assignment {slug} --out /autograder/results/grades.csv --gradescope /autograder/results/results.json \\
-  --feedback /autograder/results/feedback --root /autograder/source --timeout {timeout} \\
-  --hide /autograder/source
+ROBOKIT_GRADING_SEED="$(cat "/autograder/source/seed.txt")" "/opt/robocourse/bin/robocourse" grade "${{notebooks[0]}}" \\
+  --assignment {slug} --out "/autograder/results/grades.csv" --gradescope "/autograder/results/results.json" \\
+  --feedback "/autograder/results/feedback" --root "/autograder/source" --timeout {timeout} \\
+  --hide "/autograder/source"
 """
 
 

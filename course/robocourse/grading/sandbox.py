@@ -19,6 +19,8 @@ What is enforced, and where:
   whatever the job leaves running is ended at once; processes of the job uid are also swept
   through ``/proc``, for hosts that give no control group.
 * Not root: the namespace and uid steps are skipped; the report marks the run ``sandbox=limited``.
+  A fork bomb is still bounded: ``RLIMIT_NPROC`` allows the user ``max_processes`` more processes
+  than they ran when the job started.
 """
 from __future__ import annotations
 
@@ -67,7 +69,8 @@ class Limits:
     memory_bytes : int
         ``RLIMIT_AS`` (virtual address space).
     max_processes : int
-        ``RLIMIT_NPROC`` for the job uid (root only; a per-user count otherwise meaningless).
+        ``RLIMIT_NPROC`` for the job uid; not as root, the user's processes at the start plus this
+        many (``RLIMIT_NPROC`` counts all of a user's processes).
     file_bytes : int
         ``RLIMIT_FSIZE``: the largest file the worker may write (stdout/stderr included).
     disk_bytes : int
@@ -108,6 +111,19 @@ def is_root() -> bool:
     return os.geteuid() == 0
 
 
+def _processes_of(uid: int) -> int:
+    """How many processes the real uid ``uid`` runs now (read from ``/proc``)."""
+    count = 0
+    for entry in os.scandir("/proc"):
+        if entry.name.isdigit():
+            try:
+                if os.stat(entry.path).st_uid == uid:
+                    count += 1
+            except OSError:                         # the process ended meanwhile
+                pass
+    return count
+
+
 def _limits(limits: Limits, uid: int | None) -> None:
     resource.setrlimit(resource.RLIMIT_CPU, (limits.cpu_seconds, limits.cpu_seconds + 5))
     resource.setrlimit(resource.RLIMIT_AS, (limits.memory_bytes, limits.memory_bytes))
@@ -116,6 +132,11 @@ def _limits(limits: Limits, uid: int | None) -> None:
     resource.setrlimit(resource.RLIMIT_NOFILE, (256, 256))
     if uid is not None:
         resource.setrlimit(resource.RLIMIT_NPROC, (limits.max_processes, limits.max_processes))
+    else:   # as the user, RLIMIT_NPROC counts all their processes: allow this job max_processes more
+        hard = resource.getrlimit(resource.RLIMIT_NPROC)[1]
+        cap = _processes_of(os.getuid()) + limits.max_processes
+        cap = cap if hard == resource.RLIM_INFINITY else min(cap, hard)
+        resource.setrlimit(resource.RLIMIT_NPROC, (cap, cap))
 
 
 def _launch(config_path: str) -> None:
