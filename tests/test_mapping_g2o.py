@@ -168,3 +168,10 @@ def test_ids_beyond_64_bits_and_files_beyond_the_budget_are_refused(tmp_path, mo
         read_g2o(target)
     with pytest.raises(G2OFormatError, match="more than the 100"):
         read_g2o(target.read_text())
+
+
+def test_text_without_a_vertex_is_refused_before_it_is_parsed():
+    """Refused at once, not after parsing every edge (whose first bad number would be reported instead)."""
+    text = "EDGE_SE2 0 1 not numbers at all 1 0 0 1 0 1\n" * 50_000
+    with pytest.raises(G2OFormatError, match="line 0: no VERTEX_SE2 line"):
+        read_g2o(text)
