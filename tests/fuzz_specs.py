@@ -1237,7 +1237,7 @@ SPECS: dict[str, Call] = {
         "progress": Func(None, optional=True), "workers": Int(1, optional=True)}, cheap=False),
     "robocourse.lessons.corridor_localization.kidnapping.kidnapping": Call({
         "setup": Obj(corridor_setup), "origin": Int(0), "destination": Int(2), "period": Real(5.0), "after": Real(3.0),
-        "kidnap_distance": Real(1.0), "seed": Int(0)}, cheap=False),
+        "kidnap_distance": Real(1.0), "confirm": Int(2), "seed": Int(0)}, cheap=False),
     "robokit.viz.animation.animate_snapshots": Call({
         "scene": Obj(snapshot_scene), "paths": Given(["a", "b"]), "fps": Real(4.0), "repetitions": Int(1),
         "moving": Text("robot", optional=True),

@@ -49,13 +49,30 @@ def test_trial_sets_judge_on_the_paper_criterion(setup):
     assert (runs.success() <= loose).all()
 
 
-def test_kidnapping_ours_recovers_amcl_does_not(setup):
-    kid = corridor_kidnapping.kidnapping(setup, origin=0, destination=2, after=8.0)
+@pytest.mark.parametrize("confirm", [1, 2])
+def test_kidnapping_ours_recovers_amcl_does_not(setup, confirm):
+    kid = corridor_kidnapping.kidnapping(setup, origin=0, destination=2, after=14.0, confirm=confirm)
     assert kid.jump == pytest.approx(trials.START_POSES[2][0] - trials.START_POSES[0][0])
-    late = kid.times > 6.0
+    recovered = min(t for t in kid.reinitialised if t >= 0)
+    assert recovered < 5.0 * confirm                           # one retrieval period per confirmation
+    late = kid.times > recovered + 1.0
     assert np.abs(kid.errors["amcl"][late]).min() > kid.jump - 1.0
     assert np.abs(kid.errors["ours"][late]).max() < 0.5
-    assert any(t >= 0 for t in kid.reinitialised)
+    assert abs(kid.final_error("ours")) < 0.5 < kid.jump - 1.0 < abs(kid.final_error("amcl"))
+
+
+def test_one_wrong_retrieval_does_not_overrule_the_filter():
+    vote = corridor_kidnapping.Confirmation(confirm=2, distance=1.0)
+    # tracking at x = 5, 6.5, 8: one retrieval says x = 20 (a look-alike), the next agrees with the filter
+    assert not vote.disagrees([20.0, 0, 0], [5.0, 0, 0], [0.0, 0, 0])
+    assert not vote.disagrees([6.4, 0, 0], [6.5, 0, 0], [1.5, 0, 0])
+    assert not vote.disagrees([21.0, 0, 0], [8.0, 0, 0], [3.0, 0, 0])      # a run of one again
+    # two far retrievals that disagree with each other (20 then 30, 1.5 m of odometry apart): no
+    assert not vote.disagrees([30.0, 0, 0], [9.5, 0, 0], [4.5, 0, 0])
+    # ... but one that follows the last by the odometry confirms it
+    assert vote.disagrees([31.4, 0.1, 0], [11.0, 0, 0], [6.0, 0, 0])
+    printed = corridor_kidnapping.Confirmation(confirm=1, distance=1.0)
+    assert printed.disagrees([20.0, 0, 0], [5.0, 0, 0], [0.0, 0, 0])        # the algorithm as printed
 
 
 @pytest.mark.parametrize("bad, match", [(dict(method="both"), "method"), (dict(share=1.5), "share"),

@@ -5,6 +5,10 @@ start place it is lifted and put down at another that looks alike to the laser. 
 (now wrong) pose; the paper's method retrieves an image every few seconds and re-initialises its
 particles around the retrieved keyframe when the two disagree (Algorithm 1, lines 14-15).
 
+One wrong retrieval would then throw away a converged filter, so by default a disagreement must be
+confirmed: the next retrieval must disagree too, and agree with the first one carried forward by the
+odometry between them (``confirm=2``; ``confirm=1`` is the algorithm as printed).
+
 References
 ----------
 .. [1] G. Ge, Y. Zhang, W. Wang, L. Hu, Y. Wang and Q. Jiang, "Visual-feature-assisted mobile robot
@@ -17,13 +21,52 @@ import dataclasses
 
 import numpy as np
 
+from robokit.geometry import se2_between, se2_compose
 from robokit.localization import largest_cluster_mean
 from robokit.sim import noisy_odometry, waypoint_path
 from robokit.validation import as_rng, as_int, as_positive
 from robocourse.lessons.corridor_localization.experiment import MAPPING_ALPHAS, CorridorMap, as_corridor_map
 from robocourse.lessons.corridor_localization.trials import ELLIPSE_SIGMA, METHODS, PARTICLES, RATE, SPEED, START_POSES, corridor_localizer, retrieve_pose
 
-__all__ = ["KidnapResult", "kidnapping"]
+__all__ = ["KidnapResult", "Confirmation", "kidnapping"]
+
+
+class Confirmation:
+    """When the retrievals overrule the filter: ``confirm`` of them in a row must disagree with its
+    estimate (farther than ``distance``) and agree with one another, each earlier one carried forward
+    by the odometry since it was taken.
+
+    Ours, not the paper's: Algorithm 1 (lines 14-15) re-initialises on one disagreement
+    (``confirm=1``), so one wrong retrieval throws a converged filter away.
+
+    Examples
+    --------
+    >>> vote = Confirmation(confirm=2, distance=1.0)
+    >>> vote.disagrees([10.0, 0, 0], [5.0, 0, 0], [0.0, 0, 0])      # one far retrieval: wait
+    False
+    >>> vote.disagrees([11.5, 0, 0], [6.5, 0, 0], [1.5, 0, 0])      # the next, 1.5 m on, agrees with it
+    True
+    """
+
+    def __init__(self, confirm: int, distance: float) -> None:
+        self.confirm = as_int(confirm, "confirm", minimum=1, maximum=10)
+        self.distance = as_positive(distance, "distance", allow_zero=True)
+        self.pending: list = []            # (retrieved pose, odometry pose) of the disagreeing run
+
+    def disagrees(self, retrieved, estimate, odometry) -> bool:
+        """Record one retrieval; ``True`` when the run of disagreements is confirmed (then it restarts)."""
+        retrieved = np.asarray(retrieved, float)
+        if np.hypot(*(retrieved[:2] - np.asarray(estimate, float)[:2])) <= self.distance:
+            self.pending = []
+            return False
+        carried = [se2_compose(p, se2_between(o, odometry)) for p, o in self.pending]
+        if any(np.hypot(*(c[:2] - retrieved[:2])) > self.distance for c in carried):
+            self.pending = []              # the far retrievals disagree with one another: start again
+        self.pending.append((retrieved, np.asarray(odometry, float)))
+        if len(self.pending) < self.confirm:
+            return False
+        self.pending = []
+        return True
 
 
 @dataclasses.dataclass
@@ -41,16 +84,23 @@ class KidnapResult:
     reinitialised : list of float
         Ours: the times (s after the kidnapping; negative before it) the retrieval re-initialised the
         particles.
+    retrievals : list of tuple
+        Ours: ``(time, retrieved pose, distance from the estimate)`` of every retrieval.
     """
 
     times: np.ndarray
     errors: dict
     jump: float
     reinitialised: list
+    retrievals: list = dataclasses.field(default_factory=list)
+
+    def final_error(self, method: str) -> float:
+        """The longitudinal error (m) at the last update: where the filter ended, not an average."""
+        return float(self.errors[method][-1])
 
 
 def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, period: float = 5.0,
-               after: float = 20.0, kidnap_distance: float = 1.0, seed: int = 0) -> KidnapResult:
+               after: float = 20.0, kidnap_distance: float = 1.0, confirm: int = 2, seed: int = 0) -> KidnapResult:
     """Drive from the entrance, carry the robot from start ``origin`` to ``destination``, watch both filters.
 
     Parameters
@@ -67,6 +117,11 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
         Ours: a retrieval farther than this (m) from the filter's estimate re-initialises the
         particles around it (Algorithm 1, lines 14-15; 0 re-initialises at every retrieval, as the
         algorithm is printed).
+    confirm : int, default 2
+        Ours: how many retrievals in a row must disagree with the estimate, and agree with each other
+        once carried forward by the odometry between them (within ``kidnap_distance``), before the
+        particles are re-initialised. 1 re-initialises on the first disagreement (the algorithm as
+        printed), so one wrong retrieval throws a converged filter away.
     seed : int, default 0
 
     Returns
@@ -84,7 +139,8 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
     rates of 0, no random particles are injected); their method re-localizes
     after the next 5 s retrieval. Both filters start tracking at the true pose at the entrance; ours
     retrieves every ``period`` seconds from the start, and a retrieval that agrees with the estimate
-    changes nothing.
+    (amcl's published pose, the heaviest cluster's mean) changes nothing. The confirmation rule is
+    ours, not the paper's.
 
     Examples
     --------
@@ -97,7 +153,7 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
     a = as_int(origin, "origin", minimum=0, maximum=len(START_POSES) - 1)
     b = as_int(destination, "destination", minimum=0, maximum=len(START_POSES) - 1)
     period, after = as_positive(period, "period"), as_positive(after, "after")
-    kidnap_distance = as_positive(kidnap_distance, "kidnap_distance", allow_zero=True)
+    vote = Confirmation(confirm, as_positive(kidnap_distance, "kidnap_distance", allow_zero=True))
     rng = as_rng(as_int(seed, "seed", minimum=0))
     x_a, x_b = START_POSES[a][0], START_POSES[b][0]
     if x_b + SPEED * after > setup.world.info["length"] - 0.8:
@@ -114,7 +170,7 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
     filters = {m: corridor_localizer(setup, m, rng) for m in METHODS}
     for m, mcl in filters.items():
         mcl.initialize_gaussian(truth[0], np.diag([0.05, 0.05, 0.02]) ** 2, n=PARTICLES[m])
-    times, errors, reinit = [], {m: [] for m in METHODS}, []
+    times, errors, reinit, retrievals = [], {m: [] for m in METHODS}, [], []
     last_retrieval = -np.inf
     for k in range(len(truth)):
         scan = lidar.scan(world, truth[k], rng)
@@ -124,11 +180,15 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
             last_retrieval = t
             pose_k = retrieve_pose(setup, truth[k], rng)[0]
             ours = filters["ours"]
-            if pose_k is not None and np.hypot(*(pose_k[:2] - ours.estimate()[:2])) > kidnap_distance:
-                ours.initialize_ellipse(pose_k, *ELLIPSE_SIGMA)
-                reinit.append(t)
+            estimate = largest_cluster_mean(ours.particles, ours.weights)   # amcl's published pose
+            if pose_k is not None:                                          # the image found a keyframe
+                retrievals.append((t, pose_k, float(np.hypot(*(pose_k[:2] - estimate[:2])))))
+                if vote.disagrees(pose_k, estimate, odometry[k]):
+                    ours.initialize_ellipse(pose_k, *ELLIPSE_SIGMA)
+                    reinit.append(t)
         if k >= kidnap and any(updated):
             times.append(t)
             for m, mcl in filters.items():
                 errors[m].append(float(largest_cluster_mean(mcl.particles, mcl.weights)[0] - truth[k, 0]))
-    return KidnapResult(np.array(times), {m: np.array(v) for m, v in errors.items()}, float(x_b - x_a), reinit)
+    return KidnapResult(np.array(times), {m: np.array(v) for m, v in errors.items()}, float(x_b - x_a), reinit,
+                        retrievals)
