@@ -546,14 +546,24 @@ class MonteCarloLocalizer:
 
     # --- results -------------------------------------------------------------------------------
     def estimate(self) -> np.ndarray:
-        """The weighted mean pose (:func:`~robokit.localization.particle_filter.weighted_pose_mean`).
+        """The weighted mean pose of all particles (:func:`~robokit.localization.particle_filter.weighted_pose_mean`).
+
+        Not the pose ROS amcl publishes: amcl reports the weighted mean of the heaviest particle
+        cluster (:func:`~robokit.localization.particle_clusters.largest_cluster_mean`). While the cloud
+        holds several clusters (after a global start, in a corridor of look-alike stretches) the
+        mean of all particles lies between them, near none.
 
         Examples
         --------
+        >>> from robokit.localization import largest_cluster_mean
         >>> from robokit.mapping import OccupancyGrid
-        >>> mcl = MonteCarloLocalizer(OccupancyGrid.from_probability(np.zeros((10, 10)), 0.1), rng=0)
+        >>> mcl = MonteCarloLocalizer(OccupancyGrid.from_probability(np.zeros((100, 100)), 0.1), rng=0)
         >>> mcl.initialize_gaussian([0.3, 0.6, 1.0], np.zeros((3, 3)), n=3); mcl.estimate().tolist()
         [0.3, 0.6, 1.0]
+        >>> mcl.particles = np.array([[1.0, 1.0, 0.0]] * 3 + [[7.0, 1.0, 0.0]] * 2)   # two clusters
+        >>> mcl.weights = np.full(5, 0.2)
+        >>> mcl.estimate().round(2).tolist(), largest_cluster_mean(mcl.particles, mcl.weights).round(2).tolist()
+        ([3.4, 1.0, 0.0], [1.0, 1.0, 0.0])
         """
         return weighted_pose_mean(self.particles, self.weights)
 
