@@ -3,9 +3,10 @@
 Generated datasets (recorded runs, maps, experiments) are deterministic, so they are computed once
 and kept under :func:`cache_dir`. A file's name holds :func:`cache_key` of everything that made it,
 including :func:`code_version` of the code, so an edit never serves an old result; it is written
-atomically (:func:`write_atomically`) so notebooks running side by side never read one half
-written, and read back by :func:`read_arrays`, which treats a damaged, stale or foreign file as
-absent (docs/DESIGN.md, "Caching"). Course conventions; not from a paper.
+by :func:`write_arrays` (atomically, through :func:`robokit.files.write_atomically`) so notebooks
+running side by side never read one half written, and read back by :func:`read_arrays`, which treats
+a damaged, stale or foreign file as absent (docs/DESIGN.md, "Caching"). Course conventions; not from
+a paper.
 """
 from __future__ import annotations
 

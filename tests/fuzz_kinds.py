@@ -210,16 +210,17 @@ class File(Kind):
     """A path to a file a reader reads (``valid``: a factory of a valid file's path).
 
     ``budget``: the reader's byte bound; ``foreign``: a factory of another format's valid file;
-    ``extra``: ``valid bytes -> {label: bytes}``, the reader's own hostile contents.
+    ``extra``: ``valid bytes -> {label: bytes}``, the reader's own hostile contents; ``missing``: what
+    the reader documents for a missing file (``FileNotFoundError`` unless it says otherwise).
     """
 
     #: Labels whose right answer is ``FileNotFoundError`` (naming the file), not the reader's error.
     MISSING = ("a missing file", "a dangling link")
 
     def __init__(self, valid: Any, *, budget: int, foreign: Callable[[], Any], error: type = ValueError,
-                 extra: Callable[[bytes], dict] | None = None, **kw: Any) -> None:
+                 missing: type = FileNotFoundError, extra: Callable[[bytes], dict] | None = None, **kw: Any) -> None:
         super().__init__(valid, **kw)
-        self.budget, self.foreign, self.error, self.extra = budget, foreign, error, extra
+        self.budget, self.foreign, self.error, self.missing, self.extra = budget, foreign, error, missing, extra
         self._files: list[tuple[str, Any]] | None = None
 
     def hostile(self, label: str) -> bool:
@@ -244,15 +245,15 @@ class File(Kind):
         oversized = folder / f"oversized{valid.suffix}"
         with open(oversized, "wb") as fh:
             fh.truncate(self.budget + 1)                     # sparse: costs no disk
-        os.mkfifo(folder / "fifo")
+        os.mkfifo(folder / "a-fifo")
         (folder / "device-link").symlink_to("/dev/zero")
         (folder / "loop-a").symlink_to(folder / "loop-b")
         (folder / "loop-b").symlink_to(folder / "loop-a")
-        (folder / "dangling").symlink_to(folder / "nowhere")
+        (folder / "dangling-link").symlink_to(folder / "nowhere")
         out += [("one byte over the budget", str(oversized)), ("a device", "/dev/zero"),
-                ("a directory", str(folder)), ("a FIFO", str(folder / "fifo")),
+                ("a directory", str(folder)), ("a FIFO", str(folder / "a-fifo")),
                 ("a link to a device", str(folder / "device-link")), ("a loop of links", str(folder / "loop-a")),
-                ("a dangling link", str(folder / "dangling")), ("a missing file", str(folder / "missing"))]
+                ("a dangling link", str(folder / "dangling-link")), ("a missing file", str(folder / "missing-file"))]
         return out
 
     def invalid(self) -> list[tuple[str, Any]]:

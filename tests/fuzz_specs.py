@@ -1613,7 +1613,8 @@ def _reader_specs() -> dict:
         "robokit.mapping.g2o.read_g2o": Call({"source": File(saved_g2o, budget=MAX_G2O_BYTES, foreign=saved_arrays,
                                                              error=G2OFormatError)}),
         "robokit.mapping.map_server.load_map": Call({"yaml_path": File(saved_map, budget=MAX_YAML_BYTES, foreign=saved_g2o,
-                                                                       error=MapFileError, extra=map_extras)}),
+                                                                       error=MapFileError, missing=MapFileError,
+                                                                       extra=map_extras)}),
     }
 
 

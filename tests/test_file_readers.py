@@ -98,29 +98,66 @@ def test_a_database_file_with_too_many_entries_is_refused_before_adding_them(tmp
 
 
 @pytest.mark.parametrize("writer", ["write_g2o", "save_map"])
-def test_an_interrupted_text_save_leaves_the_old_files(writer, tmp_path, monkeypatch):
+def test_an_interrupted_text_save_leaves_whole_files(writer, tmp_path, monkeypatch):
+    """A new map interrupted as its last file is written: every file is old or new, none half written."""
     from robokit.mapping import OccupancyGrid, PoseGraph, load_map, read_g2o, save_map, write_g2o
 
     if writer == "write_g2o":
-        graph = PoseGraph([[0, 0, 0], [1, 0, 0.1]], [[0, 1]], [[1, 0, 0.1]])
-        save = lambda: write_g2o(graph, tmp_path / "g.g2o")       # noqa: E731
-        load = lambda: read_g2o(tmp_path / "g.g2o")              # noqa: E731
+        graphs = [PoseGraph([[0, 0, 0], [x, 0, 0.1]], [[0, 1]], [[x, 0, 0.1]]) for x in (1.0, 2.0)]
+        save = lambda k: write_g2o(graphs[k], tmp_path / "g.g2o")       # noqa: E731
+        load = lambda: read_g2o(tmp_path / "g.g2o")                      # noqa: E731
+        last = "g.g2o"
     else:
-        grid = OccupancyGrid.from_probability(np.array([[0.0, 1.0], [0.5, 0.0]]), 0.1, [0.0, 0.0])
-        save = lambda: save_map(grid, str(tmp_path / "m"))       # noqa: E731
-        load = lambda: load_map(tmp_path / "m.yaml")             # noqa: E731
-    save()
+        grids = [OccupancyGrid.from_probability(np.array(p), res, [0.0, 0.0])
+                 for p, res in (([[0.0, 1.0], [0.5, 0.0]], 0.1), ([[1.0, 1.0, 0.0]], 0.2))]
+        save = lambda k: save_map(grids[k], str(tmp_path / "m"))        # noqa: E731
+        load = lambda: load_map(tmp_path / "m.yaml")                     # noqa: E731
+        last = "m.yaml"
+    save(0)
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    real_text = Path.write_text
 
-    def half_then_fail(self, data, *args, **kwargs):
-        with open(self, "wb") as fh:
-            fh.write((data.encode() if isinstance(data, str) else data)[:5])
-        raise KeyboardInterrupt("interrupted")
+    def interrupt_the_last(self, data, *args, **kwargs):
+        if self.name.startswith(last.split(".")[0]) and self.suffix == Path(last).suffix:
+            with open(self, "wb") as fh:
+                fh.write(data.encode()[:5])
+            raise KeyboardInterrupt("interrupted")
+        return real_text(self, data, *args, **kwargs)
 
-    monkeypatch.setattr(Path, "write_text", half_then_fail)
-    monkeypatch.setattr(Path, "write_bytes", half_then_fail)
+    monkeypatch.setattr(Path, "write_text", interrupt_the_last)
     with pytest.raises(KeyboardInterrupt):
-        save()
+        save(1)
     monkeypatch.undo()
-    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
-    load()
+    after = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    assert after.keys() == before.keys() and after[last] == before[last]     # no temporary file left
+    load()                                                                     # each file is whole
+
+
+def test_a_small_file_costs_little_memory_whatever_the_readers_budget(tmp_path):
+    """read_regular asks for the bytes the file holds, not for its budget (load_map's is 256 MiB)."""
+    import resource
+
+    from robokit.mapping import OccupancyGrid, load_map, save_map
+
+    grid = OccupancyGrid.from_probability(np.array([[0.0, 1.0], [0.5, 0.0]]), 0.1, [0.0, 0.0])
+    yaml = save_map(grid, str(tmp_path / "m"))[1]
+    with open("/proc/self/statm") as f:
+        used = int(f.read().split()[0]) * resource.getpagesize()
+    old = resource.getrlimit(resource.RLIMIT_AS)
+    resource.setrlimit(resource.RLIMIT_AS, (used + 100 * 2**20, old[1]))
+    try:
+        back = load_map(yaml)
+    finally:
+        resource.setrlimit(resource.RLIMIT_AS, old)
+    assert back.occupied_mask().tolist() == [[False, True], [False, False]]
+
+
+def test_a_database_reloads_with_its_entries_empty_ones_included(tmp_path):
+    db = BowDatabase(_vocabulary())
+    assert len(BowDatabase.load(db.save(tmp_path / "none.npz"))) == 0
+    db.add(np.zeros((0, 32), np.uint8))                            # an image without features keeps its id
+    db.add(np.random.default_rng(2).integers(0, 256, (30, 32), dtype=np.uint8))
+    back = BowDatabase.load(db.save(tmp_path / "two.npz"))
+    assert len(back) == 2 and back.vector(0).words.size == 0
+    np.testing.assert_array_equal(back.vector(1).words, db.vector(1).words)
+    np.testing.assert_allclose(back.vector(1).weights, db.vector(1).weights)

@@ -149,8 +149,17 @@ def _names(name: str, pname: str, value: Any) -> list[str]:
     if isinstance(spec.kinds[pname], Options):
         out = list(value)
     if isinstance(spec.kinds[pname], File) and isinstance(value, str) and value:
-        out.append(Path(value).name)      # a hostile file: the error may name the file instead
+        out.append(value)                 # a hostile file: the error may name the file instead,
+        if any(c in Path(value).name for c in "-."):          # by a distinctive name ("zero" is not)
+            out.append(Path(value).name)
     return out
+
+
+def _missing(what: str, kind: File, exc: Exception, value: str) -> str | None:
+    """A missing file (or a link to one) must get the error the reader documents, naming the file."""
+    if isinstance(exc, kind.missing) and Path(value).name in str(exc):
+        return None
+    return f"{what}: {type(exc).__name__}, not a {kind.missing.__name__} naming the file: {str(exc)[:160]}"
 
 
 def fuzz_one(name: str, pname: str, label: str, value: Any, *, huge: bool = False) -> str | None:
@@ -165,14 +174,17 @@ def fuzz_one(name: str, pname: str, label: str, value: Any, *, huge: bool = Fals
     except (ValueError, TypeError) as exc:
         text = str(exc)
         kind = SPECS[name].kinds[pname]
+        if isinstance(kind, File) and label in File.MISSING:
+            return _missing(what, kind, exc, value)
         if isinstance(kind, File) and kind.hostile(label) and not isinstance(exc, kind.error):
             return f"{what}: {type(exc).__name__}, not the reader's {kind.error.__name__}: {text[:160]}"
         if any(re.search(rf"(?<![\w.]){re.escape(n)}(?!\w)", text) for n in _names(name, pname, value)):
             return None
         return f"{what}: {type(exc).__name__} that does not name {pname!r}: {text[:160]}"
     except FileNotFoundError as exc:
-        if isinstance(SPECS[name].kinds[pname], File) and label in File.MISSING:
-            return None
+        kind = SPECS[name].kinds[pname]
+        if isinstance(kind, File) and label in File.MISSING:
+            return _missing(what, kind, exc, value)
         return f"{what}: crash FileNotFoundError: {str(exc)[:160]}"
     except Exception as exc:   # noqa: BLE001 - any other exception is the failure being looked for
         return f"{what}: crash {type(exc).__name__}: {str(exc)[:160]}"

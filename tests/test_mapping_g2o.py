@@ -171,7 +171,9 @@ def test_ids_beyond_64_bits_and_files_beyond_the_budget_are_refused(tmp_path, mo
 
 
 def test_text_without_a_vertex_is_refused_before_it_is_parsed():
-    """Refused at once, not after parsing every edge (whose first bad number would be reported instead)."""
+    """No line is parsed: the malformed edges are not even read (before, line 1's bad number was the error)."""
     text = "EDGE_SE2 0 1 not numbers at all 1 0 0 1 0 1\n" * 50_000
     with pytest.raises(G2OFormatError, match="line 0: no VERTEX_SE2 line"):
         read_g2o(text)
+    with pytest.raises(G2OFormatError, match="line 1: VERTEX_SE3:QUAT is not supported"):   # a 3-D file says so
+        read_g2o("VERTEX_SE3:QUAT 0 0 0 0 0 0 0 1\n")

@@ -418,6 +418,15 @@ def save_trial(path: Any, log: TrialLog) -> Path:
     return write_atomically(target, write)
 
 
+def _is_lone_npy(source: Path, refuse) -> bool:
+    """Whether a file :func:`read_npz` refused is a single ``.npy`` array (for a clearer message)."""
+    try:
+        with open_regular(source, MAX_LOG_BYTES, refuse) as fh:
+            return fh.read(6) == b"\x93NUMPY"
+    except (OSError, ValueError):
+        return False
+
+
 def load_trial(path: Any) -> TrialLog:
     """Read a trial log written by :func:`save_trial`.
 
@@ -460,13 +469,12 @@ def load_trial(path: Any) -> TrialLog:
         return TrialLogError(f"{source}: not a readable trial log (it {reason})")
 
     try:
-        with open_regular(source, MAX_LOG_BYTES, refuse) as fh:
-            if fh.read(6) == b"\x93NUMPY":                 # a lone .npy array
-                raise TrialLogError(f"{source}: not a {LOG_FORMAT} file (one .npy array, not an .npz archive)")
         arrays = read_npz(source, max_bytes=MAX_LOG_BYTES, max_arrays=len(LOG_LAYOUT) + 8, max_values=MAX_LOG_BYTES)
-    except (FileNotFoundError, TrialLogError):
+    except FileNotFoundError:
         raise
     except (OSError, ValueError) as err:
+        if _is_lone_npy(source, refuse):
+            raise TrialLogError(f"{source}: not a {LOG_FORMAT} file (one .npy array, not an .npz archive)") from None
         raise TrialLogError(f"{source}: not a readable trial log (truncated or corrupt: {err})") from None
     if "__meta__" not in arrays:
         raise TrialLogError(f"{source}: not a {LOG_FORMAT} file (it has no __meta__ record; arrays "

@@ -49,6 +49,13 @@ H_VELOCITY = np.array([[0.0, 0, 0, 1, 0], [0, 0, 0, 0, 1]])
 H_POSE = np.eye(3, 5)
 
 
+def _state_and_step(x: Any, dt: Any) -> tuple[np.ndarray, float]:
+    """The state and a time step whose heading change ``omega * dt`` stays within ``MAX_ANGLE``."""
+    state, step = _state(x), as_positive(dt, "dt", allow_zero=True)
+    require_angles(state[4] * step, "x, dt", "a heading change omega * dt")
+    return state, step
+
+
 def _state(x: Any, name: str = "x") -> np.ndarray:
     state = as_array(x, name, shape=(5,))
     require_angles(state[2], name, "heading (element 2)")
@@ -90,9 +97,7 @@ def unicycle_jacobian(x: Any, dt: float) -> np.ndarray:
     >>> np.round(F[:3, 2:], 4).tolist()          # d(x, y, theta) / d(theta, v, omega)
     [[0.0, 0.5, 0.0], [0.5, 0.0, 0.125], [1.0, 0.0, 0.5]]
     """
-    state, step = _state(x), as_positive(dt, "dt", allow_zero=True)
-    require_angles(state[4] * step, "x, dt", "a heading change omega * dt")
-    F = _jacobian(state, step)
+    F = _jacobian(*_state_and_step(x, dt))
     require_finite_result("x, dt", F)
     return F
 
@@ -147,7 +152,7 @@ def unicycle_process_noise(x: Any, dt: float, sigma_accel: float, sigma_alpha: f
     >>> np.round(np.sqrt(np.diag(Q)), 5).tolist()     # 0.5 * 0.1^2 / 2 = 0.0025 on x
     [0.0025, 0.00025, 0.005, 0.05, 0.1]
     """
-    Q = _process_noise(_state(x), as_positive(dt, "dt", allow_zero=True),
+    Q = _process_noise(*_state_and_step(x, dt),
                        as_positive(sigma_accel, "sigma_accel", allow_zero=True),
                        as_positive(sigma_alpha, "sigma_alpha", allow_zero=True))
     require_finite_result("x, dt, sigma_accel, sigma_alpha", Q)
@@ -201,7 +206,8 @@ def ekf_predict(x: Any, P: Any, dt: float, Q: Any) -> tuple[np.ndarray, np.ndarr
     >>> np.round(x, 3).tolist(), round(float(P[1, 1]), 4)    # heading variance spreads sideways
     ([1.0, 0.0, 0.0, 1.0, 0.0], 0.0225)
     """
-    return _predict(_state(x), as_covariance(P, "P", 5), as_positive(dt, "dt", allow_zero=True),
+    state, step = _state_and_step(x, dt)
+    return _predict(state, as_covariance(P, "P", 5), step,
                     as_covariance(Q, "Q", 5, semidefinite=True))
 
 
@@ -278,7 +284,7 @@ def ekf_update(x: Any, P: Any, z: Any, H: Any, R: Any, *, angles: Sequence[int] 
         raise TypeError(f"angles: expected a sequence of indices into z, got {describe(angles)}")
     angles = [as_int(i, "angles", minimum=0, maximum=m - 1) for i in np.asarray(angles, dtype=object).ravel()]
     require_angles(z[angles], "z", "angles (the rows named by angles)")
-    require_angles((H @ x)[angles], "H", "predicted angles (H x in the rows named by angles)")
+    require_angles((H @ x)[angles], "x, H", "predicted angles (H x in the rows named by angles)")
     return _update(x, P, z, H, R, angles)
 
 
@@ -449,7 +455,7 @@ class UnicycleEKF:
 
     def predict(self, dt: float) -> None:
         """Move the estimate ``dt`` seconds along Eq. (6) (:func:`ekf_predict`)."""
-        h = as_positive(dt, "dt", allow_zero=True)
+        _, h = _state_and_step(self._x, dt)
         Q = _process_noise(self._x, h, self.sigma_accel, self.sigma_alpha)
         self._x, self._P = _predict(self._x, self._P, h, Q)
 

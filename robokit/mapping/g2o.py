@@ -29,13 +29,12 @@ from __future__ import annotations
 
 import math
 import os
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..files import as_file_path, read_regular, write_atomically
-from ..validation import as_text, describe
+from ..validation import describe
 from .pose_graph import PoseGraph, as_pose_graph, positive_definite
 
 __all__ = ["G2OFormatError", "read_g2o", "write_g2o", "MAX_G2O_BYTES"]
@@ -149,8 +148,8 @@ def read_g2o(source: Any) -> PoseGraph:
     if not isinstance(source, (str, os.PathLike)):
         raise TypeError(f"source: expected a path or g2o text (a str), got {describe(source)}")
     text, where = _text_of(source)
-    if "VERTEX_SE2" not in text:                          # refused before the parse, not after it
-        raise G2OFormatError(where, 0, "no VERTEX_SE2 line")
+    if "VERTEX_SE2" not in text and not any(tag in text for tag in UNSUPPORTED):
+        raise G2OFormatError(where, 0, "no VERTEX_SE2 line")   # before the parse (a 3-D file is named below)
     index: dict[int, int] = {}
     poses, edge_ids, edge_lines, measurements, upper = [], [], [], [], []
     fixed: tuple[int, int] | None = None                  # (vertex id, line)
@@ -248,8 +247,7 @@ def write_g2o(graph: PoseGraph, path: Any = None) -> str:
     FIX 0
     """
     as_pose_graph(graph)
-    if path is not None and not isinstance(path, os.PathLike):
-        as_text(path, "path", empty=False)
+    target = None if path is None else as_file_path(path, "path")
 
     def num(values) -> str:
         return " ".join(repr(float(v)) for v in values)
@@ -260,6 +258,6 @@ def write_g2o(graph: PoseGraph, path: Any = None) -> str:
     lines += [f"EDGE_SE2 {a} {b} {num(z)} {num(u)}" for (a, b), z, u in zip(ids, graph.measurements, upper)]
     lines.append(f"FIX {graph.ids[graph.fixed]}")
     text = "\n".join(lines) + "\n"
-    if path is not None:
-        write_atomically(Path(path), lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    if target is not None:
+        write_atomically(target, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     return text

@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from ..files import as_file_path, read_regular, write_atomically
-from ..validation import as_choice, as_int, as_text, describe
+from ..validation import as_choice, as_int, describe
 from .occupancy_grid import FREE_THRESHOLD, OCCUPIED_THRESHOLD, OccupancyGrid
 
 __all__ = ["MapFileError", "save_map", "load_map", "OCCUPIED_VALUE", "FREE_VALUE", "UNKNOWN_VALUE",
@@ -103,7 +103,9 @@ def save_map(grid: OccupancyGrid, stem: Any, *, occupied_thresh: float = OCCUPIE
     Returns
     -------
     (pathlib.Path, pathlib.Path)
-        The PGM and the YAML written (each atomically); the YAML names the image relatively.
+        The PGM and the YAML written (each atomically, the image first); the YAML names the image
+        relatively. A save interrupted between the two leaves the new image beside the old YAML: two
+        files cannot be replaced in one step (save under a new stem to keep the old map whole).
 
     Raises
     ------
@@ -132,7 +134,7 @@ def save_map(grid: OccupancyGrid, stem: Any, *, occupied_thresh: float = OCCUPIE
     """
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"grid: expected an OccupancyGrid, got {describe(grid)}")
-    base = Path(as_text(stem, "stem", empty=False) if not isinstance(stem, Path) else stem)
+    base = as_file_path(stem, "stem")
     _yaml_name(base.name + ".pgm")                              # refused before anything is written
     f, o = _thresholds(free_thresh, occupied_thresh, _value_error)
     neg = as_int(negate, "negate", minimum=0, maximum=1)

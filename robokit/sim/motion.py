@@ -234,9 +234,7 @@ def sample_motion_model_odometry(odom_prev: Any, odom_now: Any, poses: Any, alph
     [[1.013, -0.004, -0.024], [1.054, -0.003, -0.015], [0.905, -0.037, -0.019]]
     """
     delta = odometry_increment(as_planar(odom_prev, "odom_prev", shape=(3,)), as_planar(odom_now, "odom_now", shape=(3,)))
-    P = as_array(poses, "poses")
-    if P.shape[-1:] != (3,) or P.ndim > 2:
-        raise ValueError(f"poses: expected shape (3,) or (N, 3), got shape {P.shape}")
+    P = as_planar(poses, "poses")
     d = _perturb(np.broadcast_to(delta, P.shape), _alphas(alphas), as_rng(rng))
     return _apply(P, d)
 

@@ -90,8 +90,9 @@ class Run:
 
         Notes
         -----
-        :func:`robokit.files.save_npz`; loading uses ``allow_pickle=False`` so a run file can never
-        execute code (course convention, DESIGN.md "Caching").
+        :func:`robokit.files.save_npz`, atomically; :meth:`load` reads it back through
+        :func:`robokit.files.read_npz`, which never unpickles, so a run file can never execute code
+        (course convention, DESIGN.md "Files").
         """
         arrays = {"t": self.t, "poses": self.poses, "odometry": self.odometry,
                   "meta": np.array(json.dumps({**self.meta, "format": _FORMAT}))}

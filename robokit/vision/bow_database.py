@@ -203,9 +203,10 @@ class BowDatabase:
         totals = np.bincount(entry, weights, minlength=sizes.size)
         keep = totals[entry] > 0                                 # an entry of zero weight is empty, as in add()
         entry, words, weights = entry[keep], words[keep], weights[keep] / totals[entry[keep]]
-        cuts = np.cumsum(np.bincount(entry, minlength=sizes.size))[:-1]
         db = cls(voc)
-        db._words, db._weights = np.split(words, cuts), np.split(weights, cuts)
+        if sizes.size:                                           # (np.split of nothing gives one empty part)
+            cuts = np.cumsum(np.bincount(entry, minlength=sizes.size))[:-1]
+            db._words, db._weights = np.split(words, cuts), np.split(weights, cuts)
         return db
 
     @classmethod

@@ -19,8 +19,8 @@ What is enforced, and where:
   whatever the job leaves running is ended at once; processes of the job uid are also swept
   through ``/proc``, for hosts that give no control group.
 * Not root: the namespace and uid steps are skipped; the report marks the run ``sandbox=limited``.
-  A fork bomb is still bounded: ``RLIMIT_NPROC`` allows the user ``max_processes`` more processes
-  than they ran when the job started.
+  A fork bomb is still bounded: ``RLIMIT_NPROC`` allows the user ``max_processes`` more threads
+  and processes than they ran when the job started.
 """
 from __future__ import annotations
 
@@ -69,8 +69,8 @@ class Limits:
     memory_bytes : int
         ``RLIMIT_AS`` (virtual address space).
     max_processes : int
-        ``RLIMIT_NPROC`` for the job uid; not as root, the user's processes at the start plus this
-        many (``RLIMIT_NPROC`` counts all of a user's processes).
+        ``RLIMIT_NPROC`` for the job uid; not as root, the user's threads at the start plus this
+        many (``RLIMIT_NPROC`` counts every thread of the user's real uid).
     file_bytes : int
         ``RLIMIT_FSIZE``: the largest file the worker may write (stdout/stderr included).
     disk_bytes : int
@@ -111,15 +111,17 @@ def is_root() -> bool:
     return os.geteuid() == 0
 
 
-def _processes_of(uid: int) -> int:
-    """How many processes the real uid ``uid`` runs now (read from ``/proc``)."""
+def _tasks_of(uid: int) -> int:
+    """How many threads the real uid ``uid`` runs now: what ``RLIMIT_NPROC`` counts (from ``/proc``)."""
     count = 0
     for entry in os.scandir("/proc"):
         if entry.name.isdigit():
             try:
-                if os.stat(entry.path).st_uid == uid:
-                    count += 1
-            except OSError:                         # the process ended meanwhile
+                with open(f"{entry.path}/status") as fh:
+                    real = next(int(line.split()[1]) for line in fh if line.startswith("Uid:"))
+                if real == uid:
+                    count += len(os.listdir(f"{entry.path}/task"))
+            except (OSError, StopIteration, ValueError, IndexError):   # ended meanwhile, or unreadable
                 pass
     return count
 
@@ -132,9 +134,9 @@ def _limits(limits: Limits, uid: int | None) -> None:
     resource.setrlimit(resource.RLIMIT_NOFILE, (256, 256))
     if uid is not None:
         resource.setrlimit(resource.RLIMIT_NPROC, (limits.max_processes, limits.max_processes))
-    else:   # as the user, RLIMIT_NPROC counts all their processes: allow this job max_processes more
+    else:   # as the user, RLIMIT_NPROC counts all their threads: allow this job max_processes more
         hard = resource.getrlimit(resource.RLIMIT_NPROC)[1]
-        cap = _processes_of(os.getuid()) + limits.max_processes
+        cap = _tasks_of(os.getuid()) + limits.max_processes
         cap = cap if hard == resource.RLIM_INFINITY else min(cap, hard)
         resource.setrlimit(resource.RLIMIT_NPROC, (cap, cap))
 

@@ -85,7 +85,8 @@ class KidnapResult:
         Ours: the times (s after the kidnapping; negative before it) the retrieval re-initialised the
         particles.
     retrievals : list of tuple
-        Ours: ``(time, retrieved pose, distance from the estimate)`` of every retrieval.
+        Ours: ``(time, retrieved pose, true pose, distance from the estimate)`` of every retrieval
+        that found a keyframe.
     """
 
     times: np.ndarray
@@ -115,8 +116,8 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
         Seconds to drive on after the kidnapping.
     kidnap_distance : float, default 1.0
         Ours: a retrieval farther than this (m) from the filter's estimate re-initialises the
-        particles around it (Algorithm 1, lines 14-15; 0 re-initialises at every retrieval, as the
-        algorithm is printed).
+        particles around it (Algorithm 1, lines 14-15); with ``confirm=1``, 0 re-initialises at every
+        retrieval, as the algorithm is printed.
     confirm : int, default 2
         Ours: how many retrievals in a row must disagree with the estimate, and agree with each other
         once carried forward by the odometry between them (within ``kidnap_distance``), before the
@@ -154,6 +155,9 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
     b = as_int(destination, "destination", minimum=0, maximum=len(START_POSES) - 1)
     period, after = as_positive(period, "period"), as_positive(after, "after")
     vote = Confirmation(confirm, as_positive(kidnap_distance, "kidnap_distance", allow_zero=True))
+    if vote.distance == 0 and vote.confirm > 1:
+        raise ValueError(f"kidnap_distance: 0 (re-initialise at every retrieval) needs confirm=1, got confirm="
+                         f"{vote.confirm}: retrievals can never agree within 0 m")
     rng = as_rng(as_int(seed, "seed", minimum=0))
     x_a, x_b = START_POSES[a][0], START_POSES[b][0]
     if x_b + SPEED * after > setup.world.info["length"] - 0.8:
@@ -182,7 +186,7 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
             ours = filters["ours"]
             estimate = largest_cluster_mean(ours.particles, ours.weights)   # amcl's published pose
             if pose_k is not None:                                          # the image found a keyframe
-                retrievals.append((t, pose_k, float(np.hypot(*(pose_k[:2] - estimate[:2])))))
+                retrievals.append((t, pose_k, truth[k], float(np.hypot(*(pose_k[:2] - estimate[:2])))))
                 if vote.disagrees(pose_k, estimate, odometry[k]):
                     ours.initialize_ellipse(pose_k, *ELLIPSE_SIGMA)
                     reinit.append(t)
