@@ -326,6 +326,10 @@ def read_npz(path: Any, *, max_bytes: int = 1 << 30, max_arrays: int = 10_000,
         raise NpzFileError(f"path: {path.name}: not a readable .npz archive (truncated or corrupt: {err})") from None
 
 
+#: How much of an ``.npy`` member :func:`read_npz` reads at a time.
+_CHUNK_BYTES = 1 << 24
+
+
 def _read_member(archive: zipfile.ZipFile, member: zipfile.ZipInfo, label: str, max_bytes: int, max_values: int):
     """One ``.npy`` member, its header checked against the budget before its data are read."""
     import numpy as np
@@ -338,8 +342,6 @@ def _read_member(archive: zipfile.ZipFile, member: zipfile.ZipInfo, label: str, 
             version = np.lib.format.read_magic(fh)
             header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
             shape, fortran, dtype = header(fh, max_header_size=10_000)
-        except NpzFileError:
-            raise
         except Exception as err:  # numpy parses the header as a Python literal: a damaged one fails in many ways
             raise NpzFileError(f"path: {label}: array {name[:-4]!r} has a damaged header ({type(err).__name__})") from None
         count = int(np.prod(shape, dtype=object))
@@ -348,8 +350,12 @@ def _read_member(archive: zipfile.ZipFile, member: zipfile.ZipInfo, label: str, 
         if count > max_values:
             raise NpzFileError(f"path: {label}: array {name[:-4]!r} declares {count} values, more than this "
                                f"reader's {max_values}")
-        data = fh.read(count * dtype.itemsize)
-        if len(data) != count * dtype.itemsize:
-            raise NpzFileError(f"path: {label}: array {name[:-4]!r} is truncated")
-        arr = np.frombuffer(data, dtype=dtype, count=count).copy()
+        arr = np.empty(count, dtype=dtype)
+        raw, done = arr.view(np.uint8) if arr.nbytes else np.empty(0, np.uint8), 0
+        while done < raw.size:                  # in chunks, into the array: memory for one copy, not two
+            chunk = fh.read(min(raw.size - done, _CHUNK_BYTES))
+            if not chunk:
+                raise NpzFileError(f"path: {label}: array {name[:-4]!r} is truncated")
+            raw[done:done + len(chunk)] = np.frombuffer(chunk, np.uint8)
+            done += len(chunk)
         return arr.reshape(shape[::-1]).T if fortran else arr.reshape(shape)

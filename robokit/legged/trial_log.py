@@ -418,10 +418,10 @@ def save_trial(path: Any, log: TrialLog) -> Path:
     return write_atomically(target, write)
 
 
-def _is_lone_npy(source: Path, refuse) -> bool:
+def _is_lone_npy(source: Path) -> bool:
     """Whether a file :func:`read_npz` refused is a single ``.npy`` array (for a clearer message)."""
     try:
-        with open_regular(source, MAX_LOG_BYTES, refuse) as fh:
+        with open_regular(source, MAX_LOG_BYTES, ValueError) as fh:
             return fh.read(6) == b"\x93NUMPY"
     except (OSError, ValueError):
         return False
@@ -464,16 +464,12 @@ def load_trial(path: Any) -> TrialLog:
     robokit.legged.trial_log.TrialLogError: ...cut.npz: not a readable trial log (truncated or corrupt: ...)
     """
     source = as_file_path(path, "path")
-
-    def refuse(reason: str) -> TrialLogError:
-        return TrialLogError(f"{source}: not a readable trial log (it {reason})")
-
     try:
         arrays = read_npz(source, max_bytes=MAX_LOG_BYTES, max_arrays=len(LOG_LAYOUT) + 8, max_values=MAX_LOG_BYTES)
     except FileNotFoundError:
         raise
     except (OSError, ValueError) as err:
-        if _is_lone_npy(source, refuse):
+        if _is_lone_npy(source):
             raise TrialLogError(f"{source}: not a {LOG_FORMAT} file (one .npy array, not an .npz archive)") from None
         raise TrialLogError(f"{source}: not a readable trial log (truncated or corrupt: {err})") from None
     if "__meta__" not in arrays:
