@@ -324,3 +324,23 @@ def test_save_map_refuses_a_name_it_cannot_write_and_load_map_bounds_what_it_rea
     big.write_text("# padding\n" * 10_000)
     with pytest.raises(MapFileError, match="more than"):
         load_map(big)
+
+
+def test_a_cropped_grid_keeps_its_cells_where_they_were():
+    rng = np.random.default_rng(0)
+    grid = OccupancyGrid(rng.normal(size=(30, 40)), 0.1, origin=(-1.0, 2.0))
+    part = grid.crop((0.0, 2.5, 1.5, 4.0))
+    assert part.shape == (15, 15) and part.bounds == pytest.approx((0.0, 2.5, 1.5, 4.0))
+    points = rng.uniform([0.01, 2.51], [1.49, 3.99], size=(50, 2))
+    ij, _ = grid.cell_of(points)
+    km, inside = part.cell_of(points)
+    assert inside.all()
+    np.testing.assert_array_equal(grid.log_odds[ij[:, 0], ij[:, 1]], part.log_odds[km[:, 0], km[:, 1]])
+
+
+@pytest.mark.parametrize("bounds, match", [((0.0, 2.5, -1.0, 4.0), "x1 > x0"), ((-2.0, 2.5, 1.0, 4.0), "inside"),
+                                           ((0.0, 2.5, 0.04, 4.0), "whole cell"), ((0.0, np.nan, 1.0, 4.0), "finite")])
+def test_a_crop_outside_or_empty_is_refused(bounds, match):
+    grid = OccupancyGrid(np.zeros((30, 40)), 0.1, origin=(-1.0, 2.0))
+    with pytest.raises(ValueError, match=match):
+        grid.crop(bounds)

@@ -157,3 +157,62 @@ def test_box_corners_are_counter_clockwise_and_validated_arrays_are_shared():
 def test_bad_input_is_named(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
         call()
+
+
+# --- a grid's outline as walls ---------------------------------------------------------------
+
+def _march(occupied: np.ndarray, resolution: float, origin: np.ndarray, o: np.ndarray, angle: float,
+           r_max: float) -> float:
+    """Reference: Amanatides & Woo's (1987) exact cell walk, cell by cell along the ray, stopping at
+    the entry into the first occupied cell."""
+    d = np.array([np.cos(angle), np.sin(angle)])
+    g = (o - origin) / resolution                       # grid units
+    cell = np.floor(g).astype(int)
+    step = np.where(d > 0, 1, -1)
+    with np.errstate(divide="ignore"):
+        t_next = np.where(d != 0, (cell + (step > 0) - g) / d, np.inf)
+        t_delta = np.where(d != 0, 1 / np.abs(d), np.inf)
+    t = 0.0
+    while t * resolution < r_max:
+        axis = int(np.argmin(t_next))
+        t = t_next[axis]
+        cell[axis] += step[axis]
+        t_next[axis] += t_delta[axis]
+        j, i = cell
+        if 0 <= i < occupied.shape[0] and 0 <= j < occupied.shape[1] and occupied[i, j]:
+            return min(float(t * resolution), r_max)
+    return r_max
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_grid_outline_stops_rays_at_the_first_occupied_cell(seed):
+    rng = np.random.default_rng(seed)
+    occupied = rng.random((12, 15)) < 0.25
+    res, origin = 0.2, np.array([-1.0, 0.5])
+    walls = Layout.from_cells(occupied, res, origin)
+    free = np.argwhere(~occupied)
+    for i, j in free[rng.choice(len(free), 5, replace=False)]:
+        o = origin + (np.array([j, i]) + rng.uniform(0.2, 0.8, 2)) * res
+        angles = rng.uniform(-np.pi, np.pi, 20)
+        got = walls.raycast(o, angles, 4.0)
+        want = [_march(occupied, res, origin, o, a, 4.0) for a in angles]
+        np.testing.assert_allclose(got, want, atol=1e-9)
+
+
+def test_a_grid_outline_merges_runs_of_cell_edges():
+    walls = Layout.from_cells(np.ones((3, 50), bool), 0.1)      # one solid block: four sides
+    assert len(walls.segments) == 4
+    assert sorted(np.ptp(walls.segments[:, :, 0], axis=1).round(9).tolist()) == [0.0, 0.0, 5.0, 5.0]
+
+
+def test_a_grid_outline_refuses_bad_input():
+    with pytest.raises(ValueError, match="occupied"):
+        Layout.from_cells(np.ones(4, bool), 0.1)
+    for bad in ([[0.0, 1.0]], [[np.nan]], [["a"]], None):
+        with pytest.raises(TypeError, match="occupied"):
+            Layout.from_cells(bad, 0.1)
+    with pytest.raises(ValueError, match="resolution"):
+        Layout.from_cells(np.ones((2, 2), bool), 0.0)
+    with pytest.raises(ValueError, match="origin"):
+        Layout.from_cells(np.ones((2, 2), bool), 0.1, origin=(np.nan, 0.0))
+    assert len(Layout.from_cells(np.zeros((3, 3), bool), 0.1).segments) == 0

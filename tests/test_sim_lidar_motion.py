@@ -165,3 +165,15 @@ def test_odometry_covariance_of_a_turn_on_the_spot_with_a_slip_is_a_small_rotati
     for slip in ([-0.003, 0.0], [0.003, 0.0], [0.0, -0.003]):
         slipped = odometry_covariance([[0.0, 0.0, 0.0], [*slip, 0.3]], alphas)[-1]
         assert slipped[2, 2] < 2 * clean[2, 2], (slip, slipped[2, 2], clean[2, 2])
+
+
+def test_a_scan_over_a_layout_is_the_scan_over_the_world_it_came_from():
+    from robokit.sim import Layout, long_corridor
+    corridor, lidar = long_corridor(), Lidar(noise=0.01, height=0.45)
+    pose = [12.3, 0.2, 0.4]
+    np.testing.assert_array_equal(lidar.scan(corridor, pose, rng=3),
+                                  lidar.scan_layout(corridor.layout(0.45), pose, rng=3))
+    with pytest.raises(TypeError, match="layout"):
+        lidar.scan_layout(corridor, pose)
+    with pytest.raises(ValueError, match="robot_pose"):
+        lidar.scan_layout(Layout(), [np.nan, 0.0, 0.0])

@@ -231,6 +231,50 @@ class OccupancyGrid:
             lo = np.log(p) - np.log1p(-p)                 # log odds, Sec. 9.2 (+-inf at 1 and 0)
         return cls(np.clip(lo, LOG_ODDS_MIN, LOG_ODDS_MAX), resolution, origin)
 
+    def crop(self, bounds: Any) -> "OccupancyGrid":
+        """The cells inside ``bounds = (x0, y0, x1, y1)``: a part of the map as a map of its own.
+
+        Parameters
+        ----------
+        bounds : array_like, shape (4,)
+            A world rectangle inside :attr:`bounds`; its corners are rounded to the nearest cell
+            edge.
+
+        Returns
+        -------
+        OccupancyGrid
+            The same cells (a copy), the origin moved to the rectangle's lower-left cell edge.
+
+        Raises
+        ------
+        ValueError
+            For a rectangle with ``x1 <= x0`` or ``y1 <= y0``, one that reaches outside the grid, or one
+            that holds no whole cell.
+
+        Notes
+        -----
+        A sub-map of the grid of Thrun et al. (2005), Sec. 9.2 (cells are independent, so a part of
+        the map is a map).
+
+        Examples
+        --------
+        >>> grid = OccupancyGrid(np.arange(12.0).reshape(3, 4), 0.5)
+        >>> part = grid.crop((0.5, 0.5, 1.5, 1.5))
+        >>> part.log_odds.tolist(), part.origin.tolist()
+        ([[5.0, 6.0], [9.0, 10.0]], [0.5, 0.5])
+        """
+        b = as_array(bounds, "bounds", shape=(4,))
+        x0, y0, x1, y1 = self.bounds
+        tol = 1e-9 * self.resolution
+        if not (b[2] > b[0] and b[3] > b[1]):
+            raise ValueError(f"bounds: expected (x0, y0, x1, y1) with x1 > x0 and y1 > y0, got {b.tolist()}")
+        if b[0] < x0 - tol or b[1] < y0 - tol or b[2] > x1 + tol or b[3] > y1 + tol:
+            raise ValueError(f"bounds: expected a rectangle inside the grid's {[x0, y0, x1, y1]}, got {b.tolist()}")
+        c0, r0, c1, r1 = np.rint((b - np.tile(self.origin, 2)) / self.resolution).astype(int)
+        if c1 <= c0 or r1 <= r0:
+            raise ValueError(f"bounds: expected a rectangle holding at least one whole cell, got {b.tolist()}")
+        return OccupancyGrid(self.log_odds[r0:r1, c0:c1], self.resolution, self.origin + np.array([c0, r0]) * self.resolution)
+
     def cell_of(self, xy: Any) -> tuple[np.ndarray, np.ndarray]:
         """Cell indices ``[i, j]`` (row, column) of world points, and whether each is on the map.
 
