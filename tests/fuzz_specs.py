@@ -1055,6 +1055,11 @@ SPECS: dict[str, Call] = {
     "robokit.localization.beam_models.likelihood_field_log_weights": Call({
         "particles": Array(np.array([[0.0, 0.0, 0.0], [0.2, 0.1, 0.5]]), "N,3"), "ranges": Array(SCAN, "N", inf_ok=True),
         "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field), **beam_model_kinds()}),
+    "robokit.localization.scan_matching.match_scan": Call({
+        "pose": Array(np.array([0.2, 0.1, 0.5]), "3"), "ranges": Array(SCAN, "N", inf_ok=True),
+        "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field),
+        "window": Array(np.array([0.1, 0.1, 0.05]), "3"), "steps": Int(5), "levels": Int(2),
+        "sensor_offset": Array(np.zeros(3), "3"), "sigma_hit": Real(0.05), "r_max": Real(8.0)}),
     "robokit.localization.beam_models.likelihood_field_log_weight_readable": Call({
         "pose": Array(np.array([0.2, 0.1, 0.5]), "3"), "ranges": Array(SCAN, "N", inf_ok=True),
         "angles": Array(SCAN_ANGLES, "N"), "field": Obj(small_field), **beam_model_kinds()}),
@@ -1665,6 +1670,7 @@ HUGE_ANGLES: dict[str, tuple[str, ...]] = {
 
 
 EXTRA: tuple[str, ...] = (
+    "robokit.localization.scan_matching.match_scan",   # lesson 03 refines Table 2's runs with it (trials)
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view
