@@ -384,6 +384,26 @@ def corridor_setup():   # lesson 03's fast corridor map (cached on disk after th
 
 
 @functools.cache
+def willow_section():   # lesson 03's part of the Willow Garage map
+    from robocourse.lessons.corridor_localization.real_map import willow_section as section
+    return section()
+
+
+@functools.cache
+def willow_walls():
+    from robokit.sim import Layout
+    grid = willow_section()
+    return Layout.from_cells(grid.occupied_mask(), grid.resolution, grid.origin)
+
+
+@functools.cache
+def willow_drive():
+    from robocourse.lessons.corridor_localization.real_map import building_routes
+    from robokit.sim import waypoint_path
+    return waypoint_path(building_routes(willow_section(), 1, 1.0, rng=0)[0], 0.3).poses
+
+
+@functools.cache
 def corridor_calibration():
     from robocourse.lessons.corridor_localization.experiment import calibration_run
     return calibration_run(fast=True)
@@ -1240,6 +1260,21 @@ SPECS: dict[str, Call] = {
         "setup": Obj(corridor_setup), "method": Choice("ours"), "trials": Int(1, optional=True),
         "positions": Given([0]), "seed": Int(0), "max_distance": Real(3.0), "cache": Flag(False),
         "progress": Func(None, optional=True), "workers": Int(1, optional=True)}, cheap=False),
+    "robocourse.lessons.corridor_localization.real_map.willow_map": Call({}),
+    "robocourse.lessons.corridor_localization.real_map.willow_section": Call({}),
+    "robocourse.lessons.corridor_localization.real_map.building_routes": Call({
+        "grid": Obj(willow_section), "n": Int(1), "length": Real(3.0), "rng": Rng(0), "clearance": Real(0.35)},
+        cheap=False),
+    "robocourse.lessons.corridor_localization.real_map.global_localization_runs": Call({
+        "grid": Obj(willow_section), "walls": Obj(willow_walls), "drives": Given([willow_drive()]), "particles": Int(200),
+        "seed": Int(0), "workers": Int(1, optional=True), "progress": Func(None, optional=True)}, cheap=False),
+    "robocourse.lessons.corridor_localization.real_map.real_map_comparison": Call({
+        "setup": Obj(corridor_setup), "runs": Int(1, optional=True), "length": Real(1.0, optional=True), "seed": Int(0),
+        "cache": Flag(False), "progress": Func(None, optional=True)}, cheap=False),
+    "robokit.sim.layout.Layout.from_cells": Call({
+        # a boolean mask (Array's cases are numeric): its bad values are in test_sim_layout
+        "occupied": Given(np.array([[True, False], [False, True]])), "resolution": Real(0.1),
+        "origin": Array(np.zeros(2), "2")}),
     "robocourse.lessons.corridor_localization.kidnapping.kidnapping": Call({
         "setup": Obj(corridor_setup), "origin": Int(0), "destination": Int(2), "period": Real(5.0), "after": Real(3.0),
         "kidnap_distance": Real(1.0), "confirm": Int(2), "seed": Int(0)}, cheap=False),
@@ -1671,6 +1706,9 @@ HUGE_ANGLES: dict[str, tuple[str, ...]] = {
 
 EXTRA: tuple[str, ...] = (
     "robokit.localization.scan_matching.match_scan",   # lesson 03 refines Table 2's runs with it (trials)
+    "robokit.sim.layout.Layout.from_cells",          # lesson 03's real map, through real_map
+    "robocourse.lessons.corridor_localization.real_map.building_routes",
+    "robocourse.lessons.corridor_localization.real_map.global_localization_runs",
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view

@@ -4,6 +4,8 @@ experiment  the lesson's laser and camera; the calibration video, the vocabulary
             (each cached)
 trials      Table 2's runs, AMCL against the retrieval-started MCL (cached), and their records
 kidnapping  Fig. 15's kidnapped robot
+real_map    the same AMCL on a real building's map (Willow Garage, ROS navigation tutorials) and in the
+            corridor (cached)
 aliasing    one scan and the poses a laser-only filter confuses it with (assignment 03's question)
 exercises   assignment 03
 """
