@@ -397,10 +397,10 @@ def willow_walls():
 
 
 @functools.cache
-def willow_drive():
+def willow_drives():    # one short drive (made when a test first asks, not at import)
     from robocourse.lessons.corridor_localization.real_map import building_routes
     from robokit.sim import waypoint_path
-    return waypoint_path(building_routes(willow_section(), 1, 1.0, rng=0)[0], 0.3).poses
+    return [waypoint_path(building_routes(willow_section(), 1, 1.0, rng=0)[0], 0.3).poses]
 
 
 @functools.cache
@@ -1261,12 +1261,12 @@ SPECS: dict[str, Call] = {
         "positions": Given([0]), "seed": Int(0), "max_distance": Real(3.0), "cache": Flag(False),
         "progress": Func(None, optional=True), "workers": Int(1, optional=True)}, cheap=False),
     "robocourse.lessons.corridor_localization.real_map.willow_map": Call({}),
-    "robocourse.lessons.corridor_localization.real_map.willow_section": Call({}),
+    "robocourse.lessons.corridor_localization.real_map.willow_section": Call({"name": Choice("rooms")}),
     "robocourse.lessons.corridor_localization.real_map.building_routes": Call({
         "grid": Obj(willow_section), "n": Int(1), "length": Real(3.0), "rng": Rng(0), "clearance": Real(0.35)},
         cheap=False),
     "robocourse.lessons.corridor_localization.real_map.global_localization_runs": Call({
-        "grid": Obj(willow_section), "walls": Obj(willow_walls), "drives": Given([willow_drive()]), "particles": Int(200),
+        "grid": Obj(willow_section), "walls": Obj(willow_walls), "drives": Given(willow_drives), "particles": Int(200),
         "seed": Int(0), "workers": Int(1, optional=True), "progress": Func(None, optional=True)}, cheap=False),
     "robocourse.lessons.corridor_localization.real_map.real_map_comparison": Call({
         "setup": Obj(corridor_setup), "runs": Int(1, optional=True), "length": Real(1.0, optional=True), "seed": Int(0),

@@ -35,17 +35,19 @@ def test_the_matcher_recovers_heading_and_sideways_position(corridor):
     assert np.all(np.array(along) == 0.0)                      # a zero window keeps x exactly
 
 
-def test_the_answer_never_fits_worse_than_the_guess(corridor):
+def test_the_answer_fits_better_than_the_guess_when_the_truth_is_in_the_window(corridor):
     world, lidar, field = corridor
     rng = np.random.default_rng(2)
     for _ in range(5):
         truth = np.array([rng.uniform(2.0, 34.0), 0.0, 0.0])
         scan = lidar.scan(world, truth, rng)
-        guess = truth + [0.5, -0.3, 0.2]                        # outside the window: no promise of the truth
-        got = match_scan(guess, scan, lidar.angles, field, window=(0.05, 0.05, 0.01), levels=1, r_max=lidar.r_max)
-        at_guess = likelihood_field_log_weights(guess[None], scan, lidar.angles, field, sigma_hit=0.05,
-                                                r_max=lidar.r_max, combine="product")[0]
-        assert got.log_likelihood >= at_guess
+        guess = truth + [0.0, 0.06, np.deg2rad(2.0)]
+        got = match_scan(guess, scan, lidar.angles, field, window=(0.0, 0.1, np.deg2rad(3.0)), r_max=lidar.r_max)
+        score = lambda pose: likelihood_field_log_weights(np.asarray(pose)[None], scan, lidar.angles, field,  # noqa: E731
+                                                          sigma_hit=0.05, r_max=lidar.r_max, combine="product")[0]
+        assert got.log_likelihood == pytest.approx(score(got.pose))
+        assert score(got.pose) > score(guess) + 10.0              # 2 deg and 6 cm off cost a lot of beams
+        assert abs(wrap_angle(got.pose[2] - truth[2])) < np.deg2rad(0.5)
 
 
 @pytest.mark.parametrize("kwargs, error, match", [

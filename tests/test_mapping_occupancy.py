@@ -344,3 +344,9 @@ def test_a_crop_outside_or_empty_is_refused(bounds, match):
     grid = OccupancyGrid(np.zeros((30, 40)), 0.1, origin=(-1.0, 2.0))
     with pytest.raises(ValueError, match=match):
         grid.crop(bounds)
+
+
+def test_a_crop_rounds_its_corners_to_the_nearest_cell_edge():
+    grid = OccupancyGrid(np.zeros((30, 40)), 0.1, origin=(-1.0, 2.0))
+    part = grid.crop((0.02, 2.48, 1.46, 4.03))
+    assert part.bounds == pytest.approx((0.0, 2.5, 1.5, 4.0))

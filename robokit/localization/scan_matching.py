@@ -2,8 +2,10 @@
 
 A particle filter's estimate is only as fine as its particles are dense; a scan matcher refines it
 by searching a small window of poses around it for the one under which the scan's end points lie
-closest to the map's walls. Olson (2009) does this exhaustively over a grid of poses, coarse to
-fine; each candidate is scored with the likelihood-field model (Thrun et al. 2005, Table 6.3,
+closest to the map's walls. Olson (2009) scores a grid of poses exhaustively (and finds the grid's
+best with a multi-resolution bound); here each level searches a grid around the previous level's
+best, a greedy coarse-to-fine refinement that can miss a better pose far from the guess. Each
+candidate is scored with the likelihood-field model (Thrun et al. 2005, Table 6.3,
 :func:`~robokit.localization.beam_models.likelihood_field_log_weights`, with every beam and the
 product of their likelihoods). A window of zero on an axis keeps that coordinate, so a matcher can
 refine the heading and the sideways position but leave a coordinate the scan cannot pin down (the
@@ -22,6 +24,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from ..geometry import wrap_angle
 from ..geometry.planar import as_planar
 from ..mapping import LikelihoodField
 from ..validation import as_array, as_int, as_positive
@@ -76,7 +79,7 @@ def match_scan(pose: Any, ranges: Any, angles: Any, field: LikelihoodField, *,
     Returns
     -------
     ScanMatch
-        The best candidate of the last level and its log-likelihood (the product model over every
+        The best candidate of the last level (heading wrapped to [-pi, pi)) and its log-likelihood (the product model over every
         beam). The guess itself is a candidate of the first level, so the answer never fits worse.
 
     Raises
@@ -86,8 +89,9 @@ def match_scan(pose: Any, ranges: Any, angles: Any, field: LikelihoodField, *,
 
     Notes
     -----
-    Olson (2009), Sec. III (exhaustive search of a pose window, multi-resolution); the score is
-    Thrun et al. (2005), Table 6.3 (likelihood field, product of beams).
+    After Olson (2009), Sec. III (search of a pose window for the best-scoring pose), but greedy:
+    each level re-centres on the previous best, so it refines a guess rather than guaranteeing the
+    window's optimum. The score is Thrun et al. (2005), Table 6.3 (likelihood field, product of beams).
 
     Examples
     --------
@@ -125,4 +129,6 @@ def match_scan(pose: Any, ranges: Any, angles: Any, field: LikelihoodField, *,
         if scores[k] > best_score:
             best, best_score = best + offsets[k], float(scores[k])
         win = win * 2.0 / (steps - 1)
+    best = best.copy()
+    best[2] = wrap_angle(best[2])
     return ScanMatch(best, best_score)

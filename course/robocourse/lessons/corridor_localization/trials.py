@@ -52,8 +52,8 @@ from robokit.sim import noisy_odometry, waypoint_path
 from robokit.validation import as_array, as_callable, as_choice, as_int, as_positive, as_rng
 from robokit.vision import detect_orb_features
 
-__all__ = ["middle_line_drive", "START_POSES", "ELLIPSE_SIGMA", "CLUSTER_SHARE", "PARTICLES", "SETTLE", "REFINE_WINDOW", "retrieve_pose",
-           "localization_trial", "localization_trials", "corridor_localizer", "PAPER_TOLERANCE", "TrialResult",
+__all__ = ["middle_line_drive", "START_POSES", "ELLIPSE_SIGMA", "CLUSTER_SHARE", "PARTICLES", "SETTLE", "RIGHT_PLACE",
+           "REFINE_WINDOW", "retrieve_pose", "localization_trial", "localization_trials", "corridor_localizer", "PAPER_TOLERANCE", "TrialResult",
            "TrialSet"]
 
 
@@ -177,6 +177,8 @@ CLUSTER_SHARE = 0.95
 ELLIPSE_SIGMA = (0.3, 0.1)
 #: Updates a run goes on after convergence before it is judged a second time.
 SETTLE = 5
+#: Our looser judgement, "the right place": within 0.5 m and 10 degrees of the truth.
+RIGHT_PLACE = (0.5, float(np.deg2rad(10.0)))
 #: Scan matching at convergence (:func:`robokit.localization.match_scan`): half-widths of the search
 #: in x, y (m) and heading (rad). x, the position along the corridor, is left to the filter: the walls
 #: say nothing about it, and only the few beams on a door's edge do (ours).
@@ -184,14 +186,34 @@ REFINE_WINDOW = (0.0, 0.15, float(np.deg2rad(3.0)))
 SPEED, RATE = 0.3, 10.0
 
 
-def middle_line_drive(start: np.ndarray, length: float, distance: float) -> np.ndarray:
+def middle_line_drive(start: Any, length: float, distance: float) -> np.ndarray:
     """True poses at :data:`RATE` driving ``distance`` m along the middle line from ``start``.
 
-    The robot drives the way it faces, turns on the spot 0.8 m before an end wall (where the paper's
-    mapping run stopped) and drives back; the moving strategy's line keeping is taken as exact here
-    (it holds the line to about a centimetre, see :func:`robokit.controllers.move_to_middle_line`).
-    ``start`` is ``[x, y, theta]`` in the corridor, ``length`` the corridor's (m), ``distance`` at
-    most 1000 m; a :class:`ValueError` names a bad one.
+    Parameters
+    ----------
+    start : array_like, shape (3,)
+        ``[x, y, theta]`` with ``x`` between the turning points (0.8 m from each end); a ``y`` off the
+        middle line is left on the first leg, which runs straight to the line at its end.
+    length : float
+        The corridor's length (m, more than 1.6).
+    distance : float
+        Metres to drive (at most 1000).
+
+    Returns
+    -------
+    numpy.ndarray, shape (K, 3)
+
+    Raises
+    ------
+    ValueError, TypeError
+        For a bad start, length or distance (the error names it).
+
+    Notes
+    -----
+    The robot drives the way it faces, turns on the spot 0.8 m before an end wall (where the mapping
+    run of Ge et al. 2023, Sec. 4, stopped) and drives back; the moving strategy's line keeping is
+    taken as exact here (it holds the line to about a centimetre, see
+    :func:`robokit.controllers.move_to_middle_line`).
 
     Examples
     --------
@@ -202,9 +224,12 @@ def middle_line_drive(start: np.ndarray, length: float, distance: float) -> np.n
     start = as_array(start, "start", shape=(3,))
     length = as_positive(length, "length")
     distance = as_positive(distance, "distance")
-    if length <= 1.6 or distance > 1000 or not 0.0 <= start[0] <= length:
-        raise ValueError(f"length, distance, start: expected a corridor longer than 1.6 m, at most 1000 m to drive "
-                         f"and a start inside it, got {length}, {distance}, x = {start[0]}")
+    if length <= 1.6:
+        raise ValueError(f"length: expected a corridor longer than 1.6 m, got {length}")
+    if distance > 1000:
+        raise ValueError(f"distance: expected at most 1000 m, got {distance}")
+    if not 0.8 - 1e-9 <= start[0] <= length - 0.8 + 1e-9:
+        raise ValueError(f"start: expected x between the turning points 0.8 and {length - 0.8:.2f} m, got {start[0]}")
     ends = (0.8, length - 0.8)
     x, heading = float(start[0]), float(start[2])
     points, left = [[x, float(start[1])]], distance
