@@ -28,6 +28,10 @@ from .world import World
 
 __all__ = ["Lidar", "scan_points"]
 
+#: How far past ``r_max`` a beam is cast (a factor): far enough that "nothing within range" is told
+#: apart from a return at ``r_max``, near enough that the ray caster culls everything beyond reach.
+_BEYOND = 1.001
+
 
 @dataclasses.dataclass
 class Lidar:
@@ -176,8 +180,9 @@ class Lidar:
 
     def _cast(self, layout: Layout, sp: np.ndarray, rng: Any) -> np.ndarray:
         """Ranges from sensor pose ``sp`` over ``layout``, with noise and the valid interval applied."""
-        # obstacles out of reach are skipped (max_range); a miss within it reads 2 r_max, out of range below
-        true = layout.raycast(sp[:2], self.angles + sp[2], 2 * self.r_max, validate=False)
+        # only obstacles within reach are cast against (max_range culls the rest); a beam that hits
+        # nothing within it reads just over r_max, which the mask below turns into inf
+        true = layout.raycast(sp[:2], self.angles + sp[2], _BEYOND * self.r_max, validate=False)
         out = true.copy()
         if self.noise > 0:
             out = out + as_rng(rng).normal(0.0, self.noise, self.beams)
