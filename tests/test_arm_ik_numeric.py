@@ -176,3 +176,24 @@ def test_single_solve_options_are_checked():
         ik_numeric(PANDA, T @ np.diag([1.0, 1.0, -1.0, 1.0]))
     r = ik_numeric(PANDA, T, rng=1, history=True)           # the vectorised search, with its iterates
     assert r.success
+
+
+def test_the_compile_notice_waits_for_the_first_call_that_runs_the_search(monkeypatch):
+    # an out-of-reach first target returns before the compiled search: the notice (and the record
+    # that keeps later processes quiet) belongs to the first call that runs it
+    import importlib
+
+    from robokit.arm import jit
+    module = importlib.import_module("robokit.arm.ik_numeric")
+    arm = iiwa14()
+
+    calls = []
+    monkeypatch.setattr(module, "_FIRST", [True])
+    monkeypatch.setattr(jit, "compile_notice", lambda kernel, what: calls.append(("notice", kernel)) or "record")
+    monkeypatch.setattr(jit, "compiled", lambda record: calls.append(("compiled", record)))
+    far = np.eye(4)
+    far[:3, 3] = [5.0, 0.0, 0.0]
+    assert not ik_numeric(arm, far).success
+    assert calls == [] and module._FIRST == [True]
+    ik_numeric(arm, arm.fk(np.full(7, 0.3)))
+    assert calls == [("notice", "numeric_search"), ("compiled", "record")] and module._FIRST == []

@@ -269,11 +269,6 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
         settings = _settings(*(opts[k] for k in _SETTINGS))
     method, tol, max_iter, restarts, damping, gain, clamp, max_step, patience, P = settings
     K = _kernels()
-    record = None
-    if _FIRST:
-        _FIRST.clear()
-        from .jit import compile_notice
-        record = compile_notice("numeric_search", "the numerical IK solver")
     if not (type(T) is np.ndarray and T.dtype == np.float64 and T.shape == (4, 4) and T.flags.c_contiguous
             and K.se3_defect(T, ROTATION_TOL) == 0):
         T = np.ascontiguousarray(as_se3(T, "T"))
@@ -287,6 +282,11 @@ def ik_numeric(chain: Chain, T: Any, q0: Any = None, **options: Any) -> IKResult
     else:
         pool = as_rng(seed).uniform(chain.qmin, chain.qmax, size=(P - 1 + restarts, chain.n))
     q_out, info = np.empty(chain.n), np.zeros(4)
+    record = None
+    if _FIRST:            # here, not earlier: a call that returns before the search compiles nothing
+        _FIRST.clear()
+        from .jit import compile_notice
+        record = compile_notice("numeric_search", "the numerical IK solver")
     winner = K.search(T, q, pool, *args, lo, hi, _METHOD_CODE[method], tol, max_iter, restarts, damping**2, gain,
                       clamp, max_step, patience, P, NULL_SPACE_FADE, PROJECTION_EPS, q_out, info)
     if record is not None:

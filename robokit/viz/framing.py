@@ -1,10 +1,10 @@
-"""Where the viewer's camera stands: :func:`look_from` a given point, or :func:`frame` what a scene draws.
+"""Where the viewer's camera stands: :func:`look_from` a given point, or :func:`fit_view` to what a scene draws.
 
 meshcat's viewer has one perspective camera (three.js ``PerspectiveCamera(75, 1, 0.01, 100)`` in the
 viewer bundled with the ``meshcat`` package: a 75 degree vertical field of view, and nothing nearer
 than 1 cm or farther than 100 m is drawn), orbiting a target point. A lesson's scene shows what its
 text talks about when the camera looks at that and stands just far enough away for it to fill the
-view: :func:`frame` works that distance out from the box around the objects (:meth:`Scene.bounding_box`)
+view: :func:`fit_view` works that distance out from the box around the objects (:meth:`Scene.bounding_box`)
 and moves the clipping planes past the box, so a 100 m field is not cut off at 100 m.
 """
 from __future__ import annotations
@@ -21,7 +21,7 @@ __all__ = ["look_from", "fit_view", "FOV", "NEAR", "FAR", "VIEW_WIDTH"]
 FOV = 75.0
 """Vertical field of view (degrees) of meshcat's default camera."""
 NEAR, FAR = 0.01, 100.0
-"""meshcat's default clipping distances (metres): :func:`frame` only ever widens them."""
+"""meshcat's default clipping distances (metres): :func:`fit_view` only ever widens them."""
 _CAMERA = ("Cameras", "default", "rotated", "<object>")
 _SMALLEST = 0.1          # a box smaller than this (metres) is framed as one this size
 
