@@ -44,7 +44,7 @@ from scipy.sparse import csgraph
 
 from robocourse.lessons.corridor_localization.experiment import (MAPPING_ALPHAS, CorridorMap, as_corridor_map,
                                                                  corridor_lidar)
-from robocourse.lessons.corridor_localization.trials import RATE, RIGHT_PLACE, SPEED, middle_line_drive
+from robocourse.lessons.corridor_localization.trials import RATE, RIGHT_PLACE, SPEED, as_tolerance, middle_line_drive
 from robocourse.source import code_version_of
 from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
 from robokit.config import fast_mode
@@ -228,13 +228,6 @@ def building_routes(grid: OccupancyGrid, n: int, length: float, rng: Any = 0, *,
     return routes
 
 
-def _tolerance(tolerance: Any) -> np.ndarray:
-    tol = as_array(tolerance, "tolerance", shape=(2,))
-    if np.any(tol <= 0):
-        raise ValueError(f"tolerance: expected positive (metres, radians), got {tol.tolist()}")
-    return tol
-
-
 @dataclasses.dataclass
 class GlobalRuns:
     """Global localizations from a uniform cloud along given drives.
@@ -278,7 +271,7 @@ class GlobalRuns:
         >>> runs.right_place().tolist()
         [True, False]
         """
-        tol = _tolerance(tolerance)
+        tol = as_tolerance(tolerance)
         last = self.final_errors()
         return (last[:, 0] <= tol[0]) & (last[:, 1] <= tol[1])
 
@@ -296,7 +289,7 @@ class GlobalRuns:
         >>> runs.localized_after().tolist()
         [0.5]
         """
-        tol = _tolerance(tolerance)
+        tol = as_tolerance(tolerance)
         out = np.full(len(self.errors), np.nan)
         for r, (err, dist) in enumerate(zip(self.errors, self.travelled)):
             valid = np.isfinite(err[:, 0])
@@ -465,10 +458,11 @@ def real_map_comparison(setup: CorridorMap, *, runs: int | None = None, length: 
         raise ValueError(f"length: expected at most 100 m, got {length}")
     seed = as_int(seed, "seed", minimum=0)
     progress = as_callable(progress, "progress")
-    sections = {name: willow_section(name) for name in SECTIONS}
+    willow = willow_map()                        # read once: both sections and the cache key come from it
+    sections = {name: willow.crop(bounds) for name, bounds in SECTIONS.items()}
     places = list(SECTIONS) + ["corridor"]
     meta = {"setup": setup.key, "runs": runs, "length": length, "seed": seed, "sections": SECTIONS,
-            "map": hashlib.sha256(willow_map().log_odds.tobytes()).hexdigest()[:16],
+            "map": hashlib.sha256(willow.log_odds.tobytes()).hexdigest()[:16],
             "particles": AMCL_PARTICLES, "code": code_version_of(__name__)}
     target = cache_dir("corridor") / f"realmap-{cache_key(**meta)}.npz"
     names = {p: p.replace(" ", "_") for p in places}

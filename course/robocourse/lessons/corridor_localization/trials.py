@@ -53,12 +53,26 @@ from robokit.validation import as_array, as_callable, as_choice, as_int, as_posi
 from robokit.vision import detect_orb_features
 
 __all__ = ["middle_line_drive", "START_POSES", "ELLIPSE_SIGMA", "CLUSTER_SHARE", "PARTICLES", "SETTLE", "RIGHT_PLACE",
-           "REFINE_WINDOW", "retrieve_pose", "localization_trial", "localization_trials", "corridor_localizer", "PAPER_TOLERANCE", "TrialResult",
-           "TrialSet"]
+           "REFINE_WINDOW", "as_tolerance", "retrieve_pose", "localization_trial", "localization_trials",
+           "corridor_localizer", "PAPER_TOLERANCE", "TrialResult", "TrialSet"]
 
 
 #: The paper's success criterion (Sec. 4.1): 0.05 m and 0.5 degrees.
 PAPER_TOLERANCE = (0.05, float(np.deg2rad(0.5)))
+
+
+def as_tolerance(tolerance: Any) -> np.ndarray:
+    """A success tolerance ``(metres, radians)``, both positive, as an array (else a ValueError naming it).
+
+    Examples
+    --------
+    >>> as_tolerance(PAPER_TOLERANCE).round(4).tolist()
+    [0.05, 0.0087]
+    """
+    tol = as_array(tolerance, "tolerance", shape=(2,))
+    if np.any(tol <= 0):
+        raise ValueError(f"tolerance: expected positive (metres, radians), got {tol.tolist()}")
+    return tol
 
 
 @dataclasses.dataclass
@@ -151,9 +165,7 @@ class TrialSet:
         >>> runs.success().tolist(), runs.success((0.01, 0.1)).tolist(), runs.success((0.02, 0.1), settled=True).tolist()
         ([True, False], [False, False], [True, False])
         """
-        tol = as_array(tolerance, "tolerance", shape=(2,))
-        if np.any(tol <= 0):
-            raise ValueError(f"tolerance: expected positive (metres, radians), got {tol.tolist()}")
+        tol = as_tolerance(tolerance)
         if settled and refined:
             raise ValueError("settled, refined: expected at most one of them")
         err = np.nan_to_num(self.settled if settled else self.refined if refined else self.error, nan=np.inf)
