@@ -7,6 +7,8 @@
   see ``pyproject.toml``).
 * Every module of a topic subpackage or a lesson that cites a source in its docstrings has a
   ``References`` section in its module docstring giving the full citation.
+* Every dotted ``robokit.`` or ``robocourse.`` name written in a notebook, a docstring, the README
+  or docs/ names something that exists (a renamed function leaves no stale name behind).
 """
 from __future__ import annotations
 
@@ -152,3 +154,55 @@ def test_each_package_docstring_maps_exactly_its_modules(package):
 def test_the_map_test_reads_a_map():
     doc = "Summary.\n\nplanar  SE(2)\nrotations   SO(3),\n            continued\nNot a line.\n"
     assert MAP_LINE.findall(doc) == ["planar", "rotations"]
+
+
+_DOTTED = re.compile(r"(?<![\w.])((?:robokit|robocourse)(?:\.[A-Za-z_]\w*)+)")
+#: Dotted names that are not Python names on purpose: a notebook metadata key, and the module an
+#: old submission imports ``check`` from (the grader maps it to ``robocourse.check``).
+_NOT_PYTHON = {"robokit.cold_seconds": "metadata.robokit.cold_seconds, a notebook metadata key",
+               "robokit.grading": "the old home of check(), still accepted in submissions (barrier.py)"}
+
+
+def _resolves(name: str) -> bool:
+    parts = name.split(".")
+    for i in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:i]))
+        except ImportError:
+            continue
+        try:
+            for part in parts[i:]:
+                obj = getattr(obj, part)
+        except AttributeError:
+            return False
+        return True
+    return False
+
+
+def _written_names() -> dict[str, set[str]]:
+    texts = {}
+    for folder in ("lessons", "solutions", "assignments"):
+        for nb in sorted((ROOT / folder).glob("*.ipynb")):
+            cells = json.loads(nb.read_text(encoding="utf-8"))["cells"]
+            texts[f"{folder}/{nb.name}"] = "\n".join("".join(c["source"]) for c in cells)
+    for path in [*ROOT.glob("robokit/**/*.py"), *ROOT.glob("course/robocourse/**/*.py"), *ROOT.glob("docs/*.md"),
+                 ROOT / "README.md"]:
+        texts[str(path.relative_to(ROOT))] = path.read_text(encoding="utf-8")
+    names: dict[str, set[str]] = {}
+    for where, text in texts.items():
+        for name in _DOTTED.findall(text):
+            names.setdefault(name, set()).add(where)
+    return names
+
+
+def test_every_dotted_library_name_in_the_text_exists():
+    names = _written_names()
+    assert len(names) > 200, len(names)                     # the scan reads what it should
+    stale = {name: sorted(where)[:3] for name, where in names.items()
+             if name not in _NOT_PYTHON and not _resolves(name)}
+    assert not stale, f"names that do not resolve (renamed or removed?): {stale}"
+
+
+def test_the_name_check_catches_a_stale_name():
+    assert _resolves("robokit.viz.fit_view") and _resolves("robocourse.check")
+    assert not _resolves("robokit.viz.frame") and not _resolves("robokit.no_such_module.f")

@@ -8,7 +8,7 @@ import pytest
 from robocourse.cli import main
 from robocourse.exercises import Case, close, exact, unordered_rows
 from robocourse.grading import check
-from robocourse.grading.assign import AssignmentError, make_assignment, write_assignment
+from robocourse.grading.assign import RAISES, AssignmentError, make_assignment, mark_stub_failures, write_assignment
 from robocourse.lessons import UnknownExerciseError, assignments, get_exercise
 from robocourse.exercises.plain import NotPlainData, to_plain
 from robocourse.grading.transport import TransportError, read_plain, write_plain
@@ -178,6 +178,55 @@ def test_assignment_hides_solutions_and_carries_nbgrader_metadata():
                                                                "00.why_seeds": 1.0}
     assert all(c["metadata"]["nbgrader"]["schema_version"] == 3 for c in nb["cells"])
     assert nb["metadata"]["robokit"]["assignment"] == "00_getting_started"
+
+
+def _cell(source, *, grade=False, solution=False):
+    return {"cell_type": "code", "source": source, "outputs": [], "execution_count": None,
+            "metadata": {"nbgrader": {"grade": grade, "solution": solution}}}
+
+
+def test_only_cells_a_blank_exercise_can_break_are_marked_to_let_run_all_go_on():
+    cells = [_cell("import numpy as np\nfrom robocourse import check"),          # setup: a real error must stop
+             _cell("def f(x):\n    raise NotImplementedError", solution=True),   # defining a stub raises nothing
+             _cell("check('00.f', f)", grade=True),
+             _cell("data = np.arange(3)"),                                        # given data
+             _cell("y = f(data)\nz = 2"),                                         # uses the student's function
+             _cell("print(z + 1)"),                                               # uses what that cell made
+             _cell("print(data.sum())"),                                          # given data only
+             _cell("raise NotImplementedError", solution=True),                   # a stub at the top level
+             _cell("%matplotlib inline\nimport math\nprint(math.pi)")]           # magics parse
+    nb = mark_stub_failures({"cells": cells})
+    marked = [RAISES in c["metadata"].get("tags", []) for c in nb["cells"]]
+    assert marked == [False, False, True, False, True, True, False, True, False]
+    assert mark_stub_failures(nb)["cells"][2]["metadata"]["tags"] == [RAISES]      # idempotent
+
+
+@pytest.mark.parametrize("slug", sorted(assignments()))
+def test_every_check_and_every_cell_using_a_stub_is_marked_in_the_committed_assignments(slug):
+    nb = json.loads((ROOT / "assignments" / f"{slug}.ipynb").read_text())
+    code = [c for c in nb["cells"] if c["cell_type"] == "code"]
+    grade = [c for c in code if c["metadata"]["nbgrader"]["grade"]]
+    assert grade and all(RAISES in c["metadata"]["tags"] for c in grade)
+    assert not any(RAISES in c["metadata"].get("tags", []) for c in code if c["metadata"]["nbgrader"]["solution"])
+    solutions = json.loads((ROOT / "solutions" / f"{slug}.ipynb").read_text())
+    assert all(RAISES not in c["metadata"].get("tags", []) for c in solutions["cells"])  # solutions still stop
+
+
+def test_run_all_on_a_blank_assignment_runs_every_cell_and_shows_every_check(tmp_path):
+    """nbclient without allow_errors stops at the first error, as JupyterLab's Run All does, except
+    on cells tagged raises-exception: the blank assignment runs to its end."""
+    from robocourse.site.execute import execute_in_process
+
+    src = ROOT / "assignments" / "00_getting_started.ipynb"
+    status, error = execute_in_process(src, tmp_path / "out.ipynb", cwd=tmp_path, cell_timeout=120)
+    assert status == "ok", error
+    out = json.loads((tmp_path / "out.ipynb").read_text())
+    code = [c for c in out["cells"] if c["cell_type"] == "code"]
+    assert all(c["execution_count"] for c in code)
+    checks = [c for c in code if c["metadata"]["nbgrader"]["grade"]]
+    assert len(checks) == 2 and all(any(o["output_type"] == "error" for o in c["outputs"]) for c in checks)
+    text = json.dumps([c["outputs"] for c in checks])
+    assert "00.wrap_angle" in text and "00.se2_compose" in text
 
 
 def test_assign_rejects_broken_markers():

@@ -11,6 +11,11 @@ Conventions in ``solutions/NN_slug.ipynb`` (the single source of the assignment)
   ``<!-- END SOLUTION -->``; the answer becomes "YOUR ANSWER HERE" and the cell a manually graded
   nbgrader cell worth ``WRITTEN[NN.name]`` points;
 * every other cell is locked;
+* every code cell that can fail only because an exercise is still blank is tagged
+  ``raises-exception`` (:func:`mark_stub_failures`): a check cell, a solution cell whose stub
+  raises at its top level, and a cell that uses a name such a cell defines. JupyterLab's Run All
+  and nbclient then go on past it, so a student sees every exercise's feedback in one run; the
+  grader ignores the tag (it runs every cell and scores each check);
 * the grading worker runs every code cell not tagged ``skip-grading`` (:data:`~.submission.SKIP_TAGS`)
   and has no robokit: such a cell may import only ``check`` and ``assignment_data`` from
   robocourse. A cell that interprets results with the library (for a written question) carries
@@ -34,7 +39,7 @@ from robocourse.grading.submission import SKIP_TAGS
 from robocourse.lessons import get_assignment
 from robocourse.site.hygiene import strip_notebook
 
-__all__ = ["make_assignment", "write_assignment", "AssignmentError"]
+__all__ = ["make_assignment", "write_assignment", "mark_stub_failures", "AssignmentError", "RAISES"]
 
 _BEGIN = re.compile(r"^(\s*)#+\s*BEGIN SOLUTION\s*$")
 _END = re.compile(r"^\s*#+\s*END SOLUTION\s*$")
@@ -42,6 +47,10 @@ _CHECK = re.compile(r"""\bcheck\(\s*["'](\d\d\.[a-z][a-z0-9_]*)["']""")
 _MD_BEGIN = re.compile(r"<!--\s*BEGIN SOLUTION\s+(\d\d\.[a-z][a-z0-9_]*)\s*-->")
 _MD_REGION = re.compile(r"<!--\s*BEGIN SOLUTION\s+(\d\d\.[a-z][a-z0-9_]*)\s*-->.*?<!--\s*END SOLUTION\s*-->", re.S)
 _DEF = re.compile(r"^def\s+([A-Za-z_]\w*)\s*\(", re.M)
+
+
+#: The cell tag with which JupyterLab's Run All (and nbclient) go on past a cell's error.
+RAISES = "raises-exception"
 
 
 class AssignmentError(ValueError):
@@ -79,13 +88,20 @@ def _clear_code(src: str, where: str) -> str:
 WORKER_IMPORTS = {"robocourse": {"check", "assignment_data"}}
 
 
+def _parse(src: str) -> ast.Module | None:
+    """The syntax tree of a code cell (IPython magics and shell lines left out), None if it has none."""
+    code = "\n".join("" if line.lstrip().startswith(("%", "!")) else line for line in src.splitlines())
+    try:
+        return ast.parse(code)
+    except SyntaxError:
+        return None
+
+
 def _library_imports(src: str) -> list[str]:
     """The imports of robokit or robocourse in ``src`` beyond :data:`WORKER_IMPORTS` (IPython magics
     and shell lines are left out of the parse)."""
-    code = "\n".join("" if line.lstrip().startswith(("%", "!")) else line for line in src.splitlines())
-    try:
-        tree = ast.parse(code)
-    except SyntaxError:
+    tree = _parse(src)
+    if tree is None:
         return []
     found = []
     for node in ast.walk(tree):
@@ -95,6 +111,51 @@ def _library_imports(src: str) -> list[str]:
             allowed = WORKER_IMPORTS.get(node.module, set())
             found += [f"{node.module}.{a.name}" for a in node.names if a.name not in allowed]
     return found
+
+
+def _names(tree: ast.Module) -> tuple[set[str], set[str]]:
+    """(names the cell's top level binds, names it reads anywhere)."""
+    bound = set()
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            bound.add(node.name)
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            bound |= {(a.asname or a.name).split(".")[0] for a in node.names}
+        else:
+            bound |= {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
+    read = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+    return bound, read
+
+
+def _raises_at_top(tree: ast.Module) -> bool:
+    return any(isinstance(node, ast.Raise) for node in tree.body)
+
+
+def mark_stub_failures(nb: dict[str, Any]) -> dict[str, Any]:
+    """Tag ``raises-exception`` every code cell of a blank assignment that can fail because of a stub.
+
+    A cell is tagged when it is a grade (check) cell, when its own top level raises (a stub left in
+    module-level code), or when it reads a name that a tagged cell or a solution cell binds (a
+    student's function, or a result computed from one). Everything else (imports, given data) stays
+    untagged, so a real error there still stops Run All. Changes ``nb`` in place and returns it.
+    """
+    tainted: set[str] = set()
+    for cell in nb.get("cells", []):
+        if cell.get("cell_type") != "code":
+            continue
+        meta = cell.setdefault("metadata", {})
+        grading = meta.get("nbgrader", {})
+        tree = _parse(_source(cell))
+        bound, read = _names(tree) if tree is not None else (set(), set())
+        solution = bool(grading.get("solution"))
+        if solution:
+            tainted |= bound
+        if grading.get("grade") or (tree is not None and _raises_at_top(tree)) or (not solution and read & tainted):
+            tainted |= bound
+            tags = meta.setdefault("tags", [])
+            if RAISES not in tags:
+                tags.append(RAISES)
+    return nb
 
 
 def _nbgrader(grade_id: str, *, grade: bool, solution: bool, locked: bool, points: float | None = None) -> dict:
@@ -162,6 +223,7 @@ def make_assignment(solution: dict[str, Any], slug: str) -> dict[str, Any]:
     if missing:
         raise AssignmentError(f"solutions/{slug}.ipynb: missing " +
                               ", ".join(f"{what} for {k}" for k, what in missing))
+    mark_stub_failures(nb)
     nb.setdefault("metadata", {})["robokit"] = {"assignment": slug, "generated_from": f"solutions/{slug}.ipynb"}
     return nb
 
