@@ -8,7 +8,6 @@ enforces the order); each subpackage's docstring maps its modules:
 
 validation    the input checks every public function uses (errors that name the argument)
 config        settings from the environment: headless, fast mode, worker processes
-about         the versions of robokit and what it needs
 files         bounded file readers and atomic writers (.npz round trips)
 cache         the dataset cache (keys, meta, rebuilds)
 progress      the one progress bar of every long step

@@ -507,8 +507,7 @@ def touchdown_detectors():
 
 
 SPECS: dict[str, Call] = {
-    # --- about, geometry --------------------------------------------------------------------
-    "robokit.about.versions": Call({"extra": Obj(("numpy",), optional=True)}),
+    # --- geometry --------------------------------------------------------------------------
     "robokit.geometry.planar.wrap_angle": Call({"angle": Array(np.array([0.5, 4.0]), "|N|N,N", min_rows=0),
                                                 "validate": Flag(True)}),
     "robokit.geometry.planar.se2_compose": Call({"a": Array(np.array([1.0, 2.0, 0.5]), "3|N,3"),
@@ -1554,6 +1553,9 @@ NOT_FUZZED: dict[str, str] = {
     "robocourse.grading.check.check": "the notebook's checker of a student's function (grading's own tests cover it)",
 }
 SPECS["robocourse.grading.data.assignment_data"] = Call({"slug": Choice("04_littledog")})
+SPECS["robocourse.environment.check_environment"] = Call({})
+SPECS["robocourse.environment.environment_table"] = Call(
+    {"rows": Obj([{"package": "numpy", "version": "2.0", "status": "ok", "lessons": "all", "used_by": "robokit"}])})
 
 #: Besides the lessons' API: the exercises' references (students reproduce their contracts) and
 #: the functions the issue's fuzz named.

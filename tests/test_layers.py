@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: rows (and from itself).
 PACKAGES: dict[str, tuple[Path, list[set[str]]]] = {
     "robokit": (ROOT / "robokit", [
-        {"validation", "config", "about"},              # base: input checks, settings
+        {"validation", "config"},                       # base: input checks, settings
         {"files"},                                      # bounded readers and atomic writers
         {"cache"},                                      # the dataset cache (its files through files)
         {"progress"},                                   # the one progress bar (reads fast/headless from config)
@@ -42,7 +42,8 @@ PACKAGES: dict[str, tuple[Path, list[set[str]]]] = {
         {"viz"},                                        # meshcat scenes and figures
     ]),
     "robocourse": (ROOT / "course" / "robocourse", [
-        {"config", "source"},                           # fast mode; the code an experiment or the worker runs
+        {"config", "source", "environment"},            # fast mode; the code an experiment or the worker runs;
+                                                        # the installation check of lesson 00
         {"site"},                                       # notebook execution, hygiene, the two sites, browser checks
         {"exercises"},                                  # the vocabulary: Case, Exercise, comparisons, plain data
         {"lessons"},                                    # each lesson's experiments and exercises; their discovery
