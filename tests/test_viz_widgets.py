@@ -28,7 +28,7 @@ def test_the_static_slider_embeds_one_distinct_figure_per_value_and_shows_the_st
     assert len(images) == 4
     assert len({png for png, _ in images}) == 4, "each value must have its own figure"
     assert [shown for _, shown in images] == ["none", "none", "block", "none"]
-    assert 'min="0" max="3"' in page and 'value="2"' in page and "3.0" in page
+    assert 'min="1.0" max="4.0"' in page and 'value="3.0"' in page and "3.0" in page
     assert "http" not in page, "the static slider must work offline"
     assert set(plt.get_fignums()) == open_before, "every pre-computed figure is closed"
 
@@ -40,6 +40,7 @@ def test_the_static_slider_embeds_one_distinct_figure_per_value_and_shows_the_st
     ({"draw": _draw, "values": "ab"}, "values"),
     ({"draw": lambda v: None, "values": [1, 2]}, "draw"),
     ({"draw": _draw, "values": [1, 2], "start": 5}, "start"),
+    ({"draw": _draw, "values": [1, 2], "spacing": "log"}, "spacing"),
 ])
 def test_bad_slider_input_names_the_argument(kwargs, error):
     with pytest.raises((TypeError, ValueError), match=error):
@@ -58,3 +59,40 @@ def test_headless_refuses_a_typo():
     assert headless({"ROBOKIT_HEADLESS": "yes"}) is True
     with pytest.raises(ValueError, match="ROBOKIT_HEADLESS"):
         headless({"ROBOKIT_HEADLESS": "maybe"})
+
+
+def test_numbers_sit_at_their_values_and_anything_else_at_equal_steps():
+    uneven = static_slider_html(_draw, [0.5, 1.0, 8.0], start=1)
+    assert 'min="0.5" max="8.0" step="any" value="1.0"' in uneven and "each at its place" in uneven
+    for values, spacing in (([3, 1, 2], "value"), (["a", "b"], "value"), ([1, 2, 4], "even"),
+                            ([1.0, float("nan")], "value"), ([True, False], "value")):
+        page = static_slider_html(_draw, values, spacing=spacing)
+        assert f'min="0" max="{len(values) - 1}" step="1"' in page and "at equal steps" in page, values
+
+
+def test_the_live_slider_snaps_a_typed_value_to_the_nearest_and_draws_it():
+    pytest.importorskip("ipywidgets")
+    from robokit.viz.widgets import live_slider
+
+    drawn = []
+
+    def draw(k):
+        drawn.append(k)
+        return _draw(k)
+
+    open_before = set(plt.get_fignums())
+    box, control, redraw = live_slider(draw, [0.5, 1.0, 2.0, 8.0], label="alpha", fmt="{:.1f}", start=1)
+    assert type(control).__name__ == "FloatSlider" and (control.min, control.max, control.value) == (0.5, 8.0, 1.0)
+    redraw()
+    control.value = 6.1                      # typed into the readout
+    control.value = 4.9                      # nearer 2.0 than 8.0
+    assert control.value == 2.0 and drawn == [1.0, 8.0, 2.0]
+    shown = box.children[2].outputs[0]["data"]
+    assert shown["text/plain"] == "alpha = 2.0" and len(shown["image/png"]) > 100
+    assert "each at its place" in box.children[1].value and "Run this cell again" in box.children[1].value
+    assert set(plt.get_fignums()) == open_before
+
+    box, control, redraw = live_slider(draw, ["chained", "free"], start=1)
+    assert type(control).__name__ == "SelectionSlider" and control.value == 1
+    control.value = 0
+    assert drawn[-1] == "chained" and "at equal steps" in box.children[1].value

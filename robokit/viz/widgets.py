@@ -2,7 +2,10 @@
 
 A lesson asks "what happens when alpha doubles?" with :func:`slider`: it draws one matplotlib
 figure per value. With a person at the notebook (JupyterLab, ipywidgets installed) the figure is
-redrawn live as the slider moves. When the notebook runs headless (``ROBOKIT_HEADLESS=1``, set by
+redrawn live as the slider moves. Numeric values sit on the track at their values (a gap in the
+values shows as a gap on the track) and a number typed into the readout moves the slider to the
+nearest value computed; other values (or ``spacing="even"``) sit at equal steps, and the note under
+the slider says so. When the notebook runs headless (``ROBOKIT_HEADLESS=1``, set by
 the course build and the tests) every value's figure is drawn once and embedded as a PNG behind a
 plain HTML range input, so the built site keeps a working slider with no kernel and no network.
 """
@@ -13,12 +16,14 @@ import html as _html
 import io
 import itertools
 import json
+import math
+from numbers import Real as numbers_Real
 from typing import Any, Callable, Sequence
 
 from ..config import headless
-from ..validation import as_callable, as_int, as_text
+from ..validation import as_callable, as_choice, as_int, as_text
 
-__all__ = ["slider", "static_slider_html"]
+__all__ = ["slider", "static_slider_html", "live_slider"]
 
 _ids = itertools.count()
 MAX_VALUES = 24  # pre-computed figures embedded in one page
@@ -33,14 +38,43 @@ def _values(values: Any) -> list:
     return out
 
 
-def _checked(draw: Any, values: Any, label: Any, fmt: Any, start: Any) -> tuple:
+def _checked(draw: Any, values: Any, label: Any, fmt: Any, start: Any, spacing: Any) -> tuple:
     draw = as_callable(draw, "draw", optional=False)
     vals = _values(values)
+    spacing = as_choice(spacing, "spacing", ("value", "even"))
     return (draw, vals, as_text(label, "label"), as_text(fmt, "fmt", empty=False),
-            as_int(start, "start", minimum=0, maximum=len(vals) - 1))
+            as_int(start, "start", minimum=0, maximum=len(vals) - 1), _positions(vals, spacing))
 
 
-def _figure_png(draw: Callable[[Any], Any], value: Any) -> str:
+def _positions(vals: list, spacing: str) -> list[float] | None:
+    """Where each value sits on the track: the value itself when ``spacing`` is "value" and the
+    values are finite real numbers in increasing order; None (equal steps) otherwise."""
+    if spacing == "even":
+        return None
+    numbers = []
+    for v in vals:
+        if isinstance(v, bool) or not isinstance(v, numbers_Real) or not math.isfinite(v):
+            return None
+        numbers.append(float(v))
+    if any(b <= a for a, b in zip(numbers, numbers[1:])):
+        return None
+    return numbers
+
+
+def _nearest(positions: list[float], x: float) -> int:
+    """Index of the position nearest ``x`` (the first of two equally near)."""
+    return min(range(len(positions)), key=lambda k: abs(positions[k] - x))
+
+
+def _note(vals: list, texts: list[str], positions: list[float] | None) -> str:
+    """The line under a slider that says how it moves."""
+    if positions is None:
+        return f"The slider steps through {len(vals)} values at equal steps; its readout cannot be typed into."
+    return (f"The slider stops at the {len(vals)} values computed ({', '.join(texts)}), each at its place "
+            "on the track; a number typed into the readout moves it to the nearest.")
+
+
+def _figure_png(draw: Callable[[Any], Any], value: Any, dpi: int = 80) -> str:
     import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
 
@@ -48,13 +82,13 @@ def _figure_png(draw: Callable[[Any], Any], value: Any) -> str:
     if not isinstance(fig, Figure):
         raise TypeError(f"draw: expected draw(value) to return a matplotlib Figure, got {type(fig).__name__}")
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=80, bbox_inches="tight")
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
     plt.close(fig)
     return base64.b64encode(buf.getvalue()).decode("ascii")
 
 
 def static_slider_html(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "value",
-                       fmt: str = "{}", start: int = 0) -> str:
+                       fmt: str = "{}", start: int = 0, spacing: str = "value") -> str:
     """The pre-computed form of :func:`slider`: one PNG per value behind an HTML range input.
 
     Parameters
@@ -68,11 +102,15 @@ def static_slider_html(draw: Callable[[Any], Any], values: Sequence[Any], *, lab
         ``str.format`` pattern of the value shown beside the slider.
     start : int, default 0
         Index of the value shown first.
+    spacing : {"value", "even"}, default "value"
+        "value": increasing real values sit on the track at their values and the input snaps to
+        the nearest; "even" (and any other values): equal steps.
 
     Returns
     -------
     str
-        A self-contained HTML fragment (images inline, a one-line ``oninput`` handler).
+        A self-contained HTML fragment (images inline, a one-line ``oninput`` handler, the note
+        that says how the slider moves).
 
     Raises
     ------
@@ -93,11 +131,11 @@ def static_slider_html(draw: Callable[[Any], Any], values: Sequence[Any], *, lab
     ...     fig, ax = plt.subplots(figsize=(2, 1))
     ...     ax.plot([0, 1], [0, k])
     ...     return fig
-    >>> page = static_slider_html(draw, [1, 2, 3], label="slope")
-    >>> page.count("<img"), 'max="2"' in page
+    >>> page = static_slider_html(draw, [1, 2, 4], label="slope")
+    >>> page.count("<img"), 'min="1.0" max="4.0"' in page
     (3, True)
     """
-    draw, vals, label, fmt, start = _checked(draw, values, label, fmt, start)
+    draw, vals, label, fmt, start, positions = _checked(draw, values, label, fmt, start, spacing)
     texts = [fmt.format(v) for v in vals]
     pngs = [_figure_png(draw, v) for v in vals]
     uid = f"robokit-slider-{next(_ids)}"
@@ -106,22 +144,29 @@ def static_slider_html(draw: Callable[[Any], Any], values: Sequence[Any], *, lab
         f'style="display:{"block" if k == start else "none"};max-width:100%">'
         for k, (png, t) in enumerate(zip(pngs, texts)))
     names = _html.escape(json.dumps(texts), quote=True)
-    handler = ("var k=+this.value,box=this.parentNode.parentNode;"
+    if positions is None:
+        track, pick = f'min="0" max="{len(vals) - 1}" step="1" value="{start}"', "var k=+this.value"
+    else:
+        track = f'min="{positions[0]!r}" max="{positions[-1]!r}" step="any" value="{positions[start]!r}"'
+        places = _html.escape(json.dumps(positions), quote=True)
+        pick = (f"var p={places},x=+this.value,k=0;p.forEach(function(v,i){{if(Math.abs(v-x)<Math.abs(p[k]-x))k=i}});"
+                "this.value=p[k]")
+    handler = (f"{pick};var box=this.parentNode.parentNode;"
                "box.querySelectorAll('img').forEach(function(im,i){im.style.display=i==k?'block':'none'});"
                f"this.nextSibling.textContent=' '+{names}[k];")
     return (f'<div id="{uid}" class="robokit-slider"><label>{_html.escape(label)} '
-            f'<input type="range" min="0" max="{len(vals) - 1}" step="1" value="{start}" '
-            f'oninput="{handler}"><span> {_html.escape(texts[start])}</span></label>{images}</div>')
+            f'<input type="range" {track} oninput="{handler}"><span> {_html.escape(texts[start])}</span></label>'
+            f'<div style="font-size:smaller;color:#555">{_html.escape(_note(vals, texts, positions))}</div>{images}</div>')
 
 
 def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "value", fmt: str = "{}",
-           start: int = 0) -> None:
+           start: int = 0, spacing: str = "value") -> None:
     """Show ``draw(value)`` under a slider over ``values``: live in JupyterLab, pre-computed headless.
 
     Parameters
     ----------
     draw : callable
-        ``draw(value) -> matplotlib.figure.Figure``.
+        ``draw(value) -> matplotlib.figure.Figure``; called only with members of ``values``.
     values : sequence
         2 to 24 values, in slider order.
     label : str, default "value"
@@ -130,6 +175,10 @@ def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "v
         ``str.format`` pattern of the value shown beside the slider.
     start : int, default 0
         Index of the value shown first.
+    spacing : {"value", "even"}, default "value"
+        "value": increasing real values sit on the track at their values, and a number typed into
+        the readout moves the slider to the nearest of them; "even" (and any other values, such
+        as names): equal steps, readout not editable. A note under the slider says which.
 
     Raises
     ------
@@ -138,9 +187,12 @@ def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "v
 
     Notes
     -----
-    Live form: ``ipywidgets.interact`` with a ``SelectionSlider`` (ipywidgets is in the ``lab``
-    extra). Static form: :func:`static_slider_html`, used when ``ROBOKIT_HEADLESS=1``
-    (:func:`robokit.config.headless`) or when ipywidgets is not installed.
+    Live form: an ipywidgets ``FloatSlider`` that snaps to the values (``SelectionSlider`` for
+    equal steps) above an ``Output`` that is redrawn; ipywidgets is in the ``lab`` extra. A live
+    slider needs its kernel: in a notebook reopened from disk JupyterLab shows "Error displaying
+    widget" until the cell runs again, which the note says. Static form: :func:`static_slider_html`,
+    used when ``ROBOKIT_HEADLESS=1`` (:func:`robokit.config.headless`) or when ipywidgets is not
+    installed.
 
     Examples
     --------
@@ -153,7 +205,7 @@ def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "v
     ...     return fig
     >>> slider(draw, [1, 2], label="slope")  # doctest: +SKIP
     """
-    draw, vals, label, fmt, start = _checked(draw, values, label, fmt, start)
+    draw, vals, label, fmt, start, positions = _checked(draw, values, label, fmt, start, spacing)
     from IPython.display import display
 
     widgets = None
@@ -163,15 +215,77 @@ def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "v
         except ImportError:  # the static form still teaches
             widgets = None
     if widgets is None:
-        display({"text/html": static_slider_html(draw, vals, label=label, fmt=fmt, start=start)}, raw=True)
+        display({"text/html": static_slider_html(draw, vals, label=label, fmt=fmt, start=start, spacing=spacing)},
+                raw=True)
         return
+    box, _, redraw = live_slider(draw, vals, label=label, fmt=fmt, start=start, spacing=spacing)
+    display(box)
+    redraw()
 
-    import matplotlib.pyplot as plt
 
-    def show(value):
-        draw(value)
-        plt.show()
+def live_slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "value", fmt: str = "{}",
+                start: int = 0, spacing: str = "value") -> tuple:
+    """The widgets of :func:`slider`'s live form, unshown: ``(box, control, redraw)``.
 
-    options = [(fmt.format(v), v) for v in vals]
-    widgets.interact(show, value=widgets.SelectionSlider(options=options, value=vals[start], description=label,
-                                                          continuous_update=False))
+    ``box`` holds the slider, the note that says how it moves and the figure; ``control`` is the
+    slider (its ``description`` is ``label``); ``redraw()`` draws the figure of the control's value
+    into the box (a call of ``draw``, its figure shown and closed). Moving
+    ``control`` (or setting its value, as a typed readout does) snaps it to the nearest value and
+    redraws. Arguments as :func:`slider`; needs ipywidgets.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`static_slider_html`.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Visualisation"); not from a paper.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import matplotlib.pyplot as plt
+    >>> drawn = []
+    >>> def draw(k):
+    ...     drawn.append(k)
+    ...     return plt.figure()
+    >>> box, control, redraw = live_slider(draw, [1.0, 2.0, 8.0])
+    >>> control.value = 6.5          # as if typed: it snaps to 8.0 and draws that figure
+    >>> control.value, drawn
+    (8.0, [8.0])
+    """
+    draw, vals, label, fmt, start, positions = _checked(draw, values, label, fmt, start, spacing)
+    import ipywidgets as widgets
+
+    texts = [fmt.format(v) for v in vals]
+    note = _note(vals, texts, positions) + " Reopened the notebook and see 'Error displaying widget'? Run this cell again."
+    if positions is None:
+        control = widgets.SelectionSlider(options=[(t, k) for k, t in enumerate(texts)], value=start,
+                                          description=label, continuous_update=False)
+    else:
+        control = widgets.FloatSlider(min=positions[0], max=positions[-1], step=None, value=positions[start],
+                                      description=label, continuous_update=False)
+    control.style.description_width = "initial"
+    output = widgets.Output()
+
+    def index() -> int:
+        return control.value if positions is None else _nearest(positions, control.value)
+
+    def redraw() -> None:
+        k = index()
+        png = _figure_png(draw, vals[k], dpi=100)         # whatever matplotlib backend the kernel runs
+        output.outputs = ({"output_type": "display_data", "metadata": {},
+                           "data": {"image/png": png, "text/plain": f"{label} = {texts[k]}"}},)
+
+    def changed(change) -> None:
+        if positions is not None and change["new"] != positions[index()]:
+            control.value = positions[index()]     # snapping sets the value again, which redraws
+            return
+        redraw()
+
+    control.observe(changed, names="value")
+    box = widgets.VBox([control, widgets.HTML(f'<span style="font-size:smaller;color:#555">{_html.escape(note)}</span>'),
+                        output])
+    return box, control, redraw
