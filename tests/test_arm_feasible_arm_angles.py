@@ -183,15 +183,16 @@ def test_the_first_compiling_call_says_so_once_and_a_cache_hit_stays_quiet(tmp_p
     monkeypatch.setattr(numba_config, "CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(jit, "CACHING", True)
     record = jit.compile_notice("srs_solve", "the analytic IK solver")
-    err = capsys.readouterr().err
-    assert record is not None and record.parent == tmp_path
-    assert err.count("\n") == 1 and "compiling the analytic IK solver" in err and "once" in err
+    said = capsys.readouterr()
+    assert record is not None and record.parent == tmp_path and said.err == ""     # information, not an error
+    assert said.out.count("\n") == 1 and said.out.startswith("robokit note: compiling the analytic IK solver")
+    assert "once" in said.out
     jit.compiled(record)
     assert jit.compile_notice("srs_solve", "the analytic IK solver") is None      # recorded: quiet
-    assert capsys.readouterr().err == ""
+    assert capsys.readouterr().out == ""
     monkeypatch.setattr(jit, "CACHING", False)                  # no cache: every process compiles, and says so
     assert jit.compile_notice("srs_solve", "the analytic IK solver") is None
-    assert "every new process" in capsys.readouterr().err
+    assert "every new process" in capsys.readouterr().out
 
 
 def test_the_compiled_cache_folder_changes_with_any_kernel_source(monkeypatch):

@@ -104,7 +104,8 @@ def _record(kernel: str) -> Path:
 def compile_notice(kernel: str, what: str) -> Path | None:
     """Say, before the first call of compiled ``kernel`` in this process, that it compiles now.
 
-    One line on standard error, only when this machine's cache has no record that ``kernel`` was
+    One line on standard output labelled "robokit note" (information, not an error: a notebook shows
+    it in a plain box, not a red one), only when this machine's cache has no record that ``kernel`` was
     compiled from the current source (a cache hit stays quiet). Call :func:`compiled` with the
     returned record after the call.
 
@@ -126,8 +127,8 @@ def compile_notice(kernel: str, what: str) -> Path | None:
     True
     """
     if not CACHING:
-        print(f"robokit: compiling {what} for this machine (no writable cache folder, so every new "
-              "process compiles it again)", file=sys.stderr)
+        print(f"robokit note: compiling {what} for this machine (no writable cache folder, so every new "
+              "process compiles it again)")
         return None
     try:
         record = _record(kernel)
@@ -135,8 +136,8 @@ def compile_notice(kernel: str, what: str) -> Path | None:
             return None
     except OSError:
         return None
-    print(f"robokit: compiling {what} for this machine; this happens once, later runs load it from the "
-          f"cache ({record.parent})", file=sys.stderr)
+    print(f"robokit note: compiling {what} for this machine; this happens once, later runs load it from "
+          f"the cache ({record.parent})")
     return record
 
 
