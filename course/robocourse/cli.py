@@ -1,4 +1,4 @@
-"""The ``robocourse`` command: build the course, keep notebooks clean, generate assignments, grade."""
+"""The ``robocourse`` command: build the course, keep notebooks clean, generate assignments, grade, hand out."""
 from __future__ import annotations
 
 import argparse
@@ -137,6 +137,14 @@ def _cmd_gradescope(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_student_kit(args: argparse.Namespace) -> int:
+    from robocourse.grading.handout import write_handout
+
+    path, count = write_handout(args.root, args.output)
+    print(f"wrote {path} ({count} files: lessons, assignments, robokit, the course package; no solutions)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``robocourse`` command."""
     parser = argparse.ArgumentParser(
@@ -198,6 +206,13 @@ def build_parser() -> argparse.ArgumentParser:
     gs.add_argument("--root", default=".")
     gs.add_argument("--timeout", type=float, default=600)
     gs.set_defaults(func=_cmd_gradescope)
+
+    kit = sub.add_parser("student-kit", help="zip what students get: lessons, assignments, robokit and the "
+                                             "course package, without solutions/")
+    kit.add_argument("-o", "--output", default="build/robokit-student.zip", help="the zip to write "
+                     "(default: build/robokit-student.zip)")
+    kit.add_argument("--root", default=".", help="course repository root (default: .)")
+    kit.set_defaults(func=_cmd_student_kit)
     return parser
 
 

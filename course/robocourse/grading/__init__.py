@@ -1,4 +1,4 @@
-"""Grading: feedback in the notebook, the assignment generator and the sandboxed grader.
+"""Grading: feedback in the notebook, the assignment generator, the sandboxed grader and the handout.
 
 check            ``check(exercise_id, fn)``: a notebook's feedback on an exercise's public cases
 judge            one case judged: the student's call, the expected answer, the comparison
@@ -19,6 +19,7 @@ budget           the grader's reading and judging of one submission, in a child 
 reports          the gradebook, feedback files and Gradescope results
 safetext         student text escaped for feedback, CSV and Markdown
 gradescope       an autograder zip for Gradescope
+handout          ``robocourse student-kit``: the zip students get, lessons and blank assignments, no solutions
 selfcheck        the course build's step that grades every solution (full marks) and blank (zero)
 """
 from robocourse.grading.check import PUBLIC_SEED, check
