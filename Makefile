@@ -1,6 +1,7 @@
-# robokit courseware. The two commands an instructor needs:
+# robokit courseware. The commands an instructor needs:
 #   make course   build the course: run every lesson and solution notebook, write build/course/
-#   make test     run the test-suite (the README's test command; .ci/run calls exactly this)
+#   make test     run the test-suite
+#   make check    the same suite with the browser tests required, not skipped (.ci/run calls exactly this)
 # Each target creates .venv on first use and installs both packages, editable, with their extras:
 # the robokit library (pyproject.toml) and the robocourse course package (course/pyproject.toml).
 
@@ -11,7 +12,7 @@ STAMP  := $(VENV)/.robokit-installed
 PYTEST_ARGS ?=
 COURSE_ARGS ?=
 
-.PHONY: course test lab venv assignments bench clean
+.PHONY: course test check lab venv assignments bench clean
 
 $(STAMP): pyproject.toml course/pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -26,6 +27,9 @@ course: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest $(PYTEST_ARGS)
+
+check: $(STAMP)
+	ROBOKIT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest $(PYTEST_ARGS)
 
 lab: $(STAMP)
 	$(BIN)/jupyter lab --notebook-dir=.

@@ -83,6 +83,7 @@ def test_the_live_slider_snaps_a_typed_value_to_the_nearest_and_draws_it():
     open_before = set(plt.get_fignums())
     box, control, redraw = live_slider(draw, [0.5, 1.0, 2.0, 8.0], label="alpha", fmt="{:.1f}", start=1)
     assert type(control).__name__ == "FloatSlider" and (control.min, control.max, control.value) == (0.5, 8.0, 1.0)
+    assert control.readout_format == ".1f"                  # as few decimals as the values need
     redraw()
     control.value = 6.1                      # typed into the readout
     control.value = 4.9                      # nearer 2.0 than 8.0
@@ -94,5 +95,6 @@ def test_the_live_slider_snaps_a_typed_value_to_the_nearest_and_draws_it():
 
     box, control, redraw = live_slider(draw, ["chained", "free"], start=1)
     assert type(control).__name__ == "SelectionSlider" and control.value == 1
+    assert live_slider(draw, [0, 7, 14])[1].readout_format == ".0f"
     control.value = 0
-    assert drawn[-1] == "chained" and "at equal steps" in box.children[1].value
+    assert drawn[-1] == "chained" and "at equal steps" in box.children[1].value and "ignored" in box.children[1].value

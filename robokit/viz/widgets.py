@@ -66,10 +66,16 @@ def _nearest(positions: list[float], x: float) -> int:
     return min(range(len(positions)), key=lambda k: abs(positions[k] - x))
 
 
+def _decimals(positions: list[float]) -> int:
+    """The fewest decimals (up to 4) that write every position exactly: 0 for counts, 1 for 0.5 steps."""
+    return next((n for n in range(4) if all(abs(round(p, n) - p) < 1e-9 * max(1.0, abs(p)) for p in positions)), 4)
+
+
 def _note(vals: list, texts: list[str], positions: list[float] | None) -> str:
     """The line under a slider that says how it moves."""
     if positions is None:
-        return f"The slider steps through {len(vals)} values at equal steps; its readout cannot be typed into."
+        return (f"The slider steps through {len(vals)} values at equal steps; drag it or use the arrow keys "
+                "(text typed into its readout is ignored).")
     return (f"The slider stops at the {len(vals)} values computed ({', '.join(texts)}), each at its place "
             "on the track; a number typed into the readout moves it to the nearest.")
 
@@ -266,7 +272,8 @@ def live_slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str
                                           description=label, continuous_update=False)
     else:
         control = widgets.FloatSlider(min=positions[0], max=positions[-1], step=None, value=positions[start],
-                                      description=label, continuous_update=False)
+                                      description=label, continuous_update=False,
+                                      readout_format=f".{_decimals(positions)}f")
     control.style.description_width = "initial"
     output = widgets.Output()
 
