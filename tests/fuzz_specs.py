@@ -837,7 +837,7 @@ SPECS: dict[str, Call] = {
                                            "image": Given(np.zeros((4, 6, 3), np.uint8)),
                                            "centre": Array(np.array([1.0, 2.0, 3.0]), "3"), "width": Real(1.5)}),
     "robokit.viz.widgets.slider": Call({"draw": Func(lambda: draw_figure), "values": Given([1.0, 2.0]), "label": Text("k"),
-                                        "fmt": Text("{}"), "start": Int(0)}, cheap=False),
+                                        "fmt": Text("{}"), "start": Int(0), "spacing": Choice("value")}, cheap=False),
     # --- lesson 02: controllers.path_following(_loop), localization.pose_ekf, navigation.visual_path --------
     "robokit.controllers.path_geometry.VisualPath": Call({
         "poses": Array(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]), "N,3"),

@@ -42,7 +42,9 @@ class LabServer:
         for folder in folders:
             shutil.copytree(ROOT / folder, self.root / folder)
         self.port, self.token = _free_port(), secrets.token_hex(16)
+        # every Jupyter folder of this run is its own: no user-level kernel, setting or workspace applies
         env = dict(os.environ, ROBOKIT_FAST="1", JUPYTER_RUNTIME_DIR=str(workdir / "runtime"),
+                   JUPYTER_DATA_DIR=str(workdir / "data"),
                    JUPYTER_CONFIG_DIR=str(workdir / "config"), JUPYTERLAB_SETTINGS_DIR=str(workdir / "settings"),
                    JUPYTERLAB_WORKSPACES_DIR=str(workdir / "workspaces"))
         env.pop("ROBOKIT_HEADLESS", None)               # a student's kernel: live widgets
@@ -92,10 +94,12 @@ _RUN_ALL_JS = """async (path) => {
   await panel.sessionContext.ready;
   const started = performance.now();
   await app.commands.execute('notebook:run-all-cells');
-  while (panel.sessionContext.session.kernel.status !== 'idle') {
+  for (;;) {
+    const status = panel.sessionContext.session.kernel.status;
+    if (status === 'idle') break;
+    if (status === 'dead' || status === 'unknown') throw new Error('the kernel is ' + status);
     await new Promise(r => setTimeout(r, 200));
   }
-  await new Promise(r => setTimeout(r, 1500));     // the last outputs and widget views render
   return (performance.now() - started) / 1000;
 }"""
 
@@ -119,7 +123,7 @@ _READ_JS = """() => {
   const sliders = [...panel.node.querySelectorAll('.widget-slider')].map(s => ({
     readout: (s.querySelector('.widget-readout') || {}).textContent || '',
     editable: !!s.querySelector('.widget-readout[contenteditable="true"]')}));
-  return {cells, scenes, sliders, text: panel.node.innerText};
+  return {cells, scenes, sliders, text: panel.node.textContent};   // off-screen cells too
 }"""
 
 # Type a value into the n-th slider's readout and press Enter, as a student would.
@@ -184,9 +188,17 @@ class LabPage:
         self.evaluate("async (path) => { await window.jupyterapp.commands.execute('docmanager:open', {path}); "
                       "return true; }", path)
 
-    def read(self) -> dict:
-        """The notebook in front: its cells (type, tags, execution count, outputs), scenes and sliders."""
-        return self.evaluate(_READ_JS)
+    def read(self, settle: float = 20.0) -> dict:
+        """The notebook in front: its cells (type, tags, execution count, outputs), scenes and sliders,
+        read again until two reads agree on scenes and sliders (views render after the kernel is idle)."""
+        deadline, last = time.monotonic() + settle, None
+        while True:
+            report = self.evaluate(_READ_JS)
+            shape = json.dumps([report["scenes"], [s["readout"] for s in report["sliders"]]])
+            if shape == last or time.monotonic() > deadline:
+                return report
+            last = shape
+            time.sleep(1.0)
 
     def type_into_slider(self, index: int, value: str) -> None:
         self.evaluate(_TYPE_JS, index, value)

@@ -94,14 +94,22 @@ def test_run_notebook_blocks_network(tmp_path):
     assert run.status == "failed" and "network access is disabled" in run.error
 
 
-def test_assignment_stubs_are_allowed_but_real_errors_are_not(tmp_path):
+def test_assignment_stubs_are_allowed_in_tagged_cells_but_real_errors_are_not(tmp_path):
     folder = tmp_path / "assignments"
     folder.mkdir()
     stub = _notebook(folder / "a.ipynb", "def f():\n    raise NotImplementedError", "f()", "print('went on')")
+    tagged = json.loads(stub.read_text())
+    tagged["cells"][1]["metadata"]["tags"] = ["raises-exception"]
+    stub.write_text(json.dumps(tagged))
     run = run_notebook(stub, timeout=120)
     assert run.status == "ok", run.error
+    untagged = _notebook(folder / "c.ipynb", "def f():\n    raise NotImplementedError", "f()", "print('went on')")
+    assert run_notebook(untagged, timeout=120).status == "failed"   # Run All would stop there
     broken = _notebook(folder / "b.ipynb", "f = None", "f()")
-    assert run_notebook(broken, timeout=120).status == "failed"
+    broken_tagged = json.loads(broken.read_text())
+    broken_tagged["cells"][1]["metadata"]["tags"] = ["raises-exception"]
+    broken.write_text(json.dumps(broken_tagged))
+    assert run_notebook(broken, timeout=120).status == "failed"     # a TypeError is no stub
 
 
 def test_bad_arguments():

@@ -186,7 +186,7 @@ def _written_names() -> dict[str, set[str]]:
             cells = json.loads(nb.read_text(encoding="utf-8"))["cells"]
             texts[f"{folder}/{nb.name}"] = "\n".join("".join(c["source"]) for c in cells)
     for path in [*ROOT.glob("robokit/**/*.py"), *ROOT.glob("course/robocourse/**/*.py"), *ROOT.glob("docs/*.md"),
-                 ROOT / "README.md"]:
+                 *ROOT.glob("book/**/*.md"), ROOT / "README.md", ROOT / "course" / "README.md"]:
         texts[str(path.relative_to(ROOT))] = path.read_text(encoding="utf-8")
     names: dict[str, set[str]] = {}
     for where, text in texts.items():

@@ -86,7 +86,8 @@ def test_a_missing_or_broken_package_is_named(monkeypatch):
     assert rows[1]["status"] == "missing" and rows[1]["version"] == "missing"
 
 
-@pytest.mark.parametrize("bad", ["rows", [{"package": "numpy"}], None])
+@pytest.mark.parametrize("bad", ["rows", [{"package": "numpy"}], None,
+                                 [{"package": "numpy", "version": None, "status": "ok", "lessons": "all", "used_by": "x"}]])
 def test_the_table_refuses_what_is_not_a_report(bad):
     with pytest.raises(TypeError, match="rows"):
         environment_table(bad)

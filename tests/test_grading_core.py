@@ -186,19 +186,36 @@ def _cell(source, *, grade=False, solution=False):
 
 
 def test_only_cells_a_blank_exercise_can_break_are_marked_to_let_run_all_go_on():
-    cells = [_cell("import numpy as np\nfrom robocourse import check"),          # setup: a real error must stop
-             _cell("def f(x):\n    raise NotImplementedError", solution=True),   # defining a stub raises nothing
-             _cell("check('00.f', f)", grade=True),
-             _cell("data = np.arange(3)"),                                        # given data
-             _cell("y = f(data)\nz = 2"),                                         # uses the student's function
-             _cell("print(z + 1)"),                                               # uses what that cell made
-             _cell("print(data.sum())"),                                          # given data only
-             _cell("raise NotImplementedError", solution=True),                   # a stub at the top level
-             _cell("%matplotlib inline\nimport math\nprint(math.pi)")]           # magics parse
-    nb = mark_stub_failures({"cells": cells})
-    marked = [RAISES in c["metadata"].get("tags", []) for c in nb["cells"]]
-    assert marked == [False, False, True, False, True, True, False, True, False]
+    cases = [("import numpy as np\nfrom robocourse import check", False),      # setup: a real error must stop
+             ("check('00.f', f)", True),
+             ("data = np.arange(3)", False),                                    # given data
+             ("y = f(data)\nz = 2", True),                                      # uses the student's function
+             ("print(z + 1)", True),                                            # uses what that cell made
+             ("print(data.sum())", False),                                      # given data only
+             ("for i in range(2):\n    raise NotImplementedError", True),       # a stub's raise, run at the top
+             ("res = {}\nres['a'] = f(1)", True),
+             ("print(res)", True),                                              # filled by a tagged cell
+             ("out = []\nout.append(f(2))", True),
+             ("print(out)", True),
+             ("w = 1", False),
+             ("w += f(1)", True),
+             ("v = w + 1", True),                                               # w changed by a tagged cell
+             ("w = 5", False),                                                  # bound afresh: clean again
+             ("u = w * 2", False),
+             ("import math\nt = f(0)", True),
+             ("print(math.pi)", False),                                         # its import stays clean
+             ("def g():\n    return f(1)", True),                               # g would call the stub
+             ("del t", True),
+             ("%matplotlib inline\nimport cmath\nprint(cmath.pi)", False)]      # magics parse
+    nb = {"cells": [_cell("def f(x):\n    raise NotImplementedError", solution=True)]
+          + [_cell(src, grade=src.startswith("check(")) for src, _ in cases]
+          + [_cell("def h():\n    return f(1)\nh_value = h()", solution=True),    # runs a stub: marked
+             _cell("def k():\n    return f(1)", solution=True)]}                  # only defines: not
+    marked = [RAISES in c["metadata"].get("tags", []) for c in mark_stub_failures(nb)["cells"]]
+    assert marked == [False] + [want for _, want in cases] + [True, False]
     assert mark_stub_failures(nb)["cells"][2]["metadata"]["tags"] == [RAISES]      # idempotent
+    with pytest.raises(TypeError, match="nb"):
+        mark_stub_failures([{"cell_type": "code"}])
 
 
 @pytest.mark.parametrize("slug", sorted(assignments()))

@@ -43,7 +43,7 @@ def test_the_handout_has_the_lessons_assignments_and_packages_and_no_solutions(h
     assert sorted(p.name for p in (folder / "lessons").glob("*.ipynb")) == lessons
     assert sorted(p.name for p in (folder / "assignments").glob("*.ipynb")) == \
         sorted(p.name for p in (ROOT / "assignments").glob("*.ipynb"))
-    for needed in ("pyproject.toml", "course/pyproject.toml", "environment.yml", "Makefile", "README.md",
+    for needed in ("pyproject.toml", "course/pyproject.toml", "environment.yml", "Makefile", "README.md", "course/README.md",
                    "robokit/__init__.py", "course/robocourse/grading/check.py", "course/robocourse/data/04_littledog.json"):
         assert (folder / needed).is_file(), needed
     assert not any(part in ("solutions", "tests", "benchmarks", "__pycache__") for n in names for part in n.split("/"))
@@ -56,6 +56,12 @@ def test_the_handout_has_the_lessons_assignments_and_packages_and_no_solutions(h
             assert not leaked, (f, leaked[:2])
     readme = (folder / "README.md").read_text()
     assert "## Student guide" in readme and "## Instructor guide" not in readme and "make lab" in readme
+    environment = (folder / "environment.yml").read_text()
+    assert "numpy" in environment and "mujoco" in environment and "jupyterlab" in environment
+    assert not any(dev in environment for dev in ("pytest", "gtsam", "roboticstoolbox", "hypothesis"))
+    makefile = (folder / "Makefile").read_text()
+    assert "'.[legged,arm]'" in makefile and "dev" not in makefile and "\tlab" not in makefile
+    assert (folder / "course" / "README.md").is_file()                # course/pyproject.toml names it
 
 
 def test_the_handout_imports_its_own_course_package_and_check_works(handout):
@@ -84,6 +90,10 @@ def test_a_stale_assignment_or_a_bad_output_stops_the_handout(tmp_path, capsys):
         write_handout(ROOT, ROOT / "lessons" / "kit.zip")
     with pytest.raises(FileNotFoundError, match="root"):
         handout_files(tmp_path)
+    with pytest.raises(TypeError, match="output"):
+        write_handout(ROOT, 3)
+    with pytest.raises(TypeError, match="root"):
+        handout_files(None)
     assert main(["student-kit", "--root", str(tmp_path), "-o", str(tmp_path / "k.zip")]) == 2
     assert "robocourse student-kit: error" in capsys.readouterr().err
     assert not (tmp_path / "k.zip").exists()

@@ -113,13 +113,14 @@ def environment_table(rows: list[dict[str, str]]) -> str:
     --------
     >>> print(environment_table([{"package": "numpy", "version": "2.1.0", "status": "ok",
     ...                           "lessons": "all", "used_by": "robokit"}]))
-    package                  version     lessons              used by                      status
-    numpy                    2.1.0       all                  robokit                      ok
+    package                  version     lessons              used by                              status
+    numpy                    2.1.0       all                  robokit                              ok
     """
     keys = ("package", "version", "status", "lessons", "used_by")
-    if not isinstance(rows, list) or not all(isinstance(r, dict) and all(k in r for k in keys) for r in rows):
-        raise TypeError(f"rows: expected the list of dicts check_environment() returns, got {rows!r:.80}")
-    lines = [f"{'package':<24} {'version':<11} {'lessons':<20} {'used by':<28} status"]
+    if not isinstance(rows, list) or not all(isinstance(r, dict) and all(isinstance(r.get(k), str) for k in keys)
+                                             for r in rows):
+        raise TypeError(f"rows: expected the list of dicts of text check_environment() returns, got {rows!r:.80}")
+    lines = [f"{'package':<24} {'version':<11} {'lessons':<20} {'used by':<36} status"]
     for r in rows:
-        lines.append(f"{r['package']:<24} {r['version']:<11} {r['lessons']:<20} {r['used_by']:<28} {r['status']}")
+        lines.append(f"{r['package']:<24} {r['version']:<11} {r['lessons']:<20} {r['used_by']:<36} {r['status']}")
     return "\n".join(lines)

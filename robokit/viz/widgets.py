@@ -17,6 +17,7 @@ import io
 import itertools
 import json
 import math
+import traceback
 from numbers import Real as numbers_Real
 from typing import Any, Callable, Sequence
 
@@ -67,17 +68,18 @@ def _nearest(positions: list[float], x: float) -> int:
 
 
 def _decimals(positions: list[float]) -> int:
-    """The fewest decimals (up to 4) that write every position exactly: 0 for counts, 1 for 0.5 steps."""
+    """The fewest decimals that write every position exactly (0 for counts, 1 for 0.5 steps), at most 4."""
     return next((n for n in range(4) if all(abs(round(p, n) - p) < 1e-9 * max(1.0, abs(p)) for p in positions)), 4)
 
 
-def _note(vals: list, texts: list[str], positions: list[float] | None) -> str:
-    """The line under a slider that says how it moves."""
+def _note(vals: list, texts: list[str], positions: list[float] | None, live: bool) -> str:
+    """The line under a slider that says how it moves (the live form also takes typed numbers)."""
     if positions is None:
-        return (f"The slider steps through {len(vals)} values at equal steps; drag it or use the arrow keys "
-                "(text typed into its readout is ignored).")
-    return (f"The slider stops at the {len(vals)} values computed ({', '.join(texts)}), each at its place "
-            "on the track; a number typed into the readout moves it to the nearest.")
+        return (f"The slider steps through {len(vals)} values at equal steps; drag it or use the arrow keys"
+                + (" (text typed into its readout is ignored)." if live else "."))
+    return (f"The slider stops at the {len(vals)} values computed ({', '.join(texts)}), each at its place on the "
+            "track; " + ("a number typed into the readout moves it to the nearest." if live
+                         else "the arrow keys step from one to the next."))
 
 
 def _figure_png(draw: Callable[[Any], Any], value: Any, dpi: int = 80) -> str:
@@ -149,20 +151,27 @@ def static_slider_html(draw: Callable[[Any], Any], values: Sequence[Any], *, lab
         f'<img src="data:image/png;base64,{png}" alt="{_html.escape(label)} = {_html.escape(t)}" '
         f'style="display:{"block" if k == start else "none"};max-width:100%">'
         for k, (png, t) in enumerate(zip(pngs, texts)))
-    names = _html.escape(json.dumps(texts), quote=True)
+    names = json.dumps(texts)
+    show = ("var box=this.parentNode.parentNode;"
+            "box.querySelectorAll('img').forEach(function(im,i){im.style.display=i==k?'block':'none'});"
+            f"this.nextSibling.textContent=' '+{names}[k];")
     if positions is None:
-        track, pick = f'min="0" max="{len(vals) - 1}" step="1" value="{start}"', "var k=+this.value"
+        track, keys = f'min="0" max="{len(vals) - 1}" step="1" value="{start}"', ""
+        handler = f"var k=+this.value;{show}"
     else:
         track = f'min="{positions[0]!r}" max="{positions[-1]!r}" step="any" value="{positions[start]!r}"'
-        places = _html.escape(json.dumps(positions), quote=True)
-        pick = (f"var p={places},x=+this.value,k=0;p.forEach(function(v,i){{if(Math.abs(v-x)<Math.abs(p[k]-x))k=i}});"
-                "this.value=p[k]")
-    handler = (f"{pick};var box=this.parentNode.parentNode;"
-               "box.querySelectorAll('img').forEach(function(im,i){im.style.display=i==k?'block':'none'});"
-               f"this.nextSibling.textContent=' '+{names}[k];")
+        places = json.dumps(positions)
+        nearest = f"var p={places},x=+this.value,k=0;p.forEach(function(v,i){{if(Math.abs(v-x)<Math.abs(p[k]-x))k=i}});"
+        handler = f"{nearest}this.value=p[k];{show}"
+        # the arrow keys step to the next computed value (a step of "any" would snap back to the same one)
+        step = ("var d={ArrowRight:1,ArrowUp:1,ArrowLeft:-1,ArrowDown:-1}[event.key];if(!d)return;"
+                f"event.preventDefault();{nearest}k=Math.min(p.length-1,Math.max(0,k+d));this.value=p[k];{show}")
+        keys = f' onkeydown="{_html.escape(step, quote=True)}"'
     return (f'<div id="{uid}" class="robokit-slider"><label>{_html.escape(label)} '
-            f'<input type="range" {track} oninput="{handler}"><span> {_html.escape(texts[start])}</span></label>'
-            f'<div style="font-size:smaller;color:#555">{_html.escape(_note(vals, texts, positions))}</div>{images}</div>')
+            f'<input type="range" {track} oninput="{_html.escape(handler, quote=True)}"{keys}>'
+            f'<span> {_html.escape(texts[start])}</span></label>'
+            f'<div style="font-size:smaller;color:#555">{_html.escape(_note(vals, texts, positions, False))}</div>'
+            f'{images}</div>')
 
 
 def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "value", fmt: str = "{}",
@@ -266,7 +275,8 @@ def live_slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str
     import ipywidgets as widgets
 
     texts = [fmt.format(v) for v in vals]
-    note = _note(vals, texts, positions) + " Reopened the notebook and see 'Error displaying widget'? Run this cell again."
+    note = _note(vals, texts, positions, True) + (" Reopened the notebook and see 'Error displaying widget'? "
+                                                 "Run this cell again.")
     if positions is None:
         control = widgets.SelectionSlider(options=[(t, k) for k, t in enumerate(texts)], value=start,
                                           description=label, continuous_update=False)
@@ -282,7 +292,12 @@ def live_slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str
 
     def redraw() -> None:
         k = index()
-        png = _figure_png(draw, vals[k], dpi=100)         # whatever matplotlib backend the kernel runs
+        try:
+            png = _figure_png(draw, vals[k], dpi=100)     # whatever matplotlib backend the kernel runs
+        except Exception:                                 # shown where the figure would be, not lost
+            output.outputs = ({"output_type": "stream", "name": "stderr",
+                               "text": f"draw({texts[k]}) failed:\n{traceback.format_exc()}"},)
+            return
         output.outputs = ({"output_type": "display_data", "metadata": {},
                            "data": {"image/png": png, "text/plain": f"{label} = {texts[k]}"}},)
 

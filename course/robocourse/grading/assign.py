@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import ast
 import copy
+import dataclasses
 import json
 import re
 from pathlib import Path
@@ -113,32 +114,82 @@ def _library_imports(src: str) -> list[str]:
     return found
 
 
-def _names(tree: ast.Module) -> tuple[set[str], set[str]]:
-    """(names the cell's top level binds, names it reads anywhere)."""
-    bound = set()
-    for node in tree.body:
+def _executed(tree: ast.Module):
+    """The nodes a cell runs when it runs: everything but the bodies of the functions it defines."""
+    stack = list(tree.body)
+    while stack:
+        node = stack.pop()
+        yield node
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            stack.extend(node.decorator_list)           # the body runs only when called
+        elif not isinstance(node, ast.Lambda):
+            stack.extend(ast.iter_child_nodes(node))
+
+
+def _base_name(node: ast.AST) -> str | None:
+    """``res`` of ``res``, ``res[k]``, ``res.a.b`` or ``res[k].append``."""
+    while isinstance(node, (ast.Attribute, ast.Subscript)):
+        node = node.value
+    return node.id if isinstance(node, ast.Name) else None
+
+
+@dataclasses.dataclass
+class _CellNames:
+    binds: set[str]      # names the cell (re)binds when it runs, its imports among them
+    changes: set[str]    # names whose object it changes in place (res[k] = ..., res.append(...), x += 1)
+    modules: set[str]    # names it binds by import
+    runs_reading: set[str]   # names read by what it runs
+    reads: set[str]      # names read anywhere, the bodies of its functions included
+    raises: bool         # a raise statement runs (a stub left at the top level)
+
+
+def _cell_names(tree: ast.Module) -> _CellNames:
+    binds, changes, modules, runs_reading, raises = set(), set(), set(), set(), False
+    for node in _executed(tree):
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
-            bound.add(node.name)
+            binds.add(node.name)
         elif isinstance(node, (ast.Import, ast.ImportFrom)):
-            bound |= {(a.asname or a.name).split(".")[0] for a in node.names}
-        else:
-            bound |= {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
-    read = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
-    return bound, read
-
-
-def _raises_at_top(tree: ast.Module) -> bool:
-    return any(isinstance(node, ast.Raise) for node in tree.body)
+            names = {(a.asname or a.name).split(".")[0] for a in node.names}
+            binds |= names
+            modules |= names
+        elif isinstance(node, ast.Name):
+            (binds if isinstance(node.ctx, ast.Store) else runs_reading).add(node.id)   # del x reads x
+            if isinstance(node.ctx, ast.Del):
+                changes.add(node.id)
+        elif isinstance(node, (ast.Attribute, ast.Subscript)) and isinstance(node.ctx, (ast.Store, ast.Del)):
+            changes.add(_base_name(node))
+        elif isinstance(node, ast.AugAssign):
+            changes.add(_base_name(node.target))
+            runs_reading.add(_base_name(node.target))        # x += 1 reads x
+        elif isinstance(node, ast.Expr) and isinstance(node.value, ast.Call) \
+                and isinstance(node.value.func, ast.Attribute):
+            changes.add(_base_name(node.value.func.value))     # res.append(f(x)) changes res
+        elif isinstance(node, ast.Raise):
+            raises = True
+    reads = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, (ast.Load, ast.Del))}
+    reads |= {_base_name(n.target) for n in ast.walk(tree) if isinstance(n, ast.AugAssign)}
+    return _CellNames(binds, changes - {None}, modules, runs_reading - {None}, reads - {None}, raises)
 
 
 def mark_stub_failures(nb: dict[str, Any]) -> dict[str, Any]:
     """Tag ``raises-exception`` every code cell of a blank assignment that can fail because of a stub.
 
-    A cell is tagged when it is a grade (check) cell, when its own top level raises (a stub left in
-    module-level code), or when it reads a name that a tagged cell or a solution cell binds (a
-    student's function, or a result computed from one). Everything else (imports, given data) stays
-    untagged, so a real error there still stops Run All. Changes ``nb`` in place and returns it.
+    A name is *tainted* when a solution cell binds it (a student's function) or a tagged cell binds
+    or changes it (a result computed from a stub, perhaps never made); an untagged cell that binds
+    it afresh clears it. A cell is tagged when it is a grade (check) cell, when a ``raise`` runs
+    at its top level (a stub left in module-level code), or when it reads a tainted name (a solution
+    cell: only in what it runs, since defining a function that calls a stub raises nothing). Cells
+    that use only imports and given data stay untagged, so a real error there still stops Run All.
+    Changes ``nb`` in place and returns it.
+
+    Raises
+    ------
+    TypeError
+        If ``nb`` is not a notebook (a dict whose ``cells`` is a list of dicts).
     """
+    if not isinstance(nb, dict) or not isinstance(nb.get("cells", []), list) \
+            or not all(isinstance(c, dict) for c in nb.get("cells", [])):
+        raise TypeError(f"nb: expected a notebook (a dict with a list of cells), got {type(nb).__name__}")
     tainted: set[str] = set()
     for cell in nb.get("cells", []):
         if cell.get("cell_type") != "code":
@@ -146,15 +197,18 @@ def mark_stub_failures(nb: dict[str, Any]) -> dict[str, Any]:
         meta = cell.setdefault("metadata", {})
         grading = meta.get("nbgrader", {})
         tree = _parse(_source(cell))
-        bound, read = _names(tree) if tree is not None else (set(), set())
+        names = _cell_names(tree) if tree is not None else _CellNames(set(), set(), set(), set(), set(), False)
         solution = bool(grading.get("solution"))
         if solution:
-            tainted |= bound
-        if grading.get("grade") or (tree is not None and _raises_at_top(tree)) or (not solution and read & tainted):
-            tainted |= bound
+            tainted |= names.binds | names.changes
+        reads = names.runs_reading if solution else names.reads
+        if grading.get("grade") or names.raises or reads & tainted:
+            tainted |= (names.binds | names.changes) - names.modules
             tags = meta.setdefault("tags", [])
             if RAISES not in tags:
                 tags.append(RAISES)
+        elif not solution:
+            tainted -= names.binds
     return nb
 
 

@@ -2,25 +2,54 @@
 
 The handout holds the lessons, the blank assignments, the robokit library and the course package
 (``check()``, the assignments' data, the lessons' experiments), with the files that install them
-(``pyproject.toml``, ``course/pyproject.toml``, ``environment.yml``, the ``Makefile`` for
-``make lab``) and a README that is the repository README's student guide. It leaves out
-``solutions/`` (reference code and model answers), the tests, benchmarks, design notes and the
-sites' sources. An assignment that differs from what ``robocourse assign`` generates, or a
-notebook with outputs, stops the handout: students get what the course checks.
+(``pyproject.toml``, ``course/pyproject.toml``) and three written for students: a README that is the
+repository README's student guide, an ``environment.yml`` without the developers' extra and a
+``Makefile`` whose ``make lab`` installs what the lessons need and opens JupyterLab. It leaves out
+``solutions/`` (the solution notebooks and the model answers to written questions), the tests,
+benchmarks, design notes and the sites' sources. In a git checkout only tracked files are packed.
+An assignment that differs from what ``robocourse assign`` generates, or a notebook with outputs,
+stops the handout: students get what the course checks.
+
+The course package carries the exercises' reference answers (``check()`` computes the public cases'
+expected results with them); most are robokit's own functions, some are written out in
+``robocourse/lessons/*/exercises.py``. Grades come from hidden cases in a worker that has neither.
 """
 from __future__ import annotations
 
+import os
 import re
+import subprocess
 import zipfile
 from pathlib import Path
 
 from robokit.files import write_atomically
 
-__all__ = ["HANDOUT_PATHS", "handout_files", "write_handout"]
+__all__ = ["HANDOUT_PATHS", "STUDENT_MAKEFILE", "handout_files", "write_handout"]
 
 #: What the handout copies from the course root (folders whole, minus caches and build leftovers).
-HANDOUT_PATHS = ("lessons", "assignments", "robokit", "course/robocourse", "course/pyproject.toml", "pyproject.toml",
-             "environment.yml", "Makefile")
+HANDOUT_PATHS = ("lessons", "assignments", "robokit", "course/robocourse", "course/pyproject.toml", "course/README.md",
+                 "pyproject.toml")
+#: The handout's own Makefile: a student's ``make lab`` (no test or developer extras).
+STUDENT_MAKEFILE = """\
+# robokit courseware, the students' handout. `make lab` sets up .venv on first use and opens JupyterLab.
+PYTHON ?= python3
+VENV   ?= .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.robokit-installed
+
+.PHONY: lab venv
+
+$(STAMP): pyproject.toml course/pyproject.toml
+\t@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+\t$(BIN)/python -m pip install --quiet --upgrade pip
+\t$(BIN)/python -m pip install --quiet -e '.[legged,arm]' -e './course[lab]'
+\t@touch $(STAMP)
+
+venv: $(STAMP)
+
+lab: $(STAMP)
+\t$(BIN)/jupyter lab --notebook-dir=.
+"""
 _SKIP_PARTS = {"__pycache__", ".ipynb_checkpoints", ".pytest_cache"}
 _SKIP_SUFFIXES = (".pyc", ".pyo", ".egg-info")
 TOP = "robokit-course"
@@ -37,15 +66,37 @@ def _student_readme(readme: str) -> str:
             "## Student guide\n" + match.group(1).rstrip() + "\n")
 
 
+def _student_environment(text: str) -> str:
+    """environment.yml without its block of the developers' extra (tests, peers, benchmarks)."""
+    match = re.search(r"^  # robokit's dev extra\n(?:  - (?!pip:).*\n)+", text, re.M)
+    if match is None:
+        raise ValueError("environment.yml: expected a '# robokit's dev extra' block to leave out of the handout")
+    return text[:match.start()] + text[match.end():]
+
+
+def _tracked(root: Path) -> set[str] | None:
+    """The files git tracks under ``root`` (POSIX paths), or None when it is not a git checkout."""
+    if not (root / ".git").exists():
+        return None
+    try:
+        out = subprocess.run(["git", "-C", str(root), "ls-files", "-z"], capture_output=True, timeout=60, check=True)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return set(out.stdout.decode("utf-8", "surrogateescape").split("\0")) - {""}
+
+
 def handout_files(root: str | Path) -> dict[str, Path]:
     """The files of the handout: path inside the handout (POSIX) to the file it copies.
 
     Raises
     ------
+    TypeError
+        If ``root`` is not a path.
     FileNotFoundError
-        If ``root`` lacks one of :data:`HANDOUT_PATHS` or its README.md.
+        If ``root`` lacks one of :data:`HANDOUT_PATHS`, its README.md or its environment.yml.
     """
-    root = Path(root)
+    root = _as_path(root, "root")
+    tracked = _tracked(root)
     files: dict[str, Path] = {}
     for rel in HANDOUT_PATHS:
         path = root / rel
@@ -56,10 +107,19 @@ def handout_files(root: str | Path) -> dict[str, Path]:
             parts = f.relative_to(root).parts
             if _SKIP_PARTS & set(parts) or any(p.endswith(_SKIP_SUFFIXES) for p in parts) or f.is_symlink():
                 continue
+            if tracked is not None and "/".join(parts) not in tracked:      # untracked leftovers stay home
+                continue
             files["/".join(parts)] = f
-    if not (root / "README.md").is_file():
-        raise FileNotFoundError(f"root: {root} has no README.md")
+    for rel in ("README.md", "environment.yml"):
+        if not (root / rel).is_file():
+            raise FileNotFoundError(f"root: {root} has no {rel}")
     return files
+
+
+def _as_path(value: object, name: str) -> Path:
+    if not isinstance(value, (str, os.PathLike)) or not str(value):
+        raise TypeError(f"{name}: expected a path (str or os.PathLike), got {value!r:.60}")
+    return Path(value)
 
 
 def write_handout(root: str | Path, output: str | Path) -> tuple[Path, int]:
@@ -82,6 +142,8 @@ def write_handout(root: str | Path, output: str | Path) -> tuple[Path, int]:
     ValueError
         If an assignment is stale (differs from what ``robocourse assign`` generates), a notebook
         carries outputs, ``output`` does not end in ``.zip`` or lies inside a folder the handout copies.
+    TypeError
+        If ``root`` or ``output`` is not a path.
     FileNotFoundError
         If ``root`` is not a course repository.
 
@@ -93,7 +155,7 @@ def write_handout(root: str | Path, output: str | Path) -> tuple[Path, int]:
     from robocourse.lessons import assignments
     from robocourse.site.hygiene import notebook_problems
 
-    root, output = Path(root).resolve(), Path(output).resolve()
+    root, output = _as_path(root, "root").resolve(), _as_path(output, "output").resolve()
     if output.suffix != ".zip":
         raise ValueError(f"output: expected a path ending in .zip, got {str(output)!r}")
     if any(output.is_relative_to(root / rel) for rel in HANDOUT_PATHS):
@@ -107,13 +169,16 @@ def write_handout(root: str | Path, output: str | Path) -> tuple[Path, int]:
     if problems:
         raise ValueError(f"notebooks must be stripped before they are handed out: {problems[:3]}")
     readme = _student_readme((root / "README.md").read_text(encoding="utf-8"))
+    environment = _student_environment((root / "environment.yml").read_text(encoding="utf-8"))
 
     def write(path: Path) -> None:
         with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as z:
             for rel, f in sorted(files.items()):
                 z.write(f, f"{TOP}/{rel}")
             z.writestr(f"{TOP}/README.md", readme)
+            z.writestr(f"{TOP}/environment.yml", environment)
+            z.writestr(f"{TOP}/Makefile", STUDENT_MAKEFILE)
 
     output.parent.mkdir(parents=True, exist_ok=True)
     write_atomically(output, write)
-    return output, len(files) + 1
+    return output, len(files) + 3

@@ -96,9 +96,10 @@ def execute_in_process(src: Path, dst: Path, *, cwd: Path, cell_timeout: int,
     The kernel talks over Unix sockets created in ``runtime_dir`` (default: a new temporary
     directory), never in ``cwd``, so the notebook starts in an empty directory.
 
-    Returns ``(status, error_tail)``. With ``allowed_errors`` every cell runs and the notebook
-    fails only on an error whose exception name is not in the list (used for assignments, whose
-    stubs raise ``NotImplementedError``).
+    Returns ``(status, error_tail)``. Like JupyterLab's Run All, execution stops at the first error
+    of a cell not tagged ``raises-exception``; with ``allowed_errors`` an error of a tagged cell
+    fails the notebook only if its exception name is not in the list (used for assignments, whose
+    stubs raise ``NotImplementedError`` in the cells ``robocourse assign`` tags).
     """
     import nbformat
     from nbclient import NotebookClient
@@ -115,7 +116,7 @@ def execute_in_process(src: Path, dst: Path, *, cwd: Path, cell_timeout: int,
         km=KernelManager(kernel_name="python3", transport="ipc", ip=str(sockets / "kernel")),
         timeout=cell_timeout,
         kernel_name="python3",
-        allow_errors=bool(allowed_errors),
+        allow_errors=False,               # an untagged cell's error stops the run, as in JupyterLab
         resources={"metadata": {"path": str(cwd)}},
         record_timing=False,
     )
