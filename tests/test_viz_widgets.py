@@ -142,7 +142,8 @@ def test_the_static_slider_snaps_and_steps_in_a_browser(tmp_path):
                              session)["result"].get("value")
 
         deadline = time.monotonic() + 20
-        while js("document.readyState") != "complete" and time.monotonic() < deadline:
+        while not js("document.readyState == 'complete' && document.querySelector('input') !== null") \
+                and time.monotonic() < deadline:              # the tab starts on about:blank
             time.sleep(0.1)
         assert js(state) == ["-1", "-1.0", 1]
         js("document.querySelector('input').focus()")
