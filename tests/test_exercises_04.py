@@ -39,7 +39,7 @@ def _wrong_fk(q_leg, leg):   # forgets that the right legs' pitch axis sits outw
     c, s = np.cos(q[0]), np.sin(q[0])
     x = -littledog.UPPER_LEG * np.sin(q[1]) - littledog.LOWER_LEG * np.sin(q[1] + q[2])
     z = -littledog.UPPER_LEG * np.cos(q[1]) - littledog.LOWER_LEG * np.cos(q[1] + q[2])
-    y = littledog.HIP_OFFSET
+    y = littledog.HIP_OFFSETS[littledog.LEGS.index(leg)]
     return (littledog.HIP_POSITIONS[littledog.LEGS.index(leg)] + [x, c * y - s * z, s * y + c * z]).tolist()
 
 
@@ -113,7 +113,7 @@ def test_the_fk_cases_match_a_chain_of_homogeneous_transforms():
         q, leg = case.args
         i = littledog.LEGS.index(leg)
         side = 1.0 if leg.endswith("L") else -1.0
-        T = (tf(p=littledog.HIP_POSITIONS[i]) @ tf(rot(0, q[0])) @ tf(p=(0, side * littledog.HIP_OFFSET, 0))
+        T = (tf(p=littledog.HIP_POSITIONS[i]) @ tf(rot(0, q[0])) @ tf(p=(0, side * littledog.HIP_OFFSETS[i], 0))
              @ tf(rot(1, q[1])) @ tf(p=(0, 0, -littledog.UPPER_LEG)) @ tf(rot(1, q[2])))
         foot = T @ [0, 0, -littledog.LOWER_LEG, 1]
         assert np.allclose(EXERCISES["04.leg_fk"].answer(q, leg), foot[:3], atol=1e-12)

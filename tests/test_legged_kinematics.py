@@ -6,7 +6,7 @@ import pytest
 
 from robokit.legged import leg_kinematics as lk
 from robokit.legged import leg_kinematics as ls
-from robokit.legged.littledog import (GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_NAMES, LEGS, LOWER_LEG, MARKERS,
+from robokit.legged.littledog import (GUIDE, HIP_OFFSETS, HIP_POSITIONS, JOINT_NAMES, LEGS, LOWER_LEG, MARKERS,
                                       STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG, littledog_mjcf,
                                       littledog_model)
 
@@ -200,7 +200,7 @@ def test_body_ik_in_the_world_frame_and_batch():
 
 def test_workspace_respects_limits_and_reach():
     pts = lk.reachable_workspace("HR", 5000, rng=1)
-    pitch = HIP_POSITIONS[3] + [0, -HIP_OFFSET, 0]
+    pitch = HIP_POSITIONS[3] + [0, -HIP_OFFSETS[3], 0]
     assert len(pts) > 1000
-    assert np.all(np.linalg.norm(pts - HIP_POSITIONS[3], axis=1) <= UPPER_LEG + LOWER_LEG + HIP_OFFSET + 1e-12)
+    assert np.all(np.linalg.norm(pts - HIP_POSITIONS[3], axis=1) <= UPPER_LEG + LOWER_LEG + HIP_OFFSETS[3] + 1e-12)
     assert np.linalg.norm(pts - pitch, axis=1).min() < 0.06     # folded knees come close to the hip

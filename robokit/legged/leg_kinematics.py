@@ -9,8 +9,8 @@ A leg is a hip roll about the body's x axis, then a hip pitch and a knee about t
         + R_y(q_2)\left(\begin{bmatrix}0\\0\\-L_1\end{bmatrix}
         + R_y(q_3)\begin{bmatrix}0\\0\\-L_2\end{bmatrix}\right)\right)
 
-with ``h`` the hip position, ``s`` = +1 for a left leg and -1 for a right one, ``d`` the hip-pitch
-offset, ``L1``, ``L2`` the upper and lower leg (Siciliano & Khatib 2016, Ch. 2, Eq. (2.40) composes
+with ``h`` the hip position, ``s`` = +1 for a left leg and -1 for a right one, ``d`` the leg's hip-pitch
+offset (:data:`~robokit.legged.littledog.HIP_OFFSETS`), ``L1``, ``L2`` the upper and lower leg (Siciliano & Khatib 2016, Ch. 2, Eq. (2.40) composes
 the same elementary rotations). The inverse is closed-form: the roll is the angle that puts the
 foot in the leg's sagittal plane (a point at distance ``d`` from the roll axis gives two tangents;
 the one with the foot below the hip is taken), and the pitch and knee solve a planar two-link arm
@@ -38,7 +38,7 @@ import numpy as np
 
 from ..geometry import as_se3
 from ..validation import as_array, as_int, as_rng, describe, require_angles, require_finite_result
-from .littledog import HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, LEGS, LOWER_LEG, UPPER_LEG
+from .littledog import HIP_OFFSETS, HIP_POSITIONS, JOINT_LIMITS, LEGS, LOWER_LEG, UPPER_LEG
 
 __all__ = ["KNEE_BRANCH", "UnreachableFootError", "leg_index", "foot_position", "leg_points", "foot_jacobian",
            "leg_ik", "leg_ik_batch", "LegIK", "within_limits", "reachable_workspace", "body_ik", "body_fk",
@@ -89,7 +89,7 @@ def _chain(q: np.ndarray, i: int):
     # sagittal-plane coordinates after the roll (x forward, z down the leg)
     kx, kz = -UPPER_LEG * np.sin(a2), -UPPER_LEG * np.cos(a2)
     fx, fz = kx - LOWER_LEG * np.sin(a23), kz - LOWER_LEG * np.cos(a23)
-    y = _side(i) * HIP_OFFSET
+    y = _side(i) * HIP_OFFSETS[i]
     hip = np.broadcast_to(HIP_POSITIONS[i], q.shape).copy()
 
     def rolled(x, z):  # R_x(q1) [x, y, z] + hip
@@ -136,7 +136,7 @@ def leg_points(q_leg: Any, leg: Any) -> np.ndarray:
     i = leg_index(leg)
     hip, knee, foot = _chain(q, i)
     c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
-    y = _side(i) * HIP_OFFSET
+    y = _side(i) * HIP_OFFSETS[i]
     pitch = hip + np.stack([np.zeros_like(c1), c1 * y, s1 * y], axis=-1)
     return np.stack([hip, pitch, knee, foot], axis=-2)
 
@@ -178,10 +178,10 @@ class LegIK(NamedTuple):
 def _solve(p: np.ndarray, i: int, branch: np.ndarray):
     """Unchecked closed-form IK: angles (N, 3), reach flags (N,)."""
     v = p - HIP_POSITIONS[i]
-    d = _side(i) * HIP_OFFSET
+    d = _side(i) * HIP_OFFSETS[i]
     r2 = v[:, 1] ** 2 + v[:, 2] ** 2
-    ok = r2 >= HIP_OFFSET ** 2 * (1 - _REACH_TOL)
-    r = np.sqrt(np.maximum(r2, HIP_OFFSET ** 2))
+    ok = r2 >= HIP_OFFSETS[i] ** 2 * (1 - _REACH_TOL)
+    r = np.sqrt(np.maximum(r2, HIP_OFFSETS[i] ** 2))
     # roll: the foot, turned back by q1, sits at y = d in the leg's plane; take the root with z < 0
     phi = np.arctan2(v[:, 2], v[:, 1])
     q1 = phi + np.arccos(np.clip(d / r, -1.0, 1.0))
@@ -283,7 +283,7 @@ def leg_ik(p_foot: Any, leg: Any, branch: Any = None) -> np.ndarray:
         raise UnreachableFootError(
             f"p_foot: {p.round(4).tolist()} is out of reach of leg {LEGS[i]} "
             f"({np.linalg.norm(v):.4f} m from the hip; the leg spans {abs(UPPER_LEG - LOWER_LEG):.4f}-"
-            f"{UPPER_LEG + LOWER_LEG:.4f} m from its pitch axis, which is {HIP_OFFSET} m out from the hip)")
+            f"{UPPER_LEG + LOWER_LEG:.4f} m from its pitch axis, which is {HIP_OFFSETS[i]} m out from the hip)")
     return q[0]
 
 

@@ -16,9 +16,18 @@ What comes from where:
   the guide gives no hip positions, segment lengths, masses of parts or joint limits. Those come
   from the MIT LittleDog model (converted from the CSAIL LittleDog simulator; Drake's
   ``examples/LittleDog/LittleDog.urdf``): hips at x = +-0.101 m, y = +-0.03625 m; the hip-pitch axis
-  0.0236 m further out; upper leg 0.0751 m; lower leg 0.102 m to the foot centre (we make the lower
-  leg straight: that model bends it by 0.26 rad, which only shifts the knee angle's zero); the
-  parts' masses and the joint limits.
+  0.0236 m further out (0.0207 m on the hind-right leg, as that model gives it: :data:`HIP_OFFSETS`);
+  upper leg 0.0751 m; the foot centre 0.0985 m down the lower leg and 0.0265 m off its line
+  (backwards on the front legs, forwards on the hind ones); the parts' masses and the joint limits.
+  We draw the lower leg straight from knee to foot (0.1020 m): that only moves the knee angle's zero
+  by :data:`KNEE_ZERO` = 0.2628 rad, so our knee angle is the model's plus 0.2628 rad on a front
+  leg and minus 0.2628 rad on a hind one, and :data:`JOINT_LIMITS` are the model's limits moved by
+  the same amount (:data:`SOURCE_JOINT_LIMITS` keeps them as the model states them). The feet and
+  legs then stand exactly where the model's do; ``tests/test_legged_source_model.py`` compares them
+  with the model's file.
+* Assumptions of ours, not the model's: the shapes drawn and simulated for the links (cylinders and
+  capsules), the foot sphere's radius, the motors (:mod:`robokit.controllers.dc_motor`) and the
+  trunk below.
 * Our reading of the guide's body size: the trunk is 0.24 x 0.09 x 0.023 m and, standing, its
   bottom is 0.120 m above the ground (the guide's clearance) and its top 0.143 m (the guide's
   height); the trunk mass makes the total 3 kg (the MIT model's parts sum to 2.75 kg).
@@ -45,8 +54,8 @@ import numpy as np
 from ..controllers.dc_motor import DCMotor, reflected_inertia
 from ..validation import as_finite_scalar, as_positive
 
-__all__ = ["LEGS", "JOINTS", "JOINT_NAMES", "GUIDE", "HIP_POSITIONS", "HIP_OFFSET", "UPPER_LEG",
-           "LOWER_LEG", "FOOT_RADIUS", "TRUNK_SIZE", "TRUNK_MASS", "LEG_MASSES", "TOTAL_MASS",
+__all__ = ["LEGS", "JOINTS", "JOINT_NAMES", "GUIDE", "HIP_POSITIONS", "HIP_OFFSETS", "UPPER_LEG", "SHANK",
+           "LOWER_LEG", "KNEE_ZERO", "KNEE_SHIFT", "SOURCE_JOINT_LIMITS", "FOOT_RADIUS", "TRUNK_SIZE", "TRUNK_MASS", "LEG_MASSES", "TOTAL_MASS",
            "STANDING_HEIGHT", "STANCE_FEET", "MARKERS", "JOINT_LIMITS", "TIMESTEP", "littledog_mjcf",
            "littledog_model"]
 
@@ -73,12 +82,19 @@ GUIDE = {
 HIP_POSITIONS = np.array([[0.101, 0.03625, 0.0], [0.101, -0.03625, 0.0],
                           [-0.101, 0.03625, 0.0], [-0.101, -0.03625, 0.0]])
 """Hip-roll joint of each leg in the body frame (m); MIT model."""
-HIP_OFFSET = 0.0236
-"""Lateral distance from the hip-roll joint to the hip-pitch axis (m, outwards); MIT model."""
+HIP_OFFSETS = np.array([0.0236, 0.0236, 0.0236, 0.0207])
+"""Lateral distance from each leg's hip-roll joint to its hip-pitch axis (m, outwards), legs in
+:data:`LEGS` order; MIT model, whose hind-right leg has 0.0207 m (the guide gives no value)."""
 UPPER_LEG = 0.0751
 """Hip pitch to knee (m); MIT model."""
-LOWER_LEG = 0.1020
-"""Knee to foot centre (m); MIT model (0.0265 m x 0.0985 m bent shank, made straight)."""
+SHANK = (0.0265, 0.0985)
+"""The MIT model's foot centre seen from the knee (m): off the leg's line, along it."""
+LOWER_LEG = float(np.hypot(*SHANK))
+"""Knee to foot centre (m): 0.1020, the MIT model's bent shank drawn straight."""
+KNEE_ZERO = float(np.arctan2(*SHANK))
+"""How far our straight-shank knee zero turns from the MIT model's (rad): 0.2628."""
+KNEE_SHIFT = np.array([KNEE_ZERO, KNEE_ZERO, -KNEE_ZERO, -KNEE_ZERO])
+"""Our knee angle minus the MIT model's, per leg (rad): the front feet sit behind the knee's line."""
 FOOT_RADIUS = 0.01
 """Radius of the foot sphere (m); ours."""
 TRUNK_SIZE = (0.24, 0.09, 0.023)
@@ -96,19 +112,23 @@ STANCE_FEET = np.array([[0.16, 0.08, 0.0], [0.16, -0.08, 0.0],
 MARKERS = np.array([[0.10, 0.03, 0.0115], [0.10, -0.04, 0.0115],
                     [-0.11, 0.035, 0.0115], [-0.05, -0.02, 0.04]])
 """MoCap markers in the body frame (m): three on the trunk's top, one on a post (not coplanar)."""
-JOINT_LIMITS = np.array([
+SOURCE_JOINT_LIMITS = np.array([
     [-0.6, 0.6], [-3.5, 2.4], [-3.1, 1.0],     # FL
     [-0.6, 0.6], [-3.5, 2.4], [-3.1, 1.0],     # FR
     [-0.6, 0.6], [-2.4, 3.5], [-1.0, 3.1],     # HL
     [-0.6, 0.6], [-2.4, 3.5], [-1.0, 3.1],     # HR
 ])
-"""Joint limits (rad), rows in :data:`JOINT_NAMES` order; MIT model."""
+"""Joint limits (rad) as the MIT model states them (its knee zero), rows in :data:`JOINT_NAMES` order."""
+JOINT_LIMITS = SOURCE_JOINT_LIMITS.copy()
+JOINT_LIMITS[2::3] += KNEE_SHIFT[:, None]                     # the knee rows, one per leg
+"""Joint limits (rad) in our convention, rows in :data:`JOINT_NAMES` order: the MIT model's, its
+knee rows moved by :data:`KNEE_SHIFT` (front knees -2.8372 to 1.2628, hind -1.2628 to 2.8372)."""
 TIMESTEP = 0.001
 """MuJoCo's physics step (s): two steps per 500 Hz servo tick."""
 
 
 def _f(x: float) -> str:
-    return f"{x:.6g}"
+    return f"{x:.15g}"
 
 
 def _vec(v) -> str:
@@ -125,8 +145,8 @@ def _leg_xml(i: int, armature: float, damping: float) -> str:
     return f"""
       <body name="{leg}_hip" pos="{_vec(HIP_POSITIONS[i])}">
         <joint name="{leg}_hip_roll" axis="1 0 0" range="{_vec(lim[0])}" {joint}/>
-        <geom class="link" type="cylinder" size="0.012 0.012" fromto="0 0 0 0 {_f(side * HIP_OFFSET)} 0" mass="{_f(m_hip)}"/>
-        <body name="{leg}_upper" pos="0 {_f(side * HIP_OFFSET)} 0">
+        <geom class="link" type="cylinder" size="0.012 0.012" fromto="0 0 0 0 {_f(side * HIP_OFFSETS[i])} 0" mass="{_f(m_hip)}"/>
+        <body name="{leg}_upper" pos="0 {_f(side * HIP_OFFSETS[i])} 0">
           <joint name="{leg}_hip_pitch" axis="0 1 0" range="{_vec(lim[1])}" {joint}/>
           <geom class="link" type="capsule" size="0.011" fromto="0 0 0 0 0 {_f(-UPPER_LEG)}" mass="{_f(m_upper)}"/>
           <body name="{leg}_lower" pos="0 0 {_f(-UPPER_LEG)}">

@@ -51,6 +51,11 @@ __all__ = ["LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "F
 FALL_HEIGHT = 0.06
 """The robot has fallen when its trunk's centre is lower than this (m) or it tips past 45 deg."""
 
+SET_DOWN_DEPTH = 1e-6
+"""How far below the plan's first body pose the robot is set down (m): its standing feet then start
+in contact. Feet placed exactly on the ground are a tie that MuJoCo breaks by rounding, so whether the
+first record shows them loaded would depend on the model's last digits."""
+
 CONTACT_FORCE = 0.2
 """A foot is truly in contact (the log's ``contact``) when the ground pushes it with more than this
 normal force (N): MuJoCo also reports touching contacts that carry nothing."""
@@ -249,9 +254,10 @@ def _host_period(plan: WalkPlan) -> tuple[float, int]:
 
 
 def _place(model: mujoco.MjModel, T_world_body: np.ndarray, q: np.ndarray) -> mujoco.MjData:
-    """The robot standing at the plan's first body pose with joint angles ``q``."""
+    """The robot standing at the plan's first body pose with joint angles ``q``, its feet
+    :data:`SET_DOWN_DEPTH` into the ground."""
     data = mujoco.MjData(model)
-    data.qpos[:3] = T_world_body[:3, 3]
+    data.qpos[:3] = T_world_body[:3, 3] - [0.0, 0.0, SET_DOWN_DEPTH]
     mujoco.mju_mat2Quat(data.qpos[3:7], T_world_body[:3, :3].ravel())
     data.qpos[7:] = q
     mujoco.mj_forward(model, data)

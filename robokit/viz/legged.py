@@ -9,7 +9,7 @@ quaternion per joint per frame. Paths under ``path`` (default ``"littledog"``)::
     littledog                                 the trunk's frame (T_world_body)
     littledog/trunk, littledog/markers/<k>    the trunk box and the four MoCap markers
     littledog/<leg>/hip_roll                  at the hip, turned about x by q_roll
-    littledog/<leg>/hip_roll/hip_pitch        at the pitch axis (HIP_OFFSET out), turned about y
+    littledog/<leg>/hip_roll/hip_pitch        at the pitch axis (HIP_OFFSETS out), turned about y
     littledog/<leg>/hip_roll/hip_pitch/knee   at the knee (UPPER_LEG down), turned about y
     .../<joint>/link, .../knee/foot           the link that joint moves; the foot sphere
 
@@ -35,7 +35,7 @@ import numpy as np
 
 from ..geometry import as_se3, rot_x, rot_y, se3_from_rt
 from ..legged.leg_kinematics import body_ik, leg_index
-from ..legged.littledog import (FOOT_RADIUS, HIP_OFFSET, HIP_POSITIONS, JOINTS, LEGS, LOWER_LEG, MARKERS,
+from ..legged.littledog import (FOOT_RADIUS, HIP_OFFSETS, HIP_POSITIONS, JOINTS, LEGS, LOWER_LEG, MARKERS,
                                 STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG)
 from ..legged.trial_log import TrialLog
 from ..validation import as_array, as_choice, as_int, as_positive, as_text, describe
@@ -86,7 +86,7 @@ def _joint_offsets() -> np.ndarray:
     """(4, 3, 3): where each joint sits in its parent's frame (trunk, roll, pitch)."""
     off = np.zeros((4, 3, 3))
     off[:, 0] = HIP_POSITIONS
-    off[:, 1, 1] = _SIDE * HIP_OFFSET
+    off[:, 1, 1] = _SIDE * HIP_OFFSETS
     off[:, 2, 2] = -UPPER_LEG
     return off
 
@@ -143,9 +143,9 @@ def add_littledog(scene: Scene, path: str = "littledog", T_world_body: Any = Non
     scene.add_box(f"{root}/trunk", TRUNK_SIZE, color=_COLORS["trunk"])
     for k, m in enumerate(MARKERS):
         scene.add_sphere(f"{root}/markers/{k}", 0.006, se3_from_rt(np.eye(3), m), color=_COLORS["marker"])
-    lengths = (HIP_OFFSET, UPPER_LEG, LOWER_LEG)
     for i, leg in enumerate(LEGS):
-        stub = se3_from_rt(np.eye(3), [0.0, _SIDE[i] * HIP_OFFSET / 2, 0.0])
+        lengths = (HIP_OFFSETS[i], UPPER_LEG, LOWER_LEG)
+        stub = se3_from_rt(np.eye(3), [0.0, _SIDE[i] * HIP_OFFSETS[i] / 2, 0.0])
         scene.add_cylinder(f"{joint_path(root, leg, 'hip_roll')}/link", lengths[0], _RADII[0], stub,
                            color=_COLORS["link"])
         for j, joint in ((1, "hip_pitch"), (2, "knee")):

@@ -22,7 +22,7 @@ import numpy as np
 from robokit.geometry.rotations import rot_x, rot_y, rot_z
 from robokit.geometry.spatial import se3_from_rt
 from robokit.validation import as_rng, as_int, as_positive
-from robokit.legged.littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSET, HIP_POSITIONS, JOINT_LIMITS, JOINTS, LEGS, LOWER_LEG,
+from robokit.legged.littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSETS, HIP_POSITIONS, JOINT_LIMITS, JOINTS, LEGS, LOWER_LEG,
                         MARKERS, STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG)
 from robokit.legged.mocap import simulate_mocap
 
@@ -43,7 +43,7 @@ def model_facts() -> dict:
     Returns
     -------
     dict
-        ``LEGS``, ``JOINTS``, ``HIP_POSITIONS`` (4 x 3, m, body frame), ``HIP_OFFSET``,
+        ``LEGS``, ``JOINTS``, ``HIP_POSITIONS`` (4 x 3, m, body frame), ``HIP_OFFSETS`` (4, m),
         ``UPPER_LEG``, ``LOWER_LEG``, ``FOOT_RADIUS`` (m), ``STANCE_FEET`` (4 x 3, m),
         ``STANDING_HEIGHT`` (m), ``TRUNK_SIZE`` (m), ``JOINT_LIMITS`` (12 x 2, rad), ``MARKERS``
         (4 x 3, m) and ``GUIDE`` (the guide's numbers, SI units); lists, tuples and floats, named as in
@@ -56,10 +56,11 @@ def model_facts() -> dict:
     Examples
     --------
     >>> facts = model_facts()
-    >>> facts["LEGS"], facts["UPPER_LEG"], facts["LOWER_LEG"], facts["HIP_POSITIONS"][0]
-    (('FL', 'FR', 'HL', 'HR'), 0.0751, 0.102, [0.101, 0.03625, 0.0])
+    >>> facts["LEGS"], facts["UPPER_LEG"], round(facts["LOWER_LEG"], 6), facts["HIP_OFFSETS"]
+    (('FL', 'FR', 'HL', 'HR'), 0.0751, 0.102002, [0.0236, 0.0236, 0.0236, 0.0207])
     """
-    return {"LEGS": LEGS, "JOINTS": JOINTS, "HIP_POSITIONS": HIP_POSITIONS.tolist(), "HIP_OFFSET": HIP_OFFSET,
+    return {"LEGS": LEGS, "JOINTS": JOINTS, "HIP_POSITIONS": HIP_POSITIONS.tolist(),
+            "HIP_OFFSETS": HIP_OFFSETS.tolist(),
             "UPPER_LEG": UPPER_LEG, "LOWER_LEG": LOWER_LEG, "FOOT_RADIUS": FOOT_RADIUS,
             "STANCE_FEET": STANCE_FEET.round(6).tolist(), "STANDING_HEIGHT": STANDING_HEIGHT,
             "TRUNK_SIZE": TRUNK_SIZE, "JOINT_LIMITS": JOINT_LIMITS.tolist(), "MARKERS": MARKERS.tolist(),
