@@ -11,9 +11,11 @@ from robokit.legged.gait import GaitSchedule, crawl_gait, stance_pattern, swing_
 from robokit.legged.support import stability_margin
 
 LEGS = ("FL", "FR", "HL", "HR")
-# The model's facts (tests/BRIEF): hip roll axes in the body frame, the hip-pitch axis 0.0236 m further out.
+# The model's facts (tests/BRIEF): hip roll axes in the body frame, the hip-pitch axis 0.0236 m further
+# out (0.0207 m on the hind-right leg, as the MIT model gives it).
 HIPS = np.array([[0.101, 0.03625, 0.0], [0.101, -0.03625, 0.0], [-0.101, 0.03625, 0.0], [-0.101, -0.03625, 0.0]])
-PITCH_POINTS = HIPS + np.array([[0, 1, 0], [0, -1, 0], [0, 1, 0], [0, -1, 0]]) * 0.0236
+PITCH_POINTS = HIPS + np.array([[0, 1, 0], [0, -1, 0], [0, 1, 0], [0, -1, 0]]) * np.array([[0.0236], [0.0236], [0.0236],
+                                                                                     [0.0207]])
 REACH = 0.17
 FOOT_Z = 0.01
 

@@ -15,7 +15,7 @@ trial_log         the checked trial log and its .npz file
 power             electrical power, cost of transport, the battery's endurance
 """
 from .littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSETS, HIP_POSITIONS, JOINT_LIMITS, JOINT_NAMES, JOINTS, KNEE_SHIFT,
-                        KNEE_ZERO, LEG_MASSES, LEGS, LOWER_LEG, MARKERS, SOURCE_JOINT_LIMITS, STANCE_FEET,
+                        KNEE_ZERO, LEG_MASSES, LEGS, LOWER_LEG, MARKERS, SHANK, SOURCE_JOINT_LIMITS, STANCE_FEET,
                         STANDING_HEIGHT, TRUNK_MASS, TRUNK_SIZE, UPPER_LEG, littledog_mjcf, littledog_model)
 from .support import SupportPolygonError, stability_margin, stability_margins, support_polygon
 from .gait_schedule import GaitSchedule, crawl_gait, trot_gait
@@ -30,7 +30,7 @@ from .trial_log import LOG_LAYOUT, TrialLog, TrialLogError, describe_layout, loa
 from .power import battery_energy, cost_of_transport, endurance, trial_power
 
 __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSETS", "HIP_POSITIONS", "JOINT_LIMITS", "JOINT_NAMES", "JOINTS",
-           "KNEE_SHIFT", "KNEE_ZERO", "SOURCE_JOINT_LIMITS", "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS",
+           "KNEE_SHIFT", "KNEE_ZERO", "SHANK", "SOURCE_JOINT_LIMITS", "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS",
            "STANCE_FEET", "STANDING_HEIGHT", "TRUNK_MASS",
            "TRUNK_SIZE", "UPPER_LEG", "littledog_mjcf", "littledog_model", "SupportPolygonError", "stability_margin",
            "stability_margins", "support_polygon", "GaitSchedule", "crawl_gait", "trot_gait", "WalkPlan",

@@ -10,8 +10,8 @@ A leg is a hip roll about the body's x axis, then a hip pitch and a knee about t
         + R_y(q_3)\begin{bmatrix}0\\0\\-L_2\end{bmatrix}\right)\right)
 
 with ``h`` the hip position, ``s`` = +1 for a left leg and -1 for a right one, ``d`` the leg's hip-pitch
-offset (:data:`~robokit.legged.littledog.HIP_OFFSETS`), ``L1``, ``L2`` the upper and lower leg (Siciliano & Khatib 2016, Ch. 2, Eq. (2.40) composes
-the same elementary rotations). The inverse is closed-form: the roll is the angle that puts the
+offset (:data:`~robokit.legged.littledog.HIP_OFFSETS`), ``L1``, ``L2`` the upper and lower leg
+(Siciliano & Khatib 2016, Ch. 2, Eq. (2.40) composes the same elementary rotations). The inverse is closed-form: the roll is the angle that puts the
 foot in the leg's sagittal plane (a point at distance ``d`` from the roll axis gives two tangents;
 the one with the foot below the hip is taken), and the pitch and knee solve a planar two-link arm
 by the law of cosines, whose two roots are the two knee branches: ``branch = -1`` bends the knee

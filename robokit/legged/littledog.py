@@ -22,12 +22,12 @@ What comes from where:
   We draw the lower leg straight from knee to foot (0.1020 m): that only moves the knee angle's zero
   by :data:`KNEE_ZERO` = 0.2628 rad, so our knee angle is the model's plus 0.2628 rad on a front
   leg and minus 0.2628 rad on a hind one, and :data:`JOINT_LIMITS` are the model's limits moved by
-  the same amount (:data:`SOURCE_JOINT_LIMITS` keeps them as the model states them). The feet and
-  legs then stand exactly where the model's do; ``tests/test_legged_source_model.py`` compares them
-  with the model's file.
+  the same amount (:data:`SOURCE_JOINT_LIMITS` keeps them as the model states them). Knees and feet
+  then stand exactly where the model's do; ``tests/test_legged_source_model.py`` compares them with
+  the model's file.
 * Assumptions of ours, not the model's: the shapes drawn and simulated for the links (cylinders and
-  capsules), the foot sphere's radius, the motors (:mod:`robokit.controllers.dc_motor`) and the
-  trunk below.
+  capsules, whose inertias and centres of mass MuJoCo takes from those shapes), the foot sphere's
+  radius, the motors (:mod:`robokit.controllers.dc_motor`) and the trunk below.
 * Our reading of the guide's body size: the trunk is 0.24 x 0.09 x 0.023 m and, standing, its
   bottom is 0.120 m above the ground (the guide's clearance) and its top 0.143 m (the guide's
   height); the trunk mass makes the total 3 kg (the MIT model's parts sum to 2.75 kg).
@@ -55,7 +55,8 @@ from ..controllers.dc_motor import DCMotor, reflected_inertia
 from ..validation import as_finite_scalar, as_positive
 
 __all__ = ["LEGS", "JOINTS", "JOINT_NAMES", "GUIDE", "HIP_POSITIONS", "HIP_OFFSETS", "UPPER_LEG", "SHANK",
-           "LOWER_LEG", "KNEE_ZERO", "KNEE_SHIFT", "SOURCE_JOINT_LIMITS", "FOOT_RADIUS", "TRUNK_SIZE", "TRUNK_MASS", "LEG_MASSES", "TOTAL_MASS",
+           "LOWER_LEG", "KNEE_ZERO", "KNEE_SHIFT", "SOURCE_JOINT_LIMITS", "FOOT_RADIUS", "TRUNK_SIZE", "TRUNK_MASS",
+           "LEG_MASSES", "TOTAL_MASS",
            "STANDING_HEIGHT", "STANCE_FEET", "MARKERS", "JOINT_LIMITS", "TIMESTEP", "littledog_mjcf",
            "littledog_model"]
 
@@ -139,14 +140,15 @@ def _leg_xml(i: int, armature: float, damping: float) -> str:
     leg = LEGS[i]
     side = 1.0 if leg.endswith("L") else -1.0
     lim = JOINT_LIMITS[3 * i:3 * i + 3]
+    offset = HIP_OFFSETS[i]
     m_hip, m_upper, m_lower = LEG_MASSES
     m_foot = 0.005
     joint = f'armature="{_f(armature)}" damping="{_f(damping)}"'
     return f"""
       <body name="{leg}_hip" pos="{_vec(HIP_POSITIONS[i])}">
         <joint name="{leg}_hip_roll" axis="1 0 0" range="{_vec(lim[0])}" {joint}/>
-        <geom class="link" type="cylinder" size="0.012 0.012" fromto="0 0 0 0 {_f(side * HIP_OFFSETS[i])} 0" mass="{_f(m_hip)}"/>
-        <body name="{leg}_upper" pos="0 {_f(side * HIP_OFFSETS[i])} 0">
+        <geom class="link" type="cylinder" size="0.012 0.012" fromto="0 0 0 0 {_f(side * offset)} 0" mass="{_f(m_hip)}"/>
+        <body name="{leg}_upper" pos="0 {_f(side * offset)} 0">
           <joint name="{leg}_hip_pitch" axis="0 1 0" range="{_vec(lim[1])}" {joint}/>
           <geom class="link" type="capsule" size="0.011" fromto="0 0 0 0 0 {_f(-UPPER_LEG)}" mass="{_f(m_upper)}"/>
           <body name="{leg}_lower" pos="0 0 {_f(-UPPER_LEG)}">
@@ -191,8 +193,8 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
         :data:`JOINT_NAMES`, one actuator per joint (named like its joint), sites
         ``imu`` (gyro ``imu_gyro`` and accelerometer ``imu_acc``), ``marker0``..``marker3`` and per
         leg ``<leg>_force`` (a 3-axis ``force`` sensor at the knee, in the lower leg's frame whose z
-        axis runs along the shank: the guide's single-axis lower-leg force sensor is its z
-        component) and ``<leg>_foot``.
+        axis runs from the knee to the foot centre, about 15 deg from the MIT model's bent shank:
+        the guide's single-axis lower-leg force sensor is its z component) and ``<leg>_foot``.
 
     Notes
     -----

@@ -22,7 +22,8 @@ import numpy as np
 from robokit.geometry.rotations import rot_x, rot_y, rot_z
 from robokit.geometry.spatial import se3_from_rt
 from robokit.validation import as_rng, as_int, as_positive
-from robokit.legged.littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSETS, HIP_POSITIONS, JOINT_LIMITS, JOINTS, LEGS, LOWER_LEG,
+from robokit.legged.littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSETS, HIP_POSITIONS, JOINT_LIMITS, JOINTS, LEGS,
+                                      LOWER_LEG,
                         MARKERS, STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG)
 from robokit.legged.mocap import simulate_mocap
 
