@@ -33,7 +33,7 @@ from robocourse.exercises.spec import Case, Exercise
 
 ASSIGNMENT = "04_littledog"
 #: Written (manually graded) questions: id -> points.
-WRITTEN = {"04.architecture": 2, "04.touchdown_tradeoff": 2, "04.marker_geometry": 2}
+WRITTEN = {"04.architecture": 2, "04.touchdown_tradeoff": 2, "04.marker_geometry": 2, "04.system": 3}
 
 
 def data() -> dict:
