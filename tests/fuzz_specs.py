@@ -1529,6 +1529,8 @@ SPECS: dict[str, Call] = {
         "latencies": Array(np.array([0.0]), "N"), "bandwidths": Array(np.array([15.0]), "N"), "rng": Rng(0),
         "progress": Func(None, optional=True)}, cheap=False),
     "robocourse.lessons.littledog.experiment.estimation_table": Call({"log": Obj(trial_log)}),
+    "robocourse.lessons.littledog.experiment.imu_drift": Call({"log": Obj(trial_log),
+                                                              "sensors": Obj(sensor_settings, optional=True)}),
     "robocourse.lessons.littledog.experiment.touchdown_table": Call({
         "log": Obj(trial_log), "detectors": Obj(touchdown_detectors, optional=True), "tolerance": Int(5),
         "plan": Obj(tiny_walk_plan, optional=True), "gate": Int(10)}),

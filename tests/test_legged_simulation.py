@@ -158,3 +158,20 @@ def test_with_perfect_sensors_the_log_integrates_to_the_truth():
     assert np.degrees(orientation_errors(shifted, T[:, :3, :3])).max() > 0.5
     table = estimation_table(out.log)
     assert table["mocap"]["position_mm"] < 1e-9 and table["fused"]["position_mm"] < 0.5
+
+
+def test_the_imu_alone_drifts_as_its_biases_predict():
+    """Tilt grows as the horizontal gyro bias times t, position as g b t^3 / 6; with no bias, neither."""
+    from robocourse.lessons.littledog.experiment import imu_drift
+
+    plan = walking_plan(crawl_gait(), 0.2)
+    drift = imu_drift(simulate_walk(plan, rng=0).log)
+    late = drift.t > 0.5 * drift.t[-1]
+    assert np.allclose(drift.tilt_error[late], drift.tilt_rate * drift.t[late], rtol=0.05)
+    assert np.allclose(drift.position_error[late], drift.from_tilt[late], rtol=0.25)
+    assert np.all(drift.from_acc_bias[late] < 0.5 * drift.position_error[late])
+    still = SensorSettings(gyro_bias=(0.0, 0.0, 0.0), acc_bias=(0.0, 0.0, 0.0))
+    quiet = imu_drift(simulate_walk(plan, sensors=still, rng=0).log, still)
+    assert quiet.tilt_rate == 0.0 and quiet.position_error[-1] < 0.1 * drift.position_error[-1]
+    with pytest.raises(TypeError, match="sensors"):
+        imu_drift(simulate_walk(plan, rng=0).log, {"gyro_bias": (0, 0, 0)})

@@ -6,7 +6,7 @@ Each function makes one of the lesson's tables from trials of :func:`robokit.leg
 * :func:`loop_table` - servo rate (the guide's 500 Hz against 100 Hz) x link latency
   (0 / 10 / 30 / 50 ms) x servo stiffness: set-point tracking, distance, falls, motor power;
 * :func:`estimation_table` - the trunk's pose from MoCap alone, from the IMU alone and fused,
-  against the simulator's truth;
+  against the simulator's truth; :func:`imu_drift` - why the IMU alone drifts so far;
 * :func:`touchdown_table` - touchdown detection on the lower-leg force sensors against MuJoCo's
   true contacts;
 * :func:`endurance_table` - the motors' electrical power against the battery's 31.08 Wh and the
@@ -22,10 +22,13 @@ References
 .. [2] G. Gabrielli and T. von Karman, "What price speed?", *Mechanical Engineering* 72(10), 1950,
    and V. A. Tucker, "The energetic cost of moving about", *American Scientist* 63(4), 1975 (cost of
    transport, unnumbered).
+.. [3] O. J. Woodman, "An introduction to inertial navigation", Technical Report UCAM-CL-TR-696,
+   University of Cambridge Computer Laboratory, 2007, Sec. 6 (a gyro bias tilts the attitude; the
+   gravity it leaks in grows the position error with the cube of time).
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -39,7 +42,8 @@ from robokit.legged.littledog import GUIDE, MARKERS, TOTAL_MASS
 from robokit.legged.mocap import mocap_body_poses
 from robokit.legged.power import battery_energy, cost_of_transport, endurance
 from robokit.legged.servo_design import SERVO_BANDWIDTH, littledog_servo_gains, servo_inertia
-from robokit.legged.simulation import LoopSettings, TrialOutcome, simulate_walk
+from robokit.legged.imu import GRAVITY
+from robokit.legged.simulation import LoopSettings, SensorSettings, TrialOutcome, simulate_walk
 from robokit.legged.state_estimation import fuse_body_state, orientation_errors, position_errors
 from robokit.legged.support import stability_margins
 from robokit.legged.touchdown import contact_events, event_precision_recall, score_leg_events
@@ -47,8 +51,8 @@ from robokit.legged.touchdown import detect_contacts, gate_touchdowns
 from robokit.legged.trial_log import TrialLog
 
 __all__ = ["LESSON_CRAWL", "LESSON_TROT", "LESSON_DISTANCE", "LATENCIES", "TOUCHDOWN_DETECTORS", "lesson_plans",
-           "loop_table",
-           "estimation_table", "touchdown_table", "endurance_table", "true_margins"]
+           "loop_table", "estimation_table", "ImuDrift", "imu_drift", "touchdown_table", "endurance_table",
+           "true_margins"]
 
 LESSON_CRAWL = {"period": 2.0, "step_length": 0.08, "step_height": 0.04, "duty_factor": 0.9}
 """The lesson's crawl: a 2 s cycle, 8 cm steps (0.04 m/s)."""
@@ -193,13 +197,10 @@ def estimation_table(log: TrialLog) -> dict:
     if not isinstance(log, TrialLog):
         raise TypeError(f"log: expected a TrialLog, got {type(log).__name__}")
     truth = log.T_world_body()
-    dt = float(log.t[1] - log.t[0])
     mocap = mocap_body_poses(MARKERS, log.mocap, log.mocap_visible)
-    first = np.zeros(len(log), bool)
-    first[0] = True
-    start = {"R0": truth[0, :3, :3], "p0": truth[0, :3, 3]}
-    imu = fuse_body_state(log.imu_gyro, log.imu_acc, dt, mocap.T_world_body, first, **start)
-    fused = fuse_body_state(log.imu_gyro, log.imu_acc, dt, mocap.T_world_body, mocap.ok, **start)
+    imu = _imu_alone(log, truth, mocap.T_world_body)
+    fused = fuse_body_state(log.imu_gyro, log.imu_acc, float(log.t[1] - log.t[0]), mocap.T_world_body, mocap.ok,
+                            R0=truth[0, :3, :3], p0=truth[0, :3, 3])
     lost = ~mocap.ok
     table = {"lost_fraction": float(lost.mean())}
     for name, R, p in (("mocap", mocap.T_world_body[:, :3, :3], mocap.T_world_body[:, :3, 3]),
@@ -210,6 +211,64 @@ def estimation_table(log: TrialLog) -> dict:
                        "orientation_deg": _rms(oe), "orientation_lost_deg": _rms(oe[lost]),
                        "final_position_mm": float(pe[-1])}
     return table
+
+
+def _imu_alone(log: TrialLog, truth: np.ndarray, mocap_poses: np.ndarray):
+    """The fusion filter with only the first MoCap frame: gyro and accelerometer integrated, biases and all."""
+    first = np.zeros(len(log), bool)
+    first[0] = True
+    return fuse_body_state(log.imu_gyro, log.imu_acc, float(log.t[1] - log.t[0]), mocap_poses, first,
+                           R0=truth[0, :3, :3], p0=truth[0, :3, 3])
+
+
+class ImuDrift(NamedTuple):
+    """Why the IMU alone drifts: measured errors against two growth laws (:func:`imu_drift`)."""
+
+    t: np.ndarray                  # s from the trial's start
+    position_error: np.ndarray     # m, |p_imu - p_true|
+    tilt_error: np.ndarray         # rad, angle between the true and the estimated up axis
+    tilt_rate: float               # rad/s, the gyro bias about the horizontal axes
+    from_tilt: np.ndarray          # m, g * tilt_rate * t^3 / 6: gravity leaking through the tilt
+    from_acc_bias: np.ndarray      # m, |acc_bias| * t^2 / 2: the accelerometer's own bias
+
+
+def imu_drift(log: TrialLog, sensors: SensorSettings = SensorSettings()) -> ImuDrift:
+    """The IMU-only pose's errors over a trial, beside what the sensor biases predict.
+
+    A gyro bias ``b`` about a horizontal axis tilts the estimated attitude by ``b t``; the
+    accelerometer's reading of gravity, rotated by that wrong attitude, leaves ``g sin(b t) ~ g b t`` of
+    false horizontal acceleration, which integrates twice to ``g b t^3 / 6``. An accelerometer bias
+    ``a`` alone gives ``a t^2 / 2`` (Woodman 2007, Sec. 6, propagates both errors this way).
+
+    Parameters
+    ----------
+    log : TrialLog
+        A trial simulated with ``sensors``.
+    sensors : SensorSettings, default SensorSettings()
+        The biases the trial's IMU had.
+
+    Returns
+    -------
+    ImuDrift
+
+    Examples
+    --------
+    >>> drift = imu_drift(simulate_walk(lesson_plans(0.05)["crawl"]).log)
+    >>> bool(drift.position_error[-1] > drift.from_acc_bias[-1])      # the tilt term dominates
+    True
+    """
+    if not isinstance(log, TrialLog):
+        raise TypeError(f"log: expected a TrialLog, got {type(log).__name__}")
+    if not isinstance(sensors, SensorSettings):
+        raise TypeError(f"sensors: expected a SensorSettings, got {type(sensors).__name__}")
+    truth = log.T_world_body()
+    imu = _imu_alone(log, truth, mocap_body_poses(MARKERS, log.mocap, log.mocap_visible).T_world_body)
+    t = log.t - log.t[0]
+    up_true, up_est = truth[:, :3, 2], imu.R[:, :, 2]
+    tilt = np.arccos(np.clip(np.einsum("ij,ij->i", up_true, up_est), -1.0, 1.0))
+    rate = float(np.hypot(*np.asarray(sensors.gyro_bias, float)[:2]))
+    return ImuDrift(t, position_errors(imu.p, truth[:, :3, 3]), tilt, rate, GRAVITY * rate * t ** 3 / 6,
+                    0.5 * float(np.linalg.norm(sensors.acc_bias)) * t ** 2)
 
 
 def _detectors(detectors: Any, log: TrialLog) -> list:
