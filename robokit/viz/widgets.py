@@ -72,12 +72,12 @@ def _decimals(positions: list[float]) -> int:
     return next((n for n in range(4) if all(abs(round(p, n) - p) < 1e-9 * max(1.0, abs(p)) for p in positions)), 4)
 
 
-def _note(vals: list, texts: list[str], positions: list[float] | None, live: bool) -> str:
+def _note(texts: list[str], positions: list[float] | None, live: bool) -> str:
     """The line under a slider that says how it moves (the live form also takes typed numbers)."""
     if positions is None:
-        return (f"The slider steps through {len(vals)} values at equal steps; drag it or use the arrow keys"
+        return (f"The slider steps through {len(texts)} values at equal steps; drag it or use the arrow keys"
                 + (" (text typed into its readout is ignored)." if live else "."))
-    return (f"The slider stops at the {len(vals)} values computed ({', '.join(texts)}), each at its place on the "
+    return (f"The slider stops at the {len(texts)} values computed ({', '.join(texts)}), each at its place on the "
             "track; " + ("a number typed into the readout moves it to the nearest." if live
                          else "the arrow keys step from one to the next."))
 
@@ -143,7 +143,12 @@ def static_slider_html(draw: Callable[[Any], Any], values: Sequence[Any], *, lab
     >>> page.count("<img"), 'min="1.0" max="4.0"' in page
     (3, True)
     """
-    draw, vals, label, fmt, start, positions = _checked(draw, values, label, fmt, start, spacing)
+    return _static_html(*_checked(draw, values, label, fmt, start, spacing))
+
+
+def _static_html(draw: Callable[[Any], Any], vals: list, label: str, fmt: str, start: int,
+                 positions: list[float] | None) -> str:
+    """:func:`static_slider_html` on checked arguments."""
     texts = [fmt.format(v) for v in vals]
     pngs = [_figure_png(draw, v) for v in vals]
     uid = f"robokit-slider-{next(_ids)}"
@@ -170,7 +175,7 @@ def static_slider_html(draw: Callable[[Any], Any], values: Sequence[Any], *, lab
     return (f'<div id="{uid}" class="robokit-slider"><label>{_html.escape(label)} '
             f'<input type="range" {track} oninput="{_html.escape(handler, quote=True)}"{keys}>'
             f'<span> {_html.escape(texts[start])}</span></label>'
-            f'<div style="font-size:smaller;color:#555">{_html.escape(_note(vals, texts, positions, False))}</div>'
+            f'<div style="font-size:smaller;color:#555">{_html.escape(_note(texts, positions, False))}</div>'
             f'{images}</div>')
 
 
@@ -193,7 +198,7 @@ def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "v
     spacing : {"value", "even"}, default "value"
         "value": increasing real values sit on the track at their values, and a number typed into
         the readout moves the slider to the nearest of them; "even" (and any other values, such
-        as names): equal steps, readout not editable. A note under the slider says which.
+        as names): equal steps, text typed into the readout ignored. A note under the slider says which.
 
     Raises
     ------
@@ -220,7 +225,7 @@ def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "v
     ...     return fig
     >>> slider(draw, [1, 2], label="slope")  # doctest: +SKIP
     """
-    draw, vals, label, fmt, start, positions = _checked(draw, values, label, fmt, start, spacing)
+    checked = _checked(draw, values, label, fmt, start, spacing)
     from IPython.display import display
 
     widgets = None
@@ -230,10 +235,9 @@ def slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str = "v
         except ImportError:  # the static form still teaches
             widgets = None
     if widgets is None:
-        display({"text/html": static_slider_html(draw, vals, label=label, fmt=fmt, start=start, spacing=spacing)},
-                raw=True)
+        display({"text/html": _static_html(*checked)}, raw=True)
         return
-    box, _, redraw = live_slider(draw, vals, label=label, fmt=fmt, start=start, spacing=spacing)
+    box, _, redraw = _live(widgets, *checked)
     display(box)
     redraw()
 
@@ -271,11 +275,16 @@ def live_slider(draw: Callable[[Any], Any], values: Sequence[Any], *, label: str
     >>> control.value, drawn
     (8.0, [8.0])
     """
-    draw, vals, label, fmt, start, positions = _checked(draw, values, label, fmt, start, spacing)
     import ipywidgets as widgets
 
+    return _live(widgets, *_checked(draw, values, label, fmt, start, spacing))
+
+
+def _live(widgets: Any, draw: Callable[[Any], Any], vals: list, label: str, fmt: str, start: int,
+          positions: list[float] | None) -> tuple:
+    """:func:`live_slider` on checked arguments, with the ipywidgets module it builds from."""
     texts = [fmt.format(v) for v in vals]
-    note = _note(vals, texts, positions, True) + (" Reopened the notebook and see 'Error displaying widget'? "
+    note = _note(texts, positions, True) + (" Reopened the notebook and see 'Error displaying widget'? "
                                                  "Run this cell again.")
     if positions is None:
         control = widgets.SelectionSlider(options=[(t, k) for k, t in enumerate(texts)], value=start,

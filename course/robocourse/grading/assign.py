@@ -196,8 +196,7 @@ def mark_stub_failures(nb: dict[str, Any]) -> dict[str, Any]:
             continue
         meta = cell.setdefault("metadata", {})
         grading = meta.get("nbgrader", {})
-        tree = _parse(_source(cell))
-        names = _cell_names(tree) if tree is not None else _CellNames(set(), set(), set(), set(), set(), False)
+        names = _cell_names(_parse(_source(cell)) or ast.Module(body=[], type_ignores=[]))   # unparsable: no names
         solution = bool(grading.get("solution"))
         if solution:
             tainted |= names.binds | names.changes

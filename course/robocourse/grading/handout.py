@@ -168,17 +168,17 @@ def write_handout(root: str | Path, output: str | Path) -> tuple[Path, int]:
     problems = [m for rel, f in files.items() if rel.endswith(".ipynb") for m in notebook_problems(f)]
     if problems:
         raise ValueError(f"notebooks must be stripped before they are handed out: {problems[:3]}")
-    readme = _student_readme((root / "README.md").read_text(encoding="utf-8"))
-    environment = _student_environment((root / "environment.yml").read_text(encoding="utf-8"))
+    written = {"README.md": _student_readme((root / "README.md").read_text(encoding="utf-8")),
+               "environment.yml": _student_environment((root / "environment.yml").read_text(encoding="utf-8")),
+               "Makefile": STUDENT_MAKEFILE}                  # the handout's own versions
 
     def write(path: Path) -> None:
         with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as z:
             for rel, f in sorted(files.items()):
                 z.write(f, f"{TOP}/{rel}")
-            z.writestr(f"{TOP}/README.md", readme)
-            z.writestr(f"{TOP}/environment.yml", environment)
-            z.writestr(f"{TOP}/Makefile", STUDENT_MAKEFILE)
+            for rel, text in written.items():
+                z.writestr(f"{TOP}/{rel}", text)
 
     output.parent.mkdir(parents=True, exist_ok=True)
     write_atomically(output, write)
-    return output, len(files) + 3
+    return output, len(files) + len(written)
