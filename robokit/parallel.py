@@ -27,6 +27,8 @@ import pickle
 import signal
 import sys
 import traceback
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Sequence
 
 import cv2
@@ -158,8 +160,9 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
         defined in a notebook), a ``shared`` object or task that does not pickle, or one whose
         class the workers cannot import (defined in a notebook), or a result that cannot be
         rebuilt here. An error inside a run is raised here, the first in the order of ``tasks`` (as
-        the plain loop would raise it), and the workers are stopped at once, as they are when the
-        caller is interrupted. With workers, an error that cannot travel back (it does not pickle,
+        the plain loop would raise it); then, as when the caller is interrupted, no further run starts
+        and the call returns once the runs in progress end. A worker that dies (killed, out of
+        memory) is a ``RuntimeError``, not a wait for its lost run. With workers, an error that cannot travel back (it does not pickle,
         or it is ``SystemExit``) comes as a ``RuntimeError`` carrying its text and traceback.
 
     Notes
@@ -243,19 +246,36 @@ def _in_place(run: Callable, shared: Any, tasks: list, desc: str, unit: str, pro
 
 def _in_workers(run: Callable, blobs: dict, settings: dict, jobs: list, workers: int, desc: str, unit: str,
                 progress: Callable | None) -> Iterator:
-    """The runs made by a pool of ``workers`` processes, results rebuilt here in order."""
+    """The runs made by a pool of ``workers`` processes, results rebuilt here in order.
+
+    A :class:`~concurrent.futures.ProcessPoolExecutor`, not :class:`multiprocessing.pool.Pool`: the
+    latter's ``terminate`` can kill a worker while it holds the lock of the results pipe (a large
+    result half written), and then waits for that lock forever. The executor is never killed: at
+    the end, on an error, an interrupt or a closed iterator, the runs not started are cancelled and
+    those in progress end first; a worker that dies is an error here, not a lost run.
+    """
     threads = max(1, worker_count() // workers)     # this process's share of the cores, per worker
     with progress_bar(len(jobs), desc, unit=unit, callback=progress) as bar:
-        pool = _context(run).Pool(workers, initializer=_receive, initargs=(blobs, settings, threads))
+        pool = ProcessPoolExecutor(workers, mp_context=_context(run), initializer=_receive,
+                                   initargs=(blobs, settings, threads))
         try:
-            for blob in pool.imap(_run_shared, jobs):     # in order
-                try:
-                    result = pickle.loads(blob)
-                except Exception as exc:                  # noqa: BLE001 - named, then the workers stop
-                    raise TypeError(f"run: its result could not be rebuilt here ({type(exc).__name__}: "
-                                    f"{exc})") from exc
+            futures = [pool.submit(_run_shared, job) for job in jobs]
+            for future in futures:                        # in order
+                result = _rebuilt(future)
                 bar.update()
                 yield result
         finally:
-            pool.terminate()       # at the end, and at once on an error, an interrupt or a closed iterator
-            pool.join()
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _rebuilt(future) -> Any:
+    """A run's result, rebuilt here; a worker that died is named."""
+    try:
+        blob = future.result()
+    except BrokenProcessPool as exc:
+        raise RuntimeError("run: a worker process died during the runs (killed, out of memory, or a crash "
+                           "in compiled code); the runs in progress are lost") from exc
+    try:
+        return pickle.loads(blob)
+    except Exception as exc:                  # noqa: BLE001 - named, then the workers stop
+        raise TypeError(f"run: its result could not be rebuilt here ({type(exc).__name__}: {exc})") from exc

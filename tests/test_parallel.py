@@ -1,6 +1,10 @@
 """Independent runs in worker processes: same results, same order, same errors as a plain loop."""
+import os
+import subprocess
+import sys
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -46,6 +50,26 @@ def test_closing_the_results_early_stops_the_workers(tmp_path):
     assert len(list(tmp_path.iterdir())) == started < 40
     with pytest.raises(StopIteration):
         next(results)
+
+
+def _large(shared, task):
+    return bytes(shared) + bytes([task])
+
+
+def test_closing_early_with_large_results_in_flight_does_not_hang():
+    # multiprocessing's Pool.terminate killed a worker halfway through writing a large result, then
+    # waited forever for the lock it held (a lesson's rendered frames, closed after the first batch)
+    script = ("from robokit.parallel import iter_runs\n"
+              "from test_parallel import _large\n"
+              "for _ in range(5):\n"
+              "    results = iter_runs(_large, 2_000_000, list(range(8)), workers=2)\n"
+              "    assert len(next(results)) == 2_000_001\n"
+              "    results.close()\n"
+              "print('closed')\n")
+    path = os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")]))
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": path})
+    assert done.returncode == 0 and done.stdout.strip() == "closed", done.stderr[-2000:]
 
 
 def _interrupt_handler(shared, task):
