@@ -3,7 +3,9 @@
 #   make test     run the test-suite
 #   make check    the same suite with the browser tests required, not skipped (.ci/run calls exactly this)
 # Each target creates .venv on first use and installs both packages, editable, with their extras:
-# the robokit library (pyproject.toml) and the robocourse course package (course/pyproject.toml).
+# the robokit library (pyproject.toml) and the robocourse course package (course/pyproject.toml),
+# every dependency at the version constraints.txt pins (the versions that made the lessons' numbers).
+#   make upgrade  install the newest versions the pyproject ranges allow and rewrite constraints.txt
 
 PYTHON ?= python3
 VENV   ?= .venv
@@ -12,12 +14,12 @@ STAMP  := $(VENV)/.robokit-installed
 PYTEST_ARGS ?=
 COURSE_ARGS ?=
 
-.PHONY: course test check lab venv assignments bench clean
+.PHONY: course test check lab venv upgrade assignments bench clean
 
-$(STAMP): pyproject.toml course/pyproject.toml
+$(STAMP): pyproject.toml course/pyproject.toml constraints.txt
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[legged,arm,dev]' -e './course[lab]'
+	$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[legged,arm,dev]' -e './course[lab]'
 	@touch $(STAMP)
 
 venv: $(STAMP)
@@ -30,6 +32,15 @@ test: $(STAMP)
 
 check: $(STAMP)
 	ROBOKIT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest $(PYTEST_ARGS)
+
+# A deliberate upgrade: then update environment.yml's pins (tests/test_packaging.py names them), run
+# `make course` and `make check`, and commit the new numbers with constraints.txt.
+upgrade: $(STAMP)
+	$(BIN)/python -m pip install --quiet --upgrade --upgrade-strategy eager -e '.[legged,arm,dev]' -e './course[lab]'
+	{ grep '^#' constraints.txt; $(BIN)/python -m pip list --format=freeze --exclude-editable \
+	  | grep -viE '^(pip|setuptools|wheel|robokit|robocourse)=='; } > constraints.txt.new
+	mv constraints.txt.new constraints.txt
+	@touch $(STAMP)
 
 lab: $(STAMP)
 	$(BIN)/jupyter lab --notebook-dir=.

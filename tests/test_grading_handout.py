@@ -43,8 +43,8 @@ def test_the_handout_has_the_lessons_assignments_and_packages_and_no_solutions(h
     assert sorted(p.name for p in (folder / "lessons").glob("*.ipynb")) == lessons
     assert sorted(p.name for p in (folder / "assignments").glob("*.ipynb")) == \
         sorted(p.name for p in (ROOT / "assignments").glob("*.ipynb"))
-    for needed in ("pyproject.toml", "course/pyproject.toml", "environment.yml", "Makefile", "README.md", "course/README.md",
-                   "robokit/__init__.py", "course/robocourse/grading/check.py", "course/robocourse/data/04_littledog.json"):
+    for needed in ("pyproject.toml", "course/pyproject.toml", "environment.yml", "constraints.txt", "Makefile", "README.md",
+                   "course/README.md", "robokit/__init__.py", "course/robocourse/grading/check.py", "course/robocourse/data/04_littledog.json"):
         assert (folder / needed).is_file(), needed
     assert not any(part in ("solutions", "tests", "benchmarks", "__pycache__") for n in names for part in n.split("/"))
     texts = _solution_texts()

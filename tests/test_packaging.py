@@ -57,6 +57,58 @@ def test_environment_mirrors_pyproject():
     assert editable == ["-e .", "-e ./course"], "environment.yml must install both packages in editable mode via pip"
 
 
+def _pins(text: str) -> dict:
+    pins = {}
+    for line in text.splitlines():
+        line = line.split("#", 1)[0].strip()
+        if line:
+            assert re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*==[0-9][A-Za-z0-9.+!-]*", line), \
+                f"constraints.txt: expected name==version, got {line!r}"
+            name, version = line.split("==")
+            assert _name(name) not in pins, f"constraints.txt: {name} pinned twice"
+            pins[_name(name)] = version
+    return pins
+
+
+def test_every_dependency_is_pinned_and_environment_yml_pins_the_same_versions():
+    # a build in March prints what the site printed in January (issue: OpenCV 5.0 -> 5.1 on the index)
+    pins = _pins((ROOT / "constraints.txt").read_text())
+    pypi = {v: k for k, v in CONDA_NAME.items()}
+    assert not {"pip", "setuptools", "robokit", "robocourse"} & set(pins)
+    unpinned = sorted(n for n in _pyproject_names() if pypi.get(n, n) not in pins)
+    assert not unpinned, f"constraints.txt pins none of {unpinned}"
+    env = yaml.safe_load((ROOT / "environment.yml").read_text())
+    entries = [d for d in env["dependencies"] if isinstance(d, str)]
+    entries += [p for d in env["dependencies"] if isinstance(d, dict) for p in d.get("pip", []) if not p.startswith("-e")]
+    differ = []
+    for entry in entries:
+        name = _name(entry)
+        if name in {"python", "pip"}:
+            continue
+        version = entry.partition("==")[2].split()[0] if "==" in entry else None
+        if version != pins[pypi.get(name, name)]:
+            differ.append(f"{name}: environment.yml {version or entry!r}, constraints.txt {pins[pypi.get(name, name)]}")
+    assert not differ, "environment.yml must pin what constraints.txt pins: " + "; ".join(differ)
+    for project, _ in PACKAGES.items():          # each pin satisfies the range its pyproject asks for
+        reqs = _project(project)["dependencies"] + [r for e in _project(project)["optional-dependencies"].values()
+                                                    for r in e]
+        for req in reqs:
+            floor = re.search(r">=([0-9][0-9.]*)", req)
+            name = _name(req)
+            if floor and name in pins:
+                have = tuple(int(x) for x in re.findall(r"\d+", pins[name])[:3])
+                want = tuple(int(x) for x in floor.group(1).split("."))
+                assert have[:len(want)] >= want, f"{name}: pinned {pins[name]}, {project} asks >= {floor.group(1)}"
+
+
+def test_make_installs_with_the_constraints():
+    makefile = (ROOT / "Makefile").read_text()
+    installs = [line for line in makefile.splitlines() if "pip install" in line and "-e '." in line]
+    assert installs and all("-c constraints.txt" in line for line in installs if "--upgrade-strategy" not in line)
+    from robocourse.grading.handout import HANDOUT_PATHS, STUDENT_MAKEFILE
+    assert "-c constraints.txt" in STUDENT_MAKEFILE and "constraints.txt" in HANDOUT_PATHS
+
+
 def test_the_library_needs_nothing_of_the_course():
     project = _project("pyproject.toml")
     runtime = project["dependencies"] + [r for e in ("legged", "arm") for r in project["optional-dependencies"][e]]

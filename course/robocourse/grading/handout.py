@@ -28,7 +28,7 @@ __all__ = ["HANDOUT_PATHS", "STUDENT_MAKEFILE", "handout_files", "write_handout"
 
 #: What the handout copies from the course root (folders whole, minus caches and build leftovers).
 HANDOUT_PATHS = ("lessons", "assignments", "robokit", "course/robocourse", "course/pyproject.toml", "course/README.md",
-                 "pyproject.toml")
+                 "pyproject.toml", "constraints.txt")
 #: The handout's own Makefile: a student's ``make lab`` (no test or developer extras).
 STUDENT_MAKEFILE = """\
 # robokit courseware, the students' handout. `make lab` sets up .venv on first use and opens JupyterLab.
@@ -39,10 +39,10 @@ STAMP  := $(VENV)/.robokit-installed
 
 .PHONY: lab venv
 
-$(STAMP): pyproject.toml course/pyproject.toml
+$(STAMP): pyproject.toml course/pyproject.toml constraints.txt
 \t@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 \t$(BIN)/python -m pip install --quiet --upgrade pip
-\t$(BIN)/python -m pip install --quiet -e '.[legged,arm]' -e './course[lab]'
+\t$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[legged,arm]' -e './course[lab]'
 \t@touch $(STAMP)
 
 venv: $(STAMP)
