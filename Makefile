@@ -1,7 +1,7 @@
 # robokit courseware. The commands an instructor needs:
 #   make course   build the course: run every lesson and solution notebook, write build/course/
-#   make test     run the test-suite
-#   make check    the same suite with the browser tests required, not skipped (.ci/run calls exactly this)
+#   make test     the everyday test-suite (no site builds, browser tests or whole hostile batches): minutes
+#   make check    every test, the browser tests required, not skipped (.ci/run calls exactly this)
 # Each target creates .venv on first use and installs both packages, editable, with their extras:
 # the robokit library (pyproject.toml) and the robocourse course package (course/pyproject.toml),
 # every dependency at the version constraints.txt pins (the versions that made the lessons' numbers).
@@ -12,6 +12,8 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.robokit-installed
 PYTEST_ARGS ?=
+# pytest-xdist over every core; tests sharing the fast course build stay on one worker (tests/conftest.py)
+XDIST  ?= -n auto --dist loadgroup
 COURSE_ARGS ?=
 
 .PHONY: course test check lab venv upgrade assignments bench clean
@@ -28,10 +30,10 @@ course: $(STAMP)
 	$(BIN)/robocourse build $(COURSE_ARGS)
 
 test: $(STAMP)
-	$(BIN)/python -m pytest $(PYTEST_ARGS)
+	$(BIN)/python -m pytest $(XDIST) -m "not slow" $(PYTEST_ARGS)
 
 check: $(STAMP)
-	ROBOKIT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest $(PYTEST_ARGS)
+	ROBOKIT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest $(XDIST) $(PYTEST_ARGS)
 
 # A deliberate upgrade: then update environment.yml's pins (tests/test_packaging.py names them), run
 # `make course` and `make check`, and commit the new numbers with constraints.txt.

@@ -20,6 +20,14 @@ needs_chromium = pytest.mark.skipif(
     reason="no Chromium on PATH (Debian package 'chromium'; .ci/run installs it)")
 
 
+def pytest_collection_modifyitems(config, items):
+    """Under pytest-xdist (`make test`, `make check`: ``-n auto --dist loadgroup``) every test that needs
+    the ``fast_course`` build runs on one worker, so the course is executed and its sites built once."""
+    for item in items:
+        if "fast_course" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.xdist_group("fast_course"))
+
+
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     return ROOT

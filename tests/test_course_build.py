@@ -19,6 +19,7 @@ def _notebook(path, *sources):
     return path
 
 
+# A small course built whole (about 35 s): its tests are slow (`make check` runs them).
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
     root = tmp_path_factory.mktemp("course")
@@ -37,6 +38,7 @@ def course(tmp_path_factory):
     return root, code
 
 
+@pytest.mark.slow
 def test_build_exits_nonzero_but_builds_everything(course):
     root, code = course
     assert code == 1
@@ -50,6 +52,7 @@ def test_build_exits_nonzero_but_builds_everything(course):
     assert not (student / "solutions").exists()
 
 
+@pytest.mark.slow
 def test_instructor_build_report_has_status_and_error_tail(course):
     root, _ = course
     report = (root / "build" / "instructor" / "instructor" / "build.html").read_text()
@@ -59,6 +62,7 @@ def test_instructor_build_report_has_status_and_error_tail(course):
     assert "instructor/build" not in (root / "build" / "course" / "index.html").read_text()
 
 
+@pytest.mark.slow
 def test_pages_have_outputs_figures_titles_and_folded_imports(course):
     root, _ = course
     page = (root / "build" / "course" / "lessons" / "00_good.html").read_text()
@@ -72,6 +76,7 @@ def test_pages_have_outputs_figures_titles_and_folded_imports(course):
     assert "did not run to the end when the site was built (timeout)" in solution
 
 
+@pytest.mark.slow
 def test_sites_are_linked_in_lesson_order_with_previous_next(course):
     root, _ = course
     index = (root / "build" / "course" / "index.html").read_text()
@@ -196,6 +201,7 @@ def test_build_needs_the_site_sources(tmp_path, capsys):
     assert "book/" in capsys.readouterr().out and not (root / "build" / "executed").exists()
 
 
+@pytest.mark.slow
 def test_a_solution_starts_after_its_lesson_and_the_longest_goes_first(tmp_path):
     from robocourse.site.build import run_notebooks
     stamp = tmp_path / "stamps.txt"
@@ -225,6 +231,7 @@ def test_a_solution_starts_after_its_lesson_and_the_longest_goes_first(tmp_path)
     assert first == ("lessons/01_long.ipynb", "start")
 
 
+@pytest.mark.slow
 def test_a_fresh_full_build_starts_the_notebook_declaring_the_longest_cold_time(tmp_path):
     from robocourse.site.build import run_notebooks
     stamp = tmp_path / "stamps.txt"
@@ -239,6 +246,7 @@ def test_a_fresh_full_build_starts_the_notebook_declaring_the_longest_cold_time(
     assert stamp.read_text().split() == ["02_slow.ipynb", "01_quick.ipynb"]
 
 
+@pytest.mark.slow
 def test_the_notebooks_running_at_once_share_the_cores(tmp_path, monkeypatch):
     # each kernel gets ROBOKIT_WORKERS = cores // notebooks at once, so the build never runs more
     # worker processes than cores (two notebooks on two cores: one worker each, the runs made in

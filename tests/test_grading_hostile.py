@@ -125,6 +125,7 @@ def _can_connect():
     return _with(replace_wrap=code + wrap_angle_unless("_can_connect()"))
 
 
+# Every hostile submission graded in one batch (about 45 s): its tests are slow (`make check` runs them).
 @pytest.fixture(scope="module")
 def graded(tmp_path_factory):
     folder = tmp_path_factory.mktemp("subs")
@@ -162,6 +163,7 @@ def graded(tmp_path_factory):
 
 @pytest.mark.parametrize("name", list(HOSTILE) + ["writes_output_paths", "reads_solution", "honest",
                                                   "reaches_network", "check_from_its_module"])
+@pytest.mark.slow
 def test_hostile_submission_scores_only_what_it_earned(graded, name):
     results, cases, _, _, _ = graded
     if name in ("reads_solution", "reaches_network") and not is_root():
@@ -178,6 +180,7 @@ def test_hostile_submission_scores_only_what_it_earned(graded, name):
         assert result.flags == ([] if is_root() else ["sandbox=limited"]) and result.worker_log == ""
 
 
+@pytest.mark.slow
 def test_check_is_silenced_however_it_is_imported(graded):
     # check() on public cases would fail this lambda and raise in the cell; under grading it only
     # prints that it is skipped, whether imported from robocourse or under its old name, robokit.grading
@@ -185,12 +188,14 @@ def test_check_is_silenced_however_it_is_imported(graded):
     assert results["check_from_its_module"].cell_errors == []
 
 
+@pytest.mark.slow
 def test_batch_time_is_bounded(graded):
     _, cases, elapsed, _, _ = graded
     # two jobs; at most a few submissions reach the 40 s wall limit
     assert elapsed < 180, f"batch of {len(cases)} took {elapsed:.0f}s"
 
 
+@pytest.mark.slow
 def test_output_paths_untouched(graded):
     _, _, _, out, feedback = graded
     if not is_root():
@@ -199,6 +204,7 @@ def test_output_paths_untouched(graded):
     assert not (out / "grades.csv").exists()
 
 
+@pytest.mark.slow
 def test_no_worker_processes_left(graded):
     if not is_root():
         pytest.skip("job uids exist only when grading as root")

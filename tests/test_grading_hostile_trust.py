@@ -87,6 +87,7 @@ def _grade_capped(folder: Path, names: list[str], memory_bytes: int) -> tuple[su
     return done, rows
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not is_root(), reason="a memory cap on the whole batch needs a control group (root)")
 def test_a_memory_bomb_answer_costs_only_its_own_case_under_a_1_gib_cap():
     with public_tmp() as folder:
@@ -179,12 +180,14 @@ def _attackers(ex, slug):
     return out
 
 
+# Every exercise's hidden cases drawn (about 30 s with their tests): slow (`make check` runs them).
 @pytest.fixture(scope="module")
 def hidden_cases():
     """Every assignment's prepared cases for three hidden seeds and the public one."""
     return {(slug, seed): prepare_cases(slug, seed) for slug in assignments() for seed in ("h1", "h2", str(PUBLIC_SEED))}
 
 
+@pytest.mark.slow
 def test_constants_that_raise_on_bad_input_score_nothing(hidden_cases):
     # the strongest trivial submission: the answer is a constant (or an argument, or a shortcut)
     # and the function raises exactly on the bad inputs
@@ -204,6 +207,7 @@ def test_constants_that_raise_on_bad_input_score_nothing(hidden_cases):
     assert not earned
 
 
+@pytest.mark.slow
 def test_an_honest_function_unlocks_every_exercise(hidden_cases):
     # the other side of the rule: in every draw, a right function's passes show work
     locked = []

@@ -11,8 +11,16 @@ from tests.conftest import ROOT
 TIME_LIMIT = 300  # seconds per notebook under ROBOKIT_FAST=1 (the fast_course fixture uses the same)
 
 
+def _params():
+    """Assignments run here (their raises-exception tags are what is under test): `make test`. Lessons
+    and solutions come from the ``fast_course`` build, which also builds the sites: slow, `make check`."""
+    for path in discover(ROOT, ALL_DIRS):
+        marks = [] if path.parent.name == "assignments" else [pytest.mark.slow, pytest.mark.xdist_group("fast_course")]
+        yield pytest.param(path, marks=marks, id=f"{path.parent.name}/{path.name}")
+
+
 @pytest.mark.notebook
-@pytest.mark.parametrize("path", discover(ROOT, ALL_DIRS), ids=lambda p: f"{p.parent.name}/{p.name}")
+@pytest.mark.parametrize("path", _params())
 def test_notebook_runs(path, request):
     if path.parent.name == "assignments":
         run = run_notebook(path, timeout=TIME_LIMIT, fast=True)
