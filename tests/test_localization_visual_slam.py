@@ -208,6 +208,7 @@ def test_ransac_recovers_the_rendered_motion_with_half_the_matches_wrong():
     assert np.hypot(*(res.pqt[:2] - truth[:2])) < 0.02 and abs(wrap_angle(res.pqt[2] - truth[2])) < np.deg2rad(0.5)
 
 
+@pytest.mark.slow    # a lesson experiment built whole; make check
 def test_lab_experiment_is_cached_and_a_bad_cache_file_is_rebuilt(tmp_path, monkeypatch):
     import robocourse.lessons.visual_slam.experiment as lab
 

@@ -20,7 +20,7 @@ def _params():
 
 
 @pytest.mark.notebook
-@pytest.mark.parametrize("path", _params())
+@pytest.mark.parametrize("path", list(_params()))
 def test_notebook_runs(path, request):
     if path.parent.name == "assignments":
         run = run_notebook(path, timeout=TIME_LIMIT, fast=True)

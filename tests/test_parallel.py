@@ -149,6 +149,7 @@ def test_bad_arguments_are_named():
         map_runs(divmod, 1, [1], progress=3)
 
 
+@pytest.mark.slow    # a lesson experiment built whole; make check
 def test_table_2_runs_do_not_depend_on_the_number_of_workers(monkeypatch):
     # each run is seeded from its start and number: made side by side, they give the same table
     monkeypatch.setenv("ROBOKIT_FAST", "1")
