@@ -12,8 +12,9 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.robokit-installed
 PYTEST_ARGS ?=
-# pytest-xdist over every core; tests sharing the fast course build stay on one worker (tests/conftest.py)
-XDIST  ?= -n auto --dist loadgroup
+# pytest-xdist over every core, a test module per unit of work; the tests sharing the fast course
+# build make one unit, started early (tests/conftest.py)
+XDIST  ?= -n auto --dist loadscope --no-loadscope-reorder
 COURSE_ARGS ?=
 
 .PHONY: course test check lab venv upgrade assignments bench clean

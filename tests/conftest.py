@@ -20,12 +20,41 @@ needs_chromium = pytest.mark.skipif(
     reason="no Chromium on PATH (Debian package 'chromium'; .ci/run installs it)")
 
 
+#: The tests that need the ``fast_course`` build (their node ids): under pytest-xdist they make one
+#: unit of work, so the course is executed and its sites built once, not once per worker.
+FAST_COURSE_FILES = ("tests/test_course_site.py::", "tests/test_course_site_browser.py::")
+FAST_COURSE_PARAMS = ("tests/test_notebooks.py::test_notebook_runs[lessons/",
+                      "tests/test_notebooks.py::test_notebook_runs[solutions/")
+
+
+def shares_fast_course(nodeid: str) -> bool:
+    return nodeid.startswith(FAST_COURSE_FILES + FAST_COURSE_PARAMS)
+
+
 def pytest_collection_modifyitems(config, items):
-    """Under pytest-xdist (`make test`, `make check`: ``-n auto --dist loadgroup``) every test that needs
-    the ``fast_course`` build runs on one worker, so the course is executed and its sites built once."""
-    for item in items:
-        if "fast_course" in getattr(item, "fixturenames", ()):
-            item.add_marker(pytest.mark.xdist_group("fast_course"))
+    """Every test that uses ``fast_course`` must be one :func:`shares_fast_course` names (else a second
+    worker would build the course again)."""
+    stray = [item.nodeid for item in items
+             if "fast_course" in getattr(item, "fixturenames", ()) and not shares_fast_course(item.nodeid)]
+    if stray:
+        raise pytest.UsageError(f"tests/conftest.py: add these users of fast_course to FAST_COURSE_FILES: {stray}")
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``make test`` / ``make check`` (``-n auto --dist loadscope``): each test module is one unit of
+    work, so its module fixtures (a graded batch of hostile submissions) are built once, and every
+    test of the fast course build is one unit (pytest-xdist's ``xdist_group`` marks are not honoured
+    with this pytest)."""
+    if config.getvalue("dist") != "loadscope":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class SharedBuildScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return "fast_course" if shares_fast_course(nodeid) else nodeid.split("::", 1)[0]
+
+    return SharedBuildScheduling(config, log)
 
 
 @pytest.fixture(scope="session")

@@ -15,7 +15,7 @@ def _params():
     """Assignments run here (their raises-exception tags are what is under test): `make test`. Lessons
     and solutions come from the ``fast_course`` build, which also builds the sites: slow, `make check`."""
     for path in discover(ROOT, ALL_DIRS):
-        marks = [] if path.parent.name == "assignments" else [pytest.mark.slow, pytest.mark.xdist_group("fast_course")]
+        marks = [] if path.parent.name == "assignments" else [pytest.mark.slow]
         yield pytest.param(path, marks=marks, id=f"{path.parent.name}/{path.name}")
 
 
