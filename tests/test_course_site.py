@@ -102,3 +102,25 @@ def test_home_page_says_what_who_and_how_to_start(fast_course):
     text = html.unescape(re.sub(r"<[^>]+>", " ", (fast_course.student / "index.html").read_text()))
     for phrase in ("Who it is for", "How to start", "Lesson 00"):
         assert phrase in text, phrase
+
+
+def test_sites_are_light_one_viewer_clean_downloads_and_only_the_mathjax_they_use(fast_course):
+    from robocourse.site.slim import VIEWER_SCRIPT
+    from robokit.viz.scene import viewer_javascript
+
+    inline = html.escape(viewer_javascript()[:2000], quote=True)
+    for site in (fast_course.student, fast_course.instructor):
+        size = sum(p.stat().st_size for p in site.rglob("*") if p.is_file())
+        assert size < 40e6, f"{site.name}: {size / 1e6:.1f} MB"
+        pages = {p: p.read_text(encoding="utf-8") for p in site.rglob("*.html")}
+        assert not [p.name for p, text in pages.items() if inline in text], "a scene still carries its own viewer"
+        scenes = [p for p, text in pages.items() if "meshcat-viewer.js" in text]
+        assert len(scenes) >= 6 and (site / VIEWER_SCRIPT).read_text(encoding="utf-8") == viewer_javascript()
+        downloads = sorted((site / "_sources").rglob("*.ipynb"))
+        assert len(downloads) >= 8
+        for path in downloads:
+            cells = json.loads(path.read_text(encoding="utf-8"))["cells"]
+            assert not any(c.get("outputs") for c in cells) and any(c["cell_type"] == "code" for c in cells), path
+        bundles = set(re.findall(r"_static/mathjax/([\w-]+\.js)", "".join(pages.values())))
+        assert bundles and all((site / "_static" / "mathjax" / b).is_file() for b in bundles)
+        assert not list(site.rglob("*.js.map")) and not (site / "_static" / "mathjax" / "tex-svg-full.js").exists()

@@ -26,6 +26,8 @@ import time
 from pathlib import Path
 from typing import Mapping, Sequence
 
+from .slim import slim_site
+
 __all__ = ["SITES", "API_MODULES", "SITE_TOOLS", "BookPage", "is_import_cell", "prepare_notebook",
            "write_sources", "sphinx_build", "SiteBuild", "site_tool_problems", "site_out_problem",
            "replace_site"]
@@ -300,7 +302,9 @@ def sphinx_build(src: Path, out: Path, *, instructor: bool = False, timeout: flo
 
     Sphinx runs in its own process (``python -m sphinx``), from scratch (``-E``), into a private
     folder beside ``src`` (``html/``; myst-nb's ``jupyter_execute/`` and the doctrees go there too),
-    and only a finished site replaces ``out`` (:func:`replace_site`), so a site never keeps a page
+    and only a finished site, slimmed (:func:`~robocourse.site.slim.slim_site`: one copy of the 3D
+    viewer, notebooks without outputs to download, the MathJax parts the pages load), replaces
+    ``out`` (:func:`replace_site`), so a site never keeps a page
     the build no longer writes and a failed build leaves the previous site in place. Warnings are
     returned, not fatal: a docstring Sphinx cannot format must not hide the course.
 
@@ -341,6 +345,7 @@ def sphinx_build(src: Path, out: Path, *, instructor: bool = False, timeout: flo
         ok, log = False, f"sphinx-build stopped after the time limit of {timeout:.0f} s"
     text = warnings.read_text(encoding="utf-8") if warnings.exists() else ""
     if ok:
+        slim_site(html_dir)
         replace_site(html_dir, out)
     else:
         text = (text + "\n" + log).strip()

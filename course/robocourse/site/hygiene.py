@@ -5,6 +5,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+from robokit.files import write_atomically
+
 __all__ = ["notebook_problems", "strip_notebook", "strip_file"]
 
 
@@ -73,6 +75,6 @@ def strip_file(path: str | Path) -> bool:
     nb = strip_notebook(json.loads(before))
     after = json.dumps(nb, indent=1, ensure_ascii=False) + "\n"
     if after != before:
-        path.write_text(after, encoding="utf-8")
+        write_atomically(path, lambda tmp: tmp.write_text(after, encoding="utf-8"))
         return True
     return False
