@@ -36,14 +36,17 @@ test: $(STAMP)
 check: $(STAMP)
 	ROBOKIT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest $(XDIST) $(PYTEST_ARGS)
 
-# A deliberate upgrade: then update environment.yml's pins (tests/test_packaging.py names them), run
-# `make course` and `make check`, and commit the new numbers with constraints.txt.
-upgrade: $(STAMP)
-	$(BIN)/python -m pip install --quiet --upgrade --upgrade-strategy eager -e '.[legged,arm,dev]' -e './course[lab]'
-	{ grep '^#' constraints.txt; $(BIN)/python -m pip list --format=freeze --exclude-editable \
-	  | grep -viE '^(pip|setuptools|wheel|robokit|robocourse)=='; } > constraints.txt.new
+# A deliberate upgrade: the newest versions the pyproject ranges allow, resolved in a fresh venv (so
+# nothing installed by hand is pinned); then update environment.yml's pins (tests/test_packaging.py
+# names them), run `make course` and `make check`, and commit the new numbers with constraints.txt.
+upgrade:
+	rm -rf $(VENV)-upgrade && $(PYTHON) -m venv $(VENV)-upgrade
+	$(VENV)-upgrade/bin/python -m pip install --quiet --upgrade pip
+	$(VENV)-upgrade/bin/python -m pip install --quiet -e '.[legged,arm,dev]' -e './course[lab]'
+	{ grep '^#' constraints.txt; $(VENV)-upgrade/bin/python -m pip list --format=freeze --exclude-editable \
+	  | grep -viE '^(pip|setuptools|wheel|robokit|robocourse)==' | sort -f; } > constraints.txt.new
 	mv constraints.txt.new constraints.txt
-	@touch $(STAMP)
+	rm -rf $(VENV)-upgrade
 
 lab: $(STAMP)
 	$(BIN)/jupyter lab --notebook-dir=.

@@ -26,8 +26,10 @@ import os
 import pickle
 import signal
 import sys
+import queue
+import threading
 import traceback
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Sequence
 
@@ -47,15 +49,15 @@ _SHARED: dict = {}    # in a worker: the run and the object every run needs, sen
 
 
 def _receive(blobs: dict, settings: dict, threads: int) -> None:
-    # an interrupt is the caller's to handle (it stops the workers): a worker that died of it would
-    # be replaced and its run lost, and a caller still taking results would wait for it forever
+    # an interrupt is the caller's to handle (it stops the runs): a worker that died of it would
+    # break the whole pool and lose every run in progress
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     os.environ.update(settings)            # the caller's ROBOKIT_* settings, not the fork server's
     os.environ["ROBOKIT_WORKERS"] = "1"     # a run that makes runs of its own makes them in place
     cv2.setNumThreads(threads)             # the workers already fill the cores: no OpenCV threads on top
     _SHARED.clear()
     for name, blob in blobs.items():       # "run", then "shared"
-        try:                               # a failure here would make the pool restart workers forever
+        try:                               # a failure here would break the pool before any run
             _SHARED[name] = pickle.loads(blob)
         except BaseException as exc:       # noqa: BLE001 - reported by every run instead
             _SHARED["error"] = _unreadable(name, exc)
@@ -69,8 +71,8 @@ def _unreadable(name: str, exc: BaseException) -> TypeError:
 
 def _run_shared(blob: bytes) -> bytes:
     """One run in a worker: everything goes in and comes out as bytes, and every failure comes back as
-    an error the caller can rebuild, so no failure can kill a worker (the pool would lose the run and
-    wait for it forever) or the caller's result thread."""
+    an error the caller can rebuild, so no failure can kill a worker (the pool would break and lose
+    every run in progress) or the executor's result thread."""
     if "error" in _SHARED:
         raise _SHARED["error"]
     try:
@@ -160,10 +162,11 @@ def map_runs(run: Callable, shared: Any, tasks: Sequence, *, workers: int | None
         defined in a notebook), a ``shared`` object or task that does not pickle, or one whose
         class the workers cannot import (defined in a notebook), or a result that cannot be
         rebuilt here. An error inside a run is raised here, the first in the order of ``tasks`` (as
-        the plain loop would raise it); then, as when the caller is interrupted, no further run starts
-        and the call returns once the runs in progress end. A worker that dies (killed, out of
-        memory) is a ``RuntimeError``, not a wait for its lost run. With workers, an error that cannot travel back (it does not pickle,
-        or it is ``SystemExit``) comes as a ``RuntimeError`` carrying its text and traceback.
+        the plain loop would raise it); then, as when the caller is interrupted, no further run
+        starts and the call returns once the runs in progress end. A worker that dies (killed, out
+        of memory) is a ``RuntimeError``. With workers, an error that cannot travel back (it does
+        not pickle, or it is ``SystemExit``) comes as a ``RuntimeError`` carrying its text and
+        traceback.
 
     Notes
     -----
@@ -250,27 +253,52 @@ def _in_workers(run: Callable, blobs: dict, settings: dict, jobs: list, workers:
 
     A :class:`~concurrent.futures.ProcessPoolExecutor`, not :class:`multiprocessing.pool.Pool`: the
     latter's ``terminate`` can kill a worker while it holds the lock of the results pipe (a large
-    result half written), and then waits for that lock forever. The executor is never killed: at
-    the end, on an error, an interrupt or a closed iterator, the runs not started are cancelled and
-    those in progress end first; a worker that dies is an error here, not a lost run.
+    result half written), and then waits for that lock forever. The executor is never killed. A
+    feeder thread keeps at most ``workers`` runs submitted and not finished (the executor would queue
+    more, which could no longer be cancelled), so at the end, on an error, an interrupt or a closed
+    iterator, no run starts after the stop and the call returns once the runs in progress end; the
+    workers never wait for the caller. Each result is let go once it is handed over.
     """
     threads = max(1, worker_count() // workers)     # this process's share of the cores, per worker
-    with progress_bar(len(jobs), desc, unit=unit, callback=progress) as bar:
-        pool = ProcessPoolExecutor(workers, mp_context=_context(run), initializer=_receive,
-                                   initargs=(blobs, settings, threads))
+    pool = ProcessPoolExecutor(workers, mp_context=_context(run), initializer=_receive,
+                               initargs=(blobs, settings, threads))
+    submitted: queue.SimpleQueue = queue.SimpleQueue()     # futures in task order, then None
+    slots, stop = threading.Semaphore(workers), threading.Event()
+
+    def feed() -> None:
         try:
-            futures = [pool.submit(_run_shared, job) for job in jobs]
-            for future in futures:                        # in order
+            for job in jobs:
+                slots.acquire()
+                if stop.is_set():
+                    return
+                future = pool.submit(_run_shared, job)
+                future.add_done_callback(lambda _: slots.release())
+                submitted.put(future)
+        except BrokenProcessPool as exc:   # a worker died while runs were being handed out
+            submitted.put(exc)
+        finally:
+            submitted.put(None)
+
+    feeder = threading.Thread(target=feed, name="robokit-runs-feeder", daemon=True)
+    with progress_bar(len(jobs), desc, unit=unit, callback=progress) as bar:
+        feeder.start()
+        try:
+            for future in iter(submitted.get, None):      # in order
                 result = _rebuilt(future)
                 bar.update()
                 yield result
         finally:
+            stop.set()
+            slots.release()                               # a feeder waiting for a slot sees the stop
+            feeder.join()
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _rebuilt(future) -> Any:
+def _rebuilt(future: Future | BrokenProcessPool) -> Any:
     """A run's result, rebuilt here; a worker that died is named."""
     try:
+        if isinstance(future, BrokenProcessPool):
+            raise future
         blob = future.result()
     except BrokenProcessPool as exc:
         raise RuntimeError("run: a worker process died during the runs (killed, out of memory, or a crash "

@@ -345,7 +345,10 @@ def sphinx_build(src: Path, out: Path, *, instructor: bool = False, timeout: flo
         ok, log = False, f"sphinx-build stopped after the time limit of {timeout:.0f} s"
     text = warnings.read_text(encoding="utf-8") if warnings.exists() else ""
     if ok:
-        slim_site(html_dir)
+        try:
+            slim_site(html_dir)
+        except (OSError, ValueError, UnicodeDecodeError) as exc:    # published whole, with a warning
+            text = (text + f"\nrobocourse: the site was not slimmed ({type(exc).__name__}: {exc})").strip()
         replace_site(html_dir, out)
     else:
         text = (text + "\n" + log).strip()

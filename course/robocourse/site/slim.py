@@ -49,6 +49,11 @@ def slim_site(site: Path) -> dict[str, int]:
     dict
         Bytes saved by each step: ``"viewer"``, ``"sources"``, ``"mathjax"``, ``"maps"``.
 
+    Raises
+    ------
+    ValueError
+        If ``site`` holds no ``index.html``.
+
     Notes
     -----
     Course convention (DESIGN.md, "The course site"); not from a paper.
@@ -102,6 +107,8 @@ def _prune_mathjax(site: Path, pages: list[Path]) -> int:
     bundles = set()
     for page in pages:
         bundles.update(_BUNDLE.findall(page.read_text(encoding="utf-8")))
+    if not bundles:             # no page names a top-level bundle (another layout): keep it all
+        return 0
     parts = {part for b in bundles for part in b[:-3].split("-")}           # tex-chtml.js: tex, chtml
     keep = {mathjax / b for b in bundles} | {mathjax / d for d in _MATHJAX_ON_DEMAND}
     keep |= {mathjax / "input" / p for p in parts} | {mathjax / "output" / p for p in parts}
