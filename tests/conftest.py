@@ -31,6 +31,16 @@ def shares_fast_course(nodeid: str) -> bool:
     return nodeid.startswith(FAST_COURSE_FILES + FAST_COURSE_PARAMS)
 
 
+def work_unit(nodeid: str) -> str:
+    """The unit of work of a test under pytest-xdist: its module; every test of the fast course build;
+    every grading test, since they share the machine's job uids and control groups (a test that
+    counts a job's leftover processes would count another test's job)."""
+    if shares_fast_course(nodeid):
+        return "fast_course"
+    module = nodeid.split("::", 1)[0]
+    return "grading" if module.startswith("tests/test_grading_") else module
+
+
 def pytest_collection_modifyitems(config, items):
     """Every test that uses ``fast_course`` must be one :func:`shares_fast_course` names (else a second
     worker would build the course again)."""
@@ -42,17 +52,16 @@ def pytest_collection_modifyitems(config, items):
 
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config, log):
-    """``make test`` / ``make check`` (``-n auto --dist loadscope``): each test module is one unit of
-    work, so its module fixtures (a graded batch of hostile submissions) are built once, and every
-    test of the fast course build is one unit (pytest-xdist's ``xdist_group`` marks are not honoured
-    with this pytest)."""
+    """``make test`` / ``make check`` (``-n auto --dist loadscope``): the units of :func:`work_unit`, so
+    module fixtures (a graded batch of hostile submissions) and the fast course are built once
+    (pytest-xdist's ``xdist_group`` marks are not honoured with this pytest)."""
     if config.getvalue("dist") != "loadscope":
         return None
     from xdist.scheduler import LoadScopeScheduling
 
     class SharedBuildScheduling(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
-            return "fast_course" if shares_fast_course(nodeid) else nodeid.split("::", 1)[0]
+            return work_unit(nodeid)
 
     return SharedBuildScheduling(config, log)
 
