@@ -24,9 +24,9 @@ from __future__ import annotations
 import multiprocessing
 import os
 import pickle
+import queue
 import signal
 import sys
-import queue
 import threading
 import traceback
 from concurrent.futures import Future, ProcessPoolExecutor
@@ -275,7 +275,9 @@ def _in_workers(run: Callable, blobs: dict, settings: dict, jobs: list, workers:
                 future.add_done_callback(lambda _: slots.release())
                 submitted.put(future)
         except BrokenProcessPool as exc:   # a worker died while runs were being handed out
-            submitted.put(exc)
+            failed = Future()
+            failed.set_exception(exc)
+            submitted.put(failed)
         finally:
             submitted.put(None)
 
@@ -294,11 +296,9 @@ def _in_workers(run: Callable, blobs: dict, settings: dict, jobs: list, workers:
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _rebuilt(future: Future | BrokenProcessPool) -> Any:
+def _rebuilt(future: Future) -> Any:
     """A run's result, rebuilt here; a worker that died is named."""
     try:
-        if isinstance(future, BrokenProcessPool):
-            raise future
         blob = future.result()
     except BrokenProcessPool as exc:
         raise RuntimeError("run: a worker process died during the runs (killed, out of memory, or a crash "

@@ -20,6 +20,7 @@ import os
 import re
 import shutil
 from pathlib import Path
+from typing import Iterable
 
 from robokit.files import write_atomically
 from robokit.viz.scene import viewer_javascript
@@ -61,17 +62,16 @@ def slim_site(site: Path) -> dict[str, int]:
     site = Path(site)
     if not (site / "index.html").is_file():
         raise ValueError(f"site: expected a built site with an index.html, got {str(site)!r}")
-    pages = sorted(site.rglob("*.html"))
+    pages = {page: page.read_text(encoding="utf-8") for page in sorted(site.rglob("*.html"))}    # read once
     return {"viewer": _share_viewer(site, pages), "sources": _strip_sources(site),
-            "mathjax": _prune_mathjax(site, pages), "maps": _remove(list(site.rglob("*.js.map")))}
+            "mathjax": _prune_mathjax(site, pages.values()), "maps": _remove(list(site.rglob("*.js.map")))}
 
 
-def _share_viewer(site: Path, pages: list[Path]) -> int:
+def _share_viewer(site: Path, pages: dict[Path, str]) -> int:
     """Every scene's inline viewer script replaced by one file the scenes load."""
     inline = html.escape(f"<script>{viewer_javascript()}</script>", quote=True)
     saved, shared = 0, False
-    for page in pages:
-        text = page.read_text(encoding="utf-8")
+    for page, text in pages.items():
         if inline not in text:
             continue
         root = os.path.relpath(site, page.parent).replace(os.sep, "/")
@@ -99,14 +99,12 @@ def _strip_sources(site: Path) -> int:
     return saved
 
 
-def _prune_mathjax(site: Path, pages: list[Path]) -> int:
+def _prune_mathjax(site: Path, texts: Iterable[str]) -> int:
     """MathJax without the bundles no page names and the inputs and outputs those do not use."""
     mathjax = site / "_static" / "mathjax"
     if not mathjax.is_dir():
         return 0
-    bundles = set()
-    for page in pages:
-        bundles.update(_BUNDLE.findall(page.read_text(encoding="utf-8")))
+    bundles = {bundle for text in texts for bundle in _BUNDLE.findall(text)}   # the viewer swap keeps these
     if not bundles:             # no page names a top-level bundle (another layout): keep it all
         return 0
     parts = {part for b in bundles for part in b[:-3].split("-")}           # tex-chtml.js: tex, chtml
