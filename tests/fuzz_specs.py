@@ -295,6 +295,12 @@ def pose_graph():          # a small generated pose graph (30 poses, loop closur
     return manhattan_world_graph(30, seed=1, closure_probability=1.0)[0]
 
 
+@functools.cache
+def intel_graph():         # lesson 02's real benchmark graph (943 poses), read once
+    from robocourse.lessons.omni_localization.benchmark import benchmark_graph
+    return benchmark_graph()
+
+
 # --- lesson 03's occupancy grid (robokit.mapping.occupancy_grid, grid_mapping, map_server) ---
 
 def small_grid():
@@ -817,6 +823,10 @@ SPECS: dict[str, Call] = {
     "robocourse.lessons.omni_localization.experiment.route_recognition": Call({
         "setup": Obj(office_experiment), "n_nodes": Int(2), "offset": Real(0.15), "same_place": Real(0.5),
         "rng": Rng(1)}, cheap=False),
+    "robocourse.lessons.omni_localization.benchmark.benchmark_graph": Call({}),
+    "robocourse.lessons.omni_localization.benchmark.solve_benchmark": Call({
+        "graph": Obj(intel_graph), "max_sweeps": Int(5, optional=True), "method": Choice("gauss-newton"),
+        "fast": Flag(True, optional=True)}, cheap=False),
     "robocourse.lessons.omni_localization.navigation.navigation_trials": Call({
         "setup": Obj(office_experiment), "n_starts": Int(1), "first_node": Int(0, optional=True),
         "n_path_nodes": Int(3), "clearance": Real(0.3), "fix_period": Real(1.0), "alpha": Real(2.0),
@@ -1713,6 +1723,9 @@ EXTRA: tuple[str, ...] = (
     "robokit.sim.layout.Layout.from_cells",          # lesson 03's real map, through real_map
     "robocourse.lessons.corridor_localization.real_map.building_routes",
     "robocourse.lessons.corridor_localization.real_map.global_localization_runs",
+    # lesson 02 on a real pose graph (the snippet that prints its table is not in the notebook yet)
+    "robocourse.lessons.omni_localization.benchmark.benchmark_graph",
+    "robocourse.lessons.omni_localization.benchmark.solve_benchmark",
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view

@@ -3,5 +3,6 @@
 experiment  the office: its tour, the topological map built from it (cached), the test poses and
             the route
 navigation  the autonomous runs along a recorded visual path from perturbed starts (cached)
+benchmark   both map aligners on g2o's Intel Research Lab pose graph (shipped): cost, iterations, time
 exercises   assignment 02
 """
