@@ -159,3 +159,26 @@ def test_a_view_given_its_histogram_equals_the_view_computed_whole():
     for bad, match in ((np.full(16, 1 / 16), "histogram"), (-given, "histogram"), (np.full(32, np.nan), "histogram")):
         with pytest.raises(ValueError, match=match):
             omni_view(image, camera(), histogram=bad)
+
+
+def test_an_unverified_top_k_widens_to_the_right_node():
+    # node 3's histogram is replaced by one all in the bin the query has least of, so the coarse stage
+    # ranks node 3 last: the plain top-2 search cannot find it, the coarse-to-fine check goes on down
+    # the ranking until it does
+    tmap = true_node_map()
+    pose, image = query_near(3, offset=(0.1, -0.1))
+    h = omni_view(image, camera(), features=False).histogram
+    hist = tmap.histograms.copy()
+    hist[3] = np.eye(len(h))[int(np.argmin(h))]
+    swapped = TopologicalMap(**{**tmap.to_arrays(), "histograms": hist})
+    plain = HierarchicalLocalizer(swapped, camera(), top_k=2, max_rounds=1).localize(image)
+    checked = HierarchicalLocalizer(swapped, camera(), top_k=2).localize(image)
+    assert 3 not in plain.candidates.tolist() and plain.rounds == 1
+    assert checked.node == 3 and checked.rounds > 1 and checked.metric
+    assert len(checked.candidates) == 2 * checked.rounds or len(checked.candidates) == len(tmap)
+    assert np.hypot(*(checked.pose - pose)[:2]) < METRIC_BOUND
+    # the check stops at the first batch with a verified metric pose: a good first batch costs nothing
+    fine = HierarchicalLocalizer(tmap, camera(), top_k=2).localize(image)
+    assert fine.rounds == 1 and len(fine.candidates) == 2
+    with pytest.raises(ValueError, match="max_rounds"):
+        HierarchicalLocalizer(tmap, camera(), max_rounds=0)

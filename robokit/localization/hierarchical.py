@@ -86,6 +86,9 @@ class Localization:
         relative pose), ``"bearings"`` (where the essential matrices' directions from two or more
         nodes cross, heading from the recognised node's), or ``"node"`` (the node's own pose,
         its heading corrected when the essential matrix gave one).
+    rounds : int
+        Batches of ``top_k`` coarse candidates the fine stage matched (hierarchical mode: more
+        than 1 when the first batch gave no verified metric pose; 1 in the other modes).
     """
 
     node: int
@@ -102,6 +105,7 @@ class Localization:
     mode: str
     times: dict = field(default_factory=dict)
     method: str = "node"
+    rounds: int = 1
 
 
 class HierarchicalLocalizer:
@@ -115,6 +119,11 @@ class HierarchicalLocalizer:
         The camera of the map's images and of the queries (same size).
     top_k : int, default 5
         Candidates the coarse stage passes on.
+    max_rounds : int or None, default None
+        Hierarchical mode's coarse-to-fine check: when the best of the ``top_k`` candidates gives no
+        verified metric pose (a wrong place rarely does), the fine stage goes on with the next
+        ``top_k`` of the coarse ranking, and so on, for at most ``max_rounds`` batches (``None``:
+        until the whole map has been matched). ``1`` is the plain top-k search.
     ratio : float, default 0.7
         SIFT distance-ratio bound of the fine stage (as the map's builder).
     min_matches : int, default 25
@@ -160,7 +169,8 @@ class HierarchicalLocalizer:
     (1, True, ['coarse', 'histogram', 'matching', 'sift', 'total', 'verification'])
     """
 
-    def __init__(self, map: TopologicalMap, camera: OmniCamera, *, top_k: int = 5, ratio: float = 0.7,
+    def __init__(self, map: TopologicalMap, camera: OmniCamera, *, top_k: int = 5, max_rounds: int | None = None,
+                 ratio: float = 0.7,
                  min_matches: int = 25, ambiguity: float = 0.8, n_features: int = 500,
                  mode: str = "hierarchical", min_crossing: float = 0.26, max_range: float = 4.0) -> None:
         if not isinstance(map, TopologicalMap):
@@ -169,6 +179,7 @@ class HierarchicalLocalizer:
             raise EmptyMapError("map: expected a map with at least one node, got none")
         self.map, self.camera = map, as_omni_camera(camera)
         self.top_k = as_int(top_k, "top_k", minimum=1)
+        self.max_rounds = None if max_rounds is None else as_int(max_rounds, "max_rounds", minimum=1)
         self.ratio = as_positive(ratio, "ratio")
         if self.ratio > 1:
             raise ValueError(f"ratio: expected a value in (0, 1], got {self.ratio}")
@@ -265,10 +276,42 @@ class HierarchicalLocalizer:
             pose = self.map.poses[node].copy()
             return Localization(node, pose, pose.copy(), None, order, distances, np.zeros(len(order), int), True,
                                 False, False, False, self.mode, times, "node")
-        if self.mode == "hierarchical":
-            order, distances = order[:self.top_k], distances[:self.top_k]
-        counts, matches = self.fine(view.features, order)
-        t2 = time.perf_counter()
+        k = len(order) if self.mode == "fine" else min(self.top_k, len(order))
+        limit = len(order) if self.max_rounds is None else min(len(order), k * self.max_rounds)
+        counts, matches = self.fine(view.features, order[:k])
+        times["matching"], times["verification"], n, rounds = time.perf_counter() - t1, 0.0, k, 1
+        while True:
+            t2 = time.perf_counter()
+            best, recognised, ambiguous, relative, method, pose = self._decide(view, order[:n], counts, matches)
+            times["verification"] += time.perf_counter() - t2
+            if method != "node" or n >= limit:
+                break
+            # the coarse-to-fine check: no verified metric pose among these candidates, so the next
+            # top_k of the coarse ranking are matched too
+            t3 = time.perf_counter()
+            more, more_matches = self.fine(view.features, order[n:n + k])
+            counts, matches = np.concatenate([counts, more]), list(matches) + list(more_matches)
+            n, rounds = min(n + k, len(order)), rounds + 1
+            times["matching"] += time.perf_counter() - t3
+        order, distances = order[:n], distances[:n]
+        times["total"] = sum(v for key, v in times.items() if key != "total")
+        node = int(order[best])
+        node_pose = self.map.poses[node].copy()
+        if pose is None:
+            pose = se2_compose(node_pose, relative.pose) if relative is not None else node_pose.copy()
+        else:                         # the crossing, as a relative pose: pose = node_pose (+) relative.pose holds
+            relative = dataclasses.replace(relative, pose=se2_between(node_pose, pose), metric=True, verified=True)
+        return Localization(node, pose, node_pose, relative, order, distances, counts, recognised, ambiguous,
+                            bool(relative is not None and relative.verified), method != "node", self.mode, times,
+                            method, rounds)
+
+    def _decide(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list) -> tuple:
+        """The fine stage's answer among the candidates ``order`` with their match ``counts``.
+
+        Returns ``(best, recognised, ambiguous, relative, method, pose)``: the winning candidate's
+        index, whether it has ``min_matches``, whether the runner-up comes close, its relative pose
+        (None when not recognised), how the pose is found and the pose when it is a crossing.
+        """
         ranked = np.argsort(-counts, kind="stable")
         best = int(ranked[0])
         recognised = bool(counts[best] >= self.min_matches)
@@ -283,18 +326,7 @@ class HierarchicalLocalizer:
                 if crossing is not None:
                     heading = self.map.poses[int(order[best]), 2] + relative.heading_epipolar
                     pose, method = np.array([crossing[0], crossing[1], wrap_angle(heading)]), "bearings"
-        times["matching"] = t2 - t1
-        times["verification"] = time.perf_counter() - t2
-        times["total"] = sum(v for k, v in times.items() if k != "total")
-        node = int(order[best])
-        node_pose = self.map.poses[node].copy()
-        if pose is None:
-            pose = se2_compose(node_pose, relative.pose) if relative is not None else node_pose.copy()
-        else:                         # the crossing, as a relative pose: pose = node_pose (+) relative.pose holds
-            relative = dataclasses.replace(relative, pose=se2_between(node_pose, pose), metric=True, verified=True)
-        return Localization(node, pose, node_pose, relative, order, distances, counts, recognised, ambiguous,
-                            bool(relative is not None and relative.verified), method != "node", self.mode, times,
-                            method)
+        return best, recognised, ambiguous, relative, method, pose
 
     def _verify(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list, ranked: np.ndarray,
                 ambiguous: bool) -> tuple[RelativePose, int, list]:
