@@ -1048,9 +1048,21 @@ SPECS: dict[str, Call] = {
                                   ("offsets", "N", 1), ("edges", "N,2", 0), ("measurements", "N,3", 0),
                                   ("covariances", "N,3,3", 0), ("kinds", "N", 0)]} | {"index": Choice("opencv")}),
     "robokit.localization.hierarchical.HierarchicalLocalizer": Call({
-        "map": Obj(office_map), "camera": Obj(small_omni), "top_k": Int(2), "ratio": Real(0.7), "min_matches": Int(25),
-        "ambiguity": Real(0.8), "n_features": Int(100), "mode": Choice("hierarchical"), "min_crossing": Real(0.26),
-        "max_range": Real(4.0)}),
+        "map": Obj(office_map), "camera": Obj(small_omni), "top_k": Int(2), "max_rounds": Int(2, optional=True),
+        "ratio": Real(0.7), "min_matches": Int(25), "ambiguity": Real(0.8), "n_features": Int(100),
+        "mode": Choice("hierarchical"), "min_crossing": Real(0.26), "max_range": Real(4.0)}),
+    "robokit.localization.appearance_mcl.place_hypotheses": Call({
+        "localizer": Obj(lambda: __import__("robokit.localization", fromlist=["x"]).HierarchicalLocalizer(
+            office_map(), small_omni(), top_k=2, n_features=100)),
+        "image": Array(lambda: office_views()[0][0], "120,160,3"), "max_hypotheses": Int(2)}),
+    "robokit.localization.appearance_mcl.monte_carlo_check": Call({
+        "localizer": Obj(lambda: __import__("robokit.localization", fromlist=["x"]).HierarchicalLocalizer(
+            office_map(), small_omni(), top_k=2, n_features=100)),
+        "image": Array(lambda: office_views()[0][0], "120,160,3"),
+        "drive_images": Obj(lambda: [office_views()[0][1]]), "drive_odometry": Array(lambda: office_views()[1][:2], "2,3"),
+        "max_hypotheses": Int(2), "n_particles": Int(20), "spread": Array(np.array([0.15, 0.15, 0.1]), "3"),
+        "alphas": Array(np.array([0.01, 0.001, 0.01, 0.001]), "4"), "sigma": Real(0.3), "same_place": Real(0.5),
+        "rng": Rng(0)}, cheap=False),
     "robokit.geometry.planar.intersect_lines": Call({"origins": Array(np.array([[0.0, 0.0], [4.0, 0.0]]), "N,2"),
                                                      "directions": Array(np.array([[1.0, 1.0], [-1.0, 1.0]]), "N,2")}),
     # --- robokit.localization.particle_filter, beam_models, mcl (lesson 03's Monte-Carlo localization) --
@@ -1719,6 +1731,8 @@ HUGE_ANGLES: dict[str, tuple[str, ...]] = {
 
 
 EXTRA: tuple[str, ...] = (
+    "robokit.localization.appearance_mcl.place_hypotheses",      # lesson 02's Monte-Carlo check (checks)
+    "robokit.localization.appearance_mcl.monte_carlo_check",
     "robokit.localization.scan_matching.match_scan",   # lesson 03 refines Table 2's runs with it (trials)
     "robokit.sim.layout.Layout.from_cells",          # lesson 03's real map, through real_map
     "robocourse.lessons.corridor_localization.real_map.building_routes",
