@@ -301,6 +301,17 @@ def intel_graph():         # lesson 02's real benchmark graph (943 poses), read 
     return benchmark_graph()
 
 
+@functools.cache
+def pose_graph_truth():    # the true poses of pose_graph()
+    from robokit.mapping import manhattan_world_graph
+    return manhattan_world_graph(30, seed=1, closure_probability=1.0)[1]
+
+
+def pose_graph_loops():    # two of pose_graph()'s loop edges (rows of its edges)
+    from robocourse.lessons.omni_localization.alignment import loop_rows
+    return loop_rows(pose_graph())[:2]
+
+
 # --- lesson 03's occupancy grid (robokit.mapping.occupancy_grid, grid_mapping, map_server) ---
 
 def small_grid():
@@ -827,6 +838,21 @@ SPECS: dict[str, Call] = {
     "robocourse.lessons.omni_localization.benchmark.solve_benchmark": Call({
         "graph": Obj(intel_graph), "max_sweeps": Int(5, optional=True), "method": Choice("gauss-newton"),
         "fast": Flag(True, optional=True)}, cheap=False),
+    "robocourse.lessons.omni_localization.alignment.loop_rows": Call({"graph": Obj(pose_graph)}),
+    "robocourse.lessons.omni_localization.alignment.loop_subsets": Call({"graph": Obj(pose_graph), "k": Int(3)}),
+    "robocourse.lessons.omni_localization.alignment.held_share": Call({
+        "graph": Obj(pose_graph), "keep": Array(pose_graph_loops, "N", optional=True, min_rows=0)}),
+    "robocourse.lessons.omni_localization.alignment.with_loops": Call({
+        "graph": Obj(pose_graph), "keep": Array(pose_graph_loops, "N", optional=True, min_rows=0)}),
+    "robocourse.lessons.omni_localization.alignment.alignment_errors": Call({
+        "graph": Obj(pose_graph), "truth": Array(pose_graph_truth, "N,3"),
+        "keep": Array(pose_graph_loops, "N", optional=True, min_rows=0), "max_sweeps": Int(20000)}),
+    "robocourse.lessons.omni_localization.alignment.loop_edge_errors": Call({
+        "graph": Obj(pose_graph), "truth": Array(pose_graph_truth, "N,3"),
+        "keep": Array(pose_graph_loops, "N", optional=True, min_rows=0)}),
+    "robocourse.lessons.omni_localization.alignment.odometry_redraws": Call({
+        "graph": Obj(pose_graph), "truth": Array(pose_graph_truth, "N,3"),
+        "keep": Array(pose_graph_loops, "N", optional=True, min_rows=0), "draws": Int(3), "rng": Rng(0)}),
     "robocourse.lessons.omni_localization.navigation.navigation_trials": Call({
         "setup": Obj(office_experiment), "n_starts": Int(1), "first_node": Int(0, optional=True),
         "n_path_nodes": Int(3), "clearance": Real(0.3), "fix_period": Real(1.0), "alpha": Real(2.0),
@@ -1744,6 +1770,10 @@ EXTRA: tuple[str, ...] = (
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view
     "robokit.vision.plot_detector.scale_space_maxima",   # public since PLOT's search moved out
+    # lesson 02's map alignment study (issue 35), fuzzed before the notebook calls it
+    *(f"robocourse.lessons.omni_localization.alignment.{n}" for n in (
+        "loop_rows", "loop_subsets", "held_share", "with_loops", "alignment_errors", "loop_edge_errors",
+        "odometry_redraws")),
     # lesson 02 (path following, pose EKF, navigation), fuzzed before the lesson exists
     *(f"robokit.controllers.path_geometry.{n}" for n in ("VisualPath", "path_from_poses", "reference_point")),
     *(f"robokit.controllers.path_following.{n}" for n in (
