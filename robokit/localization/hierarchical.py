@@ -16,8 +16,9 @@ navigation loop's business (:mod:`robokit.navigation`).
 
 References
 ----------
-.. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 .. [2] D. G. Lowe, "Distinctive image features from scale-invariant keypoints", International Journal
    of Computer Vision 60(2), 91-110, 2004.
 """

@@ -20,8 +20,9 @@ features of two views into the pose of one robot in the other's frame:
 
 References
 ----------
-.. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 .. [2] R. Hartley and A. Zisserman, *Multiple View Geometry in Computer Vision*, 2nd ed., Cambridge
    University Press, 2004 (Sec. 9.6).
 .. [3] M. A. Fischler and R. C. Bolles, "Random sample consensus: a paradigm for model fitting with

@@ -15,8 +15,9 @@ generated graphs with ground truth in :mod:`robokit.mapping.manhattan`.
 
 References
 ----------
-.. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (the lesson's source paper; our copy gives no authors, venue or year).
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 .. [2] F. Lu and E. Milios, "Globally consistent range scan alignment for environment mapping",
    *Autonomous Robots* 4(4), 333-349, 1997.
 """

@@ -26,8 +26,9 @@ the optimum relaxation is compared against.
 
 References
 ----------
-.. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (the lesson's source paper; our copy gives no authors, venue or year).
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 .. [2] R. Kummerle, G. Grisetti, H. Strasdat, K. Konolige and W. Burgard, "g2o: A general framework
    for graph optimization", Proc. IEEE Int. Conf. on Robotics and Automation (ICRA), 3607-3613, 2011.
 .. [3] G. Grisetti, R. Kummerle, C. Stachniss and W. Burgard, "A tutorial on graph-based SLAM",

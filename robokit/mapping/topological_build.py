@@ -31,8 +31,9 @@ numbers, so they can be studied and tested apart from the omni views.
 
 References
 ----------
-.. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 .. [2] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
 """
 from __future__ import annotations

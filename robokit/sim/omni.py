@@ -31,8 +31,9 @@ References
    2007.
 .. [3] N. Greene, "Environment mapping and other applications of world projections", *IEEE
    Computer Graphics and Applications* 6(11), 21-29, 1986.
-.. [4] *Robust Omnidirectional Vision based Mobile Robot Hierarchical Localization and Autonomous
-   Navigation* (the course's source paper for lesson 02; our copy gives no authors, venue or year).
+.. [4] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 """
 from __future__ import annotations
 

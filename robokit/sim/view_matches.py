@@ -15,8 +15,9 @@ References
 .. [3] C. Mei and P. Rives, "Single view point omnidirectional camera calibration from planar
    grids", *Proc. IEEE International Conference on Robotics and Automation (ICRA)*, 3945-3950,
    2007.
-.. [4] *Robust Omnidirectional Vision based Mobile Robot Hierarchical Localization and Autonomous
-   Navigation* (the course's source paper for lesson 02; our copy gives no authors, venue or year).
+.. [4] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 """
 from __future__ import annotations
 

@@ -17,8 +17,9 @@ References
 .. [2] Ge et al., "Visual-feature-assisted mobile robot localization in a long corridor
    environment", *Frontiers of Information Technology & Electronic Engineering*, 2023,
    doi:10.1631/FITEE.2200208.
-.. [3] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
+.. [3] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 """
 from __future__ import annotations
 

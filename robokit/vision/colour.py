@@ -20,9 +20,9 @@ in between.
 
 References
 ----------
-.. [1] *Robust Omnidirectional Vision based Mobile Robot Hierarchical Localization and Autonomous
-   Navigation* (the course's source paper for lesson 02; our copy gives no authors, venue or year),
-   Sec. "Global image features", Eqs. (4) and (5).
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011, Sec. "Global image features", Eqs. (4) and (5).
 .. [2] M. J. Swain and D. H. Ballard, "Color indexing", *International Journal of Computer Vision*
    7(1), 11-32, 1991.
 .. [3] R. C. Gonzalez and R. E. Woods, *Digital Image Processing*, 3rd ed., Prentice Hall, 2008,

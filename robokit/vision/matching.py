@@ -26,8 +26,9 @@ References
    of Computer Vision 60(2), 91-110, 2004.
 .. [3] S. Se, D. Lowe and J. Little, "Global localization using distinctive visual features", Proc.
    IEEE/RSJ Int. Conf. on Intelligent Robots and Systems (IROS), 2002.
-.. [4] *Robust Omnidirectional Vision based Mobile Robot Hierarchical Localization and Autonomous
-   Navigation* (the course's source paper for lesson 02; our copy gives no authors, venue or year).
+.. [4] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 .. [5] M. Muja and D. G. Lowe, "Fast approximate nearest neighbors with automatic algorithm
    configuration", Proc. Int. Conf. on Computer Vision Theory and Applications (VISAPP), 2009
    (FLANN).

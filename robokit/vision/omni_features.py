@@ -22,9 +22,9 @@ describes at the given angles): about 1.3 x plain SIFT's time.
 
 References
 ----------
-.. [1] *Robust Omnidirectional Vision based Mobile Robot Hierarchical Localization and Autonomous
-   Navigation* (the course's source paper for lesson 02; our copy gives no authors, venue or year),
-   Sec. "Local image features".
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011, Sec. "Local image features".
 .. [2] D. G. Lowe, "Distinctive image features from scale-invariant keypoints", International Journal
    of Computer Vision 60(2), 91-110, 2004.
 """

