@@ -834,6 +834,21 @@ SPECS: dict[str, Call] = {
     "robocourse.lessons.omni_localization.experiment.route_recognition": Call({
         "setup": Obj(office_experiment), "n_nodes": Int(2), "offset": Real(0.15), "same_place": Real(0.5),
         "rng": Rng(1)}, cheap=False),
+    "robocourse.lessons.omni_localization.checks.test_places": Call({
+        "setup": Obj(office_experiment), "n": Int(2), "near": Real(1.0), "clearance": Real(0.4), "rng": Rng(0)}),
+    "robocourse.lessons.omni_localization.checks.drive_on": Call({
+        "setup": Obj(office_experiment), "start": Array(np.array([12.0, 2.5, 0.0]), "3"), "length": Real(1.0),
+        "step": Real(0.25), "clearance": Real(0.3)}),
+    "robocourse.lessons.omni_localization.checks.check_trials": Call({
+        "setup": Obj(office_experiment), "places": Array(np.array([[13.0, 3.7, 2.0]]), "N,3"),
+        "map": Choice("relaxed"), "length": Real(0.5), "step": Real(0.25), "seed": Int(0), "cache": Flag(False),
+        "workers": Int(1, optional=True), "progress": Func(None, optional=True)}, cheap=False),
+    "robocourse.lessons.omni_localization.checks.mask_trials": Call({
+        "setup": Obj(office_experiment), "places": Array(np.array([[13.0, 3.7, 2.0]]), "N,3"),
+        "thresholds": Array(np.array([0.15]), "N"), "bins": Int(32), "gain": Real(0.7), "rng": Rng(0)}, cheap=False),
+    "robocourse.lessons.omni_localization.landmarks.landmark_map": Call({
+        "tmap": Obj(lambda: office_experiment().relaxed), "camera": Obj(lambda: office_experiment().camera),
+        "ratio": Real(0.7), "min_angle": Real(0.26), "max_range": Real(6.0)}),
     "robocourse.lessons.omni_localization.benchmark.benchmark_graph": Call({}),
     "robocourse.lessons.omni_localization.benchmark.solve_benchmark": Call({
         "graph": Obj(intel_graph), "max_sweeps": Int(5, optional=True), "method": Choice("gauss-newton"),
@@ -1759,13 +1774,11 @@ HUGE_ANGLES: dict[str, tuple[str, ...]] = {
 EXTRA: tuple[str, ...] = (
     "robokit.localization.appearance_mcl.place_hypotheses",      # lesson 02's Monte-Carlo check (checks)
     "robokit.localization.appearance_mcl.monte_carlo_check",
+    "robocourse.lessons.omni_localization.checks.drive_on",      # the Monte-Carlo check's drives (check_trials)
     "robokit.localization.scan_matching.match_scan",   # lesson 03 refines Table 2's runs with it (trials)
     "robokit.sim.layout.Layout.from_cells",          # lesson 03's real map, through real_map
     "robocourse.lessons.corridor_localization.real_map.building_routes",
     "robocourse.lessons.corridor_localization.real_map.global_localization_runs",
-    # lesson 02 on a real pose graph (the snippet that prints its table is not in the notebook yet)
-    "robocourse.lessons.omni_localization.benchmark.benchmark_graph",
-    "robocourse.lessons.omni_localization.benchmark.solve_benchmark",
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view

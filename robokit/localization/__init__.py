@@ -4,6 +4,7 @@ egomotion          Lin et al.'s RANSAC ego-motion from 3D matches (Secs. 4-7) an
 hough              Se et al.'s Hough-transform global localization (Sec. 5)
 visual_slam        the whole stereo pipeline over a sequence: VisualSLAM
 hierarchical       lesson 02's coarse-to-fine localization in a topological map
+appearance_mcl     lesson 02's Monte-Carlo check: image-based MCL over a short drive decides between places
 pose_ekf           lesson 02's EKF over (x, y, theta, v, omega) on the unicycle model
 particle_filter    normalised weights, low-variance and KLD resampling, Ge et al.'s ellipse start (Eq. (19))
 particle_clusters  ROS amcl's clusters of particles and the largest one's share

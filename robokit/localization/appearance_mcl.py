@@ -125,11 +125,11 @@ def place_hypotheses(localizer: HierarchicalLocalizer, image: Any, *, max_hypoth
     """
     loc = _as_localizer(localizer)
     m = as_int(max_hypotheses, "max_hypotheses", minimum=1, maximum=100)
-    result = loc.localize(image)
+    view, times = loc.view(image)                     # SIFT once, for the answer and the hypotheses
+    result = loc.localize_view(view, times)
     ranked = np.argsort(-result.match_counts, kind="stable")
     best = int(np.flatnonzero(result.candidates == result.node)[0])
     others = [int(c) for c in ranked if int(c) != best and result.match_counts[c] >= loc.min_matches][:m - 1]
-    view, _ = loc.view(image)
     nodes = result.candidates[[best] + others].astype(int)
     counts, matches = loc.fine(view.features, nodes)
     poses, metric = [result.pose.copy()], [result.metric]      # the localizer's own answer first
