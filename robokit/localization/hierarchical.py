@@ -10,9 +10,10 @@ of :func:`robokit.mapping.relative_pose` (floor points below the horizon, checke
 essential matrix). Each stage is timed (the paper's Fig. 11 compares coarse-only, fine-only and
 hierarchical localization by error and by time): :class:`HierarchicalLocalizer` runs all three.
 
-The paper also names Monte-Carlo localization for the ambiguous case; a single image with a
-verified relative pose resolves it here, and a particle filter over a sequence of images is the
-navigation loop's business (:mod:`robokit.navigation`).
+When no candidate gives a verified metric pose, the fine stage goes on with the next ``top_k``
+candidates of the coarse ranking (``max_rounds``; our reading of the paper's verification step).
+The paper also names Monte-Carlo localization for the ambiguous case: that needs more than one
+image, and is :func:`robokit.localization.appearance_mcl.monte_carlo_check`.
 
 References
 ----------
@@ -281,9 +282,10 @@ class HierarchicalLocalizer:
         limit = len(order) if self.max_rounds is None else min(len(order), k * self.max_rounds)
         counts, matches = self.fine(view.features, order[:k])
         times["matching"], times["verification"], n, rounds = time.perf_counter() - t1, 0.0, k, 1
+        poses: dict = {}                     # relative poses by node, kept across rounds (RANSAC is seeded)
         while True:
             t2 = time.perf_counter()
-            best, recognised, ambiguous, relative, method, pose = self._decide(view, order[:n], counts, matches)
+            best, recognised, ambiguous, relative, method, pose = self._decide(view, order[:n], counts, matches, poses)
             times["verification"] += time.perf_counter() - t2
             if method != "node" or n >= limit:
                 break
@@ -306,7 +308,13 @@ class HierarchicalLocalizer:
                             bool(relative is not None and relative.verified), method != "node", self.mode, times,
                             method, rounds)
 
-    def _decide(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list) -> tuple:
+    def _relative(self, view: OmniView, node: int, matches: Any, poses: dict) -> RelativePose:
+        """The query's relative pose to ``node`` (:func:`robokit.mapping.relative_pose`), computed once."""
+        if node not in poses:
+            poses[node] = relative_pose(view, self.map.node_view(node), matches, self.camera)
+        return poses[node]
+
+    def _decide(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list, poses: dict) -> tuple:
         """The fine stage's answer among the candidates ``order`` with their match ``counts``.
 
         Returns ``(best, recognised, ambiguous, relative, method, pose)``: the winning candidate's
@@ -319,18 +327,18 @@ class HierarchicalLocalizer:
         ambiguous = bool(recognised and len(ranked) > 1 and counts[ranked[1]] >= self.ambiguity * counts[best])
         relative, method, pose = None, "node", None
         if recognised:
-            relative, best, tried = self._verify(view, order, counts, matches, ranked, ambiguous)
+            relative, best, tried = self._verify(view, order, counts, matches, ranked, ambiguous, poses)
             if relative.metric:
                 method = "floor"
             elif relative.epipolar:
-                crossing = self._crossing(view, order, counts, matches, ranked, tried)
+                crossing = self._crossing(view, order, counts, matches, ranked, tried, poses)
                 if crossing is not None:
                     heading = self.map.poses[int(order[best]), 2] + relative.heading_epipolar
                     pose, method = np.array([crossing[0], crossing[1], wrap_angle(heading)]), "bearings"
         return best, recognised, ambiguous, relative, method, pose
 
     def _verify(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list, ranked: np.ndarray,
-                ambiguous: bool) -> tuple[RelativePose, int, list]:
+                ambiguous: bool, poses: dict) -> tuple[RelativePose, int, list]:
         """Relative pose to the best candidate, or to a runner-up when that one verifies and the best does not.
 
         The contenders are the best candidate and, when the answer is ambiguous or the best one
@@ -344,13 +352,13 @@ class HierarchicalLocalizer:
             if rank and not (counts[c] >= self.min_matches and (ambiguous or not (tried[0][0].verified
                                                                                     and tried[0][0].metric))):
                 break
-            rel = relative_pose(view, self.map.node_view(int(order[c])), matches[c], self.camera)
+            rel = self._relative(view, int(order[c]), matches[c], poses)
             tried.append((rel, c))
         rel, c = max(tried, key=lambda rc: (rc[0].verified and rc[0].metric, rc[0].verified, counts[rc[1]]))
         return rel, c, tried
 
     def _crossing(self, view: OmniView, order: np.ndarray, counts: np.ndarray, matches: list, ranked: np.ndarray,
-                  tried: list) -> np.ndarray | None:
+                  tried: list, poses: dict) -> np.ndarray | None:
         """Where the directions of travel from two or more candidate nodes cross (world x, y), or None.
 
         Each candidate whose essential matrix holds puts the query on a ray from the node's pose;
@@ -363,7 +371,7 @@ class HierarchicalLocalizer:
         for c in ranked[:3]:
             c = int(c)
             if c not in done and counts[c] >= self.min_matches:
-                rel = relative_pose(view, self.map.node_view(int(order[c])), matches[c], self.camera)
+                rel = self._relative(view, int(order[c]), matches[c], poses)
                 if rel.epipolar:
                     rays.append((rel, c))
         if len(rays) < 2:
