@@ -49,7 +49,8 @@ class MonteCarloCheck:
     winner : int
         Its index in ``nodes`` / ``hypotheses``.
     confirmed : bool
-        The localizer's answer (hypothesis 0) won.
+        The localizer's answer (hypothesis 0) stands: its place won, or no drive image gave a
+        metric fix, or no other place holds more than half of the particles.
     nodes : numpy.ndarray of int, shape (m,)
         The candidate nodes, most matches first.
     hypotheses : numpy.ndarray, shape (m, 3)
@@ -97,8 +98,10 @@ def place_hypotheses(localizer: HierarchicalLocalizer, image: Any, *, max_hypoth
     nodes, poses, counts, metric : numpy.ndarray
         Candidate nodes, the localizer's answer first, then the others by match count; the image's
         pose as each gives it (the first: the localizer's own pose; the others: the node's pose
-        composed with the relative pose of :func:`robokit.mapping.relative_pose` when that is
-        metric, else the node's own pose), their match counts and whether each pose is metric.
+        composed with the relative pose of :func:`robokit.mapping.relative_pose`, which is the
+        node's position with the essential matrix's heading when it is not metric; a candidate
+        without an essential matrix gives no hypothesis), their match counts and whether each pose
+        is metric.
 
     Raises
     ------
@@ -132,13 +135,15 @@ def place_hypotheses(localizer: HierarchicalLocalizer, image: Any, *, max_hypoth
     others = [int(c) for c in ranked if int(c) != best and result.match_counts[c] >= loc.min_matches][:m - 1]
     nodes = result.candidates[[best] + others].astype(int)
     counts, matches = loc.fine(view.features, nodes)
-    poses, metric = [result.pose.copy()], [result.metric]      # the localizer's own answer first
-    for node, found in zip(nodes[1:], matches[1:]):
+    poses, metric, keep = [result.pose.copy()], [result.metric], [0]   # the localizer's own answer first
+    for j, (node, found) in enumerate(zip(nodes[1:], matches[1:]), start=1):
         rel = relative_pose(view, loc.map.node_view(int(node)), found, loc.camera)
-        node_pose = loc.map.poses[int(node)]
-        poses.append(se2_compose(node_pose, rel.pose) if rel.metric else node_pose.copy())
+        if not rel.epipolar:
+            continue                                 # no heading to place the robot at this node: no hypothesis
+        poses.append(se2_compose(loc.map.poses[int(node)], rel.pose))   # [0, 0, heading] unless metric
         metric.append(rel.metric)
-    return nodes, np.array(poses).reshape(-1, 3), np.asarray(counts, int), np.array(metric, bool)
+        keep.append(j)
+    return nodes[keep], np.array(poses).reshape(-1, 3), np.asarray(counts, int)[keep], np.array(metric, bool)
 
 
 def monte_carlo_check(localizer: HierarchicalLocalizer, image: Any, drive_images: Any, drive_odometry: Any, *,
@@ -184,8 +189,9 @@ def monte_carlo_check(localizer: HierarchicalLocalizer, image: Any, drive_images
     Li et al. (2011), Sec. "Hierarchical localization" (the Monte-Carlo verification of an
     ambiguous answer), as image-based MCL after Menegatti et al. (2004). Motion by Table 5.6 of
     Thrun et al. (2005); the measurement of a drive image is a mixture over its place hypotheses
-    ``f_j`` that are metric, with their match counts ``c_j``: ``p(z | x) = eps + sum_j c_j
-    N(|x - f_j|; 0, sigma)`` (positions only; an image without a metric hypothesis is skipped); low-variance resampling (Table 4.4) after each image. A wrong first
+    ``f_j`` that are metric, with their match counts ``c_j``: ``p(z | x) = eps + sum_j (c_j /
+    max_j c_j) exp(-|x - f_j|^2 / (2 sigma^2))`` (positions only, ``eps = 1e-6``; an image without a
+    metric hypothesis is skipped); low-variance resampling (Table 4.4) after each image. A wrong first
     hypothesis keeps support only if the drive's images keep being recognised where odometry
     carries it.
 
@@ -194,6 +200,8 @@ def monte_carlo_check(localizer: HierarchicalLocalizer, image: Any, drive_images
     See lesson 02 (``robocourse.lessons.omni_localization.checks``) for drives in the office.
     """
     loc = _as_localizer(localizer)
+    if isinstance(drive_images, np.ndarray) and drive_images.ndim == 4:
+        drive_images = list(drive_images)            # a stack of images
     images = list(drive_images) if isinstance(drive_images, (list, tuple)) else None
     if not images:
         raise ValueError(f"drive_images: expected a non-empty list of omni images, got {describe(drive_images)}")
@@ -213,25 +221,30 @@ def monte_carlo_check(localizer: HierarchicalLocalizer, image: Any, drive_images
     g = as_rng(rng)
     images = [as_omni_image(im, loc.camera, f"drive_images[{k}]") for k, im in enumerate(images)]  # before any work
     nodes, hyps, counts, _ = place_hypotheses(loc, image, max_hypotheses=max_hypotheses)
-    # hypotheses within same_place of an earlier one are that place (the localizer's answer is place 0)
+    # hypotheses within same_place of an earlier one are that place (the localizer's answer is place 0);
+    # the particles are split evenly between places, each started at its first hypothesis
     place = np.arange(len(hyps))
     for j in range(1, len(hyps)):
         near = np.flatnonzero(np.hypot(*(hyps[:j, :2] - hyps[j, :2]).T) <= same_place)
         if len(near):
             place[j] = place[near[0]]
-    labels = np.arange(n) % len(hyps)
+    firsts = np.unique(place)
+    labels = firsts[np.arange(n) % len(firsts)]
     particles = hyps[labels] + g.normal(0.0, 1.0, (n, 3)) * sd
     particles[:, 2] = wrap_angle(particles[:, 2])
+    evidence = 0
     for k, im in enumerate(images):
         particles = sample_motion_model_odometry(odo[k], odo[k + 1], particles, alphas, g)
         _, fixes, c, metric = place_hypotheses(loc, im, max_hypotheses=max_hypotheses)
         if not metric.any():
             continue                                 # no metric fix: this image says nothing about position
+        evidence += 1
         fixes, c = fixes[metric], c[metric].astype(float)
         d2 = ((particles[:, None, :2] - fixes[None, :, :2]) ** 2).sum(axis=-1)
         likelihood = 1e-6 + (c[None, :] / c.max() * np.exp(-0.5 * d2 / sigma ** 2)).sum(axis=1)
         keep = low_variance_resample(normalise_log_weights(np.log(likelihood)).weights, g)
         particles, labels = particles[keep], labels[keep]
-    support = np.bincount(place[labels], minlength=len(hyps)) / n
-    winner = int(np.argmax(support))                 # a place; its first hypothesis stands for it
+    support = np.bincount(labels, minlength=len(hyps)) / n
+    # another place wins only with evidence and a majority of the particles
+    winner = int(np.argmax(support)) if evidence and support.max() > 0.5 else 0
     return MonteCarloCheck(hyps[winner].copy(), winner, winner == 0, nodes, hyps, counts, support, particles)
