@@ -177,3 +177,23 @@ def test_intersect_lines_least_squares_point_and_cheirality():
         intersect_lines([[0.0, 0.0], [0.0, 1.0]], [[1.0, 0.0], [2.0, 0.0]])
     with pytest.raises(ValueError, match="origins"):
         intersect_lines([[0.0, 0.0]], [[1.0, 0.0]])
+
+
+def test_cross_rays_agrees_with_intersect_lines_and_marks_parallel_pairs():
+    from robokit.geometry.planar import cross_rays, intersect_lines
+    g = np.random.default_rng(3)
+    p, q = g.normal(size=(50, 2)), g.normal(size=(50, 2))
+    a, b = g.uniform(-np.pi, np.pi, 50), g.uniform(-np.pi, np.pi, 50)
+    d, e = np.column_stack([np.cos(a), np.sin(a)]), np.column_stack([np.cos(b), np.sin(b)])
+    s, t, sin = cross_rays(p, d, q, e)
+    assert np.allclose(p + s[:, None] * d, q + t[:, None] * e)           # the same point from both rays
+    assert np.allclose(sin, np.sin(b - a))
+    for k in range(5):                                                   # the least-squares crossing of two lines
+        point, along = intersect_lines(np.array([p[k], q[k]]), np.array([d[k], e[k]]))
+        assert np.allclose(point, p[k] + s[k] * d[k]) and np.allclose(along, [s[k], t[k]])
+    s, t, sin = cross_rays([0.0, 0.0], [[1.0, 0.0]], [[0.0, 1.0]], [[1.0, 0.0]])   # parallel: no crossing
+    assert sin[0] == 0.0 and not np.isfinite(s[0])
+    with pytest.raises(ValueError, match="p, d, q, e"):
+        cross_rays(np.zeros((3, 2)), np.ones((2, 2)), np.zeros((3, 2)), np.ones((3, 2)))
+    with pytest.raises(ValueError, match="d"):
+        cross_rays([0.0, 0.0], [[np.nan, 0.0]], [1.0, 1.0], [[0.0, 1.0]])

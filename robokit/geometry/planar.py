@@ -26,7 +26,7 @@ from ..validation import as_array, require_angles
 from .rotations import as_rotation
 
 __all__ = ["as_planar", "wrap_angle", "se2_compose", "se2_inverse", "se2_between", "se2_to_matrix", "matrix_to_se2",
-           "intersect_lines"]
+           "intersect_lines", "cross_rays"]
 
 
 def as_planar(value: Any, name: str, *, shape: Any = None, min_count: int = 0) -> np.ndarray:
@@ -343,3 +343,54 @@ def intersect_lines(origins: Any, directions: Any) -> tuple[np.ndarray, np.ndarr
         raise ValueError("directions: expected lines that are not all parallel, got parallel ones")
     point = np.linalg.solve(A, b)
     return point, ((point - o) * u).sum(1)
+
+
+def cross_rays(p: Any, d: Any, q: Any, e: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where pairs of lines in the plane cross: ``p + s d = q + t e``, for N pairs at once.
+
+    Parameters
+    ----------
+    p, q : array_like, shape (N, 2) or (2,)
+        A point of each first and each second line (a single point is shared by all pairs).
+    d, e : array_like, shape (N, 2)
+        Their unit directions.
+
+    Returns
+    -------
+    s, t : numpy.ndarray, shape (N,)
+        Distances along ``d`` from ``p`` and along ``e`` from ``q`` to the crossing (negative:
+        behind the point; NaN or inf for parallel lines).
+    sin : numpy.ndarray, shape (N,)
+        ``d x e``, the sine of the angle from ``d`` to ``e`` (0 for parallel lines).
+
+    Raises
+    ------
+    ValueError
+        For shapes that do not broadcast to (N, 2), or NaN or inf entries.
+
+    Notes
+    -----
+    Cramer's rule on ``[d, -e] [s, t]^T = q - p``; with unit directions the determinant is the
+    sine of the angle between the rays (Hartley & Zisserman 2004, Sec. 12.2, two-view triangulation
+    in the plane). Lesson 02 places landmarks where two nodes' feature rays cross.
+
+    Examples
+    --------
+    >>> s, t, sin = cross_rays([0.0, 0.0], [[1.0, 0.0]], [[2.0, -1.0]], [[0.0, 1.0]])
+    >>> s.tolist(), t.tolist(), sin.tolist()          # they cross at (2, 0)
+    ([2.0], [1.0], [1.0])
+    """
+    P, D, Q, E = (np.atleast_2d(as_array(v, name)) for v, name in ((p, "p"), (d, "d"), (q, "q"), (e, "e")))
+    try:
+        P, D, Q, E = np.broadcast_arrays(P, D, Q, E)
+    except ValueError:
+        raise ValueError(f"p, d, q, e: expected shapes that broadcast to (N, 2), got {P.shape}, {D.shape}, "
+                         f"{Q.shape}, {E.shape}") from None
+    if P.ndim != 2 or P.shape[1] != 2:
+        raise ValueError(f"p, d, q, e: expected shapes that broadcast to (N, 2), got {P.shape}")
+    b = Q - P
+    sin = D[:, 0] * E[:, 1] - D[:, 1] * E[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = (b[:, 0] * E[:, 1] - b[:, 1] * E[:, 0]) / sin
+        t = (b[:, 0] * D[:, 1] - b[:, 1] * D[:, 0]) / sin
+    return s, t, sin

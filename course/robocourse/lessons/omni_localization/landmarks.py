@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from robokit.geometry.planar import cross_rays
 from robokit.mapping import TopologicalMap
 from robokit.sim import OmniCamera
 from robokit.sim.omni import as_omni_camera
@@ -103,11 +104,7 @@ def landmark_map(tmap: TopologicalMap, camera: OmniCamera, *, ratio: float = 0.7
         p_i, p_j = tmap.poses[i, :2], tmap.poses[i + 1, :2]
         d_i = np.column_stack([np.cos(th_i), np.sin(th_i)])
         d_j = np.column_stack([np.cos(th_j), np.sin(th_j)])
-        cross = d_i[:, 0] * d_j[:, 1] - d_i[:, 1] * d_j[:, 0]      # sin of the angle between the rays
-        b = p_j - p_i
-        with np.errstate(divide="ignore", invalid="ignore"):
-            s = (b[0] * d_j[:, 1] - b[1] * d_j[:, 0]) / cross         # along the ray from node i
-            t = (b[0] * d_i[:, 1] - b[1] * d_i[:, 0]) / cross         # along the ray from node j
+        s, t, cross = cross_rays(p_i, d_i, p_j, d_j)             # along each node's ray; sin of their angle
         keep = (np.abs(cross) >= np.sin(min_angle)) & (s > 0) & (t > 0) & (s <= max_range) & (t <= max_range)
         points.append(p_i + s[keep, None] * d_i[keep])
         pairs.append(np.tile([i, i + 1], (int(keep.sum()), 1)))
