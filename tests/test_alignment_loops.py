@@ -193,6 +193,9 @@ def _graph():
     (lambda: al.odometry_redraws(_graph(), np.zeros((6, 3)), rng="seed"), "rng"),
     (lambda: al.loop_edge_errors(_graph(), np.zeros((6, 3)), keep=[9]), "keep"),
     (lambda: al.held_share(PoseGraph(np.zeros((3, 3)), [[0, 2]], [[0.0, 0.0, 0.0]])), "graph"),   # no chain
+    # an odometry edge stored backwards (1 -> 0): redrawing would write a forward step into it
+    (lambda: al.odometry_redraws(PoseGraph(np.zeros((3, 3)), [[1, 0], [1, 2]], np.zeros((2, 3))), np.zeros((3, 3))),
+     "graph"),
 ])
 def test_bad_input_is_refused_naming_the_argument(call, name):
     with pytest.raises((TypeError, ValueError)) as info:

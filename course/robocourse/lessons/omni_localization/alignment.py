@@ -66,6 +66,11 @@ def _chain(graph: Any) -> tuple[PoseGraph, np.ndarray, np.ndarray]:
         k = int(np.flatnonzero(first < 0)[0])
         raise ValueError(f"graph: expected a graph from a run, an odometry edge joining node k and k + 1 for every "
                          f"k, got none between nodes {k} and {k + 1}")
+    backwards = np.flatnonzero(g.edges[first, 0] != np.arange(g.n_poses - 1))
+    if len(backwards):                               # redrawing writes k -> k + 1 measurements into these rows
+        k = int(backwards[0])
+        raise ValueError(f"graph: expected each odometry edge stored from node k to k + 1, got edge "
+                         f"{g.edges[first[k]].tolist()} between nodes {k} and {k + 1}")
     return g, consecutive, first
 
 
