@@ -834,7 +834,7 @@ SPECS: dict[str, Call] = {
     "robocourse.lessons.omni_localization.experiment.route_recognition": Call({
         "setup": Obj(office_experiment), "n_nodes": Int(2), "offset": Real(0.15), "same_place": Real(0.5),
         "rng": Rng(1)}, cheap=False),
-    "robocourse.lessons.omni_localization.checks.test_places": Call({
+    "robocourse.lessons.omni_localization.checks.query_places": Call({
         "setup": Obj(office_experiment), "n": Int(2), "near": Real(1.0), "clearance": Real(0.4), "rng": Rng(0)}),
     "robocourse.lessons.omni_localization.checks.drive_on": Call({
         "setup": Obj(office_experiment), "start": Array(np.array([12.0, 2.5, 0.0]), "3"), "length": Real(1.0),
@@ -845,7 +845,8 @@ SPECS: dict[str, Call] = {
         "workers": Int(1, optional=True), "progress": Func(None, optional=True)}, cheap=False),
     "robocourse.lessons.omni_localization.checks.mask_trials": Call({
         "setup": Obj(office_experiment), "places": Array(np.array([[13.0, 3.7, 2.0]]), "N,3"),
-        "thresholds": Array(np.array([0.15]), "N"), "bins": Int(32), "gain": Real(0.7), "rng": Rng(0)}, cheap=False),
+        "thresholds": Array(np.array([0.15]), "N"), "bins": Int(32), "gain": Real(0.7), "noise": Real(2.0),
+        "rng": Rng(0)}, cheap=False),
     "robocourse.lessons.omni_localization.landmarks.landmark_map": Call({
         "tmap": Obj(lambda: office_experiment().relaxed), "camera": Obj(lambda: office_experiment().camera),
         "ratio": Real(0.7), "min_angle": Real(0.26), "max_range": Real(6.0)}),

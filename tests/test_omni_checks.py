@@ -16,15 +16,15 @@ def setup():
     return experiment.office_setup(fast=True)
 
 
-def test_test_places_are_free_near_a_node_and_seeded(setup):
-    places = checks.test_places(setup, 8, near=0.8, clearance=0.3, rng=4)
+def test_query_places_are_free_near_a_node_and_seeded(setup):
+    places = checks.query_places(setup, 8, near=0.8, clearance=0.3, rng=4)
     assert places.shape == (8, 3)
     assert setup.world.is_free(places[:, :2], clearance=0.3).all()
     nearest = np.min(np.hypot(setup.truth[:, None, 0] - places[:, 0], setup.truth[:, None, 1] - places[:, 1]), axis=0)
     assert np.all(nearest <= 0.8)
-    assert np.array_equal(places, checks.test_places(setup, 8, near=0.8, clearance=0.3, rng=4))
+    assert np.array_equal(places, checks.query_places(setup, 8, near=0.8, clearance=0.3, rng=4))
     with pytest.raises(ValueError, match="n"):
-        checks.test_places(setup, 3, near=0.01, clearance=5.0)
+        checks.query_places(setup, 3, near=0.01, clearance=5.0)
 
 
 def test_a_drive_turns_away_from_a_wall_and_stays_free(setup):
@@ -40,18 +40,24 @@ def test_a_drive_turns_away_from_a_wall_and_stays_free(setup):
         checks.drive_on(setup, start, length=0.2, step=0.5)
 
 
-def test_check_trials_agree_with_their_parts_and_come_back_from_the_cache(setup):
+def test_check_trials_agree_with_their_parts_and_come_back_from_the_cache(setup, monkeypatch):
     places = np.array(OFFICE_TEST_POSES[:2])
     first = checks.check_trials(setup, places, workers=1)
-    again = checks.check_trials(setup, places, workers=1)
     for way in checks.WAYS:
         assert first.errors[way].shape == (2, 2)
-        assert np.array_equal(first.errors[way], again.errors[way])
     # the Monte-Carlo answer is the widened one wherever the check did not run or did not overturn it
     same = ~first.overturned
     assert np.array_equal(first.errors["monte_carlo"][same], first.errors["widened"][same])
     assert np.all(first.rounds >= 1)
-    assert np.all(first.seconds["monte_carlo"] >= first.seconds["widened"])
+    assert np.allclose(first.distances["fine"], np.hypot(*first.errors["fine"].T))
+    # the same call is read back from the cache: no run is made; another seed is run again
+    runs = []
+    real = checks.map_runs
+    monkeypatch.setattr(checks, "map_runs", lambda *a, **k: runs.append(1) or real(*a, **k))
+    again = checks.check_trials(setup, places, workers=1)
+    assert runs == [] and all(np.array_equal(first.errors[w], again.errors[w]) for w in checks.WAYS)
+    checks.check_trials(setup, places, seed=1, workers=1)
+    assert runs == [1]
     with pytest.raises(ValueError, match="map"):
         checks.check_trials(setup, places, map="best")
 
@@ -59,11 +65,15 @@ def test_check_trials_agree_with_their_parts_and_come_back_from_the_cache(setup)
 def test_mask_trials_count_pixels_and_rank_the_nearest_node(setup):
     out = checks.mask_trials(setup, OFFICE_TEST_POSES[:3], [0.0, 0.15, 1.0])
     assert out["kept"][0] > out["kept"][1] >= out["kept"][2] == 0.0      # a higher threshold keeps fewer pixels
-    for key in ("top1", "top5", "top1_darker", "top5_darker"):
-        assert np.all((out[key] >= 0) & (out[key] <= 1))
-        assert np.all(out[key.replace("1", "5")] >= out[key]) if "1" in key else True
+    for key in ("top1", "top1_darker", "top1_noisy"):
+        assert np.all((out[key] >= 0) & (out[key] <= out[key.replace("1", "5")]) & (out[key.replace("1", "5")] <= 1))
+    # a query at a node's own pose, lit as in the map and noiseless, has that node's histogram: first
+    at_nodes = checks.mask_trials(setup, setup.truth[[2, 20, 40]], [0.15], noise=0.0)
+    assert at_nodes["top1"][0] == 1.0
     with pytest.raises(ValueError, match="thresholds"):
         checks.mask_trials(setup, OFFICE_TEST_POSES[:1], [1.5])
+    with pytest.raises(ValueError, match="noise"):
+        checks.mask_trials(setup, OFFICE_TEST_POSES[:1], [0.15], noise=-1.0)
 
 
 def test_landmarks_lie_on_the_world_and_move_with_the_map(setup):

@@ -9,8 +9,7 @@ Monte-Carlo localization strategy are employed to verify the result". Two checks
 - the *Monte-Carlo* check (:func:`robokit.localization.appearance_mcl.monte_carlo_check`): the robot
   drives on about a metre and image-based MCL decides between the candidates' places.
 
-:func:`test_places` draws query places near the recorded tour (the paper's 11 cases lie along it, Fig.
-8); :func:`check_trials` localizes each with and without the checks and records which stage decided.
+:func:`query_places` draws query places near the recorded tour, as the lesson's 11 cases lie; :func:`check_trials` localizes each with and without the checks and records which stage decided.
 
 References
 ----------
@@ -38,10 +37,10 @@ from robokit.parallel import map_runs
 from robokit.sim import noisy_odometry
 from robokit.validation import as_array, as_callable, as_choice, as_int, as_points, as_positive, as_rng
 
-__all__ = ["test_places", "drive_on", "CheckTrials", "WAYS", "check_trials", "mask_trials"]
+__all__ = ["query_places", "drive_on", "CheckTrials", "WAYS", "check_trials", "mask_trials"]
 
 
-def test_places(setup: OfficeSetup, n: int, *, near: float = 1.0, clearance: float = 0.4, rng: Any = 0) -> np.ndarray:
+def query_places(setup: OfficeSetup, n: int, *, near: float = 1.0, clearance: float = 0.4, rng: Any = 0) -> np.ndarray:
     """``n`` random query poses in free space within ``near`` metres of a map node, random headings.
 
     Parameters
@@ -62,10 +61,15 @@ def test_places(setup: OfficeSetup, n: int, *, near: float = 1.0, clearance: flo
     TypeError, ValueError
         For a bad setup or parameter, or when no such place is found in 100 n draws.
 
+    Notes
+    -----
+    Li et al. (2011), Sec. "Experimental results": 11 test locations (Fig. 8); more of them, drawn
+    like the lesson's, make the mean error of Fig. 9 less of a matter of luck.
+
     Examples
     --------
     >>> from robocourse.lessons.omni_localization.experiment import office_setup
-    >>> test_places(office_setup(fast=True), 3).shape
+    >>> query_places(office_setup(fast=True), 3).shape
     (3, 3)
     """
     setup = as_setup(setup)
@@ -90,13 +94,19 @@ def drive_on(setup: OfficeSetup, start: Any, *, length: float = 1.0, step: float
     """True poses of a short drive from ``start``: straight ahead, or after a turn if ahead is blocked.
 
     The robot tries its heading, then left, behind and right (quarter turns on the spot); it takes
-    the first direction whose ``length`` metres stay ``clearance`` from walls (the last tried when
-    none does, shortened to what is free). Returns ``[start, pose after step, ...]``, shape (K + 1, 3).
+    the first direction whose ``length`` metres stay ``clearance`` from walls, or, when none does,
+    the one that stays free longest, shortened to what is free. Returns ``[start, pose after step,
+    ...]``, shape (K + 1, 3).
 
     Raises
     ------
     TypeError, ValueError
-        For a bad setup, start or length.
+        For a bad setup, start, length or step.
+
+    Notes
+    -----
+    The drive of the Monte-Carlo check (Li et al. 2011, Sec. "Hierarchical localization"; image-based
+    Monte-Carlo localization as Menegatti et al. 2004 run it on a moving robot).
 
     Examples
     --------
@@ -147,7 +157,8 @@ class CheckTrials:
     overturned : numpy.ndarray of bool (n,)
         The Monte-Carlo check chose another place than the widened answer's.
     seconds : dict of str to numpy.ndarray (n,)
-        Query time of each way (the Monte-Carlo check's: the widened query plus the check).
+        Query time of each way (the Monte-Carlo check's: the widened query plus the check, which
+        localizes the first image again for its hypotheses).
     """
 
     places: np.ndarray
@@ -269,11 +280,11 @@ def check_trials(setup: OfficeSetup, places: Any, *, map: str = "relaxed", lengt
 
 
 def mask_trials(setup: OfficeSetup, places: Any, thresholds: Any, *, bins: int = 32, gain: float = 0.7,
-                rng: Any = 0) -> dict:
+                noise: float = 2.0, rng: Any = 0) -> dict:
     """The coarse stage's pixel mask tried: pixels kept and nearest-node retrieval per saturation threshold.
 
     Every node's key image is rendered again at the node's true pose and every query at its place,
-    once as lit in the map and once darker (``gain``); per threshold the hue histograms of Eq. (5) are
+    as lit in the map, darker (``gain``) and with pixel noise (``noise``); per threshold the hue histograms of Eq. (5) are
     computed over the pixels :func:`robokit.vision.hue_mask` keeps, and each query's nodes ranked.
 
     Parameters
@@ -286,6 +297,8 @@ def mask_trials(setup: OfficeSetup, places: Any, thresholds: Any, *, bins: int =
     bins : int, default 32
     gain : float, default 0.7
         The darker queries' lighting (``robokit.sim.textures.illuminate``).
+    noise : float, default 2.0
+        The noisy queries' Gaussian pixel noise (grey levels, standard deviation).
     rng : Generator or int, default 0
         Rendering noise.
 
@@ -294,7 +307,8 @@ def mask_trials(setup: OfficeSetup, places: Any, thresholds: Any, *, bins: int =
     dict
         ``kept`` (m,): mean share of the image's pixels that count; ``top1``, ``top5`` (m,): share of
         queries whose nearest node (by true position) ranks first / in the first five;
-        ``top1_darker``, ``top5_darker`` (m,): the same for the darker queries.
+        ``top1_darker``, ``top5_darker``, ``top1_noisy``, ``top5_noisy`` (m,): the same for the darker
+        and for the noisy queries.
 
     Raises
     ------
@@ -311,7 +325,7 @@ def mask_trials(setup: OfficeSetup, places: Any, thresholds: Any, *, bins: int =
     >>> from robocourse.lessons.omni_localization.experiment import office_setup
     >>> out = mask_trials(office_setup(fast=True), [[12.0, 2.5, 0.3]], [0.15])
     >>> sorted(out), out["kept"].shape
-    (['kept', 'top1', 'top1_darker', 'top5', 'top5_darker'], (1,))
+    (['kept', 'top1', 'top1_darker', 'top1_noisy', 'top5', 'top5_darker', 'top5_noisy'], (1,))
     """
     from robokit.mapping.omni_views import HISTOGRAM_STEP
     from robokit.vision import histogram_distance, hue_histogram, hue_mask
@@ -322,21 +336,26 @@ def mask_trials(setup: OfficeSetup, places: Any, thresholds: Any, *, bins: int =
         raise ValueError(f"thresholds: expected saturation thresholds in [0, 1], got {thresholds!r}")
     bins = as_int(bins, "bins", minimum=1)
     gain = as_positive(gain, "gain")
+    noise = as_positive(noise, "noise", allow_zero=True)
+    if noise > 100:
+        raise ValueError(f"noise: expected at most 100 grey levels, got {noise}")
     g = as_rng(rng)
     step = HISTOGRAM_STEP
 
-    def view(pose, lighting=None):
-        return setup.camera.observe(setup.world, pose, rng=g, lighting=lighting).image[::step, ::step]
+    def view(pose, lighting=None, sigma=0.0):
+        return setup.camera.observe(setup.world, pose, rng=g, lighting=lighting, noise=sigma).image[::step, ::step]
 
     nodes = [view(p) for p in setup.truth]
     lit = [view(p) for p in P]
     dark = [view(p, {"gain": gain}) for p in P]
+    noisy = [view(p, sigma=noise) for p in P]
     nearest = np.array([np.argmin(np.hypot(*(setup.truth[:, :2] - p[:2]).T)) for p in P])
-    out = {k: np.zeros(len(ts)) for k in ("kept", "top1", "top5", "top1_darker", "top5_darker")}
+    out = {k: np.zeros(len(ts)) for k in ("kept", "top1", "top5", "top1_darker", "top5_darker", "top1_noisy",
+                                          "top5_noisy")}
     for k, t in enumerate(ts):
         H = np.array([hue_histogram(im, bins, min_saturation=t) for im in nodes])
         out["kept"][k] = np.mean([hue_mask(im, min_saturation=t).mean() for im in lit])
-        for suffix, queries in (("", lit), ("_darker", dark)):
+        for suffix, queries in (("", lit), ("_darker", dark), ("_noisy", noisy)):
             ranks = np.array([int(np.flatnonzero(np.argsort(histogram_distance(hue_histogram(q, bins, min_saturation=t),
                                                                                H), kind="stable") == n)[0])
                               for q, n in zip(queries, nearest)])
