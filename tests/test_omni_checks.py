@@ -40,9 +40,14 @@ def test_a_drive_turns_away_from_a_wall_and_stays_free(setup):
         checks.drive_on(setup, start, length=0.2, step=0.5)
 
 
-def test_check_trials_agree_with_their_parts_and_come_back_from_the_cache(setup, monkeypatch):
+def test_check_trials_agree_with_their_parts_and_come_back_from_the_cache(setup, monkeypatch, tmp_path):
+    monkeypatch.setenv("ROBOKIT_CACHE", str(tmp_path))          # a cache of this test's own
+    runs = []
+    real = checks.map_runs
+    monkeypatch.setattr(checks, "map_runs", lambda *a, **k: runs.append(1) or real(*a, **k))
     places = np.array(OFFICE_TEST_POSES[:2])
     first = checks.check_trials(setup, places, workers=1)
+    assert runs == [1]
     for way in checks.WAYS:
         assert first.errors[way].shape == (2, 2)
     # the Monte-Carlo answer is the widened one wherever the check did not run or did not overturn it
@@ -51,13 +56,10 @@ def test_check_trials_agree_with_their_parts_and_come_back_from_the_cache(setup,
     assert np.all(first.rounds >= 1)
     assert np.allclose(first.distances["fine"], np.hypot(*first.errors["fine"].T))
     # the same call is read back from the cache: no run is made; another seed is run again
-    runs = []
-    real = checks.map_runs
-    monkeypatch.setattr(checks, "map_runs", lambda *a, **k: runs.append(1) or real(*a, **k))
     again = checks.check_trials(setup, places, workers=1)
-    assert runs == [] and all(np.array_equal(first.errors[w], again.errors[w]) for w in checks.WAYS)
+    assert runs == [1] and all(np.array_equal(first.errors[w], again.errors[w]) for w in checks.WAYS)
     checks.check_trials(setup, places, seed=1, workers=1)
-    assert runs == [1]
+    assert runs == [1, 1]
     with pytest.raises(ValueError, match="map"):
         checks.check_trials(setup, places, map="best")
 
