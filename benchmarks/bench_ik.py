@@ -23,8 +23,9 @@ compile time a student pays once) and again with the cache filled.
 
 Usage::
 
-    python benchmarks/bench_ik.py            # 10,000 targets per arm
+    python benchmarks/bench_ik.py            # 10,000 targets per arm, drawn afresh (the seed is printed)
     python benchmarks/bench_ik.py --n 1000   # quicker
+    python benchmarks/bench_ik.py --seed 7   # the same targets as an earlier run
     ROBOKIT_FAST=1 python benchmarks/bench_ik.py
     python benchmarks/bench_ik.py --cold     # also the cold-cache compile time (about a minute)
 
@@ -114,9 +115,13 @@ def main(argv=None):
     parser.add_argument("--n", type=int, default=200 if fast_mode() else 10_000, help="targets per arm (batched)")
     parser.add_argument("--n-single", type=int, default=50 if fast_mode() else 1000,
                         help="targets timed one at a time")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=None,
+                        help="seed of the targets and start configurations (default: fresh each run, printed)")
     parser.add_argument("--cold", action="store_true", help="also time import and first calls in fresh processes")
     args = parser.parse_args(argv)
+    if args.seed is None:                  # targets the solvers have never been tuned on, drawn afresh each run
+        args.seed = int(np.random.SeedSequence().entropy % 2 ** 31)
+    print(f"targets and starts drawn with --seed {args.seed} (pass it to repeat this run)")
 
     t0 = time.perf_counter()
     ik_srs(iiwa14(), iiwa14().fk(np.zeros(7)))
