@@ -49,8 +49,10 @@ _FOOT_CONE = np.deg2rad(15.0)   # ... if within this angle of the normal (a spar
 _BIN = 0.02               # Hough bin (m) of the lateral coordinate
 _VOTE_RANGE = 100.0       # only returns this near (m) vote for the axis: the tables stay under 10,000 bins
 _BAND = 0.05              # half-width (m) of a wall's inlier band for the line fit
-_CANDIDATES = np.deg2rad(np.arange(-90.0, 90.0, 1.0))      # the Hough vote's directions, 1 deg apart
-_ACROSS = np.stack([-np.sin(_CANDIDATES), np.cos(_CANDIDATES)])   # unit normal of each direction
+_CANDIDATES = np.deg2rad(np.arange(-90.0, 90.0, 1.0))      # the exhaustive vote's directions, 1 deg apart
+_COARSE = np.deg2rad(np.arange(-90.0, 90.0, 5.0))          # the vote's first pass: every 5 deg ...
+_FINE = np.deg2rad(np.arange(-4.0, 5.0, 1.0))              # ... then 1 deg apart around the best ...
+_KEEP = 3                                                  # ... three of them
 
 
 class NoWallError(ValueError):
@@ -79,7 +81,9 @@ def corridor_axis(ranges: Any, angles: Any) -> float:
     Notes
     -----
     Ge et al. (2023) assume the robot can align with the corridor (Sec. 3.1, unnumbered) without
-    saying how; this is ours. A Hough vote (Duda & Hart 1972) over 180 directions, 1 deg apart,
+    saying how; this is ours. A Hough vote (Duda & Hart 1972), coarse to fine (36 directions 5 deg
+    apart, then 9 directions 1 deg apart around each of the best three; ``_axis_exhaustive`` votes
+    over all 180),
     scores each direction by how sharply the points' coordinates across it pile up (the sum of the
     squared counts of 2 cm bins): two parallel walls give two sharp piles. Only returns within
     100 m vote (farther ones, sentinel values included, cannot help place a 2 cm bin and would
@@ -103,21 +107,41 @@ def corridor_axis(ranges: Any, angles: Any) -> float:
     return _axis(r, a)
 
 
-def _axis(r: np.ndarray, a: np.ndarray) -> float:
-    """:func:`corridor_axis` of a scan :func:`as_scan` has checked."""
+def _vote(pts: np.ndarray, candidates: np.ndarray) -> np.ndarray:
+    """Hough score of each candidate direction: the sum of squared counts of its 2 cm lateral bins."""
+    s = pts @ np.stack([-np.sin(candidates), np.cos(candidates)])     # (N, C) lateral coordinates
+    lo = np.floor(s.min() / _BIN)
+    bins = (np.floor(s / _BIN) - lo).astype(np.int64)
+    nb = int(bins.max()) + 1
+    counts = np.bincount((bins + nb * np.arange(len(candidates))).ravel(), minlength=nb * len(candidates))
+    counts = counts.reshape(len(candidates), nb)
+    return np.einsum("ij,ij->i", counts, counts)
+
+
+def _wall_points(r: np.ndarray, a: np.ndarray) -> np.ndarray:
     ok = r <= _VOTE_RANGE                 # farther returns (sentinels too) would only widen the tables
     if np.count_nonzero(ok) < 3:
         raise EmptyScanError(f"ranges: expected at least 3 valid returns within {_VOTE_RANGE:g} m to find the "
                              f"corridor axis, got {ok.sum()}")
-    pts = r[ok, None] * np.column_stack([np.cos(a[ok]), np.sin(a[ok])])
-    s = pts @ _ACROSS                                                 # (N, 180) lateral coordinates
-    lo = np.floor(s.min() / _BIN)
-    bins = (np.floor(s / _BIN) - lo).astype(np.int64)
-    nb = int(bins.max()) + 1
-    counts = np.bincount((bins + nb * np.arange(len(_CANDIDATES))).ravel(), minlength=nb * len(_CANDIDATES))
-    counts = counts.reshape(len(_CANDIDATES), nb)
-    score = np.einsum("ij,ij->i", counts, counts)                    # Hough vote: sum of squared counts
-    axis = float(_CANDIDATES[np.argmax(score)])
+    return r[ok, None] * np.column_stack([np.cos(a[ok]), np.sin(a[ok])])
+
+
+def _axis_exhaustive(r: np.ndarray, a: np.ndarray) -> float:
+    """The readable reference of :func:`_axis`: the vote over all 180 directions, then the same fit."""
+    pts = _wall_points(r, a)
+    return _fit_axis(pts, float(_CANDIDATES[np.argmax(_vote(pts, _CANDIDATES))]))
+
+
+def _axis(r: np.ndarray, a: np.ndarray) -> float:
+    """:func:`corridor_axis` of a scan :func:`as_scan` has checked: the vote coarse to fine, then the fit."""
+    pts = _wall_points(r, a)
+    coarse = _COARSE[np.argsort(-_vote(pts, _COARSE), kind="stable")[:_KEEP]]
+    fine = (coarse[:, None] + _FINE).ravel()            # a wall 2.5 deg off the 5 deg grid can rank low
+    return _fit_axis(pts, float(fine[np.argmax(_vote(pts, fine))]))
+
+
+def _fit_axis(pts: np.ndarray, axis: float) -> float:
+    """Total least squares of the two walls' inliers around the voted ``axis`` (twice), modulo pi."""
     for _ in range(2):                                                           # TLS refinement
         s = pts @ np.array([-np.sin(axis), np.cos(axis)])
         scatter = np.zeros((2, 2))
