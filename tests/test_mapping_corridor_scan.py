@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from robokit.mapping import (EmptyScanError, NoWallError, corridor_axis, corridor_state, invalid_areas, middle_line_condition, theta_limits, theta_limits_geometric, wall_distances, width_condition)
+from robokit.mapping import (EmptyScanError, NoWallError, corridor_axis, corridor_axis_readable, corridor_state, invalid_areas, middle_line_condition, theta_limits, theta_limits_geometric, wall_distances, width_condition)
 from robokit.mapping.corridor_areas import as_scan
 from robokit.mapping.corridor_scan import door_sides
 from robokit.sim import Lidar, long_corridor
@@ -239,7 +239,6 @@ def test_a_sparse_scan_gives_no_wall_rather_than_a_negative_distance():
 def test_the_coarse_to_fine_vote_finds_the_exhaustive_votes_axis():
     # the vote over 36 + 9 directions against the readable one over all 180, on simulated scans of
     # the long corridor: anywhere across it, near and far from its ends, turned up to 60 deg either way
-    from robokit.mapping.corridor_scan import _axis, _axis_exhaustive
     world, lidar = long_corridor(), Lidar(noise=0.01)
     g = np.random.default_rng(7)
     L, half = world.info["length"], world.info["width"] / 2
@@ -247,7 +246,7 @@ def test_the_coarse_to_fine_vote_finds_the_exhaustive_votes_axis():
         pose = np.array([g.uniform(0.4, L - 0.4), g.uniform(-half + 0.3, half - 0.3), g.uniform(-1.05, 1.05)])
         pose[2] += np.pi * g.integers(0, 2)
         r, a = as_scan(lidar.scan(world, pose, g), lidar.angles)
-        assert _axis(r, a) == pytest.approx(_axis_exhaustive(r, a), abs=1e-9), pose
+        assert corridor_axis(r, a) == pytest.approx(corridor_axis_readable(r, a), abs=1e-9), pose
         # and both find the corridor: the robot's heading error is minus the axis, modulo pi
         err = math.remainder(pose[2], math.pi)
-        assert math.degrees(abs(math.remainder(_axis(r, a) + err, math.pi))) < 1.0, pose   # centering asks 2 deg
+        assert math.degrees(abs(math.remainder(corridor_axis(r, a) + err, math.pi))) < 1.0, pose   # centering asks 2 deg

@@ -32,7 +32,7 @@ from .grid_mapping import (L_FREE, L_OCC, inverse_range_sensor_model, occupancy_
                            occupancy_grid_mapping_readable, update_log_odds)
 from .map_server import MapFileError, load_map, save_map
 from .corridor_areas import EmptyScanError, invalid_areas, theta_limits, theta_limits_geometric
-from .corridor_scan import (CorridorState, NoWallError, corridor_axis, corridor_state, middle_line_condition,
+from .corridor_scan import (CorridorState, NoWallError, corridor_axis, corridor_axis_readable, corridor_state, middle_line_condition,
                             wall_distances, width_condition)
 from .hybrid_map import geo_index, geo_tag
 
@@ -44,5 +44,5 @@ __all__ = ["LandmarkMap", "kalman_fuse", "transform_covariance", "DisconnectedGr
            "OccupancyGrid", "likelihood_field", "log_odds", "probability", "L_FREE", "L_OCC",
            "inverse_range_sensor_model", "occupancy_grid_mapping", "occupancy_grid_mapping_readable",
            "update_log_odds", "MapFileError", "load_map", "save_map", "EmptyScanError", "invalid_areas",
-           "theta_limits", "theta_limits_geometric", "CorridorState", "NoWallError", "corridor_axis",
+           "theta_limits", "theta_limits_geometric", "CorridorState", "NoWallError", "corridor_axis", "corridor_axis_readable",
            "corridor_state", "middle_line_condition", "wall_distances", "width_condition", "geo_index", "geo_tag"]

@@ -39,7 +39,7 @@ from ..geometry import wrap_angle
 from ..validation import as_choice, as_finite_scalar, as_positive
 from .corridor_areas import EmptyScanError, as_scan, invalid_areas, theta_limits, theta_limits_geometric
 
-__all__ = ["NoWallError", "CorridorState", "corridor_axis", "wall_distances", "door_sides", "width_condition",
+__all__ = ["NoWallError", "CorridorState", "corridor_axis", "corridor_axis_readable", "wall_distances", "door_sides", "width_condition",
            "middle_line_condition", "corridor_state", "EmptyScanError", "as_scan", "invalid_areas", "theta_limits",
            "theta_limits_geometric"]
 
@@ -82,8 +82,8 @@ def corridor_axis(ranges: Any, angles: Any) -> float:
     -----
     Ge et al. (2023) assume the robot can align with the corridor (Sec. 3.1, unnumbered) without
     saying how; this is ours. A Hough vote (Duda & Hart 1972), coarse to fine (36 directions 5 deg
-    apart, then 9 directions 1 deg apart around each of the best three; ``_axis_exhaustive`` votes
-    over all 180),
+    apart, then 9 directions 1 deg apart around each of the best three;
+    :func:`corridor_axis_readable` votes over all 180),
     scores each direction by how sharply the points' coordinates across it pile up (the sum of the
     squared counts of 2 cm bins): two parallel walls give two sharp piles. Only returns within
     100 m vote (farther ones, sentinel values included, cannot help place a 2 cm bin and would
@@ -126,8 +126,40 @@ def _wall_points(r: np.ndarray, a: np.ndarray) -> np.ndarray:
     return r[ok, None] * np.column_stack([np.cos(a[ok]), np.sin(a[ok])])
 
 
-def _axis_exhaustive(r: np.ndarray, a: np.ndarray) -> float:
-    """The readable reference of :func:`_axis`: the vote over all 180 directions, then the same fit."""
+def corridor_axis_readable(ranges: Any, angles: Any) -> float:
+    """The readable reference of :func:`corridor_axis`: the Hough vote over all 180 directions.
+
+    Parameters
+    ----------
+    ranges, angles : array_like, shape (B,)
+        As :func:`corridor_axis`.
+
+    Returns
+    -------
+    float
+        Axis angle in ``[-pi/2, pi/2)``, found as :func:`corridor_axis` finds it but voting over every
+        direction 1 deg apart in one pass instead of coarse to fine (same fit afterwards).
+
+    Raises
+    ------
+    EmptyScanError
+        For fewer than 3 valid returns.
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 3.1 (the robot aligns with the corridor; how is ours); the vote of Duda &
+    Hart (1972) and the total-least-squares fit of Golub & Van Loan (1980) as in :func:`corridor_axis`.
+
+    Examples
+    --------
+    >>> ang = 2 * np.pi * np.arange(360) / 360
+    >>> rel = ang - np.deg2rad(10)
+    >>> r = np.where(np.sin(rel) > 0, 1.0 / np.abs(np.sin(rel) + 1e-300), 1.2 / np.abs(np.sin(rel) + 1e-300))
+    >>> r[r > 8] = np.inf
+    >>> round(float(np.rad2deg(corridor_axis_readable(r, ang))), 3)
+    10.0
+    """
+    r, a = as_scan(ranges, angles)
     pts = _wall_points(r, a)
     return _fit_axis(pts, float(_CANDIDATES[np.argmax(_vote(pts, _CANDIDATES))]))
 
