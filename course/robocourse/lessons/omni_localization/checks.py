@@ -33,9 +33,11 @@ from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
 from robokit.geometry import wrap_angle
 from robokit.localization import HierarchicalLocalizer
 from robokit.localization.appearance_mcl import monte_carlo_check
+from robokit.mapping.omni_views import HISTOGRAM_STEP
 from robokit.parallel import map_runs
 from robokit.sim import noisy_odometry
 from robokit.validation import as_array, as_callable, as_choice, as_int, as_points, as_positive, as_rng
+from robokit.vision import histogram_distance, hue_histogram, hue_mask
 
 __all__ = ["query_places", "drive_on", "CheckTrials", "WAYS", "check_trials", "mask_trials"]
 
@@ -327,8 +329,6 @@ def mask_trials(setup: OfficeSetup, places: Any, thresholds: Any, *, bins: int =
     >>> sorted(out), out["kept"].shape
     (['kept', 'top1', 'top1_darker', 'top1_noisy', 'top5', 'top5_darker', 'top5_noisy'], (1,))
     """
-    from robokit.mapping.omni_views import HISTOGRAM_STEP
-    from robokit.vision import histogram_distance, hue_histogram, hue_mask
     setup = as_setup(setup)
     P = as_points(places, "places", 3, min_count=1)
     ts = as_array(thresholds, "thresholds", ndim=1)

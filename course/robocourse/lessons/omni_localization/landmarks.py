@@ -19,8 +19,6 @@ References
 """
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from robokit.geometry.planar import cross_rays
