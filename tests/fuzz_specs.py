@@ -508,6 +508,11 @@ def loop_settings():
     return LoopSettings()
 
 
+def posture_feedback():
+    from robokit.legged.posture import PostureFeedback
+    return PostureFeedback()
+
+
 def sensor_settings():
     from robokit.legged.simulation import SensorSettings
     return SensorSettings()
@@ -1586,12 +1591,22 @@ SPECS: dict[str, Call] = {
         "force_noise": Real(0.1)}),
     "robokit.legged.simulation.simulate_walk": Call({
         "plan": Obj(tiny_walk_plan), "loops": Obj(loop_settings), "sensors": Obj(sensor_settings),
-        "motor": Obj(littledog_motor), "rng": Rng(0)}, cheap=False),
+        "motor": Obj(littledog_motor), "host": Obj(posture_feedback, optional=True), "rng": Rng(0)}, cheap=False),
+    "robokit.legged.posture.PostureFeedback": Call({
+        "gain": Real(20.0), "axes": Obj(("z", "roll", "pitch")), "limit": Obj((0.03, 0.2))}),
+    "robokit.legged.posture.delay_gain_limit": Call({"delay_cycles": Int(3)}),
     "robocourse.lessons.littledog.experiment.lesson_plans": Call({"distance": Real(0.05)}),
     "robocourse.lessons.littledog.experiment.loop_table": Call({
         "plan": Obj(tiny_walk_plan), "servo_rates": Array(np.array([500.0]), "N"),
         "latencies": Array(np.array([0.0]), "N"), "bandwidths": Array(np.array([15.0]), "N"), "rng": Rng(0),
         "progress": Func(None, optional=True)}, cheap=False),
+    "robocourse.lessons.littledog.experiment.host_table": Call({
+        "plan": Obj(tiny_walk_plan), "gains": Array(np.array([20.0]), "N", min_rows=0),
+        "latencies": Array(np.array([0.0]), "N"), "losses": Array(np.array([0.0]), "N"), "rng": Int(0),
+        "progress": Func(None, optional=True)}, cheap=False),
+    "robocourse.lessons.littledog.experiment.host_lag": Call({"step": Real(0.005), "latency": Real(0.0),
+                                                             "dt": Real(0.01)}, cheap=False),
+    "robocourse.lessons.littledog.experiment.posture_errors": Call({"log": Obj(trial_log), "plan": Obj(tiny_walk_plan)}),
     "robocourse.lessons.littledog.experiment.estimation_table": Call({"log": Obj(trial_log)}),
     "robocourse.lessons.littledog.experiment.imu_drift": Call({"log": Obj(trial_log),
                                                               "sensors": Obj(sensor_settings, optional=True)}),

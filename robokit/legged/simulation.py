@@ -12,7 +12,9 @@ runs exactly that loop around MuJoCo:
   the link and sets a new voltage by a discrete PD law - :func:`robokit.controllers.pd_servo_step`;
 * every host cycle (10 ms): the host logs the state and the sensors, and sends the set-point that
   the walking plan asks for next (leg IK of the planned feet seen from the planned body) over the
-  link, which may delay, jitter or drop it - :class:`robokit.controllers.SetpointChannel`.
+  link, which may delay, jitter or drop it - :class:`robokit.controllers.SetpointChannel`. A
+  reactive host (``host=``, :class:`~robokit.legged.posture.PostureFeedback`) first fits the trunk's
+  pose to the MoCap markers of that cycle and solves the IK for a body pose corrected by it.
 
 The sensors are recorded true and then corrupted the way the real ones are (MoCap marker noise and
 dropouts, IMU noise and bias), so the trial log holds what the host would have seen. The IMU
@@ -35,13 +37,14 @@ import mujoco
 import numpy as np
 
 from ..controllers import LITTLEDOG_MOTOR, DCMotor, SetpointChannel, motor_current, pd_servo_step
-from ..geometry import as_se3, quat_to_matrix, se3_from_rt
+from ..geometry import as_se3, fit_rigid, quat_to_matrix, se3_from_rt
 from ..validation import as_array, as_rng, as_int, as_positive
 from .gait import WalkPlan
 from .imu import simulate_imu
 from .leg_kinematics import body_ik
 from .littledog import LEGS, MARKERS, TIMESTEP, littledog_model
-from .mocap import simulate_mocap
+from .mocap import MocapFrames, simulate_mocap
+from .posture import PostureFeedback
 from .power import trial_power
 from .servo_design import littledog_servo_gains
 from .trial_log import TrialLog, empty_streams, trial_meta
@@ -194,6 +197,7 @@ class _Probes(NamedTuple):
     force_adr: list
     imu: slice
     trunk: int
+    markers: list
 
     @classmethod
     def of(cls, model: mujoco.MjModel) -> "_Probes":
@@ -202,7 +206,7 @@ class _Probes(NamedTuple):
             raise RuntimeError("the model's IMU sensors are not gyro then accelerometer")
         return cls([model.geom(f"{leg}_foot").id for leg in LEGS], [model.site(f"{leg}_foot").id for leg in LEGS],
                    [model.sensor_adr[model.sensor(f"{leg}_force").id] + 2 for leg in LEGS],
-                   slice(gyro, gyro + 6), model.body("trunk").id)
+                   slice(gyro, gyro + 6), model.body("trunk").id, [model.site(f"marker{k}").id for k in range(len(MARKERS))])
 
 
 class _Servo:
@@ -288,22 +292,52 @@ def _snapshot(rec: dict, k: int, model: mujoco.MjModel, data: mujoco.MjData, pro
                 rec["contact"][k, i] |= wrench[0] > CONTACT_FORCE      # normal force, contact frame
 
 
+class _MocapFeed:
+    """The MoCap frames a reactive host sees as the walk runs: each frame's markers where the trunk
+    truly is, corrupted by noise and occlusions drawn before the walk (they do not depend on the pose),
+    and the trunk's pose fitted to them (None when fewer than three markers are seen)."""
+
+    def __init__(self, n: int, sensors: SensorSettings, gen: np.random.Generator):
+        frames = simulate_mocap(np.broadcast_to(np.eye(4), (n, 4, 4)), MARKERS, sensors.mocap_noise,
+                                sensors.mocap_dropout, gen, bursts=sensors.mocap_bursts,
+                                burst_length=sensors.mocap_burst_length)
+        self.visible = frames.visible
+        self.noise = np.where(frames.visible[..., None], frames.positions - MARKERS, 0.0)
+        self.positions = np.zeros_like(self.noise)
+
+    def see(self, k: int, markers: np.ndarray) -> np.ndarray | None:
+        """Frame ``k`` of markers truly at ``markers`` (M, 3): record what MoCap reports, return the fitted pose."""
+        vis = self.visible[k]
+        self.positions[k] = np.where(vis[:, None], markers + self.noise[k], 0.0)
+        if vis.sum() < 3:
+            return None
+        fit = fit_rigid(MARKERS, self.positions[k], vis.astype(float), validate=False)
+        return None if fit.degenerate else se3_from_rt(fit.R, fit.t)
+
+    def frames(self, rows: int) -> MocapFrames:
+        """The frames the host saw in the first ``rows`` cycles."""
+        return MocapFrames(self.positions[:rows], self.visible[:rows])
+
+
 def _sensed(streams: dict, gyro: np.ndarray, acc: np.ndarray, sensors: SensorSettings,
-            gen: np.random.Generator) -> dict:
-    """The true streams with the sensors corrupted as :class:`SensorSettings` says (forces, IMU, MoCap)."""
+            gen: np.random.Generator, seen: MocapFrames | None = None) -> dict:
+    """The true streams with the sensors corrupted as :class:`SensorSettings` says (forces, IMU, MoCap);
+    ``seen``: the MoCap frames a reactive host already saw, kept as they were."""
     streams["foot_force"] = streams["foot_force"] + gen.normal(0.0, sensors.force_noise, (len(gyro), 4))
     streams["imu_gyro"], streams["imu_acc"] = simulate_imu(
         gyro, acc, gen, gyro_noise=sensors.gyro_noise, acc_noise=sensors.acc_noise,
         gyro_bias=np.asarray(sensors.gyro_bias), acc_bias=np.asarray(sensors.acc_bias))
-    T_true = se3_from_rt(quat_to_matrix(streams["body_quat"]), streams["body_pos"])
-    streams["mocap"], streams["mocap_visible"] = simulate_mocap(
-        T_true, MARKERS, sensors.mocap_noise, sensors.mocap_dropout, gen, bursts=sensors.mocap_bursts,
-        burst_length=sensors.mocap_burst_length)
+    if seen is None:
+        T_true = se3_from_rt(quat_to_matrix(streams["body_quat"]), streams["body_pos"])
+        seen = simulate_mocap(T_true, MARKERS, sensors.mocap_noise, sensors.mocap_dropout, gen,
+                              bursts=sensors.mocap_bursts, burst_length=sensors.mocap_burst_length)
+    streams["mocap"], streams["mocap_visible"] = seen
     return streams
 
 
 def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors: SensorSettings = SensorSettings(),
-                  *, motor: DCMotor = LITTLEDOG_MOTOR, rng: Any = 0) -> TrialOutcome:
+                  *, motor: DCMotor = LITTLEDOG_MOTOR, host: PostureFeedback | None = None,
+                  rng: Any = 0) -> TrialOutcome:
     """Walk LittleDog through a plan in MuJoCo with the servo and host loops of the guide.
 
     Parameters
@@ -316,8 +350,14 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         Sensor noise and biases.
     motor : DCMotor
         The joint motors (all twelve alike).
+    host : PostureFeedback, optional
+        A reactive host: every cycle it fits the trunk's pose to that cycle's MoCap markers and
+        solves the IK for the planned feet from the plan's body pose corrected by the feedback
+        (:mod:`robokit.legged.posture`); a cycle whose corrected IK is out of reach resends the last
+        set-point. Default: the host plays the plan.
     rng : numpy.random.Generator or int, default 0
-        Seeds the link and the sensor noise.
+        Seeds the link and the sensor noise. A reactive host's MoCap noise comes from a generator
+        spawned from it, so the link's draws are those of the same seed without feedback.
 
     Returns
     -------
@@ -326,7 +366,7 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     Raises
     ------
     TypeError
-        If ``plan``, ``loops``, ``sensors`` or ``motor`` is not of its class.
+        If ``plan``, ``loops``, ``sensors``, ``motor`` or ``host`` is not of its class.
     ValueError
         If the plan's times are not even steps of whole physics steps, its arrays disagree in
         length, or it asks for feet out of reach.
@@ -349,6 +389,8 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         if not isinstance(value, cls):
             hint = " (robokit.legged.walking_plan)" if cls is WalkPlan else ""
             raise TypeError(f"{name}: expected a {cls.__name__}{hint}, got {type(value).__name__}")
+    if host is not None and not isinstance(host, PostureFeedback):
+        raise TypeError(f"host: expected a PostureFeedback or None, got {type(host).__name__}")
     seed = rng if isinstance(rng, int) and not isinstance(rng, bool) else None
     gen = as_rng(rng)
     host_dt, host_steps = _host_period(plan)
@@ -365,7 +407,9 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     gains = loops.gains if loops.gains is not None else littledog_servo_gains(motor=motor)
     servo = _Servo(q_cmd[0], data.qpos[7:], gains, servo_steps * TIMESTEP, motor, -(-n * host_steps // servo_steps))
     rec = empty_streams(n, 1.0 / host_dt)
-    rec["t"][:], rec["q_cmd"][:] = plan.t, q_cmd
+    rec["t"][:] = plan.t
+    feed = None if host is None else _MocapFeed(n, sensors, gen.spawn(1)[0])
+    posture = None if host is None else host.start(host_dt)
     imu_true, imu_sum = np.zeros((n, 6)), data.sensordata[probes.imu] * host_steps
     fell, rows = False, n
     for k in range(n):
@@ -376,6 +420,10 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         if data.qpos[2] < FALL_HEIGHT or _tipped(data.qpos[3:7]):
             fell, rows = True, k + 1
             break
+        if posture is not None:      # a reactive host: the IK from the plan's body corrected by what MoCap sees
+            T_cmd = posture.command(plan.T_world_body[k], feed.see(k, data.site_xpos[probes.markers]))
+            q, ok = body_ik(plan.feet_world[k], T_cmd, validate=False)
+            q_cmd[k] = q[0] if ok[0] else q_cmd[max(k - 1, 0)]
         channel.send(now, q_cmd[k])
         for s in range(host_steps):
             if (k * host_steps + s) % servo_steps == 0:                   # the servo's own clock
@@ -384,8 +432,9 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
             mujoco.mj_step(model, data)
             imu_sum += data.sensordata[probes.imu]
     energy = servo.energy(data.qpos[7:])
+    rec["q_cmd"][:] = q_cmd
     streams = _sensed({key: value[:rows] for key, value in rec.items()}, imu_true[:rows, :3], imu_true[:rows, 3:],
-                      sensors, gen)
+                      sensors, gen, None if feed is None else feed.frames(rows))
     meta = trial_meta(gait=plan.gait, host_rate=1.0 / host_dt, servo_rate=loops.servo_rate,
                       link_latency=loops.latency, link_jitter=loops.jitter, link_loss=loops.loss, seed=seed,
                       notes="simulated in MuJoCo by robokit.legged.simulate_walk", kp=servo.kp, kd=servo.kd)

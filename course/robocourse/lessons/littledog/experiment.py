@@ -5,6 +5,9 @@ Each function makes one of the lesson's tables from trials of :func:`robokit.leg
 * :func:`lesson_plans` - the crawl and the trot the lesson walks (1 m; 0.3 m in fast mode);
 * :func:`loop_table` - servo rate (the guide's 500 Hz against 100 Hz) x link latency
   (0 / 10 / 30 / 50 ms) x servo stiffness: set-point tracking, distance, falls, motor power;
+* :func:`host_table` - the same latencies (and packet loss) under a host that plays the plan and
+  under hosts that feed the MoCap's trunk pose back (:class:`robokit.legged.PostureFeedback`):
+  trunk tilt and height against the plan, falls, distance;
 * :func:`estimation_table` - the trunk's pose from MoCap alone, from the IMU alone and fused,
   against the simulator's truth; :func:`imu_drift` - why the IMU alone drifts so far;
 * :func:`touchdown_table` - touchdown detection on the lower-leg force sensors against MuJoCo's
@@ -14,7 +17,9 @@ Each function makes one of the lesson's tables from trials of :func:`robokit.leg
 * :func:`true_margins` - the static stability margin of the true centre of mass over the feet
   truly on the ground.
 
-No cache: every trial runs in about a second (the simulation runs at more than 20 x real time).
+No cache: every trial runs in about a second (the simulation runs at more than 20 x real time; a
+reactive host's trial in about two); :func:`host_table` runs its trials side by side
+(:func:`robokit.parallel.map_runs`).
 
 References
 ----------
@@ -34,12 +39,15 @@ import numpy as np
 
 from robocourse import FAST
 from robokit.controllers import LITTLEDOG_MOTOR, servo_analysis
+from robokit.geometry import quat_to_matrix, so3_log
+from robokit.parallel import map_runs
 from robokit.progress import progress_bar
 from robokit.validation import as_array, as_callable, as_int, as_positive, describe
 from robokit.legged.gait import WalkPlan, walking_plan
 from robokit.legged.gait_schedule import crawl_gait, trot_gait
-from robokit.legged.littledog import GUIDE, MARKERS, TOTAL_MASS
+from robokit.legged.littledog import GUIDE, MARKERS, STANCE_FEET, STANDING_HEIGHT, TOTAL_MASS
 from robokit.legged.mocap import mocap_body_poses
+from robokit.legged.posture import PostureFeedback, delay_gain_limit
 from robokit.legged.power import battery_energy, cost_of_transport, endurance
 from robokit.legged.servo_design import SERVO_BANDWIDTH, littledog_servo_gains, servo_inertia
 from robokit.legged.imu import GRAVITY
@@ -51,7 +59,7 @@ from robokit.legged.touchdown import detect_contacts, gate_touchdowns
 from robokit.legged.trial_log import TrialLog
 
 __all__ = ["LESSON_CRAWL", "LESSON_TROT", "LESSON_DISTANCE", "LATENCIES", "TOUCHDOWN_DETECTORS", "lesson_plans",
-           "loop_table", "estimation_table", "ImuDrift", "imu_drift", "touchdown_table", "endurance_table",
+           "loop_table", "HOST_GAINS", "HostLag", "host_lag", "host_table", "posture_errors", "estimation_table", "ImuDrift", "imu_drift", "touchdown_table", "endurance_table",
            "true_margins"]
 
 LESSON_CRAWL = {"period": 2.0, "step_length": 0.08, "step_height": 0.04, "duty_factor": 0.9}
@@ -62,6 +70,8 @@ LESSON_DISTANCE = 0.3 if FAST else 1.0
 """How far the lesson walks (m): 1 m, the issue's distance (0.3 m in fast mode)."""
 LATENCIES = (0.0, 0.01, 0.03, 0.05)
 """Link latencies of the loop table (s)."""
+HOST_GAINS = (20.0, 50.0)
+"""Integral gains (1/s) of the reactive hosts the lesson compares with the plan-playing host."""
 TOUCHDOWN_DETECTORS = (("threshold 2 N", 2.0, 2.0 - 1e-9, 1), ("hysteresis 3 / 1 N", 3.0, 1.0, 1),
                        ("hysteresis + debounce 2", 3.0, 1.0, 2))
 """The touchdown detectors the lesson compares: ``(label, threshold_on, threshold_off, debounce)``
@@ -155,6 +165,170 @@ def loop_table(plan: WalkPlan, *, servo_rates: Any = (500.0, 100.0), latencies: 
                 bar(len(rows), total)
     bar.close()
     return rows
+
+
+def posture_errors(log: TrialLog, plan: WalkPlan) -> tuple[float, float]:
+    """RMS of the trunk's true tilt (roll and pitch, deg) and height (mm) against the plan's, over a trial.
+
+    Parameters
+    ----------
+    log : TrialLog
+        A trial of ``plan`` (its first ``len(log)`` host cycles).
+    plan : WalkPlan
+
+    Returns
+    -------
+    (float, float)
+        Tilt RMS (deg) of the rotation vector ``log(R_plan^T R_true)``'s x and y components, and
+        height RMS (mm).
+
+    Examples
+    --------
+    >>> plan = lesson_plans(0.05)["crawl"]
+    >>> tilt, height = posture_errors(simulate_walk(plan).log, plan)
+    >>> tilt < 2 and height < 10
+    True
+    """
+    if not isinstance(log, TrialLog):
+        raise TypeError(f"log: expected a TrialLog, got {type(log).__name__}")
+    if not isinstance(plan, WalkPlan):
+        raise TypeError(f"plan: expected a WalkPlan, got {type(plan).__name__}")
+    n = len(log)
+    if n > len(plan.t):
+        raise ValueError(f"log: expected at most the plan's {len(plan.t)} host cycles, got {n}")
+    R_err = np.swapaxes(plan.T_world_body[:n, :3, :3], 1, 2) @ quat_to_matrix(log.body_quat)
+    tilt = so3_log(R_err)[:, :2]
+    height = log.body_pos[:, 2] - plan.T_world_body[:n, 2, 3]
+    return float(np.degrees(_rms(tilt))), 1000 * _rms(height)
+
+
+class HostLag(NamedTuple):
+    """How the standing trunk answers a step in the body height the host asks for."""
+
+    #: (N,) host cycles since the step was sent.
+    cycles: np.ndarray
+    #: (N,) height change as a fraction of the step.
+    response: np.ndarray
+    #: Host cycles until the trunk is half-way (interpolated).
+    half_cycles: float
+
+
+def host_lag(step: float = 0.005, *, latency: float = 0.0, dt: float = 0.01) -> HostLag:
+    """The lag a reactive host has to live with: the standing trunk's answer to a height step.
+
+    The host plays a plan that stands still and, at one cycle, asks for the body ``step`` metres
+    higher (feet where they are); the trunk's true height is read every cycle after. The cycles it
+    takes to get half-way are the delay of the loop a reactive host closes (servo, motors, legs),
+    before any link latency.
+
+    Parameters
+    ----------
+    step : float, default 0.005
+        Height step (m, > 0, at most 0.02).
+    latency : float, default 0
+        One-way link delay (s).
+    dt : float, default 0.01
+        Host period (s).
+
+    Returns
+    -------
+    HostLag
+
+    Examples
+    --------
+    >>> lag = host_lag()
+    >>> 1 < lag.half_cycles < 3
+    True
+    """
+    step = as_positive(step, "step")
+    if step > 0.02:
+        raise ValueError(f"step: expected at most 0.02 m (the legs' reach), got {step}")
+    LoopSettings(latency=latency)                          # refuses a bad latency by name
+    dt = as_positive(dt, "dt")
+    before, after = 20, 40
+    n = before + after
+    T = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
+    T[:, 2, 3] = STANDING_HEIGHT + np.where(np.arange(n) >= before, step, 0.0)
+    feet = np.broadcast_to(STANCE_FEET + [0.0, 0.0, STANDING_HEIGHT], (n, 4, 3))
+    plan = WalkPlan(np.arange(n) * dt, T, feet, np.ones((n, 4), bool), np.zeros(n), "stand")
+    z = simulate_walk(plan, LoopSettings(latency=latency), rng=0).log.body_pos[:, 2]
+    response = (z[before:] - z[before - 1]) / step
+    k = int(np.argmax(response >= 0.5))
+    half = k - 1 + (0.5 - response[k - 1]) / (response[k] - response[k - 1]) if k > 0 else 0.0
+    return HostLag(np.arange(after), response, float(half))
+
+
+def _host_trial(plan: WalkPlan, task: tuple) -> dict:
+    """One row of :func:`host_table`: the plan walked under one host, latency and loss."""
+    gain, latency, loss, seed, lag = task
+    host = None if gain == 0 else PostureFeedback(gain=gain)
+    out = simulate_walk(plan, LoopSettings(latency=latency, loss=loss), host=host, rng=seed)
+    tilt, height = posture_errors(out.log, plan)
+    dt = float(plan.t[1] - plan.t[0])
+    delay = int(round(lag + latency / dt))                  # the legs' own lag, then the link
+    return {"gain": gain, "latency": latency, "loss": loss, "fell": out.fell, "distance": out.distance,
+            "tilt_deg": tilt, "height_mm": height, "tracking_deg": float(np.degrees(out.tracking_rms)),
+            "step_gain": gain * dt, "delay_cycles": delay,
+            "predicted_stable": None if gain == 0 else bool(gain * dt < delay_gain_limit(delay))}
+
+
+def host_table(plan: WalkPlan, *, gains: Any = HOST_GAINS, latencies: Any = LATENCIES, losses: Any = (0.0,),
+               rng: int = 0, progress: Any = None) -> list:
+    """Walk one plan under a host that plays it and under reactive hosts, over links of every latency.
+
+    Parameters
+    ----------
+    plan : WalkPlan
+    gains : sequence of float
+        Integral gains (1/s, > 0) of the reactive hosts (:class:`robokit.legged.PostureFeedback`,
+        default axes: height, roll, pitch); a plan-playing host (gain 0) is always walked too.
+    latencies : sequence of float
+        One-way link delays (s, >= 0).
+    losses : sequence of float
+        Packet-loss probabilities (in [0, 1)).
+    rng : int
+        Seed of every trial (the same for all, so rows differ only by the host and the link).
+    progress : callable, optional
+        ``progress(done, total)``.
+
+    Returns
+    -------
+    list of dict
+        One row per (gain, latency, loss), the plan-playing host first: ``gain`` (0 for it),
+        ``latency``, ``loss``, ``fell``, ``distance`` (m), ``tilt_deg`` and ``height_mm``
+        (:func:`posture_errors`), ``tracking_deg``, ``step_gain`` (``gain dt``), ``delay_cycles``
+        (:func:`host_lag`'s half-way time plus the latency, in host cycles, rounded) and ``predicted_stable``
+        (``step_gain`` below :func:`robokit.legged.delay_gain_limit` of that delay; None for the
+        plan-playing host).
+
+    Notes
+    -----
+    The trials are independent and made side by side (:func:`robokit.parallel.map_runs`).
+
+    Examples
+    --------
+    >>> rows = host_table(lesson_plans(0.05)["crawl"], gains=(20.0,), latencies=(0.0,))
+    >>> [(r["gain"], r["fell"], r["predicted_stable"]) for r in rows]
+    [(0.0, False, None), (20.0, False, True)]
+    """
+    if not isinstance(plan, WalkPlan):
+        raise TypeError(f"plan: expected a WalkPlan, got {type(plan).__name__}")
+    g = as_array(gains, "gains", ndim=1, min_size=0)
+    lats = as_array(latencies, "latencies", ndim=1, min_size=1)
+    losses = as_array(losses, "losses", ndim=1, min_size=1)
+    progress = as_callable(progress, "progress")
+    if np.any(g <= 0):
+        raise ValueError(f"gains: expected positive integral gains (1/s), got {g.tolist()}")
+    for lat in lats:
+        for loss in losses:     # every setting is refused by name before the first trial runs
+            try:
+                LoopSettings(latency=float(lat), loss=float(loss))
+            except ValueError as exc:
+                raise ValueError(f"latencies, losses: {exc}") from None
+    seed = as_int(rng, "rng", minimum=0)
+    lag = host_lag(dt=float(plan.t[1] - plan.t[0])).half_cycles
+    tasks = [(float(gain), float(lat), float(loss), seed, lag) for gain in (0.0, *g) for lat in lats for loss in losses]
+    return map_runs(_host_trial, plan, tasks, desc="walking trials", unit="trial", progress=progress)
 
 
 def _duration(log: TrialLog) -> float:
