@@ -175,10 +175,13 @@ class LegIK(NamedTuple):
     ok: np.ndarray
 
 
-def _solve(p: np.ndarray, i: int, branch: np.ndarray):
-    """Unchecked closed-form IK: angles (N, 3), reach flags (N,)."""
-    v = p - HIP_POSITIONS[i]
-    d = _side(i) * HIP_OFFSETS[i]
+_SIDES = np.array([_side(k) for k in range(4)])
+
+
+def _solve(p: np.ndarray, i: Any, branch: np.ndarray):
+    """Unchecked closed-form IK: angles (N, 3), reach flags (N,); ``i`` one leg, or one leg per target."""
+    v = p - HIP_POSITIONS[i]                                   # (3,) for one leg, (N, 3) for one per target
+    d = _SIDES[i] * HIP_OFFSETS[i]
     r2 = v[:, 1] ** 2 + v[:, 2] ** 2
     ok = r2 >= HIP_OFFSETS[i] ** 2 * (1 - _REACH_TOL)
     r = np.sqrt(np.maximum(r2, HIP_OFFSETS[i] ** 2))
@@ -419,13 +422,9 @@ def body_ik(feet: Any, T_world_body: Any = None, *, validate: bool = True) -> Le
     if T_world_body is not None:
         R, t = T[:, :3, :3], T[:, :3, 3]
         f = np.einsum("nji,nkj->nki", R, f - t[:, None, :])    # R^T (p - t)
-    q = np.empty((len(f), 12))
-    ok = np.ones(len(f), bool)
-    for i in range(4):
-        qi, oki = _solve(f[:, i], i, np.full(len(f), float(KNEE_BRANCH[i])))
-        q[:, 3 * i:3 * i + 3] = qi
-        ok &= oki
-    return LegIK(q, ok)
+    legs = np.tile(np.arange(4), len(f))                      # all four legs in one batch
+    q, ok = _solve(f.reshape(-1, 3), legs, np.asarray(KNEE_BRANCH, float)[legs])
+    return LegIK(q.reshape(len(f), 12), ok.reshape(len(f), 4).all(axis=1))
 
 
 def _vectors(value: Any, name: str, batch: tuple, against: str = "q_leg's") -> np.ndarray:
