@@ -142,6 +142,26 @@ def test_case_inputs_are_plain():
         Case((object(),))
 
 
+def test_a_case_that_knows_its_answer_is_judged_by_it_not_by_the_answer():
+    """A simulator's truth (lesson 04's touchdowns) travels in the case: the answer is not called."""
+    from robocourse.exercises import Exercise
+    from robocourse.grading.judge import call_student, expected_output, judge
+
+    calls = []
+    ex = Exercise(id="00.truth", function="truth", signature="truth(x)", points=1, cases=lambda rng: [],
+                  answer=lambda x: calls.append(x) or 0.0)
+    case = Case((1.0,), expected=(np.int64(7), 8.5), label="simulated")
+    assert case.expected == [7, 8.5] and type(case.expected[0]) is int
+    assert expected_output(ex, case) == [7, 8.5] and not calls
+    assert judge(ex, case, expected_output(ex, case), call_student(lambda x: [7, 8.5], case)).passed
+    assert not judge(ex, case, expected_output(ex, case), call_student(lambda x: 0.0, case)).passed
+    assert expected_output(ex, Case((2.0,))) == 0.0 and calls == [2.0]
+    with pytest.raises(ValueError, match="expected"):
+        Case((1.0,), raises="ValueError", expected=1.0)
+    with pytest.raises(NotPlainData):
+        Case((1.0,), expected=object())
+
+
 @pytest.mark.parametrize("slug", list(assignments()))
 def test_reference_passes_its_own_cases(slug):
     from robocourse.grading.judge import call_student, expected_output, judge

@@ -54,6 +54,18 @@ def test_the_worker_gets_case_inputs_only(job):
     assert [len(inputs) for _, inputs in job.read_spec().exercises] == [len(cs) for cs in prepared.cases]
 
 
+def test_the_worker_never_gets_a_cases_known_answer(job):
+    from robocourse.grading.grader import PreparedCases, job_spec
+    from robocourse.grading.sandbox import Limits
+    from robocourse.grading.submission import Submission
+
+    case = Case((1.25,), expected=[987654.321], label="a simulated truth")
+    prepared = PreparedCases((_exercise(),), [[case]], [[case.expected]], [[frozenset()]], "00_getting_started", "s")
+    job.write_spec(job_spec(Submission(("x = 1",), (False,)), prepared, Limits()))
+    text = (job.inbox / "job.json").read_text()
+    assert "1.25" in text and "987654" not in text and "simulated" not in text
+
+
 def test_exercise_report_round_trip(job):
     class Odd(ValueError):
         pass

@@ -34,23 +34,34 @@ class Case:
 
     ``raises`` names the exception class the function must raise (e.g. ``"ValueError"``), for
     bad-input cases; a subclass is accepted. ``label`` says what the case tests, for feedback.
-    The inputs are converted to plain data; anything else raises
+    ``expected`` is the case's right answer when its generator knows a truth that no function of the
+    inputs can compute (a simulator's: lesson 04's touchdowns are MuJoCo's contacts); the grader and
+    ``check()`` then compare with it instead of calling the exercise's ``answer``. Like the label,
+    it never reaches the grading worker, which gets only ``args`` and ``kwargs``. The inputs and
+    ``expected`` are converted to plain data; anything else raises
     :class:`~robocourse.exercises.plain.NotPlainData`.
 
     Examples
     --------
     >>> Case(((1, 2),), label="a tuple").args
     ([1, 2],)
+    >>> Case(([0.0, 9.0, 9.0],), expected=(1,)).expected
+    [1]
     """
 
     args: tuple = ()
     kwargs: dict = dataclasses.field(default_factory=dict)
     raises: str | None = None
     label: str = ""
+    expected: Any = None
 
     def __post_init__(self):
         object.__setattr__(self, "args", tuple(to_plain(list(self.args))))
         object.__setattr__(self, "kwargs", to_plain(dict(self.kwargs)))
+        if self.expected is not None:
+            if self.raises:
+                raise ValueError("expected: a case that must raise has no expected answer")
+            object.__setattr__(self, "expected", to_plain(self.expected))
 
     def call_text(self, function: str, limit: int = 400) -> str:
         """The call this case makes, for feedback: ``function(arg, ..., key=value)``.
@@ -99,6 +110,8 @@ class Exercise:
         ``cases(rng) -> list[Case]``; must be deterministic for a given generator.
     answer : callable
         Computes the expected output of a (non-raising) case; called by the trusted grader only.
+        For a case that carries its ``expected`` answer (a simulator's truth), it is the reference
+        solution, tested on the cases like any answer but not called to grade them.
     compare : callable
         ``compare(expected, got) -> None | message``; defaults to :func:`~robocourse.exercises.compare.close`.
     description : str
