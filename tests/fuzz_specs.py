@@ -1536,15 +1536,20 @@ SPECS: dict[str, Call] = {
         "detected": Array(np.array([3, 5, 8]), "N", min_rows=0), "truth": Array(np.array([2, 8]), "N", min_rows=0),
         "tolerance": Int(2)}),
     "robocourse.lessons.littledog.data.model_facts": Call({}),
-    "robocourse.lessons.littledog.data.touchdown_trace": Call({
-        "rng": Rng(0), "duration": Real(3.0), "noise": Real(0.2), "bounce": Real(0.5), "drift": Real(0.5)}),
-    "robocourse.lessons.littledog.data.touchdown_traces": Call({"seed": Int(0)}),
+    "robocourse.lessons.littledog.data.crawl_touchdowns": Call({
+        "gait": Mapping({"period": 2.4, "duty_factor": 0.92}, optional=True), "distance": Real(0.05),
+        "latency": Real(0.02), "force_noise": Real(0.1), "seed": Int(0)}, cheap=False),
     "robocourse.lessons.littledog.data.mocap_frames": Call({"seed": Int(0), "n": Int(5), "noise": Real(0.001)}),
     "robocourse.lessons.littledog.exercises.battery_endurance": Call({
         "capacity_ah": Real(2.1), "voltage": Real(14.8), "mean_power_w": Real(62.0)}),
     "robocourse.lessons.littledog.exercises.detect_touchdowns": Call({
-        "force": Array(np.array([0.0, 0.2, 9.0, 0.5, 11.0, 10.0, 10.0, 10.0, 4.0, 1.0, 0.0]), "N", min_rows=0),
+        "force": Array(lambda: np.column_stack([[9, 9, 0, 0, 0, 0, 0, 9, 9, 0.5, 9, 9]] + [np.full(12, 9.0)] * 3),
+                       "N,4", min_rows=0),
+        "planned_stance": Array(lambda: np.arange(12)[:, None] % 6 != np.array([2, 3, 4, 5]), "N,4", min_rows=0,
+                                accepts=("booleans",)),
         "dt": Real(0.01)}),
+    "robokit.legged.touchdown.score_leg_events": Call({
+        "detected": Given([[3, 5, 8], [10]]), "truth": Given([[2, 8], [30]]), "tolerance": Int(2)}),
     # --- lesson 04: leg kinematics and statics, the MuJoCo model, the servo design (robokit.legged.leg_kinematics,
     #     littledog, servo_design) -------------------------------------------------------------------
     "robokit.legged.leg_kinematics.leg_points": Call({
@@ -1927,8 +1932,7 @@ EXTRA: tuple[str, ...] = (
         "support_outline", "plot_gait_diagram", "plot_joint_tracking", "plot_foot_forces", "plot_support")),
     # assignment 04's exercises and helpers
     "robokit.legged.leg_kinematics.foot_position", "robokit.legged.leg_kinematics.leg_ik",
-    *(f"robocourse.lessons.littledog.data.{n}" for n in ("model_facts", "touchdown_trace", "touchdown_traces",
-                                                     "mocap_frames")),
+    *(f"robocourse.lessons.littledog.data.{n}" for n in ("model_facts", "crawl_touchdowns", "mocap_frames")),
     "robocourse.lessons.littledog.exercises.battery_endurance", "robocourse.lessons.littledog.exercises.detect_touchdowns",
 )
 

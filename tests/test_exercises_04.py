@@ -12,10 +12,9 @@ from robocourse.grading import check
 from robocourse.lessons import exercises_for
 from tests.conftest import assert_check_passes
 from robokit.legged import littledog
-from robokit.legged.touchdown import contact_events, score_events
-from robocourse.lessons.littledog.data import model_facts, mocap_frames, touchdown_traces
+from robokit.legged.touchdown import contact_events, detect_contacts, gate_touchdowns, score_leg_events
+from robocourse.lessons.littledog.data import crawl_touchdowns, model_facts, mocap_frames
 from robokit.legged.mocap import fit_marker_pose
-from robokit.legged.touchdown import detect_contacts
 
 EXERCISES = {ex.id: ex for ex in module.EXERCISES}
 
@@ -68,11 +67,12 @@ def _ignores_visibility(markers_body, observed, visible):   # fits the hidden ma
     return fit_marker_pose(markers_body, observed).tolist()
 
 
-def _plain_threshold(force, dt):   # a tempting shortcut: rising edges of force > 4 N
+def _plain_threshold(force, planned_stance, dt):   # the tempting shortcut: each leg's rises through 2 N
     f = np.asarray(force, float)
-    if f.ndim != 1 or not np.isfinite(f).all() or not dt > 0:
-        raise ValueError("force, dt")
-    return (np.flatnonzero(np.diff((f > 4.0).astype(int)) == 1) + 1).tolist()
+    if f.ndim != 2 or f.shape[1] != 4 or not np.isfinite(f).all() or np.shape(planned_stance) != f.shape \
+            or not dt > 0:
+        raise ValueError("force, planned_stance, dt")
+    return [(np.flatnonzero(np.diff((leg > 2.0).astype(int)) == 1) + 1).tolist() for leg in f.T]
 
 
 def _wrong_endurance(capacity_ah, voltage, mean_power_w):   # watt-hours over watts: hours, not minutes
@@ -134,43 +134,65 @@ def test_the_ik_cases_are_inverted_on_the_branch_asked_for_with_the_foot_below_t
 
 # --- the open exercises ---------------------------------------------------------------------------
 
-@pytest.mark.parametrize("seed", list(range(10)) + ["instructor-secret"])
-def test_the_open_touchdown_exercise_is_fair(seed, monkeypatch):
-    """The expected touchdowns are the generator's true ones (the reference finds exactly them); a
-    causal detector as the host would run it (hysteresis 5/3 N, 30 ms debounce) passes every case;
-    a plain threshold counts the bounces as touchdowns and fails some."""
-    truths = []
-    generate = module.touchdown_trace
+def _hysteresis(force, planned_stance, dt):   # the lesson's best detector without the plan (3 / 1 N, debounce 2)
+    return [e.tolist() for e in contact_events(detect_contacts(np.asarray(force), 3.0, 1.0, 2))]
 
-    def recording(*args, **kwargs):
-        out = generate(*args, **kwargs)
-        truths.append(out["touchdowns"])
-        return out
-    monkeypatch.setattr(module, "touchdown_trace", recording)
+
+def _lesson_gate(force, planned_stance, dt):   # the lesson's gate: the first rise within 100 ms of the plan
+    found = contact_events(detect_contacts(np.asarray(force), 3.0, 1.0, 2))
+    return [gate_touchdowns(d, p, 10).tolist() for d, p in zip(found, contact_events(np.asarray(planned_stance)))]
+
+
+@pytest.mark.parametrize("seed", [0, 1, "instructor-secret"])
+def test_the_open_touchdown_exercise_is_fair(seed):
+    """The cases are crawls simulated in MuJoCo, graded against its true touchdowns: the reference
+    (hysteresis gated by the plan) passes every one; the force alone (a threshold, the lesson's
+    hysteresis) fails every one; the plan alone, shifted by any fixed delay, fails at least one; the
+    lesson's +-100 ms gate fails the slow link."""
     exercise = EXERCISES["04.detect_touchdowns"]
     cases = [c for c in exercise.make_cases(seed) if not c.raises]
-    assert len(truths) == len(cases) == 5
-    fooled = 0
-    for case, truth in zip(cases, truths):
-        force, dt = case.args
-        assert exercise.answer(force, dt) == truth
-        causal = contact_events(detect_contacts(force, 5.0, 3.0, 3)).tolist()
-        assert exercise.compare(truth, causal) is None, case.label
-        assert 2.0 <= score_events(causal, truth, 5).mean_delay_samples <= 5.0       # what the host pays
-        fooled += exercise.compare(truth, _plain_threshold(force, dt)) is not None
-    assert fooled >= 1
+    assert len(cases) == len(module.TOUCHDOWN_LINKS) == 3
+    for case in cases:
+        force, stance, dt = case.args
+        assert np.shape(force) == np.shape(stance) and np.shape(force)[1] == 4 and dt == 0.01
+        assert sum(map(len, case.expected)) >= 12, case.label                 # touchdowns enough for 0.9 to mean much
+        assert exercise.compare(case.expected, exercise.answer(*case.args)) is None, case.label
+        for blind in (_plain_threshold, _hysteresis):
+            assert score_leg_events(blind(*case.args), case.expected, 5).precision < 0.4, (blind, case.label)
+    assert exercise.compare(cases[2].expected, _lesson_gate(*cases[2].args)) is not None
+    for name, shortcut in exercise.shortcuts.items():
+        assert any(exercise.compare(c.expected, shortcut(*c.args)) is not None for c in cases), name
+    assert exercise.compare(cases[0].expected, exercise.shortcuts["the plan's touchdowns"](*cases[0].args)) is None
+
+
+def test_the_touchdown_cases_are_mujocos_truth():
+    """A crawl's touchdowns are the rising edges of MuJoCo's contacts, whatever the sensor noise's seed."""
+    from robokit.legged import crawl_gait, simulate_walk, walking_plan
+    from robokit.legged.simulation import LoopSettings
+    gait = {"period": 2.4, "step_length": 0.07, "step_height": 0.045, "duty_factor": 0.92}
+    run = crawl_touchdowns(gait, distance=0.1, latency=0.05, seed=3)
+    out = simulate_walk(walking_plan(crawl_gait(**gait), 0.1), LoopSettings(latency=0.05), rng=7)
+    assert run["touchdowns"] == [e.tolist() for e in contact_events(out.log.contact)]
+    other = crawl_touchdowns(gait, distance=0.1, latency=0.05, seed=4)
+    assert other["touchdowns"] == run["touchdowns"] and other["force"] != run["force"]
+    assert other["planned_stance"] == walking_plan(crawl_gait(**gait), 0.1).stance[:len(out.log)].tolist()
 
 
 def test_the_touchdown_compare_needs_both_precision_and_recall():
     compare = EXERCISES["04.detect_touchdowns"].compare
-    truth = list(range(10, 1000, 50))                                  # 20 true touchdowns
-    assert compare(truth, [t + 5 for t in truth]) is None              # 50 ms late: still a match
-    assert compare(truth, [t + 6 for t in truth]) is not None          # 60 ms late: none matches
-    assert compare(truth, truth[:18]) is None                          # recall 0.9
-    assert "recall 0.85" in compare(truth, truth[:17])
-    assert "precision 0.87" in compare(truth, sorted(truth + [t + 3 for t in truth[:3]]))   # 3 bounces
-    assert compare(truth, np.array(truth)) is None and compare(truth, [float(t) for t in truth]) is None
-    for bad in ("10, 60", [10.5], [-1], [[10]], None):
+    truth = [list(range(10 + 50 * leg, 1000, 200)) for leg in range(4)]        # 20 true touchdowns
+    assert compare(truth, [[t + 5 for t in leg] for leg in truth]) is None      # 50 ms late: still a match
+    assert "0 right" in compare(truth, [[t + 6 for t in leg] for leg in truth]) # 60 ms late: none matches
+    assert compare(truth, [truth[0][:3], *truth[1:]]) is None                   # recall 0.9
+    missed = compare(truth, [truth[0][:2], *truth[1:]])
+    assert "recall 0.85" in missed and "3 missed" in missed and "FL at sample 410" in missed
+    bounces = compare(truth, [sorted(truth[0] + [t + 3 for t in truth[0][:3]]), *truth[1:]])
+    assert "precision 0.87" in bounces and "the first false one: FL at sample 13" in bounces
+    assert compare(truth, [np.array(leg) for leg in truth]) is None
+    assert compare(truth, [[float(t) for t in leg] for leg in truth]) is None
+    assert compare(truth, truth[::-1]) is not None                              # each leg's own touchdowns
+    for bad in ("10, 60", [[10.5], [], [], []], [[-1], [], [], []], truth[:3], [10, 20, 30, 40], None,
+                np.zeros((4, 5))):
         assert compare(truth, bad) is not None
 
 
@@ -249,19 +271,20 @@ def test_model_facts_are_the_models_constants():
     assert np.allclose(facts["STANCE_FEET"], littledog.STANCE_FEET)
 
 
-def test_the_touchdown_question_traces_show_the_trade_off():
-    """On the question's traces the host-style detector finds every touchdown, some tens of ms late; a
-    plain threshold is early and exact on the clean trace but counts the bouncy trace's bounces."""
-    traces = touchdown_traces()
-    for name, trace in traces.items():
-        f = trace["force"]
-        tuned = score_events(contact_events(detect_contacts(f, 5.0, 3.0, 3)), trace["touchdowns"], 5)
-        plain = score_events(_plain_threshold(f, trace["dt"]), trace["touchdowns"], 5)
-        assert tuned.precision == tuned.recall == 1.0 and tuned.mean_delay_samples >= 2.0, name
-        assert plain.recall == 1.0 and plain.mean_delay_samples <= 0.5, name
-        assert (plain.precision == 1.0) == (name == "clean"), name
-    bouncy = score_events(_plain_threshold(traces["bouncy"]["force"], 0.01), traces["bouncy"]["touchdowns"], 5)
-    assert bouncy.precision < 0.65
+def test_the_touchdown_question_crawls_show_the_trade_off():
+    """Question 2's crawls: the plain threshold finds every touchdown but counts mid-stance rises; the
+    plan alone is exact over the quick link and useless over the slow one; the reference is exact on
+    both."""
+    crawl = {"period": 2.4, "step_length": 0.07, "step_height": 0.045, "duty_factor": 0.92}
+    for latency in (0.0, 0.13):
+        run = crawl_touchdowns(crawl, distance=0.5, latency=latency, force_noise=0.2, seed=1)
+        args, truth = (run["force"], run["planned_stance"], run["dt"]), run["touchdowns"]
+        plain = score_leg_events(_plain_threshold(*args), truth, 5)
+        planned = score_leg_events(contact_events(np.array(run["planned_stance"])), truth, 5)
+        ours = score_leg_events(module.detect_touchdowns(*args), truth, 5)
+        assert plain.recall == 1.0 and plain.precision < 0.3
+        assert ours.precision == ours.recall == 1.0
+        assert (planned.precision, planned.recall) == ((1.0, 1.0) if latency == 0.0 else (0.0, 0.0))
 
 
 def test_the_marker_question_frames_show_the_narrow_marker_set():

@@ -1,6 +1,6 @@
 """Lesson 04, the LittleDog quadruped as a system (LittleDog User Guide).
 
 experiment  the lesson's tables: walks in MuJoCo under the servo and host loops, sensing, power
-data        assignment 04's data: the model's constants, force traces with known touchdowns, MoCap frames
+data        assignment 04's data: the model's constants, simulated crawls with their true touchdowns, MoCap frames
 exercises   assignment 04
 """

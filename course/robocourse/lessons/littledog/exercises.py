@@ -2,8 +2,9 @@
 
 Inputs come from the model of :mod:`robokit.legged.littledog` (hips, legs, markers, the servo's
 gains and period, the battery) with random joint angles, poses and loads; the open touchdown
-exercise's force traces come from :func:`robocourse.lessons.littledog.data.touchdown_trace`, whose
-true touchdowns are known.
+exercise's cases are the lesson's crawl simulated in MuJoCo
+(:func:`robocourse.lessons.littledog.data.crawl_touchdowns`): the lower legs' forces and the plan's
+stance go to the student, MuJoCo's true touchdowns are the case's expected answer.
 
 References
 ----------
@@ -19,8 +20,8 @@ import numpy as np
 
 from robokit.controllers.joint_servo import pd_servo_step
 from robokit.geometry import se3_from_rt, so3_exp, transform_points
-from robokit.legged.touchdown import contact_events, detect_contacts, score_events
-from robocourse.lessons.littledog.data import model_facts, touchdown_trace
+from robokit.legged.touchdown import contact_events, detect_contacts, gate_touchdowns, match_events, score_leg_events
+from robocourse.lessons.littledog.data import crawl_touchdowns, model_facts
 from robokit.legged.leg_kinematics import KNEE_BRANCH, foot_position, leg_ik
 from robokit.legged.littledog import HIP_POSITIONS, JOINT_LIMITS, LEGS, MARKERS, STANCE_FEET, STANDING_HEIGHT
 from robokit.legged.mocap import fit_marker_pose
@@ -47,8 +48,15 @@ def data() -> dict:
     return {"model_facts": model_facts()}
 #: A detected touchdown counts for a true one within this many samples (50 ms at the host's 100 Hz).
 TOUCHDOWN_TOLERANCE = 5
-#: Precision and recall a touchdown detector must both reach on a trace.
+#: Precision and recall a touchdown detector must both reach on a crawl, counted over the four legs.
 TOUCHDOWN_SCORE = 0.9
+#: The touchdown cases' links: the range (s) of the delay every set-point has, and what the case tests.
+#: A foot lands from about 0.02 s before to 0.16 s after its planned touchdown; the quick and the
+#: slow link are far enough apart that no one shift of the plan's touchdowns passes both.
+TOUCHDOWN_LINKS = ((0.0, 0.01, "a quick link"), (0.04, 0.06, "a lagging link"), (0.12, 0.14, "a slow link"))
+#: Where :func:`detect_touchdowns` looks for each planned touchdown: from this long before it to
+#: this long after (s).
+TOUCHDOWN_GATE = (0.04, 0.18)
 #: How far (m) a fitted pose may move any point within 0.2 m of the body's origin (per axis) from
 #: where the least-squares optimum puts it: far below the markers' noise (1-2 mm), far above the
 #: error of a converged iterative solver (about 3e-6 m with scipy's default tolerances).
@@ -71,62 +79,107 @@ def battery_endurance(capacity_ah: float, voltage: float, mean_power_w: float) -
     return endurance(battery_energy(capacity_ah, voltage), mean_power_w) / 60.0
 
 
-def detect_touchdowns(force: Any, dt: float) -> list:
-    """The touchdowns of one foot-force trace (the open exercise's answer: it finds the true ones).
+def detect_touchdowns(force: Any, planned_stance: Any, dt: float) -> list:
+    """The touchdowns of a crawl's four feet, from their force sensors and the plan (the open exercise's reference).
 
-    Offline: :func:`robokit.legged.touchdown.detect_contacts` with hysteresis (contact above 5 N,
-    none below 3 N) and a 30 ms debounce, its touchdowns (:func:`~robokit.legged.touchdown.contact_events`),
-    and each dated back to the first sample above 5 N in the 80 ms up to it - the look back a host
-    loop, deciding as the samples come, cannot make. On :func:`~robocourse.lessons.littledog.data.touchdown_trace`'s
-    traces these are exactly the true touchdowns (tests/test_exercises_04.py).
+    Each foot's touchdowns are the rising edges of a hysteresis on its force (contact above 3 N,
+    none below 1 N: :func:`~robokit.legged.touchdown.detect_contacts`), gated by the plan
+    (:func:`~robokit.legged.touchdown.gate_touchdowns`): for each planned touchdown, the first one
+    from 0.04 s before it to 0.18 s after (:data:`TOUCHDOWN_GATE`: the set-points may reach the robot
+    up to 0.14 s late). The lesson's Sec. 9 method with a wider gate.
 
     Parameters
     ----------
-    force : array_like, shape (N,)
-        Lower-leg axial force (N).
+    force : array_like, shape (N, 4)
+        Lower-leg axial forces (N), legs ``FL, FR, HL, HR``, one row per host cycle.
+    planned_stance : array_like of bool, shape (N, 4)
+        The plan's feet on the ground at the same samples.
     dt : float
         Sample period (s, > 0).
 
     Returns
     -------
-    list of int
+    list of 4 lists of int
+        Each leg's touchdowns (sample indices, increasing).
 
     Raises
     ------
     ValueError
-        For a force that is not 1-D or holds NaN or inf, or a non-positive ``dt``.
+        For a force that is not (N, 4) or holds NaN or inf, a ``planned_stance`` of another shape,
+        or a non-positive ``dt``.
+    TypeError
+        For a ``planned_stance`` that is not booleans (or 0/1).
 
     Examples
     --------
-    >>> f = [0.0, 0.2, 9.0, 0.5, 11.0, 10.0, 10.0, 10.0, 4.0, 1.0, 0.0, 0.1, 0.0]   # a bounce at sample 3
-    >>> detect_touchdowns(f, 0.01)
-    [2]
+    One foot lands 3 samples after its planned touchdown (sample 4) and reads nothing for a sample
+    mid-stance; the other three stand:
+
+    >>> f = np.full((14, 4), 9.0)
+    >>> f[:, 0] = [9, 9, 0, 0, 0, 0, 0, 9, 9, 0.5, 9, 9, 9, 9]
+    >>> plan = np.ones((14, 4), bool)
+    >>> plan[2:4, 0] = False
+    >>> detect_touchdowns(f, plan, 0.01)
+    [[7], [], [], []]
     """
-    f = as_array(force, "force", ndim=1)
+    f = as_array(force, "force", shape=(None, 4))
+    stance = as_array(planned_stance, "planned_stance", dtype=bool)
+    if stance.shape != f.shape:
+        raise ValueError(f"planned_stance: expected shape {f.shape} (that of force), got shape {stance.shape}")
     period = as_positive(dt, "dt")
-    on, off = 5.0, 3.0
-    debounce, look_back = max(1, round(0.03 / period)), max(1, round(0.08 / period))
-    found = []
-    for k in contact_events(detect_contacts(f, on, off, debounce)):
-        start = max(0, k - look_back + 1)
-        found.append(int(start + np.flatnonzero(f[start:k + 1] > on)[0]))
-    return found
+    early, late = (round(s / period) for s in TOUCHDOWN_GATE)
+    found = contact_events(detect_contacts(f, 3.0, 1.0))
+    return [gate_touchdowns(d, p + (late - early) // 2, (late + early + 1) // 2).tolist()
+            for d, p in zip(found, contact_events(stance))]
+
+
+def _leg_indices(got: Any) -> list | str:
+    """A student's touchdowns as 4 lists of sample indices, or what is wrong with them."""
+    values = got.tolist() if isinstance(got, np.ndarray) else got
+    if not isinstance(values, (list, tuple)) or len(values) != 4:
+        return f"expected 4 lists of sample indices (legs FL, FR, HL, HR), got {summarize(got)}"
+    legs = [v.tolist() if isinstance(v, np.ndarray) else v for v in values]
+    if not all(isinstance(v, (list, tuple)) and all(type(k) in (int, float) for k in v) for v in legs):
+        return f"expected 4 lists of sample indices (legs FL, FR, HL, HR), got {summarize(got)}"
+    return [list(v) for v in legs]
+
+
+def _first_misses(expected: list, legs: list) -> str:
+    """Where the first true touchdown without a detection and the first detection without a true
+    touchdown are (legs and samples), for the feedback."""
+    notes = []
+    for what, pick in (("the first touchdown you missed", 1), ("the first false one", 0)):
+        firsts = []
+        for leg, truth, found in zip(LEGS, expected, legs):
+            pairs = match_events(found, truth, TOUCHDOWN_TOLERANCE)
+            own = np.asarray(truth if pick else found, dtype=np.int64)
+            left = np.setdiff1d(own, pairs[:, pick]) if len(own) else own
+            if len(left):
+                firsts.append((int(left.min()), leg))
+        if firsts:
+            k, leg = min(firsts)
+            notes.append(f"{what}: {leg} at sample {k}")
+    return "; ".join(notes)
 
 
 def _touchdowns_found(expected: Any, got: Any) -> str | None:
-    """Accept sample indices whose precision and recall against the true touchdowns both reach 0.9."""
-    values = got.tolist() if isinstance(got, np.ndarray) else got
-    if not isinstance(values, list) or not all(type(v) in (int, float) for v in values):
-        return f"expected a list of sample indices, got {summarize(got)}"
+    """Accept each leg's sample indices when precision and recall against the true touchdowns,
+    counted over the four legs, both reach 0.9."""
+    legs = _leg_indices(got)
+    if isinstance(legs, str):
+        return legs
     try:
-        score = score_events(values, expected, TOUCHDOWN_TOLERANCE)
+        score = score_leg_events(legs, expected, TOUCHDOWN_TOLERANCE)
     except (TypeError, ValueError) as exc:
         return f"expected whole sample indices >= 0 ({exc})"
     if score.precision >= TOUCHDOWN_SCORE and score.recall >= TOUCHDOWN_SCORE:
         return None
+    found, true = sum(len(v) for v in legs), sum(len(v) for v in expected)
+    right = round(score.recall * true)
     return (f"precision {score.precision:.2f}, recall {score.recall:.2f}: both must reach {TOUCHDOWN_SCORE} "
-            f"({len(values)} touchdowns found, {len(expected)} true ones; a detection counts within "
-            f"{TOUCHDOWN_TOLERANCE} samples of a true touchdown)")
+            f"({found} touchdowns found, {true} true ones; {right} right, {found - right} false, "
+            f"{true - right} missed; a detection counts within {TOUCHDOWN_TOLERANCE} samples of a true "
+            f"touchdown of its leg; {_first_misses(expected, legs)})")
 
 
 def _same_rigid_fit(expected: Any, got: Any) -> str | None:
@@ -254,21 +307,50 @@ def _fit_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
+#: The crawls of the touchdown cases: ranges of :func:`~robokit.legged.crawl_gait`'s parameters. Around
+#: the lesson's crawl (2 s cycle, 8 cm steps, 4 cm lift, duty factor 0.9), a little slower and with a
+#: higher lift: at the lesson's own, an unloaded hind foot sometimes leaves the ground for a few
+#: samples just before its lift-off, and MuJoCo's truth then counts a touchdown no plan foresees.
+TOUCHDOWN_CRAWLS = {"period": (2.2, 2.6), "step_length": (0.06, 0.08), "step_height": (0.045, 0.05),
+                    "duty_factor": (0.9, 0.94)}
+
+
+def _crawl_case(rng: np.random.Generator, link: tuple) -> Case:
+    low, high, label = link
+    gait = {key: round(float(rng.uniform(*span)), 3) for key, span in TOUCHDOWN_CRAWLS.items()}
+    latency = round(float(rng.uniform(low, high)), 3)
+    run = crawl_touchdowns(gait, distance=round(float(rng.uniform(0.2, 0.3)), 2), latency=latency,
+                           force_noise=round(float(rng.uniform(0.05, 0.3)), 2), seed=int(rng.integers(2 ** 31)))
+    return Case((np.round(run["force"], 4).tolist(), run["planned_stance"], run["dt"]), expected=run["touchdowns"],
+                label=f"a crawl ({gait['period']:.2f} s cycle, {gait['step_length'] * 100:.1f} cm steps) over {label}: "
+                      f"set-points {latency * 1000:.0f} ms late")
+
+
 def _touchdown_cases(rng: np.random.Generator) -> list[Case]:
-    settings = [(0.05, 0.0, 0.0, "a clean trace"), (0.1, 0.9, 0.2, "most touchdowns bounce"),
-                (rng.uniform(0.3, 0.4), 0.3, 1.0, "noisy, with the sensor's offset drifting by 1 N"),
-                (rng.uniform(0.1, 0.4), rng.uniform(0.3, 0.7), rng.uniform(0.2, 1.0), "a mixed trace"),
-                (rng.uniform(0.1, 0.4), rng.uniform(0.3, 0.7), rng.uniform(0.2, 1.0), "another mixed trace")]
-    cases = []
-    for noise, bounce, drift, label in settings:
-        trace = touchdown_trace(rng, duration=8.0, noise=noise, bounce=bounce, drift=drift)
-        cases.append(Case((np.round(trace["force"], 4).tolist(), trace["dt"]), label=label))
-    force = cases[0].args[0]
+    cases = [_crawl_case(rng, link) for link in TOUCHDOWN_LINKS]
+    force, stance, dt = cases[0].args
+    nan = [row[:] for row in force]
+    nan[50][2] = float("nan")
     return cases + [
-        Case((force[:50] + [float("nan")] + force[51:], 0.01), raises="ValueError", label="a NaN sample"),
-        Case((force, 0.0), raises="ValueError", label="a sample period of zero"),
-        Case(([force[:100], force[100:200]], 0.01), raises="ValueError", label="two traces at once: 2-D"),
+        Case((nan, stance, dt), raises="ValueError", label="a NaN sample"),
+        Case((force, stance[:-1], dt), raises="ValueError", label="a plan one sample shorter than the forces"),
+        Case((force, stance, 0.0), raises="ValueError", label="a sample period of zero"),
+        Case(([row[0] for row in force], [row[0] for row in stance], dt), raises="ValueError",
+             label="one foot's trace instead of four"),
     ]
+
+
+def _plan_late(samples: int):
+    """The shortcut that ignores the force: the plan's touchdowns, ``samples`` late."""
+    def shortcut(force, planned_stance, dt):
+        return [(e + samples).tolist() for e in contact_events(np.asarray(planned_stance, bool))]
+    return shortcut
+
+
+#: Ways to pass a touchdown case without the force sensors: the plan's touchdowns shifted by a
+#: fixed delay (no one shift passes a quick and a slow link).
+TOUCHDOWN_SHORTCUTS = {"the plan's touchdowns" + (f", {abs(k)} samples {'late' if k > 0 else 'early'}" if k else ""):
+                       _plan_late(k) for k in range(-4, 19)}
 
 
 def _endurance_cases(rng: np.random.Generator) -> list[Case]:
@@ -314,10 +396,14 @@ EXERCISES = [
                     "(SVD, quaternions, least squares); ValueError for fewer than three visible markers."),
     Exercise(
         id="04.detect_touchdowns", function="detect_touchdowns",
-        signature="detect_touchdowns(force: (N,) newtons, dt: float) -> list of sample indices",
+        signature="detect_touchdowns(force: (N, 4) newtons, planned_stance: (N, 4) bool, dt: float) "
+                  "-> 4 lists of sample indices",
         points=2, cases=_touchdown_cases, answer=detect_touchdowns, compare=_touchdowns_found,
-        description="Open: touchdowns of one lower-leg force trace with bounces, noise and drift; precision and "
-                    "recall within 5 samples must both reach 0.9; ValueError for NaN, 2-D force or dt <= 0."),
+        shortcuts=TOUCHDOWN_SHORTCUTS,
+        description="Open: the four feet's touchdowns in a simulated crawl from the lower-leg forces and the plan's "
+                    "stance, graded against MuJoCo's true contacts; precision and recall within 5 samples over "
+                    "the legs must both reach 0.9; ValueError for NaN, shapes that differ or are not (N, 4), "
+                    "or dt <= 0."),
     Exercise(
         id="04.battery_endurance", function="battery_endurance",
         signature="battery_endurance(capacity_ah, voltage, mean_power_w) -> minutes",
