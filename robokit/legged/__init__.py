@@ -1,6 +1,7 @@
 """The LittleDog quadruped (lesson 04): model, kinematics, gaits, sensing, simulation, trial logs, power.
 
 littledog         the guide's facts and the MuJoCo model written from them (one set of constants)
+terrain           step boards on the floor: their height map, edges, and their pose from MoCap markers
 leg_kinematics    one leg's FK, closed-form IK on both knee branches, Jacobian and statics (J^T f)
 support           the support polygon and the static stability margin
 gait_schedule     crawl and trot schedules
@@ -18,6 +19,7 @@ power             electrical power, cost of transport, the battery's endurance
 from .littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSETS, HIP_POSITIONS, JOINT_LIMITS, JOINT_NAMES, JOINTS, KNEE_SHIFT,
                         KNEE_ZERO, LEG_MASSES, LEGS, LOWER_LEG, MARKERS, SHANK, SOURCE_JOINT_LIMITS, STANCE_FEET,
                         STANDING_HEIGHT, TRUNK_MASS, TRUNK_SIZE, UPPER_LEG, littledog_mjcf, littledog_model)
+from .terrain import Terrain, edge_distance, height_at, locate_terrain, step_terrain, terrain_transform
 from .support import SupportPolygonError, stability_margin, stability_margins, support_polygon
 from .gait_schedule import GaitSchedule, crawl_gait, trot_gait
 from .gait import WalkPlan, walking_plan
@@ -34,7 +36,8 @@ from .power import battery_energy, cost_of_transport, endurance, trial_power
 __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSETS", "HIP_POSITIONS", "JOINT_LIMITS", "JOINT_NAMES", "JOINTS",
            "KNEE_SHIFT", "KNEE_ZERO", "SHANK", "SOURCE_JOINT_LIMITS", "LEG_MASSES", "LEGS", "LOWER_LEG", "MARKERS",
            "STANCE_FEET", "STANDING_HEIGHT", "TRUNK_MASS",
-           "TRUNK_SIZE", "UPPER_LEG", "littledog_mjcf", "littledog_model", "SupportPolygonError", "stability_margin",
+           "TRUNK_SIZE", "UPPER_LEG", "littledog_mjcf", "littledog_model", "Terrain", "edge_distance", "height_at",
+           "locate_terrain", "step_terrain", "terrain_transform", "SupportPolygonError", "stability_margin",
            "stability_margins", "support_polygon", "GaitSchedule", "crawl_gait", "trot_gait", "WalkPlan",
            "walking_plan", "SERVO_BANDWIDTH", "link_inertias", "littledog_servo_gains", "servo_inertia",
            "POSTURE_AXES", "PostureFeedback", "PostureLoop", "delay_gain_limit", "LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "ImuReadings", "integrate_gyro",
