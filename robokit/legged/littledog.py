@@ -53,6 +53,7 @@ import numpy as np
 
 from ..controllers.dc_motor import DCMotor, reflected_inertia
 from ..validation import as_finite_scalar, as_positive
+from .terrain import Terrain, terrain_transform
 
 __all__ = ["LEGS", "JOINTS", "JOINT_NAMES", "GUIDE", "HIP_POSITIONS", "HIP_OFFSETS", "UPPER_LEG", "SHANK",
            "LOWER_LEG", "KNEE_ZERO", "KNEE_SHIFT", "SOURCE_JOINT_LIMITS", "FOOT_RADIUS", "TRUNK_SIZE", "TRUNK_MASS",
@@ -162,8 +163,27 @@ def _leg_xml(i: int, armature: float, damping: float) -> str:
       </body>"""
 
 
+def _terrain_xml(terrain: Terrain | None) -> str:
+    """The terrain's boards as static boxes that collide like the ground, and its markers as sites."""
+    if terrain is None:
+        return ""
+    if not isinstance(terrain, Terrain):
+        raise TypeError(f"terrain: expected a robokit.legged.Terrain or None, got {type(terrain).__name__}")
+    T = terrain_transform(terrain)
+    out = []
+    for k, (x0, x1, y0, y1, h) in enumerate(terrain.blocks):
+        centre = T[:3, :3] @ [(x0 + x1) / 2, (y0 + y1) / 2, h / 2] + T[:3, 3]
+        half = [(x1 - x0) / 2, (y1 - y0) / 2, h / 2]
+        out.append(f'\n    <geom name="terrain{k}" type="box" pos="{_vec(centre)}" size="{_vec(half)}" '
+                   f'euler="0 0 {_f(terrain.pose[2])}" contype="1" conaffinity="1" rgba="0.72 0.6 0.42 1"/>')
+    for k, m in enumerate(terrain.markers):
+        out.append(f'\n    <site name="terrain_marker{k}" pos="{_vec(T[:3, :3] @ m + T[:3, 3])}" size="0.006" '
+                   f'rgba="0.9 0.9 0.9 1"/>')
+    return "".join(out)
+
+
 def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: float = 1.0,
-                   timestep: float = TIMESTEP, motor: DCMotor | None = None) -> str:
+                   timestep: float = TIMESTEP, motor: DCMotor | None = None, terrain: Terrain | None = None) -> str:
     """Write the LittleDog model as MJCF (MuJoCo's XML), from this module's constants.
 
     Parameters
@@ -185,6 +205,10 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
         :func:`robokit.controllers.joint_torque` itself, every physics step, as an affine actuator
         (gain ``K`` = ``motor.torque_per_volt``, bias ``-B dq/dt`` with ``B`` = ``motor.damping``).
         Without it ``ctrl`` is the joint torque (N m).
+    terrain : Terrain, optional
+        Boards on the floor (:class:`robokit.legged.terrain.Terrain`): each a static box
+        ``terrain<k>`` the feet and the trunk collide with as with the ground, and its MoCap markers
+        as sites ``terrain_marker<k>``. Default: the flat floor alone.
 
     Returns
     -------
@@ -198,8 +222,9 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
 
     Notes
     -----
-    Only the feet and the trunk collide, and only with the ground; the legs' capsules carry mass
-    and inertia (from their shapes) and are drawn, but pass through each other.
+    Only the feet and the trunk collide, and only with the ground and the terrain's boards; the
+    legs' capsules carry mass and inertia (from their shapes) and are drawn, but pass through each
+    other and through the boards.
 
     Examples
     --------
@@ -207,6 +232,10 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
     >>> model = mujoco.MjModel.from_xml_string(littledog_mjcf())
     >>> model.nu, model.nq, round(float(sum(model.body_mass)), 4)
     (12, 19, 3.0)
+    >>> from robokit.legged.terrain import Terrain
+    >>> board = Terrain([[0.3, 0.5, -0.3, 0.3, 0.02]])
+    >>> mujoco.MjModel.from_xml_string(littledog_mjcf(terrain=board)).geom("terrain0").size.tolist()
+    [0.1, 0.3, 0.01]
     """
     armature = as_positive(armature, "armature", allow_zero=True)
     damping = as_positive(damping, "damping", allow_zero=True)
@@ -220,6 +249,7 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
     timestep = as_positive(timestep, "timestep")
     if timestep > 0.01:
         raise ValueError(f"timestep: expected at most 0.01 s (the host period), got {timestep}")
+    boards = _terrain_xml(terrain)
     legs = "".join(_leg_xml(i, armature, damping) for i in range(4))
     markers = "".join(f'\n      <site name="marker{k}" pos="{_vec(m)}" size="0.006" rgba="0.9 0.9 0.9 1"/>'
                       for k, m in enumerate(MARKERS))
@@ -240,7 +270,7 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
     <default class="foot"><geom type="sphere" size="{_f(FOOT_RADIUS)}" contype="1" rgba="0.1 0.1 0.1 1"/></default>
   </default>
   <worldbody>
-    <geom name="ground" type="plane" size="5 5 0.1" contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>
+    <geom name="ground" type="plane" size="5 5 0.1" contype="1" conaffinity="1" rgba="0.8 0.8 0.8 1"/>{boards}
     <body name="trunk" pos="0 0 {_f(STANDING_HEIGHT)}">
       <freejoint name="trunk"/>
       <geom name="trunk" type="box" size="{_f(lx)} {_f(ly)} {_f(lz)}" contype="1" mass="{_f(TRUNK_MASS)}" rgba="0.15 0.15 0.6 1"/>
@@ -258,14 +288,15 @@ def littledog_mjcf(*, armature: float = 0.0, damping: float = 0.0, friction: flo
 
 
 @functools.lru_cache(maxsize=8)
-def _compiled(armature: float, damping: float, friction: float, timestep: float, motor: DCMotor | None):
+def _compiled(armature: float, damping: float, friction: float, timestep: float, motor: DCMotor | None,
+              terrain: Terrain | None):
     import mujoco
-    return mujoco.MjModel.from_xml_string(littledog_mjcf(armature=armature, damping=damping,
-                                                         friction=friction, timestep=timestep, motor=motor))
+    return mujoco.MjModel.from_xml_string(littledog_mjcf(armature=armature, damping=damping, friction=friction,
+                                                         timestep=timestep, motor=motor, terrain=terrain))
 
 
 def littledog_model(*, armature: float = 0.0, damping: float = 0.0, friction: float = 1.0,
-                    timestep: float = TIMESTEP, motor: DCMotor | None = None):
+                    timestep: float = TIMESTEP, motor: DCMotor | None = None, terrain: Terrain | None = None):
     """The compiled MuJoCo model of :func:`littledog_mjcf` (compiled once per set of arguments).
 
     Parameters
@@ -274,6 +305,8 @@ def littledog_model(*, armature: float = 0.0, damping: float = 0.0, friction: fl
         As in :func:`littledog_mjcf`.
     motor : DCMotor, optional
         As in :func:`littledog_mjcf`: voltage-driven joints.
+    terrain : Terrain, optional
+        As in :func:`littledog_mjcf`: boards on the floor (a terrain is hashable, so each compiles once).
 
     Returns
     -------
@@ -289,5 +322,6 @@ def littledog_model(*, armature: float = 0.0, damping: float = 0.0, friction: fl
     import copy
     args = [as_finite_scalar(v, n) for v, n in ((armature, "armature"), (damping, "damping"),
                                                    (friction, "friction"), (timestep, "timestep"))]
-    littledog_mjcf(armature=args[0], damping=args[1], friction=args[2], timestep=args[3], motor=motor)  # validates
-    return copy.deepcopy(_compiled(*args, motor))
+    littledog_mjcf(armature=args[0], damping=args[1], friction=args[2], timestep=args[3], motor=motor,
+                   terrain=terrain)  # validates
+    return copy.deepcopy(_compiled(*args, motor, terrain))
