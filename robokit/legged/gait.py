@@ -32,6 +32,7 @@ References
 """
 from __future__ import annotations
 
+import itertools
 import math
 from typing import Any, NamedTuple
 
@@ -42,6 +43,7 @@ from .gait_schedule import (CRAWL_SEQUENCE, TROT_PAIRS, GaitSchedule, as_gait_sc
                             stance_pattern, trot_gait)
 from .littledog import LEGS, STANCE_FEET, STANDING_HEIGHT
 from .support import SupportPolygonError, nearest_boundary_point, stability_margins, support_polygon
+from .terrain import Terrain, edge_distance, height_at
 
 __all__ = ["GaitSchedule", "crawl_gait", "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan",
            "walking_plan", "CRAWL_SEQUENCE", "TROT_PAIRS"]
@@ -49,6 +51,8 @@ __all__ = ["GaitSchedule", "crawl_gait", "trot_gait", "stance_pattern", "swing_t
 _EPS = 1e-9      # s and m: below this, two instants or two footholds are the same
 #: Most steps (``distance / step_length``) a plan may take: a bound no walk comes near.
 MAX_STEPS = 100_000
+#: On terrain, how far (m) a foothold may move away from the body's middle to leave a board edge.
+OUTWARD_SHIFT = 0.005
 
 
 def _smoothstep(u: np.ndarray) -> np.ndarray:
@@ -166,6 +170,7 @@ class _Swing(NamedTuple):
     touchdown: float
     start: np.ndarray    # (3,) world foothold left
     end: np.ndarray      # (3,) world foothold reached
+    top: float | None = None       # on terrain: the height (m) the foot is carried across at
 
 
 def _progress(tau: Any, distance: float, speed: float, ramp: float) -> np.ndarray:
@@ -230,7 +235,8 @@ def _rest_to_rest(knot_t: np.ndarray, knot_p: np.ndarray, t: np.ndarray) -> np.n
 
 
 def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any = None, body_height: float = STANDING_HEIGHT,
-                 dt: float = 0.01, settle: float = 0.5, margin: float = 0.02) -> WalkPlan:
+                 dt: float = 0.01, settle: float = 0.5, margin: float = 0.02, terrain: Terrain | None = None,
+                 clearance: float = 0.025) -> WalkPlan:
     """Plan a straight walk of ``distance`` metres along +x, from standing to standing.
 
     Parameters
@@ -253,6 +259,11 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     margin : float, default 0.02
         Crawl only: stability margin (m, > 0) the trunk centre must have over the three stance feet
         when a leg lifts.
+    terrain : Terrain, optional
+        The terrain map (:mod:`robokit.legged.terrain`) to plan on; default flat ground (the plan
+        is then exactly the flat one, whatever ``clearance``).
+    clearance : float, default 0.025
+        With ``terrain``: how far (m, >= 0) a foothold must stay from every board edge.
 
     Returns
     -------
@@ -289,6 +300,20 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     ramps). Static stability does not apply: two stance feet span a line, and the margin is
     ``-inf`` except at the standing start and end.
 
+    Terrain (footholds chosen on the map). Each foothold moves along x to the nearest point at
+    least ``clearance`` from every board edge (:func:`~robokit.legged.terrain.edge_distance`; the
+    least bad point if none is), looking up to half a step towards the body's middle and up to
+    :data:`OUTWARD_SHIFT` away from it (the legs' reach); its height is the terrain's there
+    (:func:`~robokit.legged.terrain.height_at`) plus the flat plan's, so the foot sphere rests on
+    the board. A swing is carried: straight up to ``step_height`` above the highest of its start,
+    its end and the boards along its way, across, and straight down, each move quintic
+    rest-to-rest and timed by its length (the blended :func:`swing_trajectory`, tracked with the
+    servos' lag, caught risers with the foot still low: measured on LittleDog). The body stays
+    level, ``body_height`` above the lowest terrain height under the four footholds (a leg on a
+    board bends more; none stretches further than on the flat), and moves to each new one while
+    the feet that change it swing (quintic rest-to-rest again, so it stays C2). The final stance is
+    the flat one's unless a foothold had to leave an edge.
+
     The trunk's centre stands in for the centre of mass (the legs move it by millimetres). The
     plan does not check leg reach: that is the kinematics' job (the tests check it for LittleDog).
 
@@ -299,6 +324,11 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     (17.6, 0.2, True)
     >>> round(float(plan.margin.min()), 6)
     0.02
+    >>> from robokit.legged.terrain import Terrain
+    >>> board = Terrain([[0.25, 0.6, -0.3, 0.3, 0.03]])              # a 3 cm board ahead
+    >>> on = walking_plan(crawl_gait(), 0.2, terrain=board)
+    >>> round(float(on.feet_world[-1, 0, 2]), 6), round(float(on.T_world_body[-1, 2, 3]), 6)   # FL on it
+    (0.04, 0.1315)
     """
     schedule = as_gait_schedule(schedule)
     distance = as_positive(distance, "distance")
@@ -307,6 +337,9 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     dt = as_positive(dt, "dt")
     settle = as_positive(settle, "settle", allow_zero=True)
     margin = as_positive(margin, "margin")
+    clearance = as_positive(clearance, "clearance", allow_zero=True)
+    if terrain is not None and not isinstance(terrain, Terrain):
+        raise TypeError(f"terrain: expected a robokit.legged.Terrain or None, got {type(terrain).__name__}")
     T, beta = schedule.period, schedule.duty_factor
     if not distance / schedule.step_length <= MAX_STEPS:
         raise ValueError(f"distance, schedule: expected at most {MAX_STEPS} steps of step_length, got "
@@ -322,6 +355,8 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     tau0 = min(0.0, float(np.max(schedule.phase_offsets - beta)) * T)   # the last swing before 0 ended: start there
     footholds = feet0 + [0.0, 0.0, height]
     swings = _swings(schedule, footholds.copy(), distance, tau0)
+    if terrain is not None:
+        footholds, swings = _on_terrain(terrain, footholds, swings, schedule, clearance)
 
     def progress(tau):
         return _progress(np.asarray(tau) - tau0, distance, schedule.speed, T)
@@ -344,6 +379,8 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     feet, stance = _feet_along(swings, footholds, tau, schedule.step_height)
     T_world_body = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
     T_world_body[:, :2, 3], T_world_body[:, 2, 3] = body_xy, height
+    if terrain is not None:
+        T_world_body[:, 2, 3] += _body_rise(swings, footholds, feet0[:, 2] + height, tau, tau0)
     margins = stability_margins(feet[..., :2], stance, body_xy)
     return WalkPlan(t, T_world_body, feet, stance, margins, schedule.name)
 
@@ -388,7 +425,73 @@ def _feet_along(swings: list[_Swing], footholds: np.ndarray, tau: np.ndarray, st
     for sw in swings:
         i0, i1 = np.searchsorted(tau, [sw.lift - _EPS, sw.touchdown - _EPS])
         phase = np.clip((tau[i0:i1] - sw.lift) / (sw.touchdown - sw.lift), 0.0, 1.0)
-        feet[i0:i1, sw.leg] = swing_trajectory(sw.start, sw.end, phase, step_height)
+        if sw.top is None:
+            feet[i0:i1, sw.leg] = swing_trajectory(sw.start, sw.end, phase, step_height)
+        else:
+            feet[i0:i1, sw.leg] = _carried_swing(sw.start, sw.end, phase, sw.top)
         feet[i1:, sw.leg] = sw.end
         stance[i0:i1, sw.leg] = False
     return feet, stance
+
+
+def _on_terrain(terrain: Terrain, footholds: np.ndarray, swings: list[_Swing], schedule: GaitSchedule,
+                clearance: float) -> tuple[np.ndarray, list[_Swing]]:
+    """The standing footholds and the swings of a flat plan moved onto the terrain map: each landing
+    off the board edges and on the surface, each swing lifted over what lies on its way."""
+    flat_z = footholds[:, 2]
+    now = footholds.copy()
+    now[:, 2] += height_at(terrain, now[:, :2])
+    start = now.copy()
+    inward = -np.sign([footholds[sw.leg, 0] for sw in swings])       # towards the middle of the body
+    chosen = _flat_footholds(terrain, np.array([sw.end[:2] for sw in swings]), inward, clearance,
+                             schedule.step_length / 2)
+    out = []
+    for sw, xy in zip(swings, chosen):
+        end = np.array([xy[0], xy[1], flat_z[sw.leg] + height_at(terrain, xy)])
+        path = now[sw.leg, :2] + np.linspace(0.0, 1.0, 17)[:, None] * (xy - now[sw.leg, :2])
+        top = max(now[sw.leg, 2], end[2], flat_z[sw.leg] + float(height_at(terrain, path).max()))
+        out.append(sw._replace(start=now[sw.leg].copy(), end=end, top=top + schedule.step_height))
+        now[sw.leg] = end
+    return start, out
+
+
+def _flat_footholds(terrain: Terrain, xy: np.ndarray, inward: np.ndarray, clearance: float,
+                    search: float) -> np.ndarray:
+    """For each point (S, 2), the nearest point along x that is ``clearance`` from every board edge
+    (5 mm candidates, inward first on a tie), else the farthest from one. The search runs ``search``
+    towards the body's middle (``inward``, +-1 per point: the leg bends more) but only
+    :data:`OUTWARD_SHIFT` away from it: the lesson's crawl already stretches its legs to within
+    13 mm of their reach (10 mm let some plans reach too far)."""
+    offsets = np.arange(-round(OUTWARD_SHIFT / 0.005), round(search / 0.005) + 1) * 0.005
+    offsets = offsets[np.lexsort((-offsets, np.abs(offsets)))]
+    candidates = xy[:, None, :] + (offsets[None, :] * inward[:, None])[..., None] * [1.0, 0.0]
+    distance = edge_distance(terrain, candidates)
+    ok = distance >= clearance
+    pick = np.where(ok.any(axis=1), np.argmax(ok, axis=1), np.argmax(distance, axis=1))
+    return candidates[np.arange(len(xy)), pick]
+
+
+def _body_rise(swings: list[_Swing], footholds: np.ndarray, flat_z: np.ndarray, tau: np.ndarray,
+               tau0: float) -> np.ndarray:
+    """How far (m) the level body rises above the flat plan's height at gait times ``tau``: the lowest
+    terrain height under the four footholds (so no leg stretches further than on flat ground),
+    moved to each new one while the feet that change it swing (quintic rest-to-rest, so C2)."""
+    now = footholds[:, 2] - flat_z
+    knots_t, knots_z = [tau0], [now.min()]
+    for (lift, touchdown), group in itertools.groupby(swings, key=lambda sw: (sw.lift, sw.touchdown)):
+        before = now.min()
+        for sw in group:
+            now[sw.leg] = sw.end[2] - flat_z[sw.leg]
+        knots_t += [lift, touchdown]
+        knots_z += [before, now.min()]
+    return _rest_to_rest(np.array(knots_t), np.array(knots_z)[:, None], tau)[:, 0]
+
+
+def _carried_swing(start: np.ndarray, end: np.ndarray, phase: np.ndarray, top: float) -> np.ndarray:
+    """A swing on terrain: straight up to ``top``, across, straight down, each a quintic rest-to-rest
+    move (so C2) timed by its length: the foot is over no riser before it is above it."""
+    lift, carry = np.array([start[0], start[1], top]), np.array([end[0], end[1], top])
+    points = np.array([start, lift, carry, end])
+    lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    knots = np.concatenate([[0.0], np.cumsum(lengths)]) / max(lengths.sum(), _EPS)
+    return _rest_to_rest(knots, points, phase)
