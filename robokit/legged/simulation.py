@@ -30,7 +30,7 @@ References
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any, NamedTuple
 
 import mujoco
@@ -47,6 +47,7 @@ from .mocap import MocapFrames, simulate_mocap
 from .posture import PostureFeedback
 from .power import trial_power
 from .servo_design import littledog_servo_gains
+from .terrain import Terrain
 from .trial_log import TrialLog, empty_streams, trial_meta
 
 __all__ = ["LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "FALL_HEIGHT", "CONTACT_FORCE"]
@@ -337,7 +338,7 @@ def _sensed(streams: dict, gyro: np.ndarray, acc: np.ndarray, sensors: SensorSet
 
 def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors: SensorSettings = SensorSettings(),
                   *, motor: DCMotor = LITTLEDOG_MOTOR, host: PostureFeedback | None = None,
-                  rng: Any = 0) -> TrialOutcome:
+                  rng: Any = 0, terrain: Terrain | None = None) -> TrialOutcome:
     """Walk LittleDog through a plan in MuJoCo with the servo and host loops of the guide.
 
     Parameters
@@ -358,6 +359,9 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     rng : numpy.random.Generator or int, default 0
         Seeds the link and the sensor noise. A reactive host's MoCap noise comes from a generator
         spawned from it, so the link's draws are those of the same seed without feedback.
+    terrain : Terrain, optional
+        Boards on the floor to walk over (:func:`~robokit.legged.littledog.littledog_mjcf`); the
+        trial's meta records it. Default: flat ground.
 
     Returns
     -------
@@ -399,7 +403,7 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     if not ok.all():
         raise ValueError(f"plan: {int((~ok).sum())} host cycles ask for feet out of reach (first at "
                          f"t = {plan.t[~ok][0]:.2f} s)")
-    model = littledog_model(motor=motor)
+    model = littledog_model(motor=motor, terrain=terrain)
     data = _place(model, plan.T_world_body[0], q_cmd[0])
     probes = _Probes.of(model)
     channel = SetpointChannel(period=host_dt, latency=loops.latency, jitter=loops.jitter, loss=loops.loss, rng=gen)
@@ -437,7 +441,8 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
                       sensors, gen, None if feed is None else feed.frames(rows))
     meta = trial_meta(gait=plan.gait, host_rate=1.0 / host_dt, servo_rate=loops.servo_rate,
                       link_latency=loops.latency, link_jitter=loops.jitter, link_loss=loops.loss, seed=seed,
-                      notes="simulated in MuJoCo by robokit.legged.simulate_walk", kp=servo.kp, kd=servo.kd)
+                      notes="simulated in MuJoCo by robokit.legged.simulate_walk", kp=servo.kp, kd=servo.kd,
+                      **({} if terrain is None else {"terrain": asdict(terrain)}))
     heading = plan.T_world_body[-1, :3, 3] - plan.T_world_body[0, :3, 3]
     heading = heading / max(np.linalg.norm(heading), 1e-12)
     distance = float((streams["body_pos"][-1] - streams["body_pos"][0]) @ heading)
