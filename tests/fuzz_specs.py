@@ -503,6 +503,18 @@ def tiny_walk_plan():   # 0.02 m of trot: a few dozen host cycles, ~0.1 s of MuJ
     return walking_plan(trot_gait(), 0.02)
 
 
+@functools.cache
+def step_board():       # one 2 cm board across the lane ahead, with four markers on it
+    from robokit.legged.terrain import Terrain
+    return Terrain([[0.3, 0.5, -0.3, 0.3, 0.02]],
+                   markers=[[0.3, -0.3, 0.02], [0.3, 0.3, 0.02], [0.5, -0.3, 0.02], [0.5, 0.3, 0.02]])
+
+
+def board_markers_seen():
+    from robokit.geometry import se2_to_se3, transform_points
+    return transform_points(se2_to_se3([0.02, -0.01, 0.05]), np.array(step_board().markers))
+
+
 def loop_settings():
     from robokit.legged.simulation import LoopSettings
     return LoopSettings()
@@ -1434,7 +1446,24 @@ SPECS: dict[str, Call] = {
         "nominal_feet": Array(lambda: np.array([[0.16, 0.08, -0.1215], [0.16, -0.08, -0.1215],
                                                 [-0.16, 0.08, -0.1215], [-0.16, -0.08, -0.1215]]), "4,3",
                               optional=True),
-        "body_height": Real(0.1315), "dt": Real(0.01), "settle": Real(0.5), "margin": Real(0.02)}),
+        "body_height": Real(0.1315), "dt": Real(0.01), "settle": Real(0.5), "margin": Real(0.02),
+        "terrain": Obj(step_board, optional=True), "clearance": Real(0.025)}),
+    # --- robokit.legged.terrain (lesson 04's terrain boards) -----------------------------------------
+    "robokit.legged.terrain.Terrain": Call({
+        "blocks": Array(np.array([[0.3, 0.5, -0.3, 0.3, 0.02]]), "N,5", min_rows=0),
+        "markers": Array(np.array([[0.3, -0.3, 0.02], [0.3, 0.3, 0.02], [0.5, 0.0, 0.02]]), "N,3", min_rows=0),
+        "pose": Array(np.array([0.1, 0.0, 0.05]), "3")}),
+    "robokit.legged.terrain.height_at": Call({
+        "terrain": Obj(step_board), "xy": Array(np.array([[0.0, 0.0], [0.4, 0.1], [0.6, 0.0]]), "...,2")}),
+    "robokit.legged.terrain.edge_distance": Call({
+        "terrain": Obj(step_board), "xy": Array(np.array([[0.0, 0.0], [0.4, 0.1], [0.6, 0.0]]), "...,2")}),
+    "robokit.legged.terrain.step_terrain": Call({
+        "rng": Rng(0), "start": Real(0.3), "length": Real(1.0), "heights": Array(np.array([0.01, 0.04]), "2"),
+        "width": Real(0.6)}),
+    "robokit.legged.terrain.locate_terrain": Call({
+        "terrain": Obj(step_board), "observed": Array(board_markers_seen, "N,3|N,N,3"),
+        "visible": Array(np.ones(4, bool), "N|N,N", optional=True, accepts=("booleans",))}),
+    "robokit.legged.terrain.terrain_transform": Call({"terrain": Obj(step_board)}),
     # --- lesson 04's loops: controllers.servo_loop, dc_motor, joint_servo, host_link; legged.power ---
     "robokit.controllers.servo_loop.servo_plant": Call({"tau": Real(0.3), "gain": Real(1.0)}),
     "robokit.controllers.servo_loop.servo_closed_loop": Call({"kp": Real(2.0), "kd": Real(0.1), "tau": Real(0.3),
@@ -1576,10 +1605,10 @@ SPECS: dict[str, Call] = {
         "T_world_body": T_(lambda: np.eye(4), optional=True), "validate": Flag(True)}),
     "robokit.legged.littledog.littledog_mjcf": Call({
         "armature": Real(0.0), "damping": Real(0.0), "friction": Real(1.0), "timestep": Real(0.001),
-        "motor": Obj(littledog_motor, optional=True)}),
+        "motor": Obj(littledog_motor, optional=True), "terrain": Obj(step_board, optional=True)}),
     "robokit.legged.littledog.littledog_model": Call({
         "armature": Real(0.0), "damping": Real(0.0), "friction": Real(1.0), "timestep": Real(0.001),
-        "motor": Obj(littledog_motor, optional=True)}),
+        "motor": Obj(littledog_motor, optional=True), "terrain": Obj(step_board, optional=True)}),
     "robokit.legged.servo_design.link_inertias": Call({}),
     "robokit.legged.servo_design.servo_inertia": Call({"motor": Obj(littledog_motor)}),
     "robokit.legged.servo_design.littledog_servo_gains": Call({"bandwidth_hz": Real(15.0),
@@ -1596,7 +1625,8 @@ SPECS: dict[str, Call] = {
         "force_noise": Real(0.1)}),
     "robokit.legged.simulation.simulate_walk": Call({
         "plan": Obj(tiny_walk_plan), "loops": Obj(loop_settings), "sensors": Obj(sensor_settings),
-        "motor": Obj(littledog_motor), "host": Obj(posture_feedback, optional=True), "rng": Rng(0)}, cheap=False),
+        "motor": Obj(littledog_motor), "host": Obj(posture_feedback, optional=True), "rng": Rng(0),
+        "terrain": Obj(step_board, optional=True)}, cheap=False),
     "robokit.legged.posture.PostureFeedback": Call({
         "gain": Real(20.0), "axes": Obj(("z", "roll", "pitch")), "limit": Obj((0.03, 0.2))}),
     "robokit.legged.posture.delay_gain_limit": Call({"delay_cycles": Int(3)}),
@@ -1620,6 +1650,10 @@ SPECS: dict[str, Call] = {
         "plan": Obj(tiny_walk_plan, optional=True), "gate": Int(10)}),
     "robocourse.lessons.littledog.experiment.endurance_table": Call({"outcomes": Mapping(trial_outcomes)}),
     "robocourse.lessons.littledog.experiment.true_margins": Call({"log": Obj(trial_log)}),
+    "robocourse.lessons.littledog.terrain.terrain_table": Call({
+        "trials": Int(1), "distance": Real(0.05), "heights": Array(np.array([0.01, 0.02]), "2"),
+        "gaits": Obj(("crawl",)), "modes": Obj(("blind",)), "seed": Int(0), "workers": Int(1, optional=True),
+        "progress": Func(None, optional=True)}, cheap=False),
     "robokit.legged.touchdown.match_events": Call({
         "detected": Array(np.array([3, 5, 8]), "N", min_rows=0), "truth": Array(np.array([2, 8]), "N", min_rows=0),
         "tolerance": Int(2)}),
@@ -1912,6 +1946,10 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.legged.gait_schedule.{n}" for n in (
         "GaitSchedule", "crawl_gait", "trot_gait", "as_gait_schedule", "stance_pattern")),
     "robokit.legged.gait.swing_trajectory", "robokit.legged.gait.walking_plan",
+    # lesson 04's terrain boards and their table (issue 36), fuzzed before the notebook uses them
+    *(f"robokit.legged.terrain.{n}" for n in (
+        "Terrain", "height_at", "edge_distance", "step_terrain", "locate_terrain", "terrain_transform")),
+    "robocourse.lessons.littledog.terrain.terrain_table",
     # lesson 04's loops (controllers.servo_loop, dc_motor, joint_servo, host_link; legged.power), before the lesson
     *(f"robokit.controllers.servo_loop.{n}" for n in (
         "servo_plant", "servo_closed_loop", "servo_loop_gain", "servo_step_response", "servo_frequency_response",
