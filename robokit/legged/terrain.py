@@ -118,8 +118,8 @@ def _terrain(value: Any) -> Terrain:
     return value
 
 
-def _local(terrain: Terrain, xy: Any) -> tuple[np.ndarray, np.ndarray]:
-    """The validated points (..., 2) and the same points in the terrain frame."""
+def _local(terrain: Terrain, xy: Any) -> np.ndarray:
+    """The validated world points (..., 2) in the terrain frame."""
     p = as_array(xy, "xy")
     if p.ndim == 0 or p.shape[-1] != 2:
         raise ValueError(f"xy: expected points of shape (2,) or (..., 2), got shape {p.shape}")
@@ -127,7 +127,7 @@ def _local(terrain: Terrain, xy: Any) -> tuple[np.ndarray, np.ndarray]:
     x, y, yaw = terrain.pose
     c, s = np.cos(yaw), np.sin(yaw)
     d = p - [x, y]
-    return p, np.stack([c * d[..., 0] + s * d[..., 1], -s * d[..., 0] + c * d[..., 1]], axis=-1)
+    return np.stack([c * d[..., 0] + s * d[..., 1], -s * d[..., 0] + c * d[..., 1]], axis=-1)
 
 
 def height_at(terrain: Terrain, xy: Any) -> np.ndarray:
@@ -157,11 +157,7 @@ def height_at(terrain: Terrain, xy: Any) -> np.ndarray:
     [0.0, 0.02, 0.03, 0.03]
     """
     terrain = _terrain(terrain)
-    _, q = _local(terrain, xy)
-    return _heights(terrain, q)
-
-
-def _heights(terrain: Terrain, q: np.ndarray) -> np.ndarray:
+    q = _local(terrain, xy)
     if not terrain.blocks:
         return np.zeros(q.shape[:-1])
     b = np.array(terrain.blocks)
@@ -178,9 +174,8 @@ def edge_distance(terrain: Terrain, xy: Any) -> np.ndarray:
 
     Parameters
     ----------
-    terrain : Terrain
-    xy : array_like, shape (..., 2)
-        World points (m).
+    terrain, xy
+        As :func:`height_at`.
 
     Returns
     -------
@@ -206,7 +201,7 @@ def edge_distance(terrain: Terrain, xy: Any) -> np.ndarray:
     [0.3, 0.02, 0.1]
     """
     terrain = _terrain(terrain)
-    _, q = _local(terrain, xy)
+    q = _local(terrain, xy)
     if not terrain.blocks:
         return np.full(q.shape[:-1], np.inf)
     b = np.array(terrain.blocks)
