@@ -197,3 +197,10 @@ def test_terrain_table_rows_and_names(tmp_path, monkeypatch):
                                 ({"heights": (0.0, 0.02)}, ValueError, "heights"), ({"trials": 0}, ValueError, "trials")):
         with pytest.raises(error, match=f"^{name}: "):
             terrain_table(**kwargs)
+
+
+def test_terrain_table_reacting_modes_walk_under_a_reactive_host(tmp_path, monkeypatch):
+    monkeypatch.setenv("ROBOKIT_CACHE", str(tmp_path))
+    table = terrain_table(1, distance=0.3, gaits=("crawl",), modes=("blind", "reacting"), workers=1)
+    blind, reacting = table["tilt_deg"][0, :, 0]
+    assert table["walked"].all() and blind != reacting            # same course and plan: only the host differs
