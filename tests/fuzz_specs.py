@@ -1529,6 +1529,7 @@ SPECS: dict[str, Call] = {
     "robokit.viz.animation.animate_tracks": Call({
         "scene": Obj(scene), "tracks": Mapping(lambda: {"a": {"position": np.zeros((3, 3)), "scale": np.ones((3, 3))}}),
         "fps": Real(10.0), "repetitions": Int(1), "validate": Flag(True)}),
+    "robokit.viz.legged.add_terrain": Call({"scene": Obj(scene), "terrain": Obj(step_board), "path": Text("terrain")}),
     "robokit.viz.legged.joint_path": Call({"path": Text("littledog"), "leg": Choice("HL"), "joint": Choice("knee")}),
     "robokit.viz.legged.add_littledog": Call({"scene": Obj(scene), "path": Text("littledog"),
                                               "T_world_body": T_(lambda: np.eye(4), optional=True),

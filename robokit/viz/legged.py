@@ -37,6 +37,7 @@ from ..geometry import as_se3, rot_x, rot_y, se3_from_rt
 from ..legged.leg_kinematics import body_ik, leg_index
 from ..legged.littledog import (FOOT_RADIUS, HIP_OFFSETS, HIP_POSITIONS, JOINTS, LEGS, LOWER_LEG, MARKERS,
                                 STANCE_FEET, STANDING_HEIGHT, TRUNK_SIZE, UPPER_LEG)
+from ..legged.terrain import Terrain, terrain_transform
 from ..legged.trial_log import TrialLog
 from ..validation import as_array, as_choice, as_int, as_positive, as_text, describe
 from .animation import HIDDEN_SCALE, animate_tracks
@@ -44,11 +45,11 @@ from .legged_plots import support_outline
 from .scene import Scene, as_scene
 from . import framing
 
-__all__ = ["joint_path", "add_littledog", "pose_littledog", "animate_trial", "GROUND_Z"]
+__all__ = ["joint_path", "add_littledog", "pose_littledog", "animate_trial", "add_terrain", "GROUND_Z"]
 
 GROUND_Z = 0.001
 """Height (m) at which ground overlays are drawn: just above meshcat's grid, so they are not hidden."""
-_COLORS = {"trunk": 0x2B2B8C, "link": 0x404048, "foot": 0x151515, "marker": 0xEEEEEE, "mocap": 0xE0309A,
+_COLORS = {"board": 0xB08A5A, "trunk": 0x2B2B8C, "link": 0x404048, "foot": 0x151515, "marker": 0xEEEEEE, "mocap": 0xE0309A,
            "support": 0x2E9E4F, "com": 0xF2B705, "force": 0xE8551C}
 _RADII = (0.012, 0.011, 0.008)                    # hip stub, upper and lower leg, as in the MJCF
 _SIDE = np.array([1.0 if leg.endswith("L") else -1.0 for leg in LEGS])
@@ -371,3 +372,45 @@ def animate_trial(scene: Scene, log: TrialLog, path: str = "littledog", every: i
             tracks[f"{overlay}/mocap/{k}"] = {"position": log.mocap[rows, k],
                                               "scale": np.where(seen[:, None], 1.0, HIDDEN_SCALE) * np.ones(3)}
     return animate_tracks(scene, tracks, fps, validate=False)
+
+
+def add_terrain(scene: Scene, terrain: Terrain, path: str = "terrain") -> Scene:
+    """Draw a terrain's boards and their MoCap markers where the terrain lies.
+
+    Parameters
+    ----------
+    scene : Scene
+    terrain : Terrain
+        Boards and markers in the terrain's frame, placed by its ``pose``
+        (:mod:`robokit.legged.terrain`; LittleDog User Guide, Sec. 1: the MoCap tracks markers on the
+        terrain as on the robot).
+    path : str, default "terrain"
+        Scene path: boards at ``<path>/board<k>``, markers at ``<path>/marker<k>``.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    TypeError
+        For a ``scene`` that is not a Scene or a ``terrain`` that is not a Terrain.
+
+    Examples
+    --------
+    >>> from robokit.legged import Terrain
+    >>> board = Terrain([[0.3, 0.5, -0.3, 0.3, 0.02]], markers=[[0.3, 0.3, 0.02]], pose=(1.0, 0.0, 0.0))
+    >>> lo, hi = add_terrain(Scene(), board).bounding_box("terrain")     # the board 1 m further on
+    >>> np.round(lo, 3).tolist(), np.round(hi, 3).tolist()
+    ([1.294, -0.3, 0.0], [1.5, 0.306, 0.026])
+    """
+    scene = as_scene(scene, path)
+    if not isinstance(terrain, Terrain):
+        raise TypeError(f"terrain: expected a Terrain (robokit.legged.terrain), got {type(terrain).__name__}")
+    T = terrain_transform(terrain)
+    for k, (x0, x1, y0, y1, h) in enumerate(terrain.blocks):
+        centre = se3_from_rt(np.eye(3), [(x0 + x1) / 2, (y0 + y1) / 2, h / 2])
+        scene.add_box(f"{path}/board{k}", [x1 - x0, y1 - y0, h], T @ centre, color=_COLORS["board"])
+    for k, m in enumerate(terrain.markers):
+        scene.add_sphere(f"{path}/marker{k}", 0.006, T @ se3_from_rt(np.eye(3), m), color=_COLORS["marker"])
+    return scene
