@@ -5,8 +5,9 @@ import dataclasses
 
 import numpy as np
 import pytest
+import scipy.linalg
 
-from robokit.geometry import se2_compose, se2_to_matrix, wrap_angle
+from robokit.geometry import se2_between, se2_compose, se2_to_matrix, wrap_angle
 from robokit.mapping import (DisconnectedGraphError, PoseGraph, manhattan_world_graph, optimize_pose_graph, pose_graph_cost, pose_graph_from_odometry, relax, relax_sweep)
 from robokit.mapping.pose_graph import edge_variances, is_connected, unreachable_nodes
 from robokit.mapping.pose_graph_optimize import pose_graph_jacobian, pose_graph_residuals
@@ -199,6 +200,29 @@ def test_fixed_node_keeps_its_pose_and_solvers_agree(fixed):
     np.testing.assert_allclose(gn.poses, sc.poses, atol=1e-3)
     assert gn.cost == pytest.approx(pose_graph_cost(g, gn.poses), rel=1e-12)
     assert gn.cost < 0.02 * gn.initial_cost
+
+
+@pytest.mark.parametrize("seed, fixed", [(0, 0), (1, 5), (2, 11)])
+def test_a_gauss_newton_step_solves_the_readable_normal_equations(seed, fixed):
+    # the solver sums J^T Omega J edge by edge on a fixed pattern and factors it with CHOLMOD; the
+    # readable version forms it from the sparse Jacobian and solves it densely. Repeated edges,
+    # edges in both directions, full information matrices and any fixed node must give the same step
+    rng = np.random.default_rng(seed)
+    g = random_graph(rng, n=12, m=40)
+    i, j = g.edges.T
+    exact = se2_between(g.poses[i], g.poses[j])
+    g = dataclasses.replace(g, fixed=fixed, measurements=exact + rng.normal(0.0, 0.05, exact.shape),
+                            poses=g.poses + rng.normal(0.0, 0.05, g.poses.shape))
+    jac = pose_graph_jacobian(g).toarray()
+    omega = scipy.linalg.block_diag(*g.information)
+    free = np.arange(3 * g.n_poses) // 3 != fixed
+    hessian, gradient = jac.T @ omega @ jac, jac.T @ omega @ pose_graph_residuals(g).ravel()
+    expected = g.poses.copy()
+    expected[np.arange(g.n_poses) != fixed] += np.linalg.solve(hessian[np.ix_(free, free)], -gradient[free]).reshape(-1, 3)
+    expected[:, 2] = wrap_angle(expected[:, 2])
+    assert pose_graph_cost(g, expected) < pose_graph_cost(g)          # so no damping: one plain step
+    np.testing.assert_allclose(optimize_pose_graph(g, max_iterations=1).poses, expected, rtol=0, atol=1e-10)
+    assert len({tuple(e) for e in np.sort(g.edges, axis=1)}) < g.n_edges and (g.edges[:, 0] > g.edges[:, 1]).any()
 
 
 def test_gauss_newton_stops_at_a_stationary_point():
