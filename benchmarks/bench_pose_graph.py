@@ -1,8 +1,9 @@
 """Benchmark robokit.mapping's pose-graph solvers against gtsam on the same graphs.
 
-On a generated Manhattan-world graph (3500 poses, like Olson's M3500, with ground truth) and on
-any g2o files given on the command line (Intel, MIT, CSAIL, M3500 ... as distributed in the g2o
-format), this runs:
+On a generated Manhattan-world graph (3500 poses, like Olson's M3500, with ground truth), on
+graphs gtsam ships with its Python package (``--gtsam-example w10000``: Olson's 10,000-pose W10000,
+64,311 edges) and on any g2o files given on the command line (Intel, MIT, CSAIL, M3500 ... as
+distributed in the g2o format), this runs:
 
 * robokit's hand-written sparse Gauss-Newton (``optimize_pose_graph(method="gauss-newton")``),
 * robokit's scipy ``least_squares`` path (``method="scipy"``),
@@ -22,6 +23,8 @@ Usage::
     python benchmarks/bench_pose_graph.py                     # 3500-pose Manhattan graph
     python benchmarks/bench_pose_graph.py data/input_INTEL_g2o.g2o --n 0   # a file only
     python benchmarks/bench_pose_graph.py big.g2o --n 0 --no-scipy --relax-iterations 2000
+    python benchmarks/bench_pose_graph.py --n 0 --gtsam-example w10000 --no-scipy --relax-iterations 0
+    python benchmarks/bench_pose_graph.py --n 10000 --no-scipy --relax-iterations 0
     ROBOKIT_FAST=1 python benchmarks/bench_pose_graph.py      # 500 poses
 
 Numbers depend on the machine and its load; compare the ratios to the peer run in the same process.
@@ -34,7 +37,7 @@ import time
 import numpy as np
 
 from robokit.config import fast_mode
-from robokit.mapping import manhattan_world_graph, optimize_pose_graph, pose_graph_cost, read_g2o, relax
+from robokit.mapping import PoseGraph, manhattan_world_graph, optimize_pose_graph, pose_graph_cost, read_g2o, relax
 
 
 def gtsam_solve(graph):
@@ -69,6 +72,25 @@ def gtsam_solve(graph):
         return 2.0 * between.error(v)
 
     return poses, seconds, optimizer.iterations(), build, gtsam_chi2
+
+
+def gtsam_example(name):
+    """A planar pose graph from gtsam's bundled data (``gtsam.load2D``) as a robokit PoseGraph, node 0 fixed."""
+    import gtsam
+    factors, values = gtsam.load2D(gtsam.findExampleDataFile(name))
+    keys = sorted(values.keys())
+    index = {k: n for n, k in enumerate(keys)}
+    poses = np.array([[values.atPose2(k).x(), values.atPose2(k).y(), values.atPose2(k).theta()] for k in keys])
+    edges, measurements, information = [], [], []
+    for k in range(factors.size()):
+        factor = factors.at(k)
+        if not isinstance(factor, gtsam.BetweenFactorPose2):
+            continue
+        z, root = factor.measured(), factor.noiseModel().R()         # information = R^T R
+        edges.append([index[key] for key in factor.keys()])
+        measurements.append([z.x(), z.y(), z.theta()])
+        information.append(root.T @ root)
+    return PoseGraph(poses, edges, measurements, np.array(information), ids=keys)
 
 
 def run(name, graph, truth, relax_iterations, methods):
@@ -108,6 +130,8 @@ def main(argv=None):
     parser.add_argument("files", nargs="*", help="g2o files (VERTEX_SE2 / EDGE_SE2) to run as well")
     parser.add_argument("--n", type=int, default=500 if fast_mode() else 3500,
                         help="poses of the generated Manhattan graph (0: none)")
+    parser.add_argument("--gtsam-example", action="append", default=[], metavar="NAME",
+                        help="a 2-D graph gtsam ships, e.g. w10000 (repeatable; needs gtsam)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--relax-iterations", type=int, default=20000, help="most relaxation sweeps")
     parser.add_argument("--no-scipy", action="store_true",
@@ -117,6 +141,8 @@ def main(argv=None):
     if args.n:
         graph, truth = manhattan_world_graph(args.n, seed=args.seed)
         run(f"Manhattan world (seed {args.seed})", graph, truth, args.relax_iterations, methods)
+    for name in args.gtsam_example:
+        run(f"gtsam example {name}", gtsam_example(name), None, args.relax_iterations, methods)
     for path in args.files:
         run(path, read_g2o(path), None, args.relax_iterations, methods)
     print("\nchi2 = sum e^T Omega e with g2o's error; chi2/peer divides by robokit's chi2 at gtsam's optimum; "
