@@ -50,6 +50,7 @@ PACKAGES = (
     Package("control", "control", "02-05", "robokit.controllers"),
     Package("mujoco", "mujoco", "04", "robokit.legged"),
     Package("numba", "numba", "06", "robokit.arm"),
+    Package("cvxopt", "cvxopt", "02-03", "robokit.mapping"),
     Package("ipywidgets", "ipywidgets", "all (live sliders)", "robokit.viz"),
     Package("nbformat", "nbformat", "assignments", "robocourse (check, assignment data)"),
     Package("ipykernel", "ipykernel", "all", "JupyterLab's Python kernel"),
