@@ -22,7 +22,7 @@ COURSE_ARGS ?=
 $(STAMP): pyproject.toml course/pyproject.toml constraints.txt
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[legged,arm,dev]' -e './course[lab]'
+	$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[legged,arm,cholmod,dev]' -e './course[lab]'
 	@touch $(STAMP)
 
 venv: $(STAMP)
@@ -42,7 +42,7 @@ check: $(STAMP)
 upgrade:
 	rm -rf $(VENV)-upgrade && $(PYTHON) -m venv $(VENV)-upgrade
 	$(VENV)-upgrade/bin/python -m pip install --quiet --upgrade pip
-	$(VENV)-upgrade/bin/python -m pip install --quiet -e '.[legged,arm,dev]' -e './course[lab]'
+	$(VENV)-upgrade/bin/python -m pip install --quiet -e '.[legged,arm,cholmod,dev]' -e './course[lab]'
 	{ grep '^#' constraints.txt; $(VENV)-upgrade/bin/python -m pip list --format=freeze --exclude-editable \
 	  | grep -viE '^(pip|setuptools|wheel|robokit|robocourse)==' | sort -f; } > constraints.txt.new
 	mv constraints.txt.new constraints.txt

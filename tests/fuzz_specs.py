@@ -1031,7 +1031,8 @@ SPECS: dict[str, Call] = {
     "robokit.mapping.pose_graph_optimize.pose_graph_jacobian": Call({"graph": Obj(pose_graph),
                                                             "poses": Array(lambda: pose_graph().poses, "N,3", optional=True)}),
     "robokit.mapping.pose_graph_optimize.optimize_pose_graph": Call({
-        "graph": Obj(pose_graph), "method": Choice("gauss-newton"), "max_iterations": Int(20), "tolerance": Real(1e-9)}),
+        "graph": Obj(pose_graph), "method": Choice("gauss-newton"), "max_iterations": Int(20), "tolerance": Real(1e-9),
+        "linear_solver": Choice("auto")}),
     "robokit.mapping.relaxation.relax": Call({"graph": Obj(pose_graph), "max_iterations": Int(50), "tolerance": Real(1e-6),
                                               "variances": Array(lambda: np.full(30, 0.01), "N", optional=True)}),
     "robokit.mapping.relaxation.relax_sweep": Call({

@@ -10,7 +10,7 @@ from importlib import metadata
 import pytest
 
 from robocourse import environment
-from robocourse.environment import PACKAGES, check_environment, environment_table
+from robocourse.environment import OPTIONAL, PACKAGES, check_environment, environment_table
 from tests.conftest import ROOT
 
 _STD = set(sys.stdlib_module_names) | {"__future__"}
@@ -45,13 +45,13 @@ def test_every_package_the_library_and_the_notebooks_import_is_checked():
     for path, text in sources.items():
         for module in _third_party(text):
             imported.setdefault(module, path.relative_to(ROOT))
-    checked = {p.module for p in PACKAGES}
+    checked = {p.module for p in PACKAGES + OPTIONAL}
     missing = {m: str(where) for m, where in imported.items() if m not in checked}
-    assert not missing, f"imported but not in robocourse.environment.PACKAGES: {missing}"
+    assert not missing, f"imported but not in robocourse.environment.PACKAGES or OPTIONAL: {missing}"
     assert {"mujoco", "numba", "ipywidgets", "IPython", "tqdm"} <= checked
 
 
-@pytest.mark.parametrize("package", [p for p in PACKAGES if p.used_by.startswith("robokit.")],
+@pytest.mark.parametrize("package", [p for p in PACKAGES + OPTIONAL if p.used_by.startswith("robokit.")],
                          ids=lambda p: p.distribution)
 def test_the_named_robokit_user_imports_the_package(package):
     base = ROOT / package.used_by.replace(".", "/")

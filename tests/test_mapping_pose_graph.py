@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import dataclasses
 
+import importlib.util
+
 import numpy as np
 import pytest
 import scipy.linalg
@@ -202,8 +204,12 @@ def test_fixed_node_keeps_its_pose_and_solvers_agree(fixed):
     assert gn.cost < 0.02 * gn.initial_cost
 
 
+SOLVERS = ["superlu"] + (["cholmod"] if importlib.util.find_spec("cvxopt") else [])
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
 @pytest.mark.parametrize("seed, fixed", [(0, 0), (1, 5), (2, 11)])
-def test_a_gauss_newton_step_solves_the_readable_normal_equations(seed, fixed):
+def test_a_gauss_newton_step_solves_the_readable_normal_equations(seed, fixed, solver):
     # the solver sums J^T Omega J edge by edge on a fixed pattern and factors it with CHOLMOD; the
     # readable version forms it from the sparse Jacobian and solves it densely. Repeated edges,
     # edges in both directions, full information matrices and any fixed node must give the same step
@@ -221,8 +227,27 @@ def test_a_gauss_newton_step_solves_the_readable_normal_equations(seed, fixed):
     expected[np.arange(g.n_poses) != fixed] += np.linalg.solve(hessian[np.ix_(free, free)], -gradient[free]).reshape(-1, 3)
     expected[:, 2] = wrap_angle(expected[:, 2])
     assert pose_graph_cost(g, expected) < pose_graph_cost(g)          # so no damping: one plain step
-    np.testing.assert_allclose(optimize_pose_graph(g, max_iterations=1).poses, expected, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(optimize_pose_graph(g, max_iterations=1, linear_solver=solver).poses, expected,
+                               rtol=0, atol=1e-10)
     assert len({tuple(e) for e in np.sort(g.edges, axis=1)}) < g.n_edges and (g.edges[:, 0] > g.edges[:, 1]).any()
+
+
+def test_both_factorisations_reach_the_same_optimum():
+    g, _ = manhattan_world_graph(300, seed=2)
+    results = [optimize_pose_graph(g, linear_solver=solver) for solver in SOLVERS]
+    auto = optimize_pose_graph(g)
+    for res in results + [auto]:
+        assert res.converged and res.cost == pytest.approx(results[0].cost, rel=1e-9)
+        np.testing.assert_allclose(res.poses, results[0].poses, atol=1e-7)
+
+
+def test_cholmod_without_cvxopt_is_refused_by_name(monkeypatch):
+    import robokit.mapping.pose_graph_optimize as module
+    monkeypatch.setattr(module, "cholmod", None)
+    g, _ = manhattan_world_graph(30, seed=1)
+    with pytest.raises(ValueError, match="^linear_solver: .*cvxopt"):
+        optimize_pose_graph(g, linear_solver="cholmod")
+    assert optimize_pose_graph(g).converged                     # "auto" falls back to SuperLU
 
 
 def test_gauss_newton_stops_at_a_stationary_point():

@@ -16,7 +16,7 @@ def _name(req: str) -> str:
 
 
 #: Each package's pyproject and the extras `make venv` installs with it.
-PACKAGES = {"pyproject.toml": ("legged", "arm", "dev"), "course/pyproject.toml": ("lab",)}
+PACKAGES = {"pyproject.toml": ("legged", "arm", "cholmod", "dev"), "course/pyproject.toml": ("lab",)}
 #: What only the course needs: the library must not depend on any of it.
 COURSE_ONLY = {"nbformat", "nbclient", "nbconvert", "ipython", "ipykernel", "jupyterlab", "sphinx", "myst-nb",
                "sphinx-book-theme", "sphinx-mathjax-offline"}

@@ -3,8 +3,9 @@
 Lesson 00 calls :func:`check_environment` so that a missing or broken package (a MuJoCo or numba
 that is installed but does not import) shows up in the first five minutes, named with the lesson
 that would otherwise fail, not in the middle of lesson 04 or 06. ``tests/test_environment.py`` keeps
-:data:`PACKAGES` complete: every third-party module that robokit, robocourse or a notebook imports
-is in it, and each entry's robokit user does import it.
+:data:`PACKAGES` (with :data:`OPTIONAL`, what robokit can do without) complete: every third-party
+module that robokit, robocourse or a notebook imports is in one of them, and each entry's robokit
+user does import it.
 """
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import dataclasses
 import importlib
 from importlib import metadata
 
-__all__ = ["Package", "PACKAGES", "check_environment", "environment_table"]
+__all__ = ["Package", "PACKAGES", "OPTIONAL", "check_environment", "environment_table"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -50,11 +51,15 @@ PACKAGES = (
     Package("control", "control", "02-05", "robokit.controllers"),
     Package("mujoco", "mujoco", "04", "robokit.legged"),
     Package("numba", "numba", "06", "robokit.arm"),
-    Package("cvxopt", "cvxopt", "02-03", "robokit.mapping"),
     Package("ipywidgets", "ipywidgets", "all (live sliders)", "robokit.viz"),
     Package("nbformat", "nbformat", "assignments", "robocourse (check, assignment data)"),
     Package("ipykernel", "ipykernel", "all", "JupyterLab's Python kernel"),
     Package("jupyterlab", None, "all", "JupyterLab"),
+)
+
+#: What robokit uses when it is installed and does without otherwise (not checked by lesson 00).
+OPTIONAL = (
+    Package("cvxopt", "cvxopt", "02-03 (big pose graphs faster; GPL-3, opt-in)", "robokit.mapping"),
 )
 
 

@@ -16,8 +16,10 @@ sparse Jacobian :func:`pose_graph_jacobian`. Each error is whitened first: with 
 * ``method="gauss-newton"``: the method of the lesson. Each iteration solves the sparse normal
   equations ``(J^T J) dx = -J^T r`` (Kummerle et al. 2011, Sec. III), summed edge by edge as in
   Grisetti et al. (2010), Algorithm 1, with CHOLMOD's supernodal sparse Cholesky (Chen et al. 2008,
-  through cvxopt): one symbolic analysis (AMD fill-reducing ordering, supernodes) serves every
-  iteration. A step that does not lower the cost is retried with Levenberg-Marquardt damping
+  through cvxopt, the optional ``cholmod`` extra: GPL-3): one symbolic analysis (AMD fill-reducing
+  ordering, supernodes) serves every iteration. Without cvxopt, scipy's SuperLU factorises each
+  iteration afresh (minimum degree on the symmetric pattern): the same steps, slower on big loopy
+  graphs. A step that does not lower the cost is retried with Levenberg-Marquardt damping
   ``J^T J + lambda diag(J^T J)``, so the plain Gauss-Newton step is taken whenever it works.
 * ``method="scipy"``: ``scipy.optimize.least_squares`` (trust-region reflective, LSMR on the
   sparse Jacobian, variables scaled by the Jacobian's columns, no extra regularisation of the
@@ -49,15 +51,24 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from cvxopt import cholmod, matrix, spmatrix
 from scipy.optimize import least_squares
+from scipy.sparse.linalg import splu
+
+try:                                   # the optional `cholmod` extra (cvxopt is GPL-3)
+    from cvxopt import cholmod, matrix, spmatrix
+except ImportError:                    # pragma: no cover - exercised where cvxopt is not installed
+    cholmod = None
 
 from ..geometry import se2_between, wrap_angle
 from ..geometry.planar import as_planar
 from ..validation import as_choice, as_int, as_positive, require_finite_result
 from .pose_graph import PoseGraph, as_pose_graph, require_connected
 
-__all__ = ["pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph"]
+__all__ = ["pose_graph_residuals", "pose_graph_cost", "pose_graph_jacobian", "PoseGraphResult", "optimize_pose_graph",
+           "LINEAR_SOLVERS"]
+
+LINEAR_SOLVERS = ("auto", "cholmod", "superlu")
+"""The sparse factorisations Gauss-Newton can use: ``"auto"`` is CHOLMOD where cvxopt is installed."""
 
 #: Largest Levenberg-Marquardt damping tried before a step is given up (the cost is at a minimum).
 MAX_DAMPING = 1e12
@@ -248,11 +259,12 @@ class _NormalEquations:
     Grisetti et al. 2010, Algorithm 1) into the lower triangle of a sparsity pattern fixed by the
     edges, the fixed node's rows and columns left out. CHOLMOD's supernodal Cholesky (through
     cvxopt) analyses that pattern once (fill-reducing AMD ordering, elimination tree, supernodes)
-    and every iteration and damping reuses the analysis for its numeric factorisation. The plain
-    ``J^T J`` of :func:`pose_graph_jacobian` is the readable version; the tests compare the two.
+    and every iteration and damping reuses the analysis for its numeric factorisation; SuperLU
+    (``solver="superlu"``) factorises the symmetric matrix afresh each time. The plain ``J^T J``
+    of :func:`pose_graph_jacobian` is the readable version; the tests compare the two.
     """
 
-    def __init__(self, graph: PoseGraph, whiten: np.ndarray, free: np.ndarray) -> None:
+    def __init__(self, graph: PoseGraph, whiten: np.ndarray, free: np.ndarray, solver: str) -> None:
         self._graph, self._whiten = graph, whiten
         column = np.full(graph.n_poses, -1)
         column[free] = 3 * np.arange(free.size)
@@ -266,8 +278,11 @@ class _NormalEquations:
         pattern, self._slot = np.unique(key, return_inverse=True)
         self._size = pattern.size
         self._diagonal = np.flatnonzero(pattern // n == pattern % n)
-        self._matrix = spmatrix(1.0, matrix(pattern % n), matrix(pattern // n), (n, n))
-        self._factor = cholmod.symbolic(self._matrix, uplo="L")
+        self._rows, self._cols, self._n = pattern % n, pattern // n, n
+        if solver == "cholmod":
+            self._matrix = spmatrix(1.0, matrix(self._rows), matrix(self._cols), (n, n))
+            self._factor = cholmod.symbolic(self._matrix, uplo="L")
+        self._solver = solver
 
     def residuals(self, poses: np.ndarray) -> np.ndarray:
         """Whitened errors ``L^T e`` of every edge, shape (M, 3): their squared norm is ``chi2``."""
@@ -288,6 +303,13 @@ class _NormalEquations:
         """The step ``dx``, or None where the matrix is not numerically positive definite."""
         values = hessian.copy()
         values[self._diagonal] *= 1.0 + damping
+        if self._solver == "superlu":
+            lower = sp.csc_matrix((values, (self._rows, self._cols)), shape=(self._n, self._n))
+            full = (lower + sp.tril(lower, -1).T).tocsc()
+            try:
+                return splu(full, permc_spec="MMD_AT_PLUS_A", options=_SYMMETRIC, diag_pivot_thresh=0.0).solve(-gradient)
+            except RuntimeError:                                  # exactly singular
+                return None
         self._matrix.V = matrix(values)
         try:
             cholmod.numeric(self._matrix, self._factor)
@@ -298,9 +320,12 @@ class _NormalEquations:
         return np.asarray(step).ravel()
 
 
-def _gauss_newton(graph, whiten, free, max_iterations, tolerance):
+_SYMMETRIC = {"SymmetricMode": True}      # SuperLU: diagonal pivots on the symmetric pattern
+
+
+def _gauss_newton(graph, whiten, free, max_iterations, tolerance, solver):
     """Gauss-Newton with damping only when a step fails; returns (poses, iterations, converged)."""
-    system = _NormalEquations(graph, whiten, free)
+    system = _NormalEquations(graph, whiten, free, solver)
     poses = graph.poses.copy()
     r = system.residuals(poses)
     cost = np.sum(r * r)
@@ -351,7 +376,7 @@ def _scipy(graph, white, free, max_iterations, tolerance):
 
 
 def optimize_pose_graph(graph: PoseGraph, *, method: str = "gauss-newton", max_iterations: int = 100,
-                        tolerance: float = 1e-9) -> PoseGraphResult:
+                        tolerance: float = 1e-9, linear_solver: str = "auto") -> PoseGraphResult:
     """Least-squares poses of a pose graph: the minimum of ``chi2`` with the fixed node held.
 
     Parameters
@@ -368,6 +393,10 @@ def optimize_pose_graph(graph: PoseGraph, *, method: str = "gauss-newton", max_i
     tolerance : float, default 1e-9
         Gauss-Newton stops when the cost falls by less than ``tolerance`` times itself or no pose
         moves by more than ``tolerance``; scipy gets it as ``ftol``, ``xtol`` and ``gtol``.
+    linear_solver : {"auto", "cholmod", "superlu"}, default "auto"
+        Gauss-Newton's sparse factorisation: CHOLMOD's supernodal Cholesky with one symbolic
+        analysis (needs cvxopt, robokit's ``cholmod`` extra), or scipy's SuperLU; ``"auto"`` takes
+        CHOLMOD where it is installed. Both give the same steps to rounding.
 
     Returns
     -------
@@ -378,7 +407,8 @@ def optimize_pose_graph(graph: PoseGraph, *, method: str = "gauss-newton", max_i
     DisconnectedGraphError
         If some node is not linked to the fixed node (it would have no defined pose).
     ValueError
-        For a bad option, or poses so large that the cost overflows.
+        For a bad option (``linear_solver="cholmod"`` without cvxopt), or poses so large that the
+        cost overflows.
 
     Notes
     -----
@@ -407,6 +437,12 @@ def optimize_pose_graph(graph: PoseGraph, *, method: str = "gauss-newton", max_i
     """
     as_pose_graph(graph)
     method = as_choice(method, "method", ("gauss-newton", "scipy"))
+    solver = as_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)
+    if solver == "auto":
+        solver = "superlu" if cholmod is None else "cholmod"
+    elif solver == "cholmod" and cholmod is None:
+        raise ValueError("linear_solver: expected 'auto' or 'superlu' (CHOLMOD needs cvxopt: pip install "
+                         "'robokit[cholmod]'), got 'cholmod'")
     max_iterations = as_int(max_iterations, "max_iterations", minimum=0)
     tolerance = as_positive(tolerance, "tolerance")
     require_connected(graph)
@@ -420,7 +456,7 @@ def optimize_pose_graph(graph: PoseGraph, *, method: str = "gauss-newton", max_i
     if max_iterations == 0 or free.size == 0 or graph.n_edges == 0:
         poses, iterations, converged = graph.poses.copy(), 0, free.size == 0 or graph.n_edges == 0
     elif method == "gauss-newton":
-        poses, iterations, converged = _gauss_newton(graph, whiten, free, max_iterations, tolerance)
+        poses, iterations, converged = _gauss_newton(graph, whiten, free, max_iterations, tolerance, solver)
     else:
         poses, iterations, converged = _scipy(graph, white, free, max_iterations, tolerance)
     r = white @ pose_graph_residuals(graph, poses).ravel()
