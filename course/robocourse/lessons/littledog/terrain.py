@@ -52,7 +52,8 @@ from robokit.validation import as_array, as_callable, as_int, as_positive
 
 from .experiment import HOST_GAINS, LESSON_CRAWL, LESSON_DISTANCE, LESSON_TROT
 
-__all__ = ["TERRAIN_TRIALS", "TERRAIN_MODES", "TABLE_MODES", "TERRAIN_GAITS", "PLACEMENT", "SUCCESS_TOLERANCE", "terrain_table"]
+__all__ = ["TERRAIN_TRIALS", "TERRAIN_MODES", "TABLE_MODES", "TERRAIN_GAITS", "PLACEMENT", "SUCCESS_TOLERANCE", "MOCAP_FRAMES",
+           "terrain_table"]
 
 TERRAIN_TRIALS = 2 if FAST else 10
 """Random courses per row of the table: 10 (2 in fast mode)."""
