@@ -1829,6 +1829,8 @@ HUGE_ANGLES: dict[str, tuple[str, ...]] = {
 
 
 EXTRA: tuple[str, ...] = (
+    "robokit.legged.posture.PostureFeedback",          # lesson 04's reactive host, built by host_table and terrain_table
+    "robocourse.lessons.littledog.experiment.posture_errors",   # host_table's tilt and sag
     "robokit.localization.appearance_mcl.place_hypotheses",      # lesson 02's Monte-Carlo check (checks)
     "robokit.localization.appearance_mcl.monte_carlo_check",
     "robocourse.lessons.omni_localization.checks.drive_on",      # the Monte-Carlo check's drives (check_trials)
