@@ -58,7 +58,7 @@ def test_the_handout_has_the_lessons_assignments_and_packages_and_no_solutions(h
     assert "## Student guide" in readme and "## Instructor guide" not in readme and "make lab" in readme
     environment = (folder / "environment.yml").read_text()
     assert "numpy" in environment and "mujoco" in environment and "jupyterlab" in environment
-    assert not any(dev in environment for dev in ("pytest", "gtsam", "roboticstoolbox", "hypothesis"))
+    assert not any(dev in environment for dev in ("pytest", "gtsam", "roboticstoolbox", "hypothesis", "cvxopt"))
     makefile = (folder / "Makefile").read_text()
     assert "'.[legged,arm]'" in makefile and "dev" not in makefile and "\tlab" not in makefile
     assert (folder / "course" / "README.md").is_file()                # course/pyproject.toml names it

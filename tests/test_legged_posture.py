@@ -136,3 +136,28 @@ def test_host_table_rows_and_predictions(crawl):
         experiment.host_table(plan, gains=(-1.0,))
     with pytest.raises(ValueError, match="loss"):
         experiment.host_table(plan, losses=(1.5,))
+
+
+def test_host_lag_refuses_what_it_cannot_measure():
+    for kwargs, name in (({"step": 1e-9}, "step"), ({"latency": 0.45}, "latency"), ({"dt": 0.0105}, "dt"),
+                         ({"latency": float("nan")}, "latency")):
+        with pytest.raises(ValueError, match=f"^{name}: "):
+            experiment.host_lag(**kwargs)
+
+
+def test_a_reactive_trial_that_falls_logs_a_mocap_frame_on_its_last_row():
+    plan = experiment.lesson_plans(0.05)["crawl"]
+    out = legged.simulate_walk(plan, legged.LoopSettings(gains=(0.05, 0.0)), host=PostureFeedback(), rng=0)
+    assert out.fell                                         # servos this weak let the trunk down
+    last = out.log.mocap[-1][out.log.mocap_visible[-1]]
+    truth = out.log.T_world_body()[-1]
+    assert len(last) and np.all(np.abs(last[:, 2] - truth[2, 3]) < 0.1)   # markers where the trunk is
+    assert out.log.meta["host"]["gain"] == PostureFeedback().gain
+
+
+def test_the_reactive_host_sees_the_logged_trunk_pose():
+    plan = experiment.lesson_plans(0.05)["crawl"]
+    quiet = legged.SensorSettings(mocap_noise=0.0, mocap_dropout=0.0, mocap_bursts=0.0)
+    out = legged.simulate_walk(plan, sensors=quiet, host=PostureFeedback(), rng=0)
+    poses = legged.mocap_body_poses(legged.MARKERS, out.log.mocap, out.log.mocap_visible)
+    np.testing.assert_allclose(poses.T_world_body[:, :3, 3], out.log.body_pos, atol=1e-9)

@@ -7,8 +7,8 @@ support           the support polygon and the static stability margin
 gait_schedule     crawl and trot schedules
 gait              walking plans: body and feet along a crawl or a trot
 servo_design      the joint servo designed on the model's inertia
-simulation        a walk in MuJoCo under the 500 Hz servo and the 100 Hz host over the link
 posture           a reactive host: the trunk's pose from MoCap fed back into the set-points
+simulation        a walk in MuJoCo under the 500 Hz servo and the 100 Hz host over the link
 imu               the body's IMU: gyro and accelerometer readings, gyro integration
 mocap             the Vicon markers a trial reports, and the body pose fitted back from them
 state_estimation  MoCap and IMU fused into the body state; its errors
@@ -24,7 +24,7 @@ from .support import SupportPolygonError, stability_margin, stability_margins, s
 from .gait_schedule import GaitSchedule, crawl_gait, trot_gait
 from .gait import WalkPlan, walking_plan
 from .servo_design import SERVO_BANDWIDTH, link_inertias, littledog_servo_gains, servo_inertia
-from .posture import POSTURE_AXES, PostureFeedback, PostureLoop, delay_gain_limit
+from .posture import POSTURE_AXES, PostureFeedback, delay_gain_limit
 from .simulation import LoopSettings, SensorSettings, TrialOutcome, simulate_walk
 from .imu import ImuReadings, integrate_gyro, simulate_imu
 from .mocap import MocapFrames, MocapPoses, TooFewMarkersError, fit_marker_pose, mocap_body_poses, simulate_mocap
@@ -40,7 +40,7 @@ __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSETS", "HIP_POSITIONS", "JOINT_LIMITS
            "locate_terrain", "step_terrain", "terrain_transform", "SupportPolygonError", "stability_margin",
            "stability_margins", "support_polygon", "GaitSchedule", "crawl_gait", "trot_gait", "WalkPlan",
            "walking_plan", "SERVO_BANDWIDTH", "link_inertias", "littledog_servo_gains", "servo_inertia",
-           "POSTURE_AXES", "PostureFeedback", "PostureLoop", "delay_gain_limit", "LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "ImuReadings", "integrate_gyro",
+           "POSTURE_AXES", "PostureFeedback", "delay_gain_limit", "LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "ImuReadings", "integrate_gyro",
            "simulate_imu", "MocapFrames", "MocapPoses", "TooFewMarkersError", "fit_marker_pose", "mocap_body_poses",
            "simulate_mocap", "BodyState", "fuse_body_state", "orientation_errors", "position_errors", "EventScore",
            "contact_events", "detect_contacts", "event_precision_recall", "score_events", "LOG_LAYOUT", "TrialLog",

@@ -308,7 +308,7 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     the board. A swing is carried: straight up to ``step_height`` above the highest of its start,
     its end and the boards along its way, across, and straight down, each move quintic
     rest-to-rest and timed by its length (the blended :func:`swing_trajectory`, tracked with the
-    servos' lag, caught risers with the foot still low: measured on LittleDog). The body stays
+    servos' lag, caught risers with the foot still low: measured in the MuJoCo simulation). The body stays
     level, ``body_height`` above the lowest terrain height under the four footholds (a leg on a
     board bends more; none stretches further than on the flat), and moves to each new one while
     the feet that change it swing (quintic rest-to-rest again, so it stays C2). The final stance is

@@ -10,7 +10,7 @@ IK assumes:
 
 and the set-points are the IK of the planned feet seen from the body pose
 ``p_plan - u_p``, ``R_plan exp(-u_r)``. With the feet on the ground, legs solved for a body that is
-lower than planned push the real body up: a trunk that sags, rolls or lags is brought back to its
+higher than planned push the real body up: a trunk that sags, rolls or lags is brought back to its
 plan (the height, the balance over the support polygon, the attitude). Only the axes named in
 ``axes`` are corrected.
 
@@ -37,7 +37,7 @@ import numpy as np
 from ..geometry import so3_exp, so3_log
 from ..validation import as_int, as_positive
 
-__all__ = ["POSTURE_AXES", "PostureFeedback", "PostureLoop", "delay_gain_limit"]
+__all__ = ["POSTURE_AXES", "PostureFeedback", "delay_gain_limit"]
 
 POSTURE_AXES = ("x", "y", "z", "roll", "pitch", "yaw")
 """The six axes of the trunk's pose: world position, then rotation about the body's x, y, z."""
@@ -110,13 +110,16 @@ class PostureFeedback:
         as_positive(self.limit[0], "limit[0] (m)")
         as_positive(self.limit[1], "limit[1] (rad)")
 
-    def start(self, dt: float) -> "PostureLoop":
-        """A fresh loop state for a walk whose host runs every ``dt`` seconds."""
-        return PostureLoop(self, as_positive(dt, "dt"))
+    def start(self, dt: float) -> "_PostureLoop":
+        """A fresh loop state for a walk whose host runs every ``dt`` seconds (> 0): an object with
+        ``command(T_plan, T_est)`` (the body pose the IK should assume this cycle; ``T_est`` None
+        when the MoCap has no pose) and ``u``, the correction so far (:data:`POSTURE_AXES` order)."""
+        return _PostureLoop(self, as_positive(dt, "dt"))
 
 
-class PostureLoop:
-    """One walk's running correction of :class:`PostureFeedback` (create with ``feedback.start(dt)``).
+class _PostureLoop:
+    """One walk's running correction of :class:`PostureFeedback` (made by ``feedback.start(dt)``, which
+    validates; the host loop's kernel trusts its rigid (4, 4) inputs).
 
     Attributes
     ----------

@@ -41,7 +41,7 @@ from ..geometry import as_se3, fit_rigid, quat_to_matrix, se3_from_rt
 from ..validation import as_array, as_rng, as_int, as_positive
 from .gait import WalkPlan
 from .imu import simulate_imu
-from .leg_kinematics import body_ik
+from .leg_kinematics import UnreachableFootError, body_ik
 from .littledog import LEGS, MARKERS, TIMESTEP, littledog_model
 from .mocap import MocapFrames, simulate_mocap
 from .posture import PostureFeedback
@@ -198,7 +198,6 @@ class _Probes(NamedTuple):
     force_adr: list
     imu: slice
     trunk: int
-    markers: list
 
     @classmethod
     def of(cls, model: mujoco.MjModel) -> "_Probes":
@@ -207,7 +206,7 @@ class _Probes(NamedTuple):
             raise RuntimeError("the model's IMU sensors are not gyro then accelerometer")
         return cls([model.geom(f"{leg}_foot").id for leg in LEGS], [model.site(f"{leg}_foot").id for leg in LEGS],
                    [model.sensor_adr[model.sensor(f"{leg}_force").id] + 2 for leg in LEGS],
-                   slice(gyro, gyro + 6), model.body("trunk").id, [model.site(f"marker{k}").id for k in range(len(MARKERS))])
+                   slice(gyro, gyro + 6), model.body("trunk").id)
 
 
 class _Servo:
@@ -306,9 +305,11 @@ class _MocapFeed:
         self.noise = np.where(frames.visible[..., None], frames.positions - MARKERS, 0.0)
         self.positions = np.zeros_like(self.noise)
 
-    def see(self, k: int, markers: np.ndarray) -> np.ndarray | None:
-        """Frame ``k`` of markers truly at ``markers`` (M, 3): record what MoCap reports, return the fitted pose."""
+    def see(self, k: int, qpos: np.ndarray) -> np.ndarray | None:
+        """Frame ``k`` of the trunk at MuJoCo's ``qpos`` (position, quaternion first): record the markers
+        the MoCap reports, return the pose fitted to them."""
         vis = self.visible[k]
+        markers = MARKERS @ quat_to_matrix(qpos[3:7], validate=False).T + qpos[:3]   # where the log's pose puts them
         self.positions[k] = np.where(vis[:, None], markers + self.noise[k], 0.0)
         if vis.sum() < 3:
             return None
@@ -370,10 +371,12 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     Raises
     ------
     TypeError
-        If ``plan``, ``loops``, ``sensors``, ``motor`` or ``host`` is not of its class.
+        If ``plan``, ``loops``, ``sensors``, ``motor``, ``host`` or ``terrain`` is not of its class.
+    UnreachableFootError
+        (A ``ValueError``) if the plan asks for feet out of reach.
     ValueError
-        If the plan's times are not even steps of whole physics steps, its arrays disagree in
-        length, or it asks for feet out of reach.
+        If the plan's times are not even steps of whole physics steps or its arrays disagree in
+        length.
 
     Notes
     -----
@@ -401,7 +404,7 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     servo_steps = int(round(1.0 / (loops.servo_rate * TIMESTEP)))
     q_cmd, ok = body_ik(plan.feet_world, plan.T_world_body, validate=False)
     if not ok.all():
-        raise ValueError(f"plan: {int((~ok).sum())} host cycles ask for feet out of reach (first at "
+        raise UnreachableFootError(f"plan: {int((~ok).sum())} host cycles ask for feet out of reach (first at "
                          f"t = {plan.t[~ok][0]:.2f} s)")
     model = littledog_model(motor=motor, terrain=terrain)
     data = _place(model, plan.T_world_body[0], q_cmd[0])
@@ -412,7 +415,7 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     servo = _Servo(q_cmd[0], data.qpos[7:], gains, servo_steps * TIMESTEP, motor, -(-n * host_steps // servo_steps))
     rec = empty_streams(n, 1.0 / host_dt)
     rec["t"][:] = plan.t
-    feed = None if host is None else _MocapFeed(n, sensors, gen.spawn(1)[0])
+    feed = None if host is None else _MocapFeed(n, sensors, gen.spawn(1)[0])     # numpy >= 1.25
     posture = None if host is None else host.start(host_dt)
     imu_true, imu_sum = np.zeros((n, 6)), data.sensordata[probes.imu] * host_steps
     fell, rows = False, n
@@ -421,11 +424,12 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
         # host cycle: snapshot of the state and sensors, then the next set-point goes out
         _snapshot(rec, k, model, data, probes, servo)
         imu_true[k], imu_sum = imu_sum / host_steps, np.zeros(6)          # the IMU's average over the period
+        seen = None if feed is None else feed.see(k, data.qpos)          # every logged row has its MoCap frame
         if data.qpos[2] < FALL_HEIGHT or _tipped(data.qpos[3:7]):
             fell, rows = True, k + 1
             break
         if posture is not None:      # a reactive host: the IK from the plan's body corrected by what MoCap sees
-            T_cmd = posture.command(plan.T_world_body[k], feed.see(k, data.site_xpos[probes.markers]))
+            T_cmd = posture.command(plan.T_world_body[k], seen)
             q, ok = body_ik(plan.feet_world[k], T_cmd, validate=False)
             q_cmd[k] = q[0] if ok[0] else q_cmd[max(k - 1, 0)]
         channel.send(now, q_cmd[k])
@@ -442,7 +446,8 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
     meta = trial_meta(gait=plan.gait, host_rate=1.0 / host_dt, servo_rate=loops.servo_rate,
                       link_latency=loops.latency, link_jitter=loops.jitter, link_loss=loops.loss, seed=seed,
                       notes="simulated in MuJoCo by robokit.legged.simulate_walk", kp=servo.kp, kd=servo.kd,
-                      **({} if terrain is None else {"terrain": asdict(terrain)}))
+                      **({} if terrain is None else {"terrain": asdict(terrain)}),
+                      **({} if host is None else {"host": asdict(host)}))
     heading = plan.T_world_body[-1, :3, 3] - plan.T_world_body[0, :3, 3]
     heading = heading / max(np.linalg.norm(heading), 1e-12)
     distance = float((streams["body_pos"][-1] - streams["body_pos"][0]) @ heading)

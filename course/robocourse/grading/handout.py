@@ -67,11 +67,16 @@ def _student_readme(readme: str) -> str:
 
 
 def _student_environment(text: str) -> str:
-    """environment.yml without its block of the developers' extra (tests, peers, benchmarks)."""
-    match = re.search(r"^  # robokit's dev extra\n(?:  - (?!pip:).*\n)+", text, re.M)
-    if match is None:
-        raise ValueError("environment.yml: expected a '# robokit's dev extra' block to leave out of the handout")
-    return text[:match.start()] + text[match.end():]
+    """environment.yml without its blocks of the developers' extra (tests, peers, benchmarks) and of the
+    opt-in GPL-3 ``cholmod`` extra (a student who wants it installs ``robokit[cholmod]``)."""
+    for extra, required in (("dev", True), ("cholmod", False)):
+        match = re.search(rf"^  # robokit's {extra} extra.*\n(?:  - (?!pip:).*\n)+", text, re.M)
+        if match is None:
+            if required:
+                raise ValueError(f"environment.yml: expected a '# robokit's {extra} extra' block to leave out of the handout")
+            continue
+        text = text[:match.start()] + text[match.end():]
+    return text
 
 
 def _tracked(root: Path) -> set[str] | None:

@@ -45,7 +45,7 @@ from robokit.progress import progress_bar
 from robokit.validation import as_array, as_callable, as_int, as_positive, describe
 from robokit.legged.gait import WalkPlan, walking_plan
 from robokit.legged.gait_schedule import crawl_gait, trot_gait
-from robokit.legged.littledog import GUIDE, MARKERS, STANCE_FEET, STANDING_HEIGHT, TOTAL_MASS
+from robokit.legged.littledog import GUIDE, MARKERS, STANCE_FEET, STANDING_HEIGHT, TIMESTEP, TOTAL_MASS
 from robokit.legged.mocap import mocap_body_poses
 from robokit.legged.posture import PostureFeedback, delay_gain_limit
 from robokit.legged.power import battery_energy, cost_of_transport, endurance
@@ -224,15 +224,22 @@ def host_lag(step: float = 0.005, *, latency: float = 0.0, dt: float = 0.01) -> 
     Parameters
     ----------
     step : float, default 0.005
-        Height step (m, > 0, at most 0.02).
+        Height step (m, 0.001 to 0.02: well above the servo's resolution, within the legs' reach).
     latency : float, default 0
-        One-way link delay (s).
+        One-way link delay (s, 0 to 20 host periods: the trunk is watched for 40).
     dt : float, default 0.01
-        Host period (s).
+        Host period (s): a whole number of 1 ms physics steps, at most 0.05.
 
     Returns
     -------
     HostLag
+
+    Raises
+    ------
+    ValueError
+        For values outside the ranges above.
+    RuntimeError
+        If the trunk never gets half-way within the 40 host periods it is watched.
 
     Examples
     --------
@@ -241,11 +248,15 @@ def host_lag(step: float = 0.005, *, latency: float = 0.0, dt: float = 0.01) -> 
     True
     """
     step = as_positive(step, "step")
-    if step > 0.02:
-        raise ValueError(f"step: expected at most 0.02 m (the legs' reach), got {step}")
-    LoopSettings(latency=latency)                          # refuses a bad latency by name
+    if not 0.001 <= step <= 0.02:
+        raise ValueError(f"step: expected 0.001 to 0.02 m, got {step}")
     dt = as_positive(dt, "dt")
+    if dt > 0.05 or abs(dt / TIMESTEP - round(dt / TIMESTEP)) > 1e-9:
+        raise ValueError(f"dt: expected a whole number of 1 ms physics steps, at most 0.05 s, got {dt}")
     before, after = 20, 40
+    latency = as_positive(latency, "latency", allow_zero=True)
+    if latency > after / 2 * dt:
+        raise ValueError(f"latency: expected at most {after // 2} host periods ({after / 2 * dt:g} s), got {latency}")
     n = before + after
     T = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
     T[:, 2, 3] = STANDING_HEIGHT + np.where(np.arange(n) >= before, step, 0.0)
@@ -253,6 +264,8 @@ def host_lag(step: float = 0.005, *, latency: float = 0.0, dt: float = 0.01) -> 
     plan = WalkPlan(np.arange(n) * dt, T, feet, np.ones((n, 4), bool), np.zeros(n), "stand")
     z = simulate_walk(plan, LoopSettings(latency=latency), rng=0).log.body_pos[:, 2]
     response = (z[before:] - z[before - 1]) / step
+    if not np.any(response >= 0.5):
+        raise RuntimeError(f"the trunk did not get half-way up a {step} m step within {after} host periods")
     k = int(np.argmax(response >= 0.5))
     half = k - 1 + (0.5 - response[k - 1]) / (response[k] - response[k - 1]) if k > 0 else 0.0
     return HostLag(np.arange(after), response, float(half))

@@ -35,6 +35,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+import mujoco
 import numpy as np
 
 from robocourse import FAST
@@ -43,6 +44,7 @@ from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
 from robokit.geometry import quat_to_matrix, wrap_angle
 from robokit.legged.gait import walking_plan
 from robokit.legged.gait_schedule import crawl_gait, trot_gait
+from robokit.legged.leg_kinematics import UnreachableFootError
 from robokit.legged.mocap import simulate_mocap
 from robokit.legged.posture import PostureFeedback
 from robokit.legged.simulation import SensorSettings, simulate_walk
@@ -110,7 +112,7 @@ def _trial(shared: tuple, task: tuple) -> tuple:
     plan = walking_plan(_gait(gait), distance, terrain=known)
     try:
         out = simulate_walk(plan, terrain=None if mode == "flat" else true, host=host, rng=seed)
-    except ValueError:              # the host refuses a plan whose feet are out of reach
+    except UnreachableFootError:    # the host refuses a plan whose feet are out of reach
         return 0.0, False, False, float("nan")
     return out.distance, out.fell, True, _tilt_deg(out)
 
@@ -221,7 +223,7 @@ def terrain_table(trials: int = TERRAIN_TRIALS, *, distance: float = LESSON_DIST
     workers = None if workers is None else as_int(workers, "workers", minimum=1, maximum=64)
     progress = as_callable(progress, "progress")
     meta = {"trials": trials, "distance": distance, "heights": [lo, hi], "gaits": list(gaits), "modes": list(modes),
-            "seed": seed, "code": code_version_of(__name__)}
+            "seed": seed, "code": code_version_of(__name__), "mujoco": mujoco.__version__}
     target = cache_dir("littledog") / f"terrain-{cache_key(**meta)}.npz"
     data = read_arrays(target, _ARRAYS, meta)
     if data is None:
