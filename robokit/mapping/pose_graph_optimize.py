@@ -105,7 +105,11 @@ def pose_graph_residuals(graph: PoseGraph, poses: Any = None) -> np.ndarray:
     [[ 0.   0.  -0.1]]
     """
     g = as_pose_graph(graph)
-    p = _poses(poses, g)
+    return _edge_errors(g, _poses(poses, g))
+
+
+def _edge_errors(g: PoseGraph, p: np.ndarray) -> np.ndarray:
+    """Kernel of :func:`pose_graph_residuals`: g2o's error of every edge at checked poses ``p``."""
     return se2_between(g.measurements, se2_between(p[g.edges[:, 0]], p[g.edges[:, 1]]))
 
 
@@ -286,9 +290,7 @@ class _NormalEquations:
 
     def residuals(self, poses: np.ndarray) -> np.ndarray:
         """Whitened errors ``L^T e`` of every edge, shape (M, 3): their squared norm is ``chi2``."""
-        g = self._graph
-        e = se2_between(g.measurements, se2_between(poses[g.edges[:, 0]], poses[g.edges[:, 1]]))
-        return (self._whiten @ e[:, :, None])[:, :, 0]
+        return (self._whiten @ _edge_errors(self._graph, poses)[:, :, None])[:, :, 0]
 
     def linearise(self, poses: np.ndarray, residuals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(values of J^T J on the pattern, J^T r)`` at ``poses``."""
