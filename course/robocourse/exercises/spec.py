@@ -19,13 +19,25 @@ from robocourse.exercises.compare import Comparison, close
 from robokit.validation import as_int, as_text
 from robocourse.exercises.plain import numeric_array, summarize, to_plain
 
-__all__ = ["Case", "Exercise", "EXERCISE_ID", "PUBLIC_SEED"]
+__all__ = ["Case", "Exercise", "EXERCISE_ID", "KINDS", "PUBLIC_SEED"]
 
 #: Seed of the public cases that ``check()`` runs in the student's notebook; grading uses the
 #: instructor's secret seed.
 PUBLIC_SEED = 2024
 #: An exercise or written-question id: the two-digit lesson number, a dot and a snake_case name.
 EXERCISE_ID = re.compile(r"^\d\d\.[a-z][a-z0-9_]*$")
+#: What an exercise asks of the student (issue 37), by name:
+#:
+#: * ``"warm-up"``: a transcription worth at most one point;
+#: * ``"transcription"``: the task (or the lesson) states the formula or the procedure and the student
+#:   codes it;
+#: * ``"derivation"``: the student works out a formula or procedure the task does not state, from a
+#:   definition or a model (IK from FK, a Jacobian, a signed distance);
+#: * ``"open"``: any method passes; graded on the outcome;
+#: * ``"loop"``: assembles a loop the lesson is about, graded on the outcome over hidden seeded runs.
+KINDS = ("warm-up", "transcription", "derivation", "open", "loop")
+#: The most a warm-up is worth.
+WARM_UP_POINTS = 1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -116,6 +128,9 @@ class Exercise:
         ``compare(expected, got) -> None | message``; defaults to :func:`~robocourse.exercises.compare.close`.
     description : str
         One sentence for the instructor's overview.
+    kind : str, default "transcription"
+        What the exercise asks, one of :data:`KINDS`; a warm-up is worth at most one point. The
+        default is the weakest claim, so an exercise nobody classified counts as a transcription.
     shortcuts : dict of str to callable
         Known ways to pass some cases without solving the exercise, by name (e.g. ``"the heaviest
         particle, repeated"``): functions of a case's inputs. With the constants and the other
@@ -124,16 +139,17 @@ class Exercise:
     Raises
     ------
     ValueError
-        For a malformed ``id``, a ``function`` that is not an identifier, non-positive ``points`` or
-        ``shortcuts`` that are not named functions.
+        For a malformed ``id``, a ``function`` that is not an identifier, non-positive ``points``,
+        ``shortcuts`` that are not named functions, a ``kind`` not in :data:`KINDS` or a warm-up worth
+        more than one point.
 
     Examples
     --------
     >>> ex = Exercise(id="00.double", function="double", signature="double(x: float) -> float",
     ...               points=1, cases=lambda rng: [Case((float(rng.integers(10)),))],
     ...               answer=lambda x: 2 * x)
-    >>> ex.lesson, len(ex.make_cases(2024))
-    ('00', 1)
+    >>> ex.lesson, len(ex.make_cases(2024)), ex.kind
+    ('00', 1, 'transcription')
     """
 
     id: str
@@ -144,6 +160,7 @@ class Exercise:
     answer: Callable[..., Any]
     compare: Comparison = dataclasses.field(default_factory=close)
     description: str = ""
+    kind: str = "transcription"
     shortcuts: Mapping[str, Callable[..., Any]] = dataclasses.field(default_factory=dict, hash=False, compare=False)
 
     def __post_init__(self):
@@ -155,6 +172,11 @@ class Exercise:
             raise ValueError(f"points: expected a positive number, got {self.points!r}")
         if not all(isinstance(k, str) and callable(f) for k, f in dict(self.shortcuts).items()):
             raise ValueError("shortcuts: expected a dict of names to functions")
+        if self.kind not in KINDS:
+            raise ValueError(f"kind: expected one of {list(KINDS)}, got {self.kind!r}")
+        if self.kind == "warm-up" and self.points > WARM_UP_POINTS:
+            raise ValueError(f"kind: a warm-up is worth at most {WARM_UP_POINTS} point, got {self.points!r} points; "
+                             "call it a transcription (or make it ask more)")
         object.__setattr__(self, "shortcuts", dict(self.shortcuts))
 
     @property

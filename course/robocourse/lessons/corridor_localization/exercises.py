@@ -352,6 +352,7 @@ EXERCISES = [
         id="03.width_case", function="width_case",
         signature="width_case(d_l, d_r, width, recess=0.07, tol=0.03) -> str or None",
         points=1, cases=_width_cases, answer=width_condition, compare=exact(),
+        kind="warm-up",
         description="Which of Eqs. (1), (2), (3) the wall distances satisfy ('corridor', 'facing doors', "
                     "'staggered doors'; the one with the smallest error), or None; ValueError for a negative "
                     "distance."),
@@ -359,24 +360,28 @@ EXERCISES = [
         id="03.invalid_areas", function="invalid_areas",
         signature="invalid_areas(ranges: (B,), angles: (B,) increasing in [0, 2 pi)) -> numpy.ndarray (K, 3)",
         points=2, cases=_invalid_cases, answer=invalid_areas, compare=close(rtol=1e-9, atol=1e-9),
+        kind="derivation",
         description="Eq. (9): (first angle, last angle, theta_null) of each run of invalid (inf) returns, a run "
                     "wrapping past the last beam counted once, rows ordered by first angle; ValueError for NaN."),
     Exercise(
         id="03.cell_log_odds", function="cell_log_odds",
         signature="cell_log_odds(probabilities: (T,), prior=0.5) -> float",
         points=1, cases=_log_odds_cases, answer=cell_log_odds, compare=close(rtol=1e-9, atol=1e-12),
+        kind="warm-up",
         description="Thrun et al. Table 9.1 line 4 for one cell over a sequence of readings (no clamping); "
                     "ValueError for a reading of 0 or 1."),
     Exercise(
         id="03.bow_similarity", function="bow_similarity",
         signature="bow_similarity(words_a: list of int, words_b: list of int, idf: (m,)) -> float",
         points=2, cases=_bow_cases, answer=bow_similarity, compare=close(rtol=1e-9, atol=1e-12),
+        kind="transcription",
         description="TF-IDF vectors, Eq. (16), of two images' words, then the L1 score, Eq. (17); ValueError for "
                     "a word outside the vocabulary."),
     Exercise(
         id="03.resample_indices", function="resample_indices",
         signature="resample_indices(weights: (M,), r: float in [0, 1/M)) -> list of int",
         points=1, cases=_resample_cases, answer=resample_indices, compare=exact(),
+        kind="warm-up",
         description="Thrun et al. Table 4.4 with its random number given (weights normalised first); "
                     "ValueError for r outside [0, 1/M) or a negative weight.",
         shortcuts={"the heaviest particle, repeated": _heaviest_repeated}),
@@ -385,17 +390,20 @@ EXERCISES = [
         signature="likelihood_field_weight(pose, ranges, angles, distance: (H, W), resolution, origin, "
                   "sigma_hit=0.2, z_hit=0.95, z_rand=0.05, r_max=8.0, max_distance=2.0) -> float",
         points=2, cases=_field_cases, answer=likelihood_field_weight, compare=close(rtol=1e-7, atol=1e-9),
+        kind="transcription",
         description="The log of Thrun et al. Table 6.3's q for one pose (end points looked up in the distance "
                     "grid, max_distance off it, inf returns skipped); ValueError for NaN ranges."),
     Exercise(
         id="03.ellipse_start_weights", function="ellipse_start_weights",
         signature="ellipse_start_weights(points: (N, 2), centre: (2,), sigma_x, sigma_y) -> numpy.ndarray (N,)",
         points=1, cases=_ellipse_cases, answer=ellipse_start_weights, compare=close(rtol=1e-9, atol=1e-12),
+        kind="warm-up",
         description="Eq. (19), unnormalised; ValueError for a non-positive sigma."),
     Exercise(
         id="03.recognise_keyframe", function="recognise_keyframe",
         signature="recognise_keyframe(query: (N, 32) uint8, keyframes: list of (M_k, 32) uint8) -> int",
         points=3, cases=_keyframe_cases, answer=recognise_keyframe, compare=exact(),
+        kind="open",
         description="Open: the index of the keyframe the query was taken at, by any method; ValueError for no "
                     "keyframes."),
 ]

@@ -45,6 +45,7 @@ EXERCISES = [
         cases=_wrap_cases,
         answer=wrap_angle,
         compare=close(rtol=0, atol=1e-9),
+        kind="warm-up",
         description="Wrap angles in radians to [-pi, pi); raise ValueError on NaN.",
     ),
     Exercise(
@@ -55,6 +56,7 @@ EXERCISES = [
         cases=_compose_cases,
         answer=se2_compose,
         compare=close(rtol=0, atol=1e-9),
+        kind="transcription",
         description="Compose planar poses [x, y, theta]; raise ValueError on a wrong shape.",
     ),
 ]

@@ -240,6 +240,7 @@ EXERCISES = [
         cases=_checksum_cases,
         answer=nmea_checksum,
         compare=exact(),
+        kind="warm-up",
         description="XOR of the characters between '$' and '*' as two upper-case hex digits.",
     ),
     Exercise(
@@ -250,6 +251,7 @@ EXERCISES = [
         cases=_position_cases,
         answer=fix_position,
         compare=close(rtol=0, atol=1e-9),
+        kind="transcription",
         description="[lat, lon] in degrees from an RMC or GGA sentence; ValueError on bad input.",
     ),
     Exercise(
@@ -260,6 +262,7 @@ EXERCISES = [
         cases=_haversine_cases,
         answer=haversine_distance_bearing,
         compare=close(rtol=1e-9, atol=1e-6),
+        kind="transcription",
         description="Great-circle distance (mean radius) and initial bearing in [0, 2 pi).",
     ),
     Exercise(
@@ -270,6 +273,7 @@ EXERCISES = [
         cases=_pulse_cases,
         answer=pulse_width_to_cm_inches,
         compare=close(rtol=1e-9, atol=1e-9),
+        kind="warm-up",
         description="LV-MaxSonar-EZ pulse width (147 us per inch) to inches and centimetres.",
     ),
     Exercise(
@@ -280,6 +284,7 @@ EXERCISES = [
         cases=_avoid_cases,
         answer=avoidance_decision,
         compare=exact(),
+        kind="transcription",
         description="'forward', 'left' or 'right' from the four sonar ranges.",
     ),
     Exercise(
@@ -290,6 +295,7 @@ EXERCISES = [
         cases=_gains_cases,
         answer=design_heading_gains,
         compare=close(rtol=1e-6, atol=1e-9),
+        kind="derivation",
         description="Rate-feedback gains that place the closed-loop poles for an overshoot/settling spec.",
     ),
     Exercise(
@@ -300,6 +306,7 @@ EXERCISES = [
         cases=_bias_cases,
         answer=compass_bias,
         compare=close(rtol=0, atol=1.0),
+        kind="open",
         description="Open: a compass's constant error from a straight GPS drive, by any method, within 1 degree.",
     ),
 ]

@@ -368,30 +368,35 @@ EXERCISES = [
     Exercise(
         id="04.leg_fk", function="leg_fk", signature="leg_fk(q_leg: [q1, q2, q3], leg: 'FL'|'FR'|'HL'|'HR') -> [x, y, z]",
         points=1, cases=_fk_cases, answer=foot_position, compare=close(rtol=0, atol=1e-9),
+        kind="warm-up",
         description="The foot centre in the body frame from the leg's hip roll, hip pitch and knee (m); "
                     "ValueError for a wrong number of angles or an unknown leg."),
     Exercise(
         id="04.leg_ik", function="leg_ik",
         signature="leg_ik(p_foot: [x, y, z], leg: str, branch: -1|+1) -> [q1, q2, q3]",
         points=2, cases=_ik_cases, answer=leg_ik, compare=close(rtol=0, atol=1e-7),
+        kind="derivation",
         description="Closed-form IK: the roll root with the foot below the hip, the knee on the given branch, "
                     "angles in (-pi, pi]; ValueError for an unreachable target or a bad branch."),
     Exercise(
         id="04.stability_margin", function="stability_margin",
         signature="stability_margin(feet_xy: (k, 2), com_xy: (2,)) -> float",
         points=1, cases=_margin_cases, answer=stability_margin, compare=close(rtol=1e-9, atol=1e-12),
+        kind="derivation",
         description="McGhee & Frank's margin, signed: distance to the support polygon's boundary, negative "
                     "outside; ValueError for fewer than three feet."),
     Exercise(
         id="04.pd_servo_step", function="pd_servo_step",
         signature="pd_servo_step(q_ref, q, q_prev, kp, kd, dt, voltage_max) -> list of voltages",
         points=1, cases=_servo_cases, answer=pd_servo_step, compare=close(rtol=1e-9, atol=1e-9),
+        kind="warm-up",
         description="One 500 Hz servo tick, V = kp (q_ref - q) - kd (q - q_prev) / dt clipped at +-voltage_max; "
                     "ValueError for a NaN set-point."),
     Exercise(
         id="04.marker_fit", function="marker_fit",
         signature="marker_fit(markers_body: (M, 3), observed: (M, 3), visible: (M,) bool) -> 4x4 list",
         points=2, cases=_fit_cases, answer=fit_marker_pose, compare=_same_rigid_fit,
+        kind="open",
         description="Open: T_world_body minimising the squared distances of the visible markers, by any method "
                     "(SVD, quaternions, least squares); ValueError for fewer than three visible markers."),
     Exercise(
@@ -400,6 +405,7 @@ EXERCISES = [
                   "-> 4 lists of sample indices",
         points=2, cases=_touchdown_cases, answer=detect_touchdowns, compare=_touchdowns_found,
         shortcuts=TOUCHDOWN_SHORTCUTS,
+        kind="open",
         description="Open: the four feet's touchdowns in a simulated crawl from the lower-leg forces and the plan's "
                     "stance, graded against MuJoCo's true contacts; precision and recall within 5 samples over "
                     "the legs must both reach 0.9; ValueError for NaN, shapes that differ or are not (N, 4), "
@@ -408,6 +414,7 @@ EXERCISES = [
         id="04.battery_endurance", function="battery_endurance",
         signature="battery_endurance(capacity_ah, voltage, mean_power_w) -> minutes",
         points=1, cases=_endurance_cases, answer=battery_endurance, compare=close(rtol=1e-9, atol=1e-12),
+        kind="warm-up",
         description="Minutes of running: capacity x 3600 x voltage / power / 60; ValueError for non-positive "
                     "inputs."),
 ]

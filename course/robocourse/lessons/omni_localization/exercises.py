@@ -322,6 +322,7 @@ EXERCISES = [
         id="02.rgb_to_hsi", function="rgb_to_hsi",
         signature="rgb_to_hsi(pixels: (N, 3) floats in [0, 1]) -> numpy.ndarray (N, 3)  # [H, S, I]",
         points=1, cases=_rgb_cases, answer=rgb_to_hsi, compare=close(rtol=1e-5, atol=1e-5),
+        kind="warm-up",
         description="The paper's Eq. (4): H in [0, 2 pi) (2 pi - theta when B > G), S = max - min, I = mean; "
                     "H = 0 where R = G = B; ValueError for a wrong shape, NaN or values outside [0, 1]."),
     Exercise(
@@ -329,12 +330,14 @@ EXERCISES = [
         signature="hue_histogram(image: (H, W, 3) floats, bins=32, min_saturation=0.15, min_intensity=0.04, "
                   "max_intensity=0.98) -> numpy.ndarray (bins,)",
         points=2, cases=_histogram_cases, answer=hue_histogram, compare=close(rtol=1e-9, atol=1e-12),
+        kind="transcription",
         description="Normalised histogram of the hue of pixels with S >= min_saturation and min_intensity <= I "
                     "<= max_intensity; all zeros when none qualifies; ValueError for bins < 1 or a bad image."),
     Exercise(
         id="02.histogram_distance", function="histogram_distance",
         signature="histogram_distance(h: (m,), H: (m,) or (n, m)) -> float or numpy.ndarray (n,)",
         points=1, cases=_distance_cases, answer=histogram_distance, compare=close(rtol=1e-9, atol=1e-12),
+        kind="warm-up",
         description="The paper's Eq. (5), the Euclidean distance, against one histogram or each row of a stack; "
                     "ValueError for different bin counts."),
     Exercise(
@@ -342,6 +345,7 @@ EXERCISES = [
         signature="fine_stage_counts(query: (N, D), node_descriptors: list of (M_k, D), candidates: list of int, "
                   "ratio=0.8) -> numpy.ndarray of int",
         points=2, cases=_fine_cases, answer=fine_stage_counts, compare=exact(),
+        kind="transcription",
         description="For each candidate node, how many query descriptors pass the nearest/second-nearest "
                     "distance-ratio test against that node's descriptors (the fine stage); ValueError for an "
                     "unknown candidate or descriptors of different lengths."),
@@ -350,17 +354,20 @@ EXERCISES = [
         signature="relax_sweep(poses: (N, 3), variances: (N,), edges: (M, 2), measurements: (M, 3), "
                   "edge_variances: (M,), fixed=0) -> (poses (N, 3), variances (N,))",
         points=3, cases=_relax_cases, answer=relax_sweep, compare=close(rtol=1e-7, atol=1e-9),
+        kind="transcription",
         description="One sweep of the paper's Eqs. (1)-(3) (Jacobi: every node from the input values), the "
                     "fixed node unchanged; ValueError for a negative variance or an edge to a missing node."),
     Exercise(
         id="02.path_following_command", function="path_following_command",
         signature="path_following_command(d, theta_tilde, curvature, v, k2, k3) -> float  # omega",
         points=1, cases=_command_cases, answer=path_following_command, compare=close(rtol=1e-9, atol=1e-12),
+        kind="warm-up",
         description="The paper's Eq. (8); ValueError for negative gains or 1 - c d <= 0."),
     Exercise(
         id="02.ekf_update", function="ekf_update",
         signature="ekf_update(x: (n,), P: (n, n), z: (m,), H: (m, n), R: (m, m), angles=()) -> (x, P)",
         points=2, cases=_ekf_cases, answer=ekf_update, compare=close(rtol=1e-7, atol=1e-10),
+        kind="transcription",
         description="Kalman update with the innovation's angle components wrapped and the Joseph-form "
                     "covariance; ValueError for a covariance that is not positive definite or shapes that "
                     "disagree."),
@@ -368,6 +375,7 @@ EXERCISES = [
         id="02.recognise_node", function="recognise_node",
         signature="recognise_node(query_histogram, query_descriptors, node_histograms, node_descriptors) -> int",
         points=3, cases=_recognise_cases, answer=recognise_node, compare=exact(),
+        kind="open",
         description="Open: the index of the node the query was taken at, by any method; ValueError for a map "
                     "with no nodes."),
 ]

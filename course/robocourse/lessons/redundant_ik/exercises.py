@@ -265,6 +265,7 @@ EXERCISES = [
         cases=_dh_cases,
         answer=dh_transform,
         compare=close(rtol=0, atol=1e-9),
+        kind="warm-up",
         description="Standard DH link transform Rz(theta) Tz(d) Tx(a) Rx(alpha), 4x4; ValueError on NaN.",
     ),
     Exercise(
@@ -275,6 +276,7 @@ EXERCISES = [
         cases=_fk_cases,
         answer=dh_fk,
         compare=close(rtol=0, atol=1e-9),
+        kind="warm-up",
         description=("Flange pose (4x4) of a standard-DH chain with rows [d, a, alpha]; "
                      "ValueError on a length mismatch."),
     ),
@@ -286,6 +288,7 @@ EXERCISES = [
         cases=_jacobian_cases,
         answer=dh_jacobian,
         compare=close(rtol=0, atol=1e-9),
+        kind="transcription",
         description="6 x n geometric Jacobian [v; omega] in the base frame; ValueError on a length mismatch.",
     ),
     Exercise(
@@ -296,6 +299,7 @@ EXERCISES = [
         cases=_wrist_cases,
         answer=wrist_centre,
         compare=close(rtol=0, atol=1e-9),
+        kind="warm-up",
         description="W = p - d_wf * z of the target pose; ValueError if T is not SE(3).",
     ),
     Exercise(
@@ -306,6 +310,7 @@ EXERCISES = [
         cases=_elbow_cases,
         answer=elbow_angle,
         compare=close(rtol=0, atol=1e-7),
+        kind="warm-up",
         description="Elbow joint q4 >= 0 by the law of cosines; ValueError when the wrist is out of reach.",
     ),
     Exercise(
@@ -317,6 +322,7 @@ EXERCISES = [
         cases=_shoulder_cases,
         answer=shoulder_angles,
         compare=close(rtol=0, atol=1e-7),
+        kind="transcription",
         description="(q1, q2 >= 0, q3) of the iiwa for arm angle psi; ValueError on NaN.",
     ),
     Exercise(
@@ -328,6 +334,7 @@ EXERCISES = [
         cases=_null_space_cases,
         answer=null_space_step,
         compare=close(rtol=1e-6, atol=1e-9),
+        kind="transcription",
         description="DLS step plus the gradient projected into the null space; ValueError on a bad Jacobian shape.",
     ),
     Exercise(
@@ -338,6 +345,7 @@ EXERCISES = [
         cases=_solve_ik_cases,
         answer=solve_ik,
         compare=_reaches_target,
+        kind="open",
         description=("Open: iiwa joints inside the limits reaching T to 1e-6 m and rad, any method; "
                      "ValueError when no posture inside the limits reaches it (out of reach, or no arm angle)."),
     ),

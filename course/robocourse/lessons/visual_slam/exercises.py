@@ -314,12 +314,14 @@ EXERCISES = [
         id="01.junction_strength", function="junction_strength",
         signature="junction_strength(tensor: array (..., 2, 2)) -> numpy.ndarray (...)", points=1,
         cases=_junction_cases, answer=junction_strength, compare=close(rtol=1e-6, atol=1e-9),
+        kind="warm-up",
         description="The smaller eigenvalue lambda_2 of each symmetric 2 x 2 tensor (Lin et al. Sec. 2.i); "
                     "ValueError unless the last two axes are 2 x 2."),
     Exercise(
         id="01.match_ratio", function="match_ratio",
         signature="match_ratio(query: (N, D), train: (M, D), ratio: float = 0.65) -> numpy.ndarray (K, 2) of int",
         points=2, cases=_ratio_cases, answer=match_ratio, compare=unordered_rows(atol=0),
+        kind="transcription",
         description="Pairs [query_row, train_row] whose nearest / second-nearest Euclidean distance ratio is below "
                     "`ratio` (Lin et al. Sec. 3); (0, 2) when train has fewer than two rows; ValueError for "
                     "different descriptor lengths or a ratio outside (0, 1]."),
@@ -327,12 +329,14 @@ EXERCISES = [
         id="01.triangulate_svd", function="triangulate_svd",
         signature="triangulate_svd(p_left: (3, 4), p_right: (3, 4), uv_left: (N, 2), uv_right: (N, 2)) -> (N, 3)",
         points=2, cases=_triangulate_cases, answer=triangulate_svd, compare=close(rtol=1e-6, atol=1e-7),
+        kind="transcription",
         description="Linear triangulation: the right singular vector of the 4 x 4 system (Lin et al. Sec. 3); "
                     "ValueError for wrong shapes."),
     Exercise(
         id="01.stereo_point", function="stereo_point",
         signature="stereo_point(c, r, d, focal, c0, r0, baseline) -> (points (N, 3), covariances (N, 3, 3))",
         points=2, cases=_stereo_cases, answer=stereo_point, compare=close(rtol=1e-6, atol=1e-9),
+        kind="derivation",
         description="X = (c - c0) I / d, Y = (r0 - r) I / d, Z = f I / d and the first-order covariance with "
                     "sigma_c = sigma_r = sigma_d = 1 px (Se et al. Sec. 3.1); ValueError for d <= 0 or "
                     "arrays of different lengths."),
@@ -340,18 +344,21 @@ EXERCISES = [
         id="01.ransac_sample_count", function="ransac_sample_count",
         signature="ransac_sample_count(contamination: float, sample_size: int = 2, confidence: float = 0.99) -> int",
         points=1, cases=_sample_count_cases, answer=ransac_sample_count, compare=exact(),
+        kind="warm-up",
         description="Smallest m with 1 - (1 - (1 - eps)^p)^m >= P, at least 1 (Lin et al. Sec. 7); ValueError "
                     "for eps outside [0, 1) or P outside (0, 1)."),
     Exercise(
         id="01.pose_from_two", function="pose_from_two",
         signature="pose_from_two(robot_points: (2, 3), world_points: (2, 3)) -> numpy.ndarray [p, q, theta]",
         points=2, cases=_two_point_cases, answer=pose_from_two, compare=close(rtol=1e-6, atol=1e-9),
+        kind="derivation",
         description="Heading from the direction between the two points on the ground plane (X, Z), translation "
                     "from the midpoints (Lin et al. Sec. 5); ValueError for coincident points or not 2 x 3."),
     Exercise(
         id="01.kalman_fuse", function="kalman_fuse",
         signature="kalman_fuse(s, sigma, r_new, sigma_new) -> (s_fused, sigma_fused)", points=2,
         cases=_fuse_cases, answer=kalman_fuse, compare=close(rtol=1e-6, atol=1e-9),
+        kind="transcription",
         description="Information-form fusion Sigma' = (Sigma^-1 + Sigma_new^-1)^-1, "
                     "s' = Sigma' (Sigma^-1 s + Sigma_new^-1 r_new) for one (3,) or N (N, 3) landmarks (Se et al. "
                     "Sec. 3.5); ValueError for covariances that are not symmetric positive definite."),
@@ -360,6 +367,7 @@ EXERCISES = [
         signature="hough_votes(robot_xz, robot_cov_xz, world_xz, world_cov_xz, bounds, bin_size, angle_bin) "
                   "-> numpy.ndarray (T, NX, NZ) of int",
         points=3, cases=hough_cases, answer=hough_votes, compare=close(rtol=0, atol=0),
+        kind="transcription",
         description="For each heading bin centre, each match votes for every (X, Z) bin within +-2.8 sigma of the "
                     "position (X, Z) - R(theta) (X', Z') (Se et al. Sec. 5); see the notebook for the bin layout; "
                     "ValueError for empty bounds."),
@@ -367,6 +375,7 @@ EXERCISES = [
         id="01.robust_pose", function="robust_pose",
         signature="robust_pose(robot_points: (N, 3), world_points: (N, 3)) -> numpy.ndarray [p, q, theta]",
         points=3, cases=_robust_pose_cases, answer=robust_pose, compare=_same_pose,
+        kind="open",
         description="Open: any method. The pose [p, q, theta] (theta in [-pi, pi); headings are compared modulo "
                     "2 pi) that explains the true matches, within 2 cm and 0.02 rad, when 20 to 60 % of the matches "
                     "are wrong; ValueError for fewer than two matches or unequal shapes."),
