@@ -17,7 +17,7 @@ from .egomotion import (DegenerateCorrespondenceError, EgomotionResult, Insuffic
                         pose_from_two, ransac_pose, track)
 from .hough import Hypothesis, global_localize, hough_accumulator
 from .visual_slam import FrameReport, VisualSLAM
-from .hierarchical import HierarchicalLocalizer, Localization, MODES
+from .hierarchical import HierarchicalLocalizer, Localization, MODES, TOP_K
 from .particle_filter import (ellipse_weights, kld_resample, low_variance_resample, normalise_log_weights,
                               sample_ellipse_poses, weighted_pose_mean)
 from .beam_models import likelihood_field_log_weight_readable, likelihood_field_log_weights
@@ -27,7 +27,7 @@ from .scan_matching import ScanMatch, match_scan
 
 __all__ = ["DegenerateCorrespondenceError", "EgomotionResult", "InsufficientMatchesError", "fit_pose",
            "pose_from_two", "ransac_pose", "track", "Hypothesis", "global_localize", "hough_accumulator",
-           "FrameReport", "VisualSLAM", "HierarchicalLocalizer", "Localization", "MODES", "ellipse_weights",
+           "FrameReport", "VisualSLAM", "HierarchicalLocalizer", "Localization", "MODES", "TOP_K", "ellipse_weights",
            "kld_resample", "low_variance_resample", "normalise_log_weights", "sample_ellipse_poses",
            "weighted_pose_mean", "likelihood_field_log_weight_readable", "likelihood_field_log_weights",
            "AMCL_DEFAULTS", "KLDConfig", "MCLStep", "MonteCarloLocalizer", "mcl_step", "uniform_free_poses",

@@ -35,11 +35,14 @@ import numpy as np
 from ..geometry import se2_between, se2_compose, wrap_angle
 from ..geometry.planar import intersect_lines
 from ..mapping.omni_views import OmniView, RelativePose, omni_view, relative_pose
-from ..mapping.topological import EmptyMapError, TopologicalMap
+from ..mapping.topological import EmptyMapError, OMNI_RATIO, TopologicalMap
 from ..sim.omni import OmniCamera, as_omni_camera
 from ..validation import as_choice, as_int, as_positive, describe
 
-__all__ = ["MODES", "Localization", "HierarchicalLocalizer"]
+__all__ = ["MODES", "TOP_K", "Localization", "HierarchicalLocalizer"]
+
+#: Candidates the coarse stage passes on to the fine stage, in the lesson and in its assignment alike.
+TOP_K = 5
 
 #: The three ways of localizing that the paper's Fig. 11 compares.
 MODES = ("coarse", "fine", "hierarchical")
@@ -171,8 +174,8 @@ class HierarchicalLocalizer:
     (1, True, ['coarse', 'histogram', 'matching', 'sift', 'total', 'verification'])
     """
 
-    def __init__(self, map: TopologicalMap, camera: OmniCamera, *, top_k: int = 5, max_rounds: int | None = None,
-                 ratio: float = 0.7,
+    def __init__(self, map: TopologicalMap, camera: OmniCamera, *, top_k: int = TOP_K, max_rounds: int | None = None,
+                 ratio: float = OMNI_RATIO,
                  min_matches: int = 25, ambiguity: float = 0.8, n_features: int = 500,
                  mode: str = "hierarchical", min_crossing: float = 0.26, max_range: float = 4.0) -> None:
         if not isinstance(map, TopologicalMap):

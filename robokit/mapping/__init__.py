@@ -24,7 +24,7 @@ from .relaxation import RelaxationResult, relax, relax_sweep
 from .g2o import G2OFormatError, read_g2o, write_g2o
 from .manhattan import manhattan_world_graph
 from .omni_views import OmniView, RelativePose, omni_view, relative_pose
-from .topological import EmptyMapError, LOOP_EDGE, TopologicalMap
+from .topological import EmptyMapError, LOOP_EDGE, OMNI_RATIO, TopologicalMap
 from .topological_build import build_topological_map
 from .occupancy_grid import (LikelihoodField, LOG_ODDS_MAX, LOG_ODDS_MIN, OccupancyGrid, likelihood_field, log_odds,
                              probability)
@@ -40,7 +40,8 @@ __all__ = ["LandmarkMap", "kalman_fuse", "transform_covariance", "DisconnectedGr
            "pose_graph_from_odometry", "PoseGraphResult", "optimize_pose_graph", "pose_graph_cost",
            "RelaxationResult", "relax", "relax_sweep", "G2OFormatError", "read_g2o", "write_g2o",
            "manhattan_world_graph", "OmniView", "RelativePose", "omni_view", "relative_pose", "EmptyMapError",
-           "LOOP_EDGE", "TopologicalMap", "build_topological_map", "LikelihoodField", "LOG_ODDS_MAX", "LOG_ODDS_MIN",
+           "LOOP_EDGE", "OMNI_RATIO", "TopologicalMap", "build_topological_map", "LikelihoodField", "LOG_ODDS_MAX",
+           "LOG_ODDS_MIN",
            "OccupancyGrid", "likelihood_field", "log_odds", "probability", "L_FREE", "L_OCC",
            "inverse_range_sensor_model", "occupancy_grid_mapping", "occupancy_grid_mapping_readable",
            "update_log_odds", "MapFileError", "load_map", "save_map", "EmptyScanError", "invalid_areas",

@@ -54,7 +54,7 @@ from ..geometry.planar import as_planar
 from ..validation import as_array, as_callable, as_choice, as_int, as_positive, describe
 from .omni_views import as_omni_image, omni_view, relative_pose
 from .pose_graph import position_variance
-from .topological import EmptyMapError, LOOP_EDGE, ODOMETRY_EDGE, TopologicalMap
+from .topological import EmptyMapError, LOOP_EDGE, ODOMETRY_EDGE, OMNI_RATIO, TopologicalMap
 
 __all__ = ["build_topological_map", "Comparison", "appearance_changed", "local_map_full", "select_key_frames"]
 
@@ -249,7 +249,7 @@ _COVARIANCE_FLOOR = np.diag([1e-6, 1e-6, 1e-8])   # a robot that stood still sti
 def build_topological_map(images: Any, odometry: Any, camera: OmniCamera, *, similarity: float = 0.1,
                           min_matches: int = 80, occlusion_frames: int = 3, max_features: int = 930,
                           max_variance: float = 0.1, odometry_alphas: Any = (0.01, 0.001, 0.01, 0.001),
-                          bins: int = 32, n_features: int = 500, ratio: float = 0.7, loop_closure: bool = True,
+                          bins: int = 32, n_features: int = 500, ratio: float = OMNI_RATIO, loop_closure: bool = True,
                           loop_top_k: int = 5, loop_min_matches: int = 25, loop_exclude: int = 5,
                           sigma_visual: Any = (0.05, 0.05, 0.02), index: str = "opencv",
                           progress: Callable | None = None, log: Callable | None = None) -> TopologicalMap:

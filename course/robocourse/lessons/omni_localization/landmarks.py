@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from robokit.geometry.planar import cross_rays
-from robokit.mapping import TopologicalMap
+from robokit.mapping import OMNI_RATIO, TopologicalMap
 from robokit.sim import OmniCamera
 from robokit.sim.omni import as_omni_camera
 from robokit.validation import as_positive, describe
@@ -37,7 +37,7 @@ def _world_azimuths(tmap: TopologicalMap, camera: OmniCamera, node: int, rows: n
     return tmap.poses[node, 2] + np.arctan2(body[:, 1], body[:, 0])
 
 
-def landmark_map(tmap: TopologicalMap, camera: OmniCamera, *, ratio: float = 0.7, min_angle: float = 0.26,
+def landmark_map(tmap: TopologicalMap, camera: OmniCamera, *, ratio: float = OMNI_RATIO, min_angle: float = 0.26,
                  max_range: float = 6.0) -> tuple[np.ndarray, np.ndarray]:
     """Landmark positions (x, y) from the bearings two consecutive nodes share.
 
