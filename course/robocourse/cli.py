@@ -82,6 +82,7 @@ def _cmd_grade(args: argparse.Namespace) -> int:
 
     from robocourse.grading.grader import GradingError, grade_batch, isolation_note, needs_review
     from robocourse.grading.reports import write_feedback, write_gradebook, write_gradescope
+    from robocourse.grading.rubrics import write_grading_guide
     from robocourse.grading.safetext import clean
     from robocourse.grading.sandbox import Limits
 
@@ -97,7 +98,8 @@ def _cmd_grade(args: argparse.Namespace) -> int:
     limits = Limits(wall_seconds=args.timeout, cpu_seconds=int(args.timeout),
                     memory_bytes=int(args.memory_mb) * 1024 * 1024)
     root = Path(args.root).resolve()
-    hide = [p for p in (root / "solutions", Path(args.out).resolve().parent,
+    guide = Path(args.guide) if args.guide else Path(args.out).with_name(f"{Path(args.out).stem}-guide.md")
+    hide = [p for p in (root / "solutions", Path(args.out).resolve().parent, guide.resolve().parent,
                         Path(args.feedback).resolve() if args.feedback else None, Path.home(),
                         *[Path(h).resolve() for h in args.hide]) if p]
     print(f"grading {len(args.submissions)} submission(s) of {args.assignment} with {args.jobs} job(s); "
@@ -109,6 +111,11 @@ def _cmd_grade(args: argparse.Namespace) -> int:
         return 2
     write_gradebook(results, args.out)
     print(f"gradebook: {args.out}")
+    guide, complete = write_grading_guide(args.assignment, root, guide)
+    print(f"grading guide for TAs (model answers and rubrics: keep it private): {guide}")
+    if not complete:
+        print(f"robocourse grade: no solutions/{args.assignment}.ipynb under {root}: the grading guide has no "
+              "model answers or rubrics (pass --root)", file=sys.stderr)
     if args.feedback:
         write_feedback(results, args.feedback, args.assignment)
         print(f"feedback: {args.feedback}/")
@@ -190,6 +197,8 @@ def build_parser() -> argparse.ArgumentParser:
     grade.add_argument("--seed", help="instructor's secret seed (or env ROBOKIT_GRADING_SEED)")
     grade.add_argument("--out", default="grades.csv", help="gradebook CSV (default: grades.csv)")
     grade.add_argument("--feedback", help="folder for per-student feedback (markdown)")
+    grade.add_argument("--guide", help="grading guide for TAs: exercises by kind, written questions with model "
+                                       "answers and rubrics (default: <gradebook>-guide.md beside the gradebook)")
     grade.add_argument("--jobs", type=int, default=1, help="submissions graded at once (default: 1)")
     grade.add_argument("--gradescope", help="also write Gradescope's results.json (one submission)")
     grade.add_argument("--timeout", type=float, default=300, help="seconds per submission (default: 300)")

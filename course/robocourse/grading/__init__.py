@@ -17,6 +17,7 @@ job_cgroup       a control group that bounds a job's memory, processes and CPU, 
 grader           ``robocourse grade``: cases from the secret seed, expected answers, scores, flags
 budget           the grader's reading and judging of one submission, in a child under a memory and time budget
 reports          the gradebook, feedback files and Gradescope results
+rubrics          the written questions' rubrics and the grading guide for TAs beside the gradebook
 safetext         student text escaped for feedback, CSV and Markdown
 gradescope       an autograder zip for Gradescope
 handout          ``robocourse student-kit``: the zip students get, lessons and blank assignments, no solutions

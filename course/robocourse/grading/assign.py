@@ -8,8 +8,9 @@ Conventions in ``solutions/NN_slug.ipynb`` (the single source of the assignment)
 * a check cell calls ``check("NN.name", function)``; it becomes an nbgrader *grade* cell worth
   the exercise's points (from ``robocourse.exercises``);
 * a written answer is a markdown cell with ``<!-- BEGIN SOLUTION NN.name -->`` ...
-  ``<!-- END SOLUTION -->``; the answer becomes "YOUR ANSWER HERE" and the cell a manually graded
-  nbgrader cell worth ``WRITTEN[NN.name]`` points;
+  ``<!-- END SOLUTION -->``, holding the model answer and then its rubric (:mod:`.rubrics`); the
+  whole region becomes "YOUR ANSWER HERE" and the cell a manually graded nbgrader cell worth
+  ``WRITTEN[NN.name]`` points;
 * every other cell is locked;
 * every code cell that can fail only because an exercise is still blank is tagged
   ``raises-exception`` (:func:`mark_stub_failures`): a check cell, a solution cell whose stub
@@ -40,13 +41,16 @@ from robocourse.grading.submission import SKIP_TAGS
 from robocourse.lessons import get_assignment
 from robocourse.site.hygiene import strip_notebook
 
-__all__ = ["make_assignment", "write_assignment", "mark_stub_failures", "AssignmentError", "RAISES"]
+__all__ = ["make_assignment", "write_assignment", "mark_stub_failures", "AssignmentError", "RAISES", "WRITTEN_REGION"]
 
 _BEGIN = re.compile(r"^(\s*)#+\s*BEGIN SOLUTION\s*$")
 _END = re.compile(r"^\s*#+\s*END SOLUTION\s*$")
 _CHECK = re.compile(r"""\bcheck\(\s*["'](\d\d\.[a-z][a-z0-9_]*)["']""")
 _MD_BEGIN = re.compile(r"<!--\s*BEGIN SOLUTION\s+(\d\d\.[a-z][a-z0-9_]*)\s*-->")
-_MD_REGION = re.compile(r"<!--\s*BEGIN SOLUTION\s+(\d\d\.[a-z][a-z0-9_]*)\s*-->.*?<!--\s*END SOLUTION\s*-->", re.S)
+#: A written answer's solution region in a markdown cell: group 1 the question's id, group 2 what the
+#: generator replaces (the model answer and its rubric, :mod:`.rubrics`).
+WRITTEN_REGION = re.compile(r"<!--\s*BEGIN SOLUTION\s+(\d\d\.[a-z][a-z0-9_]*)\s*-->(.*?)<!--\s*END SOLUTION\s*-->",
+                            re.S)
 _DEF = re.compile(r"^def\s+([A-Za-z_]\w*)\s*\(", re.M)
 
 
@@ -261,10 +265,10 @@ def make_assignment(solution: dict[str, Any], slug: str) -> dict[str, Any]:
             qid = _MD_BEGIN.search(src).group(1)
             if qid not in written:
                 raise AssignmentError(f"{where}: written question {qid!r} is not in WRITTEN of {slug}")
-            if not _MD_REGION.search(src):
+            if not WRITTEN_REGION.search(src):
                 raise AssignmentError(f"{where}: '<!-- BEGIN SOLUTION {qid} -->' without END")
             seen_written.add(qid)
-            cell["source"] = _MD_REGION.sub("YOUR ANSWER HERE", src)
+            cell["source"] = WRITTEN_REGION.sub("YOUR ANSWER HERE", src)
             meta["nbgrader"] = _nbgrader(qid, grade=True, solution=True, locked=False, points=float(written[qid]))
         else:
             meta["nbgrader"] = _nbgrader(f"locked-{i:02d}", grade=False, solution=False, locked=True)
