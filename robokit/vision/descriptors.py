@@ -67,20 +67,44 @@ def _gradients(space: ScaleSpace, scales, cache=None):
 def _sample(gx, gy, xy, scale, angle, half_width):
     """Sample the gradient on a rotated _GRID x _GRID grid; return (gx, gy) in the keypoint frame.
 
-    Grid sample ``s`` sits at ``(u, v) = _grid()[s]`` in [-1, 1]^2 of the keypoint frame.
+    Grid sample ``s`` sits at ``(u, v) = _grid()[s]`` in [-1, 1]^2 of the keypoint frame; ``angle``
+    None samples the unrotated grid (the orientation histogram's), which skips the rotation.
+    All per-sample arithmetic is float32 and in place, in the order of the plain expressions
+    ``x + (r cos u - r sin v)``, ``y + (r sin u + r cos v)`` and ``(c gx + s gy, c gy - s gx)``.
     """
-    u, v = _grid()
+    u, v = _grid32()
     f32 = np.float32
-    # rotated, scaled grid offsets (r cos, r sin per keypoint), all per-sample arithmetic in float32
+    x, y = xy[:, :1].astype(f32), xy[:, 1:].astype(f32)
+    if angle is None:
+        r = (half_width * scale).astype(f32)[:, None]
+        mx, my = r * u, r * v
+        mx += x
+        my += y
+        return _remap(gx, mx, my), _remap(gy, mx, my)
+    # rotated, scaled grid offsets (r cos, r sin per keypoint)
     rc = (half_width * scale * np.cos(angle)).astype(f32)[:, None]
     rs = (half_width * scale * np.sin(angle)).astype(f32)[:, None]
-    u32, v32 = u.astype(f32), v.astype(f32)
-    mx = xy[:, :1].astype(f32) + (rc * u32 - rs * v32)
-    my = xy[:, 1:].astype(f32) + (rs * u32 + rc * v32)
+    mx, my, tmp = rc * u, rs * u, rs * v
+    mx -= tmp
+    mx += x
+    my += np.multiply(rc, v, out=tmp)
+    my += y
+    sx, sy = _remap(gx, mx, my), _remap(gy, mx, my)
     c, s = np.cos(angle).astype(f32)[:, None], np.sin(angle).astype(f32)[:, None]
-    sx = cv2.remap(gx, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-    sy = cv2.remap(gy, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-    return c * sx + s * sy, -s * sx + c * sy
+    rx, ry = np.multiply(c, sx, out=mx), np.multiply(c, sy, out=my)
+    rx += np.multiply(s, sy, out=tmp)
+    ry -= np.multiply(s, sx, out=tmp)
+    return rx, ry
+
+
+def _remap(g, mx, my):
+    return cv2.remap(g, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+
+
+@lru_cache(maxsize=None)
+def _grid32():
+    u, v = _grid()
+    return u.astype(np.float32), v.astype(np.float32)
 
 
 @lru_cache(maxsize=None)
@@ -114,8 +138,7 @@ def _orientations(grads, keypoints: Keypoints, ratio: float) -> Keypoints:
     # window half-width is 3 x the Gaussian sigma, so the weight in grid units is exp(-9 r^2 / 2)
     gauss = np.exp(-4.5 * (u * u + v * v)).astype(np.float32)
     for idx, gx, gy, step in grads:
-        rx, ry = _sample(gx, gy, keypoints.xy[idx] / step, keypoints.scale[idx] / step, np.zeros(idx.size),
-                         3 * _WINDOW)
+        rx, ry = _sample(gx, gy, keypoints.xy[idx] / step, keypoints.scale[idx] / step, None, 3 * _WINDOW)
         mag, ang = cv2.cartToPolar(np.ascontiguousarray(rx), np.ascontiguousarray(ry))  # angle in [0, 2 pi)
         weight = mag * gauss
         pos = ang * np.float32(nbins / (2 * np.pi))
