@@ -386,3 +386,15 @@ def test_check_refuses_a_function_that_uses_robokit_as_the_grader_would():
     for fn in (uses_it, imports_it):
         with pytest.raises(CheckFailed, match="uses robokit .* would score zero"):
             check("00.wrap_angle", fn)
+
+
+def test_a_value_of_the_assignment_data_is_a_trivial_answer():
+    # a notebook can return any value the kit hands it (assignment 02 hands top_k = 5, an index too)
+    from robocourse.exercises.spec import Case, Exercise
+    from robocourse.exercises.trivial import data_values, trivial_passes
+    ex = Exercise(id="00.pick", function="pick", signature="pick(x) -> int", points=1,
+                  cases=lambda rng: [], answer=lambda x: int(x))
+    cases = [Case((5.0,)), Case((2.0,))]
+    passes = trivial_passes(ex, cases, [5, 2], data=data_values({"ratio": 0.7, "top_k": 5}))
+    assert any("assignment's data" in name for name in passes[0])
+    assert not any("assignment's data" in name for name in passes[1])

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from robocourse.exercises.spec import PUBLIC_SEED
-from robocourse.exercises.trivial import CONSTANTS, explained
+from robocourse.exercises.trivial import CONSTANTS, data_values, explained
 from robocourse.grading import job_cgroup
 from robocourse.grading.data import assignment_data, data_file
 from robocourse.grading.grader import grade_batch, prepare_cases, score_exercise
@@ -155,14 +155,7 @@ def public_all(ex):
 
 def _data_values(slug):
     """Every value inside the assignment's data (what the kit hands a notebook), or nothing."""
-    if not data_file(slug).is_file():
-        return []
-    out, stack = [], [assignment_data(slug)]
-    while stack:
-        v = stack.pop()
-        out.append(v)
-        stack.extend(v.values() if isinstance(v, dict) else v if isinstance(v, list) else ())
-    return out
+    return data_values(assignment_data(slug)) if data_file(slug).is_file() else []
 
 
 def _attackers(ex, slug):

@@ -21,6 +21,8 @@ never sees them):
   shaped like the expected answer;
 * each valid case's answer, as a constant (``"case 3's answer, always"``);
 * each public case's answer, as a constant, and the public answers looked up by their inputs;
+* each value inside the assignment's data (what the kit hands the notebook: a number, a list, any
+  nested list or dict in it), as a constant (:func:`data_values`);
 * each positional argument, returned unchanged;
 * the exercise's ``shortcuts``: named functions of the case's inputs.
 """
@@ -34,7 +36,7 @@ import numpy as np
 from robocourse.exercises.plain import numeric_array, to_plain
 from robocourse.exercises.spec import Case, Exercise
 
-__all__ = ["CONSTANTS", "LOOKUP", "trivial_passes", "explained", "own_answer"]
+__all__ = ["CONSTANTS", "LOOKUP", "trivial_passes", "explained", "own_answer", "data_values"]
 
 #: The constants every case is tried against.
 CONSTANTS: tuple = (None, True, False, 0, 0.0, "", [], {})
@@ -52,8 +54,24 @@ def _inputs_key(case: Case) -> str:
     return json.dumps([list(case.args), case.kwargs], sort_keys=True, default=lambda a: np.asarray(a).tolist())
 
 
+def data_values(data: Any) -> list:
+    """Every value inside an assignment's data: the data itself, each dict value and list item, nested.
+
+    Examples
+    --------
+    >>> data_values({"top_k": 5, "legs": ["FL", "FR"]})
+    [{'top_k': 5, 'legs': ['FL', 'FR']}, ['FL', 'FR'], 'FR', 'FL', 5]
+    """
+    out, stack = [], [data]
+    while stack:
+        v = stack.pop()
+        out.append(v)
+        stack.extend(v.values() if isinstance(v, dict) else v if isinstance(v, list) else ())
+    return out
+
+
 def _candidates(exercise: Exercise, cases: Sequence[Case], expected: Sequence[Any],
-                public: dict[str, Any], i: int) -> list[tuple[str, Any]]:
+                public: dict[str, Any], i: int, data: Sequence[Any]) -> list[tuple[str, Any]]:
     """``(name, answer)`` of every trivial answer on case ``i`` (see the module docstring)."""
     case, own = cases[i], expected[i]
     out = [(f"the constant {c!r}", c) for c in CONSTANTS]
@@ -65,6 +83,7 @@ def _candidates(exercise: Exercise, cases: Sequence[Case], expected: Sequence[An
     if _inputs_key(case) in public:
         out.append((LOOKUP, public[_inputs_key(case)]))
     out += [(f"argument {k + 1}, returned unchanged", to_plain(arg)) for k, arg in enumerate(case.args)]
+    out += [(f"a value of the assignment's data ({value!r:.40})", value) for value in data]
     for name, shortcut in exercise.shortcuts.items():
         try:
             out.append((name, to_plain(shortcut(*case.args, **case.kwargs))))
@@ -74,7 +93,7 @@ def _candidates(exercise: Exercise, cases: Sequence[Case], expected: Sequence[An
 
 
 def trivial_passes(exercise: Exercise, cases: Sequence[Case], expected: Sequence[Any],
-                   public: Sequence[tuple[Case, Any]] = ()) -> list[frozenset[str]]:
+                   public: Sequence[tuple[Case, Any]] = (), data: Sequence[Any] = ()) -> list[frozenset[str]]:
     """For each case, the names of the trivial answers that pass it (empty for bad-input cases).
 
     Parameters
@@ -85,6 +104,8 @@ def trivial_passes(exercise: Exercise, cases: Sequence[Case], expected: Sequence
         The cases' expected answers as plain data (``None`` for bad-input cases).
     public : sequence of (Case, answer)
         The exercise's valid public cases and their answers (``check()`` shows them).
+    data : sequence
+        The values of the assignment's data (:func:`data_values`), each tried as a constant.
 
     Notes
     -----
@@ -107,7 +128,7 @@ def trivial_passes(exercise: Exercise, cases: Sequence[Case], expected: Sequence
             out.append(frozenset())
             continue
         names = set()
-        for name, answer in _candidates(exercise, cases, expected, known, i):
+        for name, answer in _candidates(exercise, cases, expected, known, i, data):
             try:
                 if exercise.compare(expected[i], answer) is None:
                     names.add(name)

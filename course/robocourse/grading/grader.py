@@ -34,7 +34,8 @@ from typing import Any, Callable, Sequence
 
 from robocourse.lessons import UnknownAssignmentError, get_assignment
 from robocourse.exercises.spec import PUBLIC_SEED, Case, Exercise
-from robocourse.exercises.trivial import explained, trivial_passes
+from robocourse.exercises.trivial import data_values, explained, trivial_passes
+from robocourse.grading.data import assignment_data, data_file
 from robocourse.grading.filesystem_view import View, installed_package_dirs, runtime_paths
 from robocourse.grading.job_cgroup import cgroup_note
 from robocourse.grading.judge import expected_output, judge
@@ -154,10 +155,11 @@ def _public(ex: Exercise) -> tuple[tuple[Case, Any], ...]:
 REDRAWS = 20
 
 
-def draw_cases(ex: Exercise, seed: str) -> tuple[list[Case], list[Any], list[frozenset[str]]]:
+def draw_cases(ex: Exercise, seed: str, data: Sequence[Any] = ()) -> tuple[list[Case], list[Any], list[frozenset[str]]]:
     """One exercise's cases, answers and trivial passes for ``seed``: the first draw in which a
     right function's passes show work (:func:`~robocourse.exercises.trivial.explained`), trying
-    ``seed`` and then up to :data:`REDRAWS` seeds derived from it.
+    ``seed`` and then up to :data:`REDRAWS` seeds derived from it. ``data``: the values of the
+    assignment's data (:func:`~robocourse.exercises.trivial.data_values`), trivial answers too.
 
     Raises
     ------
@@ -167,7 +169,7 @@ def draw_cases(ex: Exercise, seed: str) -> tuple[list[Case], list[Any], list[fro
     for k in range(REDRAWS + 1):
         cases = ex.make_cases(seed if k == 0 else f"{seed}\x00redraw {k}")
         expected = [expected_output(ex, c) for c in cases]
-        trivial = trivial_passes(ex, cases, expected, _public(ex))
+        trivial = trivial_passes(ex, cases, expected, _public(ex), data)
         valid = [i for i, c in enumerate(cases) if not c.raises]
         if explained(valid, valid, trivial) is None:
             return cases, expected, trivial
@@ -190,7 +192,8 @@ def prepare_cases(assignment: str, seed: str) -> PreparedCases:
     if not isinstance(seed, str) or not seed:
         raise GradingError("seed: a non-empty secret seed is required (--seed or ROBOKIT_GRADING_SEED)")
     exercises = get_assignment(assignment).exercises
-    cases, expected, trivial = zip(*(draw_cases(ex, seed) for ex in exercises))
+    data = data_values(assignment_data(assignment)) if data_file(assignment).is_file() else []
+    cases, expected, trivial = zip(*(draw_cases(ex, seed, data) for ex in exercises))
     return PreparedCases(exercises, list(cases), list(expected), list(trivial), assignment, seed)
 
 
