@@ -22,7 +22,7 @@ from .littledog import (FOOT_RADIUS, GUIDE, HIP_OFFSETS, HIP_POSITIONS, JOINT_LI
 from .terrain import Terrain, edge_distance, height_at, locate_terrain, step_terrain, terrain_transform
 from .support import SupportPolygonError, stability_margin, stability_margins, support_polygon
 from .gait_schedule import GaitSchedule, crawl_gait, trot_gait
-from .gait import WalkPlan, walking_plan
+from .gait import FOOTHOLD_CLEARANCE, WalkPlan, walking_plan
 from .servo_design import SERVO_BANDWIDTH, link_inertias, littledog_servo_gains, servo_inertia
 from .posture import POSTURE_AXES, PostureFeedback, delay_gain_limit
 from .simulation import LoopSettings, SensorSettings, TrialOutcome, simulate_walk
@@ -38,7 +38,7 @@ __all__ = ["FOOT_RADIUS", "GUIDE", "HIP_OFFSETS", "HIP_POSITIONS", "JOINT_LIMITS
            "STANCE_FEET", "STANDING_HEIGHT", "TRUNK_MASS",
            "TRUNK_SIZE", "UPPER_LEG", "littledog_mjcf", "littledog_model", "Terrain", "edge_distance", "height_at",
            "locate_terrain", "step_terrain", "terrain_transform", "SupportPolygonError", "stability_margin",
-           "stability_margins", "support_polygon", "GaitSchedule", "crawl_gait", "trot_gait", "WalkPlan",
+           "stability_margins", "support_polygon", "GaitSchedule", "crawl_gait", "trot_gait", "WalkPlan", "FOOTHOLD_CLEARANCE",
            "walking_plan", "SERVO_BANDWIDTH", "link_inertias", "littledog_servo_gains", "servo_inertia",
            "POSTURE_AXES", "PostureFeedback", "delay_gain_limit", "LoopSettings", "SensorSettings", "TrialOutcome", "simulate_walk", "ImuReadings", "integrate_gyro",
            "simulate_imu", "MocapFrames", "MocapPoses", "TooFewMarkersError", "fit_marker_pose", "mocap_body_poses",

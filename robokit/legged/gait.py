@@ -45,7 +45,7 @@ from .littledog import LEGS, STANCE_FEET, STANDING_HEIGHT
 from .support import SupportPolygonError, nearest_boundary_point, stability_margins, support_polygon
 from .terrain import Terrain, edge_distance, height_at
 
-__all__ = ["GaitSchedule", "crawl_gait", "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan",
+__all__ = ["FOOTHOLD_CLEARANCE", "GaitSchedule", "crawl_gait", "trot_gait", "stance_pattern", "swing_trajectory", "WalkPlan",
            "walking_plan", "CRAWL_SEQUENCE", "TROT_PAIRS"]
 
 _EPS = 1e-9      # s and m: below this, two instants or two footholds are the same
@@ -53,6 +53,8 @@ _EPS = 1e-9      # s and m: below this, two instants or two footholds are the sa
 MAX_STEPS = 100_000
 #: On terrain, how far (m) a foothold may move away from the body's middle to leave a board edge.
 OUTWARD_SHIFT = 0.005
+#: On terrain, how far (m) :func:`walking_plan` keeps footholds from board edges by default.
+FOOTHOLD_CLEARANCE = 0.025
 
 
 def _smoothstep(u: np.ndarray) -> np.ndarray:
@@ -236,7 +238,7 @@ def _rest_to_rest(knot_t: np.ndarray, knot_p: np.ndarray, t: np.ndarray) -> np.n
 
 def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any = None, body_height: float = STANDING_HEIGHT,
                  dt: float = 0.01, settle: float = 0.5, margin: float = 0.02, terrain: Terrain | None = None,
-                 clearance: float = 0.025) -> WalkPlan:
+                 clearance: float = FOOTHOLD_CLEARANCE) -> WalkPlan:
     """Plan a straight walk of ``distance`` metres along +x, from standing to standing.
 
     Parameters
@@ -262,7 +264,7 @@ def walking_plan(schedule: GaitSchedule, distance: float, *, nominal_feet: Any =
     terrain : Terrain, optional
         The terrain map (:mod:`robokit.legged.terrain`) to plan on; default flat ground (the plan
         is then exactly the flat one, whatever ``clearance``).
-    clearance : float, default 0.025
+    clearance : float, default :data:`FOOTHOLD_CLEARANCE` (0.025)
         With ``terrain``: how far (m, >= 0) a foothold must stay from every board edge.
 
     Returns

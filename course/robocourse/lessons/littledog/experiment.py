@@ -39,7 +39,7 @@ import numpy as np
 
 from robocourse import FAST
 from robokit.controllers import LITTLEDOG_MOTOR, servo_analysis
-from robokit.geometry import quat_to_matrix, so3_log
+from robokit.geometry import so3_log
 from robokit.parallel import map_runs
 from robokit.progress import progress_bar
 from robokit.validation import as_array, as_callable, as_int, as_positive, describe
@@ -196,7 +196,7 @@ def posture_errors(log: TrialLog, plan: WalkPlan) -> tuple[float, float]:
     n = len(log)
     if n > len(plan.t):
         raise ValueError(f"log: expected at most the plan's {len(plan.t)} host cycles, got {n}")
-    R_err = np.swapaxes(plan.T_world_body[:n, :3, :3], 1, 2) @ quat_to_matrix(log.body_quat)
+    R_err = np.swapaxes(plan.T_world_body[:n, :3, :3], 1, 2) @ log.T_world_body()[:, :3, :3]
     tilt = so3_log(R_err)[:, :2]
     height = log.body_pos[:, 2] - plan.T_world_body[:n, 2, 3]
     return float(np.degrees(_rms(tilt))), 1000 * _rms(height)

@@ -41,7 +41,7 @@ import numpy as np
 from robocourse import FAST
 from robocourse.source import code_version_of
 from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
-from robokit.geometry import quat_to_matrix, wrap_angle
+from robokit.geometry import wrap_angle
 from robokit.legged.gait import walking_plan
 from robokit.legged.gait_schedule import crawl_gait, trot_gait
 from robokit.legged.leg_kinematics import UnreachableFootError
@@ -96,7 +96,7 @@ def _course(seed: int, k: int, heights: tuple):
 
 def _tilt_deg(out) -> float:
     """The largest angle (deg) between the trunk's up axis and the vertical over a trial."""
-    up_z = quat_to_matrix(out.log.body_quat)[:, 2, 2]
+    up_z = out.log.T_world_body()[:, 2, 2]
     return float(np.degrees(np.arccos(np.clip(up_z, -1.0, 1.0))).max())
 
 
@@ -197,7 +197,7 @@ def terrain_table(trials: int = TERRAIN_TRIALS, *, distance: float = LESSON_DIST
         trunk's largest tilt in a walk, averaged); the per-walk arrays ``distance``, ``fell``,
         ``walked``, ``tilt_deg`` (gait x mode x trial); ``located_mm`` and ``located_deg`` (how far
         the MoCap's placement of each course is from the truth); ``gaits``, ``modes``,
-        ``distance_planned`` and ``success_tolerance``.
+        ``distance_planned``, ``heights`` and ``success_tolerance``.
 
     Raises
     ------
@@ -230,7 +230,7 @@ def terrain_table(trials: int = TERRAIN_TRIALS, *, distance: float = LESSON_DIST
         data = _run(trials, distance, (lo, hi), seed, gaits, modes, workers, progress)
         write_arrays(target, data, meta)
     return {"rows": _rows(data, gaits, modes, distance), **{k: data[k] for k in _ARRAYS}, "gaits": gaits,
-            "modes": modes, "distance_planned": distance, "success_tolerance": SUCCESS_TOLERANCE}
+            "modes": modes, "distance_planned": distance, "heights": (lo, hi), "success_tolerance": SUCCESS_TOLERANCE}
 
 
 def _names(value: Any, name: str, allowed: tuple) -> tuple:
