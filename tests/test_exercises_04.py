@@ -1,4 +1,4 @@
-"""Assignment 04: registration, check() rejecting wrong answers, two open exercises that are fair, helpers."""
+"""Assignment 04: registration, check() rejecting wrong answers, an open exercise and a loop, both fair, helpers."""
 from __future__ import annotations
 
 import numpy as np
@@ -132,7 +132,7 @@ def test_the_ik_cases_are_inverted_on_the_branch_asked_for_with_the_foot_below_t
         assert -np.sin(q[0]) * v[1] + np.cos(q[0]) * v[2] < 0
 
 
-# --- the open exercises ---------------------------------------------------------------------------
+# --- the open exercise and the loop --------------------------------------------------------------
 
 def _hysteresis(force, planned_stance, dt):   # the lesson's best detector without the plan (3 / 1 N, debounce 2)
     return [e.tolist() for e in contact_events(detect_contacts(np.asarray(force), 3.0, 1.0, 2))]
@@ -144,7 +144,7 @@ def _lesson_gate(force, planned_stance, dt):   # the lesson's gate: the first ri
 
 
 @pytest.mark.parametrize("seed", [0, 1, "instructor-secret"])
-def test_the_open_touchdown_exercise_is_fair(seed):
+def test_the_touchdown_loop_is_fair(seed):
     """The cases are crawls simulated in MuJoCo, graded against its true touchdowns: the reference
     (hysteresis gated by the plan) passes every one; the force alone (a threshold, the lesson's
     hysteresis) fails every one; the plan alone, shifted by any fixed delay, fails at least one; the

@@ -1,7 +1,7 @@
 """Exercises of assignment 04 (the LittleDog quadruped as a system, from the LittleDog User Guide).
 
 Inputs come from the model of :mod:`robokit.legged.littledog` (hips, legs, markers, the servo's
-gains and period, the battery) with random joint angles, poses and loads; the open touchdown
+gains and period, the battery) with random joint angles, poses and loads; the touchdown loop
 exercise's cases are the lesson's crawl simulated in MuJoCo
 (:func:`robocourse.lessons.littledog.data.crawl_touchdowns`): the lower legs' forces and the plan's
 stance go to the student, MuJoCo's true touchdowns are the case's expected answer.
@@ -80,7 +80,7 @@ def battery_endurance(capacity_ah: float, voltage: float, mean_power_w: float) -
 
 
 def detect_touchdowns(force: Any, planned_stance: Any, dt: float) -> list:
-    """The touchdowns of a crawl's four feet, from their force sensors and the plan (the open exercise's reference).
+    """The touchdowns of a crawl's four feet, from their force sensors and the plan (the loop exercise's reference).
 
     Each foot's touchdowns are the rising edges of a hysteresis on its force (contact above 3 N,
     none below 1 N: :func:`~robokit.legged.touchdown.detect_contacts`), gated by the plan
@@ -405,8 +405,8 @@ EXERCISES = [
                   "-> 4 lists of sample indices",
         points=2, cases=_touchdown_cases, answer=detect_touchdowns, compare=_touchdowns_found,
         shortcuts=TOUCHDOWN_SHORTCUTS,
-        kind="open",
-        description="Open: the four feet's touchdowns in a simulated crawl from the lower-leg forces and the plan's "
+        kind="loop",
+        description="Loop: the four feet's touchdowns in a simulated crawl from the lower-leg forces and the plan's "
                     "stance, graded against MuJoCo's true contacts; precision and recall within 5 samples over "
                     "the legs must both reach 0.9; ValueError for NaN, shapes that differ or are not (N, 4), "
                     "or dt <= 0."),
