@@ -17,7 +17,6 @@ from robocourse.lessons import catalog
 #: shrink. Rewrite an exercise (or show it asks more than a transcription), set its kind, and delete
 #: its line here; the test fails on an id listed here that is no longer a transcription.
 TRANSCRIPTION_DEBT = {
-    "00.se2_compose",            # the composition formula is printed in the task
     "01.match_ratio",            # the ratio test, stated in the task
     "01.triangulate_svd",        # the four equations and the SVD recipe, stated in the task
     "01.kalman_fuse",            # Sigma' and s' printed in the task

@@ -1,7 +1,15 @@
-"""Exercises of assignment 00 (getting started): two tiny warm-ups that exercise the grader."""
+"""Exercises of assignment 00 (getting started): a warm-up and a small derivation that exercise the grader.
+
+References
+----------
+.. [1] R. Smith, M. Self and P. Cheeseman, "Estimating uncertain spatial relationships in robotics",
+   in *Autonomous Robot Vehicles*, Springer, 1990 (the compounding operation).
+"""
 from __future__ import annotations
 
 import numpy as np
+
+from typing import Any
 
 from robokit.geometry import se2_compose, wrap_angle
 from robocourse.exercises.compare import close
@@ -36,6 +44,31 @@ def _compose_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
+_CLOSE = close(rtol=0, atol=1e-9)
+
+
+def _compose_diagnosis(expected: Any, got: Any) -> str | None:
+    """Accept ``a (+) b`` within 1e-9; otherwise say which part of the derivation is wrong: the
+    position (how b's offset enters the world) or the heading (the sum, or its wrap)."""
+    message = _CLOSE(expected, got)
+    if message is None:
+        return None
+    e, g = np.asarray(expected, float), np.asarray(got, float)
+    if g.shape != (3,):
+        return message
+    hints = []
+    if not np.allclose(g[:2], e[:2], rtol=0, atol=1e-9):
+        hints.append("the position is wrong: b's x and y are measured along frame a's axes, so they reach the "
+                     "world only after a rotation by a's heading (check its direction: a turn of +90 deg takes "
+                     "a's x axis to the world's y axis)")
+    d = g[2] - e[2]
+    if abs(wrap_angle(d)) < 1e-9 and abs(d) > 1e-9:
+        hints.append("the heading is right up to a whole turn: wrap it to [-pi, pi)")
+    elif abs(d) > 1e-9:
+        hints.append("the heading is wrong: how much has the frame turned from the world's x axis in all?")
+    return message + ("; " + "; ".join(hints) if hints else "")
+
+
 EXERCISES = [
     Exercise(
         id="00.wrap_angle",
@@ -55,8 +88,9 @@ EXERCISES = [
         points=2,
         cases=_compose_cases,
         answer=se2_compose,
-        compare=close(rtol=0, atol=1e-9),
-        kind="transcription",
-        description="Compose planar poses [x, y, theta]; raise ValueError on a wrong shape.",
+        compare=_compose_diagnosis,
+        kind="derivation",
+        description="Compose planar poses [x, y, theta], derived from what a pose means (a rotation and a "
+                    "translation of a frame); raise ValueError on a wrong shape.",
     ),
 ]
