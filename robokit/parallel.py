@@ -278,6 +278,14 @@ def _in_workers(run: Callable, blobs: dict, settings: dict, jobs: list, workers:
             failed = Future()
             failed.set_exception(exc)
             submitted.put(failed)
+        except Exception as exc:           # noqa: BLE001 - the workers could not be started: never fewer results
+            failed = Future()
+            failed.set_exception(RuntimeError(
+                f"run: the worker processes could not be started ({type(exc).__name__}: {exc}); a script that "
+                "makes runs in workers must do so under `if __name__ == \"__main__\":`, as the worker "
+                "processes import it"))
+            failed.exception().__cause__ = exc
+            submitted.put(failed)
         finally:
             submitted.put(None)
 
@@ -301,8 +309,9 @@ def _rebuilt(future: Future) -> Any:
     try:
         blob = future.result()
     except BrokenProcessPool as exc:
-        raise RuntimeError("run: a worker process died during the runs (killed, out of memory, or a crash "
-                           "in compiled code); the runs in progress are lost") from exc
+        raise RuntimeError("run: a worker process died during the runs (killed, out of memory, a crash in "
+                           "compiled code, or a script that starts runs outside `if __name__ == \"__main__\":`); "
+                           "the runs in progress are lost") from exc
     try:
         return pickle.loads(blob)
     except Exception as exc:                  # noqa: BLE001 - named, then the workers stop

@@ -231,3 +231,19 @@ def test_a_run_that_ends_badly_is_an_error_not_a_hang(task, error, text):
     with pytest.raises(error, match=text):
         map_runs(_awkward, None, ["fine", task, "fine", "fine"], workers=2)
     assert time.perf_counter() - started < 60
+
+
+def test_a_script_without_a_main_guard_gets_an_error_not_fewer_results(tmp_path):
+    """Workers import the calling script; one that starts runs at import (no ``if __name__ ==
+    "__main__":``) once made the feeder stop early, and the caller got an empty list (which a lesson
+    then cached as an empty recording)."""
+    script = tmp_path / "no_guard.py"
+    script.write_text("from robokit.parallel import map_runs\n"
+                      "print('results', len(map_runs(divmod, 100, list(range(1, 9)), workers=2)))\n")
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=env,
+                          cwd=tmp_path)
+    assert "results 0" not in done.stdout, done.stdout
+    assert done.returncode != 0 or done.stdout.strip() == "results 8", (done.stdout, done.stderr[-2000:])
+    if done.returncode != 0:
+        assert "__main__" in done.stderr, done.stderr[-2000:]
