@@ -1321,7 +1321,7 @@ SPECS: dict[str, Call] = {
         "setup": Obj(corridor_setup), "method": Choice("ours"), "rng": Rng(0)}, cheap=False),
     "robocourse.lessons.corridor_localization.aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),
     "robocourse.lessons.corridor_localization.experiment.corridor_lidar": Call({}),
-    "robocourse.lessons.corridor_localization.experiment.corridor_camera": Call({"fast": Flag(True, optional=True)}),
+    "robocourse.lessons.corridor_localization.experiment.corridor_camera": Call({}),
     "robocourse.lessons.corridor_localization.experiment.calibration_run": Call({
         "fast": Flag(True, optional=True), "start": Real(12.0), "length": Real(10.0), "speed": Real(0.2),
         "frame_rate": Real(30.0), "progress": Func(None, optional=True)}, cheap=False),
