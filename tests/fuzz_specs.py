@@ -842,6 +842,14 @@ SPECS: dict[str, Call] = {
         "query_descriptors": Array(lambda: rec_nodes()[1][:4] + 0.01, "N,N", min_rows=0),
         "node_histograms": Array(np.eye(3), "N,N"), "node_descriptors": Obj(rec_nodes), "top_k": Int(2),
         "ratio": Real(0.8)}),
+    "robocourse.lessons.omni_localization.relaxation_runs.relax_map": Call({
+        "poses": Array(lambda: pose_graph().poses, "N,3"), "edges": Array(lambda: pose_graph().edges, "N,2"),
+        "measurements": Array(lambda: pose_graph().measurements, "N,3"),
+        "edge_variances": Array(lambda: np.full(pose_graph().n_edges, 0.02), "N"), "tolerance": Real(1e-3),
+        "max_sweeps": Int(50)}),
+    "robocourse.lessons.omni_localization.exercises.node_fix_update": Call({
+        "x": Array(EKF_X, "N"), "P": Array(np.eye(5) * 0.01, "N,N"), "node_pose": Array(np.array([0.5, 0.2, 1.0]), "N"),
+        "z": Array(np.array([0.1, 0.2, 3.1]), "N"), "R": Array(np.eye(3) * 0.01, "N,N")}),
     "robocourse.lessons.omni_localization.experiment.office_setup": Call({"fast": Flag(True), "progress": Func(None, optional=True)},
                                                             cheap=False),
     "robocourse.lessons.omni_localization.experiment.localization_trials": Call({
@@ -1817,6 +1825,8 @@ HUGE_ANGLES: dict[str, tuple[str, ...]] = {
     "robokit.localization.particle_filter.sample_ellipse_poses": ("pose", "sigma_theta"),
     "robokit.localization.particle_filter.weighted_pose_mean": ("particles",),
     "robokit.localization.pose_ekf.ekf_update": ("z", "H"),
+    "robocourse.lessons.omni_localization.exercises.node_fix_update": ("node_pose", "z"),
+    "robocourse.lessons.omni_localization.relaxation_runs.relax_map": ("poses", "measurements"),
     "robokit.localization.pose_ekf.unicycle_jacobian": ("x", "dt"),
     "robokit.mapping.hybrid_map.geo_tag": ("poses",),
     "robokit.mapping.hybrid_map.geo_index": ("poses",),
