@@ -21,10 +21,6 @@ TRANSCRIPTION_DEBT = {
     "01.triangulate_svd",        # the four equations and the SVD recipe, stated in the task
     "01.kalman_fuse",            # Sigma' and s' printed in the task
     "01.hough_votes",            # the accumulator's layout and the voting rule, spelled out
-    "02.hue_histogram",          # the mask and the bin rule, stated in the task
-    "02.fine_stage_counts",      # the ratio test per candidate, stated in the task
-    "02.relax_sweep",            # Eqs. (1)-(3) printed in full
-    "02.ekf_update",             # S, K, x' and the Joseph form printed in the task
     "03.bow_similarity",         # Eqs. (16)-(17) printed in the task
     "03.likelihood_field_weight",  # Table 6.3's sum, printed in the task (the issue asks for its normalisation derived)
     "05.fix_position",           # the fields and their formats, stated in the task

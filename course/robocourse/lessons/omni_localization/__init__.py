@@ -7,5 +7,7 @@ checks      the coarse-to-fine checks measured (widening, Monte-Carlo) and the h
 alignment   when aligning the map beats odometry: loop sets kept, loop-edge errors, redrawn odometry
 navigation  the autonomous runs along a recorded visual path from perturbed starts (cached)
 benchmark   both map aligners on g2o's Intel Research Lab pose graph (shipped): cost, iterations, time
+relaxation_runs  the relaxation loop exercise: office-tour pose graphs, the reference loop, its outcome
+            check
 exercises   assignment 02
 """

@@ -1,19 +1,33 @@
-"""Exercises of assignment 02 (omnidirectional hierarchical localization and visual path following)."""
+"""Exercises of assignment 02 (omnidirectional hierarchical localization and visual path following).
+
+The relaxation loop's cases and outcome check live in :mod:`.relaxation_runs`; the EKF's fix model
+(a pose measured in the recognised node's frame) and the fine stage's count are here.
+
+References
+----------
+.. [1] Li M., Sun L., Huang Q., Cai Z. and Piao S., "Robust omnidirectional vision based mobile robot
+   hierarchical localization and autonomous navigation", *Information Technology Journal* 10(1),
+   29-39, 2011.
+.. [2] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
+"""
 from __future__ import annotations
 
 import numpy as np
 
 from robokit.controllers.path_following import path_following_command
 from robokit.localization.hierarchical import TOP_K
+from robokit.geometry import se2_between, wrap_angle
+from robokit.geometry.planar import as_planar
 from robokit.localization.pose_ekf import ekf_update
-from robokit.mapping.relaxation import relax_sweep
 from robokit.mapping.topological import OMNI_RATIO
 from robokit.vision.colour import histogram_distance, hue_histogram, rgb_to_hsi
 from robokit.vision.matching import DescriptorIndex
 from robokit.vision.matching import as_ratio
-from robokit.validation import as_array, as_int
+from robokit.validation import as_array, as_covariance, as_int, require_angles
 from robocourse.exercises.compare import close, exact
+from robocourse.exercises.plain import summarize
 from robocourse.exercises.spec import Case, Exercise
+from robocourse.lessons.omni_localization.relaxation_runs import TOLERANCE, map_outcome, relax_map, tour_graph
 
 ASSIGNMENT = "02_omni_localization"
 #: Written (manually graded) questions: id -> points.
@@ -160,6 +174,127 @@ def recognise_node(query_histogram, query_descriptors, node_histograms, node_des
     return int(coarse[int(np.argmax(counts))])
 
 
+#: The names of the entries of the fix's Jacobian: the fix is ``[a, b, phi]``, the robot's position along
+#: the node's heading, to its left and its heading relative to the node's; the state ``[x, y, theta, v, omega]``.
+JACOBIAN_TERMS = [[f"d{z}/d{s}" for s in ("x", "y", "theta", "v", "omega")] for z in ("a", "b", "phi")]
+
+
+def node_fix_jacobian(node_pose) -> np.ndarray:
+    """The Jacobian ``H = dh/dx`` of the node-relative fix ``h(x) = se2_between(node_pose, x[:3])``.
+
+    Parameters
+    ----------
+    node_pose : array_like, shape (3,)
+        The recognised node's pose ``[x_n, y_n, theta_n]`` in the map.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 5)
+        ``[[c, s, 0, 0, 0], [-s, c, 0, 0, 0], [0, 0, 1, 0, 0]]`` with ``c, s = cos, sin theta_n``: the
+        position rotated into the node's frame, the heading less the node's; the velocities unseen.
+
+    Examples
+    --------
+    >>> node_fix_jacobian([2.0, 1.0, np.pi / 2]).round(6).tolist()[:2]
+    [[0.0, 1.0, 0.0, 0.0, 0.0], [-1.0, 0.0, 0.0, 0.0, 0.0]]
+    """
+    n = as_planar(node_pose, "node_pose", shape=(3,))
+    c, s = np.cos(n[2]), np.sin(n[2])
+    return np.array([[c, s, 0, 0, 0], [-s, c, 0, 0, 0], [0, 0, 1, 0, 0]], float)
+
+
+def node_fix_update(x, P, node_pose, z, R) -> dict:
+    """EKF update of ``[x, y, theta, v, omega]`` with a fix measured relative to the recognised node.
+
+    The derivation exercise's reference: the hierarchical localizer recognises a node and measures the
+    robot's pose in that node's frame, ``z = h(x) + noise`` with ``h(x) = se2_between(node_pose, x[:3])``
+    (Sec. "Visual-servoing for navigation": the EKF's outputs are poses; the fix comes from the
+    localizer of Sec. "Hierarchical localization"). The update linearises ``h`` at ``x``
+    (:func:`node_fix_jacobian`) and uses the innovation ``z - h(x)``, its heading wrapped.
+
+    Parameters
+    ----------
+    x : array_like, shape (5,)
+    P : array_like, shape (5, 5)
+        Positive definite.
+    node_pose : array_like, shape (3,)
+    z : array_like, shape (3,)
+        ``[a, b, phi]``: the robot ahead of the node, to its left, and its heading relative to the node's.
+    R : array_like, shape (3, 3)
+        Positive definite.
+
+    Returns
+    -------
+    dict
+        ``H`` (3, 5), ``x`` (5,), ``P`` (5, 5) as lists, and ``mistakes``: what two common slips give
+        (the linear innovation ``z - H x``; the heading innovation not wrapped), for the feedback.
+
+    Raises
+    ------
+    ValueError
+        For wrong shapes, NaN or infinity, or covariances that are not symmetric positive definite.
+
+    Notes
+    -----
+    Thrun et al. (2005), Table 3.3 (the EKF), with :func:`robokit.localization.pose_ekf.ekf_update`
+    given the linearised measurement ``z - h(x) + H x``.
+
+    Examples
+    --------
+    >>> out = node_fix_update([1, 1, 0, 0.3, 0], np.eye(5), [0, 0, 0], [1.2, 1, 0], np.eye(3))
+    >>> np.round(out["x"], 3).tolist()        # halfway to the fix, the velocities untouched
+    [1.1, 1.0, 0.0, 0.3, 0.0]
+    """
+    state = as_array(x, "x", shape=(5,))
+    require_angles(state[2], "x", "heading (element 2)")
+    cov = as_covariance(P, "P", 5)
+    node = as_planar(node_pose, "node_pose", shape=(3,))
+    fix = as_planar(z, "z", shape=(3,))
+    noise = as_covariance(R, "R", 3)
+    H = node_fix_jacobian(node)
+    predicted = se2_between(node, state[:3])                 # h(x)
+    unwrapped = fix - np.r_[predicted[:2], state[2] - node[2]]
+    wrapped, linear = unwrapped.copy(), fix - H @ state
+    wrapped[2], linear[2] = wrap_angle(wrapped[2]), wrap_angle(linear[2])
+    out = {}
+    for name, innovation in (("right", wrapped), ("linear", linear), ("unwrapped", unwrapped)):
+        new_x, new_P = ekf_update(state, cov, innovation + H @ state, H, noise)
+        out[name] = (new_x.tolist(), new_P.tolist())
+    return {"H": H.tolist(), "x": out["right"][0], "P": out["right"][1],
+            "mistakes": {"the innovation z - H x: the predicted fix is h(x), the robot's pose in the node's frame":
+                         out["linear"][0],
+                         "the heading innovation not wrapped to [-pi, pi)": out["unwrapped"][0]}}
+
+
+def _fix_update_checked(expected, got):
+    """Judge ``H`` term by term (naming the wrong partial derivatives), then ``x`` and ``P``."""
+    if not isinstance(got, dict) or not {"H", "x", "P"} <= set(got):
+        return f"expected a dict with keys 'H', 'x' and 'P', got {summarize(got)}"
+    try:
+        H, new_x, new_P = (np.asarray(got[k], float) for k in ("H", "x", "P"))
+    except (TypeError, ValueError):
+        return "'H', 'x', 'P': expected arrays of numbers"
+    E = np.asarray(expected["H"])
+    if H.shape != E.shape:
+        return f"'H': expected shape {E.shape} (3 fix components by 5 state components), got shape {H.shape}"
+    wrong = np.argwhere(~np.isclose(H, E, rtol=1e-6, atol=1e-9))
+    if len(wrong):
+        terms = "; ".join(f"H[{r}, {c}] = {JACOBIAN_TERMS[r][c]}: expected {E[r, c]:.4g}, got {H[r, c]:.4g}"
+                          for r, c in wrong[:3])
+        return f"'H': {len(wrong)} of 15 partial derivatives are wrong: {terms}"
+    ex = np.asarray(expected["x"])
+    miss = new_x - ex if new_x.shape == ex.shape else None
+    if miss is not None:
+        miss[2] = wrap_angle(miss[2])                       # a heading 2 pi off is the same heading
+    if miss is None or not np.allclose(miss, 0, atol=1e-7):
+        for slip, value in expected["mistakes"].items():
+            if miss is not None and np.allclose(new_x, value, rtol=1e-6, atol=1e-8):
+                return f"'x': H is right, but your update uses {slip}"
+        return "'x': H is right, but the updated state is not: " + str(close(1e-7, 1e-9)(expected["x"], got["x"]))
+    message = close(1e-7, 1e-9)(expected["P"], new_P.tolist())
+    return message and f"'P': H and x are right, the covariance is not: {message}"
+
+
 # --- cases ------------------------------------------------------------------------------------
 
 def _rgb_cases(rng: np.random.Generator) -> list[Case]:
@@ -244,12 +379,36 @@ def _fine_cases(rng: np.random.Generator) -> list[Case]:
         Case((r(query), [r(n) for n in nodes], [0, 1, 2, 3, 4]), label="every node a candidate"),
         Case((r(query), [r(n) for n in nodes], [4, 2]), label="two candidates, in the coarse stage's order"),
         Case((r(query), [r(n) for n in nodes], [1, 3]), {"ratio": 0.6}, label="the right node not among them"),
+        Case((r(query), [r(n) for n in nodes[:2]] + [r(np.vstack([nodes[2], nodes[2][:10]]))] + [r(n) for n in nodes[3:]],
+              [2, 0]), label="node 2 stores ten descriptors twice: a match to one of them is ambiguous"),
         Case((r(query), [r(n) for n in nodes], [7]), raises="ValueError", label="a candidate that does not exist"),
         Case((r(query), [r(n) for n in nodes[:2]] + [r(nodes[2][:1])], [2]), raises="ValueError",
              label="a node with one descriptor (no second neighbour)"),
         Case((r(query[:3]), [r(n[:, :8]) for n in nodes], [0]), raises="ValueError",
              label="descriptors of different lengths"),
     ]
+
+
+def _counts_checked(expected, got):
+    """:func:`exact`, and which way a count is off: too many means ambiguous matches were counted."""
+    message = exact()(expected, got)
+    if message is None:
+        return None
+    try:
+        more = np.asarray(got, float).ravel() - np.asarray(expected, float).ravel()
+    except (TypeError, ValueError):
+        return message
+    if more.shape != np.shape(expected) or not np.isfinite(more).all():
+        return message
+    hints = []
+    if (more > 0).any():
+        hints.append(f"at candidate position(s) {np.flatnonzero(more > 0).tolist()} you count more than the "
+                     "unambiguous matches: a descriptor counts only when one node descriptor beats every other by the "
+                     "ratio")
+    if (more < 0).any():
+        hints.append(f"at candidate position(s) {np.flatnonzero(more < 0).tolist()} you count fewer: check the "
+                     "distance you compare and the ratio you use")
+    return f"{message}; {'; '.join(hints)}"
 
 
 def _recognise_cases(rng: np.random.Generator) -> list[Case]:
@@ -276,26 +435,36 @@ def _recognise_cases(rng: np.random.Generator) -> list[Case]:
 
 
 def _relax_cases(rng: np.random.Generator) -> list[Case]:
-    square = [[0, 0, 0], [1, 0, np.pi / 2], [1, 1, np.pi], [0, 1, -np.pi / 2]]
-    meas = [[1, 0, np.pi / 2]] * 4
-    noisy = (np.array(square, float) + rng.normal(0, [0.1, 0.1, 0.05], (4, 3))).round(4)
-    noisy[0] = 0
-    chain = np.cumsum(rng.uniform(0.5, 1, (5, 3)) * [1, 0.2, 0.1], axis=0).round(4)
-    chain[0] = 0
-    chain_meas = rng.normal([1, 0, 0.1], 0.05, (5, 3)).round(4)
-    edges5 = [[0, 1], [1, 2], [2, 3], [3, 4], [4, 0]]
+    """Maps of the lesson's office tour: every return closed, one long loop, a cap that stops the loop early."""
+    def case(graph, label, raises=None, **kwargs):
+        args = (graph["poses"], graph["edges"], graph["measurements"], graph["edge_variances"])
+        return Case(args, {"tolerance": TOLERANCE, **kwargs}, raises=raises, label=label)
+    every, one, capped = (tour_graph(rng, 2.5, "all"), tour_graph(rng, 2.0, "last"), tour_graph(rng, 2.5, "all"))
+    bad = dict(every, edge_variances=[-0.01] + every["edge_variances"][1:])
+    stray = dict(every, edges=every["edges"][:-1] + [[0, len(every["poses"]) + 3]])
     return [
-        Case((noisy.tolist(), [0.0, 0.1, 0.2, 0.3], [[0, 1], [1, 2], [2, 3], [3, 0]], meas, [0.1] * 4),
-             label="a square loop, odometry drifted"),
-        Case((chain.tolist(), [0.0, 0.05, 0.1, 0.15, 0.2], edges5, chain_meas.tolist(), [0.05, 0.05, 0.05, 0.05, 0.5]),
-             label="a loop closed by one uncertain edge"),
-        Case((chain.tolist(), [0.0, 0.05, 0.1, 0.15, 0.2], edges5, chain_meas.tolist(), [0.05] * 5), {"fixed": 2},
-             label="node 2 fixed"),
-        Case((noisy.tolist(), [0.0, 0.1, 0.2, 0.3], [[0, 1]], [[1, 0, 0]], [-0.1]), raises="ValueError",
-             label="a negative edge variance"),
-        Case((noisy.tolist(), [0.0, 0.1, 0.2, 0.3], [[0, 9]], [[1, 0, 0]], [0.1]), raises="ValueError",
-             label="an edge to a node that does not exist"),
+        case(every, "the office tour, every return to a place closed"),
+        case(one, "the office tour, only its last return to R1 closed: one long loop"),
+        case(capped, "a cap of 40 sweeps: the loop stops before it converges", max_sweeps=40),
+        case(bad, "a negative edge variance", raises="ValueError"),
+        case(stray, "a loop edge to a node that does not exist", raises="ValueError"),
     ]
+
+
+def _odometry_unchanged(poses, edges, measurements, edge_variances, tolerance=TOLERANCE, max_sweeps=5000):
+    return {"poses": poses, "sweeps": 1, "converged": True, "changes": [0.0]}
+
+
+def _fixed_sweeps(k: int):
+    def shortcut(poses, edges, measurements, edge_variances, tolerance=TOLERANCE, max_sweeps=5000):
+        out = relax_map(poses, edges, measurements, edge_variances, tolerance=1e-12, max_sweeps=min(k, max_sweeps))
+        return dict(out, converged=True)
+    return shortcut
+
+
+#: Ways to pass some relaxation cases without the loop: no sweep at all, one, or a fixed number.
+RELAX_SHORTCUTS = {"the odometry, unchanged": _odometry_unchanged, "one sweep": _fixed_sweeps(1),
+                   "a fixed 100 sweeps, called converged": _fixed_sweeps(100)}
 
 
 def _command_cases(rng: np.random.Generator) -> list[Case]:
@@ -313,24 +482,31 @@ def _command_cases(rng: np.random.Generator) -> list[Case]:
 
 
 def _ekf_cases(rng: np.random.Generator) -> list[Case]:
-    x = [1.0, 2.0, 0.3, 0.3, 0.1]
+    """Fixes relative to nodes facing every way, one across the +-pi seam, with correlated covariances."""
     A = rng.normal(0, 0.1, (5, 5))
     P = (A @ A.T + np.diag([0.04, 0.04, 0.01, 0.01, 0.01])).round(6)
-    P = (P + P.T) / 2
-    H = np.hstack([np.eye(3), np.zeros((3, 2))])
-    R = np.diag([0.01, 0.0225, 0.0025])
-    z = (np.array(x[:3]) + rng.normal(0, [0.1, 0.15, 0.05])).round(4)
-    return [
-        Case((x, P.tolist(), z.tolist(), H.tolist(), R.tolist()), label="a visual fix [x, y, theta]"),
-        Case((x, P.tolist(), [1.05, 2.1, 0.3 - 2 * np.pi], H.tolist(), R.tolist()), {"angles": [2]},
-             label="the fix's heading wrapped by 2 pi"),
-        Case(([0.0, 0.0, 0.0, 0.5, 0.0], np.eye(5).tolist(), [0.4, 0.0], [[0, 0, 0, 1, 0], [0, 0, 0, 0, 1]],
-              np.diag([0.01, 0.01]).tolist()), label="an odometry update of (v, omega)"),
-        Case((x, P.tolist(), z.tolist(), H.tolist(), (-R).tolist()), raises="ValueError",
-             label="a negative measurement covariance"),
-        Case((x, P.tolist(), z[:2].tolist(), H.tolist(), R.tolist()), raises="ValueError",
-             label="z and H do not agree"),
+    P = ((P + P.T) / 2).tolist()
+    R = np.diag([0.01, 0.0225, 0.0025]).tolist()
+    cases = []
+    for label, node_heading, robot_heading in (("a node facing north-east", rng.uniform(0.5, 1.2), 0.3),
+                                               ("a node facing south-west, the robot ahead of it",
+                                                rng.uniform(-2.6, -2.0), -2.0),
+                                               ("node and robot facing west: the relative heading crosses +-pi",
+                                                rng.uniform(3.0, 3.1), -3.0)):
+        node = [float(rng.uniform(2, 12)), float(rng.uniform(1, 10)), float(node_heading)]
+        offset = rng.uniform(-0.6, 0.6, 2)
+        c, s = np.cos(node[2]), np.sin(node[2])
+        x = [node[0] + c * offset[0] - s * offset[1], node[1] + s * offset[0] + c * offset[1], robot_heading,
+             float(rng.uniform(0.1, 0.4)), float(rng.uniform(-0.3, 0.3))]
+        true = se2_between(node, x[:3]) + rng.normal(0, [0.15, 0.15, 0.08])
+        true[2] = wrap_angle(true[2])
+        cases.append(Case((np.round(x, 4).tolist(), P, node, np.round(true, 4).tolist(), R), label=label))
+    x, node, z = cases[0].args[0], cases[0].args[2], cases[0].args[3]
+    cases += [
+        Case((x, P, node, z, (-np.asarray(R)).tolist()), raises="ValueError", label="a negative measurement covariance"),
+        Case((x, P, node[:2], z, R), raises="ValueError", label="a node pose without its heading"),
     ]
+    return cases
 
 
 EXERCISES = [
@@ -345,8 +521,8 @@ EXERCISES = [
         id="02.hue_histogram", function="hue_histogram",
         signature="hue_histogram(image: (H, W, 3) floats, bins=32, min_saturation=0.15, min_intensity=0.04, "
                   "max_intensity=0.98) -> numpy.ndarray (bins,)",
-        points=2, cases=_histogram_cases, answer=hue_histogram, compare=close(rtol=1e-9, atol=1e-12),
-        kind="transcription",
+        points=1, cases=_histogram_cases, answer=hue_histogram, compare=close(rtol=1e-9, atol=1e-12),
+        kind="warm-up",
         description="Normalised histogram of the hue of pixels with S >= min_saturation and min_intensity <= I "
                     "<= max_intensity; all zeros when none qualifies; ValueError for bins < 1 or a bad image."),
     Exercise(
@@ -360,19 +536,22 @@ EXERCISES = [
         id="02.fine_stage_counts", function="fine_stage_counts",
         signature="fine_stage_counts(query: (N, D), node_descriptors: list of (M_k, D), candidates: list of int, "
                   f"ratio={RATIO}) -> numpy.ndarray of int",
-        points=2, cases=_fine_cases, answer=fine_stage_counts, compare=exact(),
-        kind="transcription",
-        description="For each candidate node, how many query descriptors pass the nearest/second-nearest "
-                    "distance-ratio test against that node's descriptors (the fine stage); ValueError for an "
-                    "unknown candidate or descriptors of different lengths."),
+        points=2, cases=_fine_cases, answer=fine_stage_counts, compare=_counts_checked,
+        kind="derivation",
+        description="For each candidate node, how many query descriptors have an unambiguous match there (one node "
+                    "descriptor closer than ratio times every other: the task states the goal, the student works "
+                    "out the test, duplicates included); ValueError for an unknown candidate or descriptors of "
+                    "different lengths."),
     Exercise(
-        id="02.relax_sweep", function="relax_sweep",
-        signature="relax_sweep(poses: (N, 3), variances: (N,), edges: (M, 2), measurements: (M, 3), "
-                  "edge_variances: (M,), fixed=0) -> (poses (N, 3), variances (N,))",
-        points=3, cases=_relax_cases, answer=relax_sweep, compare=close(rtol=1e-7, atol=1e-9),
-        kind="transcription",
-        description="One sweep of the paper's Eqs. (1)-(3) (Jacobi: every node from the input values), the "
-                    "fixed node unchanged; ValueError for a negative variance or an edge to a missing node."),
+        id="02.relax_map", function="relax_map",
+        signature="relax_map(poses: (N, 3), edges: (M, 2), measurements: (M, 3), edge_variances: (M,), "
+                  f"tolerance={TOLERANCE}, max_sweeps=5000) -> dict(poses, sweeps, converged, changes)",
+        points=4, cases=_relax_cases, answer=relax_map, compare=map_outcome, shortcuts=RELAX_SHORTCUTS,
+        kind="loop",
+        description="Loop: align the office tour's drifted map by relaxation (start the variances along the chain, "
+                    "sweep Eqs. (1)-(3) until a sweep's total change is under the tolerance or the cap); graded "
+                    "on the map (within 5 cm of the reference's up to the gauge), the converged flag and the "
+                    "sweep count; ValueError for a negative variance or an edge to a missing node."),
     Exercise(
         id="02.path_following_command", function="path_following_command",
         signature="path_following_command(d, theta_tilde, curvature, v, k2, k3) -> float  # omega",
@@ -380,13 +559,14 @@ EXERCISES = [
         kind="warm-up",
         description="The paper's Eq. (8); ValueError for negative gains or 1 - c d <= 0."),
     Exercise(
-        id="02.ekf_update", function="ekf_update",
-        signature="ekf_update(x: (n,), P: (n, n), z: (m,), H: (m, n), R: (m, m), angles=()) -> (x, P)",
-        points=2, cases=_ekf_cases, answer=ekf_update, compare=close(rtol=1e-7, atol=1e-10),
-        kind="transcription",
-        description="Kalman update with the innovation's angle components wrapped and the Joseph-form "
-                    "covariance; ValueError for a covariance that is not positive definite or shapes that "
-                    "disagree."),
+        id="02.node_fix_update", function="node_fix_update",
+        signature="node_fix_update(x: (5,), P: (5, 5), node_pose: (3,), z: (3,), R: (3, 3)) -> dict(H, x, P)",
+        points=2, cases=_ekf_cases, answer=node_fix_update, compare=_fix_update_checked,
+        kind="derivation",
+        description="EKF update with a fix measured in the recognised node's frame: the student derives h(x) and "
+                    "its Jacobian H (checked entry by entry, the wrong partial derivatives named), wraps the "
+                    "heading innovation and updates; ValueError for a covariance that is not positive definite "
+                    "or a node pose without its heading."),
     Exercise(
         id="02.recognise_node", function="recognise_node",
         signature="recognise_node(query_histogram, query_descriptors, node_histograms, node_descriptors) -> int",
