@@ -21,8 +21,6 @@ TRANSCRIPTION_DEBT = {
     "01.triangulate_svd",        # the four equations and the SVD recipe, stated in the task
     "01.kalman_fuse",            # Sigma' and s' printed in the task
     "01.hough_votes",            # the accumulator's layout and the voting rule, spelled out
-    "03.bow_similarity",         # Eqs. (16)-(17) printed in the task
-    "03.likelihood_field_weight",  # Table 6.3's sum, printed in the task (the issue asks for its normalisation derived)
     "05.fix_position",           # the fields and their formats, stated in the task
     "05.haversine",              # both formulas printed in the task
     "05.avoidance_decision",     # the decision rules, listed in the task

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from robocourse.lessons.corridor_localization import exercises as module
+from robocourse.exercises.plain import to_plain
 from robocourse.grading import check
 from robocourse.lessons import exercises_for
 from tests.conftest import assert_check_passes
@@ -16,7 +17,7 @@ EXERCISES = {ex.id: ex for ex in module.EXERCISES}
 def test_assignment_is_registered():
     assert module.ASSIGNMENT == "03_corridor_localization"
     assert [e.id for e in exercises_for("03_corridor_localization")] == list(EXERCISES)
-    assert 7 <= len(EXERCISES) <= 8 and len(module.WRITTEN) >= 2
+    assert 7 <= len(EXERCISES) <= 9 and len(module.WRITTEN) >= 2
 
 
 def test_cases_differ_between_seeds():
@@ -57,13 +58,14 @@ def _wrong_log_odds(probabilities, prior=0.5):   # adds the log odds without sub
     return float(np.sum(np.log(p / (1 - p)))) + np.log(prior / (1 - prior))
 
 
-def _wrong_bow(words_a, words_b, idf):   # forgets the IDF (plain term frequencies)
+def _wrong_bow(words_a, words_b, idf):   # maps the L1 distance to 1 - d (not 1 - d / 2)
     idf = np.asarray(idf, float)
     if max(list(words_a) + list(words_b) + [0]) >= len(idf):
         raise ValueError("words")
-    va = np.bincount(words_a, minlength=len(idf)) / max(len(words_a), 1)
-    vb = np.bincount(words_b, minlength=len(idf)) / max(len(words_b), 1)
-    return float(np.minimum(va, vb).sum())
+    va = np.bincount(words_a, minlength=len(idf)) * idf
+    vb = np.bincount(words_b, minlength=len(idf)) * idf
+    va, vb = (v / v.sum() if v.sum() > 0 else v for v in (va, vb))
+    return {"a": va, "b": vb, "score": float(1 - np.abs(va - vb).sum()) if va.sum() and vb.sum() else 0.0}
 
 
 def _wrong_resample(weights, r):   # multinomial-style pointers r + m (not r + m / M)
@@ -75,21 +77,45 @@ def _wrong_resample(weights, r):   # multinomial-style pointers r + m (not r + m
 
 
 def _wrong_field(pose, ranges, angles, distance, resolution, origin, sigma_hit=0.2, z_hit=0.95, z_rand=0.05,
-                 r_max=8.0, max_distance=2.0):   # an unnormalised Gaussian (ROS's), not Table 6.3's density
+                 r_max=8.0, max_distance=2.0):   # an unnormalised Gaussian (ROS's), not the normal density
     r = np.asarray(ranges, float)
     if np.isnan(r).any():
         raise ValueError("ranges")
     d = np.asarray(distance, float)
-    total = 0.0
+    dists = []
     for z, a in zip(r, angles):
         if not np.isfinite(z) or z >= r_max:
             continue
         x = pose[0] + z * np.cos(pose[2] + a)
         y = pose[1] + z * np.sin(pose[2] + a)
         j, i = int(np.floor((x - origin[0]) / resolution)), int(np.floor((y - origin[1]) / resolution))
-        dist = d[i, j] if 0 <= i < d.shape[0] and 0 <= j < d.shape[1] else max_distance
-        total += np.log(z_hit * np.exp(-dist ** 2 / (2 * sigma_hit ** 2)) + z_rand / r_max)
-    return float(total)
+        dists.append(d[i, j] if 0 <= i < d.shape[0] and 0 <= j < d.shape[1] else max_distance)
+    hit = z_hit * np.exp(-np.array(dists) ** 2 / (2 * sigma_hit ** 2))
+    return {"distance": dists, "hit": hit, "rand": z_rand / r_max, "log_q": float(np.log(hit + z_rand / r_max).sum())}
+
+
+def _uniform_rand_field(*args, **kwargs):   # the random-return term without its 1 / r_max
+    out = module.likelihood_field_weight(*args, **kwargs)
+    rand = kwargs.get("z_rand", 0.05)
+    return dict(out, rand=rand, log_q=float(np.log(np.asarray(out["hit"]) + rand).sum()))
+
+
+def _no_resampling(run):   # importance weights multiplied up, never resampled: the cloud degenerates
+    P = np.asarray(run["particles"], float)
+    if len(run["scans"]) != len(run["odometry"]) or any(not 0 <= r < 1 / len(P) for r in run["uniforms"]):
+        raise ValueError("run")
+    log_w, out = np.zeros(len(P)), []
+    for t, u in enumerate(np.asarray(run["odometry"], float)):
+        du = u + np.asarray(run["noise"][t]) * run["motion_std"]
+        c, s = np.cos(P[:, 2]), np.sin(P[:, 2])
+        P = np.column_stack([P[:, 0] + c * du[:, 0] - s * du[:, 1], P[:, 1] + s * du[:, 0] + c * du[:, 1],
+                             P[:, 2] + du[:, 2]])
+        log_w += [module.likelihood_field_weight(p, run["scans"][t], run["angles"], run["distance"], run["resolution"],
+                                                 run["origin"])["log_q"] for p in P]
+        w = np.exp(log_w - log_w.max())
+        w /= w.sum()
+        out.append([w @ P[:, 0], w @ P[:, 1], np.arctan2(w @ np.sin(P[:, 2]), w @ np.cos(P[:, 2]))])
+    return out
 
 
 def _wrong_ellipse(points, centre, sigma_x, sigma_y):   # drops the normalising constant
@@ -109,7 +135,7 @@ def _exact_equality(query, keyframes):   # a tempting shortcut: count identical 
 WRONG = {"03.width_case": _wrong_width, "03.invalid_areas": _wrong_areas, "03.cell_log_odds": _wrong_log_odds,
          "03.bow_similarity": _wrong_bow, "03.resample_indices": _wrong_resample,
          "03.likelihood_field_weight": _wrong_field, "03.ellipse_start_weights": _wrong_ellipse,
-         "03.recognise_keyframe": _exact_equality}
+         "03.recognise_keyframe": _exact_equality, "03.mcl_track": _no_resampling}
 
 
 @pytest.mark.parametrize("exercise_id", list(EXERCISES))
@@ -147,7 +173,69 @@ def test_the_aliasing_helper_shows_a_look_alike():
     from robocourse.lessons.corridor_localization.aliasing import aliasing_example
     data = aliasing_example()
     weight = {k: module.likelihood_field_weight(data[k], data["ranges"], data["angles"], data["distance"],
-                                                data["resolution"], data["origin"])
+                                                data["resolution"], data["origin"])["log_q"]
               for k in ("true", "look_alike", "elsewhere")}
     assert weight["true"] > weight["look_alike"] > weight["elsewhere"]
     assert weight["true"] - weight["look_alike"] < weight["true"] - weight["elsewhere"]
+
+
+@pytest.mark.parametrize("exercise_id, wrong, term", [
+    ("03.likelihood_field_weight", _wrong_field, "'hit'"),
+    ("03.likelihood_field_weight", _uniform_rand_field, "'rand'"),
+    ("03.bow_similarity", _wrong_bow, "'score'"),
+])
+def test_derivation_feedback_names_the_wrong_term(exercise_id, wrong, term, capsys):
+    """A derivation checked term by term: the feedback names the wrong term and no other upstream one
+    (log q follows a wrong term), and says when every value is off by one factor (a normalisation)."""
+    ex = EXERCISES[exercise_id]
+    messages = [ex.compare(to_plain(ex.answer(*c.args, **c.kwargs)), to_plain(wrong(*c.args, **c.kwargs)))
+                for c in ex.make_cases(2024) if not c.raises]
+    failed = [m for m in messages if m]
+    right = {"03.likelihood_field_weight": ["'distance'", "'hit'", "'rand'"], "03.bow_similarity": ["'a'", "'b'"]}
+    assert failed and all(f"{term} (" in m for m in failed)
+    assert not any(f"{other} (" in m for m in failed for other in right[exercise_id] if other != term)
+    if term == "'hit'":                             # every hit off by 1 / (sqrt(2 pi) sigma_hit)
+        assert all("same factor" in m for m in failed)
+
+
+def test_field_terms_add_up_to_the_lessons_weight():
+    """log_q is the log of the product of hit + rand over the used beams, and equals the lesson's
+    likelihood field (robokit) on the public cases."""
+    from robokit.localization import likelihood_field_log_weights
+    from robokit.mapping import LikelihoodField
+    for c in EXERCISES["03.likelihood_field_weight"].make_cases(7):
+        if c.raises:
+            continue
+        out = module.likelihood_field_weight(*c.args)
+        pose, ranges, angles, distance, resolution, origin = c.args
+        field = LikelihoodField(np.asarray(distance), resolution, np.asarray(origin), 2.0)
+        assert out["log_q"] == pytest.approx(float(np.log(np.asarray(out["hit"]) + out["rand"]).sum()), abs=1e-9)
+        assert out["log_q"] == pytest.approx(float(likelihood_field_log_weights([pose], ranges, angles, field)[0]),
+                                             abs=1e-9)
+
+
+def test_loop_cases_are_fair_and_shortcuts_fail():
+    """The loop's runs: the reference converges on every run, every registered shortcut (dead
+    reckoning, the held start, the laser-blind filter, one look) fails every run, and the feedback of
+    a failed run shows the error at a few updates."""
+    ex = EXERCISES["03.mcl_track"]
+    runs = [c for c in ex.make_cases(5) if not c.raises]
+    assert len(runs) == 3
+    for c in runs:
+        assert ex.compare(c.expected, np.asarray(ex.answer(*c.args)).tolist()) is None
+        for name, shortcut in ex.shortcuts.items():
+            message = ex.compare(c.expected, np.asarray(shortcut(*c.args)).tolist())
+            assert message and "did not converge" in message and "Error at update 1:" in message, name
+
+
+def test_loop_truth_is_hidden_from_the_inputs():
+    """The truth travels only in Case.expected: no input holds the true poses."""
+    for c in EXERCISES["03.mcl_track"].make_cases(9):
+        if c.raises:
+            continue
+        run = c.args[0]
+        assert set(run) == {"particles", "odometry", "motion_std", "noise", "scans", "angles", "distance",
+                            "resolution", "origin", "uniforms"}
+        truth = np.asarray(c.expected)
+        start = np.mean(np.asarray(run["particles"])[:, :2], axis=0)
+        assert np.hypot(*(start - truth[0, :2])) > 0.3

@@ -7,5 +7,6 @@ kidnapping  Fig. 15's kidnapped robot
 real_map    the same AMCL on a real building's map (Willow Garage, ROS navigation tutorials) and in the
             corridor (cached)
 aliasing    one scan and the poses a laser-only filter confuses it with (assignment 03's question)
+mcl_runs    short drives in the corridor as plain data, for assignment 03's loop exercise
 exercises   assignment 03
 """

@@ -9,11 +9,14 @@ References
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
+from robokit.geometry import se2_compose
 from robokit.geometry.planar import as_planar
 from robokit.localization.beam_models import likelihood_field_log_weights
-from robokit.localization.particle_filter import ellipse_weights, low_variance_resample
+from robokit.localization.particle_filter import ellipse_weights, low_variance_resample, weighted_pose_mean
 from robokit.mapping.corridor_areas import invalid_areas
 from robokit.mapping.corridor_scan import width_condition
 from robokit.mapping.occupancy_grid import LikelihoodField, log_odds
@@ -21,7 +24,11 @@ from robokit.validation import as_array, as_finite_scalar, as_positive
 from robokit.vision.bag_of_words import l1_score, tf_idf
 from robokit.vision.hamming import as_binary_descriptors, hamming_match
 from robocourse.exercises.compare import close, exact
+from robocourse.exercises.plain import summarize
 from robocourse.exercises.spec import Case, Exercise
+from robocourse.lessons.corridor_localization.mcl_runs import (SETTLED, TOLERANCE, dead_reckoning, one_shot,
+                                                               simulate_run,
+                                                               track, track_errors)
 
 ASSIGNMENT = "03_corridor_localization"
 #: Written (manually graded) questions: id -> points.
@@ -65,11 +72,13 @@ def cell_log_odds(probabilities, prior: float = 0.5) -> float:
     return float(l0 + np.sum(log_odds(p) - l0)) if p.size else l0
 
 
-def bow_similarity(words_a, words_b, idf) -> float:
-    """The L1 score, Eq. (17), of two images given the vocabulary word of each of their features.
+def bow_similarity(words_a, words_b, idf) -> dict:
+    """Two images' bag-of-words vectors and their L1 score, Eqs. (16)-(17), term by term.
 
-    Each image's vector is its TF-IDF weights, Eq. (16) (``TF = n_ik / n_k``, ``IDF = idf[word]``),
-    then Eq. (17) on the L1-normalised vectors. Words with zero IDF drop out.
+    Each image's vector weighs word ``i`` by its term frequency (its share of the image's features)
+    times ``idf[i]``, Eq. (16), scaled to sum to 1; the score, Eq. (17), is
+    ``1 - |v_a - v_b|_1 / 2``: 1 for identical vectors, 0 for vectors with no word in common (the
+    L1 distance of two non-negative unit-sum vectors is at most 2, reached exactly then).
 
     Parameters
     ----------
@@ -80,8 +89,9 @@ def bow_similarity(words_a, words_b, idf) -> float:
 
     Returns
     -------
-    float
-        In [0, 1]; 0 when either image has no weighted word.
+    dict
+        ``a``, ``b``: the two unit-sum vectors (m,) (all zeros for an image with no weighted word);
+        ``score``: Eq. (17) in [0, 1], 0 when either image has no weighted word.
 
     Raises
     ------
@@ -90,8 +100,9 @@ def bow_similarity(words_a, words_b, idf) -> float:
 
     Examples
     --------
-    >>> round(bow_similarity([0, 1, 1], [1, 2], [1.0, 1.0, 1.0]), 6)    # min(2/3, 1/2) = 1/2
-    0.5
+    >>> out = bow_similarity([0, 1, 1], [1, 2], [1.0, 1.0, 1.0])
+    >>> np.round(out["a"], 4).tolist(), round(out["score"], 6)          # min(2/3, 1/2) = 1/2
+    ([0.3333, 0.6667, 0.0], 0.5)
     """
     weights = as_array(idf, "idf", ndim=1, min_size=1)
     vectors = []
@@ -100,13 +111,39 @@ def bow_similarity(words_a, words_b, idf) -> float:
         if np.any(w != np.round(w)) or np.any((w < 0) | (w >= len(weights))):
             raise ValueError(f"{name}: expected word ids in [0, {len(weights)}), got {w.tolist()[:8]}")
         vectors.append(tf_idf(w.astype(np.int64), weights))
-    return l1_score(*vectors)
+    dense = []
+    for v in vectors:
+        full = np.zeros(len(weights))
+        full[v.words] = v.weights
+        dense.append(full / full.sum() if full.sum() > 0 else full)
+    return {"a": dense[0], "b": dense[1], "score": l1_score(*vectors)}
+
+
+#: What each term of :func:`likelihood_field_weight`'s answer stands for, for the feedback.
+FIELD_TERMS = {
+    "distance": "d_k, the distance from each used beam's end point to the nearest obstacle (the end point's "
+                "position, its grid cell, max_distance off the grid, and which beams are skipped)",
+    "hit": "z_hit times the hit model's density at d_k",
+    "rand": "z_rand times the density of a random return",
+    "log_q": "the log of the scan's likelihood, from the per-beam likelihoods hit + rand",
+}
+#: What each term of :func:`bow_similarity`'s answer stands for, for the feedback.
+BOW_TERMS = {
+    "a": "image A's vector (term frequency times IDF per word, scaled to sum to 1)",
+    "b": "image B's vector (term frequency times IDF per word, scaled to sum to 1)",
+    "score": "the score from the two vectors' L1 distance (1 for identical images, 0 for no shared word)",
+}
 
 
 def likelihood_field_weight(pose, ranges, angles, distance, resolution, origin, *, sigma_hit: float = 0.2,
                             z_hit: float = 0.95, z_rand: float = 0.05, r_max: float = 8.0,
-                            max_distance: float = 2.0) -> float:
-    """The log of Table 6.3's ``q`` for one pose: the likelihood-field model of a scan.
+                            max_distance: float = 2.0) -> dict:
+    """The likelihood-field model of a scan for one pose (Thrun et al. 2005, Table 6.3), term by term.
+
+    Each beam's likelihood mixes a hit, whose end point's distance ``d`` to the nearest obstacle is
+    normal with mean 0 and standard deviation ``sigma_hit``, and a random return, uniform over
+    ``[0, r_max)``: ``p_k = z_hit N(d_k; 0, sigma_hit^2) + z_rand / r_max``; the beams are
+    independent, so ``log q = sum_k log p_k``.
 
     Parameters
     ----------
@@ -123,8 +160,9 @@ def likelihood_field_weight(pose, ranges, angles, distance, resolution, origin, 
 
     Returns
     -------
-    float
-        ``sum_k log(z_hit N(dist_k; 0, sigma_hit^2) + z_rand / r_max)``.
+    dict
+        ``distance``: ``d_k`` of each used beam, in scan order; ``hit``: ``z_hit N(d_k; 0, sigma_hit^2)``
+        of each; ``rand``: ``z_rand / r_max``; ``log_q``: ``sum_k log(hit_k + rand)``.
 
     Raises
     ------
@@ -134,14 +172,27 @@ def likelihood_field_weight(pose, ranges, angles, distance, resolution, origin, 
     Examples
     --------
     >>> d = np.abs(np.arange(20)[None, :] * 0.1 + 0.05 - 1.55) * np.ones((20, 1))   # a wall at x = 1.55 m
-    >>> round(likelihood_field_weight([0.55, 1.0, 0.0], [1.0], [0.0], d, 0.1, [0.0, 0.0]), 3)
-    0.642
+    >>> out = likelihood_field_weight([0.55, 1.0, 0.0], [1.0], [0.0], d, 0.1, [0.0, 0.0])
+    >>> out["distance"], round(out["rand"], 6), round(out["log_q"], 3)
+    ([0.0], 0.00625, 0.642)
     """
     field = LikelihoodField(as_array(distance, "distance", ndim=2), as_positive(resolution, "resolution"),
                             as_array(origin, "origin", shape=(2,)), as_positive(max_distance, "max_distance"))
-    return float(likelihood_field_log_weights([as_planar(pose, "pose", shape=(3,))], ranges, angles, field,
-                                              sigma_hit=sigma_hit, z_hit=z_hit, z_rand=z_rand, r_max=r_max,
-                                              combine="product")[0])
+    p = as_planar(pose, "pose", shape=(3,))
+    r = as_array(ranges, "ranges", ndim=1, finite=False)
+    a = as_array(angles, "angles", shape=r.shape)
+    if np.isnan(r).any():
+        raise ValueError("ranges: expected numbers or inf, got NaN")
+    for name, value in (("sigma_hit", sigma_hit), ("r_max", r_max)):
+        as_positive(value, name)
+    used = np.isfinite(r) & (r < r_max)
+    ends = p[:2] + r[used, None] * np.column_stack([np.cos(p[2] + a[used]), np.sin(p[2] + a[used])])
+    d = field.lookup(ends) if used.any() else np.zeros(0)
+    hit = z_hit * np.exp(-0.5 * (d / sigma_hit) ** 2) / (np.sqrt(2 * np.pi) * sigma_hit)
+    rand = z_rand / r_max
+    log_q = float(likelihood_field_log_weights([p], r, a, field, sigma_hit=sigma_hit, z_hit=z_hit, z_rand=z_rand,
+                                               r_max=r_max, combine="product")[0])
+    return {"distance": d, "hit": hit, "rand": float(rand), "log_q": log_q}
 
 
 def resample_indices(weights, r: float) -> list:
@@ -212,6 +263,86 @@ def recognise_keyframe(query, keyframes) -> int:
     counts = [len(hamming_match(q, as_binary_descriptors(k, f"keyframes[{i}]")).query)
               for i, k in enumerate(keyframes)]
     return int(np.argmax(counts))
+
+
+def mcl_track(run: dict) -> np.ndarray:
+    """Monte-Carlo localization over a pre-simulated corridor run: the estimate after each update.
+
+    The loop exercise's reference, :func:`~robocourse.lessons.corridor_localization.mcl_runs.track`
+    (motion with the given noise draws, Table 6.3's likelihood field, the weighted mean, Table 4.4's
+    resampling with the given uniforms).
+
+    Examples
+    --------
+    >>> from robocourse.lessons.corridor_localization.mcl_runs import simulate_run
+    >>> run, truth = simulate_run(np.random.default_rng(1))
+    >>> bool(np.hypot(*(mcl_track(run)[-1, :2] - truth[-1, :2])) < 0.25)
+    True
+    """
+    return track(run)
+
+
+def _terms(terms: dict, rtol: float, atol: float):
+    """A comparison of a dict answer term by term that names each wrong term and what it stands for;
+    a term whose values (two or more) are all off by one factor says so (a normalising constant)."""
+    one = close(rtol=rtol, atol=atol)
+
+    def compare(expected: Any, got: Any) -> str | None:
+        if not isinstance(got, dict):
+            return f"expected a dict with the terms {list(terms)}, got {summarize(got)}"
+        missing = [k for k in terms if k not in got]
+        if missing:
+            return f"expected a dict with the terms {list(terms)}; missing {missing}"
+        wrong = []
+        for key, meaning in terms.items():
+            msg = one(expected[key], got[key])
+            if msg is None:
+                continue
+            note = ""
+            try:
+                e, g = np.atleast_1d(np.asarray(expected[key], float)), np.atleast_1d(np.asarray(got[key], float))
+                big = np.abs(e) > 1e-12
+                if e.shape == g.shape and big.sum() >= 2 and np.all(np.isfinite(g)):
+                    ratio = g[big] / e[big]
+                    if np.ptp(ratio) <= 1e-6 * np.abs(ratio).max() and abs(ratio[0] - 1) > 1e-6:
+                        note = f"; every value is off by the same factor, {ratio[0]:.6g}: check the normalisation"
+            except (TypeError, ValueError):
+                pass
+            wrong.append(f"'{key}' ({meaning}) is wrong: {msg}{note}")
+        if not wrong:
+            return None
+        return f"{len(wrong)} of {len(terms)} terms wrong. " + " | ".join(wrong)
+
+    return compare
+
+
+def _converges(expected: Any, got: Any) -> str | None:
+    """Accept a track of estimates whose last :data:`SETTLED` are each within :data:`TOLERANCE` of
+    the truth (``expected``); the feedback shows the error at a few updates."""
+    truth = np.asarray(expected, dtype=float)
+    try:
+        est = np.asarray(got, dtype=float)
+    except (TypeError, ValueError):
+        return f"expected a ({len(truth)}, 3) array of estimates [x, y, theta], got {summarize(got)}"
+    if est.shape != truth.shape:
+        return f"expected a ({len(truth)}, 3) array of estimates [x, y, theta], one per update, got shape {est.shape}"
+    if not np.all(np.isfinite(est)):
+        return f"your estimates hold NaN or inf (first at update {int(np.argmax(~np.isfinite(est).all(axis=1))) + 1})"
+    err = track_errors(est, truth)
+    T = len(err)
+    show = sorted({0, T // 4, T // 2, 3 * T // 4, T - SETTLED, T - 1})
+    shown = ", ".join(f"{k + 1}: {err[k, 0]:.2f} m {np.rad2deg(err[k, 1]):.1f} deg" for k in show)
+    ok = (err <= TOLERANCE).all(axis=1)
+    if ok[-SETTLED:].all():
+        return None
+    inside = np.flatnonzero(ok)
+    if not inside.size:
+        story = "it was never within the tolerance"
+    else:
+        story = (f"it was within the tolerance at update {inside[0] + 1} and left it again at update "
+                 f"{inside[0] + 1 + int(np.argmin(ok[inside[0]:]))}")
+    return (f"did not converge: the last {SETTLED} estimates must each be within {TOLERANCE[0]} m and "
+            f"{np.rad2deg(TOLERANCE[1]):.1f} deg of the truth; {story}. Error at update {shown}")
 
 
 # --- cases ------------------------------------------------------------------------------------
@@ -347,6 +478,57 @@ def _keyframe_cases(rng: np.random.Generator) -> list[Case]:
     return cases
 
 
+
+def _truncated(run: dict, updates: int) -> dict:
+    """The first ``updates`` updates of a run (a small input for the bad-input cases)."""
+    out = dict(run)
+    for key in ("odometry", "noise", "scans", "uniforms"):
+        out[key] = run[key][:updates]
+    return out
+
+
+def _track_cases(rng: np.random.Generator) -> list[Case]:
+    """Three fair drives in the lesson's corridor (:func:`~.mcl_runs.simulate_run`), judged on the truth."""
+    cases = []
+    for _ in range(3):
+        run, truth = simulate_run(rng)
+        start = np.mean(np.asarray(run["particles"])[:, 0])
+        cases.append(Case((run,), expected=truth.round(4).tolist(),
+                          label=f"a drive {'east' if np.cos(truth[0, 2]) > 0 else 'west'} from x = {truth[0, 0]:.1f} m, "
+                                f"the start cloud centred {start - truth[0, 0]:+.2f} m along the corridor from the "
+                                f"robot"))
+    small = _truncated(cases[0].args[0], 4)
+    bad_r = dict(small, uniforms=[0.5] + small["uniforms"][1:])
+    short = dict(small, scans=small["scans"][:3])
+    return cases + [
+        Case((bad_r,), raises="ValueError", label="a resampling number outside [0, 1/M)"),
+        Case((short,), raises="ValueError", label="one scan fewer than odometry increments"),
+    ]
+
+
+def _held_start(run: dict) -> list:
+    """A shortcut: the start cloud's mean, every update."""
+    mean = np.mean(np.asarray(run["particles"], dtype=float), axis=0)
+    return [mean.tolist()] * len(run["odometry"])
+
+
+def _laser_blind(run: dict) -> np.ndarray:
+    """A shortcut: the filter without its measurement update (equal weights), so dead reckoning with noise."""
+    P = np.asarray(run["particles"], dtype=float)
+    std, out = np.asarray(run["motion_std"], dtype=float), []
+    for u, n in zip(np.asarray(run["odometry"], dtype=float), np.asarray(run["noise"], dtype=float)):
+        P = se2_compose(P, u + n * std)
+        out.append(weighted_pose_mean(P))
+    return np.array(out)
+
+
+#: Ways to produce a track without the loop: they pass no fair run (:mod:`.mcl_runs`).
+TRACK_SHORTCUTS = {"dead reckoning from the start cloud's mean": dead_reckoning,
+                   "the start cloud's mean, held": _held_start,
+                   "the filter without its measurement update": _laser_blind,
+                   "the particle the first scan likes best, dead-reckoned": one_shot}
+
+
 EXERCISES = [
     Exercise(
         id="03.width_case", function="width_case",
@@ -372,11 +554,14 @@ EXERCISES = [
                     "ValueError for a reading of 0 or 1."),
     Exercise(
         id="03.bow_similarity", function="bow_similarity",
-        signature="bow_similarity(words_a: list of int, words_b: list of int, idf: (m,)) -> float",
-        points=2, cases=_bow_cases, answer=bow_similarity, compare=close(rtol=1e-9, atol=1e-12),
-        kind="transcription",
-        description="TF-IDF vectors, Eq. (16), of two images' words, then the L1 score, Eq. (17); ValueError for "
-                    "a word outside the vocabulary."),
+        signature="bow_similarity(words_a: list of int, words_b: list of int, idf: (m,)) -> dict "
+                  "{'a': (m,), 'b': (m,), 'score': float}",
+        points=1, cases=_bow_cases, answer=bow_similarity, compare=_terms(BOW_TERMS, 1e-9, 1e-12),
+        kind="derivation",
+        description="Eqs. (16)-(17) from their description: each image's TF-IDF vector scaled to sum to 1, and "
+                    "the affine map of their L1 distance that gives 1 for the same image and 0 for no shared word "
+                    "(derived, not given); feedback names the wrong term; ValueError for a word outside the "
+                    "vocabulary."),
     Exercise(
         id="03.resample_indices", function="resample_indices",
         signature="resample_indices(weights: (M,), r: float in [0, 1/M)) -> list of int",
@@ -388,11 +573,14 @@ EXERCISES = [
     Exercise(
         id="03.likelihood_field_weight", function="likelihood_field_weight",
         signature="likelihood_field_weight(pose, ranges, angles, distance: (H, W), resolution, origin, "
-                  "sigma_hit=0.2, z_hit=0.95, z_rand=0.05, r_max=8.0, max_distance=2.0) -> float",
-        points=2, cases=_field_cases, answer=likelihood_field_weight, compare=close(rtol=1e-7, atol=1e-9),
-        kind="transcription",
-        description="The log of Thrun et al. Table 6.3's q for one pose (end points looked up in the distance "
-                    "grid, max_distance off it, inf returns skipped); ValueError for NaN ranges."),
+                  "sigma_hit=0.2, z_hit=0.95, z_rand=0.05, r_max=8.0, max_distance=2.0) -> dict "
+                  "{'distance': (K,), 'hit': (K,), 'rand': float, 'log_q': float}",
+        points=2, cases=_field_cases, answer=likelihood_field_weight, compare=_terms(FIELD_TERMS, 1e-7, 1e-9),
+        kind="derivation",
+        description="Thrun et al. Table 6.3 derived from the model's description: each used beam's end-point "
+                    "distance, the hit term (the normal density, its normalisation derived), the random-return "
+                    "term (the uniform density) and log q; feedback names the wrong term; ValueError for NaN "
+                    "ranges."),
     Exercise(
         id="03.ellipse_start_weights", function="ellipse_start_weights",
         signature="ellipse_start_weights(points: (N, 2), centre: (2,), sigma_x, sigma_y) -> numpy.ndarray (N,)",
@@ -402,8 +590,19 @@ EXERCISES = [
     Exercise(
         id="03.recognise_keyframe", function="recognise_keyframe",
         signature="recognise_keyframe(query: (N, 32) uint8, keyframes: list of (M_k, 32) uint8) -> int",
-        points=3, cases=_keyframe_cases, answer=recognise_keyframe, compare=exact(),
+        points=2, cases=_keyframe_cases, answer=recognise_keyframe, compare=exact(),
         kind="open",
         description="Open: the index of the keyframe the query was taken at, by any method; ValueError for no "
                     "keyframes."),
+    Exercise(
+        id="03.mcl_track", function="mcl_track",
+        signature="mcl_track(run: dict) -> array-like (T, 3) of estimates [x, y, theta]",
+        points=2, cases=_track_cases, answer=mcl_track, compare=_converges,
+        kind="loop",
+        description="Loop: Monte-Carlo localization over a pre-simulated drive in the lesson's corridor (motion "
+                    "with the given noise draws, the likelihood-field weight, the weighted mean, low-variance "
+                    "resampling with the given numbers); passes when the last 5 estimates are within 0.25 m and "
+                    "5.7 deg of the simulator's truth; ValueError for a resampling number outside [0, 1/M) or "
+                    "inputs of mismatched lengths.",
+        shortcuts=TRACK_SHORTCUTS),
 ]
