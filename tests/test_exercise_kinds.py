@@ -24,9 +24,6 @@ TRANSCRIPTION_DEBT = {
     "05.fix_position",           # the fields and their formats, stated in the task
     "05.haversine",              # both formulas printed in the task
     "05.avoidance_decision",     # the decision rules, listed in the task
-    "06.geometric_jacobian",     # Siciliano et al.'s Eq. 3.30 printed in the task
-    "06.shoulder_angles",        # the three steps with their formulas, in the task
-    "06.null_space_step",        # the step's formula printed in the task
 }
 
 

@@ -17,7 +17,23 @@ def test_assignment_is_registered():
     assert set(redundant_ik.WRITTEN) == {"06.extra_dof", "06.self_motion", "06.your_solver"}
     assert {e.id for e in EXERCISES} >= {"06.dh_transform", "06.forward_kinematics", "06.geometric_jacobian",
                                          "06.wrist_centre", "06.elbow_angle", "06.shoulder_angles",
-                                         "06.null_space_step", "06.solve_ik"}
+                                         "06.null_space_step", "06.track_path", "06.solve_ik"}
+
+
+def test_total_points_unchanged():
+    """Issue 37 rebalanced the points (a loop exercise added), not the assignment's total of 19."""
+    assert sum(e.points for e in EXERCISES) + sum(redundant_ik.WRITTEN.values()) == 19
+
+
+def test_data_is_the_lessons_iiwa():
+    """The notebook's arm and the exercises' cases are robokit's iiwa14, the arm the lesson runs."""
+    from robokit.arm import iiwa14
+
+    arm, d = iiwa14(), redundant_ik.data()
+    assert np.allclose(d["dh"], np.stack([arm.d, arm.a, arm.alpha], 1))
+    assert np.allclose(d["qmin"], arm.qmin) and np.allclose(d["qmax"], arm.qmax)
+    assert d["shoulder"] == [0.0, 0.0, arm.d[0]] and (d["d_se"], d["d_ew"], d["d_wf"]) == tuple(arm.d[[2, 4, 6]])
+    assert d["track"] == redundant_ik.TRACK
 
 
 def test_cases_depend_on_the_seed():
@@ -169,3 +185,160 @@ def test_open_ik_feedback_says_how_far_a_joint_is_over():
     outside[2] = np.radians(175)
     message = SOLVE_IK.compare(q.tolist(), outside.tolist())
     assert "joint 3" in message and "5 deg beyond" in message
+
+
+def _exercise(eid):
+    return next(e for e in EXERCISES if e.id == eid)
+
+
+def _valid(eid, seed=2024):
+    from robocourse.grading.judge import expected_output
+
+    ex = _exercise(eid)
+    return [(c, expected_output(ex, c)) for c in ex.make_cases(seed) if not c.raises]
+
+
+# --- 06.geometric_jacobian: a derivation; the feedback names the column and the part ---------------------
+def test_jacobian_feedback_names_the_column_and_the_part():
+    ex = _exercise("06.geometric_jacobian")
+    for case, expected in _valid("06.geometric_jacobian"):
+        J = np.array(expected)
+        if J.shape[1] < 3:
+            continue
+        linear = J.copy()
+        linear[:3, 2] *= -1                                   # the cross product the wrong way round
+        msg = ex.compare(expected, linear)
+        assert "column 3 (joint 3)" in msg and "linear part" in msg and "angular part" not in msg, msg
+        assert "opposite" in msg or np.allclose(J[:3, 2], 0)
+        shifted = J.copy()
+        shifted[3:] = np.roll(J[3:], -1, axis=1)              # each joint about the next frame's z axis
+        msg = ex.compare(expected, shifted)
+        assert "angular part" in msg and "linear part" not in msg and "next joint's axis" in msg, msg
+        assert ex.compare(expected, J) is None
+
+
+def _jacobian_about_the_wrong_frame(dh, q):
+    """A wrong Jacobian: joint i turns about the z axis of frame i (not i - 1)."""
+    from robokit.arm import dh_jacobian
+
+    J = np.array(dh_jacobian(dh, q))
+    J[3:] = np.roll(J[3:], -1, axis=1)
+    return J
+
+
+def test_check_fails_a_jacobian_with_the_wrong_axes():
+    with pytest.raises(AssertionError):
+        check("06.geometric_jacobian", _jacobian_about_the_wrong_frame)
+
+
+def test_finite_differences_do_not_pass_the_jacobian():
+    """A central-difference Jacobian is close (1e-8) but not exact: the check asks for the derived columns."""
+    ex = _exercise("06.geometric_jacobian")
+    fd = ex.shortcuts["central differences of the flange pose"]
+    for seed in (0, 1):
+        for case, expected in _valid("06.geometric_jacobian", seed):
+            got = fd(*case.args)
+            assert np.abs(got - np.array(expected)).max() < 1e-7
+            assert ex.compare(expected, got) is not None
+
+
+# --- 06.shoulder_angles: the feedback says wrist, arm angle or branch ----------------------------------
+def test_shoulder_feedback_says_what_is_wrong():
+    from robokit.arm import shoulder_angles
+
+    ex = _exercise("06.shoulder_angles")
+    for case, expected in _valid("06.shoulder_angles"):
+        S, W, q4, psi, d_se, d_ew = case.args
+        q = np.array(expected["q"])
+        assert ex.compare(expected, q) is None
+        assert ex.compare(expected, q + [2 * np.pi, 0, -2 * np.pi]) is None          # the same angles
+        assert "branch" in ex.compare(expected, q + [np.pi, -2 * q[1], np.pi])
+        assert "wrist centre" in ex.compare(expected, q + [0, 0.05, 0])
+        if abs(np.sin(psi)) > 0.05:
+            assert "-psi" in ex.compare(expected, shoulder_angles(S, W, q4, -psi, d_se, d_ew))
+            assert "arm angle" in ex.compare(expected, shoulder_angles(S, W, q4, 0.0, d_se, d_ew))
+
+
+# --- 06.null_space_step: the feedback says which term --------------------------------------------------
+def test_null_space_feedback_names_the_term():
+    ex = _exercise("06.null_space_step")
+    unprojected = ex.shortcuts["the DLS step plus the gradient, not projected"]
+    plain = ex.shortcuts["the DLS step alone (no null-space term)"]
+    for case, expected in _valid("06.null_space_step"):
+        J, e, g, lam, k = case.args
+        if not np.any(g) or k == 0:
+            continue
+        assert "as it is" in ex.compare(expected, unprojected(*case.args))
+        assert "null-space term" in ex.compare(expected, plain(*case.args))
+        dq = np.array(expected["dq"])
+        null = dq - plain(*case.args)
+        assert "null-space term" in ex.compare(expected, dq - 2 * null)               # the gradient's sign flipped
+        if lam > 0:
+            undamped = np.array(J).T @ np.linalg.solve(np.array(J) @ np.array(J).T, e) + null
+            assert "damping" in ex.compare(expected, undamped)
+
+
+# --- 06.track_path: the loop, graded on its outcome ---------------------------------------------------
+def _loop_with(**changes):
+    """The reference loop with one thing changed (a student's mistake)."""
+    def loop(dh, qmin, qmax, q_start, targets, settings):
+        return redundant_ik.track_path(dh, qmin, qmax, q_start, targets, {**settings, **changes})
+    return loop
+
+
+def test_loop_feedback_shows_the_run():
+    ex = _exercise("06.track_path")
+    case, expected = _valid("06.track_path")[0]
+    steps = expected["settings"]["steps"]
+    assert ex.compare(expected, ex.answer(*case.args)) is None
+    msg = ex.compare(expected, _loop_with(steps=5)(*case.args))                       # stops early
+    assert "shape" in msg
+    short = np.array(_loop_with(damping=3.0)(*case.args))                              # far too damped to arrive
+    msg = ex.compare(expected, short)
+    assert "target 1 of" in msg and "not reached" in msg and "iterations 1:" in msg and f"{steps}:" in msg, msg
+    msg = ex.compare(expected, _loop_with(max_step=0.5)(*case.args))
+    assert msg is None or "more than max_step" in msg
+    msg = ex.compare(expected, ex.shortcuts["plain DLS (no secondary task)"](*case.args))
+    assert "secondary task" in msg and "plain DLS ends at" in msg, msg
+    run = np.array(ex.answer(*case.args))
+    tighter = {**expected, "qmax": list(expected["qmax"])}
+    tighter["qmax"][2] = float(run[:, 2].max()) - 1e-3             # joint 3's range ends just inside the run
+    msg = ex.compare(tighter, run)
+    assert "puts joint 3" in msg and "beyond its limits" in msg, msg
+
+
+def test_check_fails_a_loop_that_turns_the_wrong_way():
+    """The rotation error with the wrong sign (R R_target^T instead of R_target R^T): the hand turns away."""
+    from robokit.geometry import pose_error
+
+    def wrong(dh, qmin, qmax, q_start, targets, settings):
+        flipped = []
+        for T in targets:
+            T = np.array(T)
+            T[:3, :3] = T[:3, :3].T                     # any wrong orientation target misses the pose
+            flipped.append(T)
+        return redundant_ik.track_path(dh, qmin, qmax, q_start, flipped, settings)
+
+    assert pose_error is not None
+    with pytest.raises(AssertionError):
+        check("06.track_path", wrong)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_loop_shortcuts_fail_every_case(seed):
+    ex = _exercise("06.track_path")
+    for case, expected in _valid("06.track_path", seed):
+        assert ex.compare(expected, ex.answer(*case.args)) is None
+        for name, shortcut in ex.shortcuts.items():
+            assert ex.compare(expected, shortcut(*case.args)) is not None, name
+
+
+def test_loop_cases_are_what_their_labels_say():
+    """Starts far from mid-range, inside the limits; plain DLS ends well above the reference in joint-range cost."""
+    for seed in (0, 1):
+        for case, expected in _valid("06.track_path", seed):
+            q0, qmin, qmax = (np.array(expected[k]) for k in ("q_start", "qmin", "qmax"))
+            assert np.all((q0 > qmin) & (q0 < qmax))
+            assert expected["cost_start"] >= 1.2
+            assert expected["cost_dls"] - expected["cost_reference"] >= redundant_ik.TRACK_MARGIN
+            assert len(expected["targets"]) == redundant_ik.TRACK_WAYPOINTS

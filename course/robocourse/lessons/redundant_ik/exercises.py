@@ -1,8 +1,11 @@
 """Exercises of assignment 06 (redundant 7-DOF arm IK): from one DH transform to a null-space step,
-and an open exercise, a whole IK solver for the iiwa by any method.
+a resolved-rate tracking loop with a secondary task, and an open exercise, a whole IK solver for the
+iiwa by any method.
 
 Inputs are generated from the KUKA LBR iiwa 14 R820 and the Franka Panda of :mod:`robokit.arm`
-(random configurations inside the joint limits), plus small hand-checkable chains.
+(random configurations inside the joint limits), plus small hand-checkable chains and random DH
+chains. The notebook's arm (DH table, limits, link lengths) and the tracking loop's settings come
+from :func:`data`, which takes them from :func:`robokit.arm.iiwa14`, the arm the lesson runs.
 
 References
 ----------
@@ -11,6 +14,14 @@ References
 .. [2] M. Shimizu, H. Kakuya, W.-K. Yoon, K. Kitagaki and K. Kosuge, "Analytical inverse kinematic
    computation for 7-DOF redundant manipulators with joint limits and its application to redundancy
    resolution", *IEEE Transactions on Robotics* 24(5), 1131-1142, 2008.
+.. [3] B. Siciliano, L. Sciavicco, L. Villani and G. Oriolo, *Robotics: Modelling, Planning and
+   Control*, Springer, 2009 (Sec. 3.1.3, the geometric Jacobian; Sec. 3.7, inverse kinematics
+   algorithms).
+.. [4] A. Liégeois, "Automatic supervisory control of the configuration and behavior of multibody
+   mechanisms", *IEEE Transactions on Systems, Man, and Cybernetics* 7(12), 868-871, 1977.
+.. [5] C. W. Wampler, "Manipulator inverse kinematic solutions based on vector formulations and
+   damped least-squares methods", *IEEE Transactions on Systems, Man, and Cybernetics* 16(1),
+   93-101, 1986.
 """
 from __future__ import annotations
 
@@ -19,9 +30,11 @@ import numpy as np
 from typing import Any
 
 from robokit.arm import (LIMIT_TOL, dh_fk, dh_jacobian, dh_transform, elbow_angle, feasible_arm_angles, geometric_jacobian,
-                   iiwa14, ik_srs_readable, limit_distance_gradient, null_space_step, panda, shoulder_angles,
-                   wrist_centre)
-from robokit.geometry import as_se3, pose_error
+                         iiwa14, ik_srs_readable, limit_distance_gradient, null_space_step, panda, shoulder_angles,
+                         wrist_centre)
+from robokit.arm.srs_geometry import arm_angle_terms
+from robokit.geometry import as_se3, pose_error, so3_exp
+from robokit.validation import as_array
 from robocourse.exercises.compare import close
 from robocourse.exercises.plain import numeric_array, summarize
 from robocourse.exercises.spec import Case, Exercise
@@ -35,8 +48,28 @@ IK_TOL = 1e-6
 _IIWA = iiwa14()
 _IIWA_DH = np.stack([_IIWA.d, _IIWA.a, _IIWA.alpha], 1).tolist()
 _PLANAR = [[0.0, 1.0, 0.0], [0.0, 0.5, 0.0]]            # two-link planar arm, lengths 1 m and 0.5 m
-_SHOULDER = [0.0, 0.0, 0.36]
-_D_SE, _D_EW, _D_WF = 0.42, 0.40, 0.126
+#: The iiwa's S-R-S geometry: shoulder point [m] and the shoulder-elbow, elbow-wrist and wrist-flange
+#: distances [m] (the DH table's d_1, d_3, d_5, d_7).
+_SHOULDER = [0.0, 0.0, float(_IIWA.d[0])]
+_D_SE, _D_EW, _D_WF = (float(_IIWA.d[i]) for i in (2, 4, 6))
+#: The tracking loop's settings (:func:`track_path`): iterations per waypoint, the pose error [m and
+#: rad] each waypoint must be reached to by the end of its iterations, the largest joint move per
+#: iteration [rad], the DLS damping and the null-space gain of the joint-range criterion.
+TRACK = {"steps": 30, "tol": 1e-3, "max_step": 0.1, "damping": 0.02, "gain": 1.0}
+
+
+def data() -> dict:
+    """What the notebook works on: the iiwa of the lesson (:func:`robokit.arm.iiwa14`) as plain data,
+    and the tracking loop's settings (:data:`TRACK`); the grading worker has no robokit.
+
+    Examples
+    --------
+    >>> d = data()
+    >>> d["dh"][0], d["d_wf"], d["track"]["steps"]
+    ([0.36, 0.0, -1.5707963267948966], 0.126, 30)
+    """
+    return {"dh": _IIWA_DH, "qmin": _IIWA.qmin.tolist(), "qmax": _IIWA.qmax.tolist(), "shoulder": _SHOULDER,
+            "d_se": _D_SE, "d_ew": _D_EW, "d_wf": _D_WF, "track": dict(TRACK)}
 
 
 def _iiwa_q(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -130,13 +163,84 @@ def _fk_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
+def _random_chain(rng: np.random.Generator, n: int) -> list:
+    """A standard-DH table of ``n`` revolute joints with offsets and twists of every kind (no structure
+    a student could rely on: no zero ``a``, no right-angle twists)."""
+    return np.round(np.column_stack([rng.uniform(-0.4, 0.4, n), rng.uniform(-0.4, 0.4, n),
+                                     rng.uniform(-np.pi, np.pi, n)]), 4).tolist()
+
+
 def _jacobian_cases(rng: np.random.Generator) -> list[Case]:
     q = _iiwa_q(rng, 2)
+    n = rng.integers(3, 7, size=2)
     return [
-        Case((_PLANAR, [0.3, 0.4]), label="planar arm"),
+        Case((_PLANAR, rng.uniform(-np.pi, np.pi, 2).round(4).tolist()), label="planar arm"),
         *[Case((_IIWA_DH, qi.tolist()), label="iiwa, random configuration") for qi in q],
+        *[Case((_random_chain(rng, int(k)), rng.uniform(-np.pi, np.pi, int(k)).round(4).tolist()),
+               label=f"a random {k}-joint chain (offsets a and d, twists of any angle)") for k in n],
         Case((_IIWA_DH, [0.1] * 8), raises="ValueError", label="8 angles for 7 joints"),
     ]
+
+
+#: Tolerance on a Jacobian entry: far above rounding of the exact columns (1e-15), far below what a
+#: central difference of the pose can reach (about 1e-10 at its best step).
+JACOBIAN_TOL = 1e-11
+
+
+def finite_difference_jacobian(dh: Any, q: Any, h: float = 1e-6) -> np.ndarray:
+    """The 6 x n Jacobian by central differences of the flange pose: ``(p(q + h e_i) - p(q - h e_i)) / 2h``
+    and the rotation vector of ``R(q + h e_i) R(q - h e_i)^T`` over ``2h`` (a check, and a shortcut).
+
+    Examples
+    --------
+    >>> J = finite_difference_jacobian([[0.0, 1.0, 0.0], [0.0, 0.5, 0.0]], [0.3, 0.4])
+    >>> bool(np.abs(J - dh_jacobian([[0.0, 1.0, 0.0], [0.0, 0.5, 0.0]], [0.3, 0.4])).max() < 1e-8)
+    True
+    """
+    q = as_array(q, "q", shape=(None,))
+    J = np.zeros((6, len(q)))
+    for i in range(len(q)):
+        dq = np.zeros(len(q))
+        dq[i] = h
+        J[:, i] = pose_error(dh_fk(dh, q + dq), dh_fk(dh, q - dq)) / (2 * h)
+    return J
+
+
+def _jacobian_columns(expected: Any, got: Any) -> str | None:
+    """Name the wrong columns of a geometric Jacobian (joints), and in each the part, linear or angular."""
+    J = np.asarray(expected, dtype=float)
+    g = numeric_array(got)
+    if g is None or g.dtype.kind == "b" or g.shape != J.shape:
+        return f"expected a {J.shape[0]} x {J.shape[1]} array (6 rows, one column per joint), got {summarize(got)}"
+    g = g.astype(float)
+    if not np.all(np.isfinite(g)):
+        return "your Jacobian holds NaN or inf"
+    bad = np.abs(g - J) > JACOBIAN_TOL
+    if not bad.any():
+        return None
+    cols = np.flatnonzero(bad.any(axis=0))
+    i = int(cols[0])
+    parts = [name for name, rows in (("linear part (rows 1-3, the flange's velocity)", slice(0, 3)),
+                                     ("angular part (rows 4-6, the flange's angular velocity)", slice(3, 6)))
+             if bad[rows, i].any()]
+    message = (f"{len(cols)} of {J.shape[1]} columns are wrong; the first, column {i + 1} (joint {i + 1}): the "
+               f"{' and the '.join(parts)} {'is' if len(parts) == 1 else 'are'} wrong: yours "
+               f"{np.round(g[:, i], 6).tolist()}, the central difference of the flange pose gives "
+               f"{np.round(J[:, i], 6).tolist()}")
+    hints = []
+    for part, rows in (("linear", slice(0, 3)), ("angular", slice(3, 6))):
+        if bad[rows, i].any() and np.allclose(g[rows, i], -J[rows, i], atol=1e-9):
+            hints.append(f"your {part} part is the exact opposite: check the sign (the order of a cross product, "
+                         f"or of a difference)")
+    for k, shift in ((i + 1, "the next joint's"), (i - 1, "the previous joint's")):
+        if 0 <= k < J.shape[1] and np.allclose(g[3:, i], J[3:, k], atol=1e-9) and not np.allclose(J[3:, i], J[3:, k], atol=1e-9):
+            hints.append(f"your angular part is {shift} axis: which frame's z axis does joint {i + 1} turn about?")
+    if not bad[:3].any() and bad[3:].any() and np.allclose(np.linalg.norm(g[3:, i]), 1.0, atol=1e-9):
+        hints.append("your angular part is a unit vector, but not this joint's axis in the base frame")
+    if bad[:3].any() and not bad[3:].any():
+        hints.append("the axis is right: check the point the axis passes through, and the point whose velocity "
+                     "you take (the flange's origin)")
+    return message + ("; " + "; ".join(hints) if hints else "")
 
 
 def _wrist_cases(rng: np.random.Generator) -> list[Case]:
@@ -160,31 +264,456 @@ def _elbow_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
+def _shoulder_case(S: list, W: Any, q4: float, psi: float, label: str) -> Case:
+    """A case of :func:`shoulder_angles` that carries, beside the answer, the geometry its feedback needs."""
+    args = (S, np.asarray(W).tolist(), float(q4), float(psi), _D_SE, _D_EW)
+    q = shoulder_angles(*args)
+    return Case(args, label=label, expected={"q": q.tolist(), "shoulder": S, "wrist": args[1], "q4": args[2],
+                                             "psi": args[3], "d_se": _D_SE, "d_ew": _D_EW})
+
+
 def _shoulder_cases(rng: np.random.Generator) -> list[Case]:
     q = _iiwa_q(rng, 4)
     W = _IIWA.link_frames(q)[:, 5, :3, 3]
     psi = rng.uniform(-np.pi, np.pi, size=4)
     return [
-        *[Case((_SHOULDER, w.tolist(), float(qi[3]), float(p), _D_SE, _D_EW), label="iiwa, random arm angle")
-          for w, qi, p in zip(W, q, psi)],
+        _shoulder_case(_SHOULDER, W[0], q[0, 3], 0.0, "iiwa, the reference plane (psi = 0)"),
+        *[_shoulder_case(_SHOULDER, w, qi[3], p, "iiwa, random arm angle") for w, qi, p in zip(W[1:], q[1:], psi)],
         Case((_SHOULDER, W[0].tolist(), float(q[0, 3]), float("nan"), _D_SE, _D_EW), raises="ValueError",
              label="NaN arm angle"),
     ]
 
 
+#: Ways to pass the reference-plane case without the arm angle: ignore psi, or turn the wrong way.
+SHOULDER_SHORTCUTS = {"the arm angle ignored (psi = 0)": lambda S, W, q4, psi, d_se, d_ew: shoulder_angles(S, W, q4, 0.0, d_se, d_ew),
+                      "the arm angle with the wrong sign": lambda S, W, q4, psi, d_se, d_ew: shoulder_angles(S, W, q4, -psi, d_se, d_ew)}
+
+
+def _rz(t: float) -> np.ndarray:
+    return np.array([[np.cos(t), -np.sin(t), 0.0], [np.sin(t), np.cos(t), 0.0], [0.0, 0.0, 1.0]])
+
+
+def _ry(t: float) -> np.ndarray:
+    return np.array([[np.cos(t), 0.0, np.sin(t)], [0.0, 1.0, 0.0], [-np.sin(t), 0.0, np.cos(t)]])
+
+
+def _shoulder_geometry(expected: Any, got: Any) -> str | None:
+    """Judge shoulder joints by what they do: put the wrist centre at W, at the arm angle asked, on the
+    branch q2 >= 0; say which of the three fails first."""
+    want = np.asarray(expected["q"], dtype=float)
+    g = numeric_array(got)
+    if g is None or g.dtype.kind == "b" or g.shape != (3,):
+        return f"expected 3 shoulder angles (q1, q2, q3), got {summarize(got)}"
+    g = g.astype(float)
+    if not np.all(np.isfinite(g)):
+        return "your shoulder angles hold NaN or inf"
+    d = np.angle(np.exp(1j * (g - want)))                       # compared on the circle
+    if np.abs(d).max() <= 1e-7:
+        return None
+    S, W = np.asarray(expected["shoulder"], float), np.asarray(expected["wrist"], float)
+    q4, psi, d_se, d_ew = expected["q4"], expected["psi"], expected["d_se"], expected["d_ew"]
+    v = np.array([-d_ew * np.sin(q4), 0.0, d_se + d_ew * np.cos(q4)])
+    wrist = S + _rz(g[0]) @ _ry(g[1]) @ _rz(g[2]) @ v
+    miss = float(np.linalg.norm(wrist - W))
+    yours = f"yours (q1, q2, q3) = {np.degrees(g).round(3).tolist()} deg, expected {np.degrees(want).round(3).tolist()} deg"
+    if miss > 1e-6:
+        return (f"{yours}: your joints put the wrist centre {miss * 1e3:.3g} mm from W; the reference posture "
+                f"(where does q3 = 0 put the arm, and which q1, q2 send the wrist to W?) or the reading of the "
+                f"angles back from the rotation is wrong")
+    got_psi = float(arm_angle_terms(*g, q4, d_se, d_ew))
+    off = float(np.angle(np.exp(1j * (got_psi - psi))))
+    if abs(off) > 1e-6:
+        flipped = abs(float(np.angle(np.exp(1j * (got_psi + psi))))) < 1e-6
+        return (f"{yours}: the wrist centre is right, but your posture's arm angle is {np.degrees(got_psi):.3f} deg "
+                f"where the case asks for psi = {np.degrees(psi):.3f} deg"
+                + ("; it is -psi: you turn the arm plane the wrong way about the line from S to W" if flipped
+                   else "; check the reference plane (psi = 0) and the rotation about the line from S to W"))
+    return (f"{yours}: the wrist centre and the arm angle are right, but not the branch: the task asks for "
+            f"q2 >= 0 (the same arm as (q1 + 180, -q2, q3 + 180) deg)")
+
+
+def null_space_step_exact(J: Any, e: Any, gradient: Any, damping: float, gain: float) -> np.ndarray:
+    """The damped least-squares step plus ``gain`` times the gradient's orthogonal projection onto the
+    Jacobian's null space (the answer of ``06.null_space_step``).
+
+    ``J# e`` minimises ``|J dq - e|^2 + damping^2 |dq|^2``, so ``J# = J^T (J J^T + damping^2 I)^-1``
+    (Wampler 1986); the projection of ``g`` onto the null space of a full-rank ``J`` is
+    ``g - J^T (J J^T)^-1 J g`` (Liégeois 1977, Eq. 9, with the exact pseudo-inverse). Unlike
+    :func:`robokit.arm.null_space_step`, whose projector is regularised for singular Jacobians, the
+    projection here is exact; the cases keep ``J`` far from singular.
+
+    Parameters
+    ----------
+    J : array_like, shape (6, n)
+    e : array_like, shape (6,)
+    gradient : array_like, shape (n,)
+    damping, gain : float
+        ``lambda >= 0`` and ``k >= 0``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+
+    Raises
+    ------
+    ValueError
+        On shapes that do not match, NaN, or a negative damping or gain.
+
+    Examples
+    --------
+    >>> J = np.hstack([np.eye(6), np.zeros((6, 1))])
+    >>> print(null_space_step_exact(J, [0.1, 0, 0, 0, 0, 0], [1, 1, 1, 1, 1, 1, 1], 0.0, 0.5))
+    [0.1 0.  0.  0.  0.  0.  0.5]
+    """
+    null_space_step(J, e, gradient, damping, gain)         # robokit's (regularised) step validates the inputs
+    J, e, g = (np.asarray(x, dtype=float) for x in (J, e, gradient))
+    JJt = J @ J.T
+    primary = J.T @ np.linalg.solve(JJt + damping ** 2 * np.eye(6), e)
+    projected = g - J.T @ np.linalg.solve(JJt, J @ g)
+    return primary + gain * projected
+
+
+def _null_space_case(J, e, g, damping, gain, label) -> Case:
+    args = (np.asarray(J).round(10).tolist(), np.asarray(e).round(10).tolist(), np.asarray(g).round(10).tolist(),
+            damping, gain)
+    dq = null_space_step_exact(*args)
+    return Case(args, label=label, expected={"dq": dq.tolist(), "J": args[0], "e": args[1], "gradient": args[2],
+                                             "damping": damping, "gain": gain})
+
+
 def _null_space_cases(rng: np.random.Generator) -> list[Case]:
     arm = panda()
-    q = arm.random_q(3, rng)
+    q = arm.random_q(8, rng)
     J = geometric_jacobian(arm, q)
-    g = limit_distance_gradient(arm, q)
+    keep = [i for i in range(len(q)) if np.linalg.svd(J[i], compute_uv=False)[-1] > 0.05][:3]
+    J, g = J[keep], limit_distance_gradient(arm, q[keep])
     e = rng.normal(0, 0.01, size=(3, 6))
     return [
-        Case((J[0], [0.0] * 6, g[0].tolist(), 0.0, 1.0), label="zero pose error: pure self-motion"),
-        Case((J[1], e[1].tolist(), [0.0] * 7, 0.05, 1.0), label="zero gradient: plain DLS"),
-        Case((J[2], e[2].tolist(), g[2].tolist(), 0.01, 0.5), label="both terms"),
-        Case((J[0][:5], e[0].tolist(), g[0].tolist(), 0.01, 0.5), raises="ValueError",
+        _null_space_case(J[0], [0.0] * 6, g[0], 0.0, 1.0, "zero pose error: pure self-motion"),
+        _null_space_case(J[1], e[1], [0.0] * 7, 0.05, 1.0, "zero gradient: plain DLS"),
+        _null_space_case(J[2], e[2], g[2], 0.1, 0.5, "both terms"),
+        _null_space_case(J[0], e[0], g[0], 0.05, 0.3, "both terms, another damping and gain"),
+        Case((J[0][:5].tolist(), e[0].tolist(), g[0].tolist(), 0.01, 0.5), raises="ValueError",
              label="Jacobian with 5 rows"),
     ]
+
+
+def _plain_dls(J, e, gradient, damping, gain):
+    """Shortcut: the damped least-squares step alone, no secondary task."""
+    J = np.asarray(J, float)
+    return J.T @ np.linalg.solve(J @ J.T + damping ** 2 * np.eye(6), np.asarray(e, float))
+
+
+def _unprojected(J, e, gradient, damping, gain):
+    """Shortcut: the DLS step plus the raw gradient (it moves the hand too)."""
+    return _plain_dls(J, e, gradient, damping, gain) + gain * np.asarray(gradient, float)
+
+
+#: Ways to pass some null-space cases without both terms.
+NULL_SPACE_SHORTCUTS = {"the DLS step alone (no null-space term)": _plain_dls,
+                        "the DLS step plus the gradient, not projected": _unprojected}
+
+
+def _null_space_terms(expected: Any, got: Any) -> str | None:
+    """Judge a null-space step and say which term is wrong: the part that moves the hand (J dq) or the
+    part the hand does not see (the projected gradient)."""
+    want = np.asarray(expected["dq"], dtype=float)
+    g = numeric_array(got)
+    if g is None or g.dtype.kind == "b" or g.shape != want.shape:
+        return f"expected a joint step of shape {want.shape}, got {summarize(got)}"
+    g = g.astype(float)
+    if not np.all(np.isfinite(g)):
+        return "your step holds NaN or inf"
+    tol = 1e-9 + 1e-6 * np.abs(want)
+    if np.all(np.abs(g - want) <= tol):
+        return None
+    J, e = np.asarray(expected["J"], float), np.asarray(expected["e"], float)
+    grad, lam, k = np.asarray(expected["gradient"], float), expected["damping"], expected["gain"]
+    worst = int(np.argmax(np.abs(g - want) - tol))
+    head = (f"joint {worst + 1} of your step is {g[worst]:.6g}, expected {want[worst]:.6g} "
+            f"({int(np.sum(np.abs(g - want) > tol))} of {want.size} joints differ)")
+    hand, hand_want = J @ g, J @ want
+    primary = _plain_dls(J, e, grad, lam, k)
+    if np.allclose(hand, hand_want, rtol=1e-6, atol=1e-9):
+        extra = g - primary
+        why = ("it is missing" if np.allclose(extra, 0, atol=1e-9) else
+               "check its sign and the gain" if np.allclose(J @ extra, 0, atol=1e-8) else "check the projection")
+        return (f"{head}: the hand part J dq is right (to 1e-6); the difference is motion the hand does not see, "
+                f"so the null-space term is wrong: {why}")
+    if np.allclose(g, primary + k * grad, rtol=1e-6, atol=1e-9) and np.abs(grad).max() > 0:
+        return (f"{head}: you added the gradient as it is; part of it moves the hand (J dq differs by "
+                f"{np.linalg.norm(k * J @ grad):.3g}): keep only the part in the null space of J")
+    undamped = J.T @ np.linalg.solve(J @ J.T, e)
+    if lam > 0 and np.allclose(J @ g, J @ undamped, rtol=1e-6, atol=1e-9):
+        return f"{head}: your hand part is the undamped least-squares step; the damping {lam:g} is missing"
+    return (f"{head}: the hand part is wrong (J dq is {np.round(hand, 6).tolist()}, expected "
+            f"{np.round(hand_want, 6).tolist()}): the damped least-squares term minimises |J dq - e|^2 + "
+            f"damping^2 |dq|^2")
+
+
+# --- the loop: resolved-rate tracking with a null-space secondary task -------------------------------
+def _frames_fast(dh: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Base-frame transforms (n + 1, 4, 4) of frames 0..n of a standard-DH chain (unchecked; the loop's
+    inner step)."""
+    d, a, al = dh.T
+    ct, st, ca, sa = np.cos(q), np.sin(q), np.cos(al), np.sin(al)
+    A = np.zeros((len(q), 4, 4))
+    A[:, 0] = np.stack([ct, -st * ca, st * sa, a * ct], 1)
+    A[:, 1] = np.stack([st, ct * ca, -ct * sa, a * st], 1)
+    A[:, 2, 1], A[:, 2, 2], A[:, 2, 3], A[:, 3, 3] = sa, ca, d, 1.0
+    F = np.empty((len(q) + 1, 4, 4))
+    F[0] = np.eye(4)
+    for i in range(len(q)):
+        F[i + 1] = F[i] @ A[i]
+    return F
+
+
+def _jacobian_fast(F: np.ndarray) -> np.ndarray:
+    z, r = F[:-1, :3, 2].T, (F[-1, :3, 3][None] - F[:-1, :3, 3]).T
+    v = np.array([z[1] * r[2] - z[2] * r[1], z[2] * r[0] - z[0] * r[2], z[0] * r[1] - z[1] * r[0]])
+    return np.vstack([v, z])                                        # Siciliano et al. (2009), Eq. 3.30
+
+
+def _loop_error(T: np.ndarray, F: np.ndarray) -> np.ndarray:
+    return pose_error(T, F, validate=False)
+
+
+def _joint_range_cost(q: Any, qmin: Any, qmax: Any) -> np.ndarray:
+    """Liégeois's joint-range criterion as a cost, ``1/2 sum(((q - mid) / half)^2)`` (per row of ``q``)."""
+    q, qmin, qmax = (np.asarray(x, dtype=float) for x in (q, qmin, qmax))
+    return 0.5 * np.sum(((q - 0.5 * (qmin + qmax)) / (0.5 * (qmax - qmin))) ** 2, axis=-1)
+
+
+def _run(dh, qmin, qmax, q_start, targets, steps, max_step, damping, gain) -> np.ndarray:
+    """The loop, unchecked: ``steps`` iterations per target of the damped least-squares step plus the
+    joint-range gradient projected into the null space, scaled so that no joint moves more than
+    ``max_step``."""
+    dh, qmin, qmax = (np.asarray(x, dtype=float) for x in (dh, qmin, qmax))
+    mid, half = 0.5 * (qmin + qmax), 0.5 * (qmax - qmin)
+    q, out, eye = np.array(q_start, dtype=float), [], np.eye(6)
+    for T in np.asarray(targets, dtype=float):
+        for _ in range(steps):
+            F = _frames_fast(dh, q)
+            e = _loop_error(T, F[-1])
+            J = _jacobian_fast(F)
+            JJt = J @ J.T
+            dq = J.T @ np.linalg.solve(JJt + damping ** 2 * eye, e)                       # Wampler (1986)
+            if gain:
+                g = -(q - mid) / half ** 2                                                # Liégeois (1977), Eq. 14
+                dq = dq + gain * (g - J.T @ np.linalg.solve(JJt, J @ g))                  # Liégeois (1977), Eq. 9
+            biggest = np.abs(dq).max()
+            if biggest > max_step:
+                dq = dq * (max_step / biggest)
+            q = q + dq
+            out.append(q)
+    return np.array(out)
+
+
+def track_path(dh: Any, qmin: Any, qmax: Any, q_start: Any, targets: Any, settings: dict) -> np.ndarray:
+    """Follow a path of flange poses with damped least squares and a joint-range secondary task (the
+    loop exercise's reference).
+
+    For each target in turn, ``settings["steps"]`` iterations of ``dq = J# e + k (I - J+ J) g`` with the
+    damped pseudo-inverse ``J# = J^T (J J^T + lambda^2 I)^-1`` (Wampler 1986), the exact pseudo-inverse
+    ``J+`` in the projector and ``g`` the gradient of Liégeois's joint-range criterion
+    ``H = -1/2 sum(((q - mid) / half)^2)`` (Liégeois 1977, Eqs. 9 and 14); each step is scaled down so
+    that no joint moves more than ``settings["max_step"]``. The lesson's Sec. 7 tracks a circle with the
+    same feedback; Siciliano et al. (2009), Sec. 3.7, describe the scheme.
+
+    Parameters
+    ----------
+    dh : array_like, shape (n, 3)
+        Standard-DH rows ``[d, a, alpha]``.
+    qmin, qmax : array_like, shape (n,)
+        Joint limits [rad].
+    q_start : array_like, shape (n,)
+        Start posture, inside the limits.
+    targets : array_like, shape (K, 4, 4)
+        The path's flange poses, in order.
+    settings : dict
+        ``steps`` (int >= 1), ``max_step`` (rad, > 0), ``damping`` (>= 0) and ``gain`` (>= 0); ``tol``
+        is the grader's and is not used here.
+
+    Returns
+    -------
+    numpy.ndarray, shape (K * steps, n)
+        The posture after every iteration.
+
+    Raises
+    ------
+    ValueError
+        For shapes that do not match, a start outside the limits, a target that is not a rigid
+        transform, or settings missing or out of range.
+
+    Examples
+    --------
+    >>> d = data()
+    >>> q0 = np.radians([10, 40, 0, -70, 0, 50, 0])
+    >>> T = np.array(dh_fk(d["dh"], q0 + 0.1))
+    >>> run = track_path(d["dh"], d["qmin"], d["qmax"], q0, [T], d["track"])
+    >>> run.shape, bool(np.abs(pose_error(T, dh_fk(d["dh"], run[-1]))).max() < 1e-6)
+    ((30, 7), True)
+    """
+    dh = as_array(dh, "dh", shape=(None, 3))
+    n = len(dh)
+    qmin, qmax, q0 = (as_array(x, name, shape=(n,)) for x, name in ((qmin, "qmin"), (qmax, "qmax"), (q_start, "q_start")))
+    if np.any(qmin >= qmax):
+        raise ValueError("qmin, qmax: expected qmin < qmax for every joint")
+    if np.any((q0 < qmin - LIMIT_TOL) | (q0 > qmax + LIMIT_TOL)):
+        raise ValueError("q_start: expected a posture inside the joint limits")
+    T = as_array(targets, "targets", shape=(None, 4, 4))
+    if not len(T):
+        raise ValueError("targets: expected at least one pose")
+    for Ti in T:
+        as_se3(Ti, "targets")
+    if not isinstance(settings, dict) or not {"steps", "max_step", "damping", "gain"} <= set(settings):
+        raise ValueError("settings: expected a dict with steps, max_step, damping and gain")
+    steps, max_step, damping, gain = (settings[k] for k in ("steps", "max_step", "damping", "gain"))
+    if int(steps) != steps or steps < 1 or not max_step > 0 or not damping >= 0 or not gain >= 0:
+        raise ValueError(f"settings: expected steps >= 1, max_step > 0, damping >= 0, gain >= 0, got {settings}")
+    return _run(dh, qmin, qmax, q0, T, int(steps), float(max_step), float(damping), float(gain))
+
+
+def _slot_errors(dh, run: np.ndarray, targets: np.ndarray, steps: int) -> np.ndarray:
+    """Pose error (the larger of position [m] and rotation [rad]) of every iterate against its target."""
+    T = np.repeat(np.asarray(targets, dtype=float), steps, axis=0)
+    dh = np.asarray(dh, float)
+    e = pose_error(T, np.array([_frames_fast(dh, q)[-1] for q in run]), validate=False)
+    return np.maximum(np.linalg.norm(e[:, :3], axis=1), np.linalg.norm(e[:, 3:], axis=1))
+
+
+def _arc_path(rng: np.random.Generator, T0: np.ndarray, k: int) -> np.ndarray:
+    """``k`` flange poses along a circular arc from ``T0``'s origin (radius 4-8 cm, a quarter to a half
+    turn, in a random plane), the orientation turning by up to 0.2 rad about a random axis: a short
+    stretch of the lesson's Sec. 7 circle."""
+    r, turn = rng.uniform(0.04, 0.08), rng.uniform(0.5, 1.0) * np.pi
+    a, b = np.linalg.qr(rng.normal(size=(3, 2)))[0].T
+    w = rng.normal(size=3)
+    w *= rng.uniform(0.05, 0.2) / np.linalg.norm(w)
+    out = np.repeat(T0[None], k, axis=0)
+    for i in range(k):
+        t = turn * (i + 1) / k
+        out[i, :3, 3] = T0[:3, 3] + r * (np.sin(t) * a + (1 - np.cos(t)) * b)
+        out[i, :3, :3] = so3_exp(w * (i + 1) / k) @ T0[:3, :3]
+    return out
+
+
+#: The tracking cases: waypoints per path, and how much lower (in joint-range cost) the reference's
+#: final posture must be than plain DLS's for a run to be a case (so the secondary task shows).
+TRACK_WAYPOINTS = 4
+TRACK_MARGIN = 0.3
+
+
+def _track_run(rng: np.random.Generator, label: str) -> Case:
+    """A start posture with joints far from the middle of their ranges and a short arc from its pose; drawn
+    until the reference reaches every waypoint (to a third of the tolerance) inside the limits and ends
+    at least :data:`TRACK_MARGIN` lower in joint-range cost than plain DLS."""
+    s, qmin, qmax = TRACK, _IIWA.qmin, _IIWA.qmax
+    for _ in range(2000):
+        q0 = rng.uniform(0.85 * qmin, 0.85 * qmax).round(4)
+        if _joint_range_cost(q0, qmin, qmax) < 1.2:
+            continue
+        targets = _arc_path(rng, _frames_fast(np.asarray(_IIWA_DH), q0)[-1], TRACK_WAYPOINTS).round(10)
+        ref = _run(_IIWA_DH, qmin, qmax, q0, targets, s["steps"], s["max_step"], s["damping"], s["gain"])
+        err = _slot_errors(_IIWA_DH, ref, targets, s["steps"])[s["steps"] - 1::s["steps"]]
+        if err.max() > s["tol"] / 3 or np.any((ref < qmin + 0.01) | (ref > qmax - 0.01)):
+            continue
+        dls = _run(_IIWA_DH, qmin, qmax, q0, targets, s["steps"], s["max_step"], s["damping"], 0.0)
+        cost = _joint_range_cost([q0, dls[-1], ref[-1]], qmin, qmax)
+        if cost[1] - cost[2] < TRACK_MARGIN:
+            continue
+        args = (_IIWA_DH, qmin.tolist(), qmax.tolist(), q0.tolist(), targets.tolist(), dict(s))
+        return Case(args, label=label, expected={
+            "dh": _IIWA_DH, "qmin": qmin.tolist(), "qmax": qmax.tolist(), "q_start": q0.tolist(),
+            "targets": targets.tolist(), "settings": dict(s), "cost_start": float(cost[0]),
+            "cost_dls": float(cost[1]), "cost_reference": float(cost[2])})
+    raise RuntimeError("no tracking case in 2000 draws")  # pragma: no cover
+
+
+def _track_cases(rng: np.random.Generator) -> list[Case]:
+    runs = [_track_run(rng, f"a {TRACK_WAYPOINTS}-waypoint arc from a posture far from mid-range ({k})")
+            for k in ("run 1", "run 2")]
+    dh, qmin, qmax, q0, targets, settings = runs[0].args
+    outside = list(q0)
+    outside[1] = qmax[1] + 0.1
+    return runs + [
+        Case((dh, qmin, qmax, outside, targets, settings), raises="ValueError",
+             label="a start posture outside the joint limits"),
+        Case((dh, qmin, qmax, q0[:6], targets, settings), raises="ValueError", label="6 start angles for 7 joints"),
+    ]
+
+
+def _show_errors(err: np.ndarray, first: int, steps: int) -> str:
+    at = [i for i in (1, 2, 5, 10, 20, steps) if i <= steps]
+    return ", ".join(f"{i}: {err[first + i - 1]:.2g}" for i in at)
+
+
+def _tracks(expected: Any, got: Any) -> str | None:
+    """Judge a tracking run by its outcome: step sizes, the limits, every waypoint reached by the end of its
+    iterations, and the joint-range cost at the end well below plain DLS's; show the run where it fails."""
+    s = expected["settings"]
+    steps, K = s["steps"], len(expected["targets"])
+    qmin, qmax = np.asarray(expected["qmin"], float), np.asarray(expected["qmax"], float)
+    run = numeric_array(got)
+    if run is None or run.dtype.kind == "b" or run.shape != (K * steps, len(qmin)):
+        return (f"expected the posture after every iteration, shape ({K * steps}, {len(qmin)}) "
+                f"({steps} iterations for each of the {K} targets), got {summarize(got)}")
+    run = run.astype(float)
+    if not np.all(np.isfinite(run)):
+        i = int(np.flatnonzero(~np.isfinite(run).all(axis=1))[0])
+        return f"your run holds NaN or inf from iteration {i + 1} on (the loop diverged)"
+    moves = np.abs(np.diff(np.vstack([expected["q_start"], run]), axis=0))
+    if moves.max() > s["max_step"] + 1e-9:
+        i, j = np.unravel_index(int(np.argmax(moves)), moves.shape)
+        return (f"iteration {i + 1} moves joint {j + 1} by {moves[i, j]:.3g} rad, more than max_step = "
+                f"{s['max_step']:g} rad: scale the step down")
+    over = np.maximum(qmin - run, run - qmax)
+    if over.max() > LIMIT_TOL:
+        i, j = np.unravel_index(int(np.argmax(over > LIMIT_TOL)), over.shape)
+        return (f"iteration {i + 1} puts joint {j + 1} at {np.degrees(run[i, j]):.2f} deg, beyond its limits "
+                f"[{np.degrees(qmin[j]):.0f}, {np.degrees(qmax[j]):.0f}] deg")
+    err = _slot_errors(expected["dh"], run, expected["targets"], steps)
+    for k in range(K):
+        if err[(k + 1) * steps - 1] > s["tol"]:
+            trend = "it diverged" if err[(k + 1) * steps - 1] > err[k * steps] else "it did not get close enough"
+            return (f"target {k + 1} of {K} not reached: pose error {err[(k + 1) * steps - 1]:.3g} after its {steps} "
+                    f"iterations (tolerance {s['tol']:g} m and rad; {trend}). The error at its iterations "
+                    f"{_show_errors(err, k * steps, steps)}")
+    cost = float(_joint_range_cost(run[-1], qmin, qmax))
+    dls, ref = expected["cost_dls"], expected["cost_reference"]
+    bound = dls - 0.5 * (dls - ref)
+    if cost > bound:
+        return (f"every target reached, but the secondary task did little: the joint-range cost "
+                f"1/2 sum(((q - mid) / half)^2) is {expected['cost_start']:.3f} at the start and {cost:.3f} at your "
+                f"end; plain DLS ends at {dls:.3f}, DLS with the projected gradient at {ref:.3f}; at most {bound:.3f} "
+                f"passes")
+    return None
+
+
+def _start_repeated(dh, qmin, qmax, q_start, targets, settings):
+    """Shortcut: never move."""
+    return [q_start] * (len(targets) * settings["steps"])
+
+
+def _dls_only(dh, qmin, qmax, q_start, targets, settings):
+    """Shortcut: the loop without its secondary task (plain DLS)."""
+    return track_path(dh, qmin, qmax, q_start, targets, {**settings, "gain": 0.0})
+
+
+def _dls_clamped(dh, qmin, qmax, q_start, targets, settings):
+    """Shortcut: plain DLS, every posture clipped into the limits."""
+    return np.clip(_dls_only(dh, qmin, qmax, q_start, targets, settings), qmin, qmax)
+
+
+def _last_target_only(dh, qmin, qmax, q_start, targets, settings):
+    """Shortcut: the loop aimed at the last waypoint throughout."""
+    return track_path(dh, qmin, qmax, q_start, [targets[-1]] * len(targets), settings)
+
+
+#: Ways to produce a run without the loop the exercise asks for.
+TRACK_SHORTCUTS = {"the start posture, repeated": _start_repeated, "plain DLS (no secondary task)": _dls_only,
+                   "plain DLS clipped into the limits": _dls_clamped,
+                   "the loop aimed at the last waypoint only": _last_target_only}
 
 
 def _arcs(T: np.ndarray) -> np.ndarray:
@@ -287,9 +816,12 @@ EXERCISES = [
         points=2,
         cases=_jacobian_cases,
         answer=dh_jacobian,
-        compare=close(rtol=0, atol=1e-9),
-        kind="transcription",
-        description="6 x n geometric Jacobian [v; omega] in the base frame; ValueError on a length mismatch.",
+        compare=_jacobian_columns,
+        kind="derivation",
+        shortcuts={"central differences of the flange pose": finite_difference_jacobian},
+        description=("6 x n geometric Jacobian [v; omega] in the base frame, derived from the chain (the task "
+                     "gives no formula), to 1e-11 per entry; the feedback names the wrong column and part; "
+                     "ValueError on a length mismatch."),
     ),
     Exercise(
         id="06.wrist_centre",
@@ -321,27 +853,50 @@ EXERCISES = [
         points=2,
         cases=_shoulder_cases,
         answer=shoulder_angles,
-        compare=close(rtol=0, atol=1e-7),
-        kind="transcription",
-        description="(q1, q2 >= 0, q3) of the iiwa for arm angle psi; ValueError on NaN.",
+        compare=_shoulder_geometry,
+        kind="derivation",
+        shortcuts=SHOULDER_SHORTCUTS,
+        description=("(q1, q2 >= 0, q3) of the iiwa for arm angle psi, derived from the shoulder's geometry and "
+                     "the definition of psi; the feedback says whether the wrist, the arm angle or the branch "
+                     "is wrong; ValueError on NaN."),
     ),
     Exercise(
         id="06.null_space_step",
         function="null_space_step",
         signature=("null_space_step(J: numpy.ndarray, e: list[float], gradient: list[float], damping: float, "
                    "gain: float) -> numpy.ndarray"),
-        points=2,
+        points=1,
         cases=_null_space_cases,
-        answer=null_space_step,
-        compare=close(rtol=1e-6, atol=1e-9),
-        kind="transcription",
-        description="DLS step plus the gradient projected into the null space; ValueError on a bad Jacobian shape.",
+        answer=null_space_step_exact,
+        compare=_null_space_terms,
+        kind="derivation",
+        shortcuts=NULL_SPACE_SHORTCUTS,
+        description=("The minimiser of |J dq - e|^2 + damping^2 |dq|^2 plus gain times the gradient's projection "
+                     "onto the null space of J, both derived from their definitions; the feedback says which "
+                     "term is wrong; ValueError on a bad Jacobian shape."),
+    ),
+    Exercise(
+        id="06.track_path",
+        function="track_path",
+        signature=("track_path(dh: list[list[float]], qmin: list[float], qmax: list[float], q_start: list[float], "
+                   "targets: list of 4x4, settings: dict) -> (K * steps, 7) array"),
+        points=2,
+        cases=_track_cases,
+        answer=track_path,
+        compare=_tracks,
+        kind="loop",
+        shortcuts=TRACK_SHORTCUTS,
+        description=("Loop: resolved-rate tracking of a short arc of iiwa flange poses with DLS and the "
+                     "joint-range gradient in the null space; graded on the run: steps <= max_step, inside the "
+                     "limits, every waypoint within tol by the end of its iterations, the final joint-range cost "
+                     "at least halfway from plain DLS's to the reference's; ValueError for a start outside the "
+                     "limits or shapes that do not match."),
     ),
     Exercise(
         id="06.solve_ik",
         function="solve_ik",
         signature="solve_ik(T: list[list[float]], q_start: list[float]) -> numpy.ndarray",
-        points=3,
+        points=2,
         cases=_solve_ik_cases,
         answer=solve_ik,
         compare=_reaches_target,
