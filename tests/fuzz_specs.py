@@ -43,6 +43,12 @@ def iiwa():
 
 
 @functools.cache
+def mcl_run():
+    from robocourse.lessons.corridor_localization.mcl_runs import simulate_run
+    return simulate_run(np.random.default_rng(0))[0]
+
+
+@functools.cache
 def panda_arm():
     from robokit.arm import panda
     return panda()
@@ -605,6 +611,15 @@ SPECS: dict[str, Call] = {
     "robokit.arm.ik_steps.null_space_step": Call({"J": Array(lambda: np.eye(6, 7) + 0.1, "6,N|N,6,N"),
                                                   "e": Array(np.full(6, 0.01), "6"), "gradient": Array(np.full(7, 0.1), "7"),
                                                   "damping": Real(0.01), "gain": Real(1.0)}),
+    "robocourse.lessons.redundant_ik.exercises.null_space_step_exact": Call({
+        "J": Array(lambda: np.eye(6, 7) + 0.1, "6,N"), "e": Array(np.full(6, 0.01), "6"),
+        "gradient": Array(np.full(7, 0.1), "7"), "damping": Real(0.01), "gain": Real(1.0)}),
+    "robocourse.lessons.redundant_ik.tracking.track_path": Call({
+        "dh": Array(lambda: np.stack([iiwa().d, iiwa().a, iiwa().alpha], 1), "7,3"),
+        "qmin": Array(lambda: iiwa().qmin, "7"), "qmax": Array(lambda: iiwa().qmax, "7"),
+        "q_start": Array(np.radians([10, 40, 0, -70, 0, 50, 0]), "7"),
+        "targets": Array(lambda: iiwa().fk(np.radians([12, 42, 2, -68, 2, 52, 2]))[None], "N,4,4"),
+        "settings": Mapping({"steps": 3, "tol": 1e-3, "max_step": 0.1, "damping": 0.02, "gain": 1.0})}),
     # --- controllers -----------------------------------------------------------------------
     "robokit.controllers.heading.design_heading_gains": Call({"tau": Real(0.3), "overshoot": Real(0.05),
                                                               "settling_time": Real(1.5), "gain": Real(1.0)}),
@@ -1300,6 +1315,7 @@ SPECS: dict[str, Call] = {
         "angles": Array(np.array([0.0, 1.5]), "N"), "distance": Array(distance_grid, "N,N"), "resolution": Real(0.1),
         "origin": Array(np.array([0.0, 0.0]), "2"), "sigma_hit": Real(0.2), "z_hit": Real(0.95), "z_rand": Real(0.05),
         "r_max": Real(8.0), "max_distance": Real(2.0)}),
+    "robocourse.lessons.corridor_localization.exercises.mcl_track": Call({"run": Mapping(mcl_run)}),
     "robocourse.lessons.corridor_localization.exercises.resample_indices": Call({
         "weights": Array(np.array([0.1, 0.6, 0.3]), "N"), "r": Real(0.2)}),
     "robocourse.lessons.corridor_localization.exercises.ellipse_start_weights": Call({

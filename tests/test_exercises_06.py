@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from robocourse.lessons.redundant_ik import exercises as redundant_ik
+from robocourse.lessons.redundant_ik import exercises as redundant_ik, tracking
 from robocourse.grading import check
 from robocourse.lessons import exercises_for
 from tests.conftest import assert_check_passes
@@ -282,7 +282,7 @@ def test_null_space_feedback_names_the_term():
 def _loop_with(**changes):
     """The reference loop with one thing changed (a student's mistake)."""
     def loop(dh, qmin, qmax, q_start, targets, settings):
-        return redundant_ik.track_path(dh, qmin, qmax, q_start, targets, {**settings, **changes})
+        return tracking.track_path(dh, qmin, qmax, q_start, targets, {**settings, **changes})
     return loop
 
 
@@ -317,7 +317,7 @@ def test_check_fails_a_loop_that_turns_the_wrong_way():
             T = np.array(T)
             T[:3, :3] = T[:3, :3].T                     # any wrong orientation target misses the pose
             flipped.append(T)
-        return redundant_ik.track_path(dh, qmin, qmax, q_start, flipped, settings)
+        return tracking.track_path(dh, qmin, qmax, q_start, flipped, settings)
 
     assert pose_error is not None
     with pytest.raises(AssertionError):
@@ -340,5 +340,5 @@ def test_loop_cases_are_what_their_labels_say():
             q0, qmin, qmax = (np.array(expected[k]) for k in ("q_start", "qmin", "qmax"))
             assert np.all((q0 > qmin) & (q0 < qmax))
             assert expected["cost_start"] >= 1.2
-            assert expected["cost_dls"] - expected["cost_reference"] >= redundant_ik.TRACK_MARGIN
-            assert len(expected["targets"]) == redundant_ik.TRACK_WAYPOINTS
+            assert expected["cost_dls"] - expected["cost_reference"] >= tracking.TRACK_MARGIN
+            assert len(expected["targets"]) == tracking.TRACK_WAYPOINTS

@@ -79,7 +79,7 @@ def test_grade_writes_the_guide_beside_the_gradebook(tmp_path, capsys):
     assert main(["grade", str(sub), "--assignment", "00_getting_started", "--seed", "s", "--out", str(out),
                  "--feedback", str(tmp_path / "fb"), "--root", str(ROOT)]) == 0
     guide = (tmp_path / "grades" / "g-guide.md").read_text()
-    assert "00.why_seeds" in guide and "*Full (1):*" in guide and "| 00.se2_compose | transcription | 2 |" in guide
+    assert "00.why_seeds" in guide and "*Full (1):*" in guide and "| 00.se2_compose | derivation | 2 |" in guide
     assert "Rubric" not in (tmp_path / "fb" / "alice.md").read_text()      # feedback goes to students
     assert "grading guide for TAs" in capsys.readouterr().out
 

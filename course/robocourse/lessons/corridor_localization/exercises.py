@@ -183,8 +183,8 @@ def likelihood_field_weight(pose, ranges, angles, distance, resolution, origin, 
     a = as_array(angles, "angles", shape=r.shape)
     if np.isnan(r).any():
         raise ValueError("ranges: expected numbers or inf, got NaN")
-    for name, value in (("sigma_hit", sigma_hit), ("r_max", r_max)):
-        as_positive(value, name)
+    sigma_hit, r_max = as_positive(sigma_hit, "sigma_hit"), as_positive(r_max, "r_max")
+    z_hit, z_rand = as_positive(z_hit, "z_hit", allow_zero=True), as_positive(z_rand, "z_rand", allow_zero=True)
     used = np.isfinite(r) & (r < r_max)
     ends = p[:2] + r[used, None] * np.column_stack([np.cos(p[2] + a[used]), np.sin(p[2] + a[used])])
     d = field.lookup(ends) if used.any() else np.zeros(0)

@@ -30,14 +30,16 @@ import numpy as np
 from typing import Any
 
 from robokit.arm import (LIMIT_TOL, dh_fk, dh_jacobian, dh_transform, elbow_angle, feasible_arm_angles, geometric_jacobian,
-                         iiwa14, ik_srs_readable, limit_distance_gradient, null_space_step, panda, shoulder_angles,
+                         ik_srs_readable, limit_distance_gradient, null_space_step, panda, shoulder_angles,
                          wrist_centre)
 from robokit.arm.srs_geometry import arm_angle_terms
-from robokit.geometry import as_se3, pose_error, so3_exp
+from robokit.geometry import as_se3, pose_error
 from robokit.validation import as_array
 from robocourse.exercises.compare import close
 from robocourse.exercises.plain import numeric_array, summarize
 from robocourse.exercises.spec import Case, Exercise
+from robocourse.lessons.redundant_ik.tracking import (ARM, IIWA_DH, TRACK, TRACK_SHORTCUTS, judge_track, track_cases,
+                                                     track_path)
 
 ASSIGNMENT = "06_redundant_ik"
 #: Written (manually graded) questions: id -> points.
@@ -45,17 +47,11 @@ WRITTEN = {"06.extra_dof": 2, "06.self_motion": 2, "06.your_solver": 2}
 #: Tolerance on the open exercise's answers: flange position [m] and orientation [rad].
 IK_TOL = 1e-6
 
-_IIWA = iiwa14()
-_IIWA_DH = np.stack([_IIWA.d, _IIWA.a, _IIWA.alpha], 1).tolist()
 _PLANAR = [[0.0, 1.0, 0.0], [0.0, 0.5, 0.0]]            # two-link planar arm, lengths 1 m and 0.5 m
 #: The iiwa's S-R-S geometry: shoulder point [m] and the shoulder-elbow, elbow-wrist and wrist-flange
 #: distances [m] (the DH table's d_1, d_3, d_5, d_7).
-_SHOULDER = [0.0, 0.0, float(_IIWA.d[0])]
-_D_SE, _D_EW, _D_WF = (float(_IIWA.d[i]) for i in (2, 4, 6))
-#: The tracking loop's settings (:func:`track_path`): iterations per waypoint, the pose error [m and
-#: rad] each waypoint must be reached to by the end of its iterations, the largest joint move per
-#: iteration [rad], the DLS damping and the null-space gain of the joint-range criterion.
-TRACK = {"steps": 30, "tol": 1e-3, "max_step": 0.1, "damping": 0.02, "gain": 1.0}
+_SHOULDER = [0.0, 0.0, float(ARM.d[0])]
+_D_SE, _D_EW, _D_WF = (float(ARM.d[i]) for i in (2, 4, 6))
 
 
 def data() -> dict:
@@ -68,12 +64,12 @@ def data() -> dict:
     >>> d["dh"][0], d["d_wf"], d["track"]["steps"]
     ([0.36, 0.0, -1.5707963267948966], 0.126, 30)
     """
-    return {"dh": _IIWA_DH, "qmin": _IIWA.qmin.tolist(), "qmax": _IIWA.qmax.tolist(), "shoulder": _SHOULDER,
+    return {"dh": IIWA_DH, "qmin": ARM.qmin.tolist(), "qmax": ARM.qmax.tolist(), "shoulder": _SHOULDER,
             "d_se": _D_SE, "d_ew": _D_EW, "d_wf": _D_WF, "track": dict(TRACK)}
 
 
 def _iiwa_q(rng: np.random.Generator, n: int) -> np.ndarray:
-    q = _IIWA.random_q(n, rng)
+    q = ARM.random_q(n, rng)
     # keep clear of the shoulder/wrist singularities (sin q2 = 0), where q1 and q3 are not unique
     q[:, 1] = np.sign(q[:, 1]) * np.clip(np.abs(q[:, 1]), 0.2, None)
     return q
@@ -107,12 +103,12 @@ def solve_ik(T: Any, q_start: Any) -> np.ndarray:
     Examples
     --------
     >>> q = np.radians([35, 50, -40, -75, 60, 45, 20])
-    >>> bool(np.abs(solve_ik(_IIWA.fk(q), q) - q).max() < 1e-6)
+    >>> bool(np.abs(solve_ik(ARM.fk(q), q) - q).max() < 1e-6)
     True
     """
     T = as_se3(T, "T")
-    q0 = _IIWA.as_q(q_start, "q_start")
-    q, _, cost = ik_srs_readable(_IIWA, T, q0)
+    q0 = ARM.as_q(q_start, "q_start")
+    q, _, cost = ik_srs_readable(ARM, T, q0)
     if not np.isfinite(cost):
         raise ValueError("T: no posture of the iiwa reaches this target inside its joint limits "
                          "(the wrist centre is out of reach, or no arm angle keeps every joint inside)")
@@ -127,14 +123,14 @@ def _reaches_target(expected: Any, got: Any) -> str | None:
     q = q.astype(float)
     if q.shape != (7,) or not np.all(np.isfinite(q)):
         return f"expected 7 finite joint angles (shape (7,)), got {summarize(got)}"
-    err = pose_error(_IIWA.fk(np.asarray(expected, dtype=float)), _IIWA.fk(q))
+    err = pose_error(ARM.fk(np.asarray(expected, dtype=float)), ARM.fk(q))
     pos, rot = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
-    outside = np.flatnonzero((q < _IIWA.qmin - LIMIT_TOL) | (q > _IIWA.qmax + LIMIT_TOL))
+    outside = np.flatnonzero((q < ARM.qmin - LIMIT_TOL) | (q > ARM.qmax + LIMIT_TOL))
     if outside.size:
         j = int(outside[0])
-        over = max(_IIWA.qmin[j] - q[j], q[j] - _IIWA.qmax[j])
+        over = max(ARM.qmin[j] - q[j], q[j] - ARM.qmax[j])
         return (f"joint {j + 1} is at {np.degrees(q[j]):.2f} deg, {np.degrees(over):.3g} deg beyond its limits "
-                f"[{np.degrees(_IIWA.qmin[j]):.0f}, {np.degrees(_IIWA.qmax[j]):.0f}] deg ({outside.size} joint(s) "
+                f"[{np.degrees(ARM.qmin[j]):.0f}, {np.degrees(ARM.qmax[j]):.0f}] deg ({outside.size} joint(s) "
                 f"outside; the flange is {pos * 1e3:.3g} mm and {rot:.3g} rad from the target)")
     if pos > IK_TOL or rot > IK_TOL:
         return (f"your joints put the flange {pos * 1e3:.3g} mm and {rot:.3g} rad from the target "
@@ -157,9 +153,9 @@ def _fk_cases(rng: np.random.Generator) -> list[Case]:
     return [
         Case((_PLANAR, [0.0, 0.0]), label="planar arm stretched out"),
         Case((_PLANAR, [np.pi / 2, -np.pi / 2]), label="planar arm, elbow bent"),
-        Case((_IIWA_DH, [0.0] * 7), label="iiwa at zero: 1.306 m straight up"),
-        *[Case((_IIWA_DH, qi.tolist()), label="iiwa, random configuration") for qi in q],
-        Case((_IIWA_DH, [0.0] * 6), raises="ValueError", label="6 angles for 7 joints"),
+        Case((IIWA_DH, [0.0] * 7), label="iiwa at zero: 1.306 m straight up"),
+        *[Case((IIWA_DH, qi.tolist()), label="iiwa, random configuration") for qi in q],
+        Case((IIWA_DH, [0.0] * 6), raises="ValueError", label="6 angles for 7 joints"),
     ]
 
 
@@ -175,10 +171,10 @@ def _jacobian_cases(rng: np.random.Generator) -> list[Case]:
     n = rng.integers(3, 7, size=2)
     return [
         Case((_PLANAR, rng.uniform(-np.pi, np.pi, 2).round(4).tolist()), label="planar arm"),
-        *[Case((_IIWA_DH, qi.tolist()), label="iiwa, random configuration") for qi in q],
+        *[Case((IIWA_DH, qi.tolist()), label="iiwa, random configuration") for qi in q],
         *[Case((_random_chain(rng, int(k)), rng.uniform(-np.pi, np.pi, int(k)).round(4).tolist()),
                label=f"a random {k}-joint chain (offsets a and d, twists of any angle)") for k in n],
-        Case((_IIWA_DH, [0.1] * 8), raises="ValueError", label="8 angles for 7 joints"),
+        Case((IIWA_DH, [0.1] * 8), raises="ValueError", label="8 angles for 7 joints"),
     ]
 
 
@@ -244,7 +240,7 @@ def _jacobian_columns(expected: Any, got: Any) -> str | None:
 
 
 def _wrist_cases(rng: np.random.Generator) -> list[Case]:
-    T = _IIWA.fk(_iiwa_q(rng, 3))
+    T = ARM.fk(_iiwa_q(rng, 3))
     bad = T[0].copy()
     bad[:3, :3] *= 1.5
     return [
@@ -255,7 +251,7 @@ def _wrist_cases(rng: np.random.Generator) -> list[Case]:
 
 
 def _elbow_cases(rng: np.random.Generator) -> list[Case]:
-    frames = _IIWA.link_frames(_iiwa_q(rng, 3))
+    frames = ARM.link_frames(_iiwa_q(rng, 3))
     W = frames[:, 5, :3, 3]
     return [
         *[Case((_SHOULDER, w.tolist(), _D_SE, _D_EW), label="iiwa wrist centre") for w in W],
@@ -274,7 +270,7 @@ def _shoulder_case(S: list, W: Any, q4: float, psi: float, label: str) -> Case:
 
 def _shoulder_cases(rng: np.random.Generator) -> list[Case]:
     q = _iiwa_q(rng, 4)
-    W = _IIWA.link_frames(q)[:, 5, :3, 3]
+    W = ARM.link_frames(q)[:, 5, :3, 3]
     psi = rng.uniform(-np.pi, np.pi, size=4)
     return [
         _shoulder_case(_SHOULDER, W[0], q[0, 3], 0.0, "iiwa, the reference plane (psi = 0)"),
@@ -451,281 +447,18 @@ def _null_space_terms(expected: Any, got: Any) -> str | None:
             f"damping^2 |dq|^2")
 
 
-# --- the loop: resolved-rate tracking with a null-space secondary task -------------------------------
-def _frames_fast(dh: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Base-frame transforms (n + 1, 4, 4) of frames 0..n of a standard-DH chain (unchecked; the loop's
-    inner step)."""
-    d, a, al = dh.T
-    ct, st, ca, sa = np.cos(q), np.sin(q), np.cos(al), np.sin(al)
-    A = np.zeros((len(q), 4, 4))
-    A[:, 0] = np.stack([ct, -st * ca, st * sa, a * ct], 1)
-    A[:, 1] = np.stack([st, ct * ca, -ct * sa, a * st], 1)
-    A[:, 2, 1], A[:, 2, 2], A[:, 2, 3], A[:, 3, 3] = sa, ca, d, 1.0
-    F = np.empty((len(q) + 1, 4, 4))
-    F[0] = np.eye(4)
-    for i in range(len(q)):
-        F[i + 1] = F[i] @ A[i]
-    return F
-
-
-def _jacobian_fast(F: np.ndarray) -> np.ndarray:
-    z, r = F[:-1, :3, 2].T, (F[-1, :3, 3][None] - F[:-1, :3, 3]).T
-    v = np.array([z[1] * r[2] - z[2] * r[1], z[2] * r[0] - z[0] * r[2], z[0] * r[1] - z[1] * r[0]])
-    return np.vstack([v, z])                                        # Siciliano et al. (2009), Eq. 3.30
-
-
-def _loop_error(T: np.ndarray, F: np.ndarray) -> np.ndarray:
-    return pose_error(T, F, validate=False)
-
-
-def _joint_range_cost(q: Any, qmin: Any, qmax: Any) -> np.ndarray:
-    """Liégeois's joint-range criterion as a cost, ``1/2 sum(((q - mid) / half)^2)`` (per row of ``q``)."""
-    q, qmin, qmax = (np.asarray(x, dtype=float) for x in (q, qmin, qmax))
-    return 0.5 * np.sum(((q - 0.5 * (qmin + qmax)) / (0.5 * (qmax - qmin))) ** 2, axis=-1)
-
-
-def _run(dh, qmin, qmax, q_start, targets, steps, max_step, damping, gain) -> np.ndarray:
-    """The loop, unchecked: ``steps`` iterations per target of the damped least-squares step plus the
-    joint-range gradient projected into the null space, scaled so that no joint moves more than
-    ``max_step``."""
-    dh, qmin, qmax = (np.asarray(x, dtype=float) for x in (dh, qmin, qmax))
-    mid, half = 0.5 * (qmin + qmax), 0.5 * (qmax - qmin)
-    q, out, eye = np.array(q_start, dtype=float), [], np.eye(6)
-    for T in np.asarray(targets, dtype=float):
-        for _ in range(steps):
-            F = _frames_fast(dh, q)
-            e = _loop_error(T, F[-1])
-            J = _jacobian_fast(F)
-            JJt = J @ J.T
-            dq = J.T @ np.linalg.solve(JJt + damping ** 2 * eye, e)                       # Wampler (1986)
-            if gain:
-                g = -(q - mid) / half ** 2                                                # Liégeois (1977), Eq. 14
-                dq = dq + gain * (g - J.T @ np.linalg.solve(JJt, J @ g))                  # Liégeois (1977), Eq. 9
-            biggest = np.abs(dq).max()
-            if biggest > max_step:
-                dq = dq * (max_step / biggest)
-            q = q + dq
-            out.append(q)
-    return np.array(out)
-
-
-def track_path(dh: Any, qmin: Any, qmax: Any, q_start: Any, targets: Any, settings: dict) -> np.ndarray:
-    """Follow a path of flange poses with damped least squares and a joint-range secondary task (the
-    loop exercise's reference).
-
-    For each target in turn, ``settings["steps"]`` iterations of ``dq = J# e + k (I - J+ J) g`` with the
-    damped pseudo-inverse ``J# = J^T (J J^T + lambda^2 I)^-1`` (Wampler 1986), the exact pseudo-inverse
-    ``J+`` in the projector and ``g`` the gradient of Liégeois's joint-range criterion
-    ``H = -1/2 sum(((q - mid) / half)^2)`` (Liégeois 1977, Eqs. 9 and 14); each step is scaled down so
-    that no joint moves more than ``settings["max_step"]``. The lesson's Sec. 7 tracks a circle with the
-    same feedback; Siciliano et al. (2009), Sec. 3.7, describe the scheme.
-
-    Parameters
-    ----------
-    dh : array_like, shape (n, 3)
-        Standard-DH rows ``[d, a, alpha]``.
-    qmin, qmax : array_like, shape (n,)
-        Joint limits [rad].
-    q_start : array_like, shape (n,)
-        Start posture, inside the limits.
-    targets : array_like, shape (K, 4, 4)
-        The path's flange poses, in order.
-    settings : dict
-        ``steps`` (int >= 1), ``max_step`` (rad, > 0), ``damping`` (>= 0) and ``gain`` (>= 0); ``tol``
-        is the grader's and is not used here.
-
-    Returns
-    -------
-    numpy.ndarray, shape (K * steps, n)
-        The posture after every iteration.
-
-    Raises
-    ------
-    ValueError
-        For shapes that do not match, a start outside the limits, a target that is not a rigid
-        transform, or settings missing or out of range.
-
-    Examples
-    --------
-    >>> d = data()
-    >>> q0 = np.radians([10, 40, 0, -70, 0, 50, 0])
-    >>> T = np.array(dh_fk(d["dh"], q0 + 0.1))
-    >>> run = track_path(d["dh"], d["qmin"], d["qmax"], q0, [T], d["track"])
-    >>> run.shape, bool(np.abs(pose_error(T, dh_fk(d["dh"], run[-1]))).max() < 1e-6)
-    ((30, 7), True)
-    """
-    dh = as_array(dh, "dh", shape=(None, 3))
-    n = len(dh)
-    qmin, qmax, q0 = (as_array(x, name, shape=(n,)) for x, name in ((qmin, "qmin"), (qmax, "qmax"), (q_start, "q_start")))
-    if np.any(qmin >= qmax):
-        raise ValueError("qmin, qmax: expected qmin < qmax for every joint")
-    if np.any((q0 < qmin - LIMIT_TOL) | (q0 > qmax + LIMIT_TOL)):
-        raise ValueError("q_start: expected a posture inside the joint limits")
-    T = as_array(targets, "targets", shape=(None, 4, 4))
-    if not len(T):
-        raise ValueError("targets: expected at least one pose")
-    for Ti in T:
-        as_se3(Ti, "targets")
-    if not isinstance(settings, dict) or not {"steps", "max_step", "damping", "gain"} <= set(settings):
-        raise ValueError("settings: expected a dict with steps, max_step, damping and gain")
-    steps, max_step, damping, gain = (settings[k] for k in ("steps", "max_step", "damping", "gain"))
-    if int(steps) != steps or steps < 1 or not max_step > 0 or not damping >= 0 or not gain >= 0:
-        raise ValueError(f"settings: expected steps >= 1, max_step > 0, damping >= 0, gain >= 0, got {settings}")
-    return _run(dh, qmin, qmax, q0, T, int(steps), float(max_step), float(damping), float(gain))
-
-
-def _slot_errors(dh, run: np.ndarray, targets: np.ndarray, steps: int) -> np.ndarray:
-    """Pose error (the larger of position [m] and rotation [rad]) of every iterate against its target."""
-    T = np.repeat(np.asarray(targets, dtype=float), steps, axis=0)
-    dh = np.asarray(dh, float)
-    e = pose_error(T, np.array([_frames_fast(dh, q)[-1] for q in run]), validate=False)
-    return np.maximum(np.linalg.norm(e[:, :3], axis=1), np.linalg.norm(e[:, 3:], axis=1))
-
-
-def _arc_path(rng: np.random.Generator, T0: np.ndarray, k: int) -> np.ndarray:
-    """``k`` flange poses along a circular arc from ``T0``'s origin (radius 4-8 cm, a quarter to a half
-    turn, in a random plane), the orientation turning by up to 0.2 rad about a random axis: a short
-    stretch of the lesson's Sec. 7 circle."""
-    r, turn = rng.uniform(0.04, 0.08), rng.uniform(0.5, 1.0) * np.pi
-    a, b = np.linalg.qr(rng.normal(size=(3, 2)))[0].T
-    w = rng.normal(size=3)
-    w *= rng.uniform(0.05, 0.2) / np.linalg.norm(w)
-    out = np.repeat(T0[None], k, axis=0)
-    for i in range(k):
-        t = turn * (i + 1) / k
-        out[i, :3, 3] = T0[:3, 3] + r * (np.sin(t) * a + (1 - np.cos(t)) * b)
-        out[i, :3, :3] = so3_exp(w * (i + 1) / k) @ T0[:3, :3]
-    return out
-
-
-#: The tracking cases: waypoints per path, and how much lower (in joint-range cost) the reference's
-#: final posture must be than plain DLS's for a run to be a case (so the secondary task shows).
-TRACK_WAYPOINTS = 4
-TRACK_MARGIN = 0.3
-
-
-def _track_run(rng: np.random.Generator, label: str) -> Case:
-    """A start posture with joints far from the middle of their ranges and a short arc from its pose; drawn
-    until the reference reaches every waypoint (to a third of the tolerance) inside the limits and ends
-    at least :data:`TRACK_MARGIN` lower in joint-range cost than plain DLS."""
-    s, qmin, qmax = TRACK, _IIWA.qmin, _IIWA.qmax
-    for _ in range(2000):
-        q0 = rng.uniform(0.85 * qmin, 0.85 * qmax).round(4)
-        if _joint_range_cost(q0, qmin, qmax) < 1.2:
-            continue
-        targets = _arc_path(rng, _frames_fast(np.asarray(_IIWA_DH), q0)[-1], TRACK_WAYPOINTS).round(10)
-        ref = _run(_IIWA_DH, qmin, qmax, q0, targets, s["steps"], s["max_step"], s["damping"], s["gain"])
-        err = _slot_errors(_IIWA_DH, ref, targets, s["steps"])[s["steps"] - 1::s["steps"]]
-        if err.max() > s["tol"] / 3 or np.any((ref < qmin + 0.01) | (ref > qmax - 0.01)):
-            continue
-        dls = _run(_IIWA_DH, qmin, qmax, q0, targets, s["steps"], s["max_step"], s["damping"], 0.0)
-        cost = _joint_range_cost([q0, dls[-1], ref[-1]], qmin, qmax)
-        if cost[1] - cost[2] < TRACK_MARGIN:
-            continue
-        args = (_IIWA_DH, qmin.tolist(), qmax.tolist(), q0.tolist(), targets.tolist(), dict(s))
-        return Case(args, label=label, expected={
-            "dh": _IIWA_DH, "qmin": qmin.tolist(), "qmax": qmax.tolist(), "q_start": q0.tolist(),
-            "targets": targets.tolist(), "settings": dict(s), "cost_start": float(cost[0]),
-            "cost_dls": float(cost[1]), "cost_reference": float(cost[2])})
-    raise RuntimeError("no tracking case in 2000 draws")  # pragma: no cover
-
-
-def _track_cases(rng: np.random.Generator) -> list[Case]:
-    runs = [_track_run(rng, f"a {TRACK_WAYPOINTS}-waypoint arc from a posture far from mid-range ({k})")
-            for k in ("run 1", "run 2")]
-    dh, qmin, qmax, q0, targets, settings = runs[0].args
-    outside = list(q0)
-    outside[1] = qmax[1] + 0.1
-    return runs + [
-        Case((dh, qmin, qmax, outside, targets, settings), raises="ValueError",
-             label="a start posture outside the joint limits"),
-        Case((dh, qmin, qmax, q0[:6], targets, settings), raises="ValueError", label="6 start angles for 7 joints"),
-    ]
-
-
-def _show_errors(err: np.ndarray, first: int, steps: int) -> str:
-    at = [i for i in (1, 2, 5, 10, 20, steps) if i <= steps]
-    return ", ".join(f"{i}: {err[first + i - 1]:.2g}" for i in at)
-
-
-def _tracks(expected: Any, got: Any) -> str | None:
-    """Judge a tracking run by its outcome: step sizes, the limits, every waypoint reached by the end of its
-    iterations, and the joint-range cost at the end well below plain DLS's; show the run where it fails."""
-    s = expected["settings"]
-    steps, K = s["steps"], len(expected["targets"])
-    qmin, qmax = np.asarray(expected["qmin"], float), np.asarray(expected["qmax"], float)
-    run = numeric_array(got)
-    if run is None or run.dtype.kind == "b" or run.shape != (K * steps, len(qmin)):
-        return (f"expected the posture after every iteration, shape ({K * steps}, {len(qmin)}) "
-                f"({steps} iterations for each of the {K} targets), got {summarize(got)}")
-    run = run.astype(float)
-    if not np.all(np.isfinite(run)):
-        i = int(np.flatnonzero(~np.isfinite(run).all(axis=1))[0])
-        return f"your run holds NaN or inf from iteration {i + 1} on (the loop diverged)"
-    moves = np.abs(np.diff(np.vstack([expected["q_start"], run]), axis=0))
-    if moves.max() > s["max_step"] + 1e-9:
-        i, j = np.unravel_index(int(np.argmax(moves)), moves.shape)
-        return (f"iteration {i + 1} moves joint {j + 1} by {moves[i, j]:.3g} rad, more than max_step = "
-                f"{s['max_step']:g} rad: scale the step down")
-    over = np.maximum(qmin - run, run - qmax)
-    if over.max() > LIMIT_TOL:
-        i, j = np.unravel_index(int(np.argmax(over > LIMIT_TOL)), over.shape)
-        return (f"iteration {i + 1} puts joint {j + 1} at {np.degrees(run[i, j]):.2f} deg, beyond its limits "
-                f"[{np.degrees(qmin[j]):.0f}, {np.degrees(qmax[j]):.0f}] deg")
-    err = _slot_errors(expected["dh"], run, expected["targets"], steps)
-    for k in range(K):
-        if err[(k + 1) * steps - 1] > s["tol"]:
-            trend = "it diverged" if err[(k + 1) * steps - 1] > err[k * steps] else "it did not get close enough"
-            return (f"target {k + 1} of {K} not reached: pose error {err[(k + 1) * steps - 1]:.3g} after its {steps} "
-                    f"iterations (tolerance {s['tol']:g} m and rad; {trend}). The error at its iterations "
-                    f"{_show_errors(err, k * steps, steps)}")
-    cost = float(_joint_range_cost(run[-1], qmin, qmax))
-    dls, ref = expected["cost_dls"], expected["cost_reference"]
-    bound = dls - 0.5 * (dls - ref)
-    if cost > bound:
-        return (f"every target reached, but the secondary task did little: the joint-range cost "
-                f"1/2 sum(((q - mid) / half)^2) is {expected['cost_start']:.3f} at the start and {cost:.3f} at your "
-                f"end; plain DLS ends at {dls:.3f}, DLS with the projected gradient at {ref:.3f}; at most {bound:.3f} "
-                f"passes")
-    return None
-
-
-def _start_repeated(dh, qmin, qmax, q_start, targets, settings):
-    """Shortcut: never move."""
-    return [q_start] * (len(targets) * settings["steps"])
-
-
-def _dls_only(dh, qmin, qmax, q_start, targets, settings):
-    """Shortcut: the loop without its secondary task (plain DLS)."""
-    return track_path(dh, qmin, qmax, q_start, targets, {**settings, "gain": 0.0})
-
-
-def _dls_clamped(dh, qmin, qmax, q_start, targets, settings):
-    """Shortcut: plain DLS, every posture clipped into the limits."""
-    return np.clip(_dls_only(dh, qmin, qmax, q_start, targets, settings), qmin, qmax)
-
-
-def _last_target_only(dh, qmin, qmax, q_start, targets, settings):
-    """Shortcut: the loop aimed at the last waypoint throughout."""
-    return track_path(dh, qmin, qmax, q_start, [targets[-1]] * len(targets), settings)
-
-
-#: Ways to produce a run without the loop the exercise asks for.
-TRACK_SHORTCUTS = {"the start posture, repeated": _start_repeated, "plain DLS (no secondary task)": _dls_only,
-                   "plain DLS clipped into the limits": _dls_clamped,
-                   "the loop aimed at the last waypoint only": _last_target_only}
 
 
 def _arcs(T: np.ndarray) -> np.ndarray:
     """The exact feasible arm-angle arcs of all eight branches of target ``T``, stacked (k, 2) [rad]."""
-    return np.concatenate([iv.reshape(-1, 2) for iv in feasible_arm_angles(_IIWA, T)])
+    return np.concatenate([iv.reshape(-1, 2) for iv in feasible_arm_angles(ARM, T)])
 
 
 def _psi_zero_infeasible(rng: np.random.Generator) -> np.ndarray:
     """A configuration whose pose no branch reaches inside the limits at arm angle 0 (drawn until found)."""
     for _ in range(1000):
-        q = _IIWA.random_q(rng=rng)
-        arcs = _arcs(_IIWA.fk(q))
+        q = ARM.random_q(rng=rng)
+        arcs = _arcs(ARM.fk(q))
         if not ((arcs[:, 0] <= 0.0) & (arcs[:, 1] >= 0.0)).any():
             return q
     raise RuntimeError("no configuration with an infeasible arm angle 0 in 1000 draws")  # pragma: no cover
@@ -735,7 +468,7 @@ def _no_feasible_arm_angle(rng: np.random.Generator) -> np.ndarray:
     """Joints (some outside the limits) whose pose has a reachable wrist centre but no feasible arm angle."""
     for _ in range(1000):
         q = rng.uniform(-np.pi, np.pi, 7)
-        if not len(_arcs(_IIWA.fk(q))):
+        if not len(_arcs(ARM.fk(q))):
             return q
     raise RuntimeError("no target without a feasible arm angle in 1000 draws")  # pragma: no cover
 
@@ -745,12 +478,12 @@ def _narrow(rng: np.random.Generator) -> np.ndarray:
     containing a multiple of 10 deg, one containing a whole degree: between a feasible target and
     one with no feasible arm angle, bisected on the straight line of joint values between them."""
     for _ in range(200):
-        q_in, q_out = _IIWA.random_q(rng=rng), _no_feasible_arm_angle(rng)
+        q_in, q_out = ARM.random_q(rng=rng), _no_feasible_arm_angle(rng)
         lo, hi = 0.0, 1.0
         for _ in range(40):
             t = 0.5 * (lo + hi)
             q = (1 - t) * q_in + t * q_out
-            arcs = np.degrees(_arcs(_IIWA.fk(q)))
+            arcs = np.degrees(_arcs(ARM.fk(q)))
             total = float(np.diff(arcs, axis=1).sum())
             if 1.5 < total < 5.0:
                 whole = np.floor(arcs[:, 1]) >= arcs[:, 0]
@@ -763,23 +496,23 @@ def _narrow(rng: np.random.Generator) -> np.ndarray:
 
 
 def _solve_ik_cases(rng: np.random.Generator) -> list[Case]:
-    q = _IIWA.random_q(3, rng)
-    starts = _IIWA.random_q(3, rng)
+    q = ARM.random_q(3, rng)
+    starts = ARM.random_q(3, rng)
     hard = [_psi_zero_infeasible(rng) for _ in range(4)]
-    near = np.clip(hard[0] + rng.normal(0.0, 0.05, 7), _IIWA.qmin, _IIWA.qmax)
+    near = np.clip(hard[0] + rng.normal(0.0, 0.05, 7), ARM.qmin, ARM.qmax)
     narrow = [_narrow(rng) for _ in range(2)]
     blocked = _no_feasible_arm_angle(rng)
     far = np.eye(4)
     far[:3, 3] = [1.2, 0.3, 0.5]
     return [
-        *[Case((_IIWA.fk(qi).tolist(), si.tolist()), label="a random reachable target, random start")
+        *[Case((ARM.fk(qi).tolist(), si.tolist()), label="a random reachable target, random start")
           for qi, si in zip(q, starts)],
-        Case((_IIWA.fk(hard[0]).tolist(), near.tolist()), label="arm angle 0 breaks a limit on every branch; start nearby"),
-        *[Case((_IIWA.fk(h).tolist(), _IIWA.random_q(rng=rng).tolist()),
+        Case((ARM.fk(hard[0]).tolist(), near.tolist()), label="arm angle 0 breaks a limit on every branch; start nearby"),
+        *[Case((ARM.fk(h).tolist(), ARM.random_q(rng=rng).tolist()),
                label="arm angle 0 breaks a limit on every branch; random start") for h in hard[1:]],
-        *[Case((_IIWA.fk(n).tolist(), _IIWA.random_q(rng=rng).tolist()),
+        *[Case((ARM.fk(n).tolist(), ARM.random_q(rng=rng).tolist()),
                label="feasible arm angles total under 5 deg, none at a multiple of 10 deg") for n in narrow],
-        Case((_IIWA.fk(blocked).tolist(), [0.0] * 7), raises="ValueError",
+        Case((ARM.fk(blocked).tolist(), [0.0] * 7), raises="ValueError",
              label="wrist centre in reach, but no arm angle keeps every joint inside its limits"),
         Case((far.tolist(), [0.0] * 7), raises="ValueError", label="target 1.3 m away: out of reach"),
     ]
@@ -881,9 +614,9 @@ EXERCISES = [
         signature=("track_path(dh: list[list[float]], qmin: list[float], qmax: list[float], q_start: list[float], "
                    "targets: list of 4x4, settings: dict) -> (K * steps, 7) array"),
         points=2,
-        cases=_track_cases,
+        cases=track_cases,
         answer=track_path,
-        compare=_tracks,
+        compare=judge_track,
         kind="loop",
         shortcuts=TRACK_SHORTCUTS,
         description=("Loop: resolved-rate tracking of a short arc of iiwa flange poses with DLS and the "
