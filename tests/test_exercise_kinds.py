@@ -17,10 +17,6 @@ from robocourse.lessons import catalog
 #: shrink. Rewrite an exercise (or show it asks more than a transcription), set its kind, and delete
 #: its line here; the test fails on an id listed here that is no longer a transcription.
 TRANSCRIPTION_DEBT = {
-    "01.match_ratio",            # the ratio test, stated in the task
-    "01.triangulate_svd",        # the four equations and the SVD recipe, stated in the task
-    "01.kalman_fuse",            # Sigma' and s' printed in the task
-    "01.hough_votes",            # the accumulator's layout and the voting rule, spelled out
     "05.fix_position",           # the fields and their formats, stated in the task
     "05.haversine",              # both formulas printed in the task
     "05.avoidance_decision",     # the decision rules, listed in the task
