@@ -2,5 +2,7 @@
 
 experiment  Se et al.'s Sec. 6 re-run in the simulated lab: the calibrated rig, the mapping lap,
             the map and the kidnapped test poses (cached), and the map's consistency check
+odometry    stretches of the lab lap as stereo features and matches per frame, without rendering
+            (the loop exercise's runs)
 exercises   assignment 01
 """

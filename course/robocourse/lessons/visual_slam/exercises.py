@@ -227,8 +227,8 @@ def _junction_cases(rng: np.random.Generator) -> list[Case]:
 
 def _ratio_cases(rng: np.random.Generator) -> list[Case]:
     train = rng.normal(size=(12, 8))
-    query = train[[2, 5, 7, 9]] + rng.normal(scale=0.05, size=(4, 8))
-    query = np.vstack([query, rng.normal(size=(3, 8))])
+    query = train[rng.choice(12, 4, replace=False)] + rng.normal(scale=0.05, size=(4, 8))
+    query = np.vstack([query, rng.normal(size=(3, 8))])[rng.permutation(7)]    # true matches anywhere
     return [
         Case((query.tolist(), train.tolist()), label="four true matches among seven queries"),
         Case((query.tolist(), train.tolist(), 0.9), label="looser ratio 0.9"),
@@ -609,10 +609,11 @@ def _robust_pose_cases(rng: np.random.Generator) -> list[Case]:
 
 
 #: The loop exercise's outcome: every frame's position (m) and heading (rad) within these of the
-#: simulator's truth. About 3 m driven in 13 steps with a corner: a working chain drifts a few
-#: centimetres (the reference at most about 0.2 m over 200 seeds, tests/test_exercises_01.py); a
-#: chain that keeps wrong matches, or composes the steps wrongly, ends a metre or more away.
-LOOP_TOLERANCE = {"position": 0.35, "heading": float(np.deg2rad(5.0))}
+#: simulator's truth. About 3 m driven in 13 steps round a corner: a working chain drifts about
+#: 5 cm (median; the reference's worst frame over 120 runs was 25 cm and 3 degrees, the notebook's
+#: solution's alike); a chain that keeps the wrong matches ends about 2 m away (median; its best run
+#: 0.46 m), one that composes the steps wrongly 3 m or more.
+LOOP_TOLERANCE = {"position": 0.4, "heading": float(np.deg2rad(5.0))}
 #: Runs per seed of the loop exercise.
 LOOP_RUNS = 3
 
@@ -782,6 +783,6 @@ EXERCISES = [
         kind="loop", shortcuts=LOOP_SHORTCUTS,
         description="Loop: the stereo front end over simulated stretches of the lesson's lab lap (stereo features "
                     "per frame, matches to the previous frame, 20-45 % wrong): chain robust frame-to-frame poses "
-                    "from the start pose; every frame within 35 cm and 5 deg of the simulator's truth; ValueError "
+                    "from the start pose; every frame within 40 cm and 5 deg of the simulator's truth; ValueError "
                     "for match lists that do not fit the frames."),
 ]

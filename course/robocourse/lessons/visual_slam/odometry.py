@@ -1,7 +1,7 @@
 """Stereo visual odometry runs in the lesson's lab, cheap enough to make grading cases from.
 
 The assignment's loop exercise (``01.stereo_odometry``) needs what the lesson's front end sees every
-frame, without rendering: the robot drives a stretch of :func:`robokit.sim.lab_lap` in
+frame, without rendering: the robot drives a stretch of (a variation of) :func:`robokit.sim.lab_lap` in
 :func:`robokit.sim.lab_room` at 1 frame per second (the lesson's mapping rate), and at each frame
 the stereo rig of the lesson (65 degree field of view, 640 x 480 pixels, 12 cm baseline, camera
 0.8 m above the floor) sees points on the lab's walls and furniture. Each visible point is measured
@@ -34,17 +34,20 @@ __all__ = ["ODOMETRY_RUN", "odometry_run", "compose_pqt", "lab_points"]
 #: frame at most, how likely a visible point is detected, the depth range (m) of the stereo
 #: features kept, the rig (baseline and camera height, m) and how much (rad) every run turns at
 #: least (each run takes a corner of the lap) and how many right matches every step has at least (a
-#: draw with fewer is drawn again: Lin et al. keep odometry below 15 supporting matches, Sec. 7).
-ODOMETRY_RUN = {"frames": 14, "rate": 1.0, "pixel_noise": 0.1, "contamination": (0.2, 0.45),
-                "max_features": 200, "detection": 0.8, "depth": (0.5, 6.0), "baseline": 0.12,
-                "camera_height": 0.8, "min_turn": 0.5, "min_true_matches": 20}
+#: draw with fewer is drawn again: Lin et al. keep odometry below 15 supporting matches, Sec. 7);
+#: ``stride`` scales the lap's speed (0.3 m/s) per run and ``weave`` is the range of the amplitude
+#: (m) and the period (s) of a sideways weave about the lap (see :func:`odometry_run`).
+ODOMETRY_RUN = {"frames": 14, "rate": 1.0, "pixel_noise": 0.08, "contamination": (0.2, 0.45),
+                "max_features": 250, "detection": 0.8, "depth": (0.5, 6.0), "baseline": 0.12,
+                "camera_height": 0.8, "min_turn": 0.8, "min_true_matches": 20,
+                "stride": (0.7, 1.0), "weave": ((0.03, 0.12), (6.0, 12.0))}
 
 
 @functools.lru_cache(maxsize=1)
 def _lab():
     world = lab_room()
-    lap = lab_lap(world, rate=ODOMETRY_RUN["rate"])
-    return world, se2_to_pqt(lap.poses), world.layout(ODOMETRY_RUN["camera_height"])
+    lap = lab_lap(world, rate=10.0)
+    return world, lap, world.layout(ODOMETRY_RUN["camera_height"])
 
 
 @functools.lru_cache(maxsize=1)
@@ -166,6 +169,8 @@ def odometry_run(rng, frames: int | None = None) -> dict:
 
     Notes
     -----
+    The stretch is not the lap itself: its speed is scaled and it weaves a few centimetres to
+    either side (:data:`ODOMETRY_RUN`), so the start pose does not give away the rest.
     The wrong matches pair a feature with the previous frame's feature nearest to where its true
     partner would be moved by 1-3 m in one direction (one direction per step, each wrong match
     then off by a different amount), so they all pull a least-squares fit the same way without
@@ -186,12 +191,38 @@ def odometry_run(rng, frames: int | None = None) -> dict:
     return run
 
 
+def _stretch(gen: np.random.Generator, k: int) -> np.ndarray:
+    """``k`` true poses ``[p, q, theta]`` along the lap: a random start, a random stride (the robot
+    a little faster or slower than the lap's 0.3 m/s, :data:`ODOMETRY_RUN`'s ``stride``) and a
+    gentle weave across the lap (``weave``: amplitude in m and period in s), so that no two runs
+    share their poses; a draw whose stretch of the lap turns less than ``min_turn`` between its
+    fourth and its fourth-last frame (a corner in the middle of the run) or comes within 0.15 m of a wall or
+    a piece of furniture is drawn again."""
+    world, lap, _ = _lab()
+    t, poses = lap.t, lap.poses
+    dt = float(t[1] - t[0])
+    for _ in range(50):
+        stride = round(float(gen.uniform(*ODOMETRY_RUN["stride"])) / ODOMETRY_RUN["rate"] / dt)
+        first = int(gen.integers(0, len(t) - (k - 1) * stride))
+        index = first + stride * np.arange(k)
+        amp = gen.uniform(*ODOMETRY_RUN["weave"][0])
+        period, phase = gen.uniform(*ODOMETRY_RUN["weave"][1]), gen.uniform(0.0, 2 * np.pi)
+        w = 2 * np.pi / period
+        side = amp * np.sin(w * t[index] + phase)
+        drift = amp * w * np.cos(w * t[index] + phase)            # the weave's sideways speed (m/s)
+        sim = poses[index].copy()
+        sim[:, 0] -= side * np.sin(sim[:, 2])
+        sim[:, 1] += side * np.cos(sim[:, 2])
+        sim[:, 2] = wrap_angle(sim[:, 2] + np.arctan2(drift, 0.3))
+        middle = index[min(3, k // 3):max(k - 3, k - k // 3)]           # the corner away from both ends
+        turn = np.abs(wrap_angle(np.diff(poses[middle, 2]))).sum() if len(middle) > 1 else 0.0
+        if turn >= ODOMETRY_RUN["min_turn"] and np.all(world.is_free(sim[:, :2], clearance=0.15)):
+            break
+    return se2_to_pqt(sim)
+
+
 def _draw_run(gen: np.random.Generator, k: int) -> dict:
-    _, lap, _ = _lab()
-    turns = np.abs(wrap_angle(np.diff(lap[:, 2])))
-    starts = [i for i in range(len(lap) - k + 1) if turns[i:i + k - 1].sum() >= ODOMETRY_RUN["min_turn"]]
-    first = int(gen.choice(starts)) if starts else int(gen.integers(0, len(lap) - k + 1))
-    truth = lap[first:first + k].copy()
+    truth = _stretch(gen, k)
     points = lab_points(gen)
     features, ids = [], []
     for pose in truth:
