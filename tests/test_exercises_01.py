@@ -261,3 +261,26 @@ def test_the_loop_feedback_shows_the_run():
     msg = ex.compare(case.expected, _chain_least_squares(*case.args))
     assert "error by frame: 0: 0 cm" in msg and "the worst step is" in msg
     assert "expected one pose" in ex.compare(case.expected, case.expected[:-1])
+
+
+def _graded_points(exercise, fn, seed):
+    """The grader's points for ``fn`` on a seed's cases, trivial answers and shortcuts discounted."""
+    from robocourse.exercises.trivial import trivial_passes
+    from robocourse.grading.grader import score_exercise
+    from robocourse.grading.judge import call_student
+
+    cases = exercise.make_cases(seed)
+    expected = [expected_output(exercise, c) for c in cases]
+    public = [(c, expected_output(exercise, c)) for c in exercise.make_cases(2024) if not c.raises]
+    trivial = trivial_passes(exercise, cases, expected, public)
+    return score_exercise(exercise, cases, expected, trivial, [call_student(fn, c) for c in cases])[0].points
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_disparity_shortcut_earns_nothing_on_triangulation(seed):
+    """Exercise 4's formulas pass the exact cases on the lesson's rectified rig, and nothing else: as a
+    registered shortcut they earn no points; the reference earns all."""
+    exercise = _exercise("01.triangulate_svd")
+    shortcut = exercise.shortcuts["Exercise 4's disparity formulas (a rectified horizontal pair assumed)"]
+    assert _graded_points(exercise, shortcut, seed) == 0
+    assert _graded_points(exercise, exercise.answer, seed) == exercise.points

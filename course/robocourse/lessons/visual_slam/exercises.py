@@ -293,6 +293,21 @@ def _triangulate_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
+def _disparity_shortcut(p_left, p_right, uv_left, uv_right):
+    """Exercise 4's formulas with f, c0, r0 and the baseline read off the matrices, as if the pair were
+    rectified and horizontal: right on the lesson's rig, wrong on a verged or a vertical pair."""
+    pl, pr = np.asarray(p_left, float), np.asarray(p_right, float)
+    ul, ur = np.asarray(uv_left, float), np.asarray(uv_right, float)
+    focal, c0, r0, base = pl[0, 0], pl[0, 2], pl[1, 2], -pr[0, 3] / pr[0, 0]
+    d = ul[:, 0] - ur[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):       # a vertical pair has no horizontal disparity
+        return np.column_stack([(ul[:, 0] - c0) * base / d, (r0 - ul[:, 1]) * base / d, focal * base / d])
+
+
+#: Ways to pass triangulation cases without deriving the method, by name.
+TRIANGULATION_SHORTCUTS = {"Exercise 4's disparity formulas (a rectified horizontal pair assumed)": _disparity_shortcut}
+
+
 _COORDINATES = ("the left camera's u", "the left camera's v", "the right camera's u", "the right camera's v")
 
 
@@ -723,7 +738,7 @@ EXERCISES = [
         id="01.triangulate_svd", function="triangulate_svd",
         signature="triangulate_svd(p_left: (3, 4), p_right: (3, 4), uv_left: (N, 2), uv_right: (N, 2)) -> (N, 3)",
         points=2, cases=_triangulate_cases, answer=triangulate_svd, compare=_reprojects,
-        kind="derivation",
+        kind="derivation", shortcuts=TRIANGULATION_SHORTCUTS,
         description="Triangulation derived from the projection model u = P^1 x / P^3 x, v = P^2 x / P^3 x (Lin et "
                     "al. Sec. 3): points that reproject into both cameras as well as the least-squares point, on "
                     "the lesson's rig, a verged pair and a vertical baseline; ValueError for wrong shapes."),
