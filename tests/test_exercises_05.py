@@ -34,9 +34,10 @@ def _wrong_position(sentence):  # forgets that the minutes are minutes
     return [float(fields[i]) / 100, float(fields[i + 2]) / 100]
 
 
-def _wrong_haversine(lat1, lon1, lat2, lon2):  # flat Earth, bearing counter-clockwise from east
-    dy, dx = lat2 - lat1, (lon2 - lon1) * np.cos(lat1)
-    return np.array([6371008.8 * np.hypot(dx, dy), np.arctan2(dy, dx) % (2 * np.pi)])
+def _wrong_offset(origin, point):  # forgets that a parallel is a smaller circle than a meridian
+    if len(origin) != 2 or len(point) != 2 or abs(origin[0]) > 90 or abs(point[0]) > 90:
+        raise ValueError("origin, point")
+    return [6371008.8 * np.radians((point[1] - origin[1] + 180) % 360 - 180), 6371008.8 * np.radians(point[0] - origin[0])]
 
 
 def _wrong_pulse(pulse_width_us):
@@ -44,8 +45,10 @@ def _wrong_pulse(pulse_width_us):
     return {"inches": inches, "cm": inches * 2.54}
 
 
-def _always_forward(ranges, front=1.2, side=0.8, prefer="left"):
-    return "forward"
+def _stand_still(course):
+    if not course["waypoints"]:
+        raise ValueError("course")
+    return [[0.0, 0.0]] * 100
 
 
 def _wrong_gains(tau, overshoot, settling_time):
@@ -61,8 +64,8 @@ def _first_to_last(fixes, compass_deg):   # a tempting shortcut: course from two
 
 
 WRONG = {"05.compass_bias": _first_to_last, "05.nmea_checksum": _wrong_checksum, "05.fix_position": _wrong_position,
-         "05.haversine": _wrong_haversine, "05.pulse_to_distance": _wrong_pulse,
-         "05.avoidance_decision": _always_forward, "05.heading_gains": _wrong_gains}
+         "05.local_offset": _wrong_offset, "05.pulse_to_distance": _wrong_pulse,
+         "05.drive_course": _stand_still, "05.heading_gains": _wrong_gains}
 
 
 @pytest.mark.parametrize("exercise_id", list(EXERCISES))
@@ -75,6 +78,57 @@ def test_check_fails_a_wrong_implementation(exercise_id, capsys):
 @pytest.mark.parametrize("exercise_id", list(EXERCISES))
 def test_check_passes_the_reference(exercise_id, capsys):
     assert_check_passes(exercise_id, EXERCISES[exercise_id].answer, len(EXERCISES[exercise_id].make_cases(2024)))
+
+
+def _hemisphere_ignored(sentence):
+    return [abs(v) for v in module.fix_position(sentence)]
+
+
+def _minutes_as_hundredths(sentence):
+    lat, lon = module.fix_position(sentence)
+    def read(x):
+        d = np.floor(abs(x))
+        return np.sign(x) * (d + (abs(x) - d) * 60 / 100)
+    return [read(lat), read(lon)]
+
+
+def _other_field(sentence):                     # GGA's places used for RMC too: time and status read
+    fields = sentence.split(",")
+    return [float(fields[2][:2]) + float(fields[2][2:]) / 60 if fields[2][:1].isdigit() else 0.0,
+            float(fields[4][:3]) + float(fields[4][3:]) / 60 if fields[4][:1].isdigit() else 0.0]
+
+
+@pytest.mark.parametrize("wrong, words", [(_hemisphere_ignored, ["wrong sign", "hemisphere letter"]),
+                                          (_minutes_as_hundredths, ["hundredths of a degree"]),
+                                          (_other_field, ["latitude", "longitude"])])
+def test_fix_position_feedback_names_the_coordinate_and_the_misreading(wrong, words):
+    ex = EXERCISES["05.fix_position"]
+    messages = [ex.compare(ex.answer(*c.args), wrong(*c.args)) for c in ex.make_cases(3) if not c.raises]
+    failed = [m for m in messages if m]
+    assert failed and all(all(w in m for w in words) for m in failed[:1]), failed[:2]
+
+
+def test_local_offset_feedback_names_the_term():
+    ex = EXERCISES["05.local_offset"]
+    far_north = next(c for c in ex.make_cases(4) if c.label.startswith("far north"))
+    message = ex.compare(ex.answer(*far_north.args), _wrong_offset(*far_north.args))
+    assert message.startswith("east:") and "longitude term" in message and "north" not in message.split(";")[0][:6]
+    swapped = ex.compare(ex.answer(*far_north.args), ex.answer(*far_north.args)[::-1])
+    assert "swapped" in swapped
+
+
+def _equidistant(origin, point):                # another sound local map: haversine distance and bearing
+    from robokit.outdoor import haversine_distance_bearing
+    d, b = haversine_distance_bearing(*np.radians([*origin, *point]))
+    return [d * np.sin(b), d * np.cos(b)]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_local_offset_accepts_another_sound_local_map(seed):
+    ex = EXERCISES["05.local_offset"]
+    for c in ex.make_cases(seed):
+        if not c.raises:
+            assert ex.compare(ex.answer(*c.args), _equidistant(*c.args)) is None, c.label
 
 
 def _course_from(fixes, compass_deg, a, b):   # course from fix a to fix b, circular mean of the readings

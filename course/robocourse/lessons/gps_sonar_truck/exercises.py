@@ -16,14 +16,16 @@ import datetime as dt
 import numpy as np
 
 from robokit.controllers.heading import design_heading_gains
-from robokit.outdoor.geodesy import haversine_distance_bearing
-from robokit.outdoor.navigator import avoidance_decision
+from robokit.outdoor.geodesy import EARTH_MEAN_RADIUS
 from robokit.outdoor.nmea import fix_position, nmea_checksum
 from robokit.outdoor.nmea_write import format_sentence, gga_sentence, hdg_sentence, random_sentences, rmc_sentence
 from robokit.outdoor.sonar import pulse_width_to_cm_inches
 from robokit.validation import as_array, as_points
 from robocourse.exercises.compare import close, exact
+from robocourse.exercises.plain import summarize
 from robocourse.exercises.spec import Case, Exercise
+from robocourse.lessons.gps_sonar_truck.loop import course_case, drive_course, make_controller, mission_outcome
+from robocourse.lessons.gps_sonar_truck.plant import run_mission
 
 ASSIGNMENT = "05_gps_sonar_truck"
 #: Written (manually graded) questions: id -> points.
@@ -133,6 +135,115 @@ BIAS_DRIVES = (
 )
 
 
+def local_offset(origin, point) -> list:
+    """East and north offsets (m) of ``point`` from ``origin`` in a flat map about the origin, on the sphere.
+
+    Parameters
+    ----------
+    origin, point : array_like, shape (2,)
+        ``[latitude, longitude]`` in degrees (north and east positive).
+
+    Returns
+    -------
+    list of float
+        ``[east, north]`` in metres: ``north = R dphi`` along the origin's meridian and
+        ``east = R cos(phi0) dlambda`` along its parallel (a circle of radius ``R cos(phi0)``), with
+        ``R`` the mean Earth radius and ``dlambda`` wrapped to (-180, 180] degrees.
+
+    Raises
+    ------
+    ValueError
+        For a latitude outside [-90, 90] or a longitude outside [-180, 180] degrees, or not two
+        numbers per point.
+
+    Notes
+    -----
+    The equirectangular map about the origin: the first-order local plane of the sphere, which
+    robokit's :class:`~robokit.outdoor.geodesy.LocalTangentPlane` refines with the ellipsoid's two
+    radii; over a football field it agrees with the haversine distance (Hamid et al. 2009 steer by
+    it) to far below the GPS error.
+
+    Examples
+    --------
+    >>> east, north = local_offset([0.0, 0.0], [0.001, 0.001])
+    >>> round(east, 3), round(north, 3)
+    (111.195, 111.195)
+    """
+    (lat0, lon0), (lat, lon) = (as_array(x, name, shape=(2,)) for x, name in ((origin, "origin"), (point, "point")))
+    for name, la, lo in (("origin", lat0, lon0), ("point", lat, lon)):
+        if abs(la) > 90 or abs(lo) > 180:
+            raise ValueError(f"{name}: expected [latitude, longitude] in degrees within +-90 and +-180, got "
+                             f"{[float(la), float(lo)]}")
+    dlon = -((180.0 - (lon - lon0)) % 360.0 - 180.0)           # wrapped to (-180, 180]
+    return [float(EARTH_MEAN_RADIUS * np.cos(np.radians(lat0)) * np.radians(dlon)),
+            float(EARTH_MEAN_RADIUS * np.radians(lat - lat0))]
+
+
+def _position_diagnosis(name: str, e: float, g: float) -> str:
+    """What a wrong coordinate says about how the field was read (``e`` the truth, ``g`` the answer)."""
+    deg = np.floor(abs(e))
+    minutes = (abs(e) - deg) * 60
+    if abs(g + e) < 1e-6:
+        return f"{name}: right size, wrong sign: the hemisphere letter after the {name} field sets it"
+    for read, why in ((deg + minutes / 100, "the minutes read as hundredths of a degree (a minute is 1/60 degree)"),
+                      (deg * 100 + minutes, "the field returned as written: degrees and minutes run together"),
+                      ((deg * 100 + minutes) / 100, "the field divided by 100: its minutes are not hundredths")):
+        if abs(abs(g) - read) < 1e-6:
+            return f"{name}: {g:.9f} is {why}"
+    return f"{name}: expected {e:.9f}, got {g:.9f} (off by {g - e:.6g} degrees)"
+
+
+def _same_position(expected, got) -> str | None:
+    """Accept ``[lat, lon]`` within 1e-9 degrees; name the coordinate and what went wrong with it."""
+    try:
+        g = np.array(got, dtype=float)
+    except (TypeError, ValueError):
+        return f"expected [latitude, longitude] as two numbers, got {summarize(got)}"
+    if g.shape != (2,):
+        return f"expected [latitude, longitude] as two numbers, got {summarize(got)}"
+    e = np.asarray(expected, dtype=float)
+    if np.all(np.abs(g - e) <= 1e-9):
+        return None
+    if np.all(np.abs(g[::-1] - e) <= 1e-9):
+        return "latitude and longitude swapped: the latitude field comes first"
+    return "; ".join(_position_diagnosis(n, float(a), float(b))
+                     for n, a, b in zip(("latitude", "longitude"), e, g) if abs(b - a) > 1e-9)
+
+
+def _same_offset(expected, got) -> str | None:
+    """Accept ``[east, north]`` within 1 mm plus ``3 d^2 / R`` of the answer (``d`` its distance): any
+    sound local plane of the sphere or the ellipsoid differs from the equirectangular map by about
+    ``d^2 / R`` times a factor that grows with the latitude's tangent; the cases stay below 60 degrees
+    and 2 km. Name the offset that is wrong and the likely term."""
+    try:
+        g = np.array(got, dtype=float)
+    except (TypeError, ValueError):
+        return f"expected [east, north] in metres, got {summarize(got)}"
+    if g.shape != (2,):
+        return f"expected [east, north] in metres, got {summarize(got)}"
+    e = np.asarray(expected, dtype=float)
+    d = float(np.hypot(*e))
+    tol = 1e-3 + 3 * d * d / EARTH_MEAN_RADIUS
+    if np.all(np.abs(g - e) <= tol):
+        return None
+    if np.all(np.abs(g[::-1] - e) <= tol):
+        return "east and north swapped: [east, north] is [along the parallel, along the meridian]"
+    notes = []
+    for name, a, b, hint in (("east", e[0], g[0], "the longitude term: how long is a degree of longitude at "
+                              "this latitude (the parallel is a circle of radius R cos(latitude))?"),
+                             ("north", e[1], g[1], "the latitude term: an arc of the meridian, a circle of radius R")):
+        if abs(b - a) <= tol:
+            continue
+        ratio = b / a if abs(a) > 1e-6 else float("nan")
+        if abs(ratio + 1) < 1e-3:
+            notes.append(f"{name} has the wrong sign")
+        elif any(abs(ratio - k) < 1e-3 * k for k in (180 / np.pi, np.pi / 180)):
+            notes.append(f"{name} is {ratio:.4g} times ours: degrees and radians mixed up")
+        else:
+            notes.append(f"{name}: expected {a:.4f} m, got {b:.4f} m ({ratio:.4f} times ours; check {hint})")
+    return "; ".join(notes)
+
+
 def _bias_cases(rng: np.random.Generator) -> list[Case]:
     cases, first = [], None
     for label, kwargs in BIAS_DRIVES:
@@ -173,6 +284,8 @@ def _position_cases(rng: np.random.Generator) -> list[Case]:
         Case((good[0],), label="RMC, GP talker"),
         Case((good[1],), label="GGA, GN talker"),
         Case((good[2],), label="southern and western hemispheres"),
+        Case((gga_sentence(when.time(), -float(rng.uniform(1, 9)), float(rng.uniform(1, 9))),),
+             label="GGA near the equator and the prime meridian: leading zeros"),
         Case(("$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A",), label="textbook RMC"),
         Case((bad_checksum,), raises="ValueError", label="wrong checksum"),
         Case((too_far,), raises="ValueError", label="latitude above 90 degrees"),
@@ -181,17 +294,61 @@ def _position_cases(rng: np.random.Generator) -> list[Case]:
     ]
 
 
-def _haversine_cases(rng: np.random.Generator) -> list[Case]:
-    lat0, lon0 = np.radians(6.459), np.radians(100.35)
-    near = rng.normal(0, 3e-4, (3, 2))
-    far = rng.uniform([-1.2, -3.0], [1.2, 3.0], (2, 2))
-    cases = [Case((lat0, lon0, lat0 + 1e-5, lon0), label="10 cm north: bearing 0")]
-    for d in near:
-        cases.append(Case((lat0, lon0, float(lat0 + d[0]), float(lon0 + d[1])), label="across a football field"))
-    cases.append(Case((float(far[0, 0]), float(far[0, 1]), float(far[1, 0]), float(far[1, 1])), label="far apart"))
-    cases.append(Case((0.0, 0.0, 0.0, -0.01), label="due west: bearing 3 pi / 2"))
-    cases.append(Case((48.1, 11.5, 48.2, 11.6), raises="ValueError", label="degrees instead of radians"))
-    return cases
+def _destination(lat0: float, lon0: float, d: float, bearing: float) -> list:
+    """``[lat, lon]`` (degrees) ``d`` metres from ``[lat0, lon0]`` along the great circle at ``bearing`` (rad)."""
+    p1, l1, delta = np.radians(lat0), np.radians(lon0), d / EARTH_MEAN_RADIUS
+    p2 = np.arcsin(np.sin(p1) * np.cos(delta) + np.cos(p1) * np.sin(delta) * np.cos(bearing))
+    l2 = l1 + np.arctan2(np.sin(bearing) * np.sin(delta) * np.cos(p1), np.cos(delta) - np.sin(p1) * np.sin(p2))
+    return [round(float(np.degrees(p2)), 9), round(float((np.degrees(l2) + 180) % 360 - 180), 9)]
+
+
+def _offset_cases(rng: np.random.Generator) -> list[Case]:
+    field = [6.459, 100.3505]                                   # the lesson's field (UNIMAP_ORIGIN)
+    far_north = [round(float(rng.uniform(50, 60)), 6), round(float(rng.uniform(-20, 20)), 6)]
+    south = [round(float(rng.uniform(-45, -30)), 6), round(float(rng.uniform(140, 150)), 6)]
+    line = [round(float(rng.uniform(-10, 10)), 6), 179.9995]
+    cases = [Case((field, _destination(*field, 40.0, np.radians(60.0))), label="the lesson's field: 40 m at 60 degrees"),
+             Case((field, _destination(*field, float(rng.uniform(5, 80)), float(rng.uniform(0, 2 * np.pi)))),
+                  label="across the football field"),
+             Case((far_north, _destination(*far_north, float(rng.uniform(300, 1500)), float(rng.uniform(0.3, 1.2)))),
+                  label="far north, mostly east: a degree of longitude is short there"),
+             Case((south, _destination(*south, float(rng.uniform(300, 1500)), float(rng.uniform(3.5, 4.5)))),
+                  label="southern hemisphere, south-west"),
+             Case((line, _destination(*line, float(rng.uniform(100, 200)), np.pi / 2)),
+                  label="across the date line, due east"),
+             Case((field, field), label="the origin itself")]
+    return cases + [Case(([95.0, 10.0], field), raises="ValueError", label="a latitude beyond the pole"),
+                    Case((field, [6.459]), raises="ValueError", label="a point without a longitude")]
+
+
+def _course_cases(rng: np.random.Generator) -> list[Case]:
+    seeds = [int(s) for s in rng.integers(0, 2 ** 31, 3)]
+    cases = [course_case(s, label=f"course {i + 1}") for i, s in enumerate(seeds)]
+    empty = dict(cases[0].args[0], waypoints=[])
+    return cases + [Case((empty,), raises="ValueError", label="a course without waypoints")]
+
+
+def _stand_still(course):
+    return [[0.0, 0.0]] * course["steps"]
+
+
+def _full_ahead(course):
+    return [[course["truck"]["max_wheel_speed"]] * 2] * course["steps"]
+
+
+def _sonars_off(course):
+    return run_mission(course, make_controller(course, front=1e-9, side=1e-9))
+
+
+def _truth_for_fixes(course):
+    return drive_course(dict(course, gps_errors=[[0.0, 0.0]] * len(course["gps_errors"])))
+
+
+#: Ways to a loop case's answer without the loop: standing still, full speed ahead, the reference
+#: with its sonars off (GPS only: the posts are where it drives), and the reference steering by
+#: the true position instead of the fixes (what a controller that simulates the plant itself knows).
+COURSE_SHORTCUTS = {"stand still": _stand_still, "full speed ahead": _full_ahead,
+                    "GPS only, the sonars ignored": _sonars_off, "the true position instead of the fixes": _truth_for_fixes}
 
 
 def _pulse_cases(rng: np.random.Generator) -> list[Case]:
@@ -200,22 +357,6 @@ def _pulse_cases(rng: np.random.Generator) -> list[Case]:
         [Case((float(w),), label="inside the sensor's range") for w in widths] + \
         [Case((-10.0,), raises="ValueError", label="negative width"),
          Case((float("nan"),), raises="ValueError", label="NaN")]
-
-
-def _avoid_cases(rng: np.random.Generator) -> list[Case]:
-    far = 6.45
-    near = [round(float(x), 2) for x in rng.uniform(0.3, 0.75, 4)]
-    return [
-        Case(([far, far, far, far],), label="nothing in range"),
-        Case(([far, near[0], near[1], far],), label="front blocked, sides equal: preferred side"),
-        Case(([far, near[0], near[1], far],), {"prefer": "right"}, label="front blocked, prefer right"),
-        Case(([near[2], 0.9, 1.0, far],), label="front blocked, less room on the left"),
-        Case(([far, 1.1, 0.95, near[3]],), label="front blocked, less room on the right"),
-        Case(([near[1], far, far, far],), label="left side only"),
-        Case(([far, far, far, near[2]],), label="right side only"),
-        Case(([1.0, 2.0, 3.0],), raises="ValueError", label="three ranges"),
-        Case(([1.0, -2.0, 3.0, 4.0],), raises="ValueError", label="negative range"),
-    ]
 
 
 def _gains_cases(rng: np.random.Generator) -> list[Case]:
@@ -250,20 +391,22 @@ EXERCISES = [
         points=2,
         cases=_position_cases,
         answer=fix_position,
-        compare=close(rtol=0, atol=1e-9),
-        kind="transcription",
-        description="[lat, lon] in degrees from an RMC or GGA sentence; ValueError on bad input.",
+        compare=_same_position,
+        kind="derivation",
+        description="[lat, lon] in signed degrees from an RMC or GGA sentence, the fields' places and the "
+                    "degrees-and-minutes format worked out from the receiver's examples; ValueError on bad input.",
     ),
     Exercise(
-        id="05.haversine",
-        function="haversine",
-        signature="haversine(lat1, lon1, lat2, lon2) -> numpy.ndarray  # [distance_m, bearing_rad]",
+        id="05.local_offset",
+        function="local_offset",
+        signature="local_offset(origin: [lat, lon], point: [lat, lon]) -> [east_m, north_m]  # degrees in",
         points=2,
-        cases=_haversine_cases,
-        answer=haversine_distance_bearing,
-        compare=close(rtol=1e-9, atol=1e-6),
-        kind="transcription",
-        description="Great-circle distance (mean radius) and initial bearing in [0, 2 pi).",
+        cases=_offset_cases,
+        answer=local_offset,
+        compare=_same_offset,
+        kind="derivation",
+        description="The flat east-north map about a point, derived from the sphere (arcs of the meridian and "
+                    "of the parallel); any sound local plane within 1 mm + 3 d^2 / R passes.",
     ),
     Exercise(
         id="05.pulse_to_distance",
@@ -275,17 +418,6 @@ EXERCISES = [
         compare=close(rtol=1e-9, atol=1e-9),
         kind="warm-up",
         description="LV-MaxSonar-EZ pulse width (147 us per inch) to inches and centimetres.",
-    ),
-    Exercise(
-        id="05.avoidance_decision",
-        function="avoidance_decision",
-        signature="avoidance_decision(ranges, front=1.2, side=0.8, prefer='left') -> str",
-        points=2,
-        cases=_avoid_cases,
-        answer=avoidance_decision,
-        compare=exact(),
-        kind="transcription",
-        description="'forward', 'left' or 'right' from the four sonar ranges.",
     ),
     Exercise(
         id="05.heading_gains",
@@ -302,11 +434,26 @@ EXERCISES = [
         id="05.compass_bias",
         function="compass_bias",
         signature="compass_bias(fixes: (N, 2), compass_deg: (N,)) -> float  # degrees, in (-180, 180]",
-        points=3,
+        points=2,
         cases=_bias_cases,
         answer=compass_bias,
         compare=close(rtol=0, atol=1.0),
         kind="open",
         description="Open: a compass's constant error from a straight GPS drive, by any method, within 1 degree.",
+    ),
+    Exercise(
+        id="05.drive_course",
+        function="drive_course",
+        signature="drive_course(course: dict) -> list of [left, right]  # the wheel commands sent",
+        points=3,
+        cases=_course_cases,
+        answer=drive_course,
+        compare=mission_outcome,
+        kind="loop",
+        shortcuts=COURSE_SHORTCUTS,
+        description="Loop: the truck's controller (fixes to distance and bearing, compass heading loop, sonar "
+                    "avoidance, waypoint after waypoint) run on the given plant over hidden seeded courses; the "
+                    "commands are replayed on robokit's truck: every waypoint reached by a fix within the "
+                    "radius, in order, no contact, within the step budget; ValueError without waypoints.",
     ),
 ]
