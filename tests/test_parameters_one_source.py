@@ -109,7 +109,7 @@ def test_lesson_02_notebooks_write_no_ratio_or_top_k(folder):
 SHARED = [
     ("03.likelihood_field_weight", "robokit.localization.mcl:MonteCarloLocalizer", ("sigma_hit", "z_hit", "z_rand", "r_max")),
     ("03.likelihood_field_weight", "robokit.mapping:likelihood_field", ("max_distance",)),
-    ("05.avoidance_decision", "robokit.outdoor.navigator:Navigator", ("front", "side")),
+    ("05.drive_course", "robokit.outdoor.navigator:Navigator", ("front", "side")),
 ]
 
 
