@@ -307,7 +307,8 @@ def _offset_cases(rng: np.random.Generator) -> list[Case]:
     far_north = [round(float(rng.uniform(50, 60)), 6), round(float(rng.uniform(-20, 20)), 6)]
     south = [round(float(rng.uniform(-45, -30)), 6), round(float(rng.uniform(140, 150)), 6)]
     line = [round(float(rng.uniform(-10, 10)), 6), 179.9995]
-    cases = [Case((field, _destination(*field, 40.0, np.radians(60.0))), label="the lesson's field: 40 m at 60 degrees"),
+    cases = [Case((field, _destination(*field, round(float(rng.uniform(30, 50)), 1), np.radians(60.0))),
+                  label="the lesson's field: a waypoint tens of metres away at 60 degrees"),
              Case((field, _destination(*field, float(rng.uniform(5, 80)), float(rng.uniform(0, 2 * np.pi)))),
                   label="across the football field"),
              Case((far_north, _destination(*far_north, float(rng.uniform(300, 1500)), float(rng.uniform(0.3, 1.2)))),
