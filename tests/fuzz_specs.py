@@ -49,6 +49,18 @@ def mcl_run():
 
 
 @functools.cache
+def odometry_run():
+    from robocourse.lessons.visual_slam.odometry import odometry_run as run
+    return run(0, frames=3)
+
+
+@functools.cache
+def truck_course():
+    from robocourse.lessons.gps_sonar_truck.loop import course_case
+    return course_case(0).args[0]
+
+
+@functools.cache
 def panda_arm():
     from robokit.arm import panda
     return panda()
@@ -808,14 +820,17 @@ SPECS: dict[str, Call] = {
         "c": Array(np.array([320.0, 100.0]), "N"), "r": Array(np.array([240.0, 50.0]), "N"),
         "d": Array(np.array([10.0, 20.0]), "N"), "focal": Real(500.0), "c0": Real(320.0), "r0": Real(240.0),
         "baseline": Real(0.12)}),
-    "robocourse.lessons.visual_slam.exercises.robust_pose": Call({
+    "robocourse.lessons.visual_slam.odometry_loop.robust_pose": Call({
         "robot_points": Array(np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [-1.0, 0.2, 3.0]]), "N,3"),
         "world_points": Array(np.array([[1.0, 0.0, 2.0], [2.0, 0.0, 3.0], [0.0, 0.2, 4.0]]), "N,3")}),
     "robocourse.lessons.visual_slam.exercises.robust_pose_problems": Call({"rng": Rng()}),
-    "robocourse.lessons.visual_slam.exercises.hough_votes": Call({
+    "robocourse.lessons.visual_slam.exercises.hough_candidates": Call({
         "robot_xz": Array(np.array([[0.0, 1.0], [0.5, 2.0]]), "N,2"), "robot_cov_xz": Array(np.tile(np.eye(2) * 1e-3, (2, 1, 1)), "N,2,2"),
         "world_xz": Array(np.array([[0.2, 1.2], [0.7, 2.2]]), "N,2"), "world_cov_xz": Array(np.tile(np.eye(2) * 1e-3, (2, 1, 1)), "N,2,2"),
-        "bounds": Array(np.array([0.0, 0.4, 0.0, 0.4]), "4"), "bin_size": Real(0.04), "angle_bin": Real(0.5)}),
+        "thetas": Array(np.array([0.0, 0.5]), "N")}),
+    "robocourse.lessons.visual_slam.odometry_loop.stereo_odometry": Call({
+        "features": Obj(lambda: odometry_run()["features"]), "matches": Obj(lambda: odometry_run()["matches"]),
+        "start_pose": Array(lambda: odometry_run()["start"], "3")}, cheap=False),
     # --- viz -------------------------------------------------------------------------------
     "robokit.viz.maps.plot_covariance": Call({"mean": Array(np.zeros(2), "2"), "cov": Array(np.eye(2) * 0.1, "2,2"),
                                               "ax": Given(axes), "nsigma": Real(1.0), "kwargs": Given({})}),
@@ -1325,6 +1340,10 @@ SPECS: dict[str, Call] = {
         "query": Array(lambda: orb_descriptors(40, 2)[:10], "N,32"),
         "keyframes": Obj(lambda: [orb_descriptors(40, 1), orb_descriptors(40, 2)])}),
     # --- lesson 05: the open exercise's reference ---
+    "robocourse.lessons.gps_sonar_truck.exercises.local_offset": Call({
+        "origin": Array(np.array([6.45, 100.35]), "2"), "point": Array(np.array([6.46, 100.36]), "2")}),
+    "robocourse.lessons.gps_sonar_truck.loop.drive_course": Call({
+        "course": Mapping(lambda: truck_course()), "front": Real(1.2), "side": Real(0.8)}, cheap=False),
     "robocourse.lessons.gps_sonar_truck.exercises.compass_bias": Call({
         "fixes": Array(np.array([[0.0, 0.0], [0.7, 0.1], [1.4, 0.0]]), "N,2"),
         "compass_deg": Array(np.array([91.0, 92.0, 91.0]), "N")}),

@@ -173,7 +173,7 @@ def likelihood_field_weight(pose, ranges, angles, distance, resolution, origin, 
     --------
     >>> d = np.abs(np.arange(20)[None, :] * 0.1 + 0.05 - 1.55) * np.ones((20, 1))   # a wall at x = 1.55 m
     >>> out = likelihood_field_weight([0.55, 1.0, 0.0], [1.0], [0.0], d, 0.1, [0.0, 0.0])
-    >>> out["distance"], round(out["rand"], 6), round(out["log_q"], 3)
+    >>> out["distance"].tolist(), round(out["rand"], 6), round(out["log_q"], 3)
     ([0.0], 0.00625, 0.642)
     """
     field = LikelihoodField(as_array(distance, "distance", ndim=2), as_positive(resolution, "resolution"),

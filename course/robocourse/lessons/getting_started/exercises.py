@@ -13,6 +13,7 @@ from typing import Any
 
 from robokit.geometry import se2_compose, wrap_angle
 from robocourse.exercises.compare import close
+from robocourse.exercises.plain import numeric_array
 from robocourse.exercises.spec import Case, Exercise
 
 ASSIGNMENT = "00_getting_started"
@@ -53,9 +54,10 @@ def _compose_diagnosis(expected: Any, got: Any) -> str | None:
     message = _CLOSE(expected, got)
     if message is None:
         return None
-    e, g = np.asarray(expected, float), np.asarray(got, float)
-    if g.shape != (3,):
+    e, g = np.asarray(expected, float), numeric_array(got)
+    if g is None or g.shape != (3,) or g.dtype.kind not in "fiu":
         return message
+    g = g.astype(float)
     hints = []
     if not np.allclose(g[:2], e[:2], rtol=0, atol=1e-9):
         hints.append("the position is wrong: b's x and y are measured along frame a's axes, so they reach the "

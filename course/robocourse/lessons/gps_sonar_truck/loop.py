@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from robokit.validation import as_positive
 from robokit.controllers.heading import design_heading_gains
 from robokit.outdoor import (PAPER_LAYOUT, PAPER_TRUCK, Compass, Course, Field, GPSReceiver, LVMaxSonarEZ, Navigator,
                              SkidSteerTruck, TruckState, haversine_distance_bearing, random_course)
@@ -294,7 +295,19 @@ def drive_course(course: dict, front: float = FRONT, side: float = SIDE) -> list
     -------
     list of [left, right]
         The wheel commands sent, one per step.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a course that is not a dict of a case's keys, a course without waypoints, or thresholds
+        that are not positive numbers.
     """
+    if not isinstance(course, dict):
+        raise TypeError(f"course: expected a dict (a loop case's course), got {type(course).__name__}")
+    missing = sorted({"waypoints", "model", "navigator", "dt", "compass_every", "arrival_radius"} - set(course))
+    if missing:
+        raise ValueError(f"course: missing keys {missing}")
+    front, side = as_positive(front, "front"), as_positive(side, "side")
     return run_mission(course, make_controller(course, front, side))
 
 

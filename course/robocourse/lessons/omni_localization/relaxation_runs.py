@@ -85,7 +85,7 @@ def tour_graph(rng: Any, spacing: float = 2.5, loops: str = "all") -> dict:
     --------
     >>> g = tour_graph(0)
     >>> len(g["poses"]), len(g["edges"]) - len(g["poses"]) + 1     # nodes, loop edges
-    (40, 4)
+    (40, 6)
     """
     rng = as_rng(rng)
     spacing = as_positive(spacing, "spacing")
