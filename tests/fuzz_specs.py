@@ -1874,6 +1874,7 @@ HUGE_ANGLES: dict[str, tuple[str, ...]] = {
 
 
 EXTRA: tuple[str, ...] = (
+    "robokit.outdoor.navigator.avoidance_decision",   # the Navigator's rules; assignment 05's loop folds them in
     "robokit.legged.posture.PostureFeedback",          # lesson 04's reactive host, built by host_table and terrain_table
     "robocourse.lessons.littledog.experiment.posture_errors",   # host_table's tilt and sag
     "robokit.localization.appearance_mcl.place_hypotheses",      # lesson 02's Monte-Carlo check (checks)

@@ -52,6 +52,7 @@ def robust_pose(robot_points, world_points) -> np.ndarray:
 
     Examples
     --------
+    >>> from robokit.geometry import pqt_robot_to_world
     >>> rng = np.random.default_rng(0)
     >>> robot = rng.uniform([-2.0, -0.5, 1.0], [2.0, 0.5, 5.0], (30, 3))
     >>> world = pqt_robot_to_world(robot, [1.0, 2.0, 0.3])
