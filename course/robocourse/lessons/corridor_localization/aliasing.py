@@ -11,10 +11,9 @@ References
 """
 from __future__ import annotations
 
-import numpy as np
-
 from robokit.sim.lidar import Lidar
 from robokit.sim.worlds import long_corridor
+from robocourse.lessons.corridor_localization.mcl_runs import corridor_distance
 
 __all__ = ["aliasing_example"]
 
@@ -57,13 +56,7 @@ def aliasing_example(resolution: float = 0.1) -> dict:
     world, lidar = long_corridor(), Lidar(height=0.45)
     true, look_alike, elsewhere = [23.0, 0.0, 0.0], [27.5, 0.0, 0.0], [14.0, 0.0, 0.0]
     ranges = lidar.scan(world, true)
-    x0, y0 = -0.5, -world.info["width"] / 2 - 0.5
-    nx = int(np.ceil((world.info["length"] + 1.0) / resolution))
-    ny = int(np.ceil((world.info["width"] + 1.0) / resolution))
-    xs = x0 + (np.arange(nx) + 0.5) * resolution
-    ys = y0 + (np.arange(ny) + 0.5) * resolution
-    centres = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
-    distance = np.minimum(world.layout(lidar.height).clearance(centres), 2.0).reshape(ny, nx)
+    distance, (x0, y0) = corridor_distance(resolution)
     return {"ranges": ranges.tolist(), "angles": lidar.angles.tolist(), "distance": distance.round(6).tolist(),
-            "resolution": float(resolution), "origin": [x0, y0], "true": true, "look_alike": look_alike,
+            "resolution": float(resolution), "origin": [float(x0), float(y0)], "true": true, "look_alike": look_alike,
             "elsewhere": elsewhere}

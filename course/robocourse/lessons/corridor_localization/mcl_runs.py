@@ -64,7 +64,7 @@ def corridor_distance(resolution: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
     Returns
     -------
     (distance, origin)
-        ``distance`` (H, W), rounded to mm; cell ``[i, j]`` covers ``origin + ([j, j+1), [i, i+1)) *
+        ``distance`` (H, W); cell ``[i, j]`` covers ``origin + ([j, j+1), [i, i+1)) *
         resolution``; ``origin`` the grid's lower-left corner. Cached: about 0.5 s the first time.
 
     Examples
@@ -81,7 +81,7 @@ def corridor_distance(resolution: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
     xs = x0 + (np.arange(nx) + 0.5) * resolution
     ys = y0 + (np.arange(ny) + 0.5) * resolution
     centres = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
-    distance = np.minimum(world.layout(height).clearance(centres), 2.0).reshape(ny, nx).round(3)
+    distance = np.minimum(world.layout(height).clearance(centres), 2.0).reshape(ny, nx)
     distance.setflags(write=False)
     return distance, np.array([x0, y0])
 
@@ -121,7 +121,7 @@ def _candidate(rng: np.random.Generator) -> tuple[dict, np.ndarray]:
     run = {"particles": particles.round(4).tolist(), "odometry": increments.round(5).tolist(),
            "motion_std": list(RUN["motion_std"]), "noise": rng.standard_normal((T, M, 3)).round(3).tolist(),
            "scans": np.where(np.isfinite(scans), scans.round(4), np.inf).tolist(),
-           "angles": lidar.angles.round(9).tolist(), "distance": distance[:, first:last].tolist(),
+           "angles": lidar.angles.round(9).tolist(), "distance": distance[:, first:last].round(3).tolist(),
            "resolution": res, "origin": [round(float(origin[0] + first * res), 6), float(origin[1])],
            "uniforms": rng.uniform(0.0, 1.0 / M, T).round(6).tolist()}
     return run, poses[1:]
