@@ -230,6 +230,8 @@ def test_loop_cases_are_fair_and_shortcuts_fail():
 
 def test_loop_truth_is_hidden_from_the_inputs():
     """The truth travels only in Case.expected: no input holds the true poses."""
+    from robocourse.lessons.corridor_localization.mcl_runs import corridor_distance
+    whole, origin = corridor_distance()
     for c in EXERCISES["03.mcl_track"].make_cases(9):
         if c.raises:
             continue
@@ -239,3 +241,8 @@ def test_loop_truth_is_hidden_from_the_inputs():
         truth = np.asarray(c.expected)
         start = np.mean(np.asarray(run["particles"])[:, :2], axis=0)
         assert np.hypot(*(start - truth[0, :2])) > 0.3
+        # the grid is the whole corridor's, whatever the drive: its extent says nothing of where it went
+        # (a grid cropped to the drive +- 8.5 m once gave its x away to 0.1 m)
+        assert np.shape(run["distance"]) == whole.shape and run["origin"] == origin.tolist()
+        uniforms = np.asarray(run["uniforms"])
+        assert np.all((uniforms >= 0) & (uniforms < 1 / len(run["particles"])))
