@@ -281,9 +281,8 @@ def _in_workers(run: Callable, blobs: dict, settings: dict, jobs: list, workers:
         except Exception as exc:           # noqa: BLE001 - the workers could not be started: never fewer results
             failed = Future()
             failed.set_exception(RuntimeError(
-                f"run: the worker processes could not be started ({type(exc).__name__}: {exc}); a script that "
-                "makes runs in workers must do so under `if __name__ == \"__main__\":`, as the worker "
-                "processes import it"))
+                f"run: the worker processes could not be started ({type(exc).__name__}: {exc}); if the caller "
+                "is a script, it must start runs under `if __name__ == \"__main__\":` (the workers import it)"))
             failed.exception().__cause__ = exc
             submitted.put(failed)
         finally:

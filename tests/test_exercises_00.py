@@ -65,7 +65,8 @@ def test_feedback_names_the_wrong_part(wrong, hint):
         assert "the heading is" not in report, report
 
 
-@pytest.mark.parametrize("bad", ["", "abc", None, [1.0, 2.0], ["a", "b", "c"], [True, False, True], {"x": 1}])
+@pytest.mark.parametrize("bad", ["", "abc", None, [1.0, 2.0], ["a", "b", "c"], [True, False, True], {"x": 1},
+                                 [0.0, 0.0, float("nan")], [10 ** 400, 0, 0]])
 def test_an_answer_that_is_not_a_pose_gets_a_message_not_an_error(bad):
     exercise = EXERCISES["00.se2_compose"]
     expected = se2_compose([1.0, 2.0, 0.3], [0.5, -0.2, 0.1]).tolist()

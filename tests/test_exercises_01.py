@@ -225,16 +225,12 @@ def test_the_open_exercise_judges_the_heading_modulo_two_pi():
 def test_the_loop_runs_are_the_lessons_lab():
     """Every run is a stretch of the lesson's lap with a corner, its first truth is the start pose,
     no two runs share their poses (the start pose does not give the rest away), and the plain data
-    stay small and cheap."""
+    stay small."""
     import json
-    import time
 
-    from robocourse.lessons.visual_slam.odometry import ODOMETRY_RUN, odometry_run
+    from robocourse.lessons.visual_slam.odometry import ODOMETRY_RUN
 
-    odometry_run(0)                                     # the lab and its lap, built once
-    start = time.perf_counter()
     cases = _exercise("01.stereo_odometry").make_cases(11)
-    assert time.perf_counter() - start < 2.0            # < 0.5 s on an idle machine
     for case in (c for c in cases if not c.raises):
         features, matches, start_pose = case.args
         truth = np.asarray(case.expected)

@@ -90,9 +90,9 @@ def corridor_camera() -> PinholeCamera:
     Ge et al. (2023), Sec. 4: a monocular camera with 1280 x 960 pixels at 30 frames per second,
     mounted lower than the LiDAR. We render at half that size to keep the lesson fast. Fast mode
     renders fewer frames, never smaller ones: at 320 x 240 ORB finds fewer than its 500 features
-    (about 410 mid-corridor, 340-380 in the last 6 m), so Eq. (15)'s threshold refuses every frame
-    near the far end and the keyframe database stops there, a behaviour the full-size lesson never
-    shows.
+    (about 410 mid-corridor, 340-380 in the last 6 m), so Eq. (15)'s threshold (413 there) refused
+    every frame past x = 27.5 m and the keyframe database stopped 8 m before the run's end; at
+    640 x 480 it ends 2-4 m before (lesson 03 prints where, in its kidnapping section).
 
     Examples
     --------

@@ -58,6 +58,8 @@ def _compose_diagnosis(expected: Any, got: Any) -> str | None:
     if g is None or g.shape != (3,) or g.dtype.kind not in "fiu":
         return message
     g = g.astype(float)
+    if not np.all(np.isfinite(g)):
+        return message + "; expected finite numbers"
     hints = []
     if not np.allclose(g[:2], e[:2], rtol=0, atol=1e-9):
         hints.append("the position is wrong: b's x and y are measured along frame a's axes, so they reach the "

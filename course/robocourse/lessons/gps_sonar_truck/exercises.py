@@ -212,12 +212,14 @@ def _same_position(expected, got) -> str | None:
 
 def _same_offset(expected, got) -> str | None:
     """Accept ``[east, north]`` within 1 mm plus ``3 d^2 / R`` of the answer (``d`` its distance): any
-    sound local plane of the sphere or the ellipsoid differs from the equirectangular map by about
-    ``d^2 / R`` times a factor that grows with the latitude's tangent; the cases stay below 60 degrees
-    and 2 km. Name the offset that is wrong and the likely term."""
+    sound local plane of the task's sphere (radius ``EARTH_RADIUS``) differs from the equirectangular map
+    by about ``d^2 / R`` times a factor that grows with the latitude's tangent; the cases stay below 60
+    degrees and 2 km. An ellipsoid's plane (robokit's :class:`~robokit.outdoor.geodesy.LocalTangentPlane`)
+    differs by 0.1-0.4 % of ``d`` and is rejected: the task fixes the sphere. Name the offset that is
+    wrong and the likely term."""
     try:
         g = np.array(got, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return f"expected [east, north] in metres, got {summarize(got)}"
     if g.shape != (2,):
         return f"expected [east, north] in metres, got {summarize(got)}"
@@ -407,7 +409,7 @@ EXERCISES = [
         compare=_same_offset,
         kind="derivation",
         description="The flat east-north map about a point, derived from the sphere (arcs of the meridian and "
-                    "of the parallel); any sound local plane within 1 mm + 3 d^2 / R passes.",
+                    "of the parallel); any sound local plane of that sphere (within 1 mm + 3 d^2 / R) passes.",
     ),
     Exercise(
         id="05.pulse_to_distance",

@@ -286,7 +286,7 @@ def _fix_update_checked(expected, got):
     miss = new_x - ex if new_x.shape == ex.shape else None
     if miss is not None:
         miss[2] = wrap_angle(miss[2])                       # a heading 2 pi off is the same heading
-    if miss is None or not np.allclose(miss, 0, atol=1e-7):
+    if miss is None or not np.allclose(ex + miss, ex, rtol=1e-7, atol=1e-9):      # close()'s tolerance, below
         for slip, value in expected["mistakes"].items():
             if miss is not None and np.allclose(new_x, value, rtol=1e-6, atol=1e-8):
                 return f"'x': H is right, but your update uses {slip}"

@@ -241,11 +241,12 @@ def _fields(got: Any, n: int) -> tuple | str:
     try:
         poses = np.asarray(got["poses"], float)
         changes = [float(c) for c in np.asarray(got["changes"], float).ravel()]
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return f"'poses' and 'changes': expected numbers, got {summarize(got['poses'])}, {summarize(got['changes'])}"
     if poses.shape != (n, 3) or not np.isfinite(poses).all():
         return f"'poses': expected a finite ({n}, 3) array, got shape {poses.shape}"
-    if type(got["sweeps"]) not in (int, float) or got["sweeps"] != int(got["sweeps"]):
+    sweeps = got["sweeps"]
+    if type(sweeps) not in (int, float) or (type(sweeps) is float and not np.isfinite(sweeps)) or sweeps != int(sweeps):
         return f"'sweeps': expected a whole number, got {summarize(got['sweeps'])}"
     if type(got["converged"]) is not bool:
         return f"'converged': expected True or False, got {summarize(got['converged'])}"
