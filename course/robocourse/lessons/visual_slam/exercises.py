@@ -341,16 +341,25 @@ def _fusion_mistakes(e) -> tuple[dict, dict]:
     return means, covs
 
 
+def _numeric_pair(got, names: str) -> tuple | str:
+    """A student's pair of arrays as two float arrays, or what is wrong with it (``names`` says what
+    the pair holds, for the message)."""
+    if not isinstance(got, (tuple, list)) or len(got) != 2:
+        return f"expected a pair {names}, got {summarize(got)}"
+    parts = [numeric_array(v) for v in got]
+    if any(v is None or v.dtype.kind not in "iuf" for v in parts):
+        return f"expected a pair of arrays of numbers {names}, got {summarize(got)}"
+    return tuple(v.astype(float) for v in parts)
+
+
 def _fused(expected, got) -> str | None:
     """Accept ``(s', Sigma')`` within 1e-6 relative; otherwise say which of the two is wrong and,
     where it matches a known slip, which."""
     want_mean, want_cov = (np.asarray(v, float) for v in expected["fused"])
-    if not isinstance(got, (tuple, list)) or len(got) != 2:
-        return f"expected a pair (s_fused, sigma_fused), got {summarize(got)}"
-    parts = [numeric_array(v) for v in got]
-    if any(v is None or v.dtype.kind not in "iuf" for v in parts):
-        return f"expected a pair of arrays of numbers (s_fused, sigma_fused), got {summarize(got)}"
-    mean, cov = (v.astype(float) for v in parts)
+    pair = _numeric_pair(got, "(s_fused, sigma_fused)")
+    if isinstance(pair, str):
+        return pair
+    mean, cov = pair
     if mean.shape != want_mean.shape or cov.shape != want_cov.shape:
         return (f"expected s_fused of shape {want_mean.shape} and sigma_fused of shape {want_cov.shape}, got "
                 f"{mean.shape} and {cov.shape}")
@@ -429,12 +438,10 @@ def _hough_mistakes(e) -> tuple[dict, dict]:
 def _same_candidates(expected, got) -> str | None:
     """Accept the vote centres and covariances within 1e-6 relative; else name the part that is wrong."""
     want_pos, want_cov = (np.asarray(v, float) for v in expected["candidates"])
-    if not isinstance(got, (tuple, list)) or len(got) != 2:
-        return f"expected a pair (positions, covariances), got {summarize(got)}"
-    parts = [numeric_array(v) for v in got]
-    if any(v is None or v.dtype.kind not in "iuf" for v in parts):
-        return f"expected a pair of arrays of numbers (positions, covariances), got {summarize(got)}"
-    pos, cov = (v.astype(float) for v in parts)
+    pair = _numeric_pair(got, "(positions, covariances)")
+    if isinstance(pair, str):
+        return pair
+    pos, cov = pair
     if pos.shape != want_pos.shape or cov.shape != want_cov.shape:
         return (f"expected positions of shape {want_pos.shape} (T, M, 2) and covariances of shape "
                 f"{want_cov.shape} (T, M, 2, 2), got {pos.shape} and {cov.shape}")

@@ -27,7 +27,7 @@ from robokit.geometry import pqt_world_to_robot, se2_to_pqt, wrap_angle
 from robokit.sim import PinholeCamera, lab_lap, lab_room
 from robokit.validation import as_int, as_rng
 
-__all__ = ["ODOMETRY_RUN", "odometry_run", "compose_pqt", "lab_points"]
+__all__ = ["ODOMETRY_RUN", "odometry_run", "lab_points"]
 
 #: The runs of the loop exercise: frames per run, frame rate (Hz), pixel noise (px, on each of the
 #: left column, right column and row), the share of wrong matches (a range), features kept per
@@ -98,22 +98,6 @@ def lab_points(rng, count: int = 4000) -> np.ndarray:
         xyz = np.vstack([xyz, more[(more[:, 2] > 0.1) & (more[:, 2] < 2.4)]])
     xyz = xyz[:count]
     return np.column_stack([xyz[:, 0], xyz[:, 2] - ODOMETRY_RUN["camera_height"], xyz[:, 1]])
-
-
-def compose_pqt(pose, step) -> np.ndarray:
-    """The pose reached by moving ``step`` (expressed in the frame of ``pose``) from ``pose``.
-
-    ``(X, Z)_world = R(theta) (X', Z') + (p, q)`` applied twice: ``p'' = R(theta) (p', q') + (p, q)``,
-    ``theta'' = theta + theta'`` (wrapped to ``[-pi, pi)``).
-
-    Examples
-    --------
-    >>> print(np.round(compose_pqt([1.0, 2.0, np.pi / 2], [0.0, 1.0, 0.1]), 6))
-    [0.  2.  1.670796]
-    """
-    a, b = np.asarray(pose, float), np.asarray(step, float)
-    c, s = np.cos(a[2]), np.sin(a[2])
-    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], float(wrap_angle(a[2] + b[2]))])
 
 
 def _visible(points_robot: np.ndarray, pose: np.ndarray, world_points: np.ndarray) -> np.ndarray:

@@ -15,12 +15,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from robokit.geometry import wrap_angle
+from robokit.geometry import se2_compose, wrap_angle
 from robokit.localization.egomotion import fit_pose, ransac_pose
 from robokit.validation import as_array
 from robocourse.exercises.plain import numeric_array, summarize
 from robocourse.exercises.spec import Case
-from robocourse.lessons.visual_slam.odometry import compose_pqt, odometry_run
+from robocourse.lessons.visual_slam.odometry import odometry_run
 
 __all__ = ["robust_pose", "stereo_odometry", "LOOP_TOLERANCE", "LOOP_RUNS", "odometry_cases", "on_track",
            "LOOP_SHORTCUTS"]
@@ -72,9 +72,9 @@ def stereo_odometry(features, matches, start_pose) -> np.ndarray:
 
     For every step the features of frame ``k + 1`` (robot frame ``k + 1``) matched to those of
     frame ``k`` (robot frame ``k``) give, by :func:`robust_pose`, the pose of robot ``k + 1`` in the
-    frame of robot ``k``; composing it with the pose of frame ``k`` (:func:`.odometry.compose_pqt`)
-    gives the pose of frame ``k + 1`` in the world. Lin et al. Sec. 5-7 (ego-motion by RANSAC);
-    Se et al. Sec. 3 (the map anchored at the first frame).
+    frame of robot ``k``; composing it with the pose of frame ``k`` (:func:`robokit.geometry.se2_compose`:
+    ``[p, q, theta]`` composes as a planar pose) gives the pose of frame ``k + 1`` in the world. Lin et
+    al. Sec. 5-7 (ego-motion by RANSAC); Se et al. Sec. 3 (the map anchored at the first frame).
 
     Parameters
     ----------
@@ -122,7 +122,7 @@ def stereo_odometry(features, matches, start_pose) -> np.ndarray:
             raise ValueError(f"matches[{k}]: an index outside frames {k} ({len(frames[k])} features) "
                              f"and {k + 1} ({len(frames[k + 1])} features)")
         step = robust_pose(frames[k + 1][pairs[:, 1]], frames[k][pairs[:, 0]])
-        out.append(compose_pqt(out[-1], step))
+        out.append(se2_compose(out[-1], step))
     return np.array(out)
 
 
@@ -205,17 +205,12 @@ def _least_squares_step(cur, prev):
     return fit_pose(cur, prev)[0]
 
 
-def _inverse_pqt(pose):
-    c, s = np.cos(pose[2]), np.sin(pose[2])
-    return np.array([-(c * pose[0] + s * pose[1]), s * pose[0] - c * pose[1], -pose[2]])
-
-
 #: Ways to produce a trajectory without a working loop, by name (the grader discounts their passes).
 LOOP_SHORTCUTS = {
     "the start pose at every frame": lambda features, matches, start_pose: [list(start_pose)] * len(features),
-    "least squares on every match, chained": _chain(_least_squares_step, compose_pqt),
+    "least squares on every match, chained": _chain(_least_squares_step, se2_compose),
     "robust steps added to the pose, not composed": _chain(robust_pose, lambda a, b: np.asarray(a) + b),
-    "robust steps composed in the wrong order": _chain(robust_pose, lambda a, b: compose_pqt(b, a)),
+    "robust steps composed in the wrong order": _chain(robust_pose, lambda a, b: se2_compose(b, a)),
     "robust steps with frames swapped (each step inverted)":
-        _chain(lambda cur, prev: robust_pose(prev, cur), compose_pqt),
+        _chain(lambda cur, prev: robust_pose(prev, cur), se2_compose),
 }
