@@ -33,7 +33,7 @@ from robokit.arm import (LIMIT_TOL, dh_fk, dh_jacobian, dh_transform, elbow_angl
                          ik_srs_readable, limit_distance_gradient, null_space_step, panda, shoulder_angles,
                          wrist_centre)
 from robokit.arm.srs_geometry import arm_angle_terms
-from robokit.geometry import as_se3, pose_error
+from robokit.geometry import as_se3, pose_error, rot_y, rot_z
 from robokit.validation import as_array
 from robocourse.exercises.compare import close
 from robocourse.exercises.plain import numeric_array, summarize
@@ -286,14 +286,6 @@ SHOULDER_SHORTCUTS = {"the arm angle ignored (psi = 0)": lambda S, W, q4, psi, d
                       "the arm angle with the wrong sign": lambda S, W, q4, psi, d_se, d_ew: shoulder_angles(S, W, q4, -psi, d_se, d_ew)}
 
 
-def _rz(t: float) -> np.ndarray:
-    return np.array([[np.cos(t), -np.sin(t), 0.0], [np.sin(t), np.cos(t), 0.0], [0.0, 0.0, 1.0]])
-
-
-def _ry(t: float) -> np.ndarray:
-    return np.array([[np.cos(t), 0.0, np.sin(t)], [0.0, 1.0, 0.0], [-np.sin(t), 0.0, np.cos(t)]])
-
-
 def _shoulder_geometry(expected: Any, got: Any) -> str | None:
     """Judge shoulder joints by what they do: put the wrist centre at W, at the arm angle asked, on the
     branch q2 >= 0; say which of the three fails first."""
@@ -310,7 +302,7 @@ def _shoulder_geometry(expected: Any, got: Any) -> str | None:
     S, W = np.asarray(expected["shoulder"], float), np.asarray(expected["wrist"], float)
     q4, psi, d_se, d_ew = expected["q4"], expected["psi"], expected["d_se"], expected["d_ew"]
     v = np.array([-d_ew * np.sin(q4), 0.0, d_se + d_ew * np.cos(q4)])
-    wrist = S + _rz(g[0]) @ _ry(g[1]) @ _rz(g[2]) @ v
+    wrist = S + rot_z(g[0]) @ rot_y(g[1]) @ rot_z(g[2]) @ v
     miss = float(np.linalg.norm(wrist - W))
     yours = f"yours (q1, q2, q3) = {np.degrees(g).round(3).tolist()} deg, expected {np.degrees(want).round(3).tolist()} deg"
     if miss > 1e-6:

@@ -20,13 +20,15 @@ from typing import Any
 
 import numpy as np
 
-from robokit.arm import LIMIT_TOL, iiwa14
+from robokit.arm import LIMIT_TOL, Chain, chain_from_table, iiwa14
+from robokit.arm.jacobian import jacobian_from_frames
 from robokit.geometry import as_se3, pose_error, so3_exp
 from robokit.validation import as_array
 from robocourse.exercises.plain import numeric_array, summarize
 from robocourse.exercises.spec import Case
 
-__all__ = ["ARM", "IIWA_DH", "TRACK", "TRACK_MARGIN", "TRACK_SHORTCUTS", "TRACK_WAYPOINTS", "judge_track", "track_cases", "track_path"]
+__all__ = ["ARM", "IIWA_DH", "TRACK", "TRACK_MARGIN", "TRACK_SHORTCUTS", "TRACK_WAYPOINTS", "judge_track", "track_cases",
+           "track_path"]
 
 #: The arm of the cases (the lesson's iiwa) and its DH rows ``[d, a, alpha]``.
 ARM = iiwa14()
@@ -37,30 +39,9 @@ IIWA_DH = np.stack([ARM.d, ARM.a, ARM.alpha], 1).tolist()
 TRACK = {"steps": 30, "tol": 1e-3, "max_step": 0.1, "damping": 0.02, "gain": 1.0}
 
 
-def _frames_fast(dh: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Base-frame transforms (n + 1, 4, 4) of frames 0..n of a standard-DH chain (unchecked; the loop's
-    inner step)."""
-    d, a, al = dh.T
-    ct, st, ca, sa = np.cos(q), np.sin(q), np.cos(al), np.sin(al)
-    A = np.zeros((len(q), 4, 4))
-    A[:, 0] = np.stack([ct, -st * ca, st * sa, a * ct], 1)
-    A[:, 1] = np.stack([st, ct * ca, -ct * sa, a * st], 1)
-    A[:, 2, 1], A[:, 2, 2], A[:, 2, 3], A[:, 3, 3] = sa, ca, d, 1.0
-    F = np.empty((len(q) + 1, 4, 4))
-    F[0] = np.eye(4)
-    for i in range(len(q)):
-        F[i + 1] = F[i] @ A[i]
-    return F
-
-
-def _jacobian_fast(F: np.ndarray) -> np.ndarray:
-    z, r = F[:-1, :3, 2].T, (F[-1, :3, 3][None] - F[:-1, :3, 3]).T
-    v = np.array([z[1] * r[2] - z[2] * r[1], z[2] * r[0] - z[0] * r[2], z[0] * r[1] - z[1] * r[0]])
-    return np.vstack([v, z])                                        # Siciliano et al. (2009), Eq. 3.30
-
-
-def _loop_error(T: np.ndarray, F: np.ndarray) -> np.ndarray:
-    return pose_error(T, F, validate=False)
+def _flange(chain: Chain, q: np.ndarray) -> np.ndarray:
+    """The flange transform(s) of ``q`` ((n,) or (N, n)), unchecked."""
+    return chain.flange_transform(chain.frames(q, validate=False), validate=False)
 
 
 def _joint_range_cost(q: Any, qmin: Any, qmax: Any) -> np.ndarray:
@@ -73,14 +54,15 @@ def _run(dh, qmin, qmax, q_start, targets, steps, max_step, damping, gain) -> np
     """The loop, unchecked: ``steps`` iterations per target of the damped least-squares step plus the
     joint-range gradient projected into the null space, scaled so that no joint moves more than
     ``max_step``."""
-    dh, qmin, qmax = (np.asarray(x, dtype=float) for x in (dh, qmin, qmax))
+    chain = chain_from_table(dh)
+    qmin, qmax = (np.asarray(x, dtype=float) for x in (qmin, qmax))
     mid, half = 0.5 * (qmin + qmax), 0.5 * (qmax - qmin)
     q, out, eye = np.array(q_start, dtype=float), [], np.eye(6)
     for T in np.asarray(targets, dtype=float):
         for _ in range(steps):
-            F = _frames_fast(dh, q)
-            e = _loop_error(T, F[-1])
-            J = _jacobian_fast(F)
+            F = chain.frames(q, validate=False)
+            e = pose_error(T, chain.flange_transform(F, validate=False), validate=False)
+            J = jacobian_from_frames(chain, F, validate=False)
             JJt = J @ J.T
             dq = J.T @ np.linalg.solve(JJt + damping ** 2 * eye, e)                       # Wampler (1986)
             if gain:
@@ -162,8 +144,7 @@ def track_path(dh: Any, qmin: Any, qmax: Any, q_start: Any, targets: Any, settin
 def _slot_errors(dh, run: np.ndarray, targets: np.ndarray, steps: int) -> np.ndarray:
     """Pose error (the larger of position [m] and rotation [rad]) of every iterate against its target."""
     T = np.repeat(np.asarray(targets, dtype=float), steps, axis=0)
-    dh = np.asarray(dh, float)
-    e = pose_error(T, np.array([_frames_fast(dh, q)[-1] for q in run]), validate=False)
+    e = pose_error(T, _flange(chain_from_table(dh), np.asarray(run, dtype=float)), validate=False)
     return np.maximum(np.linalg.norm(e[:, :3], axis=1), np.linalg.norm(e[:, 3:], axis=1))
 
 
@@ -198,7 +179,7 @@ def _track_run(rng: np.random.Generator, label: str) -> Case:
         q0 = rng.uniform(0.85 * qmin, 0.85 * qmax).round(4)
         if _joint_range_cost(q0, qmin, qmax) < 1.2:
             continue
-        targets = _arc_path(rng, _frames_fast(np.asarray(IIWA_DH), q0)[-1], TRACK_WAYPOINTS).round(10)
+        targets = _arc_path(rng, _flange(chain_from_table(IIWA_DH), q0), TRACK_WAYPOINTS).round(10)
         ref = _run(IIWA_DH, qmin, qmax, q0, targets, s["steps"], s["max_step"], s["damping"], s["gain"])
         err = _slot_errors(IIWA_DH, ref, targets, s["steps"])[s["steps"] - 1::s["steps"]]
         if err.max() > s["tol"] / 3 or np.any((ref < qmin + 0.01) | (ref > qmax - 0.01)):
