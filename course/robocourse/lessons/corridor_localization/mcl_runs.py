@@ -241,18 +241,19 @@ def one_shot(run: dict) -> np.ndarray:
     P = se2_compose(np.asarray(run["particles"], dtype=float),
                     odometry[0] + np.asarray(run["noise"][0], dtype=float) * np.asarray(run["motion_std"], dtype=float))
     pose = P[int(np.argmax(likelihood_field_log_weights(P, run["scans"][0], run["angles"], field)))]
-    out = [pose]
-    for u in odometry[1:]:
-        pose = se2_compose(pose, u)
-        out.append(pose)
-    return np.array(out)
+    return np.vstack([pose, _carried(pose, odometry[1:])])
 
 
 def dead_reckoning(run: dict) -> np.ndarray:
     """The shortcut that ignores the laser: the start cloud's mean pose moved by the odometry, (T, 3)."""
-    pose = weighted_pose_mean(np.asarray(run["particles"], dtype=float))
+    start = weighted_pose_mean(np.asarray(run["particles"], dtype=float))
+    return _carried(start, np.asarray(run["odometry"], dtype=float))
+
+
+def _carried(pose: np.ndarray, increments: np.ndarray) -> np.ndarray:
+    """``pose`` moved by each odometry increment in turn: the pose after each, (len(increments), 3)."""
     out = []
-    for u in np.asarray(run["odometry"], dtype=float):
+    for u in increments:
         pose = se2_compose(pose, u)
         out.append(pose)
-    return np.array(out)
+    return np.array(out).reshape(-1, 3)
