@@ -702,7 +702,7 @@ SPECS: dict[str, Call] = {
         "guidance": Choice("estimate")}),
     "robokit.outdoor.navigator.avoidance_decision": Call({
         "ranges": Array(np.array([6.45, 0.5, 0.6, 6.45]), "4", inf_ok=True), "front": Real(1.2), "side": Real(0.8),
-        "prefer": Choice("left")}),
+        "prefer": Choice("left"), "validate": Flag(True)}),
     "robokit.outdoor.nmea.NMEAReader": Call({"source": Obj(b"$GPGGA,1*00\r\n", accepts=("a string",)), "require_checksum": Flag(True),
                                              "on_error": Func(None, optional=True), "chunk_size": Int(64),
                                              "max_line": Int(4096)}),

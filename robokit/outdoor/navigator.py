@@ -41,7 +41,8 @@ DECISIONS = ("forward", "left", "right")
 GUIDANCE = ("estimate", "rmb")
 
 
-def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefer: str = "left") -> str:
+def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefer: str = "left", *,
+                       validate: bool = True) -> str:
     """Decide the move from the four sonar ranges ``[outer_left, middle_left, middle_right, outer_right]``.
 
     Parameters
@@ -55,6 +56,8 @@ def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefe
         A side is blocked when its outer (45 degree) sensor reads less than this.
     prefer : {"left", "right"}, default "left"
         Turn used when both sides are equally free (e.g. the side of the waypoint).
+    validate : bool, default True
+        Check the arguments; ``False`` skips it (a controller's inner loop, with four floats).
 
     Returns
     -------
@@ -72,15 +75,15 @@ def avoidance_decision(ranges: Any, front: float = 1.2, side: float = 0.8, prefe
     Hamid et al. (2009): the outer sensors watch the sides, the middle pair the
     front; the robot avoids by moving left or right only.
     """
-    r = as_array(ranges, "ranges", shape=(4,), finite=False)
-    if np.any(np.isnan(r)) or np.any(r < 0):
-        raise ValueError(f"ranges: expected four non-negative distances, got {r.tolist()}")
-    f = as_positive(front, "front")
-    s = as_positive(side, "side")
-    as_choice(prefer, "prefer", ("left", "right"))
-    outer_l, mid_l, mid_r, outer_r = r
-    front_blocked = min(mid_l, mid_r) < f
-    left_blocked, right_blocked = outer_l < s, outer_r < s
+    if validate:
+        ranges = as_array(ranges, "ranges", shape=(4,), finite=False)
+        if np.any(np.isnan(ranges)) or np.any(ranges < 0):
+            raise ValueError(f"ranges: expected four non-negative distances, got {ranges.tolist()}")
+        front, side = as_positive(front, "front"), as_positive(side, "side")
+        as_choice(prefer, "prefer", ("left", "right"))
+    outer_l, mid_l, mid_r, outer_r = ranges
+    front_blocked = min(mid_l, mid_r) < front
+    left_blocked, right_blocked = outer_l < side, outer_r < side
     if not (front_blocked or left_blocked or right_blocked):
         return "forward"
     if not front_blocked and left_blocked != right_blocked:

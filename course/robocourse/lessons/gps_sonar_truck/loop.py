@@ -31,7 +31,7 @@ import numpy as np
 from robokit.validation import as_positive
 from robokit.controllers.heading import design_heading_gains
 from robokit.outdoor import (PAPER_LAYOUT, PAPER_TRUCK, Compass, Course, Field, GPSReceiver, LVMaxSonarEZ, Navigator,
-                             SkidSteerTruck, TruckState, haversine_distance_bearing, random_course)
+                             SkidSteerTruck, TruckState, avoidance_decision, haversine_distance_bearing, random_course)
 from robokit.outdoor.field import UNIMAP_ORIGIN
 from robokit.outdoor.geodesy import EARTH_MEAN_RADIUS, LocalTangentPlane
 from robocourse.lessons.gps_sonar_truck.plant import run_mission, truck_step
@@ -246,22 +246,11 @@ def make_controller(course: dict, front: float = FRONT, side: float = SIDE):
     return step
 
 
-def _decide(r: list, front: float, side: float, prefer: str) -> str:
-    """:func:`robokit.outdoor.avoidance_decision` without its argument checks (the notebook's own copy)."""
-    front_blocked, left_blocked, right_blocked = min(r[1], r[2]) < front, r[0] < side, r[3] < side
-    if not (front_blocked or left_blocked or right_blocked):
-        return "forward"
-    if not front_blocked and left_blocked != right_blocked:
-        return "right" if left_blocked else "left"
-    room_l, room_r = min(r[0], r[1]), min(r[2], r[3])
-    return prefer if room_l == room_r else "left" if room_l > room_r else "right"
-
-
 def _behave(st: dict, r: list, front: float, side: float, nav: dict) -> tuple[float, float]:
     """The avoidance state machine: ``(forward speed, reference heading)``, updating ``st``."""
     err = _wrap(st["bearing"] - st["heading"])
     if st["mode"] == "GOTO":
-        decision = _decide(r, front, side, "left" if err < 0 else "right")
+        decision = avoidance_decision(r, front, side, "left" if err < 0 else "right", validate=False)
         if decision == "forward":
             return nav["cruise_speed"] * max(0.0, math.cos(err)) ** 2, st["bearing"]
         st["mode"], st["turn"] = "AVOID", decision
@@ -270,7 +259,8 @@ def _behave(st: dict, r: list, front: float, side: float, nav: dict) -> tuple[fl
             st["mode"], st["run"], st["hold"] = "BYPASS", 0.0, st["heading"]
         else:
             return 0.0, st["heading"]
-    decision = _decide(r, front, nav["bypass_side"], st["turn"])       # past the obstacle: side hysteresis
+    # past the obstacle: side hysteresis
+    decision = avoidance_decision(r, front, nav["bypass_side"], st["turn"], validate=False)
     if decision != "forward":
         st["mode"] = "AVOID"
         if decision != st["turn"] and min(r[1], r[2]) >= front:
