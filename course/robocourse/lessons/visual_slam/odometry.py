@@ -26,6 +26,7 @@ import numpy as np
 from robokit.geometry import pqt_world_to_robot, se2_to_pqt, wrap_angle
 from robokit.sim import PinholeCamera, lab_lap, lab_room
 from robokit.validation import as_int, as_rng
+from robokit.vision.stereo import StereoCalibration, disparity_to_point
 
 __all__ = ["ODOMETRY_RUN", "odometry_run", "lab_points"]
 
@@ -60,9 +61,11 @@ def _upright():
 
 
 @functools.lru_cache(maxsize=1)
-def _camera():
+def _camera() -> tuple[StereoCalibration, int, int]:
+    """The lesson's rig as a rectified stereo calibration, and its image width and height."""
     cam = PinholeCamera.from_fov()
-    return float(cam.fx), float(cam.cx), float(cam.cy), int(cam.width), int(cam.height)
+    rig = StereoCalibration(float(cam.fx), float(cam.cx), float(cam.cy), ODOMETRY_RUN["baseline"])
+    return rig, int(cam.width), int(cam.height)
 
 
 def lab_points(rng, count: int = 4000) -> np.ndarray:
@@ -102,14 +105,12 @@ def lab_points(rng, count: int = 4000) -> np.ndarray:
 
 def _visible(points_robot: np.ndarray, pose: np.ndarray, world_points: np.ndarray) -> np.ndarray:
     """Which points the left and right cameras both see: in front, in both images, not behind a wall."""
-    f, c0, r0, width, height = _camera()
-    x, y, z = points_robot.T
+    rig, width, height = _camera()
     lo, hi = ODOMETRY_RUN["depth"]
-    ok = (z > lo) & (z < hi)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        c, r = c0 + f * x / z, r0 - f * y / z
-        c_right = c0 + f * (x - ODOMETRY_RUN["baseline"]) / z
-    ok &= (c >= 0) & (c <= width - 1) & (r >= 0) & (r <= height - 1) & (c_right >= 0)
+    ok = (points_robot[:, 2] > lo) & (points_robot[:, 2] < hi)
+    left, right = rig.project(points_robot[ok])
+    (c, r), c_right = left.T, right[:, 0]
+    ok[np.flatnonzero(ok)] = (c >= 0) & (c <= width - 1) & (r >= 0) & (r <= height - 1) & (c_right >= 0)
     if ok.any():
         layout = _lab()[2]
         dx, dz = world_points[ok, 0] - pose[0], world_points[ok, 2] - pose[1]
@@ -120,15 +121,14 @@ def _visible(points_robot: np.ndarray, pose: np.ndarray, world_points: np.ndarra
 
 def _measure(points_robot: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Se et al.'s stereo measurement: noisy column, row and disparity, then back to 3-D."""
-    f, c0, r0, _, _ = _camera()
-    x, y, z = points_robot.T
-    sigma = ODOMETRY_RUN["pixel_noise"]
-    base = ODOMETRY_RUN["baseline"]
-    c = c0 + f * x / z + rng.normal(0.0, sigma, len(z))
-    c_right = c0 + f * (x - base) / z + rng.normal(0.0, sigma, len(z))
-    r = r0 - f * y / z + rng.normal(0.0, sigma, len(z))
-    d = np.maximum(c - c_right, 0.5)
-    return np.column_stack([(c - c0) * base / d, (r0 - r) * base / d, f * base / d])
+    rig = _camera()[0]
+    n, sigma = len(points_robot), ODOMETRY_RUN["pixel_noise"]
+    left, right = rig.project(points_robot)
+    (c, r), c_right = left.T, right[:, 0]
+    c = c + rng.normal(0.0, sigma, n)
+    c_right = c_right + rng.normal(0.0, sigma, n)
+    r = r + rng.normal(0.0, sigma, n)
+    return disparity_to_point(c, r, np.maximum(c - c_right, 0.5), rig)[0]
 
 
 def odometry_run(rng, frames: int | None = None) -> dict:
