@@ -1363,6 +1363,13 @@ SPECS: dict[str, Call] = {
     "robocourse.lessons.corridor_localization.trials.corridor_localizer": Call({
         "setup": Obj(corridor_setup), "method": Choice("ours"), "rng": Rng(0)}, cheap=False),
     "robocourse.lessons.corridor_localization.aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),
+    "robocourse.lessons.corridor_localization.orb_realism.move_image": Call({
+        "image": Array(image, "N,N|N,N,3|N,N,4"), "shift_x": Real(1.0), "shift_y": Real(0.0), "zoom": Real(1.01)}),
+    "robocourse.lessons.corridor_localization.orb_realism.motion_shares": Call({
+        "images": Mapping(lambda: {"photo": image()}), "motions": Mapping({"1 px": (1.0, 0.0, 1.0)}, optional=True),
+        "n_features": Int(500)}),
+    "robocourse.lessons.corridor_localization.orb_realism.feature_counts": Call({
+        "spacing": Real(5.0), "section": Array(np.array([10.0, 20.0]), "2")}, cheap=False),
     "robocourse.lessons.corridor_localization.experiment.corridor_lidar": Call({}),
     "robocourse.lessons.corridor_localization.experiment.corridor_camera": Call({}),
     "robocourse.lessons.corridor_localization.experiment.calibration_run": Call({
@@ -1883,6 +1890,7 @@ EXTRA: tuple[str, ...] = (
     "robokit.localization.scan_matching.match_scan",   # lesson 03 refines Table 2's runs with it (trials)
     "robokit.sim.layout.Layout.from_cells",          # lesson 03's real map, through real_map
     "robocourse.lessons.corridor_localization.real_map.building_routes",
+    "robocourse.lessons.corridor_localization.orb_realism.move_image",   # motion_shares moves the images with it
     "robocourse.lessons.corridor_localization.real_map.global_localization_runs",
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup

@@ -2,6 +2,7 @@
 
 experiment  the lesson's laser and camera; the calibration video, the vocabulary, the hybrid map
             (each cached)
+orb_realism  ORB on our views against a real photograph; feature counts before and after ORB's cap
 trials      Table 2's runs, AMCL against the retrieval-started MCL (cached), and their records
 kidnapping  Fig. 15's kidnapped robot
 real_map    the same AMCL on a real building's map (Willow Garage, ROS navigation tutorials) and in the

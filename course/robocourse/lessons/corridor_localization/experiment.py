@@ -109,10 +109,10 @@ N_FEATURES = 500
 #: Frames the mapping run's keyframe rule waits (condition (2) says more than 10 frames at 30 frames
 #: per second, a third of a second; the mapping run's camera runs at 10 frames per second).
 MAPPING_FRAME_GAP = 3
-#: Condition (3)'s band of shared matches, the paper's. On our rendered views ORB keeps fewer matches
-#: from frame to frame than on a real camera (about 77 % after a one-pixel shift of the same image),
-#: so the overlap falls through the band's floor between two frames and the printed rule stalls; the
-#: mapping run takes such a frame (``below_band="take"``, see docs/DECISIONS.md).
+#: Condition (3)'s band of shared matches, the paper's. ORB's mutual matches fall through the band's
+#: floor within a few frames, on our views and on a real photograph moved alike (lesson 03, Sec. 4;
+#: :mod:`.orb_realism`), and the printed rule stalls; the mapping run takes such a frame
+#: (``below_band="take"``, see docs/DECISIONS.md).
 SHARED_RANGE = (0.70, 0.90)
 
 
