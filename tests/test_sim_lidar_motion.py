@@ -177,3 +177,23 @@ def test_a_scan_over_a_layout_is_the_scan_over_the_world_it_came_from():
         lidar.scan_layout(corridor, pose)
     with pytest.raises(ValueError, match="robot_pose"):
         lidar.scan_layout(Layout(), [np.nan, 0.0, 0.0])
+
+
+def test_noisy_odometry_composes_increments_as_table_5_6_does():
+    """The loop in noisy_odometry is the readable per-step composition spelt out: same bits.
+
+    With zero noise the increments are the true ones (Table 5.5), so the odometry is the
+    step-by-step composition of Table 5.6, lines 8-10, which this reference writes as arrays.
+    """
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        steps = rng.normal(0.0, [0.1, 0.1, 0.6], (int(rng.integers(2, 200)), 3))
+        truth = np.cumsum(steps, axis=0)
+        truth[:, 2] = wrap_angle(truth[:, 2])
+        d = mo.odometry_increment(truth[:-1], truth[1:])
+        ref = [truth[0]]
+        for k in range(len(d)):
+            th = ref[-1][2] + d[k, 0]
+            ref.append(np.stack([ref[-1][0] + d[k, 1] * np.cos(th), ref[-1][1] + d[k, 1] * np.sin(th),
+                                 wrap_angle(th + d[k, 2])]))
+        assert np.array_equal(mo.noisy_odometry(truth, [0.0, 0.0, 0.0, 0.0], rng=0), np.array(ref))

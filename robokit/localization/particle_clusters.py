@@ -71,26 +71,21 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     cells = pose_bins(P, size)
     n_heading = int(np.ceil(2 * np.pi / size[2]))
     cells[:, 2] = np.mod(cells[:, 2], n_heading)
-    occupied, member = np.unique(cells, axis=0, return_inverse=True)
-    lo = occupied.min(axis=0) - 1
-    span = occupied.max(axis=0) - lo + 2
+    lo = cells.min(axis=0) - 1
+    span = cells.max(axis=0) - lo + 2
 
-    def key(c: np.ndarray) -> np.ndarray:
-        c = c.copy()
-        c[:, 2] = np.mod(c[:, 2], n_heading)
-        return ((c[:, 0] - lo[0]) * span[1] + (c[:, 1] - lo[1])) * (span[2] + n_heading) + c[:, 2]
+    def key(c: np.ndarray) -> np.ndarray:       # one integer per cell (..., 3), the heading wrapped
+        return ((c[..., 0] - lo[0]) * span[1] + (c[..., 1] - lo[1])) * (span[2] + n_heading) \
+            + np.mod(c[..., 2], n_heading)
 
-    keys = key(occupied)
-    order = np.argsort(keys)
-    rows, cols = [], []
-    for d in _OFFSETS:
-        k = key(occupied + d)
-        at = np.searchsorted(keys, k, sorter=order)
-        at = np.minimum(at, len(keys) - 1)
-        hit = keys[order[at]] == k
-        rows.append(np.flatnonzero(hit))
-        cols.append(order[at[hit]])
-    r, c = np.concatenate(rows), np.concatenate(cols)
+    # the occupied cells in lexicographic order (keys grow with it), each particle's among them
+    keys, first, member = np.unique(key(cells), return_index=True, return_inverse=True)
+    occupied = cells[first]
+    # every cell's 26 neighbours at once: (26, cells) keys, looked up among the (sorted) occupied keys
+    k = key(occupied[None, :, :] + _OFFSETS[:, None, :])
+    at = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
+    hit = keys[at] == k
+    r, c = np.nonzero(hit)[1], at[hit]
     graph = coo_matrix((np.ones(len(r)), (r, c)), shape=(len(occupied), len(occupied)))
     _, cell_label = connected_components(graph, directed=False)
     labels = cell_label[member.ravel()]

@@ -274,8 +274,17 @@ def noisy_odometry(poses: Any, alphas: Any, rng: Any = None) -> np.ndarray:
     d = _perturb(odometry_increment(P[:-1], P[1:]), a, as_rng(rng))
     out = np.empty_like(P)
     out[0] = P[0]
-    for k in range(len(d)):  # sequential by nature: each increment starts where the last ended
-        out[k + 1] = _apply(out[k], d[k])
+    # sequential by nature: each increment starts where the last ended. The loop is _apply's
+    # arithmetic on one pose, spelt out on Python floats of numpy's (the same operations in the same
+    # order, so the same bits) without its per-call array overhead (about 8x faster).
+    x, y, theta = P[0]
+    rot1, trans, rot2 = d[:, 0], d[:, 1], d[:, 2]
+    cos_th, sin_th = np.cos, np.sin
+    for k in range(len(d)):
+        th = theta + rot1[k]                                          # Table 5.6, lines 8-10
+        x, y = x + trans[k] * cos_th(th), y + trans[k] * sin_th(th)
+        theta = np.mod(th + rot2[k] + np.pi, 2 * np.pi) - np.pi       # wrap_angle
+        out[k + 1] = x, y, theta
     return out
 
 
