@@ -63,12 +63,18 @@ def test_motion_shares_are_one_for_no_motion_and_refuse_bad_input():
         motion_shares({"v": img}, {"far": (80.0, 0.0, 1.0)})
     with pytest.raises(ValueError, match="n_features"):
         motion_shares({"v": img}, n_features=0)
+    with pytest.raises(ValueError, match="images\\['blank'\\].*none"):       # no features: no share to read
+        motion_shares({"v": img, "blank": np.zeros((60, 80), np.uint8)})
+    with pytest.raises((ValueError, TypeError), match="images\\['b'\\]"):
+        motion_shares({"v": img, "b": None})
+    with pytest.raises(ValueError, match="images"):
+        motion_shares({1: img, "1": img})
 
 
 def test_feature_counts_before_and_after_the_cap():
     counts = feature_counts(2.5, section=(10.0, 20.0))
     x = counts["x"]
-    assert x[0] == 0.5 and x[-1] <= 36.1 - 0.5 and np.allclose(np.diff(x), 2.5)
+    assert x[0] == 0.5 and x[-1] <= long_corridor().info["length"] - 0.5 and np.allclose(np.diff(x), 2.5)
     assert np.all(counts["capped"] <= N_FEATURES) and np.all(counts["capped"] <= counts["uncapped"])
     inside = (x >= 10.0) & (x <= 20.0)
     assert counts["f_min"] == feature_threshold(counts["uncapped"][inside])

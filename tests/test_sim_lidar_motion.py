@@ -197,3 +197,9 @@ def test_noisy_odometry_composes_increments_as_table_5_6_does():
             ref.append(np.stack([ref[-1][0] + d[k, 1] * np.cos(th), ref[-1][1] + d[k, 1] * np.sin(th),
                                  wrap_angle(th + d[k, 2])]))
         assert np.array_equal(mo.noisy_odometry(truth, [0.0, 0.0, 0.0, 0.0], rng=0), np.array(ref))
+
+
+def test_noisy_odometry_refuses_a_trajectory_that_overflows():
+    with pytest.raises(ValueError, match="poses"):
+        mo.noisy_odometry([[0.0, 0.0, 0.1], [1e300, -1e300, 2.0], [-1e300, 1e300, -3.0]], [0.01, 0.001, 0.01, 0.001],
+                          rng=0)

@@ -68,11 +68,18 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     """
     P = as_planar(particles, "particles", shape=(None, 3), min_count=1)
     size = as_array(bin_size, "bin_size", shape=(3,))
-    cells = pose_bins(P, size)
+    with np.errstate(invalid="ignore"):      # a position too far for int64 cells is refused just below
+        cells = pose_bins(P, size)           # (which checks bin_size)
+    if np.abs(P[:, :2] / size[:2]).max() >= 2.0 ** 40:
+        raise ValueError(f"particles: expected positions within 2**40 histogram cells of the origin, got "
+                         f"{np.abs(P[:, :2]).max():.3g} m with cells of {size[:2].tolist()} m")
     n_heading = int(np.ceil(2 * np.pi / size[2]))
     cells[:, 2] = np.mod(cells[:, 2], n_heading)
     lo = cells.min(axis=0) - 1
     span = cells.max(axis=0) - lo + 2
+    if int(span[0]) * int(span[1]) * (int(span[2]) + n_heading) >= 2 ** 62:     # the cell keys below are int64
+        raise ValueError(f"particles: expected a cloud spanning fewer histogram cells, got {span[:2].tolist()} "
+                         f"cells of {size[:2].tolist()} m")
 
     def key(c: np.ndarray) -> np.ndarray:       # one integer per cell (..., 3), the heading wrapped
         return ((c[..., 0] - lo[0]) * span[1] + (c[..., 1] - lo[1])) * (span[2] + n_heading) \

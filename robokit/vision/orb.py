@@ -25,7 +25,7 @@ from .hamming import ORB_BYTES
 
 __all__ = ["ORB_FEATURES", "detect_orb_features"]
 
-#: OpenCV's (and ORB-SLAM's per-image) default number of ORB features.
+#: OpenCV's default number of ORB features.
 ORB_FEATURES = 500
 
 

@@ -104,7 +104,7 @@ def corridor_camera() -> PinholeCamera:
 
 #: Odometry noise of the simulated Kobuki base (Thrun et al. 2005, Table 5.6 alphas, our choice).
 MAPPING_ALPHAS = (0.01, 0.001, 0.01, 0.001)
-#: ORB features per image (OpenCV's default, and ORB-SLAM's per-frame count at 640 x 480).
+#: ORB features per image (OpenCV's default).
 N_FEATURES = 500
 #: Frames the mapping run's keyframe rule waits (condition (2) says more than 10 frames at 30 frames
 #: per second, a third of a second; the mapping run's camera runs at 10 frames per second).
@@ -128,6 +128,10 @@ def _descriptor_stack(descriptors: list) -> tuple[np.ndarray, np.ndarray]:
 
 def _descriptor_list(flat: np.ndarray, counts: np.ndarray) -> list:
     return np.split(flat, np.cumsum(counts)[:-1]) if len(counts) else []
+
+
+#: Where the calibration video runs along the middle line (m): 10 m, as Ge et al. (2023), Sec. 3.2.
+CALIBRATION_STRETCH = (12.0, 22.0)
 
 
 #: Frames per task when a recording is rendered in worker processes (a frame takes about 10 ms).
@@ -180,7 +184,8 @@ class CalibrationRun:
         return np.array([len(d) for d in self.descriptors], int)
 
 
-def calibration_run(*, fast: bool | None = None, start: float = 12.0, length: float = 10.0, speed: float = 0.2,
+def calibration_run(*, fast: bool | None = None, start: float = CALIBRATION_STRETCH[0],
+                    length: float = CALIBRATION_STRETCH[1] - CALIBRATION_STRETCH[0], speed: float = 0.2,
                     frame_rate: float = 30.0, progress: Callable | None = None) -> CalibrationRun:
     """Record the paper's calibration video: ``length`` metres along the middle line at ``frame_rate``.
 

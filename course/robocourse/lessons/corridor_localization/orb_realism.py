@@ -25,7 +25,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from robocourse.lessons.corridor_localization.experiment import N_FEATURES, corridor_camera
+from robocourse.lessons.corridor_localization.experiment import CALIBRATION_STRETCH, N_FEATURES, corridor_camera
 from robokit.sim import long_corridor
 from robokit.validation import as_array, as_finite_scalar, as_int, describe
 from robokit.vision.features import as_gray_image
@@ -65,8 +65,8 @@ def move_image(image, shift_x: float = 0.0, shift_y: float = 0.0, zoom: float = 
     Notes
     -----
     A camera driving forward by ``d`` sees a point at depth ``Z`` grow by ``Z / (Z - d)`` about the
-    focus of expansion: 7 cm (11 frames of the calibration video) is a 1-7 % zoom for the corridor's
-    walls 1-10 m ahead. Ge et al. (2023), Sec. 3.2, condition (3).
+    focus of expansion: 7.3 cm (11 frames of the calibration video) is a zoom of about 8 % for a wall
+    1 m ahead and 0.7 % for one 10 m ahead. Ge et al. (2023), Sec. 3.2, condition (3).
 
     Examples
     --------
@@ -74,17 +74,27 @@ def move_image(image, shift_x: float = 0.0, shift_y: float = 0.0, zoom: float = 
     >>> move_image(img, 1.0)[2].tolist()
     [0, 0, 0, 200, 0]
     """
-    grey = np.clip(np.rint(as_gray_image(image) * 255.0), 0, 255).astype(np.uint8)
-    shift = [as_finite_scalar(shift_x, "shift_x"), as_finite_scalar(shift_y, "shift_y")]
-    for name, value in zip(("shift_x", "shift_y"), shift):
-        if abs(value) > 50:
-            raise ValueError(f"{name}: expected a shift within +-50 pixels, got {value}")
-    zoom = as_finite_scalar(zoom, "zoom")
-    if not 0.5 <= zoom <= 2.0:
-        raise ValueError(f"zoom: expected a scale in [0.5, 2], got {zoom}")
+    grey = _grey(image, "image")
+    shift_x, shift_y, zoom = (as_finite_scalar(v, n) for v, n in ((shift_x, "shift_x"), (shift_y, "shift_y"),
+                                                                   (zoom, "zoom")))
+    _check_motion(shift_x, shift_y, zoom, "shift_x, shift_y, zoom")
+    return _moved(grey, shift_x, shift_y, zoom)
+
+
+def _grey(image, name: str) -> np.ndarray:
+    return np.clip(np.rint(as_gray_image(image, name) * 255.0), 0, 255).astype(np.uint8)
+
+
+def _check_motion(shift_x: float, shift_y: float, zoom: float, name: str) -> None:
+    if max(abs(shift_x), abs(shift_y)) > 50 or not 0.5 <= zoom <= 2.0:
+        raise ValueError(f"{name}: expected shifts within +-50 pixels and a zoom in [0.5, 2], "
+                         f"got {[float(shift_x), float(shift_y), float(zoom)]}")
+
+
+def _moved(grey: np.ndarray, shift_x: float, shift_y: float, zoom: float) -> np.ndarray:
     h, w = grey.shape
     M = cv2.getRotationMatrix2D(((w - 1) / 2.0, (h - 1) / 2.0), 0.0, zoom)
-    M[:, 2] += shift
+    M[:, 2] += (shift_x, shift_y)
     return cv2.warpAffine(grey, M, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT)
 
 
@@ -110,7 +120,8 @@ def motion_shares(images: dict, motions: dict | None = None, *, n_features: int 
     Raises
     ------
     ValueError, TypeError
-        For an empty or non-dict ``images`` or ``motions``, bad images or motions.
+        For an empty or non-dict ``images`` or ``motions``, keys that are equal as text, bad images
+        (or an image without ORB features, whose share would read as every match lost) or motions.
 
     Notes
     -----
@@ -128,22 +139,25 @@ def motion_shares(images: dict, motions: dict | None = None, *, n_features: int 
     for name, value in (("images", images), ("motions", motions)):
         if not isinstance(value, dict) or not value:
             raise TypeError(f"{name}: expected a non-empty dict, got {describe(value)}")
-    moves = {str(k): as_array(v, f"motions[{k!r}]", shape=(3,)) for k, v in motions.items()}
-    for k, (sx, sy, zoom) in moves.items():
-        if max(abs(sx), abs(sy)) > 50 or not 0.5 <= zoom <= 2.0:
-            raise ValueError(f"motions[{k!r}]: expected (shift_x, shift_y, zoom) with shifts within +-50 pixels "
-                             f"and a zoom in [0.5, 2], got {[float(sx), float(sy), float(zoom)]}")
+        if len({str(k) for k in value}) < len(value):
+            raise ValueError(f"{name}: expected keys that differ as text, got {list(value)}")
+    moves = {}
+    for k, v in motions.items():
+        moves[str(k)] = as_array(v, f"motions[{k!r}]", shape=(3,))
+        _check_motion(*moves[str(k)], f"motions[{k!r}]")
     n_features = as_int(n_features, "n_features", minimum=1, maximum=NO_CAP)
     out = {}
     for name, image in images.items():
-        grey = move_image(image)
+        grey = _grey(image, f"images[{name!r}]")
         own = detect_orb_features(grey, n_features).descriptors
-        out[str(name)] = {k: shared_fraction(detect_orb_features(move_image(grey, *m), n_features).descriptors, own)
+        if len(own) == 0:
+            raise ValueError(f"images[{name!r}]: expected an image in which ORB finds features, got one with none")
+        out[str(name)] = {k: shared_fraction(detect_orb_features(_moved(grey, *m), n_features).descriptors, own)
                           for k, m in moves.items()}
     return out
 
 
-def feature_counts(spacing: float = 1.0, *, section=(12.0, 22.0)) -> dict:
+def feature_counts(spacing: float = 1.0, *, section=CALIBRATION_STRETCH) -> dict:
     """ORB features of the corridor's middle-line views before and after the cap, and Eq. (15) on a section.
 
     Parameters
@@ -151,7 +165,7 @@ def feature_counts(spacing: float = 1.0, *, section=(12.0, 22.0)) -> dict:
     spacing : float, default 1
         Metres between views along the middle line, facing +x, from 0.5 m to 0.5 m before the end
         wall, in [0.1, 5].
-    section : (float, float), default (12, 22)
+    section : (float, float), default :data:`.experiment.CALIBRATION_STRETCH`
         The calibration video's stretch (:func:`.experiment.calibration_run`'s default), at least
         two views long.
 
