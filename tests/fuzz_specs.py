@@ -1381,6 +1381,9 @@ SPECS: dict[str, Call] = {
     "robocourse.lessons.corridor_localization.experiment.corridor_map": Call({
         "fast": Flag(True, optional=True), "resolution": Real(0.05), "progress": Func(None, optional=True)},
         cheap=False),
+    "robocourse.lessons.corridor_localization.trials.refine_pose": Call({
+        "setup": Obj(corridor_setup), "pose": Array(np.array([12.03, 0.04, 0.02]), "3"),
+        "scan": Array(lambda: np.full(360, 1.5), "360", inf_ok=True)}, cheap=False),
     "robocourse.lessons.corridor_localization.trials.retrieve_pose": Call({
         "setup": Obj(corridor_setup), "pose": Array(np.array([10.0, 0.0, 0.0]), "3"), "rng": Rng(0)}, cheap=False),
     "robocourse.lessons.corridor_localization.trials.localization_trial": Call({

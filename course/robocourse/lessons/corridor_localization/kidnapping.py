@@ -3,8 +3,8 @@
 The robot drives from the corridor's entrance with both localizers of Table 2 tracking it; at one
 start place it is lifted and put down at another that looks alike to the laser. amcl keeps its
 (now wrong) pose; the paper's method retrieves an image every few seconds (Algorithm 1, lines 14-15,
-go back to a retrieval every Delta t) and, as its Sec. 4.2 describes the trigger, re-initialises its
-particles around the retrieved keyframe when the two disagree.
+go back to a retrieval every Delta t; Sec. 4.2 calls the 5 s interval the trigger). We re-initialise
+its particles around the retrieved keyframe only when the two disagree (our reading).
 
 One wrong retrieval would then throw away a converged filter, so by default a disagreement must be
 confirmed: the next retrieval must disagree too, and agree with the first one carried forward by the
@@ -38,8 +38,8 @@ class Confirmation:
     estimate (farther than ``distance``) and agree with one another, each earlier one carried forward
     by the odometry since it was taken.
 
-    Ours, not the paper's: its trigger (Sec. 4.2; Algorithm 1, lines 14-15) re-initialises on one
-    disagreement (``confirm=1``), so one wrong retrieval throws a converged filter away.
+    Ours, not the paper's: re-initialising on one disagreement (``confirm=1``, our reading of
+    Algorithm 1, lines 14-15) lets one wrong retrieval throw a converged filter away.
 
     Examples
     --------
@@ -123,8 +123,8 @@ def kidnapping(setup: CorridorMap, *, origin: int = 5, destination: int = 6, per
     confirm : int, default 2
         Ours: how many retrievals in a row must disagree with the estimate, and agree with each other
         once carried forward by the odometry between them (within ``kidnap_distance``), before the
-        particles are re-initialised. 1 re-initialises on the first disagreement (Sec. 4.2's
-        trigger), so one wrong retrieval throws a converged filter away.
+        particles are re-initialised. 1 re-initialises on the first disagreement (our reading of
+        Algorithm 1), so one wrong retrieval throws a converged filter away.
     seed : int, default 0
 
     Returns

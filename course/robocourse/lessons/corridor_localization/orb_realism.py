@@ -77,18 +77,16 @@ def move_image(image, shift_x: float = 0.0, shift_y: float = 0.0, zoom: float = 
     grey = _grey(image, "image")
     shift_x, shift_y, zoom = (as_finite_scalar(v, n) for v, n in ((shift_x, "shift_x"), (shift_y, "shift_y"),
                                                                    (zoom, "zoom")))
-    _check_motion(shift_x, shift_y, zoom, "shift_x, shift_y, zoom")
+    for name, shift in (("shift_x", shift_x), ("shift_y", shift_y)):
+        if abs(shift) > 50:
+            raise ValueError(f"{name}: expected a shift within +-50 pixels, got {shift}")
+    if not 0.5 <= zoom <= 2.0:
+        raise ValueError(f"zoom: expected a scale in [0.5, 2], got {zoom}")
     return _moved(grey, shift_x, shift_y, zoom)
 
 
 def _grey(image, name: str) -> np.ndarray:
     return np.clip(np.rint(as_gray_image(image, name) * 255.0), 0, 255).astype(np.uint8)
-
-
-def _check_motion(shift_x: float, shift_y: float, zoom: float, name: str) -> None:
-    if max(abs(shift_x), abs(shift_y)) > 50 or not 0.5 <= zoom <= 2.0:
-        raise ValueError(f"{name}: expected shifts within +-50 pixels and a zoom in [0.5, 2], "
-                         f"got {[float(shift_x), float(shift_y), float(zoom)]}")
 
 
 def _moved(grey: np.ndarray, shift_x: float, shift_y: float, zoom: float) -> np.ndarray:
@@ -144,7 +142,10 @@ def motion_shares(images: dict, motions: dict | None = None, *, n_features: int 
     moves = {}
     for k, v in motions.items():
         moves[str(k)] = as_array(v, f"motions[{k!r}]", shape=(3,))
-        _check_motion(*moves[str(k)], f"motions[{k!r}]")
+        try:
+            move_image(np.zeros((3, 3), np.uint8), *moves[str(k)])
+        except ValueError as err:
+            raise ValueError(f"motions[{k!r}]: expected (shift_x, shift_y, zoom), {err}") from None
     n_features = as_int(n_features, "n_features", minimum=1, maximum=NO_CAP)
     out = {}
     for name, image in images.items():
