@@ -53,6 +53,7 @@ from robokit.sim.world import World
 from robokit.validation import as_array, as_callable, as_int, as_positive
 from robokit.vision import (BowDatabase, Vocabulary, detect_orb_features, feature_threshold, select_keyframes,
                             select_keyframes_orbslam)
+from robokit.vision.orb import ORB_FEATURES
 
 __all__ = ["CorridorMap", "corridor_map", "as_corridor_map", "CalibrationRun", "calibration_run",
            "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS", "corridor_lidar", "corridor_camera"]
@@ -104,8 +105,8 @@ def corridor_camera() -> PinholeCamera:
 
 #: Odometry noise of the simulated Kobuki base (Thrun et al. 2005, Table 5.6 alphas, our choice).
 MAPPING_ALPHAS = (0.01, 0.001, 0.01, 0.001)
-#: ORB features per image (OpenCV's default).
-N_FEATURES = 500
+#: ORB features per image: OpenCV's default, robokit's :data:`robokit.vision.orb.ORB_FEATURES`.
+N_FEATURES = ORB_FEATURES
 #: Frames the mapping run's keyframe rule waits (condition (2) says more than 10 frames at 30 frames
 #: per second, a third of a second; the mapping run's camera runs at 10 frames per second).
 MAPPING_FRAME_GAP = 3

@@ -22,6 +22,8 @@ References
 """
 from __future__ import annotations
 
+from typing import Any
+
 import cv2
 import numpy as np
 
@@ -75,14 +77,19 @@ def move_image(image, shift_x: float = 0.0, shift_y: float = 0.0, zoom: float = 
     [0, 0, 0, 200, 0]
     """
     grey = _grey(image, "image")
-    shift_x, shift_y, zoom = (as_finite_scalar(v, n) for v, n in ((shift_x, "shift_x"), (shift_y, "shift_y"),
-                                                                   (zoom, "zoom")))
+    return _moved(grey, *_motion(shift_x, shift_y, zoom))
+
+
+def _motion(shift_x: Any, shift_y: Any, zoom: Any, where: str = "") -> tuple[float, float, float]:
+    """The checked motion; an error names the argument, after ``where`` (e.g. ``"motions['a']: "``)."""
+    shift_x, shift_y, zoom = (as_finite_scalar(v, f"{where}{n}") for v, n in ((shift_x, "shift_x"),
+                                                                             (shift_y, "shift_y"), (zoom, "zoom")))
     for name, shift in (("shift_x", shift_x), ("shift_y", shift_y)):
         if abs(shift) > 50:
-            raise ValueError(f"{name}: expected a shift within +-50 pixels, got {shift}")
+            raise ValueError(f"{where}{name}: expected a shift within +-50 pixels, got {shift}")
     if not 0.5 <= zoom <= 2.0:
-        raise ValueError(f"zoom: expected a scale in [0.5, 2], got {zoom}")
-    return _moved(grey, shift_x, shift_y, zoom)
+        raise ValueError(f"{where}zoom: expected a scale in [0.5, 2], got {zoom}")
+    return shift_x, shift_y, zoom
 
 
 def _grey(image, name: str) -> np.ndarray:
@@ -139,13 +146,8 @@ def motion_shares(images: dict, motions: dict | None = None, *, n_features: int 
             raise TypeError(f"{name}: expected a non-empty dict, got {describe(value)}")
         if len({str(k) for k in value}) < len(value):
             raise ValueError(f"{name}: expected keys that differ as text, got {list(value)}")
-    moves = {}
-    for k, v in motions.items():
-        moves[str(k)] = as_array(v, f"motions[{k!r}]", shape=(3,))
-        try:
-            move_image(np.zeros((3, 3), np.uint8), *moves[str(k)])
-        except ValueError as err:
-            raise ValueError(f"motions[{k!r}]: expected (shift_x, shift_y, zoom), {err}") from None
+    moves = {str(k): _motion(*as_array(v, f"motions[{k!r}]", shape=(3,)), where=f"motions[{k!r}]: ")
+             for k, v in motions.items()}
     n_features = as_int(n_features, "n_features", minimum=1, maximum=NO_CAP)
     out = {}
     for name, image in images.items():
@@ -205,7 +207,7 @@ def feature_counts(spacing: float = 1.0, *, section=CALIBRATION_STRETCH) -> dict
                          f"{spacing} m apart, got {[float(lo), float(hi)]}")
     uncapped, capped = [], []
     for xk in x:
-        grey = move_image(camera.observe(world, [xk, 0.0, 0.0], rng=0).image)
+        grey = _grey(camera.observe(world, [xk, 0.0, 0.0], rng=0).image, "image")
         uncapped.append(len(detect_orb_features(grey, NO_CAP)))
         capped.append(len(detect_orb_features(grey, N_FEATURES)))
     uncapped = np.array(uncapped, int)

@@ -53,8 +53,9 @@ from robokit.validation import as_array, as_callable, as_choice, as_int, as_posi
 from robokit.vision import detect_orb_features
 
 __all__ = ["middle_line_drive", "START_POSES", "ELLIPSE_SIGMA", "CLUSTER_SHARE", "PARTICLES", "SETTLE", "RIGHT_PLACE",
-           "REFINE_WINDOW", "REFINE_STEPS", "REFINE_LEVELS", "refine_pose", "as_tolerance", "retrieve_pose", "localization_trial", "localization_trials",
-           "corridor_localizer", "PAPER_TOLERANCE", "TrialResult", "TrialSet"]
+           "REFINE_WINDOW", "REFINE_STEPS", "REFINE_LEVELS", "refine_pose", "as_tolerance", "retrieve_pose",
+           "localization_trial", "localization_trials", "corridor_localizer", "PAPER_TOLERANCE", "TrialResult",
+           "TrialSet"]
 
 
 #: The paper's success criterion (Sec. 4.1): 0.05 m and 0.5 degrees.
