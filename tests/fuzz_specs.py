@@ -797,6 +797,11 @@ SPECS: dict[str, Call] = {
                                                  "train": Array(lambda: features().descriptors[10:40], "N,N", min_rows=0),
                                                  "ratio": Real(0.65), "method": Choice("kdtree"),
                                                  "max_distance": Real(0.8, optional=True, inf_ok=True)}),
+    "robokit.vision.matching.pair_distances": Call({"query": Array(lambda: features().descriptors[:20], "N,N", min_rows=0),
+                                                    "train": Array(lambda: features().descriptors[10:40], "N,N", min_rows=0),
+                                                    "query_index": Array(np.array([0, 3, 19]), "N", min_rows=0),
+                                                    "train_index": Array(np.array([5, 0, 29]), "N", min_rows=0),
+                                                    "precision": Choice("float32"), "validate": Flag(True)}),
     "robokit.vision.plot_readable.detect_plot_readable": Call({"image": Array(image, "N,N|N,N,3|N,N,4"),
                                                                 "params": Obj(None, optional=True)}),
     "robokit.vision.plot_detector.plot_scales": Call({"sigma0": Real(1.6, optional=True), "k": Real(1.26, optional=True),
@@ -1899,6 +1904,7 @@ EXTRA: tuple[str, ...] = (
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view
     "robokit.vision.plot_detector.scale_space_maxima",   # public since PLOT's search moved out
+    "robokit.vision.matching.pair_distances",    # lesson 01's map association and tracking, through VisualSLAM
     # lesson 02's map alignment study (issue 35), fuzzed before the notebook calls it
     *(f"robocourse.lessons.omni_localization.alignment.{n}" for n in (
         "loop_rows", "loop_subsets", "held_share", "with_loops", "alignment_errors", "loop_edge_errors",

@@ -8,7 +8,7 @@ from PIL import Image
 from robokit.vision.descriptors import detect_plot_features, detect_sift_features
 from robokit.vision.evaluation import apply_homography, matching_score, recall_precision, similarity_homography
 from robokit.vision.features import Features, Keypoints
-from robokit.vision.matching import gated_ratio_match, k_nearest, ratio_match, two_nearest
+from robokit.vision.matching import PAIR_BLOCK, gated_ratio_match, k_nearest, pair_distances, ratio_match, two_nearest
 from robokit.vision.matching import distance_ratio
 
 
@@ -25,6 +25,24 @@ def test_ratio_test_accepts_distinct_and_rejects_ambiguous():
     m = ratio_match(query, train, ratio=0.65)
     assert m.query.tolist() == [0] and m.train.tolist() == [0]
     assert m.ratio[0] == pytest.approx(0.05 / 0.95)
+
+
+def test_pair_distances_are_the_whole_array_expression_block_by_block():
+    rng = np.random.default_rng(3)
+    query, train = rng.random((300, 128), np.float32), rng.random((500, 128), np.float32)
+    qi, ti = rng.integers(0, 300, 2 * PAIR_BLOCK + 17), rng.integers(0, 500, 2 * PAIR_BLOCK + 17)
+    d32 = pair_distances(query, train, qi, ti, precision="float32")
+    assert d32.dtype == np.float32 and np.array_equal(d32, np.linalg.norm(query[qi] - train[ti], axis=1))
+    d64 = pair_distances(query, train, qi, ti)
+    assert np.array_equal(d64, np.sqrt(((query[qi].astype(np.float64) - train[ti]) ** 2).sum(axis=1)))
+    assert np.array_equal(pair_distances(query, train, qi, ti, validate=False), d64)
+    assert pair_distances(query, train, [], []).shape == (0,)
+    with pytest.raises(ValueError, match="query_index, train_index"):
+        pair_distances(query, train, [300], [0])
+    with pytest.raises(ValueError, match="train_index"):
+        pair_distances(query, train, [0, 1], [0])
+    with pytest.raises(ValueError, match="query: expected descriptors of length 128"):
+        pair_distances(query[:, :64], train, [0], [0])
 
 
 def test_gated_matching_with_every_pair_is_plain_ratio_matching():

@@ -21,6 +21,7 @@ from scipy.spatial import cKDTree
 
 from ..geometry import pqt_robot_to_world, pqt_to_se3, pqt_world_to_robot
 from ..geometry.paper_frames import as_pqt, pqt_transform_xz
+from ..vision.matching import pair_distances
 from ..validation import array_ndim, as_array, as_int, as_positive
 
 __all__ = ["transform_covariance", "kalman_fuse", "LandmarkMap"]
@@ -411,7 +412,7 @@ class LandmarkMap:
             return out
         fi = np.repeat(np.arange(n), counts)
         li = np.concatenate([np.asarray(x, int) for x in lists if x])
-        dd = np.linalg.norm(desc[fi] - self.descriptors[li], axis=1)
+        dd = pair_distances(desc, self.descriptors, fi, li, precision="float32", validate=False)
         alike = dd <= max_distance                 # the cheap test first: only these need the gate
         fi, li, dd = fi[alike], li[alike], dd[alike]
         err = pts[fi] - predicted[li]
