@@ -87,6 +87,21 @@ def test_stale_packets_are_dropped_as_a_brute_force_replay_says():
         assert seen[k] >= arrival[k] - 1e-12 and seen[k] < arrival[k] + TICK + 1e-12
 
 
+def test_the_unchecked_path_delivers_what_the_checked_one_does():
+    links = [SetpointChannel(period=0.01, latency=0.002, jitter=0.03, loss=0.2, rng=5) for _ in range(2)]
+    held = [[], []]
+    for k in range(200):
+        for j, link in enumerate(links):
+            link.send(0.01 * k, np.array([float(k), math.nan if k % 7 == 0 else 0.0]), validate=bool(j))
+            got = link.receive(0.01 * k + 0.005, validate=bool(j))
+            held[j].append(None if got is None else got.tolist())
+    assert held[0] == held[1] and held[0][-1] is not None
+    assert [(l.sent, l.delivered, l.lost, l.stale, l.rejected) for l in links][0] == \
+        (links[1].sent, links[1].delivered, links[1].lost, links[1].stale, links[1].rejected)
+    with pytest.raises(ValueError, match="backwards"):
+        links[0].receive(0.0, validate=False)
+
+
 def test_nan_set_points_are_rejected_and_the_previous_one_held():
     link = SetpointChannel()
     link.send(0.0, [0.1, 0.2])

@@ -57,6 +57,7 @@ def test_se3_compose_inverse_and_points():
     rng = np.random.default_rng(3)
     R = g.so3_exp(rng.normal(size=3))
     T = g.se3_from_rt(R, rng.normal(size=3))
+    assert np.array_equal(g.se3_from_rt(R, T[:3, 3], validate=False), T)
     np.testing.assert_allclose(g.se3_compose(T, g.se3_inverse(T)), np.eye(4), atol=1e-12)
     pts = rng.normal(size=(10, 3))
     back = g.transform_points(g.se3_inverse(T), g.transform_points(T, pts))

@@ -104,7 +104,7 @@ class SetpointChannel:
         now = as_finite_scalar(t, "t")
         return now >= self._last_send + self.period * (1 - 1e-9)
 
-    def send(self, t: float, setpoint: Any) -> bool:
+    def send(self, t: float, setpoint: Any, *, validate: bool = True) -> bool:
         """Put a set-point on the air at time ``t`` (s); return whether it survives (is not lost).
 
         Parameters
@@ -114,6 +114,9 @@ class SetpointChannel:
         setpoint : array_like
             Numbers, the same shape at every send (12 joint angles for LittleDog). NaN and inf are
             let through: the host may send them, and the robot rejects them on arrival.
+        validate : bool, default True
+            Check ``t`` and ``setpoint``; ``False`` is the simulator's fast path (a float time and a
+            float array it made itself; the order of the times is still checked).
 
         Returns
         -------
@@ -131,10 +134,10 @@ class SetpointChannel:
         >>> [link.send(0.01 * k, [0.0]) for k in range(6)], link.lost
         ([True, True, False, True, False, False], 3)
         """
-        now = as_finite_scalar(t, "t")
+        now = as_finite_scalar(t, "t") if validate else t
         if now < self._last_send:
             raise ValueError(f"t: expected send times that do not go backwards, got {now} after {self._last_send}")
-        value = np.array(as_array(setpoint, "setpoint", finite=False), dtype=float)
+        value = np.array(as_array(setpoint, "setpoint", finite=False) if validate else setpoint, dtype=float)
         if self._shape is None:
             self._shape = value.shape
         elif value.shape != self._shape:
@@ -150,13 +153,16 @@ class SetpointChannel:
         heapq.heappush(self._queue, (now + delay, seq, value))
         return True
 
-    def receive(self, t: float) -> np.ndarray | None:
+    def receive(self, t: float, *, validate: bool = True) -> np.ndarray | None:
         """The set-point the robot holds at time ``t`` (s): the newest valid packet arrived by ``t``.
 
         Parameters
         ----------
         t : float
             The robot's clock (s), not going backwards.
+        validate : bool, default True
+            Check ``t``; ``False`` is the simulator's fast path (called every servo tick with a float
+            it computed; the order of the times is still checked).
 
         Returns
         -------
@@ -174,7 +180,7 @@ class SetpointChannel:
         >>> [link.receive(t).tolist() for t in (0.03, 0.1)], link.delivered, link.stale   # 3 overtook 1 and 2
         ([[0.0], [3.0]], 2, 2)
         """
-        now = as_finite_scalar(t, "t")
+        now = as_finite_scalar(t, "t") if validate else t
         if now < self._last_receive:
             raise ValueError(f"t: expected a clock that does not go backwards, got {now} after {self._last_receive}")
         self._last_receive = now

@@ -469,6 +469,11 @@ def quat_to_matrix(quat: Any, *, validate: bool = True) -> np.ndarray:
         raise ValueError("quat: expected non-zero quaternions (a zero one is no rotation), got [0, 0, 0, 0]")
     q = q / big
     w, x, y, z = np.moveaxis(q / np.linalg.norm(q, axis=-1, keepdims=True), -1, 0)
+    if q.ndim == 1:      # one quaternion (a simulator's every step): the same products on floats, no stacks
+        w, x, y, z = float(w), float(x), float(y), float(z)
+        return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
     return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
                      np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
                      np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)],

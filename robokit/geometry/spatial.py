@@ -81,7 +81,7 @@ def as_se3(value: Any, name: str, *, batch: bool = False, tol: float = ROTATION_
     return T
 
 
-def se3_from_rt(rotation: Any, translation: Any) -> np.ndarray:
+def se3_from_rt(rotation: Any, translation: Any, *, validate: bool = True) -> np.ndarray:
     """Build homogeneous transforms from rotation matrices and translations.
 
     Parameters
@@ -90,6 +90,9 @@ def se3_from_rt(rotation: Any, translation: Any) -> np.ndarray:
         Proper rotation matrices.
     translation : array_like, shape (3,) or (N, 3)
         Translations in metres.
+    validate : bool, default True
+        Check the shapes, the values and that ``rotation`` is a rotation; ``False`` is the fast path
+        for arrays a caller has made as rotations (e.g. by :func:`~robokit.geometry.fit_rigid`).
 
     Returns
     -------
@@ -109,8 +112,11 @@ def se3_from_rt(rotation: Any, translation: Any) -> np.ndarray:
     >>> se3_from_rt(np.eye(3), [1.0, 2.0, 3.0])[:3, 3].tolist()
     [1.0, 2.0, 3.0]
     """
-    R = as_rotation(rotation, "rotation", batch=array_ndim(rotation, "rotation") == 3)
-    t = as_array(translation, "translation", shape=R.shape[:-2] + (3,))
+    if validate:
+        R = as_rotation(rotation, "rotation", batch=array_ndim(rotation, "rotation") == 3)
+        t = as_array(translation, "translation", shape=R.shape[:-2] + (3,))
+    else:
+        R, t = rotation, translation
     T = np.zeros(R.shape[:-2] + (4, 4))
     T[..., :3, :3], T[..., :3, 3], T[..., 3, 3] = R, t, 1.0
     return T

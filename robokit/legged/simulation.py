@@ -314,7 +314,7 @@ class _MocapFeed:
         if vis.sum() < 3:
             return None
         fit = fit_rigid(MARKERS, self.positions[k], vis.astype(float), validate=False)
-        return None if fit.degenerate else se3_from_rt(fit.R, fit.t)
+        return None if fit.degenerate else se3_from_rt(fit.R, fit.t, validate=False)
 
     def frames(self, rows: int) -> MocapFrames:
         """The frames the host saw in the first ``rows`` cycles."""
@@ -432,10 +432,10 @@ def simulate_walk(plan: WalkPlan, loops: LoopSettings = LoopSettings(), sensors:
             T_cmd = posture.command(plan.T_world_body[k], seen)
             q, ok = body_ik(plan.feet_world[k], T_cmd, validate=False)
             q_cmd[k] = q[0] if ok[0] else q_cmd[max(k - 1, 0)]
-        channel.send(now, q_cmd[k])
+        channel.send(now, q_cmd[k], validate=False)
         for s in range(host_steps):
             if (k * host_steps + s) % servo_steps == 0:                   # the servo's own clock
-                data.ctrl[:] = servo.tick(channel.receive(now + s * TIMESTEP), data.qpos[7:].copy())
+                data.ctrl[:] = servo.tick(channel.receive(now + s * TIMESTEP, validate=False), data.qpos[7:].copy())
                 # MuJoCo's actuators apply joint_torque(voltage, dq/dt)
             mujoco.mj_step(model, data)
             imu_sum += data.sensordata[probes.imu]
