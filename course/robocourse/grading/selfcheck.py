@@ -11,13 +11,26 @@ from robocourse.site.book import BookPage
 from robocourse.lessons import assignments
 from robocourse.grading.grader import grade_batch
 from robocourse.grading.sandbox import Limits
+from robokit.parallel import map_runs
 
 __all__ = ["grade_course", "course_grading_step"]
 
 
-def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int = 2,
+def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int | None = None,
                  limits: Limits = Limits(wall_seconds=600, cpu_seconds=600)) -> list[dict]:
     """Grade ``solutions/NN.ipynb`` and ``assignments/NN.ipynb`` for every assignment with exercises.
+
+    Parameters
+    ----------
+    root : str or Path
+        The course repository.
+    seed : str, default "course-selfcheck"
+        The grading seed (the cases every notebook is graded on).
+    jobs : int, optional
+        Assignments graded at once, each in a worker process of :func:`robokit.parallel.map_runs`
+        (default: its :func:`~robokit.parallel.worker_count`).
+    limits : Limits
+        Per-notebook limits of the sandbox.
 
     Returns
     -------
@@ -28,26 +41,41 @@ def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int 
         with the submission's flags, reason and cell errors).
     """
     root = Path(root)
+    slugs = list(assignments())
+    # one batch per assignment (its cases are prepared once for both notebooks), ``jobs`` batches at a time,
+    # each in a worker process: preparing the cases is Python work that threads would take turns at
+    per_slug = map_runs(_grade_assignment, (root, seed, limits), slugs, workers=jobs, desc="grading self-check",
+                        unit="assignment")
+    return [row for rows in per_slug for row in rows]
+
+
+def _grade_assignment(shared: tuple, slug: str) -> list[dict]:
+    """The self-check rows of one assignment's solution and blank; ``shared``: root, seed and limits
+    (see :func:`grade_course`)."""
+    root, seed, limits = shared
+    kinds = (("solution", "solutions"), ("assignment", "assignments"))
+    paths = {kind: root / folder / f"{slug}.ipynb" for kind, folder in kinds}
+    present = [kind for kind, _ in kinds if paths[kind].exists()]
+    results = dict(zip(present, grade_batch([paths[k] for k in present], slug, seed, jobs=1, limits=limits,
+                                            log=lambda *_: None))) if present else {}
     rows = []
-    for slug in assignments():
-        for kind, folder in (("solution", "solutions"), ("assignment", "assignments")):
-            path = root / folder / f"{slug}.ipynb"
-            if not path.exists():
-                rows.append({"assignment": slug, "kind": kind, "total": 0, "max": 0, "expected": "present",
-                             "ok": False, "note": f"{folder}/{slug}.ipynb missing", "log": ""})
-                continue
-            result = grade_batch([path], slug, seed, jobs=1, limits=limits, log=lambda *_: None)[0]
-            want = result.max_total if kind == "solution" else 0.0
-            ok = result.total == want and not result.reason and "worker-ended-early" not in result.flags \
-                and "timeout" not in result.flags
-            note = "; ".join([result.reason] * bool(result.reason)
-                             + [m for s in result.scores for m in s.messages[:1]]) if not ok else ""
-            log = "\n".join([f"flags: {', '.join(result.flags) or 'none'}"]
-                            + [f"reason: {result.reason}"] * bool(result.reason)
-                            + [f"cell error: {e}" for e in result.cell_errors]
-                            + ["--- worker log ---", result.worker_log.rstrip()])
-            rows.append({"assignment": slug, "kind": kind, "total": result.total, "max": result.max_total,
-                         "expected": want, "ok": ok, "note": note, "log": log})
+    for kind, folder in kinds:
+        if kind not in results:
+            rows.append({"assignment": slug, "kind": kind, "total": 0, "max": 0, "expected": "present",
+                         "ok": False, "note": f"{folder}/{slug}.ipynb missing", "log": ""})
+            continue
+        result = results[kind]
+        want = result.max_total if kind == "solution" else 0.0
+        ok = result.total == want and not result.reason and "worker-ended-early" not in result.flags \
+            and "timeout" not in result.flags
+        note = "; ".join([result.reason] * bool(result.reason)
+                         + [m for s in result.scores for m in s.messages[:1]]) if not ok else ""
+        log = "\n".join([f"flags: {', '.join(result.flags) or 'none'}"]
+                        + [f"reason: {result.reason}"] * bool(result.reason)
+                        + [f"cell error: {e}" for e in result.cell_errors]
+                        + ["--- worker log ---", result.worker_log.rstrip()])
+        rows.append({"assignment": slug, "kind": kind, "total": result.total, "max": result.max_total,
+                     "expected": want, "ok": ok, "note": note, "log": log})
     return rows
 
 
