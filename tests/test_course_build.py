@@ -7,7 +7,7 @@ import nbformat
 import pytest
 
 from robocourse.cli import main
-from robocourse.site.execute import run_notebook
+from robocourse.site.execute import THREAD_VARIABLES, run_notebook
 from tests.conftest import ROOT
 
 
@@ -256,9 +256,13 @@ def test_the_notebooks_running_at_once_share_the_cores(tmp_path, monkeypatch):
     monkeypatch.setattr(build, "available_cpus", lambda: 4)
     monkeypatch.setattr(config, "available_cpus", lambda: 4)    # what worker_count falls back to
     out = tmp_path / "workers.txt"
-    path = _notebook(tmp_path / "nb.ipynb", f"import os\nopen({str(out)!r}, 'a').write(os.environ['ROBOKIT_WORKERS'] + '\\n')")
+    # ... and as many BLAS and OpenCV threads (OpenCV reads its variable: its own count is written too)
+    code = (f"import os, cv2\nopen({str(out)!r}, 'a').write(' '.join([os.environ['ROBOKIT_WORKERS'], "
+            f"*(os.environ[v] for v in {THREAD_VARIABLES!r}), str(cv2.getNumThreads())]) + '\\n')")
+    path = _notebook(tmp_path / "nb.ipynb", code)
     other = _notebook(tmp_path / "other.ipynb", "1 + 1")
-    monkeypatch.delenv("ROBOKIT_WORKERS", raising=False)
+    for name in ("ROBOKIT_WORKERS", *THREAD_VARIABLES):
+        monkeypatch.delenv(name, raising=False)
     # (jobs, notebooks, the caller's own setting) -> workers per kernel
     for jobs, paths, own, expected in ((2, [path, other], None, "2"), (4, [path, other], None, "2"),
                                        (1, [path], None, "4"), (None, [path], None, "4"),
@@ -268,4 +272,4 @@ def test_the_notebooks_running_at_once_share_the_cores(tmp_path, monkeypatch):
             monkeypatch.setenv("ROBOKIT_WORKERS", own)
         build.run_notebooks(paths, tmp_path / "executed", root=tmp_path, jobs=jobs, timeout=120, fast=True,
                             log=lambda line: None)
-        assert out.read_text().split() == [expected], (jobs, len(paths), own)
+        assert out.read_text().split() == [expected] * (len(THREAD_VARIABLES) + 2), (jobs, len(paths), own)

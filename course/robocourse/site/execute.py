@@ -24,7 +24,7 @@ import tempfile
 import time
 from pathlib import Path
 
-__all__ = ["NotebookRun", "run_notebook", "execute_in_process", "kill_process_group"]
+__all__ = ["NotebookRun", "run_notebook", "execute_in_process", "kill_process_group", "THREAD_VARIABLES"]
 
 #: Exception names an assignment notebook may raise: the stubs students have not filled in yet
 #: (``NotImplementedYet`` is the ``NotImplementedError`` that ``check()`` raises on a stub).
@@ -69,6 +69,10 @@ def _tail(text: str, lines: int = 12) -> str:
     return "\n".join(text.strip().splitlines()[-lines:])
 
 
+#: Environment variables that cap the threads of numpy's BLAS (OpenBLAS, MKL, OpenMP) and OpenCV.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OPENCV_FOR_THREADS_NUM")
+
+
 def _kernel_env(workdir: Path, fast: bool, workers: int | None = None) -> dict[str, str]:
     ipydir = workdir / ".ipython"
     startup = ipydir / "profile_default" / "startup"
@@ -86,6 +90,9 @@ def _kernel_env(workdir: Path, fast: bool, workers: int | None = None) -> dict[s
     env.pop("MPLBACKEND", None)  # the inline backend must stay in charge inside the kernel
     if workers is not None:
         env["ROBOKIT_WORKERS"] = str(workers)   # robokit.parallel's worker processes for this notebook
+        # and as many threads for BLAS and OpenCV: a notebook beside others on the cores that spins up
+        # threads of its own only slows them all (lesson 02 in a two-notebook build: 143 -> 126 s)
+        env.update({name: str(workers) for name in THREAD_VARIABLES})
     return env
 
 
@@ -163,8 +170,8 @@ def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
         Treat the notebook as a student assignment (``NotImplementedError`` from stubs is allowed).
         Defaults to whether the notebook lives in an ``assignments`` directory.
     workers : int, optional
-        ``ROBOKIT_WORKERS`` inside the kernel (worker processes for independent runs); default:
-        inherited.
+        ``ROBOKIT_WORKERS`` inside the kernel (worker processes for independent runs) and the
+        thread counts of BLAS and OpenCV (:data:`THREAD_VARIABLES`); default: inherited.
 
     Returns
     -------
