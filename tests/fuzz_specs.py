@@ -1904,7 +1904,7 @@ EXTRA: tuple[str, ...] = (
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view
     "robokit.vision.plot_detector.scale_space_maxima",   # public since PLOT's search moved out
-    "robokit.vision.matching.pair_distances",    # lesson 01's map association and tracking, through VisualSLAM
+    "robokit.vision.matching.pair_distances",    # lesson 01's map association, through VisualSLAM
     # lesson 02's map alignment study (issue 35), fuzzed before the notebook calls it
     *(f"robocourse.lessons.omni_localization.alignment.{n}" for n in (
         "loop_rows", "loop_subsets", "held_share", "with_loops", "alignment_errors", "loop_edge_errors",

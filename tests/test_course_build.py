@@ -273,3 +273,10 @@ def test_the_notebooks_running_at_once_share_the_cores(tmp_path, monkeypatch):
         build.run_notebooks(paths, tmp_path / "executed", root=tmp_path, jobs=jobs, timeout=120, fast=True,
                             log=lambda line: None)
         assert out.read_text().split() == [expected] * (len(THREAD_VARIABLES) + 2), (jobs, len(paths), own)
+    # a caller's own lower thread cap stays
+    out.unlink()
+    monkeypatch.delenv("ROBOKIT_WORKERS")
+    monkeypatch.setenv(THREAD_VARIABLES[0], "1")
+    build.run_notebooks([path, other], tmp_path / "executed", root=tmp_path, jobs=2, timeout=120, fast=True,
+                        log=lambda line: None)
+    assert out.read_text().split() == ["2", "1"] + ["2"] * len(THREAD_VARIABLES), "a lower cap was raised"

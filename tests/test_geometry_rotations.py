@@ -142,6 +142,9 @@ def test_quat_to_matrix_agrees_with_scipy_and_with_the_axis_angle():
     np.testing.assert_allclose(R, Rotation.from_quat(q, scalar_first=True).as_matrix(), atol=1e-14)
     np.testing.assert_allclose(g.quat_to_matrix(-q), R, atol=1e-15)             # q and -q: one rotation
     np.testing.assert_allclose(g.quat_to_matrix(q.reshape(3, 100, 4)), R.reshape(3, 100, 3, 3), atol=0)
+    one_by_one = np.array([g.quat_to_matrix(x) for x in q])          # one quaternion: its own path, same bits
+    assert np.array_equal(one_by_one, R) and np.array_equal(np.signbit(one_by_one), np.signbit(R))
+    assert np.array_equal(g.quat_to_matrix(q[0], validate=False), R[0])
     v = _rotvecs(rng, 50)                                    # [cos(t/2), sin(t/2) u] is so3_exp(t u)
     t = np.linalg.norm(v, axis=1, keepdims=True)
     np.testing.assert_allclose(g.quat_to_matrix(np.hstack([np.cos(t / 2), np.sin(t / 2) * v / t])), g.so3_exp(v),

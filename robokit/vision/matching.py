@@ -45,7 +45,7 @@ from ..validation import as_array, as_choice, as_int, as_positive
 
 __all__ = ["FLANN_TREES", "FLANN_CHECKS", "METHODS", "DescriptorIndex", "k_nearest", "two_nearest", "ratio_match",
            "gated_ratio_match", "Matches", "LIN_RATIO", "LOWE_RATIO", "distance_ratio", "as_ratio",
-           "as_distance_bound", "ratio_test", "pair_distances"]
+           "as_distance_bound", "ratio_test", "pair_distances", "PAIR_BLOCK"]
 
 
 #: Lin et al.'s nearest-neighbour ratio threshold ``t`` (PLOT paper, Sec. 3: "t is set equal to 0.65").
@@ -244,6 +244,8 @@ def pair_distances(query, train, query_index, train_index, *, precision: str = "
     ------
     ValueError
         For descriptors of different lengths or pair indices out of range or of different lengths.
+    TypeError
+        For descriptors or indices that are not numbers.
 
     Notes
     -----

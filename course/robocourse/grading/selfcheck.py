@@ -11,7 +11,9 @@ from robocourse.site.book import BookPage
 from robocourse.lessons import assignments
 from robocourse.grading.grader import grade_batch
 from robocourse.grading.sandbox import Limits
+from robokit.config import worker_count
 from robokit.parallel import map_runs
+from robokit.validation import as_int
 
 __all__ = ["grade_course", "course_grading_step"]
 
@@ -28,7 +30,8 @@ def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int 
         The grading seed (the cases every notebook is graded on).
     jobs : int, optional
         Assignments graded at once, each in a worker process of :func:`robokit.parallel.map_runs`
-        (default: its :func:`~robokit.parallel.worker_count`).
+        (default: two, or :func:`~robokit.config.worker_count` if smaller; every sandboxed job
+        counts against the user's process limit, :class:`~robocourse.grading.sandbox.Limits`).
     limits : Limits
         Per-notebook limits of the sandbox.
 
@@ -39,8 +42,16 @@ def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int 
         ``expected``, ``ok`` (solution at full marks, assignment at zero, no crash), ``note`` (the
         first message of each exercise that went wrong, whole) and ``log`` (the worker's full log
         with the submission's flags, reason and cell errors).
+
+    Raises
+    ------
+    ValueError, TypeError
+        For ``jobs`` that is not a positive whole number.
+    GradingError
+        For a host that refuses the sandbox (:func:`~robocourse.grading.grader.grade_batch`).
     """
     root = Path(root)
+    jobs = min(2, worker_count()) if jobs is None else as_int(jobs, "jobs", minimum=1)
     slugs = list(assignments())
     # one batch per assignment (its cases are prepared once for both notebooks), ``jobs`` batches at a time,
     # each in a worker process: preparing the cases is Python work that threads would take turns at

@@ -206,8 +206,8 @@ def run_notebooks(paths: Sequence[Path], executed: Path, *, root: Path, jobs: in
         Notebooks at once; the number of available cores by default (never more than there are
         notebooks). Each notebook gets the cores divided by that number (at least 1, at most the
         caller's own ``ROBOKIT_WORKERS``) as ``ROBOKIT_WORKERS`` for its independent runs
-        (:mod:`robokit.parallel`) and as its BLAS and OpenCV threads, so that the build never runs
-        more processes or threads than cores.
+        (:mod:`robokit.parallel`), so that the build never runs more worker processes than cores,
+        and as the cap of its BLAS and OpenCV threads.
     timeout : float, default 900
         Per-notebook wall-clock limit in seconds.
     fast : bool, default False

@@ -92,7 +92,10 @@ def _kernel_env(workdir: Path, fast: bool, workers: int | None = None) -> dict[s
         env["ROBOKIT_WORKERS"] = str(workers)   # robokit.parallel's worker processes for this notebook
         # and as many threads for BLAS and OpenCV: a notebook beside others on the cores that spins up
         # threads of its own only slows them all (lesson 02 in a two-notebook build: 143 -> 126 s)
-        env.update({name: str(workers) for name in THREAD_VARIABLES})
+        # (a caller's own lower cap stays)
+        for name in THREAD_VARIABLES:
+            own = env.get(name, "")
+            env[name] = str(min(workers, int(own))) if own.isdigit() and int(own) > 0 else str(workers)
     return env
 
 
@@ -171,7 +174,8 @@ def run_notebook(path: str | Path, *, timeout: float = 600, fast: bool = True,
         Defaults to whether the notebook lives in an ``assignments`` directory.
     workers : int, optional
         ``ROBOKIT_WORKERS`` inside the kernel (worker processes for independent runs) and the
-        thread counts of BLAS and OpenCV (:data:`THREAD_VARIABLES`); default: inherited.
+        thread counts of BLAS and OpenCV (:data:`THREAD_VARIABLES`, lowered to it, never raised);
+        default: inherited.
 
     Returns
     -------
