@@ -7,9 +7,12 @@ Generated datasets are cached by :mod:`robokit.cache`.
 """
 from __future__ import annotations
 
+import importlib.util
 import os
+import sys
+import types
 
-__all__ = ["fast_mode", "headless", "available_cpus", "worker_count"]
+__all__ = ["fast_mode", "headless", "available_cpus", "worker_count", "lazy_module"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -144,3 +147,50 @@ def worker_count(environ: "os._Environ[str] | dict[str, str] | None" = None) -> 
             raise ValueError(f"ROBOKIT_WORKERS: expected a whole number from 1 to 64, got {raw!r}")
         return value
     return min(64, available_cpus())
+
+
+def lazy_module(name: str) -> types.ModuleType:
+    """The module ``name``, registered now and executed on its first attribute access.
+
+    Parameters
+    ----------
+    name : str
+        An importable module's full name (e.g. ``"control"``).
+
+    Returns
+    -------
+    module
+        The module already imported, if it is; otherwise a module that :mod:`importlib`'s
+        ``LazyLoader`` executes when an attribute is first read. Later ``import name`` statements
+        get the same module, so a package that imports it at its top pays nothing until it is used.
+
+    Raises
+    ------
+    TypeError
+        For a ``name`` that is not a string.
+    ModuleNotFoundError
+        For a module that is not installed.
+
+    Notes
+    -----
+    Not from a paper: python-control (and scipy.signal and scipy.stats under it) take about 0.75 s
+    to import, which every notebook, grading worker and test process paid for robokit's
+    controllers whether it designed a loop or not.
+
+    Examples
+    --------
+    >>> lazy_module("json").dumps([1])
+    '[1]'
+    """
+    if not isinstance(name, str):
+        raise TypeError(f"name: expected a module name, got {type(name).__name__}")
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.find_spec(name)
+    if spec is None or spec.loader is None:
+        raise ModuleNotFoundError(f"name: expected an importable module, got {name!r}", name=name)
+    spec.loader = importlib.util.LazyLoader(spec.loader)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module

@@ -174,3 +174,41 @@ def test_progress_bar_refuses_bad_input(kwargs, error, match):
     with pytest.raises(TypeError, match="callback"):
         progress_bar(3, "x", callback=3)
     assert progress_bar(np.int64(3), "x", environ={"ROBOKIT_FAST": "1"}).total == 3     # a numpy count is a count
+
+
+def test_lazy_module_runs_the_module_on_first_use_only():
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom robokit.config import lazy_module\n"
+            "m = lazy_module('fractions')\nassert lazy_module('fractions') is m and 'fractions' in sys.modules\n"
+            "before = 'decimal' in sys.modules       # fractions imports decimal when it runs\n"
+            "half = m.Fraction(1, 2)\n"
+            "print(before, 'decimal' in sys.modules, half)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["False", "True", "1/2"]
+    from robokit.config import lazy_module
+    assert lazy_module("os") is __import__("os")
+    with pytest.raises(ModuleNotFoundError, match="no_such_module_here"):
+        lazy_module("no_such_module_here")
+    with pytest.raises(TypeError, match="name"):
+        lazy_module(42)
+
+
+def test_importing_robokit_leaves_python_control_and_scipy_stats_for_later():
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom robokit import controllers, localization, mapping, sim, vision\n"
+            "print(type(sys.modules['control']).__name__, 'scipy.stats' in sys.modules)\n"
+            "controllers.path_following_poles(1.0, 0.3)\nprint(type(sys.modules['control']).__name__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["_LazyModule", "False", "module"], out
+
+
+def test_the_kld_quantile_is_scipys():
+    from scipy.stats import norm
+
+    from robokit.localization.particle_filter import KLD_Z_99
+
+    assert KLD_Z_99 == float(norm.ppf(0.99))

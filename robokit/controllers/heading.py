@@ -34,13 +34,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import control
 import numpy as np
 
+from ..config import lazy_module
 from ..geometry import wrap_angle
 from ..validation import as_finite_scalar, as_positive
 from .servo_loop import (loop_metrics, servo_closed_loop, servo_frequency_response, servo_loop_gain, servo_plant,
                          servo_step_response)
+
+control = lazy_module("control")   # python-control, loaded on first use (0.75 s of every import otherwise)
 
 __all__ = ["design_heading_gains", "HeadingController", "heading_plant", "heading_closed_loop", "heading_loop_gain",
            "heading_step_response", "heading_frequency_response", "loop_metrics"]

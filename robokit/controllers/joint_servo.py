@@ -26,12 +26,14 @@ from __future__ import annotations
 import math
 from typing import Any, NamedTuple
 
-import control
 import numpy as np
 
+from ..config import lazy_module
 from ..validation import as_array, as_int, as_positive, require_sample_count
 from .dc_motor import DCMotor, reflected_inertia
 from .servo_loop import MIN_DT_OVER_TAU, ServoAnalysis, discrete_servo_analysis, servo_plant
+
+control = lazy_module("control")   # python-control, loaded on first use (0.75 s of every import otherwise)
 
 __all__ = ["JointLag", "joint_lag", "joint_plant", "design_servo_gains", "servo_analysis",
            "pd_servo_step", "ServoResponse", "discrete_servo_response"]

@@ -31,15 +31,17 @@ from __future__ import annotations
 import math
 from typing import Any, NamedTuple
 
-import control
 import numpy as np
 
+from ..config import lazy_module
 from ..sim import unicycle_step
 from ..geometry.planar import as_planar
 from ..validation import (as_array, as_finite_scalar, as_positive, describe, require_finite_result,
                           require_sample_count)
 from .path_following import XI, path_following_gains, reference_command
 from .path_geometry import VisualPath, reference_point
+
+control = lazy_module("control")   # python-control, loaded on first use (0.75 s of every import otherwise)
 
 __all__ = ["path_following_linearisation", "path_following_poles", "path_following_damping",
            "lateral_step_response", "FollowTrace", "simulate_path_following"]

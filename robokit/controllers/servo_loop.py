@@ -32,11 +32,13 @@ import math
 import warnings
 from typing import Any, NamedTuple
 
-import control
 import numpy as np
 from scipy.optimize import brentq
 
+from ..config import lazy_module
 from ..validation import as_array, as_int, as_positive, require_sample_count
+
+control = lazy_module("control")   # python-control, loaded on first use (0.75 s of every import otherwise)
 
 __all__ = ["MIN_DT_OVER_TAU", "servo_plant", "servo_closed_loop", "servo_loop_gain", "servo_step_response", "servo_frequency_response",
            "loop_metrics", "DiscreteServoLoop", "discrete_servo_loop", "ServoAnalysis", "discrete_servo_analysis"]

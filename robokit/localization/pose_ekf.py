@@ -33,7 +33,6 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 import numpy as np
-from scipy.stats import chi2
 
 from ..geometry import wrap_angle
 from ..sim import unicycle_step
@@ -384,6 +383,8 @@ def nees_bounds(dof: int, runs: int, confidence: float = 0.95) -> tuple[float, f
     c = as_positive(confidence, "confidence")
     if not c < 1:
         raise ValueError(f"confidence: expected a probability in (0, 1), got {c}")
+    from scipy.stats import chi2        # here, not at the top: importing scipy.stats takes half a second
+
     lo, hi = chi2.ppf([(1 - c) / 2, (1 + c) / 2], n * r) / r
     return float(lo), float(hi)
 
