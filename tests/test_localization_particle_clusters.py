@@ -80,30 +80,6 @@ def test_largest_cluster_mean_ignores_strays_and_follows_the_weight():
     assert largest_cluster_mean(cloud, heavy)[0] > 20.0
 
 
-def _clusters_by_pairs(particles, bin_size):
-    """Reference: join every two particles whose cells touch (26-neighbourhood, heading wrapped),
-    then number the groups in the order the particles meet them."""
-    from robokit.localization.particle_filter import pose_bins
-    size = np.asarray(bin_size, float)
-    n_heading = int(np.ceil(2 * np.pi / size[2]))
-    cells = pose_bins(np.asarray(particles, float), size)
-    cells[:, 2] %= n_heading
-    parent = list(range(len(cells)))
-
-    def root(i):
-        while parent[i] != i:
-            i = parent[i]
-        return i
-
-    for i in range(len(cells)):
-        for j in range(i):
-            d = np.abs(cells[i] - cells[j])
-            if d[0] <= 1 and d[1] <= 1 and min(d[2], n_heading - d[2]) <= 1:
-                parent[root(i)] = root(j)
-    names: dict[int, int] = {}
-    return np.array([names.setdefault(root(i), len(names)) for i in range(len(cells))])
-
-
 def test_pose_clusters_equal_the_all_pairs_reference():
     rng = np.random.default_rng(11)
     for _ in range(60):
@@ -115,7 +91,7 @@ def test_pose_clusters_equal_the_all_pairs_reference():
         P[edge, :2] = np.round(P[edge, :2] / size[:2]) * size[:2]
         P[:, 2] = np.mod(P[:, 2] + np.pi, 2 * np.pi) - np.pi
         P[rng.random(n) < 0.1, 2] = -np.pi               # on the wrap
-        assert np.array_equal(pose_clusters(P, size), _clusters_by_pairs(P, size))
+        assert np.array_equal(pose_clusters(P, size), brute_force_clusters(P, size))
 
 
 def test_pose_clusters_refuse_clouds_too_far_for_their_cells():
