@@ -262,17 +262,27 @@ def pair_distances(query, train, query_index, train_index, *, precision: str = "
     dtype = {"float64": np.float64, "float32": np.float32}[as_choice(precision, "precision", ("float64", "float32"))]
     if not validate:
         return _pair_distances(query, train, query_index, train_index, dtype)
-    q, t = _descriptors(query, "query"), _descriptors(train, "train")
-    qi = as_array(query_index, "query_index", ndim=1, dtype=int)
-    ti = as_array(train_index, "train_index", shape=(qi.size,), dtype=int)
+    q, t, qi, ti = _pair_arrays(query, train, query_index, train_index)
     if qi.size == 0:
         return np.zeros(0, dtype)
+    _require_pairs(q, t, qi, ti)
+    return _pair_distances(q, t, qi, ti, dtype)
+
+
+def _pair_arrays(query, train, query_index, train_index) -> tuple:
+    """Descriptors (float32, (N, D)) and pair indices (int, one length) as arrays, checked."""
+    q, t = _descriptors(query, "query"), _descriptors(train, "train")
+    qi = as_array(query_index, "query_index", ndim=1, dtype=int)
+    return q, t, qi, as_array(train_index, "train_index", shape=(qi.size,), dtype=int)
+
+
+def _require_pairs(q: np.ndarray, t: np.ndarray, qi: np.ndarray, ti: np.ndarray) -> None:
+    """Raise unless ``q`` and ``t`` hold descriptors of one length and the (non-empty) pair indices are their rows."""
     if q.shape[1] != t.shape[1]:
         raise ValueError(f"query: expected descriptors of length {t.shape[1]}, got {q.shape[1]}")
     if qi.min() < 0 or qi.max() >= q.shape[0] or ti.min() < 0 or ti.max() >= t.shape[0]:
         raise ValueError(f"query_index, train_index: expected rows of query (< {q.shape[0]}) and train "
                          f"(< {t.shape[0]}), got {qi.min()}..{qi.max()} and {ti.min()}..{ti.max()}")
-    return _pair_distances(q, t, qi, ti, dtype)
 
 
 #: Pairs per block in :func:`pair_distances` (1024 rows of 128 float32: 512 KB per side).
@@ -642,16 +652,10 @@ def gated_ratio_match(query, train, query_index, train_index, *, ratio: float = 
     only the landmarks predicted near each feature).
     """
     ratio = as_ratio(ratio)
-    q, t = _descriptors(query, "query"), _descriptors(train, "train")
-    qi = as_array(query_index, "query_index", ndim=1, dtype=int)
-    ti = as_array(train_index, "train_index", shape=(qi.size,), dtype=int)
+    q, t, qi, ti = _pair_arrays(query, train, query_index, train_index)
     if qi.size == 0 or q.shape[0] == 0 or t.shape[0] == 0:
         return Matches.empty()
-    if q.shape[1] != t.shape[1]:
-        raise ValueError(f"query: expected descriptors of length {t.shape[1]}, got {q.shape[1]}")
-    if qi.min() < 0 or qi.max() >= q.shape[0] or ti.min() < 0 or ti.max() >= t.shape[0]:
-        raise ValueError(f"query_index, train_index: expected rows of query (< {q.shape[0]}) and train "
-                         f"(< {t.shape[0]}), got {qi.min()}..{qi.max()} and {ti.min()}..{ti.max()}")
+    _require_pairs(q, t, qi, ti)
     dist = _pair_distances(q, t, qi, ti, np.float64)
     order = np.lexsort((dist, qi))                   # by query, nearest candidate first
     qi, ti, dist = qi[order], ti[order], dist[order]

@@ -90,9 +90,9 @@ def _kernel_env(workdir: Path, fast: bool, workers: int | None = None) -> dict[s
     env.pop("MPLBACKEND", None)  # the inline backend must stay in charge inside the kernel
     if workers is not None:
         env["ROBOKIT_WORKERS"] = str(workers)   # robokit.parallel's worker processes for this notebook
-        # and as many threads for BLAS and OpenCV: a notebook beside others on the cores that spins up
-        # threads of its own only slows them all (lesson 02 in a two-notebook build: 143 -> 126 s)
-        # (a caller's own lower cap stays)
+        # and at most as many threads for BLAS and OpenCV (a caller's own lower cap stays): a notebook
+        # beside others on the cores that spins up threads of its own only slows them all (lesson 02
+        # in a two-notebook build: 143 -> 126 s)
         for name in THREAD_VARIABLES:
             own = env.get(name, "")
             env[name] = str(min(workers, int(own))) if own.isdigit() and int(own) > 0 else str(workers)
