@@ -23,6 +23,7 @@ no longer resolves a turn, so every sine, cosine and wrap of it would be an arbi
 """
 from __future__ import annotations
 
+import math
 import numbers
 from collections.abc import Mapping
 from typing import Any, Sequence
@@ -171,7 +172,7 @@ def as_array(
         raise ValueError(f"{name}: expected a {ndim}-D array, got {arr.ndim}-D with shape {arr.shape}")
     if arr.size < min_size:
         raise ValueError(f"{name}: expected at least {min_size} elements, got {arr.size}")
-    if finite and arr.dtype.kind in "fc" and not np.all(np.isfinite(arr)):
+    if finite and arr.dtype.kind in "fc" and not np.isfinite(arr).all():   # the method: no wrapper
         raise ValueError(f"{name}: expected finite values, got NaN or infinity")
     return arr
 
@@ -292,7 +293,7 @@ def as_finite_scalar(value: Any, name: str) -> float:
         if not (isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"):
             raise TypeError(f"{name}: expected a real number, got {describe(value)}")
     out = float(value)
-    if not np.isfinite(out):
+    if not math.isfinite(out):
         raise ValueError(f"{name}: expected a finite number, got {out}")
     return out
 

@@ -1254,10 +1254,11 @@ SPECS: dict[str, Call] = {
        for n, extra in [("corridor_axis", {}), ("wall_distances", {"heading": Real(0.0, optional=True)}),
                         ("door_sides", {"heading": Real(0.0, optional=True), "recess": Real(0.07)}),
                         ("corridor_state", {"width": Real(2.17), "r_max": Real(8.0), "bounds": Choice("paper"),
-                                            "recess": Real(0.07), "tol": Real(0.04), "width_tol": Real(0.03)})]},
+                                            "recess": Real(0.07), "tol": Real(0.04), "width_tol": Real(0.03),
+                                            "validate": Flag(True)})]},
     **{f"robokit.mapping.corridor_areas.{n}": Call({"ranges": Array(corridor_ranges, "N", inf_ok=True),
-                                                     "angles": Array(corridor_angles, "N")})
-       for n in ("as_scan", "invalid_areas")},
+                                                     "angles": Array(corridor_angles, "N")} | extra)
+       for n, extra in [("as_scan", {}), ("invalid_areas", {"validate": Flag(True)})]},
     "robokit.mapping.corridor_areas.theta_limits": Call({"width": Real(2.17), "r_max": Real(8.0)}),
     "robokit.mapping.corridor_areas.theta_limits_geometric": Call({"width": Real(2.17), "r_max": Real(8.0),
                                                                    "recess": Real(0.07)}),

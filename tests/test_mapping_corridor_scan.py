@@ -250,3 +250,18 @@ def test_the_coarse_to_fine_vote_finds_the_exhaustive_votes_axis():
         # and both find the corridor: the robot's heading error is minus the axis, modulo pi
         err = math.remainder(pose[2], math.pi)
         assert math.degrees(abs(math.remainder(corridor_axis(r, a) + err, math.pi))) < 1.0, pose   # centering asks 2 deg
+
+
+def test_the_unchecked_state_of_a_checked_scan_is_the_checked_state():
+    """corridor_state(validate=False), the moving strategy's per-scan path, gives the same analysis."""
+    lidar, world, rng = Lidar(noise=0.01), long_corridor(), np.random.default_rng(3)
+    for _ in range(40):
+        pose = [rng.uniform(1.0, 35.0), rng.uniform(-0.8, 0.8), rng.uniform(-np.pi, np.pi)]
+        r, a = as_scan(lidar.scan(world, pose, rng), lidar.angles)
+        for bounds in ("paper", "geometric"):
+            slow = corridor_state(r, a, 2.17, lidar.r_max, bounds=bounds)
+            fast = corridor_state(r, a, 2.17, lidar.r_max, bounds=bounds, validate=False)
+            for field in slow.__dataclass_fields__:
+                assert np.array_equal(np.asarray(getattr(slow, field), dtype=object),
+                                      np.asarray(getattr(fast, field), dtype=object)), field
+        assert np.array_equal(invalid_areas(r, a), invalid_areas(r, a, validate=False))

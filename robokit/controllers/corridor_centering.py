@@ -23,12 +23,13 @@ References
 from __future__ import annotations
 
 import dataclasses
+import inspect
 from typing import Any
 
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..mapping.corridor_scan import CorridorState, corridor_state
+from ..mapping.corridor_scan import CorridorState, as_scan, corridor_state
 from ..sim import Lidar, World, unicycle_step
 from ..validation import as_array, as_rng, as_choice, as_finite_scalar, as_int, as_positive
 
@@ -88,8 +89,14 @@ def centering_command(lateral_offset: float, heading_error: float, *, lookahead:
     band = as_positive(deadband, "deadband", allow_zero=True)
     if vmin > vmax:
         raise ValueError(f"v_min: expected at most v_max = {vmax}, got {vmin}")
+    return _command(y, e, L, kw, kv, vmin, vmax, wmax, band)
+
+
+def _command(y: float, e: float, L: float, kw: float, kv: float, vmin: float, vmax: float, wmax: float,
+             band: float) -> tuple[float, float]:
+    """:func:`centering_command` of checked arguments."""
     inside = abs(y) <= band
-    delta = float(wrap_angle((0.0 if inside else -np.arctan2(y, L)) - e))        # aim minus heading
+    delta = float(wrap_angle((0.0 if inside else -np.arctan2(y, L)) - e, validate=False))   # aim minus heading
     omega = float(np.clip(kw * delta, -wmax, wmax))
     v = 0.0 if inside else float(np.clip(kv * abs(y), vmin, vmax) * max(0.0, np.cos(delta)) ** 2)
     return v, omega + 0.0
@@ -192,8 +199,12 @@ def move_to_middle_line(world: World, pose: Any, lidar: Lidar, *, rng: Any = 0, 
     n_settle = as_int(settle, "settle", minimum=1)
     poses, dist, good = [p.copy()], 0.0, 0
     e_prev, y, e = None, 0.0, 0.0
+    # the arguments are checked here once, each scan by as_scan; the per-scan analysis and the command trust them
+    gains = inspect.signature(centering_command).parameters
+    law = [float(gains[k].default) for k in ("lookahead", "k_omega", "k_v", "v_min", "v_max", "w_max")]
     for _ in range(steps + 1):
-        state = corridor_state(lidar.scan(world, p, gen), lidar.angles, w, lidar.r_max, recess=dda, tol=e4)
+        r, a = as_scan(lidar.scan(world, p, gen), lidar.angles)
+        state = corridor_state(r, a, w, lidar.r_max, recess=dda, tol=e4, validate=False)
         if state.lateral_offset is None:
             break
         e0 = -state.axis                                    # heading error to the nearer direction
@@ -203,10 +214,10 @@ def move_to_middle_line(world: World, pose: Any, lidar: Lidar, *, rng: Any = 0, 
         e = e0 + k * np.pi
         y = -state.lateral_offset if k % 2 else state.lateral_offset
         e_prev = e
-        good = good + 1 if abs(y) <= e4 / 4 and abs(wrap_angle(e)) <= etol else 0
+        good = good + 1 if abs(y) <= e4 / 4 and abs(wrap_angle(e, validate=False)) <= etol else 0
         if good >= n_settle or len(poses) > steps:
             break
-        v, omega = centering_command(y, float(wrap_angle(e)), deadband=e4 / 4)
+        v, omega = _command(y, float(wrap_angle(e, validate=False)), *law, e4 / 4)
         p = unicycle_step(p, v, omega, dt, validate=False)
         poses.append(p)
         dist += abs(v) * dt

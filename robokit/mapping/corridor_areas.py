@@ -94,13 +94,16 @@ def as_scan(ranges: Any, angles: Any) -> tuple[np.ndarray, np.ndarray]:
     return r, a
 
 
-def invalid_areas(ranges: Any, angles: Any) -> np.ndarray:
+def invalid_areas(ranges: Any, angles: Any, *, validate: bool = True) -> np.ndarray:
     """The contiguous runs of invalid returns of a scan and their angles ``theta_null`` (Eq. (9)).
 
     Parameters
     ----------
     ranges, angles : array_like, shape (B,)
         Ranges (m; ``inf`` = an invalid return) and beam angles (rad); see :func:`as_scan`.
+    validate : bool, default True
+        Check the scan; ``False`` is the fast path for callers that pass it as :func:`as_scan`
+        returns it.
 
     Returns
     -------
@@ -123,7 +126,7 @@ def invalid_areas(ranges: Any, angles: Any) -> np.ndarray:
     >>> np.round(np.rad2deg(invalid_areas(r, ang)), 3).tolist()
     [[180.0, 180.0, 0.0], [270.0, 0.0, 90.0]]
     """
-    r, a = as_scan(ranges, angles)
+    r, a = as_scan(ranges, angles) if validate else (ranges, angles)
     bad = ~np.isfinite(r)
     if bad.all():
         return np.array([[a[0], a[-1], a[-1] - a[0]]])

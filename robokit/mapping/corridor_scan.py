@@ -353,7 +353,11 @@ def width_condition(d_l: float, d_r: float, width: float, *, recess: float = 0.0
     """
     dl, dr = as_positive(d_l, "d_l"), as_positive(d_r, "d_r")
     w, dda = as_positive(width, "width"), as_positive(recess, "recess", allow_zero=True)
-    e = as_positive(tol, "tol", allow_zero=True)
+    return _width_case(dl, dr, w, dda, as_positive(tol, "tol", allow_zero=True))
+
+
+def _width_case(dl: float, dr: float, w: float, dda: float, e: float) -> str | None:
+    """:func:`width_condition` of checked distances, width, recess and tolerance."""
     err = np.abs(dl + dr - np.array([w, w + 2 * dda, w + dda]))   # Eqs. (1), (2), (3)
     k = int(np.argmin(err))
     return WIDTH_CASES[k] if err[k] <= e else None
@@ -406,14 +410,21 @@ def middle_line_condition(d_l: float, d_r: float, *, tol: float = 0.04, width: A
     e4 = as_positive(tol, "tol", allow_zero=True)
     dda = as_positive(recess, "recess", allow_zero=True)
     e_w = as_positive(width_tol, "width_tol", allow_zero=True)
+    w = None if width is None else as_positive(width, "width")
+    side = None if door is None else as_choice(door, "door", ["left", "right"])
+    return _middle_line(dl, dr, e4, w, dda, e_w, side)
+
+
+def _middle_line(dl: float, dr: float, e4: float, w: float | None, dda: float, e_w: float,
+                 door: str | None) -> tuple[bool, float, str]:
+    """:func:`middle_line_condition` of checked arguments (``w``: the width or ``None``)."""
     doors = "none"
-    if width is not None:
-        case = width_condition(dl, dr, width, recess=dda, tol=e_w)
+    if w is not None:
+        case = _width_case(dl, dr, w, dda, e_w)
         if case == "facing doors":
             doors = "both"
         elif case == "staggered doors":
-            side = None if door is None else as_choice(door, "door", ["left", "right"])
-            doors = side or ("left" if dl > dr else "right")
+            doors = door or ("left" if dl > dr else "right")
             dl, dr = (dl - dda, dr) if doors == "left" else (dl, dr - dda)
     holds = bool(abs(dl - dr) <= e4 + 1e-12)                  # Eq. (4)
     return holds, round((dr - dl) / 2, 12), doors
@@ -464,7 +475,8 @@ class CorridorState:
 
 
 def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, bounds: str = "paper",
-                   recess: float = 0.07, tol: float = 0.04, width_tol: float = 0.03) -> CorridorState:
+                   recess: float = 0.07, tol: float = 0.04, width_tol: float = 0.03,
+                   validate: bool = True) -> CorridorState:
     """Analyse one scan: invalid areas against Eq. (8), the end rule, wall distances and Eq. (4).
 
     Parameters
@@ -479,6 +491,9 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
         beam steps below the cone, never above.
     recess, tol, width_tol : float
         ``d_da``, ``e4`` and ``e1 = e2 = e3`` (m).
+    validate : bool, default True
+        Check the arguments; ``False`` is the fast path for a loop over scans (the moving strategy)
+        that passes a scan as :func:`as_scan` returns it and checked floats.
 
     Returns
     -------
@@ -499,15 +514,18 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
     >>> s.in_corridor, s.at_end, s.n_areas, np.rad2deg(s.areas[:, 2]).round(3).tolist()
     (True, False, 2, [14.0, 15.0])
     """
-    r, a = as_scan(ranges, angles)
-    as_choice(bounds, "bounds", ["paper", "geometric"])
-    recess = as_positive(recess, "recess", allow_zero=True)
-    tol = as_positive(tol, "tol", allow_zero=True)
-    width_tol = as_positive(width_tol, "width_tol", allow_zero=True)
+    if validate:
+        r, a = as_scan(ranges, angles)
+        as_choice(bounds, "bounds", ["paper", "geometric"])
+        recess = as_positive(recess, "recess", allow_zero=True)
+        tol = as_positive(tol, "tol", allow_zero=True)
+        width_tol = as_positive(width_tol, "width_tol", allow_zero=True)
+    else:
+        r, a = ranges, angles
     lo, hi = theta_limits(width, r_max) if bounds == "paper" else theta_limits_geometric(width, r_max, recess)
     if bounds == "geometric" and len(a) > 1:
         lo -= 2 * float(np.min(np.diff(a)))
-    areas = invalid_areas(r, a)
+    areas = invalid_areas(r, a, validate=False)
     n = int(np.sum((areas[:, 2] > lo) & (areas[:, 2] < hi)))      # Eq. (8)
     axis = None
     try:
@@ -516,8 +534,8 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
         at_door = _door_sides(r, a, axis, recess, (d_l, d_r))
     except (EmptyScanError, NoWallError):
         return CorridorState(n > 0, n == 1, n, areas, (lo, hi), axis, np.inf, np.inf, None, False, None, "none")
-    case = width_condition(d_l, d_r, width, recess=recess, tol=width_tol)
+    w = as_positive(width, "width") if validate else width
+    case = _width_case(d_l, d_r, w, recess, width_tol)
     hint = "left" if at_door == (True, False) else "right" if at_door == (False, True) else None
-    middle, offset, doors = middle_line_condition(d_l, d_r, tol=tol, width=width, recess=recess, width_tol=width_tol,
-                                                  door=hint)
+    middle, offset, doors = _middle_line(d_l, d_r, tol, w, recess, width_tol, hint)
     return CorridorState(n > 0, n == 1, n, areas, (lo, hi), axis, d_l, d_r, case, middle, offset, doors)
