@@ -30,11 +30,12 @@ venv: $(STAMP)
 course: $(STAMP)
 	$(BIN)/robocourse build $(COURSE_ARGS)
 
+# both print their 15 slowest tests, so a test that grows shows in every run's log
 test: $(STAMP)
-	$(BIN)/python -m pytest $(XDIST) -m "not slow" $(PYTEST_ARGS)
+	$(BIN)/python -m pytest $(XDIST) --durations=15 -m "not slow" $(PYTEST_ARGS)
 
 check: $(STAMP)
-	ROBOKIT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest $(XDIST) $(PYTEST_ARGS)
+	ROBOKIT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest $(XDIST) --durations=15 $(PYTEST_ARGS)
 
 # A deliberate upgrade: the newest versions the pyproject ranges allow, resolved in a fresh venv (so
 # nothing installed by hand is pinned); then update environment.yml's pins (tests/test_packaging.py
