@@ -471,6 +471,7 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
     settle = as_int(settle, "settle", minimum=0)
     if share > 1:
         raise ValueError(f"share: expected a fraction in (0, 1], got {share}")
+    sigma_x, sigma_y = as_positive(sigma_x, "sigma_x"), as_positive(sigma_y, "sigma_y")   # before any driving
     setup.world.as_viewpoint([start[0], start[1], setup.lidar.height], "start")
     centred = move_to_middle_line(setup.world, start, setup.lidar, rng=rng)   # first; the localizer starts after it
     return _run_trial(setup, method, centred, rng, max_distance, share, sigma_x, sigma_y, settle, keep_particles)
