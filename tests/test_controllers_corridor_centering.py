@@ -104,3 +104,34 @@ def test_bad_arguments_are_named():
         move_to_middle_line(long_corridor(), [14.5, 0.0, 0.0], Lidar(), direction="north")
     with pytest.raises(ValueError, match="pose"):
         move_to_middle_line(long_corridor(), [14.5, np.nan, 0.0], Lidar())
+
+
+def _public_loop(world, pose, lidar, rng, steps):
+    """move_to_middle_line's loop written with the public, checked calls only (the reference)."""
+    from robokit.mapping import corridor_state
+    width, recess, e4 = world.info["width"], world.info["recess"], 0.04
+    p, poses, e_prev, good = np.asarray(pose, float), [np.asarray(pose, float)], None, 0
+    for _ in range(steps + 1):
+        s = corridor_state(lidar.scan(world, p, rng), lidar.angles, width, lidar.r_max, recess=recess, tol=e4)
+        if s.lateral_offset is None:
+            break
+        e0 = -s.axis
+        e_prev = e0 if e_prev is None else e_prev
+        k = int(np.round((e_prev - e0) / np.pi))
+        e_prev = e = e0 + k * np.pi
+        y = -s.lateral_offset if k % 2 else s.lateral_offset
+        good = good + 1 if abs(y) <= e4 / 4 and abs(wrap_angle(e)) <= np.deg2rad(2.0) else 0
+        if good >= 3 or len(poses) > steps:
+            break
+        p = unicycle_step(p, *centering_command(y, float(wrap_angle(e)), deadband=e4 / 4), 0.1)
+        poses.append(p)
+    return np.array(poses)
+
+
+@pytest.mark.parametrize("start", [[15.0, 0.4, 0.5], [25.3, -0.6, 2.9], [4.0, 0.1, -1.2]])
+def test_the_loop_drives_exactly_as_the_public_calls_would(start):
+    """The loop checks each scan once and trusts it after; the poses are those of the checked calls."""
+    world, lidar = long_corridor(), Lidar(noise=0.01)
+    run = move_to_middle_line(world, start, lidar, rng=np.random.default_rng(7), max_steps=120)
+    reference = _public_loop(world, start, lidar, np.random.default_rng(7), 120)
+    assert len(run.poses) > 5 and np.array_equal(run.poses, reference)

@@ -252,8 +252,9 @@ def test_the_coarse_to_fine_vote_finds_the_exhaustive_votes_axis():
         assert math.degrees(abs(math.remainder(corridor_axis(r, a) + err, math.pi))) < 1.0, pose   # centering asks 2 deg
 
 
-def test_the_unchecked_state_of_a_checked_scan_is_the_checked_state():
-    """corridor_state(validate=False), the moving strategy's per-scan path, gives the same analysis."""
+def test_the_unchecked_state_agrees_with_the_public_conditions():
+    """corridor_state(validate=False), the moving strategy's per-scan path: the same state as the
+    checked call, and its width case, door sides and Eq. (4) those of the public functions."""
     lidar, world, rng = Lidar(noise=0.01), long_corridor(), np.random.default_rng(3)
     for _ in range(40):
         pose = [rng.uniform(1.0, 35.0), rng.uniform(-0.8, 0.8), rng.uniform(-np.pi, np.pi)]
@@ -265,3 +266,15 @@ def test_the_unchecked_state_of_a_checked_scan_is_the_checked_state():
                 assert np.array_equal(np.asarray(getattr(slow, field), dtype=object),
                                       np.asarray(getattr(fast, field), dtype=object)), field
         assert np.array_equal(invalid_areas(r, a), invalid_areas(r, a, validate=False))
+        if fast.lateral_offset is None:
+            continue
+        sides = door_sides(r, a, heading=fast.axis)
+        hint = "left" if sides == (True, False) else "right" if sides == (False, True) else None
+        assert fast.width_case == width_condition(fast.d_l, fast.d_r, 2.17)
+        assert (fast.middle, fast.lateral_offset, fast.doors) == middle_line_condition(fast.d_l, fast.d_r, width=2.17,
+                                                                                      door=hint)
+
+
+def test_a_bad_door_is_refused_whatever_the_distances():
+    with pytest.raises(ValueError, match="door"):
+        middle_line_condition(1.085, 1.085, width=2.17, door="up")      # Eq. (1): the door is not read

@@ -76,8 +76,12 @@ def test_one_wrong_retrieval_does_not_overrule_the_filter():
 
 
 @pytest.mark.parametrize("bad, match", [(dict(method="both"), "method"), (dict(share=1.5), "share"),
-                                        (dict(start=[50.0, 0.0, 0.0]), "start")])
-def test_bad_trial_input_is_named(setup, bad, match):
+                                        (dict(start=[50.0, 0.0, 0.0]), "start"), (dict(sigma_x=0.0), "sigma_x"),
+                                        (dict(method="amcl", sigma_y=np.nan), "sigma_y")])
+def test_bad_trial_input_is_named(setup, bad, match, monkeypatch):
+    def no_driving(*args, **kwargs):
+        raise AssertionError("the robot moved before its arguments were checked")
+    monkeypatch.setattr(trials, "move_to_middle_line", no_driving)
     kw = dict(start=trials.START_POSES[0], method="ours") | bad
     with pytest.raises((ValueError, TypeError), match=match):
         trials.localization_trial(setup, kw.pop("start"), kw.pop("method"), **kw)

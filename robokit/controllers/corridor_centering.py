@@ -23,22 +23,25 @@ References
 from __future__ import annotations
 
 import dataclasses
-import inspect
 from typing import Any
 
 import numpy as np
 
 from ..geometry import wrap_angle
-from ..mapping.corridor_scan import CorridorState, as_scan, corridor_state
+from ..mapping.corridor_areas import as_scan
+from ..mapping.corridor_scan import CorridorState, corridor_state
 from ..sim import Lidar, World, unicycle_step
 from ..validation import as_array, as_rng, as_choice, as_finite_scalar, as_int, as_positive
 
 __all__ = ["centering_command", "CenteringResult", "move_to_middle_line"]
 
+# the command law's defaults (centering_command), which move_to_middle_line drives with
+_LOOKAHEAD, _K_OMEGA, _K_V, _V_MIN, _V_MAX, _W_MAX = 0.15, 1.5, 0.5, 0.02, 0.15, 0.6
 
-def centering_command(lateral_offset: float, heading_error: float, *, lookahead: float = 0.15, k_omega: float = 1.5,
-                      k_v: float = 0.5, v_min: float = 0.02, v_max: float = 0.15, w_max: float = 0.6,
-                      deadband: float = 0.0) -> tuple[float, float]:
+
+def centering_command(lateral_offset: float, heading_error: float, *, lookahead: float = _LOOKAHEAD,
+                      k_omega: float = _K_OMEGA, k_v: float = _K_V, v_min: float = _V_MIN, v_max: float = _V_MAX,
+                      w_max: float = _W_MAX, deadband: float = 0.0) -> tuple[float, float]:
     """Speed and turn rate ``(v, omega)`` that bring a unicycle onto the corridor's middle line.
 
     Parameters
@@ -199,9 +202,7 @@ def move_to_middle_line(world: World, pose: Any, lidar: Lidar, *, rng: Any = 0, 
     n_settle = as_int(settle, "settle", minimum=1)
     poses, dist, good = [p.copy()], 0.0, 0
     e_prev, y, e = None, 0.0, 0.0
-    # the arguments are checked here once, each scan by as_scan; the per-scan analysis and the command trust them
-    gains = inspect.signature(centering_command).parameters
-    law = [float(gains[k].default) for k in ("lookahead", "k_omega", "k_v", "v_min", "v_max", "w_max")]
+    # the arguments are checked here once and each scan by as_scan: the scan's analysis and the command trust them
     for _ in range(steps + 1):
         r, a = as_scan(lidar.scan(world, p, gen), lidar.angles)
         state = corridor_state(r, a, w, lidar.r_max, recess=dda, tol=e4, validate=False)
@@ -214,10 +215,11 @@ def move_to_middle_line(world: World, pose: Any, lidar: Lidar, *, rng: Any = 0, 
         e = e0 + k * np.pi
         y = -state.lateral_offset if k % 2 else state.lateral_offset
         e_prev = e
-        good = good + 1 if abs(y) <= e4 / 4 and abs(wrap_angle(e, validate=False)) <= etol else 0
+        heading = float(wrap_angle(e, validate=False))
+        good = good + 1 if abs(y) <= e4 / 4 and abs(heading) <= etol else 0
         if good >= n_settle or len(poses) > steps:
             break
-        v, omega = _command(y, float(wrap_angle(e, validate=False)), *law, e4 / 4)
+        v, omega = _command(y, heading, _LOOKAHEAD, _K_OMEGA, _K_V, _V_MIN, _V_MAX, _W_MAX, e4 / 4)
         p = unicycle_step(p, v, omega, dt, validate=False)
         poses.append(p)
         dist += abs(v) * dt

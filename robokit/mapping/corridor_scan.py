@@ -389,6 +389,13 @@ def middle_line_condition(d_l: float, d_r: float, *, tol: float = 0.04, width: A
         Whether Eq. (4) holds; the robot's offset from the middle line, positive to the left (m);
         and where the doors are: ``"none"``, ``"both"``, ``"left"`` or ``"right"``.
 
+    Raises
+    ------
+    TypeError, ValueError
+        For a distance, tolerance, recess or width that is not a finite non-negative number (the
+        distances and the width positive), or a ``door`` other than ``None``, ``"left"`` and
+        ``"right"`` (whichever case the distances fit).
+
     Notes
     -----
     Ge et al. (2023), Eq. (4) and the rule after it: with Eqs. (1)-(3) the robot "decides whether
@@ -492,8 +499,10 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
     recess, tol, width_tol : float
         ``d_da``, ``e4`` and ``e1 = e2 = e3`` (m).
     validate : bool, default True
-        Check the arguments; ``False`` is the fast path for a loop over scans (the moving strategy)
-        that passes a scan as :func:`as_scan` returns it and checked floats.
+        Check the scan, ``recess``, ``tol`` and ``width_tol``; ``False`` is the fast path for a loop
+        over scans (the moving strategy) that passes a scan as :func:`as_scan` returns it and checked
+        floats (a raw scan is then read as it is: a 0 is not turned into ``inf``, a NaN is not
+        refused). ``width``, ``r_max`` and ``bounds`` are checked either way.
 
     Returns
     -------
@@ -514,9 +523,9 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
     >>> s.in_corridor, s.at_end, s.n_areas, np.rad2deg(s.areas[:, 2]).round(3).tolist()
     (True, False, 2, [14.0, 15.0])
     """
+    as_choice(bounds, "bounds", ["paper", "geometric"])
     if validate:
         r, a = as_scan(ranges, angles)
-        as_choice(bounds, "bounds", ["paper", "geometric"])
         recess = as_positive(recess, "recess", allow_zero=True)
         tol = as_positive(tol, "tol", allow_zero=True)
         width_tol = as_positive(width_tol, "width_tol", allow_zero=True)

@@ -443,7 +443,8 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
     Raises
     ------
     TypeError, ValueError
-        For a bad setup, start, method or parameter.
+        For a bad setup, start, method or parameter (``sigma_x`` and ``sigma_y`` for either method),
+        before the robot moves.
 
     Notes
     -----
