@@ -543,7 +543,7 @@ def corridor_state(ranges: Any, angles: Any, width: float, r_max: float, *, boun
         at_door = _door_sides(r, a, axis, recess, (d_l, d_r))
     except (EmptyScanError, NoWallError):
         return CorridorState(n > 0, n == 1, n, areas, (lo, hi), axis, np.inf, np.inf, None, False, None, "none")
-    w = as_positive(width, "width") if validate else width
+    w = float(width)                     # theta_limits checked it above, on either path
     case = _width_case(d_l, d_r, w, recess, width_tol)
     hint = "left" if at_door == (True, False) else "right" if at_door == (False, True) else None
     middle, offset, doors = _middle_line(d_l, d_r, tol, w, recess, width_tol, hint)
