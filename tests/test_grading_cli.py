@@ -71,6 +71,25 @@ def test_unreadable_and_wrong_assignment_exit_nonzero_but_batch_completes(tmp_pa
     assert rows["good"]["total"] == "3" and rows["wrong"]["total"] == "0" and rows["missing"]["total"] == "0"
 
 
+def test_a_batch_draws_only_the_cases_of_the_files_it_grades(tmp_path, monkeypatch):
+    # preparing an assignment's cases takes up to 2.5 s, and each graded file draws its own: the batch
+    # seed's own draw is made only for a file that is not graded, to name the cases it scores zero on
+    import robocourse.grading.grader as grader
+
+    real, seeds = grader.prepare_cases, []
+    monkeypatch.setattr(grader, "prepare_cases", lambda assignment, seed: seeds.append(seed) or real(assignment, seed))
+    shutil.copy(SOL, tmp_path / "good.ipynb")
+    shutil.copy(BLANK, tmp_path / "blank.ipynb")
+    results = grader.grade_batch([tmp_path / "good.ipynb", tmp_path / "blank.ipynb"], "00_getting_started", "s",
+                                 log=lambda *_: None)
+    assert [r.total for r in results] == [3, 0] and len(seeds) == 2 and "s" not in seeds
+    seeds.clear()
+    (tmp_path / "bad.ipynb").write_text("{}")
+    (bad,) = grader.grade_batch([tmp_path / "bad.ipynb"], "00_getting_started", "s", log=lambda *_: None)
+    assert seeds == ["s"] and bad.total == 0 and bad.max_total == 3
+    assert [s.total for s in bad.scores] == [len(cases) for cases in real("00_getting_started", "s").cases]
+
+
 def test_every_file_that_could_not_be_graded_makes_the_exit_code_1(tmp_path, capsys):
     # the README: exit 1 when a file could not be graded; a 200 MB notebook used to exit 0
     big = tmp_path / "big.ipynb"

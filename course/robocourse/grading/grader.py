@@ -49,7 +49,7 @@ from robocourse.grading.syscall_filter import probe as probe_filter
 from robocourse.grading.submission import Submission, SubmissionRejected, feedback_stem, read_submission, student_name
 from robocourse.grading.transport import TransportError
 
-__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "prepare_cases", "draw_cases", "cases_seed",
+__all__ = ["SubmissionResult", "ExerciseScore", "PreparedCases", "BatchSeed", "prepare_cases", "draw_cases", "cases_seed",
            "job_spec", "score_exercise", "worker_view", "grade_submission", "grade_batch", "GradingError",
            "isolation_note", "unique_students", "needs_review"]
 
@@ -129,6 +129,29 @@ class PreparedCases:
         submission's code cells (:func:`cases_seed`)."""
         return prepare_cases(self.assignment, cases_seed(self.seed, submission))
 
+    def zero(self, message: str) -> list[ExerciseScore]:
+        """Every exercise at zero on these cases, with one message."""
+        return [ExerciseScore.zero(ex, len(cs), message) for ex, cs in zip(self.exercises, self.cases)]
+
+
+@dataclasses.dataclass(frozen=True)
+class BatchSeed:
+    """A batch's assignment and secret seed, before any draw: each submission's cases are drawn from
+    it and the submission (:meth:`for_submission`). The seed's own draw is made only for a file that
+    is not graded, to name the cases it scores zero on (:meth:`zero`): preparing cases costs up to
+    2.5 s an assignment, and every graded file draws its own."""
+
+    assignment: str
+    seed: str = dataclasses.field(repr=False)
+
+    def for_submission(self, submission: Submission) -> PreparedCases:
+        """As :meth:`PreparedCases.for_submission`."""
+        return prepare_cases(self.assignment, cases_seed(self.seed, submission))
+
+    def zero(self, message: str) -> list[ExerciseScore]:
+        """Every exercise at zero on the seed's own cases, with one message."""
+        return prepare_cases(self.assignment, self.seed).zero(message)
+
 
 def cases_seed(seed: str, submission: Submission) -> str:
     """The seed of one submission's hidden cases: the secret ``seed`` and a SHA-256 of its code
@@ -189,17 +212,17 @@ def prepare_cases(assignment: str, seed: str) -> PreparedCases:
     GradingError
         For a missing seed, or an exercise whose cases never show work (a course error).
     """
-    if not isinstance(seed, str) or not seed:
-        raise GradingError("seed: a non-empty secret seed is required (--seed or ROBOKIT_GRADING_SEED)")
+    _require_seed(seed)
     exercises = get_assignment(assignment).exercises
     data = data_values(assignment_data(assignment)) if data_file(assignment).is_file() else []
     cases, expected, trivial = zip(*(draw_cases(ex, seed, data) for ex in exercises))
     return PreparedCases(exercises, list(cases), list(expected), list(trivial), assignment, seed)
 
 
-def _zero(prepared: PreparedCases, message: str) -> list[ExerciseScore]:
-    """Every exercise at zero, with one message."""
-    return [ExerciseScore.zero(ex, len(cs), message) for ex, cs in zip(prepared.exercises, prepared.cases)]
+def _require_seed(seed: Any) -> str:
+    if not isinstance(seed, str) or not seed:
+        raise GradingError("seed: a non-empty secret seed is required (--seed or ROBOKIT_GRADING_SEED)")
+    return seed
 
 
 def job_spec(submission: Submission, prepared: PreparedCases, limits: Limits) -> JobSpec:
@@ -221,7 +244,7 @@ def worker_view(kit: Kit, hide: Sequence[Path] = ()) -> View:
                 (*library, *(str(Path(h).resolve()) for h in hide)))
 
 
-def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases, *,
+def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases | BatchSeed, *,
                      limits: Limits = Limits(), kit: Kit | None = None, hide: Sequence[Path] = (),
                      work_root: Path | None = None) -> SubmissionResult:
     """Grade one notebook in a sandboxed worker; never raises for a bad submission.
@@ -242,7 +265,7 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
     try:
         submission = read_submission(path, assignment)
     except SubmissionRejected as exc:
-        return SubmissionResult(student, path, _zero(prepared, str(exc)), [exc.flag], str(exc))
+        return SubmissionResult(student, path, prepared.zero(str(exc)), [exc.flag], str(exc))
     prepared = prepared.for_submission(submission)
     job = JobDir.create(work_root)
     try:
@@ -257,7 +280,7 @@ def grade_submission(path: str | Path, assignment: str, prepared: PreparedCases,
             except BudgetExceeded as exc:
                 flags = ([] if exit_.isolated else ["sandbox=limited"]) + ["unusable-results"] + \
                     (["timeout"] if exit_.timed_out else [])
-                return SubmissionResult(student, path, _zero(prepared, f"not graded: {exc}"), flags,
+                return SubmissionResult(student, path, prepared.zero(f"not graded: {exc}"), flags,
                                         seconds=time.perf_counter() - start, problems=[str(exc)])
     finally:
         shutil.rmtree(job.root, ignore_errors=True)
@@ -362,7 +385,7 @@ def _score(job: JobDir, student: str, path: Path, prepared: PreparedCases, exit_
     scores, compute, imported_robokit = _score_exercises(reading, prepared, ended)
     calls = reading.get("the log of withheld imports", job.read_withheld_imports)
     if calls is _UNUSABLE:
-        scores = _zero(prepared, "not graded: the grading process's log of withheld imports was unusable")
+        scores = prepared.zero("not graded: the grading process's log of withheld imports was unusable")
     elif calls:
         imported_robokit = True
     if imported_robokit:
@@ -424,10 +447,10 @@ def _numbered(name: str, n: int) -> str:
     return numbered if feedback_stem(numbered).endswith(f"_{n}") else f"{feedback_stem(name)[:80]}#{n}"
 
 
-def _grader_failed(path: Path, student: str, prepared: PreparedCases, exc: Exception) -> SubmissionResult:
+def _grader_failed(path: Path, student: str, prepared: PreparedCases | BatchSeed, exc: Exception) -> SubmissionResult:
     """The result of a submission on which the grader itself failed (a bug, a broken environment)."""
     what = "".join(traceback.format_exception_only(type(exc), exc)).strip()[-300:]
-    return SubmissionResult(student, path, _zero(prepared, "not graded: the grader failed on this file"),
+    return SubmissionResult(student, path, prepared.zero("not graded: the grader failed on this file"),
                             ["grader-error"], f"the grader failed on this file ({what})")
 
 
@@ -451,12 +474,12 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
         the course (a worker module that would bring library code into the worker) or with the host
         (it refuses the worker's seccomp filter).
     """
-    if isinstance(seed, str) and seed:
-        conceal_secret(seed)
+    conceal_secret(_require_seed(seed))
     try:
-        prepared = prepare_cases(assignment, seed)
+        get_assignment(assignment)
     except UnknownAssignmentError as exc:
         raise GradingError(str(exc)) from None
+    prepared = BatchSeed(assignment, seed)      # each file draws its own cases from it
     if not paths:
         raise GradingError("submissions: expected at least one notebook")
     refused = probe_filter()
