@@ -41,6 +41,21 @@ def work_unit(nodeid: str) -> str:
     return "grading" if module.startswith("tests/test_grading_") else module
 
 
+def pytest_configure(config):
+    """Under pytest-xdist the test workers already fill the cores: each one's runs in worker processes
+    (:func:`robokit.parallel.map_runs`) and OpenCV's threads get its share of them, as a course build
+    shares the cores between the notebooks it runs at once. A caller's own ``ROBOKIT_WORKERS`` stays;
+    tests that need workers ask for them."""
+    count = os.environ.get("PYTEST_XDIST_WORKER_COUNT", "")
+    if os.environ.get("PYTEST_XDIST_WORKER") and count.isdigit() and "ROBOKIT_WORKERS" not in os.environ:
+        import cv2
+
+        from robokit.config import available_cpus
+        share = max(1, available_cpus() // int(count))
+        os.environ["ROBOKIT_WORKERS"] = str(share)
+        cv2.setNumThreads(share)
+
+
 def pytest_collection_modifyitems(config, items):
     """Every test that uses ``fast_course`` must be one :func:`shares_fast_course` names (else a second
     worker would build the course again)."""

@@ -3,7 +3,6 @@ import json
 import re
 import shutil
 
-import nbformat
 import pytest
 
 from robocourse.cli import main
@@ -12,6 +11,8 @@ from tests.conftest import ROOT
 
 
 def _notebook(path, *sources):
+    import nbformat     # here, not at the top: its import (about 1.5 s) would be paid by every test worker
+
     nb = nbformat.v4.new_notebook()
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
     nb.cells = [nbformat.v4.new_code_cell(s) for s in sources]
@@ -233,6 +234,8 @@ def test_a_solution_starts_after_its_lesson_and_the_longest_goes_first(tmp_path)
 
 @pytest.mark.slow
 def test_a_fresh_full_build_starts_the_notebook_declaring_the_longest_cold_time(tmp_path):
+    import nbformat
+
     from robocourse.site.build import run_notebooks
     stamp = tmp_path / "stamps.txt"
     paths = []

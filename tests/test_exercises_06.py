@@ -151,7 +151,7 @@ def _failed_labels(fn, seed):
     return failed
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2024])
+@pytest.mark.parametrize("seed", [0, 1, pytest.param(2024, marks=pytest.mark.slow)])
 def test_open_ik_tempting_shortcuts_fail_some_cases(seed):
     """Arm angle 0 fails where no branch is inside at psi = 0 and where no arm angle is; a 30-degree
     (or 10-degree) grid of arm angles misses the narrow feasible arcs; the reference passes all."""

@@ -163,17 +163,6 @@ def test_a_case_that_knows_its_answer_is_judged_by_it_not_by_the_answer():
 
 
 @pytest.mark.parametrize("slug", list(assignments()))
-def test_reference_passes_its_own_cases(slug):
-    from robocourse.grading.judge import call_student, expected_output, judge
-
-    for ex in assignments()[slug]:
-        for seed in ("public", 12345):
-            for case in ex.make_cases(seed):
-                outcome = judge(ex, case, expected_output(ex, case), call_student(ex.answer, case))
-                assert outcome.passed, (ex.id, case.label, outcome.message)
-
-
-@pytest.mark.parametrize("slug", list(assignments()))
 def test_cases_are_deterministic_per_seed(slug):
     for ex in assignments()[slug]:
         a, b = repr(ex.make_cases("seed-a")), repr(ex.make_cases("seed-a"))

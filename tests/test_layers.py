@@ -18,6 +18,7 @@ A new subpackage must be placed in ``PACKAGES`` (and in DESIGN.md's picture), or
 from __future__ import annotations
 
 import ast
+import functools
 import re
 from pathlib import Path
 
@@ -120,7 +121,10 @@ def _imports(module: str, path: Path) -> list[tuple[str, int, list[str]]]:
     return [f for f in found if f[0]]
 
 
-GRAPH = {m: _imports(m, p) for m, p in MODULES.items()}
+@functools.cache
+def _graph() -> dict:
+    """Every module's imports (parsed on first use, not at collection by every test worker)."""
+    return {m: _imports(m, p) for m, p in MODULES.items()}
 
 
 def test_every_unit_has_a_layer():
@@ -131,7 +135,7 @@ def test_every_unit_has_a_layer():
 
 
 def test_the_library_never_imports_the_course():
-    bad = [f"{MODULES[m].relative_to(ROOT)}:{line}: imports {t}" for m, imps in GRAPH.items() if m.startswith("robokit")
+    bad = [f"{MODULES[m].relative_to(ROOT)}:{line}: imports {t}" for m, imps in _graph().items() if m.startswith("robokit")
            for t, line, _ in imps if t.startswith("robocourse")]
     assert not bad, "robokit must not depend on the course:\n" + "\n".join(bad)
 
@@ -139,7 +143,7 @@ def test_the_library_never_imports_the_course():
 def test_no_upward_imports():
     layer = _layer_of()
     bad = []
-    for module, imports in GRAPH.items():
+    for module, imports in _graph().items():
         src = _unit(module)
         for target, line, _ in imports:
             dst = _unit(target)
@@ -153,13 +157,13 @@ def test_no_upward_imports():
 
 def test_package_roots_stay_light():
     for package, (_, rows) in PACKAGES.items():
-        bad = [t for t, _, _ in GRAPH[package] if t.startswith(package + ".") and _unit(t)[1] not in rows[0]
+        bad = [t for t, _, _ in _graph()[package] if t.startswith(package + ".") and _unit(t)[1] not in rows[0]
                and t.split(".")[1] != "grading"]
         assert not bad, f"{package}/__init__.py must import only its base layer ({package}.grading lazily): {bad}"
 
 
 def test_no_import_cycles():
-    graph = {m: sorted({t for t, _, _ in imps if t != m}) for m, imps in GRAPH.items()}
+    graph = {m: sorted({t for t, _, _ in imps if t != m}) for m, imps in _graph().items()}
     # a package's __init__ importing its own submodules is how packages are built, not a cycle
     for m in graph:
         graph[m] = [t for t in graph[m] if not t.startswith(m + ".")]
@@ -221,7 +225,7 @@ def test_no_private_names_across_modules(module):
     tree = ast.parse(path.read_text(encoding="utf-8"))
     own = _defined_private(tree)
     bad = []
-    for target, line, names in GRAPH[module]:
+    for target, line, names in _graph()[module]:
         bad += [f"line {line}: imports {n} from {target}" for n in names
                 if n.startswith("_") and not n.startswith("__")]
     for node in ast.walk(tree):
