@@ -35,7 +35,7 @@ test: $(STAMP)
 	$(BIN)/python -m pytest $(XDIST) --durations=15 -m "not slow" $(PYTEST_ARGS)
 
 check: $(STAMP)
-	ROBOKIT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest $(XDIST) --durations=15 $(PYTEST_ARGS)
+	ROBOKIT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest $(XDIST) --durations=15 --hypothesis-profile=check $(PYTEST_ARGS)
 
 # A deliberate upgrade: the newest versions the pyproject ranges allow, resolved in a fresh venv (so
 # nothing installed by hand is pinned); then update environment.yml's pins (tests/test_packaging.py

@@ -9,8 +9,17 @@ from pathlib import Path
 from typing import Iterator
 
 import pytest
+from hypothesis import settings
 
 ROOT = Path(__file__).resolve().parents[1]
+
+#: Random draws per property test that does not set its own count (the random invalid inputs of
+#: tests/test_fuzz_public_api.py, per public function): ``make check`` passes
+#: ``--hypothesis-profile=check``; ``make test`` and a plain pytest run use ``everyday``. The fixed
+#: invalid cases of every parameter run in both.
+settings.register_profile("check", max_examples=25)
+settings.register_profile("everyday", max_examples=10)
+settings.load_profile("everyday")
 
 #: Headless Chromium for the browser tests (Debian's ``chromium``; ``.ci/run`` installs it).
 CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
@@ -31,14 +40,28 @@ def shares_fast_course(nodeid: str) -> bool:
     return nodeid.startswith(FAST_COURSE_FILES + FAST_COURSE_PARAMS)
 
 
+#: Test modules that share what one process builds: the map of the short office run
+#: (tests/office_runs.py keeps it per process) and the IK solvers' compiled kernels (numba compiles
+#: them in each process that finds no cache). In one unit they are built once, not by both workers at
+#: the same time (about 7 s each).
+SHARED_BUILDS = {
+    "office_runs": ("tests/test_localization_appearance_mcl.py", "tests/test_localization_hierarchical.py",
+                    "tests/test_mapping_topological.py"),
+    "arm": ("tests/test_arm_", "tests/test_exercises_06.py"),
+}
+
+
 def work_unit(nodeid: str) -> str:
     """The unit of work of a test under pytest-xdist: its module; every test of the fast course build;
     every grading test, since they share the machine's job uids and control groups (a test that
-    counts a job's leftover processes would count another test's job)."""
+    counts a job's leftover processes would count another test's job); the modules of each
+    :data:`SHARED_BUILDS` entry."""
     if shares_fast_course(nodeid):
         return "fast_course"
     module = nodeid.split("::", 1)[0]
-    return "grading" if module.startswith("tests/test_grading_") else module
+    if module.startswith("tests/test_grading_"):
+        return "grading"
+    return next((unit for unit, modules in SHARED_BUILDS.items() if module.startswith(modules)), module)
 
 
 def pytest_configure(config):
