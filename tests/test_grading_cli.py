@@ -72,8 +72,8 @@ def test_unreadable_and_wrong_assignment_exit_nonzero_but_batch_completes(tmp_pa
 
 
 def test_a_batch_draws_only_the_cases_of_the_files_it_grades(tmp_path, monkeypatch):
-    # preparing an assignment's cases takes up to 2.5 s, and each graded file draws its own: the batch
-    # seed's own draw is made only for a file that is not graded, to name the cases it scores zero on
+    # preparing an assignment's cases takes up to 2.8 s, and each graded file draws its own: the batch
+    # seed's own draw is made only for files that are rejected, once, to name the cases they score zero on
     import robocourse.grading.grader as grader
 
     real, seeds = grader.prepare_cases, []
@@ -85,9 +85,24 @@ def test_a_batch_draws_only_the_cases_of_the_files_it_grades(tmp_path, monkeypat
     assert [r.total for r in results] == [3, 0] and len(seeds) == 2 and "s" not in seeds
     seeds.clear()
     (tmp_path / "bad.ipynb").write_text("{}")
-    (bad,) = grader.grade_batch([tmp_path / "bad.ipynb"], "00_getting_started", "s", log=lambda *_: None)
+    (tmp_path / "worse.ipynb").write_text("[")
+    bad, _ = grader.grade_batch([tmp_path / "bad.ipynb", tmp_path / "worse.ipynb"], "00_getting_started", "s",
+                                log=lambda *_: None)
     assert seeds == ["s"] and bad.total == 0 and bad.max_total == 3
     assert [s.total for s in bad.scores] == [len(cases) for cases in real("00_getting_started", "s").cases]
+
+
+def test_an_exercise_whose_cases_never_show_work_stops_the_batch(tmp_path, monkeypatch):
+    # a course error, not one file's: the batch raises it rather than scoring every file "grader-error"
+    import robocourse.grading.grader as grader
+
+    def never(assignment, seed):
+        raise grader.GradingError("00.wrap_angle: in 21 draws of its cases, trivial answers pass every valid case")
+
+    monkeypatch.setattr(grader, "prepare_cases", never)
+    shutil.copy(SOL, tmp_path / "good.ipynb")
+    with pytest.raises(grader.GradingError, match="00.wrap_angle: in 21 draws"):
+        grader.grade_batch([tmp_path / "good.ipynb"], "00_getting_started", "s", log=lambda *_: None)
 
 
 def test_every_file_that_could_not_be_graded_makes_the_exit_code_1(tmp_path, capsys):

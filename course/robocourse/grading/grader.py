@@ -26,6 +26,7 @@ import hashlib
 import json
 import shutil
 import tempfile
+import threading
 import time
 import traceback
 from concurrent.futures import ThreadPoolExecutor
@@ -134,23 +135,31 @@ class PreparedCases:
         return [ExerciseScore.zero(ex, len(cs), message) for ex, cs in zip(self.exercises, self.cases)]
 
 
-@dataclasses.dataclass(frozen=True)
 class BatchSeed:
     """A batch's assignment and secret seed, before any draw: each submission's cases are drawn from
-    it and the submission (:meth:`for_submission`). The seed's own draw is made only for a file that
-    is not graded, to name the cases it scores zero on (:meth:`zero`): preparing cases costs up to
-    2.5 s an assignment, and every graded file draws its own."""
+    it and the submission (:meth:`for_submission`). The seed's own draw is made only if a file is
+    rejected or the grader fails on it, to name the cases it scores zero on (:meth:`zero`), and then
+    once for the batch: preparing an assignment's cases takes up to 2.8 s, and every graded file
+    draws its own."""
 
-    assignment: str
-    seed: str = dataclasses.field(repr=False)
+    def __init__(self, assignment: str, seed: str):
+        self.assignment, self.seed = assignment, seed
+        self._drawn: PreparedCases | None = None
+        self._lock = threading.Lock()
+
+    def __repr__(self) -> str:
+        return f"BatchSeed(assignment={self.assignment!r})"     # never the seed
 
     def for_submission(self, submission: Submission) -> PreparedCases:
         """As :meth:`PreparedCases.for_submission`."""
         return prepare_cases(self.assignment, cases_seed(self.seed, submission))
 
     def zero(self, message: str) -> list[ExerciseScore]:
-        """Every exercise at zero on the seed's own cases, with one message."""
-        return prepare_cases(self.assignment, self.seed).zero(message)
+        """Every exercise at zero on the seed's own cases (drawn on first use), with one message."""
+        with self._lock:            # the batch's threads share one draw
+            if self._drawn is None:
+                self._drawn = prepare_cases(self.assignment, self.seed)
+        return self._drawn.zero(message)
 
 
 def cases_seed(seed: str, submission: Submission) -> str:
@@ -495,6 +504,8 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
         try:
             result = grade_submission(path, assignment, prepared, limits=limits, kit=kit, hide=hide,
                                       work_root=work_root)
+        except GradingError:      # a course error (no draw of an exercise's cases shows work): every file has it
+            raise
         except Exception as exc:  # one submission's failure, whatever it is, must not cost the batch
             result = _grader_failed(path, name[0], prepared, exc)
         result.student = name[0]
