@@ -9,17 +9,8 @@ from pathlib import Path
 from typing import Iterator
 
 import pytest
-from hypothesis import settings
 
 ROOT = Path(__file__).resolve().parents[1]
-
-#: Random draws per property test that does not set its own count (the random invalid inputs of
-#: tests/test_fuzz_public_api.py, per public function): ``make check`` passes
-#: ``--hypothesis-profile=check``; ``make test`` and a plain pytest run use ``everyday``. The fixed
-#: invalid cases of every parameter run in both.
-settings.register_profile("check", max_examples=25)
-settings.register_profile("everyday", max_examples=10)
-settings.load_profile("everyday")
 
 #: Headless Chromium for the browser tests (Debian's ``chromium``; ``.ci/run`` installs it).
 CHROMIUM = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)), None)
@@ -40,10 +31,10 @@ def shares_fast_course(nodeid: str) -> bool:
     return nodeid.startswith(FAST_COURSE_FILES + FAST_COURSE_PARAMS)
 
 
-#: Test modules that share what one process builds: the map of the short office run
+#: Test modules that share what one process builds first: the map of the short office run
 #: (tests/office_runs.py keeps it per process) and the IK solvers' compiled kernels (numba compiles
-#: them in each process that finds no cache). In one unit they are built once, not by both workers at
-#: the same time (about 7 s each).
+#: them in each process that finds no cache). In one unit, their modules build it once between them,
+#: not on both workers at the same time (about 7 s each).
 SHARED_BUILDS = {
     "office_runs": ("tests/test_localization_appearance_mcl.py", "tests/test_localization_hierarchical.py",
                     "tests/test_mapping_topological.py"),

@@ -266,6 +266,7 @@ EVERYDAY = "03_corridor_localization"
 
 
 def _every_assignment() -> list:
+    assert EVERYDAY in assignments(), f"EVERYDAY names no assignment: {EVERYDAY}"
     return [pytest.param(slug, marks=() if slug == EVERYDAY else pytest.mark.slow) for slug in sorted(assignments())]
 
 
