@@ -198,6 +198,19 @@ def test_a_blob_is_found_at_its_centre_and_at_a_scale_proportional_to_its_size(c
     assert np.ptp(ratios) < 0.06, ratios
 
 
+def test_scale_space_maxima_are_the_samples_no_lower_than_their_26_neighbours():
+    # the plain definition, sample by sample, against the search (which compares same-grid levels densely)
+    from robokit.vision.plot_detector import scale_space_maxima
+
+    rng = np.random.default_rng(5)
+    levels = [rng.random((40, 50)).astype(np.float32) for _ in range(5)]
+    _, _, strength = scale_space_maxima(levels, [1] * 5, 0.3, 2)
+    expected = [float(levels[n][r, c]) for n in range(1, 4) for r in range(2, 38) for c in range(2, 48)
+                if levels[n][r, c] > 0.3
+                and levels[n][r, c] >= max(levels[m][r - 1:r + 2, c - 1:c + 2].max() for m in (n - 1, n, n + 1))]
+    assert len(expected) > 20 and sorted(strength.tolist()) == sorted(expected)
+
+
 def test_scale_space_maxima_refines_a_peak_between_octaves_and_refuses_mismatched_levels():
     from robokit.vision.plot_detector import scale_space_maxima
     levels = [np.zeros((17, 17), np.float32), np.zeros((17, 17), np.float32), np.zeros((9, 9), np.float32)]
