@@ -92,15 +92,24 @@ def test_a_batch_draws_only_the_cases_of_the_files_it_grades(tmp_path, monkeypat
     assert [s.total for s in bad.scores] == [len(cases) for cases in real("00_getting_started", "s").cases]
 
 
-def test_an_exercise_whose_cases_never_show_work_stops_the_batch(tmp_path, monkeypatch):
-    # a course error, not one file's: the batch raises it rather than scoring every file "grader-error"
+def test_a_draw_that_never_shows_work_costs_its_file_or_with_the_batch_seed_the_batch(tmp_path, monkeypatch):
+    # a file's cases are drawn from the seed and its code: if only that draw fails, the file is a
+    # grader error and the batch goes on; if the batch seed's own draw fails too, the course is at fault
     import robocourse.grading.grader as grader
 
-    def never(assignment, seed):
-        raise grader.GradingError("00.wrap_angle: in 21 draws of its cases, trivial answers pass every valid case")
+    real, failing = grader.prepare_cases, set()
 
-    monkeypatch.setattr(grader, "prepare_cases", never)
+    def draw(assignment, seed):
+        if seed in failing or (seed != "s" and "file" in failing):
+            raise grader.GradingError("00.wrap_angle: in 21 draws of its cases, trivial answers pass every valid case")
+        return real(assignment, seed)
+
+    monkeypatch.setattr(grader, "prepare_cases", draw)
     shutil.copy(SOL, tmp_path / "good.ipynb")
+    failing.add("file")
+    (result,) = grader.grade_batch([tmp_path / "good.ipynb"], "00_getting_started", "s", log=lambda *_: None)
+    assert result.flags == ["grader-error"] and result.total == 0 and "00.wrap_angle" in result.reason
+    failing.add("s")
     with pytest.raises(grader.GradingError, match="00.wrap_angle: in 21 draws"):
         grader.grade_batch([tmp_path / "good.ipynb"], "00_getting_started", "s", log=lambda *_: None)
 

@@ -203,7 +203,7 @@ def test_scale_space_maxima_are_the_samples_no_lower_than_their_26_neighbours():
     from robokit.vision.plot_detector import scale_space_maxima
 
     rng = np.random.default_rng(5)
-    levels = [rng.random((40, 50)).astype(np.float32) for _ in range(5)]
+    levels = [(rng.integers(0, 8, (40, 50)) / 8).astype(np.float32) for _ in range(5)]   # eight values: many ties
     _, _, strength = scale_space_maxima(levels, [1] * 5, 0.3, 2)
     expected = [float(levels[n][r, c]) for n in range(1, 4) for r in range(2, 38) for c in range(2, 48)
                 if levels[n][r, c] > 0.3

@@ -504,9 +504,9 @@ def grade_batch(paths: Sequence[str | Path], assignment: str, seed: str, *, jobs
         try:
             result = grade_submission(path, assignment, prepared, limits=limits, kit=kit, hide=hide,
                                       work_root=work_root)
-        except GradingError:      # a course error (no draw of an exercise's cases shows work): every file has it
-            raise
-        except Exception as exc:  # one submission's failure, whatever it is, must not cost the batch
+        except Exception as exc:  # one submission's failure, whatever it is, must not cost the batch (its
+            # draw of cases may fail alone: the draw's seed hashes its code; the zero scores below draw
+            # the batch seed's cases, and a course error that fails that draw too stops the batch)
             result = _grader_failed(path, name[0], prepared, exc)
         result.student = name[0]
         if name[1]:
