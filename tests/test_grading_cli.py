@@ -8,17 +8,37 @@ import pytest
 
 from robocourse.cli import main
 from robocourse.grading.selfcheck import grade_course
+from robocourse.lessons import assignments
 from tests.conftest import ROOT
 
 SOL = ROOT / "solutions" / "00_getting_started.ipynb"
 BLANK = ROOT / "assignments" / "00_getting_started.ipynb"
 
 
-def test_every_solution_full_marks_and_every_blank_assignment_zero():
-    rows = grade_course(ROOT)
-    assert rows, "no assignments found"
+#: ``make test`` grades these two assignments' solution and blank in the sandbox (the smallest, and one
+#: with a data file and a simulator); ``make check`` grades the rest too, as every ``make course`` does.
+EVERYDAY_GRADED = ("00_getting_started", "03_corridor_localization")
+
+
+def _graded_groups() -> list:
+    assert set(EVERYDAY_GRADED) <= set(assignments()), f"EVERYDAY_GRADED names no assignment: {EVERYDAY_GRADED}"
+    rest = tuple(slug for slug in assignments() if slug not in EVERYDAY_GRADED)
+    return [pytest.param(EVERYDAY_GRADED, id="everyday"), pytest.param(rest, id="the-rest", marks=pytest.mark.slow)]
+
+
+@pytest.mark.parametrize("slugs", _graded_groups())
+def test_every_solution_full_marks_and_every_blank_assignment_zero(slugs):
+    rows = grade_course(ROOT, only=slugs)
+    assert sorted({r["assignment"] for r in rows}) == sorted(slugs) and len(rows) == 2 * len(slugs)
     bad = [r for r in rows if not r["ok"]]
     assert not bad, bad
+
+
+def test_the_self_check_refuses_an_assignment_the_course_lacks():
+    with pytest.raises(ValueError, match="only: expected assignments of the course.*99_nothing"):
+        grade_course(ROOT, only=["99_nothing"])
+    with pytest.raises(TypeError, match="only: expected a sequence"):
+        grade_course(ROOT, only="03_corridor_localization")
 
 
 def test_grade_writes_gradebook_feedback_and_gradescope(tmp_path, capsys):

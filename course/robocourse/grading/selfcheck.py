@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import html
 from pathlib import Path
+from typing import Sequence
 
 from robocourse.site.book import BookPage
 from robocourse.lessons import assignments
@@ -19,7 +20,8 @@ __all__ = ["grade_course", "course_grading_step"]
 
 
 def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int | None = None,
-                 limits: Limits = Limits(wall_seconds=600, cpu_seconds=600)) -> list[dict]:
+                 limits: Limits = Limits(wall_seconds=600, cpu_seconds=600),
+                 only: Sequence[str] | None = None) -> list[dict]:
     """Grade ``solutions/NN.ipynb`` and ``assignments/NN.ipynb`` for every assignment with exercises.
 
     Parameters
@@ -34,6 +36,8 @@ def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int 
         counts against the user's process limit, :class:`~robocourse.grading.sandbox.Limits`).
     limits : Limits
         Per-notebook limits of the sandbox.
+    only : sequence of str, optional
+        Grade these assignments (their slugs, e.g. ``"03_corridor_localization"``) instead of all.
 
     Returns
     -------
@@ -46,13 +50,21 @@ def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int 
     Raises
     ------
     ValueError, TypeError
-        For ``jobs`` that is not a positive whole number.
+        For ``jobs`` that is not a positive whole number, or ``only`` naming no assignment of the
+        course.
     GradingError
         For a host that refuses the sandbox (:func:`~robocourse.grading.grader.grade_batch`).
     """
     root = Path(root)
     jobs = min(2, worker_count()) if jobs is None else as_int(jobs, "jobs", minimum=1)
     slugs = list(assignments())
+    if only is not None:
+        if isinstance(only, (str, bytes)) or not all(isinstance(slug, str) for slug in only):
+            raise TypeError(f"only: expected a sequence of assignment slugs, got {only!r}")
+        unknown = [slug for slug in only if slug not in slugs]
+        if unknown:
+            raise ValueError(f"only: expected assignments of the course ({', '.join(slugs)}), got {unknown}")
+        slugs = [slug for slug in slugs if slug in only]
     # one batch per assignment (its cases are prepared once for both notebooks), ``jobs`` batches at a time,
     # each in a worker process: preparing the cases is Python work that threads would take turns at
     per_slug = map_runs(_grade_assignment, (root, seed, limits), slugs, workers=jobs, desc="grading self-check",
