@@ -6,6 +6,6 @@ from tests.conftest import ROOT
 
 
 def test_pyflakes_is_clean():
-    out = subprocess.run([sys.executable, "-m", "pyflakes", "robokit", "tests", "benchmarks", "conftest.py"],
-                         cwd=ROOT, capture_output=True, text=True)
+    paths = ["robokit", "course", "tests", "benchmarks", "conftest.py"]
+    out = subprocess.run([sys.executable, "-m", "pyflakes", *paths], cwd=ROOT, capture_output=True, text=True)
     assert out.returncode == 0, out.stdout + out.stderr
