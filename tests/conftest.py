@@ -31,11 +31,14 @@ def shares_fast_course(nodeid: str) -> bool:
     return nodeid.startswith(FAST_COURSE_FILES + FAST_COURSE_PARAMS)
 
 
-#: Test modules that share what one process builds first: the map of the short office run
-#: (tests/office_runs.py keeps it per process) and the IK solvers' compiled kernels (numba compiles
-#: them in each process that finds no cache). In one unit, their modules build it once between them,
-#: not on both workers at the same time (about 7 s each).
-SHARED_BUILDS = {
+#: Test modules that make one unit of work, by the prefix of their path: the grading tests share the
+#: machine's job uids and control groups (a test that counts a job's leftover processes would count
+#: another test's job); the others share what one process builds first, the map of the short office
+#: run (tests/office_runs.py keeps it per process) and the IK solvers' compiled kernels (numba compiles
+#: them in each process that finds no cache), which in one unit is built once, not on both workers at
+#: the same time (about 7 s each).
+SHARED_UNITS = {
+    "grading": ("tests/test_grading_",),
     "office_runs": ("tests/test_localization_appearance_mcl.py", "tests/test_localization_hierarchical.py",
                     "tests/test_mapping_topological.py"),
     "arm": ("tests/test_arm_", "tests/test_exercises_06.py"),
@@ -43,16 +46,12 @@ SHARED_BUILDS = {
 
 
 def work_unit(nodeid: str) -> str:
-    """The unit of work of a test under pytest-xdist: its module; every test of the fast course build;
-    every grading test, since they share the machine's job uids and control groups (a test that
-    counts a job's leftover processes would count another test's job); the modules of each
-    :data:`SHARED_BUILDS` entry."""
+    """The unit of work of a test under pytest-xdist: every test of the fast course build; the modules
+    of each :data:`SHARED_UNITS` entry; else its module."""
     if shares_fast_course(nodeid):
         return "fast_course"
     module = nodeid.split("::", 1)[0]
-    if module.startswith("tests/test_grading_"):
-        return "grading"
-    return next((unit for unit, modules in SHARED_BUILDS.items() if module.startswith(modules)), module)
+    return next((unit for unit, prefixes in SHARED_UNITS.items() if module.startswith(prefixes)), module)
 
 
 def pytest_configure(config):

@@ -65,8 +65,8 @@ def grade_course(root: str | Path, *, seed: str = "course-selfcheck", jobs: int 
         if unknown:
             raise ValueError(f"only: expected assignments of the course ({', '.join(slugs)}), got {unknown}")
         slugs = [slug for slug in slugs if slug in only]
-    # one batch per assignment (its cases are prepared once for both notebooks), ``jobs`` batches at a time,
-    # each in a worker process: preparing the cases is Python work that threads would take turns at
+    # one batch per assignment (its solution and blank), ``jobs`` batches at a time, each in a worker
+    # process: preparing each notebook's cases is Python work that threads would take turns at
     per_slug = map_runs(_grade_assignment, (root, seed, limits), slugs, workers=jobs, desc="grading self-check",
                         unit="assignment")
     return [row for rows in per_slug for row in rows]
