@@ -181,6 +181,12 @@ def features():
 
 
 @functools.cache
+def orb_features():
+    from robokit.vision import detect_orb_features
+    return detect_orb_features(image(), 200)
+
+
+@functools.cache
 def course():
     from robokit.outdoor import random_course
     return random_course(0, n_waypoints=2)
@@ -1304,17 +1310,24 @@ SPECS: dict[str, Call] = {
                                                       "desc_keyframe": Array(lambda: orb_descriptors(30), "N,32",
                                                                              min_rows=0),
                                                       "max_distance": Real(50.0)}),
+    "robokit.vision.keyframes.tracked_matches": Call({"current": Obj(orb_features), "keyframe": Obj(orb_features),
+                                                      "window": Real(15.0), "max_distance": Real(100.0),
+                                                      "scale_factor": Real(1.2), "check_orientation": Flag(True)}),
+    "robokit.vision.keyframes.tracked_fraction": Call({"current": Obj(orb_features), "keyframe": Obj(orb_features),
+                                                       "window": Real(15.0), "max_distance": Real(100.0),
+                                                       "scale_factor": Real(1.2), "check_orientation": Flag(True)}),
     "robokit.vision.keyframes.KeyframeSelector": Call({"f_min": Real(100.0), "min_frame_gap": Int(10),
                                                        "shared_range": Array(np.array([0.7, 0.9]), "2"),
                                                        "min_distance": Real(0.02), "max_distance": Real(50.0),
-                                                       "below_band": Choice("skip")}),
+                                                       "matching": Choice("mutual"), "below_band": Choice("skip")}),
     "robokit.vision.keyframes.select_keyframes": Call({
         "descriptor_list": Obj(lambda: [orb_descriptors(40, 0)] * 3), "positions": Array(np.zeros((3, 2)), "N,2|N,3"),
         "f_min": Real(10.0), "kw": Options({"min_frame_gap": 1})}),
     "robokit.vision.keyframes.select_keyframes_orbslam": Call({
         "descriptor_list": Obj(lambda: [orb_descriptors(40, 0)] * 3),
         "positions": Array(np.zeros((3, 2)), "N,2|N,3", optional=True), "min_frame_gap": Int(1),
-        "min_tracked": Int(10), "max_tracked_fraction": Real(0.9), "max_distance": Real(50.0)}),
+        "min_tracked": Int(10), "max_tracked_fraction": Real(0.9), "max_distance": Real(50.0),
+        "matching": Choice("mutual")}),
     "robokit.vision.bag_of_words.tf_idf": Call({"word_ids": Array(np.array([0, 0, 1, 2]), "N", min_rows=0),
                                                 "idf": Array(np.log2([3.0, 3.0, 1.5, 1.0]), "N")}),
     "robokit.vision.bag_of_words.l1_score": Call({"v_a": Obj(([0, 2], [0.5, 0.5])), "v_b": Obj(([0, 3], [0.2, 0.8]))}),
@@ -1373,7 +1386,7 @@ SPECS: dict[str, Call] = {
         "image": Array(image, "N,N|N,N,3|N,N,4"), "shift_x": Real(1.0), "shift_y": Real(0.0), "zoom": Real(1.01)}),
     "robocourse.lessons.corridor_localization.orb_realism.motion_shares": Call({
         "images": Mapping(lambda: {"photo": image()}), "motions": Mapping({"1 px": (1.0, 0.0, 1.0)}, optional=True),
-        "n_features": Int(500)}),
+        "n_features": Int(500), "matching": Choice("mutual")}),
     "robocourse.lessons.corridor_localization.orb_realism.feature_counts": Call({
         "spacing": Real(5.0), "section": Array(np.array([10.0, 20.0]), "2")}, cheap=False),
     "robocourse.lessons.corridor_localization.experiment.corridor_lidar": Call({}),
@@ -1383,7 +1396,7 @@ SPECS: dict[str, Call] = {
         "frame_rate": Real(30.0), "progress": Func(None, optional=True)}, cheap=False),
     "robocourse.lessons.corridor_localization.experiment.keyframe_comparison": Call({
         "run": Obj(corridor_calibration), "min_frame_gap": Int(10), "shared_range": Array(np.array([0.7, 0.9]), "2"),
-        "below_band": Choice("take")}, cheap=False),
+        "below_band": Choice("take"), "matching": Choice("mutual")}, cheap=False),
     "robocourse.lessons.corridor_localization.experiment.corridor_map": Call({
         "fast": Flag(True, optional=True), "resolution": Real(0.05), "progress": Func(None, optional=True)},
         cheap=False),
@@ -1994,7 +2007,8 @@ EXTRA: tuple[str, ...] = (
     *(f"robokit.vision.{n}" for n in (
         "orb.detect_orb_features", "hamming.hamming_distance",
         "hamming.hamming_distances", "hamming.hamming_match", "keyframes.feature_threshold",
-        "keyframes.shared_fraction", "keyframes.KeyframeSelector", "keyframes.select_keyframes",
+        "keyframes.shared_fraction", "keyframes.tracked_matches", "keyframes.tracked_fraction",
+        "keyframes.KeyframeSelector", "keyframes.select_keyframes",
         "keyframes.select_keyframes_orbslam", "bag_of_words.tf_idf", "bag_of_words.l1_score",
         "bag_of_words.Vocabulary", "bag_of_words.Vocabulary.train",
         "bow_database.BowDatabase")),

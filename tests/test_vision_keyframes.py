@@ -128,3 +128,133 @@ def test_below_band_take_never_stalls_where_skip_does():
     assert select_keyframes(frames, positions, 10, min_frame_gap=1).tolist() == [0]
     taken = select_keyframes(frames, positions, 10, min_frame_gap=1, below_band="take")
     assert taken.tolist() == [0, 2, 4, 6, 8, 10]
+
+
+# --- the second reading: ORB-SLAM-style tracking in search windows ------------------------------
+
+def orb_like(xy, level, orientation=None, descriptors=None):
+    """Features at ``xy`` on pyramid ``level`` (scale 1.2 ** level), by default with POOL's rows."""
+    from robokit.vision import Features, Keypoints
+    xy = np.asarray(xy, float)
+    n = len(xy)
+    scale = 1.2 ** np.asarray(level, float) * np.ones(n)
+    angle = np.zeros(n) if orientation is None else np.asarray(orientation, float)
+    desc = POOL[:n] if descriptors is None else descriptors
+    return Features(Keypoints(xy, scale, np.ones(n), angle), desc)
+
+
+def tracked_reference(cur, key, window=15.0, max_distance=100, check_orientation=True):
+    """ORB-SLAM's frame-to-frame search written out pair by pair (the kernel's readable twin)."""
+    from robokit.vision.hamming import hamming_distance
+    level = lambda f: np.rint(np.log(f.keypoints.scale) / np.log(1.2)).astype(int)   # noqa: E731
+    lk, lc = level(key), level(cur)
+    taken, pairs = set(), []
+    for i in range(len(key)):
+        best = None
+        for j in range(len(cur)):
+            dx, dy = np.abs(cur.keypoints.xy[j] - key.keypoints.xy[i])
+            r = window * key.keypoints.scale[i]
+            if j in taken or dx > r or dy > r or abs(lc[j] - lk[i]) > 1:
+                continue
+            d = int(hamming_distance(key.descriptors[i], cur.descriptors[j]))
+            if d <= max_distance and (best is None or d < best[0]):
+                best = (d, j)
+        if best is not None:
+            taken.add(best[1])
+            pairs.append((i, best[1]))
+    if check_orientation and pairs:
+        turn = [np.degrees(key.keypoints.orientation[i] - cur.keypoints.orientation[j]) % 360 for i, j in pairs]
+        bins = [int(np.rint(t / 12.0)) % 30 for t in turn]
+        counts = np.bincount(bins, minlength=30)
+        top = sorted(range(30), key=lambda b: (-counts[b], b))[:3]
+        keep = {b for b in top if counts[b] >= 0.1 * counts[top[0]]}
+        pairs = [p for p, b in zip(pairs, bins) if b in keep]
+    return pairs
+
+
+def test_tracked_pairs_equal_the_pair_by_pair_reference():
+    from robokit.vision import tracked_matches
+    rng = np.random.default_rng(5)
+    for trial in range(25):
+        n_key, n_cur = rng.integers(1, 60, 2)
+        key = orb_like(rng.uniform(0, 120, (n_key, 2)), rng.integers(0, 8, n_key), rng.uniform(0, 2 * np.pi, n_key),
+                       rng.integers(0, 256, (n_key, 32), dtype=np.uint8))
+        # current features: moved, re-levelled, turned and bit-flipped copies of some keyframe ones, and others
+        src = rng.integers(0, n_key, n_cur)
+        desc = key.descriptors[src].copy()
+        flips = rng.random(desc.shape) < rng.choice([0.02, 0.3])
+        desc[flips] ^= np.uint8(1) << rng.integers(0, 8, flips.sum()).astype(np.uint8)
+        xy = key.keypoints.xy[src] + rng.normal(0, 8, (n_cur, 2))
+        lv = np.clip(np.rint(np.log(key.keypoints.scale[src]) / np.log(1.2)) + rng.integers(-2, 3, n_cur), 0, 7)
+        turn = key.keypoints.orientation[src] + rng.choice([0.0, 0.05, 0.5, 2.0], n_cur)
+        cur = orb_like(xy, lv, turn, desc)
+        got = list(zip(*(a.tolist() for a in tracked_matches(cur, key))))
+        assert got == tracked_reference(cur, key), trial
+        got = list(zip(*(a.tolist() for a in tracked_matches(cur, key, max_distance=60, check_orientation=False))))
+        assert got == tracked_reference(cur, key, max_distance=60, check_orientation=False), trial
+
+
+def test_tracked_fraction_window_levels_and_one_match_per_feature():
+    from robokit.vision import tracked_fraction
+    key = orb_like([[10, 10], [60, 10], [110, 10], [160, 10]], 0)
+    assert tracked_fraction(orb_like(key.keypoints.xy + [14.0, -14.0], 0), key) == 1.0    # inside the 15 px window
+    assert tracked_fraction(orb_like(key.keypoints.xy + [16.0, 0.0], 0), key) == 0.0      # outside it
+    level_one = orb_like(key.keypoints.xy, 1)                                             # an 18 px window
+    assert tracked_fraction(orb_like(key.keypoints.xy + [16.0, 0.0], 1), level_one) == 1.0
+    assert tracked_fraction(orb_like(key.keypoints.xy, 1), key) == 1.0                    # the next level is searched
+    assert tracked_fraction(orb_like(key.keypoints.xy, 2), key) == 0.0                    # two levels apart is not
+    # two keyframe features at one place, one current feature there: it matches only the first
+    twin = orb_like([[10, 10], [10, 10]], 0, descriptors=np.stack([POOL[0], POOL[0]]))
+    assert tracked_fraction(orb_like([[10, 10]], 0), twin) == 0.5
+    # a descriptor more than 100 bits away is no match
+    far = POOL[0] ^ np.r_[np.full(13, 255), np.zeros(19)].astype(np.uint8)               # 104 bits flipped
+    assert tracked_fraction(orb_like([[10, 10]], 0, descriptors=far[None]), orb_like([[10, 10]], 0)) == 0.0
+
+
+def test_tracked_fraction_orientation_check_drops_the_odd_turn():
+    from robokit.vision import tracked_fraction
+    xy = np.c_[np.arange(20) * 40.0, np.zeros(20)]
+    key = orb_like(xy, 0)
+    turned = np.zeros(20)
+    turned[0] = np.pi / 2                              # one match turned by 90 degrees, the rest not at all
+    assert tracked_fraction(orb_like(xy, 0, turned), key) == 0.95
+    assert tracked_fraction(orb_like(xy, 0, turned), key, check_orientation=False) == 1.0
+    assert tracked_fraction(orb_like(xy, 0, np.full(20, np.pi / 2)), key) == 1.0          # all turned alike: kept
+
+
+def test_tracked_fraction_refuses_what_is_not_orb_features():
+    from robokit.vision import Features, Keypoints, tracked_fraction
+    key = orb_like([[10, 10]], 0)
+    with pytest.raises(TypeError, match="current"):
+        tracked_fraction(POOL[:1], key)
+    sift_like = Features(Keypoints(np.array([[10.0, 10.0]]), np.ones(1), np.ones(1), np.zeros(1)), np.zeros((1, 128)))
+    with pytest.raises(ValueError, match="keyframe"):
+        tracked_fraction(key, sift_like)
+    for kw, name in (({"window": 0.0}, "window"), ({"max_distance": -1}, "max_distance"),
+                     ({"scale_factor": 1.0}, "scale_factor"), ({"window": np.nan}, "window")):
+        with pytest.raises(ValueError, match=name):
+            tracked_fraction(key, key, **kw)
+    with pytest.raises(TypeError, match="frame"):
+        KeyframeSelector(5, matching="tracked").offer(POOL[:3], [0.0, 0.0])
+    with pytest.raises(ValueError, match="matching"):
+        KeyframeSelector(5, matching="windows")
+
+
+def test_selector_tracked_mode_on_a_drive():
+    """On rendered views 1.5 cm apart, the selector's condition (3) is tracked_fraction against the last keyframe."""
+    from robokit.vision import tracked_fraction
+    world = sim.long_corridor()
+    camera = sim.PinholeCamera.from_fov(np.deg2rad(65.0), 640, 480, mount=sim.camera_mount(0.35))
+    xs = 14.0 + 0.015 * np.arange(12)
+    views = [detect_orb_features(camera.observe(world, [x, 0.0, 0.0]).image) for x in xs]
+    sel = KeyframeSelector(100, min_frame_gap=0, min_distance=0.02, matching="tracked")
+    decisions = []
+    for view, x in zip(views, xs):
+        last = sel.indices[-1] if sel.indices else None
+        decisions.append(sel.offer(view, [x, 0.0]))
+        if last is not None:
+            share = tracked_fraction(view, views[last])
+            assert sel.conditions.fraction == share
+            assert decisions[-1] == (0.7 < share < 0.9 and x - xs[last] >= 0.02 - 1e-12)
+    assert decisions[0] and sum(decisions) >= 2                      # the rule took more than the first view
+    assert select_keyframes(views, np.c_[xs, 0 * xs], 100, min_frame_gap=0, matching="tracked").tolist() == sel.indices

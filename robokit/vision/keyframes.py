@@ -13,7 +13,12 @@ keyframe's features that find a match in the current frame (mutual nearest neigh
 distance within ORB-SLAM's 50 bits, :func:`.hamming.hamming_match`). The denominator is the
 keyframe's feature count, as in ORB-SLAM's "tracks less than 90 % points than K_ref": it asks how
 much of the stored keyframe is still seen, and does not change while the current frame's own count
-varies. Taken literally, condition (3) also means that a frame sharing 70 % or less is never a
+varies. The paper does not say how it matches; a second reading, :func:`tracked_fraction`, finds the
+keyframe's features the way ORB-SLAM tracks them from frame to frame (a search window around each
+feature, the nearest neighbour there within 100 bits, an orientation check), and matching mode
+``"tracked"`` of :class:`KeyframeSelector` uses it.
+
+Taken literally, condition (3) also means that a frame sharing 70 % or less is never a
 keyframe: if the robot jumps too far between frames, selection stops until it sees the last
 keyframe's scene again (``below_band="skip"``); ``below_band="take"`` takes such a frame when the
 other conditions hold (:class:`KeyframeSelector` records each frame's conditions).
@@ -42,10 +47,20 @@ from typing import NamedTuple
 import numpy as np
 
 from ..validation import as_array, as_choice, as_finite_scalar, as_int, describe
-from .hamming import ORB_MATCH_DISTANCE, as_binary_descriptors, hamming_match, same_width
+from .features import Features
+from .hamming import ORB_MATCH_DISTANCE, as_binary_descriptors, hamming_distance, hamming_match, same_width
 
-__all__ = ["KeyframeConditions", "KeyframeSelector", "feature_threshold", "shared_fraction", "select_keyframes",
-           "select_keyframes_orbslam"]
+__all__ = ["KeyframeConditions", "KeyframeSelector", "feature_threshold", "shared_fraction", "tracked_matches",
+           "tracked_fraction",
+           "select_keyframes", "select_keyframes_orbslam", "TRACK_WINDOW", "TRACK_DISTANCE"]
+
+#: ORB-SLAM's search window when it tracks a monocular frame with its motion model: 15 pixels each way
+#: at pyramid level 0, times the level's scale (``Tracking::TrackWithMotionModel``, ``th = 15``).
+TRACK_WINDOW = 15.0
+#: ORB-SLAM's ``TH_HIGH``: the largest Hamming distance of a match found in a search window.
+TRACK_DISTANCE = 100
+#: ORB-SLAM's rotation-consistency histogram (``HISTO_LENGTH``): 30 bins over 360 degrees.
+ROTATION_BINS = 30
 
 
 def feature_threshold(counts) -> float:
@@ -117,6 +132,203 @@ def shared_fraction(desc_current, desc_keyframe, *, max_distance: float = ORB_MA
     return _match_count(cur, key, max_distance) / len(key)    # denominator: the keyframe's features
 
 
+def _orb_features(value, name: str = "features") -> Features:
+    """Check that ``value`` is a :class:`.features.Features` with binary (ORB) descriptors; return it."""
+    if not isinstance(value, Features):
+        raise TypeError(f"{name}: expected Features (detect_orb_features), got {describe(value)}")
+    if value.descriptors.dtype != np.uint8:
+        raise ValueError(f"{name}: expected binary (uint8) ORB descriptors, got {value.descriptors.dtype}")
+    return value
+
+
+def _octaves(scale: np.ndarray, scale_factor: float) -> np.ndarray:
+    return np.rint(np.log(scale) / np.log(scale_factor)).astype(np.int64)
+
+
+def _window_pairs(centres: np.ndarray, points: np.ndarray, half_width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All ``(i, j)`` with ``points[j]`` within ``half_width[i]`` of ``centres[i]`` in x and in y, by row."""
+    by_x = np.argsort(points[:, 0], kind="stable")
+    xs = points[by_x, 0]
+    lo = np.searchsorted(xs, centres[:, 0] - half_width, "left")
+    count = np.searchsorted(xs, centres[:, 0] + half_width, "right") - lo
+    rows = np.repeat(np.arange(len(centres)), count)
+    cols = by_x[np.repeat(lo - np.cumsum(count) + count, count) + np.arange(count.sum())]
+    keep = np.abs(points[cols, 1] - centres[rows, 1]) <= half_width[rows]
+    return rows[keep], cols[keep]
+
+
+def _tracked_count(cur: Features, key: Features, window: float = TRACK_WINDOW, max_distance: float = TRACK_DISTANCE,
+                   scale_factor: float = 1.2, check_orientation: bool = True) -> int:
+    """How many of ``key``'s features :func:`tracked_matches` finds in ``cur`` (trusted inputs)."""
+    if len(key) == 0 or len(cur) == 0:
+        return 0
+    return len(_tracked_pairs(cur, key, window, max_distance, scale_factor, check_orientation)[0])
+
+
+def _tracked_pairs(cur: Features, key: Features, window: float, max_distance: float, scale_factor: float,
+                   check_orientation: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Keyframe rows and current rows of the matches :func:`tracked_fraction` counts (trusted inputs)."""
+    rows, cols = _window_pairs(key.keypoints.xy, cur.keypoints.xy, window * key.keypoints.scale)
+    level_cur, level_key = _octaves(cur.keypoints.scale, scale_factor), _octaves(key.keypoints.scale, scale_factor)
+    level_step = np.abs(level_cur[cols] - level_key[rows])
+    rows, cols = rows[level_step <= 1], cols[level_step <= 1]                      # window and pyramid levels
+    dist = hamming_distance(key.descriptors[rows], cur.descriptors[cols], validate=False)
+    near = dist <= max_distance
+    order = np.lexsort((cols[near], dist[near], rows[near]))   # each keyframe feature's candidates, nearest first
+    rows, cols = rows[near][order], cols[near][order].tolist()
+    first = np.searchsorted(rows, np.arange(len(key) + 1)).tolist()
+    partner = np.full(len(key), -1, np.int64)
+    taken = np.zeros(len(cur), bool)
+    for i in range(len(key)):                                  # in keyframe order, a current feature matches once
+        for j in cols[first[i]:first[i + 1]]:
+            if not taken[j]:
+                partner[i], taken[j] = j, True
+                break
+    ki = np.flatnonzero(partner >= 0)
+    ci = partner[ki]
+    if check_orientation and len(ki):
+        turn = np.degrees(key.keypoints.orientation[ki] - cur.keypoints.orientation[ci]) % 360.0
+        bins = np.rint(turn * ROTATION_BINS / 360.0).astype(np.int64) % ROTATION_BINS
+        counts = np.bincount(bins, minlength=ROTATION_BINS)
+        top = np.argsort(-counts, kind="stable")[:3]       # the three fullest bins, earlier bins first on ties
+        keep = top[counts[top] >= 0.1 * counts[top[0]]]
+        ki, ci = ki[np.isin(bins, keep)], ci[np.isin(bins, keep)]
+    return ki, ci
+
+
+def _tracking_args(current, keyframe, window, max_distance, scale_factor) -> tuple:
+    cur = _orb_features(current, "current")
+    key = _orb_features(keyframe, "keyframe")
+    same_width(cur.descriptors, key.descriptors, "current", "keyframe")
+    window = as_finite_scalar(window, "window")
+    max_distance = as_finite_scalar(max_distance, "max_distance")
+    scale_factor = as_finite_scalar(scale_factor, "scale_factor")
+    if window <= 0:
+        raise ValueError(f"window: expected a positive half-width in pixels, got {window}")
+    if max_distance <= 0:
+        raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
+    if not 1 < scale_factor <= 2:
+        raise ValueError(f"scale_factor: expected a pyramid step in (1, 2], got {scale_factor}")
+    return cur, key, window, max_distance, scale_factor
+
+
+def tracked_matches(current, keyframe, *, window: float = TRACK_WINDOW, max_distance: float = TRACK_DISTANCE,
+                    scale_factor: float = 1.2, check_orientation: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """A keyframe's features found again in the current frame by ORB-SLAM-style tracking.
+
+    Each keyframe feature is searched for the way ORB-SLAM tracks a map point into a new frame
+    (Mur-Artal et al. 2015, Sec. V-B; ``ORBmatcher::SearchByProjection`` of ORB-SLAM2). Without map
+    points or a motion model, the window is centred on the feature's own position in the keyframe, as
+    if the camera had not moved:
+
+    1. candidates: current features within ``window`` times the keyframe feature's scale in x and in y,
+       on the same pyramid level or the next one up or down;
+    2. the keyframe's features in order, each takes its nearest candidate by Hamming distance that no
+       earlier feature took (ties: the lowest index), if that distance is at most ``max_distance``;
+    3. orientation check: the rotations between matched keypoints go into 30 bins over 360 degrees;
+       matches outside the three fullest bins (ties: the earlier bin), or in a bin with under a tenth
+       of the fullest one's count, are dropped (a camera turning in its own plane turns every keypoint
+       alike).
+
+    Parameters
+    ----------
+    current, keyframe : Features
+        ORB features (:func:`.orb.detect_orb_features`) of the current frame and of the last keyframe.
+    window : float, default 15
+        Half-width of the search window at pyramid level 0, pixels (ORB-SLAM's monocular ``th``), > 0.
+    max_distance : float, default 100
+        Largest Hamming distance of a match (ORB-SLAM's ``TH_HIGH``), > 0.
+    scale_factor : float, default 1.2
+        The pyramid's scale step the features were detected with (keypoint scale = factor ** level), in (1, 2].
+    check_orientation : bool, default True
+        Apply step 3.
+
+    Returns
+    -------
+    keyframe_index, current_index : numpy.ndarray of int64
+        Matched rows of ``keyframe`` (increasing) and of ``current``; empty when either has no features.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For something that is not ORB ``Features``, or a window, distance or scale factor out of range.
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 3.2, condition (3), read as ORB-SLAM counts tracked points
+    (:func:`tracked_fraction`). ORB-SLAM2's code bins the rotation as ``round(rot / 30)``,
+    30-degree bins of which only 13 are used; we use the 30 bins of 12 degrees its ``HISTO_LENGTH``
+    describes.
+
+    Examples
+    --------
+    >>> from robokit.vision import Features, Keypoints
+    >>> d = np.random.default_rng(0).integers(0, 256, (3, 32), dtype=np.uint8)
+    >>> kp = Keypoints(np.array([[10.0, 10.0], [50.0, 10.0], [90.0, 10.0]]), np.ones(3), np.ones(3), np.zeros(3))
+    >>> now = Features(Keypoints(kp.xy[::-1] + [2.0, 0.0], kp.scale, kp.response, kp.orientation), d[::-1])
+    >>> [a.tolist() for a in tracked_matches(now, Features(kp, d))]      # the rows come reversed
+    [[0, 1, 2], [2, 1, 0]]
+    """
+    cur, key, window, max_distance, scale_factor = _tracking_args(current, keyframe, window, max_distance,
+                                                                  scale_factor)
+    if len(key) == 0 or len(cur) == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    return _tracked_pairs(cur, key, window, max_distance, scale_factor, bool(check_orientation))
+
+
+def tracked_fraction(current, keyframe, *, window: float = TRACK_WINDOW, max_distance: float = TRACK_DISTANCE,
+                     scale_factor: float = 1.2, check_orientation: bool = True) -> float:
+    """Fraction of a keyframe's features found again by ORB-SLAM-style tracking (Ge et al. (2023), condition (3)).
+
+    A second reading of condition (3)'s "shares matched points" (Sec. 3.2): the keyframe features
+    :func:`tracked_matches` finds in the current frame (search windows around each feature's position,
+    neighbouring pyramid levels, the nearest within ``max_distance`` bits, each current feature used
+    once, an orientation check), over the keyframe's feature count.
+
+    Parameters
+    ----------
+    current, keyframe : Features
+        ORB features (:func:`.orb.detect_orb_features`) of the current frame and of the last keyframe.
+    window, max_distance, scale_factor, check_orientation
+        As in :func:`tracked_matches` (defaults 15 px, 100 bits, 1.2, True).
+
+    Returns
+    -------
+    float
+        Matches kept, divided by the keyframe's feature count, in [0, 1]; 0 when either frame has no
+        features.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For something that is not ORB ``Features``, or a window, distance or scale factor out of range.
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 3.2, condition (3); Mur-Artal et al. (2015), Sec. V-B and V-E (ORB-SLAM
+    counts a frame's tracked points against its reference keyframe's).
+
+    Examples
+    --------
+    >>> from robokit.vision import Features, Keypoints
+    >>> rng = np.random.default_rng(0)
+    >>> d = rng.integers(0, 256, (4, 32), dtype=np.uint8)
+    >>> kp = Keypoints(np.array([[10., 10.], [50., 10.], [90., 10.], [130., 10.]]), np.ones(4), np.ones(4), np.zeros(4))
+    >>> key = Features(kp, d)
+    >>> moved = Features(Keypoints(kp.xy + [3.0, 0.0], kp.scale, kp.response, kp.orientation), d)
+    >>> tracked_fraction(moved, key)                               # every feature 3 px on: all found
+    1.0
+    >>> far = Features(Keypoints(kp.xy + [30.0, 0.0], kp.scale, kp.response, kp.orientation), d)
+    >>> tracked_fraction(far, key)                                 # 30 px is outside the 15 px window
+    0.0
+    """
+    cur, key, window, max_distance, scale_factor = _tracking_args(current, keyframe, window, max_distance,
+                                                                  scale_factor)
+    if len(key) == 0:
+        return 0.0
+    return _tracked_count(cur, key, window, max_distance, scale_factor, bool(check_orientation)) / len(key)
+
+
 class KeyframeConditions(NamedTuple):
     """Ge et al. (2023)'s conditions (1)-(4) for one frame, and the measured quantities."""
 
@@ -158,7 +370,11 @@ class KeyframeSelector:
     min_distance : float, default 0.02
         Condition (4): metres moved since the last keyframe, at least.
     max_distance : float, default 50
-        Hamming bound of a match in :func:`shared_fraction`.
+        Hamming bound of a match in :func:`shared_fraction` (``matching="mutual"``).
+    matching : {"mutual", "tracked"}, default "mutual"
+        What "shares matched points" means: :func:`shared_fraction` (mutual nearest neighbours over the
+        whole image; frames are descriptor arrays) or :func:`tracked_fraction` (ORB-SLAM-style search
+        windows; frames are ORB ``Features``, with keypoints).
     below_band : {"skip", "take"}, default "skip"
         A frame sharing ``low`` or less: ``"skip"`` it, as condition (3) is printed (once no frame
         shares more than ``low``, selection stalls for good), or ``"take"`` it when (1), (2) and (4)
@@ -188,7 +404,7 @@ class KeyframeSelector:
     """
 
     def __init__(self, f_min: float, *, min_frame_gap: int = 10, shared_range=(0.70, 0.90), min_distance: float = 0.02,
-                 max_distance: float = ORB_MATCH_DISTANCE, below_band: str = "skip") -> None:
+                 max_distance: float = ORB_MATCH_DISTANCE, matching: str = "mutual", below_band: str = "skip") -> None:
         self.f_min = as_finite_scalar(f_min, "f_min")
         self.min_frame_gap = as_int(min_frame_gap, "min_frame_gap", minimum=0)
         rng = as_array(shared_range, "shared_range", shape=(2,))
@@ -199,6 +415,9 @@ class KeyframeSelector:
         if self.min_distance < 0:
             raise ValueError(f"min_distance: expected a non-negative distance, got {self.min_distance}")
         self.max_distance = as_finite_scalar(max_distance, "max_distance")
+        if self.max_distance <= 0:
+            raise ValueError(f"max_distance: expected a positive number of bits, got {self.max_distance}")
+        self.matching = as_choice(matching, "matching", ("mutual", "tracked"))
         self.below_band = as_choice(below_band, "below_band", ("skip", "take"))
         self.reset()
 
@@ -207,16 +426,24 @@ class KeyframeSelector:
         self.indices: list[int] = []
         self.conditions: KeyframeConditions | None = None
         self._n = 0
-        self._key_desc = None
+        self._key = None
         self._key_pos = None
 
-    def evaluate(self, descriptors, position) -> KeyframeConditions:
+    def _frame(self, frame):
+        if self.matching == "tracked":
+            return _orb_features(frame, "frame")
+        return as_binary_descriptors(frame, "frame")
+
+    def evaluate(self, frame, position) -> KeyframeConditions:
         """Evaluate conditions (1)-(4) for a frame against the last keyframe, without recording it."""
-        if self._key_desc is None:
+        if self._key is None:
             raise ValueError("evaluate: no keyframe yet (offer the first frame, which is always one)")
-        d = as_binary_descriptors(descriptors, "descriptors")
+        d = self._frame(frame)
         p = _position(position)
-        fraction = shared_fraction(d, self._key_desc, max_distance=self.max_distance)
+        if self.matching == "tracked":
+            fraction = _tracked_count(d, self._key) / len(self._key) if len(self._key) else 0.0
+        else:
+            fraction = shared_fraction(d, self._key, max_distance=self.max_distance)
         gap = self._n - self.indices[-1]
         moved = float(np.hypot(*(p - self._key_pos)))
         low, high = self.shared_range
@@ -225,37 +452,37 @@ class KeyframeSelector:
                                   low < fraction < high, moved >= self.min_distance,   # (3), (4)
                                   len(d), gap, fraction, moved)
 
-    def offer(self, descriptors, position) -> bool:
+    def offer(self, frame, position) -> bool:
         """Offer the next frame; returns whether it becomes a keyframe (the first always does).
 
         Parameters
         ----------
-        descriptors : array_like of uint8, shape (N, 32)
-            The frame's ORB descriptors (N may be 0).
+        frame : array_like of uint8, shape (N, 32), or Features
+            The frame's ORB descriptors (N may be 0), or with ``matching="tracked"`` its ORB features.
         position : array_like, shape (2,) or (3,)
             The robot's position ``[x, y]`` or pose ``[x, y, theta]`` in metres.
         """
-        if self._key_desc is None:
-            d = as_binary_descriptors(descriptors, "descriptors")
-            self._accept(d, _position(position))
+        if self._key is None:
+            self._accept(self._frame(frame), _position(position))
             return True
-        self.conditions = self.evaluate(descriptors, position)
+        self.conditions = self.evaluate(frame, position)
         if self.conditions.all:
-            self._accept(as_binary_descriptors(descriptors, "descriptors"), _position(position))
+            self._accept(self._frame(frame), _position(position))
             return True
         self._n += 1
         return False
 
     def _accept(self, d, p) -> None:
         self.indices.append(self._n)
-        self._key_desc, self._key_pos = d, p
+        self._key, self._key_pos = d, p
         self._n += 1
 
 
-def _stream(descriptor_list, positions):
+def _stream(descriptor_list, positions, matching="mutual"):
     if not isinstance(descriptor_list, (list, tuple)):
         raise TypeError(f"descriptor_list: expected a list of per-frame descriptor arrays, got {describe(descriptor_list)}")
-    frames = [as_binary_descriptors(d, f"descriptor_list[{i}]") for i, d in enumerate(descriptor_list)]
+    check = _orb_features if matching == "tracked" else as_binary_descriptors
+    frames = [check(d, f"descriptor_list[{i}]") for i, d in enumerate(descriptor_list)]
     if positions is None:
         return frames, None
     p = as_array(positions, "positions", ndim=2)
@@ -269,15 +496,15 @@ def select_keyframes(descriptor_list, positions, f_min: float, **kw) -> np.ndarr
 
     Parameters
     ----------
-    descriptor_list : list of array_like of uint8, shape (N_i, 32) each
-        Every frame's ORB descriptors, in time order.
+    descriptor_list : list of array_like of uint8, shape (N_i, 32) each, or of Features
+        Every frame's ORB descriptors, in time order (ORB ``Features`` with ``matching="tracked"``).
     positions : array_like, shape (n_frames, 2) or (n_frames, 3)
         The robot's position (or pose) at each frame, metres.
     f_min : float
         Condition (1)'s threshold (:func:`feature_threshold`).
     **kw
-        ``min_frame_gap``, ``shared_range``, ``min_distance``, ``max_distance``, ``below_band`` of
-        :class:`KeyframeSelector`.
+        ``min_frame_gap``, ``shared_range``, ``min_distance``, ``max_distance``, ``matching``,
+        ``below_band`` of :class:`KeyframeSelector`.
 
     Returns
     -------
@@ -291,24 +518,24 @@ def select_keyframes(descriptor_list, positions, f_min: float, **kw) -> np.ndarr
     >>> select_keyframes(frames, np.c_[np.arange(5) * 0.1, np.zeros(5)], 5, min_frame_gap=1).tolist()
     [0, 2, 4]
     """
-    frames, p = _stream(descriptor_list, positions)
+    selector = KeyframeSelector(f_min, **kw)
+    frames, p = _stream(descriptor_list, positions, selector.matching)
     if p is None:
         raise TypeError("positions: expected an array of shape (n_frames, 2) or (n_frames, 3), got None")
-    selector = KeyframeSelector(f_min, **kw)
     for d, x in zip(frames, p):
         selector.offer(d, x)
     return np.array(selector.indices, dtype=np.int64)
 
 
 def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: int = 20, min_tracked: int = 50,
-                             max_tracked_fraction: float = 0.90,
-                             max_distance: float = ORB_MATCH_DISTANCE) -> np.ndarray:
+                             max_tracked_fraction: float = 0.90, max_distance: float = ORB_MATCH_DISTANCE,
+                             matching: str = "mutual") -> np.ndarray:
     """Indices of the keyframes an ORB-SLAM-like rule picks (Mur-Artal et al. 2015, Sec. V-E).
 
     Parameters
     ----------
-    descriptor_list : list of array_like of uint8, shape (N_i, 32) each
-        Every frame's ORB descriptors, in time order.
+    descriptor_list : list of array_like of uint8, shape (N_i, 32) each, or of Features
+        Every frame's ORB descriptors, in time order (ORB ``Features`` with ``matching="tracked"``).
     positions : array_like, shape (n_frames, 2|3), optional
         Accepted (and checked) so both rules take the same arguments; ORB-SLAM's rule does not
         use the distance moved.
@@ -319,7 +546,10 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
     max_tracked_fraction : float, default 0.90
         ... and fewer than this fraction of the reference keyframe's features.
     max_distance : float, default 50
-        Hamming bound of a match.
+        Hamming bound of a match (``matching="mutual"``).
+    matching : {"mutual", "tracked"}, default "mutual"
+        How a point counts as tracked: a mutual nearest neighbour within ``max_distance``, or found by
+        :func:`tracked_fraction`'s search windows.
 
     Returns
     -------
@@ -334,7 +564,8 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
     >>> select_keyframes_orbslam(frames, min_frame_gap=2).tolist()
     [0, 3]
     """
-    frames, _ = _stream(descriptor_list, positions)
+    matching = as_choice(matching, "matching", ("mutual", "tracked"))
+    frames, _ = _stream(descriptor_list, positions, matching)
     min_frame_gap = as_int(min_frame_gap, "min_frame_gap", minimum=0)
     min_tracked = as_int(min_tracked, "min_tracked", minimum=0)
     top = as_finite_scalar(max_tracked_fraction, "max_tracked_fraction")
@@ -351,7 +582,10 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
         ref = frames[keys[-1]]
         if i - keys[-1] <= min_frame_gap:
             continue
-        tracked = _match_count(d, ref, max_distance) if len(d) and len(ref) else 0
+        if matching == "tracked":
+            tracked = _tracked_count(d, ref)
+        else:
+            tracked = _match_count(d, ref, max_distance) if len(d) and len(ref) else 0
         if tracked >= min_tracked and tracked < top * len(ref):
             keys.append(i)
     return np.array(keys, dtype=np.int64)

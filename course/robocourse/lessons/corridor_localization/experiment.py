@@ -50,9 +50,9 @@ from robokit.parallel import map_runs
 from robokit.sim import (Lidar, PinholeCamera, camera_mount, corridor_path, describe_sensor, long_corridor,
                          waypoint_path)
 from robokit.sim.world import World
-from robokit.validation import as_array, as_callable, as_int, as_positive
-from robokit.vision import (BowDatabase, Vocabulary, detect_orb_features, feature_threshold, select_keyframes,
-                            select_keyframes_orbslam)
+from robokit.validation import as_array, as_callable, as_choice, as_int, as_positive
+from robokit.vision import (BowDatabase, Features, Keypoints, Vocabulary, detect_orb_features, feature_threshold,
+                            select_keyframes, select_keyframes_orbslam)
 from robokit.vision.orb import ORB_FEATURES
 
 __all__ = ["CorridorMap", "corridor_map", "as_corridor_map", "CalibrationRun", "calibration_run",
@@ -140,18 +140,21 @@ _FRAMES_PER_TASK = 64
 
 
 def _orb_batch(shared: tuple, task: tuple) -> list:
-    """ORB descriptors of frames ``first ..`` at ``poses``; frame ``k``'s pixel noise is seeded by ``(seed, k)``."""
-    world, camera, seed = shared
+    """ORB features (or only their descriptors) of frames ``first ..`` at ``poses``; frame ``k``'s pixel
+    noise is seeded by ``(seed, k)``."""
+    world, camera, seed, whole = shared
     first, poses = task
-    return [detect_orb_features(camera.observe(world, pose, rng=np.random.default_rng([seed, first + k])).image,
-                                N_FEATURES).descriptors for k, pose in enumerate(poses)]
+    found = [detect_orb_features(camera.observe(world, pose, rng=np.random.default_rng([seed, first + k])).image,
+                                 N_FEATURES) for k, pose in enumerate(poses)]
+    return found if whole else [f.descriptors for f in found]
 
 
 def _orb_frames(world: World, camera: PinholeCamera, poses: np.ndarray, seed: int, progress: Callable | None,
-                desc: str) -> list:
-    """Render every pose and detect its ORB features, batches side by side (:func:`robokit.parallel.map_runs`)."""
+                desc: str, *, keypoints: bool = False) -> list:
+    """Render every pose and detect its ORB features, batches side by side (:func:`robokit.parallel.map_runs`);
+    descriptor arrays, or whole ``Features`` with ``keypoints``."""
     tasks = [(k, poses[k:k + _FRAMES_PER_TASK]) for k in range(0, len(poses), _FRAMES_PER_TASK)]
-    batches = map_runs(_orb_batch, (world, camera, seed), tasks, desc=desc,
+    batches = map_runs(_orb_batch, (world, camera, seed, keypoints), tasks, desc=desc,
                        unit=f"{_FRAMES_PER_TASK} frames", progress=progress)
     return [d for batch in batches for d in batch]
 
@@ -160,11 +163,12 @@ def _orb_frames(world: World, camera: PinholeCamera, poses: np.ndarray, seed: in
 
 @dataclasses.dataclass
 class CalibrationRun:
-    """The 10 m calibration video: ``descriptors`` per frame, ``positions`` (N, 2), ``f_min`` (Eq. (15)).
+    """The 10 m calibration video: ORB ``features`` per frame, ``positions`` (N, 2), ``f_min`` (Eq. (15)).
 
     Attributes
     ----------
-    descriptors : list of numpy.ndarray (n_k, 32) uint8
+    features : list of robokit.vision.Features
+        Each frame's ORB keypoints and descriptors (``descriptors`` lists the descriptors alone).
     positions : numpy.ndarray (N, 2)
         Where each frame was taken (metres).
     frame_rate, speed : float
@@ -173,16 +177,21 @@ class CalibrationRun:
         Eq. (15) over the frames' feature counts.
     """
 
-    descriptors: list
+    features: list
     positions: np.ndarray
     frame_rate: float
     speed: float
     f_min: float
 
     @property
+    def descriptors(self) -> list:
+        """Each frame's ORB descriptors, (n_k, 32) uint8."""
+        return [f.descriptors for f in self.features]
+
+    @property
     def counts(self) -> np.ndarray:
         """ORB features per frame."""
-        return np.array([len(d) for d in self.descriptors], int)
+        return np.array([len(f) for f in self.features], int)
 
 
 def calibration_run(*, fast: bool | None = None, start: float = CALIBRATION_STRETCH[0],
@@ -241,18 +250,22 @@ def calibration_run(*, fast: bool | None = None, start: float = CALIBRATION_STRE
     meta = {"camera": describe_sensor(camera), "start": start, "length": length, "speed": speed,
             "rate": frame_rate, "features": N_FEATURES, "code": _code()}
     target = cache_dir("corridor") / f"calibration-{cache_key(**meta)}.npz"
-    data = read_arrays(target, ("flat", "counts", "positions"), meta)
+    data = read_arrays(target, ("flat", "counts", "keypoints", "positions"), meta)
     if data is None:
-        flat, counts = _descriptor_stack(_orb_frames(world, camera, path.poses, 5, progress,
-                                                        "calibration run"))
-        data = {"flat": flat, "counts": counts, "positions": path.poses[:, :2]}
+        found = _orb_frames(world, camera, path.poses, 5, progress, "calibration run", keypoints=True)
+        flat, counts = _descriptor_stack([f.descriptors for f in found])
+        rows = [np.c_[f.keypoints.xy, f.keypoints.scale, f.keypoints.orientation] for f in found]
+        data = {"flat": flat, "counts": counts, "keypoints": np.concatenate(rows + [np.zeros((0, 4))]),
+                "positions": path.poses[:, :2]}
         write_arrays(target, data, meta)
-    descriptors = _descriptor_list(data["flat"], data["counts"])
-    return CalibrationRun(descriptors, data["positions"], frame_rate, speed, float(feature_threshold(data["counts"])))
+    kps = _descriptor_list(data["keypoints"], data["counts"])
+    features = [Features(Keypoints(k[:, :2], k[:, 2], np.zeros(len(k)), k[:, 3]), d)
+                for k, d in zip(kps, _descriptor_list(data["flat"], data["counts"]))]
+    return CalibrationRun(features, data["positions"], frame_rate, speed, float(feature_threshold(data["counts"])))
 
 
 def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_range: Any = SHARED_RANGE,
-                        below_band: str = "take") -> dict:
+                        below_band: str = "take", matching: str = "mutual") -> dict:
     """Table 1 re-run: keyframes of our rule (conditions (1)-(4)) and of an ORB-SLAM-like rule.
 
     Parameters
@@ -265,6 +278,9 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     below_band : {"take", "skip"}, default "take"
         A frame below the band (:class:`robokit.vision.KeyframeSelector`); ``"skip"`` is the rule as
         printed.
+    matching : {"mutual", "tracked"}, default "mutual"
+        What "matched points" means for both rules (:class:`robokit.vision.KeyframeSelector`): mutual
+        nearest neighbours, or ORB-SLAM-style search windows (:func:`robokit.vision.tracked_fraction`).
 
     Returns
     -------
@@ -296,14 +312,19 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     flat, counts = _descriptor_stack(run.descriptors)
     content = hashlib.sha256(flat.tobytes() + counts.tobytes() + np.asarray(run.positions, float).tobytes())
     band = as_array(shared_range, "shared_range", shape=(2,)).tolist()   # checked before any cache lookup
+    matching = as_choice(matching, "matching", ("mutual", "tracked"))
+    if matching == "tracked":
+        for f in run.features:
+            content.update(np.c_[f.keypoints.xy, f.keypoints.scale, f.keypoints.orientation].tobytes())
     meta = {"run": content.hexdigest()[:16], "f_min": float(run.f_min), "gap": gap, "shared_range": band,
-            "below_band": str(below_band), "code": _code()}
+            "below_band": str(below_band), "matching": matching, "code": _code()}
     target = cache_dir("corridor") / f"keyframes-{cache_key(**meta)}.npz"
     data = read_arrays(target, ("ours", "orbslam"), meta)
     if data is None:
-        ours = select_keyframes(run.descriptors, run.positions, run.f_min, min_frame_gap=gap,
-                                shared_range=shared_range, below_band=below_band)
-        orbslam = select_keyframes_orbslam(run.descriptors, run.positions)
+        frames = run.features if matching == "tracked" else run.descriptors
+        ours = select_keyframes(frames, run.positions, run.f_min, min_frame_gap=gap, shared_range=shared_range,
+                                below_band=below_band, matching=matching)
+        orbslam = select_keyframes_orbslam(frames, run.positions, matching=matching)
         data = {"ours": np.asarray(ours, int), "orbslam": np.asarray(orbslam, int)}
         write_arrays(target, data, meta)
     return {"ours": data["ours"], "orbslam": data["orbslam"], "images": len(run.descriptors)}

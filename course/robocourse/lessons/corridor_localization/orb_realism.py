@@ -29,9 +29,9 @@ import numpy as np
 
 from robocourse.lessons.corridor_localization.experiment import CALIBRATION_STRETCH, N_FEATURES, corridor_camera
 from robokit.sim import long_corridor
-from robokit.validation import as_array, as_finite_scalar, as_int, describe
+from robokit.validation import as_array, as_choice, as_finite_scalar, as_int, describe
 from robokit.vision.features import as_gray_image
-from robokit.vision import detect_orb_features, feature_threshold, shared_fraction
+from robokit.vision import detect_orb_features, feature_threshold, shared_fraction, tracked_fraction
 
 __all__ = ["MOTIONS", "move_image", "motion_shares", "feature_counts"]
 
@@ -103,7 +103,8 @@ def _moved(grey: np.ndarray, shift_x: float, shift_y: float, zoom: float) -> np.
     return cv2.warpAffine(grey, M, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT)
 
 
-def motion_shares(images: dict, motions: dict | None = None, *, n_features: int = N_FEATURES) -> dict:
+def motion_shares(images: dict, motions: dict | None = None, *, n_features: int = N_FEATURES,
+                  matching: str = "mutual") -> dict:
     """Share of each image's ORB features still matched after each small motion (condition (3)'s measure).
 
     Parameters
@@ -114,13 +115,15 @@ def motion_shares(images: dict, motions: dict | None = None, *, n_features: int 
         Named ``(shift_x, shift_y, zoom)`` (:func:`move_image`); default :data:`MOTIONS`.
     n_features : int, default 500
         ORB's cap (the lesson's).
+    matching : {"mutual", "tracked"}, default "mutual"
+        The share's reading: :func:`robokit.vision.shared_fraction` (mutual nearest neighbours within
+        50 bits) or :func:`robokit.vision.tracked_fraction` (ORB-SLAM-style search windows).
 
     Returns
     -------
     dict of str -> dict of str -> float
-        ``shares[image][motion]``: :func:`robokit.vision.shared_fraction` of the moved image's ORB
-        descriptors against the image's own (mutual nearest neighbours within 50 bits, over the
-        original's feature count), in [0, 1].
+        ``shares[image][motion]``: the moved image's ORB features against the image's own, over the
+        original's feature count, in [0, 1].
 
     Raises
     ------
@@ -149,14 +152,16 @@ def motion_shares(images: dict, motions: dict | None = None, *, n_features: int 
     moves = {str(k): _motion(*as_array(v, f"motions[{k!r}]", shape=(3,)), where=f"motions[{k!r}]: ")
              for k, v in motions.items()}
     n_features = as_int(n_features, "n_features", minimum=1, maximum=NO_CAP)
+    matching = as_choice(matching, "matching", ("mutual", "tracked"))
     out = {}
     for name, image in images.items():
         grey = _grey(image, f"images[{name!r}]")
-        own = detect_orb_features(grey, n_features).descriptors
+        own = detect_orb_features(grey, n_features)
         if len(own) == 0:
             raise ValueError(f"images[{name!r}]: expected an image in which ORB finds features, got one with none")
-        out[str(name)] = {k: shared_fraction(detect_orb_features(_moved(grey, *m), n_features).descriptors, own)
-                          for k, m in moves.items()}
+        moved = {k: detect_orb_features(_moved(grey, *m), n_features) for k, m in moves.items()}
+        out[str(name)] = {k: (tracked_fraction(f, own) if matching == "tracked"
+                              else shared_fraction(f.descriptors, own.descriptors)) for k, f in moved.items()}
     return out
 
 
