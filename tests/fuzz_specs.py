@@ -1314,6 +1314,8 @@ SPECS: dict[str, Call] = {
                                                       "window": Real(15.0), "max_distance": Real(100.0),
                                                       "scale_factor": Real(1.2), "check_orientation": Flag(True)}),
     "robokit.vision.keyframes.tracked_fraction": Call({"current": Obj(orb_features), "keyframe": Obj(orb_features),
+                                                       "points": Array(np.array([0, 1, 2]), "N", min_rows=0,
+                                                                       optional=True),
                                                        "window": Real(15.0), "max_distance": Real(100.0),
                                                        "scale_factor": Real(1.2), "check_orientation": Flag(True)}),
     "robokit.vision.keyframes.KeyframeSelector": Call({"f_min": Real(100.0), "min_frame_gap": Int(10),

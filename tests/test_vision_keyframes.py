@@ -240,21 +240,61 @@ def test_tracked_fraction_refuses_what_is_not_orb_features():
         KeyframeSelector(5, matching="windows")
 
 
-def test_selector_tracked_mode_on_a_drive():
-    """On rendered views 1.5 cm apart, the selector's condition (3) is tracked_fraction against the last keyframe."""
-    from robokit.vision import tracked_fraction
+def test_selector_tracked_mode_shares_the_keyframes_matched_points():
+    """On rendered views 1.5 cm apart, condition (3) is tracked_fraction over the last keyframe's matched
+    points: its features tracked from the view before it (the first keyframe's: into the next view)."""
+    from robokit.vision import tracked_fraction, tracked_matches
     world = sim.long_corridor()
     camera = sim.PinholeCamera.from_fov(np.deg2rad(65.0), 640, 480, mount=sim.camera_mount(0.35))
-    xs = 14.0 + 0.015 * np.arange(12)
+    xs = 14.0 + 0.015 * np.arange(14)
     views = [detect_orb_features(camera.observe(world, [x, 0.0, 0.0]).image) for x in xs]
-    sel = KeyframeSelector(100, min_frame_gap=0, min_distance=0.02, matching="tracked")
-    decisions = []
-    for view, x in zip(views, xs):
+    sel = KeyframeSelector(100, min_frame_gap=1, min_distance=0.02, matching="tracked")
+    decisions, shares = [], []
+    for k, (view, x) in enumerate(zip(views, xs)):
         last = sel.indices[-1] if sel.indices else None
         decisions.append(sel.offer(view, [x, 0.0]))
         if last is not None:
-            share = tracked_fraction(view, views[last])
-            assert sel.conditions.fraction == share
-            assert decisions[-1] == (0.7 < share < 0.9 and x - xs[last] >= 0.02 - 1e-12)
-    assert decisions[0] and sum(decisions) >= 2                      # the rule took more than the first view
-    assert select_keyframes(views, np.c_[xs, 0 * xs], 100, min_frame_gap=0, matching="tracked").tolist() == sel.indices
+            points = tracked_matches(views[last - 1] if last else views[1], views[last])[0]
+            assert 0 < len(points) < len(views[last])
+            share = tracked_fraction(view, views[last], points=points)
+            if k - last > 1:                                 # condition (2) holds: the share was measured
+                shares.append(share)
+                assert sel.conditions.fraction == share
+            else:                                            # inside the gap it is not (and no keyframe)
+                assert np.isnan(sel.conditions.fraction) and not sel.conditions.shared
+            assert decisions[-1] == (k - last > 1 and 0.7 < share < 0.9 and x - xs[last] >= 0.02 - 1e-12)
+    assert decisions[0] and sum(decisions) >= 3 and min(shares) < 0.9      # the band was reached, more than once
+    assert select_keyframes(views, np.c_[xs, 0 * xs], 100, min_frame_gap=1, matching="tracked").tolist() == sel.indices
+    # the same share over all of the keyframe's features is lower: the matched points are the stable ones
+    assert tracked_fraction(views[5], views[2]) < tracked_fraction(views[5], views[2], points=tracked_matches(views[1], views[2])[0])
+
+
+def test_orbslam_rule_tracked_counts_the_reference_keyframes_matched_points():
+    from robokit.vision import tracked_matches
+    world = sim.long_corridor()
+    camera = sim.PinholeCamera.from_fov(np.deg2rad(65.0), 640, 480, mount=sim.camera_mount(0.35))
+    views = [detect_orb_features(camera.observe(world, [14.0 + 0.02 * k, 0.0, 0.0]).image) for k in range(16)]
+
+    def rule(matched_points):
+        keys = [0]
+        points = tracked_matches(views[1], views[0])[0] if matched_points else np.arange(len(views[0]))
+        for i in range(1, len(views)):
+            found = np.isin(points, tracked_matches(views[i], views[keys[-1]])[0]).sum()
+            if 50 <= found < 0.8 * len(points):
+                keys.append(i)
+                points = tracked_matches(views[i - 1], views[i])[0] if matched_points else np.arange(len(views[i]))
+        return keys
+
+    keys = select_keyframes_orbslam(views, min_frame_gap=0, max_tracked_fraction=0.8, matching="tracked").tolist()
+    assert keys == rule(matched_points=True) != rule(matched_points=False)     # the two counts pick differently
+    assert len(keys) >= 3
+
+
+def test_tracked_fraction_points_must_be_distinct_rows():
+    from robokit.vision import tracked_fraction
+    key = orb_like([[10, 10], [60, 10]], 0)
+    assert tracked_fraction(orb_like([[10, 10]], 0), key, points=[1]) == 0.0
+    assert tracked_fraction(orb_like([[10, 10]], 0), key, points=[]) == 0.0
+    for bad in ([2], [-1], [0.5], [0, 0]):
+        with pytest.raises(ValueError, match="points"):
+            tracked_fraction(key, key, points=bad)

@@ -13,10 +13,12 @@ keyframe's features that find a match in the current frame (mutual nearest neigh
 distance within ORB-SLAM's 50 bits, :func:`.hamming.hamming_match`). The denominator is the
 keyframe's feature count, as in ORB-SLAM's "tracks less than 90 % points than K_ref": it asks how
 much of the stored keyframe is still seen, and does not change while the current frame's own count
-varies. The paper does not say how it matches; a second reading, :func:`tracked_fraction`, finds the
-keyframe's features the way ORB-SLAM tracks them from frame to frame (a search window around each
-feature, the nearest neighbour there within 100 bits, an orientation check), and matching mode
-``"tracked"`` of :class:`KeyframeSelector` uses it.
+varies. The paper does not say how it matches. A second reading follows ORB-SLAM, whose rule the
+paper adapts: :func:`tracked_matches` finds a keyframe's features the way ORB-SLAM tracks points from
+frame to frame (a search window around each feature, the nearest neighbour there within 100 bits, an
+orientation check), and the keyframe's *matched points* are its features tracked from the frame
+before it, as ORB-SLAM counts only a keyframe's points that other views also saw. Matching mode
+``"tracked"`` of :class:`KeyframeSelector` shares those: :func:`tracked_fraction` with ``points``.
 
 Taken literally, condition (3) also means that a frame sharing 70 % or less is never a
 keyframe: if the robot jumps too far between frames, selection stops until it sees the last
@@ -157,12 +159,28 @@ def _window_pairs(centres: np.ndarray, points: np.ndarray, half_width: np.ndarra
     return rows[keep], cols[keep]
 
 
-def _tracked_count(cur: Features, key: Features, window: float = TRACK_WINDOW, max_distance: float = TRACK_DISTANCE,
-                   scale_factor: float = 1.2, check_orientation: bool = True) -> int:
-    """How many of ``key``'s features :func:`tracked_matches` finds in ``cur`` (trusted inputs)."""
+def _rows(points, n: int) -> np.ndarray:
+    """Distinct row indices into n rows (``points`` of :func:`tracked_fraction`)."""
+    p = as_array(points, "points", ndim=1)
+    if len(p) and (np.any(p != np.rint(p)) or p.min() < 0 or p.max() >= n):
+        raise ValueError(f"points: expected row indices of keyframe (0 .. {n - 1}), got values from {p.min()} to {p.max()}")
+    rows = p.astype(np.int64)
+    if len(np.unique(rows)) < len(rows):
+        raise ValueError("points: expected distinct rows, got a row more than once")
+    return rows
+
+
+def _tracked_rows(cur: Features, key: Features, window: float = TRACK_WINDOW, max_distance: float = TRACK_DISTANCE,
+                  scale_factor: float = 1.2, check_orientation: bool = True) -> np.ndarray:
+    """The rows of ``key`` :func:`tracked_matches` finds in ``cur`` (trusted inputs)."""
     if len(key) == 0 or len(cur) == 0:
-        return 0
-    return len(_tracked_pairs(cur, key, window, max_distance, scale_factor, check_orientation)[0])
+        return np.zeros(0, np.int64)
+    return _tracked_pairs(cur, key, window, max_distance, scale_factor, check_orientation)[0]
+
+
+def _tracked_share(cur: Features, key: Features, rows: np.ndarray, *args) -> float:
+    """Share of ``key``'s rows ``rows`` found in ``cur``; 0 for no rows (trusted inputs)."""
+    return float(np.isin(rows, _tracked_rows(cur, key, *args)).sum() / len(rows)) if len(rows) else 0.0
 
 
 def _tracked_pairs(cur: Features, key: Features, window: float, max_distance: float, scale_factor: float,
@@ -276,37 +294,43 @@ def tracked_matches(current, keyframe, *, window: float = TRACK_WINDOW, max_dist
     return _tracked_pairs(cur, key, window, max_distance, scale_factor, bool(check_orientation))
 
 
-def tracked_fraction(current, keyframe, *, window: float = TRACK_WINDOW, max_distance: float = TRACK_DISTANCE,
-                     scale_factor: float = 1.2, check_orientation: bool = True) -> float:
+def tracked_fraction(current, keyframe, *, points=None, window: float = TRACK_WINDOW,
+                     max_distance: float = TRACK_DISTANCE, scale_factor: float = 1.2,
+                     check_orientation: bool = True) -> float:
     """Fraction of a keyframe's features found again by ORB-SLAM-style tracking (Ge et al. (2023), condition (3)).
 
-    A second reading of condition (3)'s "shares matched points" (Sec. 3.2): the keyframe features
-    :func:`tracked_matches` finds in the current frame (search windows around each feature's position,
-    neighbouring pyramid levels, the nearest within ``max_distance`` bits, each current feature used
-    once, an orientation check), over the keyframe's feature count.
+    A second reading of condition (3)'s "shares matched points" (Sec. 3.2): of the keyframe features
+    ``points``, the share :func:`tracked_matches` finds in the current frame (search windows around
+    each feature's position, neighbouring pyramid levels, the nearest within ``max_distance`` bits,
+    each current feature used once, an orientation check).
 
     Parameters
     ----------
     current, keyframe : Features
         ORB features (:func:`.orb.detect_orb_features`) of the current frame and of the last keyframe.
+    points : array_like of int, optional
+        Rows of ``keyframe`` to count, each once (e.g. its matched points, :class:`KeyframeSelector`);
+        default all of them.
     window, max_distance, scale_factor, check_orientation
         As in :func:`tracked_matches` (defaults 15 px, 100 bits, 1.2, True).
 
     Returns
     -------
     float
-        Matches kept, divided by the keyframe's feature count, in [0, 1]; 0 when either frame has no
-        features.
+        The ``points`` found, divided by their count, in [0, 1]; 0 when there are none or the current
+        frame has no features.
 
     Raises
     ------
     TypeError, ValueError
-        For something that is not ORB ``Features``, or a window, distance or scale factor out of range.
+        For something that is not ORB ``Features``, points that are not distinct rows of ``keyframe``,
+        or a window, distance or scale factor out of range.
 
     Notes
     -----
     Ge et al. (2023), Sec. 3.2, condition (3); Mur-Artal et al. (2015), Sec. V-B and V-E (ORB-SLAM
-    counts a frame's tracked points against its reference keyframe's).
+    counts a frame's tracked points against those of its reference keyframe that other keyframes
+    also observe).
 
     Examples
     --------
@@ -321,12 +345,14 @@ def tracked_fraction(current, keyframe, *, window: float = TRACK_WINDOW, max_dis
     >>> far = Features(Keypoints(kp.xy + [30.0, 0.0], kp.scale, kp.response, kp.orientation), d)
     >>> tracked_fraction(far, key)                                 # 30 px is outside the 15 px window
     0.0
+    >>> half = Features(Keypoints(kp.xy[:2], kp.scale[:2], kp.response[:2], kp.orientation[:2]), d[:2])
+    >>> tracked_fraction(half, key), tracked_fraction(half, key, points=[0, 1, 2])
+    (0.5, 0.6666666666666666)
     """
     cur, key, window, max_distance, scale_factor = _tracking_args(current, keyframe, window, max_distance,
                                                                   scale_factor)
-    if len(key) == 0:
-        return 0.0
-    return _tracked_count(cur, key, window, max_distance, scale_factor, bool(check_orientation)) / len(key)
+    rows = np.arange(len(key)) if points is None else _rows(points, len(key))
+    return _tracked_share(cur, key, rows, window, max_distance, scale_factor, bool(check_orientation))
 
 
 class KeyframeConditions(NamedTuple):
@@ -372,9 +398,10 @@ class KeyframeSelector:
     max_distance : float, default 50
         Hamming bound of a match in :func:`shared_fraction` (``matching="mutual"``).
     matching : {"mutual", "tracked"}, default "mutual"
-        What "shares matched points" means: :func:`shared_fraction` (mutual nearest neighbours over the
-        whole image; frames are descriptor arrays) or :func:`tracked_fraction` (ORB-SLAM-style search
-        windows; frames are ORB ``Features``, with keypoints).
+        What "shares matched points" means. ``"mutual"``: :func:`shared_fraction` over all of the
+        keyframe's features; frames are descriptor arrays. ``"tracked"``: :func:`tracked_fraction` over
+        the keyframe's matched points, its features tracked from the frame offered just before it (for
+        the first keyframe, those tracked into the next frame); frames are ORB ``Features``.
     below_band : {"skip", "take"}, default "skip"
         A frame sharing ``low`` or less: ``"skip"`` it, as condition (3) is printed (once no frame
         shares more than ``low``, selection stalls for good), or ``"take"`` it when (1), (2) and (4)
@@ -386,7 +413,9 @@ class KeyframeSelector:
     indices : list of int
         Frame numbers (0-based, in offer order) of the keyframes so far.
     conditions : KeyframeConditions or None
-        The last offered frame's conditions (None for the first frame, always a keyframe).
+        The last offered frame's conditions (None for the first frame, always a keyframe). Its share
+        is measured only when condition (2) holds (otherwise ``fraction`` is NaN and ``shared``
+        False); :meth:`evaluate` always measures it.
 
     Examples
     --------
@@ -428,6 +457,8 @@ class KeyframeSelector:
         self._n = 0
         self._key = None
         self._key_pos = None
+        self._points = None        # "tracked": the last keyframe's matched points (rows)
+        self._previous = None      # "tracked": the frame offered last
 
     def _frame(self, frame):
         if self.matching == "tracked":
@@ -438,13 +469,17 @@ class KeyframeSelector:
         """Evaluate conditions (1)-(4) for a frame against the last keyframe, without recording it."""
         if self._key is None:
             raise ValueError("evaluate: no keyframe yet (offer the first frame, which is always one)")
-        d = self._frame(frame)
-        p = _position(position)
-        if self.matching == "tracked":
-            fraction = _tracked_count(d, self._key) / len(self._key) if len(self._key) else 0.0
+        return self._evaluate(self._frame(frame), _position(position))
+
+    def _evaluate(self, d, p, measure: bool = True) -> KeyframeConditions:
+        gap = self._n - self.indices[-1]
+        if not measure:
+            fraction = np.nan
+        elif self.matching == "tracked":
+            points = _tracked_rows(d, self._key) if self._points is None else self._points
+            fraction = _tracked_share(d, self._key, points)
         else:
             fraction = shared_fraction(d, self._key, max_distance=self.max_distance)
-        gap = self._n - self.indices[-1]
         moved = float(np.hypot(*(p - self._key_pos)))
         low, high = self.shared_range
         low = -1.0 if self.below_band == "take" else low
@@ -462,18 +497,26 @@ class KeyframeSelector:
         position : array_like, shape (2,) or (3,)
             The robot's position ``[x, y]`` or pose ``[x, y, theta]`` in metres.
         """
+        d, p = self._frame(frame), _position(position)
         if self._key is None:
-            self._accept(self._frame(frame), _position(position))
+            self._accept(d, p)
             return True
-        self.conditions = self.evaluate(frame, position)
+        if self.matching == "tracked" and self._points is None:     # the first keyframe's matched points
+            self._points = _tracked_rows(d, self._key)
+        # a frame inside condition (2)'s gap cannot be a keyframe: its share is not measured (NaN)
+        self.conditions = self._evaluate(d, p, measure=self._n - self.indices[-1] > self.min_frame_gap)
         if self.conditions.all:
-            self._accept(self._frame(frame), _position(position))
+            self._accept(d, p)
             return True
+        self._previous = d
         self._n += 1
         return False
 
     def _accept(self, d, p) -> None:
         self.indices.append(self._n)
+        if self.matching == "tracked":
+            self._points = None if self._previous is None else _tracked_rows(self._previous, d)
+            self._previous = d
         self._key, self._key_pos = d, p
         self._n += 1
 
@@ -548,8 +591,10 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
     max_distance : float, default 50
         Hamming bound of a match (``matching="mutual"``).
     matching : {"mutual", "tracked"}, default "mutual"
-        How a point counts as tracked: a mutual nearest neighbour within ``max_distance``, or found by
-        :func:`tracked_fraction`'s search windows.
+        How a point counts as tracked: a mutual nearest neighbour of any of the reference keyframe's
+        features within ``max_distance``; or, of the reference keyframe's matched points (its features
+        tracked from the frame before it; frame 0's, into frame 1), one :func:`tracked_matches` finds
+        (ORB-SLAM counts only points other views also observed).
 
     Returns
     -------
@@ -582,10 +627,12 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
         ref = frames[keys[-1]]
         if i - keys[-1] <= min_frame_gap:
             continue
-        if matching == "tracked":
-            tracked = _tracked_count(d, ref)
+        if matching == "tracked":                # the reference keyframe's matched points, as the selector's
+            k = keys[-1]
+            points = _tracked_rows(frames[k - 1] if k else frames[1], ref)
+            tracked, reference = int(np.isin(points, _tracked_rows(d, ref)).sum()), len(points)
         else:
-            tracked = _match_count(d, ref, max_distance) if len(d) and len(ref) else 0
-        if tracked >= min_tracked and tracked < top * len(ref):
+            tracked, reference = (_match_count(d, ref, max_distance) if len(d) and len(ref) else 0), len(ref)
+        if tracked >= min_tracked and tracked < top * reference:
             keys.append(i)
     return np.array(keys, dtype=np.int64)
