@@ -154,7 +154,7 @@ def tracked_reference(cur, key, window=15.0, max_distance=100, check_orientation
         for j in range(len(cur)):
             dx, dy = np.abs(cur.keypoints.xy[j] - key.keypoints.xy[i])
             r = window * key.keypoints.scale[i]
-            if j in taken or dx > r or dy > r or abs(lc[j] - lk[i]) > 1:
+            if j in taken or dx >= r or dy >= r or abs(lc[j] - lk[i]) > 1:
                 continue
             d = int(hamming_distance(key.descriptors[i], cur.descriptors[j]))
             if d <= max_distance and (best is None or d < best[0]):
@@ -242,8 +242,8 @@ def test_tracked_fraction_refuses_what_is_not_orb_features():
 
 def test_selector_tracked_mode_shares_the_keyframes_matched_points():
     """On rendered views 1.5 cm apart, condition (3) is tracked_fraction over the last keyframe's matched
-    points: its features tracked from the view before it (the first keyframe's: into the next view)."""
-    from robokit.vision import tracked_fraction, tracked_matches
+    points: found from the view before it (the first keyframe's: from the next view)."""
+    from robokit.vision import matched_points, tracked_fraction
     world = sim.long_corridor()
     camera = sim.PinholeCamera.from_fov(np.deg2rad(65.0), 640, 480, mount=sim.camera_mount(0.35))
     xs = 14.0 + 0.015 * np.arange(14)
@@ -254,7 +254,8 @@ def test_selector_tracked_mode_shares_the_keyframes_matched_points():
         last = sel.indices[-1] if sel.indices else None
         decisions.append(sel.offer(view, [x, 0.0]))
         if last is not None:
-            points = tracked_matches(views[last - 1] if last else views[1], views[last])[0]
+            points = (matched_points(views[last], views[last - 1]) if last
+                      else matched_points(views[0], following=views[1]))
             assert 0 < len(points) < len(views[last])
             share = tracked_fraction(view, views[last], points=points)
             if k - last > 1:                                 # condition (2) holds: the share was measured
@@ -266,27 +267,36 @@ def test_selector_tracked_mode_shares_the_keyframes_matched_points():
     assert decisions[0] and sum(decisions) >= 3 and min(shares) < 0.9      # the band was reached, more than once
     assert select_keyframes(views, np.c_[xs, 0 * xs], 100, min_frame_gap=1, matching="tracked").tolist() == sel.indices
     # the same share over all of the keyframe's features is lower: the matched points are the stable ones
-    assert tracked_fraction(views[5], views[2]) < tracked_fraction(views[5], views[2], points=tracked_matches(views[1], views[2])[0])
+    stable = matched_points(views[2], views[1])
+    assert tracked_fraction(views[5], views[2]) < tracked_fraction(views[5], views[2], points=stable)
+    sel.reset()                                                      # reset: the next view is a first keyframe again
+    assert sel.offer(views[3], [xs[3], 0.0]) and sel.indices == [0] and sel.conditions is None
+    first = matched_points(views[3], following=views[4])
+    sel.offer(views[4], [xs[4], 0.0])                               # inside the gap: defines them, measures nothing
+    assert np.isnan(sel.conditions.fraction)
+    assert sel.evaluate(views[8], [xs[8], 0.0]).fraction == tracked_fraction(views[8], views[3], points=first)
+    sel.offer(views[5], [xs[5], 0.0])
+    assert sel.conditions.fraction == tracked_fraction(views[5], views[3], points=first)
 
 
 def test_orbslam_rule_tracked_counts_the_reference_keyframes_matched_points():
-    from robokit.vision import tracked_matches
+    from robokit.vision import matched_points, tracked_matches
     world = sim.long_corridor()
     camera = sim.PinholeCamera.from_fov(np.deg2rad(65.0), 640, 480, mount=sim.camera_mount(0.35))
     views = [detect_orb_features(camera.observe(world, [14.0 + 0.02 * k, 0.0, 0.0]).image) for k in range(16)]
 
-    def rule(matched_points):
+    def rule(only_matched):
         keys = [0]
-        points = tracked_matches(views[1], views[0])[0] if matched_points else np.arange(len(views[0]))
+        points = matched_points(views[0], following=views[1]) if only_matched else np.arange(len(views[0]))
         for i in range(1, len(views)):
             found = np.isin(points, tracked_matches(views[i], views[keys[-1]])[0]).sum()
             if 50 <= found < 0.8 * len(points):
                 keys.append(i)
-                points = tracked_matches(views[i - 1], views[i])[0] if matched_points else np.arange(len(views[i]))
+                points = matched_points(views[i], views[i - 1]) if only_matched else np.arange(len(views[i]))
         return keys
 
     keys = select_keyframes_orbslam(views, min_frame_gap=0, max_tracked_fraction=0.8, matching="tracked").tolist()
-    assert keys == rule(matched_points=True) != rule(matched_points=False)     # the two counts pick differently
+    assert keys == rule(only_matched=True) != rule(only_matched=False)        # the two counts pick differently
     assert len(keys) >= 3
 
 
@@ -298,3 +308,29 @@ def test_tracked_fraction_points_must_be_distinct_rows():
     for bad in ([2], [-1], [0.5], [0, 0]):
         with pytest.raises(ValueError, match="points"):
             tracked_fraction(key, key, points=bad)
+
+
+def test_matched_points_track_the_previous_frame_into_the_keyframe():
+    from robokit.vision import matched_points
+    same = POOL[0]
+    near = same ^ np.r_[np.full(5, 255), np.zeros(27)].astype(np.uint8)                 # 40 bits from it
+    key = orb_like([[10, 10], [20, 10]], 0, descriptors=np.stack([near, same]))
+    before = orb_like([[12, 10]], 0, descriptors=same[None])
+    # tracking the earlier frame's feature into the keyframe finds its nearest there: row 1, not row 0
+    assert matched_points(key, before).tolist() == [1]
+    # the first keyframe: its features tracked into the next frame (row 0 comes first and takes it)
+    assert matched_points(key, following=before).tolist() == [0]
+    assert matched_points(key).tolist() == [0, 1]
+    assert matched_points(key, orb_like(np.zeros((0, 2)), 0, descriptors=np.zeros((0, 32), np.uint8))).tolist() == []
+    with pytest.raises(TypeError, match="previous"):
+        matched_points(key, POOL[:2])
+
+
+def test_tracked_window_is_open_at_its_edge():
+    from robokit.vision import tracked_fraction
+    key = orb_like([[10, 10]], 0)
+    assert tracked_fraction(orb_like([[24.9, 10]], 0), key) == 1.0
+    assert tracked_fraction(orb_like([[25.0, 10]], 0), key) == 0.0                     # 15 px: outside, as ORB-SLAM
+    assert tracked_fraction(orb_like([[10, -5.0]], 0), key) == 0.0
+    assert tracked_fraction(orb_like([[-5.0, 10]], 0), key) == 0.0
+    assert tracked_fraction(orb_like([[-4.9, 24.9]], 0), key) == 1.0

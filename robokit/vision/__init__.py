@@ -36,7 +36,8 @@ from .spherical import EssentialFit, essential_from_bearings, ransac_essential
 from .orb import detect_orb_features
 from .hamming import as_binary_descriptors, hamming_distance, hamming_distances, hamming_match
 from .keyframes import (TRACK_DISTANCE, TRACK_WINDOW, KeyframeConditions, KeyframeSelector, feature_threshold,
-                        select_keyframes, select_keyframes_orbslam, shared_fraction, tracked_fraction, tracked_matches)
+                        matched_points, select_keyframes, select_keyframes_orbslam, shared_fraction, tracked_fraction,
+                        tracked_matches)
 from .bag_of_words import BowVector, TooFewDescriptorsError, Vocabulary, VocabularyFileError, l1_score, tf_idf
 from .bow_database import BowDatabase, DatabaseFileError, QueryResult
 
@@ -49,5 +50,6 @@ __all__ = ["Features", "Keypoints", "PlotParams", "detect_plot", "junction_stren
            "ransac_sample_count", "ransac_se2", "EssentialFit", "essential_from_bearings", "ransac_essential",
            "detect_orb_features", "as_binary_descriptors", "hamming_distance", "hamming_distances", "hamming_match",
            "KeyframeConditions", "KeyframeSelector", "feature_threshold", "select_keyframes",
-           "select_keyframes_orbslam", "shared_fraction", "tracked_fraction", "tracked_matches", "TRACK_WINDOW",
-           "TRACK_DISTANCE", "BowVector", "TooFewDescriptorsError", "Vocabulary", "VocabularyFileError", "l1_score", "tf_idf", "BowDatabase", "DatabaseFileError", "QueryResult"]
+           "select_keyframes_orbslam", "shared_fraction", "tracked_fraction", "tracked_matches", "matched_points",
+           "TRACK_WINDOW", "TRACK_DISTANCE", "BowVector", "TooFewDescriptorsError", "Vocabulary", "VocabularyFileError",
+           "l1_score", "tf_idf", "BowDatabase", "DatabaseFileError", "QueryResult"]

@@ -13,12 +13,14 @@ keyframe's features that find a match in the current frame (mutual nearest neigh
 distance within ORB-SLAM's 50 bits, :func:`.hamming.hamming_match`). The denominator is the
 keyframe's feature count, as in ORB-SLAM's "tracks less than 90 % points than K_ref": it asks how
 much of the stored keyframe is still seen, and does not change while the current frame's own count
-varies. The paper does not say how it matches. A second reading follows ORB-SLAM, whose rule the
-paper adapts: :func:`tracked_matches` finds a keyframe's features the way ORB-SLAM tracks points from
-frame to frame (a search window around each feature, the nearest neighbour there within 100 bits, an
-orientation check), and the keyframe's *matched points* are its features tracked from the frame
-before it, as ORB-SLAM counts only a keyframe's points that other views also saw. Matching mode
-``"tracked"`` of :class:`KeyframeSelector` shares those: :func:`tracked_fraction` with ``points``.
+varies. The paper does not say how it matches. A second reading follows ORB-SLAM, the system the
+paper compares its rule with (Table 1): :func:`tracked_matches` finds a keyframe's features the way
+ORB-SLAM tracks points from frame to frame (a search window around each feature, the nearest
+neighbour there within 100 bits, an orientation check), and the share is taken over the keyframe's
+*matched points* (:func:`matched_points`), its features that another view also saw: tracked into it
+from the frame before it. ORB-SLAM likewise counts only a reference keyframe's points that other
+keyframes (at least three) observe. Matching mode ``"tracked"`` of :class:`KeyframeSelector` shares
+those: :func:`tracked_fraction` with ``points``.
 
 Taken literally, condition (3) also means that a frame sharing 70 % or less is never a
 keyframe: if the robot jumps too far between frames, selection stops until it sees the last
@@ -28,8 +30,8 @@ other conditions hold (:class:`KeyframeSelector` records each frame's conditions
 The ORB-SLAM rule beside it (Mur-Artal, Montiel & Tardos 2015, Sec. V-E, conditions 2-4; the
 relocalisation and local-mapping-idle parts do not apply here): more than 20 frames since the last
 keyframe insertion, the current frame tracks at least 50 points, and it tracks fewer than 90 % of
-the reference keyframe's points. "Tracked points" are approximated by Hamming matches with the
-reference keyframe (ORB-SLAM tracks map points; we have no map).
+the reference keyframe's points. "Tracked points" are approximated by matches with the reference
+keyframe, mutual or tracked as above (ORB-SLAM tracks map points; we have no map).
 
 Positions are planar robot positions ``(N, 2)`` or poses ``[x, y, theta]`` ``(N, 3)`` in metres;
 condition (4) uses the Euclidean distance between positions (the heading is ignored).
@@ -53,7 +55,7 @@ from .features import Features
 from .hamming import ORB_MATCH_DISTANCE, as_binary_descriptors, hamming_distance, hamming_match, same_width
 
 __all__ = ["KeyframeConditions", "KeyframeSelector", "feature_threshold", "shared_fraction", "tracked_matches",
-           "tracked_fraction",
+           "matched_points", "tracked_fraction",
            "select_keyframes", "select_keyframes_orbslam", "TRACK_WINDOW", "TRACK_DISTANCE"]
 
 #: ORB-SLAM's search window when it tracks a monocular frame with its motion model: 15 pixels each way
@@ -148,23 +150,23 @@ def _octaves(scale: np.ndarray, scale_factor: float) -> np.ndarray:
 
 
 def _window_pairs(centres: np.ndarray, points: np.ndarray, half_width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """All ``(i, j)`` with ``points[j]`` within ``half_width[i]`` of ``centres[i]`` in x and in y, by row."""
+    """All ``(i, j)`` with ``points[j]`` less than ``half_width[i]`` from ``centres[i]`` in x and in y, by row."""
     by_x = np.argsort(points[:, 0], kind="stable")
     xs = points[by_x, 0]
-    lo = np.searchsorted(xs, centres[:, 0] - half_width, "left")
-    count = np.searchsorted(xs, centres[:, 0] + half_width, "right") - lo
+    lo = np.searchsorted(xs, centres[:, 0] - half_width, "right")
+    count = np.maximum(np.searchsorted(xs, centres[:, 0] + half_width, "left") - lo, 0)
     rows = np.repeat(np.arange(len(centres)), count)
     cols = by_x[np.repeat(lo - np.cumsum(count) + count, count) + np.arange(count.sum())]
-    keep = np.abs(points[cols, 1] - centres[rows, 1]) <= half_width[rows]
+    keep = np.abs(points[cols, 1] - centres[rows, 1]) < half_width[rows]
     return rows[keep], cols[keep]
 
 
 def _rows(points, n: int) -> np.ndarray:
     """Distinct row indices into n rows (``points`` of :func:`tracked_fraction`)."""
-    p = as_array(points, "points", ndim=1)
-    if len(p) and (np.any(p != np.rint(p)) or p.min() < 0 or p.max() >= n):
-        raise ValueError(f"points: expected row indices of keyframe (0 .. {n - 1}), got values from {p.min()} to {p.max()}")
-    rows = p.astype(np.int64)
+    rows = as_array(points, "points", ndim=1, dtype=np.int64)
+    if len(rows) and (rows.min() < 0 or rows.max() >= n):
+        expected = f"rows 0 .. {n - 1} of keyframe" if n else "no rows (keyframe has no features)"
+        raise ValueError(f"points: expected {expected}, got values from {rows.min()} to {rows.max()}")
     if len(np.unique(rows)) < len(rows):
         raise ValueError("points: expected distinct rows, got a row more than once")
     return rows
@@ -239,8 +241,8 @@ def tracked_matches(current, keyframe, *, window: float = TRACK_WINDOW, max_dist
     points or a motion model, the window is centred on the feature's own position in the keyframe, as
     if the camera had not moved:
 
-    1. candidates: current features within ``window`` times the keyframe feature's scale in x and in y,
-       on the same pyramid level or the next one up or down;
+    1. candidates: current features less than ``window`` times the keyframe feature's scale away in x
+       and in y, on the same pyramid level or the next one up or down;
     2. the keyframe's features in order, each takes its nearest candidate by Hamming distance that no
        earlier feature took (ties: the lowest index), if that distance is at most ``max_distance``;
     3. orientation check: the rotations between matched keypoints go into 30 bins over 360 degrees;
@@ -294,6 +296,68 @@ def tracked_matches(current, keyframe, *, window: float = TRACK_WINDOW, max_dist
     return _tracked_pairs(cur, key, window, max_distance, scale_factor, bool(check_orientation))
 
 
+def _matched_rows(key: Features, previous: Features | None = None, following: Features | None = None) -> np.ndarray:
+    """:func:`matched_points` on trusted inputs."""
+    if previous is not None:
+        if len(previous) == 0 or len(key) == 0:
+            return np.zeros(0, np.int64)
+        return np.sort(_tracked_pairs(key, previous, TRACK_WINDOW, TRACK_DISTANCE, 1.2, True)[1])
+    if following is not None:
+        return _tracked_rows(following, key)
+    return np.arange(len(key))
+
+
+def matched_points(keyframe, previous=None, *, following=None) -> np.ndarray:
+    """A keyframe's matched points: the rows of its features that another view also saw.
+
+    With ``previous``, the keyframe's features found when the previous frame's features are tracked
+    into it (:func:`tracked_matches` ``(keyframe, previous)``); without it (the first keyframe), those
+    tracked from it into ``following``, the next frame; with neither, all of its features.
+
+    Parameters
+    ----------
+    keyframe : Features
+        The keyframe's ORB features.
+    previous, following : Features, optional
+        The frame just before the keyframe, or (when there is none) the frame just after it.
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        Increasing rows of ``keyframe``: ``points`` for :func:`tracked_fraction`.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For something that is not ORB ``Features``, or descriptors of another width.
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 3.2, condition (3) ("shares ... matched points with the last keyframe"),
+    read after ORB-SLAM (Mur-Artal et al. 2015, Sec. V-E), which compares a frame's tracked points with
+    those of its reference keyframe that at least three keyframes observe; here one neighbouring frame
+    suffices. A frame offered just after a first keyframe shares all of that keyframe's matched points
+    by construction (they were found in it).
+
+    Examples
+    --------
+    >>> from robokit.vision import Features, Keypoints
+    >>> d = np.random.default_rng(0).integers(0, 256, (3, 32), dtype=np.uint8)
+    >>> kp = Keypoints(np.array([[10.0, 10.0], [50.0, 10.0], [90.0, 10.0]]), np.ones(3), np.ones(3), np.zeros(3))
+    >>> key = Features(kp, d)
+    >>> before = Features(Keypoints(kp.xy[1:] - [2.0, 0.0], kp.scale[1:], kp.response[1:], kp.orientation[1:]), d[1:])
+    >>> matched_points(key, before).tolist()                # feature 0 was not in the frame before
+    [1, 2]
+    """
+    key = _orb_features(keyframe, "keyframe")
+    others = {}
+    for name, value in (("previous", previous), ("following", following)):
+        if value is not None:
+            others[name] = _orb_features(value, name)
+            same_width(others[name].descriptors, key.descriptors, name, "keyframe")
+    return _matched_rows(key, others.get("previous"), others.get("following"))
+
+
 def tracked_fraction(current, keyframe, *, points=None, window: float = TRACK_WINDOW,
                      max_distance: float = TRACK_DISTANCE, scale_factor: float = 1.2,
                      check_orientation: bool = True) -> float:
@@ -309,8 +373,7 @@ def tracked_fraction(current, keyframe, *, points=None, window: float = TRACK_WI
     current, keyframe : Features
         ORB features (:func:`.orb.detect_orb_features`) of the current frame and of the last keyframe.
     points : array_like of int, optional
-        Rows of ``keyframe`` to count, each once (e.g. its matched points, :class:`KeyframeSelector`);
-        default all of them.
+        Rows of ``keyframe`` to count, each once (e.g. its :func:`matched_points`); default all of them.
     window, max_distance, scale_factor, check_orientation
         As in :func:`tracked_matches` (defaults 15 px, 100 bits, 1.2, True).
 
@@ -392,16 +455,18 @@ class KeyframeSelector:
     min_frame_gap : int, default 10
         Condition (2): more than this many frames since the last keyframe.
     shared_range : (float, float), default (0.70, 0.90)
-        Condition (3): ``low < shared_fraction < high``.
+        Condition (3): ``low < share < high``, the share as ``matching`` reads it.
     min_distance : float, default 0.02
         Condition (4): metres moved since the last keyframe, at least.
     max_distance : float, default 50
-        Hamming bound of a match in :func:`shared_fraction` (``matching="mutual"``).
+        Hamming bound of a match in :func:`shared_fraction` (``matching="mutual"`` only).
     matching : {"mutual", "tracked"}, default "mutual"
         What "shares matched points" means. ``"mutual"``: :func:`shared_fraction` over all of the
-        keyframe's features; frames are descriptor arrays. ``"tracked"``: :func:`tracked_fraction` over
-        the keyframe's matched points, its features tracked from the frame offered just before it (for
-        the first keyframe, those tracked into the next frame); frames are ORB ``Features``.
+        keyframe's features; frames are descriptor arrays. ``"tracked"``: :func:`tracked_fraction` with
+        its defaults (ORB's scale step 1.2) over the keyframe's :func:`matched_points`, found from the
+        frame offered just before it (for the first keyframe, from the next frame, which therefore
+        shares them all); frames are ORB ``Features``. A keyframe after a frame without features has
+        no matched points and shares 0 with every frame.
     below_band : {"skip", "take"}, default "skip"
         A frame sharing ``low`` or less: ``"skip"`` it, as condition (3) is printed (once no frame
         shares more than ``low``, selection stalls for good), or ``"take"`` it when (1), (2) and (4)
@@ -476,7 +541,8 @@ class KeyframeSelector:
         if not measure:
             fraction = np.nan
         elif self.matching == "tracked":
-            points = _tracked_rows(d, self._key) if self._points is None else self._points
+            same_width(d.descriptors, self._key.descriptors, "frame", "keyframe")
+            points = _matched_rows(self._key, following=d) if self._points is None else self._points
             fraction = _tracked_share(d, self._key, points)
         else:
             fraction = shared_fraction(d, self._key, max_distance=self.max_distance)
@@ -502,7 +568,8 @@ class KeyframeSelector:
             self._accept(d, p)
             return True
         if self.matching == "tracked" and self._points is None:     # the first keyframe's matched points
-            self._points = _tracked_rows(d, self._key)
+            same_width(d.descriptors, self._key.descriptors, "frame", "keyframe")
+            self._points = _matched_rows(self._key, following=d)
         # a frame inside condition (2)'s gap cannot be a keyframe: its share is not measured (NaN)
         self.conditions = self._evaluate(d, p, measure=self._n - self.indices[-1] > self.min_frame_gap)
         if self.conditions.all:
@@ -515,7 +582,7 @@ class KeyframeSelector:
     def _accept(self, d, p) -> None:
         self.indices.append(self._n)
         if self.matching == "tracked":
-            self._points = None if self._previous is None else _tracked_rows(self._previous, d)
+            self._points = None if self._previous is None else _matched_rows(d, previous=self._previous)
             self._previous = d
         self._key, self._key_pos = d, p
         self._n += 1
@@ -523,7 +590,8 @@ class KeyframeSelector:
 
 def _stream(descriptor_list, positions, matching="mutual"):
     if not isinstance(descriptor_list, (list, tuple)):
-        raise TypeError(f"descriptor_list: expected a list of per-frame descriptor arrays, got {describe(descriptor_list)}")
+        raise TypeError(f"descriptor_list: expected a list of per-frame descriptor arrays (or Features), "
+                        f"got {describe(descriptor_list)}")
     check = _orb_features if matching == "tracked" else as_binary_descriptors
     frames = [check(d, f"descriptor_list[{i}]") for i, d in enumerate(descriptor_list)]
     if positions is None:
@@ -620,6 +688,7 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
     if max_distance <= 0:
         raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
     keys: list[int] = []
+    points = None                                # "tracked": the reference keyframe's matched points
     for i, d in enumerate(frames):
         if not keys:
             keys.append(i)
@@ -627,12 +696,14 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
         ref = frames[keys[-1]]
         if i - keys[-1] <= min_frame_gap:
             continue
-        if matching == "tracked":                # the reference keyframe's matched points, as the selector's
-            k = keys[-1]
-            points = _tracked_rows(frames[k - 1] if k else frames[1], ref)
+        if matching == "tracked":
+            if points is None:
+                k = keys[-1]
+                points = _matched_rows(ref, previous=frames[k - 1]) if k else _matched_rows(ref, following=frames[1])
             tracked, reference = int(np.isin(points, _tracked_rows(d, ref)).sum()), len(points)
         else:
             tracked, reference = (_match_count(d, ref, max_distance) if len(d) and len(ref) else 0), len(ref)
         if tracked >= min_tracked and tracked < top * reference:
             keys.append(i)
+            points = None
     return np.array(keys, dtype=np.int64)

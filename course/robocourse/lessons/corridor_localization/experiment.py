@@ -127,7 +127,8 @@ def _descriptor_stack(descriptors: list) -> tuple[np.ndarray, np.ndarray]:
     return flat, counts
 
 
-def _descriptor_list(flat: np.ndarray, counts: np.ndarray) -> list:
+def _per_frame(flat: np.ndarray, counts: np.ndarray) -> list:
+    """Stacked per-frame rows (descriptors or keypoints) split back into one array per frame."""
     return np.split(flat, np.cumsum(counts)[:-1]) if len(counts) else []
 
 
@@ -194,6 +195,11 @@ class CalibrationRun:
         return np.array([len(f) for f in self.features], int)
 
 
+def _keypoint_rows(f: Features) -> np.ndarray:
+    """A frame's keypoints as rows ``x, y, scale, orientation`` (what the calibration run stores)."""
+    return np.c_[f.keypoints.xy, f.keypoints.scale, f.keypoints.orientation]
+
+
 def calibration_run(*, fast: bool | None = None, start: float = CALIBRATION_STRETCH[0],
                     length: float = CALIBRATION_STRETCH[1] - CALIBRATION_STRETCH[0], speed: float = 0.2,
                     frame_rate: float = 30.0, progress: Callable | None = None) -> CalibrationRun:
@@ -254,13 +260,13 @@ def calibration_run(*, fast: bool | None = None, start: float = CALIBRATION_STRE
     if data is None:
         found = _orb_frames(world, camera, path.poses, 5, progress, "calibration run", keypoints=True)
         flat, counts = _descriptor_stack([f.descriptors for f in found])
-        rows = [np.c_[f.keypoints.xy, f.keypoints.scale, f.keypoints.orientation] for f in found]
-        data = {"flat": flat, "counts": counts, "keypoints": np.concatenate(rows + [np.zeros((0, 4))]),
+        data = {"flat": flat, "counts": counts, "keypoints": np.concatenate([_keypoint_rows(f) for f in found]
+                                                                             + [np.zeros((0, 4))]),
                 "positions": path.poses[:, :2]}
         write_arrays(target, data, meta)
-    kps = _descriptor_list(data["keypoints"], data["counts"])
+    kps = _per_frame(data["keypoints"], data["counts"])
     features = [Features(Keypoints(k[:, :2], k[:, 2], np.zeros(len(k)), k[:, 3]), d)
-                for k, d in zip(kps, _descriptor_list(data["flat"], data["counts"]))]
+                for k, d in zip(kps, _per_frame(data["flat"], data["counts"]))]
     return CalibrationRun(features, data["positions"], frame_rate, speed, float(feature_threshold(data["counts"])))
 
 
@@ -315,7 +321,7 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
     matching = as_choice(matching, "matching", ("mutual", "tracked"))
     if matching == "tracked":
         for f in run.features:
-            content.update(np.c_[f.keypoints.xy, f.keypoints.scale, f.keypoints.orientation].tobytes())
+            content.update(_keypoint_rows(f).tobytes())
     meta = {"run": content.hexdigest()[:16], "f_min": float(run.f_min), "gap": gap, "shared_range": band,
             "below_band": str(below_band), "matching": matching, "code": _code()}
     target = cache_dir("corridor") / f"keyframes-{cache_key(**meta)}.npz"
@@ -327,7 +333,7 @@ def keyframe_comparison(run: CalibrationRun, *, min_frame_gap: int = 10, shared_
         orbslam = select_keyframes_orbslam(frames, run.positions, matching=matching)
         data = {"ours": np.asarray(ours, int), "orbslam": np.asarray(orbslam, int)}
         write_arrays(target, data, meta)
-    return {"ours": data["ours"], "orbslam": data["orbslam"], "images": len(run.descriptors)}
+    return {"ours": data["ours"], "orbslam": data["orbslam"], "images": len(run.features)}
 
 
 # --- the vocabulary -----------------------------------------------------------------------------
@@ -518,7 +524,7 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress
         write_arrays(target, data, meta)
     grid = OccupancyGrid(data["log_odds"], float(data["resolution"]), data["origin"])
     database = BowDatabase(vocabulary)
-    for d in _descriptor_list(data["kf_flat"], data["kf_counts"]):
+    for d in _per_frame(data["kf_flat"], data["kf_counts"]):
         database.add(d)
     kf_poses = geo_tag(data["kf_times"], data["times"], data["poses"])
     return CorridorMap(world, lidar, camera, grid, likelihood_field(grid), database, kf_poses, data["kf_times"],
