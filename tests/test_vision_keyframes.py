@@ -164,7 +164,7 @@ def tracked_reference(cur, key, window=15.0, max_distance=100, check_orientation
             pairs.append((i, best[1]))
     if check_orientation and pairs:
         turn = [np.degrees(key.keypoints.orientation[i] - cur.keypoints.orientation[j]) % 360 for i, j in pairs]
-        bins = [int(np.rint(t / 12.0)) % 30 for t in turn]
+        bins = [int(np.floor(t / 12.0 + 0.5)) % 30 for t in turn]                   # C's round, as ORB-SLAM2
         counts = np.bincount(bins, minlength=30)
         top = sorted(range(30), key=lambda b: (-counts[b], b))[:3]
         keep = {b for b in top if counts[b] >= 0.1 * counts[top[0]]}

@@ -98,6 +98,14 @@ def feature_threshold(counts) -> float:
     return float(max(0.5 * c.mean(), c.min()))                  # Eq. (15)
 
 
+def _bits(max_distance) -> float:
+    """The checked Hamming bound ``max_distance`` (a positive number of bits)."""
+    bits = as_finite_scalar(max_distance, "max_distance")
+    if bits <= 0:
+        raise ValueError(f"max_distance: expected a positive number of bits, got {bits}")
+    return bits
+
+
 def _match_count(current: np.ndarray, keyframe: np.ndarray, max_distance: float) -> int:
     m = hamming_match(current, keyframe, ratio=1.0, max_distance=max_distance, cross_check=True)
     return len(m)
@@ -127,9 +135,7 @@ def shared_fraction(desc_current, desc_keyframe, *, max_distance: float = ORB_MA
     """
     cur = as_binary_descriptors(desc_current, "desc_current")
     key = as_binary_descriptors(desc_keyframe, "desc_keyframe")
-    max_distance = as_finite_scalar(max_distance, "max_distance")
-    if max_distance <= 0:
-        raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
+    max_distance = _bits(max_distance)
     same_width(cur, key, "desc_current", "desc_keyframe")
     if len(key) == 0 or len(cur) == 0:
         return 0.0
@@ -208,7 +214,7 @@ def _tracked_pairs(cur: Features, key: Features, window: float, max_distance: fl
     ci = partner[ki]
     if check_orientation and len(ki):
         turn = np.degrees(key.keypoints.orientation[ki] - cur.keypoints.orientation[ci]) % 360.0
-        bins = np.rint(turn * ROTATION_BINS / 360.0).astype(np.int64) % ROTATION_BINS
+        bins = np.floor(turn * ROTATION_BINS / 360.0 + 0.5).astype(np.int64) % ROTATION_BINS   # C's round
         counts = np.bincount(bins, minlength=ROTATION_BINS)
         top = np.argsort(-counts, kind="stable")[:3]       # the three fullest bins, earlier bins first on ties
         keep = top[counts[top] >= 0.1 * counts[top[0]]]
@@ -221,12 +227,10 @@ def _tracking_args(current, keyframe, window, max_distance, scale_factor) -> tup
     key = _orb_features(keyframe, "keyframe")
     same_width(cur.descriptors, key.descriptors, "current", "keyframe")
     window = as_finite_scalar(window, "window")
-    max_distance = as_finite_scalar(max_distance, "max_distance")
+    max_distance = _bits(max_distance)
     scale_factor = as_finite_scalar(scale_factor, "scale_factor")
     if window <= 0:
         raise ValueError(f"window: expected a positive half-width in pixels, got {window}")
-    if max_distance <= 0:
-        raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
     if not 1 < scale_factor <= 2:
         raise ValueError(f"scale_factor: expected a pyramid step in (1, 2], got {scale_factor}")
     return cur, key, window, max_distance, scale_factor
@@ -508,9 +512,7 @@ class KeyframeSelector:
         self.min_distance = as_finite_scalar(min_distance, "min_distance")
         if self.min_distance < 0:
             raise ValueError(f"min_distance: expected a non-negative distance, got {self.min_distance}")
-        self.max_distance = as_finite_scalar(max_distance, "max_distance")
-        if self.max_distance <= 0:
-            raise ValueError(f"max_distance: expected a positive number of bits, got {self.max_distance}")
+        self.max_distance = _bits(max_distance)
         self.matching = as_choice(matching, "matching", ("mutual", "tracked"))
         self.below_band = as_choice(below_band, "below_band", ("skip", "take"))
         self.reset()
@@ -545,7 +547,9 @@ class KeyframeSelector:
             points = _matched_rows(self._key, following=d) if self._points is None else self._points
             fraction = _tracked_share(d, self._key, points)
         else:
-            fraction = shared_fraction(d, self._key, max_distance=self.max_distance)
+            same_width(d, self._key, "frame", "keyframe")
+            empty = len(d) == 0 or len(self._key) == 0
+            fraction = 0.0 if empty else _match_count(d, self._key, self.max_distance) / len(self._key)
         moved = float(np.hypot(*(p - self._key_pos)))
         low, high = self.shared_range
         low = -1.0 if self.below_band == "take" else low
@@ -653,7 +657,8 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
     min_frame_gap : int, default 20
         More than this many frames since the last keyframe insertion.
     min_tracked : int, default 50
-        The frame tracks at least this many points (Hamming matches with the reference keyframe).
+        The frame tracks at least this many points (matches with the reference keyframe, as
+        ``matching`` reads them).
     max_tracked_fraction : float, default 0.90
         ... and fewer than this fraction of the reference keyframe's features.
     max_distance : float, default 50
@@ -684,9 +689,7 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
     top = as_finite_scalar(max_tracked_fraction, "max_tracked_fraction")
     if not 0 < top <= 1:
         raise ValueError(f"max_tracked_fraction: expected a value in (0, 1], got {top}")
-    max_distance = as_finite_scalar(max_distance, "max_distance")
-    if max_distance <= 0:
-        raise ValueError(f"max_distance: expected a positive number of bits, got {max_distance}")
+    max_distance = _bits(max_distance)
     keys: list[int] = []
     points = None                                # "tracked": the reference keyframe's matched points
     for i, d in enumerate(frames):
