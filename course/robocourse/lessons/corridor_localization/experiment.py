@@ -196,8 +196,8 @@ class CalibrationRun:
 
 
 def _keypoint_rows(f: Features) -> np.ndarray:
-    """A frame's keypoints as rows ``x, y, scale, orientation`` (what the calibration run stores)."""
-    return np.c_[f.keypoints.xy, f.keypoints.scale, f.keypoints.orientation]
+    """A frame's keypoints as rows ``x, y, scale, response, orientation`` (what the calibration run stores)."""
+    return np.c_[f.keypoints.xy, f.keypoints.scale, f.keypoints.response, f.keypoints.orientation]
 
 
 def calibration_run(*, fast: bool | None = None, start: float = CALIBRATION_STRETCH[0],
@@ -261,11 +261,11 @@ def calibration_run(*, fast: bool | None = None, start: float = CALIBRATION_STRE
         found = _orb_frames(world, camera, path.poses, 5, progress, "calibration run", keypoints=True)
         flat, counts = _descriptor_stack([f.descriptors for f in found])
         data = {"flat": flat, "counts": counts, "keypoints": np.concatenate([_keypoint_rows(f) for f in found]
-                                                                             + [np.zeros((0, 4))]),
+                                                                             + [np.zeros((0, 5))]),
                 "positions": path.poses[:, :2]}
         write_arrays(target, data, meta)
     kps = _per_frame(data["keypoints"], data["counts"])
-    features = [Features(Keypoints(k[:, :2], k[:, 2], np.zeros(len(k)), k[:, 3]), d)
+    features = [Features(Keypoints(k[:, :2], k[:, 2], k[:, 3], k[:, 4]), d)
                 for k, d in zip(kps, _per_frame(data["flat"], data["counts"]))]
     return CalibrationRun(features, data["positions"], frame_rate, speed, float(feature_threshold(data["counts"])))
 
