@@ -226,7 +226,10 @@ class Browser:
             pipe.send("Runtime.terminateExecution", session=session)     # stops a script stuck in a loop
         if state.crashed:
             return
-        short = min(timeout, 5.0)
+        # A small query must answer within this; the page's own thread also runs its software-rendered
+        # WebGL scenes, and on a loaded 2-core machine lesson 04's animated scenes kept it busy past 5 s
+        # (make check, twice, 2026-12-07); a page that hangs still fails, 15 s later.
+        short = min(timeout, 15.0)
         report.title, report.final_url = self._evaluate(session, "() => [document.title, location.href]",
                                                         timeout=short, what="its title")
         math = self._evaluate(session, _MATH_JS, math_timeout * 1000, list(MATH_ERROR_TEXTS),
