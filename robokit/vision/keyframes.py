@@ -53,6 +53,7 @@ import numpy as np
 from ..validation import as_array, as_choice, as_finite_scalar, as_int, describe
 from .features import Features
 from .hamming import ORB_MATCH_DISTANCE, as_binary_descriptors, hamming_distance, hamming_match, same_width
+from .orb import ORB_SCALE_FACTOR
 
 __all__ = ["KeyframeConditions", "KeyframeSelector", "feature_threshold", "shared_fraction", "tracked_matches",
            "matched_points", "tracked_fraction",
@@ -179,7 +180,7 @@ def _rows(points, n: int) -> np.ndarray:
 
 
 def _tracked_rows(cur: Features, key: Features, window: float = TRACK_WINDOW, max_distance: float = TRACK_DISTANCE,
-                  scale_factor: float = 1.2, check_orientation: bool = True) -> np.ndarray:
+                  scale_factor: float = ORB_SCALE_FACTOR, check_orientation: bool = True) -> np.ndarray:
     """The rows of ``key`` :func:`tracked_matches` finds in ``cur`` (trusted inputs)."""
     if len(key) == 0 or len(cur) == 0:
         return np.zeros(0, np.int64)
@@ -237,7 +238,7 @@ def _tracking_args(current, keyframe, window, max_distance, scale_factor) -> tup
 
 
 def tracked_matches(current, keyframe, *, window: float = TRACK_WINDOW, max_distance: float = TRACK_DISTANCE,
-                    scale_factor: float = 1.2, check_orientation: bool = True) -> tuple[np.ndarray, np.ndarray]:
+                    scale_factor: float = ORB_SCALE_FACTOR, check_orientation: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """A keyframe's features found again in the current frame by ORB-SLAM-style tracking.
 
     Each keyframe feature is searched for the way ORB-SLAM tracks a map point into a new frame
@@ -305,7 +306,7 @@ def _matched_rows(key: Features, previous: Features | None = None, following: Fe
     if previous is not None:
         if len(previous) == 0 or len(key) == 0:
             return np.zeros(0, np.int64)
-        return np.sort(_tracked_pairs(key, previous, TRACK_WINDOW, TRACK_DISTANCE, 1.2, True)[1])
+        return np.sort(_tracked_pairs(key, previous, TRACK_WINDOW, TRACK_DISTANCE, ORB_SCALE_FACTOR, True)[1])
     if following is not None:
         return _tracked_rows(following, key)
     return np.arange(len(key))
@@ -323,7 +324,8 @@ def matched_points(keyframe, previous=None, *, following=None) -> np.ndarray:
     keyframe : Features
         The keyframe's ORB features.
     previous, following : Features, optional
-        The frame just before the keyframe, or (when there is none) the frame just after it.
+        The frame just before the keyframe and the frame just after it; ``following`` counts only
+        without ``previous`` (the first keyframe).
 
     Returns
     -------
@@ -363,7 +365,7 @@ def matched_points(keyframe, previous=None, *, following=None) -> np.ndarray:
 
 
 def tracked_fraction(current, keyframe, *, points=None, window: float = TRACK_WINDOW,
-                     max_distance: float = TRACK_DISTANCE, scale_factor: float = 1.2,
+                     max_distance: float = TRACK_DISTANCE, scale_factor: float = ORB_SCALE_FACTOR,
                      check_orientation: bool = True) -> float:
     """Fraction of a keyframe's features found again by ORB-SLAM-style tracking (Ge et al. (2023), condition (3)).
 
@@ -700,9 +702,9 @@ def select_keyframes_orbslam(descriptor_list, positions=None, *, min_frame_gap: 
         if i - keys[-1] <= min_frame_gap:
             continue
         if matching == "tracked":
-            if points is None:
+            if points is None:                   # frame k + 1 exists: frame i comes after it
                 k = keys[-1]
-                points = _matched_rows(ref, previous=frames[k - 1]) if k else _matched_rows(ref, following=frames[1])
+                points = _matched_rows(ref, frames[k - 1] if k else None, frames[k + 1])
             tracked, reference = int(np.isin(points, _tracked_rows(d, ref)).sum()), len(points)
         else:
             tracked, reference = (_match_count(d, ref, max_distance) if len(d) and len(ref) else 0), len(ref)

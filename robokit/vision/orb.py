@@ -23,13 +23,15 @@ from ..validation import as_array, as_finite_scalar, as_int
 from .features import Features, Keypoints, as_gray_image
 from .hamming import ORB_BYTES
 
-__all__ = ["ORB_FEATURES", "detect_orb_features"]
+__all__ = ["ORB_FEATURES", "ORB_SCALE_FACTOR", "detect_orb_features"]
 
 #: OpenCV's default number of ORB features.
 ORB_FEATURES = 500
+#: OpenCV's default step between ORB's pyramid levels (a keypoint's scale is this to the power of its level).
+ORB_SCALE_FACTOR = 1.2
 
 
-def detect_orb_features(image, n_features: int = ORB_FEATURES, *, scale_factor: float = 1.2, n_levels: int = 8,
+def detect_orb_features(image, n_features: int = ORB_FEATURES, *, scale_factor: float = ORB_SCALE_FACTOR, n_levels: int = 8,
                         fast_threshold: int = 20, mask=None) -> Features:
     """Detect ORB keypoints and compute their binary descriptors (OpenCV ``cv2.ORB_create``).
 
