@@ -92,19 +92,20 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
     image = np.zeros((height, width, 3), np.uint8)
     zinv_buf = np.zeros((height, width), np.float32)
     # each surface in turn (in the world's order, which settles ties): rasterise, z-test, texture
+    drawn = np.flatnonzero(seen)
+    outlines = _fixed_point(polygons, box, drawn)
     box = box.astype(int).tolist()
-    cols, rows = np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32)
-    for i in np.flatnonzero(seen).tolist():
+    # 1/Z = (w0 u + w1 v) + w2 in float64, as one expression over the box would give it, with the
+    # products made once per column and per row (of every drawn surface at once), not once per pixel
+    col_terms = plane[drawn, :1] * np.arange(width, dtype=np.float32)
+    row_terms = plane[drawn, 1:2] * np.arange(height, dtype=np.float32)
+    for k, i in enumerate(drawn.tolist()):
         x0, y0, x1, y1 = box[i]
-        w = plane[i]
-        # 1/Z = (w0 u + w1 v) + w2 in float64, as one expression over the box would give it, with the
-        # products made once per column and per row instead of once per pixel
-        zi = np.add.outer(w[1] * rows[y0:y1 + 1], w[0] * cols[x0:x1 + 1])
-        zi += w[2]
+        zi = np.add.outer(row_terms[k, y0:y1 + 1], col_terms[k, x0:x1 + 1])
+        zi += plane[i, 2]
         zi = zi.astype(np.float32)
         mask = np.zeros((y1 - y0 + 1, x1 - x0 + 1), np.uint8)
-        cv2.fillPoly(mask, [np.round((polygons[i] - [x0, y0]) * 16).astype(np.int32)], 1, lineType=cv2.LINE_8,
-                     shift=4)
+        cv2.fillPoly(mask, [outlines[k]], 1, lineType=cv2.LINE_8, shift=4)
         sub_z = zinv_buf[y0:y1 + 1, x0:x1 + 1]
         update = zi > sub_z                 # the z-buffer keeps the largest inverse depth (Catmull 1974)
         update &= mask.view(bool)           # fillPoly wrote 0 or 1
@@ -116,8 +117,9 @@ def render_pinhole(world: World, K: np.ndarray, width: int, height: int, T_world
         # OpenCV's masked copy writes into the views (the image and the z-buffer) in place
         cv2.copyTo(warped, update.view(np.uint8), image[y0:y1 + 1, x0:x1 + 1])
         cv2.copyTo(zi, update.view(np.uint8), sub_z)
+    # inverse depth is 0 (1/Z = inf) where no surface was drawn and positive elsewhere
     with np.errstate(divide="ignore"):
-        depth = np.where(zinv_buf > 0, 1.0 / zinv_buf, np.inf).astype(np.float32)
+        depth = np.float32(1.0) / zinv_buf
     return image, depth
 
 
@@ -152,6 +154,17 @@ def _image_polygons(Pk: np.ndarray, K: np.ndarray, width: int, height: int, near
     seen &= (box[:, 2] >= box[:, 0]) & (box[:, 3] >= box[:, 1])
     box[~seen] = 0                      # never drawn; keeps inf and NaN out of the integer box
     return polygons, box, zmin, zmax, seen
+
+
+def _fixed_point(polygons: list, box: np.ndarray, drawn: np.ndarray) -> list:
+    """The outlines of the ``drawn`` surfaces for ``cv2.fillPoly`` with ``shift=4``: int32 vertices in
+    sixteenths of a pixel from each one's box corner; the unclipped quadrilaterals all at once."""
+    quads = [i for i in drawn.tolist() if len(polygons[i]) == 4]
+    corners = box[:, None, :2]
+    fixed = dict(zip(quads, np.round((np.array([polygons[i] for i in quads]).reshape(-1, 4, 2) - corners[quads]) * 16)
+                          .astype(np.int32)))
+    return [fixed[i] if i in fixed else np.round((polygons[i] - corners[i]) * 16).astype(np.int32)
+            for i in drawn.tolist()]
 
 
 def _texture_maps(arrays: dict, idx: np.ndarray, Pk: np.ndarray, R_cw: np.ndarray, K: np.ndarray, box: np.ndarray,
