@@ -82,8 +82,15 @@ def imports_of(module: str, *, homes: bool = False) -> set[str]:
     path = module_file(module)
     if path is None:
         raise ModuleNotFoundError(f"{module} has no source file")
+    return set(_imports(module, homes, path, path.stat().st_mtime_ns))
+
+
+@functools.lru_cache(maxsize=None)
+def _imports(module: str, homes: bool, path: Path, mtime_ns: int) -> frozenset[str]:
+    """:func:`imports_of` for one version of the file (a lesson's cached experiments ask for the same
+    modules' imports many times in one process)."""
     found: set[str] = set()
-    for node in ast.walk(_tree(path, path.stat().st_mtime_ns)):
+    for node in ast.walk(_tree(path, mtime_ns)):
         if isinstance(node, ast.Import):
             for alias in node.names:
                 parts = alias.name.split(".")
@@ -99,7 +106,7 @@ def imports_of(module: str, *, homes: bool = False) -> set[str]:
         elif (isinstance(node, ast.Call) and getattr(node.func, "attr", getattr(node.func, "id", "")) == "import_module"
               and node.args and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str)):
             found.add(node.args[0].value)
-    return {m for m in found if m.split(".")[0] in PACKAGES}
+    return frozenset(m for m in found if m.split(".")[0] in PACKAGES)
 
 
 def _parents(module: str) -> list[str]:
