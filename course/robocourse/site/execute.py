@@ -246,6 +246,11 @@ def kill_process_group(proc: subprocess.Popen) -> None:
 
 
 def _main(argv: list[str] | None = None) -> int:
+    # This process only reads, runs and writes one notebook. nbformat imports jsonschema, which at
+    # import builds rfc3987_syntax's grammars for the "iri" string formats (1.0-1.4 s of every
+    # notebook's run on the 2-core machine); no notebook schema uses those formats, and jsonschema
+    # leaves them out when that package cannot be imported.
+    sys.modules.setdefault("rfc3987_syntax", None)
     parser = argparse.ArgumentParser(description="robokit notebook worker (internal)")
     parser.add_argument("src", type=Path)
     parser.add_argument("dst", type=Path)
