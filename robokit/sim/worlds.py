@@ -164,7 +164,7 @@ def _door_plan(layout: str) -> tuple[list, list]:
 
 
 @functools.lru_cache(maxsize=6)
-def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
+def long_corridor(layout: str = "mixed", seed: int = 2, clutter: float = 0.0) -> World:
     """The long corridor of Ge et al. (2023): 36.10 m x 2.17 m, 0.07 m door recesses, 1.00/2.25 m doors.
 
     Parameters
@@ -174,6 +174,12 @@ def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
         and staggered in the second.
     seed : int, default 2
         Seeds textures, posters, boards and room-number plates.
+    clutter : float, default 0
+        How much the corridor departs from its repeating door pattern, as a laser sees it: the share
+        (0 to 1) of the wall stretches between doors that hold a cabinet (0.3-0.9 m long, 0.2-0.45 m
+        deep, 0.6-1.2 m high) against the wall, each at its own place. Every stretch draws its
+        cabinet and its chance whatever the share, so a larger share keeps the cabinets of a
+        smaller one and adds others. 0 (default): no cabinet, the geometry repeats every 4.5 m.
 
     Returns
     -------
@@ -184,13 +190,16 @@ def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
     Raises
     ------
     ValueError, TypeError
-        For an unknown layout or a bad seed.
+        For an unknown layout, a bad seed or a clutter share outside [0, 1].
 
     Notes
     -----
     Ge et al. (2023), Sec. 4.1 (dimensions) and Sec. 3.1, Fig. 3 and Eqs. (1)-(3) (door recesses
     in facing and staggered layouts). The door geometry repeats every 4.5 m, so LiDAR scans alias;
     plates, posters and boards make each stretch look different to a camera (their Sec. 3.2).
+    The cabinets stand for what makes the paper's real corridor only partly repetitive to its
+    LiDAR (Sec. 4.2 and Fig. 12 mark just two look-alike pairs of areas); ``info["clutter"]`` lists
+    them as ``(side, x0, x1, depth)``.
 
     Examples
     --------
@@ -199,7 +208,11 @@ def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
     (36.1, 2.17, ('north', 2.5, 3.5))
     """
     layout = as_choice(layout, "layout", ["mixed", "facing", "staggered"])
-    rng = np.random.default_rng(as_int(seed, "seed", minimum=0))
+    seed = as_int(seed, "seed", minimum=0)
+    share = as_positive(clutter, "clutter", allow_zero=True)
+    if share > 1:
+        raise ValueError(f"clutter: expected a share between 0 and 1, got {share}")
+    rng = np.random.default_rng(seed)
     L, W, D, H = 36.10, 2.17, 0.07, 2.6
     b = Builder(rng, density=100)
     north, south = _door_plan(layout)
@@ -232,8 +245,33 @@ def long_corridor(layout: str = "mixed", seed: int = 2) -> World:
             s = (g0 + 0.1) if side == "north" else (L - g0 - 0.1 - width)
             _hang(b, f"decor/{side}/{k}", a, t, s, width, 1.9, width * rng.uniform(0.6, 0.9),
                   random_decoration(rng))
+    cabinets = _cabinets(b, share, seed, L, W, doors)
     return b.world("long_corridor", (1.0, 0.0), H,
-                   info={"length": L, "width": W, "recess": D, "layout": layout, "doors": doors, "seed": seed})
+                   info={"length": L, "width": W, "recess": D, "layout": layout, "doors": doors, "seed": seed,
+                         "clutter": cabinets})
+
+
+def _cabinets(b: Builder, share: float, seed: int, length: float, width: float, doors: list) -> list:
+    """Stand a cabinet against the wall in ``share`` of the stretches between doors (and the ends);
+    drawn from their own generator, after every other surface, so the rest of the corridor is the
+    same whatever the share."""
+    rng = np.random.default_rng([seed, 1])
+    placed = []
+    for side, y in (("north", width / 2), ("south", -width / 2)):
+        edges = sorted((x0, x1) for s, x0, x1 in doors if s == side)
+        bounds = [0.0] + [e for edge in edges for e in edge] + [length]
+        for k, (g0, g1) in enumerate(zip(bounds[::2], bounds[1::2])):
+            chance, size = rng.random(), rng.uniform(0.3, 0.9)
+            depth, height = rng.uniform([0.2, 0.6], [0.45, 1.2])
+            at = rng.random()
+            room = g1 - g0 - 0.4 - size          # 0.2 m clear of each door frame (or end wall)
+            if chance >= share or room < 0:
+                continue
+            x0 = g0 + 0.2 + at * room
+            inward = -np.sign(y)
+            b.box(f"cabinet/{side}/{k}", (x0 + size / 2, y + inward * (depth / 2 + 0.005)), (size, depth, height))
+            placed.append((side, float(x0), float(x0 + size), float(depth)))
+    return placed
 
 
 @functools.lru_cache(maxsize=4)
