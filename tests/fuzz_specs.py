@@ -772,7 +772,8 @@ SPECS: dict[str, Call] = {
                                                "v": Array(np.array([1.0, 0.5]), "|N"), "omega": Array(np.array([0.3, 0.0]), "|N"),
                                                "dt": Real(0.1), "validate": Flag(True)}),
     "robokit.sim.worlds.lab_room": Call({"seed": Int(3)}, cheap=False),
-    "robokit.sim.worlds.long_corridor": Call({"layout": Choice("mixed"), "seed": Int(2)}, cheap=False),
+    "robokit.sim.worlds.long_corridor": Call({"layout": Choice("mixed"), "seed": Int(2), "clutter": Real(0.5)},
+                                              cheap=False),
     "robokit.sim.worlds.office_floor": Call({"seed": Int(1)}, cheap=False),
     "robokit.sim.worlds_outdoor.open_field": Call({"seed": Int(0), "size": Array(np.array([30.0, 20.0]), "2"),
                                                    "n_obstacles": Int(2), "shed": Flag(True), "border": Real(3.0)}, cheap=False),
@@ -1425,7 +1426,20 @@ SPECS: dict[str, Call] = {
         cheap=False),
     "robocourse.lessons.corridor_localization.real_map.global_localization_runs": Call({
         "grid": Obj(willow_section), "walls": Obj(willow_walls), "drives": Given(willow_drives), "particles": Int(200),
-        "seed": Int(0), "workers": Int(1, optional=True), "progress": Func(None, optional=True)}, cheap=False),
+        "settings": Choice("defaults"), "seed": Int(0), "workers": Int(1, optional=True),
+        "progress": Func(None, optional=True)}, cheap=False),
+    "robocourse.lessons.corridor_localization.repetition.clutter_map": Call({
+        "clutter": Real(0.5), "resolution": Real(0.1)}, cheap=False),
+    "robocourse.lessons.corridor_localization.repetition.clutter_comparison": Call({
+        "shares": Array(np.array([1.0]), "N", optional=True), "settings": Given(["defaults"]), "runs": Int(1, optional=True),
+        "length": Real(1.0, optional=True), "seed": Int(0), "cache": Flag(False),
+        "progress": Func(None, optional=True)}, cheap=False),
+    "robocourse.lessons.corridor_localization.trials.amcl_localizer": Call({
+        "grid": Obj(willow_section), "field": Obj(None, optional=True), "lidar": Obj(corridor_lidar),
+        "settings": Choice("turtlebot2"), "particles": Int(600), "rng": Rng(0)}),
+    "robocourse.lessons.corridor_localization.experiment.mapping_grid": Call({
+        "world": Obj(corridor_world), "lidar": Obj(corridor_lidar), "poses": Array(np.array([[5.0, 0.0, 0.0]]), "N,3"),
+        "resolution": Real(0.1)}, cheap=False),
     "robocourse.lessons.corridor_localization.real_map.real_map_comparison": Call({
         "setup": Obj(corridor_setup), "runs": Int(1, optional=True), "length": Real(1.0, optional=True), "seed": Int(0),
         "cache": Flag(False), "progress": Func(None, optional=True)}, cheap=False),
@@ -1966,6 +1980,9 @@ EXTRA: tuple[str, ...] = (
     "robokit.sim.motion.waypoint_path", "robokit.sim.layout.Layout", "robokit.sim.runs.describe_sensor",
     "robocourse.lessons.visual_slam.exercises.robust_pose_problems",
     "robocourse.lessons.corridor_localization.trials.corridor_localizer",
+    "robocourse.lessons.corridor_localization.trials.amcl_localizer",
+    "robocourse.lessons.corridor_localization.experiment.mapping_grid",
+    "robocourse.lessons.corridor_localization.repetition.clutter_map",
     # every file reader (hostile files: tests/fuzz_kinds.File)
     "robokit.files.read_npz", "robokit.mapping.topological.TopologicalMap.load",
     "robokit.vision.bag_of_words.Vocabulary.load", "robokit.vision.bow_database.BowDatabase.load",

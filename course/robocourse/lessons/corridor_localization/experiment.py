@@ -55,7 +55,7 @@ from robokit.vision import (BowDatabase, Features, Keypoints, Vocabulary, detect
                             select_keyframes, select_keyframes_orbslam)
 from robokit.vision.orb import ORB_FEATURES
 
-__all__ = ["CorridorMap", "corridor_map", "as_corridor_map", "CalibrationRun", "calibration_run",
+__all__ = ["CorridorMap", "corridor_map", "as_corridor_map", "mapping_grid", "CalibrationRun", "calibration_run",
            "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS", "corridor_lidar", "corridor_camera"]
 
 
@@ -531,15 +531,59 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress
                        data["kf_truth"], data["times"], data["poses"], int(data["frame_count"]), f_min, key)
 
 
+def mapping_grid(world: World, lidar: Lidar, poses: Any, resolution: float = 0.05) -> OccupancyGrid:
+    """The occupancy grid of a mapping run: ``lidar``'s scans at ``poses`` in a corridor ``world``.
+
+    Parameters
+    ----------
+    world : robokit.sim.World
+        A corridor (:func:`robokit.sim.long_corridor`: its ``info`` gives the length and width).
+    lidar : robokit.sim.Lidar
+    poses : array_like, shape (N, 3)
+        Where each scan is taken (the grid uses these true poses: the paper's Gmapping output).
+    resolution : float, default 0.05
+        Cell size (m, 0.01 to 1).
+
+    Returns
+    -------
+    robokit.mapping.OccupancyGrid
+        Over the corridor and 0.5 m around it; the scans' noise is seeded by 3.
+
+    Raises
+    ------
+    ValueError, TypeError
+        For a world that is not a corridor, a bad LiDAR, poses or resolution.
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 3.4 (the grid half of the hybrid map); Thrun et al. (2005), Table 9.1.
+
+    Examples
+    --------
+    >>> world = long_corridor()
+    >>> grid = mapping_grid(world, corridor_lidar(), [[5.0, 0.0, 0.0], [5.3, 0.0, 0.0]])
+    >>> grid.resolution, bool(grid.occupied_mask().any())
+    (0.05, True)
+    """
+    if not isinstance(world, World) or not {"length", "width"} <= set(world.info):
+        raise TypeError(f"world: expected a corridor World (robokit.sim.long_corridor), got {type(world).__name__}")
+    if not isinstance(lidar, Lidar):
+        raise TypeError(f"lidar: expected a robokit.sim Lidar, got {type(lidar).__name__}")
+    poses = as_array(poses, "poses", shape=(None, 3))
+    resolution = as_positive(resolution, "resolution")
+    if not 0.01 <= resolution <= 1.0:
+        raise ValueError(f"resolution: expected a cell size between 0.01 and 1 m, got {resolution}")
+    rng = np.random.default_rng(3)
+    scans = np.array([lidar.scan(world, p, rng) for p in poses]).reshape(len(poses), -1)
+    L, W = world.info["length"], world.info["width"]
+    return occupancy_grid_mapping(poses, scans, lidar.angles, (-0.5, -W / 2 - 0.5, L + 0.5, W / 2 + 0.5), resolution,
+                                  r_max=lidar.r_max, sensor_offset=lidar.offset)
+
+
 def _build_map(world: World, lidar: Lidar, camera: PinholeCamera, path, f_min: float, resolution: float,
                every: int, gap: int, progress: Callable | None) -> dict:
-    rng = np.random.default_rng(3)
     times, poses = path.t, path.poses
-    scans = np.array([lidar.scan(world, p, rng) for p in poses])
-    L, W = world.info["length"], world.info["width"]
-    bounds = (-0.5, -W / 2 - 0.5, L + 0.5, W / 2 + 0.5)
-    grid = occupancy_grid_mapping(poses, scans, lidar.angles, bounds, resolution, r_max=lidar.r_max,
-                                  sensor_offset=lidar.offset)
+    grid = mapping_grid(world, lidar, poses, resolution)
     # camera frames half a period after each scan: their poses are what Eq. (18) must recover
     frame_times = (times[:-1] + 0.5 * np.diff(times))[::every]
     # the true pose at each frame (the path is piecewise linear in time) is also its geo-tag: the

@@ -44,12 +44,13 @@ from scipy.sparse import csgraph
 
 from robocourse.lessons.corridor_localization.experiment import (MAPPING_ALPHAS, CorridorMap, as_corridor_map,
                                                                  corridor_lidar)
-from robocourse.lessons.corridor_localization.trials import RATE, RIGHT_PLACE, SPEED, as_tolerance, middle_line_drive
+from robocourse.lessons.corridor_localization.trials import (AMCL_SETTINGS, RATE, RIGHT_PLACE, SPEED, amcl_localizer,
+                                                             as_tolerance, middle_line_drive)
 from robocourse.source import code_version_of
 from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
 from robokit.config import fast_mode
 from robokit.geometry import wrap_angle
-from robokit.localization import KLDConfig, MonteCarloLocalizer, largest_cluster_mean
+from robokit.localization import largest_cluster_mean
 from robokit.mapping import OccupancyGrid, likelihood_field, load_map
 from robokit.parallel import map_runs
 from robokit.sim import Layout, noisy_odometry, waypoint_path
@@ -302,15 +303,13 @@ class GlobalRuns:
 
 def _one_run(shared: tuple, task: tuple) -> tuple[np.ndarray, ...]:
     """One drive ``truth`` with a filter from a uniform cloud; seeded by ``(seed, run)``."""
-    grid, field, walls, particles, seed = shared
+    grid, field, walls, particles, settings, seed = shared
     run, truth = task
     rng = np.random.default_rng([seed, run])
     lidar = corridor_lidar()
     odometry = noisy_odometry(truth, MAPPING_ALPHAS, rng)
     travelled = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(truth[:, :2], axis=0).T))])
-    mcl = MonteCarloLocalizer(grid, field=field, n_particles=particles, alphas=MAPPING_ALPHAS, r_max=lidar.r_max,
-                              sensor_offset=lidar.offset, kld=KLDConfig(min_particles=100, max_particles=particles),
-                              rng=rng)
+    mcl = amcl_localizer(grid, field, lidar, settings, particles, rng)
     mcl.initialize_uniform()
     estimates, seen, dist, held = [], [], [], []
     for k in range(len(truth)):
@@ -327,7 +326,7 @@ def _one_run(shared: tuple, task: tuple) -> tuple[np.ndarray, ...]:
 
 
 def global_localization_runs(grid: OccupancyGrid, walls: Layout, drives: list, *, particles: int = AMCL_PARTICLES,
-                             seed: int = 0, workers: int | None = None,
+                             settings: str = "defaults", seed: int = 0, workers: int | None = None,
                              progress: Callable | None = None) -> GlobalRuns:
     """amcl's global localization along each drive: a uniform cloud, then the filter as the robot moves.
 
@@ -340,7 +339,9 @@ def global_localization_runs(grid: OccupancyGrid, walls: Layout, drives: list, *
     drives : list of array_like, each (K, 3)
         True poses at 10 Hz (:func:`robokit.sim.waypoint_path`), one drive per run.
     particles : int, default 5000
-        amcl's ``max_particles`` (KLD-sampling may shrink the cloud to 100).
+        amcl's ``max_particles`` (KLD-sampling may shrink the cloud to the settings' ``min_particles``).
+    settings : {"defaults", "turtlebot2"}, default "defaults"
+        amcl's settings (:data:`~robocourse.lessons.corridor_localization.trials.AMCL_SETTINGS`).
     seed : int, default 0
         Run ``r`` is seeded by ``(seed, r)`` (odometry noise, scans, filter).
     workers : int, optional
@@ -381,10 +382,11 @@ def global_localization_runs(grid: OccupancyGrid, walls: Layout, drives: list, *
     for i, t in enumerate(truths):
         if t.shape[1] != 3 or len(t) < 2:
             raise ValueError(f"drives[{i}]: expected at least two poses of shape (3,), got shape {t.shape}")
-    particles = as_int(particles, "particles", minimum=100, maximum=100_000)
+    settings = as_choice(settings, "settings", tuple(AMCL_SETTINGS))
+    particles = as_int(particles, "particles", minimum=AMCL_SETTINGS[settings]["min_particles"], maximum=100_000)
     seed = as_int(seed, "seed", minimum=0)
     progress = as_callable(progress, "progress")
-    shared = (grid, likelihood_field(grid), walls, particles, seed)
+    shared = (grid, likelihood_field(grid), walls, particles, settings, seed)
     out = map_runs(_one_run, shared, list(enumerate(truths)), workers=workers, desc="global localization",
                    unit="run", progress=progress)
     width = max(len(run[2]) for run in out)

@@ -47,15 +47,16 @@ from robokit.controllers import CenteringResult, move_to_middle_line
 from robokit.geometry import wrap_angle
 from robokit.localization import (KLDConfig, MonteCarloLocalizer, largest_cluster_mean, largest_cluster_share,
                                   match_scan, pose_clusters)
+from robokit.mapping import LikelihoodField, OccupancyGrid
 from robokit.parallel import map_runs
-from robokit.sim import noisy_odometry, waypoint_path
+from robokit.sim import Lidar, noisy_odometry, waypoint_path
 from robokit.validation import as_array, as_callable, as_choice, as_int, as_positive, as_rng
 from robokit.vision import detect_orb_features
 
 __all__ = ["middle_line_drive", "START_POSES", "ELLIPSE_SIGMA", "CLUSTER_SHARE", "PARTICLES", "SETTLE", "RIGHT_PLACE",
            "REFINE_WINDOW", "REFINE_STEPS", "REFINE_LEVELS", "refine_pose", "as_tolerance", "retrieve_pose",
            "localization_trial", "localization_trials", "corridor_localizer", "PAPER_TOLERANCE", "TrialResult",
-           "TrialSet"]
+           "TrialSet", "AMCL_SETTINGS", "amcl_localizer"]
 
 
 #: The paper's success criterion (Sec. 4.1): 0.05 m and 0.5 degrees.
@@ -183,7 +184,22 @@ METHODS = ("amcl", "ours")
 #: Particles per method (Table 2): AMCL spreads 500 over the map and, by KLD-sampling, may shrink to
 #: ROS's minimum of 100; ours keeps 50.
 PARTICLES = {"amcl": 500, "ours": 50}
-AMCL_KLD = KLDConfig(min_particles=100, max_particles=500)
+#: amcl's settings the lesson compares; everything not named is ROS's default
+#: (:data:`robokit.localization.AMCL_DEFAULTS`). ``"defaults"``: ROS's defaults with the robot's own
+#: odometry noise (:data:`MAPPING_ALPHAS`), Table 2's AMCL here. ``"turtlebot2"``: what ROS's TurtleBot 2
+#: navigation package gives amcl on the Kobuki base the paper's robot is built on (Sec. 4.1;
+#: turtlebot_apps, ``turtlebot_navigation/launch/includes/amcl.launch.xml``): 500 to 2000 particles,
+#: kld_err 0.05, z_hit = z_rand = 0.5, 60 beams, an update every 0.25 m or 0.2 rad, resampling at each,
+#: and odometry alphas (0.6, 0.2, 0.8, 0.2) of ROS's "diff" model. That model takes them as standard
+#: deviations per squared motion, robokit as variances per squared motion (robokit.localization.mcl's
+#: notes), so they enter here matched at one update's motion (0.25 m, 0.2 rad): (0.6 x 0.2)^2,
+#: (0.2 x 0.25)^2, (0.8 x 0.25)^2 and (0.2 x 0.2)^2.
+AMCL_SETTINGS = {
+    "defaults": {"min_particles": 100, "kld_err": 0.01, "alphas": MAPPING_ALPHAS, "z_hit": 0.95, "z_rand": 0.05,
+                 "max_beams": 30, "update_min_d": 0.2, "update_min_a": float(np.pi / 6), "resample_interval": 2},
+    "turtlebot2": {"min_particles": 500, "kld_err": 0.05, "alphas": (0.0144, 0.0025, 0.04, 0.0016), "z_hit": 0.5,
+                   "z_rand": 0.5, "max_beams": 60, "update_min_d": 0.25, "update_min_a": 0.2, "resample_interval": 1},
+}
 #: The share of the particles the largest cluster must hold to count as "a single cluster".
 CLUSTER_SHARE = 0.95
 #: Ours: the ellipse of Eq. (19) around the retrieved keyframe, (along, across) the corridor in metres.
@@ -359,9 +375,61 @@ def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0) -> MonteCa
     setup = as_corridor_map(setup)
     method = as_choice(method, "method", METHODS)
     lidar = setup.lidar
+    if method == "amcl":
+        return amcl_localizer(setup.grid, setup.field, lidar, "defaults", PARTICLES["amcl"], rng)
     return MonteCarloLocalizer(setup.grid, field=setup.field, n_particles=PARTICLES[method], alphas=MAPPING_ALPHAS,
-                               r_max=lidar.r_max, sensor_offset=lidar.offset,
-                               kld=AMCL_KLD if method == "amcl" else None, rng=rng)
+                               r_max=lidar.r_max, sensor_offset=lidar.offset, rng=rng)
+
+
+def amcl_localizer(grid: OccupancyGrid, field: LikelihoodField | None, lidar: Lidar, settings: str = "defaults",
+                   particles: int = 500, rng: Any = 0) -> MonteCarloLocalizer:
+    """amcl with one of :data:`AMCL_SETTINGS` for ``lidar`` on ``grid`` (not yet initialised).
+
+    Parameters
+    ----------
+    grid : robokit.mapping.OccupancyGrid
+    field : robokit.mapping.LikelihoodField, optional
+        The grid's likelihood field (default: made from ``grid``).
+    lidar : robokit.sim.Lidar
+        Its range and mounting enter the laser model.
+    settings : {"defaults", "turtlebot2"}, default "defaults"
+    particles : int, default 500
+        amcl's ``max_particles``, the size of a global start's cloud (at least the settings'
+        ``min_particles``, to which KLD-sampling may shrink it).
+    rng : Generator or int, default 0
+
+    Returns
+    -------
+    robokit.localization.MonteCarloLocalizer
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a bad grid, field, LiDAR, settings name or particle count.
+
+    Notes
+    -----
+    Thrun et al. (2005), Table 8.3 with KLD-sampling (Table 8.4), as ROS amcl runs them; Ge et al.
+    (2023), Table 2 (AMCL with 500 particles; the settings are our reading, :data:`AMCL_SETTINGS`).
+
+    Examples
+    --------
+    >>> from robocourse.lessons.corridor_localization.experiment import corridor_map
+    >>> setup = corridor_map(fast=True)
+    >>> mcl = amcl_localizer(setup.grid, setup.field, setup.lidar, "turtlebot2", 2000)
+    >>> mcl.n_particles, mcl.kld.min_particles, mcl.model["max_beams"]
+    (2000, 500, 60)
+    """
+    if not isinstance(lidar, Lidar):
+        raise TypeError(f"lidar: expected a robokit.sim Lidar, got {type(lidar).__name__}")
+    s = AMCL_SETTINGS[as_choice(settings, "settings", tuple(AMCL_SETTINGS))]
+    particles = as_int(particles, "particles", minimum=s["min_particles"], maximum=100_000)
+    kld = KLDConfig(min_particles=s["min_particles"], max_particles=particles, epsilon=s["kld_err"])
+    return MonteCarloLocalizer(grid, field=field, n_particles=particles, alphas=s["alphas"], z_hit=s["z_hit"],
+                               z_rand=s["z_rand"], r_max=lidar.r_max, max_beams=s["max_beams"],
+                               sensor_offset=lidar.offset, update_min_d=s["update_min_d"],
+                               update_min_a=s["update_min_a"], resample_interval=s["resample_interval"], kld=kld,
+                               rng=rng)
 
 
 def refine_pose(setup: CorridorMap, pose: Any, scan: Any) -> np.ndarray:

@@ -1,0 +1,174 @@
+"""Lesson 03: AMCL from a uniform start against how repetitive the corridor is, under two amcl settings.
+
+Ge et al. (2023), Table 2, report AMCL with 500 particles reaching the paper's 0.05 m / 0.5 degree
+criterion in 47.3 % and 52.9 % of runs after 9.43 m and 12.27 m, in a corridor whose LiDAR scans
+repeat in only two pairs of areas (Sec. 4.2, Fig. 12). The lesson's corridor repeats its door
+geometry every 4.5 m along its whole length. This module asks which of two things decides AMCL's
+result there: the corridor's repetitiveness, set by :func:`robokit.sim.long_corridor`'s ``clutter``
+(the share of wall stretches with a cabinet of their own), or amcl's settings
+(:data:`~robocourse.lessons.corridor_localization.trials.AMCL_SETTINGS`: ROS's defaults, as the
+lesson's Table 2 runs AMCL, or what ROS's TurtleBot 2 package sets for the Kobuki base of the
+paper's robot, whose ``min_particles`` is Table 2's 500).
+
+- :func:`clutter_map` makes a corridor and the grid of its mapping run (laser only: AMCL needs no
+  camera).
+- :func:`clutter_comparison` runs the same drives, from Table 2's ten start poses
+  (:data:`~robocourse.lessons.corridor_localization.trials.START_POSES`), with each setting in each
+  corridor (:func:`~robocourse.lessons.corridor_localization.real_map.global_localization_runs`), and
+  caches them like the lesson's other datasets.
+
+References
+----------
+.. [1] G. Ge, Y. Zhang, W. Wang, L. Hu, Y. Wang and Q. Jiang, "Visual-feature-assisted mobile robot
+   localization in a long corridor environment", *Frontiers of Information Technology & Electronic
+   Engineering* 24(6), 876-889, 2023, doi:10.1631/FITEE.2200208.
+.. [2] S. Thrun, W. Burgard and D. Fox, *Probabilistic Robotics*, MIT Press, 2005.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+from robocourse.lessons.corridor_localization.experiment import corridor_lidar, mapping_grid
+from robocourse.lessons.corridor_localization.real_map import GlobalRuns, global_localization_runs
+from robocourse.lessons.corridor_localization.trials import AMCL_SETTINGS, START_POSES, middle_line_drive
+from robocourse.source import code_version_of
+from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
+from robokit.config import fast_mode
+from robokit.mapping import OccupancyGrid
+from robokit.sim import World, corridor_path, long_corridor
+from robokit.validation import as_array, as_callable, as_choice, as_int, as_positive
+
+__all__ = ["SHARES", "PARTICLES", "RUNS", "DRIVE_LENGTH", "clutter_map", "clutter_comparison"]
+
+#: Clutter shares compared: (full size, fast mode).
+SHARES = ((0.0, 0.5, 1.0), (0.0, 1.0))
+#: amcl's ``max_particles`` per setting: Table 2's 500 for ROS's defaults, TurtleBot 2's 2000.
+PARTICLES = {"defaults": 500, "turtlebot2": 2000}
+#: Drives per start pose and metres per drive: (full size, fast mode); fast mode uses the first
+#: three start poses.
+RUNS, DRIVE_LENGTH = (2, 1), (20.0, 10.0)
+
+
+def clutter_map(clutter: float = 0.0, *, resolution: float = 0.05) -> tuple[World, OccupancyGrid]:
+    """The lesson's corridor with ``clutter`` and the grid of its mapping run (laser only).
+
+    Parameters
+    ----------
+    clutter : float, default 0
+        :func:`robokit.sim.long_corridor`'s share of wall stretches with a cabinet (0 to 1).
+    resolution : float, default 0.05
+        Grid cell size (m).
+
+    Returns
+    -------
+    (World, OccupancyGrid)
+
+    Raises
+    ------
+    ValueError, TypeError
+        For a share outside [0, 1] or a bad resolution.
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 3.4 and Sec. 4: the mapping run drives the middle line at 0.3 m/s with
+    a scan every 0.1 s (:func:`~robocourse.lessons.corridor_localization.experiment.mapping_grid`).
+
+    Examples
+    --------
+    >>> world, grid = clutter_map(1.0)
+    >>> len(world.info["clutter"]) > 10, grid.resolution
+    (True, 0.05)
+    """
+    share = as_positive(clutter, "clutter", allow_zero=True)     # before the cached builder, which hashes it
+    if share > 1:
+        raise ValueError(f"clutter: expected a share between 0 and 1, got {share}")
+    world = long_corridor(clutter=share)
+    return world, mapping_grid(world, corridor_lidar(), corridor_path(world, speed=0.3, rate=10.0).poses, resolution)
+
+
+_FIELDS = ("estimates", "truth", "travelled", "particles")
+
+
+def clutter_comparison(*, shares: Any = None, settings: Any = tuple(AMCL_SETTINGS), runs: int | None = None,
+                       length: float | None = None, seed: int = 0, cache: bool = True,
+                       progress: Callable | None = None) -> dict[str, dict[float, GlobalRuns]]:
+    """AMCL from a uniform start along the same drives, per setting and clutter share.
+
+    Parameters
+    ----------
+    shares : sequence of float, optional
+        Clutter shares, each in [0, 1] (default :data:`SHARES`: 0, 0.5, 1; 0 and 1 in fast mode).
+    settings : sequence of str, default both of ``AMCL_SETTINGS``
+        amcl's settings, each with :data:`PARTICLES`.
+    runs : int, optional
+        Drives per start pose (default :data:`RUNS`: 2; 1 in fast mode, from the first three poses).
+    length : float, optional
+        Metres per drive (default :data:`DRIVE_LENGTH`: 20; 10 in fast mode; at most 100).
+    seed : int, default 0
+        Drive ``r`` is seeded by ``(seed, r)`` in every corridor and setting, so they share the
+        odometry noise, the scans' noise where the corridors agree, and the filters' draws.
+    cache : bool, default True
+        Load from / save to ``cache_dir("corridor")``, keyed by the parameters and the code.
+    progress : callable ``(done, total)``, optional
+
+    Returns
+    -------
+    dict
+        ``{setting: {share: GlobalRuns}}``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a bad share, setting or parameter.
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 4.1 and Table 2 (AMCL from particles scattered over the whole map); the
+    drives start at Table 2's ten poses and follow the middle line, turning 0.8 m before an end.
+
+    Examples
+    --------
+    >>> out = clutter_comparison(shares=[0.0], settings=["defaults"], runs=1, length=2.0, cache=False)
+    >>> list(out), list(out["defaults"]), out["defaults"][0.0].errors.shape[0]
+    (['defaults'], [0.0], 10)
+    """
+    fast = fast_mode()
+    shares = SHARES[fast] if shares is None else as_array(shares, "shares", shape=(None,))
+    if not len(shares) or np.any((np.asarray(shares) < 0) | (np.asarray(shares) > 1)):
+        raise ValueError(f"shares: expected one or more clutter shares in [0, 1], got {list(shares)}")
+    shares = [float(s) for s in shares]
+    if isinstance(settings, str) or not hasattr(settings, "__iter__"):
+        raise TypeError(f"settings: expected a sequence of names of AMCL_SETTINGS, got {type(settings).__name__}")
+    settings = [as_choice(s, "settings", tuple(AMCL_SETTINGS)) for s in settings]
+    if not settings:
+        raise ValueError("settings: expected at least one name of AMCL_SETTINGS, got none")
+    runs = RUNS[fast] if runs is None else as_int(runs, "runs", minimum=1, maximum=100)
+    length = DRIVE_LENGTH[fast] if length is None else as_positive(length, "length")
+    if length > 100:
+        raise ValueError(f"length: expected at most 100 m, got {length}")
+    seed = as_int(seed, "seed", minimum=0)
+    progress = as_callable(progress, "progress")
+    starts = START_POSES[:3] if fast else START_POSES
+    meta = {"shares": shares, "settings": settings, "particles": PARTICLES, "runs": runs, "length": length,
+            "seed": seed, "starts": [list(s) for s in starts], "amcl": AMCL_SETTINGS, "code": code_version_of(__name__)}
+    target = cache_dir("corridor") / f"clutter-{cache_key(**meta)}.npz"
+    names = [f"{name}_{k}_{f}" for name in settings for k in range(len(shares)) for f in _FIELDS]
+    if cache:
+        data = read_arrays(target, names, meta)
+        if data is not None:
+            return {name: {share: GlobalRuns(*(data[f"{name}_{k}_{f}"] for f in _FIELDS))
+                           for k, share in enumerate(shares)} for name in settings}
+    out: dict[str, dict[float, GlobalRuns]] = {name: {} for name in settings}
+    for share in shares:
+        world, grid = clutter_map(share)
+        walls = world.layout(corridor_lidar().height)
+        drives = [middle_line_drive(start, world.info["length"], length) for start in starts for _ in range(runs)]
+        for name in settings:
+            out[name][share] = global_localization_runs(grid, walls, drives, particles=PARTICLES[name],
+                                                        settings=name, seed=seed, progress=progress)
+    if cache:
+        write_arrays(target, {f"{name}_{k}_{f}": getattr(out[name][share], f) for name in settings
+                              for k, share in enumerate(shares) for f in _FIELDS}, meta)
+    return out
