@@ -1432,6 +1432,7 @@ SPECS: dict[str, Call] = {
         "clutter": Real(0.5), "resolution": Real(0.1)}, cheap=False),
     "robocourse.lessons.corridor_localization.repetition.clutter_comparison": Call({
         "shares": Array(np.array([1.0]), "N", optional=True), "settings": Given(["defaults"]), "runs": Int(1, optional=True),
+        "positions": Given([0]),
         "length": Real(1.0, optional=True), "seed": Int(0), "cache": Flag(False),
         "progress": Func(None, optional=True)}, cheap=False),
     "robocourse.lessons.corridor_localization.trials.amcl_localizer": Call({

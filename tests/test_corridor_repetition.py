@@ -73,11 +73,17 @@ def test_the_default_settings_are_table_2s_amcl_and_turtlebot2s_are_its_package(
     assert (t.n_particles, t.kld.min_particles, t.kld.max_particles, t.kld.epsilon) == (2000, 500, 2000, 0.05)
     assert (t.model["z_hit"], t.model["z_rand"], t.model["max_beams"]) == (0.5, 0.5, 60)
     assert (t.update_min_d, t.update_min_a, t.resample_interval) == (0.25, 0.2, 1)
-    # TurtleBot 2's diff-model alphas (0.6, 0.2, 0.8, 0.2), standard deviations per squared motion,
-    # as robokit's variances per squared motion at one update's 0.25 m and 0.2 rad
-    expected = [(0.6 * 0.2) ** 2, (0.2 * 0.25) ** 2, (0.8 * 0.25) ** 2, (0.2 * 0.2) ** 2]
-    assert np.allclose(t.alphas, expected)
-    assert set(AMCL_SETTINGS) == {"defaults", "turtlebot2"}
+    # turtlebot_navigation's amcl.launch.xml: odom_alpha1..4 = 0.2 in ROS's diff model, standard deviations
+    # per squared motion; robokit's are variances per squared motion, matched at one update's 0.25 m and
+    # 0.2 rad. The translation noise of one update, sqrt(alpha3) x 0.25 m, is then ROS's 0.2 x 0.25^2 m.
+    ros, step, turn = 0.2, t.update_min_d, t.update_min_a
+    assert np.allclose(t.alphas, [(ros * turn) ** 2, (ros * step) ** 2, (ros * step) ** 2, (ros * turn) ** 2])
+    assert np.sqrt(t.alphas[2]) * step == pytest.approx(ros * step ** 2)
+    # amcl's diff-corrected model reads the same 0.2 as variances, as robokit does: sqrt(0.2) x 0.25 m a step
+    c = amcl_localizer(grid, None, lidar, "turtlebot2-corrected", 2000)
+    assert np.allclose(c.alphas, ros) and (c.n_particles, c.kld.min_particles, c.model["max_beams"]) == (2000, 500, 60)
+    assert np.sqrt(c.alphas[2]) * step > 8 * np.sqrt(t.alphas[2]) * step
+    assert set(AMCL_SETTINGS) == {"defaults", "turtlebot2", "turtlebot2-corrected"}
 
 
 @pytest.mark.parametrize("kwargs, match", [({"settings": "ros"}, "settings"),
@@ -100,9 +106,26 @@ def test_the_mapping_grid_names_a_bad_argument():
         mapping_grid(world, lidar, [[5.0, 0.0, 0.0]], resolution=5.0)
 
 
+def test_the_clutter_map_holds_the_cabinets():
+    world, grid = repetition.clutter_map(1.0)
+    assert world is long_corridor(clutter=1.0)
+    occupied = grid.occupied_mask()
+    mapped = []
+    for side, x0, x1, depth in world.info["clutter"]:
+        face = (world.info["width"] / 2 - depth - 0.005) * (1 if side == "north" else -1)
+        (ij, inside) = grid.cell_of(np.array([[(x0 + x1) / 2, face]]))       # the cells the laser hit at its face
+        mapped.append(inside.all() and occupied[ij[0, 0] - 1:ij[0, 0] + 2, ij[0, 1]].any())
+    # a face just short of a cell's far edge can stay free: the beams that cross the cell on their way
+    # to the face further along outvote the few that end in it (15 of the 17 are mapped)
+    assert len(mapped) == 17 and np.mean(mapped) >= 0.8
+    plain = repetition.clutter_map(0.0)[1]
+    assert occupied.sum() > plain.occupied_mask().sum()
+
+
 def test_the_comparison_runs_the_same_drives_everywhere_and_comes_back_from_the_cache(tmp_path, monkeypatch):
     monkeypatch.setenv("ROBOKIT_CACHE", str(tmp_path))
-    kw = dict(shares=[1.0], runs=1, length=1.5, seed=3, progress=None)
+    kw = dict(shares=[1.0], settings=["defaults", "turtlebot2"], runs=1, positions=range(10), length=1.5, seed=3,
+              progress=None)
     out = repetition.clutter_comparison(**kw)
     assert list(out) == ["defaults", "turtlebot2"] and list(out["defaults"]) == [1.0]
     d, t = out["defaults"][1.0], out["turtlebot2"][1.0]
@@ -124,7 +147,9 @@ def test_the_comparison_runs_the_same_drives_everywhere_and_comes_back_from_the_
 @pytest.mark.parametrize("kwargs, match", [({"shares": [1.5]}, "shares"), ({"shares": []}, "shares"),
                                            ({"settings": "defaults"}, "settings"), ({"settings": ["ros"]}, "settings"),
                                            ({"settings": []}, "settings"), ({"length": 200.0}, "length"),
-                                           ({"runs": 0}, "runs")])
+                                           ({"runs": 0}, "runs"), ({"shares": [0.5, 0.5]}, "shares"),
+                                           ({"positions": [10]}, "positions"), ({"positions": []}, "positions"),
+                                           ({"positions": 3}, "positions")])
 def test_the_comparison_names_a_bad_argument(kwargs, match):
     with pytest.raises((ValueError, TypeError), match=match):
         repetition.clutter_comparison(cache=False, **kwargs)

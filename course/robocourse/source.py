@@ -82,31 +82,40 @@ def imports_of(module: str, *, homes: bool = False) -> set[str]:
     path = module_file(module)
     if path is None:
         raise ModuleNotFoundError(f"{module} has no source file")
-    return set(_imports(module, homes, path, path.stat().st_mtime_ns))
+    found: set[str] = set()
+    # what the file itself says is walked once per version of it; which module defines a name is
+    # looked up every time, since other files (a package's __init__, a new module) decide that
+    for kind, base, name in _import_statements(module, path, path.stat().st_mtime_ns):
+        if kind == "import":
+            parts = base.split(".")
+            found.update(".".join(parts[:i]) for i in range(1, len(parts) + 1))
+        elif kind == "from":                       # `from pkg import mod` imports the module pkg.mod
+            sub = f"{base}.{name}"
+            if module_file(sub) is not None:
+                found.add(sub)
+            else:
+                found.add(_home(base, name) if homes else base)
+        else:
+            found.add(base)
+    return {m for m in found if m.split(".")[0] in PACKAGES}
 
 
 @functools.lru_cache(maxsize=None)
-def _imports(module: str, homes: bool, path: Path, mtime_ns: int) -> frozenset[str]:
-    """:func:`imports_of` for one version of the file (a lesson's cached experiments ask for the same
-    modules' imports many times in one process)."""
-    found: set[str] = set()
+def _import_statements(module: str, path: Path, mtime_ns: int) -> tuple[tuple[str, str, str], ...]:
+    """The import statements of one version of a file, as ``(kind, module, name)``: ``("import", "a.b", "")``,
+    ``("from", absolute base, imported name)`` and ``("dynamic", "a.b", "")`` for ``import_module("a.b")``
+    (a lesson's cached experiments ask for the same modules' imports many times in one process)."""
+    found = []
     for node in ast.walk(_tree(path, mtime_ns)):
         if isinstance(node, ast.Import):
-            for alias in node.names:
-                parts = alias.name.split(".")
-                found.update(".".join(parts[:i]) for i in range(1, len(parts) + 1))
+            found.extend(("import", alias.name, "") for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
             base = _absolute(module, path, node)
-            for alias in node.names:  # `from pkg import mod` imports the module pkg.mod
-                sub = f"{base}.{alias.name}"
-                if module_file(sub) is not None:
-                    found.add(sub)
-                else:
-                    found.add(_home(base, alias.name) if homes else base)
+            found.extend(("from", base, alias.name) for alias in node.names)
         elif (isinstance(node, ast.Call) and getattr(node.func, "attr", getattr(node.func, "id", "")) == "import_module"
               and node.args and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str)):
-            found.add(node.args[0].value)
-    return frozenset(m for m in found if m.split(".")[0] in PACKAGES)
+            found.append(("dynamic", node.args[0].value, ""))
+    return tuple(found)
 
 
 def _parents(module: str) -> list[str]:

@@ -197,9 +197,10 @@ def long_corridor(layout: str = "mixed", seed: int = 2, clutter: float = 0.0) ->
     Ge et al. (2023), Sec. 4.1 (dimensions) and Sec. 3.1, Fig. 3 and Eqs. (1)-(3) (door recesses
     in facing and staggered layouts). The door geometry repeats every 4.5 m, so LiDAR scans alias;
     plates, posters and boards make each stretch look different to a camera (their Sec. 3.2).
-    The cabinets stand for what makes the paper's real corridor only partly repetitive to its
-    LiDAR (Sec. 4.2 and Fig. 12 mark just two look-alike pairs of areas); ``info["clutter"]`` lists
-    them as ``(side, x0, x1, depth)``.
+    The cabinets are our device for grading how repetitive the corridor is to a laser, not the
+    paper's: its corridor has many symmetrical and similar areas (Sec. 4; Sec. 4.2 names two pairs),
+    and it removed fire extinguishers and garbage cans before its runs (Sec. 4).
+    ``info["clutter"]`` lists them as ``(side, x0, x1, depth)``.
 
     Examples
     --------

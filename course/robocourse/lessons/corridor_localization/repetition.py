@@ -1,14 +1,17 @@
 """Lesson 03: AMCL from a uniform start against how repetitive the corridor is, under two amcl settings.
 
 Ge et al. (2023), Table 2, report AMCL with 500 particles reaching the paper's 0.05 m / 0.5 degree
-criterion in 47.3 % and 52.9 % of runs after 9.43 m and 12.27 m, in a corridor whose LiDAR scans
-repeat in only two pairs of areas (Sec. 4.2, Fig. 12). The lesson's corridor repeats its door
-geometry every 4.5 m along its whole length. This module asks which of two things decides AMCL's
-result there: the corridor's repetitiveness, set by :func:`robokit.sim.long_corridor`'s ``clutter``
-(the share of wall stretches with a cabinet of their own), or amcl's settings
-(:data:`~robocourse.lessons.corridor_localization.trials.AMCL_SETTINGS`: ROS's defaults, as the
-lesson's Table 2 runs AMCL, or what ROS's TurtleBot 2 package sets for the Kobuki base of the
-paper's robot, whose ``min_particles`` is Table 2's 500).
+criterion in 47.3 % and 52.9 % of runs after 9.43 m and 12.27 m. They call their corridor one with
+many symmetrical and similar areas (Sec. 4) and name two pairs of look-alike areas as examples (Sec.
+4.2, Fig. 12); they do not list amcl's settings. The lesson's corridor repeats its door geometry
+exactly every 4.5 m along its whole length. This module asks how much each of two things moves
+AMCL's result there: the corridor's repetitiveness, set by :func:`robokit.sim.long_corridor`'s
+``clutter`` (the share of wall stretches with a cabinet of their own: our device, not the paper's,
+which removed fire extinguishers and garbage cans from its corridor, Sec. 4), and amcl's settings
+(:data:`~robocourse.lessons.corridor_localization.trials.AMCL_SETTINGS`: what ROS's TurtleBot 2
+package sets for the Kobuki base of the paper's robot, whose ``min_particles`` is Table 2's 500, with
+amcl's "diff" odometry model as shipped or its "diff-corrected" one; the lesson's Table 2 runs ROS's
+defaults).
 
 - :func:`clutter_map` makes a corridor and the grid of its mapping run (laser only: AMCL needs no
   camera).
@@ -40,12 +43,15 @@ from robokit.mapping import OccupancyGrid
 from robokit.sim import World, corridor_path, long_corridor
 from robokit.validation import as_array, as_callable, as_choice, as_int, as_positive
 
-__all__ = ["SHARES", "PARTICLES", "RUNS", "DRIVE_LENGTH", "clutter_map", "clutter_comparison"]
+__all__ = ["SHARES", "PARTICLES", "SETTINGS", "RUNS", "DRIVE_LENGTH", "clutter_map", "clutter_comparison"]
 
 #: Clutter shares compared: (full size, fast mode).
 SHARES = ((0.0, 0.5, 1.0), (0.0, 1.0))
 #: amcl's ``max_particles`` per setting: Table 2's 500 for ROS's defaults, TurtleBot 2's 2000.
-PARTICLES = {"defaults": 500, "turtlebot2": 2000}
+PARTICLES = {"defaults": 500, "turtlebot2": 2000, "turtlebot2-corrected": 2000}
+#: The settings compared by default: TurtleBot 2's, with amcl's "diff" and "diff-corrected" odometry models
+#: (Table 2 above runs ROS's defaults).
+SETTINGS = ("turtlebot2", "turtlebot2-corrected")
 #: Drives per start pose and metres per drive: (full size, fast mode); fast mode uses the first
 #: three start poses.
 RUNS, DRIVE_LENGTH = (2, 1), (20.0, 10.0)
@@ -91,19 +97,22 @@ def clutter_map(clutter: float = 0.0, *, resolution: float = 0.05) -> tuple[Worl
 _FIELDS = ("estimates", "truth", "travelled", "particles")
 
 
-def clutter_comparison(*, shares: Any = None, settings: Any = tuple(AMCL_SETTINGS), runs: int | None = None,
-                       length: float | None = None, seed: int = 0, cache: bool = True,
+def clutter_comparison(*, shares: Any = None, settings: Any = SETTINGS, runs: int | None = None,
+                       positions: Any = None, length: float | None = None, seed: int = 0, cache: bool = True,
                        progress: Callable | None = None) -> dict[str, dict[float, GlobalRuns]]:
     """AMCL from a uniform start along the same drives, per setting and clutter share.
 
     Parameters
     ----------
     shares : sequence of float, optional
-        Clutter shares, each in [0, 1] (default :data:`SHARES`: 0, 0.5, 1; 0 and 1 in fast mode).
-    settings : sequence of str, default both of ``AMCL_SETTINGS``
-        amcl's settings, each with :data:`PARTICLES`.
+        Clutter shares, different, each in [0, 1] (default :data:`SHARES`: 0, 0.5, 1; 0 and 1 in fast
+        mode).
+    settings : sequence of str, default :data:`SETTINGS`
+        Names of ``AMCL_SETTINGS``, each run with :data:`PARTICLES`.
     runs : int, optional
-        Drives per start pose (default :data:`RUNS`: 2; 1 in fast mode, from the first three poses).
+        Drives per start pose (default :data:`RUNS`: 2; 1 in fast mode).
+    positions : sequence of int, optional
+        Indices into Table 2's start poses (default all ten; the first three in fast mode).
     length : float, optional
         Metres per drive (default :data:`DRIVE_LENGTH`: 20; 10 in fast mode; at most 100).
     seed : int, default 0
@@ -130,15 +139,18 @@ def clutter_comparison(*, shares: Any = None, settings: Any = tuple(AMCL_SETTING
 
     Examples
     --------
-    >>> out = clutter_comparison(shares=[0.0], settings=["defaults"], runs=1, length=2.0, cache=False)
+    >>> out = clutter_comparison(shares=[0.0], settings=["defaults"], runs=1, positions=[0, 5], length=2.0,
+    ...                          cache=False)
     >>> list(out), list(out["defaults"]), out["defaults"][0.0].errors.shape[0]
-    (['defaults'], [0.0], 10)
+    (['defaults'], [0.0], 2)
     """
     fast = fast_mode()
     shares = SHARES[fast] if shares is None else as_array(shares, "shares", shape=(None,))
     if not len(shares) or np.any((np.asarray(shares) < 0) | (np.asarray(shares) > 1)):
         raise ValueError(f"shares: expected one or more clutter shares in [0, 1], got {list(shares)}")
     shares = [float(s) for s in shares]
+    if len(set(shares)) < len(shares):
+        raise ValueError(f"shares: expected different clutter shares, got {shares}")
     if isinstance(settings, str) or not hasattr(settings, "__iter__"):
         raise TypeError(f"settings: expected a sequence of names of AMCL_SETTINGS, got {type(settings).__name__}")
     settings = [as_choice(s, "settings", tuple(AMCL_SETTINGS)) for s in settings]
@@ -148,9 +160,15 @@ def clutter_comparison(*, shares: Any = None, settings: Any = tuple(AMCL_SETTING
     length = DRIVE_LENGTH[fast] if length is None else as_positive(length, "length")
     if length > 100:
         raise ValueError(f"length: expected at most 100 m, got {length}")
+    if positions is None:
+        positions = range(3 if fast else len(START_POSES))
+    elif isinstance(positions, (str, bytes)) or not hasattr(positions, "__iter__"):
+        raise TypeError(f"positions: expected a sequence of start indices, got {type(positions).__name__}")
+    starts = [START_POSES[as_int(p, "positions", minimum=0, maximum=len(START_POSES) - 1)] for p in positions]
+    if not starts:
+        raise ValueError("positions: expected at least one start index, got none")
     seed = as_int(seed, "seed", minimum=0)
     progress = as_callable(progress, "progress")
-    starts = START_POSES[:3] if fast else START_POSES
     meta = {"shares": shares, "settings": settings, "particles": PARTICLES, "runs": runs, "length": length,
             "seed": seed, "starts": [list(s) for s in starts], "amcl": AMCL_SETTINGS, "code": code_version_of(__name__)}
     target = cache_dir("corridor") / f"clutter-{cache_key(**meta)}.npz"

@@ -187,19 +187,23 @@ PARTICLES = {"amcl": 500, "ours": 50}
 #: amcl's settings the lesson compares; everything not named is ROS's default
 #: (:data:`robokit.localization.AMCL_DEFAULTS`). ``"defaults"``: ROS's defaults with the robot's own
 #: odometry noise (:data:`MAPPING_ALPHAS`), Table 2's AMCL here. ``"turtlebot2"``: what ROS's TurtleBot 2
-#: navigation package gives amcl on the Kobuki base the paper's robot is built on (Sec. 4.1;
-#: turtlebot_apps, ``turtlebot_navigation/launch/includes/amcl.launch.xml``): 500 to 2000 particles,
-#: kld_err 0.05, z_hit = z_rand = 0.5, 60 beams, an update every 0.25 m or 0.2 rad, resampling at each,
-#: and odometry alphas (0.6, 0.2, 0.8, 0.2) of ROS's "diff" model. That model takes them as standard
-#: deviations per squared motion, robokit as variances per squared motion (robokit.localization.mcl's
-#: notes), so they enter here matched at one update's motion (0.25 m, 0.2 rad): (0.6 x 0.2)^2,
-#: (0.2 x 0.25)^2, (0.8 x 0.25)^2 and (0.2 x 0.2)^2.
+#: navigation package gives amcl on the Kobuki base the paper's robot is built on (Sec. 4; turtlebot_apps,
+#: ``turtlebot_navigation/launch/includes/amcl/amcl.launch.xml``): 500 to 2000 particles, kld_err 0.05,
+#: z_hit = z_rand = 0.5, 60 beams, an update every 0.25 m or 0.2 rad, resampling at each, and odometry alphas
+#: of 0.2 in amcl's "diff" model, which takes them as standard deviations per squared motion; robokit takes
+#: variances per squared motion (robokit.localization.mcl's notes), so they enter matched at one update's
+#: motion (0.25 m, 0.2 rad): (0.2 x 0.2)^2 where the noise comes from turning (alpha1, alpha4), (0.2 x
+#: 0.25)^2 where it comes from driving (alpha2, alpha3). ``"turtlebot2-corrected"``: the same with amcl's
+#: "diff-corrected" model, which reads the alphas as robokit does (variances): 0.2 each, about nine times the
+#: translation noise of one update. Their ``laser_max_range`` of 12 m changes nothing here: the lesson's
+#: LiDAR returns nothing past 8 m.
 AMCL_SETTINGS = {
     "defaults": {"min_particles": 100, "kld_err": 0.01, "alphas": MAPPING_ALPHAS, "z_hit": 0.95, "z_rand": 0.05,
                  "max_beams": 30, "update_min_d": 0.2, "update_min_a": float(np.pi / 6), "resample_interval": 2},
-    "turtlebot2": {"min_particles": 500, "kld_err": 0.05, "alphas": (0.0144, 0.0025, 0.04, 0.0016), "z_hit": 0.5,
+    "turtlebot2": {"min_particles": 500, "kld_err": 0.05, "alphas": (0.0016, 0.0025, 0.0025, 0.0016), "z_hit": 0.5,
                    "z_rand": 0.5, "max_beams": 60, "update_min_d": 0.25, "update_min_a": 0.2, "resample_interval": 1},
 }
+AMCL_SETTINGS["turtlebot2-corrected"] = dict(AMCL_SETTINGS["turtlebot2"], alphas=(0.2, 0.2, 0.2, 0.2))
 #: The share of the particles the largest cluster must hold to count as "a single cluster".
 CLUSTER_SHARE = 0.95
 #: Ours: the ellipse of Eq. (19) around the retrieved keyframe, (along, across) the corridor in metres.
@@ -383,7 +387,7 @@ def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0) -> MonteCa
 
 def amcl_localizer(grid: OccupancyGrid, field: LikelihoodField | None, lidar: Lidar, settings: str = "defaults",
                    particles: int = 500, rng: Any = 0) -> MonteCarloLocalizer:
-    """amcl with one of :data:`AMCL_SETTINGS` for ``lidar`` on ``grid`` (not yet initialised).
+    """amcl with one of :data:`AMCL_SETTINGS` for ``lidar`` on ``grid``, its cloud spread over the free cells.
 
     Parameters
     ----------
@@ -392,7 +396,7 @@ def amcl_localizer(grid: OccupancyGrid, field: LikelihoodField | None, lidar: Li
         The grid's likelihood field (default: made from ``grid``).
     lidar : robokit.sim.Lidar
         Its range and mounting enter the laser model.
-    settings : {"defaults", "turtlebot2"}, default "defaults"
+    settings : {"defaults", "turtlebot2", "turtlebot2-corrected"}, default "defaults"
     particles : int, default 500
         amcl's ``max_particles``, the size of a global start's cloud (at least the settings'
         ``min_particles``, to which KLD-sampling may shrink it).
