@@ -163,7 +163,6 @@ def _door_plan(layout: str) -> tuple[list, list]:
     return north, south
 
 
-@functools.lru_cache(maxsize=6)
 def long_corridor(layout: str = "mixed", seed: int = 2, clutter: float = 0.0) -> World:
     """The long corridor of Ge et al. (2023): 36.10 m x 2.17 m, 0.07 m door recesses, 1.00/2.25 m doors.
 
@@ -202,6 +201,9 @@ def long_corridor(layout: str = "mixed", seed: int = 2, clutter: float = 0.0) ->
     and it removed fire extinguishers and garbage cans before its runs (Sec. 4).
     ``info["clutter"]`` lists them as ``(side, x0, x1, depth)``.
 
+    The world is built once per set of arguments and shared (``long_corridor.cache_clear()`` forgets
+    the built ones).
+
     Examples
     --------
     >>> corridor = long_corridor()
@@ -213,6 +215,12 @@ def long_corridor(layout: str = "mixed", seed: int = 2, clutter: float = 0.0) ->
     share = as_positive(clutter, "clutter", allow_zero=True)
     if share > 1:
         raise ValueError(f"clutter: expected a share between 0 and 1, got {share}")
+    return _long_corridor(layout, seed, share)
+
+
+@functools.lru_cache(maxsize=6)
+def _long_corridor(layout: str, seed: int, share: float) -> World:
+    """:func:`long_corridor` from checked arguments (the cache sees only those: a list would not hash)."""
     rng = np.random.default_rng(seed)
     L, W, D, H = 36.10, 2.17, 0.07, 2.6
     b = Builder(rng, density=100)
@@ -273,6 +281,9 @@ def _cabinets(b: Builder, share: float, seed: int, length: float, width: float, 
             b.box(f"cabinet/{side}/{k}", (x0 + size / 2, y + inward * (depth / 2 + 0.005)), (size, depth, height))
             placed.append((side, float(x0), float(x0 + size), float(depth)))
     return placed
+
+
+long_corridor.cache_clear = _long_corridor.cache_clear
 
 
 @functools.lru_cache(maxsize=4)

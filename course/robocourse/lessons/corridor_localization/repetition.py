@@ -87,10 +87,7 @@ def clutter_map(clutter: float = 0.0, *, resolution: float = 0.05) -> tuple[Worl
     >>> len(world.info["clutter"]) > 10, grid.resolution
     (True, 0.05)
     """
-    share = as_positive(clutter, "clutter", allow_zero=True)     # before the cached builder, which hashes it
-    if share > 1:
-        raise ValueError(f"clutter: expected a share between 0 and 1, got {share}")
-    world = long_corridor(clutter=share)
+    world = long_corridor(clutter=clutter)
     return world, mapping_grid(world, corridor_lidar(), corridor_path(world, speed=0.3, rate=10.0).poses, resolution)
 
 
