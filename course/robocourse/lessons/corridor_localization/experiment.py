@@ -503,9 +503,7 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress
     (True, 0.05)
     """
     fast = fast_mode() if fast is None else bool(fast)
-    resolution = as_positive(resolution, "resolution")
-    if not 0.01 <= resolution <= 1.0:
-        raise ValueError(f"resolution: expected a cell size between 0.01 and 1 m, got {resolution}")
+    resolution = _as_cell_size(resolution)
     progress = as_callable(progress, "progress")
     world, lidar, camera = long_corridor(), corridor_lidar(), corridor_camera()
     f_min = calibration_run(fast=fast).f_min
@@ -529,6 +527,14 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress
     kf_poses = geo_tag(data["kf_times"], data["times"], data["poses"])
     return CorridorMap(world, lidar, camera, grid, likelihood_field(grid), database, kf_poses, data["kf_times"],
                        data["kf_truth"], data["times"], data["poses"], int(data["frame_count"]), f_min, key)
+
+
+def _as_cell_size(resolution: Any) -> float:
+    """A grid cell size in metres, 0.01 to 1 (the lesson's grids), or a named error."""
+    resolution = as_positive(resolution, "resolution")
+    if not 0.01 <= resolution <= 1.0:
+        raise ValueError(f"resolution: expected a cell size between 0.01 and 1 m, got {resolution}")
+    return resolution
 
 
 def mapping_grid(world: World, lidar: Lidar, poses: Any, resolution: float = 0.05) -> OccupancyGrid:
@@ -570,9 +576,7 @@ def mapping_grid(world: World, lidar: Lidar, poses: Any, resolution: float = 0.0
     if not isinstance(lidar, Lidar):
         raise TypeError(f"lidar: expected a robokit.sim Lidar, got {type(lidar).__name__}")
     poses = as_array(poses, "poses", shape=(None, 3))
-    resolution = as_positive(resolution, "resolution")
-    if not 0.01 <= resolution <= 1.0:
-        raise ValueError(f"resolution: expected a cell size between 0.01 and 1 m, got {resolution}")
+    resolution = _as_cell_size(resolution)
     rng = np.random.default_rng(3)
     scans = np.array([lidar.scan(world, p, rng) for p in poses]).reshape(len(poses), -1)
     L, W = world.info["length"], world.info["width"]
