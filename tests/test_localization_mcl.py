@@ -124,6 +124,18 @@ def test_kld_resample_stops_where_table_8_4_stops():
     assert len(kld_resample(P * [3, 3, 6], w, rng=3, min_count=50, max_count=700)) == 700
 
 
+@pytest.mark.parametrize("far", [40.0, 1e17])      # bins on both sides of zero; spans too wide for one integer
+def test_kld_resample_counts_the_bins_of_any_spread_the_way_the_loop_does(far):
+    rng = np.random.default_rng(4)
+    P = np.column_stack([rng.uniform(-far, far, 2000), rng.uniform(-3, 3, 2000), rng.uniform(-np.pi, np.pi, 2000)])
+    P[:1500] = P[rng.integers(0, 40, 1500)]                  # many particles share a few bins
+    out = kld_resample(P, np.ones(2000), rng=1, min_count=10, max_count=3000)
+    keys = pose_bins(out)
+    k_at = np.array([len({tuple(b) for b in keys[:m]}) for m in range(1, len(out) + 1)])
+    ok = (np.arange(1, len(out) + 1) >= kld_sample_count(k_at)) & (np.arange(1, len(out) + 1) >= 10)
+    assert (ok[-1] or len(out) == 3000) and not ok[:-1].any()
+
+
 # --- normalisation and the estimate ----------------------------------------------------------------
 def test_normalise_recovers_from_all_zero_weights_without_nan():
     out = normalise_log_weights(np.full(5, -np.inf))

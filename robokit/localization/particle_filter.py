@@ -277,6 +277,21 @@ def pose_bins(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarray:
     return np.floor(P / size).astype(np.int64)
 
 
+def _first_in_bin(keys: np.ndarray) -> np.ndarray:
+    """Indices of the first row of each distinct row of the integer ``keys`` (N, 3).
+
+    The same indices as ``np.unique(keys, axis=0, return_index=True)[1]``, from one integer per row
+    (the bins counted from the smallest in each axis) when those fit in 62 bits: a sort of N
+    integers instead of N rows.
+    """
+    lo = keys.min(axis=0)
+    span = keys.max(axis=0) - lo + 1
+    if float(np.prod(span.astype(float))) >= 2.0 ** 62:
+        return np.unique(keys, axis=0, return_index=True)[1]
+    flat = ((keys[:, 0] - lo[0]) * span[1] + (keys[:, 1] - lo[1])) * span[2] + (keys[:, 2] - lo[2])
+    return np.unique(flat, return_index=True)[1]
+
+
 def kld_resample(particles: Any, weights: Any, rng: Any = None, *, min_count: int = 100,
                  max_count: int = 5000, epsilon: float = 0.01, z: float = KLD_Z_99,
                  bin_size: Any = ROS_KLD_BIN_SIZE, random_pose: Any = None,
@@ -343,10 +358,8 @@ def kld_resample(particles: Any, weights: Any, rng: Any = None, *, min_count: in
     injected = g.random(hi) < p_inj                                  # Table 8.3, max(0, 1 - w_fast / w_slow)
     if injected.any():
         cand[injected] = as_planar(random_pose(int(injected.sum()), g), "random_pose(n, rng)", shape=(None, 3))
-    keys = pose_bins(cand, bin_size)
-    _, first = np.unique(keys, axis=0, return_index=True)
     new_bin = np.zeros(hi, dtype=bool)
-    new_bin[first] = True
+    new_bin[_first_in_bin(pose_bins(cand, bin_size))] = True
     k = np.cumsum(new_bin)                                           # Table 8.4, lines 11-13
     m = np.arange(1, hi + 1)
     needed = kld_sample_count(k, epsilon=epsilon, z=z)               # line 15
