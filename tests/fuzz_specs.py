@@ -1386,7 +1386,8 @@ SPECS: dict[str, Call] = {
         "bin_size": Array(np.array([0.5, 0.5, 0.17]), "3"),
         "labels": Array(np.array([0, 0, 1]), "N", optional=True)}),
     "robocourse.lessons.corridor_localization.trials.corridor_localizer": Call({
-        "setup": Obj(corridor_setup), "method": Choice("ours"), "rng": Rng(0)}, cheap=False),
+        "setup": Obj(corridor_setup), "method": Choice("ours"), "rng": Rng(0), "amcl": Choice("turtlebot2")},
+        cheap=False),
     "robocourse.lessons.corridor_localization.aliasing.aliasing_example": Call({"resolution": Real(0.5)}, cheap=False),
     "robocourse.lessons.corridor_localization.orb_realism.move_image": Call({
         "image": Array(image, "N,N|N,N,3|N,N,4"), "shift_x": Real(1.0), "shift_y": Real(0.0), "zoom": Real(1.01)}),
@@ -1404,8 +1405,8 @@ SPECS: dict[str, Call] = {
         "run": Obj(corridor_calibration), "min_frame_gap": Int(10), "shared_range": Array(np.array([0.7, 0.9]), "2"),
         "below_band": Choice("take"), "matching": Choice("mutual")}, cheap=False),
     "robocourse.lessons.corridor_localization.experiment.corridor_map": Call({
-        "fast": Flag(True, optional=True), "resolution": Real(0.05), "progress": Func(None, optional=True)},
-        cheap=False),
+        "fast": Flag(True, optional=True), "resolution": Real(0.05), "clutter": Real(0.0),
+        "progress": Func(None, optional=True)}, cheap=False),
     "robocourse.lessons.corridor_localization.trials.refine_pose": Call({
         "setup": Obj(corridor_setup), "pose": Array(np.array([12.03, 0.04, 0.02]), "3"),
         "scan": Array(lambda: np.full(360, 1.5), "360", inf_ok=True)}, cheap=False),
@@ -1414,11 +1415,11 @@ SPECS: dict[str, Call] = {
     "robocourse.lessons.corridor_localization.trials.localization_trial": Call({
         "setup": Obj(corridor_setup), "start": Array(np.array([12.0, 0.3, 0.4]), "3"), "method": Choice("ours"),
         "rng": Rng(1), "max_distance": Real(3.0), "share": Real(0.95), "sigma_x": Real(0.3), "sigma_y": Real(0.1),
-        "settle": Int(1), "keep_particles": Flag(False)}, cheap=False),
+        "settle": Int(1), "keep_particles": Flag(False), "amcl": Choice("defaults")}, cheap=False),
     "robocourse.lessons.corridor_localization.trials.localization_trials": Call({
         "setup": Obj(corridor_setup), "method": Choice("ours"), "trials": Int(1, optional=True),
-        "positions": Given([0]), "seed": Int(0), "max_distance": Real(3.0), "cache": Flag(False),
-        "progress": Func(None, optional=True), "workers": Int(1, optional=True)}, cheap=False),
+        "positions": Given([0]), "seed": Int(0), "max_distance": Real(3.0), "amcl": Choice("defaults"),
+        "cache": Flag(False), "progress": Func(None, optional=True), "workers": Int(1, optional=True)}, cheap=False),
     "robocourse.lessons.corridor_localization.real_map.willow_map": Call({}),
     "robocourse.lessons.corridor_localization.real_map.willow_section": Call({"name": Choice("rooms")}),
     "robocourse.lessons.corridor_localization.real_map.building_routes": Call({

@@ -77,7 +77,8 @@ def test_one_wrong_retrieval_does_not_overrule_the_filter():
 
 @pytest.mark.parametrize("bad, match", [(dict(method="both"), "method"), (dict(share=1.5), "share"),
                                         (dict(start=[50.0, 0.0, 0.0]), "start"), (dict(sigma_x=0.0), "sigma_x"),
-                                        (dict(method="amcl", sigma_y=np.nan), "sigma_y")])
+                                        (dict(method="amcl", sigma_y=np.nan), "sigma_y"),
+                                        (dict(method="amcl", amcl="turtlebot"), "amcl")])
 def test_bad_trial_input_is_named(setup, bad, match, monkeypatch):
     def no_driving(*args, **kwargs):
         raise AssertionError("the robot moved before its arguments were checked")
@@ -85,6 +86,40 @@ def test_bad_trial_input_is_named(setup, bad, match, monkeypatch):
     kw = dict(start=trials.START_POSES[0], method="ours") | bad
     with pytest.raises((ValueError, TypeError), match=match):
         trials.localization_trial(setup, kw.pop("start"), kw.pop("method"), **kw)
+
+
+def test_amcl_runs_with_the_named_settings_and_ours_keeps_its_own(setup):
+    tb = trials.corridor_localizer(setup, "amcl", amcl="turtlebot2-corrected")
+    assert (tb.n_particles, tb.kld.min_particles, tb.model["max_beams"]) == (2000, 500, 60)
+    assert np.allclose(tb.alphas, 0.2)
+    default = trials.corridor_localizer(setup, "amcl")
+    assert (default.n_particles, default.kld.min_particles) == (trials.PARTICLES["amcl"], 100)
+    ours = trials.corridor_localizer(setup, "ours", amcl="turtlebot2-corrected")
+    assert ours.n_particles == trials.PARTICLES["ours"] and np.allclose(ours.alphas, experiment.MAPPING_ALPHAS)
+    with pytest.raises(ValueError, match="amcl"):
+        trials.corridor_localizer(setup, "amcl", amcl="ros")
+    with pytest.raises(ValueError, match="amcl"):
+        trials.localization_trials(setup, "amcl", amcl="ros", cache=False)
+
+
+def test_each_amcl_setting_keeps_its_own_cached_runs(setup, tmp_path, monkeypatch):
+    monkeypatch.setattr(trials, "cache_dir", lambda *parts: tmp_path)
+    kw = dict(trials=1, positions=[0], max_distance=2.0, workers=1)
+    default = trials.localization_trials(setup, "amcl", **kw)
+    assert len(list(tmp_path.glob("trials-*.npz"))) == 2              # both methods, from one moving strategy
+    turtlebot = trials.localization_trials(setup, "amcl", amcl="turtlebot2-corrected", **kw)
+    assert len(list(tmp_path.glob("trials-*.npz"))) == 3              # ours was cached already
+    assert turtlebot.iterations[0] != default.iterations[0]          # an update every 0.25 m, not 0.2 m
+    again = trials.localization_trials(setup, "amcl", amcl="turtlebot2-corrected", **kw)
+    assert np.array_equal(again.iterations, turtlebot.iterations) and len(list(tmp_path.glob("*.npz"))) == 3
+
+
+def test_a_bad_clutter_share_is_named_before_the_map_is_built(monkeypatch):
+    monkeypatch.setattr(experiment, "calibration_run", lambda **kw: pytest.fail("built before the check"))
+    with pytest.raises(ValueError, match="clutter"):
+        experiment.corridor_map(fast=True, clutter=1.5)
+    with pytest.raises(TypeError, match="clutter"):
+        experiment.corridor_map(fast=True, clutter="some")
 
 
 def test_keyframe_comparison_is_cached_and_a_stale_file_is_rebuilt(tmp_path, monkeypatch):

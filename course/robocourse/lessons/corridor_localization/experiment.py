@@ -16,7 +16,9 @@ and run of the lesson uses:
 3. :func:`corridor_map` drives the mapping run: scans at 10 Hz build the log-odds grid from the
    known poses (the paper runs Gmapping; the simulator's poses stand in for its output), camera
    frames half a period later go through the keyframe rule, and the keyframes are geo-tagged by
-   interpolating the scan-time poses at their timestamps (Eq. (18)) and added to the database.
+   interpolating the scan-time poses at their timestamps (Eq. (18)) and added to the database. Its
+   ``clutter`` maps the corridor with cabinets along the walls (:func:`robokit.sim.long_corridor`),
+   where the lesson re-runs Table 2.
 
 Everything is cached (keyed by the parameters and the code that makes it); a cache is never needed
 for correctness. Poses are robokit's ``[x, y, theta]``: the corridor runs along +x from 0 to
@@ -467,13 +469,18 @@ _MAP_ARRAYS = ("log_odds", "resolution", "origin", "kf_index", "kf_flat", "kf_co
                "times", "poses", "frame_count")
 
 
-def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress: Callable | None = None) -> CorridorMap:
+def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, clutter: float = 0.0,
+                 progress: Callable | None = None) -> CorridorMap:
     """Drive the mapping run along the middle line and build the hybrid map.
 
     Parameters
     ----------
     fast : bool, optional
         A camera frame every fourth scan (default: :func:`robokit.config.fast_mode`).
+    clutter : float, default 0
+        The corridor's share of wall stretches with a cabinet (:func:`robokit.sim.long_corridor`, 0 to
+        1; 0: the door pattern repeats along the whole corridor). ``F_min`` and the vocabulary stay
+        those of the plain corridor's calibration and training runs.
     resolution : float, default 0.05
         Grid cell size (m, 0.01 to 1), Gmapping's default.
     progress : callable ``(done, total)``, optional
@@ -486,7 +493,7 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress
     Raises
     ------
     ValueError, TypeError
-        For a bad resolution or progress callback.
+        For a bad resolution, clutter share or progress callback.
 
     Notes
     -----
@@ -505,12 +512,12 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, progress
     fast = fast_mode() if fast is None else bool(fast)
     resolution = _as_cell_size(resolution)
     progress = as_callable(progress, "progress")
-    world, lidar, camera = long_corridor(), corridor_lidar(), corridor_camera()
+    world, lidar, camera = long_corridor(clutter=clutter), corridor_lidar(), corridor_camera()
     f_min = calibration_run(fast=fast).f_min
     vocabulary = training_vocabulary(fast=fast)
     path = corridor_path(world, speed=0.3, rate=10.0)
     every, gap = (4, 0) if fast else (1, MAPPING_FRAME_GAP)
-    meta = {"camera": describe_sensor(camera), "lidar": describe_sensor(lidar),
+    meta = {"camera": describe_sensor(camera), "lidar": describe_sensor(lidar), "clutter": world.info["clutter"],
             "resolution": resolution, "f_min": f_min, "gap": gap, "every": every, "band": list(SHARED_RANGE),
             "features": N_FEATURES,
             "path": cache_key(poses=path.poses.round(9).tolist()), "code": _code()}

@@ -43,12 +43,10 @@ from robokit.mapping import OccupancyGrid
 from robokit.sim import World, corridor_path, long_corridor
 from robokit.validation import as_array, as_callable, as_choice, as_int, as_positive
 
-__all__ = ["SHARES", "PARTICLES", "SETTINGS", "RUNS", "DRIVE_LENGTH", "clutter_map", "clutter_comparison"]
+__all__ = ["SHARES", "SETTINGS", "RUNS", "DRIVE_LENGTH", "clutter_map", "clutter_comparison"]
 
 #: Clutter shares compared: (full size, fast mode).
 SHARES = ((0.0, 0.5, 1.0), (0.0, 1.0))
-#: amcl's ``max_particles`` per setting: Table 2's 500 for ROS's defaults, TurtleBot 2's 2000.
-PARTICLES = {"defaults": 500, "turtlebot2": 2000, "turtlebot2-corrected": 2000}
 #: The settings compared by default: TurtleBot 2's, with amcl's "diff" and "diff-corrected" odometry models
 #: (Table 2 above runs ROS's defaults).
 SETTINGS = ("turtlebot2", "turtlebot2-corrected")
@@ -105,7 +103,7 @@ def clutter_comparison(*, shares: Any = None, settings: Any = SETTINGS, runs: in
         Clutter shares, different, each in [0, 1] (default :data:`SHARES`: 0, 0.5, 1; 0 and 1 in fast
         mode).
     settings : sequence of str, default :data:`SETTINGS`
-        Names of ``AMCL_SETTINGS``, each run with :data:`PARTICLES`.
+        Names of ``AMCL_SETTINGS``, each run with its ``max_particles``.
     runs : int, optional
         Drives per start pose (default :data:`RUNS`: 2; 1 in fast mode).
     positions : sequence of int, optional
@@ -166,7 +164,7 @@ def clutter_comparison(*, shares: Any = None, settings: Any = SETTINGS, runs: in
         raise ValueError("positions: expected at least one start index, got none")
     seed = as_int(seed, "seed", minimum=0)
     progress = as_callable(progress, "progress")
-    meta = {"shares": shares, "settings": settings, "particles": PARTICLES, "runs": runs, "length": length,
+    meta = {"shares": shares, "settings": settings, "runs": runs, "length": length,
             "seed": seed, "starts": [list(s) for s in starts], "amcl": AMCL_SETTINGS, "code": code_version_of(__name__)}
     target = cache_dir("corridor") / f"clutter-{cache_key(**meta)}.npz"
     names = [f"{name}_{k}_{f}" for name in settings for k in range(len(shares)) for f in _FIELDS]
@@ -181,7 +179,8 @@ def clutter_comparison(*, shares: Any = None, settings: Any = SETTINGS, runs: in
         walls = world.layout(corridor_lidar().height)
         drives = [middle_line_drive(start, world.info["length"], length) for start in starts for _ in range(runs)]
         for name in settings:
-            out[name][share] = global_localization_runs(grid, walls, drives, particles=PARTICLES[name],
+            out[name][share] = global_localization_runs(grid, walls, drives,
+                                                        particles=AMCL_SETTINGS[name]["max_particles"],
                                                         settings=name, seed=seed, progress=progress)
     if cache:
         write_arrays(target, {f"{name}_{k}_{f}": getattr(out[name][share], f) for name in settings

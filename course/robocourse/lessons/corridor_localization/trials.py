@@ -196,12 +196,15 @@ PARTICLES = {"amcl": 500, "ours": 50}
 #: 0.25)^2 where it comes from driving (alpha2, alpha3). ``"turtlebot2-corrected"``: the same with amcl's
 #: "diff-corrected" model, which reads the alphas as robokit does (variances): 0.2 each, about nine times the
 #: translation noise of one update. Their ``laser_max_range`` of 12 m changes nothing here: the lesson's
-#: LiDAR returns nothing past 8 m.
+#: LiDAR returns nothing past 8 m. ``max_particles`` is the size of a global start's cloud: Table 2's 500 with
+#: ROS's defaults, TurtleBot 2's 2000 (our reading: Table 2's 500 is its ``min_particles``).
 AMCL_SETTINGS = {
-    "defaults": {"min_particles": 100, "kld_err": 0.01, "alphas": MAPPING_ALPHAS, "z_hit": 0.95, "z_rand": 0.05,
-                 "max_beams": 30, "update_min_d": 0.2, "update_min_a": float(np.pi / 6), "resample_interval": 2},
-    "turtlebot2": {"min_particles": 500, "kld_err": 0.05, "alphas": (0.0016, 0.0025, 0.0025, 0.0016), "z_hit": 0.5,
-                   "z_rand": 0.5, "max_beams": 60, "update_min_d": 0.25, "update_min_a": 0.2, "resample_interval": 1},
+    "defaults": {"min_particles": 100, "max_particles": PARTICLES["amcl"], "kld_err": 0.01, "alphas": MAPPING_ALPHAS,
+                 "z_hit": 0.95, "z_rand": 0.05, "max_beams": 30, "update_min_d": 0.2, "update_min_a": float(np.pi / 6),
+                 "resample_interval": 2},
+    "turtlebot2": {"min_particles": 500, "max_particles": 2000, "kld_err": 0.05,
+                   "alphas": (0.0016, 0.0025, 0.0025, 0.0016), "z_hit": 0.5, "z_rand": 0.5, "max_beams": 60,
+                   "update_min_d": 0.25, "update_min_a": 0.2, "resample_interval": 1},
 }
 AMCL_SETTINGS["turtlebot2-corrected"] = dict(AMCL_SETTINGS["turtlebot2"], alphas=(0.2, 0.2, 0.2, 0.2))
 #: The share of the particles the largest cluster must hold to count as "a single cluster".
@@ -345,7 +348,8 @@ def _pose_error(estimate: np.ndarray, truth: np.ndarray) -> np.ndarray:
     return np.array([np.hypot(*(estimate[:2] - truth[:2])), abs(wrap_angle(estimate[2] - truth[2]))])
 
 
-def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0) -> MonteCarloLocalizer:
+def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0, *,
+                       amcl: str = "defaults") -> MonteCarloLocalizer:
     """The Monte-Carlo localizer of Table 2's ``method`` on the corridor's grid (not yet initialised).
 
     Parameters
@@ -353,6 +357,8 @@ def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0) -> MonteCa
     setup : CorridorMap
     method : {"amcl", "ours"}
     rng : Generator or int, default 0
+    amcl : str, default "defaults"
+        AMCL's settings, a name of :data:`AMCL_SETTINGS` (its ``max_particles`` particles; ignored by ours).
 
     Returns
     -------
@@ -361,14 +367,14 @@ def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0) -> MonteCa
     Raises
     ------
     TypeError, ValueError
-        For a bad setup or method.
+        For a bad setup, method or settings name.
 
     Notes
     -----
-    ROS amcl's defaults (:data:`robokit.localization.AMCL_DEFAULTS`) but two: the motion noise is
-    the robot's own (:data:`MAPPING_ALPHAS`; amcl's 0.2 describe a far worse odometry), and the
-    particle counts of Ge et al. (2023), Table 2 (AMCL: 500 with KLD-sampling down to amcl's 100;
-    ours: 50).
+    By default ROS amcl's defaults (:data:`robokit.localization.AMCL_DEFAULTS`) but two: the motion
+    noise is the robot's own (:data:`MAPPING_ALPHAS`; amcl's 0.2 describe a far worse odometry), and
+    the particle counts of Ge et al. (2023), Table 2 (AMCL: 500 with KLD-sampling down to amcl's 100;
+    ours: 50). Ours keeps those whatever ``amcl`` says.
 
     Examples
     --------
@@ -378,9 +384,10 @@ def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0) -> MonteCa
     """
     setup = as_corridor_map(setup)
     method = as_choice(method, "method", METHODS)
+    amcl = as_choice(amcl, "amcl", tuple(AMCL_SETTINGS))
     lidar = setup.lidar
     if method == "amcl":
-        return amcl_localizer(setup.grid, setup.field, lidar, "defaults", PARTICLES["amcl"], rng)
+        return amcl_localizer(setup.grid, setup.field, lidar, amcl, AMCL_SETTINGS[amcl]["max_particles"], rng)
     return MonteCarloLocalizer(setup.grid, field=setup.field, n_particles=PARTICLES[method], alphas=MAPPING_ALPHAS,
                                r_max=lidar.r_max, sensor_offset=lidar.offset, rng=rng)
 
@@ -483,8 +490,8 @@ def refine_pose(setup: CorridorMap, pose: Any, scan: Any) -> np.ndarray:
 
 def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any = 0, max_distance: float = 40.0,
                        share: float = CLUSTER_SHARE, sigma_x: float = ELLIPSE_SIGMA[0],
-                       sigma_y: float = ELLIPSE_SIGMA[1],
-                       settle: int = SETTLE, keep_particles: bool = False) -> TrialResult:
+                       sigma_y: float = ELLIPSE_SIGMA[1], settle: int = SETTLE, keep_particles: bool = False,
+                       amcl: str = "defaults") -> TrialResult:
     """One global localization from ``start``: AMCL from a uniform cloud, or ours from the image.
 
     Parameters
@@ -507,6 +514,8 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
         Updates to run on after convergence before the second judgement (``TrialResult.settled``).
     keep_particles : bool, default False
         Keep the particles after every update (``TrialResult.particles``), to draw the cloud.
+    amcl : str, default "defaults"
+        AMCL's settings, a name of :data:`AMCL_SETTINGS` (:func:`corridor_localizer`).
 
     Returns
     -------
@@ -545,19 +554,21 @@ def localization_trial(setup: CorridorMap, start: Any, method: str, *, rng: Any 
     if share > 1:
         raise ValueError(f"share: expected a fraction in (0, 1], got {share}")
     sigma_x, sigma_y = as_positive(sigma_x, "sigma_x"), as_positive(sigma_y, "sigma_y")   # before any driving
+    amcl = as_choice(amcl, "amcl", tuple(AMCL_SETTINGS))
     setup.world.as_viewpoint([start[0], start[1], setup.lidar.height], "start")
     centred = move_to_middle_line(setup.world, start, setup.lidar, rng=rng)   # first; the localizer starts after it
-    return _run_trial(setup, method, centred, rng, max_distance, share, sigma_x, sigma_y, settle, keep_particles)
+    return _run_trial(setup, method, centred, rng, max_distance, share, sigma_x, sigma_y, settle, keep_particles,
+                      amcl)
 
 
 def _run_trial(setup: CorridorMap, method: str, centred: CenteringResult, rng: np.random.Generator,
                max_distance: float, share: float, sigma_x: float, sigma_y: float, settle: int,
-               keep_particles: bool) -> TrialResult:
+               keep_particles: bool, amcl: str) -> TrialResult:
     """:func:`localization_trial` (checked arguments) after the moving strategy ``centred``, with
     ``rng`` in the state that run left it in."""
     world, lidar = setup.world, setup.lidar
     start = centred.poses[0]
-    mcl = corridor_localizer(setup, method, rng)
+    mcl = corridor_localizer(setup, method, rng, amcl=amcl)
     before = centred.poses
     retrieval_error = np.nan
     if method == "ours":
@@ -614,19 +625,19 @@ def _trials_from_start(shared: tuple, task: tuple) -> list:
 
     Both methods go on from the generator's state after one shared moving strategy.
     """
-    setup, methods, seed, max_distance = shared
+    setup, methods, seed, max_distance, amcl = shared
     i, j = task
     rng = np.random.default_rng([seed, i, j])
     centred = move_to_middle_line(setup.world, START_POSES[i], setup.lidar, rng=rng)
     return [_run_trial(setup, m, centred, copy.deepcopy(rng), max_distance, CLUSTER_SHARE, *ELLIPSE_SIGMA, SETTLE,
-                       False) for m in methods]
+                       False, amcl) for m in methods]
 
 
 _SET_FIELDS = ("positions", "converged", "iterations", "distance", "error", "settled", "refined", "retrieval_error")
 
 
 def localization_trials(setup: CorridorMap, method: str, *, trials: int | None = None, positions: Any = None,
-                        seed: int = 0, max_distance: float = 40.0, cache: bool = True,
+                        seed: int = 0, max_distance: float = 40.0, amcl: str = "defaults", cache: bool = True,
                         progress: Callable | None = None, workers: int | None = None) -> TrialSet:
     """Table 2 re-run: ``trials`` global localizations of ``method`` from each start pose.
 
@@ -642,6 +653,8 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
         Run ``j`` from start ``i`` is seeded by ``(seed, i, j)``.
     max_distance : float, default 40.0
         See :func:`localization_trial`.
+    amcl : str, default "defaults"
+        AMCL's settings, a name of :data:`AMCL_SETTINGS` (ours keeps its own, whatever this says).
     cache : bool, default True
         Load from / save to ``robokit.cache.cache_dir("corridor")``, keyed by every parameter, the map and
         the code. When the other method's runs are not
@@ -682,6 +695,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
         [as_int(p, "positions", minimum=0, maximum=len(START_POSES) - 1) for p in positions]
     seed = as_int(seed, "seed", minimum=0)
     max_distance = as_positive(max_distance, "max_distance")
+    amcl = as_choice(amcl, "amcl", tuple(AMCL_SETTINGS))
     progress = as_callable(progress, "progress")
     workers = None if workers is None else as_int(workers, "workers", minimum=1, maximum=64)
     code = code_version_of(__name__)
@@ -689,6 +703,8 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     def cache_file(m: str) -> tuple[Any, dict]:
         meta = {"setup": setup.key, "method": m, "trials": trials, "starts": starts, "seed": seed,
                 "max_distance": max_distance, "code": code}
+        if m == "amcl":
+            meta["amcl"] = AMCL_SETTINGS[amcl]
         return cache_dir("corridor") / f"trials-{cache_key(**meta)}.npz", meta
 
     todo = [method]
@@ -702,7 +718,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
         if read_arrays(target, _SET_FIELDS, meta) is None:
             todo.append(other)
     tasks = [(i, j) for i in starts for j in range(trials)]
-    pairs = map_runs(_trials_from_start, (setup, tuple(todo), seed, max_distance), tasks, workers=workers,
+    pairs = map_runs(_trials_from_start, (setup, tuple(todo), seed, max_distance, amcl), tasks, workers=workers,
                      desc=f"localization trials ({' and '.join(todo)})", unit="run", progress=progress)
     runs = {m: [pair[k] for pair in pairs] for k, m in enumerate(todo)}
     sets = {m: TrialSet(m, np.repeat(starts, trials).astype(int), np.array([r.converged for r in rs]),
