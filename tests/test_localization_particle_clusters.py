@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robokit.localization import largest_cluster_mean, largest_cluster_share, pose_clusters
+from robokit.localization import largest_cluster_mean, largest_cluster_share, particle_clusters, pose_clusters
 from robokit.localization.particle_filter import ROS_KLD_BIN_SIZE
 
 
@@ -80,11 +80,15 @@ def test_largest_cluster_mean_ignores_strays_and_follows_the_weight():
     assert largest_cluster_mean(cloud, heavy)[0] > 20.0
 
 
-def test_pose_clusters_equal_the_all_pairs_reference():
+@pytest.mark.parametrize("dense_cells", [0, None])      # only the occupied cells; a dense box (the default)
+def test_pose_clusters_equal_the_all_pairs_reference(dense_cells, monkeypatch):
+    if dense_cells is not None:
+        monkeypatch.setattr(particle_clusters, "_DENSE_CELLS", dense_cells)
     rng = np.random.default_rng(11)
-    for _ in range(60):
+    for _ in range(80):
         n, m = int(rng.integers(1, 120)), int(rng.integers(1, 5))
-        size = np.array([rng.choice([0.25, 0.5]), rng.choice([0.25, 0.5]), rng.choice([np.deg2rad(10), 0.5, 1.0])])
+        size = np.array([rng.choice([0.25, 0.5]), rng.choice([0.25, 0.5]),
+                         rng.choice([np.deg2rad(10), 0.5, 1.0, 2.5, 4.0, 7.0])])     # 36 to 1 heading cells
         centres = np.c_[rng.uniform(-5, 5, m), rng.uniform(-2, 2, m), rng.uniform(-np.pi, np.pi, m)]
         P = centres[rng.integers(0, m, n)] + rng.normal(0.0, [0.4, 0.3, 0.6], (n, 3))
         edge = rng.random(n) < 0.3                       # some exactly on cell edges

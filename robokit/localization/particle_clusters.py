@@ -21,6 +21,7 @@ import itertools
 from typing import Any
 
 import numpy as np
+from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
@@ -81,6 +82,22 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
         raise ValueError(f"particles: expected a cloud spanning fewer histogram cells, got {span[:2].tolist()} "
                          f"cells of {size[:2].tolist()} m")
 
+    box = float(span[0] - 2) * float(span[1] - 2) * n_heading          # the cloud's bounding box, in cells
+    labels = _components_dense(cells, n_heading) if box <= _DENSE_CELLS else \
+        _components_sparse(cells, n_heading, lo, span)
+    _, first, component = np.unique(labels, return_index=True, return_inverse=True)
+    renumber = np.empty(len(first), np.int64)                # number clusters as the particles meet them
+    renumber[np.argsort(first)] = np.arange(len(first))
+    return renumber[component.ravel()]
+
+
+#: Up to this many histogram cells in the cloud's bounding box, :func:`pose_clusters` labels a dense
+#: array (one byte and one int32 a cell); beyond it, only the occupied cells.
+_DENSE_CELLS = 2_000_000
+
+
+def _components_sparse(cells: np.ndarray, n_heading: int, lo: np.ndarray, span: np.ndarray) -> np.ndarray:
+    """Each particle's connected component, found among the occupied cells only (the readable reference)."""
     def key(c: np.ndarray) -> np.ndarray:       # one integer per cell (..., 3), the heading wrapped
         return ((c[..., 0] - lo[0]) * span[1] + (c[..., 1] - lo[1])) * (span[2] + n_heading) \
             + np.mod(c[..., 2], n_heading)
@@ -95,11 +112,35 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     r, c = np.nonzero(hit)[1], at[hit]
     graph = coo_matrix((np.ones(len(r)), (r, c)), shape=(len(occupied), len(occupied)))
     _, cell_label = connected_components(graph, directed=False)
-    labels = cell_label[member.ravel()]
-    _, first = np.unique(labels, return_index=True)         # number clusters as the particles meet them
-    renumber = np.empty(len(first), np.int64)
-    renumber[np.argsort(first)] = np.arange(len(first))
-    return renumber[labels]
+    return cell_label[member.ravel()]
+
+
+def _components_dense(cells: np.ndarray, n_heading: int) -> np.ndarray:
+    """Each particle's connected component, labelled on a dense array of the cloud's bounding box.
+
+    The same partition as :func:`_components_sparse` (labels may differ): ``scipy.ndimage.label``
+    with all 26 neighbours, then the components that touch across the heading's wrap (the last
+    heading slice against the first, one cell either way in x and y) are joined.
+    """
+    ix, iy, ih = cells[:, 0] - cells[:, 0].min(), cells[:, 1] - cells[:, 1].min(), cells[:, 2]
+    occupied = np.zeros((ix.max() + 1, iy.max() + 1, n_heading), bool)
+    occupied[ix, iy, ih] = True
+    grid, count = ndimage.label(occupied, structure=np.ones((3, 3, 3), bool))
+    if n_heading <= 2 or not (occupied[:, :, 0].any() and occupied[:, :, -1].any()):
+        return grid[ix, iy, ih]              # nothing to join across the wrap (n <= 2: neighbours already)
+    nx, ny = occupied.shape[:2]
+    last, first = np.pad(grid[:, :, -1], 1), grid[:, :, 0]
+    pairs = []
+    for dx, dy in itertools.product((0, 1, 2), repeat=2):
+        across = last[dx:dx + nx, dy:dy + ny]
+        both = (across > 0) & (first > 0)
+        pairs.append(np.column_stack([across[both], first[both]]))
+    pairs = np.concatenate(pairs)
+    if not len(pairs):
+        return grid[ix, iy, ih]
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(count + 1, count + 1))
+    _, joined = connected_components(graph, directed=False)
+    return joined[grid[ix, iy, ih]]
 
 
 def _cluster_labels(particles: Any, bin_size: Any, labels: Any) -> np.ndarray:
