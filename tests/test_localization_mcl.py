@@ -124,16 +124,29 @@ def test_kld_resample_stops_where_table_8_4_stops():
     assert len(kld_resample(P * [3, 3, 6], w, rng=3, min_count=50, max_count=700)) == 700
 
 
-@pytest.mark.parametrize("far", [40.0, 1e17])      # bins on both sides of zero; spans too wide for one integer
-def test_kld_resample_counts_the_bins_of_any_spread_the_way_the_loop_does(far):
-    rng = np.random.default_rng(4)
-    P = np.column_stack([rng.uniform(-far, far, 2000), rng.uniform(-3, 3, 2000), rng.uniform(-np.pi, np.pi, 2000)])
-    P[:1500] = P[rng.integers(0, 40, 1500)]                  # many particles share a few bins
-    out = kld_resample(P, np.ones(2000), rng=1, min_count=10, max_count=3000)
+@pytest.mark.parametrize("shift", [-1.0, -1e3, -1e17])     # bins on both sides of zero; too far for one integer
+def test_kld_resample_stops_where_table_8_4_stops_for_any_place(shift):
+    rng = np.random.default_rng(2)
+    P = np.column_stack([rng.uniform(0, 2, 3000), rng.uniform(0, 2, 3000), rng.uniform(-0.5, 0.5, 3000)])
+    P[:1000, 0] += shift                                     # a third of the cloud far away along x
+    out = kld_resample(P, rng.random(3000), rng=3, min_count=50, max_count=4000, epsilon=0.05, z=0.99)
     keys = pose_bins(out)
+    k_at = np.array([len({tuple(b) for b in keys[:m]}) for m in range(1, len(out) + 1)])   # Table 8.4's k
+    m = np.arange(1, len(out) + 1)
+    ok = (m >= kld_sample_count(k_at, epsilon=0.05, z=0.99)) & (m >= 50)
+    assert ok[-1] and not ok[:-1].any() and len(out) < 4000  # stopped by the bound, not by max_count
+
+
+@pytest.mark.parametrize("far", [2.0 ** 40, 2.0 ** 62])  # bins up to 2**41 and 2**63 apart (past int64)
+def test_kld_resample_counts_bins_however_far_apart(far):
+    rng = np.random.default_rng(6)
+    P = np.column_stack([rng.choice([-far, 0.0, far], 300), rng.choice([0.2, 0.7], 300), np.zeros(300)])
+    out = kld_resample(P, np.ones(300), rng=2, min_count=2, max_count=5000, epsilon=0.2, bin_size=[1.0, 0.5, 0.17])
+    keys = pose_bins(out, [1.0, 0.5, 0.17])                  # six bins: three places, two rows
     k_at = np.array([len({tuple(b) for b in keys[:m]}) for m in range(1, len(out) + 1)])
-    ok = (np.arange(1, len(out) + 1) >= kld_sample_count(k_at)) & (np.arange(1, len(out) + 1) >= 10)
-    assert (ok[-1] or len(out) == 3000) and not ok[:-1].any()
+    m = np.arange(1, len(out) + 1)
+    ok = (m >= kld_sample_count(k_at, epsilon=0.2)) & (m >= 2)
+    assert ok[-1] and not ok[:-1].any() and k_at[-1] == 6
 
 
 # --- normalisation and the estimate ----------------------------------------------------------------

@@ -285,9 +285,9 @@ def _first_in_bin(keys: np.ndarray) -> np.ndarray:
     integers instead of N rows.
     """
     lo = keys.min(axis=0)
-    span = keys.max(axis=0) - lo + 1
-    if float(np.prod(span.astype(float))) >= 2.0 ** 62:
+    if np.prod(keys.max(axis=0).astype(float) - lo.astype(float) + 1) >= 2.0 ** 62:   # before any int64 sum
         return np.unique(keys, axis=0, return_index=True)[1]
+    span = keys.max(axis=0) - lo + 1
     flat = ((keys[:, 0] - lo[0]) * span[1] + (keys[:, 1] - lo[1])) * span[2] + (keys[:, 2] - lo[2])
     return np.unique(flat, return_index=True)[1]
 
