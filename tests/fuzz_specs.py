@@ -1438,7 +1438,7 @@ SPECS: dict[str, Call] = {
         "progress": Func(None, optional=True)}, cheap=False),
     "robocourse.lessons.corridor_localization.trials.amcl_localizer": Call({
         "grid": Obj(willow_section), "field": Obj(None, optional=True), "lidar": Obj(corridor_lidar),
-        "settings": Choice("turtlebot2"), "particles": Int(600), "rng": Rng(0)}),
+        "settings": Choice("turtlebot2"), "particles": Int(600, optional=True), "rng": Rng(0)}),
     "robocourse.lessons.corridor_localization.experiment.mapping_grid": Call({
         "world": Obj(corridor_world), "lidar": Obj(corridor_lidar), "poses": Array(np.array([[5.0, 0.0, 0.0]]), "N,3"),
         "resolution": Real(0.1)}, cheap=False),

@@ -81,6 +81,7 @@ def test_the_default_settings_are_table_2s_amcl_and_turtlebot2s_are_its_package(
     assert np.allclose(t.alphas, [(ros * turn) ** 2, (ros * step) ** 2, (ros * step) ** 2, (ros * turn) ** 2])
     assert np.sqrt(t.alphas[2]) * step == pytest.approx(ros * step ** 2)
     # amcl's diff-corrected model reads the same 0.2 as variances, as robokit does: sqrt(0.2) x 0.25 m a step
+    assert amcl_localizer(grid, None, lidar, "turtlebot2").n_particles == 2000       # the settings' max_particles
     c = amcl_localizer(grid, None, lidar, "turtlebot2-corrected", 2000)
     assert np.allclose(c.alphas, ros) and (c.n_particles, c.kld.min_particles, c.model["max_beams"]) == (2000, 500, 60)
     assert np.sqrt(c.alphas[2]) * step > 8 * np.sqrt(t.alphas[2]) * step

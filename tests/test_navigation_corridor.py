@@ -98,8 +98,13 @@ def test_amcl_runs_with_the_named_settings_and_ours_keeps_its_own(setup):
     assert ours.n_particles == trials.PARTICLES["ours"] and np.allclose(ours.alphas, experiment.MAPPING_ALPHAS)
     with pytest.raises(ValueError, match="amcl"):
         trials.corridor_localizer(setup, "amcl", amcl="ros")
+
+
+def test_a_bad_amcl_setting_is_named_before_any_run(setup, monkeypatch):
+    monkeypatch.setattr(trials, "map_runs", lambda *a, **k: pytest.fail("ran before the settings were checked"))
+    monkeypatch.setattr(trials, "read_arrays", lambda *a, **k: pytest.fail("read the cache before the check"))
     with pytest.raises(ValueError, match="amcl"):
-        trials.localization_trials(setup, "amcl", amcl="ros", cache=False)
+        trials.localization_trials(setup, "amcl", amcl="ros")
 
 
 def test_each_amcl_setting_keeps_its_own_cached_runs(setup, tmp_path, monkeypatch):
@@ -110,8 +115,10 @@ def test_each_amcl_setting_keeps_its_own_cached_runs(setup, tmp_path, monkeypatc
     turtlebot = trials.localization_trials(setup, "amcl", amcl="turtlebot2-corrected", **kw)
     assert len(list(tmp_path.glob("trials-*.npz"))) == 3              # ours was cached already
     assert turtlebot.iterations[0] != default.iterations[0]          # an update every 0.25 m, not 0.2 m
+    monkeypatch.setattr(trials, "map_runs", lambda *a, **k: pytest.fail("ran again instead of reading the cache"))
     again = trials.localization_trials(setup, "amcl", amcl="turtlebot2-corrected", **kw)
-    assert np.array_equal(again.iterations, turtlebot.iterations) and len(list(tmp_path.glob("*.npz"))) == 3
+    assert np.array_equal(again.iterations, turtlebot.iterations)
+    assert np.array_equal(trials.localization_trials(setup, "amcl", **kw).iterations, default.iterations)
 
 
 def test_a_bad_clutter_share_is_named_before_the_map_is_built(monkeypatch):

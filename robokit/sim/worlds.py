@@ -178,7 +178,7 @@ def long_corridor(layout: str = "mixed", seed: int = 2, clutter: float = 0.0) ->
         (0 to 1) of the wall stretches between doors that hold a cabinet (0.3-0.9 m long, 0.2-0.45 m
         deep, 0.6-1.2 m high) against the wall, each at its own place. Every stretch draws its
         cabinet and its chance whatever the share, so a larger share keeps the cabinets of a
-        smaller one and adds others. 0 (default): no cabinet, the geometry repeats every 4.5 m.
+        smaller one and adds others. 0 (default): no cabinet, only the doors along the walls.
 
     Returns
     -------
@@ -194,7 +194,8 @@ def long_corridor(layout: str = "mixed", seed: int = 2, clutter: float = 0.0) ->
     Notes
     -----
     Ge et al. (2023), Sec. 4.1 (dimensions) and Sec. 3.1, Fig. 3 and Eqs. (1)-(3) (door recesses
-    in facing and staggered layouts). The door geometry repeats every 4.5 m, so LiDAR scans alias;
+    in facing and staggered layouts). The doors stand every 4.5 m on each wall (the last north one 3.6 m after its
+    neighbour), in two widths, so LiDAR scans alias;
     plates, posters and boards make each stretch look different to a camera (their Sec. 3.2).
     The cabinets are our device for grading how repetitive the corridor is to a laser, not the
     paper's: its corridor has many symmetrical and similar areas (Sec. 4; Sec. 4.2 names two pairs),

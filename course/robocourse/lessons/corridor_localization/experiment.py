@@ -477,12 +477,12 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, clutter:
     ----------
     fast : bool, optional
         A camera frame every fourth scan (default: :func:`robokit.config.fast_mode`).
-    clutter : float, default 0
-        The corridor's share of wall stretches with a cabinet (:func:`robokit.sim.long_corridor`, 0 to
-        1; 0: the door pattern repeats along the whole corridor). ``F_min`` and the vocabulary stay
-        those of the plain corridor's calibration and training runs.
     resolution : float, default 0.05
         Grid cell size (m, 0.01 to 1), Gmapping's default.
+    clutter : float, default 0
+        The corridor's share of wall stretches with a cabinet (:func:`robokit.sim.long_corridor`, 0 to
+        1; 0: only doors along the walls). ``F_min`` and the vocabulary stay those of the plain
+        corridor's calibration and training runs.
     progress : callable ``(done, total)``, optional
         Told about the rendering (only when the map is not cached).
 

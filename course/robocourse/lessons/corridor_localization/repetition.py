@@ -3,8 +3,8 @@
 Ge et al. (2023), Table 2, report AMCL with 500 particles reaching the paper's 0.05 m / 0.5 degree
 criterion in 47.3 % and 52.9 % of runs after 9.43 m and 12.27 m. They call their corridor one with
 many symmetrical and similar areas (Sec. 4) and name two pairs of look-alike areas as examples (Sec.
-4.2, Fig. 12); they do not list amcl's settings. The lesson's corridor repeats its door geometry
-exactly every 4.5 m along its whole length. This module asks how much each of two things moves
+4.2, Fig. 12); they do not list amcl's settings. In the lesson's plain corridor the doors stand every
+4.5 m on each wall, with nothing else along the walls. This module asks how much each of two things moves
 AMCL's result there: the corridor's repetitiveness, set by :func:`robokit.sim.long_corridor`'s
 ``clutter`` (the share of wall stretches with a cabinet of their own: our device, not the paper's,
 which removed fire extinguishers and garbage cans from its corridor, Sec. 4), and amcl's settings

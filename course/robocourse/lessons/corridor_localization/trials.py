@@ -387,13 +387,13 @@ def corridor_localizer(setup: CorridorMap, method: str, rng: Any = 0, *,
     amcl = as_choice(amcl, "amcl", tuple(AMCL_SETTINGS))
     lidar = setup.lidar
     if method == "amcl":
-        return amcl_localizer(setup.grid, setup.field, lidar, amcl, AMCL_SETTINGS[amcl]["max_particles"], rng)
+        return amcl_localizer(setup.grid, setup.field, lidar, amcl, rng=rng)
     return MonteCarloLocalizer(setup.grid, field=setup.field, n_particles=PARTICLES[method], alphas=MAPPING_ALPHAS,
                                r_max=lidar.r_max, sensor_offset=lidar.offset, rng=rng)
 
 
 def amcl_localizer(grid: OccupancyGrid, field: LikelihoodField | None, lidar: Lidar, settings: str = "defaults",
-                   particles: int = 500, rng: Any = 0) -> MonteCarloLocalizer:
+                   particles: int | None = None, rng: Any = 0) -> MonteCarloLocalizer:
     """amcl with one of :data:`AMCL_SETTINGS` for ``lidar`` on ``grid``, its cloud spread over the free cells.
 
     Parameters
@@ -404,9 +404,9 @@ def amcl_localizer(grid: OccupancyGrid, field: LikelihoodField | None, lidar: Li
     lidar : robokit.sim.Lidar
         Its range and mounting enter the laser model.
     settings : {"defaults", "turtlebot2", "turtlebot2-corrected"}, default "defaults"
-    particles : int, default 500
+    particles : int, optional
         amcl's ``max_particles``, the size of a global start's cloud (at least the settings'
-        ``min_particles``, to which KLD-sampling may shrink it).
+        ``min_particles``, to which KLD-sampling may shrink it; default the settings' ``max_particles``).
     rng : Generator or int, default 0
 
     Returns
@@ -434,7 +434,8 @@ def amcl_localizer(grid: OccupancyGrid, field: LikelihoodField | None, lidar: Li
     if not isinstance(lidar, Lidar):
         raise TypeError(f"lidar: expected a robokit.sim Lidar, got {type(lidar).__name__}")
     s = AMCL_SETTINGS[as_choice(settings, "settings", tuple(AMCL_SETTINGS))]
-    particles = as_int(particles, "particles", minimum=s["min_particles"], maximum=100_000)
+    particles = s["max_particles"] if particles is None else \
+        as_int(particles, "particles", minimum=s["min_particles"], maximum=100_000)
     kld = KLDConfig(min_particles=s["min_particles"], max_particles=particles, epsilon=s["kld_err"])
     return MonteCarloLocalizer(grid, field=field, n_particles=particles, alphas=s["alphas"], z_hit=s["z_hit"],
                                z_rand=s["z_rand"], r_max=lidar.r_max, max_beams=s["max_beams"],
@@ -674,7 +675,7 @@ def localization_trials(setup: CorridorMap, method: str, *, trials: int | None =
     Raises
     ------
     TypeError, ValueError
-        For a bad setup, method, count or start index.
+        For a bad setup, method, count, start index, seed, distance, settings name or callback.
 
     Notes
     -----
