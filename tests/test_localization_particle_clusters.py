@@ -103,3 +103,16 @@ def test_pose_clusters_refuse_clouds_too_far_for_their_cells():
         pose_clusters([[0.0, 0.0, 0.0], [1e300, 0.0, 0.0]])
     with pytest.raises(ValueError, match="particles"):
         pose_clusters([[0.0, 0.0, 0.0], [2e11, 2e11, 0.0]])
+
+
+def test_a_dense_box_only_where_the_cloud_fills_it(monkeypatch):
+    rng = np.random.default_rng(3)
+    spread = np.c_[rng.uniform(0, 36, 2000), rng.uniform(-1, 1, 2000), rng.uniform(-np.pi, np.pi, 2000)]
+    converged = np.c_[rng.normal(10, 0.2, 200), rng.normal(0, 0.05, 200), rng.normal(0, 0.05, 200)]
+    stray = np.vstack([converged, [[60.0, 50.0, 0.0]]])         # a nearly empty box of 121 x 100 x 36 cells
+    expected = {name: pose_clusters(cloud) for name, cloud in (("spread", spread), ("stray", stray))}
+    monkeypatch.setattr(particle_clusters, "_components_sparse", lambda *a: pytest.fail("searched sparsely"))
+    assert np.array_equal(pose_clusters(spread), expected["spread"])
+    monkeypatch.undo()
+    monkeypatch.setattr(particle_clusters.ndimage, "label", lambda *a, **k: pytest.fail("labelled a dense box"))
+    assert np.array_equal(pose_clusters(stray), expected["stray"]) and expected["stray"].max() == 1

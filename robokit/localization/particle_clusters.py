@@ -59,7 +59,9 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     ROS amcl's ``pf_cluster_stats`` (via ``pf_kdtree_cluster``): cells whose indices differ by at most
     one in every axis are neighbours (26 of them). Unlike amcl we also join cells across the
     heading's wrap at +-pi, so one cluster pointing west is never split in two. Fox (2003), Sec. 3,
-    for the histogram. Connected components by :func:`scipy.sparse.csgraph.connected_components`.
+    for the histogram. Connected components by :func:`scipy.ndimage.label` over the cloud's bounding
+    box of cells when it is small, else by :func:`scipy.sparse.csgraph.connected_components` over the
+    occupied cells only (the readable reference; both give the same labels).
 
     Examples
     --------
@@ -83,7 +85,7 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
                          f"cells of {size[:2].tolist()} m")
 
     box = float(span[0] - 2) * float(span[1] - 2) * n_heading          # the cloud's bounding box, in cells
-    labels = _components_dense(cells, n_heading) if box <= _DENSE_CELLS else \
+    labels = _components_dense(cells, n_heading) if box <= min(_DENSE_CELLS, _DENSE_PER_PARTICLE * len(P)) else \
         _components_sparse(cells, n_heading, lo, span)
     _, first, component = np.unique(labels, return_index=True, return_inverse=True)
     renumber = np.empty(len(first), np.int64)                # number clusters as the particles meet them
@@ -91,9 +93,10 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     return renumber[component.ravel()]
 
 
-#: Up to this many histogram cells in the cloud's bounding box, :func:`pose_clusters` labels a dense
-#: array (one byte and one int32 a cell); beyond it, only the occupied cells.
-_DENSE_CELLS = 2_000_000
+#: Up to this many histogram cells in the cloud's bounding box, and this many per particle,
+#: :func:`pose_clusters` labels a dense array (one byte and one int32 a cell); beyond either, only the
+#: occupied cells (a converged cloud with one far stray has a large, nearly empty box).
+_DENSE_CELLS, _DENSE_PER_PARTICLE = 2_000_000, 64
 
 
 def _components_sparse(cells: np.ndarray, n_heading: int, lo: np.ndarray, span: np.ndarray) -> np.ndarray:
