@@ -137,12 +137,20 @@ def test_kld_resample_stops_where_table_8_4_stops_for_any_place(shift):
     assert ok[-1] and not ok[:-1].any() and len(out) < 4000  # stopped by the bound, not by max_count
 
 
-@pytest.mark.parametrize("far", [2.0 ** 40, 2.0 ** 62])  # bins up to 2**41 and 2**63 apart (past int64)
+def test_pose_bins_refuse_a_pose_whose_bin_is_no_int64():
+    with pytest.raises(ValueError, match="particles"):
+        pose_bins([[0.0, 0.0, 0.0], [3e18, 0.0, 0.0]])                  # 6e18 bins of 0.5 m
+    with pytest.raises(ValueError, match="particles"):
+        kld_resample([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]], [1.0, 1.0], bin_size=[0.5, 0.5, 1e-19])
+    assert pose_bins([[2.0 ** 60, 0.0, 0.0]], [1.0, 1.0, 1.0])[0, 0] == 2 ** 60
+
+
+@pytest.mark.parametrize("far", [2.0 ** 40, 2.0 ** 61])  # 2**62 x 8 bins in the box: past 2**64
 def test_kld_resample_counts_bins_however_far_apart(far):
     rng = np.random.default_rng(6)
-    P = np.column_stack([rng.choice([-far, 0.0, far], 300), rng.choice([0.2, 0.7], 300), np.zeros(300)])
+    P = np.column_stack([rng.choice([-far, 0.0, far], 300), rng.choice([0.2, 3.7], 300), np.zeros(300)])
     out = kld_resample(P, np.ones(300), rng=2, min_count=2, max_count=5000, epsilon=0.2, bin_size=[1.0, 0.5, 0.17])
-    keys = pose_bins(out, [1.0, 0.5, 0.17])                  # six bins: three places, two rows
+    keys = pose_bins(out, [1.0, 0.5, 0.17])                  # six bins: three places, two rows 8 bins apart
     k_at = np.array([len({tuple(b) for b in keys[:m]}) for m in range(1, len(out) + 1)])
     m = np.arange(1, len(out) + 1)
     ok = (m >= kld_sample_count(k_at, epsilon=0.2)) & (m >= 2)

@@ -261,6 +261,12 @@ def pose_bins(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarray:
     -------
     numpy.ndarray of int64, shape (N, 3)
 
+    Raises
+    ------
+    ValueError
+        For bad particles or bin sizes, or a pose 2**62 bins or more from the origin (its bin would
+        not be an int64).
+
     Notes
     -----
     Fox (2003), Sec. 3: the multi-dimensional histogram whose occupied bins ``k`` set the count.
@@ -274,7 +280,11 @@ def pose_bins(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarray:
     size = as_array(bin_size, "bin_size", shape=(3,))
     if np.any(size <= 0):
         raise ValueError(f"bin_size: expected three positive sizes, got {size.tolist()}")
-    return np.floor(P / size).astype(np.int64)
+    scaled = P / size
+    if len(scaled) and np.abs(scaled).max() >= 2.0 ** 62:
+        raise ValueError(f"particles: expected poses within 2**62 bins of the origin (bin_size {size.tolist()}), "
+                         f"got one {np.abs(scaled).max():.3g} bins away")
+    return np.floor(scaled).astype(np.int64)
 
 
 def _first_in_bin(keys: np.ndarray) -> np.ndarray:
