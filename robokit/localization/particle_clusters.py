@@ -71,8 +71,7 @@ def pose_clusters(particles: Any, bin_size: Any = ROS_KLD_BIN_SIZE) -> np.ndarra
     """
     P = as_planar(particles, "particles", shape=(None, 3), min_count=1)
     size = as_array(bin_size, "bin_size", shape=(3,))
-    with np.errstate(invalid="ignore"):      # a position too far for int64 cells is refused just below
-        cells = pose_bins(P, size)           # (which checks bin_size)
+    cells = pose_bins(P, size)               # checks bin_size, refuses a bin beyond int64
     if np.abs(P[:, :2] / size[:2]).max() >= 2.0 ** 40:
         raise ValueError(f"particles: expected positions within 2**40 histogram cells of the origin, got "
                          f"{np.abs(P[:, :2]).max():.3g} m with cells of {size[:2].tolist()} m")
