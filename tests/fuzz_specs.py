@@ -444,6 +444,11 @@ def willow_drives():    # one short drive (made when a test first asks, not at i
     return [waypoint_path(building_routes(willow_section(), 1, 1.0, rng=0)[0], 0.3).poses]
 
 
+def willow_groups():    # two groups of global_localization_batch (its own checks of them: test_real_map)
+    return [dict(grid=willow_section(), walls=willow_walls(), drives=willow_drives(), particles=200),
+            dict(grid=willow_section(), walls=willow_walls(), drives=willow_drives(), particles=300, seed=1)]
+
+
 @functools.cache
 def corridor_calibration():
     from robocourse.lessons.corridor_localization.experiment import calibration_run
@@ -1429,7 +1434,10 @@ SPECS: dict[str, Call] = {
         "grid": Obj(willow_section), "walls": Obj(willow_walls), "drives": Given(willow_drives), "particles": Int(200),
         "settings": Choice("defaults"), "seed": Int(0), "workers": Int(1, optional=True),
         "progress": Func(None, optional=True)}, cheap=False),
-    "robocourse.lessons.corridor_localization.repetition.clutter_map": Call({
+    "robocourse.lessons.corridor_localization.real_map.global_localization_batch": Call({
+        "groups": Given(willow_groups), "workers": Int(1, optional=True), "progress": Func(None, optional=True)},
+        cheap=False),
+    "robocourse.lessons.corridor_localization.experiment.clutter_map": Call({
         "clutter": Real(0.5), "resolution": Real(0.1)}, cheap=False),
     "robocourse.lessons.corridor_localization.repetition.clutter_comparison": Call({
         "shares": Array(np.array([1.0]), "N", optional=True), "settings": Given(["defaults"]), "runs": Int(1, optional=True),
@@ -1935,6 +1943,7 @@ EXTRA: tuple[str, ...] = (
     "robocourse.lessons.corridor_localization.real_map.building_routes",
     "robocourse.lessons.corridor_localization.orb_realism.move_image",   # motion_shares moves the images with it
     "robocourse.lessons.corridor_localization.real_map.global_localization_runs",
+    "robocourse.lessons.corridor_localization.real_map.global_localization_batch",
     "robokit.sim.vehicle.unicycle_step",
     "robokit.sim.runs.record_stream",     # lesson 02 builds its map from it, through office_setup
     "robokit.viz.framing.look_from",      # public; no lesson calls it since viz.fit_view
@@ -1984,7 +1993,7 @@ EXTRA: tuple[str, ...] = (
     "robocourse.lessons.corridor_localization.trials.corridor_localizer",
     "robocourse.lessons.corridor_localization.trials.amcl_localizer",
     "robocourse.lessons.corridor_localization.experiment.mapping_grid",
-    "robocourse.lessons.corridor_localization.repetition.clutter_map",
+    "robocourse.lessons.corridor_localization.experiment.clutter_map",
     # every file reader (hostile files: tests/fuzz_kinds.File)
     "robokit.files.read_npz", "robokit.mapping.topological.TopologicalMap.load",
     "robokit.vision.bag_of_words.Vocabulary.load", "robokit.vision.bow_database.BowDatabase.load",

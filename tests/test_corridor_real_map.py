@@ -1,4 +1,5 @@
 """Lesson 03's real-map experiment: routes through a map, the runs' records, the shipped map."""
+import dataclasses
 import hashlib
 from importlib import resources
 
@@ -9,6 +10,7 @@ from robocourse.lessons.corridor_localization import real_map
 from robocourse.lessons.corridor_localization.real_map import GlobalRuns, building_routes
 from robocourse.lessons.corridor_localization.trials import middle_line_drive
 from robokit.mapping import OccupancyGrid
+from robokit.sim import Layout, waypoint_path
 
 
 def _room(free_rows: slice, free_cols: slice, shape=(40, 60)) -> OccupancyGrid:
@@ -57,6 +59,29 @@ def test_global_runs_of_unequal_length_are_judged_at_their_own_ends():
     assert runs.localized_after().tolist() == [3.0, 1.0]
     with pytest.raises(ValueError, match="tolerance"):
         runs.right_place((-0.5, 0.1))
+
+
+def test_a_batch_is_its_groups_run_one_by_one():
+    """One pool for several maps and settings: each group's runs equal its own call, with or without
+    workers beside them; a bad group is refused by its index."""
+    section = real_map.willow_section()
+    walls = Layout.from_cells(section.occupied_mask(), section.resolution, section.origin)
+    drives = [waypoint_path(r, 0.3).poses for r in building_routes(section, 2, 1.5, rng=4)]
+    groups = [dict(grid=section, walls=walls, drives=drives, particles=300),
+              dict(grid=section, walls=walls, drives=drives[:1], particles=600, settings="turtlebot2", seed=2)]
+    alone = [real_map.global_localization_runs(**g, workers=1) for g in groups]
+    for workers in (1, 2):
+        batch = real_map.global_localization_batch(groups, workers=workers)
+        for one, other in zip(alone, batch):
+            for a, b in zip(dataclasses.astuple(one), dataclasses.astuple(other)):
+                assert np.array_equal(a, b, equal_nan=True)
+    assert not np.array_equal(alone[0].errors[:1], alone[1].errors, equal_nan=True)   # the groups differ
+    with pytest.raises(ValueError, match=r"groups\[1\]: particles"):
+        real_map.global_localization_batch([groups[0], dict(groups[1], particles=10)])
+    with pytest.raises(ValueError, match=r"groups\[0\]"):
+        real_map.global_localization_batch([dict(groups[0], speed=1.0)])
+    with pytest.raises(ValueError, match=r"groups\[1\]: drives"):      # too short for one filter update
+        real_map.global_localization_batch([groups[0], dict(groups[1], drives=[drives[0][:2] * 0.0])], workers=1)
 
 
 def test_the_middle_line_drive_turns_before_the_ends():

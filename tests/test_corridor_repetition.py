@@ -2,11 +2,11 @@
 import numpy as np
 import pytest
 
-from robocourse.lessons.corridor_localization import repetition
+from robocourse.lessons.corridor_localization import experiment, repetition
 from robocourse.lessons.corridor_localization.experiment import MAPPING_ALPHAS, corridor_lidar, mapping_grid
 from robocourse.lessons.corridor_localization.trials import AMCL_SETTINGS, START_POSES, amcl_localizer, middle_line_drive
 from robokit.mapping import OccupancyGrid
-from robokit.sim import box_room, long_corridor
+from robokit.sim import box_room, corridor_path, long_corridor
 
 
 def _same_surfaces(a, b):
@@ -109,7 +109,7 @@ def test_the_mapping_grid_names_a_bad_argument():
 
 
 def test_the_clutter_map_holds_the_cabinets():
-    world, grid = repetition.clutter_map(1.0)
+    world, grid = experiment.clutter_map(1.0)
     assert world is long_corridor(clutter=1.0)
     occupied = grid.occupied_mask()
     mapped = []
@@ -120,8 +120,25 @@ def test_the_clutter_map_holds_the_cabinets():
     # a face just short of a cell's far edge can stay free: the beams that cross the cell on their way
     # to the face further along outvote the few that end in it (15 of the 17 are mapped)
     assert len(mapped) == 17 and np.mean(mapped) >= 0.8
-    plain = repetition.clutter_map(0.0)[1]
+    plain = experiment.clutter_map(0.0)[1]
     assert occupied.sum() > plain.occupied_mask().sum()
+
+
+def test_the_clutter_map_is_its_mapping_run_and_comes_back_from_the_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("ROBOKIT_CACHE", str(tmp_path))
+    world, grid = experiment.clutter_map(0.5, resolution=0.2)
+    run = mapping_grid(world, corridor_lidar(), corridor_path(world, speed=0.3, rate=10.0).poses, 0.2)
+    assert np.array_equal(grid.log_odds, run.log_odds) and np.array_equal(grid.origin, run.origin)
+    assert len(list(tmp_path.rglob("grid-*.npz"))) == 1
+
+    def no_second_run(*args, **kwargs):
+        raise AssertionError("the mapping run was made again")
+
+    monkeypatch.setattr(experiment, "mapping_grid", no_second_run)
+    again = experiment.clutter_map(0.5, resolution=0.2)[1]
+    assert np.array_equal(again.log_odds, grid.log_odds) and again.resolution == 0.2
+    with pytest.raises(AssertionError, match="again"):                # another corridor is another run
+        experiment.clutter_map(0.0, resolution=0.2)
 
 
 def test_the_comparison_runs_the_same_drives_everywhere_and_comes_back_from_the_cache(tmp_path, monkeypatch):

@@ -22,6 +22,13 @@ def test_the_hybrid_map_geo_tags_every_keyframe_where_it_was_taken(setup):
     assert inside.all() and walls.any() and setup.grid.free_mask().sum() > walls.sum()
 
 
+def test_the_hybrid_maps_grid_is_the_clutter_maps(setup):
+    """One mapping run per corridor: AMCL's runs (clutter_map) localize in the hybrid map's own grid."""
+    world, grid = experiment.clutter_map(0.0)
+    assert world is setup.world
+    assert np.array_equal(grid.log_odds, setup.grid.log_odds) and np.array_equal(grid.origin, setup.grid.origin)
+
+
 def test_retrieval_finds_the_place_facing_the_way_the_map_was_recorded(setup):
     found = [trials.retrieve_pose(setup, [x, 0.0, 0.0], rng=2)[0] for x in (4.0, 9.0, 14.0, 19.0)]
     assert all(p is not None and abs(p[0] - x) < 0.5 for p, x in zip(found, (4.0, 9.0, 14.0, 19.0)))

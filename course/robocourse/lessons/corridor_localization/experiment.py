@@ -57,8 +57,8 @@ from robokit.vision import (BowDatabase, Features, Keypoints, Vocabulary, detect
                             select_keyframes, select_keyframes_orbslam)
 from robokit.vision.orb import ORB_FEATURES
 
-__all__ = ["CorridorMap", "corridor_map", "as_corridor_map", "mapping_grid", "CalibrationRun", "calibration_run",
-           "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS", "corridor_lidar", "corridor_camera"]
+__all__ = ["CorridorMap", "corridor_map", "as_corridor_map", "mapping_grid", "clutter_map", "CalibrationRun",
+           "calibration_run", "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS", "corridor_lidar", "corridor_camera"]
 
 
 def corridor_lidar() -> Lidar:
@@ -591,10 +591,62 @@ def mapping_grid(world: World, lidar: Lidar, poses: Any, resolution: float = 0.0
                                   r_max=lidar.r_max, sensor_offset=lidar.offset)
 
 
+def clutter_map(clutter: float = 0.0, *, resolution: float = 0.05) -> tuple[World, OccupancyGrid]:
+    """The lesson's corridor with ``clutter`` and the grid of its mapping run (laser only).
+
+    Parameters
+    ----------
+    clutter : float, default 0
+        :func:`robokit.sim.long_corridor`'s share of wall stretches with a cabinet (0 to 1).
+    resolution : float, default 0.05
+        Grid cell size (m, 0.01 to 1).
+
+    Returns
+    -------
+    (World, OccupancyGrid)
+        The grid is the one :func:`corridor_map` builds for the same corridor (cached on disk, so the
+        hybrid map and AMCL's runs share one mapping run).
+
+    Raises
+    ------
+    ValueError, TypeError
+        For a share outside [0, 1] or a bad resolution.
+
+    Notes
+    -----
+    Ge et al. (2023), Sec. 3.4 and Sec. 4: the mapping run drives the middle line at 0.3 m/s with
+    a scan every 0.1 s (:func:`mapping_grid`).
+
+    Examples
+    --------
+    >>> world, grid = clutter_map(1.0)
+    >>> len(world.info["clutter"]) > 10, grid.resolution
+    (True, 0.05)
+    """
+    resolution = _as_cell_size(resolution)
+    world = long_corridor(clutter=clutter)
+    return world, _mapping_run_grid(world, corridor_lidar(), corridor_path(world, speed=0.3, rate=10.0).poses,
+                                    resolution)
+
+
+def _mapping_run_grid(world: World, lidar: Lidar, poses: np.ndarray, resolution: float) -> OccupancyGrid:
+    """:func:`mapping_grid` of a corridor's mapping run, cached by the corridor, the LiDAR, the poses
+    and the code."""
+    meta = {"lidar": describe_sensor(lidar), "clutter": world.info["clutter"], "resolution": resolution,
+            "path": cache_key(poses=poses.round(9).tolist()), "code": _code()}
+    target = cache_dir("corridor") / f"grid-{cache_key(**meta)}.npz"
+    data = read_arrays(target, ("log_odds", "resolution", "origin"), meta)
+    if data is None:
+        grid = mapping_grid(world, lidar, poses, resolution)
+        data = {"log_odds": grid.log_odds, "resolution": np.float64(grid.resolution), "origin": np.asarray(grid.origin)}
+        write_arrays(target, data, meta)
+    return OccupancyGrid(data["log_odds"], float(data["resolution"]), data["origin"])
+
+
 def _build_map(world: World, lidar: Lidar, camera: PinholeCamera, path, f_min: float, resolution: float,
                every: int, gap: int, progress: Callable | None) -> dict:
     times, poses = path.t, path.poses
-    grid = mapping_grid(world, lidar, poses, resolution)
+    grid = _mapping_run_grid(world, lidar, poses, resolution)
     # camera frames half a period after each scan: their poses are what Eq. (18) must recover
     frame_times = (times[:-1] + 0.5 * np.diff(times))[::every]
     # the true pose at each frame (the path is piecewise linear in time) is also its geo-tag: the

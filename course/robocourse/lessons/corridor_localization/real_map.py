@@ -57,7 +57,7 @@ from robokit.sim import Layout, noisy_odometry, waypoint_path
 from robokit.validation import as_array, as_callable, as_choice, as_int, as_positive, as_rng
 
 __all__ = ["SECTIONS", "AMCL_PARTICLES", "RUNS", "DRIVE_LENGTH", "willow_map", "willow_section", "building_routes",
-           "GlobalRuns", "global_localization_runs", "real_map_comparison"]
+           "GlobalRuns", "global_localization_runs", "global_localization_batch", "real_map_comparison"]
 
 #: The parts of the Willow Garage map the lesson localizes in, ``(x0, y0, x1, y1)`` in the map's metres:
 #: the rooms, and the rooms with the row of look-alike offices below them.
@@ -302,9 +302,9 @@ class GlobalRuns:
 
 
 def _one_run(shared: tuple, task: tuple) -> tuple[np.ndarray, ...]:
-    """One drive ``truth`` with a filter from a uniform cloud; seeded by ``(seed, run)``."""
-    grid, field, walls, particles, settings, seed = shared
-    run, truth = task
+    """One drive ``truth`` of group ``g`` with a filter from a uniform cloud; seeded by ``(seed, run)``."""
+    g, run, truth = task
+    grid, field, walls, particles, settings, seed = shared[g]
     rng = np.random.default_rng([seed, run])
     lidar = corridor_lidar()
     odometry = noisy_odometry(truth, MAPPING_ALPHAS, rng)
@@ -361,7 +361,8 @@ def global_localization_runs(grid: OccupancyGrid, walls: Layout, drives: list, *
     -----
     Thrun et al. (2005), Table 8.2 (MCL) and Sec. 8.3.7 (KLD-sampling), as ROS amcl runs them
     (:class:`robokit.localization.MonteCarloLocalizer`); Ge et al. (2023), Sec. 4.1 start AMCL the
-    same way ("scattered particles evenly on the whole map").
+    same way ("scattered particles evenly on the whole map"). :func:`global_localization_batch` makes
+    the runs of several maps or settings side by side.
 
     Examples
     --------
@@ -372,6 +373,72 @@ def global_localization_runs(grid: OccupancyGrid, walls: Layout, drives: list, *
     >>> runs.errors.shape[0], bool(np.nanmax(runs.particles) <= 300)
     (1, True)
     """
+    group = _as_group(grid, walls, drives, particles, settings, seed)
+    return _run_groups([group], workers, as_callable(progress, "progress"))[0]
+
+
+def global_localization_batch(groups: list, *, workers: int | None = None,
+                              progress: Callable | None = None) -> list[GlobalRuns]:
+    """:func:`global_localization_runs` for several maps or settings at once: all their runs in one pool.
+
+    Parameters
+    ----------
+    groups : list of dict
+        Each the keyword arguments of one :func:`global_localization_runs` call: ``grid``, ``walls``
+        and ``drives``, optionally ``particles``, ``settings`` and ``seed``.
+    workers : int, optional
+        Worker processes (:func:`robokit.parallel.map_runs`).
+    progress : callable ``(done, total)``, optional
+        Told as runs finish, over all the groups.
+
+    Returns
+    -------
+    list of GlobalRuns
+        One per group, equal to its :func:`global_localization_runs` (each run is seeded by its own
+        group's ``(seed, run)``, whatever runs beside it).
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a bad list, or a group :func:`global_localization_runs` would refuse (named by its index).
+
+    Notes
+    -----
+    Thrun et al. (2005), Table 8.2 and Sec. 8.3.7, as :func:`global_localization_runs`. One pool
+    keeps both cores busy to the end where a call per map would wait for its slowest run each time.
+
+    Examples
+    --------
+    >>> section = willow_section()
+    >>> walls = Layout.from_cells(section.occupied_mask(), section.resolution, section.origin)
+    >>> drive = waypoint_path(building_routes(section, 1, 3.0, rng=1)[0], 0.3).poses
+    >>> two = global_localization_batch([dict(grid=section, walls=walls, drives=[drive], particles=300),
+    ...                                  dict(grid=section, walls=walls, drives=[drive], particles=400, seed=1)],
+    ...                                 workers=1)
+    >>> len(two), two[0].errors.shape[0]
+    (2, 1)
+    """
+    if not isinstance(groups, (list, tuple)) or not groups:
+        raise ValueError(f"groups: expected a non-empty list of dicts of global_localization_runs' arguments, "
+                         f"got {type(groups).__name__}")
+    checked = []
+    for i, group in enumerate(groups):
+        if not isinstance(group, dict) or not {"grid", "walls", "drives"} <= set(group) or \
+                not set(group) <= {"grid", "walls", "drives", "particles", "settings", "seed"}:
+            got = sorted(group) if isinstance(group, dict) else type(group).__name__
+            raise ValueError(f"groups[{i}]: expected a dict with grid, walls, drives and optionally particles, "
+                             f"settings, seed, got {got}")
+        try:
+            checked.append(_as_group(**group))
+        except (TypeError, ValueError) as exc:
+            raise type(exc)(f"groups[{i}]: {exc}") from None
+    names = [f"groups[{i}]: drives" for i in range(len(checked))]
+    return _run_groups(checked, workers, as_callable(progress, "progress"), names)
+
+
+def _as_group(grid: Any, walls: Any, drives: Any, particles: Any = AMCL_PARTICLES, settings: Any = "defaults",
+              seed: Any = 0) -> tuple:
+    """One group of runs, checked: ``(grid, field, walls, particles, settings, seed)`` and the drives."""
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"grid: expected a robokit.mapping.OccupancyGrid, got {type(grid).__name__}")
     if not isinstance(walls, Layout):
@@ -385,19 +452,26 @@ def global_localization_runs(grid: OccupancyGrid, walls: Layout, drives: list, *
     settings = as_choice(settings, "settings", tuple(AMCL_SETTINGS))
     particles = as_int(particles, "particles", minimum=AMCL_SETTINGS[settings]["min_particles"], maximum=100_000)
     seed = as_int(seed, "seed", minimum=0)
-    progress = as_callable(progress, "progress")
-    shared = (grid, likelihood_field(grid), walls, particles, settings, seed)
-    out = map_runs(_one_run, shared, list(enumerate(truths)), workers=workers, desc="global localization",
-                   unit="run", progress=progress)
-    width = max(len(run[2]) for run in out)
-    if min(len(run[2]) for run in out) == 0:
-        raise ValueError("drives: expected drives long enough for a filter update (amcl's 0.2 m), got one shorter")
+    return (grid, likelihood_field(grid), walls, particles, settings, seed), truths
 
-    def padded(k: int) -> np.ndarray:
-        return np.array([np.concatenate([run[k], np.full((width - len(run[k]),) + run[k].shape[1:], np.nan)])
-                         for run in out])
 
-    return GlobalRuns(*(padded(k) for k in range(4)))
+def _run_groups(groups: list, workers: int | None, progress: Callable | None, names: list | None = None) -> list:
+    """Every run of every checked group in one :func:`robokit.parallel.map_runs`; the results per group
+    (``names``: how an error names each group's drives)."""
+    tasks = [(g, run, truth) for g, (_, truths) in enumerate(groups) for run, truth in enumerate(truths)]
+    out = map_runs(_one_run, tuple(shared for shared, _ in groups), tasks, workers=workers,
+                   desc="global localization", unit="run", progress=progress)
+    results, first = [], 0
+    for g, (_, truths) in enumerate(groups):
+        runs, first = out[first:first + len(truths)], first + len(truths)
+        if min(len(run[2]) for run in runs) == 0:
+            raise ValueError(f"{names[g] if names else 'drives'}: expected drives long enough for a filter update "
+                             "(amcl's 0.2 m), got one shorter")
+        width = max(len(run[2]) for run in runs)
+        results.append(GlobalRuns(*(np.array([np.concatenate([run[k], np.full((width - len(run[k]),) + run[k].shape[1:],
+                                                                               np.nan)]) for run in runs])
+                                    for k in range(4))))
+    return results
 
 
 def _corridor_drives(setup: CorridorMap, n: int, length: float, rng: np.random.Generator) -> list[np.ndarray]:
@@ -473,14 +547,14 @@ def real_map_comparison(setup: CorridorMap, *, runs: int | None = None, length: 
         if data is not None:
             return {p: GlobalRuns(*(data[f"{names[p]}_{f}"] for f in _FIELDS)) for p in places}
     rng = np.random.default_rng(seed)
-    out = {}
-    for k, (name, section) in enumerate(sections.items()):
+    groups = []
+    for k, section in enumerate(sections.values()):
         walls = Layout.from_cells(section.occupied_mask(), section.resolution, section.origin)
         drives = [waypoint_path(r, SPEED, rate=RATE).poses for r in building_routes(section, runs, length, rng)]
-        out[name] = global_localization_runs(section, walls, drives, seed=seed + k, progress=progress)
-    out["corridor"] = global_localization_runs(setup.grid, setup.world.layout(setup.lidar.height),
-                                               _corridor_drives(setup, runs, length, rng), seed=seed + len(sections),
-                                               progress=progress)
+        groups.append(_as_group(section, walls, drives, seed=seed + k))
+    groups.append(_as_group(setup.grid, setup.world.layout(setup.lidar.height),
+                            _corridor_drives(setup, runs, length, rng), seed=seed + len(sections)))
+    out = dict(zip(places, _run_groups(groups, None, progress)))
     if cache:
         write_arrays(target, {f"{names[p]}_{f}": getattr(r, f) for p, r in out.items() for f in _FIELDS}, meta)
     return out

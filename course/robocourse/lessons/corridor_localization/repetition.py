@@ -13,11 +13,11 @@ package sets for the Kobuki base of the paper's robot, whose ``min_particles`` i
 amcl's "diff" odometry model as shipped or its "diff-corrected" one; the lesson's Table 2 runs ROS's
 defaults).
 
-- :func:`clutter_map` makes a corridor and the grid of its mapping run (laser only: AMCL needs no
-  camera).
+- :func:`~robocourse.lessons.corridor_localization.experiment.clutter_map` makes a corridor and the
+  grid of its mapping run (laser only: AMCL needs no camera).
 - :func:`clutter_comparison` runs the same drives, from Table 2's ten start poses
   (:data:`~robocourse.lessons.corridor_localization.trials.START_POSES`), with each setting in each
-  corridor (:func:`~robocourse.lessons.corridor_localization.real_map.global_localization_runs`), and
+  corridor (:func:`~robocourse.lessons.corridor_localization.real_map.global_localization_batch`), and
   caches them like the lesson's other datasets.
 
 References
@@ -33,17 +33,15 @@ from typing import Any, Callable
 
 import numpy as np
 
-from robocourse.lessons.corridor_localization.experiment import corridor_lidar, mapping_grid
-from robocourse.lessons.corridor_localization.real_map import GlobalRuns, global_localization_runs
+from robocourse.lessons.corridor_localization.experiment import clutter_map, corridor_lidar
+from robocourse.lessons.corridor_localization.real_map import GlobalRuns, global_localization_batch
 from robocourse.lessons.corridor_localization.trials import AMCL_SETTINGS, START_POSES, middle_line_drive
 from robocourse.source import code_version_of
 from robokit.cache import cache_dir, cache_key, read_arrays, write_arrays
 from robokit.config import fast_mode
-from robokit.mapping import OccupancyGrid
-from robokit.sim import World, corridor_path, long_corridor
 from robokit.validation import as_array, as_callable, as_choice, as_int, as_positive
 
-__all__ = ["SHARES", "SETTINGS", "RUNS", "DRIVE_LENGTH", "clutter_map", "clutter_comparison"]
+__all__ = ["SHARES", "SETTINGS", "RUNS", "DRIVE_LENGTH", "clutter_comparison"]
 
 #: Clutter shares compared: (full size, fast mode).
 SHARES = ((0.0, 0.5, 1.0), (0.0, 1.0))
@@ -53,40 +51,6 @@ SETTINGS = ("turtlebot2", "turtlebot2-corrected")
 #: Drives per start pose and metres per drive: (full size, fast mode); fast mode uses the first
 #: three start poses.
 RUNS, DRIVE_LENGTH = (2, 1), (20.0, 10.0)
-
-
-def clutter_map(clutter: float = 0.0, *, resolution: float = 0.05) -> tuple[World, OccupancyGrid]:
-    """The lesson's corridor with ``clutter`` and the grid of its mapping run (laser only).
-
-    Parameters
-    ----------
-    clutter : float, default 0
-        :func:`robokit.sim.long_corridor`'s share of wall stretches with a cabinet (0 to 1).
-    resolution : float, default 0.05
-        Grid cell size (m).
-
-    Returns
-    -------
-    (World, OccupancyGrid)
-
-    Raises
-    ------
-    ValueError, TypeError
-        For a share outside [0, 1] or a bad resolution.
-
-    Notes
-    -----
-    Ge et al. (2023), Sec. 3.4 and Sec. 4: the mapping run drives the middle line at 0.3 m/s with
-    a scan every 0.1 s (:func:`~robocourse.lessons.corridor_localization.experiment.mapping_grid`).
-
-    Examples
-    --------
-    >>> world, grid = clutter_map(1.0)
-    >>> len(world.info["clutter"]) > 10, grid.resolution
-    (True, 0.05)
-    """
-    world = long_corridor(clutter=clutter)
-    return world, mapping_grid(world, corridor_lidar(), corridor_path(world, speed=0.3, rate=10.0).poses, resolution)
 
 
 _FIELDS = ("estimates", "truth", "travelled", "particles")
@@ -173,15 +137,18 @@ def clutter_comparison(*, shares: Any = None, settings: Any = SETTINGS, runs: in
         if data is not None:
             return {name: {share: GlobalRuns(*(data[f"{name}_{k}_{f}"] for f in _FIELDS))
                            for k, share in enumerate(shares)} for name in settings}
-    out: dict[str, dict[float, GlobalRuns]] = {name: {} for name in settings}
+    groups, keys = [], []
     for share in shares:
         world, grid = clutter_map(share)
         walls = world.layout(corridor_lidar().height)
         drives = [middle_line_drive(start, world.info["length"], length) for start in starts for _ in range(runs)]
         for name in settings:
-            out[name][share] = global_localization_runs(grid, walls, drives,
-                                                        particles=AMCL_SETTINGS[name]["max_particles"],
-                                                        settings=name, seed=seed, progress=progress)
+            groups.append(dict(grid=grid, walls=walls, drives=drives, particles=AMCL_SETTINGS[name]["max_particles"],
+                               settings=name, seed=seed))
+            keys.append((name, share))
+    out: dict[str, dict[float, GlobalRuns]] = {name: {} for name in settings}
+    for (name, share), result in zip(keys, global_localization_batch(groups, progress=progress)):
+        out[name][share] = result
     if cache:
         write_arrays(target, {f"{name}_{k}_{f}": getattr(out[name][share], f) for name in settings
                               for k, share in enumerate(shares) for f in _FIELDS}, meta)
