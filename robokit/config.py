@@ -1,18 +1,21 @@
-"""Run-time settings read from the environment: fast mode, headless, worker processes.
+"""Run-time settings read from the environment: fast mode, headless, worker processes, the heap.
 
 ``ROBOKIT_FAST=1`` (set by the test-suite and the course build) asks for small runs: the progress
 bar is quiet, and the course's experiments shrink (``robocourse.FAST``). ``ROBOKIT_HEADLESS`` and
 ``ROBOKIT_WORKERS`` say whether anyone is watching and how many worker processes to use.
-Generated datasets are cached by :mod:`robokit.cache`.
+Generated datasets are cached by :mod:`robokit.cache`. ``ROBOKIT_HEAP_PAD_MB`` says how much freed
+memory the C heap keeps (:func:`pad_heap`, which ``import robokit`` calls once).
 """
 from __future__ import annotations
 
+import ctypes
 import importlib.util
 import os
 import sys
 import types
+from collections.abc import Mapping
 
-__all__ = ["fast_mode", "headless", "available_cpus", "worker_count", "lazy_module"]
+__all__ = ["fast_mode", "headless", "available_cpus", "worker_count", "HEAP_PAD_MB", "pad_heap", "lazy_module"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -147,6 +150,67 @@ def worker_count(environ: "os._Environ[str] | dict[str, str] | None" = None) -> 
             raise ValueError(f"ROBOKIT_WORKERS: expected a whole number from 1 to 64, got {raw!r}")
         return value
     return min(64, available_cpus())
+
+
+#: Megabytes of freed memory the C heap keeps at its top by default (:func:`pad_heap`).
+HEAP_PAD_MB = 64
+_M_TOP_PAD = -2          # glibc's malloc.h
+
+
+def pad_heap(environ: "os._Environ[str] | dict[str, str] | None" = None) -> int:
+    """Let the C heap keep freed memory at its top, up to ``ROBOKIT_HEAP_PAD_MB`` megabytes (glibc only).
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        Environment to read (default :data:`os.environ`).
+
+    Returns
+    -------
+    int
+        The pad set, in bytes; 0 when nothing was changed: ``ROBOKIT_HEAP_PAD_MB=0``, the user's own
+        ``MALLOC_TOP_PAD_`` in ``environ``, or a C library without glibc's ``mallopt``.
+
+    Raises
+    ------
+    ValueError
+        If ``ROBOKIT_HEAP_PAD_MB`` is not a whole number from 0 to 4096.
+    TypeError
+        If ``environ`` is not a mapping.
+
+    Notes
+    -----
+    Course convention (DESIGN.md, "Speed"); not from a paper. A filter update over thousands of
+    particles makes and frees arrays of megabytes (2000 particles x 60 beams x 2 coordinates of
+    float64 is 1.9 MB). By default glibc gives freed memory at the top of its heap back to the
+    system as soon as more than its small pad (128 KiB) is free, and the next update pays a page fault
+    for every 4 KiB it takes back: about half of such an update's time. This sets glibc's
+    ``M_TOP_PAD`` (``mallopt``), so that up to the pad stays mapped (:data:`HEAP_PAD_MB` by default,
+    per process); no number computed changes. ``benchmarks/bench_heap.py`` measures it.
+
+    Examples
+    --------
+    >>> pad_heap({"ROBOKIT_HEAP_PAD_MB": "0"})
+    0
+    """
+    env = os.environ if environ is None else environ
+    if not isinstance(env, Mapping):
+        raise TypeError(f"environ: expected a mapping of environment variables, got {type(env).__name__}")
+    raw = str(env.get("ROBOKIT_HEAP_PAD_MB", "")).strip()
+    try:
+        megabytes = int(raw) if raw else HEAP_PAD_MB
+    except ValueError:
+        megabytes = -1
+    if not 0 <= megabytes <= 4096:
+        raise ValueError(f"ROBOKIT_HEAP_PAD_MB: expected a whole number of megabytes from 0 to 4096, got {raw!r}")
+    if megabytes == 0 or "MALLOC_TOP_PAD_" in env or not sys.platform.startswith("linux"):
+        return 0
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):      # not glibc (musl has no mallopt)
+        return 0
+    mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
+    return megabytes << 20 if mallopt(_M_TOP_PAD, megabytes << 20) == 1 else 0
 
 
 def lazy_module(name: str) -> types.ModuleType:

@@ -1434,6 +1434,7 @@ SPECS: dict[str, Call] = {
         "grid": Obj(willow_section), "walls": Obj(willow_walls), "drives": Given(willow_drives), "particles": Int(200),
         "settings": Choice("defaults"), "seed": Int(0), "workers": Int(1, optional=True),
         "progress": Func(None, optional=True)}, cheap=False),
+    "robokit.config.pad_heap": Call({"environ": Mapping({"ROBOKIT_HEAP_PAD_MB": "0"}, optional=True)}),
     "robocourse.lessons.corridor_localization.real_map.global_localization_batch": Call({
         "groups": Given(willow_groups), "workers": Int(1, optional=True), "progress": Func(None, optional=True)},
         cheap=False),
@@ -1932,6 +1933,7 @@ HUGE_ANGLES: dict[str, tuple[str, ...]] = {
 
 
 EXTRA: tuple[str, ...] = (
+    "robokit.config.pad_heap",                         # called by `import robokit`: the environment it reads
     "robokit.outdoor.navigator.avoidance_decision",   # the Navigator's rules; assignment 05's loop folds them in
     "robokit.legged.posture.PostureFeedback",          # lesson 04's reactive host, built by host_table and terrain_table
     "robocourse.lessons.littledog.experiment.posture_errors",   # host_table's tilt and sag

@@ -1,8 +1,13 @@
+import os
+import platform
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
 import robokit
-from robokit.config import fast_mode
+from robokit.config import HEAP_PAD_MB, fast_mode, pad_heap
 from robokit.cache import cache_dir, cache_key
 
 
@@ -212,3 +217,26 @@ def test_the_kld_quantile_is_scipys():
     from robokit.localization.particle_filter import KLD_Z_99
 
     assert KLD_Z_99 == float(norm.ppf(0.99))
+
+
+def test_the_heap_pad_reads_its_variable_and_leaves_a_users_own_setting():
+    on_glibc = sys.platform.startswith("linux") and platform.libc_ver()[0] == "glibc"
+    try:
+        assert pad_heap({}) == (HEAP_PAD_MB << 20 if on_glibc else 0)
+        assert pad_heap({"ROBOKIT_HEAP_PAD_MB": "16"}) == (16 << 20 if on_glibc else 0)
+        assert pad_heap({"ROBOKIT_HEAP_PAD_MB": "0"}) == 0
+        assert pad_heap({"MALLOC_TOP_PAD_": "4096"}) == 0          # glibc read the user's own at start-up
+    finally:
+        pad_heap()                                                  # back to the process's own setting
+
+
+@pytest.mark.parametrize("bad", ["lots", "-1", "4097", "1.5"])
+def test_the_heap_pad_refuses_a_bad_variable(bad):
+    with pytest.raises(ValueError, match="ROBOKIT_HEAP_PAD_MB"):
+        pad_heap({"ROBOKIT_HEAP_PAD_MB": bad})
+
+
+def test_import_robokit_refuses_a_bad_heap_pad_by_name():
+    env = dict(os.environ, ROBOKIT_HEAP_PAD_MB="plenty")
+    done = subprocess.run([sys.executable, "-c", "import robokit"], env=env, capture_output=True, text=True)
+    assert done.returncode != 0 and "ROBOKIT_HEAP_PAD_MB" in done.stderr
