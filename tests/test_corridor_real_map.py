@@ -78,8 +78,14 @@ def test_a_batch_is_its_groups_run_one_by_one():
     assert not np.array_equal(alone[0].errors[:1], alone[1].errors, equal_nan=True)   # the groups differ
     with pytest.raises(ValueError, match=r"groups\[1\]: particles"):
         real_map.global_localization_batch([groups[0], dict(groups[1], particles=10)])
-    with pytest.raises(ValueError, match=r"groups\[0\]"):
+    with pytest.raises(ValueError, match=r"groups\[0\].*unknown \['speed'\]"):
         real_map.global_localization_batch([dict(groups[0], speed=1.0)])
+    with pytest.raises(ValueError, match=r"groups\[0\].*no \['walls'\]"):
+        real_map.global_localization_batch([{k: v for k, v in groups[0].items() if k != "walls"}])
+    with pytest.raises(TypeError, match=r"groups\[1\]: expected a dict"):
+        real_map.global_localization_batch([groups[0], [section, walls, drives]])
+    with pytest.raises(TypeError, match="groups: expected a list"):
+        real_map.global_localization_batch(groups[0])
     with pytest.raises(ValueError, match=r"groups\[1\]: drives"):      # too short for one filter update
         real_map.global_localization_batch([groups[0], dict(groups[1], drives=[drives[0][:2] * 0.0])], workers=1)
 

@@ -139,6 +139,8 @@ def test_the_clutter_map_is_its_mapping_run_and_comes_back_from_the_cache(tmp_pa
     assert np.array_equal(again.log_odds, grid.log_odds) and again.resolution == 0.2
     with pytest.raises(AssertionError, match="again"):                # another corridor is another run
         experiment.clutter_map(0.0, resolution=0.2)
+    with pytest.raises(AssertionError, match="again"):                # and so is another cell size
+        experiment.clutter_map(0.5, resolution=0.25)
 
 
 def test_the_comparison_runs_the_same_drives_everywhere_and_comes_back_from_the_cache(tmp_path, monkeypatch):

@@ -630,9 +630,11 @@ def clutter_map(clutter: float = 0.0, *, resolution: float = 0.05) -> tuple[Worl
 
 
 def _mapping_run_grid(world: World, lidar: Lidar, poses: np.ndarray, resolution: float) -> OccupancyGrid:
-    """:func:`mapping_grid` of a corridor's mapping run, cached by the corridor, the LiDAR, the poses
-    and the code."""
-    meta = {"lidar": describe_sensor(lidar), "clutter": world.info["clutter"], "resolution": resolution,
+    """:func:`mapping_grid` of a corridor's mapping run, cached by the corridor's layout (doors,
+    cabinets, size), the LiDAR, the poses and the code."""
+    meta = {"corridor": {k: world.info.get(k) for k in ("length", "width", "recess", "layout", "doors", "seed",
+                                                        "clutter")},
+            "lidar": describe_sensor(lidar), "resolution": resolution,
             "path": cache_key(poses=poses.round(9).tolist()), "code": _code()}
     target = cache_dir("corridor") / f"grid-{cache_key(**meta)}.npz"
     data = read_arrays(target, ("log_odds", "resolution", "origin"), meta)

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import inspect
 from importlib import resources
 from typing import Any, Callable
 
@@ -418,27 +419,36 @@ def global_localization_batch(groups: list, *, workers: int | None = None,
     >>> len(two), two[0].errors.shape[0]
     (2, 1)
     """
-    if not isinstance(groups, (list, tuple)) or not groups:
-        raise ValueError(f"groups: expected a non-empty list of dicts of global_localization_runs' arguments, "
-                         f"got {type(groups).__name__}")
-    checked = []
+    if not isinstance(groups, (list, tuple)):
+        raise TypeError(f"groups: expected a list of dicts of global_localization_runs' arguments, "
+                        f"got {type(groups).__name__}")
+    if not groups:
+        raise ValueError("groups: expected at least one group of runs, got an empty list")
+    params = {n: p for n, p in inspect.signature(_as_group).parameters.items() if p.kind is not p.KEYWORD_ONLY}
+    required = {n for n, p in params.items() if p.default is p.empty}
+    checked, fields = [], {}              # one likelihood field per grid, however many groups share it
     for i, group in enumerate(groups):
-        if not isinstance(group, dict) or not {"grid", "walls", "drives"} <= set(group) or \
-                not set(group) <= {"grid", "walls", "drives", "particles", "settings", "seed"}:
-            got = sorted(group) if isinstance(group, dict) else type(group).__name__
-            raise ValueError(f"groups[{i}]: expected a dict with grid, walls, drives and optionally particles, "
-                             f"settings, seed, got {got}")
+        if not isinstance(group, dict):
+            raise TypeError(f"groups[{i}]: expected a dict of global_localization_runs' arguments, "
+                            f"got {type(group).__name__}")
+        unknown, missing = sorted(set(group) - set(params)), sorted(required - set(group))
+        if unknown or missing:
+            raise ValueError(f"groups[{i}]: expected the keys grid, walls, drives and optionally particles, settings, "
+                             f"seed, got " + (f"unknown {unknown}" if unknown else f"no {missing}"))
         try:
-            checked.append(_as_group(**group))
+            shared, truths = _as_group(**group, field=fields.get(id(group["grid"])))
         except (TypeError, ValueError) as exc:
             raise type(exc)(f"groups[{i}]: {exc}") from None
+        fields[id(group["grid"])] = shared[1]
+        checked.append((shared, truths))
     names = [f"groups[{i}]: drives" for i in range(len(checked))]
     return _run_groups(checked, workers, as_callable(progress, "progress"), names)
 
 
 def _as_group(grid: Any, walls: Any, drives: Any, particles: Any = AMCL_PARTICLES, settings: Any = "defaults",
-              seed: Any = 0) -> tuple:
-    """One group of runs, checked: ``(grid, field, walls, particles, settings, seed)`` and the drives."""
+              seed: Any = 0, *, field: Any = None) -> tuple:
+    """One group of runs, checked: ``(grid, field, walls, particles, settings, seed)`` and the drives
+    (``field``: the grid's likelihood field when another group already made it)."""
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"grid: expected a robokit.mapping.OccupancyGrid, got {type(grid).__name__}")
     if not isinstance(walls, Layout):
@@ -452,7 +462,7 @@ def _as_group(grid: Any, walls: Any, drives: Any, particles: Any = AMCL_PARTICLE
     settings = as_choice(settings, "settings", tuple(AMCL_SETTINGS))
     particles = as_int(particles, "particles", minimum=AMCL_SETTINGS[settings]["min_particles"], maximum=100_000)
     seed = as_int(seed, "seed", minimum=0)
-    return (grid, likelihood_field(grid), walls, particles, settings, seed), truths
+    return (grid, likelihood_field(grid) if field is None else field, walls, particles, settings, seed), truths
 
 
 def _run_groups(groups: list, workers: int | None, progress: Callable | None, names: list | None = None) -> list:
