@@ -24,10 +24,15 @@ arm           DH chains, Jacobians, analytic and numeric IK of redundant arms
 navigation    closed-loop navigation along a visual path
 viz           meshcat scenes and matplotlib figures
 """
+import warnings
+
 from .config import pad_heap
 
 __version__ = "0.1.0"
 
 __all__ = ["__version__"]
 
-pad_heap()      # freed arrays stay mapped: a filter update over thousands of particles takes half the time
+try:            # freed arrays stay mapped: a filter update over thousands of particles takes half the time
+    pad_heap()
+except ValueError as exc:       # a speed setting's typo must not stop every import: say so and go on
+    warnings.warn(f"{exc}; the C heap is left as it is", RuntimeWarning, stacklevel=2)

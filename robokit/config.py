@@ -8,14 +8,14 @@ memory the C heap keeps (:func:`pad_heap`, which ``import robokit`` calls once).
 """
 from __future__ import annotations
 
-import ctypes
 import importlib.util
 import os
 import sys
 import types
 from collections.abc import Mapping
 
-__all__ = ["fast_mode", "headless", "available_cpus", "worker_count", "HEAP_PAD_MB", "pad_heap", "lazy_module"]
+__all__ = ["fast_mode", "headless", "available_cpus", "worker_count", "HEAP_PAD_MB", "HEAP_ARRAY_LIMIT", "pad_heap",
+           "lazy_module"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"", "0", "false", "no", "off"}
@@ -154,11 +154,14 @@ def worker_count(environ: "os._Environ[str] | dict[str, str] | None" = None) -> 
 
 #: Megabytes of freed memory the C heap keeps at its top by default (:func:`pad_heap`).
 HEAP_PAD_MB = 64
-_M_TOP_PAD = -2          # glibc's malloc.h
+#: Arrays below this many bytes come from the heap, not from a fresh ``mmap`` (glibc's own ceiling
+#: for its adaptive threshold on 64-bit systems, 32 MiB).
+HEAP_ARRAY_LIMIT = 32 << 20
+_M_TOP_PAD, _M_MMAP_THRESHOLD = -2, -3          # glibc's malloc.h
 
 
 def pad_heap(environ: "os._Environ[str] | dict[str, str] | None" = None) -> int:
-    """Let the C heap keep freed memory at its top, up to ``ROBOKIT_HEAP_PAD_MB`` megabytes (glibc only).
+    """Let the C heap keep freed memory, up to ``ROBOKIT_HEAP_PAD_MB`` megabytes (glibc only).
 
     Parameters
     ----------
@@ -169,12 +172,13 @@ def pad_heap(environ: "os._Environ[str] | dict[str, str] | None" = None) -> int:
     -------
     int
         The pad set, in bytes; 0 when nothing was changed: ``ROBOKIT_HEAP_PAD_MB=0``, the user's own
-        ``MALLOC_TOP_PAD_`` in ``environ``, or a C library without glibc's ``mallopt``.
+        allocator settings in ``environ`` (any ``MALLOC_*_`` variable, or ``glibc.malloc`` in
+        ``GLIBC_TUNABLES``), or a C library without glibc's ``mallopt``.
 
     Raises
     ------
     ValueError
-        If ``ROBOKIT_HEAP_PAD_MB`` is not a whole number from 0 to 4096.
+        If ``ROBOKIT_HEAP_PAD_MB`` is not a whole number from 0 to 1024.
     TypeError
         If ``environ`` is not a mapping.
 
@@ -182,11 +186,14 @@ def pad_heap(environ: "os._Environ[str] | dict[str, str] | None" = None) -> int:
     -----
     Course convention (DESIGN.md, "Speed"); not from a paper. A filter update over thousands of
     particles makes and frees arrays of megabytes (2000 particles x 60 beams x 2 coordinates of
-    float64 is 1.9 MB). By default glibc gives freed memory at the top of its heap back to the
-    system as soon as more than its small pad (128 KiB) is free, and the next update pays a page fault
-    for every 4 KiB it takes back: about half of such an update's time. This sets glibc's
-    ``M_TOP_PAD`` (``mallopt``), so that up to the pad stays mapped (:data:`HEAP_PAD_MB` by default,
-    per process); no number computed changes. ``benchmarks/bench_heap.py`` measures it.
+    float64 is 1.9 MB). glibc serves such an array from a fresh ``mmap``, or from its heap, whose
+    freed top it gives back to the system once more than a threshold is free; either way the next
+    update pays a page fault for every 4 KiB it takes again (1600 faults and about half the time of
+    a 2000-particle update). Its thresholds adapt to the largest array freed so far, so how often
+    that happens depends on the process's history. This fixes them with ``mallopt``: arrays below
+    :data:`HEAP_ARRAY_LIMIT` come from the heap (``M_MMAP_THRESHOLD``, where glibc's adaptation
+    stops anyway), and the heap keeps up to the pad free at its top (``M_TOP_PAD``, per malloc
+    arena). No number computed changes. ``benchmarks/bench_heap.py`` measures it.
 
     Examples
     --------
@@ -201,15 +208,20 @@ def pad_heap(environ: "os._Environ[str] | dict[str, str] | None" = None) -> int:
         megabytes = int(raw) if raw else HEAP_PAD_MB
     except ValueError:
         megabytes = -1
-    if not 0 <= megabytes <= 4096:
-        raise ValueError(f"ROBOKIT_HEAP_PAD_MB: expected a whole number of megabytes from 0 to 4096, got {raw!r}")
-    if megabytes == 0 or "MALLOC_TOP_PAD_" in env or not sys.platform.startswith("linux"):
+    if not 0 <= megabytes <= 1024:
+        raise ValueError(f"ROBOKIT_HEAP_PAD_MB: expected a whole number of megabytes from 0 to 1024, got {raw!r}")
+    users_own = any(k.startswith("MALLOC_") and k.endswith("_") for k in env) or \
+        "glibc.malloc." in str(env.get("GLIBC_TUNABLES", ""))
+    if megabytes == 0 or users_own or not sys.platform.startswith("linux"):
         return 0
     try:
+        import ctypes
         mallopt = ctypes.CDLL(None).mallopt
-    except (OSError, AttributeError):      # not glibc (musl has no mallopt)
+    except (ImportError, OSError, AttributeError):      # no ctypes, or not glibc (musl has no mallopt)
         return 0
     mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
+    if mallopt(_M_MMAP_THRESHOLD, HEAP_ARRAY_LIMIT) != 1:
+        return 0
     return megabytes << 20 if mallopt(_M_TOP_PAD, megabytes << 20) == 1 else 0
 
 
