@@ -101,7 +101,7 @@ class GaitSchedule:
 
     @property
     def swing_duration(self) -> float:
-        """Time (s) each swing takes: ``(1 - duty_factor) * period``."""
+        """Seconds each swing takes: ``(1 - duty_factor) * period``."""
         return (1.0 - self.duty_factor) * self.period
 
     @property

@@ -258,18 +258,18 @@ class MonteCarloLocalizer:
     (Table 8.4) as the resampler, run the way ROS amcl schedules it. Ge et al. (2023)'s
     Algorithm 1 ("Improved AMCL"), line by line, with robokit's calls:
 
-    1. ``chi_t = {}``: the filter's state is replaced by the next line;
-    2. "Uniformly sample poses according to a keyframe retrieval": :meth:`initialize_ellipse`
-       at the retrieved keyframe's pose (Eq. (18) gives it; the lead's retrieval loop calls it);
-    3. ``w_initial`` of Eq. (19): the weights :meth:`initialize_ellipse` sets;
-    4. "Robot moves forward": the odometry passed to :meth:`update`;
-    5-9. for each particle, ``sample_motion_model`` and ``measurement_model``: one
-       :meth:`update` (:func:`mcl_step`'s motion and weights);
-    10-13. draw ``N`` particles with probability proportional to their weights: the resampling
-       inside :meth:`update` (every ``resample_interval`` updates);
-    14-16. "if time interval equals Delta t, go to step 2": call :meth:`initialize_ellipse`
-       again with a fresh retrieval (every 5 s in the paper's kidnapping test, Sec. 4.2);
-    17. return ``chi_t``: :attr:`particles`, :attr:`weights`, :meth:`estimate`.
+    - line 1: ``chi_t = {}``: the filter's state is replaced by the next line;
+    - line 2: "Uniformly sample poses according to a keyframe retrieval": :meth:`initialize_ellipse`
+      at the retrieved keyframe's pose (Eq. (18) gives it; the lead's retrieval loop calls it);
+    - line 3: ``w_initial`` of Eq. (19): the weights :meth:`initialize_ellipse` sets;
+    - line 4: "Robot moves forward": the odometry passed to :meth:`update`;
+    - lines 5-9: for each particle, ``sample_motion_model`` and ``measurement_model``: one
+      :meth:`update` (:func:`mcl_step`'s motion and weights);
+    - lines 10-13: draw ``N`` particles with probability proportional to their weights: the resampling
+      inside :meth:`update` (every ``resample_interval`` updates);
+    - lines 14-16: "if time interval equals Delta t, go to step 2": call :meth:`initialize_ellipse`
+      again with a fresh retrieval (every 5 s in the paper's kidnapping test, Sec. 4.2);
+    - line 17: return ``chi_t``: :attr:`particles`, :attr:`weights`, :meth:`estimate`.
 
     Examples
     --------
