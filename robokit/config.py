@@ -139,17 +139,22 @@ def worker_count(environ: "os._Environ[str] | dict[str, str] | None" = None) -> 
     >>> worker_count({"ROBOKIT_WORKERS": "1"})
     1
     """
-    env = os.environ if environ is None else environ
-    raw = str(env.get("ROBOKIT_WORKERS", "")).strip()
-    if raw:
-        try:
-            value = int(raw)
-        except ValueError:
-            value = 0
-        if not 1 <= value <= 64:
-            raise ValueError(f"ROBOKIT_WORKERS: expected a whole number from 1 to 64, got {raw!r}")
-        return value
-    return min(64, available_cpus())
+    value = _whole_number(os.environ if environ is None else environ, "ROBOKIT_WORKERS", 1, 64)
+    return min(64, available_cpus()) if value is None else value
+
+
+def _whole_number(env, name: str, low: int, high: int, what: str = "a whole number") -> int | None:
+    """A whole-number environment variable from ``low`` to ``high``; ``None`` when unset or blank."""
+    raw = str(env.get(name, "")).strip()
+    if not raw:
+        return None
+    try:
+        value = int(raw)
+    except ValueError:
+        value = low - 1
+    if not low <= value <= high:
+        raise ValueError(f"{name}: expected {what} from {low} to {high}, got {raw!r}")
+    return value
 
 
 #: Megabytes of freed memory the C heap keeps at its top by default (:func:`pad_heap`).
@@ -203,13 +208,8 @@ def pad_heap(environ: "os._Environ[str] | dict[str, str] | None" = None) -> int:
     env = os.environ if environ is None else environ
     if not isinstance(env, Mapping):
         raise TypeError(f"environ: expected a mapping of environment variables, got {type(env).__name__}")
-    raw = str(env.get("ROBOKIT_HEAP_PAD_MB", "")).strip()
-    try:
-        megabytes = int(raw) if raw else HEAP_PAD_MB
-    except ValueError:
-        megabytes = -1
-    if not 0 <= megabytes <= 1024:
-        raise ValueError(f"ROBOKIT_HEAP_PAD_MB: expected a whole number of megabytes from 0 to 1024, got {raw!r}")
+    megabytes = _whole_number(env, "ROBOKIT_HEAP_PAD_MB", 0, 1024, "a whole number of megabytes")
+    megabytes = HEAP_PAD_MB if megabytes is None else megabytes
     users_own = any(k.startswith("MALLOC_") and k.endswith("_") for k in env) or \
         "glibc.malloc." in str(env.get("GLIBC_TUNABLES", ""))
     if megabytes == 0 or users_own or not sys.platform.startswith("linux"):
