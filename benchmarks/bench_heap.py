@@ -3,10 +3,11 @@
 A Monte-Carlo localization update over thousands of particles makes and frees arrays of megabytes.
 With glibc's adaptive thresholds such arrays are mapped afresh, or the freed top of the heap goes
 back to the system, and the next update faults the memory in again, page by page; ``import robokit``
-fixes the thresholds and keeps a pad of ``ROBOKIT_HEAP_PAD_MB`` (64 by default) instead. The same update (:func:`robokit.localization.mcl_step`: motion model,
-likelihood field over 60 beams of a 360-beam scan, resampling) runs on the same inputs with and
-without the pad; the ratio "padded / default" of the median times is printed (below 1: the pad is
-faster), and the results must be identical.
+fixes the thresholds and keeps a pad of ``ROBOKIT_HEAP_PAD_MB`` (64 by default) instead. The same
+update (:func:`robokit.localization.mcl_step`: motion model, likelihood field over 60 beams of a
+360-beam scan, resampling) runs on the same inputs with and without the setting; the ratio "padded /
+default" of the median times is printed (below 1: the setting is faster), and the results must be
+identical.
 
 The peer cannot run in this process: the allocator's settings are the whole process's, and once
 ``mallopt`` has been called glibc no longer adapts its thresholds as it does by default. So each

@@ -198,7 +198,10 @@ def pad_heap(environ: "os._Environ[str] | dict[str, str] | None" = None) -> int:
     that happens depends on the process's history. This fixes them with ``mallopt``: arrays below
     :data:`HEAP_ARRAY_LIMIT` come from the heap (``M_MMAP_THRESHOLD``, where glibc's adaptation
     stops anyway), and the heap keeps up to the pad free at its top (``M_TOP_PAD``, per malloc
-    arena). No number computed changes. ``benchmarks/bench_heap.py`` measures it.
+    arena). No number computed changes. The cost: freed arrays below a live allocation stay with
+    the process too (heap fragmentation), where a fresh ``mmap`` would have been unmapped;
+    ``ROBOKIT_HEAP_PAD_MB=0`` leaves glibc's defaults. ``benchmarks/bench_heap.py`` measures the
+    gain.
 
     Examples
     --------

@@ -244,8 +244,12 @@ def _python(code: str, **env: str) -> subprocess.CompletedProcess:
 
 @pytest.mark.skipif(not GLIBC, reason="glibc's mallopt only")
 def test_the_heap_pad_keeps_a_filter_updates_arrays_mapped():
-    padded, default = float(_python(FAULTS).stdout), float(_python(FAULTS, ROBOKIT_HEAP_PAD_MB="0").stdout)
-    assert padded < 10 and default > 400         # a page is 4 KiB: the four arrays are 1900 pages
+    runs = {pad: _python(FAULTS, ROBOKIT_HEAP_PAD_MB=pad) for pad in ("64", "0")}
+    assert all(r.returncode == 0 for r in runs.values()), [r.stderr[-400:] for r in runs.values()]
+    padded, default = (float(r.stdout) for r in runs.values())
+    if default < 400:            # the four arrays are 1900 pages of 4 KiB; huge pages or earlier frees hide it
+        pytest.skip(f"glibc's default faulted only {default} pages a round here: nothing to keep")
+    assert padded < 10
 
 
 @pytest.mark.skipif(not GLIBC, reason="glibc's mallopt only")

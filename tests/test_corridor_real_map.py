@@ -82,6 +82,8 @@ def test_a_batch_is_its_groups_run_one_by_one():
         real_map.global_localization_batch([dict(groups[0], speed=1.0)])
     with pytest.raises(ValueError, match=r"groups\[0\].*no \['walls'\]"):
         real_map.global_localization_batch([{k: v for k, v in groups[0].items() if k != "walls"}])
+    with pytest.raises(ValueError, match=r"groups\[0\].*unknown \['speed', 1\]; no \['drives', 'grid', 'walls'\]"):
+        real_map.global_localization_batch([{1: 0, "speed": 1.0}])
     with pytest.raises(TypeError, match=r"groups\[1\]: expected a dict"):
         real_map.global_localization_batch([groups[0], [section, walls, drives]])
     with pytest.raises(TypeError, match="groups: expected a list"):

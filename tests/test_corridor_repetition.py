@@ -141,6 +141,13 @@ def test_the_clutter_map_is_its_mapping_run_and_comes_back_from_the_cache(tmp_pa
         experiment.clutter_map(0.0, resolution=0.2)
     with pytest.raises(AssertionError, match="again"):                # and so is another cell size
         experiment.clutter_map(0.5, resolution=0.25)
+    # the same cabinets (none) in a corridor with other doors: another run, not the cached grid
+    monkeypatch.setattr(experiment, "mapping_grid", mapping_grid)
+    experiment.clutter_map(0.0, resolution=0.2)
+    monkeypatch.setattr(experiment, "mapping_grid", no_second_run)
+    monkeypatch.setattr(experiment, "long_corridor", lambda clutter: long_corridor(layout="facing", clutter=clutter))
+    with pytest.raises(AssertionError, match="again"):
+        experiment.clutter_map(0.0, resolution=0.2)
 
 
 def test_the_comparison_runs_the_same_drives_everywhere_and_comes_back_from_the_cache(tmp_path, monkeypatch):

@@ -58,7 +58,8 @@ from robokit.vision import (BowDatabase, Features, Keypoints, Vocabulary, detect
 from robokit.vision.orb import ORB_FEATURES
 
 __all__ = ["CorridorMap", "corridor_map", "as_corridor_map", "mapping_grid", "clutter_map", "CalibrationRun",
-           "calibration_run", "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS", "corridor_lidar", "corridor_camera"]
+           "calibration_run", "keyframe_comparison", "training_vocabulary", "MAPPING_ALPHAS", "corridor_lidar",
+           "corridor_camera"]
 
 
 def corridor_lidar() -> Lidar:
@@ -517,7 +518,7 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, clutter:
     vocabulary = training_vocabulary(fast=fast)
     path = corridor_path(world, speed=0.3, rate=10.0)
     every, gap = (4, 0) if fast else (1, MAPPING_FRAME_GAP)
-    meta = {"camera": describe_sensor(camera), "lidar": describe_sensor(lidar), "clutter": world.info["clutter"],
+    meta = {"camera": describe_sensor(camera), "lidar": describe_sensor(lidar), "corridor": _corridor_layout(world),
             "resolution": resolution, "f_min": f_min, "gap": gap, "every": every, "band": list(SHARED_RANGE),
             "features": N_FEATURES,
             "path": cache_key(poses=path.poses.round(9).tolist()), "code": _code()}
@@ -629,12 +630,15 @@ def clutter_map(clutter: float = 0.0, *, resolution: float = 0.05) -> tuple[Worl
                                     resolution)
 
 
+def _corridor_layout(world: World) -> dict:
+    """What a cache key needs of a corridor: its size, doors, seed and cabinets."""
+    return {k: world.info.get(k) for k in ("length", "width", "recess", "layout", "doors", "seed", "clutter")}
+
+
 def _mapping_run_grid(world: World, lidar: Lidar, poses: np.ndarray, resolution: float) -> OccupancyGrid:
     """:func:`mapping_grid` of a corridor's mapping run, cached by the corridor's layout (doors,
     cabinets, size), the LiDAR, the poses and the code."""
-    meta = {"corridor": {k: world.info.get(k) for k in ("length", "width", "recess", "layout", "doors", "seed",
-                                                        "clutter")},
-            "lidar": describe_sensor(lidar), "resolution": resolution,
+    meta = {"corridor": _corridor_layout(world), "lidar": describe_sensor(lidar), "resolution": resolution,
             "path": cache_key(poses=poses.round(9).tolist()), "code": _code()}
     target = cache_dir("corridor") / f"grid-{cache_key(**meta)}.npz"
     data = read_arrays(target, ("log_odds", "resolution", "origin"), meta)

@@ -431,10 +431,11 @@ def global_localization_batch(groups: list, *, workers: int | None = None,
         if not isinstance(group, dict):
             raise TypeError(f"groups[{i}]: expected a dict of global_localization_runs' arguments, "
                             f"got {type(group).__name__}")
-        unknown, missing = sorted(set(group) - set(params)), sorted(required - set(group))
+        unknown, missing = sorted(set(group) - set(params), key=repr), sorted(required - set(group))
         if unknown or missing:
+            got = "; ".join(([f"unknown {unknown}"] if unknown else []) + ([f"no {missing}"] if missing else []))
             raise ValueError(f"groups[{i}]: expected the keys grid, walls, drives and optionally particles, settings, "
-                             f"seed, got " + (f"unknown {unknown}" if unknown else f"no {missing}"))
+                             f"seed, got {got}")
         try:
             shared, truths = _as_group(**group, field=fields.get(id(group["grid"])))
         except (TypeError, ValueError) as exc:
