@@ -516,7 +516,7 @@ def corridor_map(*, fast: bool | None = None, resolution: float = 0.05, clutter:
     world, lidar, camera = long_corridor(clutter=clutter), corridor_lidar(), corridor_camera()
     f_min = calibration_run(fast=fast).f_min
     vocabulary = training_vocabulary(fast=fast)
-    path = corridor_path(world, speed=0.3, rate=10.0)
+    path = _mapping_path(world)
     every, gap = (4, 0) if fast else (1, MAPPING_FRAME_GAP)
     meta = {"camera": describe_sensor(camera), "lidar": describe_sensor(lidar), "corridor": _corridor_layout(world),
             "resolution": resolution, "f_min": f_min, "gap": gap, "every": every, "band": list(SHARED_RANGE),
@@ -626,8 +626,12 @@ def clutter_map(clutter: float = 0.0, *, resolution: float = 0.05) -> tuple[Worl
     """
     resolution = _as_cell_size(resolution)
     world = long_corridor(clutter=clutter)
-    return world, _mapping_run_grid(world, corridor_lidar(), corridor_path(world, speed=0.3, rate=10.0).poses,
-                                    resolution)
+    return world, _mapping_run_grid(world, corridor_lidar(), _mapping_path(world).poses, resolution)
+
+
+def _mapping_path(world: World):
+    """The mapping run's path along a corridor's middle line: 0.3 m/s, a pose every 0.1 s (Sec. 4)."""
+    return corridor_path(world, speed=0.3, rate=10.0)
 
 
 def _corridor_layout(world: World) -> dict:

@@ -478,11 +478,14 @@ def _run_groups(groups: list, workers: int | None, progress: Callable | None, na
         if min(len(run[2]) for run in runs) == 0:
             raise ValueError(f"{names[g] if names else 'drives'}: expected drives long enough for a filter update "
                              "(amcl's 0.2 m), got one shorter")
-        width = max(len(run[2]) for run in runs)
-        results.append(GlobalRuns(*(np.array([np.concatenate([run[k], np.full((width - len(run[k]),) + run[k].shape[1:],
-                                                                               np.nan)]) for run in runs])
-                                    for k in range(4))))
+        results.append(GlobalRuns(*(_padded([run[k] for run in runs]) for k in range(4))))
     return results
+
+
+def _padded(records: list) -> np.ndarray:
+    """Runs' records of unequal length stacked, each padded with NaN to the longest."""
+    width = max(len(r) for r in records)
+    return np.array([np.concatenate([r, np.full((width - len(r),) + r.shape[1:], np.nan)]) for r in records])
 
 
 def _corridor_drives(setup: CorridorMap, n: int, length: float, rng: np.random.Generator) -> list[np.ndarray]:
