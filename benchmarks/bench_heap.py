@@ -5,9 +5,9 @@ With glibc's adaptive thresholds such arrays are mapped afresh, or the freed top
 back to the system, and the next update faults the memory in again, page by page; ``import robokit``
 fixes the thresholds and keeps a pad of ``ROBOKIT_HEAP_PAD_MB`` (64 by default) instead. The same
 update (:func:`robokit.localization.mcl_step`: motion model, likelihood field over 60 beams of a
-360-beam scan, resampling) runs on the same inputs with and without the setting; the ratio "padded /
-default" of the median times is printed (below 1: the setting is faster), and the results must be
-identical.
+360-beam scan, resampling; ``bench_mcl``'s inputs) runs on the same inputs with and without the
+setting; the ratio "padded / default" of the median times is printed (below 1: the setting is
+faster), and the results must be identical.
 
 The peer cannot run in this process: the allocator's settings are the whole process's, and once
 ``mallopt`` has been called glibc no longer adapts its thresholds as it does by default. So each
@@ -30,7 +30,7 @@ import sys
 
 import numpy as np
 
-from bench_mcl import ALPHAS, MODEL, room_field
+from bench_mcl import ALPHAS, MODEL, room_field, room_update
 from robokit.config import pad_heap
 from robokit.localization import mcl_step
 from timing import median_time
@@ -39,15 +39,12 @@ SIZES = (500, 2000, 5000)
 
 
 def update(n: int, field, seed: int):
-    """One MCL update of ``n`` particles spread over the room, as a function of nothing."""
-    rng = np.random.default_rng(seed)
-    particles = np.column_stack([rng.uniform(0.5, 9.5, n), rng.uniform(0.5, 7.5, n), rng.uniform(-np.pi, np.pi, n)])
-    angles = 2 * np.pi * np.arange(360) / 360
-    ranges = rng.uniform(0.3, 7.0, 360)
+    """One MCL update of ``n`` particles spread over the room (bench_mcl's inputs), as a function of nothing."""
+    particles, weights, angles, ranges, odom = room_update(n, seed)
 
     def run():
-        step = mcl_step(particles, np.full(n, 1.0 / n), [0.0, 0.0, 0.0], [0.1, 0.0, 0.02], ranges, angles, field,
-                        alphas=ALPHAS, rng=np.random.default_rng(seed), **MODEL)
+        step = mcl_step(particles, weights, *odom, ranges, angles, field, alphas=ALPHAS,
+                        rng=np.random.default_rng(seed), **MODEL)
         return step.particles, step.weights
     return run
 

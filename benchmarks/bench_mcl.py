@@ -52,14 +52,20 @@ def loop_update(particles, weights, odom_prev, odom_now, ranges, angles, field, 
     return np.array(out)
 
 
-def bench(n: int, repeats: int, field) -> tuple[float, float, float]:
-    rng = np.random.default_rng(0)
+def room_update(n: int, seed: int = 0) -> tuple:
+    """The inputs of one update: ``n`` particles spread over :func:`room_field`'s room, equal weights,
+    a 360-beam scan (every 17th beam without a return) and an odometry step."""
+    rng = np.random.default_rng(seed)
     particles = np.column_stack([rng.uniform(0.5, 9.5, n), rng.uniform(0.5, 7.5, n), rng.uniform(-np.pi, np.pi, n)])
     weights = np.full(n, 1.0 / n)
     angles = 2 * np.pi * np.arange(360) / 360
     ranges = rng.uniform(0.3, 7.0, 360)
     ranges[::17] = np.inf
-    odom = (np.zeros(3), np.array([0.2, 0.05, 0.1]))
+    return particles, weights, angles, ranges, (np.zeros(3), np.array([0.2, 0.05, 0.1]))
+
+
+def bench(n: int, repeats: int, field) -> tuple[float, float, float]:
+    particles, weights, angles, ranges, odom = room_update(n)
     times = []
     for k in range(repeats):
         start = time.perf_counter()
